@@ -1,0 +1,115 @@
+# surfblend build. `make run` and `make test` work on a fresh Debian machine: missing Debian
+# packages are installed when run as root (apt-get), otherwise the exact list is printed.
+
+CC      ?= cc
+CXX     ?= c++
+OPT     ?= -O2
+CFLAGS  ?= -std=c99 $(OPT) -g -Wall -Wextra -pedantic
+CXXFLAGS?= -std=c++14 $(OPT) -g -Wall -Wextra
+SAN     ?=
+BUILD   ?= build
+LIBS    := -lm -lpthread -ldl
+SHAPES  ?= ../shared/peers/opensubdiv-shapes
+
+SRC_MODULES := src/sfb_api.h src/sfb_internal.h $(wildcard src/*.c)
+TEST_SRCS   := $(wildcard tests/test_*.c)
+
+# Debian packages each goal needs (the library itself needs none but a C compiler).
+PKGS_BASE := build-essential
+PKGS_TEST := libosd-dev libcriterion-dev pkg-config
+PKGS_FUZZ := clang libclang-rt-14-dev
+
+.PHONY: all run test bench fuzz asan amalgamate amalgamate-check deps deps-test deps-fuzz clean unit-build
+
+all: $(BUILD)/surfblend
+
+define need_pkgs
+	@missing=""; for p in $(1); do dpkg -s $$p >/dev/null 2>&1 || missing="$$missing $$p"; done; \
+	if [ -n "$$missing" ]; then \
+	  if [ "$$(id -u)" = 0 ]; then \
+	    echo "installing Debian packages:$$missing"; \
+	    apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq $$missing >/dev/null || exit 1; \
+	  else \
+	    echo "missing Debian packages:$$missing"; echo "install them with: sudo apt-get install$$missing"; exit 1; \
+	  fi; \
+	fi
+endef
+
+deps:
+	$(call need_pkgs,$(PKGS_BASE))
+deps-test:
+	$(call need_pkgs,$(PKGS_BASE) $(PKGS_TEST))
+deps-fuzz:
+	$(call need_pkgs,$(PKGS_FUZZ))
+
+# ---- the single header ----
+amalgamate:
+	./tools/amalgamate.sh > surfblend.h.tmp && mv surfblend.h.tmp surfblend.h
+
+amalgamate-check:
+	@./tools/amalgamate.sh > $${TMPDIR:-/tmp}/surfblend.h.check && \
+	if cmp -s $${TMPDIR:-/tmp}/surfblend.h.check surfblend.h; then echo "amalgamate-check: surfblend.h is up to date"; \
+	else echo "amalgamate-check: FAILED: surfblend.h is stale against src/ (run 'make amalgamate')"; exit 1; fi
+
+# ---- library, CLI, examples ----
+$(BUILD)/libsfb.o: tools/impl.c surfblend.h
+	@mkdir -p $(BUILD)
+	$(CC) $(CFLAGS) $(SAN) -I. -c -x c tools/impl.c -o $@
+
+$(BUILD)/surfblend: tools/surfblend.c $(BUILD)/libsfb.o
+	$(CC) $(CFLAGS) $(SAN) -I. tools/surfblend.c $(BUILD)/libsfb.o -o $@ $(LIBS)
+
+$(BUILD)/examples/%: examples/%.c $(BUILD)/libsfb.o
+	@mkdir -p $(BUILD)/examples
+	$(CC) $(CFLAGS) $(SAN) -I. $< $(BUILD)/libsfb.o -o $@ $(LIBS)
+
+run: deps $(BUILD)/surfblend
+	@mkdir -p out
+	./$(BUILD)/surfblend info examples/data/creased_box.obj
+	./$(BUILD)/surfblend refine --scheme catmark --level 3 --limit examples/data/creased_box.obj -o out/creased_box_level3.obj
+	@echo "wrote out/creased_box_level3.obj"
+
+# ---- tests ----
+$(BUILD)/unit: $(TEST_SRCS) $(BUILD)/libsfb.o
+	$(CC) $(CFLAGS) $(SAN) -I. $(TEST_SRCS) $(BUILD)/libsfb.o -o $@ -lcriterion $(LIBS)
+
+$(BUILD)/osd_agree: tests/osd_agree.cpp $(BUILD)/libsfb.o
+	$(CXX) $(CXXFLAGS) $(SAN) -I. tests/osd_agree.cpp $(BUILD)/libsfb.o -o $@ -losdCPU $(LIBS)
+
+unit-build: $(BUILD)/surfblend $(BUILD)/unit $(BUILD)/osd_agree $(BUILD)/examples/01_minimal
+
+test: deps-test amalgamate-check
+	$(MAKE) --no-print-directory unit-build
+	BUILD=$(BUILD) SHAPES=$(SHAPES) CC="$(CC)" CXX="$(CXX)" ./tests/run_all.sh
+
+# The whole suite again under AddressSanitizer + UndefinedBehaviorSanitizer.
+asan:
+	$(MAKE) --no-print-directory test BUILD=build-asan OPT=-O1 \
+	  SAN="-fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined"
+
+# ---- benchmark ----
+$(BUILD)/bench: bench/bench.cpp $(BUILD)/libsfb.o
+	$(CXX) $(CXXFLAGS) -I. bench/bench.cpp $(BUILD)/libsfb.o -o $@ -losdCPU $(LIBS)
+
+bench: deps-test
+	$(MAKE) --no-print-directory $(BUILD)/bench OPT=-O3
+	./$(BUILD)/bench
+
+# ---- fuzzing (libFuzzer, clang) ----
+FUZZ_TIME ?= 60
+FUZZ_TARGETS := $(patsubst fuzz/%.c,$(BUILD)/fuzz/%,$(wildcard fuzz/fuzz_*.c))
+FUZZ_FLAGS := -std=c99 -g -O1 -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=undefined -I.
+
+$(BUILD)/fuzz/%: fuzz/%.c surfblend.h tools/impl.c
+	@mkdir -p $(BUILD)/fuzz
+	clang $(FUZZ_FLAGS) $< -x c tools/impl.c -o $@ $(LIBS)
+
+fuzz: deps-fuzz $(FUZZ_TARGETS)
+	@for t in $(FUZZ_TARGETS); do \
+	  name=$$(basename $$t); work=$(BUILD)/fuzz/corpus-$$name; mkdir -p $$work; \
+	  echo "== $$name for $(FUZZ_TIME) s"; \
+	  ./$$t -max_total_time=$(FUZZ_TIME) -dict=fuzz/obj.dict -print_final_stats=1 $$work fuzz/corpus 2>&1 | tail -n 12 || exit 1; \
+	done
+
+clean:
+	rm -rf build build-asan out

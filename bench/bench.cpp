@@ -1,0 +1,412 @@
+/* surfblend benchmark against OpenSubdiv 3.5 (uniform Catmull-Clark refinement, stencil tables).
+ *
+ * The mesh is generated here: a torus of 100 x 60 quads with creases (two semi-sharp rings,
+ * two semi-sharp meridians, one infinitely sharp ring and a corner). For levels 1..4 it measures
+ * (median of several runs, std::chrono::steady_clock):
+ *   build:  surfblend  sfb_mesh_create + sfb_surface_create(refine_level L)
+ *           OpenSubdiv TopologyRefinerFactory::Create + RefineUniform(L) + StencilTableFactory::Create
+ *                      (base vertices straight to level L: generateIntermediateLevels = false)
+ *   apply:  surfblend  sfb_surface_eval_stencils(SFB_TABLE_VERTEX) on the context's backend
+ *           OpenSubdiv Osd::CpuEvaluator::EvalStencils (single thread)
+ * and checks that both give the same refined points (matched as point sets: the vertex orders
+ * of the two libraries differ).
+ */
+#include "surfblend.h"
+
+#include <opensubdiv/far/stencilTable.h>
+#include <opensubdiv/far/stencilTableFactory.h>
+#include <opensubdiv/far/topologyDescriptor.h>
+#include <opensubdiv/far/topologyRefinerFactory.h>
+#include <opensubdiv/osd/bufferDescriptor.h>
+#include <opensubdiv/osd/cpuEvaluator.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <utility>
+#include <vector>
+
+using namespace OpenSubdiv;
+
+typedef std::chrono::steady_clock Clock;
+
+static double ms_since(Clock::time_point t0) {
+    return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+
+static double median(std::vector<double> v) {
+    if (v.empty()) return 0.0;
+    std::sort(v.begin(), v.end());
+    size_t n = v.size();
+    return (n % 2) ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+/* ---- the test mesh ---- */
+
+struct TorusMesh {
+    int nu, nv;
+    std::vector<float> positions;
+    std::vector<int> face_sizes, face_vertices;
+    std::vector<int> crease_vertices;
+    std::vector<float> crease_sharpness;
+    std::vector<int> corner_vertices;
+    std::vector<float> corner_sharpness;
+
+    int vid(int i, int j) const { return ((i + nu) % nu) * nv + ((j + nv) % nv); }
+
+    TorusMesh(int nu_, int nv_) : nu(nu_), nv(nv_) {
+        const double R = 3.0, r = 1.0, two_pi = 6.283185307179586;
+        for (int i = 0; i < nu; ++i)
+            for (int j = 0; j < nv; ++j) {
+                double u = two_pi * i / nu, v = two_pi * j / nv;
+                /* a little unevenness so that no two refined points coincide by symmetry alone */
+                double rr = r * (1.0 + 0.05 * std::sin(3.0 * u) * std::cos(2.0 * v));
+                positions.push_back((float)((R + rr * std::cos(v)) * std::cos(u)));
+                positions.push_back((float)((R + rr * std::cos(v)) * std::sin(u)));
+                positions.push_back((float)(rr * std::sin(v)));
+            }
+        for (int i = 0; i < nu; ++i)
+            for (int j = 0; j < nv; ++j) {
+                face_sizes.push_back(4);
+                face_vertices.push_back(vid(i, j));
+                face_vertices.push_back(vid(i + 1, j));
+                face_vertices.push_back(vid(i + 1, j + 1));
+                face_vertices.push_back(vid(i, j + 1));
+            }
+        /* rings: edges (i,j)-(i+1,j) for fixed j */
+        add_ring(0, 1.5f);
+        add_ring(nv / 3, 2.5f);
+        add_ring(2 * nv / 3, SFB_SHARPNESS_INFINITE);
+        /* meridians: edges (i,j)-(i,j+1) for fixed i */
+        add_meridian(0, 1.5f);
+        add_meridian(nu / 2, 2.5f);
+        corner_vertices.push_back(vid(nu / 4, nv / 2));
+        corner_sharpness.push_back(2.0f);
+    }
+    void add_ring(int j, float s) {
+        for (int i = 0; i < nu; ++i) {
+            crease_vertices.push_back(vid(i, j));
+            crease_vertices.push_back(vid(i + 1, j));
+            crease_sharpness.push_back(s);
+        }
+    }
+    void add_meridian(int i, float s) {
+        for (int j = 0; j < nv; ++j) {
+            crease_vertices.push_back(vid(i, j));
+            crease_vertices.push_back(vid(i, j + 1));
+            crease_sharpness.push_back(s);
+        }
+    }
+    int vertex_count() const { return (int)positions.size() / 3; }
+    int face_count() const { return (int)face_sizes.size(); }
+    int crease_count() const { return (int)crease_sharpness.size(); }
+
+    sfb_mesh_desc sfb_desc() const {
+        sfb_mesh_desc d;
+        memset(&d, 0, sizeof d);
+        d.vertex_count = vertex_count();
+        d.positions = &positions[0];
+        d.face_count = face_count();
+        d.face_sizes = &face_sizes[0];
+        d.face_vertices = &face_vertices[0];
+        d.crease_count = crease_count();
+        d.crease_vertices = &crease_vertices[0];
+        d.crease_sharpness = &crease_sharpness[0];
+        d.corner_count = (int)corner_vertices.size();
+        d.corner_vertices = &corner_vertices[0];
+        d.corner_sharpness = &corner_sharpness[0];
+        d.boundary = SFB_BOUNDARY_EDGE_ONLY;
+        d.crease_method = SFB_CREASE_UNIFORM;
+        d.triangle_rule = SFB_TRI_CATMARK;
+        return d;
+    }
+    Far::TopologyDescriptor osd_desc() const {
+        Far::TopologyDescriptor d;
+        d.numVertices = vertex_count();
+        d.numFaces = face_count();
+        d.numVertsPerFace = &face_sizes[0];
+        d.vertIndicesPerFace = &face_vertices[0];
+        d.numCreases = crease_count();
+        d.creaseVertexIndexPairs = &crease_vertices[0];
+        d.creaseWeights = &crease_sharpness[0];
+        d.numCorners = (int)corner_vertices.size();
+        d.cornerVertexIndices = &corner_vertices[0];
+        d.cornerWeights = &corner_sharpness[0];
+        return d;
+    }
+};
+
+/* ---- OpenSubdiv ---- */
+
+static Far::StencilTable const *osd_build(const TorusMesh &m, int level) {
+    Far::TopologyDescriptor desc = m.osd_desc();
+    Sdc::Options opt;
+    opt.SetVtxBoundaryInterpolation(Sdc::Options::VTX_BOUNDARY_EDGE_ONLY);
+    opt.SetCreasingMethod(Sdc::Options::CREASE_UNIFORM);
+    opt.SetTriangleSubdivision(Sdc::Options::TRI_SUB_CATMARK);
+    typedef Far::TopologyRefinerFactory<Far::TopologyDescriptor> Factory;
+    Far::TopologyRefiner *r = Factory::Create(desc, Factory::Options(Sdc::SCHEME_CATMARK, opt));
+    if (!r) return NULL;
+    r->RefineUniform(Far::TopologyRefiner::UniformOptions(level));
+    Far::StencilTableFactory::Options so;
+    so.interpolationMode = Far::StencilTableFactory::INTERPOLATE_VERTEX;
+    so.generateIntermediateLevels = false;
+    so.generateOffsets = true;
+    Far::StencilTable const *t = Far::StencilTableFactory::Create(*r, so);
+    delete r;
+    return t;
+}
+
+static void osd_apply(const Far::StencilTable *t, const float *src, float *dst) {
+    Osd::BufferDescriptor desc(0, 3, 3);
+    Osd::CpuEvaluator::EvalStencils(src, desc, dst, desc, &t->GetSizes()[0], &t->GetOffsets()[0],
+                                    &t->GetControlIndices()[0], &t->GetWeights()[0], 0, t->GetNumStencils());
+}
+
+/* ---- point set agreement ---- */
+
+/* Largest distance between matched points when every point of a is paired with the nearest
+ * unpaired point of b within tol (uniform grid of cell size tol); *unmatched counts the points
+ * of a without a partner. */
+static double point_set_difference(const std::vector<float> &a, const std::vector<float> &b, double tol,
+                                   int *unmatched) {
+    size_t na = a.size() / 3, nb = b.size() / 3;
+    struct G {
+        static bool cell(const float *p, double h, long long c[3]) {
+            for (int k = 0; k < 3; ++k) {
+                double q = std::floor(p[k] / h);
+                if (!std::isfinite(q)) return false;
+                c[k] = (long long)q;
+            }
+            return true;
+        }
+        static unsigned long long key(long long x, long long y, long long z) {
+            const unsigned long long m = (1ull << 21) - 1;
+            return (((unsigned long long)x & m) << 42) | (((unsigned long long)y & m) << 21) | ((unsigned long long)z & m);
+        }
+    };
+    std::vector<std::pair<unsigned long long, int> > grid;
+    grid.reserve(nb);
+    for (size_t j = 0; j < nb; ++j) {
+        long long c[3];
+        if (G::cell(&b[3 * j], tol, c)) grid.push_back(std::make_pair(G::key(c[0], c[1], c[2]), (int)j));
+    }
+    std::sort(grid.begin(), grid.end());
+    std::vector<char> used(nb, 0);
+    double worst = 0.0;
+    *unmatched = 0;
+    for (size_t i = 0; i < na; ++i) {
+        const float *p = &a[3 * i];
+        long long c[3];
+        if (!G::cell(p, tol, c)) { ++*unmatched; continue; }
+        int best = -1;
+        double best_d2 = tol * tol;
+        for (int dx = -1; dx <= 1; ++dx)
+            for (int dy = -1; dy <= 1; ++dy)
+                for (int dz = -1; dz <= 1; ++dz) {
+                    unsigned long long k = G::key(c[0] + dx, c[1] + dy, c[2] + dz);
+                    std::vector<std::pair<unsigned long long, int> >::const_iterator it =
+                        std::lower_bound(grid.begin(), grid.end(), std::make_pair(k, -1));
+                    for (; it != grid.end() && it->first == k; ++it) {
+                        if (used[(size_t)it->second]) continue;
+                        const float *q = &b[3 * (size_t)it->second];
+                        double ex = (double)q[0] - p[0], ey = (double)q[1] - p[1], ez = (double)q[2] - p[2];
+                        double d2 = ex * ex + ey * ey + ez * ez;
+                        if (d2 <= best_d2) { best_d2 = d2; best = it->second; }
+                    }
+                }
+        if (best < 0) { ++*unmatched; continue; }
+        used[(size_t)best] = 1;
+        worst = std::max(worst, std::sqrt(best_d2));
+    }
+    if (na != nb) *unmatched += (int)(na > nb ? na - nb : nb - na);
+    return worst;
+}
+
+/* ---- main ---- */
+
+struct Row {
+    int level, faces_out, rows_sfb, rows_osd;
+    double sfb_build, sfb_surface, osd_build, sfb_apply, osd_apply;
+    long long entries_sfb, entries_osd;
+    double max_diff;
+    int unmatched;
+};
+
+int main(int argc, char **argv) {
+    int max_level = 4;
+    if (argc > 1) {
+        max_level = atoi(argv[1]);
+        if (max_level < 1 || max_level > 6) {
+            fprintf(stderr, "usage: bench [MAX_LEVEL 1..6, default 4]\n");
+            return 2;
+        }
+    }
+    Clock::time_point t_start = Clock::now();
+
+    sfb_context_config cc = sfb_context_config_init();
+    sfb_context *ctx = NULL;
+    if (sfb_context_create(&cc, &ctx) != SFB_SUCCESS) {
+        fprintf(stderr, "bench: sfb_context_create failed\n");
+        return 1;
+    }
+
+    TorusMesh torus(100, 60);
+    sfb_mesh_desc desc = torus.sfb_desc();
+    double diag = 0.0;
+    {
+        float lo[3] = {1e30f, 1e30f, 1e30f}, hi[3] = {-1e30f, -1e30f, -1e30f};
+        for (int i = 0; i < torus.vertex_count(); ++i)
+            for (int c = 0; c < 3; ++c) {
+                lo[c] = std::min(lo[c], torus.positions[3 * (size_t)i + c]);
+                hi[c] = std::max(hi[c], torus.positions[3 * (size_t)i + c]);
+            }
+        for (int c = 0; c < 3; ++c) diag += (double)(hi[c] - lo[c]) * (hi[c] - lo[c]);
+        diag = std::sqrt(diag);
+    }
+    const double tol = 1e-5 * diag;
+
+    printf("surfblend %d.%d.%d vs OpenSubdiv 3.5, Catmull-Clark uniform refinement\n", SFB_VERSION_MAJOR,
+           SFB_VERSION_MINOR, SFB_VERSION_PATCH);
+    printf("mesh: torus %d x %d = %d quads, %d vertices, %d crease edges (1.5, 2.5, infinite), %d corner\n",
+           torus.nu, torus.nv, torus.face_count(), torus.vertex_count(), torus.crease_count(),
+           (int)torus.corner_vertices.size());
+    printf("surfblend backend: %s (threads: %s); OpenSubdiv: Osd::CpuEvaluator (single thread)\n",
+           sfb_context_backend_name(ctx), cc.threads ? "as configured" : "one per core");
+    printf("build = topology + refinement + stencil table base -> level; sfb build includes sfb_mesh_create,\n"
+           "sfb surf = sfb_surface_create alone. Times: median of several runs, milliseconds.\n\n");
+
+    std::vector<Row> rows;
+    int status = 0;
+    for (int level = 1; level <= max_level; ++level) {
+        Row row;
+        memset(&row, 0, sizeof row);
+        row.level = level;
+        const int build_reps = level <= 2 ? 7 : (level == 3 ? 5 : 3);
+        const int apply_reps = level <= 3 ? 11 : 5;
+        const double budget_ms = 8000.0; /* per measurement: stop repeating past this (at least one run) */
+
+        /* surfblend build */
+        std::vector<double> tb, ts;
+        sfb_surface *surf = NULL;
+        double spent = 0.0;
+        for (int rep = 0; rep < build_reps && (rep == 0 || spent < budget_ms); ++rep) {
+            if (surf) { sfb_surface_destroy(surf); surf = NULL; }
+            sfb_mesh *mesh = NULL;
+            Clock::time_point t0 = Clock::now();
+            sfb_result r = sfb_mesh_create(ctx, &desc, &mesh);
+            double t_mesh = ms_since(t0);
+            if (r != SFB_SUCCESS) {
+                fprintf(stderr, "bench: sfb_mesh_create failed: %s\n", sfb_last_error(ctx));
+                sfb_context_destroy(ctx);
+                return 1;
+            }
+            sfb_surface_config cfg = sfb_surface_config_init(SFB_SCHEME_CATMARK, level);
+            Clock::time_point t1 = Clock::now();
+            r = sfb_surface_create(ctx, mesh, &cfg, &surf);
+            double t_surf = ms_since(t1);
+            sfb_mesh_destroy(mesh);
+            if (r != SFB_SUCCESS) {
+                fprintf(stderr, "bench: sfb_surface_create (level %d) failed: %s\n", level, sfb_last_error(ctx));
+                sfb_context_destroy(ctx);
+                return 1;
+            }
+            tb.push_back(t_mesh + t_surf);
+            ts.push_back(t_surf);
+            spent += t_mesh + t_surf;
+        }
+        row.sfb_build = median(tb);
+        row.sfb_surface = median(ts);
+
+        /* OpenSubdiv build */
+        std::vector<double> to;
+        Far::StencilTable const *table = NULL;
+        spent = 0.0;
+        for (int rep = 0; rep < build_reps && (rep == 0 || spent < budget_ms); ++rep) {
+            delete table;
+            Clock::time_point t0 = Clock::now();
+            table = osd_build(torus, level);
+            double t = ms_since(t0);
+            if (!table) {
+                fprintf(stderr, "bench: OpenSubdiv could not build level %d\n", level);
+                sfb_surface_destroy(surf);
+                sfb_context_destroy(ctx);
+                return 1;
+            }
+            to.push_back(t);
+            spent += t;
+        }
+        row.osd_build = median(to);
+
+        /* table sizes */
+        sfb_stencil_info info;
+        memset(&info, 0, sizeof info);
+        if (sfb_surface_stencil_info(surf, SFB_TABLE_VERTEX, &info) != SFB_SUCCESS) {
+            fprintf(stderr, "bench: sfb_surface_stencil_info failed: %s\n", sfb_last_error(ctx));
+            status = 1;
+        }
+        row.rows_sfb = info.rows;
+        row.entries_sfb = info.entries;
+        row.rows_osd = table->GetNumStencils();
+        row.entries_osd = (long long)table->GetWeights().size();
+        row.faces_out = torus.face_count() << (2 * level);
+
+        /* apply */
+        std::vector<float> dst_sfb((size_t)std::max(info.rows, 0) * 3), dst_osd((size_t)row.rows_osd * 3);
+        sfb_buffer_desc bd;
+        bd.offset = 0;
+        bd.length = 3;
+        bd.stride = 3;
+        std::vector<double> ta, tao;
+        for (int rep = 0; rep < apply_reps; ++rep) {
+            Clock::time_point t0 = Clock::now();
+            sfb_result r = sfb_surface_eval_stencils(surf, SFB_TABLE_VERTEX, &torus.positions[0], bd,
+                                                     dst_sfb.empty() ? NULL : &dst_sfb[0], bd);
+            ta.push_back(ms_since(t0));
+            if (r != SFB_SUCCESS) {
+                fprintf(stderr, "bench: sfb_surface_eval_stencils failed: %s\n", sfb_last_error(ctx));
+                status = 1;
+                break;
+            }
+        }
+        for (int rep = 0; rep < apply_reps; ++rep) {
+            Clock::time_point t0 = Clock::now();
+            osd_apply(table, &torus.positions[0], &dst_osd[0]);
+            tao.push_back(ms_since(t0));
+        }
+        row.sfb_apply = median(ta);
+        row.osd_apply = median(tao);
+
+        row.max_diff = point_set_difference(dst_osd, dst_sfb, tol, &row.unmatched);
+        if (row.unmatched) status = 1;
+
+        rows.push_back(row);
+        delete table;
+        sfb_surface_destroy(surf);
+        fprintf(stderr, "level %d done (%.1f s so far)\n", level, ms_since(t_start) / 1000.0);
+    }
+
+    printf("%5s | %9s | %12s | %11s | %12s | %7s | %12s | %12s | %7s | %s\n", "level", "faces out",
+           "sfb build ms", "sfb surf ms", "osd build ms", "osd/sfb", "sfb apply ms", "osd apply ms", "osd/sfb",
+           "stencil entries sfb/osd");
+    for (size_t i = 0; i < rows.size(); ++i) {
+        const Row &r = rows[i];
+        char entries[64];
+        snprintf(entries, sizeof entries, "%lld/%lld", r.entries_sfb, r.entries_osd);
+        printf("%5d | %9d | %12.2f | %11.2f | %12.2f | %7.2f | %12.3f | %12.3f | %7.2f | %s\n", r.level,
+               r.faces_out, r.sfb_build, r.sfb_surface, r.osd_build, r.sfb_build > 0 ? r.osd_build / r.sfb_build : 0.0,
+               r.sfb_apply, r.osd_apply, r.sfb_apply > 0 ? r.osd_apply / r.sfb_apply : 0.0, entries);
+    }
+    printf("\nagreement (refined points matched as point sets, tolerance %.3g):\n", tol);
+    for (size_t i = 0; i < rows.size(); ++i) {
+        const Row &r = rows[i];
+        printf("  level %d: rows sfb %d / osd %d, max difference %.3g, %d unmatched%s\n", r.level, r.rows_sfb,
+               r.rows_osd, r.max_diff, r.unmatched, r.unmatched ? "  <-- DISAGREE" : "");
+    }
+    printf("total time %.1f s\n", ms_since(t_start) / 1000.0);
+    sfb_context_destroy(ctx);
+    return status;
+}

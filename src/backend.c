@@ -1,0 +1,110 @@
+/* Backend registry: ordered probing, first that initialises wins, every attempt reported. */
+
+static const char *const sfb__backend_names[SFB_BACKEND_KIND_COUNT_] = {"default", "ref", "simd", "gl", "osmesa"};
+
+SFB_API const char *sfb_backend_kind_name(sfb_backend_kind kind) {
+    if ((int)kind < 0 || kind >= SFB_BACKEND_KIND_COUNT_) return "unknown";
+    return sfb__backend_names[kind];
+}
+
+static int sfb__strieq(const char *a, const char *b) {
+    for (; *a && *b; ++a, ++b) {
+        int ca = (*a >= 'A' && *a <= 'Z') ? *a + 32 : *a;
+        int cb = (*b >= 'A' && *b <= 'Z') ? *b + 32 : *b;
+        if (ca != cb) return 0;
+    }
+    return *a == *b;
+}
+
+SFB_API sfb_backend_kind sfb_backend_kind_parse(const char *name) {
+    int i;
+    if (!name) return SFB_BACKEND_DEFAULT;
+    for (i = 1; i < SFB_BACKEND_KIND_COUNT_; ++i)
+        if (sfb__strieq(name, sfb__backend_names[i])) return (sfb_backend_kind)i;
+    return SFB_BACKEND_DEFAULT;
+}
+
+/* Optional backends live in backends/sfb_NAME.h; each defines a getter macro before this file is
+ * compiled when the user includes it. Those not compiled in report "not built in". */
+static const sfb__backend_vtable *sfb__backend_lookup(sfb_backend_kind kind) {
+    switch (kind) {
+    case SFB_BACKEND_REF: return sfb__backend_ref();
+#ifdef SFB_HAVE_SIMD_BACKEND
+    case SFB_BACKEND_SIMD: return sfb__backend_simd();
+#endif
+#ifdef SFB_HAVE_GL_BACKEND
+    case SFB_BACKEND_GL: return sfb__backend_gl();
+#endif
+#ifdef SFB_HAVE_OSMESA_BACKEND
+    case SFB_BACKEND_OSMESA: return sfb__backend_osmesa();
+#endif
+    default: return NULL;
+    }
+}
+
+static void sfb__report_add(sfb_context *ctx, const char *fmt, ...) {
+    size_t used = strlen(ctx->report);
+    va_list ap;
+    if (used + 1 >= sizeof ctx->report) return;
+    va_start(ap, fmt);
+    vsnprintf(ctx->report + used, sizeof ctx->report - used, fmt, ap);
+    va_end(ap);
+}
+
+static int sfb__try_backend(sfb_context *ctx, sfb_backend_kind kind) {
+    const sfb__backend_vtable *vt = sfb__backend_lookup(kind);
+    char why[512];
+    void *state = NULL;
+    sfb_result r;
+    if (!vt) {
+        sfb__report_add(ctx, "%s: unavailable (not built in: include backends/sfb_%s.h before the implementation)\n",
+                        sfb_backend_kind_name(kind), sfb_backend_kind_name(kind));
+        sfb__log(ctx, SFB_LOG_INFO, "backend %s not built in, trying the next", sfb_backend_kind_name(kind));
+        return 0;
+    }
+    why[0] = 0;
+    r = vt->init(ctx, &state, why, sizeof why);
+    if (r != SFB_SUCCESS) {
+        sfb__report_add(ctx, "%s: unavailable (%s: %s)\n", vt->name, sfb_result_string(r), why[0] ? why : "no reason given");
+        sfb__log(ctx, SFB_LOG_INFO, "backend %s failed to initialise (%s), trying the next", vt->name, why);
+        return 0;
+    }
+    ctx->backend = vt;
+    ctx->backend_state = state;
+    sfb__report_add(ctx, "%s: selected\n", vt->name);
+    return 1;
+}
+
+sfb_result sfb__select_backend(sfb_context *ctx, const char *env) {
+    int i;
+    ctx->report[0] = 0;
+    if (env && *env) {
+        sfb_backend_kind k = sfb_backend_kind_parse(env);
+        if (k == SFB_BACKEND_DEFAULT) {
+            sfb__report_add(ctx, "SURFBLEND_BACKEND=%.64s: unavailable (unknown backend name; known: ref, simd, gl, osmesa)\n", env);
+            sfb__log(ctx, SFB_LOG_WARN, "SURFBLEND_BACKEND=%.64s names no backend; using the default order", env);
+        } else if (sfb__try_backend(ctx, k)) {
+            return SFB_SUCCESS;
+        }
+    }
+    for (i = 0; i < ctx->order_count; ++i)
+        if (sfb__try_backend(ctx, ctx->order[i])) return SFB_SUCCESS;
+    return SFB_NO_BACKEND;
+}
+
+SFB_API const char *sfb_context_backend_name(const sfb_context *ctx) {
+    return (ctx && ctx->backend) ? ctx->backend->name : "none";
+}
+
+SFB_API sfb_result sfb_context_backend_report(const sfb_context *ctx, char *buf, size_t size) {
+    size_t n;
+    if (!ctx || !buf || size == 0) return SFB_INVALID_ARGS;
+    n = strlen(ctx->report);
+    if (n >= size) {
+        memcpy(buf, ctx->report, size - 1);
+        buf[size - 1] = 0;
+        return SFB_LIMIT_EXCEEDED;
+    }
+    memcpy(buf, ctx->report, n + 1);
+    return SFB_SUCCESS;
+}

@@ -1,0 +1,193 @@
+/* Results, context, allocator with memory budget, errors, logging, progress. */
+
+SFB_API const char *sfb_result_string(sfb_result r) {
+    switch (r) {
+#define SFB__RESULT_CASE(name, value, text) case name: return text;
+        SFB_RESULT_LIST(SFB__RESULT_CASE)
+#undef SFB__RESULT_CASE
+    default: return "unknown result";
+    }
+}
+
+static void *sfb__libc_alloc(size_t size, void *user) { (void)user; return malloc(size); }
+static void *sfb__libc_realloc(void *p, size_t size, void *user) { (void)user; return realloc(p, size); }
+static void sfb__libc_free(void *p, void *user) { (void)user; free(p); }
+
+SFB_API sfb_context_config sfb_context_config_init(void) {
+    sfb_context_config c;
+    memset(&c, 0, sizeof c);
+    return c;
+}
+
+int sfb__mul_size(size_t a, size_t b, size_t *out) {
+    if (a != 0 && b > ((size_t)-1) / a) return 0;
+    *out = a * b;
+    return 1;
+}
+
+/* Every block carries its size in a 16-byte header so that the live total can be kept
+ * against the memory budget exactly. */
+#define SFB__HDR 16
+void *sfb__alloc(sfb_context *ctx, size_t size) {
+    unsigned char *p;
+    if (size > ((size_t)-1) - SFB__HDR) return NULL;
+    if (ctx->live_bytes + size > ctx->budget || ctx->live_bytes + size < ctx->live_bytes) return NULL;
+    p = (unsigned char *)ctx->allocator.alloc(size + SFB__HDR, ctx->allocator.user);
+    if (!p) return NULL;
+    memcpy(p, &size, sizeof size);
+    ctx->live_bytes += size;
+    if (ctx->live_bytes > ctx->peak_bytes) ctx->peak_bytes = ctx->live_bytes;
+    return p + SFB__HDR;
+}
+void *sfb__calloc(sfb_context *ctx, size_t count, size_t size) {
+    size_t total;
+    void *p;
+    if (!sfb__mul_size(count, size, &total)) return NULL;
+    p = sfb__alloc(ctx, total ? total : 1);
+    if (p) memset(p, 0, total);
+    return p;
+}
+void *sfb__realloc(sfb_context *ctx, void *ptr, size_t size) {
+    unsigned char *p, *np;
+    size_t old;
+    if (!ptr) return sfb__alloc(ctx, size);
+    p = (unsigned char *)ptr - SFB__HDR;
+    memcpy(&old, p, sizeof old);
+    if (size > ((size_t)-1) - SFB__HDR) return NULL;
+    if (size > old && (ctx->live_bytes - old + size > ctx->budget)) return NULL;
+    np = (unsigned char *)ctx->allocator.realloc(p, size + SFB__HDR, ctx->allocator.user);
+    if (!np) return NULL;
+    memcpy(np, &size, sizeof size);
+    ctx->live_bytes = ctx->live_bytes - old + size;
+    if (ctx->live_bytes > ctx->peak_bytes) ctx->peak_bytes = ctx->live_bytes;
+    return np + SFB__HDR;
+}
+void sfb__free(sfb_context *ctx, void *ptr) {
+    unsigned char *p;
+    size_t old;
+    if (!ptr) return;
+    p = (unsigned char *)ptr - SFB__HDR;
+    memcpy(&old, p, sizeof old);
+    ctx->live_bytes -= old;
+    ctx->allocator.free(p, ctx->allocator.user);
+}
+
+static const char *sfb__element_name(sfb_element_kind k) {
+    switch (k) {
+    case SFB_ELEMENT_VERTEX: return "vertex";
+    case SFB_ELEMENT_EDGE: return "edge";
+    case SFB_ELEMENT_FACE: return "face";
+    case SFB_ELEMENT_LINE: return "line";
+    case SFB_ELEMENT_UV: return "uv";
+    default: return "";
+    }
+}
+
+sfb_result sfb__error(sfb_context *ctx, sfb_result r, sfb_element_kind kind, long index, const char *fmt, ...) {
+    va_list ap;
+    char body[768];
+    if (!ctx) return r;
+    va_start(ap, fmt);
+    vsnprintf(body, sizeof body, fmt, ap);
+    va_end(ap);
+    if (kind != SFB_ELEMENT_NONE && index >= 0)
+        snprintf(ctx->error, sizeof ctx->error, "%s %ld: %s", sfb__element_name(kind), index, body);
+    else
+        snprintf(ctx->error, sizeof ctx->error, "%s", body);
+    ctx->error_info.result = r;
+    ctx->error_info.element = kind;
+    ctx->error_info.index = index;
+    ctx->error_info.message = ctx->error;
+    if (ctx->logger.func) ctx->logger.func(SFB_LOG_ERROR, ctx->error, ctx->logger.user);
+    return r;
+}
+
+void sfb__log(sfb_context *ctx, int level, const char *fmt, ...) {
+    va_list ap;
+    char msg[768];
+    if (!ctx || !ctx->logger.func) return;
+    va_start(ap, fmt);
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    va_end(ap);
+    ctx->logger.func(level, msg, ctx->logger.user);
+}
+
+sfb_result sfb__progress(sfb_context *ctx, float done, const char *stage) {
+    if (ctx->progress.func && ctx->progress.func(done, stage, ctx->progress.user))
+        return sfb__error(ctx, SFB_CANCELLED, SFB_ELEMENT_NONE, -1, "cancelled by the progress callback during %s", stage);
+    return SFB_SUCCESS;
+}
+
+SFB_API sfb_result sfb_context_create(const sfb_context_config *config, sfb_context **out) {
+    sfb_context_config c = config ? *config : sfb_context_config_init();
+    sfb_allocator a = c.allocator;
+    sfb_context *ctx;
+    unsigned char *raw;
+    size_t sz = sizeof(sfb_context);
+    int i;
+    if (!out) return SFB_INVALID_ARGS;
+    *out = NULL;
+    if ((a.alloc == NULL) != (a.free == NULL) || (a.alloc && !a.realloc)) return SFB_INVALID_ARGS;
+    if (c.backend_count < 0 || c.backend_count > 16 || (c.backend_count > 0 && !c.backends)) return SFB_INVALID_ARGS;
+    if (!a.alloc) { a.alloc = sfb__libc_alloc; a.realloc = sfb__libc_realloc; a.free = sfb__libc_free; a.user = NULL; }
+    raw = (unsigned char *)a.alloc(sz, a.user);
+    if (!raw) return SFB_OUT_OF_MEMORY;
+    ctx = (sfb_context *)raw;
+    memset(ctx, 0, sizeof *ctx);
+    ctx->allocator = a;
+    ctx->logger = c.logger;
+    ctx->progress = c.progress;
+    ctx->budget = c.memory_budget ? c.memory_budget : SFB_DEFAULT_MEMORY_BUDGET;
+    ctx->threads = c.threads;
+    ctx->gl_use_current_context = c.gl_use_current_context;
+    if (c.backends && c.backend_count > 0) {
+        for (i = 0; i < c.backend_count; ++i) {
+            if (c.backends[i] <= SFB_BACKEND_DEFAULT || c.backends[i] >= SFB_BACKEND_KIND_COUNT_) {
+                a.free(raw, a.user);
+                return SFB_INVALID_ARGS;
+            }
+            ctx->order[ctx->order_count++] = c.backends[i];
+        }
+    } else {
+        /* The default order, written here only. */
+        ctx->order[ctx->order_count++] = SFB_BACKEND_SIMD;
+        ctx->order[ctx->order_count++] = SFB_BACKEND_REF;
+    }
+    ctx->error_info.index = -1;
+    ctx->error_info.message = ctx->error;
+    {
+        const char *env = c.ignore_environment ? NULL : getenv("SURFBLEND_BACKEND");
+        sfb_result r = sfb__select_backend(ctx, env);
+        if (r != SFB_SUCCESS) {
+            a.free(raw, a.user);
+            return r;
+        }
+    }
+    *out = ctx;
+    return SFB_SUCCESS;
+}
+
+SFB_API void sfb_context_destroy(sfb_context *ctx) {
+    sfb_allocator a;
+    if (!ctx) return;
+    if (ctx->backend && ctx->backend->shutdown) ctx->backend->shutdown(ctx, ctx->backend_state);
+    a = ctx->allocator;
+    a.free(ctx, a.user);
+}
+
+SFB_API const char *sfb_last_error(const sfb_context *ctx) { return ctx ? ctx->error : ""; }
+SFB_API sfb_error_info sfb_last_error_info(const sfb_context *ctx) {
+    sfb_error_info e;
+    if (ctx) return ctx->error_info;
+    memset(&e, 0, sizeof e);
+    e.index = -1;
+    e.message = "";
+    return e;
+}
+SFB_API void sfb_clear_error(sfb_context *ctx) {
+    if (!ctx) return;
+    ctx->error[0] = 0;
+    ctx->error_info.result = SFB_SUCCESS;
+    ctx->error_info.element = SFB_ELEMENT_NONE;
+    ctx->error_info.index = -1;
+}

@@ -1,0 +1,414 @@
+/* Control meshes: validation of untrusted arrays, edges, topology, creases, info. */
+
+/* Line numbers of OBJ statements, so that errors found while building the mesh can name the
+ * line they came from. Internal: sfb_mesh_read_obj passes it, sfb_mesh_create does not. */
+typedef struct sfb__src_lines {
+    const int *face, *crease, *corner, *hole;
+} sfb__src_lines;
+
+static sfb_result sfb__elem_error(sfb_context *ctx, sfb_result r, const sfb__src_lines *lines, const int *line_of,
+                                  sfb_element_kind kind, long index, const char *what, long what_index, const char *detail) {
+    if (lines && line_of)
+        return sfb__error(ctx, r, SFB_ELEMENT_LINE, line_of[what_index], "%s %ld: %s", what, what_index, detail);
+    if (kind == SFB_ELEMENT_NONE) return sfb__error(ctx, r, kind, -1, "%s %ld: %s", what, what_index, detail);
+    return sfb__error(ctx, r, kind, index, "%s", detail);
+}
+
+/* Builds the edge list of a face list by hashing vertex pairs. */
+static sfb_result sfb__build_edges(sfb_context *ctx, int nv, int nf, const int *fv_off, const int *fv, int *ne_out,
+                                   int **fe_out, int **ev_out) {
+    int nfv = fv_off[nf], f, i, ne = 0;
+    size_t cap = 16, mask;
+    uint64_t *keys = NULL;
+    int *vals = NULL, *fe = NULL, *ev = NULL;
+    (void)nv;
+    while (cap < (size_t)nfv * 2 + 16) cap <<= 1;
+    mask = cap - 1;
+    keys = (uint64_t *)sfb__alloc(ctx, cap * sizeof(uint64_t));
+    vals = (int *)sfb__alloc(ctx, cap * sizeof(int));
+    fe = (int *)sfb__alloc(ctx, ((size_t)nfv + 1) * sizeof(int));
+    ev = (int *)sfb__alloc(ctx, ((size_t)nfv * 2 + 2) * sizeof(int));
+    if (!keys || !vals || !fe || !ev) goto oom;
+    memset(keys, 0xff, cap * sizeof(uint64_t));
+    for (f = 0; f < nf; ++f) {
+        int o = fv_off[f], n = fv_off[f + 1] - o;
+        for (i = 0; i < n; ++i) {
+            unsigned a = (unsigned)fv[o + i], b = (unsigned)fv[o + (i + 1) % n];
+            uint64_t key = a < b ? ((uint64_t)a << 32 | b) : ((uint64_t)b << 32 | a);
+            size_t h = (size_t)((key * 0x9E3779B97F4A7C15ull) >> 17) & mask;
+            while (keys[h] != ~(uint64_t)0 && keys[h] != key) h = (h + 1) & mask;
+            if (a == b) {
+                /* a degenerate edge (a face repeating a vertex) is never shared: each occurrence is
+                 * an edge of its own, as in OpenSubdiv */
+                ev[2 * ne] = (int)a;
+                ev[2 * ne + 1] = (int)b;
+                fe[o + i] = ne++;
+            } else if (keys[h] == key) {
+                int k, again = 0;
+                /* the same edge twice in one face (a face folding back on itself) gives two edges */
+                for (k = 0; k < i && !again; ++k) again = fe[o + k] == vals[h];
+                if (again) {
+                    ev[2 * ne] = (int)a;
+                    ev[2 * ne + 1] = (int)b;
+                    fe[o + i] = ne++;
+                } else {
+                    fe[o + i] = vals[h];
+                }
+            } else {
+                keys[h] = key;
+                vals[h] = ne;
+                ev[2 * ne] = (int)a;
+                ev[2 * ne + 1] = (int)b;
+                fe[o + i] = ne++;
+            }
+        }
+    }
+    sfb__free(ctx, keys);
+    sfb__free(ctx, vals);
+    *ne_out = ne;
+    *fe_out = fe;
+    *ev_out = ev;
+    return SFB_SUCCESS;
+oom:
+    sfb__free(ctx, keys); sfb__free(ctx, vals); sfb__free(ctx, fe); sfb__free(ctx, ev);
+    return SFB_OUT_OF_MEMORY;
+}
+
+/* Finds the edge between a and b through a's incident edges; -1 if none. */
+static int sfb__find_edge(const sfb__level *l, int a, int b) {
+    int i;
+    for (i = l->ve_off[a]; i < l->ve_off[a + 1]; ++i) {
+        int e = l->ve[i];
+        if ((l->ev[2 * e] == a && l->ev[2 * e + 1] == b) || (l->ev[2 * e] == b && l->ev[2 * e + 1] == a)) return e;
+    }
+    return -1;
+}
+
+static int sfb__finite3(const float *p) { return isfinite(p[0]) && isfinite(p[1]) && isfinite(p[2]); }
+
+/* Builds a level (topology only, zero sharpness) from faces; validates indices. */
+static sfb_result sfb__level_from_faces(sfb_context *ctx, int nv, int nf, const int *sizes, const int *fvin,
+                                        const sfb__src_lines *lines, sfb_element_kind vkind, sfb__level *l) {
+    int f, i;
+    size_t nfv = 0;
+    sfb_result r;
+    memset(l, 0, sizeof *l);
+    for (f = 0; f < nf; ++f) {
+        char msg[160];
+        if (sizes[f] < 3) {
+            snprintf(msg, sizeof msg, "face has %d vertices; a face needs at least 3", sizes[f]);
+            return sfb__elem_error(ctx, SFB_INVALID_TOPOLOGY, lines, lines ? lines->face : NULL, SFB_ELEMENT_FACE, f, "face", f, msg);
+        }
+        if (sizes[f] > SFB_MAX_FACE_SIZE) {
+            snprintf(msg, sizeof msg, "face has %d vertices, over the limit of %d (SFB_MAX_FACE_SIZE)", sizes[f], SFB_MAX_FACE_SIZE);
+            return sfb__elem_error(ctx, SFB_LIMIT_EXCEEDED, lines, lines ? lines->face : NULL, SFB_ELEMENT_FACE, f, "face", f, msg);
+        }
+        nfv += (size_t)sizes[f];
+        if (nfv > SFB_MAX_ELEMENTS)
+            return sfb__error(ctx, SFB_LIMIT_EXCEEDED, SFB_ELEMENT_FACE, f, "total face-vertex count over the limit of %d", SFB_MAX_ELEMENTS);
+    }
+    l->nv = nv;
+    l->nf = nf;
+    l->fv_off = (int *)sfb__alloc(ctx, ((size_t)nf + 1) * sizeof(int));
+    l->fv = (int *)sfb__alloc(ctx, (nfv + 1) * sizeof(int));
+    if (!l->fv_off || !l->fv) goto oom;
+    l->fv_off[0] = 0;
+    for (f = 0; f < nf; ++f) {
+        int o = l->fv_off[f], n = sizes[f];
+        l->fv_off[f + 1] = o + n;
+        for (i = 0; i < n; ++i) {
+            int v = fvin[o + i];
+            char msg[200];
+            if (v < 0 || v >= nv) {
+                snprintf(msg, sizeof msg, "%s index %d out of range (%d %s)", vkind == SFB_ELEMENT_UV ? "uv" : "vertex", v, nv,
+                         vkind == SFB_ELEMENT_UV ? "uvs" : "vertices");
+                sfb__level_free(ctx, l);
+                return sfb__elem_error(ctx, SFB_INVALID_TOPOLOGY, lines, lines ? lines->face : NULL, SFB_ELEMENT_FACE, f, "face", f, msg);
+            }
+            l->fv[o + i] = v;
+        }
+    }
+    r = sfb__build_edges(ctx, nv, nf, l->fv_off, l->fv, &l->ne, &l->fe, &l->ev);
+    if (r != SFB_SUCCESS) goto oom;
+    l->es = (float *)sfb__calloc(ctx, (size_t)l->ne + 1, sizeof(float));
+    l->vs = (float *)sfb__calloc(ctx, (size_t)nv + 1, sizeof(float));
+    if (!l->es || !l->vs) goto oom;
+    r = sfb__level_complete(ctx, l);
+    if (r != SFB_SUCCESS) { sfb__level_free(ctx, l); return r; }
+    return SFB_SUCCESS;
+oom:
+    sfb__level_free(ctx, l);
+    return sfb__error(ctx, SFB_LIMIT_EXCEEDED, SFB_ELEMENT_NONE, -1,
+                      "building the mesh topology needs more memory than the budget (%zu bytes) allows", ctx->budget);
+}
+
+static sfb_result sfb__check_sharpness(sfb_context *ctx, float s, const sfb__src_lines *lines, const int *line_of,
+                                       const char *what, int index) {
+    char msg[160];
+    if (isnan(s) || s < 0.0f) {
+        snprintf(msg, sizeof msg, "sharpness %g is invalid: sharpness must be a number >= 0", (double)s);
+        return sfb__elem_error(ctx, SFB_INVALID_VALUE, lines, line_of, SFB_ELEMENT_NONE, -1, what, index, msg);
+    }
+    return SFB_SUCCESS;
+}
+
+void sfb_mesh_destroy(sfb_mesh *mesh);
+
+static sfb_result sfb__mesh_create(sfb_context *ctx, const sfb_mesh_desc *d, const sfb__src_lines *lines, sfb_mesh **out) {
+    sfb_mesh *m;
+    sfb_result r;
+    int i, v, e;
+    char msg[256];
+    if (!ctx) return SFB_INVALID_ARGS;
+    if (!d || !out) return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "sfb_mesh_create: NULL argument");
+    *out = NULL;
+    if (d->vertex_count < 0 || d->face_count < 0 || d->crease_count < 0 || d->corner_count < 0 || d->hole_count < 0 ||
+        d->uv_count < 0)
+        return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "negative element count in the mesh description");
+    if (d->vertex_count > SFB_MAX_ELEMENTS || d->face_count > SFB_MAX_ELEMENTS || d->uv_count > SFB_MAX_ELEMENTS ||
+        d->crease_count > SFB_MAX_ELEMENTS || d->corner_count > SFB_MAX_ELEMENTS || d->hole_count > SFB_MAX_ELEMENTS)
+        return sfb__error(ctx, SFB_LIMIT_EXCEEDED, SFB_ELEMENT_NONE, -1, "element count over the limit of %d", SFB_MAX_ELEMENTS);
+    if (d->face_count == 0) return sfb__error(ctx, SFB_INVALID_TOPOLOGY, SFB_ELEMENT_NONE, -1, "mesh has no faces");
+    if (!d->positions || !d->face_sizes || !d->face_vertices)
+        return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "mesh description lacks positions or faces");
+    if ((d->crease_count && (!d->crease_vertices || !d->crease_sharpness)) ||
+        (d->corner_count && (!d->corner_vertices || !d->corner_sharpness)) || (d->hole_count && !d->holes) ||
+        (d->uv_count && (!d->uvs || !d->face_uvs)))
+        return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "mesh description has a count without its array");
+    if (d->boundary < 0 || d->boundary > 2 || d->crease_method < 0 || d->crease_method > 1 || d->triangle_rule < 0 ||
+        d->triangle_rule > 1 || d->uv_interp < 0 || d->uv_interp > 1)
+        return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "invalid boundary/crease method/triangle rule/uv mode value");
+    for (v = 0; v < d->vertex_count; ++v)
+        if (!sfb__finite3(d->positions + 3 * (size_t)v))
+            return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_VERTEX, v, "coordinate is not finite (NaN or inf)");
+    m = (sfb_mesh *)sfb__calloc(ctx, 1, sizeof(sfb_mesh));
+    if (!m) return sfb__error(ctx, SFB_OUT_OF_MEMORY, SFB_ELEMENT_NONE, -1, "out of memory");
+    m->ctx = ctx;
+    m->boundary = d->boundary; m->crease_method = d->crease_method;
+    m->triangle_rule = d->triangle_rule; m->uv_interp = d->uv_interp;
+    r = sfb__level_from_faces(ctx, d->vertex_count, d->face_count, d->face_sizes, d->face_vertices, lines, SFB_ELEMENT_VERTEX, &m->base);
+    if (r != SFB_SUCCESS) { sfb_mesh_destroy(m); return r; }
+    for (v = 0; v < m->base.nv; ++v) {
+        int val = m->base.ve_off[v + 1] - m->base.ve_off[v];
+        int fal = m->base.vf_off[v + 1] - m->base.vf_off[v];
+        if (val > SFB_MAX_VALENCE || fal > SFB_MAX_VALENCE) {
+            sfb_mesh_destroy(m);
+            return sfb__error(ctx, SFB_LIMIT_EXCEEDED, SFB_ELEMENT_VERTEX, v, "valence %d is over the limit of %d (SFB_MAX_VALENCE)",
+                              val > fal ? val : fal, SFB_MAX_VALENCE);
+        }
+    }
+    m->positions = (float *)sfb__alloc(ctx, (size_t)d->vertex_count * 3 * sizeof(float) + 1);
+    m->face_sizes = (int *)sfb__alloc(ctx, (size_t)d->face_count * sizeof(int));
+    if (!m->positions || !m->face_sizes) { sfb_mesh_destroy(m); return sfb__oom(ctx, "mesh"); }
+    memcpy(m->positions, d->positions, (size_t)d->vertex_count * 3 * sizeof(float));
+    memcpy(m->face_sizes, d->face_sizes, (size_t)d->face_count * sizeof(int));
+    /* creases: later entries override earlier ones on the same edge (as OpenSubdiv) */
+    for (i = 0; i < d->crease_count; ++i) {
+        int a = d->crease_vertices[2 * i], b = d->crease_vertices[2 * i + 1];
+        float s = d->crease_sharpness[i];
+        const int *lo = lines ? lines->crease : NULL;
+        if (a < 0 || a >= d->vertex_count || b < 0 || b >= d->vertex_count) {
+            snprintf(msg, sizeof msg, "crease names vertex index %d out of range (%d vertices)",
+                     (a < 0 || a >= d->vertex_count) ? a : b, d->vertex_count);
+            sfb_mesh_destroy(m);
+            return sfb__elem_error(ctx, SFB_INVALID_TOPOLOGY, lines, lo, SFB_ELEMENT_EDGE, i, "crease", i, msg);
+        }
+        r = sfb__check_sharpness(ctx, s, lines, lo, "crease", i);
+        if (r != SFB_SUCCESS) { sfb_mesh_destroy(m); return r; }
+        e = sfb__find_edge(&m->base, a, b);
+        if (e < 0) {
+            snprintf(msg, sizeof msg, "crease between vertices %d and %d is not an edge of the mesh", a, b);
+            sfb_mesh_destroy(m);
+            return sfb__elem_error(ctx, SFB_INVALID_TOPOLOGY, lines, lo, SFB_ELEMENT_EDGE, i, "crease", i, msg);
+        }
+        m->base.es[e] = s;
+    }
+    if (d->face_edge_sharpness) {
+        int f;
+        for (f = 0; f < d->face_count; ++f) {
+            int o = m->base.fv_off[f], n = m->base.fv_off[f + 1] - o;
+            for (i = 0; i < n; ++i) {
+                float s = d->face_edge_sharpness[o + i];
+                if (isnan(s) || s < 0.0f) {
+                    snprintf(msg, sizeof msg, "per-face edge sharpness %g is invalid: sharpness must be a number >= 0", (double)s);
+                    sfb_mesh_destroy(m);
+                    return sfb__elem_error(ctx, SFB_INVALID_VALUE, lines, lines ? lines->face : NULL, SFB_ELEMENT_FACE, f, "face", f, msg);
+                }
+                /* seed 001: where two faces give an edge different values, the highest wins */
+                if (s > m->base.es[m->base.fe[o + i]]) m->base.es[m->base.fe[o + i]] = s;
+            }
+        }
+    }
+    for (i = 0; i < d->corner_count; ++i) {
+        int a = d->corner_vertices[i];
+        const int *lo = lines ? lines->corner : NULL;
+        if (a < 0 || a >= d->vertex_count) {
+            snprintf(msg, sizeof msg, "corner names vertex index %d out of range (%d vertices)", a, d->vertex_count);
+            sfb_mesh_destroy(m);
+            return sfb__elem_error(ctx, SFB_INVALID_TOPOLOGY, lines, lo, SFB_ELEMENT_VERTEX, a, "corner", i, msg);
+        }
+        r = sfb__check_sharpness(ctx, d->corner_sharpness[i], lines, lo, "corner", i);
+        if (r != SFB_SUCCESS) { sfb_mesh_destroy(m); return r; }
+        m->base.vs[a] = d->corner_sharpness[i];
+    }
+    for (i = 0; i < d->hole_count; ++i) {
+        int f = d->holes[i];
+        if (f < 0 || f >= d->face_count) {
+            snprintf(msg, sizeof msg, "hole names face index %d out of range (%d faces)", f, d->face_count);
+            sfb_mesh_destroy(m);
+            return sfb__elem_error(ctx, SFB_INVALID_TOPOLOGY, lines, lines ? lines->hole : NULL, SFB_ELEMENT_FACE, f, "hole", i, msg);
+        }
+        m->base.fhole[f] = 1;
+    }
+    if (d->uv_count > 0) {
+        size_t nfv = (size_t)m->base.nfv;
+        for (i = 0; i < d->uv_count; ++i)
+            if (!isfinite(d->uvs[2 * i]) || !isfinite(d->uvs[2 * i + 1])) {
+                sfb_mesh_destroy(m);
+                return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_UV, i, "uv coordinate is not finite (NaN or inf)");
+            }
+        for (i = 0; (size_t)i < nfv; ++i)
+            if (d->face_uvs[i] < 0 || d->face_uvs[i] >= d->uv_count) {
+                int f = 0;
+                while (m->base.fv_off[f + 1] <= i) ++f;
+                snprintf(msg, sizeof msg, "uv index %d out of range (%d uvs)", d->face_uvs[i], d->uv_count);
+                sfb_mesh_destroy(m);
+                return sfb__elem_error(ctx, SFB_INVALID_TOPOLOGY, lines, lines ? lines->face : NULL, SFB_ELEMENT_FACE, f, "face", f, msg);
+            }
+        m->uv_count = d->uv_count;
+        m->uvs = (float *)sfb__alloc(ctx, (size_t)d->uv_count * 2 * sizeof(float));
+        m->face_uvs = (int *)sfb__alloc(ctx, nfv * sizeof(int));
+        if (!m->uvs || !m->face_uvs) { sfb_mesh_destroy(m); return sfb__oom(ctx, "mesh uvs"); }
+        memcpy(m->uvs, d->uvs, (size_t)d->uv_count * 2 * sizeof(float));
+        memcpy(m->face_uvs, d->face_uvs, nfv * sizeof(int));
+    }
+    /* desc view: per-edge creases, corners, holes */
+    {
+        int nc = 0, nk = 0, nh = 0, f;
+        for (e = 0; e < m->base.ne; ++e) nc += m->base.es[e] > 0.0f;
+        for (v = 0; v < m->base.nv; ++v) nk += m->base.vs[v] > 0.0f;
+        for (f = 0; f < m->base.nf; ++f) nh += m->base.fhole[f] != 0;
+        m->crease_vertices = (int *)sfb__alloc(ctx, (size_t)nc * 2 * sizeof(int) + 1);
+        m->crease_sharpness = (float *)sfb__alloc(ctx, (size_t)nc * sizeof(float) + 1);
+        m->corner_vertices = (int *)sfb__alloc(ctx, (size_t)nk * sizeof(int) + 1);
+        m->corner_sharpness = (float *)sfb__alloc(ctx, (size_t)nk * sizeof(float) + 1);
+        m->holes = (int *)sfb__alloc(ctx, (size_t)nh * sizeof(int) + 1);
+        if (!m->crease_vertices || !m->crease_sharpness || !m->corner_vertices || !m->corner_sharpness || !m->holes) {
+            sfb_mesh_destroy(m);
+            return sfb__oom(ctx, "mesh");
+        }
+        for (e = 0; e < m->base.ne; ++e)
+            if (m->base.es[e] > 0.0f) {
+                m->crease_vertices[2 * m->crease_count] = m->base.ev[2 * e];
+                m->crease_vertices[2 * m->crease_count + 1] = m->base.ev[2 * e + 1];
+                m->crease_sharpness[m->crease_count++] = m->base.es[e];
+            }
+        for (v = 0; v < m->base.nv; ++v)
+            if (m->base.vs[v] > 0.0f) {
+                m->corner_vertices[m->corner_count] = v;
+                m->corner_sharpness[m->corner_count++] = m->base.vs[v];
+            }
+        for (f = 0; f < m->base.nf; ++f)
+            if (m->base.fhole[f]) m->holes[m->hole_count++] = f;
+    }
+    sfb__level_compute_rules(&m->base);
+    *out = m;
+    return SFB_SUCCESS;
+}
+
+SFB_API sfb_result sfb_mesh_create(sfb_context *ctx, const sfb_mesh_desc *desc, sfb_mesh **out) {
+    return sfb__mesh_create(ctx, desc, NULL, out);
+}
+
+SFB_API void sfb_mesh_destroy(sfb_mesh *m) {
+    sfb_context *ctx;
+    if (!m) return;
+    ctx = m->ctx;
+    sfb__level_free(ctx, &m->base);
+    sfb__free(ctx, m->positions); sfb__free(ctx, m->uvs); sfb__free(ctx, m->face_uvs); sfb__free(ctx, m->face_sizes);
+    sfb__free(ctx, m->crease_vertices); sfb__free(ctx, m->crease_sharpness);
+    sfb__free(ctx, m->corner_vertices); sfb__free(ctx, m->corner_sharpness); sfb__free(ctx, m->holes);
+    sfb__free(ctx, m);
+}
+
+SFB_API void sfb_mesh_get_desc(const sfb_mesh *m, sfb_mesh_desc *d) {
+    if (!d) return;
+    memset(d, 0, sizeof *d);
+    if (!m) return;
+    d->vertex_count = m->base.nv; d->positions = m->positions;
+    d->face_count = m->base.nf; d->face_sizes = m->face_sizes; d->face_vertices = m->base.fv;
+    d->crease_count = m->crease_count; d->crease_vertices = m->crease_vertices; d->crease_sharpness = m->crease_sharpness;
+    d->corner_count = m->corner_count; d->corner_vertices = m->corner_vertices; d->corner_sharpness = m->corner_sharpness;
+    d->hole_count = m->hole_count; d->holes = m->holes;
+    d->uv_count = m->uv_count; d->uvs = m->uvs; d->face_uvs = m->face_uvs;
+    d->boundary = m->boundary; d->crease_method = m->crease_method;
+    d->triangle_rule = m->triangle_rule; d->uv_interp = m->uv_interp;
+}
+
+SFB_API void sfb_mesh_get_info(const sfb_mesh *m, sfb_mesh_info *o) {
+    const sfb__level *l;
+    sfb__level prep;
+    int v, e, f, c;
+    if (!o) return;
+    memset(o, 0, sizeof *o);
+    if (!m) return;
+    l = &m->base;
+    o->vertex_count = l->nv; o->face_count = l->nf; o->edge_count = l->ne; o->face_vertex_count = l->nfv;
+    o->uv_count = m->uv_count;
+    for (f = 0; f < l->nf; ++f) {
+        int n = l->fv_off[f + 1] - l->fv_off[f];
+        if (n == 3) o->triangles++; else if (n == 4) o->quads++; else o->ngons++;
+        if (n > o->max_face_size) o->max_face_size = n;
+        o->holes += l->fhole[f] != 0;
+    }
+    for (e = 0; e < l->ne; ++e) {
+        if (l->etag[e] & SFB__TAG_BOUNDARY) o->boundary_edges++;
+        if (l->etag[e] & SFB__TAG_NONMANIFOLD) o->nonmanifold_edges++;
+        if (l->es[e] > 0.0f) {
+            o->sharp_edges++;
+            if (l->es[e] >= SFB_SHARPNESS_INFINITE) o->infsharp_edges++; else o->semisharp_edges++;
+        }
+    }
+    for (c = 0; c < 3; ++c) { o->bbox_min[c] = l->nv ? 3.4e38f : 0.0f; o->bbox_max[c] = l->nv ? -3.4e38f : 0.0f; }
+    for (v = 0; v < l->nv; ++v) {
+        int k = l->vf_off[v + 1] - l->vf_off[v], d = l->ve_off[v + 1] - l->ve_off[v];
+        if (l->vtag[v] & SFB__TAG_BOUNDARY) o->boundary_vertices++;
+        if (l->vtag[v] & SFB__TAG_NONMANIFOLD) { if (k == 0) o->bare_vertices++; else o->nonmanifold_vertices++; }
+        if (l->vs[v] > 0.0f) o->corners++;
+        if (d > o->max_valence) o->max_valence = d;
+        if (!(l->vtag[v] & SFB__TAG_NONMANIFOLD)) {
+            if (l->vtag[v] & SFB__TAG_BOUNDARY) {
+                o->extraordinary_catmark += k != 2 && k != 1;
+                o->extraordinary_loop += k != 3 && k != 1;
+            } else {
+                o->extraordinary_catmark += k != 4;
+                o->extraordinary_loop += k != 6;
+            }
+        }
+        for (c = 0; c < 3; ++c) {
+            float x = m->positions[3 * (size_t)v + c];
+            if (x < o->bbox_min[c]) o->bbox_min[c] = x;
+            if (x > o->bbox_max[c]) o->bbox_max[c] = x;
+        }
+    }
+    /* vertex rules as refinement will see them (after boundary sharpening) */
+    if (sfb__level_prepare(m->ctx, l, m->boundary, m->boundary == SFB_BOUNDARY_EDGE_AND_CORNER, 0, &prep) == SFB_SUCCESS) {
+        for (v = 0; v < prep.nv; ++v) {
+            o->darts += prep.vrule[v] == SFB__RULE_DART;
+            o->crease_vertices += prep.vrule[v] == SFB__RULE_CREASE;
+            o->corner_vertices += prep.vrule[v] == SFB__RULE_CORNER && prep.ve_off[v + 1] > prep.ve_off[v];
+        }
+        sfb__level_free(m->ctx, &prep);
+    }
+}
+
+SFB_API int sfb_mesh_valence_histogram(const sfb_mesh *m, int *counts, int max_valence) {
+    int v, over = 0;
+    if (!m || !counts || max_valence <= 0) return 0;
+    memset(counts, 0, sizeof(int) * (size_t)max_valence);
+    for (v = 0; v < m->base.nv; ++v) {
+        int d = m->base.ve_off[v + 1] - m->base.ve_off[v];
+        if (d < max_valence) counts[d]++; else over++;
+    }
+    return over;
+}

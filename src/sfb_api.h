@@ -1,0 +1,269 @@
+/* surfblend public API.
+ *
+ * Life cycle:  sfb_context -> sfb_mesh -> sfb_surface (compiled tables) -> refine/eval.
+ * Every fallible call returns sfb_result (0 = success, negative = error); details of the
+ * last failure are in sfb_last_error(ctx). Nothing is global: all state lives in objects.
+ *
+ * Thread safety: a context is used by one thread at a time. A built sfb_surface is
+ * immutable; sfb_surface_eval_stencils may be called from several threads at once on
+ * the same surface as long as each call passes its own output buffers.
+ */
+#include <stddef.h>
+
+#ifndef SFB_API
+#  if defined(SURFBLEND_STATIC)
+#    define SFB_API static
+#  else
+#    define SFB_API extern
+#  endif
+#endif
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define SFB_VERSION_MAJOR 0
+#define SFB_VERSION_MINOR 1
+#define SFB_VERSION_PATCH 0
+
+/* Hard limits on untrusted input; exceeding one returns SFB_LIMIT_EXCEEDED before any
+ * allocation sized by the offending value. */
+#define SFB_MAX_LEVEL    10        /* uniform refinement levels */
+#define SFB_MAX_VALENCE  4096      /* edges (or faces) around one vertex */
+#define SFB_MAX_FACE_SIZE 1024     /* vertices of one face */
+#define SFB_MAX_ELEMENTS 200000000 /* vertices, faces, face-vertices in one mesh */
+#define SFB_DEFAULT_MEMORY_BUDGET ((size_t)4 << 30) /* bytes, when the config says 0 */
+
+/* Sharpness at or above this value is infinitely sharp (OpenSubdiv's convention). */
+#define SFB_SHARPNESS_INFINITE 10.0f
+
+/* ---- results: one X-macro list makes the enum and the strings ---- */
+#define SFB_RESULT_LIST(X)                                                              \
+    X(SFB_SUCCESS, 0, "success")                                                       \
+    X(SFB_INVALID_ARGS, -1, "invalid arguments")                                       \
+    X(SFB_OUT_OF_MEMORY, -2, "out of memory")                                          \
+    X(SFB_PARSE_ERROR, -3, "parse error")                                              \
+    X(SFB_INVALID_TOPOLOGY, -4, "invalid topology")                                    \
+    X(SFB_LIMIT_EXCEEDED, -5, "limit exceeded")                                        \
+    X(SFB_UNSUPPORTED, -6, "unsupported")                                              \
+    X(SFB_NO_BACKEND, -7, "no backend available")                                      \
+    X(SFB_BACKEND_UNAVAILABLE, -8, "backend unavailable")                              \
+    X(SFB_BACKEND_ERROR, -9, "backend error")                                          \
+    X(SFB_CANCELLED, -10, "cancelled")                                                 \
+    X(SFB_IO_ERROR, -11, "i/o error")                                                  \
+    X(SFB_INVALID_VALUE, -12, "invalid value")
+
+typedef enum sfb_result {
+#define SFB__RESULT_ENUM(name, value, text) name = value,
+    SFB_RESULT_LIST(SFB__RESULT_ENUM)
+#undef SFB__RESULT_ENUM
+    SFB_RESULT_MIN_ = -12
+} sfb_result;
+
+/* Static string for a result code ("unknown result" for values outside the list). */
+SFB_API const char *sfb_result_string(sfb_result r);
+
+/* ---- context ---- */
+typedef struct sfb_allocator {
+    void *(*alloc)(size_t size, void *user);
+    void *(*realloc)(void *ptr, size_t size, void *user);
+    void (*free)(void *ptr, void *user);
+    void *user;
+} sfb_allocator;
+
+enum { SFB_LOG_ERROR = 0, SFB_LOG_WARN = 1, SFB_LOG_INFO = 2, SFB_LOG_DEBUG = 3 };
+typedef struct sfb_logger {
+    void (*func)(int level, const char *msg, void *user);
+    void *user;
+} sfb_logger;
+
+/* Called during long operations with done in [0,1]; return non-zero to cancel
+ * (the operation then returns SFB_CANCELLED and frees what it made). */
+typedef struct sfb_progress {
+    int (*func)(float done, const char *stage, void *user);
+    void *user;
+} sfb_progress;
+
+typedef enum sfb_backend_kind {
+    SFB_BACKEND_DEFAULT = 0, SFB_BACKEND_REF, SFB_BACKEND_SIMD, SFB_BACKEND_GL, SFB_BACKEND_OSMESA,
+    SFB_BACKEND_KIND_COUNT_
+} sfb_backend_kind;
+
+typedef struct sfb_context_config {
+    sfb_allocator allocator;           /* all NULL: libc */
+    sfb_logger logger;                 /* NULL func: silent */
+    sfb_progress progress;             /* NULL func: no reports, no cancel */
+    const sfb_backend_kind *backends;  /* ordered preference; NULL: default order */
+    int backend_count;
+    int threads;                       /* 0: one per core (backends that use threads) */
+    size_t memory_budget;              /* bytes; 0: SFB_DEFAULT_MEMORY_BUDGET */
+    int gl_use_current_context;        /* gl backend: run on the caller's current context */
+    int ignore_environment;            /* 1: do not read SURFBLEND_BACKEND */
+} sfb_context_config;
+
+typedef struct sfb_context sfb_context;
+
+SFB_API sfb_context_config sfb_context_config_init(void);
+SFB_API sfb_result sfb_context_create(const sfb_context_config *config, sfb_context **out);
+SFB_API void sfb_context_destroy(sfb_context *ctx);
+
+typedef enum sfb_element_kind {
+    SFB_ELEMENT_NONE = 0, SFB_ELEMENT_VERTEX, SFB_ELEMENT_EDGE, SFB_ELEMENT_FACE,
+    SFB_ELEMENT_LINE, SFB_ELEMENT_UV
+} sfb_element_kind;
+
+typedef struct sfb_error_info {
+    sfb_result result;
+    sfb_element_kind element; /* what `index` counts */
+    long index;               /* 0-based element index, or 1-based line number for SFB_ELEMENT_LINE; -1 if none */
+    const char *message;      /* full message, includes the element */
+} sfb_error_info;
+
+/* Message of the last failure on this context ("" if none). Valid until the next call. */
+SFB_API const char *sfb_last_error(const sfb_context *ctx);
+SFB_API sfb_error_info sfb_last_error_info(const sfb_context *ctx);
+SFB_API void sfb_clear_error(sfb_context *ctx);
+
+SFB_API const char *sfb_backend_kind_name(sfb_backend_kind kind);
+/* Parses "ref", "simd", "gl", "osmesa" (case-insensitive). Returns SFB_BACKEND_DEFAULT when unknown. */
+SFB_API sfb_backend_kind sfb_backend_kind_parse(const char *name);
+SFB_API const char *sfb_context_backend_name(const sfb_context *ctx);
+/* One line per backend attempt: "name: selected|unavailable (reason)|failed (reason)". */
+SFB_API sfb_result sfb_context_backend_report(const sfb_context *ctx, char *buf, size_t size);
+
+/* ---- mesh ---- */
+typedef enum sfb_boundary {
+    SFB_BOUNDARY_EDGE_ONLY = 0,      /* default (OpenSubdiv's shape loader default) */
+    SFB_BOUNDARY_EDGE_AND_CORNER = 1,/* also valence-2 boundary vertices are corners */
+    SFB_BOUNDARY_NONE = 2            /* faces at the boundary are not part of the surface */
+} sfb_boundary;
+typedef enum sfb_crease_method { SFB_CREASE_UNIFORM = 0, SFB_CREASE_CHAIKIN = 1 } sfb_crease_method;
+typedef enum sfb_triangle_rule { SFB_TRI_CATMARK = 0, SFB_TRI_SMOOTH = 1 } sfb_triangle_rule;
+typedef enum sfb_uv_interp {
+    SFB_UV_SMOOTH_CORNERS = 0, /* smooth inside UV islands, seams act as boundaries, UV corners pinned */
+    SFB_UV_LINEAR = 1          /* bilinear: UVs follow each face linearly */
+} sfb_uv_interp;
+
+typedef struct sfb_mesh_desc {
+    int vertex_count; const float *positions;             /* xyz per vertex */
+    int face_count; const int *face_sizes; const int *face_vertices;
+    int crease_count; const int *crease_vertices;           /* pairs (a,b) naming an existing edge */
+    const float *crease_sharpness;                          /* per pair, >= 0; >= 10 infinite */
+    int corner_count; const int *corner_vertices; const float *corner_sharpness;
+    int hole_count; const int *holes;                       /* face indices */
+    int uv_count; const float *uvs; const int *face_uvs;    /* optional face-varying UVs: uv per face-vertex */
+    const float *face_edge_sharpness; /* optional, per face-vertex: sharpness of the edge from face vertex i
+                                         to vertex i+1 (seed 001's fs/as lines); the highest value wins */
+    int boundary, crease_method, triangle_rule, uv_interp;  /* enums above, 0 = defaults */
+} sfb_mesh_desc;
+
+typedef struct sfb_mesh sfb_mesh;
+
+/* Validates and copies the arrays, builds topology. Errors name the offending element. */
+SFB_API sfb_result sfb_mesh_create(sfb_context *ctx, const sfb_mesh_desc *desc, sfb_mesh **out);
+/* Parses OBJ text from memory (need not be NUL-terminated). Errors name the line. */
+SFB_API sfb_result sfb_mesh_read_obj(sfb_context *ctx, const char *text, size_t size, sfb_mesh **out);
+SFB_API void sfb_mesh_destroy(sfb_mesh *mesh);
+/* Pointers into the mesh's own arrays, valid while the mesh lives. Creases are per edge
+ * (fs/as input is folded into them). */
+SFB_API void sfb_mesh_get_desc(const sfb_mesh *mesh, sfb_mesh_desc *out);
+
+typedef int (*sfb_write_fn)(const void *data, size_t size, void *user); /* returns non-zero on failure */
+/* Writes OBJ (v, vt, f, t crease/corner/hole/interpolateboundary/creasemethod/smoothtriangles). */
+SFB_API sfb_result sfb_write_obj(const sfb_mesh_desc *desc, sfb_write_fn write, void *user);
+SFB_API sfb_result sfb_mesh_write_obj(const sfb_mesh *mesh, sfb_write_fn write, void *user);
+
+typedef struct sfb_mesh_info {
+    int vertex_count, face_count, edge_count, face_vertex_count, uv_count;
+    int triangles, quads, ngons, max_face_size;
+    int boundary_edges, boundary_vertices, nonmanifold_edges, nonmanifold_vertices, bare_vertices;
+    int sharp_edges, semisharp_edges, infsharp_edges, corners, holes;
+    int darts, crease_vertices, corner_vertices;     /* by vertex rule */
+    int extraordinary_catmark, extraordinary_loop;   /* interior valence != 4 / != 6, boundary != 2 / != 3 */
+    int max_valence;
+    float bbox_min[3], bbox_max[3];
+} sfb_mesh_info;
+SFB_API void sfb_mesh_get_info(const sfb_mesh *mesh, sfb_mesh_info *out);
+/* counts[v] = number of vertices with v incident edges, for v < max_valence; returns the number of
+ * vertices whose valence did not fit. */
+SFB_API int sfb_mesh_valence_histogram(const sfb_mesh *mesh, int *counts, int max_valence);
+
+/* ---- surfaces ---- */
+typedef enum sfb_scheme {
+    SFB_SCHEME_CATMARK = 0, SFB_SCHEME_LOOP, SFB_SCHEME_BILINEAR,
+    SFB_SCHEME_MANIFOLD_BLEND, SFB_SCHEME_TRIBEZIER
+} sfb_scheme;
+SFB_API const char *sfb_scheme_name(sfb_scheme s);
+
+enum {
+    SFB_REFINE_LIMIT = 1u << 0,  /* also build limit position + limit tangent tables */
+    SFB_REFINE_UVS = 1u << 1     /* also build the face-varying UV table (when the mesh has UVs) */
+};
+
+typedef struct sfb_surface_config {
+    sfb_scheme scheme;
+    int refine_level;   /* uniform refinement level compiled into the tables (0..SFB_MAX_LEVEL) */
+    unsigned flags;     /* SFB_REFINE_* */
+} sfb_surface_config;
+SFB_API sfb_surface_config sfb_surface_config_init(sfb_scheme scheme, int level);
+
+typedef struct sfb_surface sfb_surface;
+
+/* Compiles the tables (topology of the refined mesh, stencil tables) on the CPU. The surface
+ * keeps a reference to nothing in `mesh`: the mesh may be destroyed afterwards. */
+SFB_API sfb_result sfb_surface_create(sfb_context *ctx, const sfb_mesh *mesh,
+                                      const sfb_surface_config *config, sfb_surface **out);
+SFB_API void sfb_surface_destroy(sfb_surface *surface);
+
+/* Which stencil table to apply. */
+typedef enum sfb_table {
+    SFB_TABLE_VERTEX = 0,  /* base vertices -> refined vertices */
+    SFB_TABLE_LIMIT,       /* base vertices -> limit positions of refined vertices */
+    SFB_TABLE_TANGENT_U,   /* base vertices -> first limit tangent */
+    SFB_TABLE_TANGENT_V,   /* base vertices -> second limit tangent */
+    SFB_TABLE_UV,          /* base UVs -> refined UVs (face-varying) */
+    SFB_TABLE_COUNT_
+} sfb_table;
+
+/* A strided view into a float buffer (as OpenSubdiv's BufferDescriptor): element i, component c
+ * is at data[offset + i*stride + c]; `length` is the number of components per element (1..16,
+ * e.g. 3 for positions, 2 for UVs) and must match between source and destination; stride >= length. */
+typedef struct sfb_buffer_desc { int offset, length, stride; } sfb_buffer_desc;
+
+typedef struct sfb_stencil_info { int rows, sources, entries; } sfb_stencil_info;
+/* Fails with SFB_INVALID_ARGS when the table was not built (flag missing). */
+SFB_API sfb_result sfb_surface_stencil_info(const sfb_surface *surface, sfb_table table, sfb_stencil_info *out);
+
+/* Applies one table on the context's backend: dst[row] = sum w * src[index]. src must hold
+ * `sources` elements, dst `rows`. */
+SFB_API sfb_result sfb_surface_eval_stencils(const sfb_surface *surface, sfb_table table,
+                                             const float *src, sfb_buffer_desc src_desc,
+                                             float *dst, sfb_buffer_desc dst_desc);
+
+/* The refined mesh as plain arrays. */
+typedef struct sfb_mesh_data {
+    int vertex_count, face_count, face_vertex_count, uv_count;
+    float *positions;        /* xyz per refined vertex */
+    float *limit_positions;  /* xyz, when SFB_REFINE_LIMIT */
+    float *tangents_u, *tangents_v, *normals; /* xyz, when SFB_REFINE_LIMIT; normals unit length */
+    float *uvs;              /* uv per refined UV value, when SFB_REFINE_UVS and the mesh has UVs */
+    int *face_sizes, *face_vertices, *face_uvs;
+    int crease_count; int *crease_vertices; float *crease_sharpness; /* remaining sharpness at this level */
+    int corner_count; int *corner_vertices; float *corner_sharpness;
+    int hole_count; int *holes;
+    int boundary, crease_method, triangle_rule, uv_interp;
+    sfb_context *ctx_; /* allocator owner */
+} sfb_mesh_data;
+
+/* Applies the tables to the mesh's positions (and UVs) and returns the refined mesh. */
+SFB_API sfb_result sfb_surface_refine(const sfb_surface *surface, sfb_mesh_data *out);
+/* Same with other base positions (animation: same topology, new positions). */
+SFB_API sfb_result sfb_surface_refine_positions(const sfb_surface *surface, const float *base_positions,
+                                                int base_count, sfb_mesh_data *out);
+SFB_API void sfb_mesh_data_free(sfb_mesh_data *data);
+/* A desc view of refined data (pointers into `data`), for sfb_write_obj or sfb_mesh_create. */
+SFB_API void sfb_mesh_data_desc(const sfb_mesh_data *data, sfb_mesh_desc *out);
+
+#ifdef __cplusplus
+}
+#endif

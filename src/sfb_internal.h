@@ -1,0 +1,142 @@
+/* Private declarations shared by the core's modules (everything here is sfb__ prefixed). */
+#include <stdarg.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <math.h>
+
+#ifndef SFB__PI
+#define SFB__PI 3.14159265358979323846
+#endif
+
+/* ---- backend vtable ---- */
+/* A stencil table: row r reads sizes[r] entries starting at offsets[r] from indices/weights. */
+typedef struct sfb__stencils {
+    int rows, sources;
+    int *sizes, *offsets, *indices;
+    float *weights;
+    size_t entries;
+} sfb__stencils;
+
+enum { SFB__CAP_EVAL_STENCILS = 1u << 0 };
+
+typedef struct sfb__backend_vtable {
+    const char *name;
+    sfb_backend_kind kind;
+    unsigned caps;
+    /* Returns SFB_SUCCESS and a state, or an error with `why` filled. */
+    sfb_result (*init)(sfb_context *ctx, void **state, char *why, size_t why_size);
+    void (*shutdown)(sfb_context *ctx, void *state);
+    /* dst rows [first,last) = stencils applied to src. length components per element. */
+    sfb_result (*eval_stencils)(void *state, const sfb__stencils *table, int first, int last,
+                                const float *src, sfb_buffer_desc src_desc,
+                                float *dst, sfb_buffer_desc dst_desc);
+} sfb__backend_vtable;
+
+/* ---- context ---- */
+struct sfb_context {
+    sfb_allocator allocator;
+    sfb_logger logger;
+    sfb_progress progress;
+    size_t budget, live_bytes, peak_bytes;
+    int threads, gl_use_current_context;
+    sfb_backend_kind order[SFB_BACKEND_KIND_COUNT_];
+    int order_count;
+    const sfb__backend_vtable *backend;
+    void *backend_state;
+    char report[2048];
+    char error[1024];
+    sfb_error_info error_info;
+};
+
+void *sfb__alloc(sfb_context *ctx, size_t size);
+void *sfb__calloc(sfb_context *ctx, size_t count, size_t size);
+void *sfb__realloc(sfb_context *ctx, void *ptr, size_t size);
+void sfb__free(sfb_context *ctx, void *ptr);
+/* count*size with overflow check; returns 0 on overflow. */
+int sfb__mul_size(size_t a, size_t b, size_t *out);
+sfb_result sfb__error(sfb_context *ctx, sfb_result r, sfb_element_kind kind, long index, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 5, 6)))
+#endif
+    ;
+void sfb__log(sfb_context *ctx, int level, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+/* Returns SFB_CANCELLED (with the error set) when the callback asks to stop. */
+sfb_result sfb__progress(sfb_context *ctx, float done, const char *stage);
+sfb_result sfb__select_backend(sfb_context *ctx, const char *env_override);
+const sfb__backend_vtable *sfb__backend_ref(void);
+
+/* ---- topology of one level ---- */
+enum { SFB__TAG_BOUNDARY = 1, SFB__TAG_NONMANIFOLD = 2 };
+enum { SFB__RULE_SMOOTH = 1, SFB__RULE_DART = 2, SFB__RULE_CREASE = 4, SFB__RULE_CORNER = 8 };
+
+typedef struct sfb__level {
+    int nv, nf, ne, nfv;
+    int *fv_off, *fv, *fe;      /* face vertices, face edges (edge i runs fv[i] -> fv[i+1]) */
+    int *ev;                    /* 2 per edge */
+    int *ef_off, *ef, *ef_slot; /* faces of each edge, and the edge's slot in that face */
+    int *vf_off, *vf, *vf_slot; /* faces around each vertex (counter-clockwise when manifold) */
+    int *ve_off, *ve;           /* edges around each vertex (edge i precedes face i) */
+    float *es, *vs;             /* edge and vertex sharpness */
+    unsigned char *etag, *vtag, *vrule, *fhole;
+} sfb__level;
+
+void sfb__level_free(sfb_context *ctx, sfb__level *l);
+/* From nv, nf, fv_off, fv, fe, ne, ev: builds every adjacency array and the tags. */
+sfb_result sfb__level_complete(sfb_context *ctx, sfb__level *l);
+/* Sharpness/rule helpers shared by refinement and info. */
+int sfb__rule_from(float vertex_sharpness, int sharp_edge_count);
+void sfb__level_compute_rules(sfb__level *l);
+
+/* ---- mesh ---- */
+struct sfb_mesh {
+    sfb_context *ctx;
+    sfb__level base;            /* topology, with user sharpness (not yet boundary-sharpened) */
+    float *positions;
+    int uv_count;
+    float *uvs;
+    int *face_uvs;
+    int boundary, crease_method, triangle_rule, uv_interp;
+    /* desc view arrays */
+    int *face_sizes;
+    int crease_count; int *crease_vertices; float *crease_sharpness;
+    int corner_count; int *corner_vertices; float *corner_sharpness;
+    int hole_count; int *holes;
+};
+
+/* ---- surfaces ---- */
+struct sfb_surface {
+    sfb_context *ctx;
+    sfb_surface_config config;
+    int base_vertex_count, base_uv_count;
+    float *base_positions, *base_uvs;
+    sfb__level top;              /* topology of the refined level */
+    sfb__level uv_top;           /* topology of the refined UV layout (when built) */
+    int has_uvs;
+    sfb__stencils tables[SFB_TABLE_COUNT_];
+    int built[SFB_TABLE_COUNT_];
+    int boundary, crease_method, triangle_rule, uv_interp;
+};
+
+typedef struct sfb__refine_options {
+    sfb_scheme scheme;
+    int boundary, crease_method, triangle_rule;
+    int want_limit;
+    int is_uv;           /* refining the UV layout */
+    int linear;          /* bilinear masks on the scheme's own face split (linear UVs) */
+} sfb__refine_options;
+
+/* Refines `base` (already sharpened) `level` times; fills `top` and the stencil tables
+ * (vertex, and limit/tangents when asked). */
+sfb_result sfb__refine(sfb_context *ctx, const sfb__level *base, const sfb__refine_options *opt, int level,
+                       sfb__level *top, sfb__stencils *vertex_table, sfb__stencils *limit_tables /* [3] or NULL */,
+                       float progress_from, float progress_to);
+void sfb__stencils_free(sfb_context *ctx, sfb__stencils *s);
+/* Copy of the base level with OpenSubdiv's boundary/non-manifold sharpening and holes applied. */
+sfb_result sfb__level_prepare(sfb_context *ctx, const sfb__level *src, int boundary, int sharpen_corners_option,
+                              int make_boundary_holes, sfb__level *dst);

@@ -1,0 +1,295 @@
+/* Surfaces: compile a mesh into tables once (sfb_surface_create), apply them on the
+ * context's backend as often as needed (sfb_surface_eval_stencils / sfb_surface_refine). */
+
+SFB_API const char *sfb_scheme_name(sfb_scheme s) {
+    switch (s) {
+    case SFB_SCHEME_CATMARK: return "catmark";
+    case SFB_SCHEME_LOOP: return "loop";
+    case SFB_SCHEME_BILINEAR: return "bilinear";
+    case SFB_SCHEME_MANIFOLD_BLEND: return "manifold";
+    case SFB_SCHEME_TRIBEZIER: return "tribezier";
+    default: return "unknown";
+    }
+}
+
+SFB_API sfb_surface_config sfb_surface_config_init(sfb_scheme scheme, int level) {
+    sfb_surface_config c;
+    memset(&c, 0, sizeof c);
+    c.scheme = scheme;
+    c.refine_level = level;
+    return c;
+}
+
+SFB_API void sfb_surface_destroy(sfb_surface *s) {
+    sfb_context *ctx;
+    int t;
+    if (!s) return;
+    ctx = s->ctx;
+    for (t = 0; t < SFB_TABLE_COUNT_; ++t) sfb__stencils_free(ctx, &s->tables[t]);
+    sfb__level_free(ctx, &s->top);
+    sfb__level_free(ctx, &s->uv_top);
+    sfb__free(ctx, s->base_positions);
+    sfb__free(ctx, s->base_uvs);
+    sfb__free(ctx, s);
+}
+
+/* Rough peak bytes of refining `m` to `level`: topology of the last two levels plus composed
+ * stencil rows in double during construction. Used to refuse early, before any allocation
+ * sized by the level. */
+static double sfb__estimate_bytes(const sfb_mesh *m, sfb_scheme scheme, int level, int limit, double *faces_out) {
+    double faces = m->base.nf, verts = m->base.nv;
+    int L;
+    for (L = 0; L < level; ++L) {
+        if (scheme == SFB_SCHEME_LOOP) faces *= 4.0;
+        else faces = (L == 0) ? (double)m->base.nfv : faces * 4.0;
+    }
+    verts = scheme == SFB_SCHEME_LOOP ? faces / 2.0 + 2.0 : faces + 2.0;
+    if (level == 0) verts = m->base.nv;
+    *faces_out = faces;
+    return faces * 4.0 * 40.0 + verts * 16.0 * 12.0 * (limit ? 3.0 : 1.5);
+}
+
+SFB_API sfb_result sfb_surface_create(sfb_context *ctx, const sfb_mesh *mesh, const sfb_surface_config *cfg, sfb_surface **out) {
+    sfb_surface *s;
+    sfb__level prep;
+    sfb__refine_options opt;
+    sfb_result r;
+    double faces, bytes;
+    int f;
+    if (!ctx) return SFB_INVALID_ARGS;
+    if (!mesh || !cfg || !out) return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "sfb_surface_create: NULL argument");
+    *out = NULL;
+    if (cfg->scheme != SFB_SCHEME_CATMARK && cfg->scheme != SFB_SCHEME_LOOP && cfg->scheme != SFB_SCHEME_BILINEAR)
+        return sfb__error(ctx, SFB_UNSUPPORTED, SFB_ELEMENT_NONE, -1, "scheme '%s' cannot be refined uniformly yet", sfb_scheme_name(cfg->scheme));
+    if (cfg->refine_level < 0) return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "refinement level %d is negative", cfg->refine_level);
+    if (cfg->refine_level > SFB_MAX_LEVEL)
+        return sfb__error(ctx, SFB_LIMIT_EXCEEDED, SFB_ELEMENT_NONE, -1, "refinement level %d is over the limit of %d (SFB_MAX_LEVEL)",
+                          cfg->refine_level, SFB_MAX_LEVEL);
+    if (cfg->scheme == SFB_SCHEME_LOOP)
+        for (f = 0; f < mesh->base.nf; ++f)
+            if (mesh->base.fv_off[f + 1] - mesh->base.fv_off[f] != 3)
+                return sfb__error(ctx, SFB_INVALID_TOPOLOGY, SFB_ELEMENT_FACE, f, "Loop subdivision needs triangles; this face has %d vertices",
+                                  mesh->base.fv_off[f + 1] - mesh->base.fv_off[f]);
+    bytes = sfb__estimate_bytes(mesh, cfg->scheme, cfg->refine_level, (cfg->flags & SFB_REFINE_LIMIT) != 0, &faces);
+    if (faces > (double)SFB_MAX_ELEMENTS)
+        return sfb__error(ctx, SFB_LIMIT_EXCEEDED, SFB_ELEMENT_NONE, -1,
+                          "refining to level %d would make %.0f faces, over the limit of %d", cfg->refine_level, faces, SFB_MAX_ELEMENTS);
+    if (bytes > (double)(ctx->budget - ctx->live_bytes))
+        return sfb__error(ctx, SFB_LIMIT_EXCEEDED, SFB_ELEMENT_NONE, -1,
+                          "refining to level %d needs about %.0f MiB, over the memory budget of %.1f MiB",
+                          cfg->refine_level, bytes / 1048576.0, (double)ctx->budget / 1048576.0);
+    s = (sfb_surface *)sfb__calloc(ctx, 1, sizeof *s);
+    if (!s) return sfb__oom(ctx, "surface");
+    s->ctx = ctx;
+    s->config = *cfg;
+    s->boundary = mesh->boundary; s->crease_method = mesh->crease_method;
+    s->triangle_rule = mesh->triangle_rule; s->uv_interp = mesh->uv_interp;
+    s->base_vertex_count = mesh->base.nv;
+    s->base_positions = (float *)sfb__alloc(ctx, (size_t)mesh->base.nv * 3 * sizeof(float) + 1);
+    if (!s->base_positions) { sfb_surface_destroy(s); return sfb__oom(ctx, "surface"); }
+    memcpy(s->base_positions, mesh->positions, (size_t)mesh->base.nv * 3 * sizeof(float));
+    r = sfb__level_prepare(ctx, &mesh->base, mesh->boundary, mesh->boundary == SFB_BOUNDARY_EDGE_AND_CORNER,
+                           mesh->boundary == SFB_BOUNDARY_NONE && cfg->scheme != SFB_SCHEME_BILINEAR, &prep);
+    if (r != SFB_SUCCESS) { sfb_surface_destroy(s); return r; }
+    memset(&opt, 0, sizeof opt);
+    opt.scheme = cfg->scheme;
+    opt.boundary = mesh->boundary;
+    opt.crease_method = mesh->crease_method;
+    opt.triangle_rule = mesh->triangle_rule;
+    opt.want_limit = (cfg->flags & SFB_REFINE_LIMIT) != 0;
+    r = sfb__refine(ctx, &prep, &opt, cfg->refine_level, &s->top, &s->tables[SFB_TABLE_VERTEX],
+                    opt.want_limit ? &s->tables[SFB_TABLE_LIMIT] : NULL, 0.0f, 0.8f);
+    sfb__level_free(ctx, &prep);
+    if (r != SFB_SUCCESS) { sfb_surface_destroy(s); return r; }
+    s->built[SFB_TABLE_VERTEX] = 1;
+    if (opt.want_limit) s->built[SFB_TABLE_LIMIT] = s->built[SFB_TABLE_TANGENT_U] = s->built[SFB_TABLE_TANGENT_V] = 1;
+    if ((cfg->flags & SFB_REFINE_UVS) && mesh->uv_count > 0) {
+        /* The UV layout is refined as a mesh of its own: its vertices are the UV values, so a
+         * seam (an edge whose two faces disagree on a UV) is a boundary of the layout. It keeps
+         * the vertex mesh's creases and corners; its own corners (one face, two edges) are
+         * pinned, as OpenSubdiv's "linear corners only" face-varying mode. SFB_UV_LINEAR uses
+         * bilinear masks on the same face split. */
+        sfb__level uvl, uvp;
+        sfb__stencils dummy;
+        int o, i;
+        r = sfb__level_from_faces(ctx, mesh->uv_count, mesh->base.nf, mesh->face_sizes, mesh->face_uvs, NULL, SFB_ELEMENT_UV, &uvl);
+        if (r != SFB_SUCCESS) { sfb_surface_destroy(s); return r; }
+        for (f = 0; f < mesh->base.nf; ++f)
+            for (o = mesh->base.fv_off[f], i = 0; o + i < mesh->base.fv_off[f + 1]; ++i) {
+                int ue = uvl.fe[o + i], e = mesh->base.fe[o + i], uvv = mesh->face_uvs[o + i], vv = mesh->base.fv[o + i];
+                if (mesh->base.es[e] > uvl.es[ue]) uvl.es[ue] = mesh->base.es[e];
+                if (mesh->base.vs[vv] > uvl.vs[uvv]) uvl.vs[uvv] = mesh->base.vs[vv];
+            }
+        r = sfb__level_prepare(ctx, &uvl, SFB_BOUNDARY_EDGE_AND_CORNER, 1, 0, &uvp);
+        sfb__level_free(ctx, &uvl);
+        if (r != SFB_SUCCESS) { sfb_surface_destroy(s); return r; }
+        memset(&opt, 0, sizeof opt);
+        opt.scheme = cfg->scheme;
+        opt.boundary = SFB_BOUNDARY_EDGE_AND_CORNER;
+        opt.crease_method = mesh->crease_method;
+        opt.triangle_rule = mesh->triangle_rule;
+        opt.linear = mesh->uv_interp == SFB_UV_LINEAR;
+        opt.is_uv = 1;
+        memset(&dummy, 0, sizeof dummy);
+        r = sfb__refine(ctx, &uvp, &opt, cfg->refine_level, &s->uv_top, &s->tables[SFB_TABLE_UV], NULL, 0.8f, 1.0f);
+        sfb__level_free(ctx, &uvp);
+        if (r != SFB_SUCCESS) { sfb_surface_destroy(s); return r; }
+        s->built[SFB_TABLE_UV] = 1;
+        s->has_uvs = 1;
+        s->base_uv_count = mesh->uv_count;
+        s->base_uvs = (float *)sfb__alloc(ctx, (size_t)mesh->uv_count * 2 * sizeof(float));
+        if (!s->base_uvs) { sfb_surface_destroy(s); return sfb__oom(ctx, "surface"); }
+        memcpy(s->base_uvs, mesh->uvs, (size_t)mesh->uv_count * 2 * sizeof(float));
+    }
+    r = sfb__progress(ctx, 1.0f, "refine");
+    if (r != SFB_SUCCESS) { sfb_surface_destroy(s); return r; }
+    *out = s;
+    return SFB_SUCCESS;
+}
+
+SFB_API sfb_result sfb_surface_stencil_info(const sfb_surface *s, sfb_table t, sfb_stencil_info *out) {
+    if (!s || !out || (int)t < 0 || t >= SFB_TABLE_COUNT_ || !s->built[t]) return SFB_INVALID_ARGS;
+    out->rows = s->tables[t].rows;
+    out->sources = s->tables[t].sources;
+    out->entries = (int)s->tables[t].entries;
+    return SFB_SUCCESS;
+}
+
+static int sfb__desc_ok(sfb_buffer_desc d) { return d.offset >= 0 && d.length >= 1 && d.length <= 16 && d.stride >= d.length; }
+
+SFB_API sfb_result sfb_surface_eval_stencils(const sfb_surface *s, sfb_table t, const float *src, sfb_buffer_desc sd,
+                                             float *dst, sfb_buffer_desc dd) {
+    sfb_context *ctx;
+    const sfb__backend_vtable *be;
+    if (!s) return SFB_INVALID_ARGS;
+    ctx = s->ctx;
+    if ((int)t < 0 || t >= SFB_TABLE_COUNT_ || !s->built[t])
+        return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "stencil table %d was not built for this surface", (int)t);
+    if (!src || !dst || !sfb__desc_ok(sd) || !sfb__desc_ok(dd) || sd.length != dd.length)
+        return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "invalid buffers or buffer descriptors for stencil evaluation");
+    be = ctx->backend;
+    if (!be || !(be->caps & SFB__CAP_EVAL_STENCILS) || !be->eval_stencils) {
+        sfb__log(ctx, SFB_LOG_INFO, "backend %s lacks eval_stencils; using ref", be ? be->name : "none");
+        be = sfb__backend_ref();
+        return be->eval_stencils(NULL, &s->tables[t], 0, s->tables[t].rows, src, sd, dst, dd);
+    }
+    return be->eval_stencils(ctx->backend_state, &s->tables[t], 0, s->tables[t].rows, src, sd, dst, dd);
+}
+
+SFB_API void sfb_mesh_data_free(sfb_mesh_data *d) {
+    sfb_context *ctx;
+    if (!d || !d->ctx_) return;
+    ctx = d->ctx_;
+    sfb__free(ctx, d->positions); sfb__free(ctx, d->limit_positions); sfb__free(ctx, d->tangents_u);
+    sfb__free(ctx, d->tangents_v); sfb__free(ctx, d->normals); sfb__free(ctx, d->uvs);
+    sfb__free(ctx, d->face_sizes); sfb__free(ctx, d->face_vertices); sfb__free(ctx, d->face_uvs);
+    sfb__free(ctx, d->crease_vertices); sfb__free(ctx, d->crease_sharpness);
+    sfb__free(ctx, d->corner_vertices); sfb__free(ctx, d->corner_sharpness); sfb__free(ctx, d->holes);
+    memset(d, 0, sizeof *d);
+}
+
+SFB_API sfb_result sfb_surface_refine(const sfb_surface *s, sfb_mesh_data *out) {
+    if (!s) return SFB_INVALID_ARGS;
+    return sfb_surface_refine_positions(s, s->base_positions, s->base_vertex_count, out);
+}
+
+SFB_API sfb_result sfb_surface_refine_positions(const sfb_surface *s, const float *base, int base_count, sfb_mesh_data *o) {
+    sfb_context *ctx;
+    const sfb__level *l;
+    sfb_buffer_desc d3 = {0, 3, 3}, d2 = {0, 2, 2};
+    sfb_result r;
+    int i, e, v, f, nv;
+    if (!s || !o) return SFB_INVALID_ARGS;
+    memset(o, 0, sizeof *o);
+    ctx = s->ctx;
+    if (!base || base_count != s->base_vertex_count)
+        return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "expected %d base positions, got %d", s->base_vertex_count, base_count);
+    l = &s->top;
+    nv = l->nv;
+    o->ctx_ = ctx;
+    o->vertex_count = nv;
+    o->face_count = l->nf;
+    o->face_vertex_count = l->nfv;
+    o->boundary = s->boundary; o->crease_method = s->crease_method;
+    o->triangle_rule = s->triangle_rule; o->uv_interp = s->uv_interp;
+    o->positions = (float *)sfb__alloc(ctx, (size_t)nv * 3 * sizeof(float) + 1);
+    o->face_sizes = (int *)sfb__alloc(ctx, (size_t)l->nf * sizeof(int) + 1);
+    o->face_vertices = (int *)sfb__alloc(ctx, (size_t)l->nfv * sizeof(int) + 1);
+    if (!o->positions || !o->face_sizes || !o->face_vertices) goto oom;
+    r = sfb_surface_eval_stencils(s, SFB_TABLE_VERTEX, base, d3, o->positions, d3);
+    if (r != SFB_SUCCESS) { sfb_mesh_data_free(o); return r; }
+    if (s->built[SFB_TABLE_LIMIT]) {
+        o->limit_positions = (float *)sfb__alloc(ctx, (size_t)nv * 3 * sizeof(float) + 1);
+        o->tangents_u = (float *)sfb__alloc(ctx, (size_t)nv * 3 * sizeof(float) + 1);
+        o->tangents_v = (float *)sfb__alloc(ctx, (size_t)nv * 3 * sizeof(float) + 1);
+        o->normals = (float *)sfb__alloc(ctx, (size_t)nv * 3 * sizeof(float) + 1);
+        if (!o->limit_positions || !o->tangents_u || !o->tangents_v || !o->normals) goto oom;
+        if ((r = sfb_surface_eval_stencils(s, SFB_TABLE_LIMIT, base, d3, o->limit_positions, d3)) != SFB_SUCCESS ||
+            (r = sfb_surface_eval_stencils(s, SFB_TABLE_TANGENT_U, base, d3, o->tangents_u, d3)) != SFB_SUCCESS ||
+            (r = sfb_surface_eval_stencils(s, SFB_TABLE_TANGENT_V, base, d3, o->tangents_v, d3)) != SFB_SUCCESS) {
+            sfb_mesh_data_free(o);
+            return r;
+        }
+        for (v = 0; v < nv; ++v) {
+            const float *a = o->tangents_u + 3 * (size_t)v, *b = o->tangents_v + 3 * (size_t)v;
+            double n0 = (double)a[1] * b[2] - (double)a[2] * b[1];
+            double n1 = (double)a[2] * b[0] - (double)a[0] * b[2];
+            double n2 = (double)a[0] * b[1] - (double)a[1] * b[0];
+            double len = sqrt(n0 * n0 + n1 * n1 + n2 * n2);
+            float *n = o->normals + 3 * (size_t)v;
+            /* degenerate tangents (e.g. a corner with collinear edges) give a zero normal */
+            if (len > 0.0) { n[0] = (float)(n0 / len); n[1] = (float)(n1 / len); n[2] = (float)(n2 / len); }
+            else { n[0] = n[1] = n[2] = 0.0f; }
+        }
+    }
+    for (f = 0; f < l->nf; ++f) o->face_sizes[f] = l->fv_off[f + 1] - l->fv_off[f];
+    memcpy(o->face_vertices, l->fv, (size_t)l->nfv * sizeof(int));
+    if (s->has_uvs) {
+        o->uv_count = s->uv_top.nv;
+        o->uvs = (float *)sfb__alloc(ctx, (size_t)o->uv_count * 2 * sizeof(float) + 1);
+        o->face_uvs = (int *)sfb__alloc(ctx, (size_t)l->nfv * sizeof(int) + 1);
+        if (!o->uvs || !o->face_uvs) goto oom;
+        r = sfb_surface_eval_stencils(s, SFB_TABLE_UV, s->base_uvs, d2, o->uvs, d2);
+        if (r != SFB_SUCCESS) { sfb_mesh_data_free(o); return r; }
+        memcpy(o->face_uvs, s->uv_top.fv, (size_t)l->nfv * sizeof(int));
+    }
+    /* remaining sharpness: edges with sharpness that are not boundary edges (those are always
+     * sharp), vertices with sharpness, hole faces */
+    for (e = 0; e < l->ne; ++e) o->crease_count += l->es[e] > 0.0f && !(l->etag[e] & SFB__TAG_BOUNDARY);
+    for (v = 0; v < nv; ++v) o->corner_count += l->vs[v] > 0.0f;
+    for (f = 0; f < l->nf; ++f) o->hole_count += l->fhole[f] != 0;
+    o->crease_vertices = (int *)sfb__alloc(ctx, (size_t)o->crease_count * 2 * sizeof(int) + 1);
+    o->crease_sharpness = (float *)sfb__alloc(ctx, (size_t)o->crease_count * sizeof(float) + 1);
+    o->corner_vertices = (int *)sfb__alloc(ctx, (size_t)o->corner_count * sizeof(int) + 1);
+    o->corner_sharpness = (float *)sfb__alloc(ctx, (size_t)o->corner_count * sizeof(float) + 1);
+    o->holes = (int *)sfb__alloc(ctx, (size_t)o->hole_count * sizeof(int) + 1);
+    if (!o->crease_vertices || !o->crease_sharpness || !o->corner_vertices || !o->corner_sharpness || !o->holes) goto oom;
+    for (i = 0, e = 0; e < l->ne; ++e)
+        if (l->es[e] > 0.0f && !(l->etag[e] & SFB__TAG_BOUNDARY)) {
+            o->crease_vertices[2 * i] = l->ev[2 * e];
+            o->crease_vertices[2 * i + 1] = l->ev[2 * e + 1];
+            o->crease_sharpness[i++] = l->es[e];
+        }
+    for (i = 0, v = 0; v < nv; ++v)
+        if (l->vs[v] > 0.0f) { o->corner_vertices[i] = v; o->corner_sharpness[i++] = l->vs[v]; }
+    for (i = 0, f = 0; f < l->nf; ++f)
+        if (l->fhole[f]) o->holes[i++] = f;
+    return SFB_SUCCESS;
+oom:
+    sfb_mesh_data_free(o);
+    return sfb__oom(ctx, "refined mesh output");
+}
+
+SFB_API void sfb_mesh_data_desc(const sfb_mesh_data *m, sfb_mesh_desc *d) {
+    if (!d) return;
+    memset(d, 0, sizeof *d);
+    if (!m) return;
+    d->vertex_count = m->vertex_count; d->positions = m->positions;
+    d->face_count = m->face_count; d->face_sizes = m->face_sizes; d->face_vertices = m->face_vertices;
+    d->crease_count = m->crease_count; d->crease_vertices = m->crease_vertices; d->crease_sharpness = m->crease_sharpness;
+    d->corner_count = m->corner_count; d->corner_vertices = m->corner_vertices; d->corner_sharpness = m->corner_sharpness;
+    d->hole_count = m->hole_count; d->holes = m->holes;
+    d->uv_count = m->uv_count; d->uvs = m->uvs; d->face_uvs = m->face_uvs;
+    d->boundary = m->boundary; d->crease_method = m->crease_method;
+    d->triangle_rule = m->triangle_rule; d->uv_interp = m->uv_interp;
+}

@@ -1,0 +1,3031 @@
+/* surfblend.h -- subdivision surfaces with sharp and semi-sharp creases, evaluated on
+ * several backends. Single-header library: GENERATED from src/ by `make amalgamate`; edit
+ * src/ instead.
+ *
+ * In exactly one C or C++ file:
+ *     #define SURFBLEND_IMPLEMENTATION
+ *     #include "surfblend.h"
+ * Optional backends (backends/sfb_*.h) are included before that line.
+ */
+#ifndef SURFBLEND_H
+#define SURFBLEND_H
+#line 1 "src/sfb_api.h"
+/* surfblend public API.
+ *
+ * Life cycle:  sfb_context -> sfb_mesh -> sfb_surface (compiled tables) -> refine/eval.
+ * Every fallible call returns sfb_result (0 = success, negative = error); details of the
+ * last failure are in sfb_last_error(ctx). Nothing is global: all state lives in objects.
+ *
+ * Thread safety: a context is used by one thread at a time. A built sfb_surface is
+ * immutable; sfb_surface_eval_stencils may be called from several threads at once on
+ * the same surface as long as each call passes its own output buffers.
+ */
+#include <stddef.h>
+
+#ifndef SFB_API
+#  if defined(SURFBLEND_STATIC)
+#    define SFB_API static
+#  else
+#    define SFB_API extern
+#  endif
+#endif
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define SFB_VERSION_MAJOR 0
+#define SFB_VERSION_MINOR 1
+#define SFB_VERSION_PATCH 0
+
+/* Hard limits on untrusted input; exceeding one returns SFB_LIMIT_EXCEEDED before any
+ * allocation sized by the offending value. */
+#define SFB_MAX_LEVEL    10        /* uniform refinement levels */
+#define SFB_MAX_VALENCE  4096      /* edges (or faces) around one vertex */
+#define SFB_MAX_FACE_SIZE 1024     /* vertices of one face */
+#define SFB_MAX_ELEMENTS 200000000 /* vertices, faces, face-vertices in one mesh */
+#define SFB_DEFAULT_MEMORY_BUDGET ((size_t)4 << 30) /* bytes, when the config says 0 */
+
+/* Sharpness at or above this value is infinitely sharp (OpenSubdiv's convention). */
+#define SFB_SHARPNESS_INFINITE 10.0f
+
+/* ---- results: one X-macro list makes the enum and the strings ---- */
+#define SFB_RESULT_LIST(X)                                                              \
+    X(SFB_SUCCESS, 0, "success")                                                       \
+    X(SFB_INVALID_ARGS, -1, "invalid arguments")                                       \
+    X(SFB_OUT_OF_MEMORY, -2, "out of memory")                                          \
+    X(SFB_PARSE_ERROR, -3, "parse error")                                              \
+    X(SFB_INVALID_TOPOLOGY, -4, "invalid topology")                                    \
+    X(SFB_LIMIT_EXCEEDED, -5, "limit exceeded")                                        \
+    X(SFB_UNSUPPORTED, -6, "unsupported")                                              \
+    X(SFB_NO_BACKEND, -7, "no backend available")                                      \
+    X(SFB_BACKEND_UNAVAILABLE, -8, "backend unavailable")                              \
+    X(SFB_BACKEND_ERROR, -9, "backend error")                                          \
+    X(SFB_CANCELLED, -10, "cancelled")                                                 \
+    X(SFB_IO_ERROR, -11, "i/o error")                                                  \
+    X(SFB_INVALID_VALUE, -12, "invalid value")
+
+typedef enum sfb_result {
+#define SFB__RESULT_ENUM(name, value, text) name = value,
+    SFB_RESULT_LIST(SFB__RESULT_ENUM)
+#undef SFB__RESULT_ENUM
+    SFB_RESULT_MIN_ = -12
+} sfb_result;
+
+/* Static string for a result code ("unknown result" for values outside the list). */
+SFB_API const char *sfb_result_string(sfb_result r);
+
+/* ---- context ---- */
+typedef struct sfb_allocator {
+    void *(*alloc)(size_t size, void *user);
+    void *(*realloc)(void *ptr, size_t size, void *user);
+    void (*free)(void *ptr, void *user);
+    void *user;
+} sfb_allocator;
+
+enum { SFB_LOG_ERROR = 0, SFB_LOG_WARN = 1, SFB_LOG_INFO = 2, SFB_LOG_DEBUG = 3 };
+typedef struct sfb_logger {
+    void (*func)(int level, const char *msg, void *user);
+    void *user;
+} sfb_logger;
+
+/* Called during long operations with done in [0,1]; return non-zero to cancel
+ * (the operation then returns SFB_CANCELLED and frees what it made). */
+typedef struct sfb_progress {
+    int (*func)(float done, const char *stage, void *user);
+    void *user;
+} sfb_progress;
+
+typedef enum sfb_backend_kind {
+    SFB_BACKEND_DEFAULT = 0, SFB_BACKEND_REF, SFB_BACKEND_SIMD, SFB_BACKEND_GL, SFB_BACKEND_OSMESA,
+    SFB_BACKEND_KIND_COUNT_
+} sfb_backend_kind;
+
+typedef struct sfb_context_config {
+    sfb_allocator allocator;           /* all NULL: libc */
+    sfb_logger logger;                 /* NULL func: silent */
+    sfb_progress progress;             /* NULL func: no reports, no cancel */
+    const sfb_backend_kind *backends;  /* ordered preference; NULL: default order */
+    int backend_count;
+    int threads;                       /* 0: one per core (backends that use threads) */
+    size_t memory_budget;              /* bytes; 0: SFB_DEFAULT_MEMORY_BUDGET */
+    int gl_use_current_context;        /* gl backend: run on the caller's current context */
+    int ignore_environment;            /* 1: do not read SURFBLEND_BACKEND */
+} sfb_context_config;
+
+typedef struct sfb_context sfb_context;
+
+SFB_API sfb_context_config sfb_context_config_init(void);
+SFB_API sfb_result sfb_context_create(const sfb_context_config *config, sfb_context **out);
+SFB_API void sfb_context_destroy(sfb_context *ctx);
+
+typedef enum sfb_element_kind {
+    SFB_ELEMENT_NONE = 0, SFB_ELEMENT_VERTEX, SFB_ELEMENT_EDGE, SFB_ELEMENT_FACE,
+    SFB_ELEMENT_LINE, SFB_ELEMENT_UV
+} sfb_element_kind;
+
+typedef struct sfb_error_info {
+    sfb_result result;
+    sfb_element_kind element; /* what `index` counts */
+    long index;               /* 0-based element index, or 1-based line number for SFB_ELEMENT_LINE; -1 if none */
+    const char *message;      /* full message, includes the element */
+} sfb_error_info;
+
+/* Message of the last failure on this context ("" if none). Valid until the next call. */
+SFB_API const char *sfb_last_error(const sfb_context *ctx);
+SFB_API sfb_error_info sfb_last_error_info(const sfb_context *ctx);
+SFB_API void sfb_clear_error(sfb_context *ctx);
+
+SFB_API const char *sfb_backend_kind_name(sfb_backend_kind kind);
+/* Parses "ref", "simd", "gl", "osmesa" (case-insensitive). Returns SFB_BACKEND_DEFAULT when unknown. */
+SFB_API sfb_backend_kind sfb_backend_kind_parse(const char *name);
+SFB_API const char *sfb_context_backend_name(const sfb_context *ctx);
+/* One line per backend attempt: "name: selected|unavailable (reason)|failed (reason)". */
+SFB_API sfb_result sfb_context_backend_report(const sfb_context *ctx, char *buf, size_t size);
+
+/* ---- mesh ---- */
+typedef enum sfb_boundary {
+    SFB_BOUNDARY_EDGE_ONLY = 0,      /* default (OpenSubdiv's shape loader default) */
+    SFB_BOUNDARY_EDGE_AND_CORNER = 1,/* also valence-2 boundary vertices are corners */
+    SFB_BOUNDARY_NONE = 2            /* faces at the boundary are not part of the surface */
+} sfb_boundary;
+typedef enum sfb_crease_method { SFB_CREASE_UNIFORM = 0, SFB_CREASE_CHAIKIN = 1 } sfb_crease_method;
+typedef enum sfb_triangle_rule { SFB_TRI_CATMARK = 0, SFB_TRI_SMOOTH = 1 } sfb_triangle_rule;
+typedef enum sfb_uv_interp {
+    SFB_UV_SMOOTH_CORNERS = 0, /* smooth inside UV islands, seams act as boundaries, UV corners pinned */
+    SFB_UV_LINEAR = 1          /* bilinear: UVs follow each face linearly */
+} sfb_uv_interp;
+
+typedef struct sfb_mesh_desc {
+    int vertex_count; const float *positions;             /* xyz per vertex */
+    int face_count; const int *face_sizes; const int *face_vertices;
+    int crease_count; const int *crease_vertices;           /* pairs (a,b) naming an existing edge */
+    const float *crease_sharpness;                          /* per pair, >= 0; >= 10 infinite */
+    int corner_count; const int *corner_vertices; const float *corner_sharpness;
+    int hole_count; const int *holes;                       /* face indices */
+    int uv_count; const float *uvs; const int *face_uvs;    /* optional face-varying UVs: uv per face-vertex */
+    const float *face_edge_sharpness; /* optional, per face-vertex: sharpness of the edge from face vertex i
+                                         to vertex i+1 (seed 001's fs/as lines); the highest value wins */
+    int boundary, crease_method, triangle_rule, uv_interp;  /* enums above, 0 = defaults */
+} sfb_mesh_desc;
+
+typedef struct sfb_mesh sfb_mesh;
+
+/* Validates and copies the arrays, builds topology. Errors name the offending element. */
+SFB_API sfb_result sfb_mesh_create(sfb_context *ctx, const sfb_mesh_desc *desc, sfb_mesh **out);
+/* Parses OBJ text from memory (need not be NUL-terminated). Errors name the line. */
+SFB_API sfb_result sfb_mesh_read_obj(sfb_context *ctx, const char *text, size_t size, sfb_mesh **out);
+SFB_API void sfb_mesh_destroy(sfb_mesh *mesh);
+/* Pointers into the mesh's own arrays, valid while the mesh lives. Creases are per edge
+ * (fs/as input is folded into them). */
+SFB_API void sfb_mesh_get_desc(const sfb_mesh *mesh, sfb_mesh_desc *out);
+
+typedef int (*sfb_write_fn)(const void *data, size_t size, void *user); /* returns non-zero on failure */
+/* Writes OBJ (v, vt, f, t crease/corner/hole/interpolateboundary/creasemethod/smoothtriangles). */
+SFB_API sfb_result sfb_write_obj(const sfb_mesh_desc *desc, sfb_write_fn write, void *user);
+SFB_API sfb_result sfb_mesh_write_obj(const sfb_mesh *mesh, sfb_write_fn write, void *user);
+
+typedef struct sfb_mesh_info {
+    int vertex_count, face_count, edge_count, face_vertex_count, uv_count;
+    int triangles, quads, ngons, max_face_size;
+    int boundary_edges, boundary_vertices, nonmanifold_edges, nonmanifold_vertices, bare_vertices;
+    int sharp_edges, semisharp_edges, infsharp_edges, corners, holes;
+    int darts, crease_vertices, corner_vertices;     /* by vertex rule */
+    int extraordinary_catmark, extraordinary_loop;   /* interior valence != 4 / != 6, boundary != 2 / != 3 */
+    int max_valence;
+    float bbox_min[3], bbox_max[3];
+} sfb_mesh_info;
+SFB_API void sfb_mesh_get_info(const sfb_mesh *mesh, sfb_mesh_info *out);
+/* counts[v] = number of vertices with v incident edges, for v < max_valence; returns the number of
+ * vertices whose valence did not fit. */
+SFB_API int sfb_mesh_valence_histogram(const sfb_mesh *mesh, int *counts, int max_valence);
+
+/* ---- surfaces ---- */
+typedef enum sfb_scheme {
+    SFB_SCHEME_CATMARK = 0, SFB_SCHEME_LOOP, SFB_SCHEME_BILINEAR,
+    SFB_SCHEME_MANIFOLD_BLEND, SFB_SCHEME_TRIBEZIER
+} sfb_scheme;
+SFB_API const char *sfb_scheme_name(sfb_scheme s);
+
+enum {
+    SFB_REFINE_LIMIT = 1u << 0,  /* also build limit position + limit tangent tables */
+    SFB_REFINE_UVS = 1u << 1     /* also build the face-varying UV table (when the mesh has UVs) */
+};
+
+typedef struct sfb_surface_config {
+    sfb_scheme scheme;
+    int refine_level;   /* uniform refinement level compiled into the tables (0..SFB_MAX_LEVEL) */
+    unsigned flags;     /* SFB_REFINE_* */
+} sfb_surface_config;
+SFB_API sfb_surface_config sfb_surface_config_init(sfb_scheme scheme, int level);
+
+typedef struct sfb_surface sfb_surface;
+
+/* Compiles the tables (topology of the refined mesh, stencil tables) on the CPU. The surface
+ * keeps a reference to nothing in `mesh`: the mesh may be destroyed afterwards. */
+SFB_API sfb_result sfb_surface_create(sfb_context *ctx, const sfb_mesh *mesh,
+                                      const sfb_surface_config *config, sfb_surface **out);
+SFB_API void sfb_surface_destroy(sfb_surface *surface);
+
+/* Which stencil table to apply. */
+typedef enum sfb_table {
+    SFB_TABLE_VERTEX = 0,  /* base vertices -> refined vertices */
+    SFB_TABLE_LIMIT,       /* base vertices -> limit positions of refined vertices */
+    SFB_TABLE_TANGENT_U,   /* base vertices -> first limit tangent */
+    SFB_TABLE_TANGENT_V,   /* base vertices -> second limit tangent */
+    SFB_TABLE_UV,          /* base UVs -> refined UVs (face-varying) */
+    SFB_TABLE_COUNT_
+} sfb_table;
+
+/* A strided view into a float buffer (as OpenSubdiv's BufferDescriptor): element i, component c
+ * is at data[offset + i*stride + c]; `length` is the number of components per element (1..16,
+ * e.g. 3 for positions, 2 for UVs) and must match between source and destination; stride >= length. */
+typedef struct sfb_buffer_desc { int offset, length, stride; } sfb_buffer_desc;
+
+typedef struct sfb_stencil_info { int rows, sources, entries; } sfb_stencil_info;
+/* Fails with SFB_INVALID_ARGS when the table was not built (flag missing). */
+SFB_API sfb_result sfb_surface_stencil_info(const sfb_surface *surface, sfb_table table, sfb_stencil_info *out);
+
+/* Applies one table on the context's backend: dst[row] = sum w * src[index]. src must hold
+ * `sources` elements, dst `rows`. */
+SFB_API sfb_result sfb_surface_eval_stencils(const sfb_surface *surface, sfb_table table,
+                                             const float *src, sfb_buffer_desc src_desc,
+                                             float *dst, sfb_buffer_desc dst_desc);
+
+/* The refined mesh as plain arrays. */
+typedef struct sfb_mesh_data {
+    int vertex_count, face_count, face_vertex_count, uv_count;
+    float *positions;        /* xyz per refined vertex */
+    float *limit_positions;  /* xyz, when SFB_REFINE_LIMIT */
+    float *tangents_u, *tangents_v, *normals; /* xyz, when SFB_REFINE_LIMIT; normals unit length */
+    float *uvs;              /* uv per refined UV value, when SFB_REFINE_UVS and the mesh has UVs */
+    int *face_sizes, *face_vertices, *face_uvs;
+    int crease_count; int *crease_vertices; float *crease_sharpness; /* remaining sharpness at this level */
+    int corner_count; int *corner_vertices; float *corner_sharpness;
+    int hole_count; int *holes;
+    int boundary, crease_method, triangle_rule, uv_interp;
+    sfb_context *ctx_; /* allocator owner */
+} sfb_mesh_data;
+
+/* Applies the tables to the mesh's positions (and UVs) and returns the refined mesh. */
+SFB_API sfb_result sfb_surface_refine(const sfb_surface *surface, sfb_mesh_data *out);
+/* Same with other base positions (animation: same topology, new positions). */
+SFB_API sfb_result sfb_surface_refine_positions(const sfb_surface *surface, const float *base_positions,
+                                                int base_count, sfb_mesh_data *out);
+SFB_API void sfb_mesh_data_free(sfb_mesh_data *data);
+/* A desc view of refined data (pointers into `data`), for sfb_write_obj or sfb_mesh_create. */
+SFB_API void sfb_mesh_data_desc(const sfb_mesh_data *data, sfb_mesh_desc *out);
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* SURFBLEND_H */
+
+#if defined(SURFBLEND_IMPLEMENTATION) && !defined(SURFBLEND_IMPLEMENTED)
+#define SURFBLEND_IMPLEMENTED
+#line 1 "src/sfb_internal.h"
+/* Private declarations shared by the core's modules (everything here is sfb__ prefixed). */
+#include <stdarg.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <math.h>
+
+#ifndef SFB__PI
+#define SFB__PI 3.14159265358979323846
+#endif
+
+/* ---- backend vtable ---- */
+/* A stencil table: row r reads sizes[r] entries starting at offsets[r] from indices/weights. */
+typedef struct sfb__stencils {
+    int rows, sources;
+    int *sizes, *offsets, *indices;
+    float *weights;
+    size_t entries;
+} sfb__stencils;
+
+enum { SFB__CAP_EVAL_STENCILS = 1u << 0 };
+
+typedef struct sfb__backend_vtable {
+    const char *name;
+    sfb_backend_kind kind;
+    unsigned caps;
+    /* Returns SFB_SUCCESS and a state, or an error with `why` filled. */
+    sfb_result (*init)(sfb_context *ctx, void **state, char *why, size_t why_size);
+    void (*shutdown)(sfb_context *ctx, void *state);
+    /* dst rows [first,last) = stencils applied to src. length components per element. */
+    sfb_result (*eval_stencils)(void *state, const sfb__stencils *table, int first, int last,
+                                const float *src, sfb_buffer_desc src_desc,
+                                float *dst, sfb_buffer_desc dst_desc);
+} sfb__backend_vtable;
+
+/* ---- context ---- */
+struct sfb_context {
+    sfb_allocator allocator;
+    sfb_logger logger;
+    sfb_progress progress;
+    size_t budget, live_bytes, peak_bytes;
+    int threads, gl_use_current_context;
+    sfb_backend_kind order[SFB_BACKEND_KIND_COUNT_];
+    int order_count;
+    const sfb__backend_vtable *backend;
+    void *backend_state;
+    char report[2048];
+    char error[1024];
+    sfb_error_info error_info;
+};
+
+void *sfb__alloc(sfb_context *ctx, size_t size);
+void *sfb__calloc(sfb_context *ctx, size_t count, size_t size);
+void *sfb__realloc(sfb_context *ctx, void *ptr, size_t size);
+void sfb__free(sfb_context *ctx, void *ptr);
+/* count*size with overflow check; returns 0 on overflow. */
+int sfb__mul_size(size_t a, size_t b, size_t *out);
+sfb_result sfb__error(sfb_context *ctx, sfb_result r, sfb_element_kind kind, long index, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 5, 6)))
+#endif
+    ;
+void sfb__log(sfb_context *ctx, int level, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+/* Returns SFB_CANCELLED (with the error set) when the callback asks to stop. */
+sfb_result sfb__progress(sfb_context *ctx, float done, const char *stage);
+sfb_result sfb__select_backend(sfb_context *ctx, const char *env_override);
+const sfb__backend_vtable *sfb__backend_ref(void);
+
+/* ---- topology of one level ---- */
+enum { SFB__TAG_BOUNDARY = 1, SFB__TAG_NONMANIFOLD = 2 };
+enum { SFB__RULE_SMOOTH = 1, SFB__RULE_DART = 2, SFB__RULE_CREASE = 4, SFB__RULE_CORNER = 8 };
+
+typedef struct sfb__level {
+    int nv, nf, ne, nfv;
+    int *fv_off, *fv, *fe;      /* face vertices, face edges (edge i runs fv[i] -> fv[i+1]) */
+    int *ev;                    /* 2 per edge */
+    int *ef_off, *ef, *ef_slot; /* faces of each edge, and the edge's slot in that face */
+    int *vf_off, *vf, *vf_slot; /* faces around each vertex (counter-clockwise when manifold) */
+    int *ve_off, *ve;           /* edges around each vertex (edge i precedes face i) */
+    float *es, *vs;             /* edge and vertex sharpness */
+    unsigned char *etag, *vtag, *vrule, *fhole;
+} sfb__level;
+
+void sfb__level_free(sfb_context *ctx, sfb__level *l);
+/* From nv, nf, fv_off, fv, fe, ne, ev: builds every adjacency array and the tags. */
+sfb_result sfb__level_complete(sfb_context *ctx, sfb__level *l);
+/* Sharpness/rule helpers shared by refinement and info. */
+int sfb__rule_from(float vertex_sharpness, int sharp_edge_count);
+void sfb__level_compute_rules(sfb__level *l);
+
+/* ---- mesh ---- */
+struct sfb_mesh {
+    sfb_context *ctx;
+    sfb__level base;            /* topology, with user sharpness (not yet boundary-sharpened) */
+    float *positions;
+    int uv_count;
+    float *uvs;
+    int *face_uvs;
+    int boundary, crease_method, triangle_rule, uv_interp;
+    /* desc view arrays */
+    int *face_sizes;
+    int crease_count; int *crease_vertices; float *crease_sharpness;
+    int corner_count; int *corner_vertices; float *corner_sharpness;
+    int hole_count; int *holes;
+};
+
+/* ---- surfaces ---- */
+struct sfb_surface {
+    sfb_context *ctx;
+    sfb_surface_config config;
+    int base_vertex_count, base_uv_count;
+    float *base_positions, *base_uvs;
+    sfb__level top;              /* topology of the refined level */
+    sfb__level uv_top;           /* topology of the refined UV layout (when built) */
+    int has_uvs;
+    sfb__stencils tables[SFB_TABLE_COUNT_];
+    int built[SFB_TABLE_COUNT_];
+    int boundary, crease_method, triangle_rule, uv_interp;
+};
+
+typedef struct sfb__refine_options {
+    sfb_scheme scheme;
+    int boundary, crease_method, triangle_rule;
+    int want_limit;
+    int is_uv;           /* refining the UV layout */
+    int linear;          /* bilinear masks on the scheme's own face split (linear UVs) */
+} sfb__refine_options;
+
+/* Refines `base` (already sharpened) `level` times; fills `top` and the stencil tables
+ * (vertex, and limit/tangents when asked). */
+sfb_result sfb__refine(sfb_context *ctx, const sfb__level *base, const sfb__refine_options *opt, int level,
+                       sfb__level *top, sfb__stencils *vertex_table, sfb__stencils *limit_tables /* [3] or NULL */,
+                       float progress_from, float progress_to);
+void sfb__stencils_free(sfb_context *ctx, sfb__stencils *s);
+/* Copy of the base level with OpenSubdiv's boundary/non-manifold sharpening and holes applied. */
+sfb_result sfb__level_prepare(sfb_context *ctx, const sfb__level *src, int boundary, int sharpen_corners_option,
+                              int make_boundary_holes, sfb__level *dst);
+#line 1 "src/context.c"
+/* Results, context, allocator with memory budget, errors, logging, progress. */
+
+SFB_API const char *sfb_result_string(sfb_result r) {
+    switch (r) {
+#define SFB__RESULT_CASE(name, value, text) case name: return text;
+        SFB_RESULT_LIST(SFB__RESULT_CASE)
+#undef SFB__RESULT_CASE
+    default: return "unknown result";
+    }
+}
+
+static void *sfb__libc_alloc(size_t size, void *user) { (void)user; return malloc(size); }
+static void *sfb__libc_realloc(void *p, size_t size, void *user) { (void)user; return realloc(p, size); }
+static void sfb__libc_free(void *p, void *user) { (void)user; free(p); }
+
+SFB_API sfb_context_config sfb_context_config_init(void) {
+    sfb_context_config c;
+    memset(&c, 0, sizeof c);
+    return c;
+}
+
+int sfb__mul_size(size_t a, size_t b, size_t *out) {
+    if (a != 0 && b > ((size_t)-1) / a) return 0;
+    *out = a * b;
+    return 1;
+}
+
+/* Every block carries its size in a 16-byte header so that the live total can be kept
+ * against the memory budget exactly. */
+#define SFB__HDR 16
+void *sfb__alloc(sfb_context *ctx, size_t size) {
+    unsigned char *p;
+    if (size > ((size_t)-1) - SFB__HDR) return NULL;
+    if (ctx->live_bytes + size > ctx->budget || ctx->live_bytes + size < ctx->live_bytes) return NULL;
+    p = (unsigned char *)ctx->allocator.alloc(size + SFB__HDR, ctx->allocator.user);
+    if (!p) return NULL;
+    memcpy(p, &size, sizeof size);
+    ctx->live_bytes += size;
+    if (ctx->live_bytes > ctx->peak_bytes) ctx->peak_bytes = ctx->live_bytes;
+    return p + SFB__HDR;
+}
+void *sfb__calloc(sfb_context *ctx, size_t count, size_t size) {
+    size_t total;
+    void *p;
+    if (!sfb__mul_size(count, size, &total)) return NULL;
+    p = sfb__alloc(ctx, total ? total : 1);
+    if (p) memset(p, 0, total);
+    return p;
+}
+void *sfb__realloc(sfb_context *ctx, void *ptr, size_t size) {
+    unsigned char *p, *np;
+    size_t old;
+    if (!ptr) return sfb__alloc(ctx, size);
+    p = (unsigned char *)ptr - SFB__HDR;
+    memcpy(&old, p, sizeof old);
+    if (size > ((size_t)-1) - SFB__HDR) return NULL;
+    if (size > old && (ctx->live_bytes - old + size > ctx->budget)) return NULL;
+    np = (unsigned char *)ctx->allocator.realloc(p, size + SFB__HDR, ctx->allocator.user);
+    if (!np) return NULL;
+    memcpy(np, &size, sizeof size);
+    ctx->live_bytes = ctx->live_bytes - old + size;
+    if (ctx->live_bytes > ctx->peak_bytes) ctx->peak_bytes = ctx->live_bytes;
+    return np + SFB__HDR;
+}
+void sfb__free(sfb_context *ctx, void *ptr) {
+    unsigned char *p;
+    size_t old;
+    if (!ptr) return;
+    p = (unsigned char *)ptr - SFB__HDR;
+    memcpy(&old, p, sizeof old);
+    ctx->live_bytes -= old;
+    ctx->allocator.free(p, ctx->allocator.user);
+}
+
+static const char *sfb__element_name(sfb_element_kind k) {
+    switch (k) {
+    case SFB_ELEMENT_VERTEX: return "vertex";
+    case SFB_ELEMENT_EDGE: return "edge";
+    case SFB_ELEMENT_FACE: return "face";
+    case SFB_ELEMENT_LINE: return "line";
+    case SFB_ELEMENT_UV: return "uv";
+    default: return "";
+    }
+}
+
+sfb_result sfb__error(sfb_context *ctx, sfb_result r, sfb_element_kind kind, long index, const char *fmt, ...) {
+    va_list ap;
+    char body[768];
+    if (!ctx) return r;
+    va_start(ap, fmt);
+    vsnprintf(body, sizeof body, fmt, ap);
+    va_end(ap);
+    if (kind != SFB_ELEMENT_NONE && index >= 0)
+        snprintf(ctx->error, sizeof ctx->error, "%s %ld: %s", sfb__element_name(kind), index, body);
+    else
+        snprintf(ctx->error, sizeof ctx->error, "%s", body);
+    ctx->error_info.result = r;
+    ctx->error_info.element = kind;
+    ctx->error_info.index = index;
+    ctx->error_info.message = ctx->error;
+    if (ctx->logger.func) ctx->logger.func(SFB_LOG_ERROR, ctx->error, ctx->logger.user);
+    return r;
+}
+
+void sfb__log(sfb_context *ctx, int level, const char *fmt, ...) {
+    va_list ap;
+    char msg[768];
+    if (!ctx || !ctx->logger.func) return;
+    va_start(ap, fmt);
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    va_end(ap);
+    ctx->logger.func(level, msg, ctx->logger.user);
+}
+
+sfb_result sfb__progress(sfb_context *ctx, float done, const char *stage) {
+    if (ctx->progress.func && ctx->progress.func(done, stage, ctx->progress.user))
+        return sfb__error(ctx, SFB_CANCELLED, SFB_ELEMENT_NONE, -1, "cancelled by the progress callback during %s", stage);
+    return SFB_SUCCESS;
+}
+
+SFB_API sfb_result sfb_context_create(const sfb_context_config *config, sfb_context **out) {
+    sfb_context_config c = config ? *config : sfb_context_config_init();
+    sfb_allocator a = c.allocator;
+    sfb_context *ctx;
+    unsigned char *raw;
+    size_t sz = sizeof(sfb_context);
+    int i;
+    if (!out) return SFB_INVALID_ARGS;
+    *out = NULL;
+    if ((a.alloc == NULL) != (a.free == NULL) || (a.alloc && !a.realloc)) return SFB_INVALID_ARGS;
+    if (c.backend_count < 0 || c.backend_count > 16 || (c.backend_count > 0 && !c.backends)) return SFB_INVALID_ARGS;
+    if (!a.alloc) { a.alloc = sfb__libc_alloc; a.realloc = sfb__libc_realloc; a.free = sfb__libc_free; a.user = NULL; }
+    raw = (unsigned char *)a.alloc(sz, a.user);
+    if (!raw) return SFB_OUT_OF_MEMORY;
+    ctx = (sfb_context *)raw;
+    memset(ctx, 0, sizeof *ctx);
+    ctx->allocator = a;
+    ctx->logger = c.logger;
+    ctx->progress = c.progress;
+    ctx->budget = c.memory_budget ? c.memory_budget : SFB_DEFAULT_MEMORY_BUDGET;
+    ctx->threads = c.threads;
+    ctx->gl_use_current_context = c.gl_use_current_context;
+    if (c.backends && c.backend_count > 0) {
+        for (i = 0; i < c.backend_count; ++i) {
+            if (c.backends[i] <= SFB_BACKEND_DEFAULT || c.backends[i] >= SFB_BACKEND_KIND_COUNT_) {
+                a.free(raw, a.user);
+                return SFB_INVALID_ARGS;
+            }
+            ctx->order[ctx->order_count++] = c.backends[i];
+        }
+    } else {
+        /* The default order, written here only. */
+        ctx->order[ctx->order_count++] = SFB_BACKEND_SIMD;
+        ctx->order[ctx->order_count++] = SFB_BACKEND_REF;
+    }
+    ctx->error_info.index = -1;
+    ctx->error_info.message = ctx->error;
+    {
+        const char *env = c.ignore_environment ? NULL : getenv("SURFBLEND_BACKEND");
+        sfb_result r = sfb__select_backend(ctx, env);
+        if (r != SFB_SUCCESS) {
+            a.free(raw, a.user);
+            return r;
+        }
+    }
+    *out = ctx;
+    return SFB_SUCCESS;
+}
+
+SFB_API void sfb_context_destroy(sfb_context *ctx) {
+    sfb_allocator a;
+    if (!ctx) return;
+    if (ctx->backend && ctx->backend->shutdown) ctx->backend->shutdown(ctx, ctx->backend_state);
+    a = ctx->allocator;
+    a.free(ctx, a.user);
+}
+
+SFB_API const char *sfb_last_error(const sfb_context *ctx) { return ctx ? ctx->error : ""; }
+SFB_API sfb_error_info sfb_last_error_info(const sfb_context *ctx) {
+    sfb_error_info e;
+    if (ctx) return ctx->error_info;
+    memset(&e, 0, sizeof e);
+    e.index = -1;
+    e.message = "";
+    return e;
+}
+SFB_API void sfb_clear_error(sfb_context *ctx) {
+    if (!ctx) return;
+    ctx->error[0] = 0;
+    ctx->error_info.result = SFB_SUCCESS;
+    ctx->error_info.element = SFB_ELEMENT_NONE;
+    ctx->error_info.index = -1;
+}
+#line 1 "src/backend.c"
+/* Backend registry: ordered probing, first that initialises wins, every attempt reported. */
+
+static const char *const sfb__backend_names[SFB_BACKEND_KIND_COUNT_] = {"default", "ref", "simd", "gl", "osmesa"};
+
+SFB_API const char *sfb_backend_kind_name(sfb_backend_kind kind) {
+    if ((int)kind < 0 || kind >= SFB_BACKEND_KIND_COUNT_) return "unknown";
+    return sfb__backend_names[kind];
+}
+
+static int sfb__strieq(const char *a, const char *b) {
+    for (; *a && *b; ++a, ++b) {
+        int ca = (*a >= 'A' && *a <= 'Z') ? *a + 32 : *a;
+        int cb = (*b >= 'A' && *b <= 'Z') ? *b + 32 : *b;
+        if (ca != cb) return 0;
+    }
+    return *a == *b;
+}
+
+SFB_API sfb_backend_kind sfb_backend_kind_parse(const char *name) {
+    int i;
+    if (!name) return SFB_BACKEND_DEFAULT;
+    for (i = 1; i < SFB_BACKEND_KIND_COUNT_; ++i)
+        if (sfb__strieq(name, sfb__backend_names[i])) return (sfb_backend_kind)i;
+    return SFB_BACKEND_DEFAULT;
+}
+
+/* Optional backends live in backends/sfb_NAME.h; each defines a getter macro before this file is
+ * compiled when the user includes it. Those not compiled in report "not built in". */
+static const sfb__backend_vtable *sfb__backend_lookup(sfb_backend_kind kind) {
+    switch (kind) {
+    case SFB_BACKEND_REF: return sfb__backend_ref();
+#ifdef SFB_HAVE_SIMD_BACKEND
+    case SFB_BACKEND_SIMD: return sfb__backend_simd();
+#endif
+#ifdef SFB_HAVE_GL_BACKEND
+    case SFB_BACKEND_GL: return sfb__backend_gl();
+#endif
+#ifdef SFB_HAVE_OSMESA_BACKEND
+    case SFB_BACKEND_OSMESA: return sfb__backend_osmesa();
+#endif
+    default: return NULL;
+    }
+}
+
+static void sfb__report_add(sfb_context *ctx, const char *fmt, ...) {
+    size_t used = strlen(ctx->report);
+    va_list ap;
+    if (used + 1 >= sizeof ctx->report) return;
+    va_start(ap, fmt);
+    vsnprintf(ctx->report + used, sizeof ctx->report - used, fmt, ap);
+    va_end(ap);
+}
+
+static int sfb__try_backend(sfb_context *ctx, sfb_backend_kind kind) {
+    const sfb__backend_vtable *vt = sfb__backend_lookup(kind);
+    char why[512];
+    void *state = NULL;
+    sfb_result r;
+    if (!vt) {
+        sfb__report_add(ctx, "%s: unavailable (not built in: include backends/sfb_%s.h before the implementation)\n",
+                        sfb_backend_kind_name(kind), sfb_backend_kind_name(kind));
+        sfb__log(ctx, SFB_LOG_INFO, "backend %s not built in, trying the next", sfb_backend_kind_name(kind));
+        return 0;
+    }
+    why[0] = 0;
+    r = vt->init(ctx, &state, why, sizeof why);
+    if (r != SFB_SUCCESS) {
+        sfb__report_add(ctx, "%s: unavailable (%s: %s)\n", vt->name, sfb_result_string(r), why[0] ? why : "no reason given");
+        sfb__log(ctx, SFB_LOG_INFO, "backend %s failed to initialise (%s), trying the next", vt->name, why);
+        return 0;
+    }
+    ctx->backend = vt;
+    ctx->backend_state = state;
+    sfb__report_add(ctx, "%s: selected\n", vt->name);
+    return 1;
+}
+
+sfb_result sfb__select_backend(sfb_context *ctx, const char *env) {
+    int i;
+    ctx->report[0] = 0;
+    if (env && *env) {
+        sfb_backend_kind k = sfb_backend_kind_parse(env);
+        if (k == SFB_BACKEND_DEFAULT) {
+            sfb__report_add(ctx, "SURFBLEND_BACKEND=%.64s: unavailable (unknown backend name; known: ref, simd, gl, osmesa)\n", env);
+            sfb__log(ctx, SFB_LOG_WARN, "SURFBLEND_BACKEND=%.64s names no backend; using the default order", env);
+        } else if (sfb__try_backend(ctx, k)) {
+            return SFB_SUCCESS;
+        }
+    }
+    for (i = 0; i < ctx->order_count; ++i)
+        if (sfb__try_backend(ctx, ctx->order[i])) return SFB_SUCCESS;
+    return SFB_NO_BACKEND;
+}
+
+SFB_API const char *sfb_context_backend_name(const sfb_context *ctx) {
+    return (ctx && ctx->backend) ? ctx->backend->name : "none";
+}
+
+SFB_API sfb_result sfb_context_backend_report(const sfb_context *ctx, char *buf, size_t size) {
+    size_t n;
+    if (!ctx || !buf || size == 0) return SFB_INVALID_ARGS;
+    n = strlen(ctx->report);
+    if (n >= size) {
+        memcpy(buf, ctx->report, size - 1);
+        buf[size - 1] = 0;
+        return SFB_LIMIT_EXCEEDED;
+    }
+    memcpy(buf, ctx->report, n + 1);
+    return SFB_SUCCESS;
+}
+#line 1 "src/backend_ref.c"
+/* The `ref` backend: plain C, the numeric oracle. Float storage, double accumulation in
+ * table order (row by row, entries in stored order). */
+
+static sfb_result sfb__ref_init(sfb_context *ctx, void **state, char *why, size_t why_size) {
+    (void)ctx; (void)why; (void)why_size;
+    *state = NULL;
+    return SFB_SUCCESS;
+}
+
+static void sfb__ref_shutdown(sfb_context *ctx, void *state) { (void)ctx; (void)state; }
+
+static sfb_result sfb__ref_eval_stencils(void *state, const sfb__stencils *t, int first, int last,
+                                         const float *src, sfb_buffer_desc sd, float *dst, sfb_buffer_desc dd) {
+    int r, c, k;
+    double acc[16];
+    (void)state;
+    if (sd.length != dd.length || sd.length <= 0 || sd.length > 16) return SFB_INVALID_ARGS;
+    for (r = first; r < last; ++r) {
+        const int *idx = t->indices + t->offsets[r];
+        const float *w = t->weights + t->offsets[r];
+        int n = t->sizes[r];
+        float *out = dst + dd.offset + (size_t)r * dd.stride;
+        for (c = 0; c < sd.length; ++c) acc[c] = 0.0;
+        for (k = 0; k < n; ++k) {
+            const float *in = src + sd.offset + (size_t)idx[k] * sd.stride;
+            double wk = w[k];
+            for (c = 0; c < sd.length; ++c) acc[c] += wk * in[c];
+        }
+        for (c = 0; c < sd.length; ++c) out[c] = (float)acc[c];
+    }
+    return SFB_SUCCESS;
+}
+
+static const sfb__backend_vtable sfb__ref_vtable = {
+    "ref", SFB_BACKEND_REF, SFB__CAP_EVAL_STENCILS,
+    sfb__ref_init, sfb__ref_shutdown, sfb__ref_eval_stencils
+};
+
+const sfb__backend_vtable *sfb__backend_ref(void) { return &sfb__ref_vtable; }
+#line 1 "src/topology.c"
+/* Topology of one level: adjacency, counter-clockwise ordering around manifold vertices,
+ * boundary and non-manifold tags, vertex rules. */
+
+void sfb__level_free(sfb_context *ctx, sfb__level *l) {
+    sfb__free(ctx, l->fv_off); sfb__free(ctx, l->fv); sfb__free(ctx, l->fe); sfb__free(ctx, l->ev);
+    sfb__free(ctx, l->ef_off); sfb__free(ctx, l->ef); sfb__free(ctx, l->ef_slot);
+    sfb__free(ctx, l->vf_off); sfb__free(ctx, l->vf); sfb__free(ctx, l->vf_slot);
+    sfb__free(ctx, l->ve_off); sfb__free(ctx, l->ve);
+    sfb__free(ctx, l->es); sfb__free(ctx, l->vs);
+    sfb__free(ctx, l->etag); sfb__free(ctx, l->vtag); sfb__free(ctx, l->vrule); sfb__free(ctx, l->fhole);
+    memset(l, 0, sizeof *l);
+}
+
+/* OpenSubdiv's vertex rule: any vertex sharpness makes a corner; else by sharp edge count. */
+int sfb__rule_from(float vertex_sharpness, int sharp_edge_count) {
+    if (vertex_sharpness > 0.0f) return SFB__RULE_CORNER;
+    if (sharp_edge_count > 2) return SFB__RULE_CORNER;
+    return 1 << sharp_edge_count;
+}
+
+void sfb__level_compute_rules(sfb__level *l) {
+    int v, i;
+    for (v = 0; v < l->nv; ++v) {
+        int sharp = 0;
+        for (i = l->ve_off[v]; i < l->ve_off[v + 1]; ++i) sharp += l->es[l->ve[i]] > 0.0f;
+        l->vrule[v] = (unsigned char)sfb__rule_from(l->vs[v], sharp);
+    }
+}
+
+/* Walk the faces around a manifold candidate; returns 1 and reorders vf/vf_slot/ve when the
+ * faces form one fan (or one cycle). */
+static int sfb__order_vertex(sfb__level *l, int v, int *tf, int *ts, int *te) {
+    int f0 = l->vf_off[v], k = l->vf_off[v + 1] - f0;
+    int e0 = l->ve_off[v], m = l->ve_off[v + 1] - e0;
+    int i, start = -1, boundary = (m == k + 1);
+    int f, slot, count = 0;
+    if (k == 0) return 0;
+    if (boundary) {
+        /* start at the face whose outgoing edge (v -> next) is a boundary edge */
+        for (i = 0; i < k; ++i) {
+            int ff = l->vf[f0 + i], s = l->vf_slot[f0 + i];
+            int eo = l->fe[l->fv_off[ff] + s];
+            if (l->ef_off[eo + 1] - l->ef_off[eo] == 1) { start = i; break; }
+        }
+        if (start < 0) return 0;
+    } else {
+        start = 0;
+    }
+    f = l->vf[f0 + start];
+    slot = l->vf_slot[f0 + start];
+    for (;;) {
+        int n = l->fv_off[f + 1] - l->fv_off[f];
+        int eo = l->fe[l->fv_off[f] + slot];
+        int ei = l->fe[l->fv_off[f] + (slot + n - 1) % n];
+        int nf, a, b, g, gs = -1;
+        if (count >= k) return 0;
+        tf[count] = f; ts[count] = slot; te[count] = eo;
+        ++count;
+        a = l->ef_off[ei]; b = l->ef_off[ei + 1];
+        if (b - a == 1) {
+            if (!boundary) return 0;
+            te[count] = ei;
+            break;
+        }
+        g = l->ef[a] == f ? l->ef[a + 1] : l->ef[a];
+        if (g == f) return 0;
+        /* the slot of v in g */
+        {
+            int q, gn = l->fv_off[g + 1] - l->fv_off[g];
+            for (q = 0; q < gn; ++q)
+                if (l->fv[l->fv_off[g] + q] == v) { gs = q; break; }
+        }
+        if (gs < 0) return 0;
+        nf = g;
+        if (!boundary && nf == l->vf[f0 + start]) break;
+        f = nf;
+        slot = gs;
+    }
+    if (count != k) return 0;
+    if ((boundary ? count + 1 : count) != m) return 0;
+    /* every edge must be distinct */
+    for (i = 0; i < m; ++i) {
+        int j;
+        for (j = i + 1; j < m && j < i + 64; ++j)
+            if (te[i] == te[j]) return 0;
+    }
+    memcpy(l->vf + f0, tf, (size_t)k * sizeof(int));
+    memcpy(l->vf_slot + f0, ts, (size_t)k * sizeof(int));
+    memcpy(l->ve + e0, te, (size_t)m * sizeof(int));
+    return 1;
+}
+
+sfb_result sfb__level_complete(sfb_context *ctx, sfb__level *l) {
+    int v, f, e, i, maxval = 0;
+    int *fill = NULL, *tf = NULL, *ts = NULL, *te = NULL;
+    l->nfv = l->fv_off[l->nf];
+    l->ef_off = (int *)sfb__calloc(ctx, (size_t)l->ne + 1, sizeof(int));
+    l->ef = (int *)sfb__alloc(ctx, ((size_t)l->nfv + 1) * sizeof(int));
+    l->ef_slot = (int *)sfb__alloc(ctx, ((size_t)l->nfv + 1) * sizeof(int));
+    l->vf_off = (int *)sfb__calloc(ctx, (size_t)l->nv + 1, sizeof(int));
+    l->vf = (int *)sfb__alloc(ctx, ((size_t)l->nfv + 1) * sizeof(int));
+    l->vf_slot = (int *)sfb__alloc(ctx, ((size_t)l->nfv + 1) * sizeof(int));
+    l->ve_off = (int *)sfb__calloc(ctx, (size_t)l->nv + 1, sizeof(int));
+    l->ve = (int *)sfb__alloc(ctx, ((size_t)l->ne * 2 + 1) * sizeof(int));
+    l->etag = (unsigned char *)sfb__calloc(ctx, (size_t)l->ne + 1, 1);
+    l->vtag = (unsigned char *)sfb__calloc(ctx, (size_t)l->nv + 1, 1);
+    l->vrule = (unsigned char *)sfb__calloc(ctx, (size_t)l->nv + 1, 1);
+    if (!l->fhole) l->fhole = (unsigned char *)sfb__calloc(ctx, (size_t)l->nf + 1, 1);
+    fill = (int *)sfb__calloc(ctx, (size_t)(l->nv > l->ne ? l->nv : l->ne) + 1, sizeof(int));
+    if (!l->ef_off || !l->ef || !l->ef_slot || !l->vf_off || !l->vf || !l->vf_slot || !l->ve_off || !l->ve ||
+        !l->etag || !l->vtag || !l->vrule || !l->fhole || !fill)
+        goto oom;
+    /* edge -> faces */
+    for (i = 0; i < l->nfv; ++i) l->ef_off[l->fe[i] + 1]++;
+    for (e = 0; e < l->ne; ++e) l->ef_off[e + 1] += l->ef_off[e];
+    for (f = 0; f < l->nf; ++f)
+        for (i = l->fv_off[f]; i < l->fv_off[f + 1]; ++i) {
+            int ed = l->fe[i], at = l->ef_off[ed] + fill[ed]++;
+            l->ef[at] = f;
+            l->ef_slot[at] = i - l->fv_off[f];
+        }
+    /* vertex -> faces (face order) */
+    for (i = 0; i < l->nfv; ++i) l->vf_off[l->fv[i] + 1]++;
+    for (v = 0; v < l->nv; ++v) l->vf_off[v + 1] += l->vf_off[v];
+    memset(fill, 0, sizeof(int) * (size_t)l->nv);
+    for (f = 0; f < l->nf; ++f)
+        for (i = l->fv_off[f]; i < l->fv_off[f + 1]; ++i) {
+            int vv = l->fv[i], at = l->vf_off[vv] + fill[vv]++;
+            l->vf[at] = f;
+            l->vf_slot[at] = i - l->fv_off[f];
+        }
+    /* vertex -> edges (edge order) */
+    for (e = 0; e < l->ne; ++e) { l->ve_off[l->ev[2 * e] + 1]++; l->ve_off[l->ev[2 * e + 1] + 1]++; }
+    for (v = 0; v < l->nv; ++v) l->ve_off[v + 1] += l->ve_off[v];
+    memset(fill, 0, sizeof(int) * (size_t)l->nv);
+    for (e = 0; e < l->ne; ++e) {
+        int a = l->ev[2 * e], b = l->ev[2 * e + 1];
+        l->ve[l->ve_off[a] + fill[a]++] = e;
+        l->ve[l->ve_off[b] + fill[b]++] = e;
+    }
+    /* edge tags: boundary (one face), non-manifold (more than two faces, two faces running the
+     * same direction, or no face at all) */
+    for (e = 0; e < l->ne; ++e) {
+        int a = l->ef_off[e], n = l->ef_off[e + 1] - a;
+        if (n == 1) l->etag[e] |= SFB__TAG_BOUNDARY;
+        /* a degenerate edge (both ends the same vertex, from a face that repeats a vertex) is
+         * non-manifold, as OpenSubdiv treats it */
+        if (n == 0 || n > 2 || l->ev[2 * e] == l->ev[2 * e + 1]) l->etag[e] |= SFB__TAG_NONMANIFOLD;
+        if (n == 2) {
+            int f1 = l->ef[a], s1 = l->ef_slot[a], f2 = l->ef[a + 1], s2 = l->ef_slot[a + 1];
+            if (l->fv[l->fv_off[f1] + s1] == l->fv[l->fv_off[f2] + s2]) l->etag[e] |= SFB__TAG_NONMANIFOLD;
+        }
+    }
+    for (v = 0; v < l->nv; ++v) {
+        int d = l->ve_off[v + 1] - l->ve_off[v];
+        if (d > maxval) maxval = d;
+    }
+    tf = (int *)sfb__alloc(ctx, ((size_t)maxval + 2) * sizeof(int));
+    ts = (int *)sfb__alloc(ctx, ((size_t)maxval + 2) * sizeof(int));
+    te = (int *)sfb__alloc(ctx, ((size_t)maxval + 2) * sizeof(int));
+    if (!tf || !ts || !te) goto oom;
+    for (v = 0; v < l->nv; ++v) {
+        int k = l->vf_off[v + 1] - l->vf_off[v], m = l->ve_off[v + 1] - l->ve_off[v];
+        int nm = 0, bnd = 0;
+        for (i = l->ve_off[v]; i < l->ve_off[v + 1]; ++i) {
+            if (l->etag[l->ve[i]] & SFB__TAG_NONMANIFOLD) nm = 1;
+            if (l->etag[l->ve[i]] & SFB__TAG_BOUNDARY) bnd++;
+        }
+        if (bnd) l->vtag[v] |= SFB__TAG_BOUNDARY;
+        if (nm || k == 0 || !((m == k && bnd == 0) || (m == k + 1 && bnd == 2)) || !sfb__order_vertex(l, v, tf, ts, te))
+            l->vtag[v] |= SFB__TAG_NONMANIFOLD;
+    }
+    sfb__free(ctx, fill); sfb__free(ctx, tf); sfb__free(ctx, ts); sfb__free(ctx, te);
+    return SFB_SUCCESS;
+oom:
+    sfb__free(ctx, fill); sfb__free(ctx, tf); sfb__free(ctx, ts); sfb__free(ctx, te);
+    return sfb__error(ctx, SFB_OUT_OF_MEMORY, SFB_ELEMENT_NONE, -1,
+                      "out of memory or over the memory budget building topology (%d faces)", l->nf);
+}
+
+static void *sfb__dup(sfb_context *ctx, const void *p, size_t bytes) {
+    void *q = sfb__alloc(ctx, bytes ? bytes : 1);
+    if (q && bytes) memcpy(q, p, bytes);
+    return q;
+}
+
+/* Applies OpenSubdiv's preparation of the base level: faces at uninterpolated boundaries
+ * become holes (boundary NONE), boundary and non-manifold edges become infinitely sharp,
+ * topological corners (EDGE_AND_CORNER) and non-manifold vertices infinitely sharp, except
+ * a vertex on a non-manifold crease (two non-manifold edges, no boundary, more faces than
+ * edges), which keeps its own sharpness. */
+sfb_result sfb__level_prepare(sfb_context *ctx, const sfb__level *s, int boundary, int sharpen_corners,
+                              int make_boundary_holes, sfb__level *d) {
+    int v, e, i;
+    memset(d, 0, sizeof *d);
+    d->nv = s->nv; d->nf = s->nf; d->ne = s->ne; d->nfv = s->nfv;
+    (void)boundary;
+#define SFB__DUP(field, count, type) d->field = (type *)sfb__dup(ctx, s->field, (size_t)(count) * sizeof(type))
+    SFB__DUP(fv_off, s->nf + 1, int); SFB__DUP(fv, s->nfv, int); SFB__DUP(fe, s->nfv, int);
+    SFB__DUP(ev, 2 * s->ne, int); SFB__DUP(ef_off, s->ne + 1, int); SFB__DUP(ef, s->nfv, int);
+    SFB__DUP(ef_slot, s->nfv, int); SFB__DUP(vf_off, s->nv + 1, int); SFB__DUP(vf, s->nfv, int);
+    SFB__DUP(vf_slot, s->nfv, int); SFB__DUP(ve_off, s->nv + 1, int); SFB__DUP(ve, 2 * s->ne, int);
+    SFB__DUP(es, s->ne, float); SFB__DUP(vs, s->nv, float); SFB__DUP(etag, s->ne, unsigned char);
+    SFB__DUP(vtag, s->nv, unsigned char); SFB__DUP(vrule, s->nv, unsigned char); SFB__DUP(fhole, s->nf, unsigned char);
+#undef SFB__DUP
+    if (!d->fv_off || !d->fv || !d->fe || !d->ev || !d->ef_off || !d->ef || !d->ef_slot || !d->vf_off || !d->vf ||
+        !d->vf_slot || !d->ve_off || !d->ve || !d->es || !d->vs || !d->etag || !d->vtag || !d->vrule || !d->fhole) {
+        sfb__level_free(ctx, d);
+        return sfb__error(ctx, SFB_OUT_OF_MEMORY, SFB_ELEMENT_NONE, -1, "out of memory or over the memory budget");
+    }
+    if (make_boundary_holes) {
+        for (v = 0; v < d->nv; ++v) {
+            int k = d->vf_off[v + 1] - d->vf_off[v], m = d->ve_off[v + 1] - d->ve_off[v], exclude = 0;
+            if (k == m && !(d->vtag[v] & SFB__TAG_NONMANIFOLD)) continue;
+            for (i = d->ve_off[v]; i < d->ve_off[v + 1] && !exclude; ++i) {
+                int ed = d->ve[i];
+                exclude = (d->ef_off[ed + 1] - d->ef_off[ed] == 1) && d->es[ed] < SFB_SHARPNESS_INFINITE;
+            }
+            if (exclude)
+                for (i = d->vf_off[v]; i < d->vf_off[v + 1]; ++i) d->fhole[d->vf[i]] = 1;
+        }
+    }
+    for (e = 0; e < d->ne; ++e) {
+        if (d->etag[e] & (SFB__TAG_BOUNDARY | SFB__TAG_NONMANIFOLD)) d->es[e] = SFB_SHARPNESS_INFINITE;
+        if (d->es[e] > SFB_SHARPNESS_INFINITE) d->es[e] = SFB_SHARPNESS_INFINITE;
+    }
+    for (v = 0; v < d->nv; ++v) {
+        int k = d->vf_off[v + 1] - d->vf_off[v], m = d->ve_off[v + 1] - d->ve_off[v];
+        int nm_edges = 0, bnd_edges = 0;
+        for (i = d->ve_off[v]; i < d->ve_off[v + 1]; ++i) {
+            nm_edges += (d->etag[d->ve[i]] & SFB__TAG_NONMANIFOLD) != 0;
+            bnd_edges += (d->etag[d->ve[i]] & SFB__TAG_BOUNDARY) != 0;
+        }
+        if (k == 1 && m == 2 && sharpen_corners) {
+            d->vs[v] = SFB_SHARPNESS_INFINITE;
+        } else if (d->vtag[v] & SFB__TAG_NONMANIFOLD) {
+            if (!(nm_edges == 2 && bnd_edges == 0 && k > m)) d->vs[v] = SFB_SHARPNESS_INFINITE;
+        }
+        if (d->vs[v] > SFB_SHARPNESS_INFINITE) d->vs[v] = SFB_SHARPNESS_INFINITE;
+    }
+    sfb__level_compute_rules(d);
+    return SFB_SUCCESS;
+}
+#line 1 "src/refine.c"
+/* Uniform refinement: Catmull-Clark, Loop and bilinear with semi-sharp creases (DeRose et al.,
+ * with OpenSubdiv 3.5's rules: fractional edge/vertex blending, uniform or Chaikin sharpness
+ * decay, TRI_SUB_SMOOTH), compiled into stencil tables from the base vertices straight to the
+ * last level, plus limit position and limit tangent tables at the last level's vertices.
+ *
+ * Child vertex order: children of vertices (same order), then of faces (Catmull-Clark and
+ * bilinear only), then of edges. Child faces: for Catmull-Clark/bilinear face (v0..vn-1), the
+ * quads (Vi, Ei, F, Ei-1) for i = 0..n-1; for Loop triangle (v0,v1,v2) the corners
+ * (Vi, Ei, Ei-1) and then the middle (E0, E1, E2). Child edges: the two halves of each parent
+ * edge (the half at its first vertex first), then the edges inside each face. */
+
+/* ---- sharpness arithmetic, in float exactly as OpenSubdiv's Sdc::Crease ---- */
+static float sfb__decrement(float s) {
+    if (s <= 0.0f) return 0.0f;
+    if (s >= SFB_SHARPNESS_INFINITE) return SFB_SHARPNESS_INFINITE;
+    if (s > 1.0f) return s - 1.0f;
+    return 0.0f;
+}
+
+static float sfb__sub_edge_at_vertex(float s, int chaikin, int vertex_edges, float semi_sum, int semi_count) {
+    if (!chaikin || vertex_edges < 2) return sfb__decrement(s);
+    if (s <= 0.0f) return 0.0f;
+    if (s >= SFB_SHARPNESS_INFINITE) return SFB_SHARPNESS_INFINITE;
+    if (semi_count > 1) {
+        float avg = (semi_sum - s) / (float)(semi_count - 1);
+        s = (0.75f * s) + (0.25f * avg);
+    }
+    s -= 1.0f;
+    return s > 0.0f ? s : 0.0f;
+}
+
+/* ---- composed rows (double weights) ---- */
+typedef struct sfb__rows {
+    int rows;
+    size_t *off;   /* rows + 1 */
+    int *idx;
+    double *w;
+    size_t n, cap;
+} sfb__rows;
+
+static void sfb__rows_free(sfb_context *ctx, sfb__rows *r) {
+    sfb__free(ctx, r->off); sfb__free(ctx, r->idx); sfb__free(ctx, r->w);
+    memset(r, 0, sizeof *r);
+}
+
+static int sfb__rows_reserve(sfb_context *ctx, sfb__rows *r, size_t need) {
+    size_t cap;
+    int *ni;
+    double *nw;
+    if (need <= r->cap) return 1;
+    cap = r->cap ? r->cap : 1024;
+    while (cap < need) {
+        if (cap > ((size_t)-1) / 4) return 0;
+        cap = cap + cap / 2 + 16;
+    }
+    ni = (int *)sfb__realloc(ctx, r->idx, cap * sizeof(int));
+    if (!ni) return 0;
+    r->idx = ni;
+    nw = (double *)sfb__realloc(ctx, r->w, cap * sizeof(double));
+    if (!nw) return 0;
+    r->w = nw;
+    r->cap = cap;
+    return 1;
+}
+
+/* ---- local masks: (parent vertex, weight) pairs, duplicates allowed ---- */
+typedef struct sfb__mask {
+    int *idx;
+    double *w;
+    int n, cap;
+} sfb__mask;
+
+static int sfb__mask_grow(sfb_context *ctx, sfb__mask *m, int need) {
+    int cap;
+    int *ni;
+    double *nw;
+    if (m->n + need <= m->cap) return 1;
+    cap = (m->cap ? m->cap * 2 : 64);
+    while (cap < m->n + need) cap *= 2;
+    ni = (int *)sfb__realloc(ctx, m->idx, (size_t)cap * sizeof(int));
+    if (!ni) return 0;
+    m->idx = ni;
+    nw = (double *)sfb__realloc(ctx, m->w, (size_t)cap * sizeof(double));
+    if (!nw) return 0;
+    m->w = nw;
+    m->cap = cap;
+    return 1;
+}
+
+#define SFB__MASK_ADD(m, i, wt) do { (m)->idx[(m)->n] = (i); (m)->w[(m)->n] = (wt); (m)->n++; } while (0)
+
+static int sfb__other_end(const sfb__level *l, int e, int v) {
+    return l->ev[2 * e] == v ? l->ev[2 * e + 1] : l->ev[2 * e];
+}
+
+/* Adds w * (face centroid of f). */
+static void sfb__mask_face(sfb__mask *m, const sfb__level *l, int f, double w) {
+    int i, n = l->fv_off[f + 1] - l->fv_off[f];
+    for (i = 0; i < n; ++i) SFB__MASK_ADD(m, l->fv[l->fv_off[f] + i], w / n);
+}
+
+static int sfb__mask_need_vertex(const sfb__level *l, int v) {
+    int need = 1 + 2 * (l->ve_off[v + 1] - l->ve_off[v]), i;
+    for (i = l->vf_off[v]; i < l->vf_off[v + 1]; ++i) need += l->fv_off[l->vf[i] + 1] - l->fv_off[l->vf[i]];
+    return need;
+}
+
+/* The crease pair of a vertex: first and last incident edge with sharpness > 0 in the
+ * vertex's edge order (OpenSubdiv's GetSharpEdgePairOfCrease). `sharp` is per incident edge. */
+static void sfb__crease_pair(const float *sharp, int n, int *a, int *b) {
+    int i = 0, j = n - 1;
+    while (i < n - 1 && sharp[i] <= 0.0f) ++i;
+    while (j > 0 && sharp[j] <= 0.0f) --j;
+    *a = i;
+    *b = j;
+}
+
+/* Adds w * (vertex-vertex mask of `rule`) for vertex v; `sharp` holds the sharpness of v's
+ * incident edges in ve order (parent or child values, as the rule requires). */
+static void sfb__mask_vertex_rule(sfb__mask *m, const sfb__level *l, int v, int rule, const float *sharp,
+                                  sfb_scheme scheme, double w) {
+    int e0 = l->ve_off[v], ne = l->ve_off[v + 1] - e0;
+    int f0 = l->vf_off[v], nf = l->vf_off[v + 1] - f0;
+    int i;
+    if (w == 0.0) return;
+    if (rule == SFB__RULE_CORNER) {
+        SFB__MASK_ADD(m, v, w);
+        return;
+    }
+    if (rule == SFB__RULE_CREASE) {
+        int a, b;
+        sfb__crease_pair(sharp, ne, &a, &b);
+        SFB__MASK_ADD(m, v, 0.75 * w);
+        SFB__MASK_ADD(m, sfb__other_end(l, l->ve[e0 + a], v), 0.125 * w);
+        SFB__MASK_ADD(m, sfb__other_end(l, l->ve[e0 + b], v), 0.125 * w);
+        return;
+    }
+    /* smooth or dart: needs a manifold interior neighbourhood (guaranteed by sharpening:
+     * boundary and non-manifold features are never smooth); guard anyway */
+    if (nf != ne || nf == 0 || (l->vtag[v] & SFB__TAG_NONMANIFOLD)) {
+        SFB__MASK_ADD(m, v, w);
+        return;
+    }
+    if (scheme == SFB_SCHEME_LOOP) {
+        double ew, vw;
+        if (nf == 6) {
+            ew = 0.0625;
+            vw = 0.625;
+        } else {
+            double beta = 0.25 * cos(2.0 * SFB__PI / nf) + 0.375;
+            ew = (0.625 - beta * beta) / nf;
+            vw = 1.0 - ew * nf;
+        }
+        SFB__MASK_ADD(m, v, vw * w);
+        for (i = 0; i < ne; ++i) SFB__MASK_ADD(m, sfb__other_end(l, l->ve[e0 + i], v), ew * w);
+    } else {
+        double n = nf, fw = 1.0 / (n * n);
+        SFB__MASK_ADD(m, v, (n - 2.0) / n * w);
+        for (i = 0; i < ne; ++i) SFB__MASK_ADD(m, sfb__other_end(l, l->ve[e0 + i], v), fw * w);
+        for (i = 0; i < nf; ++i) sfb__mask_face(m, l, l->vf[f0 + i], fw * w);
+    }
+}
+
+/* OpenSubdiv's Crease::ComputeFractionalWeightAtVertex. */
+static float sfb__fractional_weight(float pvs, float cvs, int n, const float *ps, const float *cs, int chaikin) {
+    int count = 0, i;
+    float sum = 0.0f, fw;
+    if (pvs > 0.0f && cvs <= 0.0f) { count = 1; sum = pvs; }
+    for (i = 0; i < n; ++i) {
+        int transition = chaikin ? (ps[i] > 0.0f && cs[i] <= 0.0f) : (ps[i] > 0.0f && ps[i] <= 1.0f);
+        if (transition) { sum += ps[i]; count++; }
+    }
+    if (!count) return 0.0f;
+    fw = sum / (float)count;
+    return fw > 1.0f ? 1.0f : fw;
+}
+
+/* ---- one refinement step ---- */
+typedef struct sfb__step {
+    sfb_context *ctx;
+    const sfb__refine_options *opt;
+    const sfb__level *p;
+    sfb__level *c;
+    float *half;           /* child sharpness of each parent edge half: [2e + side] */
+} sfb__step;
+
+static int sfb__half_at(const sfb__level *p, int e, int v) { return p->ev[2 * e] == v ? 0 : 1; }
+
+static sfb_result sfb__build_child_topology(sfb__step *st) {
+    sfb_context *ctx = st->ctx;
+    const sfb__level *p = st->p;
+    sfb__level *c = st->c;
+    int loop = st->opt->scheme == SFB_SCHEME_LOOP;
+    int nvF = loop ? 0 : p->nf;               /* face-children count */
+    int vE = p->nv + nvF;                     /* first edge-child */
+    int f, i, e, v;
+    size_t nf64, nfv64, ne64, nv64;
+    int chaikin = st->opt->crease_method == SFB_CREASE_CHAIKIN;
+    float *semi_sum = NULL;
+    int *semi_cnt = NULL;
+
+    nv64 = (size_t)p->nv + (size_t)nvF + (size_t)p->ne;
+    if (loop) { nf64 = (size_t)p->nf * 4; nfv64 = nf64 * 3; ne64 = (size_t)p->ne * 2 + (size_t)p->nf * 3; }
+    else { nf64 = (size_t)p->nfv; nfv64 = nf64 * 4; ne64 = (size_t)p->ne * 2 + (size_t)p->nfv; }
+    if (nv64 > SFB_MAX_ELEMENTS || nfv64 > SFB_MAX_ELEMENTS || ne64 > SFB_MAX_ELEMENTS)
+        return sfb__error(ctx, SFB_LIMIT_EXCEEDED, SFB_ELEMENT_NONE, -1,
+                          "refined mesh would have %zu face-vertices, over the limit of %d", nfv64, SFB_MAX_ELEMENTS);
+    memset(c, 0, sizeof *c);
+    c->nv = (int)nv64; c->nf = (int)nf64; c->ne = (int)ne64; c->nfv = (int)nfv64;
+    c->fv_off = (int *)sfb__alloc(ctx, (nf64 + 1) * sizeof(int));
+    c->fv = (int *)sfb__alloc(ctx, (nfv64 + 1) * sizeof(int));
+    c->fe = (int *)sfb__alloc(ctx, (nfv64 + 1) * sizeof(int));
+    c->ev = (int *)sfb__alloc(ctx, (ne64 * 2 + 1) * sizeof(int));
+    c->es = (float *)sfb__calloc(ctx, ne64 + 1, sizeof(float));
+    c->vs = (float *)sfb__calloc(ctx, nv64 + 1, sizeof(float));
+    c->fhole = (unsigned char *)sfb__calloc(ctx, nf64 + 1, 1);
+    st->half = (float *)sfb__alloc(ctx, ((size_t)p->ne * 2 + 1) * sizeof(float));
+    semi_sum = (float *)sfb__calloc(ctx, (size_t)p->nv + 1, sizeof(float));
+    semi_cnt = (int *)sfb__calloc(ctx, (size_t)p->nv + 1, sizeof(int));
+    if (!c->fv_off || !c->fv || !c->fe || !c->ev || !c->es || !c->vs || !c->fhole || !st->half || !semi_sum || !semi_cnt) {
+        sfb__free(ctx, semi_sum); sfb__free(ctx, semi_cnt);
+        return SFB_OUT_OF_MEMORY;
+    }
+    /* edge sharpness of the two halves of each parent edge */
+    if (chaikin) {
+        for (v = 0; v < p->nv; ++v)
+            for (i = p->ve_off[v]; i < p->ve_off[v + 1]; ++i) {
+                float s = p->es[p->ve[i]];
+                if (s > 0.0f && s < SFB_SHARPNESS_INFINITE) { semi_sum[v] += s; semi_cnt[v]++; }
+            }
+    }
+    for (e = 0; e < p->ne; ++e) {
+        int side;
+        for (side = 0; side < 2; ++side) {
+            int pv = p->ev[2 * e + side];
+            st->half[2 * e + side] = sfb__sub_edge_at_vertex(p->es[e], chaikin, p->ve_off[pv + 1] - p->ve_off[pv],
+                                                             semi_sum[pv], semi_cnt[pv]);
+        }
+        c->ev[4 * e + 0] = p->ev[2 * e];
+        c->ev[4 * e + 1] = vE + e;
+        c->ev[4 * e + 2] = vE + e;
+        c->ev[4 * e + 3] = p->ev[2 * e + 1];
+        c->es[2 * e] = st->half[2 * e];
+        c->es[2 * e + 1] = st->half[2 * e + 1];
+    }
+    sfb__free(ctx, semi_sum);
+    sfb__free(ctx, semi_cnt);
+    for (v = 0; v < p->nv; ++v) c->vs[v] = sfb__decrement(p->vs[v]);
+    /* faces and interior edges */
+    if (loop) {
+        for (f = 0; f < p->nf; ++f) {
+            int o = p->fv_off[f], ie = 2 * p->ne + 3 * f;
+            for (i = 0; i < 3; ++i) {
+                int cf = 4 * f + i, ip = (i + 2) % 3;
+                int vi = p->fv[o + i], ei = p->fe[o + i], ep = p->fe[o + ip];
+                c->fv_off[cf] = 3 * cf;
+                c->fv[3 * cf + 0] = vi;
+                c->fv[3 * cf + 1] = vE + ei;
+                c->fv[3 * cf + 2] = vE + ep;
+                c->fe[3 * cf + 0] = 2 * ei + sfb__half_at(p, ei, vi);
+                c->fe[3 * cf + 1] = ie + i;
+                c->fe[3 * cf + 2] = 2 * ep + sfb__half_at(p, ep, vi);
+                c->ev[2 * (ie + i)] = vE + ei;
+                c->ev[2 * (ie + i) + 1] = vE + ep;
+                c->fhole[cf] = p->fhole[f];
+            }
+            {
+                int cf = 4 * f + 3;
+                c->fv_off[cf] = 3 * cf;
+                for (i = 0; i < 3; ++i) {
+                    c->fv[3 * cf + i] = vE + p->fe[o + i];
+                    c->fe[3 * cf + i] = ie + (i + 1) % 3;
+                }
+                c->fhole[cf] = p->fhole[f];
+            }
+        }
+        c->fv_off[c->nf] = c->nfv;
+    } else {
+        for (f = 0; f < p->nf; ++f) {
+            int o = p->fv_off[f], n = p->fv_off[f + 1] - o, ie = 2 * p->ne + o;
+            for (i = 0; i < n; ++i) {
+                int cf = o + i, ip = (i + n - 1) % n;
+                int vi = p->fv[o + i], ei = p->fe[o + i], ep = p->fe[o + ip];
+                c->fv_off[cf] = 4 * cf;
+                c->fv[4 * cf + 0] = vi;
+                c->fv[4 * cf + 1] = vE + ei;
+                c->fv[4 * cf + 2] = p->nv + f;
+                c->fv[4 * cf + 3] = vE + ep;
+                c->fe[4 * cf + 0] = 2 * ei + sfb__half_at(p, ei, vi);
+                c->fe[4 * cf + 1] = ie + i;
+                c->fe[4 * cf + 2] = ie + ip;
+                c->fe[4 * cf + 3] = 2 * ep + sfb__half_at(p, ep, vi);
+                c->ev[2 * (ie + i)] = vE + ei;
+                c->ev[2 * (ie + i) + 1] = p->nv + f;
+                c->fhole[cf] = p->fhole[f];
+            }
+        }
+        c->fv_off[c->nf] = c->nfv;
+    }
+    {
+        sfb_result r = sfb__level_complete(ctx, c);
+        if (r != SFB_SUCCESS) return r;
+    }
+    sfb__level_compute_rules(c);
+    return SFB_SUCCESS;
+}
+
+/* Local mask of child vertex `cv` in terms of parent vertices. */
+static int sfb__child_mask(sfb__step *st, int cv, sfb__mask *m, float *ps, float *cs) {
+    sfb_context *ctx = st->ctx;
+    const sfb__level *p = st->p;
+    const sfb__level *c = st->c;
+    sfb_scheme scheme = st->opt->scheme;
+    int loop = scheme == SFB_SCHEME_LOOP;
+    int linear = scheme == SFB_SCHEME_BILINEAR || st->opt->linear;
+    int nvF = loop ? 0 : p->nf;
+    int i;
+    m->n = 0;
+    if (cv < p->nv) {
+        /* vertex child */
+        int v = cv, prule = p->vrule[v], crule = c->vrule[cv];
+        int e0 = p->ve_off[v], ne = p->ve_off[v + 1] - e0;
+        if (!sfb__mask_grow(ctx, m, 2 * sfb__mask_need_vertex(p, v) + 2)) return 0;
+        if (linear) { SFB__MASK_ADD(m, v, 1.0); return 1; }
+        for (i = 0; i < ne; ++i) {
+            int e = p->ve[e0 + i];
+            ps[i] = p->es[e];
+            cs[i] = st->half[2 * e + sfb__half_at(p, e, v)];
+        }
+        if (prule == SFB__RULE_SMOOTH || prule == SFB__RULE_DART) {
+            sfb__mask_vertex_rule(m, p, v, SFB__RULE_SMOOTH, ps, scheme, 1.0);
+        } else if (crule == prule) {
+            sfb__mask_vertex_rule(m, p, v, prule, ps, scheme, 1.0);
+        } else {
+            double pw = sfb__fractional_weight(p->vs[v], c->vs[cv], ne, ps, cs,
+                                               st->opt->crease_method == SFB_CREASE_CHAIKIN);
+            sfb__mask_vertex_rule(m, p, v, prule, ps, scheme, pw);
+            sfb__mask_vertex_rule(m, p, v, crule == SFB__RULE_DART ? SFB__RULE_SMOOTH : crule, cs, scheme, 1.0 - pw);
+        }
+        return 1;
+    }
+    if (cv < p->nv + nvF) {
+        int f = cv - p->nv, n = p->fv_off[f + 1] - p->fv_off[f];
+        if (!sfb__mask_grow(ctx, m, n)) return 0;
+        sfb__mask_face(m, p, f, 1.0);
+        return 1;
+    }
+    {
+        int e = cv - p->nv - nvF;
+        int a = p->ev[2 * e], b = p->ev[2 * e + 1];
+        int f0 = p->ef_off[e], nf = p->ef_off[e + 1] - f0;
+        float s = p->es[e];
+        double pw, cw;
+        int need = 2;
+        for (i = 0; i < nf; ++i) need += p->fv_off[p->ef[f0 + i] + 1] - p->fv_off[p->ef[f0 + i]];
+        if (!sfb__mask_grow(ctx, m, need + 2)) return 0;
+        if (linear || (s > 0.0f && c->vrule[cv] == SFB__RULE_CREASE)) {
+            SFB__MASK_ADD(m, a, 0.5);
+            SFB__MASK_ADD(m, b, 0.5);
+            return 1;
+        }
+        /* smooth mask, blended with the midpoint by the parent sharpness when 0 < s */
+        pw = s > 0.0f ? (double)s : 0.0;
+        cw = 1.0 - pw;
+        if (pw != 0.0) {
+            SFB__MASK_ADD(m, a, 0.5 * pw);
+            SFB__MASK_ADD(m, b, 0.5 * pw);
+        }
+        if (loop) {
+            double vw = 0.375, fw = nf == 2 ? 0.125 : 0.125 * 2.0 / (nf ? nf : 1);
+            SFB__MASK_ADD(m, a, vw * cw);
+            SFB__MASK_ADD(m, b, vw * cw);
+            for (i = 0; i < nf; ++i) {
+                int f = p->ef[f0 + i], slot = p->ef_slot[f0 + i], o = p->fv_off[f];
+                int n = p->fv_off[f + 1] - o;
+                SFB__MASK_ADD(m, p->fv[o + (slot + 2) % n], fw * cw);
+            }
+        } else {
+            double vw = 0.25, fw0 = 0.25, fw1 = 0.25;
+            int tri = st->opt->triangle_rule == SFB_TRI_SMOOTH && nf == 2;
+            if (tri) {
+                int n0 = p->fv_off[p->ef[f0] + 1] - p->fv_off[p->ef[f0]];
+                int n1 = p->fv_off[p->ef[f0 + 1] + 1] - p->fv_off[p->ef[f0 + 1]];
+                tri = (n0 == 3) || (n1 == 3);
+                if (tri) {
+                    /* OpenSubdiv's CATMARK_SMOOTH_TRI_EDGE_WEIGHT, in float as it computes it */
+                    float t0 = n0 == 3 ? 0.470f : 0.25f, t1 = n1 == 3 ? 0.470f : 0.25f;
+                    float fw = 0.5f * (t0 + t1);
+                    fw0 = fw1 = fw;
+                    vw = 0.5f * (1.0f - 2.0f * fw);
+                }
+            }
+            SFB__MASK_ADD(m, a, vw * cw);
+            SFB__MASK_ADD(m, b, vw * cw);
+            if (nf == 2) {
+                sfb__mask_face(m, p, p->ef[f0], fw0 * cw);
+                sfb__mask_face(m, p, p->ef[f0 + 1], fw1 * cw);
+            } else {
+                for (i = 0; i < nf; ++i) sfb__mask_face(m, p, p->ef[f0 + i], 0.5 / nf * cw);
+            }
+        }
+        return 1;
+    }
+}
+
+/* Composes local masks with the parent's composed rows using a dense accumulator. */
+typedef struct sfb__accum {
+    double *acc;
+    unsigned *mark;
+    int *touched;
+    unsigned stamp;
+} sfb__accum;
+
+static int sfb__compose_row(sfb_context *ctx, sfb__accum *A, const sfb__rows *prow, const sfb__mask *m, sfb__rows *out, int row) {
+    int i, nt = 0;
+    size_t k;
+    A->stamp++;
+    if (A->stamp == 0) return 0; /* wrapped: caller resets */
+    for (i = 0; i < m->n; ++i) {
+        int j = m->idx[i];
+        double wj = m->w[i];
+        if (wj == 0.0) continue;
+        for (k = prow->off[j]; k < prow->off[j + 1]; ++k) {
+            int b = prow->idx[k];
+            if (A->mark[b] != A->stamp) { A->mark[b] = A->stamp; A->acc[b] = 0.0; A->touched[nt++] = b; }
+            A->acc[b] += wj * prow->w[k];
+        }
+    }
+    if (!sfb__rows_reserve(ctx, out, out->n + (size_t)nt)) return 0;
+    for (i = 0; i < nt; ++i) {
+        int b = A->touched[i];
+        if (A->acc[b] == 0.0) continue;
+        out->idx[out->n] = b;
+        out->w[out->n] = A->acc[b];
+        out->n++;
+    }
+    out->off[row + 1] = out->n;
+    return 1;
+}
+
+/* ---- limit masks at the last level ---- */
+static void sfb__limit_masks(const sfb__level *l, int v, sfb_scheme scheme, sfb__mask *mp, sfb__mask *m1, sfb__mask *m2) {
+    int e0 = l->ve_off[v], ne = l->ve_off[v + 1] - e0;
+    int f0 = l->vf_off[v], nf = l->vf_off[v + 1] - f0;
+    int rule = l->vrule[v], i;
+    int loop = scheme == SFB_SCHEME_LOOP;
+    double tscale = loop ? 3.0 : 1.0;
+    mp->n = m1->n = m2->n = 0;
+    if (scheme == SFB_SCHEME_BILINEAR || ne == 0) rule = SFB__RULE_CORNER;
+    if ((rule == SFB__RULE_SMOOTH || rule == SFB__RULE_DART) &&
+        (nf != ne || (l->vtag[v] & SFB__TAG_NONMANIFOLD) || (!loop && nf == 2)))
+        rule = SFB__RULE_CORNER; /* Catmull-Clark valence 2 is a corner for the limit (as OpenSubdiv) */
+    if (rule == SFB__RULE_CORNER) {
+        SFB__MASK_ADD(mp, v, 1.0);
+        if (ne >= 2) {
+            SFB__MASK_ADD(m1, v, -tscale);
+            SFB__MASK_ADD(m1, sfb__other_end(l, l->ve[e0], v), tscale);
+            SFB__MASK_ADD(m2, v, -tscale);
+            SFB__MASK_ADD(m2, sfb__other_end(l, l->ve[e0 + 1], v), tscale);
+        }
+        return;
+    }
+    if (rule == SFB__RULE_CREASE) {
+        float sharp[SFB_MAX_VALENCE + 1];
+        int a, b, k;
+        for (i = 0; i < ne && i <= SFB_MAX_VALENCE; ++i) sharp[i] = l->es[l->ve[e0 + i]];
+        sfb__crease_pair(sharp, ne, &a, &b);
+        SFB__MASK_ADD(mp, v, 2.0 / 3.0);
+        SFB__MASK_ADD(mp, sfb__other_end(l, l->ve[e0 + a], v), 1.0 / 6.0);
+        SFB__MASK_ADD(mp, sfb__other_end(l, l->ve[e0 + b], v), 1.0 / 6.0);
+        SFB__MASK_ADD(m1, sfb__other_end(l, l->ve[e0 + a], v), 0.5 * tscale);
+        SFB__MASK_ADD(m1, sfb__other_end(l, l->ve[e0 + b], v), -0.5 * tscale);
+        k = b - a - 1; /* interior edges between the crease edges */
+#define SFB__E(i) sfb__other_end(l, l->ve[e0 + (i)], v)
+#define SFB__D(i) l->fv[l->fv_off[l->vf[f0 + (i)]] + (l->vf_slot[f0 + (i)] + 2) % (l->fv_off[l->vf[f0 + (i)] + 1] - l->fv_off[l->vf[f0 + (i)]])]
+        if (loop) {
+            if (k == 0) {
+                SFB__MASK_ADD(m2, v, -6.0); SFB__MASK_ADD(m2, SFB__E(a), 3.0); SFB__MASK_ADD(m2, SFB__E(b), 3.0);
+            } else if (k == 1) {
+                SFB__MASK_ADD(m2, v, -3.0); SFB__MASK_ADD(m2, SFB__E(a + 1), 3.0);
+            } else if (k == 2) {
+                double r3 = 1.73205080756887729352;
+                SFB__MASK_ADD(m2, v, -r3); SFB__MASK_ADD(m2, SFB__E(a), -r3 / 2); SFB__MASK_ADD(m2, SFB__E(b), -r3 / 2);
+                SFB__MASK_ADD(m2, SFB__E(a + 1), r3); SFB__MASK_ADD(m2, SFB__E(a + 2), r3);
+            } else {
+                double th = SFB__PI / (k + 1), cwt = -3.0 * sin(th), ec = -3.0 * 2.0 * (cos(th) - 1.0);
+                SFB__MASK_ADD(m2, SFB__E(a), cwt); SFB__MASK_ADD(m2, SFB__E(b), cwt);
+                for (i = 1; i <= k; ++i) SFB__MASK_ADD(m2, SFB__E(a + i), ec * sin(i * th));
+            }
+        } else {
+            if (k == 0) {
+                SFB__MASK_ADD(m2, v, -6.0); SFB__MASK_ADD(m2, SFB__E(a), 3.0); SFB__MASK_ADD(m2, SFB__E(b), 3.0);
+            } else if (k == 1) {
+                SFB__MASK_ADD(m2, v, -4.0 / 6.0);
+                SFB__MASK_ADD(m2, SFB__E(a), -1.0 / 6.0); SFB__MASK_ADD(m2, SFB__E(a + 1), 4.0 / 6.0);
+                SFB__MASK_ADD(m2, SFB__E(b), -1.0 / 6.0);
+                if (a < nf) SFB__MASK_ADD(m2, SFB__D(a), 1.0 / 6.0);
+                if (a + 1 < nf) SFB__MASK_ADD(m2, SFB__D(a + 1), 1.0 / 6.0);
+            } else {
+                double kk = k + 1, th = SFB__PI / kk, ct = cos(th), st = sin(th);
+                double den = 1.0 / (kk * (3.0 + ct)), R = (ct + 1.0) / st;
+                SFB__MASK_ADD(m2, v, 4.0 * R * (ct - 1.0) * den);
+                SFB__MASK_ADD(m2, SFB__E(a), -R * (1.0 + 2.0 * ct) * den);
+                SFB__MASK_ADD(m2, SFB__E(b), -R * (1.0 + 2.0 * ct) * den);
+                if (a < nf) SFB__MASK_ADD(m2, SFB__D(a), st * den);
+                for (i = 1; i < kk; ++i) {
+                    double si = sin(i * th), si1 = sin((i + 1) * th);
+                    SFB__MASK_ADD(m2, SFB__E(a + i), 4.0 * si * den);
+                    if (a + i < nf) SFB__MASK_ADD(m2, SFB__D(a + i), (si + si1) * den);
+                }
+            }
+        }
+        return;
+    }
+    /* smooth */
+    if (loop) {
+        double ew, vw;
+        if (nf == 6) {
+            ew = 1.0 / 12.0;
+            vw = 0.5;
+        } else {
+            double beta = 0.25 * cos(2.0 * SFB__PI / nf) + 0.375;
+            double gamma = (0.625 - beta * beta) / nf;
+            ew = 1.0 / (nf + 3.0 / (8.0 * gamma));
+            vw = 1.0 - ew * nf;
+        }
+        SFB__MASK_ADD(mp, v, vw);
+        for (i = 0; i < ne; ++i) {
+            double al = 2.0 * SFB__PI * i / ne;
+            SFB__MASK_ADD(mp, SFB__E(i), ew);
+            SFB__MASK_ADD(m1, SFB__E(i), cos(al));
+            SFB__MASK_ADD(m2, SFB__E(i), sin(al));
+        }
+    } else {
+        double n = nf, fw = 1.0 / (n * (n + 5.0)), ew = 4.0 * fw;
+        double th = 2.0 * SFB__PI / n, ct = cos(th), ch = cos(0.5 * th);
+        double lambda = 5.0 / 16.0 + (ct + ch * sqrt(2.0 * (9.0 + ct))) / 16.0;
+        double fscale = 1.0 / (4.0 * lambda - 1.0);
+        if (nf == 4) { fw = 1.0 / 36.0; ew = 1.0 / 9.0; }
+        SFB__MASK_ADD(mp, v, nf == 4 ? 4.0 / 9.0 : 1.0 - n * (ew + fw));
+        for (i = 0; i < nf; ++i) {
+            int ip = (i + nf - 1) % nf;
+            double c0 = cos(i * th), c1 = cos((i + 1) * th);
+            double t1e = 4.0 * c0, t1f = fscale * (c0 + c1);
+            double cp0 = cos(ip * th), cp1 = cos((ip + 1) * th);
+            double t2e = 4.0 * cp0, t2f = fscale * (cp0 + cp1);
+            if (nf == 4) {
+                static const double E1[4] = {4, 0, -4, 0}, F1[4] = {1, -1, -1, 1};
+                static const double E2[4] = {0, 4, 0, -4}, F2[4] = {1, 1, -1, -1};
+                t1e = E1[i]; t1f = F1[i]; t2e = E2[i]; t2f = F2[i];
+            }
+            SFB__MASK_ADD(mp, SFB__E(i), ew);
+            SFB__MASK_ADD(mp, SFB__D(i), fw);
+            SFB__MASK_ADD(m1, SFB__E(i), t1e);
+            SFB__MASK_ADD(m1, SFB__D(i), t1f);
+            SFB__MASK_ADD(m2, SFB__E(i), t2e);
+            SFB__MASK_ADD(m2, SFB__D(i), t2f);
+        }
+    }
+#undef SFB__E
+#undef SFB__D
+}
+
+void sfb__stencils_free(sfb_context *ctx, sfb__stencils *s) {
+    sfb__free(ctx, s->sizes); sfb__free(ctx, s->offsets); sfb__free(ctx, s->indices); sfb__free(ctx, s->weights);
+    memset(s, 0, sizeof *s);
+}
+
+static sfb_result sfb__rows_to_stencils(sfb_context *ctx, const sfb__rows *r, int sources, sfb__stencils *s) {
+    int i;
+    size_t k;
+    memset(s, 0, sizeof *s);
+    if (r->n > 0x7fffffff)
+        return sfb__error(ctx, SFB_LIMIT_EXCEEDED, SFB_ELEMENT_NONE, -1, "stencil table of %zu entries is over the limit", r->n);
+    s->rows = r->rows;
+    s->sources = sources;
+    s->entries = r->n;
+    s->sizes = (int *)sfb__alloc(ctx, ((size_t)r->rows + 1) * sizeof(int));
+    s->offsets = (int *)sfb__alloc(ctx, ((size_t)r->rows + 1) * sizeof(int));
+    s->indices = (int *)sfb__alloc(ctx, (r->n + 1) * sizeof(int));
+    s->weights = (float *)sfb__alloc(ctx, (r->n + 1) * sizeof(float));
+    if (!s->sizes || !s->offsets || !s->indices || !s->weights) {
+        sfb__stencils_free(ctx, s);
+        return SFB_OUT_OF_MEMORY;
+    }
+    for (i = 0; i < r->rows; ++i) {
+        s->offsets[i] = (int)r->off[i];
+        s->sizes[i] = (int)(r->off[i + 1] - r->off[i]);
+    }
+    if (r->n) memcpy(s->indices, r->idx, r->n * sizeof(int));
+    for (k = 0; k < r->n; ++k) s->weights[k] = (float)r->w[k];
+    return SFB_SUCCESS;
+}
+
+static sfb_result sfb__oom(sfb_context *ctx, const char *what) {
+    return sfb__error(ctx, SFB_LIMIT_EXCEEDED, SFB_ELEMENT_NONE, -1,
+                      "%s needs more memory than allowed: %zu bytes in use, memory budget %zu bytes (or the allocator failed)",
+                      what, ctx->live_bytes, ctx->budget);
+}
+
+sfb_result sfb__refine(sfb_context *ctx, const sfb__level *base, const sfb__refine_options *opt, int level,
+                       sfb__level *top, sfb__stencils *vt, sfb__stencils *lt, float prog0, float prog1) {
+    sfb__rows prow, crow;
+    sfb__level cur, next;
+    sfb__accum A;
+    sfb__mask m;
+    float *ps = NULL, *cs = NULL;
+    sfb_result r = SFB_SUCCESS;
+    int L, i, owns_cur = 0;
+    memset(&prow, 0, sizeof prow); memset(&crow, 0, sizeof crow);
+    memset(&A, 0, sizeof A); memset(&m, 0, sizeof m);
+    memset(&next, 0, sizeof next);
+    cur = *base;
+    A.acc = (double *)sfb__alloc(ctx, ((size_t)base->nv + 1) * sizeof(double));
+    A.mark = (unsigned *)sfb__calloc(ctx, (size_t)base->nv + 1, sizeof(unsigned));
+    A.touched = (int *)sfb__alloc(ctx, ((size_t)base->nv + 1) * sizeof(int));
+    ps = (float *)sfb__alloc(ctx, (SFB_MAX_VALENCE + 2) * sizeof(float));
+    cs = (float *)sfb__alloc(ctx, (SFB_MAX_VALENCE + 2) * sizeof(float));
+    prow.rows = base->nv;
+    prow.off = (size_t *)sfb__alloc(ctx, ((size_t)base->nv + 1) * sizeof(size_t));
+    if (!A.acc || !A.mark || !A.touched || !ps || !cs || !prow.off || !sfb__rows_reserve(ctx, &prow, (size_t)base->nv + 1)) {
+        r = sfb__oom(ctx, "refinement");
+        goto done;
+    }
+    for (i = 0; i < base->nv; ++i) { prow.off[i] = (size_t)i; prow.idx[i] = i; prow.w[i] = 1.0; }
+    prow.off[base->nv] = (size_t)base->nv;
+    prow.n = (size_t)base->nv;
+    for (L = 0; L < level; ++L) {
+        sfb__step st;
+        int cv;
+        r = sfb__progress(ctx, prog0 + (prog1 - prog0) * (float)L / (float)(level + 1), "refine");
+        if (r != SFB_SUCCESS) goto done;
+        st.ctx = ctx; st.opt = opt; st.p = &cur; st.c = &next; st.half = NULL;
+        r = sfb__build_child_topology(&st);
+        if (r != SFB_SUCCESS) {
+            sfb__free(ctx, st.half);
+            if (r == SFB_OUT_OF_MEMORY) r = sfb__oom(ctx, "refinement topology");
+            goto done;
+        }
+        crow.rows = next.nv;
+        crow.n = 0;
+        crow.off = (size_t *)sfb__alloc(ctx, ((size_t)next.nv + 1) * sizeof(size_t));
+        if (!crow.off || !sfb__rows_reserve(ctx, &crow, (size_t)next.nv * 4 + 16)) {
+            sfb__free(ctx, st.half);
+            r = sfb__oom(ctx, "stencil table");
+            goto done;
+        }
+        crow.off[0] = 0;
+        for (cv = 0; cv < next.nv; ++cv) {
+            if (!sfb__child_mask(&st, cv, &m, ps, cs) || !sfb__compose_row(ctx, &A, &prow, &m, &crow, cv)) {
+                sfb__free(ctx, st.half);
+                r = sfb__oom(ctx, "stencil table");
+                goto done;
+            }
+            if ((cv & 0xffff) == 0xffff) {
+                r = sfb__progress(ctx, prog0 + (prog1 - prog0) * ((float)L + (float)cv / next.nv) / (float)(level + 1), "refine");
+                if (r != SFB_SUCCESS) { sfb__free(ctx, st.half); goto done; }
+            }
+        }
+        sfb__free(ctx, st.half);
+        sfb__rows_free(ctx, &prow);
+        prow = crow;
+        memset(&crow, 0, sizeof crow);
+        if (owns_cur) sfb__level_free(ctx, &cur);
+        cur = next;
+        owns_cur = 1;
+        memset(&next, 0, sizeof next);
+    }
+    r = sfb__rows_to_stencils(ctx, &prow, base->nv, vt);
+    if (r != SFB_SUCCESS) { if (r == SFB_OUT_OF_MEMORY) r = sfb__oom(ctx, "stencil table"); goto done; }
+    if (lt) {
+        sfb__rows out[3];
+        sfb__mask mm[3];
+        int t, v;
+        memset(out, 0, sizeof out);
+        memset(mm, 0, sizeof mm);
+        for (t = 0; t < 3 && r == SFB_SUCCESS; ++t) {
+            out[t].rows = cur.nv;
+            out[t].off = (size_t *)sfb__alloc(ctx, ((size_t)cur.nv + 1) * sizeof(size_t));
+            if (!out[t].off) r = sfb__oom(ctx, "limit stencil table");
+            else out[t].off[0] = 0;
+        }
+        for (v = 0; v < cur.nv && r == SFB_SUCCESS; ++v) {
+            int need = 3 * sfb__mask_need_vertex(&cur, v) + 8;
+            for (t = 0; t < 3; ++t)
+                if (!sfb__mask_grow(ctx, &mm[t], need)) r = sfb__oom(ctx, "limit stencil table");
+            if (r != SFB_SUCCESS) break;
+            sfb__limit_masks(&cur, v, opt->scheme, &mm[0], &mm[1], &mm[2]);
+            for (t = 0; t < 3; ++t)
+                if (!sfb__compose_row(ctx, &A, &prow, &mm[t], &out[t], v)) { r = sfb__oom(ctx, "limit stencil table"); break; }
+        }
+        for (t = 0; t < 3; ++t) {
+            if (r == SFB_SUCCESS) {
+                r = sfb__rows_to_stencils(ctx, &out[t], base->nv, &lt[t]);
+                if (r == SFB_OUT_OF_MEMORY) r = sfb__oom(ctx, "limit stencil table");
+            }
+            sfb__rows_free(ctx, &out[t]);
+            sfb__free(ctx, mm[t].idx);
+            sfb__free(ctx, mm[t].w);
+        }
+        if (r != SFB_SUCCESS) goto done;
+    }
+    if (owns_cur) {
+        *top = cur;
+        owns_cur = 0;
+    } else {
+        /* level 0: the caller's base is the top; hand back an independent copy */
+        r = sfb__level_prepare(ctx, base, 0, 0, 0, top);
+        if (r == SFB_SUCCESS) {
+            /* sfb__level_prepare re-sharpens; base was already prepared so this is a copy */
+        }
+    }
+done:
+    if (owns_cur) sfb__level_free(ctx, &cur);
+    sfb__level_free(ctx, &next);
+    sfb__rows_free(ctx, &prow);
+    sfb__rows_free(ctx, &crow);
+    sfb__free(ctx, A.acc); sfb__free(ctx, A.mark); sfb__free(ctx, A.touched);
+    sfb__free(ctx, m.idx); sfb__free(ctx, m.w);
+    sfb__free(ctx, ps); sfb__free(ctx, cs);
+    if (r != SFB_SUCCESS) {
+        sfb__stencils_free(ctx, vt);
+        if (lt) { sfb__stencils_free(ctx, &lt[0]); sfb__stencils_free(ctx, &lt[1]); sfb__stencils_free(ctx, &lt[2]); }
+    }
+    return r;
+}
+#line 1 "src/mesh.c"
+/* Control meshes: validation of untrusted arrays, edges, topology, creases, info. */
+
+/* Line numbers of OBJ statements, so that errors found while building the mesh can name the
+ * line they came from. Internal: sfb_mesh_read_obj passes it, sfb_mesh_create does not. */
+typedef struct sfb__src_lines {
+    const int *face, *crease, *corner, *hole;
+} sfb__src_lines;
+
+static sfb_result sfb__elem_error(sfb_context *ctx, sfb_result r, const sfb__src_lines *lines, const int *line_of,
+                                  sfb_element_kind kind, long index, const char *what, long what_index, const char *detail) {
+    if (lines && line_of)
+        return sfb__error(ctx, r, SFB_ELEMENT_LINE, line_of[what_index], "%s %ld: %s", what, what_index, detail);
+    if (kind == SFB_ELEMENT_NONE) return sfb__error(ctx, r, kind, -1, "%s %ld: %s", what, what_index, detail);
+    return sfb__error(ctx, r, kind, index, "%s", detail);
+}
+
+/* Builds the edge list of a face list by hashing vertex pairs. */
+static sfb_result sfb__build_edges(sfb_context *ctx, int nv, int nf, const int *fv_off, const int *fv, int *ne_out,
+                                   int **fe_out, int **ev_out) {
+    int nfv = fv_off[nf], f, i, ne = 0;
+    size_t cap = 16, mask;
+    uint64_t *keys = NULL;
+    int *vals = NULL, *fe = NULL, *ev = NULL;
+    (void)nv;
+    while (cap < (size_t)nfv * 2 + 16) cap <<= 1;
+    mask = cap - 1;
+    keys = (uint64_t *)sfb__alloc(ctx, cap * sizeof(uint64_t));
+    vals = (int *)sfb__alloc(ctx, cap * sizeof(int));
+    fe = (int *)sfb__alloc(ctx, ((size_t)nfv + 1) * sizeof(int));
+    ev = (int *)sfb__alloc(ctx, ((size_t)nfv * 2 + 2) * sizeof(int));
+    if (!keys || !vals || !fe || !ev) goto oom;
+    memset(keys, 0xff, cap * sizeof(uint64_t));
+    for (f = 0; f < nf; ++f) {
+        int o = fv_off[f], n = fv_off[f + 1] - o;
+        for (i = 0; i < n; ++i) {
+            unsigned a = (unsigned)fv[o + i], b = (unsigned)fv[o + (i + 1) % n];
+            uint64_t key = a < b ? ((uint64_t)a << 32 | b) : ((uint64_t)b << 32 | a);
+            size_t h = (size_t)((key * 0x9E3779B97F4A7C15ull) >> 17) & mask;
+            while (keys[h] != ~(uint64_t)0 && keys[h] != key) h = (h + 1) & mask;
+            if (a == b) {
+                /* a degenerate edge (a face repeating a vertex) is never shared: each occurrence is
+                 * an edge of its own, as in OpenSubdiv */
+                ev[2 * ne] = (int)a;
+                ev[2 * ne + 1] = (int)b;
+                fe[o + i] = ne++;
+            } else if (keys[h] == key) {
+                int k, again = 0;
+                /* the same edge twice in one face (a face folding back on itself) gives two edges */
+                for (k = 0; k < i && !again; ++k) again = fe[o + k] == vals[h];
+                if (again) {
+                    ev[2 * ne] = (int)a;
+                    ev[2 * ne + 1] = (int)b;
+                    fe[o + i] = ne++;
+                } else {
+                    fe[o + i] = vals[h];
+                }
+            } else {
+                keys[h] = key;
+                vals[h] = ne;
+                ev[2 * ne] = (int)a;
+                ev[2 * ne + 1] = (int)b;
+                fe[o + i] = ne++;
+            }
+        }
+    }
+    sfb__free(ctx, keys);
+    sfb__free(ctx, vals);
+    *ne_out = ne;
+    *fe_out = fe;
+    *ev_out = ev;
+    return SFB_SUCCESS;
+oom:
+    sfb__free(ctx, keys); sfb__free(ctx, vals); sfb__free(ctx, fe); sfb__free(ctx, ev);
+    return SFB_OUT_OF_MEMORY;
+}
+
+/* Finds the edge between a and b through a's incident edges; -1 if none. */
+static int sfb__find_edge(const sfb__level *l, int a, int b) {
+    int i;
+    for (i = l->ve_off[a]; i < l->ve_off[a + 1]; ++i) {
+        int e = l->ve[i];
+        if ((l->ev[2 * e] == a && l->ev[2 * e + 1] == b) || (l->ev[2 * e] == b && l->ev[2 * e + 1] == a)) return e;
+    }
+    return -1;
+}
+
+static int sfb__finite3(const float *p) { return isfinite(p[0]) && isfinite(p[1]) && isfinite(p[2]); }
+
+/* Builds a level (topology only, zero sharpness) from faces; validates indices. */
+static sfb_result sfb__level_from_faces(sfb_context *ctx, int nv, int nf, const int *sizes, const int *fvin,
+                                        const sfb__src_lines *lines, sfb_element_kind vkind, sfb__level *l) {
+    int f, i;
+    size_t nfv = 0;
+    sfb_result r;
+    memset(l, 0, sizeof *l);
+    for (f = 0; f < nf; ++f) {
+        char msg[160];
+        if (sizes[f] < 3) {
+            snprintf(msg, sizeof msg, "face has %d vertices; a face needs at least 3", sizes[f]);
+            return sfb__elem_error(ctx, SFB_INVALID_TOPOLOGY, lines, lines ? lines->face : NULL, SFB_ELEMENT_FACE, f, "face", f, msg);
+        }
+        if (sizes[f] > SFB_MAX_FACE_SIZE) {
+            snprintf(msg, sizeof msg, "face has %d vertices, over the limit of %d (SFB_MAX_FACE_SIZE)", sizes[f], SFB_MAX_FACE_SIZE);
+            return sfb__elem_error(ctx, SFB_LIMIT_EXCEEDED, lines, lines ? lines->face : NULL, SFB_ELEMENT_FACE, f, "face", f, msg);
+        }
+        nfv += (size_t)sizes[f];
+        if (nfv > SFB_MAX_ELEMENTS)
+            return sfb__error(ctx, SFB_LIMIT_EXCEEDED, SFB_ELEMENT_FACE, f, "total face-vertex count over the limit of %d", SFB_MAX_ELEMENTS);
+    }
+    l->nv = nv;
+    l->nf = nf;
+    l->fv_off = (int *)sfb__alloc(ctx, ((size_t)nf + 1) * sizeof(int));
+    l->fv = (int *)sfb__alloc(ctx, (nfv + 1) * sizeof(int));
+    if (!l->fv_off || !l->fv) goto oom;
+    l->fv_off[0] = 0;
+    for (f = 0; f < nf; ++f) {
+        int o = l->fv_off[f], n = sizes[f];
+        l->fv_off[f + 1] = o + n;
+        for (i = 0; i < n; ++i) {
+            int v = fvin[o + i];
+            char msg[200];
+            if (v < 0 || v >= nv) {
+                snprintf(msg, sizeof msg, "%s index %d out of range (%d %s)", vkind == SFB_ELEMENT_UV ? "uv" : "vertex", v, nv,
+                         vkind == SFB_ELEMENT_UV ? "uvs" : "vertices");
+                sfb__level_free(ctx, l);
+                return sfb__elem_error(ctx, SFB_INVALID_TOPOLOGY, lines, lines ? lines->face : NULL, SFB_ELEMENT_FACE, f, "face", f, msg);
+            }
+            l->fv[o + i] = v;
+        }
+    }
+    r = sfb__build_edges(ctx, nv, nf, l->fv_off, l->fv, &l->ne, &l->fe, &l->ev);
+    if (r != SFB_SUCCESS) goto oom;
+    l->es = (float *)sfb__calloc(ctx, (size_t)l->ne + 1, sizeof(float));
+    l->vs = (float *)sfb__calloc(ctx, (size_t)nv + 1, sizeof(float));
+    if (!l->es || !l->vs) goto oom;
+    r = sfb__level_complete(ctx, l);
+    if (r != SFB_SUCCESS) { sfb__level_free(ctx, l); return r; }
+    return SFB_SUCCESS;
+oom:
+    sfb__level_free(ctx, l);
+    return sfb__error(ctx, SFB_LIMIT_EXCEEDED, SFB_ELEMENT_NONE, -1,
+                      "building the mesh topology needs more memory than the budget (%zu bytes) allows", ctx->budget);
+}
+
+static sfb_result sfb__check_sharpness(sfb_context *ctx, float s, const sfb__src_lines *lines, const int *line_of,
+                                       const char *what, int index) {
+    char msg[160];
+    if (isnan(s) || s < 0.0f) {
+        snprintf(msg, sizeof msg, "sharpness %g is invalid: sharpness must be a number >= 0", (double)s);
+        return sfb__elem_error(ctx, SFB_INVALID_VALUE, lines, line_of, SFB_ELEMENT_NONE, -1, what, index, msg);
+    }
+    return SFB_SUCCESS;
+}
+
+void sfb_mesh_destroy(sfb_mesh *mesh);
+
+static sfb_result sfb__mesh_create(sfb_context *ctx, const sfb_mesh_desc *d, const sfb__src_lines *lines, sfb_mesh **out) {
+    sfb_mesh *m;
+    sfb_result r;
+    int i, v, e;
+    char msg[256];
+    if (!ctx) return SFB_INVALID_ARGS;
+    if (!d || !out) return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "sfb_mesh_create: NULL argument");
+    *out = NULL;
+    if (d->vertex_count < 0 || d->face_count < 0 || d->crease_count < 0 || d->corner_count < 0 || d->hole_count < 0 ||
+        d->uv_count < 0)
+        return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "negative element count in the mesh description");
+    if (d->vertex_count > SFB_MAX_ELEMENTS || d->face_count > SFB_MAX_ELEMENTS || d->uv_count > SFB_MAX_ELEMENTS ||
+        d->crease_count > SFB_MAX_ELEMENTS || d->corner_count > SFB_MAX_ELEMENTS || d->hole_count > SFB_MAX_ELEMENTS)
+        return sfb__error(ctx, SFB_LIMIT_EXCEEDED, SFB_ELEMENT_NONE, -1, "element count over the limit of %d", SFB_MAX_ELEMENTS);
+    if (d->face_count == 0) return sfb__error(ctx, SFB_INVALID_TOPOLOGY, SFB_ELEMENT_NONE, -1, "mesh has no faces");
+    if (!d->positions || !d->face_sizes || !d->face_vertices)
+        return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "mesh description lacks positions or faces");
+    if ((d->crease_count && (!d->crease_vertices || !d->crease_sharpness)) ||
+        (d->corner_count && (!d->corner_vertices || !d->corner_sharpness)) || (d->hole_count && !d->holes) ||
+        (d->uv_count && (!d->uvs || !d->face_uvs)))
+        return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "mesh description has a count without its array");
+    if (d->boundary < 0 || d->boundary > 2 || d->crease_method < 0 || d->crease_method > 1 || d->triangle_rule < 0 ||
+        d->triangle_rule > 1 || d->uv_interp < 0 || d->uv_interp > 1)
+        return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "invalid boundary/crease method/triangle rule/uv mode value");
+    for (v = 0; v < d->vertex_count; ++v)
+        if (!sfb__finite3(d->positions + 3 * (size_t)v))
+            return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_VERTEX, v, "coordinate is not finite (NaN or inf)");
+    m = (sfb_mesh *)sfb__calloc(ctx, 1, sizeof(sfb_mesh));
+    if (!m) return sfb__error(ctx, SFB_OUT_OF_MEMORY, SFB_ELEMENT_NONE, -1, "out of memory");
+    m->ctx = ctx;
+    m->boundary = d->boundary; m->crease_method = d->crease_method;
+    m->triangle_rule = d->triangle_rule; m->uv_interp = d->uv_interp;
+    r = sfb__level_from_faces(ctx, d->vertex_count, d->face_count, d->face_sizes, d->face_vertices, lines, SFB_ELEMENT_VERTEX, &m->base);
+    if (r != SFB_SUCCESS) { sfb_mesh_destroy(m); return r; }
+    for (v = 0; v < m->base.nv; ++v) {
+        int val = m->base.ve_off[v + 1] - m->base.ve_off[v];
+        int fal = m->base.vf_off[v + 1] - m->base.vf_off[v];
+        if (val > SFB_MAX_VALENCE || fal > SFB_MAX_VALENCE) {
+            sfb_mesh_destroy(m);
+            return sfb__error(ctx, SFB_LIMIT_EXCEEDED, SFB_ELEMENT_VERTEX, v, "valence %d is over the limit of %d (SFB_MAX_VALENCE)",
+                              val > fal ? val : fal, SFB_MAX_VALENCE);
+        }
+    }
+    m->positions = (float *)sfb__alloc(ctx, (size_t)d->vertex_count * 3 * sizeof(float) + 1);
+    m->face_sizes = (int *)sfb__alloc(ctx, (size_t)d->face_count * sizeof(int));
+    if (!m->positions || !m->face_sizes) { sfb_mesh_destroy(m); return sfb__oom(ctx, "mesh"); }
+    memcpy(m->positions, d->positions, (size_t)d->vertex_count * 3 * sizeof(float));
+    memcpy(m->face_sizes, d->face_sizes, (size_t)d->face_count * sizeof(int));
+    /* creases: later entries override earlier ones on the same edge (as OpenSubdiv) */
+    for (i = 0; i < d->crease_count; ++i) {
+        int a = d->crease_vertices[2 * i], b = d->crease_vertices[2 * i + 1];
+        float s = d->crease_sharpness[i];
+        const int *lo = lines ? lines->crease : NULL;
+        if (a < 0 || a >= d->vertex_count || b < 0 || b >= d->vertex_count) {
+            snprintf(msg, sizeof msg, "crease names vertex index %d out of range (%d vertices)",
+                     (a < 0 || a >= d->vertex_count) ? a : b, d->vertex_count);
+            sfb_mesh_destroy(m);
+            return sfb__elem_error(ctx, SFB_INVALID_TOPOLOGY, lines, lo, SFB_ELEMENT_EDGE, i, "crease", i, msg);
+        }
+        r = sfb__check_sharpness(ctx, s, lines, lo, "crease", i);
+        if (r != SFB_SUCCESS) { sfb_mesh_destroy(m); return r; }
+        e = sfb__find_edge(&m->base, a, b);
+        if (e < 0) {
+            snprintf(msg, sizeof msg, "crease between vertices %d and %d is not an edge of the mesh", a, b);
+            sfb_mesh_destroy(m);
+            return sfb__elem_error(ctx, SFB_INVALID_TOPOLOGY, lines, lo, SFB_ELEMENT_EDGE, i, "crease", i, msg);
+        }
+        m->base.es[e] = s;
+    }
+    if (d->face_edge_sharpness) {
+        int f;
+        for (f = 0; f < d->face_count; ++f) {
+            int o = m->base.fv_off[f], n = m->base.fv_off[f + 1] - o;
+            for (i = 0; i < n; ++i) {
+                float s = d->face_edge_sharpness[o + i];
+                if (isnan(s) || s < 0.0f) {
+                    snprintf(msg, sizeof msg, "per-face edge sharpness %g is invalid: sharpness must be a number >= 0", (double)s);
+                    sfb_mesh_destroy(m);
+                    return sfb__elem_error(ctx, SFB_INVALID_VALUE, lines, lines ? lines->face : NULL, SFB_ELEMENT_FACE, f, "face", f, msg);
+                }
+                /* seed 001: where two faces give an edge different values, the highest wins */
+                if (s > m->base.es[m->base.fe[o + i]]) m->base.es[m->base.fe[o + i]] = s;
+            }
+        }
+    }
+    for (i = 0; i < d->corner_count; ++i) {
+        int a = d->corner_vertices[i];
+        const int *lo = lines ? lines->corner : NULL;
+        if (a < 0 || a >= d->vertex_count) {
+            snprintf(msg, sizeof msg, "corner names vertex index %d out of range (%d vertices)", a, d->vertex_count);
+            sfb_mesh_destroy(m);
+            return sfb__elem_error(ctx, SFB_INVALID_TOPOLOGY, lines, lo, SFB_ELEMENT_VERTEX, a, "corner", i, msg);
+        }
+        r = sfb__check_sharpness(ctx, d->corner_sharpness[i], lines, lo, "corner", i);
+        if (r != SFB_SUCCESS) { sfb_mesh_destroy(m); return r; }
+        m->base.vs[a] = d->corner_sharpness[i];
+    }
+    for (i = 0; i < d->hole_count; ++i) {
+        int f = d->holes[i];
+        if (f < 0 || f >= d->face_count) {
+            snprintf(msg, sizeof msg, "hole names face index %d out of range (%d faces)", f, d->face_count);
+            sfb_mesh_destroy(m);
+            return sfb__elem_error(ctx, SFB_INVALID_TOPOLOGY, lines, lines ? lines->hole : NULL, SFB_ELEMENT_FACE, f, "hole", i, msg);
+        }
+        m->base.fhole[f] = 1;
+    }
+    if (d->uv_count > 0) {
+        size_t nfv = (size_t)m->base.nfv;
+        for (i = 0; i < d->uv_count; ++i)
+            if (!isfinite(d->uvs[2 * i]) || !isfinite(d->uvs[2 * i + 1])) {
+                sfb_mesh_destroy(m);
+                return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_UV, i, "uv coordinate is not finite (NaN or inf)");
+            }
+        for (i = 0; (size_t)i < nfv; ++i)
+            if (d->face_uvs[i] < 0 || d->face_uvs[i] >= d->uv_count) {
+                int f = 0;
+                while (m->base.fv_off[f + 1] <= i) ++f;
+                snprintf(msg, sizeof msg, "uv index %d out of range (%d uvs)", d->face_uvs[i], d->uv_count);
+                sfb_mesh_destroy(m);
+                return sfb__elem_error(ctx, SFB_INVALID_TOPOLOGY, lines, lines ? lines->face : NULL, SFB_ELEMENT_FACE, f, "face", f, msg);
+            }
+        m->uv_count = d->uv_count;
+        m->uvs = (float *)sfb__alloc(ctx, (size_t)d->uv_count * 2 * sizeof(float));
+        m->face_uvs = (int *)sfb__alloc(ctx, nfv * sizeof(int));
+        if (!m->uvs || !m->face_uvs) { sfb_mesh_destroy(m); return sfb__oom(ctx, "mesh uvs"); }
+        memcpy(m->uvs, d->uvs, (size_t)d->uv_count * 2 * sizeof(float));
+        memcpy(m->face_uvs, d->face_uvs, nfv * sizeof(int));
+    }
+    /* desc view: per-edge creases, corners, holes */
+    {
+        int nc = 0, nk = 0, nh = 0, f;
+        for (e = 0; e < m->base.ne; ++e) nc += m->base.es[e] > 0.0f;
+        for (v = 0; v < m->base.nv; ++v) nk += m->base.vs[v] > 0.0f;
+        for (f = 0; f < m->base.nf; ++f) nh += m->base.fhole[f] != 0;
+        m->crease_vertices = (int *)sfb__alloc(ctx, (size_t)nc * 2 * sizeof(int) + 1);
+        m->crease_sharpness = (float *)sfb__alloc(ctx, (size_t)nc * sizeof(float) + 1);
+        m->corner_vertices = (int *)sfb__alloc(ctx, (size_t)nk * sizeof(int) + 1);
+        m->corner_sharpness = (float *)sfb__alloc(ctx, (size_t)nk * sizeof(float) + 1);
+        m->holes = (int *)sfb__alloc(ctx, (size_t)nh * sizeof(int) + 1);
+        if (!m->crease_vertices || !m->crease_sharpness || !m->corner_vertices || !m->corner_sharpness || !m->holes) {
+            sfb_mesh_destroy(m);
+            return sfb__oom(ctx, "mesh");
+        }
+        for (e = 0; e < m->base.ne; ++e)
+            if (m->base.es[e] > 0.0f) {
+                m->crease_vertices[2 * m->crease_count] = m->base.ev[2 * e];
+                m->crease_vertices[2 * m->crease_count + 1] = m->base.ev[2 * e + 1];
+                m->crease_sharpness[m->crease_count++] = m->base.es[e];
+            }
+        for (v = 0; v < m->base.nv; ++v)
+            if (m->base.vs[v] > 0.0f) {
+                m->corner_vertices[m->corner_count] = v;
+                m->corner_sharpness[m->corner_count++] = m->base.vs[v];
+            }
+        for (f = 0; f < m->base.nf; ++f)
+            if (m->base.fhole[f]) m->holes[m->hole_count++] = f;
+    }
+    sfb__level_compute_rules(&m->base);
+    *out = m;
+    return SFB_SUCCESS;
+}
+
+SFB_API sfb_result sfb_mesh_create(sfb_context *ctx, const sfb_mesh_desc *desc, sfb_mesh **out) {
+    return sfb__mesh_create(ctx, desc, NULL, out);
+}
+
+SFB_API void sfb_mesh_destroy(sfb_mesh *m) {
+    sfb_context *ctx;
+    if (!m) return;
+    ctx = m->ctx;
+    sfb__level_free(ctx, &m->base);
+    sfb__free(ctx, m->positions); sfb__free(ctx, m->uvs); sfb__free(ctx, m->face_uvs); sfb__free(ctx, m->face_sizes);
+    sfb__free(ctx, m->crease_vertices); sfb__free(ctx, m->crease_sharpness);
+    sfb__free(ctx, m->corner_vertices); sfb__free(ctx, m->corner_sharpness); sfb__free(ctx, m->holes);
+    sfb__free(ctx, m);
+}
+
+SFB_API void sfb_mesh_get_desc(const sfb_mesh *m, sfb_mesh_desc *d) {
+    if (!d) return;
+    memset(d, 0, sizeof *d);
+    if (!m) return;
+    d->vertex_count = m->base.nv; d->positions = m->positions;
+    d->face_count = m->base.nf; d->face_sizes = m->face_sizes; d->face_vertices = m->base.fv;
+    d->crease_count = m->crease_count; d->crease_vertices = m->crease_vertices; d->crease_sharpness = m->crease_sharpness;
+    d->corner_count = m->corner_count; d->corner_vertices = m->corner_vertices; d->corner_sharpness = m->corner_sharpness;
+    d->hole_count = m->hole_count; d->holes = m->holes;
+    d->uv_count = m->uv_count; d->uvs = m->uvs; d->face_uvs = m->face_uvs;
+    d->boundary = m->boundary; d->crease_method = m->crease_method;
+    d->triangle_rule = m->triangle_rule; d->uv_interp = m->uv_interp;
+}
+
+SFB_API void sfb_mesh_get_info(const sfb_mesh *m, sfb_mesh_info *o) {
+    const sfb__level *l;
+    sfb__level prep;
+    int v, e, f, c;
+    if (!o) return;
+    memset(o, 0, sizeof *o);
+    if (!m) return;
+    l = &m->base;
+    o->vertex_count = l->nv; o->face_count = l->nf; o->edge_count = l->ne; o->face_vertex_count = l->nfv;
+    o->uv_count = m->uv_count;
+    for (f = 0; f < l->nf; ++f) {
+        int n = l->fv_off[f + 1] - l->fv_off[f];
+        if (n == 3) o->triangles++; else if (n == 4) o->quads++; else o->ngons++;
+        if (n > o->max_face_size) o->max_face_size = n;
+        o->holes += l->fhole[f] != 0;
+    }
+    for (e = 0; e < l->ne; ++e) {
+        if (l->etag[e] & SFB__TAG_BOUNDARY) o->boundary_edges++;
+        if (l->etag[e] & SFB__TAG_NONMANIFOLD) o->nonmanifold_edges++;
+        if (l->es[e] > 0.0f) {
+            o->sharp_edges++;
+            if (l->es[e] >= SFB_SHARPNESS_INFINITE) o->infsharp_edges++; else o->semisharp_edges++;
+        }
+    }
+    for (c = 0; c < 3; ++c) { o->bbox_min[c] = l->nv ? 3.4e38f : 0.0f; o->bbox_max[c] = l->nv ? -3.4e38f : 0.0f; }
+    for (v = 0; v < l->nv; ++v) {
+        int k = l->vf_off[v + 1] - l->vf_off[v], d = l->ve_off[v + 1] - l->ve_off[v];
+        if (l->vtag[v] & SFB__TAG_BOUNDARY) o->boundary_vertices++;
+        if (l->vtag[v] & SFB__TAG_NONMANIFOLD) { if (k == 0) o->bare_vertices++; else o->nonmanifold_vertices++; }
+        if (l->vs[v] > 0.0f) o->corners++;
+        if (d > o->max_valence) o->max_valence = d;
+        if (!(l->vtag[v] & SFB__TAG_NONMANIFOLD)) {
+            if (l->vtag[v] & SFB__TAG_BOUNDARY) {
+                o->extraordinary_catmark += k != 2 && k != 1;
+                o->extraordinary_loop += k != 3 && k != 1;
+            } else {
+                o->extraordinary_catmark += k != 4;
+                o->extraordinary_loop += k != 6;
+            }
+        }
+        for (c = 0; c < 3; ++c) {
+            float x = m->positions[3 * (size_t)v + c];
+            if (x < o->bbox_min[c]) o->bbox_min[c] = x;
+            if (x > o->bbox_max[c]) o->bbox_max[c] = x;
+        }
+    }
+    /* vertex rules as refinement will see them (after boundary sharpening) */
+    if (sfb__level_prepare(m->ctx, l, m->boundary, m->boundary == SFB_BOUNDARY_EDGE_AND_CORNER, 0, &prep) == SFB_SUCCESS) {
+        for (v = 0; v < prep.nv; ++v) {
+            o->darts += prep.vrule[v] == SFB__RULE_DART;
+            o->crease_vertices += prep.vrule[v] == SFB__RULE_CREASE;
+            o->corner_vertices += prep.vrule[v] == SFB__RULE_CORNER && prep.ve_off[v + 1] > prep.ve_off[v];
+        }
+        sfb__level_free(m->ctx, &prep);
+    }
+}
+
+SFB_API int sfb_mesh_valence_histogram(const sfb_mesh *m, int *counts, int max_valence) {
+    int v, over = 0;
+    if (!m || !counts || max_valence <= 0) return 0;
+    memset(counts, 0, sizeof(int) * (size_t)max_valence);
+    for (v = 0; v < m->base.nv; ++v) {
+        int d = m->base.ve_off[v + 1] - m->base.ve_off[v];
+        if (d < max_valence) counts[d]++; else over++;
+    }
+    return over;
+}
+#line 1 "src/obj.c"
+/* OBJ reader (from memory) and writer: v/vt/vn/f, OpenSubdiv's `t` tags, seed 001's fs/as.
+ *
+ * Choices where the formats are loose:
+ * - `fs s0 s1 ...` applies to the face on the line before it; value i is the sharpness of the
+ *   edge from the face's vertex i to vertex i+1 in the order the face lists them (seed 001 says
+ *   "clockwise order" without naming the first edge; we follow the face's own order).
+ * - `as n s0 s1 ...` gives the same values to each of the next n faces (seed 001); each of those
+ *   faces must have as many edges as values. Where two faces disagree on an edge the highest
+ *   value wins. `as` counting past the last face is an error.
+ * - Faces either all carry vt indices or none does; otherwise the UVs are dropped (logged).
+ * - `t crease` with more than two vertices is a chain of edges; one value applies to all, or
+ *   one value per edge. Hierarchical edits (vertexedit, edgeedit, faceedit) and unknown tags are
+ *   ignored with a warning, as OpenSubdiv 3 does.
+ */
+
+typedef struct sfb__vec {
+    void *p;
+    size_t n, cap, elem;
+} sfb__vec;
+
+static int sfb__vec_push(sfb_context *ctx, sfb__vec *v, const void *x) {
+    if (v->n == v->cap) {
+        size_t cap = v->cap ? v->cap * 2 : 64;
+        void *np;
+        if (cap > SFB_MAX_ELEMENTS * (size_t)2) return 0;
+        np = sfb__realloc(ctx, v->p, cap * v->elem);
+        if (!np) return 0;
+        v->p = np;
+        v->cap = cap;
+    }
+    memcpy((char *)v->p + v->n * v->elem, x, v->elem);
+    v->n++;
+    return 1;
+}
+
+typedef struct sfb__objp {
+    sfb_context *ctx;
+    long line;
+    sfb__vec pos, uv, fsize, fv, fuv, fline, fsharp, cv, cs, cline, kv, ks, kline, holes, hline;
+    int faces_with_uv, faces_without_uv, any_fsharp;
+    int boundary, crease_method, triangle_rule;
+    /* pending `as` */
+    long as_left, as_line;
+    float *as_vals;
+    int as_count;
+} sfb__objp;
+
+static sfb_result sfb__perr(sfb__objp *P, sfb_result r, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+static sfb_result sfb__perr(sfb__objp *P, sfb_result r, const char *fmt, ...) {
+    char body[600];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(body, sizeof body, fmt, ap);
+    va_end(ap);
+    return sfb__error(P->ctx, r, SFB_ELEMENT_LINE, P->line, "%s", body);
+}
+
+static int sfb__next_tok(const char **cur, const char *end, const char **tok, size_t *len) {
+    const char *c = *cur;
+    while (c < end && (*c == ' ' || *c == '\t')) ++c;
+    if (c >= end || *c == '#') { *cur = end; return 0; }
+    *tok = c;
+    while (c < end && *c != ' ' && *c != '\t') ++c;
+    *len = (size_t)(c - *tok);
+    *cur = c;
+    return 1;
+}
+
+static int sfb__tok_eq(const char *t, size_t n, const char *s) { return strlen(s) == n && memcmp(t, s, n) == 0; }
+
+/* 0 ok, 1 not a number, 2 not finite */
+static int sfb__parse_double(const char *t, size_t n, double *out) {
+    char buf[72];
+    char *endp;
+    double x;
+    if (n == 0 || n >= sizeof buf) return 1;
+    memcpy(buf, t, n);
+    buf[n] = 0;
+    if (!((buf[0] >= '0' && buf[0] <= '9') || buf[0] == '-' || buf[0] == '+' || buf[0] == '.' || buf[0] == 'n' ||
+          buf[0] == 'N' || buf[0] == 'i' || buf[0] == 'I'))
+        return 1;
+    x = strtod(buf, &endp);
+    if (*endp != 0 || endp == buf) return 1;
+    *out = x;
+    if (!isfinite(x) || fabs(x) > 3.4028234663852886e38) return 2;
+    return 0;
+}
+
+static sfb_result sfb__tok_float(sfb__objp *P, const char *t, size_t n, const char *what, float *out) {
+    double x;
+    int r = sfb__parse_double(t, n, &x);
+    if (r == 1) return sfb__perr(P, SFB_PARSE_ERROR, "expected a number for %s, got '%.*s'", what, (int)(n > 40 ? 40 : n), t);
+    if (r == 2) return sfb__perr(P, SFB_INVALID_VALUE, "%s '%.*s' is not a finite number (NaN or inf)", what, (int)(n > 40 ? 40 : n), t);
+    *out = (float)x;
+    return SFB_SUCCESS;
+}
+
+static sfb_result sfb__tok_sharpness(sfb__objp *P, const char *t, size_t n, float *out) {
+    double x;
+    int r = sfb__parse_double(t, n, &x);
+    if (r == 1) return sfb__perr(P, SFB_PARSE_ERROR, "expected a sharpness number, got '%.*s'", (int)(n > 40 ? 40 : n), t);
+    if (isnan(x) || x < 0.0)
+        return sfb__perr(P, SFB_INVALID_VALUE, "sharpness '%.*s' is invalid: sharpness must be a number >= 0", (int)(n > 40 ? 40 : n), t);
+    *out = x >= SFB_SHARPNESS_INFINITE ? SFB_SHARPNESS_INFINITE : (float)x;
+    return SFB_SUCCESS;
+}
+
+/* Parses a decimal integer; 0 ok, 1 malformed, 2 overflow. Stops at '/' or the end. */
+static int sfb__parse_int(const char **c, const char *end, long *out) {
+    const char *p = *c;
+    int neg = 0;
+    long v = 0;
+    if (p < end && (*p == '-' || *p == '+')) { neg = *p == '-'; ++p; }
+    if (p >= end || *p < '0' || *p > '9') return 1;
+    while (p < end && *p >= '0' && *p <= '9') {
+        v = v * 10 + (*p - '0');
+        if (v > 0x7fffffffL) return 2;
+        ++p;
+    }
+    *c = p;
+    *out = neg ? -v : v;
+    return 0;
+}
+
+static sfb_result sfb__tok_int(sfb__objp *P, const char *t, size_t n, const char *what, long *out) {
+    const char *c = t;
+    int r = sfb__parse_int(&c, t + n, out);
+    if (r == 1 || c != t + n) return sfb__perr(P, SFB_PARSE_ERROR, "expected an integer for %s, got '%.*s'", what, (int)(n > 40 ? 40 : n), t);
+    if (r == 2) return sfb__perr(P, SFB_LIMIT_EXCEEDED, "%s '%.*s' is too large", what, (int)(n > 40 ? 40 : n), t);
+    return SFB_SUCCESS;
+}
+
+/* Resolves an OBJ index (1-based or negative relative) against `count` elements so far. */
+static sfb_result sfb__resolve(sfb__objp *P, long idx, size_t count, const char *what, int *out) {
+    if (idx == 0) return sfb__perr(P, SFB_INVALID_TOPOLOGY, "%s index 0 is invalid (OBJ indices start at 1)", what);
+    if (idx < 0) idx = (long)count + idx;
+    else idx = idx - 1;
+    if (idx < 0 || (size_t)idx >= count)
+        return sfb__perr(P, SFB_INVALID_TOPOLOGY, "%s index out of range (%zu %ss defined so far)", what, count, what);
+    *out = (int)idx;
+    return SFB_SUCCESS;
+}
+
+#define SFB__PUSH(vec, val) do { if (!sfb__vec_push(P->ctx, &(vec), &(val))) return sfb__oom(P->ctx, "OBJ reader"); } while (0)
+
+static sfb_result sfb__obj_face(sfb__objp *P, const char *cur, const char *end) {
+    const char *t;
+    size_t n;
+    int count = 0, has_uv = -1, line = (int)P->line;
+    size_t first = P->fv.n;
+    sfb_result r;
+    while (sfb__next_tok(&cur, end, &t, &n)) {
+        const char *c = t, *te = t + n;
+        long a, b = 0;
+        int vi, ti = -1, this_uv = 0, pr;
+        pr = sfb__parse_int(&c, te, &a);
+        if (pr == 1) return sfb__perr(P, SFB_PARSE_ERROR, "malformed face index '%.*s'", (int)(n > 40 ? 40 : n), t);
+        if (pr == 2) return sfb__perr(P, SFB_INVALID_TOPOLOGY, "vertex index '%.*s' out of range", (int)(n > 40 ? 40 : n), t);
+        if (c < te) {
+            if (*c != '/') return sfb__perr(P, SFB_PARSE_ERROR, "malformed face index '%.*s'", (int)(n > 40 ? 40 : n), t);
+            ++c;
+            if (c < te && *c != '/') {
+                pr = sfb__parse_int(&c, te, &b);
+                if (pr == 1) return sfb__perr(P, SFB_PARSE_ERROR, "malformed uv index in '%.*s'", (int)(n > 40 ? 40 : n), t);
+                if (pr == 2) return sfb__perr(P, SFB_INVALID_TOPOLOGY, "uv index in '%.*s' out of range", (int)(n > 40 ? 40 : n), t);
+                this_uv = 1;
+            } else if (c >= te) {
+                return sfb__perr(P, SFB_PARSE_ERROR, "truncated face index '%.*s'", (int)(n > 40 ? 40 : n), t);
+            }
+            if (c < te) {
+                long nn;
+                if (*c != '/') return sfb__perr(P, SFB_PARSE_ERROR, "malformed face index '%.*s'", (int)(n > 40 ? 40 : n), t);
+                ++c;
+                pr = sfb__parse_int(&c, te, &nn);
+                if (pr != 0 || c != te) return sfb__perr(P, SFB_PARSE_ERROR, "malformed normal index in '%.*s'", (int)(n > 40 ? 40 : n), t);
+            }
+        }
+        r = sfb__resolve(P, a, P->pos.n / 3, "vertex", &vi);
+        if (r != SFB_SUCCESS) return r;
+        if (this_uv) {
+            r = sfb__resolve(P, b, P->uv.n / 2, "uv", &ti);
+            if (r != SFB_SUCCESS) return r;
+        }
+        if (has_uv < 0) has_uv = this_uv;
+        else if (has_uv != this_uv) return sfb__perr(P, SFB_PARSE_ERROR, "face mixes corners with and without uv indices");
+        if (count >= SFB_MAX_FACE_SIZE)
+            return sfb__perr(P, SFB_LIMIT_EXCEEDED, "face has more than %d vertices (SFB_MAX_FACE_SIZE)", SFB_MAX_FACE_SIZE);
+        SFB__PUSH(P->fv, vi);
+        SFB__PUSH(P->fuv, ti);
+        count++;
+    }
+    if (count < 3) return sfb__perr(P, SFB_INVALID_TOPOLOGY, "face has %d vertices; a face needs at least 3", count);
+    SFB__PUSH(P->fsize, count);
+    SFB__PUSH(P->fline, line);
+    if (has_uv) P->faces_with_uv++; else P->faces_without_uv++;
+    {
+        float zero = 0.0f;
+        int i;
+        for (i = 0; i < count; ++i) SFB__PUSH(P->fsharp, zero);
+    }
+    if (P->as_left > 0) {
+        int i;
+        if (P->as_count != count)
+            return sfb__perr(P, SFB_PARSE_ERROR, "face has %d edges but the 'as' on line %ld gives %d sharpness values", count,
+                             P->as_line, P->as_count);
+        for (i = 0; i < count; ++i) {
+            float *fs = (float *)P->fsharp.p + first + i;
+            if (P->as_vals[i] > *fs) *fs = P->as_vals[i];
+        }
+        P->any_fsharp = 1;
+        P->as_left--;
+    }
+    return SFB_SUCCESS;
+}
+
+static sfb_result sfb__obj_tag(sfb__objp *P, const char *cur, const char *end) {
+    const char *t, *name;
+    size_t n, nn;
+    long ni, nf, ns, i;
+    long ints[64];
+    float flts[64];
+    const char *strs[4];
+    size_t strl[4];
+    long *iv = ints;
+    float *fv = flts;
+    sfb_result r = SFB_SUCCESS;
+    if (!sfb__next_tok(&cur, end, &name, &nn)) return sfb__perr(P, SFB_PARSE_ERROR, "'t' line without a tag name");
+    if (!sfb__next_tok(&cur, end, &t, &n)) return sfb__perr(P, SFB_PARSE_ERROR, "tag '%.*s' lacks its argument counts", (int)(nn > 40 ? 40 : nn), name);
+    {
+        const char *c = t, *te = t + n;
+        if (sfb__parse_int(&c, te, &ni) || c >= te || *c++ != '/' || sfb__parse_int(&c, te, &nf) || c >= te || *c++ != '/' ||
+            sfb__parse_int(&c, te, &ns) || c != te || ni < 0 || nf < 0 || ns < 0)
+            return sfb__perr(P, SFB_PARSE_ERROR, "tag '%.*s' has malformed argument counts '%.*s' (expected i/f/s)",
+                             (int)(nn > 40 ? 40 : nn), name, (int)(n > 40 ? 40 : n), t);
+    }
+    if (sfb__tok_eq(name, nn, "vertexedit") || sfb__tok_eq(name, nn, "edgeedit") || sfb__tok_eq(name, nn, "faceedit")) {
+        sfb__log(P->ctx, SFB_LOG_WARN, "line %ld: hierarchical edit '%.*s' ignored (not supported)", P->line, (int)nn, name);
+        return SFB_SUCCESS;
+    }
+    if (ni > 1000000 || nf > 1000000 || ns > 1000000)
+        return sfb__perr(P, SFB_LIMIT_EXCEEDED, "tag '%.*s' declares too many arguments", (int)(nn > 40 ? 40 : nn), name);
+    if (ni > 64) iv = (long *)sfb__alloc(P->ctx, (size_t)ni * sizeof(long));
+    if (nf > 64) fv = (float *)sfb__alloc(P->ctx, (size_t)nf * sizeof(float));
+    if (!iv || !fv) { r = sfb__oom(P->ctx, "OBJ reader"); goto out; }
+    for (i = 0; i < ni; ++i) {
+        if (!sfb__next_tok(&cur, end, &t, &n)) { r = sfb__perr(P, SFB_PARSE_ERROR, "tag '%.*s' declares %ld integers but the line has fewer values", (int)(nn > 40 ? 40 : nn), name, ni); goto out; }
+        r = sfb__tok_int(P, t, n, "tag argument", &iv[i]);
+        if (r) goto out;
+    }
+    for (i = 0; i < nf; ++i) {
+        if (!sfb__next_tok(&cur, end, &t, &n)) { r = sfb__perr(P, SFB_PARSE_ERROR, "tag '%.*s' declares %ld floats but the line has fewer values", (int)(nn > 40 ? 40 : nn), name, nf); goto out; }
+        r = sfb__tok_sharpness(P, t, n, &fv[i]);
+        if (r) goto out;
+    }
+    for (i = 0; i < ns; ++i) {
+        if (!sfb__next_tok(&cur, end, &t, &n)) { r = sfb__perr(P, SFB_PARSE_ERROR, "tag '%.*s' declares %ld strings but the line has fewer values", (int)(nn > 40 ? 40 : nn), name, ns); goto out; }
+        if (i < 4) { strs[i] = t; strl[i] = n; }
+    }
+    if (sfb__next_tok(&cur, end, &t, &n)) { r = sfb__perr(P, SFB_PARSE_ERROR, "tag '%.*s' has more values than its counts declare", (int)(nn > 40 ? 40 : nn), name); goto out; }
+    if (sfb__tok_eq(name, nn, "crease")) {
+        if (ni < 2 || !(nf == 1 || nf == ni - 1)) { r = sfb__perr(P, SFB_PARSE_ERROR, "crease needs at least 2 vertices and 1 sharpness (or one per edge)"); goto out; }
+        for (i = 0; i + 1 < ni; ++i) {
+            int a = (int)iv[i], b = (int)iv[i + 1], ln = (int)P->line;
+            float s = fv[nf == 1 ? 0 : i];
+            if (iv[i] < 0 || iv[i + 1] < 0) { r = sfb__perr(P, SFB_INVALID_TOPOLOGY, "crease vertex index %ld out of range", iv[i] < 0 ? iv[i] : iv[i + 1]); goto out; }
+            if (!sfb__vec_push(P->ctx, &P->cv, &a) || !sfb__vec_push(P->ctx, &P->cv, &b) || !sfb__vec_push(P->ctx, &P->cs, &s) ||
+                !sfb__vec_push(P->ctx, &P->cline, &ln)) { r = sfb__oom(P->ctx, "OBJ reader"); goto out; }
+        }
+    } else if (sfb__tok_eq(name, nn, "corner")) {
+        if (ni < 1 || !(nf == 1 || nf == ni)) { r = sfb__perr(P, SFB_PARSE_ERROR, "corner needs vertices and 1 sharpness (or one per vertex)"); goto out; }
+        for (i = 0; i < ni; ++i) {
+            int a = (int)iv[i], ln = (int)P->line;
+            float s = fv[nf == 1 ? 0 : i];
+            if (iv[i] < 0) { r = sfb__perr(P, SFB_INVALID_TOPOLOGY, "corner vertex index %ld out of range", iv[i]); goto out; }
+            if (!sfb__vec_push(P->ctx, &P->kv, &a) || !sfb__vec_push(P->ctx, &P->ks, &s) || !sfb__vec_push(P->ctx, &P->kline, &ln)) {
+                r = sfb__oom(P->ctx, "OBJ reader"); goto out;
+            }
+        }
+    } else if (sfb__tok_eq(name, nn, "hole")) {
+        for (i = 0; i < ni; ++i) {
+            int a = (int)iv[i], ln = (int)P->line;
+            if (iv[i] < 0) { r = sfb__perr(P, SFB_INVALID_TOPOLOGY, "hole face index %ld out of range", iv[i]); goto out; }
+            if (!sfb__vec_push(P->ctx, &P->holes, &a) || !sfb__vec_push(P->ctx, &P->hline, &ln)) { r = sfb__oom(P->ctx, "OBJ reader"); goto out; }
+        }
+    } else if (sfb__tok_eq(name, nn, "interpolateboundary")) {
+        if (ni != 1) { r = sfb__perr(P, SFB_PARSE_ERROR, "interpolateboundary needs one integer"); goto out; }
+        if (iv[0] == 0) P->boundary = SFB_BOUNDARY_NONE;
+        else if (iv[0] == 1) P->boundary = SFB_BOUNDARY_EDGE_AND_CORNER;
+        else if (iv[0] == 2) P->boundary = SFB_BOUNDARY_EDGE_ONLY;
+        else { r = sfb__perr(P, SFB_INVALID_VALUE, "interpolateboundary value %ld is not 0, 1 or 2", iv[0]); goto out; }
+    } else if (sfb__tok_eq(name, nn, "creasemethod")) {
+        if (ns != 1) { r = sfb__perr(P, SFB_PARSE_ERROR, "creasemethod needs one string"); goto out; }
+        if (sfb__tok_eq(strs[0], strl[0], "chaikin")) P->crease_method = SFB_CREASE_CHAIKIN;
+        else if (sfb__tok_eq(strs[0], strl[0], "uniform") || sfb__tok_eq(strs[0], strl[0], "normal")) P->crease_method = SFB_CREASE_UNIFORM;
+        else { r = sfb__perr(P, SFB_INVALID_VALUE, "creasemethod '%.*s' is not chaikin, uniform or normal", (int)(strl[0] > 40 ? 40 : strl[0]), strs[0]); goto out; }
+    } else if (sfb__tok_eq(name, nn, "smoothtriangles")) {
+        if (ns != 1) { r = sfb__perr(P, SFB_PARSE_ERROR, "smoothtriangles needs one string"); goto out; }
+        if (sfb__tok_eq(strs[0], strl[0], "smooth")) P->triangle_rule = SFB_TRI_SMOOTH;
+        else if (sfb__tok_eq(strs[0], strl[0], "catmark")) P->triangle_rule = SFB_TRI_CATMARK;
+        else { r = sfb__perr(P, SFB_INVALID_VALUE, "smoothtriangles '%.*s' is not smooth or catmark", (int)(strl[0] > 40 ? 40 : strl[0]), strs[0]); goto out; }
+    } else {
+        sfb__log(P->ctx, SFB_LOG_WARN, "line %ld: tag '%.*s' ignored", P->line, (int)(nn > 40 ? 40 : nn), name);
+    }
+out:
+    if (iv != ints) sfb__free(P->ctx, iv);
+    if (fv != flts) sfb__free(P->ctx, fv);
+    return r;
+}
+
+static const char *const sfb__obj_ignored[] = {"o", "g", "s", "usemtl", "mtllib", "l", "p", "vp", "cstype", "deg", "bmat",
+                                               "step", "curv", "curv2", "surf", "parm", "trim", "end", "con", "mg", "lod",
+                                               "maplib", "usemap", "shadow_obj", "trace_obj", "ctech", "stech", "bevel",
+                                               "c_interp", "d_interp", "sp", "scrv", NULL};
+
+static sfb_result sfb__obj_line(sfb__objp *P, const char *cur, const char *end) {
+    const char *kw, *t;
+    size_t kn, n;
+    sfb_result r;
+    if (!sfb__next_tok(&cur, end, &kw, &kn)) return SFB_SUCCESS;
+    if (sfb__tok_eq(kw, kn, "v")) {
+        float x[3];
+        int i;
+        for (i = 0; i < 3; ++i) {
+            if (!sfb__next_tok(&cur, end, &t, &n)) return sfb__perr(P, SFB_PARSE_ERROR, "vertex needs 3 coordinates, got %d", i);
+            r = sfb__tok_float(P, t, n, "vertex coordinate", &x[i]);
+            if (r) return r;
+        }
+        while (sfb__next_tok(&cur, end, &t, &n)) { /* w or vertex colour: must be numbers */
+            float dummy;
+            r = sfb__tok_float(P, t, n, "vertex value", &dummy);
+            if (r) return r;
+        }
+        if (P->pos.n / 3 >= SFB_MAX_ELEMENTS) return sfb__perr(P, SFB_LIMIT_EXCEEDED, "too many vertices");
+        for (i = 0; i < 3; ++i) SFB__PUSH(P->pos, x[i]);
+        return SFB_SUCCESS;
+    }
+    if (sfb__tok_eq(kw, kn, "vt")) {
+        float x[2];
+        int i;
+        for (i = 0; i < 2; ++i) {
+            if (!sfb__next_tok(&cur, end, &t, &n)) return sfb__perr(P, SFB_PARSE_ERROR, "texture coordinate needs 2 values, got %d", i);
+            r = sfb__tok_float(P, t, n, "texture coordinate", &x[i]);
+            if (r) return r;
+        }
+        if (sfb__next_tok(&cur, end, &t, &n)) {
+            float dummy;
+            r = sfb__tok_float(P, t, n, "texture coordinate", &dummy);
+            if (r) return r;
+        }
+        for (i = 0; i < 2; ++i) SFB__PUSH(P->uv, x[i]);
+        return SFB_SUCCESS;
+    }
+    if (sfb__tok_eq(kw, kn, "vn")) return SFB_SUCCESS; /* normals are recomputed from the surface */
+    if (sfb__tok_eq(kw, kn, "f")) return sfb__obj_face(P, cur, end);
+    if (sfb__tok_eq(kw, kn, "t")) return sfb__obj_tag(P, cur, end);
+    if (sfb__tok_eq(kw, kn, "fs")) {
+        size_t nfaces = P->fsize.n, first;
+        int fsz, i = 0;
+        if (nfaces == 0) return sfb__perr(P, SFB_PARSE_ERROR, "'fs' before any face");
+        fsz = ((int *)P->fsize.p)[nfaces - 1];
+        first = P->fv.n - (size_t)fsz;
+        while (sfb__next_tok(&cur, end, &t, &n)) {
+            float s;
+            if (i >= fsz) return sfb__perr(P, SFB_PARSE_ERROR, "'fs' has more values than the face's %d edges", fsz);
+            r = sfb__tok_sharpness(P, t, n, &s);
+            if (r) return r;
+            if (s > ((float *)P->fsharp.p)[first + i]) ((float *)P->fsharp.p)[first + i] = s;
+            ++i;
+        }
+        if (i != fsz) return sfb__perr(P, SFB_PARSE_ERROR, "'fs' has %d values but the face has %d edges", i, fsz);
+        P->any_fsharp = 1;
+        return SFB_SUCCESS;
+    }
+    if (sfb__tok_eq(kw, kn, "as")) {
+        long cnt;
+        int k = 0;
+        if (P->as_left > 0)
+            return sfb__perr(P, SFB_PARSE_ERROR, "'as' starts before the 'as' on line %ld covered its faces", P->as_line);
+        if (!sfb__next_tok(&cur, end, &t, &n)) return sfb__perr(P, SFB_PARSE_ERROR, "'as' needs a face count");
+        r = sfb__tok_int(P, t, n, "'as' face count", &cnt);
+        if (r) return r;
+        if (cnt <= 0) return sfb__perr(P, SFB_PARSE_ERROR, "'as' face count %ld must be positive", cnt);
+        if (!P->as_vals) {
+            P->as_vals = (float *)sfb__alloc(P->ctx, SFB_MAX_FACE_SIZE * sizeof(float));
+            if (!P->as_vals) return sfb__oom(P->ctx, "OBJ reader");
+        }
+        while (sfb__next_tok(&cur, end, &t, &n)) {
+            if (k >= SFB_MAX_FACE_SIZE) return sfb__perr(P, SFB_LIMIT_EXCEEDED, "'as' has more than %d values", SFB_MAX_FACE_SIZE);
+            r = sfb__tok_sharpness(P, t, n, &P->as_vals[k]);
+            if (r) return r;
+            ++k;
+        }
+        if (k < 3) return sfb__perr(P, SFB_PARSE_ERROR, "'as' needs one sharpness per face edge (at least 3), got %d", k);
+        P->as_left = cnt;
+        P->as_line = P->line;
+        P->as_count = k;
+        return SFB_SUCCESS;
+    }
+    {
+        int i;
+        for (i = 0; sfb__obj_ignored[i]; ++i)
+            if (sfb__tok_eq(kw, kn, sfb__obj_ignored[i])) return SFB_SUCCESS;
+    }
+    return sfb__perr(P, SFB_PARSE_ERROR, "unknown statement '%.*s'", (int)(kn > 24 ? 24 : kn), kw);
+}
+
+static void sfb__objp_free(sfb__objp *P) {
+    sfb__vec *vs[] = {&P->pos, &P->uv, &P->fsize, &P->fv, &P->fuv, &P->fline, &P->fsharp, &P->cv, &P->cs, &P->cline,
+                      &P->kv, &P->ks, &P->kline, &P->holes, &P->hline};
+    size_t i;
+    for (i = 0; i < sizeof vs / sizeof vs[0]; ++i) sfb__free(P->ctx, vs[i]->p);
+    sfb__free(P->ctx, P->as_vals);
+}
+
+SFB_API sfb_result sfb_mesh_read_obj(sfb_context *ctx, const char *text, size_t size, sfb_mesh **out) {
+    sfb__objp P;
+    const char *c, *end;
+    sfb_result r = SFB_SUCCESS;
+    if (!ctx) return SFB_INVALID_ARGS;
+    if (!out || (!text && size)) return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "sfb_mesh_read_obj: NULL argument");
+    *out = NULL;
+    memset(&P, 0, sizeof P);
+    P.ctx = ctx;
+    P.pos.elem = sizeof(float); P.uv.elem = sizeof(float); P.fsize.elem = sizeof(int); P.fv.elem = sizeof(int);
+    P.fuv.elem = sizeof(int); P.fline.elem = sizeof(int); P.fsharp.elem = sizeof(float); P.cv.elem = sizeof(int);
+    P.cs.elem = sizeof(float); P.cline.elem = sizeof(int); P.kv.elem = sizeof(int); P.ks.elem = sizeof(float);
+    P.kline.elem = sizeof(int); P.holes.elem = sizeof(int); P.hline.elem = sizeof(int);
+    c = text;
+    end = text + size;
+    while (c < end && r == SFB_SUCCESS) {
+        const char *le = (const char *)memchr(c, '\n', (size_t)(end - c)), *q;
+        const char *next = le ? le + 1 : end;
+        if (!le) le = end;
+        P.line++;
+        if (le > c && le[-1] == '\r') --le;
+        for (q = c; q < le; ++q) {
+            unsigned char ch = (unsigned char)*q;
+            if (ch == 0 || (ch < 32 && ch != '\t') || ch == 127) {
+                r = sfb__perr(&P, SFB_PARSE_ERROR, "binary data (byte 0x%02x) in text", ch);
+                break;
+            }
+        }
+        if (r == SFB_SUCCESS) r = sfb__obj_line(&P, c, le);
+        if ((P.line & 0xffff) == 0 && r == SFB_SUCCESS) r = sfb__progress(ctx, (float)(c - text) / (float)size, "read OBJ");
+        c = next;
+    }
+    if (r == SFB_SUCCESS && P.as_left > 0) {
+        P.line = P.as_line;
+        r = sfb__perr(&P, SFB_PARSE_ERROR, "'as' covers %ld more faces than the file has", P.as_left);
+    }
+    if (r == SFB_SUCCESS) {
+        sfb_mesh_desc d;
+        sfb__src_lines lines;
+        memset(&d, 0, sizeof d);
+        d.vertex_count = (int)(P.pos.n / 3);
+        d.positions = (const float *)P.pos.p;
+        d.face_count = (int)P.fsize.n;
+        d.face_sizes = (const int *)P.fsize.p;
+        d.face_vertices = (const int *)P.fv.p;
+        d.crease_count = (int)P.cs.n;
+        d.crease_vertices = (const int *)P.cv.p;
+        d.crease_sharpness = (const float *)P.cs.p;
+        d.corner_count = (int)P.ks.n;
+        d.corner_vertices = (const int *)P.kv.p;
+        d.corner_sharpness = (const float *)P.ks.p;
+        d.hole_count = (int)P.holes.n;
+        d.holes = (const int *)P.holes.p;
+        if (P.faces_with_uv > 0 && P.faces_without_uv == 0 && P.uv.n > 0) {
+            d.uv_count = (int)(P.uv.n / 2);
+            d.uvs = (const float *)P.uv.p;
+            d.face_uvs = (const int *)P.fuv.p;
+        } else if (P.faces_with_uv > 0) {
+            sfb__log(ctx, SFB_LOG_WARN, "OBJ: %d faces have uv indices and %d do not; uvs dropped", P.faces_with_uv, P.faces_without_uv);
+        }
+        d.face_edge_sharpness = P.any_fsharp ? (const float *)P.fsharp.p : NULL;
+        d.boundary = P.boundary;
+        d.crease_method = P.crease_method;
+        d.triangle_rule = P.triangle_rule;
+        lines.face = (const int *)P.fline.p;
+        lines.crease = (const int *)P.cline.p;
+        lines.corner = (const int *)P.kline.p;
+        lines.hole = (const int *)P.hline.p;
+        if (d.face_count == 0) r = sfb__error(ctx, SFB_INVALID_TOPOLOGY, SFB_ELEMENT_NONE, -1, "OBJ has no faces (line %ld is the last)", P.line);
+        else r = sfb__mesh_create(ctx, &d, &lines, out);
+    }
+    sfb__objp_free(&P);
+    return r;
+}
+
+/* ---- writer ---- */
+typedef struct sfb__wbuf {
+    sfb_write_fn fn;
+    void *user;
+    char buf[8192];
+    size_t n;
+    int failed;
+} sfb__wbuf;
+
+static void sfb__wflush(sfb__wbuf *w) {
+    if (w->n && !w->failed && w->fn(w->buf, w->n, w->user)) w->failed = 1;
+    w->n = 0;
+}
+
+static void sfb__wprintf(sfb__wbuf *w, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 2, 3)))
+#endif
+    ;
+static void sfb__wprintf(sfb__wbuf *w, const char *fmt, ...) {
+    va_list ap;
+    int k;
+    if (w->n > sizeof w->buf - 256) sfb__wflush(w);
+    va_start(ap, fmt);
+    k = vsnprintf(w->buf + w->n, sizeof w->buf - w->n, fmt, ap);
+    va_end(ap);
+    if (k > 0 && (size_t)k < sizeof w->buf - w->n) w->n += (size_t)k;
+}
+
+SFB_API sfb_result sfb_write_obj(const sfb_mesh_desc *d, sfb_write_fn write, void *user) {
+    sfb__wbuf wb, *w = &wb; /* on the stack: the writer has no context, so no allocator */
+    int i, f, o = 0;
+    static const int osd_boundary[3] = {2, 1, 0}; /* our enum -> OpenSubdiv's interpolateboundary */
+    sfb_result r = SFB_SUCCESS;
+    if (!d || !write || d->vertex_count < 0 || d->face_count < 0 || (d->vertex_count && !d->positions) ||
+        (d->face_count && (!d->face_sizes || !d->face_vertices)))
+        return SFB_INVALID_ARGS;
+    w->fn = write; w->user = user; w->n = 0; w->failed = 0;
+    sfb__wprintf(w, "# surfblend OBJ: %d vertices, %d faces\n", d->vertex_count, d->face_count);
+    for (i = 0; i < d->vertex_count; ++i)
+        sfb__wprintf(w, "v %.9g %.9g %.9g\n", d->positions[3 * i], d->positions[3 * i + 1], d->positions[3 * i + 2]);
+    for (i = 0; i < d->uv_count; ++i) sfb__wprintf(w, "vt %.9g %.9g\n", d->uvs[2 * i], d->uvs[2 * i + 1]);
+    for (f = 0; f < d->face_count; ++f) {
+        int n = d->face_sizes[f], any = 0;
+        if (n < 0 || n > SFB_MAX_FACE_SIZE) { r = SFB_INVALID_ARGS; break; }
+        sfb__wprintf(w, "f");
+        for (i = 0; i < n; ++i) {
+            if (w->n > sizeof w->buf - 64) sfb__wflush(w);
+            if (d->uv_count && d->face_uvs) sfb__wprintf(w, " %d/%d", d->face_vertices[o + i] + 1, d->face_uvs[o + i] + 1);
+            else sfb__wprintf(w, " %d", d->face_vertices[o + i] + 1);
+        }
+        sfb__wprintf(w, "\n");
+        if (d->face_edge_sharpness) {
+            for (i = 0; i < n; ++i) any |= d->face_edge_sharpness[o + i] > 0.0f;
+            if (any) {
+                sfb__wprintf(w, "fs");
+                for (i = 0; i < n; ++i) sfb__wprintf(w, " %.9g", d->face_edge_sharpness[o + i]);
+                sfb__wprintf(w, "\n");
+            }
+        }
+        o += n;
+    }
+    for (i = 0; i < d->crease_count; ++i)
+        sfb__wprintf(w, "t crease 2/1/0 %d %d %.9g\n", d->crease_vertices[2 * i], d->crease_vertices[2 * i + 1], d->crease_sharpness[i]);
+    for (i = 0; i < d->corner_count; ++i)
+        sfb__wprintf(w, "t corner 1/1/0 %d %.9g\n", d->corner_vertices[i], d->corner_sharpness[i]);
+    for (i = 0; i < d->hole_count; ++i) sfb__wprintf(w, "t hole 1/0/0 %d\n", d->holes[i]);
+    if (d->boundary >= 0 && d->boundary <= 2) sfb__wprintf(w, "t interpolateboundary 1/0/0 %d\n", osd_boundary[d->boundary]);
+    if (d->crease_method == SFB_CREASE_CHAIKIN) sfb__wprintf(w, "t creasemethod 0/0/1 chaikin\n");
+    if (d->triangle_rule == SFB_TRI_SMOOTH) sfb__wprintf(w, "t smoothtriangles 0/0/1 smooth\n");
+    sfb__wflush(w);
+    if (r == SFB_SUCCESS && w->failed) r = SFB_IO_ERROR;
+    return r;
+}
+
+SFB_API sfb_result sfb_mesh_write_obj(const sfb_mesh *mesh, sfb_write_fn write, void *user) {
+    sfb_mesh_desc d;
+    if (!mesh) return SFB_INVALID_ARGS;
+    sfb_mesh_get_desc(mesh, &d);
+    return sfb_write_obj(&d, write, user);
+}
+#line 1 "src/surface.c"
+/* Surfaces: compile a mesh into tables once (sfb_surface_create), apply them on the
+ * context's backend as often as needed (sfb_surface_eval_stencils / sfb_surface_refine). */
+
+SFB_API const char *sfb_scheme_name(sfb_scheme s) {
+    switch (s) {
+    case SFB_SCHEME_CATMARK: return "catmark";
+    case SFB_SCHEME_LOOP: return "loop";
+    case SFB_SCHEME_BILINEAR: return "bilinear";
+    case SFB_SCHEME_MANIFOLD_BLEND: return "manifold";
+    case SFB_SCHEME_TRIBEZIER: return "tribezier";
+    default: return "unknown";
+    }
+}
+
+SFB_API sfb_surface_config sfb_surface_config_init(sfb_scheme scheme, int level) {
+    sfb_surface_config c;
+    memset(&c, 0, sizeof c);
+    c.scheme = scheme;
+    c.refine_level = level;
+    return c;
+}
+
+SFB_API void sfb_surface_destroy(sfb_surface *s) {
+    sfb_context *ctx;
+    int t;
+    if (!s) return;
+    ctx = s->ctx;
+    for (t = 0; t < SFB_TABLE_COUNT_; ++t) sfb__stencils_free(ctx, &s->tables[t]);
+    sfb__level_free(ctx, &s->top);
+    sfb__level_free(ctx, &s->uv_top);
+    sfb__free(ctx, s->base_positions);
+    sfb__free(ctx, s->base_uvs);
+    sfb__free(ctx, s);
+}
+
+/* Rough peak bytes of refining `m` to `level`: topology of the last two levels plus composed
+ * stencil rows in double during construction. Used to refuse early, before any allocation
+ * sized by the level. */
+static double sfb__estimate_bytes(const sfb_mesh *m, sfb_scheme scheme, int level, int limit, double *faces_out) {
+    double faces = m->base.nf, verts = m->base.nv;
+    int L;
+    for (L = 0; L < level; ++L) {
+        if (scheme == SFB_SCHEME_LOOP) faces *= 4.0;
+        else faces = (L == 0) ? (double)m->base.nfv : faces * 4.0;
+    }
+    verts = scheme == SFB_SCHEME_LOOP ? faces / 2.0 + 2.0 : faces + 2.0;
+    if (level == 0) verts = m->base.nv;
+    *faces_out = faces;
+    return faces * 4.0 * 40.0 + verts * 16.0 * 12.0 * (limit ? 3.0 : 1.5);
+}
+
+SFB_API sfb_result sfb_surface_create(sfb_context *ctx, const sfb_mesh *mesh, const sfb_surface_config *cfg, sfb_surface **out) {
+    sfb_surface *s;
+    sfb__level prep;
+    sfb__refine_options opt;
+    sfb_result r;
+    double faces, bytes;
+    int f;
+    if (!ctx) return SFB_INVALID_ARGS;
+    if (!mesh || !cfg || !out) return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "sfb_surface_create: NULL argument");
+    *out = NULL;
+    if (cfg->scheme != SFB_SCHEME_CATMARK && cfg->scheme != SFB_SCHEME_LOOP && cfg->scheme != SFB_SCHEME_BILINEAR)
+        return sfb__error(ctx, SFB_UNSUPPORTED, SFB_ELEMENT_NONE, -1, "scheme '%s' cannot be refined uniformly yet", sfb_scheme_name(cfg->scheme));
+    if (cfg->refine_level < 0) return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "refinement level %d is negative", cfg->refine_level);
+    if (cfg->refine_level > SFB_MAX_LEVEL)
+        return sfb__error(ctx, SFB_LIMIT_EXCEEDED, SFB_ELEMENT_NONE, -1, "refinement level %d is over the limit of %d (SFB_MAX_LEVEL)",
+                          cfg->refine_level, SFB_MAX_LEVEL);
+    if (cfg->scheme == SFB_SCHEME_LOOP)
+        for (f = 0; f < mesh->base.nf; ++f)
+            if (mesh->base.fv_off[f + 1] - mesh->base.fv_off[f] != 3)
+                return sfb__error(ctx, SFB_INVALID_TOPOLOGY, SFB_ELEMENT_FACE, f, "Loop subdivision needs triangles; this face has %d vertices",
+                                  mesh->base.fv_off[f + 1] - mesh->base.fv_off[f]);
+    bytes = sfb__estimate_bytes(mesh, cfg->scheme, cfg->refine_level, (cfg->flags & SFB_REFINE_LIMIT) != 0, &faces);
+    if (faces > (double)SFB_MAX_ELEMENTS)
+        return sfb__error(ctx, SFB_LIMIT_EXCEEDED, SFB_ELEMENT_NONE, -1,
+                          "refining to level %d would make %.0f faces, over the limit of %d", cfg->refine_level, faces, SFB_MAX_ELEMENTS);
+    if (bytes > (double)(ctx->budget - ctx->live_bytes))
+        return sfb__error(ctx, SFB_LIMIT_EXCEEDED, SFB_ELEMENT_NONE, -1,
+                          "refining to level %d needs about %.0f MiB, over the memory budget of %.1f MiB",
+                          cfg->refine_level, bytes / 1048576.0, (double)ctx->budget / 1048576.0);
+    s = (sfb_surface *)sfb__calloc(ctx, 1, sizeof *s);
+    if (!s) return sfb__oom(ctx, "surface");
+    s->ctx = ctx;
+    s->config = *cfg;
+    s->boundary = mesh->boundary; s->crease_method = mesh->crease_method;
+    s->triangle_rule = mesh->triangle_rule; s->uv_interp = mesh->uv_interp;
+    s->base_vertex_count = mesh->base.nv;
+    s->base_positions = (float *)sfb__alloc(ctx, (size_t)mesh->base.nv * 3 * sizeof(float) + 1);
+    if (!s->base_positions) { sfb_surface_destroy(s); return sfb__oom(ctx, "surface"); }
+    memcpy(s->base_positions, mesh->positions, (size_t)mesh->base.nv * 3 * sizeof(float));
+    r = sfb__level_prepare(ctx, &mesh->base, mesh->boundary, mesh->boundary == SFB_BOUNDARY_EDGE_AND_CORNER,
+                           mesh->boundary == SFB_BOUNDARY_NONE && cfg->scheme != SFB_SCHEME_BILINEAR, &prep);
+    if (r != SFB_SUCCESS) { sfb_surface_destroy(s); return r; }
+    memset(&opt, 0, sizeof opt);
+    opt.scheme = cfg->scheme;
+    opt.boundary = mesh->boundary;
+    opt.crease_method = mesh->crease_method;
+    opt.triangle_rule = mesh->triangle_rule;
+    opt.want_limit = (cfg->flags & SFB_REFINE_LIMIT) != 0;
+    r = sfb__refine(ctx, &prep, &opt, cfg->refine_level, &s->top, &s->tables[SFB_TABLE_VERTEX],
+                    opt.want_limit ? &s->tables[SFB_TABLE_LIMIT] : NULL, 0.0f, 0.8f);
+    sfb__level_free(ctx, &prep);
+    if (r != SFB_SUCCESS) { sfb_surface_destroy(s); return r; }
+    s->built[SFB_TABLE_VERTEX] = 1;
+    if (opt.want_limit) s->built[SFB_TABLE_LIMIT] = s->built[SFB_TABLE_TANGENT_U] = s->built[SFB_TABLE_TANGENT_V] = 1;
+    if ((cfg->flags & SFB_REFINE_UVS) && mesh->uv_count > 0) {
+        /* The UV layout is refined as a mesh of its own: its vertices are the UV values, so a
+         * seam (an edge whose two faces disagree on a UV) is a boundary of the layout. It keeps
+         * the vertex mesh's creases and corners; its own corners (one face, two edges) are
+         * pinned, as OpenSubdiv's "linear corners only" face-varying mode. SFB_UV_LINEAR uses
+         * bilinear masks on the same face split. */
+        sfb__level uvl, uvp;
+        sfb__stencils dummy;
+        int o, i;
+        r = sfb__level_from_faces(ctx, mesh->uv_count, mesh->base.nf, mesh->face_sizes, mesh->face_uvs, NULL, SFB_ELEMENT_UV, &uvl);
+        if (r != SFB_SUCCESS) { sfb_surface_destroy(s); return r; }
+        for (f = 0; f < mesh->base.nf; ++f)
+            for (o = mesh->base.fv_off[f], i = 0; o + i < mesh->base.fv_off[f + 1]; ++i) {
+                int ue = uvl.fe[o + i], e = mesh->base.fe[o + i], uvv = mesh->face_uvs[o + i], vv = mesh->base.fv[o + i];
+                if (mesh->base.es[e] > uvl.es[ue]) uvl.es[ue] = mesh->base.es[e];
+                if (mesh->base.vs[vv] > uvl.vs[uvv]) uvl.vs[uvv] = mesh->base.vs[vv];
+            }
+        r = sfb__level_prepare(ctx, &uvl, SFB_BOUNDARY_EDGE_AND_CORNER, 1, 0, &uvp);
+        sfb__level_free(ctx, &uvl);
+        if (r != SFB_SUCCESS) { sfb_surface_destroy(s); return r; }
+        memset(&opt, 0, sizeof opt);
+        opt.scheme = cfg->scheme;
+        opt.boundary = SFB_BOUNDARY_EDGE_AND_CORNER;
+        opt.crease_method = mesh->crease_method;
+        opt.triangle_rule = mesh->triangle_rule;
+        opt.linear = mesh->uv_interp == SFB_UV_LINEAR;
+        opt.is_uv = 1;
+        memset(&dummy, 0, sizeof dummy);
+        r = sfb__refine(ctx, &uvp, &opt, cfg->refine_level, &s->uv_top, &s->tables[SFB_TABLE_UV], NULL, 0.8f, 1.0f);
+        sfb__level_free(ctx, &uvp);
+        if (r != SFB_SUCCESS) { sfb_surface_destroy(s); return r; }
+        s->built[SFB_TABLE_UV] = 1;
+        s->has_uvs = 1;
+        s->base_uv_count = mesh->uv_count;
+        s->base_uvs = (float *)sfb__alloc(ctx, (size_t)mesh->uv_count * 2 * sizeof(float));
+        if (!s->base_uvs) { sfb_surface_destroy(s); return sfb__oom(ctx, "surface"); }
+        memcpy(s->base_uvs, mesh->uvs, (size_t)mesh->uv_count * 2 * sizeof(float));
+    }
+    r = sfb__progress(ctx, 1.0f, "refine");
+    if (r != SFB_SUCCESS) { sfb_surface_destroy(s); return r; }
+    *out = s;
+    return SFB_SUCCESS;
+}
+
+SFB_API sfb_result sfb_surface_stencil_info(const sfb_surface *s, sfb_table t, sfb_stencil_info *out) {
+    if (!s || !out || (int)t < 0 || t >= SFB_TABLE_COUNT_ || !s->built[t]) return SFB_INVALID_ARGS;
+    out->rows = s->tables[t].rows;
+    out->sources = s->tables[t].sources;
+    out->entries = (int)s->tables[t].entries;
+    return SFB_SUCCESS;
+}
+
+static int sfb__desc_ok(sfb_buffer_desc d) { return d.offset >= 0 && d.length >= 1 && d.length <= 16 && d.stride >= d.length; }
+
+SFB_API sfb_result sfb_surface_eval_stencils(const sfb_surface *s, sfb_table t, const float *src, sfb_buffer_desc sd,
+                                             float *dst, sfb_buffer_desc dd) {
+    sfb_context *ctx;
+    const sfb__backend_vtable *be;
+    if (!s) return SFB_INVALID_ARGS;
+    ctx = s->ctx;
+    if ((int)t < 0 || t >= SFB_TABLE_COUNT_ || !s->built[t])
+        return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "stencil table %d was not built for this surface", (int)t);
+    if (!src || !dst || !sfb__desc_ok(sd) || !sfb__desc_ok(dd) || sd.length != dd.length)
+        return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "invalid buffers or buffer descriptors for stencil evaluation");
+    be = ctx->backend;
+    if (!be || !(be->caps & SFB__CAP_EVAL_STENCILS) || !be->eval_stencils) {
+        sfb__log(ctx, SFB_LOG_INFO, "backend %s lacks eval_stencils; using ref", be ? be->name : "none");
+        be = sfb__backend_ref();
+        return be->eval_stencils(NULL, &s->tables[t], 0, s->tables[t].rows, src, sd, dst, dd);
+    }
+    return be->eval_stencils(ctx->backend_state, &s->tables[t], 0, s->tables[t].rows, src, sd, dst, dd);
+}
+
+SFB_API void sfb_mesh_data_free(sfb_mesh_data *d) {
+    sfb_context *ctx;
+    if (!d || !d->ctx_) return;
+    ctx = d->ctx_;
+    sfb__free(ctx, d->positions); sfb__free(ctx, d->limit_positions); sfb__free(ctx, d->tangents_u);
+    sfb__free(ctx, d->tangents_v); sfb__free(ctx, d->normals); sfb__free(ctx, d->uvs);
+    sfb__free(ctx, d->face_sizes); sfb__free(ctx, d->face_vertices); sfb__free(ctx, d->face_uvs);
+    sfb__free(ctx, d->crease_vertices); sfb__free(ctx, d->crease_sharpness);
+    sfb__free(ctx, d->corner_vertices); sfb__free(ctx, d->corner_sharpness); sfb__free(ctx, d->holes);
+    memset(d, 0, sizeof *d);
+}
+
+SFB_API sfb_result sfb_surface_refine(const sfb_surface *s, sfb_mesh_data *out) {
+    if (!s) return SFB_INVALID_ARGS;
+    return sfb_surface_refine_positions(s, s->base_positions, s->base_vertex_count, out);
+}
+
+SFB_API sfb_result sfb_surface_refine_positions(const sfb_surface *s, const float *base, int base_count, sfb_mesh_data *o) {
+    sfb_context *ctx;
+    const sfb__level *l;
+    sfb_buffer_desc d3 = {0, 3, 3}, d2 = {0, 2, 2};
+    sfb_result r;
+    int i, e, v, f, nv;
+    if (!s || !o) return SFB_INVALID_ARGS;
+    memset(o, 0, sizeof *o);
+    ctx = s->ctx;
+    if (!base || base_count != s->base_vertex_count)
+        return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "expected %d base positions, got %d", s->base_vertex_count, base_count);
+    l = &s->top;
+    nv = l->nv;
+    o->ctx_ = ctx;
+    o->vertex_count = nv;
+    o->face_count = l->nf;
+    o->face_vertex_count = l->nfv;
+    o->boundary = s->boundary; o->crease_method = s->crease_method;
+    o->triangle_rule = s->triangle_rule; o->uv_interp = s->uv_interp;
+    o->positions = (float *)sfb__alloc(ctx, (size_t)nv * 3 * sizeof(float) + 1);
+    o->face_sizes = (int *)sfb__alloc(ctx, (size_t)l->nf * sizeof(int) + 1);
+    o->face_vertices = (int *)sfb__alloc(ctx, (size_t)l->nfv * sizeof(int) + 1);
+    if (!o->positions || !o->face_sizes || !o->face_vertices) goto oom;
+    r = sfb_surface_eval_stencils(s, SFB_TABLE_VERTEX, base, d3, o->positions, d3);
+    if (r != SFB_SUCCESS) { sfb_mesh_data_free(o); return r; }
+    if (s->built[SFB_TABLE_LIMIT]) {
+        o->limit_positions = (float *)sfb__alloc(ctx, (size_t)nv * 3 * sizeof(float) + 1);
+        o->tangents_u = (float *)sfb__alloc(ctx, (size_t)nv * 3 * sizeof(float) + 1);
+        o->tangents_v = (float *)sfb__alloc(ctx, (size_t)nv * 3 * sizeof(float) + 1);
+        o->normals = (float *)sfb__alloc(ctx, (size_t)nv * 3 * sizeof(float) + 1);
+        if (!o->limit_positions || !o->tangents_u || !o->tangents_v || !o->normals) goto oom;
+        if ((r = sfb_surface_eval_stencils(s, SFB_TABLE_LIMIT, base, d3, o->limit_positions, d3)) != SFB_SUCCESS ||
+            (r = sfb_surface_eval_stencils(s, SFB_TABLE_TANGENT_U, base, d3, o->tangents_u, d3)) != SFB_SUCCESS ||
+            (r = sfb_surface_eval_stencils(s, SFB_TABLE_TANGENT_V, base, d3, o->tangents_v, d3)) != SFB_SUCCESS) {
+            sfb_mesh_data_free(o);
+            return r;
+        }
+        for (v = 0; v < nv; ++v) {
+            const float *a = o->tangents_u + 3 * (size_t)v, *b = o->tangents_v + 3 * (size_t)v;
+            double n0 = (double)a[1] * b[2] - (double)a[2] * b[1];
+            double n1 = (double)a[2] * b[0] - (double)a[0] * b[2];
+            double n2 = (double)a[0] * b[1] - (double)a[1] * b[0];
+            double len = sqrt(n0 * n0 + n1 * n1 + n2 * n2);
+            float *n = o->normals + 3 * (size_t)v;
+            /* degenerate tangents (e.g. a corner with collinear edges) give a zero normal */
+            if (len > 0.0) { n[0] = (float)(n0 / len); n[1] = (float)(n1 / len); n[2] = (float)(n2 / len); }
+            else { n[0] = n[1] = n[2] = 0.0f; }
+        }
+    }
+    for (f = 0; f < l->nf; ++f) o->face_sizes[f] = l->fv_off[f + 1] - l->fv_off[f];
+    memcpy(o->face_vertices, l->fv, (size_t)l->nfv * sizeof(int));
+    if (s->has_uvs) {
+        o->uv_count = s->uv_top.nv;
+        o->uvs = (float *)sfb__alloc(ctx, (size_t)o->uv_count * 2 * sizeof(float) + 1);
+        o->face_uvs = (int *)sfb__alloc(ctx, (size_t)l->nfv * sizeof(int) + 1);
+        if (!o->uvs || !o->face_uvs) goto oom;
+        r = sfb_surface_eval_stencils(s, SFB_TABLE_UV, s->base_uvs, d2, o->uvs, d2);
+        if (r != SFB_SUCCESS) { sfb_mesh_data_free(o); return r; }
+        memcpy(o->face_uvs, s->uv_top.fv, (size_t)l->nfv * sizeof(int));
+    }
+    /* remaining sharpness: edges with sharpness that are not boundary edges (those are always
+     * sharp), vertices with sharpness, hole faces */
+    for (e = 0; e < l->ne; ++e) o->crease_count += l->es[e] > 0.0f && !(l->etag[e] & SFB__TAG_BOUNDARY);
+    for (v = 0; v < nv; ++v) o->corner_count += l->vs[v] > 0.0f;
+    for (f = 0; f < l->nf; ++f) o->hole_count += l->fhole[f] != 0;
+    o->crease_vertices = (int *)sfb__alloc(ctx, (size_t)o->crease_count * 2 * sizeof(int) + 1);
+    o->crease_sharpness = (float *)sfb__alloc(ctx, (size_t)o->crease_count * sizeof(float) + 1);
+    o->corner_vertices = (int *)sfb__alloc(ctx, (size_t)o->corner_count * sizeof(int) + 1);
+    o->corner_sharpness = (float *)sfb__alloc(ctx, (size_t)o->corner_count * sizeof(float) + 1);
+    o->holes = (int *)sfb__alloc(ctx, (size_t)o->hole_count * sizeof(int) + 1);
+    if (!o->crease_vertices || !o->crease_sharpness || !o->corner_vertices || !o->corner_sharpness || !o->holes) goto oom;
+    for (i = 0, e = 0; e < l->ne; ++e)
+        if (l->es[e] > 0.0f && !(l->etag[e] & SFB__TAG_BOUNDARY)) {
+            o->crease_vertices[2 * i] = l->ev[2 * e];
+            o->crease_vertices[2 * i + 1] = l->ev[2 * e + 1];
+            o->crease_sharpness[i++] = l->es[e];
+        }
+    for (i = 0, v = 0; v < nv; ++v)
+        if (l->vs[v] > 0.0f) { o->corner_vertices[i] = v; o->corner_sharpness[i++] = l->vs[v]; }
+    for (i = 0, f = 0; f < l->nf; ++f)
+        if (l->fhole[f]) o->holes[i++] = f;
+    return SFB_SUCCESS;
+oom:
+    sfb_mesh_data_free(o);
+    return sfb__oom(ctx, "refined mesh output");
+}
+
+SFB_API void sfb_mesh_data_desc(const sfb_mesh_data *m, sfb_mesh_desc *d) {
+    if (!d) return;
+    memset(d, 0, sizeof *d);
+    if (!m) return;
+    d->vertex_count = m->vertex_count; d->positions = m->positions;
+    d->face_count = m->face_count; d->face_sizes = m->face_sizes; d->face_vertices = m->face_vertices;
+    d->crease_count = m->crease_count; d->crease_vertices = m->crease_vertices; d->crease_sharpness = m->crease_sharpness;
+    d->corner_count = m->corner_count; d->corner_vertices = m->corner_vertices; d->corner_sharpness = m->corner_sharpness;
+    d->hole_count = m->hole_count; d->holes = m->holes;
+    d->uv_count = m->uv_count; d->uvs = m->uvs; d->face_uvs = m->face_uvs;
+    d->boundary = m->boundary; d->crease_method = m->crease_method;
+    d->triangle_rule = m->triangle_rule; d->uv_interp = m->uv_interp;
+}
+#endif /* SURFBLEND_IMPLEMENTATION */

@@ -1,0 +1,841 @@
+/* Agreement test: surfblend uniform refinement and limit positions against OpenSubdiv 3.5.
+ *
+ *   osd_agree SHAPES_DIR [--verbose]
+ *       For every *.obj in SHAPES_DIR (sorted by name; the scheme comes from the name prefix
+ *       catmark_, loop_ or bilinear_) refine levels 1..3 with surfblend and with OpenSubdiv
+ *       (built from the topology arrays surfblend parsed) and compare vertex counts, refined
+ *       positions and limit positions as point sets. Prints one line per shape
+ *       (PASS / FAIL / REJECTED) and a summary "N passed, M failed[, K skipped]".
+ *       Exit status 0 iff nothing failed.
+ *
+ *   osd_agree --counts SHAPES_DIR LEVEL
+ *       Prints "name vertex_count" per shape: the vertex count of OpenSubdiv's uniform
+ *       refinement at LEVEL. The OBJ is read by a small parser of this file (v and f lines),
+ *       independent of surfblend. Shapes with hierarchical edits and shapes that cannot be
+ *       read are left out with a note on stderr.
+ *
+ * OpenSubdiv is used only here (and in bench/), never by the library.
+ */
+#include "surfblend.h"
+
+#include <opensubdiv/far/error.h>
+#include <opensubdiv/far/primvarRefiner.h>
+#include <opensubdiv/far/topologyDescriptor.h>
+#include <opensubdiv/far/topologyRefinerFactory.h>
+
+#include <dirent.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdarg>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <map>
+#include <string>
+#include <unordered_map>
+#include <utility>
+#include <vector>
+
+using namespace OpenSubdiv;
+
+/* Shapes surfblend may refuse without failing the test: name (file name without .obj) and why.
+ * A refused shape in this list counts as skipped; a refused shape not in it counts as failed. */
+struct AllowedRejection {
+    const char *name;
+    const char *reason;
+};
+static const AllowedRejection k_allowed_rejections[] = {
+    {NULL, NULL} /* end marker; add entries above it */
+};
+
+static const char *k_hedit_reason =
+    "hierarchical edits (OpenSubdiv 3 ignores them; surfblend does not implement them)";
+
+static const int k_max_level = 3;
+static const double k_rel_tol = 1e-6; /* of the control mesh's bounding box diagonal */
+
+static bool g_verbose = false;
+static std::string g_osd_messages; /* OpenSubdiv errors and warnings for the current shape */
+
+static void osd_error_cb(Far::ErrorType, const char *message) {
+    g_osd_messages += "OpenSubdiv error: ";
+    g_osd_messages += message ? message : "";
+    g_osd_messages += "\n";
+}
+static void osd_warning_cb(const char *message) {
+    g_osd_messages += "OpenSubdiv warning: ";
+    g_osd_messages += message ? message : "";
+    g_osd_messages += "\n";
+}
+
+/* ---- small helpers ---- */
+
+static void appendf(std::string &s, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+static void appendf(std::string &s, const char *fmt, ...) {
+    char buf[2048];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(buf, sizeof buf, fmt, ap);
+    va_end(ap);
+    s += buf;
+}
+
+static bool read_file(const std::string &path, std::string &out) {
+    FILE *f = fopen(path.c_str(), "rb");
+    if (!f) return false;
+    out.clear();
+    char buf[65536];
+    size_t n;
+    while ((n = fread(buf, 1, sizeof buf, f)) > 0) out.append(buf, n);
+    bool ok = !ferror(f);
+    fclose(f);
+    return ok;
+}
+
+static bool ends_with(const std::string &s, const char *suffix) {
+    size_t n = strlen(suffix);
+    return s.size() >= n && s.compare(s.size() - n, n, suffix) == 0;
+}
+static bool starts_with(const std::string &s, const char *prefix) {
+    return s.compare(0, strlen(prefix), prefix) == 0;
+}
+
+static std::vector<std::string> list_obj_files(const std::string &dir, bool &ok) {
+    std::vector<std::string> names;
+    ok = false;
+    DIR *d = opendir(dir.c_str());
+    if (!d) return names;
+    while (struct dirent *e = readdir(d)) {
+        std::string n = e->d_name;
+        if (n.size() > 4 && ends_with(n, ".obj")) names.push_back(n);
+    }
+    closedir(d);
+    std::sort(names.begin(), names.end());
+    ok = true;
+    return names;
+}
+
+/* True when a line of the OBJ text is a hierarchical edit tag (t vertexedit|edgeedit|faceedit). */
+static bool has_hierarchical_edits(const std::string &text) {
+    size_t pos = 0;
+    while (pos < text.size()) {
+        size_t end = text.find('\n', pos);
+        if (end == std::string::npos) end = text.size();
+        size_t i = pos;
+        while (i < end && (text[i] == ' ' || text[i] == '\t')) ++i;
+        if (i < end && text[i] == 't' && i + 1 < end && (text[i + 1] == ' ' || text[i + 1] == '\t')) {
+            i += 1;
+            while (i < end && (text[i] == ' ' || text[i] == '\t')) ++i;
+            size_t j = i;
+            while (j < end && !isspace((unsigned char)text[j])) ++j;
+            std::string tag = text.substr(i, j - i);
+            if (tag == "vertexedit" || tag == "edgeedit" || tag == "faceedit") return true;
+        }
+        pos = end + 1;
+    }
+    return false;
+}
+
+static bool scheme_from_name(const std::string &name, sfb_scheme &s, Sdc::SchemeType &t) {
+    if (starts_with(name, "catmark_")) { s = SFB_SCHEME_CATMARK; t = Sdc::SCHEME_CATMARK; return true; }
+    if (starts_with(name, "loop_")) { s = SFB_SCHEME_LOOP; t = Sdc::SCHEME_LOOP; return true; }
+    if (starts_with(name, "bilinear_")) { s = SFB_SCHEME_BILINEAR; t = Sdc::SCHEME_BILINEAR; return true; }
+    return false;
+}
+
+static const char *allowed_reason(const std::string &name) {
+    for (const AllowedRejection *a = k_allowed_rejections; a->name; ++a)
+        if (name == a->name) return a->reason;
+    return NULL;
+}
+
+/* ---- OpenSubdiv side ---- */
+
+struct Vec3d {
+    double p[3];
+    void Clear(void * = 0) { p[0] = p[1] = p[2] = 0.0; }
+    void AddWithWeight(const Vec3d &s, double w) {
+        p[0] += w * s.p[0];
+        p[1] += w * s.p[1];
+        p[2] += w * s.p[2];
+    }
+};
+
+/* Builds OpenSubdiv's refiner from exactly the topology arrays surfblend parsed. */
+static Far::TopologyRefiner *osd_refiner_from_desc(const sfb_mesh_desc &d, Sdc::SchemeType type) {
+    Sdc::Options opt;
+    switch (d.boundary) {
+    case SFB_BOUNDARY_EDGE_AND_CORNER: opt.SetVtxBoundaryInterpolation(Sdc::Options::VTX_BOUNDARY_EDGE_AND_CORNER); break;
+    case SFB_BOUNDARY_NONE: opt.SetVtxBoundaryInterpolation(Sdc::Options::VTX_BOUNDARY_NONE); break;
+    default: opt.SetVtxBoundaryInterpolation(Sdc::Options::VTX_BOUNDARY_EDGE_ONLY); break;
+    }
+    opt.SetCreasingMethod(d.crease_method == SFB_CREASE_CHAIKIN ? Sdc::Options::CREASE_CHAIKIN
+                                                               : Sdc::Options::CREASE_UNIFORM);
+    opt.SetTriangleSubdivision(d.triangle_rule == SFB_TRI_SMOOTH ? Sdc::Options::TRI_SUB_SMOOTH
+                                                                 : Sdc::Options::TRI_SUB_CATMARK);
+    opt.SetFVarLinearInterpolation(Sdc::Options::FVAR_LINEAR_ALL);
+
+    /* Creases as given; the optional per-face-edge sharpness (normally folded into the creases
+     * by surfblend already) is added, the highest value per edge winning. */
+    std::vector<int> cv;
+    std::vector<float> cw;
+    if (d.crease_count > 0) {
+        cv.assign(d.crease_vertices, d.crease_vertices + 2 * d.crease_count);
+        cw.assign(d.crease_sharpness, d.crease_sharpness + d.crease_count);
+    }
+    if (d.face_edge_sharpness) {
+        std::map<std::pair<int, int>, float> extra;
+        int off = 0;
+        for (int f = 0; f < d.face_count; ++f) {
+            int n = d.face_sizes[f];
+            for (int i = 0; i < n; ++i) {
+                float s = d.face_edge_sharpness[off + i];
+                if (s <= 0.0f) continue;
+                int a = d.face_vertices[off + i], b = d.face_vertices[off + (i + 1) % n];
+                std::pair<int, int> k(std::min(a, b), std::max(a, b));
+                std::map<std::pair<int, int>, float>::iterator it = extra.find(k);
+                if (it == extra.end()) extra[k] = s;
+                else it->second = std::max(it->second, s);
+            }
+            off += n;
+        }
+        for (int c = 0; c < d.crease_count; ++c) {
+            std::pair<int, int> k(std::min(cv[2 * c], cv[2 * c + 1]), std::max(cv[2 * c], cv[2 * c + 1]));
+            std::map<std::pair<int, int>, float>::iterator it = extra.find(k);
+            if (it != extra.end()) {
+                cw[c] = std::max(cw[c], it->second);
+                extra.erase(it);
+            }
+        }
+        for (std::map<std::pair<int, int>, float>::iterator it = extra.begin(); it != extra.end(); ++it) {
+            cv.push_back(it->first.first);
+            cv.push_back(it->first.second);
+            cw.push_back(it->second);
+        }
+    }
+
+    Far::TopologyDescriptor desc;
+    desc.numVertices = d.vertex_count;
+    desc.numFaces = d.face_count;
+    desc.numVertsPerFace = d.face_sizes;
+    desc.vertIndicesPerFace = d.face_vertices;
+    desc.numCreases = (int)cw.size();
+    desc.creaseVertexIndexPairs = cv.empty() ? NULL : &cv[0];
+    desc.creaseWeights = cw.empty() ? NULL : &cw[0];
+    desc.numCorners = d.corner_count;
+    desc.cornerVertexIndices = d.corner_vertices;
+    desc.cornerWeights = d.corner_sharpness;
+    desc.numHoles = d.hole_count;
+    desc.holeIndices = d.holes;
+
+    typedef Far::TopologyRefinerFactory<Far::TopologyDescriptor> Factory;
+    return Factory::Create(desc, Factory::Options(type, opt));
+}
+
+struct OsdLevel {
+    int vertex_count, face_count;
+    std::vector<Vec3d> pos, limit;
+    /* parent of each refined vertex: kind ('v','e','f') and index in level L-1 */
+    std::vector<char> parent_kind;
+    std::vector<int> parent_index;
+};
+
+/* Uniform refinement to `level`, positions level by level, limit positions at the last level. */
+static Far::TopologyRefiner *osd_refine(const sfb_mesh_desc &d, Sdc::SchemeType type, int level,
+                                        OsdLevel &out) {
+    Far::TopologyRefiner *r = osd_refiner_from_desc(d, type);
+    if (!r) return NULL;
+    Far::TopologyRefiner::UniformOptions uo(level);
+    uo.fullTopologyInLastLevel = true;
+    r->RefineUniform(uo);
+
+    std::vector<Vec3d> all((size_t)r->GetNumVerticesTotal());
+    for (int i = 0; i < d.vertex_count; ++i)
+        for (int c = 0; c < 3; ++c) all[(size_t)i].p[c] = d.positions[3 * i + c];
+
+    Far::PrimvarRefinerReal<double> pr(*r);
+    Vec3d *src = &all[0];
+    for (int l = 1; l <= level; ++l) {
+        Vec3d *dst = src + r->GetLevel(l - 1).GetNumVertices();
+        pr.Interpolate(l, src, dst);
+        src = dst;
+    }
+    const Far::TopologyLevel &last = r->GetLevel(level);
+    out.vertex_count = last.GetNumVertices();
+    out.face_count = last.GetNumFaces();
+    out.pos.assign(src, src + out.vertex_count);
+    out.limit.resize((size_t)out.vertex_count);
+    Vec3d *lim = &out.limit[0];
+    pr.Limit(src, lim);
+
+    const Far::TopologyLevel &parent = r->GetLevel(level - 1);
+    out.parent_kind.assign((size_t)out.vertex_count, '?');
+    out.parent_index.assign((size_t)out.vertex_count, -1);
+    for (int v = 0; v < parent.GetNumVertices(); ++v) {
+        int c = parent.GetVertexChildVertex(v);
+        if (c >= 0 && c < out.vertex_count) { out.parent_kind[(size_t)c] = 'v'; out.parent_index[(size_t)c] = v; }
+    }
+    for (int e = 0; e < parent.GetNumEdges(); ++e) {
+        int c = parent.GetEdgeChildVertex(e);
+        if (c >= 0 && c < out.vertex_count) { out.parent_kind[(size_t)c] = 'e'; out.parent_index[(size_t)c] = e; }
+    }
+    for (int f = 0; f < parent.GetNumFaces() && type != Sdc::SCHEME_LOOP; ++f) { /* Loop: no face points */
+        int c = parent.GetFaceChildVertex(f);
+        if (c >= 0 && c < out.vertex_count) { out.parent_kind[(size_t)c] = 'f'; out.parent_index[(size_t)c] = f; }
+    }
+    return r;
+}
+
+static const char *rule_name(Sdc::Crease::Rule rule) {
+    switch (rule) {
+    case Sdc::Crease::RULE_SMOOTH: return "smooth";
+    case Sdc::Crease::RULE_DART: return "dart";
+    case Sdc::Crease::RULE_CREASE: return "crease";
+    case Sdc::Crease::RULE_CORNER: return "corner";
+    default: return "unknown";
+    }
+}
+
+/* A readable description of where an OpenSubdiv vertex of `level` comes from. */
+static std::string describe_osd_vertex(const Far::TopologyRefiner &r, int level, const OsdLevel &ol, int v) {
+    const Far::TopologyLevel &p = r.GetLevel(level - 1);
+    const Far::TopologyLevel &c = r.GetLevel(level);
+    char buf[512];
+    int k = ol.parent_index[(size_t)v];
+    std::string s;
+    switch (ol.parent_kind[(size_t)v]) {
+    case 'v':
+        snprintf(buf, sizeof buf, "child of level-%d vertex %d (valence %d, faces %d, rule %s, sharpness %g%s%s)",
+                 level - 1, k, p.GetVertexEdges(k).size(), p.GetVertexFaces(k).size(),
+                 rule_name(p.GetVertexRule(k)), p.GetVertexSharpness(k),
+                 p.IsVertexBoundary(k) ? ", boundary" : "", p.IsVertexNonManifold(k) ? ", non-manifold" : "");
+        s = buf;
+        break;
+    case 'e': {
+        Far::ConstIndexArray ev = p.GetEdgeVertices(k);
+        snprintf(buf, sizeof buf, "child of level-%d edge %d (%d-%d, sharpness %g, faces %d%s%s)", level - 1, k,
+                 ev[0], ev[1], p.GetEdgeSharpness(k), p.GetEdgeFaces(k).size(),
+                 p.IsEdgeBoundary(k) ? ", boundary" : "", p.IsEdgeNonManifold(k) ? ", non-manifold" : "");
+        s = buf;
+        break;
+    }
+    case 'f':
+        snprintf(buf, sizeof buf, "child of level-%d face %d (%d vertices%s)", level - 1, k,
+                 p.GetFaceVertices(k).size(), p.IsFaceHole(k) ? ", hole" : "");
+        s = buf;
+        break;
+    default:
+        s = "unknown parent";
+    }
+    snprintf(buf, sizeof buf, "; at level %d: rule %s, valence %d", level, rule_name(c.GetVertexRule(v)),
+             c.GetVertexEdges(v).size());
+    s += buf;
+    return s;
+}
+
+/* ---- point set comparison ---- */
+
+/* Static 3-d tree over a point array (nearest neighbour queries, no removal). */
+class KdTree {
+public:
+    KdTree(const double *pts, int n) : p_(pts) {
+        idx_.reserve((size_t)n);
+        for (int i = 0; i < n; ++i)
+            if (std::isfinite(pts[3 * i]) && std::isfinite(pts[3 * i + 1]) && std::isfinite(pts[3 * i + 2]))
+                idx_.push_back(i);
+        build(0, (int)idx_.size(), 0);
+    }
+    /* index of the nearest point and its distance; -1 when the tree is empty */
+    int nearest(const double *q, double &dist) const {
+        int best = -1;
+        double best_d2 = INFINITY;
+        search(0, (int)idx_.size(), 0, q, best, best_d2);
+        dist = std::sqrt(best_d2);
+        return best;
+    }
+
+private:
+    const double *p_;
+    std::vector<int> idx_;
+    void build(int lo, int hi, int axis) {
+        if (hi - lo <= 1) return;
+        int mid = (lo + hi) / 2;
+        const double *p = p_;
+        std::nth_element(idx_.begin() + lo, idx_.begin() + mid, idx_.begin() + hi,
+                         [p, axis](int a, int b) { return p[3 * a + axis] < p[3 * b + axis]; });
+        build(lo, mid, (axis + 1) % 3);
+        build(mid + 1, hi, (axis + 1) % 3);
+    }
+    void search(int lo, int hi, int axis, const double *q, int &best, double &best_d2) const {
+        if (hi <= lo) return;
+        int mid = (lo + hi) / 2;
+        int i = idx_[(size_t)mid];
+        const double *pt = p_ + 3 * i;
+        double dx = pt[0] - q[0], dy = pt[1] - q[1], dz = pt[2] - q[2];
+        double d2 = dx * dx + dy * dy + dz * dz;
+        if (d2 < best_d2) { best_d2 = d2; best = i; }
+        double diff = q[axis] - pt[axis];
+        int next = (axis + 1) % 3;
+        if (diff < 0) {
+            search(lo, mid, next, q, best, best_d2);
+            if (diff * diff < best_d2) search(mid + 1, hi, next, q, best, best_d2);
+        } else {
+            search(mid + 1, hi, next, q, best, best_d2);
+            if (diff * diff < best_d2) search(lo, mid, next, q, best, best_d2);
+        }
+    }
+};
+
+struct MatchResult {
+    double max_err;           /* over matched pairs and, for unmatched points, the nearest point of the other set */
+    double max_matched_err;   /* over matched pairs only */
+    std::vector<int> unmatched_a, unmatched_b;
+    std::vector<int> match_of_a; /* index into b, or -1 */
+};
+
+/* One-to-one matching of point set a (reference) to point set b within tol: every point of a
+ * takes the nearest not yet taken point of b within tol, found through a uniform grid of cell
+ * size tol (expected O(n)). */
+static MatchResult match_point_sets(const std::vector<double> &a, const std::vector<double> &b, double tol) {
+    MatchResult m;
+    m.max_err = 0.0;
+    m.max_matched_err = 0.0;
+    int na = (int)(a.size() / 3), nb = (int)(b.size() / 3);
+    m.match_of_a.assign((size_t)na, -1);
+    double cell = tol > 0 ? tol : 1e-300;
+
+    struct Key {
+        static bool cell_of(const double *p, double cell, long long c[3]) {
+            for (int k = 0; k < 3; ++k) {
+                double q = std::floor(p[k] / cell);
+                if (!std::isfinite(q) || std::fabs(q) > 4e18) return false;
+                c[k] = (long long)q;
+            }
+            return true;
+        }
+        static unsigned long long pack(long long x, long long y, long long z) {
+            const unsigned long long m21 = (1ull << 21) - 1;
+            return (((unsigned long long)x & m21) << 42) | (((unsigned long long)y & m21) << 21) |
+                   ((unsigned long long)z & m21);
+        }
+    };
+
+    /* grid of b as sorted (key, index) pairs */
+    std::vector<std::pair<unsigned long long, int> > grid;
+    grid.reserve((size_t)nb);
+    for (int i = 0; i < nb; ++i) {
+        long long c[3];
+        if (Key::cell_of(&b[3 * (size_t)i], cell, c)) grid.push_back(std::make_pair(Key::pack(c[0], c[1], c[2]), i));
+    }
+    std::sort(grid.begin(), grid.end());
+    std::vector<char> used((size_t)nb, 0);
+
+    for (int i = 0; i < na; ++i) {
+        const double *p = &a[3 * (size_t)i];
+        long long c[3];
+        if (!Key::cell_of(p, cell, c)) { m.unmatched_a.push_back(i); continue; }
+        int best = -1;
+        double best_d2 = tol * tol;
+        for (int dx = -1; dx <= 1; ++dx)
+            for (int dy = -1; dy <= 1; ++dy)
+                for (int dz = -1; dz <= 1; ++dz) {
+                    unsigned long long key = Key::pack(c[0] + dx, c[1] + dy, c[2] + dz);
+                    std::vector<std::pair<unsigned long long, int> >::const_iterator it =
+                        std::lower_bound(grid.begin(), grid.end(), std::make_pair(key, -1));
+                    for (; it != grid.end() && it->first == key; ++it) {
+                        int j = it->second;
+                        if (used[(size_t)j]) continue;
+                        const double *q = &b[3 * (size_t)j];
+                        double ex = q[0] - p[0], ey = q[1] - p[1], ez = q[2] - p[2];
+                        double d2 = ex * ex + ey * ey + ez * ez;
+                        if (d2 <= best_d2) { best_d2 = d2; best = j; }
+                    }
+                }
+        if (best < 0) { m.unmatched_a.push_back(i); continue; }
+        used[(size_t)best] = 1;
+        m.match_of_a[(size_t)i] = best;
+        double d = std::sqrt(best_d2);
+        m.max_matched_err = std::max(m.max_matched_err, d);
+    }
+    for (int j = 0; j < nb; ++j)
+        if (!used[(size_t)j]) m.unmatched_b.push_back(j);
+    m.max_err = m.max_matched_err;
+    if (!m.unmatched_a.empty() && nb > 0) {
+        KdTree tb(&b[0], nb);
+        for (size_t k = 0; k < m.unmatched_a.size(); ++k) {
+            double d;
+            if (tb.nearest(&a[3 * (size_t)m.unmatched_a[k]], d) < 0 || !std::isfinite(d)) d = INFINITY;
+            m.max_err = std::max(m.max_err, d);
+        }
+    }
+    if (!m.unmatched_b.empty() && na > 0) {
+        KdTree ta(&a[0], na);
+        for (size_t k = 0; k < m.unmatched_b.size(); ++k) {
+            double d;
+            if (ta.nearest(&b[3 * (size_t)m.unmatched_b[k]], d) < 0 || !std::isfinite(d)) d = INFINITY;
+            m.max_err = std::max(m.max_err, d);
+        }
+    }
+    if ((!m.unmatched_a.empty() && nb == 0) || (!m.unmatched_b.empty() && na == 0)) m.max_err = INFINITY;
+    return m;
+}
+
+static std::vector<double> to_doubles(const std::vector<Vec3d> &v) {
+    std::vector<double> out(v.size() * 3);
+    for (size_t i = 0; i < v.size(); ++i)
+        for (int c = 0; c < 3; ++c) out[3 * i + c] = v[i].p[c];
+    return out;
+}
+static std::vector<double> to_doubles(const float *p, int n) {
+    std::vector<double> out((size_t)(n > 0 ? n : 0) * 3);
+    for (size_t i = 0; i < out.size(); ++i) out[i] = p ? p[i] : NAN;
+    return out;
+}
+
+/* Verbose report of unmatched points of a comparison. */
+static void report_unmatched(std::string &rep, const char *what, const MatchResult &m, const std::vector<double> &osd,
+                             const std::vector<double> &sfb, const Far::TopologyRefiner &r, int level,
+                             const OsdLevel &ol) {
+    const size_t show = 8;
+    KdTree ts(sfb.empty() ? NULL : &sfb[0], (int)(sfb.size() / 3));
+    KdTree to(osd.empty() ? NULL : &osd[0], (int)(osd.size() / 3));
+    for (size_t k = 0; k < m.unmatched_a.size() && k < show; ++k) {
+        int i = m.unmatched_a[k];
+        const double *p = &osd[3 * (size_t)i];
+        double d = INFINITY;
+        int j = sfb.empty() ? -1 : ts.nearest(p, d);
+        appendf(rep, "    %s: OpenSubdiv vertex %d (%.9g %.9g %.9g) has no match; %s\n", what, i, p[0], p[1], p[2],
+               describe_osd_vertex(r, level, ol, i).c_str());
+        if (j >= 0)
+            appendf(rep, "      nearest surfblend vertex %d (%.9g %.9g %.9g) at distance %.3g\n", j, sfb[3 * (size_t)j],
+                   sfb[3 * (size_t)j + 1], sfb[3 * (size_t)j + 2], d);
+    }
+    if (m.unmatched_a.size() > show) appendf(rep, "    %s: ... %zu more unmatched OpenSubdiv vertices\n", what, m.unmatched_a.size() - show);
+    for (size_t k = 0; k < m.unmatched_b.size() && k < show; ++k) {
+        int j = m.unmatched_b[k];
+        const double *q = &sfb[3 * (size_t)j];
+        double d = INFINITY;
+        int i = osd.empty() ? -1 : to.nearest(q, d);
+        appendf(rep, "    %s: surfblend vertex %d (%.9g %.9g %.9g) has no match", what, j, q[0], q[1], q[2]);
+        if (i >= 0) appendf(rep, "; nearest OpenSubdiv vertex %d at distance %.3g (%s)", i, d, describe_osd_vertex(r, level, ol, i).c_str());
+        appendf(rep, "\n");
+    }
+    if (m.unmatched_b.size() > show) appendf(rep, "    %s: ... %zu more unmatched surfblend vertices\n", what, m.unmatched_b.size() - show);
+}
+
+/* ---- one shape ---- */
+
+enum Outcome { OUT_PASS, OUT_FAIL, OUT_SKIP };
+
+static void append_osd_messages(std::string &rep) {
+    size_t pos = 0;
+    while (pos < g_osd_messages.size()) {
+        size_t end = g_osd_messages.find('\n', pos);
+        if (end == std::string::npos) end = g_osd_messages.size();
+        rep += "    " + g_osd_messages.substr(pos, end - pos) + "\n";
+        pos = end + 1;
+    }
+}
+
+/* Prints the REJECTED line; counts as skipped when the allow-list names the shape. */
+static Outcome rejected(const std::string &name, const std::string &reason) {
+    const char *allowed = allowed_reason(name);
+    if (allowed) {
+        printf("REJECTED %s: %s (allowed: %s)\n", name.c_str(), reason.c_str(), allowed);
+        return OUT_SKIP;
+    }
+    printf("REJECTED %s: %s\n", name.c_str(), reason.c_str());
+    return OUT_FAIL;
+}
+
+static Outcome run_shape(sfb_context *ctx, const std::string &dir, const std::string &file) {
+    std::string name = file.substr(0, file.size() - 4);
+    std::string text;
+    g_osd_messages.clear();
+    if (!read_file(dir + "/" + file, text)) {
+        printf("FAIL %s: cannot read %s/%s\n", name.c_str(), dir.c_str(), file.c_str());
+        return OUT_FAIL;
+    }
+    if (has_hierarchical_edits(text)) {
+        printf("REJECTED %s: %s\n", name.c_str(), k_hedit_reason);
+        return OUT_SKIP;
+    }
+    sfb_scheme scheme;
+    Sdc::SchemeType osd_scheme;
+    if (!scheme_from_name(name, scheme, osd_scheme)) {
+        printf("REJECTED %s: unknown scheme (name prefix is not catmark_, loop_ or bilinear_)\n", name.c_str());
+        return OUT_FAIL;
+    }
+
+    sfb_mesh *mesh = NULL;
+    sfb_result res = sfb_mesh_read_obj(ctx, text.data(), text.size(), &mesh);
+    if (res != SFB_SUCCESS) return rejected(name, std::string("sfb_mesh_read_obj: ") + sfb_last_error(ctx));
+    sfb_mesh_desc d;
+    memset(&d, 0, sizeof d);
+    sfb_mesh_get_desc(mesh, &d);
+
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (int i = 0; i < d.vertex_count; ++i)
+        for (int c = 0; c < 3; ++c) {
+            lo[c] = std::min(lo[c], (double)d.positions[3 * i + c]);
+            hi[c] = std::max(hi[c], (double)d.positions[3 * i + c]);
+        }
+    double diag = 0.0;
+    if (d.vertex_count > 0)
+        diag = std::sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
+                         (hi[2] - lo[2]) * (hi[2] - lo[2]));
+    double tol = k_rel_tol * (diag > 0 ? diag : 1.0);
+
+    std::string fail;   /* first failure: "level L: reason (max error E, tolerance T)" */
+    std::string reject; /* surfblend refused the shape at some level */
+    std::string rep;    /* verbose report, printed after the shape's line */
+    appendf(rep, "  %s: %d vertices, %d faces, %d creases, %d corners, %d holes, boundary %d, crease method %d, "
+                 "triangle rule %d; tolerance %.3g\n",
+            sfb_scheme_name(scheme), d.vertex_count, d.face_count, d.crease_count, d.corner_count, d.hole_count,
+            d.boundary, d.crease_method, d.triangle_rule, tol);
+
+    for (int level = 1; level <= k_max_level && fail.empty() && reject.empty(); ++level) {
+        OsdLevel ol;
+        Far::TopologyRefiner *r = osd_refine(d, osd_scheme, level, ol);
+        if (!r) {
+            appendf(fail, "level %d: OpenSubdiv could not build the topology from surfblend's arrays", level);
+            break;
+        }
+        sfb_surface_config cfg = sfb_surface_config_init(scheme, level);
+        cfg.flags = SFB_REFINE_LIMIT;
+        sfb_surface *surf = NULL;
+        res = sfb_surface_create(ctx, mesh, &cfg, &surf);
+        if (res != SFB_SUCCESS) {
+            appendf(reject, "sfb_surface_create (level %d): %s", level, sfb_last_error(ctx));
+            delete r;
+            break;
+        }
+        sfb_mesh_data md;
+        memset(&md, 0, sizeof md);
+        res = sfb_surface_refine(surf, &md);
+        if (res != SFB_SUCCESS) {
+            appendf(fail, "level %d: sfb_surface_refine failed: %s", level, sfb_last_error(ctx));
+            sfb_surface_destroy(surf);
+            delete r;
+            break;
+        }
+
+        appendf(rep, "  level %d: vertices %d (OpenSubdiv %d), faces %d (OpenSubdiv %d, holes included)\n", level,
+                md.vertex_count, ol.vertex_count, md.face_count, ol.face_count);
+        if (md.vertex_count != ol.vertex_count)
+            appendf(fail, "level %d: vertex count %d, OpenSubdiv %d", level, md.vertex_count, ol.vertex_count);
+
+        /* point sets are compared even when the counts differ, for the verbose report */
+        std::vector<double> osd_pos = to_doubles(ol.pos), sfb_pos = to_doubles(md.positions, md.vertex_count);
+        std::vector<double> osd_lim = to_doubles(ol.limit), sfb_lim = to_doubles(md.limit_positions, md.vertex_count);
+        MatchResult mp = match_point_sets(osd_pos, sfb_pos, tol);
+        MatchResult ml = match_point_sets(osd_lim, sfb_lim, tol);
+        appendf(rep, "  level %d: positions max error %.3g (%zu/%zu unmatched), limit positions max error %.3g "
+                     "(%zu/%zu unmatched)\n",
+                level, mp.max_err, mp.unmatched_a.size(), mp.unmatched_b.size(), ml.max_err, ml.unmatched_a.size(),
+                ml.unmatched_b.size());
+
+        if (fail.empty() && (!mp.unmatched_a.empty() || !mp.unmatched_b.empty()))
+            appendf(fail, "level %d: %zu of %d positions have no match within tolerance (max error %.3g, tolerance %.3g)",
+                    level, mp.unmatched_a.size(), ol.vertex_count, mp.max_err, tol);
+        if (fail.empty() && !md.limit_positions) appendf(fail, "level %d: no limit positions returned", level);
+        if (fail.empty() && (!ml.unmatched_a.empty() || !ml.unmatched_b.empty()))
+            appendf(fail, "level %d: %zu of %d limit positions have no match within tolerance (max error %.3g, "
+                          "tolerance %.3g)",
+                    level, ml.unmatched_a.size(), ol.vertex_count, ml.max_err, tol);
+        if (!fail.empty()) {
+            report_unmatched(rep, "position", mp, osd_pos, sfb_pos, *r, level, ol);
+            report_unmatched(rep, "limit", ml, osd_lim, sfb_lim, *r, level, ol);
+        }
+
+        sfb_mesh_data_free(&md);
+        sfb_surface_destroy(surf);
+        delete r;
+    }
+    sfb_mesh_destroy(mesh);
+    append_osd_messages(rep);
+
+    Outcome o;
+    if (!reject.empty()) {
+        o = rejected(name, reject);
+    } else if (!fail.empty()) {
+        printf("FAIL %s: %s\n", name.c_str(), fail.c_str());
+        o = OUT_FAIL;
+    } else {
+        printf("PASS %s\n", name.c_str());
+        if (allowed_reason(name)) appendf(rep, "  note: passes, but the allow-list of rejections names it\n");
+        o = OUT_PASS;
+    }
+    if (g_verbose) fputs(rep.c_str(), stdout);
+    return o;
+}
+
+/* ---- --counts mode: OpenSubdiv only, with a parser of this file ---- */
+
+/* Reads v and f lines (f tokens "v", "v/vt", "v/vt/vn", "v//vn"; negative indices count back).
+ * Creases, corners, holes and boundary options do not change the vertex counts of uniform
+ * refinement, so they are not read. */
+static bool parse_obj_topology(const std::string &text, int &nverts, std::vector<int> &sizes,
+                               std::vector<int> &indices, std::string &err) {
+    nverts = 0;
+    sizes.clear();
+    indices.clear();
+    size_t pos = 0;
+    int line = 0;
+    while (pos < text.size()) {
+        size_t end = text.find('\n', pos);
+        if (end == std::string::npos) end = text.size();
+        ++line;
+        std::string l = text.substr(pos, end - pos);
+        pos = end + 1;
+        size_t i = 0;
+        while (i < l.size() && isspace((unsigned char)l[i])) ++i;
+        if (i + 1 >= l.size() || !isspace((unsigned char)l[i + 1])) continue;
+        if (l[i] == 'v') {
+            ++nverts;
+        } else if (l[i] == 'f') {
+            const char *s = l.c_str() + i + 1;
+            int n = 0;
+            for (;;) {
+                while (*s && isspace((unsigned char)*s)) ++s;
+                if (!*s || *s == '#') break;
+                char *e;
+                long v = strtol(s, &e, 10);
+                if (e == s) { err = "line " + std::to_string(line) + ": bad face index"; return false; }
+                if (v < 0) v = nverts + v + 1;
+                if (v < 1 || v > nverts) { err = "line " + std::to_string(line) + ": face index out of range"; return false; }
+                indices.push_back((int)v - 1);
+                ++n;
+                s = e;
+                while (*s && !isspace((unsigned char)*s)) ++s;
+            }
+            if (n < 3) { err = "line " + std::to_string(line) + ": face with fewer than 3 vertices"; return false; }
+            sizes.push_back(n);
+        }
+    }
+    return true;
+}
+
+static int run_counts(const std::string &dir, int level) {
+    bool ok;
+    std::vector<std::string> files = list_obj_files(dir, ok);
+    if (!ok) {
+        fprintf(stderr, "osd_agree: cannot open directory %s\n", dir.c_str());
+        return 2;
+    }
+    int status = 0;
+    for (size_t k = 0; k < files.size(); ++k) {
+        std::string name = files[k].substr(0, files[k].size() - 4), text;
+        if (!read_file(dir + "/" + files[k], text)) {
+            fprintf(stderr, "# %s left out: cannot read\n", name.c_str());
+            status = 1;
+            continue;
+        }
+        if (has_hierarchical_edits(text)) {
+            fprintf(stderr, "# %s left out: %s\n", name.c_str(), k_hedit_reason);
+            continue;
+        }
+        sfb_scheme s;
+        Sdc::SchemeType type;
+        if (!scheme_from_name(name, s, type)) {
+            fprintf(stderr, "# %s left out: unknown scheme prefix\n", name.c_str());
+            continue;
+        }
+        int nv;
+        std::vector<int> sizes, indices;
+        std::string err;
+        if (!parse_obj_topology(text, nv, sizes, indices, err)) {
+            fprintf(stderr, "# %s left out: %s\n", name.c_str(), err.c_str());
+            status = 1;
+            continue;
+        }
+        Far::TopologyDescriptor desc;
+        desc.numVertices = nv;
+        desc.numFaces = (int)sizes.size();
+        desc.numVertsPerFace = sizes.empty() ? NULL : &sizes[0];
+        desc.vertIndicesPerFace = indices.empty() ? NULL : &indices[0];
+        Sdc::Options opt;
+        opt.SetVtxBoundaryInterpolation(Sdc::Options::VTX_BOUNDARY_EDGE_ONLY);
+        typedef Far::TopologyRefinerFactory<Far::TopologyDescriptor> Factory;
+        g_osd_messages.clear();
+        Far::TopologyRefiner *r = Factory::Create(desc, Factory::Options(type, opt));
+        if (!r) {
+            fprintf(stderr, "# %s left out: OpenSubdiv could not build the topology\n%s", name.c_str(), g_osd_messages.c_str());
+            status = 1;
+            continue;
+        }
+        if (level > 0) {
+            Far::TopologyRefiner::UniformOptions uo(level);
+            uo.fullTopologyInLastLevel = true;
+            r->RefineUniform(uo);
+        }
+        printf("%s %d\n", name.c_str(), r->GetLevel(level).GetNumVertices());
+        delete r;
+    }
+    return status;
+}
+
+static void usage() {
+    fprintf(stderr,
+            "usage: osd_agree SHAPES_DIR [--verbose]\n"
+            "       osd_agree --counts SHAPES_DIR LEVEL\n");
+}
+
+int main(int argc, char **argv) {
+    Far::SetErrorCallback(osd_error_cb);
+    Far::SetWarningCallback(osd_warning_cb);
+
+    if (argc >= 2 && strcmp(argv[1], "--counts") == 0) {
+        if (argc != 4) { usage(); return 2; }
+        char *e;
+        long level = strtol(argv[3], &e, 10);
+        if (*e || e == argv[3] || level < 0 || level > 15) {
+            fprintf(stderr, "osd_agree: LEVEL must be 0..15\n");
+            return 2;
+        }
+        return run_counts(argv[2], (int)level);
+    }
+
+    std::string dir;
+    for (int i = 1; i < argc; ++i) {
+        if (strcmp(argv[i], "--verbose") == 0 || strcmp(argv[i], "-v") == 0) g_verbose = true;
+        else if (argv[i][0] == '-' && argv[i][1]) { usage(); return 2; }
+        else if (dir.empty()) dir = argv[i];
+        else { usage(); return 2; }
+    }
+    if (dir.empty()) { usage(); return 2; }
+
+    bool ok;
+    std::vector<std::string> files = list_obj_files(dir, ok);
+    if (!ok) {
+        fprintf(stderr, "osd_agree: cannot open directory %s\n", dir.c_str());
+        return 2;
+    }
+    if (files.empty()) {
+        fprintf(stderr, "osd_agree: no .obj files in %s\n", dir.c_str());
+        return 2;
+    }
+
+    sfb_context_config cc = sfb_context_config_init();
+    sfb_context *ctx = NULL;
+    if (sfb_context_create(&cc, &ctx) != SFB_SUCCESS) {
+        fprintf(stderr, "osd_agree: sfb_context_create failed\n");
+        return 2;
+    }
+    if (g_verbose) printf("backend: %s\n", sfb_context_backend_name(ctx));
+
+    int passed = 0, failed = 0, skipped = 0;
+    for (size_t k = 0; k < files.size(); ++k) {
+        Outcome o = run_shape(ctx, dir, files[k]);
+        if (o == OUT_PASS) ++passed;
+        else if (o == OUT_FAIL) ++failed;
+        else ++skipped;
+        fflush(stdout);
+    }
+    sfb_context_destroy(ctx);
+
+    if (skipped) printf("%d passed, %d failed, %d skipped\n", passed, failed, skipped);
+    else printf("%d passed, %d failed\n", passed, failed);
+    return failed == 0 ? 0 : 1;
+}

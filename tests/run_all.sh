@@ -1,0 +1,79 @@
+#!/bin/bash
+# Runs every test suite and prints one closing line: "N passed, N failed, N skipped".
+# Each suite reports its own counts; a suite that crashes or prints no counts is one failure.
+set -u
+BUILD=${BUILD:-build}
+SHAPES=${SHAPES:-../shared/peers/opensubdiv-shapes}
+CC=${CC:-cc}
+CXX=${CXX:-c++}
+PASS=0; FAIL=0; SKIP=0
+LOG=$BUILD/test-logs
+mkdir -p "$LOG"
+
+add_counts() { # name, passed, failed, skipped
+  echo "== $1: $2 passed, $3 failed, $4 skipped"
+  PASS=$((PASS + $2)); FAIL=$((FAIL + $3)); SKIP=$((SKIP + $4))
+}
+
+single() { # name, command...: one test, passes iff the command exits 0
+  local name=$1; shift
+  if "$@" > "$LOG/$name.log" 2>&1; then add_counts "$name" 1 0 0
+  else echo "--- $name failed; log:"; tail -n 30 "$LOG/$name.log"; add_counts "$name" 0 1 0; fi
+}
+
+# 1. the header compiles as C99 and as C++ (with the implementation), warnings as errors
+single compile-c99 $CC -std=c99 -pedantic -Wall -Wextra -Werror -c -x c tools/impl.c -I. -o "$LOG/impl_c99.o"
+single compile-cxx $CXX -std=c++11 -Wall -Wextra -Werror -c -x c++ tools/impl.c -I. -o "$LOG/impl_cxx.o"
+
+# 2. unit tests (Criterion)
+out=$("$BUILD/unit" --jobs 2 2>&1); rc=$?
+echo "$out" > "$LOG/unit.log"
+echo "$out" | grep -E "^\[(FAIL|----)\]|Synthesis" | tail -n 40
+syn=$(echo "$out" | grep -E "Synthesis: Tested:" | tail -n 1 | sed 's/\x1b\[[0-9;]*m//g')
+if [ -n "$syn" ]; then
+  t=$(echo "$syn" | sed -E 's/.*Tested: ([0-9]+).*/\1/'); p=$(echo "$syn" | sed -E 's/.*Passing: ([0-9]+).*/\1/')
+  f=$(echo "$syn" | sed -E 's/.*Failing: ([0-9]+).*/\1/'); c=$(echo "$syn" | sed -E 's/.*Crashing: ([0-9]+).*/\1/')
+  add_counts unit "$p" "$((f))" 0
+  [ "$rc" -eq 0 ] || [ "$f" -gt 0 ] || add_counts unit-exit 0 1 0
+else
+  echo "$out" | tail -n 20; add_counts unit 0 1 0
+fi
+
+# 3. agreement with OpenSubdiv 3.5 over the peer shapes
+if [ -d "$SHAPES" ]; then
+  out=$("$BUILD/osd_agree" "$SHAPES" 2>&1); rc=$?
+  echo "$out" > "$LOG/osd_agree.log"
+  echo "$out" | grep -vE "^PASS " | tail -n 40
+  line=$(echo "$out" | grep -E "^[0-9]+ passed, [0-9]+ failed" | tail -n 1)
+  if [ -n "$line" ]; then
+    p=$(echo "$line" | sed -E 's/^([0-9]+) passed.*/\1/'); f=$(echo "$line" | sed -E 's/.* ([0-9]+) failed.*/\1/')
+    s=$(echo "$line" | grep -oE "[0-9]+ skipped" | grep -oE "[0-9]+" || echo 0)
+    add_counts osd_agree "$p" "$f" "${s:-0}"
+    [ "$rc" -eq 0 ] || [ "$f" -gt 0 ] || add_counts osd_agree-exit 0 1 0
+  else
+    add_counts osd_agree 0 1 0
+  fi
+else
+  echo "peer shapes not found at $SHAPES: OpenSubdiv agreement skipped"; add_counts osd_agree 0 0 1
+fi
+
+# 4. command-line tool
+out=$(BUILD=$BUILD SHAPES=$SHAPES ./tests/cli_test.sh 2>&1)
+echo "$out" > "$LOG/cli.log"
+echo "$out" | grep -E "^(FAIL|ok)" | grep -v "^ok" | tail -n 20
+line=$(echo "$out" | grep -E "^[0-9]+ passed, [0-9]+ failed" | tail -n 1)
+if [ -n "$line" ]; then
+  p=$(echo "$line" | sed -E 's/^([0-9]+) passed.*/\1/'); f=$(echo "$line" | sed -E 's/.* ([0-9]+) failed.*/\1/')
+  add_counts cli "$p" "$f" 0
+else
+  echo "$out" | tail -n 20; add_counts cli 0 1 0
+fi
+
+# 5. examples build and run
+for ex in "$BUILD"/examples/*; do
+  [ -x "$ex" ] && single "example-$(basename "$ex")" "$ex"
+done
+
+echo
+echo "$PASS passed, $FAIL failed, $SKIP skipped"
+[ "$FAIL" -eq 0 ]
