@@ -326,6 +326,7 @@ struct sfb_context {
     sfb_logger logger;
     sfb_progress progress;
     size_t budget, live_bytes, peak_bytes;
+    int budget_refused;                /* the last failed allocation was refused by the budget */
     int threads, gl_use_current_context;
     sfb_backend_kind order[SFB_BACKEND_KIND_COUNT_];
     int order_count;
@@ -352,6 +353,9 @@ void sfb__log(sfb_context *ctx, int level, const char *fmt, ...)
     __attribute__((format(printf, 3, 4)))
 #endif
     ;
+/* Reports a failed allocation: SFB_LIMIT_EXCEEDED when the memory budget refused it,
+ * SFB_OUT_OF_MEMORY when the allocator itself failed. */
+sfb_result sfb__oom(sfb_context *ctx, const char *what);
 /* Returns SFB_CANCELLED (with the error set) when the callback asks to stop. */
 sfb_result sfb__progress(sfb_context *ctx, float done, const char *stage);
 sfb_result sfb__select_backend(sfb_context *ctx, const char *env_override);
@@ -460,7 +464,10 @@ int sfb__mul_size(size_t a, size_t b, size_t *out) {
 void *sfb__alloc(sfb_context *ctx, size_t size) {
     unsigned char *p;
     if (size > ((size_t)-1) - SFB__HDR) return NULL;
-    if (ctx->live_bytes + size > ctx->budget || ctx->live_bytes + size < ctx->live_bytes) return NULL;
+    if (ctx->live_bytes + size > ctx->budget || ctx->live_bytes + size < ctx->live_bytes) {
+        ctx->budget_refused = 1;
+        return NULL;
+    }
     p = (unsigned char *)ctx->allocator.alloc(size + SFB__HDR, ctx->allocator.user);
     if (!p) return NULL;
     memcpy(p, &size, sizeof size);
@@ -483,7 +490,10 @@ void *sfb__realloc(sfb_context *ctx, void *ptr, size_t size) {
     p = (unsigned char *)ptr - SFB__HDR;
     memcpy(&old, p, sizeof old);
     if (size > ((size_t)-1) - SFB__HDR) return NULL;
-    if (size > old && (ctx->live_bytes - old + size > ctx->budget)) return NULL;
+    if (size > old && (ctx->live_bytes - old + size > ctx->budget)) {
+        ctx->budget_refused = 1;
+        return NULL;
+    }
     np = (unsigned char *)ctx->allocator.realloc(p, size + SFB__HDR, ctx->allocator.user);
     if (!np) return NULL;
     memcpy(np, &size, sizeof size);
@@ -529,6 +539,16 @@ sfb_result sfb__error(sfb_context *ctx, sfb_result r, sfb_element_kind kind, lon
     ctx->error_info.message = ctx->error;
     if (ctx->logger.func) ctx->logger.func(SFB_LOG_ERROR, ctx->error, ctx->logger.user);
     return r;
+}
+
+sfb_result sfb__oom(sfb_context *ctx, const char *what) {
+    int budget = ctx->budget_refused;
+    ctx->budget_refused = 0;
+    if (budget)
+        return sfb__error(ctx, SFB_LIMIT_EXCEEDED, SFB_ELEMENT_NONE, -1,
+                          "%s needs more memory than the memory budget allows (%zu bytes in use, budget %zu bytes)", what,
+                          ctx->live_bytes, ctx->budget);
+    return sfb__error(ctx, SFB_OUT_OF_MEMORY, SFB_ELEMENT_NONE, -1, "out of memory: the allocator failed during %s", what);
 }
 
 void sfb__log(sfb_context *ctx, int level, const char *fmt, ...) {
@@ -948,8 +968,7 @@ sfb_result sfb__level_complete(sfb_context *ctx, sfb__level *l) {
     return SFB_SUCCESS;
 oom:
     sfb__free(ctx, fill); sfb__free(ctx, tf); sfb__free(ctx, ts); sfb__free(ctx, te);
-    return sfb__error(ctx, SFB_OUT_OF_MEMORY, SFB_ELEMENT_NONE, -1,
-                      "out of memory or over the memory budget building topology (%d faces)", l->nf);
+    return sfb__oom(ctx, "building topology");
 }
 
 static void *sfb__dup(sfb_context *ctx, const void *p, size_t bytes) {
@@ -980,7 +999,7 @@ sfb_result sfb__level_prepare(sfb_context *ctx, const sfb__level *s, int boundar
     if (!d->fv_off || !d->fv || !d->fe || !d->ev || !d->ef_off || !d->ef || !d->ef_slot || !d->vf_off || !d->vf ||
         !d->vf_slot || !d->ve_off || !d->ve || !d->es || !d->vs || !d->etag || !d->vtag || !d->vrule || !d->fhole) {
         sfb__level_free(ctx, d);
-        return sfb__error(ctx, SFB_OUT_OF_MEMORY, SFB_ELEMENT_NONE, -1, "out of memory or over the memory budget");
+        return sfb__oom(ctx, "copying topology");
     }
     if (make_boundary_holes) {
         for (v = 0; v < d->nv; ++v) {
@@ -1610,11 +1629,6 @@ static sfb_result sfb__rows_to_stencils(sfb_context *ctx, const sfb__rows *r, in
     return SFB_SUCCESS;
 }
 
-static sfb_result sfb__oom(sfb_context *ctx, const char *what) {
-    return sfb__error(ctx, SFB_LIMIT_EXCEEDED, SFB_ELEMENT_NONE, -1,
-                      "%s needs more memory than allowed: %zu bytes in use, memory budget %zu bytes (or the allocator failed)",
-                      what, ctx->live_bytes, ctx->budget);
-}
 
 sfb_result sfb__refine(sfb_context *ctx, const sfb__level *base, const sfb__refine_options *opt, int level,
                        sfb__level *top, sfb__stencils *vt, sfb__stencils *lt, float prog0, float prog1) {
@@ -1883,8 +1897,7 @@ static sfb_result sfb__level_from_faces(sfb_context *ctx, int nv, int nf, const 
     return SFB_SUCCESS;
 oom:
     sfb__level_free(ctx, l);
-    return sfb__error(ctx, SFB_LIMIT_EXCEEDED, SFB_ELEMENT_NONE, -1,
-                      "building the mesh topology needs more memory than the budget (%zu bytes) allows", ctx->budget);
+    return sfb__oom(ctx, "building the mesh topology");
 }
 
 static sfb_result sfb__check_sharpness(sfb_context *ctx, float s, const sfb__src_lines *lines, const int *line_of,
@@ -1927,7 +1940,7 @@ static sfb_result sfb__mesh_create(sfb_context *ctx, const sfb_mesh_desc *d, con
         if (!sfb__finite3(d->positions + 3 * (size_t)v))
             return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_VERTEX, v, "coordinate is not finite (NaN or inf)");
     m = (sfb_mesh *)sfb__calloc(ctx, 1, sizeof(sfb_mesh));
-    if (!m) return sfb__error(ctx, SFB_OUT_OF_MEMORY, SFB_ELEMENT_NONE, -1, "out of memory");
+    if (!m) return sfb__oom(ctx, "mesh");
     m->ctx = ctx;
     m->boundary = d->boundary; m->crease_method = d->crease_method;
     m->triangle_rule = d->triangle_rule; m->uv_interp = d->uv_interp;
@@ -2289,8 +2302,8 @@ static int sfb__parse_int(const char **c, const char *end, long *out) {
 static sfb_result sfb__tok_int(sfb__objp *P, const char *t, size_t n, const char *what, long *out) {
     const char *c = t;
     int r = sfb__parse_int(&c, t + n, out);
+    if (r == 2) return sfb__perr(P, SFB_LIMIT_EXCEEDED, "%s '%.*s' is over the limit of a 32-bit integer", what, (int)(n > 40 ? 40 : n), t);
     if (r == 1 || c != t + n) return sfb__perr(P, SFB_PARSE_ERROR, "expected an integer for %s, got '%.*s'", what, (int)(n > 40 ? 40 : n), t);
-    if (r == 2) return sfb__perr(P, SFB_LIMIT_EXCEEDED, "%s '%.*s' is too large", what, (int)(n > 40 ? 40 : n), t);
     return SFB_SUCCESS;
 }
 
@@ -2402,7 +2415,7 @@ static sfb_result sfb__obj_tag(sfb__objp *P, const char *cur, const char *end) {
         return SFB_SUCCESS;
     }
     if (ni > 1000000 || nf > 1000000 || ns > 1000000)
-        return sfb__perr(P, SFB_LIMIT_EXCEEDED, "tag '%.*s' declares too many arguments", (int)(nn > 40 ? 40 : nn), name);
+        return sfb__perr(P, SFB_LIMIT_EXCEEDED, "tag '%.*s' declares more than 1000000 arguments (over the limit)", (int)(nn > 40 ? 40 : nn), name);
     if (ni > 64) iv = (long *)sfb__alloc(P->ctx, (size_t)ni * sizeof(long));
     if (nf > 64) fv = (float *)sfb__alloc(P->ctx, (size_t)nf * sizeof(float));
     if (!iv || !fv) { r = sfb__oom(P->ctx, "OBJ reader"); goto out; }
@@ -2544,6 +2557,8 @@ static sfb_result sfb__obj_line(sfb__objp *P, const char *cur, const char *end) 
         r = sfb__tok_int(P, t, n, "'as' face count", &cnt);
         if (r) return r;
         if (cnt <= 0) return sfb__perr(P, SFB_PARSE_ERROR, "'as' face count %ld must be positive", cnt);
+        if (cnt > SFB_MAX_ELEMENTS)
+            return sfb__perr(P, SFB_LIMIT_EXCEEDED, "'as' face count %ld is over the limit of %d faces", cnt, SFB_MAX_ELEMENTS);
         if (!P->as_vals) {
             P->as_vals = (float *)sfb__alloc(P->ctx, SFB_MAX_FACE_SIZE * sizeof(float));
             if (!P->as_vals) return sfb__oom(P->ctx, "OBJ reader");
@@ -2634,7 +2649,15 @@ SFB_API sfb_result sfb_mesh_read_obj(sfb_context *ctx, const char *text, size_t 
             d.uvs = (const float *)P.uv.p;
             d.face_uvs = (const int *)P.fuv.p;
         } else if (P.faces_with_uv > 0) {
-            sfb__log(ctx, SFB_LOG_WARN, "OBJ: %d faces have uv indices and %d do not; uvs dropped", P.faces_with_uv, P.faces_without_uv);
+            /* some faces with uv indices, some without: refuse rather than drop the uvs */
+            const int *fu = (const int *)P.fuv.p, *fs = (const int *)P.fsize.p;
+            size_t f, o = 0;
+            int first = fu[0] >= 0;
+            for (f = 0; f < P.fsize.n; o += (size_t)fs[f], ++f)
+                if ((fu[o] >= 0) != first) break;
+            P.line = ((const int *)P.fline.p)[f < P.fsize.n ? f : 0];
+            r = sfb__perr(&P, SFB_INVALID_TOPOLOGY, "face %zu %s uv indices but face 0 %s (every face needs uvs, or none)", f,
+                          first ? "lacks" : "has", first ? "has them" : "does not");
         }
         d.face_edge_sharpness = P.any_fsharp ? (const float *)P.fsharp.p : NULL;
         d.boundary = P.boundary;
@@ -2644,7 +2667,8 @@ SFB_API sfb_result sfb_mesh_read_obj(sfb_context *ctx, const char *text, size_t 
         lines.crease = (const int *)P.cline.p;
         lines.corner = (const int *)P.kline.p;
         lines.hole = (const int *)P.hline.p;
-        if (d.face_count == 0) r = sfb__error(ctx, SFB_INVALID_TOPOLOGY, SFB_ELEMENT_NONE, -1, "OBJ has no faces (line %ld is the last)", P.line);
+        if (r != SFB_SUCCESS) { /* reported above */ }
+        else if (d.face_count == 0) r = sfb__error(ctx, SFB_INVALID_TOPOLOGY, SFB_ELEMENT_NONE, -1, "OBJ has no faces (line %ld is the last)", P.line);
         else r = sfb__mesh_create(ctx, &d, &lines, out);
     }
     sfb__objp_free(&P);

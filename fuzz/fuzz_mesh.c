@@ -238,7 +238,29 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     }
     d.face_sizes = face_sizes;
     int *face_vertices = array((int)fv, sizeof(int));
-    for (long i = 0; i < fv; i++) face_vertices[i] = index_of(r, nv);
+    {
+        /* corners of one face are made distinct (when there are enough vertices) unless the
+         * input asks for repeats, so that most descs get past the degenerate-face check */
+        long at = 0;
+        int allow_repeats = (flags & 8) != 0;
+        for (int f = 0; f < nf; f++) {
+            int s = face_sizes[f];
+            if (s <= 0 || s > SFB_MAX_FACE_SIZE) continue;
+            for (int k = 0; k < s; k++) {
+                int v = index_of(r, nv);
+                if (!allow_repeats && s <= nv && v >= 0 && v < nv) {
+                    for (int tries = 0; tries < nv; tries++) {
+                        int dup = 0;
+                        for (int j = 0; j < k && !dup; j++) dup = face_vertices[at + j] == v;
+                        if (!dup) break;
+                        v = (v + 1) % nv;
+                    }
+                }
+                face_vertices[at + k] = v;
+            }
+            at += s;
+        }
+    }
     d.face_vertices = face_vertices;
 
     /* creases */
@@ -248,7 +270,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     float *crease_sharpness = array(nc, sizeof(float));
     for (int i = 0; i < nc; i++) {
         /* mostly edges of existing faces */
-        if (fv > 0 && (u8(r) & 3)) {
+        if (fv > 0 && (u8(r) & 15)) {
             long at = (long)(u32(r) % (uint32_t)fv);
             /* find the face holding `at` to pick its successor */
             long base = 0;

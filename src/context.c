@@ -31,7 +31,10 @@ int sfb__mul_size(size_t a, size_t b, size_t *out) {
 void *sfb__alloc(sfb_context *ctx, size_t size) {
     unsigned char *p;
     if (size > ((size_t)-1) - SFB__HDR) return NULL;
-    if (ctx->live_bytes + size > ctx->budget || ctx->live_bytes + size < ctx->live_bytes) return NULL;
+    if (ctx->live_bytes + size > ctx->budget || ctx->live_bytes + size < ctx->live_bytes) {
+        ctx->budget_refused = 1;
+        return NULL;
+    }
     p = (unsigned char *)ctx->allocator.alloc(size + SFB__HDR, ctx->allocator.user);
     if (!p) return NULL;
     memcpy(p, &size, sizeof size);
@@ -54,7 +57,10 @@ void *sfb__realloc(sfb_context *ctx, void *ptr, size_t size) {
     p = (unsigned char *)ptr - SFB__HDR;
     memcpy(&old, p, sizeof old);
     if (size > ((size_t)-1) - SFB__HDR) return NULL;
-    if (size > old && (ctx->live_bytes - old + size > ctx->budget)) return NULL;
+    if (size > old && (ctx->live_bytes - old + size > ctx->budget)) {
+        ctx->budget_refused = 1;
+        return NULL;
+    }
     np = (unsigned char *)ctx->allocator.realloc(p, size + SFB__HDR, ctx->allocator.user);
     if (!np) return NULL;
     memcpy(np, &size, sizeof size);
@@ -100,6 +106,16 @@ sfb_result sfb__error(sfb_context *ctx, sfb_result r, sfb_element_kind kind, lon
     ctx->error_info.message = ctx->error;
     if (ctx->logger.func) ctx->logger.func(SFB_LOG_ERROR, ctx->error, ctx->logger.user);
     return r;
+}
+
+sfb_result sfb__oom(sfb_context *ctx, const char *what) {
+    int budget = ctx->budget_refused;
+    ctx->budget_refused = 0;
+    if (budget)
+        return sfb__error(ctx, SFB_LIMIT_EXCEEDED, SFB_ELEMENT_NONE, -1,
+                          "%s needs more memory than the memory budget allows (%zu bytes in use, budget %zu bytes)", what,
+                          ctx->live_bytes, ctx->budget);
+    return sfb__error(ctx, SFB_OUT_OF_MEMORY, SFB_ELEMENT_NONE, -1, "out of memory: the allocator failed during %s", what);
 }
 
 void sfb__log(sfb_context *ctx, int level, const char *fmt, ...) {

@@ -138,8 +138,7 @@ static sfb_result sfb__level_from_faces(sfb_context *ctx, int nv, int nf, const 
     return SFB_SUCCESS;
 oom:
     sfb__level_free(ctx, l);
-    return sfb__error(ctx, SFB_LIMIT_EXCEEDED, SFB_ELEMENT_NONE, -1,
-                      "building the mesh topology needs more memory than the budget (%zu bytes) allows", ctx->budget);
+    return sfb__oom(ctx, "building the mesh topology");
 }
 
 static sfb_result sfb__check_sharpness(sfb_context *ctx, float s, const sfb__src_lines *lines, const int *line_of,
@@ -182,7 +181,7 @@ static sfb_result sfb__mesh_create(sfb_context *ctx, const sfb_mesh_desc *d, con
         if (!sfb__finite3(d->positions + 3 * (size_t)v))
             return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_VERTEX, v, "coordinate is not finite (NaN or inf)");
     m = (sfb_mesh *)sfb__calloc(ctx, 1, sizeof(sfb_mesh));
-    if (!m) return sfb__error(ctx, SFB_OUT_OF_MEMORY, SFB_ELEMENT_NONE, -1, "out of memory");
+    if (!m) return sfb__oom(ctx, "mesh");
     m->ctx = ctx;
     m->boundary = d->boundary; m->crease_method = d->crease_method;
     m->triangle_rule = d->triangle_rule; m->uv_interp = d->uv_interp;

@@ -129,8 +129,8 @@ static int sfb__parse_int(const char **c, const char *end, long *out) {
 static sfb_result sfb__tok_int(sfb__objp *P, const char *t, size_t n, const char *what, long *out) {
     const char *c = t;
     int r = sfb__parse_int(&c, t + n, out);
+    if (r == 2) return sfb__perr(P, SFB_LIMIT_EXCEEDED, "%s '%.*s' is over the limit of a 32-bit integer", what, (int)(n > 40 ? 40 : n), t);
     if (r == 1 || c != t + n) return sfb__perr(P, SFB_PARSE_ERROR, "expected an integer for %s, got '%.*s'", what, (int)(n > 40 ? 40 : n), t);
-    if (r == 2) return sfb__perr(P, SFB_LIMIT_EXCEEDED, "%s '%.*s' is too large", what, (int)(n > 40 ? 40 : n), t);
     return SFB_SUCCESS;
 }
 
@@ -242,7 +242,7 @@ static sfb_result sfb__obj_tag(sfb__objp *P, const char *cur, const char *end) {
         return SFB_SUCCESS;
     }
     if (ni > 1000000 || nf > 1000000 || ns > 1000000)
-        return sfb__perr(P, SFB_LIMIT_EXCEEDED, "tag '%.*s' declares too many arguments", (int)(nn > 40 ? 40 : nn), name);
+        return sfb__perr(P, SFB_LIMIT_EXCEEDED, "tag '%.*s' declares more than 1000000 arguments (over the limit)", (int)(nn > 40 ? 40 : nn), name);
     if (ni > 64) iv = (long *)sfb__alloc(P->ctx, (size_t)ni * sizeof(long));
     if (nf > 64) fv = (float *)sfb__alloc(P->ctx, (size_t)nf * sizeof(float));
     if (!iv || !fv) { r = sfb__oom(P->ctx, "OBJ reader"); goto out; }
@@ -384,6 +384,8 @@ static sfb_result sfb__obj_line(sfb__objp *P, const char *cur, const char *end) 
         r = sfb__tok_int(P, t, n, "'as' face count", &cnt);
         if (r) return r;
         if (cnt <= 0) return sfb__perr(P, SFB_PARSE_ERROR, "'as' face count %ld must be positive", cnt);
+        if (cnt > SFB_MAX_ELEMENTS)
+            return sfb__perr(P, SFB_LIMIT_EXCEEDED, "'as' face count %ld is over the limit of %d faces", cnt, SFB_MAX_ELEMENTS);
         if (!P->as_vals) {
             P->as_vals = (float *)sfb__alloc(P->ctx, SFB_MAX_FACE_SIZE * sizeof(float));
             if (!P->as_vals) return sfb__oom(P->ctx, "OBJ reader");
@@ -474,7 +476,15 @@ SFB_API sfb_result sfb_mesh_read_obj(sfb_context *ctx, const char *text, size_t 
             d.uvs = (const float *)P.uv.p;
             d.face_uvs = (const int *)P.fuv.p;
         } else if (P.faces_with_uv > 0) {
-            sfb__log(ctx, SFB_LOG_WARN, "OBJ: %d faces have uv indices and %d do not; uvs dropped", P.faces_with_uv, P.faces_without_uv);
+            /* some faces with uv indices, some without: refuse rather than drop the uvs */
+            const int *fu = (const int *)P.fuv.p, *fs = (const int *)P.fsize.p;
+            size_t f, o = 0;
+            int first = fu[0] >= 0;
+            for (f = 0; f < P.fsize.n; o += (size_t)fs[f], ++f)
+                if ((fu[o] >= 0) != first) break;
+            P.line = ((const int *)P.fline.p)[f < P.fsize.n ? f : 0];
+            r = sfb__perr(&P, SFB_INVALID_TOPOLOGY, "face %zu %s uv indices but face 0 %s (every face needs uvs, or none)", f,
+                          first ? "lacks" : "has", first ? "has them" : "does not");
         }
         d.face_edge_sharpness = P.any_fsharp ? (const float *)P.fsharp.p : NULL;
         d.boundary = P.boundary;
@@ -484,7 +494,8 @@ SFB_API sfb_result sfb_mesh_read_obj(sfb_context *ctx, const char *text, size_t 
         lines.crease = (const int *)P.cline.p;
         lines.corner = (const int *)P.kline.p;
         lines.hole = (const int *)P.hline.p;
-        if (d.face_count == 0) r = sfb__error(ctx, SFB_INVALID_TOPOLOGY, SFB_ELEMENT_NONE, -1, "OBJ has no faces (line %ld is the last)", P.line);
+        if (r != SFB_SUCCESS) { /* reported above */ }
+        else if (d.face_count == 0) r = sfb__error(ctx, SFB_INVALID_TOPOLOGY, SFB_ELEMENT_NONE, -1, "OBJ has no faces (line %ld is the last)", P.line);
         else r = sfb__mesh_create(ctx, &d, &lines, out);
     }
     sfb__objp_free(&P);

@@ -592,11 +592,6 @@ static sfb_result sfb__rows_to_stencils(sfb_context *ctx, const sfb__rows *r, in
     return SFB_SUCCESS;
 }
 
-static sfb_result sfb__oom(sfb_context *ctx, const char *what) {
-    return sfb__error(ctx, SFB_LIMIT_EXCEEDED, SFB_ELEMENT_NONE, -1,
-                      "%s needs more memory than allowed: %zu bytes in use, memory budget %zu bytes (or the allocator failed)",
-                      what, ctx->live_bytes, ctx->budget);
-}
 
 sfb_result sfb__refine(sfb_context *ctx, const sfb__level *base, const sfb__refine_options *opt, int level,
                        sfb__level *top, sfb__stencils *vt, sfb__stencils *lt, float prog0, float prog1) {

@@ -40,6 +40,7 @@ struct sfb_context {
     sfb_logger logger;
     sfb_progress progress;
     size_t budget, live_bytes, peak_bytes;
+    int budget_refused;                /* the last failed allocation was refused by the budget */
     int threads, gl_use_current_context;
     sfb_backend_kind order[SFB_BACKEND_KIND_COUNT_];
     int order_count;
@@ -66,6 +67,9 @@ void sfb__log(sfb_context *ctx, int level, const char *fmt, ...)
     __attribute__((format(printf, 3, 4)))
 #endif
     ;
+/* Reports a failed allocation: SFB_LIMIT_EXCEEDED when the memory budget refused it,
+ * SFB_OUT_OF_MEMORY when the allocator itself failed. */
+sfb_result sfb__oom(sfb_context *ctx, const char *what);
 /* Returns SFB_CANCELLED (with the error set) when the callback asks to stop. */
 sfb_result sfb__progress(sfb_context *ctx, float done, const char *stage);
 sfb_result sfb__select_backend(sfb_context *ctx, const char *env_override);

@@ -174,8 +174,7 @@ sfb_result sfb__level_complete(sfb_context *ctx, sfb__level *l) {
     return SFB_SUCCESS;
 oom:
     sfb__free(ctx, fill); sfb__free(ctx, tf); sfb__free(ctx, ts); sfb__free(ctx, te);
-    return sfb__error(ctx, SFB_OUT_OF_MEMORY, SFB_ELEMENT_NONE, -1,
-                      "out of memory or over the memory budget building topology (%d faces)", l->nf);
+    return sfb__oom(ctx, "building topology");
 }
 
 static void *sfb__dup(sfb_context *ctx, const void *p, size_t bytes) {
@@ -206,7 +205,7 @@ sfb_result sfb__level_prepare(sfb_context *ctx, const sfb__level *s, int boundar
     if (!d->fv_off || !d->fv || !d->fe || !d->ev || !d->ef_off || !d->ef || !d->ef_slot || !d->vf_off || !d->vf ||
         !d->vf_slot || !d->ve_off || !d->ve || !d->es || !d->vs || !d->etag || !d->vtag || !d->vrule || !d->fhole) {
         sfb__level_free(ctx, d);
-        return sfb__error(ctx, SFB_OUT_OF_MEMORY, SFB_ELEMENT_NONE, -1, "out of memory or over the memory budget");
+        return sfb__oom(ctx, "copying topology");
     }
     if (make_boundary_holes) {
         for (v = 0; v < d->nv; ++v) {
