@@ -1855,7 +1855,7 @@ static sfb_result sfb__level_from_faces(sfb_context *ctx, int nv, int nf, const 
     for (f = 0; f < nf; ++f) {
         char msg[160];
         if (sizes[f] < 3) {
-            snprintf(msg, sizeof msg, "face has %d vertices; a face needs at least 3", sizes[f]);
+            snprintf(msg, sizeof msg, "face has %d %s; a face needs at least 3", sizes[f], sizes[f] == 1 ? "vertex" : "vertices");
             return sfb__elem_error(ctx, SFB_INVALID_TOPOLOGY, lines, lines ? lines->face : NULL, SFB_ELEMENT_FACE, f, "face", f, msg);
         }
         if (sizes[f] > SFB_MAX_FACE_SIZE) {
@@ -2313,7 +2313,8 @@ static sfb_result sfb__resolve(sfb__objp *P, long idx, size_t count, const char 
     if (idx < 0) idx = (long)count + idx;
     else idx = idx - 1;
     if (idx < 0 || (size_t)idx >= count)
-        return sfb__perr(P, SFB_INVALID_TOPOLOGY, "%s index out of range (%zu %ss defined so far)", what, count, what);
+        return sfb__perr(P, SFB_INVALID_TOPOLOGY, "%s index out of range (%zu %s defined so far)", what, count,
+                         strcmp(what, "vertex") == 0 ? "vertices" : "uvs");
     *out = (int)idx;
     return SFB_SUCCESS;
 }
@@ -2366,7 +2367,8 @@ static sfb_result sfb__obj_face(sfb__objp *P, const char *cur, const char *end) 
         SFB__PUSH(P->fuv, ti);
         count++;
     }
-    if (count < 3) return sfb__perr(P, SFB_INVALID_TOPOLOGY, "face has %d vertices; a face needs at least 3", count);
+    if (count < 3)
+        return sfb__perr(P, SFB_INVALID_TOPOLOGY, "face has %d %s; a face needs at least 3", count, count == 1 ? "vertex" : "vertices");
     SFB__PUSH(P->fsize, count);
     SFB__PUSH(P->fline, line);
     if (has_uv) P->faces_with_uv++; else P->faces_without_uv++;

@@ -96,7 +96,7 @@ static sfb_result sfb__level_from_faces(sfb_context *ctx, int nv, int nf, const 
     for (f = 0; f < nf; ++f) {
         char msg[160];
         if (sizes[f] < 3) {
-            snprintf(msg, sizeof msg, "face has %d vertices; a face needs at least 3", sizes[f]);
+            snprintf(msg, sizeof msg, "face has %d %s; a face needs at least 3", sizes[f], sizes[f] == 1 ? "vertex" : "vertices");
             return sfb__elem_error(ctx, SFB_INVALID_TOPOLOGY, lines, lines ? lines->face : NULL, SFB_ELEMENT_FACE, f, "face", f, msg);
         }
         if (sizes[f] > SFB_MAX_FACE_SIZE) {

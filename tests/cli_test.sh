@@ -52,9 +52,8 @@ if [ -d "$SHAPES" ] && [ -x "$BUILD/osd_agree" ]; then
       if "$CLI" refine --level "$L" "$SHAPES/$name.obj" -o "$TMP/r.obj" 2> "$TMP/err"; then
         got=$(grep -c '^v ' "$TMP/r.obj")
         if [ "$got" = "$want" ]; then P=$((P + 1)); else F=$((F + 1)); echo "FAIL refine $name level $L: $got vertices, OpenSubdiv $want"; fi
-      elif grep -q "REJECTED $name\b" "$TMP/rejected" 2>/dev/null; then :
       else
-        echo "note: refine $name level $L refused: $(head -n 1 "$TMP/err")"
+        F=$((F + 1)); echo "FAIL refine $name level $L refused: $(head -n 1 "$TMP/err")"
       fi
     done < "$TMP/counts"
   done

@@ -25,6 +25,7 @@
 #include <criterion/parameterized.h>
 
 #include <ctype.h>
+#include <math.h>
 #include <dirent.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -267,7 +268,7 @@ ParameterizedTestParameters(bad, file)
     return cr_make_param_array(struct bad_case, cases, (size_t)n, cleanup_params);
 }
 
-ParameterizedTest(struct bad_case *c, bad, file, .timeout = 60.0)
+ParameterizedTest(struct bad_case *c, bad, file)
 {
     const char *f = c->file;
     cr_assert(f[0] != '\0', "manifest %s/EXPECTED.txt is missing, unreadable or empty", bad_dir());
@@ -425,6 +426,102 @@ Test(bad_api, result_strings)
     cr_expect(u != NULL && u[0] != '\0', "sfb_result_string(-999) is empty");
 }
 
+/* ------------------------------------------------------------------ limits, both sides */
+
+/* The files in tests/bad are built for the limits of their day; these follow the macros: a
+ * mesh exactly at SFB_MAX_VALENCE / SFB_MAX_FACE_SIZE is accepted, one past it is refused. */
+
+typedef struct textbuf { char *p; size_t n, cap; } textbuf;
+
+static void tb_append(textbuf *t, const char *str)
+{
+    size_t k = strlen(str);
+    if (t->n + k + 1 > t->cap) {
+        size_t cap = t->cap ? t->cap * 2 : 65536;
+        while (cap < t->n + k + 1) cap *= 2;
+        char *np = realloc(t->p, cap);
+        cr_assert(np != NULL, "out of memory building a test mesh");
+        t->p = np;
+        t->cap = cap;
+    }
+    memcpy(t->p + t->n, str, k + 1);
+    t->n += k;
+}
+
+static void tb_circle_vertices(textbuf *t, int k)
+{
+    char line[96];
+    for (int i = 0; i < k; i++) {
+        double a = 6.283185307179586 * i / k;
+        snprintf(line, sizeof line, "v %.6f %.6f 0\n", cos(a), sin(a));
+        tb_append(t, line);
+    }
+}
+
+/* Closed fan of k triangles around vertex 1 (valence k). */
+static textbuf fan_obj(int k)
+{
+    textbuf t = { NULL, 0, 0 };
+    char line[96];
+    tb_append(&t, "v 0 0 0\n");
+    tb_circle_vertices(&t, k);
+    for (int i = 0; i < k; i++) {
+        snprintf(line, sizeof line, "f 1 %d %d\n", i + 2, (i + 1) % k + 2);
+        tb_append(&t, line);
+    }
+    return t;
+}
+
+/* One convex face with k corners. */
+static textbuf ngon_obj(int k)
+{
+    textbuf t = { NULL, 0, 0 };
+    char idx[32];
+    tb_circle_vertices(&t, k);
+    tb_append(&t, "f");
+    for (int i = 0; i < k; i++) {
+        snprintf(idx, sizeof idx, " %d", i + 1);
+        tb_append(&t, idx);
+    }
+    tb_append(&t, "\n");
+    return t;
+}
+
+static void expect_read(const char *what, textbuf t, sfb_result want, const char *keyword)
+{
+    counting cnt;
+    memset(&cnt, 0, sizeof cnt);
+    cnt.fail_at = -1;
+    sfb_context_config cfg = counting_config(&cnt, 0);
+    sfb_context *ctx = NULL;
+    cr_assert_eq(sfb_context_create(&cfg, &ctx), SFB_SUCCESS);
+    sfb_mesh *mesh = NULL;
+    sfb_result r = sfb_mesh_read_obj(ctx, t.p, t.n, &mesh);
+    char msg[1024], low[1024];
+    snprintf(msg, sizeof msg, "%s", sfb_last_error(ctx));
+    lower(low, msg, sizeof low);
+    cr_expect_eq(r, want, "%s: sfb_mesh_read_obj returned %s, expected %s; message: \"%s\"",
+                 what, result_name(r), result_name(want), msg);
+    if (keyword && r != SFB_SUCCESS)
+        cr_expect(strstr(low, keyword) != NULL, "%s: message \"%s\" lacks the keyword \"%s\"", what, msg, keyword);
+    if (mesh) sfb_mesh_destroy(mesh);
+    sfb_context_destroy(ctx);
+    free(t.p);
+    cr_expect_eq(cnt.allocs, cnt.frees, "%s: %ld allocations, %ld frees", what, cnt.allocs, cnt.frees);
+}
+
+Test(bad_limits, valence_at_and_past_the_limit)
+{
+    expect_read("fan of SFB_MAX_VALENCE triangles", fan_obj(SFB_MAX_VALENCE), SFB_SUCCESS, NULL);
+    expect_read("fan of SFB_MAX_VALENCE + 1 triangles", fan_obj(SFB_MAX_VALENCE + 1), SFB_LIMIT_EXCEEDED, "valence");
+}
+
+Test(bad_limits, face_size_at_and_past_the_limit)
+{
+    expect_read("face of SFB_MAX_FACE_SIZE corners", ngon_obj(SFB_MAX_FACE_SIZE), SFB_SUCCESS, NULL);
+    expect_read("face of SFB_MAX_FACE_SIZE + 1 corners", ngon_obj(SFB_MAX_FACE_SIZE + 1), SFB_LIMIT_EXCEEDED, "face");
+}
+
 /* ------------------------------------------------------------------ allocation failures */
 
 /* A valid mesh with creases, a corner, UVs and fs/as lines. Every allocation is made to fail in
@@ -440,7 +537,7 @@ static const char oom_obj[] =
     "t crease 2/1/0 0 1 3.0\n"
     "t corner 1/1/0 6 10\n";
 
-Test(bad_alloc, every_allocation_failure_is_clean, .timeout = 120.0)
+Test(bad_alloc, every_allocation_failure_is_clean)
 {
     int completed = 0;
     long wrong_code = 0, tried = 0;
