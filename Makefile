@@ -15,8 +15,8 @@ SRC_MODULES := src/sfb_api.h src/sfb_internal.h $(wildcard src/*.c)
 TEST_SRCS   := $(wildcard tests/test_*.c)
 
 # Debian packages each goal needs (the library itself needs none but a C compiler).
-PKGS_BASE := build-essential
-PKGS_TEST := libosd-dev libcriterion-dev pkg-config
+PKGS_BASE := $(if $(shell command -v cc 2>/dev/null),,build-essential)
+PKGS_TEST := g++ libosd-dev libcriterion-dev pkg-config
 PKGS_FUZZ := clang libclang-rt-14-dev
 
 .PHONY: all run test bench fuzz asan amalgamate amalgamate-check deps deps-test deps-fuzz clean unit-build

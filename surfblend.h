@@ -871,13 +871,9 @@ static int sfb__order_vertex(sfb__level *l, int v, int *tf, int *ts, int *te) {
         slot = gs;
     }
     if (count != k) return 0;
+    /* the walk visited k distinct faces; with no non-manifold edge their outgoing edges are
+     * distinct too, so the count decides */
     if ((boundary ? count + 1 : count) != m) return 0;
-    /* every edge must be distinct */
-    for (i = 0; i < m; ++i) {
-        int j;
-        for (j = i + 1; j < m && j < i + 64; ++j)
-            if (te[i] == te[j]) return 0;
-    }
     memcpy(l->vf + f0, tf, (size_t)k * sizeof(int));
     memcpy(l->vf_slot + f0, ts, (size_t)k * sizeof(int));
     memcpy(l->ve + e0, te, (size_t)m * sizeof(int));
@@ -1736,11 +1732,9 @@ sfb_result sfb__refine(sfb_context *ctx, const sfb__level *base, const sfb__refi
         *top = cur;
         owns_cur = 0;
     } else {
-        /* level 0: the caller's base is the top; hand back an independent copy */
+        /* level 0: the caller's base is the top; hand back an independent copy (the base is
+         * already prepared, so preparing it again changes nothing) */
         r = sfb__level_prepare(ctx, base, 0, 0, 0, top);
-        if (r == SFB_SUCCESS) {
-            /* sfb__level_prepare re-sharpens; base was already prepared so this is a copy */
-        }
     }
 done:
     if (owns_cur) sfb__level_free(ctx, &cur);

@@ -699,11 +699,9 @@ sfb_result sfb__refine(sfb_context *ctx, const sfb__level *base, const sfb__refi
         *top = cur;
         owns_cur = 0;
     } else {
-        /* level 0: the caller's base is the top; hand back an independent copy */
+        /* level 0: the caller's base is the top; hand back an independent copy (the base is
+         * already prepared, so preparing it again changes nothing) */
         r = sfb__level_prepare(ctx, base, 0, 0, 0, top);
-        if (r == SFB_SUCCESS) {
-            /* sfb__level_prepare re-sharpens; base was already prepared so this is a copy */
-        }
     }
 done:
     if (owns_cur) sfb__level_free(ctx, &cur);

@@ -77,13 +77,9 @@ static int sfb__order_vertex(sfb__level *l, int v, int *tf, int *ts, int *te) {
         slot = gs;
     }
     if (count != k) return 0;
+    /* the walk visited k distinct faces; with no non-manifold edge their outgoing edges are
+     * distinct too, so the count decides */
     if ((boundary ? count + 1 : count) != m) return 0;
-    /* every edge must be distinct */
-    for (i = 0; i < m; ++i) {
-        int j;
-        for (j = i + 1; j < m && j < i + 64; ++j)
-            if (te[i] == te[j]) return 0;
-    }
     memcpy(l->vf + f0, tf, (size_t)k * sizeof(int));
     memcpy(l->vf_slot + f0, ts, (size_t)k * sizeof(int));
     memcpy(l->ve + e0, te, (size_t)m * sizeof(int));
