@@ -128,10 +128,9 @@ struct sfb_surface {
 };
 
 typedef struct sfb__refine_options {
-    sfb_scheme scheme;
-    int boundary, crease_method, triangle_rule;
+    sfb_scheme scheme;   /* boundary options are applied beforehand, by sfb__level_prepare */
+    int crease_method, triangle_rule;
     int want_limit;
-    int is_uv;           /* refining the UV layout */
     int linear;          /* bilinear masks on the scheme's own face split (linear UVs) */
 } sfb__refine_options;
 

@@ -93,7 +93,6 @@ SFB_API sfb_result sfb_surface_create(sfb_context *ctx, const sfb_mesh *mesh, co
     if (r != SFB_SUCCESS) { sfb_surface_destroy(s); return r; }
     memset(&opt, 0, sizeof opt);
     opt.scheme = cfg->scheme;
-    opt.boundary = mesh->boundary;
     opt.crease_method = mesh->crease_method;
     opt.triangle_rule = mesh->triangle_rule;
     opt.want_limit = (cfg->flags & SFB_REFINE_LIMIT) != 0;
@@ -125,11 +124,9 @@ SFB_API sfb_result sfb_surface_create(sfb_context *ctx, const sfb_mesh *mesh, co
         if (r != SFB_SUCCESS) { sfb_surface_destroy(s); return r; }
         memset(&opt, 0, sizeof opt);
         opt.scheme = cfg->scheme;
-        opt.boundary = SFB_BOUNDARY_EDGE_AND_CORNER;
         opt.crease_method = mesh->crease_method;
         opt.triangle_rule = mesh->triangle_rule;
         opt.linear = mesh->uv_interp == SFB_UV_LINEAR;
-        opt.is_uv = 1;
         memset(&dummy, 0, sizeof dummy);
         r = sfb__refine(ctx, &uvp, &opt, cfg->refine_level, &s->uv_top, &s->tables[SFB_TABLE_UV], NULL, 0.8f, 1.0f);
         sfb__level_free(ctx, &uvp);
