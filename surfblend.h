@@ -427,8 +427,8 @@ sfb_result sfb__refine(sfb_context *ctx, const sfb__level *base, const sfb__refi
                        float progress_from, float progress_to);
 void sfb__stencils_free(sfb_context *ctx, sfb__stencils *s);
 /* Copy of the base level with OpenSubdiv's boundary/non-manifold sharpening and holes applied. */
-sfb_result sfb__level_prepare(sfb_context *ctx, const sfb__level *src, int boundary, int sharpen_corners_option,
-                              int make_boundary_holes, sfb__level *dst);
+sfb_result sfb__level_prepare(sfb_context *ctx, const sfb__level *src, int sharpen_corners, int make_boundary_holes,
+                              sfb__level *dst);
 #line 1 "src/context.c"
 /* Results, context, allocator with memory budget, errors, logging, progress. */
 
@@ -977,12 +977,11 @@ static void *sfb__dup(sfb_context *ctx, const void *p, size_t bytes) {
  * topological corners (EDGE_AND_CORNER) and non-manifold vertices infinitely sharp, except
  * a vertex on a non-manifold crease (two non-manifold edges, no boundary, more faces than
  * edges), which keeps its own sharpness. */
-sfb_result sfb__level_prepare(sfb_context *ctx, const sfb__level *s, int boundary, int sharpen_corners,
-                              int make_boundary_holes, sfb__level *d) {
+sfb_result sfb__level_prepare(sfb_context *ctx, const sfb__level *s, int sharpen_corners, int make_boundary_holes,
+                              sfb__level *d) {
     int v, e, i;
     memset(d, 0, sizeof *d);
     d->nv = s->nv; d->nf = s->nf; d->ne = s->ne; d->nfv = s->nfv;
-    (void)boundary;
 #define SFB__DUP(field, count, type) d->field = (type *)sfb__dup(ctx, s->field, (size_t)(count) * sizeof(type))
     SFB__DUP(fv_off, s->nf + 1, int); SFB__DUP(fv, s->nfv, int); SFB__DUP(fe, s->nfv, int);
     SFB__DUP(ev, 2 * s->ne, int); SFB__DUP(ef_off, s->ne + 1, int); SFB__DUP(ef, s->nfv, int);
@@ -1733,7 +1732,7 @@ sfb_result sfb__refine(sfb_context *ctx, const sfb__level *base, const sfb__refi
     } else {
         /* level 0: the caller's base is the top; hand back an independent copy (the base is
          * already prepared, so preparing it again changes nothing) */
-        r = sfb__level_prepare(ctx, base, 0, 0, 0, top);
+        r = sfb__level_prepare(ctx, base, 0, 0, top);
     }
 done:
     if (owns_cur) sfb__level_free(ctx, &cur);
@@ -2143,7 +2142,7 @@ SFB_API void sfb_mesh_get_info(const sfb_mesh *m, sfb_mesh_info *o) {
         }
     }
     /* vertex rules as refinement will see them (after boundary sharpening) */
-    if (sfb__level_prepare(m->ctx, l, m->boundary, m->boundary == SFB_BOUNDARY_EDGE_AND_CORNER, 0, &prep) == SFB_SUCCESS) {
+    if (sfb__level_prepare(m->ctx, l, m->boundary == SFB_BOUNDARY_EDGE_AND_CORNER, 0, &prep) == SFB_SUCCESS) {
         for (v = 0; v < prep.nv; ++v) {
             o->darts += prep.vrule[v] == SFB__RULE_DART;
             o->crease_vertices += prep.vrule[v] == SFB__RULE_CREASE;
@@ -2203,7 +2202,9 @@ typedef struct sfb__objp {
     sfb_context *ctx;
     long line;
     sfb__vec pos, uv, fsize, fv, fuv, fline, fsharp, cv, cs, cline, kv, ks, kline, holes, hline;
-    int faces_with_uv, faces_without_uv, any_fsharp;
+    int first_has_uv;          /* -1 before the first face */
+    long uv_mismatch_face, uv_mismatch_line; /* first face whose uv use differs from face 0; -1 none */
+    int any_fsharp;
     int boundary, crease_method, triangle_rule;
     /* pending `as` */
     long as_left, as_line;
@@ -2364,7 +2365,11 @@ static sfb_result sfb__obj_face(sfb__objp *P, const char *cur, const char *end) 
         return sfb__perr(P, SFB_INVALID_TOPOLOGY, "face has %d %s; a face needs at least 3", count, count == 1 ? "vertex" : "vertices");
     SFB__PUSH(P->fsize, count);
     SFB__PUSH(P->fline, line);
-    if (has_uv) P->faces_with_uv++; else P->faces_without_uv++;
+    if (P->first_has_uv < 0) P->first_has_uv = has_uv;
+    else if (has_uv != P->first_has_uv && P->uv_mismatch_face < 0) {
+        P->uv_mismatch_face = (long)P->fsize.n - 1;
+        P->uv_mismatch_line = line;
+    }
     {
         float zero = 0.0f;
         int i;
@@ -2595,6 +2600,8 @@ SFB_API sfb_result sfb_mesh_read_obj(sfb_context *ctx, const char *text, size_t 
     *out = NULL;
     memset(&P, 0, sizeof P);
     P.ctx = ctx;
+    P.first_has_uv = -1;
+    P.uv_mismatch_face = -1;
     P.pos.elem = sizeof(float); P.uv.elem = sizeof(float); P.fsize.elem = sizeof(int); P.fv.elem = sizeof(int);
     P.fuv.elem = sizeof(int); P.fline.elem = sizeof(int); P.fsharp.elem = sizeof(float); P.cv.elem = sizeof(int);
     P.cs.elem = sizeof(float); P.cline.elem = sizeof(int); P.kv.elem = sizeof(int); P.ks.elem = sizeof(float);
@@ -2639,20 +2646,15 @@ SFB_API sfb_result sfb_mesh_read_obj(sfb_context *ctx, const char *text, size_t 
         d.corner_sharpness = (const float *)P.ks.p;
         d.hole_count = (int)P.holes.n;
         d.holes = (const int *)P.holes.p;
-        if (P.faces_with_uv > 0 && P.faces_without_uv == 0 && P.uv.n > 0) {
+        if (P.uv_mismatch_face >= 0) {
+            /* some faces with uv indices, some without: refuse rather than drop the uvs */
+            P.line = P.uv_mismatch_line;
+            r = sfb__perr(&P, SFB_INVALID_TOPOLOGY, "face %ld %s uv indices but face 0 %s (every face needs uvs, or none)",
+                          P.uv_mismatch_face, P.first_has_uv ? "lacks" : "has", P.first_has_uv ? "has them" : "does not");
+        } else if (P.first_has_uv == 1 && P.uv.n > 0) {
             d.uv_count = (int)(P.uv.n / 2);
             d.uvs = (const float *)P.uv.p;
             d.face_uvs = (const int *)P.fuv.p;
-        } else if (P.faces_with_uv > 0) {
-            /* some faces with uv indices, some without: refuse rather than drop the uvs */
-            const int *fu = (const int *)P.fuv.p, *fs = (const int *)P.fsize.p;
-            size_t f, o = 0;
-            int first = fu[0] >= 0;
-            for (f = 0; f < P.fsize.n; o += (size_t)fs[f], ++f)
-                if ((fu[o] >= 0) != first) break;
-            P.line = ((const int *)P.fline.p)[f < P.fsize.n ? f : 0];
-            r = sfb__perr(&P, SFB_INVALID_TOPOLOGY, "face %zu %s uv indices but face 0 %s (every face needs uvs, or none)", f,
-                          first ? "lacks" : "has", first ? "has them" : "does not");
         }
         d.face_edge_sharpness = P.any_fsharp ? (const float *)P.fsharp.p : NULL;
         d.boundary = P.boundary;
@@ -2842,7 +2844,7 @@ SFB_API sfb_result sfb_surface_create(sfb_context *ctx, const sfb_mesh *mesh, co
     s->base_positions = (float *)sfb__alloc(ctx, (size_t)mesh->base.nv * 3 * sizeof(float) + 1);
     if (!s->base_positions) { sfb_surface_destroy(s); return sfb__oom(ctx, "surface"); }
     memcpy(s->base_positions, mesh->positions, (size_t)mesh->base.nv * 3 * sizeof(float));
-    r = sfb__level_prepare(ctx, &mesh->base, mesh->boundary, mesh->boundary == SFB_BOUNDARY_EDGE_AND_CORNER,
+    r = sfb__level_prepare(ctx, &mesh->base, mesh->boundary == SFB_BOUNDARY_EDGE_AND_CORNER,
                            mesh->boundary == SFB_BOUNDARY_NONE && cfg->scheme != SFB_SCHEME_BILINEAR, &prep);
     if (r != SFB_SUCCESS) { sfb_surface_destroy(s); return r; }
     memset(&opt, 0, sizeof opt);
@@ -2873,7 +2875,7 @@ SFB_API sfb_result sfb_surface_create(sfb_context *ctx, const sfb_mesh *mesh, co
                 if (mesh->base.es[e] > uvl.es[ue]) uvl.es[ue] = mesh->base.es[e];
                 if (mesh->base.vs[vv] > uvl.vs[uvv]) uvl.vs[uvv] = mesh->base.vs[vv];
             }
-        r = sfb__level_prepare(ctx, &uvl, SFB_BOUNDARY_EDGE_AND_CORNER, 1, 0, &uvp);
+        r = sfb__level_prepare(ctx, &uvl, 1, 0, &uvp);
         sfb__level_free(ctx, &uvl);
         if (r != SFB_SUCCESS) { sfb_surface_destroy(s); return r; }
         memset(&opt, 0, sizeof opt);

@@ -391,7 +391,7 @@ SFB_API void sfb_mesh_get_info(const sfb_mesh *m, sfb_mesh_info *o) {
         }
     }
     /* vertex rules as refinement will see them (after boundary sharpening) */
-    if (sfb__level_prepare(m->ctx, l, m->boundary, m->boundary == SFB_BOUNDARY_EDGE_AND_CORNER, 0, &prep) == SFB_SUCCESS) {
+    if (sfb__level_prepare(m->ctx, l, m->boundary == SFB_BOUNDARY_EDGE_AND_CORNER, 0, &prep) == SFB_SUCCESS) {
         for (v = 0; v < prep.nv; ++v) {
             o->darts += prep.vrule[v] == SFB__RULE_DART;
             o->crease_vertices += prep.vrule[v] == SFB__RULE_CREASE;

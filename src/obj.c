@@ -37,7 +37,9 @@ typedef struct sfb__objp {
     sfb_context *ctx;
     long line;
     sfb__vec pos, uv, fsize, fv, fuv, fline, fsharp, cv, cs, cline, kv, ks, kline, holes, hline;
-    int faces_with_uv, faces_without_uv, any_fsharp;
+    int first_has_uv;          /* -1 before the first face */
+    long uv_mismatch_face, uv_mismatch_line; /* first face whose uv use differs from face 0; -1 none */
+    int any_fsharp;
     int boundary, crease_method, triangle_rule;
     /* pending `as` */
     long as_left, as_line;
@@ -198,7 +200,11 @@ static sfb_result sfb__obj_face(sfb__objp *P, const char *cur, const char *end) 
         return sfb__perr(P, SFB_INVALID_TOPOLOGY, "face has %d %s; a face needs at least 3", count, count == 1 ? "vertex" : "vertices");
     SFB__PUSH(P->fsize, count);
     SFB__PUSH(P->fline, line);
-    if (has_uv) P->faces_with_uv++; else P->faces_without_uv++;
+    if (P->first_has_uv < 0) P->first_has_uv = has_uv;
+    else if (has_uv != P->first_has_uv && P->uv_mismatch_face < 0) {
+        P->uv_mismatch_face = (long)P->fsize.n - 1;
+        P->uv_mismatch_line = line;
+    }
     {
         float zero = 0.0f;
         int i;
@@ -429,6 +435,8 @@ SFB_API sfb_result sfb_mesh_read_obj(sfb_context *ctx, const char *text, size_t 
     *out = NULL;
     memset(&P, 0, sizeof P);
     P.ctx = ctx;
+    P.first_has_uv = -1;
+    P.uv_mismatch_face = -1;
     P.pos.elem = sizeof(float); P.uv.elem = sizeof(float); P.fsize.elem = sizeof(int); P.fv.elem = sizeof(int);
     P.fuv.elem = sizeof(int); P.fline.elem = sizeof(int); P.fsharp.elem = sizeof(float); P.cv.elem = sizeof(int);
     P.cs.elem = sizeof(float); P.cline.elem = sizeof(int); P.kv.elem = sizeof(int); P.ks.elem = sizeof(float);
@@ -473,20 +481,15 @@ SFB_API sfb_result sfb_mesh_read_obj(sfb_context *ctx, const char *text, size_t 
         d.corner_sharpness = (const float *)P.ks.p;
         d.hole_count = (int)P.holes.n;
         d.holes = (const int *)P.holes.p;
-        if (P.faces_with_uv > 0 && P.faces_without_uv == 0 && P.uv.n > 0) {
+        if (P.uv_mismatch_face >= 0) {
+            /* some faces with uv indices, some without: refuse rather than drop the uvs */
+            P.line = P.uv_mismatch_line;
+            r = sfb__perr(&P, SFB_INVALID_TOPOLOGY, "face %ld %s uv indices but face 0 %s (every face needs uvs, or none)",
+                          P.uv_mismatch_face, P.first_has_uv ? "lacks" : "has", P.first_has_uv ? "has them" : "does not");
+        } else if (P.first_has_uv == 1 && P.uv.n > 0) {
             d.uv_count = (int)(P.uv.n / 2);
             d.uvs = (const float *)P.uv.p;
             d.face_uvs = (const int *)P.fuv.p;
-        } else if (P.faces_with_uv > 0) {
-            /* some faces with uv indices, some without: refuse rather than drop the uvs */
-            const int *fu = (const int *)P.fuv.p, *fs = (const int *)P.fsize.p;
-            size_t f, o = 0;
-            int first = fu[0] >= 0;
-            for (f = 0; f < P.fsize.n; o += (size_t)fs[f], ++f)
-                if ((fu[o] >= 0) != first) break;
-            P.line = ((const int *)P.fline.p)[f < P.fsize.n ? f : 0];
-            r = sfb__perr(&P, SFB_INVALID_TOPOLOGY, "face %zu %s uv indices but face 0 %s (every face needs uvs, or none)", f,
-                          first ? "lacks" : "has", first ? "has them" : "does not");
         }
         d.face_edge_sharpness = P.any_fsharp ? (const float *)P.fsharp.p : NULL;
         d.boundary = P.boundary;

@@ -701,7 +701,7 @@ sfb_result sfb__refine(sfb_context *ctx, const sfb__level *base, const sfb__refi
     } else {
         /* level 0: the caller's base is the top; hand back an independent copy (the base is
          * already prepared, so preparing it again changes nothing) */
-        r = sfb__level_prepare(ctx, base, 0, 0, 0, top);
+        r = sfb__level_prepare(ctx, base, 0, 0, top);
     }
 done:
     if (owns_cur) sfb__level_free(ctx, &cur);

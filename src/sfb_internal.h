@@ -141,5 +141,5 @@ sfb_result sfb__refine(sfb_context *ctx, const sfb__level *base, const sfb__refi
                        float progress_from, float progress_to);
 void sfb__stencils_free(sfb_context *ctx, sfb__stencils *s);
 /* Copy of the base level with OpenSubdiv's boundary/non-manifold sharpening and holes applied. */
-sfb_result sfb__level_prepare(sfb_context *ctx, const sfb__level *src, int boundary, int sharpen_corners_option,
-                              int make_boundary_holes, sfb__level *dst);
+sfb_result sfb__level_prepare(sfb_context *ctx, const sfb__level *src, int sharpen_corners, int make_boundary_holes,
+                              sfb__level *dst);

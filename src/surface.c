@@ -88,7 +88,7 @@ SFB_API sfb_result sfb_surface_create(sfb_context *ctx, const sfb_mesh *mesh, co
     s->base_positions = (float *)sfb__alloc(ctx, (size_t)mesh->base.nv * 3 * sizeof(float) + 1);
     if (!s->base_positions) { sfb_surface_destroy(s); return sfb__oom(ctx, "surface"); }
     memcpy(s->base_positions, mesh->positions, (size_t)mesh->base.nv * 3 * sizeof(float));
-    r = sfb__level_prepare(ctx, &mesh->base, mesh->boundary, mesh->boundary == SFB_BOUNDARY_EDGE_AND_CORNER,
+    r = sfb__level_prepare(ctx, &mesh->base, mesh->boundary == SFB_BOUNDARY_EDGE_AND_CORNER,
                            mesh->boundary == SFB_BOUNDARY_NONE && cfg->scheme != SFB_SCHEME_BILINEAR, &prep);
     if (r != SFB_SUCCESS) { sfb_surface_destroy(s); return r; }
     memset(&opt, 0, sizeof opt);
@@ -119,7 +119,7 @@ SFB_API sfb_result sfb_surface_create(sfb_context *ctx, const sfb_mesh *mesh, co
                 if (mesh->base.es[e] > uvl.es[ue]) uvl.es[ue] = mesh->base.es[e];
                 if (mesh->base.vs[vv] > uvl.vs[uvv]) uvl.vs[uvv] = mesh->base.vs[vv];
             }
-        r = sfb__level_prepare(ctx, &uvl, SFB_BOUNDARY_EDGE_AND_CORNER, 1, 0, &uvp);
+        r = sfb__level_prepare(ctx, &uvl, 1, 0, &uvp);
         sfb__level_free(ctx, &uvl);
         if (r != SFB_SUCCESS) { sfb_surface_destroy(s); return r; }
         memset(&opt, 0, sizeof opt);

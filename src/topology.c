@@ -184,12 +184,11 @@ static void *sfb__dup(sfb_context *ctx, const void *p, size_t bytes) {
  * topological corners (EDGE_AND_CORNER) and non-manifold vertices infinitely sharp, except
  * a vertex on a non-manifold crease (two non-manifold edges, no boundary, more faces than
  * edges), which keeps its own sharpness. */
-sfb_result sfb__level_prepare(sfb_context *ctx, const sfb__level *s, int boundary, int sharpen_corners,
-                              int make_boundary_holes, sfb__level *d) {
+sfb_result sfb__level_prepare(sfb_context *ctx, const sfb__level *s, int sharpen_corners, int make_boundary_holes,
+                              sfb__level *d) {
     int v, e, i;
     memset(d, 0, sizeof *d);
     d->nv = s->nv; d->nf = s->nf; d->ne = s->ne; d->nfv = s->nfv;
-    (void)boundary;
 #define SFB__DUP(field, count, type) d->field = (type *)sfb__dup(ctx, s->field, (size_t)(count) * sizeof(type))
     SFB__DUP(fv_off, s->nf + 1, int); SFB__DUP(fv, s->nfv, int); SFB__DUP(fe, s->nfv, int);
     SFB__DUP(ev, 2 * s->ne, int); SFB__DUP(ef_off, s->ne + 1, int); SFB__DUP(ef, s->nfv, int);
