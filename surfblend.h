@@ -5,7 +5,8 @@
  * In exactly one C or C++ file:
  *     #define SURFBLEND_IMPLEMENTATION
  *     #include "surfblend.h"
- * Optional backends (backends/sfb_*.h) are included before that line.
+ * Optional backends (code in backends/ beside this file): also define SURFBLEND_SIMD,
+ * SURFBLEND_GL, SURFBLEND_OSMESA or SURFBLEND_ALL_BACKENDS there; link -lm -lpthread -ldl.
  */
 #ifndef SURFBLEND_H
 #define SURFBLEND_H
@@ -17,8 +18,15 @@
  * last failure are in sfb_last_error(ctx). Nothing is global: all state lives in objects.
  *
  * Thread safety: a context is used by one thread at a time. A built sfb_surface is
- * immutable; sfb_surface_eval_stencils may be called from several threads at once on
- * the same surface as long as each call passes its own output buffers.
+ * immutable; on the ref and simd backends sfb_surface_eval_stencils may be called from
+ * several threads at once on the same surface as long as each call passes its own output
+ * buffers. The gl and osmesa backends use one GL context: call them from one thread (with
+ * gl_use_current_context, the thread where the host's context is current).
+ *
+ * Backends: ref is always compiled. simd, gl and osmesa are compiled into the implementation
+ * when SURFBLEND_SIMD, SURFBLEND_GL, SURFBLEND_OSMESA (or SURFBLEND_ALL_BACKENDS) are defined
+ * next to SURFBLEND_IMPLEMENTATION; their code is in backends/ beside this header. GL, EGL
+ * and OSMesa are loaded at run time: link with -lm -lpthread -ldl only.
  */
 #include <stddef.h>
 
@@ -140,8 +148,15 @@ SFB_API const char *sfb_backend_kind_name(sfb_backend_kind kind);
 /* Parses "ref", "simd", "gl", "osmesa" (case-insensitive). Returns SFB_BACKEND_DEFAULT when unknown. */
 SFB_API sfb_backend_kind sfb_backend_kind_parse(const char *name);
 SFB_API const char *sfb_context_backend_name(const sfb_context *ctx);
-/* One line per backend attempt: "name: selected|unavailable (reason)|failed (reason)". */
+/* One line per backend attempt: "name: selected (what runs)" or "name: unavailable (reason)". */
 SFB_API sfb_result sfb_context_backend_report(const sfb_context *ctx, char *buf, size_t size);
+/* What the selected backend runs on, one line: ISA and threads for simd, GL version and
+ * renderer for gl/osmesa ("" for ref). */
+SFB_API sfb_result sfb_context_backend_info(const sfb_context *ctx, char *buf, size_t size);
+/* Initialises `kind` alone on a scratch context (config: NULL for defaults; its backend list
+ * and environment are ignored). SFB_SUCCESS: available, `info` says what runs. Otherwise
+ * (SFB_BACKEND_UNAVAILABLE, ...) `info` says why not. */
+SFB_API sfb_result sfb_backend_probe(sfb_backend_kind kind, const sfb_context_config *config, char *info, size_t size);
 
 /* ---- mesh ---- */
 typedef enum sfb_boundary {
@@ -251,6 +266,13 @@ SFB_API sfb_result sfb_surface_stencil_info(const sfb_surface *surface, sfb_tabl
 SFB_API sfb_result sfb_surface_eval_stencils(const sfb_surface *surface, sfb_table table,
                                              const float *src, sfb_buffer_desc src_desc,
                                              float *dst, sfb_buffer_desc dst_desc);
+/* The engine case (gl backend with gl_use_current_context): apply a table to GL buffer
+ * objects of the host's current context, writing straight into the buffer the host draws
+ * from. Offsets and strides count floats. GL state the call binds is restored. Other
+ * backends: SFB_UNSUPPORTED. */
+SFB_API sfb_result sfb_surface_eval_stencils_gl(const sfb_surface *surface, sfb_table table,
+                                                unsigned int src_buffer, sfb_buffer_desc src_desc,
+                                                unsigned int dst_buffer, sfb_buffer_desc dst_desc);
 
 /* The refined mesh as plain arrays. */
 typedef struct sfb_mesh_data {
@@ -305,20 +327,63 @@ typedef struct sfb__stencils {
     size_t entries;
 } sfb__stencils;
 
-enum { SFB__CAP_EVAL_STENCILS = 1u << 0 };
+enum {
+    SFB__CAP_EVAL_STENCILS = 1u << 0,   /* eval_stencils on caller memory */
+    SFB__CAP_GL_BUFFERS = 1u << 1       /* eval_stencils_gl on GL buffer objects (host context) */
+};
 
+/* The kernels a backend implements. Every slot but name/kind/caps/init/shutdown may be NULL;
+ * a NULL kernel with its capability bit cleared makes the core fall back to `ref` for it. */
 typedef struct sfb__backend_vtable {
     const char *name;
     sfb_backend_kind kind;
     unsigned caps;
-    /* Returns SFB_SUCCESS and a state, or an error with `why` filled. */
+    /* Returns SFB_SUCCESS and a state, or an error with `why` filled. The backend reads its
+     * settings (threads, gl_use_current_context) from ctx and may keep ctx for errors/allocs. */
     sfb_result (*init)(sfb_context *ctx, void **state, char *why, size_t why_size);
     void (*shutdown)(sfb_context *ctx, void *state);
-    /* dst rows [first,last) = stencils applied to src. length components per element. */
-    sfb_result (*eval_stencils)(void *state, const sfb__stencils *table, int first, int last,
+    /* One line saying what runs: ISA and threads, GL version and renderer. */
+    void (*describe)(void *state, char *buf, size_t size);
+    /* Called once per built table when a surface is created (upload to device memory);
+     * `*handle` may stay NULL. release_stencils frees what upload made. */
+    sfb_result (*upload_stencils)(void *state, const sfb__stencils *table, void **handle);
+    void (*release_stencils)(void *state, void *handle);
+    /* dst rows [first,last) = stencils applied to src; length components per element.
+     * `handle` is what upload_stencils returned for this table (or NULL). */
+    sfb_result (*eval_stencils)(void *state, const sfb__stencils *table, void *handle, int first, int last,
                                 const float *src, sfb_buffer_desc src_desc,
                                 float *dst, sfb_buffer_desc dst_desc);
+    /* Same on GL buffer objects of the current (host) context: no copy through the CPU. */
+    sfb_result (*eval_stencils_gl)(void *state, const sfb__stencils *table, void *handle,
+                                   unsigned src_buffer, sfb_buffer_desc src_desc,
+                                   unsigned dst_buffer, sfb_buffer_desc dst_desc);
 } sfb__backend_vtable;
+
+/* Optional backends (backends/sfb_*.h), compiled in by SURFBLEND_SIMD / _GL / _OSMESA or
+ * SURFBLEND_ALL_BACKENDS; the headers are included at the end of the implementation. */
+#if defined(SURFBLEND_ALL_BACKENDS)
+#  ifndef SURFBLEND_SIMD
+#    define SURFBLEND_SIMD
+#  endif
+#  ifndef SURFBLEND_GL
+#    define SURFBLEND_GL
+#  endif
+#  ifndef SURFBLEND_OSMESA
+#    define SURFBLEND_OSMESA
+#  endif
+#endif
+#if defined(SURFBLEND_OSMESA) && !defined(SURFBLEND_GL)
+#  define SURFBLEND_GL /* osmesa runs the gl kernels */
+#endif
+#ifdef SURFBLEND_SIMD
+const sfb__backend_vtable *sfb__backend_simd(void);
+#endif
+#ifdef SURFBLEND_GL
+const sfb__backend_vtable *sfb__backend_gl(void);
+#endif
+#ifdef SURFBLEND_OSMESA
+const sfb__backend_vtable *sfb__backend_osmesa(void);
+#endif
 
 /* ---- context ---- */
 struct sfb_context {
@@ -359,6 +424,7 @@ sfb_result sfb__oom(sfb_context *ctx, const char *what);
 /* Returns SFB_CANCELLED (with the error set) when the callback asks to stop. */
 sfb_result sfb__progress(sfb_context *ctx, float done, const char *stage);
 sfb_result sfb__select_backend(sfb_context *ctx, const char *env_override);
+sfb_result sfb__context_create_reporting(const sfb_context_config *config, sfb_context **out, char *report, size_t size);
 const sfb__backend_vtable *sfb__backend_ref(void);
 
 /* ---- topology of one level ---- */
@@ -410,6 +476,8 @@ struct sfb_surface {
     int has_uvs;
     sfb__stencils tables[SFB_TABLE_COUNT_];
     int built[SFB_TABLE_COUNT_];
+    void *backend_tables[SFB_TABLE_COUNT_]; /* the backend's uploaded copies (upload_stencils) */
+    const sfb__backend_vtable *uploaded_by;
     int boundary, crease_method, triangle_rule, uv_interp;
 };
 
@@ -566,7 +634,9 @@ sfb_result sfb__progress(sfb_context *ctx, float done, const char *stage) {
     return SFB_SUCCESS;
 }
 
-SFB_API sfb_result sfb_context_create(const sfb_context_config *config, sfb_context **out) {
+/* sfb_context_create, keeping the backend report (what was tried, why each failed) in
+ * report/size when no backend initialises. */
+sfb_result sfb__context_create_reporting(const sfb_context_config *config, sfb_context **out, char *report, size_t size) {
     sfb_context_config c = config ? *config : sfb_context_config_init();
     sfb_allocator a = c.allocator;
     sfb_context *ctx;
@@ -607,12 +677,23 @@ SFB_API sfb_result sfb_context_create(const sfb_context_config *config, sfb_cont
         const char *env = c.ignore_environment ? NULL : getenv("SURFBLEND_BACKEND");
         sfb_result r = sfb__select_backend(ctx, env);
         if (r != SFB_SUCCESS) {
+            if (report && size) {
+                size_t n = strlen(ctx->report);
+                while (n > 0 && ctx->report[n - 1] == '\n') --n;
+                if (n >= size) n = size - 1;
+                memcpy(report, ctx->report, n);
+                report[n] = 0;
+            }
             a.free(raw, a.user);
             return r;
         }
     }
     *out = ctx;
     return SFB_SUCCESS;
+}
+
+SFB_API sfb_result sfb_context_create(const sfb_context_config *config, sfb_context **out) {
+    return sfb__context_create_reporting(config, out, NULL, 0);
 }
 
 SFB_API void sfb_context_destroy(sfb_context *ctx) {
@@ -666,18 +747,18 @@ SFB_API sfb_backend_kind sfb_backend_kind_parse(const char *name) {
     return SFB_BACKEND_DEFAULT;
 }
 
-/* Optional backends live in backends/sfb_NAME.h; each defines a getter macro before this file is
- * compiled when the user includes it. Those not compiled in report "not built in". */
+/* Optional backends live in backends/sfb_NAME.h, compiled in by SURFBLEND_NAME (see
+ * sfb_internal.h). Those not compiled in report "not built in". */
 static const sfb__backend_vtable *sfb__backend_lookup(sfb_backend_kind kind) {
     switch (kind) {
     case SFB_BACKEND_REF: return sfb__backend_ref();
-#ifdef SFB_HAVE_SIMD_BACKEND
+#ifdef SURFBLEND_SIMD
     case SFB_BACKEND_SIMD: return sfb__backend_simd();
 #endif
-#ifdef SFB_HAVE_GL_BACKEND
+#ifdef SURFBLEND_GL
     case SFB_BACKEND_GL: return sfb__backend_gl();
 #endif
-#ifdef SFB_HAVE_OSMESA_BACKEND
+#ifdef SURFBLEND_OSMESA
     case SFB_BACKEND_OSMESA: return sfb__backend_osmesa();
 #endif
     default: return NULL;
@@ -699,8 +780,8 @@ static int sfb__try_backend(sfb_context *ctx, sfb_backend_kind kind) {
     void *state = NULL;
     sfb_result r;
     if (!vt) {
-        sfb__report_add(ctx, "%s: unavailable (not built in: include backends/sfb_%s.h before the implementation)\n",
-                        sfb_backend_kind_name(kind), sfb_backend_kind_name(kind));
+        sfb__report_add(ctx, "%s: unavailable (not built in: define SURFBLEND_%s or SURFBLEND_ALL_BACKENDS with SURFBLEND_IMPLEMENTATION)\n",
+                        sfb_backend_kind_name(kind), kind == SFB_BACKEND_SIMD ? "SIMD" : kind == SFB_BACKEND_GL ? "GL" : "OSMESA");
         sfb__log(ctx, SFB_LOG_INFO, "backend %s not built in, trying the next", sfb_backend_kind_name(kind));
         return 0;
     }
@@ -713,7 +794,11 @@ static int sfb__try_backend(sfb_context *ctx, sfb_backend_kind kind) {
     }
     ctx->backend = vt;
     ctx->backend_state = state;
-    sfb__report_add(ctx, "%s: selected\n", vt->name);
+    why[0] = 0;
+    if (vt->describe) vt->describe(state, why, sizeof why);
+    if (why[0]) sfb__report_add(ctx, "%s: selected (%s)\n", vt->name, why);
+    else sfb__report_add(ctx, "%s: selected\n", vt->name);
+    sfb__log(ctx, SFB_LOG_INFO, "backend %s selected%s%s", vt->name, why[0] ? ": " : "", why);
     return 1;
 }
 
@@ -750,6 +835,38 @@ SFB_API sfb_result sfb_context_backend_report(const sfb_context *ctx, char *buf,
     memcpy(buf, ctx->report, n + 1);
     return SFB_SUCCESS;
 }
+
+SFB_API sfb_result sfb_context_backend_info(const sfb_context *ctx, char *buf, size_t size) {
+    if (!ctx || !buf || size == 0) return SFB_INVALID_ARGS;
+    buf[0] = 0;
+    if (ctx->backend && ctx->backend->describe) ctx->backend->describe(ctx->backend_state, buf, size);
+    return SFB_SUCCESS;
+}
+
+SFB_API sfb_result sfb_backend_probe(sfb_backend_kind kind, const sfb_context_config *config, char *info, size_t size) {
+    const sfb__backend_vtable *vt;
+    sfb_context_config c = config ? *config : sfb_context_config_init();
+    sfb_context *ctx = NULL;
+    sfb_result r;
+    if (!info || size == 0 || (int)kind <= SFB_BACKEND_DEFAULT || kind >= SFB_BACKEND_KIND_COUNT_) return SFB_INVALID_ARGS;
+    info[0] = 0;
+    vt = sfb__backend_lookup(kind);
+    if (!vt) {
+        snprintf(info, size, "not built in: define SURFBLEND_%s or SURFBLEND_ALL_BACKENDS with SURFBLEND_IMPLEMENTATION",
+                 kind == SFB_BACKEND_SIMD ? "SIMD" : kind == SFB_BACKEND_GL ? "GL" : kind == SFB_BACKEND_OSMESA ? "OSMESA" : "REF");
+        return SFB_BACKEND_UNAVAILABLE;
+    }
+    /* A context with this backend alone: the probe is a real initialisation. */
+    c.backends = &kind;
+    c.backend_count = 1;
+    c.ignore_environment = 1;
+    r = sfb__context_create_reporting(&c, &ctx, info, size);
+    if (r != SFB_SUCCESS) return r == SFB_NO_BACKEND ? SFB_BACKEND_UNAVAILABLE : r;
+    info[0] = 0;
+    if (vt->describe) vt->describe(ctx->backend_state, info, size);
+    sfb_context_destroy(ctx);
+    return SFB_SUCCESS;
+}
 #line 1 "src/backend_ref.c"
 /* The `ref` backend: plain C, the numeric oracle. Float storage, double accumulation in
  * table order (row by row, entries in stored order). */
@@ -762,11 +879,11 @@ static sfb_result sfb__ref_init(sfb_context *ctx, void **state, char *why, size_
 
 static void sfb__ref_shutdown(sfb_context *ctx, void *state) { (void)ctx; (void)state; }
 
-static sfb_result sfb__ref_eval_stencils(void *state, const sfb__stencils *t, int first, int last,
+static sfb_result sfb__ref_eval_stencils(void *state, const sfb__stencils *t, void *handle, int first, int last,
                                          const float *src, sfb_buffer_desc sd, float *dst, sfb_buffer_desc dd) {
     int r, c, k;
     double acc[16];
-    (void)state;
+    (void)state; (void)handle;
     if (sd.length != dd.length || sd.length <= 0 || sd.length > 16) return SFB_INVALID_ARGS;
     for (r = first; r < last; ++r) {
         const int *idx = t->indices + t->offsets[r];
@@ -786,7 +903,7 @@ static sfb_result sfb__ref_eval_stencils(void *state, const sfb__stencils *t, in
 
 static const sfb__backend_vtable sfb__ref_vtable = {
     "ref", SFB_BACKEND_REF, SFB__CAP_EVAL_STENCILS,
-    sfb__ref_init, sfb__ref_shutdown, sfb__ref_eval_stencils
+    sfb__ref_init, sfb__ref_shutdown, NULL, NULL, NULL, sfb__ref_eval_stencils, NULL
 };
 
 const sfb__backend_vtable *sfb__backend_ref(void) { return &sfb__ref_vtable; }
@@ -2781,7 +2898,11 @@ SFB_API void sfb_surface_destroy(sfb_surface *s) {
     int t;
     if (!s) return;
     ctx = s->ctx;
-    for (t = 0; t < SFB_TABLE_COUNT_; ++t) sfb__stencils_free(ctx, &s->tables[t]);
+    for (t = 0; t < SFB_TABLE_COUNT_; ++t) {
+        if (s->backend_tables[t] && s->uploaded_by && s->uploaded_by->release_stencils)
+            s->uploaded_by->release_stencils(ctx->backend_state, s->backend_tables[t]);
+        sfb__stencils_free(ctx, &s->tables[t]);
+    }
     sfb__level_free(ctx, &s->top);
     sfb__level_free(ctx, &s->uv_top);
     sfb__free(ctx, s->base_positions);
@@ -2896,6 +3017,16 @@ SFB_API sfb_result sfb_surface_create(sfb_context *ctx, const sfb_mesh *mesh, co
     }
     r = sfb__progress(ctx, 1.0f, "refine");
     if (r != SFB_SUCCESS) { sfb_surface_destroy(s); return r; }
+    /* Hand the tables to the backend once (device upload); failures come back here. */
+    if (ctx->backend && ctx->backend->upload_stencils) {
+        int t;
+        s->uploaded_by = ctx->backend;
+        for (t = 0; t < SFB_TABLE_COUNT_; ++t) {
+            if (!s->built[t] || s->tables[t].rows == 0) continue;
+            r = ctx->backend->upload_stencils(ctx->backend_state, &s->tables[t], &s->backend_tables[t]);
+            if (r != SFB_SUCCESS) { sfb_surface_destroy(s); return r; }
+        }
+    }
     *out = s;
     return SFB_SUCCESS;
 }
@@ -2924,9 +3055,31 @@ SFB_API sfb_result sfb_surface_eval_stencils(const sfb_surface *s, sfb_table t, 
     if (!be || !(be->caps & SFB__CAP_EVAL_STENCILS) || !be->eval_stencils) {
         sfb__log(ctx, SFB_LOG_INFO, "backend %s lacks eval_stencils; using ref", be ? be->name : "none");
         be = sfb__backend_ref();
-        return be->eval_stencils(NULL, &s->tables[t], 0, s->tables[t].rows, src, sd, dst, dd);
+        return be->eval_stencils(NULL, &s->tables[t], NULL, 0, s->tables[t].rows, src, sd, dst, dd);
     }
-    return be->eval_stencils(ctx->backend_state, &s->tables[t], 0, s->tables[t].rows, src, sd, dst, dd);
+    if (s->tables[t].rows == 0) return SFB_SUCCESS;
+    return be->eval_stencils(ctx->backend_state, &s->tables[t], s->uploaded_by == be ? s->backend_tables[t] : NULL,
+                             0, s->tables[t].rows, src, sd, dst, dd);
+}
+
+SFB_API sfb_result sfb_surface_eval_stencils_gl(const sfb_surface *s, sfb_table t, unsigned int src_buffer, sfb_buffer_desc sd,
+                                                unsigned int dst_buffer, sfb_buffer_desc dd) {
+    sfb_context *ctx;
+    const sfb__backend_vtable *be;
+    if (!s) return SFB_INVALID_ARGS;
+    ctx = s->ctx;
+    if ((int)t < 0 || t >= SFB_TABLE_COUNT_ || !s->built[t])
+        return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "stencil table %d was not built for this surface", (int)t);
+    if (!src_buffer || !dst_buffer || !sfb__desc_ok(sd) || !sfb__desc_ok(dd) || sd.length != dd.length)
+        return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "invalid GL buffers or buffer descriptors for stencil evaluation");
+    be = ctx->backend;
+    if (!be || !(be->caps & SFB__CAP_GL_BUFFERS) || !be->eval_stencils_gl)
+        return sfb__error(ctx, SFB_UNSUPPORTED, SFB_ELEMENT_NONE, -1,
+                          "sfb_surface_eval_stencils_gl needs the gl backend on the host's context (gl_use_current_context); this context runs %s",
+                          be ? be->name : "no backend");
+    if (s->tables[t].rows == 0) return SFB_SUCCESS;
+    return be->eval_stencils_gl(ctx->backend_state, &s->tables[t], s->uploaded_by == be ? s->backend_tables[t] : NULL,
+                                src_buffer, sd, dst_buffer, dd);
 }
 
 SFB_API void sfb_mesh_data_free(sfb_mesh_data *d) {
@@ -3046,4 +3199,17 @@ SFB_API void sfb_mesh_data_desc(const sfb_mesh_data *m, sfb_mesh_desc *d) {
     d->boundary = m->boundary; d->crease_method = m->crease_method;
     d->triangle_rule = m->triangle_rule; d->uv_interp = m->uv_interp;
 }
+#line 1 "src/backends_include.c"
+/* Optional backends: their code lives in backends/ beside surfblend.h and is compiled here,
+ * after the core, when SURFBLEND_SIMD / SURFBLEND_GL / SURFBLEND_OSMESA (or
+ * SURFBLEND_ALL_BACKENDS) are defined with SURFBLEND_IMPLEMENTATION (see sfb_internal.h). */
+#ifdef SURFBLEND_SIMD
+#include "backends/sfb_simd.h"
+#endif
+#ifdef SURFBLEND_GL
+#include "backends/sfb_gl.h"
+#endif
+#ifdef SURFBLEND_OSMESA
+#include "backends/sfb_osmesa.h"
+#endif
 #endif /* SURFBLEND_IMPLEMENTATION */

@@ -24,18 +24,18 @@ SFB_API sfb_backend_kind sfb_backend_kind_parse(const char *name) {
     return SFB_BACKEND_DEFAULT;
 }
 
-/* Optional backends live in backends/sfb_NAME.h; each defines a getter macro before this file is
- * compiled when the user includes it. Those not compiled in report "not built in". */
+/* Optional backends live in backends/sfb_NAME.h, compiled in by SURFBLEND_NAME (see
+ * sfb_internal.h). Those not compiled in report "not built in". */
 static const sfb__backend_vtable *sfb__backend_lookup(sfb_backend_kind kind) {
     switch (kind) {
     case SFB_BACKEND_REF: return sfb__backend_ref();
-#ifdef SFB_HAVE_SIMD_BACKEND
+#ifdef SURFBLEND_SIMD
     case SFB_BACKEND_SIMD: return sfb__backend_simd();
 #endif
-#ifdef SFB_HAVE_GL_BACKEND
+#ifdef SURFBLEND_GL
     case SFB_BACKEND_GL: return sfb__backend_gl();
 #endif
-#ifdef SFB_HAVE_OSMESA_BACKEND
+#ifdef SURFBLEND_OSMESA
     case SFB_BACKEND_OSMESA: return sfb__backend_osmesa();
 #endif
     default: return NULL;
@@ -57,8 +57,8 @@ static int sfb__try_backend(sfb_context *ctx, sfb_backend_kind kind) {
     void *state = NULL;
     sfb_result r;
     if (!vt) {
-        sfb__report_add(ctx, "%s: unavailable (not built in: include backends/sfb_%s.h before the implementation)\n",
-                        sfb_backend_kind_name(kind), sfb_backend_kind_name(kind));
+        sfb__report_add(ctx, "%s: unavailable (not built in: define SURFBLEND_%s or SURFBLEND_ALL_BACKENDS with SURFBLEND_IMPLEMENTATION)\n",
+                        sfb_backend_kind_name(kind), kind == SFB_BACKEND_SIMD ? "SIMD" : kind == SFB_BACKEND_GL ? "GL" : "OSMESA");
         sfb__log(ctx, SFB_LOG_INFO, "backend %s not built in, trying the next", sfb_backend_kind_name(kind));
         return 0;
     }
@@ -71,7 +71,11 @@ static int sfb__try_backend(sfb_context *ctx, sfb_backend_kind kind) {
     }
     ctx->backend = vt;
     ctx->backend_state = state;
-    sfb__report_add(ctx, "%s: selected\n", vt->name);
+    why[0] = 0;
+    if (vt->describe) vt->describe(state, why, sizeof why);
+    if (why[0]) sfb__report_add(ctx, "%s: selected (%s)\n", vt->name, why);
+    else sfb__report_add(ctx, "%s: selected\n", vt->name);
+    sfb__log(ctx, SFB_LOG_INFO, "backend %s selected%s%s", vt->name, why[0] ? ": " : "", why);
     return 1;
 }
 
@@ -106,5 +110,37 @@ SFB_API sfb_result sfb_context_backend_report(const sfb_context *ctx, char *buf,
         return SFB_LIMIT_EXCEEDED;
     }
     memcpy(buf, ctx->report, n + 1);
+    return SFB_SUCCESS;
+}
+
+SFB_API sfb_result sfb_context_backend_info(const sfb_context *ctx, char *buf, size_t size) {
+    if (!ctx || !buf || size == 0) return SFB_INVALID_ARGS;
+    buf[0] = 0;
+    if (ctx->backend && ctx->backend->describe) ctx->backend->describe(ctx->backend_state, buf, size);
+    return SFB_SUCCESS;
+}
+
+SFB_API sfb_result sfb_backend_probe(sfb_backend_kind kind, const sfb_context_config *config, char *info, size_t size) {
+    const sfb__backend_vtable *vt;
+    sfb_context_config c = config ? *config : sfb_context_config_init();
+    sfb_context *ctx = NULL;
+    sfb_result r;
+    if (!info || size == 0 || (int)kind <= SFB_BACKEND_DEFAULT || kind >= SFB_BACKEND_KIND_COUNT_) return SFB_INVALID_ARGS;
+    info[0] = 0;
+    vt = sfb__backend_lookup(kind);
+    if (!vt) {
+        snprintf(info, size, "not built in: define SURFBLEND_%s or SURFBLEND_ALL_BACKENDS with SURFBLEND_IMPLEMENTATION",
+                 kind == SFB_BACKEND_SIMD ? "SIMD" : kind == SFB_BACKEND_GL ? "GL" : kind == SFB_BACKEND_OSMESA ? "OSMESA" : "REF");
+        return SFB_BACKEND_UNAVAILABLE;
+    }
+    /* A context with this backend alone: the probe is a real initialisation. */
+    c.backends = &kind;
+    c.backend_count = 1;
+    c.ignore_environment = 1;
+    r = sfb__context_create_reporting(&c, &ctx, info, size);
+    if (r != SFB_SUCCESS) return r == SFB_NO_BACKEND ? SFB_BACKEND_UNAVAILABLE : r;
+    info[0] = 0;
+    if (vt->describe) vt->describe(ctx->backend_state, info, size);
+    sfb_context_destroy(ctx);
     return SFB_SUCCESS;
 }

@@ -9,11 +9,11 @@ static sfb_result sfb__ref_init(sfb_context *ctx, void **state, char *why, size_
 
 static void sfb__ref_shutdown(sfb_context *ctx, void *state) { (void)ctx; (void)state; }
 
-static sfb_result sfb__ref_eval_stencils(void *state, const sfb__stencils *t, int first, int last,
+static sfb_result sfb__ref_eval_stencils(void *state, const sfb__stencils *t, void *handle, int first, int last,
                                          const float *src, sfb_buffer_desc sd, float *dst, sfb_buffer_desc dd) {
     int r, c, k;
     double acc[16];
-    (void)state;
+    (void)state; (void)handle;
     if (sd.length != dd.length || sd.length <= 0 || sd.length > 16) return SFB_INVALID_ARGS;
     for (r = first; r < last; ++r) {
         const int *idx = t->indices + t->offsets[r];
@@ -33,7 +33,7 @@ static sfb_result sfb__ref_eval_stencils(void *state, const sfb__stencils *t, in
 
 static const sfb__backend_vtable sfb__ref_vtable = {
     "ref", SFB_BACKEND_REF, SFB__CAP_EVAL_STENCILS,
-    sfb__ref_init, sfb__ref_shutdown, sfb__ref_eval_stencils
+    sfb__ref_init, sfb__ref_shutdown, NULL, NULL, NULL, sfb__ref_eval_stencils, NULL
 };
 
 const sfb__backend_vtable *sfb__backend_ref(void) { return &sfb__ref_vtable; }

@@ -134,7 +134,9 @@ sfb_result sfb__progress(sfb_context *ctx, float done, const char *stage) {
     return SFB_SUCCESS;
 }
 
-SFB_API sfb_result sfb_context_create(const sfb_context_config *config, sfb_context **out) {
+/* sfb_context_create, keeping the backend report (what was tried, why each failed) in
+ * report/size when no backend initialises. */
+sfb_result sfb__context_create_reporting(const sfb_context_config *config, sfb_context **out, char *report, size_t size) {
     sfb_context_config c = config ? *config : sfb_context_config_init();
     sfb_allocator a = c.allocator;
     sfb_context *ctx;
@@ -175,12 +177,23 @@ SFB_API sfb_result sfb_context_create(const sfb_context_config *config, sfb_cont
         const char *env = c.ignore_environment ? NULL : getenv("SURFBLEND_BACKEND");
         sfb_result r = sfb__select_backend(ctx, env);
         if (r != SFB_SUCCESS) {
+            if (report && size) {
+                size_t n = strlen(ctx->report);
+                while (n > 0 && ctx->report[n - 1] == '\n') --n;
+                if (n >= size) n = size - 1;
+                memcpy(report, ctx->report, n);
+                report[n] = 0;
+            }
             a.free(raw, a.user);
             return r;
         }
     }
     *out = ctx;
     return SFB_SUCCESS;
+}
+
+SFB_API sfb_result sfb_context_create(const sfb_context_config *config, sfb_context **out) {
+    return sfb__context_create_reporting(config, out, NULL, 0);
 }
 
 SFB_API void sfb_context_destroy(sfb_context *ctx) {

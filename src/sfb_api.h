@@ -5,8 +5,15 @@
  * last failure are in sfb_last_error(ctx). Nothing is global: all state lives in objects.
  *
  * Thread safety: a context is used by one thread at a time. A built sfb_surface is
- * immutable; sfb_surface_eval_stencils may be called from several threads at once on
- * the same surface as long as each call passes its own output buffers.
+ * immutable; on the ref and simd backends sfb_surface_eval_stencils may be called from
+ * several threads at once on the same surface as long as each call passes its own output
+ * buffers. The gl and osmesa backends use one GL context: call them from one thread (with
+ * gl_use_current_context, the thread where the host's context is current).
+ *
+ * Backends: ref is always compiled. simd, gl and osmesa are compiled into the implementation
+ * when SURFBLEND_SIMD, SURFBLEND_GL, SURFBLEND_OSMESA (or SURFBLEND_ALL_BACKENDS) are defined
+ * next to SURFBLEND_IMPLEMENTATION; their code is in backends/ beside this header. GL, EGL
+ * and OSMesa are loaded at run time: link with -lm -lpthread -ldl only.
  */
 #include <stddef.h>
 
@@ -128,8 +135,15 @@ SFB_API const char *sfb_backend_kind_name(sfb_backend_kind kind);
 /* Parses "ref", "simd", "gl", "osmesa" (case-insensitive). Returns SFB_BACKEND_DEFAULT when unknown. */
 SFB_API sfb_backend_kind sfb_backend_kind_parse(const char *name);
 SFB_API const char *sfb_context_backend_name(const sfb_context *ctx);
-/* One line per backend attempt: "name: selected|unavailable (reason)|failed (reason)". */
+/* One line per backend attempt: "name: selected (what runs)" or "name: unavailable (reason)". */
 SFB_API sfb_result sfb_context_backend_report(const sfb_context *ctx, char *buf, size_t size);
+/* What the selected backend runs on, one line: ISA and threads for simd, GL version and
+ * renderer for gl/osmesa ("" for ref). */
+SFB_API sfb_result sfb_context_backend_info(const sfb_context *ctx, char *buf, size_t size);
+/* Initialises `kind` alone on a scratch context (config: NULL for defaults; its backend list
+ * and environment are ignored). SFB_SUCCESS: available, `info` says what runs. Otherwise
+ * (SFB_BACKEND_UNAVAILABLE, ...) `info` says why not. */
+SFB_API sfb_result sfb_backend_probe(sfb_backend_kind kind, const sfb_context_config *config, char *info, size_t size);
 
 /* ---- mesh ---- */
 typedef enum sfb_boundary {
@@ -239,6 +253,13 @@ SFB_API sfb_result sfb_surface_stencil_info(const sfb_surface *surface, sfb_tabl
 SFB_API sfb_result sfb_surface_eval_stencils(const sfb_surface *surface, sfb_table table,
                                              const float *src, sfb_buffer_desc src_desc,
                                              float *dst, sfb_buffer_desc dst_desc);
+/* The engine case (gl backend with gl_use_current_context): apply a table to GL buffer
+ * objects of the host's current context, writing straight into the buffer the host draws
+ * from. Offsets and strides count floats. GL state the call binds is restored. Other
+ * backends: SFB_UNSUPPORTED. */
+SFB_API sfb_result sfb_surface_eval_stencils_gl(const sfb_surface *surface, sfb_table table,
+                                                unsigned int src_buffer, sfb_buffer_desc src_desc,
+                                                unsigned int dst_buffer, sfb_buffer_desc dst_desc);
 
 /* The refined mesh as plain arrays. */
 typedef struct sfb_mesh_data {

@@ -19,20 +19,63 @@ typedef struct sfb__stencils {
     size_t entries;
 } sfb__stencils;
 
-enum { SFB__CAP_EVAL_STENCILS = 1u << 0 };
+enum {
+    SFB__CAP_EVAL_STENCILS = 1u << 0,   /* eval_stencils on caller memory */
+    SFB__CAP_GL_BUFFERS = 1u << 1       /* eval_stencils_gl on GL buffer objects (host context) */
+};
 
+/* The kernels a backend implements. Every slot but name/kind/caps/init/shutdown may be NULL;
+ * a NULL kernel with its capability bit cleared makes the core fall back to `ref` for it. */
 typedef struct sfb__backend_vtable {
     const char *name;
     sfb_backend_kind kind;
     unsigned caps;
-    /* Returns SFB_SUCCESS and a state, or an error with `why` filled. */
+    /* Returns SFB_SUCCESS and a state, or an error with `why` filled. The backend reads its
+     * settings (threads, gl_use_current_context) from ctx and may keep ctx for errors/allocs. */
     sfb_result (*init)(sfb_context *ctx, void **state, char *why, size_t why_size);
     void (*shutdown)(sfb_context *ctx, void *state);
-    /* dst rows [first,last) = stencils applied to src. length components per element. */
-    sfb_result (*eval_stencils)(void *state, const sfb__stencils *table, int first, int last,
+    /* One line saying what runs: ISA and threads, GL version and renderer. */
+    void (*describe)(void *state, char *buf, size_t size);
+    /* Called once per built table when a surface is created (upload to device memory);
+     * `*handle` may stay NULL. release_stencils frees what upload made. */
+    sfb_result (*upload_stencils)(void *state, const sfb__stencils *table, void **handle);
+    void (*release_stencils)(void *state, void *handle);
+    /* dst rows [first,last) = stencils applied to src; length components per element.
+     * `handle` is what upload_stencils returned for this table (or NULL). */
+    sfb_result (*eval_stencils)(void *state, const sfb__stencils *table, void *handle, int first, int last,
                                 const float *src, sfb_buffer_desc src_desc,
                                 float *dst, sfb_buffer_desc dst_desc);
+    /* Same on GL buffer objects of the current (host) context: no copy through the CPU. */
+    sfb_result (*eval_stencils_gl)(void *state, const sfb__stencils *table, void *handle,
+                                   unsigned src_buffer, sfb_buffer_desc src_desc,
+                                   unsigned dst_buffer, sfb_buffer_desc dst_desc);
 } sfb__backend_vtable;
+
+/* Optional backends (backends/sfb_*.h), compiled in by SURFBLEND_SIMD / _GL / _OSMESA or
+ * SURFBLEND_ALL_BACKENDS; the headers are included at the end of the implementation. */
+#if defined(SURFBLEND_ALL_BACKENDS)
+#  ifndef SURFBLEND_SIMD
+#    define SURFBLEND_SIMD
+#  endif
+#  ifndef SURFBLEND_GL
+#    define SURFBLEND_GL
+#  endif
+#  ifndef SURFBLEND_OSMESA
+#    define SURFBLEND_OSMESA
+#  endif
+#endif
+#if defined(SURFBLEND_OSMESA) && !defined(SURFBLEND_GL)
+#  define SURFBLEND_GL /* osmesa runs the gl kernels */
+#endif
+#ifdef SURFBLEND_SIMD
+const sfb__backend_vtable *sfb__backend_simd(void);
+#endif
+#ifdef SURFBLEND_GL
+const sfb__backend_vtable *sfb__backend_gl(void);
+#endif
+#ifdef SURFBLEND_OSMESA
+const sfb__backend_vtable *sfb__backend_osmesa(void);
+#endif
 
 /* ---- context ---- */
 struct sfb_context {
@@ -73,6 +116,7 @@ sfb_result sfb__oom(sfb_context *ctx, const char *what);
 /* Returns SFB_CANCELLED (with the error set) when the callback asks to stop. */
 sfb_result sfb__progress(sfb_context *ctx, float done, const char *stage);
 sfb_result sfb__select_backend(sfb_context *ctx, const char *env_override);
+sfb_result sfb__context_create_reporting(const sfb_context_config *config, sfb_context **out, char *report, size_t size);
 const sfb__backend_vtable *sfb__backend_ref(void);
 
 /* ---- topology of one level ---- */
@@ -124,6 +168,8 @@ struct sfb_surface {
     int has_uvs;
     sfb__stencils tables[SFB_TABLE_COUNT_];
     int built[SFB_TABLE_COUNT_];
+    void *backend_tables[SFB_TABLE_COUNT_]; /* the backend's uploaded copies (upload_stencils) */
+    const sfb__backend_vtable *uploaded_by;
     int boundary, crease_method, triangle_rule, uv_interp;
 };
 

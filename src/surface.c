@@ -25,7 +25,11 @@ SFB_API void sfb_surface_destroy(sfb_surface *s) {
     int t;
     if (!s) return;
     ctx = s->ctx;
-    for (t = 0; t < SFB_TABLE_COUNT_; ++t) sfb__stencils_free(ctx, &s->tables[t]);
+    for (t = 0; t < SFB_TABLE_COUNT_; ++t) {
+        if (s->backend_tables[t] && s->uploaded_by && s->uploaded_by->release_stencils)
+            s->uploaded_by->release_stencils(ctx->backend_state, s->backend_tables[t]);
+        sfb__stencils_free(ctx, &s->tables[t]);
+    }
     sfb__level_free(ctx, &s->top);
     sfb__level_free(ctx, &s->uv_top);
     sfb__free(ctx, s->base_positions);
@@ -140,6 +144,16 @@ SFB_API sfb_result sfb_surface_create(sfb_context *ctx, const sfb_mesh *mesh, co
     }
     r = sfb__progress(ctx, 1.0f, "refine");
     if (r != SFB_SUCCESS) { sfb_surface_destroy(s); return r; }
+    /* Hand the tables to the backend once (device upload); failures come back here. */
+    if (ctx->backend && ctx->backend->upload_stencils) {
+        int t;
+        s->uploaded_by = ctx->backend;
+        for (t = 0; t < SFB_TABLE_COUNT_; ++t) {
+            if (!s->built[t] || s->tables[t].rows == 0) continue;
+            r = ctx->backend->upload_stencils(ctx->backend_state, &s->tables[t], &s->backend_tables[t]);
+            if (r != SFB_SUCCESS) { sfb_surface_destroy(s); return r; }
+        }
+    }
     *out = s;
     return SFB_SUCCESS;
 }
@@ -168,9 +182,31 @@ SFB_API sfb_result sfb_surface_eval_stencils(const sfb_surface *s, sfb_table t, 
     if (!be || !(be->caps & SFB__CAP_EVAL_STENCILS) || !be->eval_stencils) {
         sfb__log(ctx, SFB_LOG_INFO, "backend %s lacks eval_stencils; using ref", be ? be->name : "none");
         be = sfb__backend_ref();
-        return be->eval_stencils(NULL, &s->tables[t], 0, s->tables[t].rows, src, sd, dst, dd);
+        return be->eval_stencils(NULL, &s->tables[t], NULL, 0, s->tables[t].rows, src, sd, dst, dd);
     }
-    return be->eval_stencils(ctx->backend_state, &s->tables[t], 0, s->tables[t].rows, src, sd, dst, dd);
+    if (s->tables[t].rows == 0) return SFB_SUCCESS;
+    return be->eval_stencils(ctx->backend_state, &s->tables[t], s->uploaded_by == be ? s->backend_tables[t] : NULL,
+                             0, s->tables[t].rows, src, sd, dst, dd);
+}
+
+SFB_API sfb_result sfb_surface_eval_stencils_gl(const sfb_surface *s, sfb_table t, unsigned int src_buffer, sfb_buffer_desc sd,
+                                                unsigned int dst_buffer, sfb_buffer_desc dd) {
+    sfb_context *ctx;
+    const sfb__backend_vtable *be;
+    if (!s) return SFB_INVALID_ARGS;
+    ctx = s->ctx;
+    if ((int)t < 0 || t >= SFB_TABLE_COUNT_ || !s->built[t])
+        return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "stencil table %d was not built for this surface", (int)t);
+    if (!src_buffer || !dst_buffer || !sfb__desc_ok(sd) || !sfb__desc_ok(dd) || sd.length != dd.length)
+        return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "invalid GL buffers or buffer descriptors for stencil evaluation");
+    be = ctx->backend;
+    if (!be || !(be->caps & SFB__CAP_GL_BUFFERS) || !be->eval_stencils_gl)
+        return sfb__error(ctx, SFB_UNSUPPORTED, SFB_ELEMENT_NONE, -1,
+                          "sfb_surface_eval_stencils_gl needs the gl backend on the host's context (gl_use_current_context); this context runs %s",
+                          be ? be->name : "no backend");
+    if (s->tables[t].rows == 0) return SFB_SUCCESS;
+    return be->eval_stencils_gl(ctx->backend_state, &s->tables[t], s->uploaded_by == be ? s->backend_tables[t] : NULL,
+                                src_buffer, sd, dst_buffer, dd);
 }
 
 SFB_API void sfb_mesh_data_free(sfb_mesh_data *d) {

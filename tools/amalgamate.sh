@@ -3,7 +3,7 @@
 # SURFBLEND_IMPLEMENTATION. Usage: tools/amalgamate.sh > surfblend.h
 set -e
 cd "$(dirname "$0")/.."
-MODULES="sfb_internal.h context.c backend.c backend_ref.c topology.c refine.c mesh.c obj.c surface.c"
+MODULES="sfb_internal.h context.c backend.c backend_ref.c topology.c refine.c mesh.c obj.c surface.c backends_include.c"
 cat <<'HDR'
 /* surfblend.h -- subdivision surfaces with sharp and semi-sharp creases, evaluated on
  * several backends. Single-header library: GENERATED from src/ by `make amalgamate`; edit
@@ -12,7 +12,8 @@ cat <<'HDR'
  * In exactly one C or C++ file:
  *     #define SURFBLEND_IMPLEMENTATION
  *     #include "surfblend.h"
- * Optional backends (backends/sfb_*.h) are included before that line.
+ * Optional backends (code in backends/ beside this file): also define SURFBLEND_SIMD,
+ * SURFBLEND_GL, SURFBLEND_OSMESA or SURFBLEND_ALL_BACKENDS there; link -lm -lpthread -ldl.
  */
 #ifndef SURFBLEND_H
 #define SURFBLEND_H

@@ -233,25 +233,20 @@ done:
     return rc;
 }
 
+/* Probes every backend on its own: available with what it runs on, or why not. */
 static int cmd_backends(void) {
     int k;
-    printf("backend order tried by default: simd, ref (SURFBLEND_BACKEND forces one)\n");
+    const char *env = getenv("SURFBLEND_BACKEND");
+    printf("default order: simd, ref%s%s%s\n", env && *env ? "  (SURFBLEND_BACKEND=" : "", env && *env ? env : "",
+           env && *env ? " forces one)" : "");
     for (k = SFB_BACKEND_REF; k < SFB_BACKEND_KIND_COUNT_; ++k) {
-        sfb_context_config cfg = sfb_context_config_init();
+        char info[512];
         sfb_backend_kind kind = (sfb_backend_kind)k;
-        sfb_context *ctx = NULL;
-        char report[2048];
-        cfg.backends = &kind;
-        cfg.backend_count = 1;
-        cfg.ignore_environment = 1;
-        if (sfb_context_create(&cfg, &ctx) == SFB_SUCCESS) {
-            sfb_context_backend_report(ctx, report, sizeof report);
-            printf("%-7s available   %s", sfb_backend_kind_name(kind), report);
-            sfb_context_destroy(ctx);
-        } else {
-            /* the report is kept only on a created context; say what we know */
-            printf("%-7s unavailable (not built in or failed to initialise)\n", sfb_backend_kind_name(kind));
-        }
+        sfb_result r = sfb_backend_probe(kind, NULL, info, sizeof info);
+        if (r == SFB_SUCCESS)
+            printf("%-7s available     %s\n", sfb_backend_kind_name(kind), info[0] ? info : "plain C, double accumulation (the oracle)");
+        else
+            printf("%-7s unavailable   %s (%s)\n", sfb_backend_kind_name(kind), info, sfb_result_string(r));
     }
     return 0;
 }

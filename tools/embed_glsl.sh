@@ -1,0 +1,14 @@
+#!/bin/sh
+# Writes backends/sfb_gl_shaders.h to stdout: every backends/glsl/* file as a C string
+# constant sfb__glsl_<name> (dots become underscores). Usage: tools/embed_glsl.sh > backends/sfb_gl_shaders.h
+set -e
+cd "$(dirname "$0")/.."
+echo "/* GENERATED from backends/glsl/ by \`make embed-glsl\`; edit the .glsl sources instead. */"
+for f in backends/glsl/*; do
+  name=$(basename "$f" | tr '.-' '__')
+  echo
+  echo "/* $f */"
+  echo "static const char sfb__glsl_$name[] ="
+  sed -e 's/\\/\\\\/g' -e 's/"/\\"/g' -e 's/^/    "/' -e 's/$/\\n"/' "$f"
+  echo "    ;"
+done
