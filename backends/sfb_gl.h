@@ -29,6 +29,18 @@
 #endif
 #include "sfb_gl_shaders.h"
 
+/* Build-time overrides, used by tests/gl_errors.c to exercise the failure paths for real: the
+ * kernel source, and the library names tried by dlopen (NULL-terminated initialisers). */
+#ifndef SFB__GL_STENCIL_SOURCE
+#define SFB__GL_STENCIL_SOURCE sfb__glsl_stencils_comp_glsl
+#endif
+#ifndef SFB__EGL_LIBRARY_NAMES
+#define SFB__EGL_LIBRARY_NAMES {"libEGL.so.1", "libEGL.so", NULL}
+#endif
+#ifndef SFB__OSMESA_LIBRARY_NAMES
+#define SFB__OSMESA_LIBRARY_NAMES {"libOSMesa.so.8", "libOSMesa.so.6", "libOSMesa.so", NULL}
+#endif
+
 /* ---- GL types and the constants we use (values from the Khronos registry) ---- */
 typedef unsigned int sfb__GLenum;
 typedef unsigned int sfb__GLuint;
@@ -106,18 +118,25 @@ typedef struct sfb__glfns {
 } sfb__glfns;
 
 /* ---- run-time loading ---- */
-/* dlopen that reuses a library the process already has before loading one. */
-static void *sfb__gl_dlopen(const char *const *names) {
+/* dlopen that reuses a library the process already has before loading one. On failure `err`
+ * (if given) gets the loader's message for the first name. */
+static void *sfb__gl_dlopen(const char *const *names, char *err, size_t err_size) {
 #if defined(_WIN32)
     (void)names;
+    if (err && err_size) snprintf(err, err_size, "run-time GL loading is not implemented on Windows yet");
     return NULL;
 #else
     int i;
     void *h;
     for (i = 0; names[i]; ++i)
         if ((h = dlopen(names[i], RTLD_LAZY | RTLD_LOCAL | RTLD_NOLOAD)) != NULL) return h;
-    for (i = 0; names[i]; ++i)
+    for (i = 0; names[i]; ++i) {
         if ((h = dlopen(names[i], RTLD_LAZY | RTLD_LOCAL)) != NULL) return h;
+        if (i == 0 && err && err_size) {
+            const char *e = dlerror();
+            snprintf(err, err_size, "%s", e ? e : "dlopen failed");
+        }
+    }
     return NULL;
 #endif
 }
@@ -185,6 +204,7 @@ typedef struct sfb__eglfns {
 #undef SFB__EGL_MEMBER
     sfb__EGLDisplay (*GetPlatformDisplayEXT)(sfb__EGLenum, void *, const sfb__EGLint *);
     sfb__EGLBoolean (*QueryDevicesEXT)(sfb__EGLint, sfb__EGLDevice *, sfb__EGLint *);
+    const char *(*QueryDeviceStringEXT)(sfb__EGLDevice, sfb__EGLint);
 } sfb__eglfns;
 
 static int sfb__egl_load(void *lib, sfb__eglfns *e) {
@@ -200,6 +220,8 @@ static int sfb__egl_load(void *lib, sfb__eglfns *e) {
     memcpy(&e->GetPlatformDisplayEXT, &p, sizeof p);
     p = e->GetProcAddress("eglQueryDevicesEXT");
     memcpy(&e->QueryDevicesEXT, &p, sizeof p);
+    p = e->GetProcAddress("eglQueryDeviceStringEXT");
+    memcpy(&e->QueryDeviceStringEXT, &p, sizeof p);
     return 1;
 }
 
@@ -365,6 +387,12 @@ static void sfb__gl_leave(sfb__gl *g, const sfb__gl_saved *s) {
     }
 }
 
+/* Drops the trailing newlines drivers end their logs with. */
+static void sfb__gl_trim(char *log) {
+    size_t n = strlen(log);
+    while (n > 0 && (log[n - 1] == '\n' || log[n - 1] == '\r' || log[n - 1] == ' ')) log[--n] = 0;
+}
+
 /* ---- shaders ---- */
 static sfb_result sfb__gl_program(sfb__gl *g, int length, sfb__GLuint *out) {
     char header[160];
@@ -376,7 +404,7 @@ static sfb_result sfb__gl_program(sfb__gl *g, int length, sfb__GLuint *out) {
     snprintf(header, sizeof header, "%s#define SFB_LENGTH %d\n",
              g->es ? "#version 310 es\nprecision highp float;\nprecision highp int;\n" : "#version 430 core\n", length);
     parts[0] = header;
-    parts[1] = sfb__glsl_stencils_comp_glsl;
+    parts[1] = SFB__GL_STENCIL_SOURCE;
     sh = g->gl.CreateShader(SFB__GL_COMPUTE_SHADER);
     if (!sh) {
         sfb_result r = sfb__gl_check(g, "glCreateShader(GL_COMPUTE_SHADER)");
@@ -389,6 +417,7 @@ static sfb_result sfb__gl_program(sfb__gl *g, int length, sfb__GLuint *out) {
         char log[768];
         log[0] = 0;
         g->gl.GetShaderInfoLog(sh, (sfb__GLsizei)sizeof log, &len, log);
+        sfb__gl_trim(log);
         g->gl.DeleteShader(sh);
         return sfb__error(g->ctx, SFB_BACKEND_ERROR, SFB_ELEMENT_NONE, -1,
                           "gl: stencils.comp.glsl (SFB_LENGTH %d) failed to compile: %s", length, log);
@@ -402,6 +431,7 @@ static sfb_result sfb__gl_program(sfb__gl *g, int length, sfb__GLuint *out) {
         char log[768];
         log[0] = 0;
         g->gl.GetProgramInfoLog(prog, (sfb__GLsizei)sizeof log, &len, log);
+        sfb__gl_trim(log);
         g->gl.DeleteProgram(prog);
         return sfb__error(g->ctx, SFB_BACKEND_ERROR, SFB_ELEMENT_NONE, -1,
                           "gl: stencils.comp.glsl (SFB_LENGTH %d) failed to link: %s", length, log);
@@ -478,15 +508,16 @@ static void sfb__gl_release_gl(sfb__gl *g) {
 
 /* ---- the own headless EGL context ---- */
 static sfb_result sfb__gl_egl_open(sfb__gl *g, char *why, size_t why_size) {
-    static const char *const egl_names[] = {"libEGL.so.1", "libEGL.so", NULL};
+    static const char *const egl_names[] = SFB__EGL_LIBRARY_NAMES;
     const char *client;
     sfb__EGLint major = 0, minor = 0, n = 0;
     sfb__EGLConfig config = NULL;
     const char *platform = "default display";
     int attempt;
-    g->libegl = sfb__gl_dlopen(egl_names);
+    char err[256] = "";
+    g->libegl = sfb__gl_dlopen(egl_names, err, sizeof err);
     if (!g->libegl) {
-        snprintf(why, why_size, "libEGL.so.1 not found (Debian: libegl1 and a driver, e.g. libegl-mesa0)");
+        snprintf(why, why_size, "libEGL.so.1 not found (Debian: libegl1 and a driver, e.g. libegl-mesa0): %s", err);
         return SFB_BACKEND_UNAVAILABLE;
     }
     if (!sfb__egl_load(g->libegl, &g->egl)) {
@@ -502,10 +533,16 @@ static sfb_result sfb__gl_egl_open(sfb__gl *g, char *why, size_t why_size) {
         if (g->terminate_display) { attrs[0] = SFB__EGL_TRACK_REFERENCES_KHR; attrs[1] = SFB__EGL_TRUE; }
         if (attempt == 0 && g->egl.GetPlatformDisplayEXT && g->egl.QueryDevicesEXT &&
             sfb__has_word(client, "EGL_EXT_platform_device")) {
-            sfb__EGLDevice devs[8];
-            sfb__EGLint count = 0;
-            if (g->egl.QueryDevicesEXT(8, devs, &count) && count > 0) {
-                d = g->egl.GetPlatformDisplayEXT(SFB__EGL_PLATFORM_DEVICE_EXT, devs[0], attrs);
+            sfb__EGLDevice devs[16];
+            sfb__EGLint count = 0, i, pick = 0;
+            if (g->egl.QueryDevicesEXT(16, devs, &count) && count > 0) {
+                /* a hardware device before Mesa's software one, when there is one */
+                for (i = 0; i < count && g->egl.QueryDeviceStringEXT; ++i)
+                    if (!sfb__has_word(g->egl.QueryDeviceStringEXT(devs[i], SFB__EGL_EXTENSIONS), "EGL_MESA_device_software")) {
+                        pick = i;
+                        break;
+                    }
+                d = g->egl.GetPlatformDisplayEXT(SFB__EGL_PLATFORM_DEVICE_EXT, devs[pick], attrs);
                 platform = "EGL device platform";
             }
         } else if (attempt == 1 && g->egl.GetPlatformDisplayEXT && sfb__has_word(client, "EGL_MESA_platform_surfaceless")) {
@@ -560,7 +597,7 @@ static sfb_result sfb__gl_egl_open(sfb__gl *g, char *why, size_t why_size) {
         sfb__gl_saved s;
         sfb_result r;
         static const char *const gl_names[] = {"libOpenGL.so.0", "libGL.so.1", "libGLESv2.so.2", NULL};
-        g->libgl = sfb__gl_dlopen(gl_names);
+        g->libgl = sfb__gl_dlopen(gl_names, NULL, 0);
         /* Make it current without the state save (the function table is not loaded yet). */
         s.api = g->egl.QueryAPI();
         s.prev_ctx = g->egl.GetCurrentContext();

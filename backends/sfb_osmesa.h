@@ -21,16 +21,17 @@ enum {
 };
 
 static sfb_result sfb__osmesa_open(sfb__gl *g, char *why, size_t why_size) {
-    static const char *const names[] = {"libOSMesa.so.8", "libOSMesa.so.6", "libOSMesa.so", NULL};
+    static const char *const names[] = SFB__OSMESA_LIBRARY_NAMES;
     static const int versions[][2] = {{4, 5}, {4, 3}};
     void *(*create)(const int *, void *) = NULL;
     sfb__glproc p, (*getproc)(const char *) = NULL;
     sfb_result r;
     size_t v;
     g->mode = SFB__GL_OSMESA;
-    g->libosmesa = sfb__gl_dlopen(names);
+    char err[256] = "";
+    g->libosmesa = sfb__gl_dlopen(names, err, sizeof err);
     if (!g->libosmesa) {
-        snprintf(why, why_size, "libOSMesa.so.8 / .so.6 not found (Debian: libosmesa6; Mesa 25.1 and later ship none)");
+        snprintf(why, why_size, "libOSMesa.so.8 / .so.6 not found (Debian: libosmesa6; Mesa 25.1 and later ship none): %s", err);
         return SFB_BACKEND_UNAVAILABLE;
     }
     p = sfb__gl_dlsym(g->libosmesa, "OSMesaCreateContextAttribs"); memcpy(&create, &p, sizeof p);

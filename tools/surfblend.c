@@ -15,7 +15,7 @@ static const char *usage_text =
     "      --scheme catmark|loop|bilinear   subdivision scheme (default: from the file name prefix, else catmark)\n"
     "      --level L                        uniform refinement level 0..10 (default 2)\n"
     "      --limit                          write limit positions (and limit normals as vn) instead of refined points\n"
-    "      --backend NAME                   ref|simd|gl|osmesa (else SURFBLEND_BACKEND, else the default order)\n"
+    "      --backend NAME                   ref|simd|gl|osmesa, tried first (else SURFBLEND_BACKEND, else the default order)\n"
     "  surfblend backends                         list the backends and whether each is available\n"
     "  surfblend --help | --version\n"
     "exit codes: 0 success, 1 bad input, 2 usage error\n";
@@ -54,25 +54,37 @@ static int file_write(const void *data, size_t size, void *user) {
     return fwrite(data, 1, size, (FILE *)user) != size;
 }
 
+/* --backend NAME is tried first; if it cannot initialise, the default order follows and the
+ * reason is printed (the same fall-through a library user gets). */
 static sfb_context *make_context(const char *backend) {
     sfb_context_config cfg = sfb_context_config_init();
-    sfb_backend_kind kinds[1];
+    sfb_backend_kind kinds[3];
     sfb_context *ctx = NULL;
     sfb_result r;
+    char report[2048];
     if (backend) {
         kinds[0] = sfb_backend_kind_parse(backend);
         if (kinds[0] == SFB_BACKEND_DEFAULT) {
             fprintf(stderr, "surfblend: unknown backend '%s' (ref, simd, gl, osmesa)\n", backend);
             return NULL;
         }
+        kinds[1] = SFB_BACKEND_SIMD;
+        kinds[2] = SFB_BACKEND_REF;
         cfg.backends = kinds;
-        cfg.backend_count = 1;
+        cfg.backend_count = 3;
         cfg.ignore_environment = 1;
     }
     r = sfb_context_create(&cfg, &ctx);
     if (r != SFB_SUCCESS) {
         fprintf(stderr, "surfblend: no backend could be initialised (%s)\n", sfb_result_string(r));
         return NULL;
+    }
+    if ((backend && sfb_backend_kind_parse(sfb_context_backend_name(ctx)) != kinds[0]) ||
+        (!backend && getenv("SURFBLEND_BACKEND") && *getenv("SURFBLEND_BACKEND") &&
+         sfb_backend_kind_parse(sfb_context_backend_name(ctx)) != sfb_backend_kind_parse(getenv("SURFBLEND_BACKEND")))) {
+        sfb_context_backend_report(ctx, report, sizeof report);
+        fprintf(stderr, "surfblend: the requested backend is unavailable; using %s. Backends tried:\n%s",
+                sfb_context_backend_name(ctx), report);
     }
     return ctx;
 }
