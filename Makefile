@@ -13,13 +13,26 @@ SHAPES  ?= ../shared/peers/opensubdiv-shapes
 
 SRC_MODULES := src/sfb_api.h src/sfb_internal.h $(wildcard src/*.c)
 TEST_SRCS   := $(wildcard tests/test_*.c)
+BACKEND_HDRS:= $(wildcard backends/*.h)
+EXAMPLES    := $(patsubst examples/%.c,$(BUILD)/examples/%,$(wildcard examples/*.c))
+# Test programs that play a GL host link EGL and GL themselves (the library never does).
+GL_LIBS     := -lEGL -lGL
+# The benchmark: OpenSubdiv's CPU evaluators (its OmpEvaluator is in Debian's libosdCPU, built
+# with OpenMP) and its GL compute evaluator (libosdGPU) on an EGL context the benchmark makes.
+BENCH_LIBS  := -losdGPU -losdCPU $(GL_LIBS)
 
 # Debian packages each goal needs (the library itself needs none but a C compiler).
+# Tests: OpenSubdiv (oracle, benchmark), Criterion; for the gl/osmesa backends at run time the
+# EGL loader (libegl1), Mesa's EGL and software drivers (libegl-mesa0, libgl1-mesa-dri: llvmpipe)
+# and libOSMesa (libosmesa6); to build tests/gl_host.c and the benchmark the EGL/GL headers and
+# link libraries (libegl-dev, libgl-dev: EGL/egl.h, GL/glcorearb.h, libEGL.so, libGL.so);
+# glslangValidator (glslang-tools) for tools/check_glsl.sh.
 PKGS_BASE := $(if $(shell command -v cc 2>/dev/null),,build-essential)
-PKGS_TEST := g++ libosd-dev libcriterion-dev pkg-config
+PKGS_TEST := g++ libosd-dev libcriterion-dev pkg-config \
+             libegl1 libegl-mesa0 libgl1-mesa-dri libosmesa6 libegl-dev libgl-dev glslang-tools
 PKGS_FUZZ := clang libclang-rt-14-dev
 
-.PHONY: all run test bench fuzz asan amalgamate amalgamate-check deps deps-test deps-fuzz clean unit-build
+.PHONY: all run test bench fuzz asan amalgamate amalgamate-check embed-glsl deps deps-test deps-fuzz clean unit-build
 
 all: $(BUILD)/surfblend
 
@@ -46,13 +59,17 @@ deps-fuzz:
 amalgamate:
 	./tools/amalgamate.sh > surfblend.h.tmp && mv surfblend.h.tmp surfblend.h
 
+# GLSL sources of the gl backend embedded as C strings (tools/check_glsl.sh checks it is current)
+embed-glsl:
+	./tools/embed_glsl.sh > backends/sfb_gl_shaders.h.tmp && mv backends/sfb_gl_shaders.h.tmp backends/sfb_gl_shaders.h
+
 amalgamate-check:
 	@./tools/amalgamate.sh > $${TMPDIR:-/tmp}/surfblend.h.check && \
 	if cmp -s $${TMPDIR:-/tmp}/surfblend.h.check surfblend.h; then echo "amalgamate-check: surfblend.h is up to date"; \
 	else echo "amalgamate-check: FAILED: surfblend.h is stale against src/ (run 'make amalgamate')"; exit 1; fi
 
 # ---- library, CLI, examples ----
-$(BUILD)/libsfb.o: tools/impl.c surfblend.h
+$(BUILD)/libsfb.o: tools/impl.c surfblend.h $(BACKEND_HDRS)
 	@mkdir -p $(BUILD)
 	$(CC) $(CFLAGS) $(SAN) -I. -c -x c tools/impl.c -o $@
 
@@ -76,24 +93,51 @@ $(BUILD)/unit: $(TEST_SRCS) $(BUILD)/libsfb.o
 $(BUILD)/osd_agree: tests/osd_agree.cpp $(BUILD)/libsfb.o
 	$(CXX) $(CXXFLAGS) $(SAN) -I. tests/osd_agree.cpp $(BUILD)/libsfb.o -o $@ -losdCPU $(LIBS)
 
-unit-build: $(BUILD)/surfblend $(BUILD)/unit $(BUILD)/osd_agree $(BUILD)/examples/01_minimal
+# Backend agreement (every optional backend against ref): links the library alone.
+$(BUILD)/agree: tests/agree.c $(BUILD)/libsfb.o
+	$(CC) $(CFLAGS) $(SAN) -I. tests/agree.c $(BUILD)/libsfb.o -o $@ $(LIBS)
 
+# The engine case: the test is the GL host, so it links EGL and GL itself.
+$(BUILD)/gl_host: tests/gl_host.c $(BUILD)/libsfb.o
+	$(CC) $(CFLAGS) $(SAN) -I. tests/gl_host.c $(BUILD)/libsfb.o -o $@ $(GL_LIBS) $(LIBS)
+
+# Failure paths of gl/osmesa: compiles its own implementation with overrides (tests/gl_errors.c).
+$(BUILD)/gl_errors: tests/gl_errors.c surfblend.h $(BACKEND_HDRS)
+	$(CC) $(CFLAGS) $(SAN) -I. tests/gl_errors.c -o $@ $(LIBS)
+
+# Table pieces and split dispatches of gl/osmesa, under tiny limits (tests/gl_pieces.c).
+$(BUILD)/gl_pieces: tests/gl_pieces.c surfblend.h $(BACKEND_HDRS)
+	$(CC) $(CFLAGS) $(SAN) -I. tests/gl_pieces.c -o $@ $(LIBS)
+
+unit-build: $(BUILD)/surfblend $(BUILD)/unit $(BUILD)/osd_agree $(BUILD)/agree $(BUILD)/gl_host \
+            $(BUILD)/gl_errors $(BUILD)/gl_pieces $(EXAMPLES)
+
+# On CI (CI set and not false/0) the optional backends must run, not be skipped: the suites
+# fail for a backend in SFB_REQUIRE_BACKENDS that is unavailable. CI has Mesa llvmpipe and
+# OSMesa but no GPU. A value already in the environment wins.
 test: deps-test amalgamate-check
 	$(MAKE) --no-print-directory unit-build
+	@if [ -n "$${CI:-}" ] && [ "$${CI}" != false ] && [ "$${CI}" != 0 ]; then \
+	  export SFB_REQUIRE_BACKENDS="$${SFB_REQUIRE_BACKENDS:-simd,gl,osmesa}"; \
+	  echo "CI=$${CI}: SFB_REQUIRE_BACKENDS=$${SFB_REQUIRE_BACKENDS}"; \
+	fi; \
 	BUILD=$(BUILD) SHAPES=$(SHAPES) CC="$(CC)" CXX="$(CXX)" ./tests/run_all.sh
 
-# The whole suite again under AddressSanitizer + UndefinedBehaviorSanitizer.
+# The whole suite again under AddressSanitizer + UndefinedBehaviorSanitizer. LeakSanitizer
+# reports inside the GL drivers (Mesa, LLVM) are suppressed by tests/lsan.supp, which names
+# driver libraries only, never surfblend's code.
 asan:
+	LSAN_OPTIONS="suppressions=$(CURDIR)/tests/lsan.supp:print_suppressions=0$${LSAN_OPTIONS:+:$$LSAN_OPTIONS}" \
 	$(MAKE) --no-print-directory test BUILD=build-asan OPT=-O1 \
 	  SAN="-fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined"
 
 # ---- benchmark ----
 $(BUILD)/bench: bench/bench.cpp $(BUILD)/libsfb.o
-	$(CXX) $(CXXFLAGS) -I. bench/bench.cpp $(BUILD)/libsfb.o -o $@ -losdCPU $(LIBS)
+	$(CXX) $(CXXFLAGS) -I. bench/bench.cpp $(BUILD)/libsfb.o -o $@ $(BENCH_LIBS) $(LIBS)
 
 bench: deps-test
 	$(MAKE) --no-print-directory $(BUILD)/bench OPT=-O3
-	./$(BUILD)/bench
+	$(abspath $(BUILD))/bench
 
 # ---- fuzzing (libFuzzer, clang) ----
 FUZZ_TIME ?= 60

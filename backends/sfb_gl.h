@@ -250,6 +250,14 @@ typedef struct sfb__gl_saved {
     sfb__EGLDisplay prev_dpy;
     sfb__EGLSurface prev_draw, prev_read;
     void *prev_osmesa;
+    /* contexts of other window-system APIs current before the call: Mesa keeps one current
+     * context per thread across EGL, GLX and OSMesa, so making ours current displaces them */
+    sfb__EGLenum fegl_api;
+    sfb__EGLContext fegl_ctx;
+    sfb__EGLDisplay fegl_dpy;
+    sfb__EGLSurface fegl_draw, fegl_read;
+    void *glx_ctx, *glx_dpy;
+    unsigned long glx_draw, glx_read;
 } sfb__gl_saved;
 
 typedef struct sfb__gl {
@@ -271,6 +279,14 @@ typedef struct sfb__gl {
     sfb__GLboolean (*osmesa_make_current)(void *, void *, sfb__GLenum, sfb__GLsizei, sfb__GLsizei);
     void (*osmesa_destroy)(void *);
     unsigned char osmesa_pixel[16];
+    /* the other window-system APIs, if the process has loaded them (never loaded by us) */
+    void *fegl_lib, *glx_lib;
+    sfb__eglfns fegl;
+    void *(*glx_get_context)(void);
+    void *(*glx_get_display)(void);
+    unsigned long (*glx_get_draw)(void);
+    unsigned long (*glx_get_read)(void);
+    int (*glx_make_current)(void *, unsigned long, unsigned long, void *);
     /* GL side */
     int es;                         /* GLES 3.1+ rather than desktop 4.3+ */
     sfb__GLint max_block;           /* GL_MAX_SHADER_STORAGE_BLOCK_SIZE, bytes */
@@ -317,9 +333,61 @@ static sfb_result sfb__gl_check(sfb__gl *g, const char *what) {
 }
 
 /* ---- making the context current for a call, and putting things back ---- */
+/* Finds GLX (and, for osmesa, EGL) if the process has loaded them, to save and restore a
+ * context of theirs that our own context displaces. Looked up again until found. */
+static void sfb__gl_find_foreign(sfb__gl *g) {
+#if !defined(_WIN32)
+    if (!g->glx_lib && (g->glx_lib = dlopen("libGL.so.1", RTLD_LAZY | RTLD_LOCAL | RTLD_NOLOAD)) != NULL) {
+        sfb__glproc p;
+        p = sfb__gl_dlsym(g->glx_lib, "glXGetCurrentContext"); memcpy(&g->glx_get_context, &p, sizeof p);
+        p = sfb__gl_dlsym(g->glx_lib, "glXGetCurrentDisplay"); memcpy(&g->glx_get_display, &p, sizeof p);
+        p = sfb__gl_dlsym(g->glx_lib, "glXGetCurrentDrawable"); memcpy(&g->glx_get_draw, &p, sizeof p);
+        p = sfb__gl_dlsym(g->glx_lib, "glXGetCurrentReadDrawable"); memcpy(&g->glx_get_read, &p, sizeof p);
+        p = sfb__gl_dlsym(g->glx_lib, "glXMakeContextCurrent"); memcpy(&g->glx_make_current, &p, sizeof p);
+        if (!g->glx_get_context || !g->glx_get_display || !g->glx_get_draw || !g->glx_get_read || !g->glx_make_current)
+            g->glx_get_context = NULL;
+    }
+    if (g->mode == SFB__GL_OSMESA && !g->fegl_lib &&
+        (g->fegl_lib = dlopen("libEGL.so.1", RTLD_LAZY | RTLD_LOCAL | RTLD_NOLOAD)) != NULL && !sfb__egl_load(g->fegl_lib, &g->fegl))
+        g->fegl.GetCurrentContext = NULL;
+#else
+    (void)g;
+#endif
+}
+
+static void sfb__gl_save_foreign(sfb__gl *g, sfb__gl_saved *s) {
+    sfb__gl_find_foreign(g);
+    if (g->glx_get_context && (s->glx_ctx = g->glx_get_context()) != NULL) {
+        s->glx_dpy = g->glx_get_display();
+        s->glx_draw = g->glx_get_draw();
+        s->glx_read = g->glx_get_read();
+    }
+    if (g->mode == SFB__GL_OSMESA && g->fegl.GetCurrentContext && (s->fegl_ctx = g->fegl.GetCurrentContext()) != NULL) {
+        s->fegl_api = g->fegl.QueryAPI();
+        s->fegl_dpy = g->fegl.GetCurrentDisplay();
+        s->fegl_draw = g->fegl.GetCurrentSurface(SFB__EGL_DRAW);
+        s->fegl_read = g->fegl.GetCurrentSurface(SFB__EGL_READ);
+    }
+}
+
+/* Puts a displaced GLX/EGL context back: released first, since re-binding a context its API
+ * still believes current is skipped by the driver. */
+static void sfb__gl_restore_foreign(sfb__gl *g, const sfb__gl_saved *s) {
+    if (s->glx_ctx) {
+        g->glx_make_current(s->glx_dpy, 0, 0, NULL);
+        g->glx_make_current(s->glx_dpy, s->glx_draw, s->glx_read, s->glx_ctx);
+    }
+    if (s->fegl_ctx) {
+        g->fegl.BindAPI(s->fegl_api);
+        g->fegl.MakeCurrent(s->fegl_dpy, NULL, NULL, NULL);
+        g->fegl.MakeCurrent(s->fegl_dpy, s->fegl_draw, s->fegl_read, s->fegl_ctx);
+    }
+}
+
 static sfb_result sfb__gl_enter(sfb__gl *g, sfb__gl_saved *s) {
     int i;
     memset(s, 0, sizeof *s);
+    if (g->mode != SFB__GL_HOST) sfb__gl_save_foreign(g, s);
     if (g->mode == SFB__GL_OWN_EGL) {
         s->api = g->egl.QueryAPI();
         if (s->api != g->egl_api) g->egl.BindAPI(g->egl_api);
@@ -335,8 +403,10 @@ static sfb_result sfb__gl_enter(sfb__gl *g, sfb__gl_saved *s) {
     } else if (g->mode == SFB__GL_OSMESA) {
         s->prev_osmesa = g->osmesa_get_current();
         if (s->prev_osmesa != g->osmesa_ctx &&
-            !g->osmesa_make_current(g->osmesa_ctx, g->osmesa_pixel, SFB__GL_UNSIGNED_BYTE, 1, 1))
+            !g->osmesa_make_current(g->osmesa_ctx, g->osmesa_pixel, SFB__GL_UNSIGNED_BYTE, 1, 1)) {
+            sfb__gl_restore_foreign(g, s);
             return sfb__error(g->ctx, SFB_BACKEND_ERROR, SFB_ELEMENT_NONE, -1, "osmesa: OSMesaMakeCurrent failed");
+        }
     }
     /* Errors pending before we start are the host's, not ours: note them and clear. */
     {
@@ -381,10 +451,13 @@ static void sfb__gl_leave(sfb__gl *g, const sfb__gl_saved *s) {
             g->egl.BindAPI(s->api);
         }
     } else if (g->mode == SFB__GL_OSMESA) {
-        /* OSMesa cannot tell which buffer another context was bound to, so a different
-         * previous OSMesa context is not restored; no previous context is restored as none. */
-        if (s->prev_osmesa != g->osmesa_ctx && !s->prev_osmesa) g->osmesa_make_current(NULL, NULL, 0, 0, 0);
+        /* With an EGL/GLX context current, OSMesaGetCurrentContext reports that one (Mesa shares
+         * the slot): release ours and put it back. OSMesa cannot tell which buffer another
+         * OSMesa context was bound to, so a different OSMesa context is not restored. */
+        if (s->prev_osmesa != g->osmesa_ctx && (!s->prev_osmesa || s->fegl_ctx || s->glx_ctx))
+            g->osmesa_make_current(NULL, NULL, 0, 0, 0);
     }
+    if (g->mode != SFB__GL_HOST) sfb__gl_restore_foreign(g, s);
 }
 
 /* Drops the trailing newlines drivers end their logs with. */
@@ -482,6 +555,12 @@ static sfb_result sfb__gl_setup(sfb__gl *g, sfb__glproc (*getproc)(const char *)
     g->gl.GetIntegeri_v(SFB__GL_MAX_COMPUTE_WORK_GROUP_COUNT, 0, &g->max_groups);
     if (g->max_block < (1 << 16)) g->max_block = 1 << 16;     /* the minimum GL guarantees is 2^27 */
     if (g->max_groups < 1) g->max_groups = 65535;
+#ifdef SFB__GL_TEST_MAX_BLOCK /* tests/gl_pieces.c: small limits force tables into pieces */
+    if (g->max_block > SFB__GL_TEST_MAX_BLOCK) g->max_block = SFB__GL_TEST_MAX_BLOCK;
+#endif
+#ifdef SFB__GL_TEST_MAX_GROUPS
+    g->max_groups = SFB__GL_TEST_MAX_GROUPS;
+#endif
     while (g->gl.GetError() != SFB__GL_NO_ERROR) {}
     snprintf(g->desc, sizeof g->desc, "%s%s; %s; %s", g->es ? "" : "OpenGL ", version, renderer ? renderer : "?",
              vendor ? vendor : "?");
@@ -599,6 +678,8 @@ static sfb_result sfb__gl_egl_open(sfb__gl *g, char *why, size_t why_size) {
         static const char *const gl_names[] = {"libOpenGL.so.0", "libGL.so.1", "libGLESv2.so.2", NULL};
         g->libgl = sfb__gl_dlopen(gl_names, NULL, 0);
         /* Make it current without the state save (the function table is not loaded yet). */
+        memset(&s, 0, sizeof s);
+        sfb__gl_save_foreign(g, &s);
         s.api = g->egl.QueryAPI();
         s.prev_ctx = g->egl.GetCurrentContext();
         s.prev_dpy = g->egl.GetCurrentDisplay();
@@ -607,6 +688,7 @@ static sfb_result sfb__gl_egl_open(sfb__gl *g, char *why, size_t why_size) {
         g->egl.BindAPI(g->egl_api);
         if (!g->egl.MakeCurrent(g->dpy, NULL, NULL, g->egl_ctx)) {
             g->egl.BindAPI(s.api);
+            sfb__gl_restore_foreign(g, &s);
             snprintf(why, why_size, "eglMakeCurrent on the new context failed (EGL error 0x%x)", (unsigned)g->egl.GetError());
             return SFB_BACKEND_UNAVAILABLE;
         }
@@ -619,6 +701,7 @@ static sfb_result sfb__gl_egl_open(sfb__gl *g, char *why, size_t why_size) {
             g->egl.MakeCurrent(g->dpy, NULL, NULL, NULL);
             g->egl.BindAPI(s.api);
         }
+        sfb__gl_restore_foreign(g, &s);
         if (r != SFB_SUCCESS) return r;
         used = strlen(g->desc);
         snprintf(g->desc + used, sizeof g->desc - used, "; headless %s", platform);

@@ -54,14 +54,21 @@ static sfb_result sfb__osmesa_open(sfb__gl *g, char *why, size_t why_size) {
         return SFB_BACKEND_UNAVAILABLE;
     }
     {
-        void *prev = g->osmesa_get_current();
+        /* as sfb__gl_enter/leave, before the function table exists */
+        sfb__gl_saved s;
+        void *prev;
+        memset(&s, 0, sizeof s);
+        sfb__gl_save_foreign(g, &s);
+        prev = g->osmesa_get_current();
         if (!g->osmesa_make_current(g->osmesa_ctx, g->osmesa_pixel, SFB__GL_UNSIGNED_BYTE, 1, 1)) {
+            sfb__gl_restore_foreign(g, &s);
             snprintf(why, why_size, "OSMesaMakeCurrent failed");
             return SFB_BACKEND_UNAVAILABLE;
         }
         r = sfb__gl_setup(g, getproc, why, why_size);
         if (r == SFB_SUCCESS) r = sfb__gl_warm(g, why, why_size);
-        if (!prev) g->osmesa_make_current(NULL, NULL, 0, 0, 0);
+        if (!prev || s.fegl_ctx || s.glx_ctx) g->osmesa_make_current(NULL, NULL, 0, 0, 0);
+        sfb__gl_restore_foreign(g, &s);
     }
     if (r == SFB_SUCCESS) {
         size_t used = strlen(g->desc);

@@ -10,8 +10,28 @@
  *           OpenSubdiv Osd::CpuEvaluator::EvalStencils (single thread)
  * and checks that both give the same refined points (matched as point sets: the vertex orders
  * of the two libraries differ).
+ *
+ * Then stencil evaluation alone, positions (length 3), Catmull-Clark level 4 of the same torus,
+ * on every surfblend backend beside OpenSubdiv's evaluators, all in this run:
+ *   surfblend  ref; simd with 1 thread and with all threads (threads = 0); gl on its own
+ *              headless EGL context (CPU copies in and out); osmesa (CPU copies); and gl on an
+ *              EGL context this program makes and makes current (gl_use_current_context = 1),
+ *              both GL buffer to GL buffer (sfb_surface_eval_stencils_gl + glFinish) and with
+ *              CPU copies (sfb_surface_eval_stencils)
+ *   OpenSubdiv Osd::CpuEvaluator, Osd::OmpEvaluator (as many threads as simd's "all"), and
+ *              Osd::GLComputeEvaluator (Osd::GLStencilTableSSBO, Osd::GLVertexBuffer) on the same
+ *              EGL context, + glFinish
+ * Each: the best (minimum) of N runs after warm-up runs, in milliseconds, with the ratio to
+ * OpenSubdiv's CpuEvaluator and to ref measured in the same run, and the difference from ref
+ * (OpenSubdiv's points matched as point sets). A backend that cannot run here prints
+ * "unavailable: why".
  */
 #include "surfblend.h"
+
+#define GL_GLEXT_PROTOTYPES 1
+#include <EGL/egl.h>
+#include <EGL/eglext.h>
+#include <GL/gl.h>
 
 #include <opensubdiv/far/stencilTable.h>
 #include <opensubdiv/far/stencilTableFactory.h>
@@ -19,6 +39,9 @@
 #include <opensubdiv/far/topologyRefinerFactory.h>
 #include <opensubdiv/osd/bufferDescriptor.h>
 #include <opensubdiv/osd/cpuEvaluator.h>
+#include <opensubdiv/osd/glComputeEvaluator.h>
+#include <opensubdiv/osd/glVertexBuffer.h>
+#include <opensubdiv/osd/ompEvaluator.h>
 
 #include <algorithm>
 #include <chrono>
@@ -26,10 +49,23 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <string>
 #include <utility>
 #include <vector>
 
+#include <unistd.h>
+
 using namespace OpenSubdiv;
+
+/* Exported by libosdGPU but declared in no public header: OpenSubdiv's GL evaluators need it
+ * called once with a context current (shared/peers/README.md). */
+namespace OpenSubdiv {
+namespace internal {
+namespace GLLoader {
+bool libraryInitializeGL();
+}
+}
+}
 
 typedef std::chrono::steady_clock Clock;
 
@@ -226,6 +262,375 @@ static double point_set_difference(const std::vector<float> &a, const std::vecto
     return worst;
 }
 
+/* ---- stencil evaluation on every backend ---- */
+
+/* Best (minimum) time of `reps` runs of f after `warm` runs, in ms; stops repeating after
+ * about budget_ms (at least one timed run). f returns false on failure. */
+template <typename F> static double best_of(int warm, int reps, double budget_ms, F f, bool *ok) {
+    double best = 1e300, spent = 0.0;
+    *ok = true;
+    for (int i = 0; i < warm; ++i)
+        if (!f()) { *ok = false; return 0.0; }
+    for (int i = 0; i < reps && (i == 0 || spent < budget_ms); ++i) {
+        Clock::time_point t0 = Clock::now();
+        if (!f()) { *ok = false; return 0.0; }
+        double t = ms_since(t0);
+        spent += t;
+        best = std::min(best, t);
+    }
+    return best;
+}
+
+struct EvalRow {
+    std::string name, note;  /* note: what runs, or why not */
+    bool ran;
+    double ms;
+    double diff;             /* max |difference| from ref (point sets for OpenSubdiv) */
+    int unmatched;           /* OpenSubdiv rows: points without a partner within tolerance */
+    EvalRow(const std::string &n) : name(n), ran(false), ms(0.0), diff(0.0), unmatched(0) {}
+};
+
+/* A headless desktop OpenGL 4.3 core context made current on this thread, as a host
+ * application would have (EGL surfaceless platform, else the default display). */
+struct HostGL {
+    EGLDisplay dpy;
+    EGLContext ctx;
+    std::string why, renderer;
+    HostGL() : dpy(EGL_NO_DISPLAY), ctx(EGL_NO_CONTEXT) {}
+    static bool has_word(const char *list, const char *w) {
+        if (!list) return false;
+        size_t n = strlen(w);
+        for (const char *p = list; (p = strstr(p, w)) != NULL; p += n)
+            if ((p == list || p[-1] == ' ') && (p[n] == ' ' || p[n] == 0)) return true;
+        return false;
+    }
+    bool open() {
+        const char *client = eglQueryString(EGL_NO_DISPLAY, EGL_EXTENSIONS);
+        EGLint major = 0, minor = 0, n = 0;
+        if (has_word(client, "EGL_MESA_platform_surfaceless")) {
+            PFNEGLGETPLATFORMDISPLAYEXTPROC gpd = (PFNEGLGETPLATFORMDISPLAYEXTPROC)eglGetProcAddress("eglGetPlatformDisplayEXT");
+            if (gpd) dpy = gpd(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, NULL);
+            if (dpy != EGL_NO_DISPLAY && !eglInitialize(dpy, &major, &minor)) dpy = EGL_NO_DISPLAY;
+        }
+        if (dpy == EGL_NO_DISPLAY) {
+            dpy = eglGetDisplay(EGL_DEFAULT_DISPLAY);
+            if (dpy == EGL_NO_DISPLAY || !eglInitialize(dpy, &major, &minor)) {
+                dpy = EGL_NO_DISPLAY;
+                why = "no EGL display";
+                return false;
+            }
+        }
+        const char *ext = eglQueryString(dpy, EGL_EXTENSIONS);
+        if (!has_word(ext, "EGL_KHR_surfaceless_context")) { why = "EGL display lacks EGL_KHR_surfaceless_context"; return false; }
+        if (!eglBindAPI(EGL_OPENGL_API)) { why = "no desktop OpenGL through EGL"; return false; }
+        EGLConfig config = EGL_NO_CONFIG_KHR;
+        if (!has_word(ext, "EGL_KHR_no_config_context") && !has_word(ext, "EGL_MESA_configless_context")) {
+            const EGLint attrs[] = {EGL_RENDERABLE_TYPE, EGL_OPENGL_BIT, EGL_NONE};
+            if (!eglChooseConfig(dpy, attrs, &config, 1, &n) || n < 1) { why = "no EGL config for desktop OpenGL"; return false; }
+        }
+        const EGLint cattrs[] = {EGL_CONTEXT_MAJOR_VERSION, 4, EGL_CONTEXT_MINOR_VERSION, 3,
+                                 EGL_CONTEXT_OPENGL_PROFILE_MASK, EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT, EGL_NONE};
+        ctx = eglCreateContext(dpy, config, EGL_NO_CONTEXT, cattrs);
+        if (ctx == EGL_NO_CONTEXT) { why = "no OpenGL 4.3 core context through EGL"; return false; }
+        if (!eglMakeCurrent(dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, ctx)) { why = "eglMakeCurrent failed"; return false; }
+        const char *v = (const char *)glGetString(GL_VERSION), *r = (const char *)glGetString(GL_RENDERER);
+        renderer = std::string("OpenGL ") + (v ? v : "?") + "; " + (r ? r : "?");
+        return true;
+    }
+    ~HostGL() {
+        if (ctx != EGL_NO_CONTEXT) {
+            eglMakeCurrent(dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+            eglDestroyContext(dpy, ctx);
+        }
+        if (dpy != EGL_NO_DISPLAY) eglTerminate(dpy);
+    }
+};
+
+static sfb_context *eval_context(sfb_backend_kind kind, int threads, int use_current, std::string *why) {
+    sfb_context_config cfg = sfb_context_config_init();
+    cfg.backends = &kind;
+    cfg.backend_count = 1;
+    cfg.ignore_environment = 1;
+    cfg.threads = threads;
+    cfg.gl_use_current_context = use_current;
+    char info[512];
+    info[0] = 0;
+    if (sfb_backend_probe(kind, &cfg, info, sizeof info) != SFB_SUCCESS) {
+        *why = info;
+        return NULL;
+    }
+    sfb_context *ctx = NULL;
+    if (sfb_context_create(&cfg, &ctx) != SFB_SUCCESS) {
+        *why = "sfb_context_create failed after a successful probe";
+        return NULL;
+    }
+    sfb_context_backend_info(ctx, info, sizeof info);
+    *why = info;
+    return ctx;
+}
+
+static double max_abs_diff(const std::vector<float> &a, const std::vector<float> &b) {
+    if (a.size() != b.size()) return INFINITY;
+    double m = 0.0;
+    for (size_t i = 0; i < a.size(); ++i) {
+        double d = std::fabs((double)a[i] - (double)b[i]);
+        if (!(d <= m)) m = std::isnan(d) ? INFINITY : d;
+    }
+    return m;
+}
+
+static int eval_section(const TorusMesh &torus, double diag) {
+    const int level = 4, warm = 2, reps = 15;
+    const double budget_ms = 6000.0, tol = 1e-5 * diag; /* DESIGN.md: backends agree with ref within 1e-5 x diagonal */
+    sfb_mesh_desc desc = torus.sfb_desc();
+    sfb_surface_config scfg = sfb_surface_config_init(SFB_SCHEME_CATMARK, level);
+    sfb_buffer_desc bd = {0, 3, 3};
+    const float *src = &torus.positions[0];
+    std::vector<EvalRow> rows;
+    std::vector<float> want;
+    int status = 0, nrows = 0, nsources = torus.vertex_count();
+    Clock::time_point t_sec = Clock::now();
+
+    /* all threads: what the simd backend takes for threads = 0 (one per online core) */
+    long cores = sysconf(_SC_NPROCESSORS_ONLN);
+    int all_threads = cores > 0 ? (int)std::min(cores, 64L) : 1;
+
+    printf("\nstencil evaluation: positions (length 3), Catmull-Clark level %d of the torus; best of up to %d runs after %d\n"
+           "warm-up runs, milliseconds; 'x OSD CPU' and 'x ref' are how many times faster than OpenSubdiv's\n"
+           "CpuEvaluator and than surfblend's ref in this run (> 1: faster); difference from ref's points\n"
+           "(OpenSubdiv's matched as point sets), tolerance %.3g.\n",
+           level, reps, warm, tol);
+    fflush(stdout);
+
+    /* one surfblend surface per backend context (tables are uploaded when a surface is made) */
+    auto run_sfb = [&](const char *name, sfb_context *ctx, const std::string &why, EvalRow *out_row) {
+        EvalRow row(name);
+        row.note = why;
+        if (ctx) {
+            sfb_mesh *mesh = NULL;
+            sfb_surface *surf = NULL;
+            if (sfb_mesh_create(ctx, &desc, &mesh) != SFB_SUCCESS || sfb_surface_create(ctx, mesh, &scfg, &surf) != SFB_SUCCESS) {
+                row.note = std::string("error: ") + sfb_last_error(ctx);
+                status = 1;
+            } else {
+                sfb_stencil_info info;
+                sfb_surface_stencil_info(surf, SFB_TABLE_VERTEX, &info);
+                nrows = info.rows;
+                std::vector<float> dst((size_t)info.rows * 3);
+                bool ok;
+                row.ms = best_of(warm, reps, budget_ms, [&]() {
+                    return sfb_surface_eval_stencils(surf, SFB_TABLE_VERTEX, src, bd, &dst[0], bd) == SFB_SUCCESS;
+                }, &ok);
+                if (!ok) {
+                    row.note = std::string("error: ") + sfb_last_error(ctx);
+                    status = 1;
+                } else {
+                    row.ran = true;
+                    if (want.empty()) want = dst;
+                    row.diff = max_abs_diff(dst, want);
+                    if (!(row.diff <= tol)) status = 1;
+                }
+            }
+            sfb_surface_destroy(surf);
+            sfb_mesh_destroy(mesh);
+        }
+        if (out_row) *out_row = row;
+        else rows.push_back(row);
+    };
+
+    std::string why;
+    sfb_context *c;
+    c = eval_context(SFB_BACKEND_REF, 1, 0, &why);
+    run_sfb("surfblend ref", c, "plain C, double accumulation", NULL);
+    if (c) sfb_context_destroy(c);
+    if (!rows[0].ran) { printf("  ref failed: %s\n", rows[0].note.c_str()); return 1; }
+    c = eval_context(SFB_BACKEND_SIMD, 1, 0, &why);
+    run_sfb("surfblend simd, 1 thread", c, why, NULL);
+    if (c) sfb_context_destroy(c);
+    c = eval_context(SFB_BACKEND_SIMD, 0, 0, &why);
+    run_sfb("surfblend simd, all threads", c, why, NULL);
+    if (c) sfb_context_destroy(c);
+    c = eval_context(SFB_BACKEND_GL, 0, 0, &why);
+    run_sfb("surfblend gl, own EGL ctx, CPU copies", c, why, NULL);
+    if (c) sfb_context_destroy(c);
+    /* osmesa before the host context below exists: OSMesa shares Mesa's current-context slot */
+    c = eval_context(SFB_BACKEND_OSMESA, 0, 0, &why);
+    run_sfb("surfblend osmesa, CPU copies", c, why, NULL);
+    if (c) sfb_context_destroy(c);
+
+    /* OpenSubdiv on the CPU */
+    Far::StencilTable const *table = osd_build(torus, level);
+    std::vector<float> osd_dst((size_t)(table ? table->GetNumStencils() : 0) * 3);
+    {
+        EvalRow row("OpenSubdiv CpuEvaluator");
+        row.note = "Osd::CpuEvaluator::EvalStencils, 1 thread";
+        bool ok = table != NULL;
+        if (ok)
+            row.ms = best_of(warm, reps, budget_ms, [&]() { osd_apply(table, src, &osd_dst[0]); return true; }, &ok);
+        if (ok) {
+            row.ran = true;
+            row.diff = point_set_difference(osd_dst, want, tol, &row.unmatched);
+        } else row.note = "OpenSubdiv could not build the table";
+        rows.push_back(row);
+    }
+    {
+        EvalRow row("OpenSubdiv OmpEvaluator");
+        char note[128];
+        snprintf(note, sizeof note, "Osd::OmpEvaluator::EvalStencils, %d threads", all_threads);
+        row.note = note;
+        bool ok = table != NULL;
+        if (ok) {
+            Osd::OmpEvaluator::SetNumThreads(all_threads);
+            Osd::BufferDescriptor d(0, 3, 3);
+            row.ms = best_of(warm, reps, budget_ms, [&]() {
+                return Osd::OmpEvaluator::EvalStencils(src, d, &osd_dst[0], d, &table->GetSizes()[0], &table->GetOffsets()[0],
+                                                       &table->GetControlIndices()[0], &table->GetWeights()[0], 0,
+                                                       table->GetNumStencils());
+            }, &ok);
+        }
+        if (ok) {
+            row.ran = true;
+            row.diff = point_set_difference(osd_dst, want, tol, &row.unmatched);
+        } else if (table) row.note = "Osd::OmpEvaluator::EvalStencils failed";
+        rows.push_back(row);
+    }
+
+    /* the host's EGL context: surfblend gl on it, and OpenSubdiv's GL compute evaluator */
+    HostGL host;
+    std::string renderer;
+    if (!host.open()) {
+        const char *names[3] = {"surfblend gl, host ctx, GL buffers", "surfblend gl, host ctx, CPU copies", "OpenSubdiv GLComputeEvaluator"};
+        for (int i = 0; i < 3; ++i) {
+            EvalRow row(names[i]);
+            row.note = host.why;
+            rows.push_back(row);
+        }
+    } else {
+        renderer = host.renderer;
+        /* host buffers: the control points, and room for the refined points */
+        GLuint gsrc = 0, gdst = 0;
+        glGenBuffers(1, &gsrc);
+        glGenBuffers(1, &gdst);
+        glBindBuffer(GL_COPY_WRITE_BUFFER, gsrc);
+        glBufferData(GL_COPY_WRITE_BUFFER, (GLsizeiptr)(nsources * 3 * sizeof(float)), src, GL_STATIC_DRAW);
+        glBindBuffer(GL_COPY_WRITE_BUFFER, gdst);
+        glBufferData(GL_COPY_WRITE_BUFFER, (GLsizeiptr)((size_t)nrows * 3 * sizeof(float)), NULL, GL_DYNAMIC_DRAW);
+        glBindBuffer(GL_COPY_WRITE_BUFFER, 0);
+        auto read_back = [&](GLuint b, size_t floats) {
+            std::vector<float> v(floats);
+            glBindBuffer(GL_COPY_READ_BUFFER, b);
+            glGetBufferSubData(GL_COPY_READ_BUFFER, 0, (GLsizeiptr)(floats * sizeof(float)), &v[0]);
+            glBindBuffer(GL_COPY_READ_BUFFER, 0);
+            return v;
+        };
+
+        c = eval_context(SFB_BACKEND_GL, 0, 1, &why);
+        {
+            EvalRow row("surfblend gl, host ctx, GL buffers");
+            row.note = why;
+            sfb_mesh *mesh = NULL;
+            sfb_surface *surf = NULL;
+            if (c && (sfb_mesh_create(c, &desc, &mesh) != SFB_SUCCESS || sfb_surface_create(c, mesh, &scfg, &surf) != SFB_SUCCESS)) {
+                row.note = std::string("error: ") + sfb_last_error(c);
+                status = 1;
+            } else if (c) {
+                bool ok;
+                row.ms = best_of(warm, reps, budget_ms, [&]() {
+                    sfb_result r = sfb_surface_eval_stencils_gl(surf, SFB_TABLE_VERTEX, gsrc, bd, gdst, bd);
+                    glFinish();
+                    return r == SFB_SUCCESS;
+                }, &ok);
+                if (!ok) {
+                    row.note = std::string("error: ") + sfb_last_error(c);
+                    status = 1;
+                } else {
+                    row.ran = true;
+                    row.diff = max_abs_diff(read_back(gdst, (size_t)nrows * 3), want);
+                    if (!(row.diff <= tol)) status = 1;
+                }
+            }
+            rows.push_back(row);
+            /* the same surface with CPU pointers: upload, dispatch, read back */
+            EvalRow row2("surfblend gl, host ctx, CPU copies");
+            row2.note = row.note;
+            if (surf) {
+                std::vector<float> dst((size_t)nrows * 3);
+                bool ok;
+                row2.ms = best_of(warm, reps, budget_ms, [&]() {
+                    return sfb_surface_eval_stencils(surf, SFB_TABLE_VERTEX, src, bd, &dst[0], bd) == SFB_SUCCESS;
+                }, &ok);
+                if (!ok) {
+                    row2.note = std::string("error: ") + sfb_last_error(c);
+                    status = 1;
+                } else {
+                    row2.ran = true;
+                    row2.diff = max_abs_diff(dst, want);
+                    if (!(row2.diff <= tol)) status = 1;
+                }
+            }
+            rows.push_back(row2);
+            sfb_surface_destroy(surf);
+            sfb_mesh_destroy(mesh);
+            if (c) sfb_context_destroy(c);
+        }
+        {
+            EvalRow row("OpenSubdiv GLComputeEvaluator");
+            row.note = "Osd::GLComputeEvaluator, GLStencilTableSSBO, GLVertexBuffer";
+            OpenSubdiv::internal::GLLoader::libraryInitializeGL();
+            Osd::BufferDescriptor d(0, 3, 3);
+            Osd::GLComputeEvaluator *ev = table ? Osd::GLComputeEvaluator::Create(d, d, Osd::BufferDescriptor(), Osd::BufferDescriptor()) : NULL;
+            Osd::GLStencilTableSSBO *gtab = table ? Osd::GLStencilTableSSBO::Create(table) : NULL;
+            Osd::GLVertexBuffer *vsrc = Osd::GLVertexBuffer::Create(3, nsources);
+            Osd::GLVertexBuffer *vdst = table ? Osd::GLVertexBuffer::Create(3, table->GetNumStencils()) : NULL;
+            if (!ev || !gtab || !vsrc || !vdst) {
+                row.note = "could not create OpenSubdiv's GL evaluator or buffers";
+            } else {
+                vsrc->UpdateData(src, 0, nsources);
+                bool ok;
+                row.ms = best_of(warm, reps, budget_ms, [&]() {
+                    bool r = Osd::GLComputeEvaluator::EvalStencils(vsrc, d, vdst, d, gtab, ev);
+                    glFinish();
+                    return r;
+                }, &ok);
+                if (ok) {
+                    row.ran = true;
+                    row.diff = point_set_difference(read_back(vdst->BindVBO(), (size_t)table->GetNumStencils() * 3), want, tol,
+                                                    &row.unmatched);
+                } else row.note = "Osd::GLComputeEvaluator::EvalStencils failed";
+            }
+            delete vdst;
+            delete vsrc;
+            delete gtab;
+            delete ev;
+            rows.push_back(row);
+        }
+        glDeleteBuffers(1, &gsrc);
+        glDeleteBuffers(1, &gdst);
+    }
+    delete table;
+
+    double osd_cpu = 0.0, ref_ms = rows[0].ms;
+    for (size_t i = 0; i < rows.size(); ++i)
+        if (rows[i].name == "OpenSubdiv CpuEvaluator" && rows[i].ran) osd_cpu = rows[i].ms;
+    printf("renderer: %s\n\n", renderer.empty() ? "(no EGL context)" : renderer.c_str());
+    printf("%-38s | %9s | %9s | %6s | %11s | %s\n", "evaluator", "best ms", "x OSD CPU", "x ref", "diff vs ref", "what runs");
+    for (size_t i = 0; i < rows.size(); ++i) {
+        const EvalRow &r = rows[i];
+        if (!r.ran) {
+            printf("%-38s | unavailable: %s\n", r.name.c_str(), r.note.c_str());
+            continue;
+        }
+        char diff[48];
+        if (r.unmatched) snprintf(diff, sizeof diff, "%d unmatched", r.unmatched);
+        else snprintf(diff, sizeof diff, "%.3g", r.diff);
+        printf("%-38s | %9.3f | %9.2f | %6.2f | %11s | %s\n", r.name.c_str(), r.ms, osd_cpu > 0 ? osd_cpu / r.ms : 0.0,
+               ref_ms > 0 ? ref_ms / r.ms : 0.0, diff, r.note.c_str());
+        if (r.unmatched || !(r.diff <= tol)) status = 1;
+    }
+    printf("(%d refined points from %d control points; section took %.1f s)\n", nrows, nsources, ms_since(t_sec) / 1000.0);
+    return status;
+}
+
 /* ---- main ---- */
 
 struct Row {
@@ -407,7 +812,8 @@ int main(int argc, char **argv) {
         printf("  level %d: rows sfb %d / osd %d, max difference %.3g, %d unmatched%s\n", r.level, r.rows_sfb,
                r.rows_osd, r.max_diff, r.unmatched, r.unmatched ? "  <-- DISAGREE" : "");
     }
-    printf("total time %.1f s\n", ms_since(t_start) / 1000.0);
     sfb_context_destroy(ctx);
+    if (eval_section(torus, diag) != 0) status = 1;
+    printf("total time %.1f s\n", ms_since(t_start) / 1000.0);
     return status;
 }

@@ -15,6 +15,28 @@ add_counts() { # name, passed, failed, skipped
   PASS=$((PASS + $2)); FAIL=$((FAIL + $3)); SKIP=$((SKIP + $4))
 }
 
+counted() { # name, command...: a suite that prints PASS/FAIL/SKIP lines and closes with
+  # "N passed, N failed[, N skipped]"; adds its counts (no closing line: one failure; a non-zero
+  # exit with no failure counted: one more). Shows FAIL lines, and SKIP lines grouped by reason.
+  local name=$1; shift
+  local out rc line p f s
+  out=$("$@" 2>&1); rc=$?
+  echo "$out" > "$LOG/$name.log"
+  echo "$out" | grep -E "^FAIL " | head -n 40
+  echo "$out" | grep -E "^SKIP " | sed -E 's/^SKIP [^:]*: //' | sort | uniq -c | sort -rn | head -n 8 |
+    sed -E 's/^ *([0-9]+) (.*)/   (\1 skipped: \2)/'
+  line=$(echo "$out" | grep -E "^[0-9]+ passed, [0-9]+ failed" | tail -n 1)
+  if [ -n "$line" ]; then
+    p=$(echo "$line" | sed -E 's/^([0-9]+) passed.*/\1/'); f=$(echo "$line" | sed -E 's/.* ([0-9]+) failed.*/\1/')
+    s=$(echo "$line" | grep -oE "[0-9]+ skipped" | grep -oE "[0-9]+" || echo 0)
+    add_counts "$name" "$p" "$f" "${s:-0}"
+    [ "$rc" -eq 0 ] || [ "$f" -gt 0 ] || add_counts "$name-exit" 0 1 0
+  else
+    echo "--- $name printed no closing line (exit $rc); log tail:"; echo "$out" | tail -n 20
+    add_counts "$name" 0 1 0
+  fi
+}
+
 single() { # name, command...: one test, passes iff the command exits 0
   local name=$1; shift
   if "$@" > "$LOG/$name.log" 2>&1; then add_counts "$name" 1 0 0
@@ -57,14 +79,31 @@ else
   echo "peer shapes not found at $SHAPES: OpenSubdiv agreement skipped"; add_counts osd_agree 0 0 1
 fi
 
+# 3b. every optional backend (simd, gl, osmesa) against ref: peer shapes, random creased meshes,
+#     buffer layouts, threads. A backend listed in SFB_REQUIRE_BACKENDS (set by `make test` on CI)
+#     fails its checks when unavailable instead of skipping them.
+if [ -d "$SHAPES" ]; then counted agree "$BUILD/agree" "$SHAPES"
+else echo "peer shapes not found at $SHAPES: agree runs without them"; counted agree "$BUILD/agree"; fi
+
+# 3c. the engine case: the gl backend on the host's own EGL context and GL buffers
+counted gl_host "$BUILD/gl_host"
+
+# 3d. failure paths of the gl/osmesa backends (broken kernel, missing libOSMesa)
+counted gl_errors "$BUILD/gl_errors"
+counted gl_pieces "$BUILD/gl_pieces"
+
+# 3e. the GLSL kernels validated with glslangValidator, embedded copies up to date
+[ -f tools/check_glsl.sh ] && counted glsl bash tools/check_glsl.sh
+
 # 4. command-line tool
 out=$(BUILD=$BUILD SHAPES=$SHAPES ./tests/cli_test.sh 2>&1)
 echo "$out" > "$LOG/cli.log"
-echo "$out" | grep -E "^(FAIL|ok)" | grep -v "^ok" | tail -n 20
+echo "$out" | grep -E "^(FAIL|SKIP)" | tail -n 20
 line=$(echo "$out" | grep -E "^[0-9]+ passed, [0-9]+ failed" | tail -n 1)
 if [ -n "$line" ]; then
   p=$(echo "$line" | sed -E 's/^([0-9]+) passed.*/\1/'); f=$(echo "$line" | sed -E 's/.* ([0-9]+) failed.*/\1/')
-  add_counts cli "$p" "$f" 0
+  s=$(echo "$line" | grep -oE "[0-9]+ skipped" | grep -oE "[0-9]+" || echo 0)
+  add_counts cli "$p" "$f" "${s:-0}"
 else
   echo "$out" | tail -n 20; add_counts cli 0 1 0
 fi

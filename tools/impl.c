@@ -1,3 +1,5 @@
-/* The one translation unit that compiles the library's implementation. */
+/* The one translation unit that compiles the library's implementation, with every optional
+ * backend (simd, gl, osmesa); programs built on it link with -lm -lpthread -ldl only. */
 #define SURFBLEND_IMPLEMENTATION
+#define SURFBLEND_ALL_BACKENDS
 #include "surfblend.h"
