@@ -115,10 +115,11 @@ typedef struct sfb_context_config {
     sfb_progress progress;             /* NULL func: no reports, no cancel */
     const sfb_backend_kind *backends;  /* ordered preference; NULL: default order */
     int backend_count;
-    int threads;                       /* 0: one per core (backends that use threads) */
+    int threads;                       /* 0: one per core, 1: no threads (simd); negative: invalid */
     size_t memory_budget;              /* bytes; 0: SFB_DEFAULT_MEMORY_BUDGET */
     int gl_use_current_context;        /* gl backend: run on the caller's current context */
-    int ignore_environment;            /* 1: do not read SURFBLEND_BACKEND */
+    int ignore_environment;            /* 1: do not read SURFBLEND_BACKEND (SURFBLEND_SIMD_ISA,
+                                          which pins the simd kernels for tests, is still read) */
 } sfb_context_config;
 
 typedef struct sfb_context sfb_context;
@@ -262,7 +263,10 @@ typedef struct sfb_stencil_info { int rows, sources, entries; } sfb_stencil_info
 SFB_API sfb_result sfb_surface_stencil_info(const sfb_surface *surface, sfb_table table, sfb_stencil_info *out);
 
 /* Applies one table on the context's backend: dst[row] = sum w * src[index]. src must hold
- * `sources` elements, dst `rows`. */
+ * `sources` elements and dst `rows`: backends read src only in [offset, offset + (sources-1) *
+ * stride + length) and write only the `length` components of each dst row (padding in the
+ * stride is left alone). Argument errors set the context's last error, which concurrent
+ * failing calls would race on: check arguments before calling from several threads. */
 SFB_API sfb_result sfb_surface_eval_stencils(const sfb_surface *surface, sfb_table table,
                                              const float *src, sfb_buffer_desc src_desc,
                                              float *dst, sfb_buffer_desc dst_desc);
@@ -647,6 +651,7 @@ sfb_result sfb__context_create_reporting(const sfb_context_config *config, sfb_c
     *out = NULL;
     if ((a.alloc == NULL) != (a.free == NULL) || (a.alloc && !a.realloc)) return SFB_INVALID_ARGS;
     if (c.backend_count < 0 || c.backend_count > 16 || (c.backend_count > 0 && !c.backends)) return SFB_INVALID_ARGS;
+    if (c.threads < 0) return SFB_INVALID_ARGS;
     if (!a.alloc) { a.alloc = sfb__libc_alloc; a.realloc = sfb__libc_realloc; a.free = sfb__libc_free; a.user = NULL; }
     raw = (unsigned char *)a.alloc(sz, a.user);
     if (!raw) return SFB_OUT_OF_MEMORY;
@@ -1735,6 +1740,8 @@ static sfb_result sfb__rows_to_stencils(sfb_context *ctx, const sfb__rows *r, in
         s->offsets[i] = (int)r->off[i];
         s->sizes[i] = (int)(r->off[i + 1] - r->off[i]);
     }
+    s->offsets[r->rows] = (int)r->n; /* end marker: offsets[rows] == entries */
+    s->sizes[r->rows] = 0;
     if (r->n) memcpy(s->indices, r->idx, r->n * sizeof(int));
     for (k = 0; k < r->n; ++k) s->weights[k] = (float)r->w[k];
     return SFB_SUCCESS;

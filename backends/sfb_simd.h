@@ -5,38 +5,54 @@
  * SURFBLEND_SIMD (or SURFBLEND_ALL_BACKENDS) is defined with SURFBLEND_IMPLEMENTATION. It sees
  * the core's private declarations (src/sfb_internal.h); do not include it directly.
  *
- * Kernels (one per instruction set, chosen once at init):
+ * Kernels (one instruction set per backend state, chosen at init):
  *   portable  plain C, any compiler and CPU
  *   sse2      x86-64 baseline (also 32-bit x86 built with SSE2)
- *   avx2      AVX2 + FMA        } compiled with __attribute__((target)) on GCC >= 5 and Clang,
- *   avx512    AVX-512 F + VL    } so the translation unit needs no -m flags; picked at run time
- *                                 with __builtin_cpu_supports. Other compilers (MSVC) get sse2.
+ *   avx2      AVX2 + FMA        } compiled with __attribute__((target)) on GCC >= 6 and Clang,
+ *   avx512    AVX-512 F + VL    } so the translation unit needs no -m flags; used when
+ *                                 __builtin_cpu_supports says the CPU (and OS) run them.
+ *                                 Other compilers (MSVC) get sse2 and portable only.
  *   neon      ARM NEON (when __ARM_NEON is defined at compile time)
- * The best one the CPU supports is used. SURFBLEND_SIMD_ISA=portable|sse2|avx2|avx512|neon
- * forces one (for tests); it is read even with ignore_environment, which is about
- * SURFBLEND_BACKEND only. An unknown or unsupported name is logged and the best one is used.
+ * The best one available is used. SURFBLEND_SIMD_ISA=portable|sse2|avx2|avx512|neon forces
+ * one (for tests); it is read even with ignore_environment, which is about SURFBLEND_BACKEND
+ * only. An unknown or unavailable name is logged (warning) and the best one is used.
  *
- * Numerics: float accumulation (ref accumulates in double). Each row is one accumulator per
- * component, components in vector lanes, starting at 0 and adding the entries in stored order:
- * acc = acc + w[k] * src[idx[k]]. avx2, avx512 and neon (AArch64) use fused multiply-add, sse2
- * and portable a rounded multiply then an add, so the kernels differ from each other in the
- * last bits (a few float ulps of the largest term) and from ref by float rounding, far
- * below 1e-6 of the coordinates' magnitude for subdivision stencils (weights >= 0, sum 1).
+ * Work layout: every kernel walks rows in order and keeps a row's components in vector lanes
+ * (xyz in 3 lanes of 4), one index and one weight per source entry; lengths above 4 are done
+ * 4 (sse2, neon, portable) or 8 (avx2) components per pass over the rows, or 8/16 at once
+ * (avx512). For lengths <= 4, avx2 puts two entries side by side in a 256-bit register and
+ * avx512 four in a 512-bit one, which is what makes them faster than one entry per step.
  *
- * Memory bounds: the source is read only inside [src_desc.offset, src_desc.offset +
- * (sources-1)*stride + length) and only the `length` components of each destination row are
- * written. A full vector load of a source element may read past its `length` components (the
- * next element or the caller's padding, lanes that are then ignored); it is used only for
- * sources whose whole vector lies inside that range (sfb__simd_safe_count); the last one or
- * two sources take a partial load. avx512 needs no such bound: its masked loads read exactly
- * `length` floats. Stores are always exact (partial stores, or masked ones on avx512).
+ * Numerics: float accumulation from 0 (ref accumulates in double), row by row:
+ *   portable, neon, and avx2/avx512 for lengths > 4: one sum per component, entries in
+ *     stored order;
+ *   sse2 (all lengths) and avx2 (lengths <= 4): two partial sums, even and odd entries,
+ *     added at the end of the row, then the last entry when the count is odd;
+ *   avx512 (lengths <= 4): four partial sums s0..s3 of the entries k = 0..3 mod 4 (with the
+ *     count's remainder entries added to s0 afterwards), combined as (s0 + s2) + (s1 + s3).
+ * avx2, avx512 and neon on AArch64 use fused multiply-add, sse2, portable and 32-bit neon a
+ * rounded product then a sum. So the kernels differ from each other and from ref in the last
+ * float bits: relative differences of ~1e-7 of the largest term, far below the 1e-5 x bounding
+ * box diagonal agreement target.
+ *
+ * Memory bounds: a source element is read only inside [src_desc.offset, src_desc.offset +
+ * (sources-1)*stride + length), and only the `length` components of each destination row are
+ * written (other components in the stride are the caller's). avx2 and avx512 load with masks
+ * (vmaskmovps / AVX-512 zero-masking: masked-off lanes are neither read nor faulted on). sse2
+ * and neon use full 4-float loads, which may read a little past an element's `length`
+ * components into the next element or the caller's padding (lanes then ignored), only for
+ * sources whose whole load lies in the range above (sfb__simd_safe_count); the last source
+ * or two take an exact partial load instead. Stores are exact: partial or masked.
  *
  * Threads: a pool of ctx->threads - 1 workers (0: one thread per online core, at most 64;
- * 1: no pool). A call splits its rows into chunks of about equal entry counts that the
- * caller and the workers take in turn. Calls under 32768 entries run on the caller alone,
- * as do calls made while another thread's call holds the pool (so concurrent calls on one
- * surface are safe, see sfb_api.h). On _WIN32, and where POSIX threads are not known to
- * exist, the backend runs single-threaded.
+ * 1: no pool), started in init and joined in shutdown. A call cuts its rows into 4 chunks per
+ * thread of about equal entry counts (from offsets); the caller and the workers claim chunks
+ * until none is left, and the caller returns once every claimed chunk is done (it never
+ * waits for a worker still asleep). Calls under 32768 entries run on the caller alone, as
+ * do calls made while another thread's call holds the pool (pthread_mutex_trylock), so
+ * concurrent calls on one backend state are safe. On _WIN32, and wherever POSIX threads are
+ * not known to exist, the backend runs single-threaded (describe says "1 thread"). A process
+ * that forks must not use a context created before the fork in the child (no workers there).
  */
 #ifndef SFB__SIMD_H
 #define SFB__SIMD_H
@@ -45,7 +61,8 @@
 #if defined(__SSE2__) || defined(_M_X64) || defined(_M_AMD64) || (defined(_M_IX86_FP) && _M_IX86_FP >= 2)
 #  define SFB__SIMD_SSE2 1
 #  include <emmintrin.h>
-#  if (defined(__x86_64__) || defined(__i386__)) && (defined(__clang__) || (defined(__GNUC__) && __GNUC__ >= 6))
+#  if (defined(__x86_64__) || defined(__i386__)) && (defined(__clang__) || (defined(__GNUC__) && __GNUC__ >= 6)) && \
+      !defined(_MSC_VER) /* clang-cl: __builtin_cpu_supports needs a runtime it does not link */
 #    define SFB__SIMD_X86_DISPATCH 1 /* avx2 / avx512 via target attributes + __builtin_cpu_supports */
 #    include <immintrin.h>
 #    define SFB__SIMD_TARGET_AVX2 __attribute__((target("avx2,fma")))
@@ -251,11 +268,13 @@ SFB__SIMD_TARGET_AVX2 static void sfb__simd_avx2(const sfb__simd_job *j, int fir
 }
 
 /* ---- avx512 (F + VL) ---- */
-/* Masked loads and stores touch exactly `length` floats: no bound to check. */
+/* Zero-masked loads and masked stores touch exactly `length` floats: no bound to check. */
+
 /* Lengths up to 4: four entries per step, one in each 128-bit lane of a 512-bit accumulator
- * (lane i sums entries k = i mod 4; an odd tail goes to lane 0); the lanes are added as
- * (0 + 2) + (1 + 3) at the end of the row. (The maskz forms below avoid g++ 12's
- * maybe-uninitialized warnings on the plain intrinsics' undefined fill, GCC bug 105593.) */
+ * (lane i sums entries k = i mod 4, then the 1-3 entries left over go to lane 0); the lanes
+ * are added as (0 + 2) + (1 + 3) at the end of the row. (The maskz forms of permutexvar,
+ * broadcast and shuffle avoid g++ 12's maybe-uninitialized warnings on the plain intrinsics'
+ * undefined fill, GCC bug 105593.) */
 SFB__SIMD_TARGET_AVX512 static void sfb__simd_avx512_4(const sfb__simd_job *j, int first, int last) {
     const __mmask8 m = (__mmask8)((1u << j->length) - 1u);
     const __m512i spread = _mm512_set_epi32(3, 3, 3, 3, 2, 2, 2, 2, 1, 1, 1, 1, 0, 0, 0, 0);
@@ -432,11 +451,10 @@ typedef struct sfb__simd_state {
     pthread_mutex_t busy;        /* held by the one call using the pool */
     pthread_mutex_t lock;        /* guards everything below */
     pthread_cond_t wake, done;
-    unsigned long generation;    /* bumped per job; workers wait for a change */
-    int active;                  /* workers that have not finished the current job */
+    unsigned long generation;    /* bumped per job; idle workers wait for a change */
     int quit;
     const sfb__simd_job *job;    /* the current job: rows [first, last) cut into `chunks` */
-    int first, last, chunks, next_chunk;
+    int first, last, chunks, next_chunk, chunks_done;
     size_t entry0, entries;
 #endif
 } sfb__simd_state;
@@ -453,17 +471,25 @@ static int sfb__simd_row_at(const int *offsets, int first, int last, size_t e) {
     return lo;
 }
 
-/* Runs chunks of the current job until none is left. Called and returns with s->lock held. */
+/* First row of chunk c of the current job: chunks hold about equal numbers of entries. */
+static int sfb__simd_chunk_start(const sfb__simd_state *s, int c) {
+    if (c <= 0) return s->first;
+    if (c >= s->chunks) return s->last;
+    return sfb__simd_row_at(s->job->offsets, s->first, s->last, s->entry0 + s->entries / (size_t)s->chunks * (size_t)c);
+}
+
+/* Runs chunks of the current job until none is left to claim. Called and returns with
+ * s->lock held. A worker that wakes late finds nothing to claim (or joins the next job):
+ * the job is only touched between claiming a chunk and counting it done. */
 static void sfb__simd_drain(sfb__simd_state *s) {
     while (s->next_chunk < s->chunks) {
         const int c = s->next_chunk++;
+        const int a = sfb__simd_chunk_start(s, c), b = sfb__simd_chunk_start(s, c + 1);
         const sfb__simd_job *j = s->job;
-        const int n = s->chunks;
-        const int a = c == 0 ? s->first : sfb__simd_row_at(j->offsets, s->first, s->last, s->entry0 + s->entries / n * c);
-        const int b = c == n - 1 ? s->last : sfb__simd_row_at(j->offsets, s->first, s->last, s->entry0 + s->entries / n * (c + 1));
         pthread_mutex_unlock(&s->lock);
         if (a < b) s->kernel(j, a, b);
         pthread_mutex_lock(&s->lock);
+        if (++s->chunks_done == s->chunks) pthread_cond_signal(&s->done);
     }
 }
 
@@ -476,7 +502,6 @@ static void *sfb__simd_worker(void *arg) {
         if (s->quit) break;
         seen = s->generation;
         sfb__simd_drain(s);
-        if (--s->active == 0) pthread_cond_signal(&s->done);
     }
     pthread_mutex_unlock(&s->lock);
     return NULL;
@@ -507,7 +532,7 @@ static int sfb__simd_pool_start(sfb__simd_state *s, char *why, size_t why_size) 
     for (i = 0; i < s->threads - 1; ++i) {
         e = pthread_create(&s->tid[i], NULL, sfb__simd_worker, s);
         if (e != 0) {
-            snprintf(why, why_size, "could not start worker thread %d of %d (error %d)", i + 1, s->threads - 1, e);
+            snprintf(why, why_size, "could not start worker thread %d of %d: %s", i + 1, s->threads - 1, strerror(e));
             sfb__simd_pool_stop(s); /* joins the i already running */
             return 0;
         }
@@ -548,8 +573,10 @@ static sfb_result sfb__simd_init(sfb_context *ctx, void **state, char *why, size
     *state = NULL;
     s = (sfb__simd_state *)sfb__alloc(ctx, sizeof *s);
     if (!s) {
-        snprintf(why, why_size, "out of memory for the backend state");
-        return ctx->budget_refused ? SFB_LIMIT_EXCEEDED : SFB_OUT_OF_MEMORY;
+        const int budget = ctx->budget_refused;
+        ctx->budget_refused = 0;
+        snprintf(why, why_size, "%s for the backend state", budget ? "over the memory budget" : "out of memory");
+        return budget ? SFB_LIMIT_EXCEEDED : SFB_OUT_OF_MEMORY;
     }
     memset(s, 0, sizeof *s);
     s->ctx = ctx;
@@ -614,11 +641,12 @@ static sfb_result sfb__simd_eval_stencils(void *state, const sfb__stencils *t, v
             s->entries = e1 - e0;
             s->chunks = 4 * s->threads; /* several per thread: a late or slow thread takes fewer */
             s->next_chunk = 0;
-            s->active = s->workers;
+            s->chunks_done = 0;
             ++s->generation;
             pthread_cond_broadcast(&s->wake);
             sfb__simd_drain(s);
-            while (s->active > 0) pthread_cond_wait(&s->done, &s->lock);
+            /* wait for chunks still running on workers, not for workers still asleep */
+            while (s->chunks_done < s->chunks) pthread_cond_wait(&s->done, &s->lock);
             s->job = NULL;
             pthread_mutex_unlock(&s->lock);
             pthread_mutex_unlock(&s->busy);

@@ -147,6 +147,7 @@ sfb_result sfb__context_create_reporting(const sfb_context_config *config, sfb_c
     *out = NULL;
     if ((a.alloc == NULL) != (a.free == NULL) || (a.alloc && !a.realloc)) return SFB_INVALID_ARGS;
     if (c.backend_count < 0 || c.backend_count > 16 || (c.backend_count > 0 && !c.backends)) return SFB_INVALID_ARGS;
+    if (c.threads < 0) return SFB_INVALID_ARGS;
     if (!a.alloc) { a.alloc = sfb__libc_alloc; a.realloc = sfb__libc_realloc; a.free = sfb__libc_free; a.user = NULL; }
     raw = (unsigned char *)a.alloc(sz, a.user);
     if (!raw) return SFB_OUT_OF_MEMORY;

@@ -587,6 +587,8 @@ static sfb_result sfb__rows_to_stencils(sfb_context *ctx, const sfb__rows *r, in
         s->offsets[i] = (int)r->off[i];
         s->sizes[i] = (int)(r->off[i + 1] - r->off[i]);
     }
+    s->offsets[r->rows] = (int)r->n; /* end marker: offsets[rows] == entries */
+    s->sizes[r->rows] = 0;
     if (r->n) memcpy(s->indices, r->idx, r->n * sizeof(int));
     for (k = 0; k < r->n; ++k) s->weights[k] = (float)r->w[k];
     return SFB_SUCCESS;

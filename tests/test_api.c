@@ -765,3 +765,42 @@ Test(api, stencils_match_refine)
     sfb_context_destroy(ctx);
     grid_free(&g);
 }
+
+Test(backend, negative_threads_is_invalid)
+{
+    sfb_context_config cc = sfb_context_config_init();
+    sfb_context *ctx = NULL;
+    cc.threads = -1;
+    cr_expect_eq(sfb_context_create(&cc, &ctx), SFB_INVALID_ARGS);
+    cr_expect_null(ctx);
+}
+
+/* Every backend kind probes to a definite answer with a reason; ref always works and
+ * sfb_context_backend_info describes what the selected backend runs on. */
+Test(backend, probe_and_info)
+{
+    char info[512];
+    cr_expect_eq(sfb_backend_probe(SFB_BACKEND_REF, NULL, info, sizeof info), SFB_SUCCESS);
+    cr_expect_eq(sfb_backend_probe(SFB_BACKEND_DEFAULT, NULL, info, sizeof info), SFB_INVALID_ARGS);
+    cr_expect_eq(sfb_backend_probe(SFB_BACKEND_REF, NULL, NULL, 0), SFB_INVALID_ARGS);
+    for (int k = SFB_BACKEND_SIMD; k < SFB_BACKEND_KIND_COUNT_; ++k) {
+        info[0] = 0;
+        sfb_result r = sfb_backend_probe((sfb_backend_kind)k, NULL, info, sizeof info);
+        cr_expect(r == SFB_SUCCESS || r == SFB_BACKEND_UNAVAILABLE, "probe %d: %s", k, sfb_result_string(r));
+        cr_expect(info[0] != 0, "probe of %s says nothing", sfb_backend_kind_name((sfb_backend_kind)k));
+        if (r == SFB_SUCCESS && k == SFB_BACKEND_SIMD) {
+            const sfb_backend_kind one = SFB_BACKEND_SIMD;
+            sfb_context_config cc = sfb_context_config_init();
+            sfb_context *ctx = NULL;
+            char line[512];
+            cc.backends = &one;
+            cc.backend_count = 1;
+            cc.ignore_environment = 1;
+            cc.threads = 1;
+            cr_assert_eq(sfb_context_create(&cc, &ctx), SFB_SUCCESS);
+            cr_expect_eq(sfb_context_backend_info(ctx, line, sizeof line), SFB_SUCCESS);
+            cr_expect_not_null(strstr(line, "1 thread"), "simd with threads = 1 says: %s", line);
+            sfb_context_destroy(ctx);
+        }
+    }
+}
