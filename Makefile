@@ -31,8 +31,10 @@ PKGS_BASE := $(if $(shell command -v cc 2>/dev/null),,build-essential)
 PKGS_TEST := g++ libosd-dev libcriterion-dev pkg-config \
              libegl1 libegl-mesa0 libgl1-mesa-dri libosmesa6 libegl-dev libgl-dev glslang-tools
 PKGS_FUZZ := clang libclang-rt-14-dev
+# The NEON kernels, cross-compiled for AArch64 and run under qemu user emulation (make test-neon).
+PKGS_NEON := gcc-aarch64-linux-gnu libc6-dev-arm64-cross qemu-user-static
 
-.PHONY: all run test bench fuzz asan amalgamate amalgamate-check embed-glsl deps deps-test deps-fuzz clean unit-build
+.PHONY: all run test test-neon deps-neon bench fuzz asan amalgamate amalgamate-check embed-glsl deps deps-test deps-fuzz clean unit-build
 
 all: $(BUILD)/surfblend
 
@@ -54,6 +56,8 @@ deps-test:
 	$(call need_pkgs,$(PKGS_BASE) $(PKGS_TEST))
 deps-fuzz:
 	$(call need_pkgs,$(PKGS_FUZZ))
+deps-neon:
+	$(call need_pkgs,$(PKGS_NEON))
 
 # ---- the single header ----
 amalgamate:
@@ -130,6 +134,10 @@ asan:
 	LSAN_OPTIONS="suppressions=$(CURDIR)/tests/lsan.supp:print_suppressions=0$${LSAN_OPTIONS:+:$$LSAN_OPTIONS}" \
 	$(MAKE) --no-print-directory test BUILD=build-asan OPT=-O1 \
 	  SAN="-fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined"
+
+# The simd backend's NEON kernels against ref, on AArch64 under qemu (tests/neon.sh).
+test-neon: deps-neon amalgamate-check
+	BUILD=$(BUILD) SHAPES=$(SHAPES) ./tests/neon.sh
 
 # ---- benchmark ----
 $(BUILD)/bench: bench/bench.cpp $(BUILD)/libsfb.o

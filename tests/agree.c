@@ -127,11 +127,13 @@ typedef struct backend {
     sfb_backend_kind kind;
     const char *name;
     int available, required;
+    int excluded;       /* left out with --only: not tested, not reported */
     char why[512];      /* probe: what runs, or why not */
     sfb_context *ctx;   /* its own context (threads = 0) */
 } backend;
 
 static sfb_context *g_ref;      /* the oracle's context */
+static const char *g_only;      /* --only LIST: the backends to test (default all) */
 static backend g_backends[3];
 static const int g_backend_count = 3;
 
@@ -152,6 +154,7 @@ static int name_listed(const char *list, const char *name) {
 /* Says a check of backend b cannot run: SKIP, or FAIL when the backend is required. */
 static void check_unavailable(const backend *b, const char *name) {
     char why[700];
+    if (b->excluded) return;
     snprintf(why, sizeof why, "%s unavailable: %s", b->name, b->why);
     if (b->required) check_fail(name, "%s (required by SFB_REQUIRE_BACKENDS)", why);
     else check_skip(name, why);
@@ -186,6 +189,11 @@ static void setup_backends(void) {
         b->kind = kinds[i];
         b->name = sfb_backend_kind_name(kinds[i]);
         b->required = req && name_listed(req, b->name);
+        if (g_only && !name_listed(g_only, b->name)) {
+            b->excluded = 1;
+            snprintf(b->why, sizeof b->why, "left out by --only");
+            continue;
+        }
         snprintf(name, sizeof name, "probe/%s", b->name);
         r = sfb_backend_probe(b->kind, NULL, b->why, sizeof b->why);
         if (r != SFB_SUCCESS) {
@@ -1218,7 +1226,7 @@ static void run_environment(void) {
         for (via_env = 0; via_env < 2; ++via_env) {
             sfb_backend_kind kind = i < 0 ? SFB_BACKEND_GL : g_backends[i].kind;
             const char *bname = sfb_backend_kind_name(kind);
-            if (i >= 0 && g_backends[i].available) break;
+            if (i >= 0 && (g_backends[i].available || g_backends[i].excluded)) break;
             snprintf(name, sizeof name, "forced/%s%s%s", bname, i < 0 ? "-current-context-without-one" : "", via_env ? "/env" : "");
             cfg = sfb_context_config_init();
             if (i < 0) cfg.gl_use_current_context = 1;
@@ -1270,8 +1278,9 @@ int main(int argc, char **argv) {
         else if (strcmp(argv[i], "--cases") == 0 && i + 1 < argc) cases = atoi(argv[++i]);
         else if (strcmp(argv[i], "--l3-faces") == 0 && i + 1 < argc) g_l3_max_faces = atoi(argv[++i]);
         else if (strcmp(argv[i], "--verbose") == 0) g_verbose = 1;
+        else if (strcmp(argv[i], "--only") == 0 && i + 1 < argc) g_only = argv[++i];
         else if (argv[i][0] == '-') {
-            fprintf(stderr, "usage: agree [SHAPES_DIR] [--seed S] [--cases N] [--l3-faces N] [--verbose]\n");
+            fprintf(stderr, "usage: agree [SHAPES_DIR] [--seed S] [--cases N] [--l3-faces N] [--only simd,gl,osmesa] [--verbose]\n");
             return 2;
         } else shapes = argv[i];
     }
