@@ -168,16 +168,24 @@ SFB_API sfb_result sfb_surface_stencil_info(const sfb_surface *s, sfb_table t, s
 
 static int sfb__desc_ok(sfb_buffer_desc d) { return d.offset >= 0 && d.length >= 1 && d.length <= 16 && d.stride >= d.length; }
 
+/* The checks both eval entry points share: a built table and two compatible views. */
+static sfb_result sfb__eval_args(const sfb_surface *s, sfb_table t, int have_buffers, sfb_buffer_desc sd, sfb_buffer_desc dd,
+                                 const char *what) {
+    if ((int)t < 0 || t >= SFB_TABLE_COUNT_ || !s->built[t])
+        return sfb__error(s->ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "stencil table %d was not built for this surface", (int)t);
+    if (!have_buffers || !sfb__desc_ok(sd) || !sfb__desc_ok(dd) || sd.length != dd.length)
+        return sfb__error(s->ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "invalid %s or buffer descriptors for stencil evaluation", what);
+    return SFB_SUCCESS;
+}
+
 SFB_API sfb_result sfb_surface_eval_stencils(const sfb_surface *s, sfb_table t, const float *src, sfb_buffer_desc sd,
                                              float *dst, sfb_buffer_desc dd) {
     sfb_context *ctx;
     const sfb__backend_vtable *be;
+    sfb_result r;
     if (!s) return SFB_INVALID_ARGS;
     ctx = s->ctx;
-    if ((int)t < 0 || t >= SFB_TABLE_COUNT_ || !s->built[t])
-        return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "stencil table %d was not built for this surface", (int)t);
-    if (!src || !dst || !sfb__desc_ok(sd) || !sfb__desc_ok(dd) || sd.length != dd.length)
-        return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "invalid buffers or buffer descriptors for stencil evaluation");
+    if ((r = sfb__eval_args(s, t, src && dst, sd, dd, "buffers")) != SFB_SUCCESS) return r;
     be = ctx->backend;
     if (!be || !(be->caps & SFB__CAP_EVAL_STENCILS) || !be->eval_stencils) {
         sfb__log(ctx, SFB_LOG_INFO, "backend %s lacks eval_stencils; using ref", be ? be->name : "none");
@@ -193,12 +201,10 @@ SFB_API sfb_result sfb_surface_eval_stencils_gl(const sfb_surface *s, sfb_table 
                                                 unsigned int dst_buffer, sfb_buffer_desc dd) {
     sfb_context *ctx;
     const sfb__backend_vtable *be;
+    sfb_result r;
     if (!s) return SFB_INVALID_ARGS;
     ctx = s->ctx;
-    if ((int)t < 0 || t >= SFB_TABLE_COUNT_ || !s->built[t])
-        return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "stencil table %d was not built for this surface", (int)t);
-    if (!src_buffer || !dst_buffer || !sfb__desc_ok(sd) || !sfb__desc_ok(dd) || sd.length != dd.length)
-        return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "invalid GL buffers or buffer descriptors for stencil evaluation");
+    if ((r = sfb__eval_args(s, t, src_buffer && dst_buffer, sd, dd, "GL buffers")) != SFB_SUCCESS) return r;
     be = ctx->backend;
     if (!be || !(be->caps & SFB__CAP_GL_BUFFERS) || !be->eval_stencils_gl)
         return sfb__error(ctx, SFB_UNSUPPORTED, SFB_ELEMENT_NONE, -1,
