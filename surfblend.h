@@ -225,14 +225,18 @@ SFB_API const char *sfb_scheme_name(sfb_scheme s);
 
 enum {
     SFB_REFINE_LIMIT = 1u << 0,  /* also build limit position + limit tangent tables */
-    SFB_REFINE_UVS = 1u << 1     /* also build the face-varying UV table (when the mesh has UVs) */
+    SFB_REFINE_UVS = 1u << 1,    /* also build the face-varying UV table (when the mesh has UVs) */
+    SFB_REFINE_PATCHES = 1u << 2 /* also build the patch table: sfb_surface_eval, sfb_surface_tessellate */
 };
 
 typedef struct sfb_surface_config {
     sfb_scheme scheme;
     int refine_level;   /* uniform refinement level compiled into the tables (0..SFB_MAX_LEVEL) */
     unsigned flags;     /* SFB_REFINE_* */
+    int isolation_level;/* patches: adaptive isolation limit around irregular features, 1..SFB_MAX_LEVEL
+                           (0: SFB_DEFAULT_ISOLATION); below it faces get an end cap */
 } sfb_surface_config;
+#define SFB_DEFAULT_ISOLATION 8
 SFB_API sfb_surface_config sfb_surface_config_init(sfb_scheme scheme, int level);
 
 typedef struct sfb_surface sfb_surface;
@@ -302,6 +306,37 @@ SFB_API void sfb_mesh_data_free(sfb_mesh_data *data);
 /* A desc view of refined data (pointers into `data`), for sfb_write_obj or sfb_mesh_create. */
 SFB_API void sfb_mesh_data_desc(const sfb_mesh_data *data, sfb_mesh_desc *out);
 
+
+/* ---- limit evaluation (SFB_REFINE_PATCHES; Catmull-Clark) ----
+ * Locations are on parametric faces: a base quad is one parametric face, (u,v) in [0,1]^2 with
+ * (0,0) at its first vertex, (1,0) at its second and (0,1) at its last; a face with n != 4
+ * vertices is n parametric quads, sub-face i being (v_i, midpoint of v_i v_i+1, centroid,
+ * midpoint of v_i-1 v_i) of the first subdivision step, (0,0) at v_i. Parametric faces are
+ * numbered base face by base face (sfb_surface_param_faces). */
+typedef struct sfb_location { int face; float u, v; } sfb_location;
+/* Output arrays, xyz per location; NULL members are not computed. du/dv are derivatives in
+ * the parametric face's (u,v); normal is unit length (du x dv normalised, and at an
+ * extraordinary vertex itself the limit normal, where du and dv are the limit tangent
+ * directions since the parametric derivatives vanish or diverge there). */
+typedef struct sfb_eval_output { float *position, *du, *dv, *normal, *duu, *duv, *dvv; } sfb_eval_output;
+
+SFB_API int sfb_surface_param_face_count(const sfb_surface *surface);
+/* The parametric faces of base face `base_face`: [*first, *first + *count). */
+SFB_API sfb_result sfb_surface_param_faces(const sfb_surface *surface, int base_face, int *first, int *count);
+/* The base face of a parametric face, and its sub-face index (-1 for a quad). */
+SFB_API sfb_result sfb_surface_param_face_base(const sfb_surface *surface, int param_face, int *base_face, int *sub_face);
+/* Evaluates the limit surface at `count` locations. Every location is checked first: a face
+ * out of range, a hole, u or v outside [0,1] or not finite returns SFB_INVALID_VALUE naming
+ * the first bad query (element SFB_ELEMENT_NONE, index = its position) and writes nothing. */
+SFB_API sfb_result sfb_surface_eval(const sfb_surface *surface, const sfb_location *locations, int count,
+                                    const sfb_eval_output *out);
+
+typedef struct sfb_patch_info {
+    int param_faces, patches, bspline, stam, end_caps, max_depth, points;
+    size_t bytes;  /* memory of the patch table and its points */
+} sfb_patch_info;
+SFB_API sfb_result sfb_surface_patch_info(const sfb_surface *surface, sfb_patch_info *out);
+
 #ifdef __cplusplus
 }
 #endif
@@ -323,6 +358,7 @@ SFB_API void sfb_mesh_data_desc(const sfb_mesh_data *data, sfb_mesh_desc *out);
 #endif
 
 /* ---- backend vtable ---- */
+struct sfb__patch_table;
 /* A stencil table: row r reads sizes[r] entries starting at offsets[r] from indices/weights. */
 typedef struct sfb__stencils {
     int rows, sources;
@@ -333,7 +369,8 @@ typedef struct sfb__stencils {
 
 enum {
     SFB__CAP_EVAL_STENCILS = 1u << 0,   /* eval_stencils on caller memory */
-    SFB__CAP_GL_BUFFERS = 1u << 1       /* eval_stencils_gl on GL buffer objects (host context) */
+    SFB__CAP_GL_BUFFERS = 1u << 1,      /* eval_stencils_gl on GL buffer objects (host context) */
+    SFB__CAP_EVAL_PATCHES = 1u << 2     /* eval_patches */
 };
 
 /* The kernels a backend implements. Every slot but name/kind/caps/init/shutdown may be NULL;
@@ -361,6 +398,12 @@ typedef struct sfb__backend_vtable {
     sfb_result (*eval_stencils_gl)(void *state, const sfb__stencils *table, void *handle,
                                    unsigned src_buffer, sfb_buffer_desc src_desc,
                                    unsigned dst_buffer, sfb_buffer_desc dst_desc);
+    /* Patch tables (limit evaluation): upload once per surface, then evaluate locations
+     * [first,last) (already validated) into the non-NULL arrays of `out` (xyz per location). */
+    sfb_result (*upload_patches)(void *state, const struct sfb__patch_table *table, void **handle);
+    void (*release_patches)(void *state, void *handle);
+    sfb_result (*eval_patches)(void *state, const struct sfb__patch_table *table, void *handle,
+                               const sfb_location *locations, int first, int last, const sfb_eval_output *out);
 } sfb__backend_vtable;
 
 /* Optional backends (backends/sfb_*.h), compiled in by SURFBLEND_SIMD / _GL / _OSMESA or
@@ -389,6 +432,42 @@ const sfb__backend_vtable *sfb__backend_gl(void);
 const sfb__backend_vtable *sfb__backend_osmesa(void);
 #endif
 
+/* ---- Stam eigen structures (stam.c) ---- */
+#define SFB__STAM_MAX_VALENCE 256
+
+typedef struct sfb__eigen_cc {
+    int N, K;
+    int dominant;      /* index of lambda = 1 (right eigenvector all ones) */
+    double sub;        /* largest |lambda| among the others (the subdominant eigenvalue) */
+    double error;      /* max |A - V L V^-1| found by the build */
+    double *lambda;    /* K */
+    double *vinv;      /* K x K, row i = left eigenvector i */
+    double *phi;       /* 3 x 16 x K: phi[((k-1)*16 + j)*K + i] */
+    double *v;         /* K x K right eigenvectors (columns), only when asked to keep them */
+    double *a;         /* K x K subdivision matrix, only when asked to keep it */
+} sfb__eigen_cc;
+
+
+/* ---- patch tables (patches.c) ---- */
+typedef struct sfb__patch_table {
+    int scheme, isolation, max_depth;
+    int npatch, ncv, nptex, nnodes;
+    int *ptype;            /* SFB__PATCH_* per patch */
+    int *pfirst;           /* npatch + 1: first control point of each patch in cv */
+    unsigned *pparam;      /* depth | i << 4 | j << 17 | corner << 30 (sub-square of the param face) */
+    int *pvalence;         /* Stam patches: valence of the extraordinary vertex */
+    int *cv;               /* control points: rows of `points` */
+    int *ptex_face, *ptex_corner; /* per param face: base face, sub-face (-1 for a quad) */
+    int *face_ptex;        /* per base face + 1: first param face */
+    int *ptex_root;        /* per param face: >= 0 node, <= -2 patch -(p+2), -1 hole */
+    int *nodes;            /* 4 per quadtree node, by quadrant x + 2y, same encoding */
+    int counts[3];         /* patches of each type */
+    sfb__stencils points;  /* base vertices -> patch points */
+    float *point_data;     /* xyz per patch point, for the surface's base positions */
+    const sfb__eigen_cc *eig[SFB__STAM_MAX_VALENCE + 1]; /* valences used (the context's cache) */
+    float *eig_f;          /* reserved for backends' packed copies */
+} sfb__patch_table;
+
 /* ---- context ---- */
 struct sfb_context {
     sfb_allocator allocator;
@@ -401,6 +480,8 @@ struct sfb_context {
     int order_count;
     const sfb__backend_vtable *backend;
     void *backend_state;
+    sfb__eigen_cc *eigen_cc[SFB__STAM_MAX_VALENCE + 1]; /* per valence, built on first use */
+    unsigned char eigen_cc_failed[SFB__STAM_MAX_VALENCE + 1];
     char report[2048];
     char error[1024];
     sfb_error_info error_info;
@@ -430,6 +511,9 @@ sfb_result sfb__progress(sfb_context *ctx, float done, const char *stage);
 sfb_result sfb__select_backend(sfb_context *ctx, const char *env_override);
 sfb_result sfb__context_create_reporting(const sfb_context_config *config, sfb_context **out, char *report, size_t size);
 const sfb__backend_vtable *sfb__backend_ref(void);
+void sfb__eigen_cc_free(sfb_context *ctx, sfb__eigen_cc *e);
+sfb_result sfb__eigen_cc_build(sfb_context *ctx, int N, int keep, sfb__eigen_cc **out);
+const sfb__eigen_cc *sfb__eigen_cc_get(sfb_context *ctx, int N);
 
 /* ---- topology of one level ---- */
 enum { SFB__TAG_BOUNDARY = 1, SFB__TAG_NONMANIFOLD = 2 };
@@ -473,7 +557,7 @@ struct sfb_mesh {
 struct sfb_surface {
     sfb_context *ctx;
     sfb_surface_config config;
-    int base_vertex_count, base_uv_count;
+    int base_vertex_count, base_uv_count, base_face_count;
     float *base_positions, *base_uvs;
     sfb__level top;              /* topology of the refined level */
     sfb__level uv_top;           /* topology of the refined UV layout (when built) */
@@ -483,6 +567,9 @@ struct sfb_surface {
     void *backend_tables[SFB_TABLE_COUNT_]; /* the backend's uploaded copies (upload_stencils) */
     const sfb__backend_vtable *uploaded_by;
     int boundary, crease_method, triangle_rule, uv_interp;
+    int has_patches;
+    sfb__patch_table patches;    /* limit evaluation (SFB_REFINE_PATCHES) */
+    void *backend_patches;       /* the backend's uploaded copy */
 };
 
 typedef struct sfb__refine_options {
@@ -501,6 +588,12 @@ void sfb__stencils_free(sfb_context *ctx, sfb__stencils *s);
 /* Copy of the base level with OpenSubdiv's boundary/non-manifold sharpening and holes applied. */
 sfb_result sfb__level_prepare(sfb_context *ctx, const sfb__level *src, int sharpen_corners, int make_boundary_holes,
                               sfb__level *dst);
+
+/* patches.c */
+void sfb__patch_table_free(sfb_context *ctx, sfb__patch_table *pt);
+sfb_result sfb__patches_build(sfb_context *ctx, const sfb__level *base, const sfb__refine_options *opt, int limit,
+                              sfb__patch_table *pt);
+int sfb__patch_locate(const sfb__patch_table *pt, int ptex, double u, double v, double *s, double *t, double *scale);
 #line 1 "src/context.c"
 /* Results, context, allocator with memory budget, errors, logging, progress. */
 
@@ -705,6 +798,10 @@ SFB_API void sfb_context_destroy(sfb_context *ctx) {
     sfb_allocator a;
     if (!ctx) return;
     if (ctx->backend && ctx->backend->shutdown) ctx->backend->shutdown(ctx, ctx->backend_state);
+    {
+        int n;
+        for (n = 0; n <= SFB__STAM_MAX_VALENCE; ++n) sfb__eigen_cc_free(ctx, ctx->eigen_cc[n]);
+    }
     a = ctx->allocator;
     a.free(ctx, a.user);
 }
@@ -906,9 +1003,14 @@ static sfb_result sfb__ref_eval_stencils(void *state, const sfb__stencils *t, vo
     return SFB_SUCCESS;
 }
 
+/* in patches.c */
+static sfb_result sfb__ref_eval_patches(void *state, const sfb__patch_table *pt, void *handle, const sfb_location *locs, int first,
+                                        int last, const sfb_eval_output *out);
+
 static const sfb__backend_vtable sfb__ref_vtable = {
-    "ref", SFB_BACKEND_REF, SFB__CAP_EVAL_STENCILS,
-    sfb__ref_init, sfb__ref_shutdown, NULL, NULL, NULL, sfb__ref_eval_stencils, NULL
+    "ref", SFB_BACKEND_REF, SFB__CAP_EVAL_STENCILS | SFB__CAP_EVAL_PATCHES,
+    sfb__ref_init, sfb__ref_shutdown, NULL, NULL, NULL, sfb__ref_eval_stencils, NULL,
+    NULL, NULL, sfb__ref_eval_patches
 };
 
 const sfb__backend_vtable *sfb__backend_ref(void) { return &sfb__ref_vtable; }
@@ -1591,6 +1693,42 @@ static int sfb__compose_row(sfb_context *ctx, sfb__accum *A, const sfb__rows *pr
     return 1;
 }
 
+/* One step: refines `p` (whose vertices have composed rows `prow`) into `c`, with the
+ * composed rows of c's vertices in `crow`. Progress is reported from p0 over a span of dp. */
+static sfb_result sfb__refine_step(sfb_context *ctx, const sfb__refine_options *opt, const sfb__level *p, const sfb__rows *prow,
+                                   sfb__level *c, sfb__rows *crow, sfb__accum *A, sfb__mask *m, float *ps, float *cs,
+                                   float p0, float dp) {
+    sfb__step st;
+    sfb_result r;
+    int cv;
+    st.ctx = ctx; st.opt = opt; st.p = p; st.c = c; st.half = NULL;
+    r = sfb__build_child_topology(&st);
+    if (r != SFB_SUCCESS) {
+        sfb__free(ctx, st.half);
+        return r == SFB_OUT_OF_MEMORY ? sfb__oom(ctx, "refinement topology") : r;
+    }
+    crow->rows = c->nv;
+    crow->n = 0;
+    crow->off = (size_t *)sfb__alloc(ctx, ((size_t)c->nv + 1) * sizeof(size_t));
+    if (!crow->off || !sfb__rows_reserve(ctx, crow, (size_t)c->nv * 4 + 16)) {
+        sfb__free(ctx, st.half);
+        return sfb__oom(ctx, "stencil table");
+    }
+    crow->off[0] = 0;
+    for (cv = 0; cv < c->nv; ++cv) {
+        if (!sfb__child_mask(&st, cv, m, ps, cs) || !sfb__compose_row(ctx, A, prow, m, crow, cv)) {
+            sfb__free(ctx, st.half);
+            return sfb__oom(ctx, "stencil table");
+        }
+        if ((cv & 0xffff) == 0xffff) {
+            r = sfb__progress(ctx, p0 + dp * (float)cv / (float)c->nv, "refine");
+            if (r != SFB_SUCCESS) { sfb__free(ctx, st.half); return r; }
+        }
+    }
+    sfb__free(ctx, st.half);
+    return SFB_SUCCESS;
+}
+
 /* ---- limit masks at the last level ---- */
 static void sfb__limit_masks(const sfb__level *l, int v, sfb_scheme scheme, sfb__mask *mp, sfb__mask *m1, sfb__mask *m2) {
     int e0 = l->ve_off[v], ne = l->ve_off[v + 1] - e0;
@@ -1776,38 +1914,11 @@ sfb_result sfb__refine(sfb_context *ctx, const sfb__level *base, const sfb__refi
     prow.off[base->nv] = (size_t)base->nv;
     prow.n = (size_t)base->nv;
     for (L = 0; L < level; ++L) {
-        sfb__step st;
-        int cv;
         r = sfb__progress(ctx, prog0 + (prog1 - prog0) * (float)L / (float)(level + 1), "refine");
         if (r != SFB_SUCCESS) goto done;
-        st.ctx = ctx; st.opt = opt; st.p = &cur; st.c = &next; st.half = NULL;
-        r = sfb__build_child_topology(&st);
-        if (r != SFB_SUCCESS) {
-            sfb__free(ctx, st.half);
-            if (r == SFB_OUT_OF_MEMORY) r = sfb__oom(ctx, "refinement topology");
-            goto done;
-        }
-        crow.rows = next.nv;
-        crow.n = 0;
-        crow.off = (size_t *)sfb__alloc(ctx, ((size_t)next.nv + 1) * sizeof(size_t));
-        if (!crow.off || !sfb__rows_reserve(ctx, &crow, (size_t)next.nv * 4 + 16)) {
-            sfb__free(ctx, st.half);
-            r = sfb__oom(ctx, "stencil table");
-            goto done;
-        }
-        crow.off[0] = 0;
-        for (cv = 0; cv < next.nv; ++cv) {
-            if (!sfb__child_mask(&st, cv, &m, ps, cs) || !sfb__compose_row(ctx, &A, &prow, &m, &crow, cv)) {
-                sfb__free(ctx, st.half);
-                r = sfb__oom(ctx, "stencil table");
-                goto done;
-            }
-            if ((cv & 0xffff) == 0xffff) {
-                r = sfb__progress(ctx, prog0 + (prog1 - prog0) * ((float)L + (float)cv / next.nv) / (float)(level + 1), "refine");
-                if (r != SFB_SUCCESS) { sfb__free(ctx, st.half); goto done; }
-            }
-        }
-        sfb__free(ctx, st.half);
+        r = sfb__refine_step(ctx, opt, &cur, &prow, &next, &crow, &A, &m, ps, cs, prog0 + (prog1 - prog0) * (float)L / (float)(level + 1),
+                             (prog1 - prog0) / (float)(level + 1));
+        if (r != SFB_SUCCESS) goto done;
         sfb__rows_free(ctx, &prow);
         prow = crow;
         memset(&crow, 0, sizeof crow);
@@ -1871,6 +1982,1381 @@ done:
         if (lt) { sfb__stencils_free(ctx, &lt[0]); sfb__stencils_free(ctx, &lt[1]); sfb__stencils_free(ctx, &lt[2]); }
     }
     return r;
+}
+#line 1 "src/stam.c"
+/* Eigen structures for Stam's exact evaluation of Catmull-Clark patches around one smooth
+ * extraordinary vertex (ALGORITHMS.md §1), in double precision.
+ *
+ * Point order (K = 2N+8): 0 the EV, 2i-1 edge neighbour e_i, 2i face diagonal f_i (i = 1..N),
+ * 2N+1..2N+7 the outer points at grid (2,2),(2,1),(2,0),(2,-1),(1,2),(0,2),(-1,2); the patch
+ * is (0, e_3, f_2, e_2) with u toward e_3 = (1,0) and v toward e_2 = (0,1).
+ *
+ * A = [S 0; S11 S12] is diagonalised without a general eigensolver:
+ * - S (the 2N+1 ring points) is block-circulant: frequency j of the ring gives a 2x2 block
+ *   (a 3x3 block with the EV for j = 0) whose eigenvalues are
+ *   ((5 + cos t) +- sqrt((1 + cos t)(9 + cos t)))/16, t = 2 pi j / N, and whose eigenvectors
+ *   are e_i = cos(i t) (or sin), f_i = (cos(i t) + cos((i+1) t))/(4 lambda - 1) (or sin);
+ * - an eigenvector u of S extends to [u; w] of A with (lambda I - S12) w = S11 u, solved with
+ *   full pivoting (a consistent singular system when lambda is also an eigenvalue of S12);
+ * - the 7 eigenvalues of S12 (1/8, 1/8, 1/16, 1/16, 1/32, 1/32, 1/64) give [0; z].
+ * V^-1 comes from an LU factorisation; every build checks max |A - V diag(lambda) V^-1| and
+ * refuses the valence when it is not at rounding level. The cost is O(K^3): valences up to
+ * SFB__STAM_MAX_VALENCE are supported; higher ones are isolated adaptively instead.
+ *
+ * What the kernels use: lambda (K), V^-1 (K x K, to make the eigen coefficients C^ = V^-1 C of
+ * a face as stencil rows) and Phi_k = P_k Abar V (16 x K per sub-patch k = 1..3), so that
+ * x(u,v) = sum_i lambda_i^(n-1) (b(u~,v~)^T Phi_k)_i C^_i. */
+
+static const double sfb__S11[7][8] = {
+    {1, 0, 0, 6, 36, 6, 0, 0}, {4, 0, 0, 4, 24, 24, 0, 0}, {6, 0, 0, 1, 6, 36, 6, 1}, {4, 0, 0, 0, 0, 24, 24, 4},
+    {4, 0, 0, 24, 24, 4, 0, 0}, {6, 1, 6, 36, 6, 1, 0, 0}, {4, 4, 24, 24, 0, 0, 0, 0}};
+static const double sfb__S12[7][7] = {
+    {1, 6, 1, 0, 6, 1, 0}, {0, 4, 4, 0, 0, 0, 0}, {0, 1, 6, 1, 0, 0, 0}, {0, 0, 4, 4, 0, 0, 0},
+    {0, 0, 0, 0, 4, 4, 0}, {0, 0, 0, 0, 1, 6, 1}, {0, 0, 0, 0, 0, 4, 4}};
+static const double sfb__S21[9][7] = {
+    {0, 0, 0, 0, 16, 0, 0}, {0, 0, 0, 0, 24, 4, 0}, {0, 0, 0, 0, 16, 16, 0}, {0, 0, 0, 0, 4, 24, 4},
+    {0, 0, 0, 0, 0, 16, 16}, {0, 0, 0, 4, 24, 0, 0}, {0, 0, 0, 16, 16, 0, 0}, {0, 0, 4, 24, 4, 0, 0},
+    {0, 0, 16, 16, 0, 0, 0}};
+static const double sfb__S22[9][7] = {
+    {16, 16, 0, 0, 16, 0, 0}, {4, 24, 4, 0, 4, 0, 0}, {0, 16, 16, 0, 0, 0, 0}, {0, 4, 24, 4, 0, 0, 0},
+    {0, 0, 16, 16, 0, 0, 0}, {4, 4, 0, 0, 24, 4, 0}, {0, 0, 0, 0, 16, 16, 0}, {0, 0, 0, 0, 4, 24, 4},
+    {0, 0, 0, 0, 0, 16, 16}};
+
+/* Picking vectors (ALGORITHMS.md §1.3): entry = offset + m*mult, m = 2N. */
+static int sfb__stam_pick(int N, int k, int j) {
+    static const signed char off[3][16] = {
+        {7, 6, 4, 12, 0, 5, 3, 11, 3, 4, 2, 10, 6, 5, 1, 9},
+        {0, 5, 3, 11, 3, 4, 2, 10, 6, 5, 1, 9, 15, 14, 13, 8},
+        {1, 0, 5, 3, 2, 3, 4, 2, 7, 6, 5, 1, 16, 15, 14, 13}};
+    static const unsigned char mul[3][16] = {
+        {0, 0, 1, 1, 0, 0, 1, 1, 0, 0, 1, 1, 1, 1, 1, 1},
+        {0, 0, 1, 1, 0, 0, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1},
+        {0, 0, 0, 1, 0, 0, 0, 1, 1, 1, 1, 1, 1, 1, 1, 1}};
+    int v = off[k - 1][j] + (mul[k - 1][j] ? 2 * N : 0);
+    /* N = 3: ring index 7 (e_4) is e_1 (the entries equal to m+1 are outer points) */
+    if (N == 3 && v == 7 && !mul[k - 1][j]) v = 1;
+    return v;
+}
+
+/* Dense A (K x K, row-major). */
+static void sfb__stam_matrix(int N, double *A) {
+    int K = 2 * N + 8, i, r, c;
+    double a = 1.0 - 7.0 / (4.0 * N), b = 3.0 / (2.0 * N * N), cc = 1.0 / (4.0 * N * N);
+#define SFB__E(i) (2 * ((((i) - 1) % N + N) % N + 1) - 1)
+#define SFB__F(i) (2 * ((((i) - 1) % N + N) % N + 1))
+    memset(A, 0, (size_t)K * K * sizeof(double));
+    A[0] = a;
+    for (i = 1; i <= N; ++i) { A[2 * i - 1] = b; A[2 * i] = cc; }
+    for (i = 1; i <= N; ++i) {
+        double *re = A + (size_t)SFB__E(i) * K, *rf = A + (size_t)SFB__F(i) * K;
+        re[0] += 0.375; re[SFB__E(i)] += 0.375; re[SFB__E(i - 1)] += 0.0625; re[SFB__E(i + 1)] += 0.0625;
+        re[SFB__F(i - 1)] += 0.0625; re[SFB__F(i)] += 0.0625;
+        rf[0] += 0.25; rf[SFB__E(i)] += 0.25; rf[SFB__F(i)] += 0.25; rf[SFB__E(i + 1)] += 0.25;
+    }
+#undef SFB__E
+#undef SFB__F
+    for (r = 0; r < 7; ++r) {
+        double *row = A + (size_t)(2 * N + 1 + r) * K;
+        for (c = 0; c < 8; ++c) {
+            int col = (N == 3 && c == 7) ? 1 : c; /* N = 3: e_4 is e_1 */
+            row[col] += sfb__S11[r][c] / 64.0;
+        }
+        for (c = 0; c < 7; ++c) row[2 * N + 1 + c] += sfb__S12[r][c] / 64.0;
+    }
+}
+
+/* Solves M x = y (n x n, row-major, destroyed) with full pivoting. Pivots below tol are
+ * treated as zero (their unknowns set to 0); returns the residual max |M x - y| relative to
+ * |y| + |M||x| computed on the original, which the caller passes as M0. */
+static double sfb__solve_full(int n, double *M, double *y, double *x, const double *M0, const double *y0) {
+    int piv_r[16], piv_c[16], i, j, k, rank = 0;
+    double tol = 1e-12, res = 0.0, scale = 1e-300;
+    int colperm[16];
+    for (i = 0; i < n; ++i) colperm[i] = i;
+    for (k = 0; k < n; ++k) {
+        int br = -1, bc = -1;
+        double best = tol;
+        for (i = k; i < n; ++i)
+            for (j = k; j < n; ++j)
+                if (fabs(M[i * n + j]) > best) { best = fabs(M[i * n + j]); br = i; bc = j; }
+        if (br < 0) break;
+        if (br != k) {
+            for (j = 0; j < n; ++j) { double t = M[k * n + j]; M[k * n + j] = M[br * n + j]; M[br * n + j] = t; }
+            { double t = y[k]; y[k] = y[br]; y[br] = t; }
+        }
+        if (bc != k) {
+            for (i = 0; i < n; ++i) { double t = M[i * n + k]; M[i * n + k] = M[i * n + bc]; M[i * n + bc] = t; }
+            { int t = colperm[k]; colperm[k] = colperm[bc]; colperm[bc] = t; }
+        }
+        piv_r[k] = br; piv_c[k] = bc;
+        for (i = k + 1; i < n; ++i) {
+            double f = M[i * n + k] / M[k * n + k];
+            if (f == 0.0) continue;
+            for (j = k; j < n; ++j) M[i * n + j] -= f * M[k * n + j];
+            y[i] -= f * y[k];
+        }
+        rank++;
+    }
+    {
+        double z[16];
+        for (i = n - 1; i >= 0; --i) {
+            double s = y[i];
+            if (i >= rank) { z[i] = 0.0; continue; }
+            for (j = i + 1; j < n; ++j) s -= M[i * n + j] * z[j];
+            z[i] = s / M[i * n + i];
+        }
+        for (i = 0; i < n; ++i) x[colperm[i]] = z[i];
+    }
+    for (i = 0; i < n; ++i) {
+        double s = -y0[i], a = fabs(y0[i]);
+        for (j = 0; j < n; ++j) { s += M0[i * n + j] * x[j]; a += fabs(M0[i * n + j] * x[j]); }
+        if (a > scale) scale = a;
+        if (fabs(s) > res) res = fabs(s);
+    }
+    (void)piv_r; (void)piv_c;
+    return res / scale;
+}
+
+/* Null space of the 7x7 (S12 - mu I): up to 2 vectors, by full-pivot elimination. */
+static int sfb__s12_null(double mu, double out[2][7]) {
+    double M[49];
+    int colperm[7], i, j, k, rank = 0, nfree, f;
+    for (i = 0; i < 7; ++i) {
+        colperm[i] = i;
+        for (j = 0; j < 7; ++j) M[i * 7 + j] = sfb__S12[i][j] / 64.0 - (i == j ? mu : 0.0);
+    }
+    for (k = 0; k < 7; ++k) {
+        int br = -1, bc = -1;
+        double best = 1e-12;
+        for (i = k; i < 7; ++i)
+            for (j = k; j < 7; ++j)
+                if (fabs(M[i * 7 + j]) > best) { best = fabs(M[i * 7 + j]); br = i; bc = j; }
+        if (br < 0) break;
+        for (j = 0; j < 7; ++j) { double t = M[k * 7 + j]; M[k * 7 + j] = M[br * 7 + j]; M[br * 7 + j] = t; }
+        for (i = 0; i < 7; ++i) { double t = M[i * 7 + k]; M[i * 7 + k] = M[i * 7 + bc]; M[i * 7 + bc] = t; }
+        { int t = colperm[k]; colperm[k] = colperm[bc]; colperm[bc] = t; }
+        for (i = 0; i < 7; ++i) {
+            double fct;
+            if (i == k) continue;
+            fct = M[i * 7 + k] / M[k * 7 + k];
+            if (fct == 0.0) continue;
+            for (j = k; j < 7; ++j) M[i * 7 + j] -= fct * M[k * 7 + j];
+        }
+        rank++;
+    }
+    nfree = 7 - rank;
+    if (nfree > 2) nfree = 2;
+    for (f = 0; f < nfree; ++f) {
+        double z[7];
+        int fc = rank + f;
+        for (i = 0; i < 7; ++i) z[i] = 0.0;
+        z[fc] = 1.0;
+        for (i = 0; i < rank; ++i) z[i] = -M[i * 7 + fc] / M[i * 7 + i];
+        for (i = 0; i < 7; ++i) out[f][colperm[i]] = z[i];
+    }
+    return nfree;
+}
+
+/* In-place inverse of an n x n row-major matrix by LU with partial pivoting (Gauss-Jordan).
+ * Returns 0 when singular. `work` holds n ints. */
+static int sfb__invert(int n, double *M, double *inv, int *perm) {
+    int i, j, k;
+    for (i = 0; i < n; ++i) {
+        perm[i] = i;
+        for (j = 0; j < n; ++j) inv[(size_t)i * n + j] = i == j ? 1.0 : 0.0;
+    }
+    for (k = 0; k < n; ++k) {
+        int p = k;
+        double best = fabs(M[(size_t)k * n + k]), d;
+        for (i = k + 1; i < n; ++i)
+            if (fabs(M[(size_t)i * n + k]) > best) { best = fabs(M[(size_t)i * n + k]); p = i; }
+        if (best < 1e-300) return 0;
+        if (p != k)
+            for (j = 0; j < n; ++j) {
+                double t = M[(size_t)k * n + j]; M[(size_t)k * n + j] = M[(size_t)p * n + j]; M[(size_t)p * n + j] = t;
+                t = inv[(size_t)k * n + j]; inv[(size_t)k * n + j] = inv[(size_t)p * n + j]; inv[(size_t)p * n + j] = t;
+            }
+        d = 1.0 / M[(size_t)k * n + k];
+        for (j = 0; j < n; ++j) { M[(size_t)k * n + j] *= d; inv[(size_t)k * n + j] *= d; }
+        for (i = 0; i < n; ++i) {
+            double f;
+            if (i == k) continue;
+            f = M[(size_t)i * n + k];
+            if (f == 0.0) continue;
+            for (j = k; j < n; ++j) M[(size_t)i * n + j] -= f * M[(size_t)k * n + j];
+            for (j = 0; j < n; ++j) inv[(size_t)i * n + j] -= f * inv[(size_t)k * n + j];
+        }
+    }
+    return 1;
+}
+
+void sfb__eigen_cc_free(sfb_context *ctx, sfb__eigen_cc *e) {
+    if (!e) return;
+    sfb__free(ctx, e->lambda); sfb__free(ctx, e->vinv); sfb__free(ctx, e->phi);
+    sfb__free(ctx, e->v); sfb__free(ctx, e->a);
+    sfb__free(ctx, e);
+}
+
+/* Builds the eigen structure of valence N (3..SFB__STAM_MAX_VALENCE). keep: also keep V and A
+ * (for tests). */
+sfb_result sfb__eigen_cc_build(sfb_context *ctx, int N, int keep, sfb__eigen_cc **out) {
+    sfb__eigen_cc *e;
+    int K = 2 * N + 8, col = 0, i, j, k, q;
+    double *A = NULL, *V = NULL, *W = NULL, *AV = NULL;
+    int *perm = NULL;
+    size_t KK = (size_t)K * K;
+    *out = NULL;
+    if (N < 3 || N > SFB__STAM_MAX_VALENCE)
+        return sfb__error(ctx, SFB_LIMIT_EXCEEDED, SFB_ELEMENT_NONE, -1, "no Stam eigen structure for valence %d (3..%d)", N,
+                          SFB__STAM_MAX_VALENCE);
+    e = (sfb__eigen_cc *)sfb__calloc(ctx, 1, sizeof *e);
+    A = (double *)sfb__alloc(ctx, KK * sizeof(double));
+    V = (double *)sfb__calloc(ctx, KK, sizeof(double));
+    W = (double *)sfb__alloc(ctx, KK * sizeof(double));
+    AV = (double *)sfb__alloc(ctx, (size_t)9 * K * sizeof(double));
+    perm = (int *)sfb__alloc(ctx, (size_t)K * sizeof(int));
+    if (e) {
+        e->lambda = (double *)sfb__alloc(ctx, (size_t)K * sizeof(double));
+        e->vinv = (double *)sfb__alloc(ctx, KK * sizeof(double));
+        e->phi = (double *)sfb__alloc(ctx, (size_t)48 * K * sizeof(double));
+    }
+    if (!e || !A || !V || !W || !AV || !perm || !e->lambda || !e->vinv || !e->phi) goto oom;
+    e->N = N;
+    e->K = K;
+    sfb__stam_matrix(N, A);
+    /* right eigenvectors of S, column by column of V (row-major: V[r*K + col]) */
+#define SFB__SET(r, value) (V[(size_t)(r) * K + col] = (value))
+    {
+        /* j = 0: constant ring; 3x3 block on (V, e, f) */
+        double a = A[0], bN = A[1] * N, cN = A[2] * N;
+        double B[3][3];
+        double tr, det, disc, l2, l3, lam[3];
+        B[0][0] = a; B[0][1] = bN; B[0][2] = cN;
+        B[1][0] = 0.375; B[1][1] = 0.5; B[1][2] = 0.125;
+        B[2][0] = 0.25; B[2][1] = 0.5; B[2][2] = 0.25;
+        tr = B[0][0] + B[1][1] + B[2][2];
+        det = B[0][0] * (B[1][1] * B[2][2] - B[1][2] * B[2][1]) - B[0][1] * (B[1][0] * B[2][2] - B[1][2] * B[2][0]) +
+              B[0][2] * (B[1][0] * B[2][1] - B[1][1] * B[2][0]);
+        /* the other two eigenvalues: l2 + l3 = tr - 1, l2 l3 = det */
+        disc = (tr - 1.0) * (tr - 1.0) - 4.0 * det;
+        if (disc < 0.0) disc = 0.0;
+        l2 = 0.5 * ((tr - 1.0) + sqrt(disc));
+        l3 = 0.5 * ((tr - 1.0) - sqrt(disc));
+        lam[0] = 1.0; lam[1] = l2; lam[2] = l3;
+        for (q = 0; q < 3; ++q) {
+            double M[3][3], best = -1.0, x[3] = {1, 1, 1};
+            int r1, r2;
+            if (q > 0) {
+                for (i = 0; i < 3; ++i)
+                    for (j = 0; j < 3; ++j) M[i][j] = B[i][j] - (i == j ? lam[q] : 0.0);
+                for (r1 = 0; r1 < 3; ++r1)
+                    for (r2 = r1 + 1; r2 < 3; ++r2) {
+                        double c0 = M[r1][1] * M[r2][2] - M[r1][2] * M[r2][1];
+                        double c1 = M[r1][2] * M[r2][0] - M[r1][0] * M[r2][2];
+                        double c2 = M[r1][0] * M[r2][1] - M[r1][1] * M[r2][0];
+                        double nn = c0 * c0 + c1 * c1 + c2 * c2;
+                        if (nn > best) { best = nn; x[0] = c0; x[1] = c1; x[2] = c2; }
+                    }
+                best = sqrt(best);
+                for (i = 0; i < 3; ++i) x[i] /= best;
+            }
+            SFB__SET(0, x[0]);
+            for (i = 1; i <= N; ++i) { SFB__SET(2 * i - 1, x[1]); SFB__SET(2 * i, x[2]); }
+            e->lambda[col] = lam[q];
+            if (q == 0) e->dominant = col;
+            col++;
+        }
+    }
+    for (j = 1; 2 * j < N; ++j) {
+        double t = 2.0 * SFB__PI * j / N, c = cos(t);
+        double root = sqrt((1.0 + c) * (9.0 + c));
+        double lams[2];
+        lams[0] = ((5.0 + c) + root) / 16.0;
+        lams[1] = ((5.0 + c) - root) / 16.0;
+        for (q = 0; q < 2; ++q) {
+            double d = 1.0 / (4.0 * lams[q] - 1.0);
+            int trig;
+            for (trig = 0; trig < 2; ++trig) {
+                SFB__SET(0, 0.0);
+                for (i = 1; i <= N; ++i) {
+                    double x0 = trig ? sin(i * t) : cos(i * t), x1 = trig ? sin((i + 1) * t) : cos((i + 1) * t);
+                    SFB__SET(2 * i - 1, x0);
+                    SFB__SET(2 * i, (x0 + x1) * d);
+                }
+                e->lambda[col++] = lams[q];
+            }
+        }
+    }
+    if (N % 2 == 0) {
+        for (q = 0; q < 2; ++q) {
+            SFB__SET(0, 0.0);
+            for (i = 1; i <= N; ++i) {
+                double s = (i % 2) ? -1.0 : 1.0;
+                SFB__SET(2 * i - 1, q == 0 ? s : 0.0);
+                SFB__SET(2 * i, q == 1 ? s : 0.0);
+            }
+            e->lambda[col++] = 0.25;
+        }
+    }
+    if (col != 2 * N + 1) goto defective;
+    /* extend each to A: (lambda I - S12) w = S11 u */
+    for (q = 0; q < col; ++q) {
+        double M[49], M0[49], y[7], y0[7], w[7], res;
+        for (i = 0; i < 7; ++i) {
+            double s = 0.0;
+            for (k = 0; k < 8; ++k) {
+                int src = (N == 3 && k == 7) ? 1 : k;
+                s += sfb__S11[i][k] / 64.0 * V[(size_t)src * K + q];
+            }
+            y[i] = y0[i] = s;
+            for (k = 0; k < 7; ++k) M[i * 7 + k] = M0[i * 7 + k] = (i == k ? e->lambda[q] : 0.0) - sfb__S12[i][k] / 64.0;
+        }
+        res = sfb__solve_full(7, M, y, w, M0, y0);
+        if (res > 1e-10) goto defective;
+        for (i = 0; i < 7; ++i) V[(size_t)(2 * N + 1 + i) * K + q] = w[i];
+    }
+    {
+        static const double mus[4] = {0.125, 0.0625, 0.03125, 0.015625};
+        static const int mult[4] = {2, 2, 2, 1};
+        for (q = 0; q < 4; ++q) {
+            double z[2][7];
+            int got = sfb__s12_null(mus[q], z), f;
+            if (got != mult[q]) goto defective;
+            for (f = 0; f < got; ++f) {
+                for (i = 0; i < 7; ++i) V[(size_t)(2 * N + 1 + i) * K + col] = z[f][i];
+                e->lambda[col++] = mus[q];
+            }
+        }
+    }
+#undef SFB__SET
+    if (col != K) goto defective;
+    /* V^-1 */
+    memcpy(W, V, KK * sizeof(double));
+    if (!sfb__invert(K, W, e->vinv, perm)) goto defective;
+    /* check A = V L V^-1 */
+    {
+        double err = 0.0;
+        int r, c;
+        for (r = 0; r < K; ++r)
+            for (c = 0; c < K; ++c) {
+                double s = 0.0;
+                for (k = 0; k < K; ++k) s += V[(size_t)r * K + k] * e->lambda[k] * e->vinv[(size_t)k * K + c];
+                s -= A[(size_t)r * K + c];
+                if (fabs(s) > err) err = fabs(s);
+            }
+        e->error = err;
+        if (!(err < 1e-9)) goto defective;
+    }
+    e->sub = 0.0;
+    for (i = 0; i < K; ++i)
+        if (i != e->dominant && fabs(e->lambda[i]) > e->sub) e->sub = fabs(e->lambda[i]);
+    /* rows K..K+8 of Abar V: [S21 0 S22] V */
+    for (i = 0; i < 9; ++i)
+        for (q = 0; q < K; ++q) {
+            double s = 0.0;
+            for (k = 0; k < 7; ++k) {
+                s += sfb__S21[i][k] / 64.0 * V[(size_t)k * K + q];
+                s += sfb__S22[i][k] / 64.0 * V[(size_t)(2 * N + 1 + k) * K + q];
+            }
+            AV[(size_t)i * K + q] = s;
+        }
+    /* Phi_k rows: picked rows of Abar V; rows < K of A V are rows of V L */
+    for (k = 1; k <= 3; ++k)
+        for (j = 0; j < 16; ++j) {
+            int p = sfb__stam_pick(N, k, j);
+            double *dst = e->phi + ((size_t)(k - 1) * 16 + j) * K;
+            for (q = 0; q < K; ++q) {
+                if (p < K) {
+                    double s = 0.0;
+                    int c;
+                    for (c = 0; c < K; ++c) s += A[(size_t)p * K + c] * V[(size_t)c * K + q];
+                    dst[q] = s;
+                } else {
+                    dst[q] = AV[(size_t)(p - K) * K + q];
+                }
+            }
+        }
+    if (keep) { e->v = V; e->a = A; V = A = NULL; }
+    sfb__free(ctx, A); sfb__free(ctx, V); sfb__free(ctx, W); sfb__free(ctx, AV); sfb__free(ctx, perm);
+    *out = e;
+    return SFB_SUCCESS;
+defective:
+    sfb__free(ctx, A); sfb__free(ctx, V); sfb__free(ctx, W); sfb__free(ctx, AV); sfb__free(ctx, perm);
+    sfb__eigen_cc_free(ctx, e);
+    return sfb__error(ctx, SFB_BACKEND_ERROR, SFB_ELEMENT_NONE, -1, "Stam eigen structure of valence %d failed its check", N);
+oom:
+    sfb__free(ctx, A); sfb__free(ctx, V); sfb__free(ctx, W); sfb__free(ctx, AV); sfb__free(ctx, perm);
+    sfb__eigen_cc_free(ctx, e);
+    return sfb__oom(ctx, "Stam eigen structure");
+}
+
+/* The context's cache: built on first use of a valence, kept until the context goes. */
+const sfb__eigen_cc *sfb__eigen_cc_get(sfb_context *ctx, int N) {
+    sfb__eigen_cc *e;
+    if (N < 3 || N > SFB__STAM_MAX_VALENCE) return NULL;
+    if (ctx->eigen_cc[N]) return ctx->eigen_cc[N];
+    if (ctx->eigen_cc_failed[N]) return NULL;
+    if (sfb__eigen_cc_build(ctx, N, 0, &e) != SFB_SUCCESS) {
+        ctx->eigen_cc_failed[N] = 1;
+        sfb__log(ctx, SFB_LOG_WARN, "valence %d: %s; its faces are isolated adaptively instead", N, ctx->error);
+        sfb_clear_error(ctx);
+        return NULL;
+    }
+    ctx->eigen_cc[N] = e;
+    return e;
+}
+#line 1 "src/patches.c"
+/* Patch tables for exact limit evaluation (Catmull-Clark), built by feature-adaptive
+ * isolation, and the ref kernel that evaluates them.
+ *
+ * Parametric faces ("param faces", as OpenSubdiv's ptex faces): a base quad is one, with
+ * (u,v) = (0,0) at its first vertex, (1,0) at the second, (0,1) at the last; an n-gon (n != 4)
+ * is n of them, sub-face i being the quad (v_i, mid(v_i,v_i+1), centroid, mid(v_i-1,v_i)) of the
+ * first Catmull-Clark step, in that corner order.
+ *
+ * Isolation. Level 0 is the prepared base mesh. A quad face becomes a patch when
+ * - all four corners are regular for it: smooth valence 4 with no sharp edge (R1), a crease
+ *   vertex with two infinitely sharp edges and two faces on this face's side (R2), or a corner
+ *   (infinitely sharp) alone in its sector (R3) -> BSPLINE16, missing points mirrored
+ *   (phantoms) across the crease/boundary, which is exact: the crease is then the uniform
+ *   cubic B-spline of its vertices, as the crease rules make it;
+ * - one corner is a smooth extraordinary vertex with no sharp edge (valence 3..256) and the
+ *   other three are R1 -> STAM (eigen form, stam.c);
+ * - otherwise it is refined: the next level is built only for these faces and the faces
+ *   around them (the 1-ring whose vertices the masks read), and its children are classified
+ *   in turn. Semi-sharp sharpness decays by one per level, so after ceil(s) levels the region
+ *   is smooth and becomes exact patches.
+ * At the isolation limit (default 8; semi-sharp features continue until smooth, at most
+ * SFB_MAX_LEVEL + 1) a face that is still irregular (a crease or corner vertex with an
+ * extraordinary sector, a dart, a non-manifold vertex) gets the END CAP: the bilinear patch
+ * through the limit positions of its four corners. Its distance to the limit surface is
+ * O(h^2) with h = 2^-limit of the base face (measured in tests/agree.c and the README).
+ * Holes produce no patches. */
+
+enum { SFB__PATCH_BSPLINE = 0, SFB__PATCH_STAM = 1, SFB__PATCH_ENDCAP = 2 };
+enum { SFB__CORNER_R1 = 1, SFB__CORNER_R2_D1 = 2, SFB__CORNER_R2_D2 = 3, SFB__CORNER_R3 = 4, SFB__CORNER_EV = 5,
+       SFB__CORNER_IRREGULAR = 0 };
+
+#define SFB__PARAM(depth, i, j, corner) ((unsigned)(depth) | ((unsigned)(i) << 4) | ((unsigned)(j) << 17) | ((unsigned)(corner) << 30))
+#define SFB__PARAM_DEPTH(p) ((int)((p) & 15u))
+#define SFB__PARAM_I(p) ((int)(((p) >> 4) & 8191u))
+#define SFB__PARAM_J(p) ((int)(((p) >> 17) & 8191u))
+#define SFB__PARAM_CORNER(p) ((int)(((p) >> 30) & 3u))
+
+void sfb__patch_table_free(sfb_context *ctx, sfb__patch_table *pt) {
+    sfb__free(ctx, pt->ptype); sfb__free(ctx, pt->pfirst); sfb__free(ctx, pt->pparam); sfb__free(ctx, pt->pvalence);
+    sfb__free(ctx, pt->cv); sfb__free(ctx, pt->ptex_face); sfb__free(ctx, pt->ptex_corner); sfb__free(ctx, pt->face_ptex);
+    sfb__free(ctx, pt->ptex_root); sfb__free(ctx, pt->nodes); sfb__free(ctx, pt->point_data); sfb__free(ctx, pt->eig_f);
+    sfb__stencils_free(ctx, &pt->points);
+    memset(pt, 0, sizeof *pt);
+}
+
+/* ---- builder state ---- */
+typedef struct sfb__pbuild {
+    sfb_context *ctx;
+    sfb__patch_table *pt;
+    int cap_patch, cap_cv, cap_nodes;
+    sfb__rows prow;          /* patch point rows over base vertices */
+    size_t cap_rows;
+    sfb__accum A;
+    sfb__mask m;
+    int *vrow;               /* point row of each vertex of the working level, -1 if none yet */
+} sfb__pbuild;
+
+static int sfb__pb_grow_int(sfb_context *ctx, int **a, int *cap, int need) {
+    int nc;
+    int *n;
+    if (need <= *cap) return 1;
+    nc = *cap ? *cap : 256;
+    while (nc < need) nc *= 2;
+    n = (int *)sfb__realloc(ctx, *a, (size_t)nc * sizeof(int));
+    if (!n) return 0;
+    *a = n;
+    *cap = nc;
+    return 1;
+}
+
+/* Adds a point row = mask over working-level vertices composed with their rows. A single
+ * vertex with weight 1 is shared through vrow. Returns the row or -1 on allocation failure. */
+static int sfb__pb_point(sfb__pbuild *b, const sfb__rows *wrows, const sfb__mask *m) {
+    int row;
+    if (m->n == 1 && m->w[0] == 1.0 && b->vrow[m->idx[0]] >= 0) return b->vrow[m->idx[0]];
+    row = b->prow.rows;
+    if ((size_t)row + 2 > b->cap_rows) {
+        size_t nc = b->cap_rows ? b->cap_rows * 2 : 1024;
+        size_t *no = (size_t *)sfb__realloc(b->ctx, b->prow.off, nc * sizeof(size_t));
+        if (!no) return -1;
+        b->prow.off = no;
+        b->cap_rows = nc;
+        if (row == 0) b->prow.off[0] = 0;
+    }
+    if (!sfb__compose_row(b->ctx, &b->A, wrows, m, &b->prow, row)) return -1;
+    b->prow.rows = row + 1;
+    if (m->n == 1 && m->w[0] == 1.0) b->vrow[m->idx[0]] = row;
+    return row;
+}
+
+/* ---- corner classification ---- */
+static int sfb__is_inf(float s) { return s >= SFB_SHARPNESS_INFINITE; }
+
+/* Fan position of face g (corner slot `slot`) around vertex v, or -1. */
+static int sfb__fan_pos(const sfb__level *l, int v, int g, int slot) {
+    int i;
+    for (i = l->vf_off[v]; i < l->vf_off[v + 1]; ++i)
+        if (l->vf[i] == g && l->vf_slot[i] == slot) return i - l->vf_off[v];
+    return -1;
+}
+
+static int sfb__face_n(const sfb__level *l, int f) { return l->fv_off[f + 1] - l->fv_off[f]; }
+
+/* Class of vertex v as a corner of quad g; *pos = g's fan position. */
+static int sfb__corner_class(const sfb__level *l, int v, int g, int slot, int *pos) {
+    int nF = l->vf_off[v + 1] - l->vf_off[v], nE = l->ve_off[v + 1] - l->ve_off[v];
+    int e0 = l->ve_off[v], f0 = l->vf_off[v];
+    int p = sfb__fan_pos(l, v, g, slot), i, nsharp = 0, ninf = 0, cyclic = nE == nF;
+    int rule = l->vrule[v];
+    float vs = l->vs[v];
+    *pos = p;
+    if (p < 0 || (l->vtag[v] & SFB__TAG_NONMANIFOLD)) return SFB__CORNER_IRREGULAR;
+    for (i = 0; i < nE; ++i) {
+        float s = l->es[l->ve[e0 + i]];
+        nsharp += s > 0.0f;
+        ninf += sfb__is_inf(s);
+    }
+    if (rule == SFB__RULE_SMOOTH && vs == 0.0f && nsharp == 0 && cyclic) {
+        for (i = 0; i < nF; ++i)
+            if (sfb__face_n(l, l->vf[f0 + i]) != 4) return SFB__CORNER_IRREGULAR;
+        return nF == 4 ? SFB__CORNER_R1 : (nF >= 3 ? SFB__CORNER_EV : SFB__CORNER_IRREGULAR);
+    }
+    if (rule == SFB__RULE_CREASE && vs == 0.0f && nsharp == 2 && ninf == 2) {
+        /* the sector of g: faces reachable without crossing a sharp edge */
+        int e_d1 = l->ve[e0 + p], e_d2 = l->ve[e0 + (p + 1) % nE];
+        if (!cyclic && p + 1 >= nE) return SFB__CORNER_IRREGULAR;
+        if (sfb__face_n(l, g) != 4) return SFB__CORNER_IRREGULAR;
+        if (sfb__is_inf(l->es[e_d1]) && !sfb__is_inf(l->es[e_d2])) {
+            /* sector {g, next}: next face exists, is a quad, and the edge after it is sharp */
+            int q = p + 1, e_next;
+            if (q >= nF && !cyclic) return SFB__CORNER_IRREGULAR;
+            q %= nF;
+            e_next = l->ve[e0 + (p + 2) % nE];
+            if (!cyclic && p + 2 >= nE) return SFB__CORNER_IRREGULAR;
+            if (sfb__face_n(l, l->vf[f0 + q]) != 4 || !sfb__is_inf(l->es[e_next])) return SFB__CORNER_IRREGULAR;
+            return SFB__CORNER_R2_D1; /* crease along d1 / -d1: phantoms at b = -1 */
+        }
+        if (!sfb__is_inf(l->es[e_d1]) && sfb__is_inf(l->es[e_d2])) {
+            int q = p - 1, e_prev;
+            if (q < 0 && !cyclic) return SFB__CORNER_IRREGULAR;
+            q = (q + nF) % nF;
+            e_prev = l->ve[e0 + (p - 1 + nE) % nE];
+            if (!cyclic && p - 1 < 0) return SFB__CORNER_IRREGULAR;
+            if (sfb__face_n(l, l->vf[f0 + q]) != 4 || !sfb__is_inf(l->es[e_prev])) return SFB__CORNER_IRREGULAR;
+            return SFB__CORNER_R2_D2; /* crease along d2 / -d2: phantoms at a = -1 */
+        }
+        return SFB__CORNER_IRREGULAR;
+    }
+    if (rule == SFB__RULE_CORNER && (vs == 0.0f || sfb__is_inf(vs)) && nsharp == ninf) {
+        int e_d1 = l->ve[e0 + p];
+        int e_d2;
+        if (!cyclic && p + 1 >= nE) return SFB__CORNER_IRREGULAR;
+        e_d2 = l->ve[e0 + (p + 1) % nE];
+        if (sfb__face_n(l, g) == 4 && sfb__is_inf(l->es[e_d1]) && sfb__is_inf(l->es[e_d2])) return SFB__CORNER_R3;
+    }
+    return SFB__CORNER_IRREGULAR;
+}
+
+/* Does anything at g's corners still have to decay (semi-sharp edge or vertex)? */
+static int sfb__face_semisharp(const sfb__level *l, int g) {
+    int k, i;
+    for (k = l->fv_off[g]; k < l->fv_off[g + 1]; ++k) {
+        int v = l->fv[k];
+        if (l->vs[v] > 0.0f && !sfb__is_inf(l->vs[v])) return 1;
+        for (i = l->ve_off[v]; i < l->ve_off[v + 1]; ++i) {
+            float s = l->es[l->ve[i]];
+            if (s > 0.0f && !sfb__is_inf(s)) return 1;
+        }
+    }
+    return 0;
+}
+
+/* ---- gathering ---- */
+/* A grid cell's mask: up to 4 (vertex, weight) terms. */
+typedef struct sfb__cell { int n, real; int v[4]; double w[4]; } sfb__cell;
+
+static const int sfb__corner_pos[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+static const int sfb__corner_d1[4][2] = {{1, 0}, {0, 1}, {-1, 0}, {0, -1}};
+static const int sfb__corner_d2[4][2] = {{0, 1}, {-1, 0}, {0, -1}, {1, 0}};
+
+static int sfb__diag(const sfb__level *l, int f, int v) {
+    int o = l->fv_off[f], k;
+    for (k = 0; k < 4; ++k)
+        if (l->fv[o + k] == v) return l->fv[o + (k + 2) % 4];
+    return -1;
+}
+
+/* The real points around corner vertex v (fan position p of g): local (a,b) -> vertex, for
+ * the quadrants present (mask bit q: 0 = (+,+) g, 1 = (-,+), 2 = (-,-), 3 = (+,-)). */
+static void sfb__corner_ring(const sfb__level *l, int v, int p, unsigned quads, int out[3][3]) {
+    int e0 = l->ve_off[v], f0 = l->vf_off[v], nE = l->ve_off[v + 1] - e0, nF = l->vf_off[v + 1] - f0;
+    int a, b;
+#define SFB__EDGE(k) sfb__other_end(l, l->ve[e0 + ((p + (k)) % nE + nE) % nE], v)
+#define SFB__FACE(k) l->vf[f0 + ((p + (k)) % nF + nF) % nF]
+    for (a = 0; a < 3; ++a)
+        for (b = 0; b < 3; ++b) out[a][b] = -1;
+    out[1][1] = v;
+    /* quadrant 0 (g) always: edges d1 (k=0) and d2 (k=1) */
+    out[2][1] = SFB__EDGE(0);
+    out[1][2] = SFB__EDGE(1);
+    out[2][2] = sfb__diag(l, SFB__FACE(0), v);
+    if (quads & 2u) { out[0][1] = SFB__EDGE(2); out[0][2] = sfb__diag(l, SFB__FACE(1), v); }
+    if (quads & 4u) { out[0][1] = SFB__EDGE(2); out[1][0] = SFB__EDGE(3); out[0][0] = sfb__diag(l, SFB__FACE(2), v); }
+    if (quads & 8u) { out[1][0] = SFB__EDGE(-1 + nE); out[2][0] = sfb__diag(l, SFB__FACE(-1 + nF), v); }
+#undef SFB__EDGE
+#undef SFB__FACE
+}
+
+/* Fills the 4x4 grid (cells x,y in -1..2 -> [y+1][x+1]) of quad g in the frame whose corner 0
+ * is slot `rot`, for corners whose class is given (R1/R2/R3; skip = corner not gathered, for
+ * the EV of a Stam patch). Returns 0 when the corners disagree. */
+static int sfb__gather(const sfb__level *l, int g, int rot, const int cls[4], const int pos[4], int skip, sfb__cell grid[4][4]) {
+    int k, a, b, x, y;
+    for (y = 0; y < 4; ++y)
+        for (x = 0; x < 4; ++x) grid[y][x].n = 0, grid[y][x].real = 0;
+    /* real points first */
+    for (k = 0; k < 4; ++k) {
+        int ring[3][3], v;
+        unsigned quads;
+        if (k == skip) continue;
+        v = l->fv[l->fv_off[g] + (rot + k) % 4];
+        quads = cls[k] == SFB__CORNER_R1 ? 15u : cls[k] == SFB__CORNER_R2_D1 ? 3u : cls[k] == SFB__CORNER_R2_D2 ? 9u : 1u;
+        sfb__corner_ring(l, v, pos[k], quads, ring);
+        for (a = -1; a <= 1; ++a)
+            for (b = -1; b <= 1; ++b) {
+                int vv = ring[a + 1][b + 1];
+                sfb__cell *c;
+                if (vv < 0) continue;
+                x = sfb__corner_pos[k][0] + a * sfb__corner_d1[k][0] + b * sfb__corner_d2[k][0];
+                y = sfb__corner_pos[k][1] + a * sfb__corner_d1[k][1] + b * sfb__corner_d2[k][1];
+                if (x < -1 || x > 2 || y < -1 || y > 2) continue;
+                c = &grid[y + 1][x + 1];
+                if (c->real && c->v[0] != vv) return 0;
+                c->real = 1; c->n = 1; c->v[0] = vv; c->w[0] = 1.0;
+            }
+    }
+    /* phantoms: mirror across the crease lines, corner by corner */
+    for (k = 0; k < 4; ++k) {
+        int pass;
+        if (k == skip || cls[k] == SFB__CORNER_R1) continue;
+        for (pass = 0; pass < 2; ++pass)
+            for (a = -1; a <= 1; ++a)
+                for (b = -1; b <= 1; ++b) {
+                    int mirror_b = (cls[k] == SFB__CORNER_R2_D1 || cls[k] == SFB__CORNER_R3) && b == -1;
+                    int mirror_a = (cls[k] == SFB__CORNER_R2_D2 || cls[k] == SFB__CORNER_R3) && a == -1;
+                    int sa, sb, t;
+                    sfb__cell *c, *p0, *p1;
+                    /* pass 0: one mirrored index; pass 1: the (-1,-1) cell of R3 from pass-0 phantoms */
+                    if (!(mirror_a || mirror_b) || (pass == 0) != !(mirror_a && mirror_b)) continue;
+                    x = sfb__corner_pos[k][0] + a * sfb__corner_d1[k][0] + b * sfb__corner_d2[k][0];
+                    y = sfb__corner_pos[k][1] + a * sfb__corner_d1[k][1] + b * sfb__corner_d2[k][1];
+                    if (x < -1 || x > 2 || y < -1 || y > 2) continue;
+                    c = &grid[y + 1][x + 1];
+                    if (c->real) return 0;
+                    if (c->n) continue;
+                    /* P = 2 P(mirror line) - P(inside) along the mirrored direction */
+                    if (mirror_b) { sa = a; sb = 0; }
+                    else { sa = 0; sb = b; }
+                    {
+                        int x0 = sfb__corner_pos[k][0] + sa * sfb__corner_d1[k][0] + sb * sfb__corner_d2[k][0];
+                        int y0 = sfb__corner_pos[k][1] + sa * sfb__corner_d1[k][1] + sb * sfb__corner_d2[k][1];
+                        int ia = mirror_b ? a : 1, ib = mirror_b ? 1 : b;
+                        int x1 = sfb__corner_pos[k][0] + ia * sfb__corner_d1[k][0] + ib * sfb__corner_d2[k][0];
+                        int y1 = sfb__corner_pos[k][1] + ia * sfb__corner_d1[k][1] + ib * sfb__corner_d2[k][1];
+                        p0 = &grid[y0 + 1][x0 + 1];
+                        p1 = &grid[y1 + 1][x1 + 1];
+                    }
+                    if (!p0->n || !p1->n || p0->n + p1->n > 4) return 0;
+                    c->n = 0;
+                    for (t = 0; t < p0->n; ++t) { c->v[c->n] = p0->v[t]; c->w[c->n++] = 2.0 * p0->w[t]; }
+                    for (t = 0; t < p1->n; ++t) { c->v[c->n] = p1->v[t]; c->w[c->n++] = -p1->w[t]; }
+                }
+    }
+    return 1;
+}
+
+/* ---- the table ---- */
+static int sfb__pb_patch(sfb__pbuild *b, int type, unsigned param, int valence, int ncv) {
+    sfb__patch_table *pt = b->pt;
+    int n = pt->npatch;
+    if (n + 1 > b->cap_patch) {
+        int nc = b->cap_patch ? b->cap_patch * 2 : 256;
+        int *t1 = (int *)sfb__realloc(b->ctx, pt->ptype, (size_t)nc * sizeof(int));
+        if (!t1) return -1;
+        pt->ptype = t1;
+        t1 = (int *)sfb__realloc(b->ctx, pt->pfirst, (size_t)(nc + 1) * sizeof(int));
+        if (!t1) return -1;
+        pt->pfirst = t1;
+        t1 = (int *)sfb__realloc(b->ctx, pt->pvalence, (size_t)nc * sizeof(int));
+        if (!t1) return -1;
+        pt->pvalence = t1;
+        {
+            unsigned *t2 = (unsigned *)sfb__realloc(b->ctx, pt->pparam, (size_t)nc * sizeof(unsigned));
+            if (!t2) return -1;
+            pt->pparam = t2;
+        }
+        b->cap_patch = nc;
+    }
+    if (!sfb__pb_grow_int(b->ctx, &pt->cv, &b->cap_cv, pt->ncv + ncv)) return -1;
+    pt->ptype[n] = type;
+    pt->pfirst[n] = pt->ncv;
+    pt->pparam[n] = param;
+    pt->pvalence[n] = valence;
+    pt->ncv += ncv;
+    pt->pfirst[n + 1] = pt->ncv;
+    pt->npatch = n + 1;
+    pt->counts[type]++;
+    return n;
+}
+
+/* Inserts patch `patch` (or -1 for a hole) at (ptex, depth, i, j) in the quadtree. */
+static int sfb__pb_insert(sfb__pbuild *b, int ptex, unsigned param, int patch) {
+    sfb__patch_table *pt = b->pt;
+    int depth = SFB__PARAM_DEPTH(param), pi = SFB__PARAM_I(param), pj = SFB__PARAM_J(param);
+    int *slot = &pt->ptex_root[ptex], d;
+    for (d = 0; d < depth; ++d) {
+        int qx = (pi >> (depth - 1 - d)) & 1, qy = (pj >> (depth - 1 - d)) & 1, node;
+        if (*slot < 0) {
+            /* a new internal node (its slot may only be empty: -1) */
+            int k;
+            ptrdiff_t off = slot - pt->nodes;
+            int in_nodes = pt->nodes && slot >= pt->nodes && slot < pt->nodes + 4 * (size_t)pt->nnodes;
+            if (!sfb__pb_grow_int(b->ctx, &pt->nodes, &b->cap_nodes, 4 * (pt->nnodes + 1))) return 0;
+            if (in_nodes) slot = pt->nodes + off;
+            node = pt->nnodes++;
+            for (k = 0; k < 4; ++k) pt->nodes[4 * node + k] = -1;
+            *slot = node;
+        }
+        node = *slot;
+        slot = &pt->nodes[4 * node + qx + 2 * qy];
+    }
+    *slot = patch >= 0 ? -(patch + 2) : -1;
+    return 1;
+}
+
+typedef struct sfb__wlevel {
+    sfb__level l;
+    sfb__rows rows;
+    int *fptex;          /* param face of a candidate face, -1 otherwise */
+    unsigned *fparam;    /* depth, i, j and rotation (in the corner bits) of candidates */
+    unsigned char *vcomp, *ecomp;
+    int owns_level;
+} sfb__wlevel;
+
+static void sfb__wlevel_free(sfb_context *ctx, sfb__wlevel *w) {
+    if (w->owns_level) sfb__level_free(ctx, &w->l);
+    sfb__rows_free(ctx, &w->rows);
+    sfb__free(ctx, w->fptex); sfb__free(ctx, w->fparam); sfb__free(ctx, w->vcomp); sfb__free(ctx, w->ecomp);
+    memset(w, 0, sizeof *w);
+}
+
+/* Classifies candidate g; adds its patch, or returns 1 in *refine. */
+static sfb_result sfb__pb_face(sfb__pbuild *b, sfb__wlevel *w, int g, int level, int limit, int *refine) {
+    const sfb__level *l = &w->l;
+    unsigned par = w->fparam[g];
+    int rot = SFB__PARAM_CORNER(par), ptex = w->fptex[g];
+    int cls[4], pos[4], k, nev = 0, evk = -1, nirr = 0, patch;
+    unsigned out_param;
+    sfb__cell grid[4][4];
+    *refine = 0;
+    if (l->fhole[g]) return sfb__pb_insert(b, ptex, par & ~(3u << 30), -1) ? SFB_SUCCESS : sfb__oom(b->ctx, "patch table");
+    if (sfb__face_n(l, g) != 4) { *refine = 1; return SFB_SUCCESS; }
+    for (k = 0; k < 4; ++k) {
+        int slot = (rot + k) % 4, v = l->fv[l->fv_off[g] + slot];
+        cls[k] = sfb__corner_class(l, v, g, slot, &pos[k]);
+        if (cls[k] == SFB__CORNER_EV) { nev++; evk = k; }
+        else if (cls[k] == SFB__CORNER_IRREGULAR) nirr++;
+    }
+    if (nirr == 0 && nev == 0 && sfb__gather(l, g, rot, cls, pos, -1, grid)) {
+        int x, y, base;
+        patch = sfb__pb_patch(b, SFB__PATCH_BSPLINE, par & ~(3u << 30), 0, 16);
+        if (patch < 0) return sfb__oom(b->ctx, "patch table");
+        base = b->pt->pfirst[patch];
+        for (y = 0; y < 4; ++y)
+            for (x = 0; x < 4; ++x) {
+                sfb__cell *c = &grid[y][x];
+                int t, row;
+                b->m.n = 0;
+                for (t = 0; t < c->n; ++t) SFB__MASK_ADD(&b->m, c->v[t], c->w[t]);
+                row = sfb__pb_point(b, &w->rows, &b->m);
+                if (row < 0) return sfb__oom(b->ctx, "patch points");
+                b->pt->cv[base + 4 * y + x] = row;
+            }
+        return sfb__pb_insert(b, ptex, par & ~(3u << 30), patch) ? SFB_SUCCESS : sfb__oom(b->ctx, "patch table");
+    }
+    if (nev == 1 && nirr == 0 && cls[(evk + 1) % 4] == SFB__CORNER_R1 && cls[(evk + 2) % 4] == SFB__CORNER_R1 &&
+        cls[(evk + 3) % 4] == SFB__CORNER_R1) {
+        int ev = l->fv[l->fv_off[g] + (rot + evk) % 4];
+        int N = l->vf_off[ev + 1] - l->vf_off[ev];
+        const sfb__eigen_cc *e = sfb__eigen_cc_get(b->ctx, N);
+        int scls[4], spos[4];
+        if (e) {
+            /* gather in the Stam frame: corner 0 = the EV */
+            for (k = 0; k < 4; ++k) { scls[k] = cls[(evk + k) % 4]; spos[k] = pos[(evk + k) % 4]; }
+            if (sfb__gather(l, g, (rot + evk) % 4, scls, spos, 0, grid)) {
+                int K = e->K, i, m, pE = spos[0], e0 = l->ve_off[ev], f0 = l->vf_off[ev], base;
+                int *C = (int *)sfb__alloc(b->ctx, (size_t)K * sizeof(int));
+                static const int outer[7][2] = {{2, 2}, {2, 1}, {2, 0}, {2, -1}, {1, 2}, {0, 2}, {-1, 2}};
+                if (!C) return sfb__oom(b->ctx, "patch table");
+                C[0] = ev;
+                for (i = 1; i <= N; ++i) {
+                    int re = ((pE + (3 - i)) % N + N) % N, rf = ((pE + (2 - i)) % N + N) % N;
+                    C[2 * i - 1] = sfb__other_end(l, l->ve[e0 + re], ev);
+                    C[2 * i] = sfb__diag(l, l->vf[f0 + rf], ev);
+                }
+                for (i = 0; i < 7; ++i) {
+                    sfb__cell *c = &grid[outer[i][1] + 1][outer[i][0] + 1];
+                    C[2 * N + 1 + i] = (c->real && c->n == 1) ? c->v[0] : -1;
+                }
+                for (i = 0; i < K; ++i)
+                    if (C[i] < 0) { sfb__free(b->ctx, C); C = NULL; break; }
+                if (C) {
+                    out_param = SFB__PARAM(SFB__PARAM_DEPTH(par), SFB__PARAM_I(par), SFB__PARAM_J(par), evk);
+                    patch = sfb__pb_patch(b, SFB__PATCH_STAM, out_param, N, K);
+                    if (patch < 0 || !sfb__mask_grow(b->ctx, &b->m, K)) { sfb__free(b->ctx, C); return sfb__oom(b->ctx, "patch table"); }
+                    base = b->pt->pfirst[patch];
+                    for (i = 0; i < K; ++i) {
+                        int row;
+                        b->m.n = 0;
+                        for (m = 0; m < K; ++m) {
+                            double wgt = e->vinv[(size_t)i * K + m];
+                            if (wgt != 0.0) SFB__MASK_ADD(&b->m, C[m], wgt);
+                        }
+                        row = sfb__pb_point(b, &w->rows, &b->m);
+                        if (row < 0) { sfb__free(b->ctx, C); return sfb__oom(b->ctx, "patch points"); }
+                        b->pt->cv[base + i] = row;
+                    }
+                    sfb__free(b->ctx, C);
+                    return sfb__pb_insert(b, ptex, out_param, patch) ? SFB_SUCCESS : sfb__oom(b->ctx, "patch table");
+                }
+            }
+        }
+    }
+    if ((level >= limit && !sfb__face_semisharp(l, g)) || level >= SFB_MAX_LEVEL + 1) {
+        /* end cap: limit positions of the corners, in frame order */
+        int base;
+        sfb__mask mp, m1, m2;
+        memset(&mp, 0, sizeof mp); memset(&m1, 0, sizeof m1); memset(&m2, 0, sizeof m2);
+        patch = sfb__pb_patch(b, SFB__PATCH_ENDCAP, par & ~(3u << 30), 0, 4);
+        if (patch < 0) return sfb__oom(b->ctx, "patch table");
+        base = b->pt->pfirst[patch];
+        for (k = 0; k < 4; ++k) {
+            int v = l->fv[l->fv_off[g] + (rot + k) % 4], row, need = 3 * sfb__mask_need_vertex(l, v) + 8;
+            if (!sfb__mask_grow(b->ctx, &mp, need) || !sfb__mask_grow(b->ctx, &m1, need) || !sfb__mask_grow(b->ctx, &m2, need)) row = -1;
+            else {
+                sfb__limit_masks(l, v, SFB_SCHEME_CATMARK, &mp, &m1, &m2);
+                row = sfb__pb_point(b, &w->rows, &mp);
+            }
+            if (row < 0) {
+                sfb__free(b->ctx, mp.idx); sfb__free(b->ctx, mp.w); sfb__free(b->ctx, m1.idx); sfb__free(b->ctx, m1.w);
+                sfb__free(b->ctx, m2.idx); sfb__free(b->ctx, m2.w);
+                return sfb__oom(b->ctx, "patch points");
+            }
+            b->pt->cv[base + k] = row;
+        }
+        sfb__free(b->ctx, mp.idx); sfb__free(b->ctx, mp.w); sfb__free(b->ctx, m1.idx); sfb__free(b->ctx, m1.w);
+        sfb__free(b->ctx, m2.idx); sfb__free(b->ctx, m2.w);
+        return sfb__pb_insert(b, ptex, par & ~(3u << 30), patch) ? SFB_SUCCESS : sfb__oom(b->ctx, "patch table");
+    }
+    *refine = 1;
+    return SFB_SUCCESS;
+}
+
+/* The sub-mesh to refine: `mark` faces (active and their 1-ring), renumbered. */
+static sfb_result sfb__pb_submesh(sfb_context *ctx, const sfb__wlevel *w, const unsigned char *mark, sfb__level *sub,
+                                  int *vmap, int *emap, int *fmap, unsigned char *vcomp, unsigned char *ecomp) {
+    const sfb__level *l = &w->l;
+    int f, k, nv = 0, ne = 0, nf = 0, nfv = 0;
+    sfb_result r;
+    memset(sub, 0, sizeof *sub);
+    for (k = 0; k < l->nv; ++k) vmap[k] = -1;
+    for (k = 0; k < l->ne; ++k) emap[k] = -1;
+    for (f = 0; f < l->nf; ++f) {
+        fmap[f] = -1;
+        if (!mark[f]) continue;
+        fmap[f] = nf++;
+        for (k = l->fv_off[f]; k < l->fv_off[f + 1]; ++k) {
+            if (vmap[l->fv[k]] < 0) vmap[l->fv[k]] = nv++;
+            if (emap[l->fe[k]] < 0) emap[l->fe[k]] = ne++;
+            nfv++;
+        }
+    }
+    sub->nv = nv; sub->ne = ne; sub->nf = nf; sub->nfv = nfv;
+    sub->fv_off = (int *)sfb__alloc(ctx, ((size_t)nf + 1) * sizeof(int));
+    sub->fv = (int *)sfb__alloc(ctx, ((size_t)nfv + 1) * sizeof(int));
+    sub->fe = (int *)sfb__alloc(ctx, ((size_t)nfv + 1) * sizeof(int));
+    sub->ev = (int *)sfb__alloc(ctx, ((size_t)ne * 2 + 1) * sizeof(int));
+    sub->es = (float *)sfb__alloc(ctx, ((size_t)ne + 1) * sizeof(float));
+    sub->vs = (float *)sfb__alloc(ctx, ((size_t)nv + 1) * sizeof(float));
+    sub->fhole = (unsigned char *)sfb__calloc(ctx, (size_t)nf + 1, 1);
+    if (!sub->fv_off || !sub->fv || !sub->fe || !sub->ev || !sub->es || !sub->vs || !sub->fhole) {
+        sfb__level_free(ctx, sub);
+        return sfb__oom(ctx, "adaptive refinement");
+    }
+    nfv = 0;
+    for (f = 0; f < l->nf; ++f) {
+        int sf = fmap[f];
+        if (sf < 0) continue;
+        sub->fv_off[sf] = nfv;
+        sub->fhole[sf] = l->fhole[f];
+        for (k = l->fv_off[f]; k < l->fv_off[f + 1]; ++k) {
+            sub->fv[nfv] = vmap[l->fv[k]];
+            sub->fe[nfv] = emap[l->fe[k]];
+            nfv++;
+        }
+    }
+    sub->fv_off[nf] = nfv;
+    for (k = 0; k < l->ne; ++k)
+        if (emap[k] >= 0) {
+            sub->ev[2 * emap[k]] = vmap[l->ev[2 * k]];
+            sub->ev[2 * emap[k] + 1] = vmap[l->ev[2 * k + 1]];
+            sub->es[emap[k]] = l->es[k];
+        }
+    for (k = 0; k < l->nv; ++k)
+        if (vmap[k] >= 0) sub->vs[vmap[k]] = l->vs[k];
+    r = sfb__level_complete(ctx, sub);
+    if (r != SFB_SUCCESS) { sfb__level_free(ctx, sub); return r; }
+    sfb__level_compute_rules(sub);
+    /* complete in the sub-mesh: complete before and nothing around it left out */
+    for (k = 0; k < l->nv; ++k)
+        if (vmap[k] >= 0)
+            vcomp[vmap[k]] = w->vcomp[k] && (sub->vf_off[vmap[k] + 1] - sub->vf_off[vmap[k]] == l->vf_off[k + 1] - l->vf_off[k]);
+    for (k = 0; k < l->ne; ++k)
+        if (emap[k] >= 0)
+            ecomp[emap[k]] = w->ecomp[k] && (sub->ef_off[emap[k] + 1] - sub->ef_off[emap[k]] == l->ef_off[k + 1] - l->ef_off[k]);
+    return SFB_SUCCESS;
+}
+
+sfb_result sfb__patches_build(sfb_context *ctx, const sfb__level *base, const sfb__refine_options *opt, int limit,
+                              sfb__patch_table *pt) {
+    sfb__pbuild b;
+    sfb__wlevel w, nw;
+    sfb_result r = SFB_SUCCESS;
+    float *ps = NULL, *cs = NULL;
+    int f, k, level, nptex = 0;
+    int *active = NULL, nactive = 0;
+    memset(&b, 0, sizeof b);
+    memset(&w, 0, sizeof w);
+    memset(&nw, 0, sizeof nw);
+    memset(pt, 0, sizeof *pt);
+    b.ctx = ctx;
+    b.pt = pt;
+    pt->scheme = opt->scheme;
+    pt->isolation = limit;
+    /* param faces */
+    pt->face_ptex = (int *)sfb__alloc(ctx, ((size_t)base->nf + 1) * sizeof(int));
+    if (!pt->face_ptex) goto oom;
+    for (f = 0; f < base->nf; ++f) {
+        pt->face_ptex[f] = nptex;
+        nptex += sfb__face_n(base, f) == 4 ? 1 : sfb__face_n(base, f);
+    }
+    pt->face_ptex[base->nf] = nptex;
+    pt->nptex = nptex;
+    pt->ptex_face = (int *)sfb__alloc(ctx, ((size_t)nptex + 1) * sizeof(int));
+    pt->ptex_corner = (int *)sfb__alloc(ctx, ((size_t)nptex + 1) * sizeof(int));
+    pt->ptex_root = (int *)sfb__alloc(ctx, ((size_t)nptex + 1) * sizeof(int));
+    if (!pt->ptex_face || !pt->ptex_corner || !pt->ptex_root) goto oom;
+    for (f = 0; f < base->nf; ++f)
+        for (k = pt->face_ptex[f]; k < pt->face_ptex[f + 1]; ++k) {
+            pt->ptex_face[k] = f;
+            pt->ptex_corner[k] = sfb__face_n(base, f) == 4 ? -1 : k - pt->face_ptex[f];
+            pt->ptex_root[k] = -1;
+        }
+    /* level 0 */
+    w.l = *base;
+    w.owns_level = 0;
+    w.rows.rows = base->nv;
+    w.rows.off = (size_t *)sfb__alloc(ctx, ((size_t)base->nv + 1) * sizeof(size_t));
+    w.fptex = (int *)sfb__alloc(ctx, ((size_t)base->nf + 1) * sizeof(int));
+    w.fparam = (unsigned *)sfb__calloc(ctx, (size_t)base->nf + 1, sizeof(unsigned));
+    w.vcomp = (unsigned char *)sfb__alloc(ctx, (size_t)base->nv + 1);
+    w.ecomp = (unsigned char *)sfb__alloc(ctx, (size_t)base->ne + 1);
+    b.A.acc = (double *)sfb__alloc(ctx, ((size_t)base->nv + 1) * sizeof(double));
+    b.A.mark = (unsigned *)sfb__calloc(ctx, (size_t)base->nv + 1, sizeof(unsigned));
+    b.A.touched = (int *)sfb__alloc(ctx, ((size_t)base->nv + 1) * sizeof(int));
+    ps = (float *)sfb__alloc(ctx, (SFB_MAX_VALENCE + 2) * sizeof(float));
+    cs = (float *)sfb__alloc(ctx, (SFB_MAX_VALENCE + 2) * sizeof(float));
+    b.vrow = (int *)sfb__alloc(ctx, ((size_t)base->nv + 1) * sizeof(int));
+    if (!w.rows.off || !w.fptex || !w.fparam || !w.vcomp || !w.ecomp || !b.A.acc || !b.A.mark || !b.A.touched || !ps || !cs ||
+        !b.vrow || !sfb__rows_reserve(ctx, &w.rows, (size_t)base->nv + 1) || !sfb__mask_grow(ctx, &b.m, 64))
+        goto oom;
+    for (k = 0; k < base->nv; ++k) { w.rows.off[k] = (size_t)k; w.rows.idx[k] = k; w.rows.w[k] = 1.0; }
+    w.rows.off[base->nv] = (size_t)base->nv;
+    w.rows.n = (size_t)base->nv;
+    memset(w.vcomp, 1, (size_t)base->nv + 1);
+    memset(w.ecomp, 1, (size_t)base->ne + 1);
+    for (f = 0; f < base->nf; ++f) w.fptex[f] = sfb__face_n(base, f) == 4 ? pt->face_ptex[f] : -1;
+    for (level = 0;; ++level) {
+        unsigned char *mark = NULL, *vc = NULL, *ec = NULL;
+        int *vmap = NULL, *emap = NULL, *fmap = NULL;
+        sfb__level sub;
+        sfb__rows subrows;
+        r = sfb__progress(ctx, 0.8f + 0.15f * (float)level / (float)(SFB_MAX_LEVEL + 2), "patches");
+        if (r != SFB_SUCCESS) goto done;
+        for (k = 0; k < w.l.nv; ++k) b.vrow[k] = -1;
+        if (level == 0) for (k = 0; k < w.l.nv; ++k) b.vrow[k] = -1;
+        sfb__free(ctx, active);
+        active = (int *)sfb__alloc(ctx, ((size_t)w.l.nf + 1) * sizeof(int));
+        if (!active) goto oom;
+        nactive = 0;
+        for (f = 0; f < w.l.nf; ++f) {
+            int refine = 0;
+            if (level == 0 && sfb__face_n(&w.l, f) != 4) {
+                if (!w.l.fhole[f]) active[nactive++] = f;
+                continue;
+            }
+            if (w.fptex[f] < 0) continue;
+            r = sfb__pb_face(&b, &w, f, level, limit, &refine);
+            if (r != SFB_SUCCESS) goto done;
+            if (refine) active[nactive++] = f;
+        }
+        if (nactive == 0) break;
+        if (level > SFB_MAX_LEVEL + 1) {
+            r = sfb__error(ctx, SFB_BACKEND_ERROR, SFB_ELEMENT_NONE, -1, "adaptive isolation did not terminate");
+            goto done;
+        }
+        /* mark the active faces and their 1-ring */
+        mark = (unsigned char *)sfb__calloc(ctx, (size_t)w.l.nf + 1, 1);
+        vmap = (int *)sfb__alloc(ctx, ((size_t)w.l.nv + 1) * sizeof(int));
+        emap = (int *)sfb__alloc(ctx, ((size_t)w.l.ne + 1) * sizeof(int));
+        fmap = (int *)sfb__alloc(ctx, ((size_t)w.l.nf + 1) * sizeof(int));
+        vc = (unsigned char *)sfb__alloc(ctx, (size_t)w.l.nv + 1);
+        ec = (unsigned char *)sfb__alloc(ctx, (size_t)w.l.ne + 1);
+        if (!mark || !vmap || !emap || !fmap || !vc || !ec) {
+            sfb__free(ctx, mark); sfb__free(ctx, vmap); sfb__free(ctx, emap); sfb__free(ctx, fmap); sfb__free(ctx, vc); sfb__free(ctx, ec);
+            goto oom;
+        }
+        for (k = 0; k < nactive; ++k) {
+            int g = active[k], q, i;
+            mark[g] = 1;
+            for (q = w.l.fv_off[g]; q < w.l.fv_off[g + 1]; ++q) {
+                int v = w.l.fv[q];
+                if (!w.vcomp[v]) {
+                    r = sfb__error(ctx, SFB_BACKEND_ERROR, SFB_ELEMENT_NONE, -1, "adaptive isolation reached an incomplete vertex");
+                    sfb__free(ctx, mark); sfb__free(ctx, vmap); sfb__free(ctx, emap); sfb__free(ctx, fmap); sfb__free(ctx, vc); sfb__free(ctx, ec);
+                    goto done;
+                }
+                for (i = w.l.vf_off[v]; i < w.l.vf_off[v + 1]; ++i) mark[w.l.vf[i]] = 1;
+            }
+        }
+        r = sfb__pb_submesh(ctx, &w, mark, &sub, vmap, emap, fmap, vc, ec);
+        if (r != SFB_SUCCESS) {
+            sfb__free(ctx, mark); sfb__free(ctx, vmap); sfb__free(ctx, emap); sfb__free(ctx, fmap); sfb__free(ctx, vc); sfb__free(ctx, ec);
+            goto done;
+        }
+        /* rows of the sub-mesh's vertices */
+        memset(&subrows, 0, sizeof subrows);
+        subrows.rows = sub.nv;
+        subrows.off = (size_t *)sfb__alloc(ctx, ((size_t)sub.nv + 1) * sizeof(size_t));
+        r = SFB_SUCCESS;
+        if (!subrows.off) r = sfb__oom(ctx, "adaptive refinement");
+        else {
+            int v;
+            subrows.off[0] = 0;
+            {
+                int *inv = (int *)sfb__alloc(ctx, ((size_t)sub.nv + 1) * sizeof(int));
+                if (!inv) r = sfb__oom(ctx, "adaptive refinement");
+                else {
+                    for (v = 0; v < w.l.nv; ++v)
+                        if (vmap[v] >= 0) inv[vmap[v]] = v;
+                    for (v = 0; v < sub.nv && r == SFB_SUCCESS; ++v) {
+                        size_t a = w.rows.off[inv[v]], z = w.rows.off[inv[v] + 1];
+                        if (!sfb__rows_reserve(ctx, &subrows, subrows.n + (z - a))) { r = sfb__oom(ctx, "adaptive refinement"); break; }
+                        memcpy(subrows.idx + subrows.n, w.rows.idx + a, (z - a) * sizeof(int));
+                        memcpy(subrows.w + subrows.n, w.rows.w + a, (z - a) * sizeof(double));
+                        subrows.n += z - a;
+                        subrows.off[v + 1] = subrows.n;
+                    }
+                    sfb__free(ctx, inv);
+                }
+            }
+        }
+        if (r == SFB_SUCCESS) {
+            memset(&nw, 0, sizeof nw);
+            r = sfb__refine_step(ctx, opt, &sub, &subrows, &nw.l, &nw.rows, &b.A, &b.m, ps, cs, 0.0f, 0.0f);
+            nw.owns_level = 1;
+        }
+        if (r == SFB_SUCCESS) {
+            /* flags and candidates of the child level */
+            const sfb__level *p = &sub;
+            nw.fptex = (int *)sfb__alloc(ctx, ((size_t)nw.l.nf + 1) * sizeof(int));
+            nw.fparam = (unsigned *)sfb__calloc(ctx, (size_t)nw.l.nf + 1, sizeof(unsigned));
+            nw.vcomp = (unsigned char *)sfb__calloc(ctx, (size_t)nw.l.nv + 1, 1);
+            nw.ecomp = (unsigned char *)sfb__calloc(ctx, (size_t)nw.l.ne + 1, 1);
+            if (!nw.fptex || !nw.fparam || !nw.vcomp || !nw.ecomp) r = sfb__oom(ctx, "adaptive refinement");
+            else {
+                int v, e;
+                for (v = 0; v < p->nv; ++v) nw.vcomp[v] = vc[v];
+                for (f = 0; f < p->nf; ++f) nw.vcomp[p->nv + f] = 1;
+                for (e = 0; e < p->ne; ++e) {
+                    nw.vcomp[p->nv + p->nf + e] = ec[e];
+                    nw.ecomp[2 * e] = nw.ecomp[2 * e + 1] = ec[e];
+                }
+                for (e = 2 * p->ne; e < nw.l.ne; ++e) nw.ecomp[e] = 1;
+                for (f = 0; f < nw.l.nf; ++f) nw.fptex[f] = -1;
+                for (k = 0; k < nactive; ++k) {
+                    int g = active[k], sf = fmap[g], o = p->fv_off[sf], n = p->fv_off[sf + 1] - o, i;
+                    unsigned par = w.fparam[g];
+                    for (i = 0; i < n; ++i) {
+                        int cf = o + i;
+                        if (level == 0 && sfb__face_n(&w.l, g) != 4) {
+                            nw.fptex[cf] = pt->face_ptex[g] + i;
+                            nw.fparam[cf] = 0;
+                        } else {
+                            int rot = SFB__PARAM_CORNER(par), c = ((i - rot) % 4 + 4) % 4;
+                            int ox = (c == 1 || c == 2), oy = (c >= 2);
+                            nw.fptex[cf] = w.fptex[g];
+                            nw.fparam[cf] = SFB__PARAM(SFB__PARAM_DEPTH(par) + 1, 2 * SFB__PARAM_I(par) + ox, 2 * SFB__PARAM_J(par) + oy,
+                                                       ((rot - i) % 4 + 4) % 4);
+                        }
+                    }
+                }
+            }
+        }
+        sfb__rows_free(ctx, &subrows);
+        sfb__level_free(ctx, &sub);
+        sfb__free(ctx, mark); sfb__free(ctx, vmap); sfb__free(ctx, emap); sfb__free(ctx, fmap); sfb__free(ctx, vc); sfb__free(ctx, ec);
+        if (r != SFB_SUCCESS) { sfb__wlevel_free(ctx, &nw); goto done; }
+        sfb__wlevel_free(ctx, &w);
+        w = nw;
+        memset(&nw, 0, sizeof nw);
+        {
+            int *nv = (int *)sfb__realloc(ctx, b.vrow, ((size_t)w.l.nv + 1) * sizeof(int));
+            if (!nv) goto oom;
+            b.vrow = nv;
+        }
+        if (level + 1 > pt->max_depth) pt->max_depth = level + 1;
+    }
+    if (b.prow.rows == 0) {
+        /* no patches at all (every face a hole): an empty table */
+        b.prow.off = (size_t *)sfb__alloc(ctx, sizeof(size_t));
+        if (!b.prow.off) goto oom;
+        b.prow.off[0] = 0;
+    }
+    r = sfb__rows_to_stencils(ctx, &b.prow, base->nv, &pt->points);
+    if (r == SFB_OUT_OF_MEMORY) r = sfb__oom(ctx, "patch points");
+    goto done;
+oom:
+    r = sfb__oom(ctx, "patch table");
+done:
+    sfb__wlevel_free(ctx, &w);
+    sfb__wlevel_free(ctx, &nw);
+    sfb__rows_free(ctx, &b.prow);
+    sfb__free(ctx, b.A.acc); sfb__free(ctx, b.A.mark); sfb__free(ctx, b.A.touched);
+    sfb__free(ctx, b.m.idx); sfb__free(ctx, b.m.w);
+    sfb__free(ctx, b.vrow);
+    sfb__free(ctx, ps); sfb__free(ctx, cs);
+    sfb__free(ctx, active);
+    if (r != SFB_SUCCESS) sfb__patch_table_free(ctx, pt);
+    return r;
+}
+
+/* ---- locating and evaluating ---- */
+
+/* Patch index (or -1: hole) and local (s,t) of a valid location; *scale = 2^depth. */
+int sfb__patch_locate(const sfb__patch_table *pt, int ptex, double u, double v, double *s, double *t, double *scale) {
+    int node = pt->ptex_root[ptex];
+    double sc = 1.0;
+    while (node >= 0) {
+        int qx, qy;
+        u *= 2.0; v *= 2.0; sc *= 2.0;
+        qx = u >= 1.0; qy = v >= 1.0;
+        if (qx) u -= 1.0;
+        if (qy) v -= 1.0;
+        node = pt->nodes[4 * node + qx + 2 * qy];
+    }
+    *s = u; *t = v; *scale = sc;
+    return node <= -2 ? -node - 2 : -1;
+}
+
+static void sfb__bspline_basis(double t, double *b, double *d, double *dd) {
+    double t2 = t * t, t3 = t2 * t, s = 1.0 - t;
+    b[0] = s * s * s / 6.0; b[1] = (3.0 * t3 - 6.0 * t2 + 4.0) / 6.0; b[2] = (-3.0 * t3 + 3.0 * t2 + 3.0 * t + 1.0) / 6.0; b[3] = t3 / 6.0;
+    d[0] = -0.5 * s * s; d[1] = 1.5 * t2 - 2.0 * t; d[2] = -1.5 * t2 + t + 0.5; d[3] = 0.5 * t2;
+    dd[0] = s; dd[1] = 3.0 * t - 2.0; dd[2] = -3.0 * t + 1.0; dd[3] = t;
+}
+
+static void sfb__cross(const double *a, const double *b, double *c) {
+    c[0] = a[1] * b[2] - a[2] * b[1];
+    c[1] = a[2] * b[0] - a[0] * b[2];
+    c[2] = a[0] * b[1] - a[1] * b[0];
+}
+
+/* res[0..5]: P, Ps, Pt, Pss, Pst, Ptt in the patch's (s,t); nrm: an unnormalised normal
+ * direction (a positive multiple of Ps x Pt, finite where Ps x Pt under- or overflows). */
+static void sfb__eval_bspline16(const float *pts, const int *cv, double s, double t, double res[6][3]) {
+    double bu[4], du[4], ddu[4], bv[4], dv[4], ddv[4];
+    int i, j, c;
+    sfb__bspline_basis(s, bu, du, ddu);
+    sfb__bspline_basis(t, bv, dv, ddv);
+    memset(res, 0, sizeof(double) * 18);
+    for (j = 0; j < 4; ++j)
+        for (i = 0; i < 4; ++i) {
+            const float *p = pts + 3 * (size_t)cv[4 * j + i];
+            double w[6];
+            w[0] = bu[i] * bv[j]; w[1] = du[i] * bv[j]; w[2] = bu[i] * dv[j];
+            w[3] = ddu[i] * bv[j]; w[4] = du[i] * dv[j]; w[5] = bu[i] * ddv[j];
+            for (c = 0; c < 3; ++c) {
+                int q;
+                for (q = 0; q < 6; ++q) res[q][c] += w[q] * p[c];
+            }
+        }
+}
+
+static void sfb__eval_endcap(const float *pts, const int *cv, double s, double t, double res[6][3]) {
+    const float *p0 = pts + 3 * (size_t)cv[0], *p1 = pts + 3 * (size_t)cv[1], *p2 = pts + 3 * (size_t)cv[2], *p3 = pts + 3 * (size_t)cv[3];
+    int c;
+    for (c = 0; c < 3; ++c) {
+        res[0][c] = (1 - s) * (1 - t) * p0[c] + s * (1 - t) * p1[c] + s * t * p2[c] + (1 - s) * t * p3[c];
+        res[1][c] = (1 - t) * ((double)p1[c] - p0[c]) + t * ((double)p2[c] - p3[c]);
+        res[2][c] = (1 - s) * ((double)p3[c] - p0[c]) + s * ((double)p2[c] - p1[c]);
+        res[3][c] = 0.0;
+        res[4][c] = (double)p0[c] - p1[c] + p2[c] - p3[c];
+        res[5][c] = 0.0;
+    }
+}
+
+/* Stam: (s,t) in the patch, the EV at frame corner `corner`. nres[2] gets the derivatives
+ * divided by sub^(n-1) 2^n (a finite tangent frame down to the EV). */
+static void sfb__eval_stam(const sfb__eigen_cc *e, const float *pts, const int *cv, int corner, double s, double t, double res[6][3],
+                           double nres[2][3]) {
+    int K = e->K, i, j, c, k, n = 1, at_ev;
+    double u, v, J[2][2], bu[4], du[4], ddu[4], bv[4], dv[4], ddv[4], uu, vv;
+    double sr[6][3], nr[2][3];
+    const double *phi;
+    switch (corner) {
+    default: u = s; v = t; J[0][0] = 1; J[0][1] = 0; J[1][0] = 0; J[1][1] = 1; break;
+    case 1: u = t; v = 1.0 - s; J[0][0] = 0; J[0][1] = 1; J[1][0] = -1; J[1][1] = 0; break;
+    case 2: u = 1.0 - s; v = 1.0 - t; J[0][0] = -1; J[0][1] = 0; J[1][0] = 0; J[1][1] = -1; break;
+    case 3: u = 1.0 - t; v = s; J[0][0] = 0; J[0][1] = -1; J[1][0] = 1; J[1][1] = 0; break;
+    }
+    /* J[a][b] = d(u,v)_a / d(s,t)_b */
+    memset(sr, 0, sizeof sr);
+    memset(nr, 0, sizeof nr);
+    at_ev = (u == 0.0 && v == 0.0);
+    if (at_ev) {
+        /* the limit point; tangents: the n -> infinity limit of the normalised derivatives */
+        k = 2; uu = 0.0; vv = 0.0;
+    } else {
+        while (u < 0.5 && v < 0.5) { u *= 2.0; v *= 2.0; ++n; }
+        if (v < 0.5) { k = 1; uu = 2.0 * u - 1.0; vv = 2.0 * v; }
+        else if (u < 0.5) { k = 3; uu = 2.0 * u; vv = 2.0 * v - 1.0; }
+        else { k = 2; uu = 2.0 * u - 1.0; vv = 2.0 * v - 1.0; }
+    }
+    sfb__bspline_basis(uu, bu, du, ddu);
+    sfb__bspline_basis(vv, bv, dv, ddv);
+    phi = e->phi + (size_t)(k - 1) * 16 * K;
+    for (i = 0; i < K; ++i) {
+        double f[6] = {0, 0, 0, 0, 0, 0}, lp, ln;
+        const float *p = pts + 3 * (size_t)cv[i];
+        for (j = 0; j < 16; ++j) {
+            double ph = phi[(size_t)j * K + i];
+            int a = j % 4, b = j / 4;
+            f[0] += bu[a] * bv[b] * ph; f[1] += du[a] * bv[b] * ph; f[2] += bu[a] * dv[b] * ph;
+            f[3] += ddu[a] * bv[b] * ph; f[4] += du[a] * dv[b] * ph; f[5] += bu[a] * ddv[b] * ph;
+        }
+        if (at_ev) {
+            lp = i == e->dominant ? 1.0 : 0.0;
+            ln = (i != e->dominant && fabs(fabs(e->lambda[i]) - e->sub) <= 1e-12) ? 1.0 : 0.0;
+        } else {
+            lp = pow(e->lambda[i], n - 1);
+            ln = i == e->dominant ? 0.0 : pow(e->lambda[i] / e->sub, n - 1);
+        }
+        for (c = 0; c < 3; ++c) {
+            sr[0][c] += lp * f[0] * p[c];
+            nr[0][c] += ln * f[1] * p[c];
+            nr[1][c] += ln * f[2] * p[c];
+            sr[3][c] += ln * f[3] * p[c];
+            sr[4][c] += ln * f[4] * p[c];
+            sr[5][c] += ln * f[5] * p[c];
+        }
+    }
+    {
+        double sc1 = at_ev ? 1.0 : pow(e->sub, n - 1) * ldexp(1.0, n);
+        double sc2 = at_ev ? 0.0 : pow(e->sub, n - 1) * ldexp(1.0, 2 * n);
+        for (c = 0; c < 3; ++c) {
+            double Pu = nr[0][c], Pv = nr[1][c], Puu = sr[3][c], Puv = sr[4][c], Pvv = sr[5][c];
+            res[0][c] = sr[0][c];
+            nres[0][c] = Pu * J[0][0] + Pv * J[1][0];
+            nres[1][c] = Pu * J[0][1] + Pv * J[1][1];
+            res[1][c] = nres[0][c] * sc1;
+            res[2][c] = nres[1][c] * sc1;
+            res[3][c] = sc2 * (Puu * J[0][0] * J[0][0] + 2.0 * Puv * J[0][0] * J[1][0] + Pvv * J[1][0] * J[1][0]);
+            res[4][c] = sc2 * (Puu * J[0][0] * J[0][1] + Puv * (J[0][0] * J[1][1] + J[0][1] * J[1][0]) + Pvv * J[1][0] * J[1][1]);
+            res[5][c] = sc2 * (Puu * J[0][1] * J[0][1] + 2.0 * Puv * J[0][1] * J[1][1] + Pvv * J[1][1] * J[1][1]);
+        }
+    }
+}
+
+/* The ref kernel: one location, double precision throughout. */
+static void sfb__ref_eval_one(const sfb__patch_table *pt, const float *pts, const sfb_location *loc, double res[6][3], double nrm[3]) {
+    double s, t, sc, nres[2][3];
+    int patch = sfb__patch_locate(pt, loc->face, loc->u, loc->v, &s, &t, &sc), c;
+    const int *cv;
+    double len;
+    memset(res, 0, sizeof(double) * 18);
+    nrm[0] = nrm[1] = nrm[2] = 0.0;
+    if (patch < 0) return;
+    cv = pt->cv + pt->pfirst[patch];
+    switch (pt->ptype[patch]) {
+    case SFB__PATCH_STAM:
+        sfb__eval_stam(pt->eig[pt->pvalence[patch]], pts, cv, SFB__PARAM_CORNER(pt->pparam[patch]), s, t, res, nres);
+        sfb__cross(nres[0], nres[1], nrm);
+        break;
+    case SFB__PATCH_ENDCAP:
+        sfb__eval_endcap(pts, cv, s, t, res);
+        sfb__cross(res[1], res[2], nrm);
+        break;
+    default:
+        sfb__eval_bspline16(pts, cv, s, t, res);
+        sfb__cross(res[1], res[2], nrm);
+        break;
+    }
+    len = sqrt(nrm[0] * nrm[0] + nrm[1] * nrm[1] + nrm[2] * nrm[2]);
+    if (!(len > 0.0) || !isfinite(len)) {
+        /* degenerate tangents (a collapsed control net): the normal a step inside the patch */
+        double r2[6][3];
+        double s2 = s + (s < 0.5 ? 1e-3 : -1e-3), t2 = t + (t < 0.5 ? 1e-3 : -1e-3);
+        if (pt->ptype[patch] == SFB__PATCH_BSPLINE) sfb__eval_bspline16(pts, cv, s2, t2, r2);
+        else if (pt->ptype[patch] == SFB__PATCH_ENDCAP) sfb__eval_endcap(pts, cv, s2, t2, r2);
+        else { sfb__eval_stam(pt->eig[pt->pvalence[patch]], pts, cv, SFB__PARAM_CORNER(pt->pparam[patch]), s2, t2, r2, nres); memcpy(r2[1], nres[0], sizeof nres[0]); memcpy(r2[2], nres[1], sizeof nres[1]); }
+        sfb__cross(r2[1], r2[2], nrm);
+        len = sqrt(nrm[0] * nrm[0] + nrm[1] * nrm[1] + nrm[2] * nrm[2]);
+    }
+    if (len > 0.0 && isfinite(len)) for (c = 0; c < 3; ++c) nrm[c] /= len;
+    else nrm[0] = nrm[1] = nrm[2] = 0.0;
+    for (c = 0; c < 3; ++c) {
+        res[1][c] *= sc; res[2][c] *= sc;
+        res[3][c] *= sc * sc; res[4][c] *= sc * sc; res[5][c] *= sc * sc;
+    }
+}
+
+static sfb_result sfb__ref_eval_patches(void *state, const sfb__patch_table *pt, void *handle, const sfb_location *locs, int first,
+                                        int last, const sfb_eval_output *out) {
+    int q, c;
+    (void)state; (void)handle;
+    for (q = first; q < last; ++q) {
+        double res[6][3], nrm[3];
+        size_t o = 3 * (size_t)q;
+        sfb__ref_eval_one(pt, pt->point_data, &locs[q], res, nrm);
+        for (c = 0; c < 3; ++c) {
+            if (out->position) out->position[o + c] = (float)res[0][c];
+            if (out->du) out->du[o + c] = (float)res[1][c];
+            if (out->dv) out->dv[o + c] = (float)res[2][c];
+            if (out->duu) out->duu[o + c] = (float)res[3][c];
+            if (out->duv) out->duv[o + c] = (float)res[4][c];
+            if (out->dvv) out->dvv[o + c] = (float)res[5][c];
+            if (out->normal) out->normal[o + c] = (float)nrm[c];
+        }
+    }
+    return SFB_SUCCESS;
 }
 #line 1 "src/mesh.c"
 /* Control meshes: validation of untrusted arrays, edges, topology, creases, info. */
@@ -2910,6 +4396,9 @@ SFB_API void sfb_surface_destroy(sfb_surface *s) {
             s->uploaded_by->release_stencils(ctx->backend_state, s->backend_tables[t]);
         sfb__stencils_free(ctx, &s->tables[t]);
     }
+    if (s->backend_patches && s->uploaded_by && s->uploaded_by->release_patches)
+        s->uploaded_by->release_patches(ctx->backend_state, s->backend_patches);
+    sfb__patch_table_free(ctx, &s->patches);
     sfb__level_free(ctx, &s->top);
     sfb__level_free(ctx, &s->uv_top);
     sfb__free(ctx, s->base_positions);
@@ -2920,6 +4409,8 @@ SFB_API void sfb_surface_destroy(sfb_surface *s) {
 /* Rough peak bytes of refining `m` to `level`: topology of the last two levels plus composed
  * stencil rows in double during construction. Used to refuse early, before any allocation
  * sized by the level. */
+static sfb_result sfb__patches_finish(sfb_surface *s);
+
 static double sfb__estimate_bytes(const sfb_mesh *m, sfb_scheme scheme, int level, int limit, double *faces_out) {
     double faces = m->base.nf, verts = m->base.nv;
     int L;
@@ -2949,6 +4440,12 @@ SFB_API sfb_result sfb_surface_create(sfb_context *ctx, const sfb_mesh *mesh, co
     if (cfg->refine_level > SFB_MAX_LEVEL)
         return sfb__error(ctx, SFB_LIMIT_EXCEEDED, SFB_ELEMENT_NONE, -1, "refinement level %d is over the limit of %d (SFB_MAX_LEVEL)",
                           cfg->refine_level, SFB_MAX_LEVEL);
+    if ((cfg->flags & SFB_REFINE_PATCHES) && cfg->scheme != SFB_SCHEME_CATMARK)
+        return sfb__error(ctx, SFB_UNSUPPORTED, SFB_ELEMENT_NONE, -1, "limit evaluation (SFB_REFINE_PATCHES) is built for Catmull-Clark only; scheme '%s' is not supported yet",
+                          sfb_scheme_name(cfg->scheme));
+    if ((cfg->flags & SFB_REFINE_PATCHES) && (cfg->isolation_level < 0 || cfg->isolation_level > SFB_MAX_LEVEL))
+        return sfb__error(ctx, SFB_LIMIT_EXCEEDED, SFB_ELEMENT_NONE, -1, "isolation level %d is outside 0..%d (0 = default %d)",
+                          cfg->isolation_level, SFB_MAX_LEVEL, SFB_DEFAULT_ISOLATION);
     if (cfg->scheme == SFB_SCHEME_LOOP)
         for (f = 0; f < mesh->base.nf; ++f)
             if (mesh->base.fv_off[f + 1] - mesh->base.fv_off[f] != 3)
@@ -2969,6 +4466,7 @@ SFB_API sfb_result sfb_surface_create(sfb_context *ctx, const sfb_mesh *mesh, co
     s->boundary = mesh->boundary; s->crease_method = mesh->crease_method;
     s->triangle_rule = mesh->triangle_rule; s->uv_interp = mesh->uv_interp;
     s->base_vertex_count = mesh->base.nv;
+    s->base_face_count = mesh->base.nf;
     s->base_positions = (float *)sfb__alloc(ctx, (size_t)mesh->base.nv * 3 * sizeof(float) + 1);
     if (!s->base_positions) { sfb_surface_destroy(s); return sfb__oom(ctx, "surface"); }
     memcpy(s->base_positions, mesh->positions, (size_t)mesh->base.nv * 3 * sizeof(float));
@@ -2982,6 +4480,10 @@ SFB_API sfb_result sfb_surface_create(sfb_context *ctx, const sfb_mesh *mesh, co
     opt.want_limit = (cfg->flags & SFB_REFINE_LIMIT) != 0;
     r = sfb__refine(ctx, &prep, &opt, cfg->refine_level, &s->top, &s->tables[SFB_TABLE_VERTEX],
                     opt.want_limit ? &s->tables[SFB_TABLE_LIMIT] : NULL, 0.0f, 0.8f);
+    if (r == SFB_SUCCESS && (cfg->flags & SFB_REFINE_PATCHES)) {
+        r = sfb__patches_build(ctx, &prep, &opt, cfg->isolation_level ? cfg->isolation_level : SFB_DEFAULT_ISOLATION, &s->patches);
+        if (r == SFB_SUCCESS) r = sfb__patches_finish(s);
+    }
     sfb__level_free(ctx, &prep);
     if (r != SFB_SUCCESS) { sfb_surface_destroy(s); return r; }
     s->built[SFB_TABLE_VERTEX] = 1;
@@ -3034,8 +4536,105 @@ SFB_API sfb_result sfb_surface_create(sfb_context *ctx, const sfb_mesh *mesh, co
             if (r != SFB_SUCCESS) { sfb_surface_destroy(s); return r; }
         }
     }
+    if (s->has_patches && ctx->backend && ctx->backend->upload_patches) {
+        s->uploaded_by = ctx->backend;
+        r = ctx->backend->upload_patches(ctx->backend_state, &s->patches, &s->backend_patches);
+        if (r != SFB_SUCCESS) { sfb_surface_destroy(s); return r; }
+    }
     *out = s;
     return SFB_SUCCESS;
+}
+
+/* Patch points for the surface's positions (ref kernel: table building, done once, the same
+ * for every backend) and the eigen structures the Stam patches use. */
+static sfb_result sfb__patches_finish(sfb_surface *s) {
+    sfb_context *ctx = s->ctx;
+    sfb__patch_table *pt = &s->patches;
+    sfb_buffer_desc d3 = {0, 3, 3};
+    int p;
+    pt->point_data = (float *)sfb__alloc(ctx, ((size_t)pt->points.rows + 1) * 3 * sizeof(float));
+    if (!pt->point_data) return sfb__oom(ctx, "patch points");
+    if (pt->points.rows)
+        sfb__backend_ref()->eval_stencils(NULL, &pt->points, NULL, 0, pt->points.rows, s->base_positions, d3, pt->point_data, d3);
+    for (p = 0; p < pt->npatch; ++p)
+        if (pt->ptype[p] == SFB__PATCH_STAM) {
+            int N = pt->pvalence[p];
+            if (!pt->eig[N]) pt->eig[N] = ctx->eigen_cc[N];
+            if (!pt->eig[N]) return sfb__error(ctx, SFB_BACKEND_ERROR, SFB_ELEMENT_NONE, -1, "missing eigen structure of valence %d", N);
+        }
+    s->has_patches = 1;
+    return SFB_SUCCESS;
+}
+
+SFB_API int sfb_surface_param_face_count(const sfb_surface *s) { return s && s->has_patches ? s->patches.nptex : 0; }
+
+SFB_API sfb_result sfb_surface_param_faces(const sfb_surface *s, int base_face, int *first, int *count) {
+    if (!s || !first || !count) return SFB_INVALID_ARGS;
+    if (!s->has_patches) return sfb__error(s->ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "the surface has no patch table (SFB_REFINE_PATCHES)");
+    if (base_face < 0 || !s->patches.face_ptex || base_face >= s->base_face_count)
+        return sfb__error(s->ctx, SFB_INVALID_VALUE, SFB_ELEMENT_FACE, base_face, "base face %d is out of range (0..%d)", base_face, s->base_face_count - 1);
+    *first = s->patches.face_ptex[base_face];
+    *count = s->patches.face_ptex[base_face + 1] - *first;
+    return SFB_SUCCESS;
+}
+
+SFB_API sfb_result sfb_surface_param_face_base(const sfb_surface *s, int pf, int *base_face, int *sub_face) {
+    if (!s || !base_face || !sub_face) return SFB_INVALID_ARGS;
+    if (!s->has_patches) return sfb__error(s->ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "the surface has no patch table (SFB_REFINE_PATCHES)");
+    if (pf < 0 || pf >= s->patches.nptex)
+        return sfb__error(s->ctx, SFB_INVALID_VALUE, SFB_ELEMENT_FACE, pf, "parametric face %d is out of range (0..%d)", pf, s->patches.nptex - 1);
+    *base_face = s->patches.ptex_face[pf];
+    *sub_face = s->patches.ptex_corner[pf];
+    return SFB_SUCCESS;
+}
+
+SFB_API sfb_result sfb_surface_patch_info(const sfb_surface *s, sfb_patch_info *o) {
+    const sfb__patch_table *pt;
+    if (!s || !o) return SFB_INVALID_ARGS;
+    memset(o, 0, sizeof *o);
+    if (!s->has_patches) return sfb__error(s->ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "the surface has no patch table (SFB_REFINE_PATCHES)");
+    pt = &s->patches;
+    o->param_faces = pt->nptex;
+    o->patches = pt->npatch;
+    o->bspline = pt->counts[SFB__PATCH_BSPLINE];
+    o->stam = pt->counts[SFB__PATCH_STAM];
+    o->end_caps = pt->counts[SFB__PATCH_ENDCAP];
+    o->max_depth = pt->max_depth;
+    o->points = pt->points.rows;
+    o->bytes = (size_t)pt->npatch * (4 * sizeof(int)) + (size_t)pt->ncv * sizeof(int) + (size_t)pt->nptex * 3 * sizeof(int) +
+               (size_t)pt->nnodes * 4 * sizeof(int) + (size_t)pt->points.rows * (2 * sizeof(int) + 3 * sizeof(float)) +
+               pt->points.entries * (sizeof(int) + sizeof(float));
+    return SFB_SUCCESS;
+}
+
+SFB_API sfb_result sfb_surface_eval(const sfb_surface *s, const sfb_location *loc, int count, const sfb_eval_output *out) {
+    sfb_context *ctx;
+    const sfb__backend_vtable *be;
+    int q;
+    if (!s) return SFB_INVALID_ARGS;
+    ctx = s->ctx;
+    if (!s->has_patches) return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "sfb_surface_eval: the surface has no patch table (create it with SFB_REFINE_PATCHES)");
+    if (count < 0 || (count > 0 && (!loc || !out)))
+        return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "sfb_surface_eval: %s", count < 0 ? "negative count" : "NULL locations or outputs");
+    for (q = 0; q < count; ++q) {
+        const sfb_location *l = &loc[q];
+        double sdum, tdum, sc;
+        if (l->face < 0 || l->face >= s->patches.nptex)
+            return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, q, "location %d: parametric face %d is out of range (0..%d)", q, l->face,
+                              s->patches.nptex - 1);
+        if (!(l->u >= 0.0f && l->u <= 1.0f && l->v >= 0.0f && l->v <= 1.0f))
+            return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, q, "location %d: (u,v) = (%g,%g) is outside [0,1]^2", q, (double)l->u,
+                              (double)l->v);
+        if (sfb__patch_locate(&s->patches, l->face, l->u, l->v, &sdum, &tdum, &sc) < 0)
+            return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, q, "location %d: parametric face %d is a hole", q, l->face);
+    }
+    if (count == 0) return SFB_SUCCESS;
+    be = ctx->backend;
+    if (!be || !(be->caps & SFB__CAP_EVAL_PATCHES) || !be->eval_patches) {
+        sfb__log(ctx, SFB_LOG_INFO, "backend %s lacks eval_patches; using ref", be ? be->name : "none");
+        return sfb__backend_ref()->eval_patches(NULL, &s->patches, NULL, loc, 0, count, out);
+    }
+    return be->eval_patches(ctx->backend_state, &s->patches, s->uploaded_by == be ? s->backend_patches : NULL, loc, 0, count, out);
 }
 
 SFB_API sfb_result sfb_surface_stencil_info(const sfb_surface *s, sfb_table t, sfb_stencil_info *out) {

@@ -660,7 +660,8 @@ static sfb_result sfb__simd_eval_stencils(void *state, const sfb__stencils *t, v
 
 static const sfb__backend_vtable sfb__simd_vtable = {
     "simd", SFB_BACKEND_SIMD, SFB__CAP_EVAL_STENCILS,
-    sfb__simd_init, sfb__simd_shutdown, sfb__simd_describe, NULL, NULL, sfb__simd_eval_stencils, NULL
+    sfb__simd_init, sfb__simd_shutdown, sfb__simd_describe, NULL, NULL, sfb__simd_eval_stencils, NULL,
+    NULL, NULL, NULL
 };
 
 const sfb__backend_vtable *sfb__backend_simd(void) { return &sfb__simd_vtable; }

@@ -31,9 +31,14 @@ static sfb_result sfb__ref_eval_stencils(void *state, const sfb__stencils *t, vo
     return SFB_SUCCESS;
 }
 
+/* in patches.c */
+static sfb_result sfb__ref_eval_patches(void *state, const sfb__patch_table *pt, void *handle, const sfb_location *locs, int first,
+                                        int last, const sfb_eval_output *out);
+
 static const sfb__backend_vtable sfb__ref_vtable = {
-    "ref", SFB_BACKEND_REF, SFB__CAP_EVAL_STENCILS,
-    sfb__ref_init, sfb__ref_shutdown, NULL, NULL, NULL, sfb__ref_eval_stencils, NULL
+    "ref", SFB_BACKEND_REF, SFB__CAP_EVAL_STENCILS | SFB__CAP_EVAL_PATCHES,
+    sfb__ref_init, sfb__ref_shutdown, NULL, NULL, NULL, sfb__ref_eval_stencils, NULL,
+    NULL, NULL, sfb__ref_eval_patches
 };
 
 const sfb__backend_vtable *sfb__backend_ref(void) { return &sfb__ref_vtable; }

@@ -201,6 +201,10 @@ SFB_API void sfb_context_destroy(sfb_context *ctx) {
     sfb_allocator a;
     if (!ctx) return;
     if (ctx->backend && ctx->backend->shutdown) ctx->backend->shutdown(ctx, ctx->backend_state);
+    {
+        int n;
+        for (n = 0; n <= SFB__STAM_MAX_VALENCE; ++n) sfb__eigen_cc_free(ctx, ctx->eigen_cc[n]);
+    }
     a = ctx->allocator;
     a.free(ctx, a.user);
 }

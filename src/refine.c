@@ -438,6 +438,42 @@ static int sfb__compose_row(sfb_context *ctx, sfb__accum *A, const sfb__rows *pr
     return 1;
 }
 
+/* One step: refines `p` (whose vertices have composed rows `prow`) into `c`, with the
+ * composed rows of c's vertices in `crow`. Progress is reported from p0 over a span of dp. */
+static sfb_result sfb__refine_step(sfb_context *ctx, const sfb__refine_options *opt, const sfb__level *p, const sfb__rows *prow,
+                                   sfb__level *c, sfb__rows *crow, sfb__accum *A, sfb__mask *m, float *ps, float *cs,
+                                   float p0, float dp) {
+    sfb__step st;
+    sfb_result r;
+    int cv;
+    st.ctx = ctx; st.opt = opt; st.p = p; st.c = c; st.half = NULL;
+    r = sfb__build_child_topology(&st);
+    if (r != SFB_SUCCESS) {
+        sfb__free(ctx, st.half);
+        return r == SFB_OUT_OF_MEMORY ? sfb__oom(ctx, "refinement topology") : r;
+    }
+    crow->rows = c->nv;
+    crow->n = 0;
+    crow->off = (size_t *)sfb__alloc(ctx, ((size_t)c->nv + 1) * sizeof(size_t));
+    if (!crow->off || !sfb__rows_reserve(ctx, crow, (size_t)c->nv * 4 + 16)) {
+        sfb__free(ctx, st.half);
+        return sfb__oom(ctx, "stencil table");
+    }
+    crow->off[0] = 0;
+    for (cv = 0; cv < c->nv; ++cv) {
+        if (!sfb__child_mask(&st, cv, m, ps, cs) || !sfb__compose_row(ctx, A, prow, m, crow, cv)) {
+            sfb__free(ctx, st.half);
+            return sfb__oom(ctx, "stencil table");
+        }
+        if ((cv & 0xffff) == 0xffff) {
+            r = sfb__progress(ctx, p0 + dp * (float)cv / (float)c->nv, "refine");
+            if (r != SFB_SUCCESS) { sfb__free(ctx, st.half); return r; }
+        }
+    }
+    sfb__free(ctx, st.half);
+    return SFB_SUCCESS;
+}
+
 /* ---- limit masks at the last level ---- */
 static void sfb__limit_masks(const sfb__level *l, int v, sfb_scheme scheme, sfb__mask *mp, sfb__mask *m1, sfb__mask *m2) {
     int e0 = l->ve_off[v], ne = l->ve_off[v + 1] - e0;
@@ -623,38 +659,11 @@ sfb_result sfb__refine(sfb_context *ctx, const sfb__level *base, const sfb__refi
     prow.off[base->nv] = (size_t)base->nv;
     prow.n = (size_t)base->nv;
     for (L = 0; L < level; ++L) {
-        sfb__step st;
-        int cv;
         r = sfb__progress(ctx, prog0 + (prog1 - prog0) * (float)L / (float)(level + 1), "refine");
         if (r != SFB_SUCCESS) goto done;
-        st.ctx = ctx; st.opt = opt; st.p = &cur; st.c = &next; st.half = NULL;
-        r = sfb__build_child_topology(&st);
-        if (r != SFB_SUCCESS) {
-            sfb__free(ctx, st.half);
-            if (r == SFB_OUT_OF_MEMORY) r = sfb__oom(ctx, "refinement topology");
-            goto done;
-        }
-        crow.rows = next.nv;
-        crow.n = 0;
-        crow.off = (size_t *)sfb__alloc(ctx, ((size_t)next.nv + 1) * sizeof(size_t));
-        if (!crow.off || !sfb__rows_reserve(ctx, &crow, (size_t)next.nv * 4 + 16)) {
-            sfb__free(ctx, st.half);
-            r = sfb__oom(ctx, "stencil table");
-            goto done;
-        }
-        crow.off[0] = 0;
-        for (cv = 0; cv < next.nv; ++cv) {
-            if (!sfb__child_mask(&st, cv, &m, ps, cs) || !sfb__compose_row(ctx, &A, &prow, &m, &crow, cv)) {
-                sfb__free(ctx, st.half);
-                r = sfb__oom(ctx, "stencil table");
-                goto done;
-            }
-            if ((cv & 0xffff) == 0xffff) {
-                r = sfb__progress(ctx, prog0 + (prog1 - prog0) * ((float)L + (float)cv / next.nv) / (float)(level + 1), "refine");
-                if (r != SFB_SUCCESS) { sfb__free(ctx, st.half); goto done; }
-            }
-        }
-        sfb__free(ctx, st.half);
+        r = sfb__refine_step(ctx, opt, &cur, &prow, &next, &crow, &A, &m, ps, cs, prog0 + (prog1 - prog0) * (float)L / (float)(level + 1),
+                             (prog1 - prog0) / (float)(level + 1));
+        if (r != SFB_SUCCESS) goto done;
         sfb__rows_free(ctx, &prow);
         prow = crow;
         memset(&crow, 0, sizeof crow);

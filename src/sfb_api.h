@@ -212,14 +212,18 @@ SFB_API const char *sfb_scheme_name(sfb_scheme s);
 
 enum {
     SFB_REFINE_LIMIT = 1u << 0,  /* also build limit position + limit tangent tables */
-    SFB_REFINE_UVS = 1u << 1     /* also build the face-varying UV table (when the mesh has UVs) */
+    SFB_REFINE_UVS = 1u << 1,    /* also build the face-varying UV table (when the mesh has UVs) */
+    SFB_REFINE_PATCHES = 1u << 2 /* also build the patch table: sfb_surface_eval, sfb_surface_tessellate */
 };
 
 typedef struct sfb_surface_config {
     sfb_scheme scheme;
     int refine_level;   /* uniform refinement level compiled into the tables (0..SFB_MAX_LEVEL) */
     unsigned flags;     /* SFB_REFINE_* */
+    int isolation_level;/* patches: adaptive isolation limit around irregular features, 1..SFB_MAX_LEVEL
+                           (0: SFB_DEFAULT_ISOLATION); below it faces get an end cap */
 } sfb_surface_config;
+#define SFB_DEFAULT_ISOLATION 8
 SFB_API sfb_surface_config sfb_surface_config_init(sfb_scheme scheme, int level);
 
 typedef struct sfb_surface sfb_surface;
@@ -288,6 +292,37 @@ SFB_API sfb_result sfb_surface_refine_positions(const sfb_surface *surface, cons
 SFB_API void sfb_mesh_data_free(sfb_mesh_data *data);
 /* A desc view of refined data (pointers into `data`), for sfb_write_obj or sfb_mesh_create. */
 SFB_API void sfb_mesh_data_desc(const sfb_mesh_data *data, sfb_mesh_desc *out);
+
+
+/* ---- limit evaluation (SFB_REFINE_PATCHES; Catmull-Clark) ----
+ * Locations are on parametric faces: a base quad is one parametric face, (u,v) in [0,1]^2 with
+ * (0,0) at its first vertex, (1,0) at its second and (0,1) at its last; a face with n != 4
+ * vertices is n parametric quads, sub-face i being (v_i, midpoint of v_i v_i+1, centroid,
+ * midpoint of v_i-1 v_i) of the first subdivision step, (0,0) at v_i. Parametric faces are
+ * numbered base face by base face (sfb_surface_param_faces). */
+typedef struct sfb_location { int face; float u, v; } sfb_location;
+/* Output arrays, xyz per location; NULL members are not computed. du/dv are derivatives in
+ * the parametric face's (u,v); normal is unit length (du x dv normalised, and at an
+ * extraordinary vertex itself the limit normal, where du and dv are the limit tangent
+ * directions since the parametric derivatives vanish or diverge there). */
+typedef struct sfb_eval_output { float *position, *du, *dv, *normal, *duu, *duv, *dvv; } sfb_eval_output;
+
+SFB_API int sfb_surface_param_face_count(const sfb_surface *surface);
+/* The parametric faces of base face `base_face`: [*first, *first + *count). */
+SFB_API sfb_result sfb_surface_param_faces(const sfb_surface *surface, int base_face, int *first, int *count);
+/* The base face of a parametric face, and its sub-face index (-1 for a quad). */
+SFB_API sfb_result sfb_surface_param_face_base(const sfb_surface *surface, int param_face, int *base_face, int *sub_face);
+/* Evaluates the limit surface at `count` locations. Every location is checked first: a face
+ * out of range, a hole, u or v outside [0,1] or not finite returns SFB_INVALID_VALUE naming
+ * the first bad query (element SFB_ELEMENT_NONE, index = its position) and writes nothing. */
+SFB_API sfb_result sfb_surface_eval(const sfb_surface *surface, const sfb_location *locations, int count,
+                                    const sfb_eval_output *out);
+
+typedef struct sfb_patch_info {
+    int param_faces, patches, bspline, stam, end_caps, max_depth, points;
+    size_t bytes;  /* memory of the patch table and its points */
+} sfb_patch_info;
+SFB_API sfb_result sfb_surface_patch_info(const sfb_surface *surface, sfb_patch_info *out);
 
 #ifdef __cplusplus
 }

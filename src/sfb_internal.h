@@ -11,6 +11,7 @@
 #endif
 
 /* ---- backend vtable ---- */
+struct sfb__patch_table;
 /* A stencil table: row r reads sizes[r] entries starting at offsets[r] from indices/weights. */
 typedef struct sfb__stencils {
     int rows, sources;
@@ -21,7 +22,8 @@ typedef struct sfb__stencils {
 
 enum {
     SFB__CAP_EVAL_STENCILS = 1u << 0,   /* eval_stencils on caller memory */
-    SFB__CAP_GL_BUFFERS = 1u << 1       /* eval_stencils_gl on GL buffer objects (host context) */
+    SFB__CAP_GL_BUFFERS = 1u << 1,      /* eval_stencils_gl on GL buffer objects (host context) */
+    SFB__CAP_EVAL_PATCHES = 1u << 2     /* eval_patches */
 };
 
 /* The kernels a backend implements. Every slot but name/kind/caps/init/shutdown may be NULL;
@@ -49,6 +51,12 @@ typedef struct sfb__backend_vtable {
     sfb_result (*eval_stencils_gl)(void *state, const sfb__stencils *table, void *handle,
                                    unsigned src_buffer, sfb_buffer_desc src_desc,
                                    unsigned dst_buffer, sfb_buffer_desc dst_desc);
+    /* Patch tables (limit evaluation): upload once per surface, then evaluate locations
+     * [first,last) (already validated) into the non-NULL arrays of `out` (xyz per location). */
+    sfb_result (*upload_patches)(void *state, const struct sfb__patch_table *table, void **handle);
+    void (*release_patches)(void *state, void *handle);
+    sfb_result (*eval_patches)(void *state, const struct sfb__patch_table *table, void *handle,
+                               const sfb_location *locations, int first, int last, const sfb_eval_output *out);
 } sfb__backend_vtable;
 
 /* Optional backends (backends/sfb_*.h), compiled in by SURFBLEND_SIMD / _GL / _OSMESA or
@@ -77,6 +85,42 @@ const sfb__backend_vtable *sfb__backend_gl(void);
 const sfb__backend_vtable *sfb__backend_osmesa(void);
 #endif
 
+/* ---- Stam eigen structures (stam.c) ---- */
+#define SFB__STAM_MAX_VALENCE 256
+
+typedef struct sfb__eigen_cc {
+    int N, K;
+    int dominant;      /* index of lambda = 1 (right eigenvector all ones) */
+    double sub;        /* largest |lambda| among the others (the subdominant eigenvalue) */
+    double error;      /* max |A - V L V^-1| found by the build */
+    double *lambda;    /* K */
+    double *vinv;      /* K x K, row i = left eigenvector i */
+    double *phi;       /* 3 x 16 x K: phi[((k-1)*16 + j)*K + i] */
+    double *v;         /* K x K right eigenvectors (columns), only when asked to keep them */
+    double *a;         /* K x K subdivision matrix, only when asked to keep it */
+} sfb__eigen_cc;
+
+
+/* ---- patch tables (patches.c) ---- */
+typedef struct sfb__patch_table {
+    int scheme, isolation, max_depth;
+    int npatch, ncv, nptex, nnodes;
+    int *ptype;            /* SFB__PATCH_* per patch */
+    int *pfirst;           /* npatch + 1: first control point of each patch in cv */
+    unsigned *pparam;      /* depth | i << 4 | j << 17 | corner << 30 (sub-square of the param face) */
+    int *pvalence;         /* Stam patches: valence of the extraordinary vertex */
+    int *cv;               /* control points: rows of `points` */
+    int *ptex_face, *ptex_corner; /* per param face: base face, sub-face (-1 for a quad) */
+    int *face_ptex;        /* per base face + 1: first param face */
+    int *ptex_root;        /* per param face: >= 0 node, <= -2 patch -(p+2), -1 hole */
+    int *nodes;            /* 4 per quadtree node, by quadrant x + 2y, same encoding */
+    int counts[3];         /* patches of each type */
+    sfb__stencils points;  /* base vertices -> patch points */
+    float *point_data;     /* xyz per patch point, for the surface's base positions */
+    const sfb__eigen_cc *eig[SFB__STAM_MAX_VALENCE + 1]; /* valences used (the context's cache) */
+    float *eig_f;          /* reserved for backends' packed copies */
+} sfb__patch_table;
+
 /* ---- context ---- */
 struct sfb_context {
     sfb_allocator allocator;
@@ -89,6 +133,8 @@ struct sfb_context {
     int order_count;
     const sfb__backend_vtable *backend;
     void *backend_state;
+    sfb__eigen_cc *eigen_cc[SFB__STAM_MAX_VALENCE + 1]; /* per valence, built on first use */
+    unsigned char eigen_cc_failed[SFB__STAM_MAX_VALENCE + 1];
     char report[2048];
     char error[1024];
     sfb_error_info error_info;
@@ -118,6 +164,9 @@ sfb_result sfb__progress(sfb_context *ctx, float done, const char *stage);
 sfb_result sfb__select_backend(sfb_context *ctx, const char *env_override);
 sfb_result sfb__context_create_reporting(const sfb_context_config *config, sfb_context **out, char *report, size_t size);
 const sfb__backend_vtable *sfb__backend_ref(void);
+void sfb__eigen_cc_free(sfb_context *ctx, sfb__eigen_cc *e);
+sfb_result sfb__eigen_cc_build(sfb_context *ctx, int N, int keep, sfb__eigen_cc **out);
+const sfb__eigen_cc *sfb__eigen_cc_get(sfb_context *ctx, int N);
 
 /* ---- topology of one level ---- */
 enum { SFB__TAG_BOUNDARY = 1, SFB__TAG_NONMANIFOLD = 2 };
@@ -161,7 +210,7 @@ struct sfb_mesh {
 struct sfb_surface {
     sfb_context *ctx;
     sfb_surface_config config;
-    int base_vertex_count, base_uv_count;
+    int base_vertex_count, base_uv_count, base_face_count;
     float *base_positions, *base_uvs;
     sfb__level top;              /* topology of the refined level */
     sfb__level uv_top;           /* topology of the refined UV layout (when built) */
@@ -171,6 +220,9 @@ struct sfb_surface {
     void *backend_tables[SFB_TABLE_COUNT_]; /* the backend's uploaded copies (upload_stencils) */
     const sfb__backend_vtable *uploaded_by;
     int boundary, crease_method, triangle_rule, uv_interp;
+    int has_patches;
+    sfb__patch_table patches;    /* limit evaluation (SFB_REFINE_PATCHES) */
+    void *backend_patches;       /* the backend's uploaded copy */
 };
 
 typedef struct sfb__refine_options {
@@ -189,3 +241,9 @@ void sfb__stencils_free(sfb_context *ctx, sfb__stencils *s);
 /* Copy of the base level with OpenSubdiv's boundary/non-manifold sharpening and holes applied. */
 sfb_result sfb__level_prepare(sfb_context *ctx, const sfb__level *src, int sharpen_corners, int make_boundary_holes,
                               sfb__level *dst);
+
+/* patches.c */
+void sfb__patch_table_free(sfb_context *ctx, sfb__patch_table *pt);
+sfb_result sfb__patches_build(sfb_context *ctx, const sfb__level *base, const sfb__refine_options *opt, int limit,
+                              sfb__patch_table *pt);
+int sfb__patch_locate(const sfb__patch_table *pt, int ptex, double u, double v, double *s, double *t, double *scale);

@@ -30,6 +30,9 @@ SFB_API void sfb_surface_destroy(sfb_surface *s) {
             s->uploaded_by->release_stencils(ctx->backend_state, s->backend_tables[t]);
         sfb__stencils_free(ctx, &s->tables[t]);
     }
+    if (s->backend_patches && s->uploaded_by && s->uploaded_by->release_patches)
+        s->uploaded_by->release_patches(ctx->backend_state, s->backend_patches);
+    sfb__patch_table_free(ctx, &s->patches);
     sfb__level_free(ctx, &s->top);
     sfb__level_free(ctx, &s->uv_top);
     sfb__free(ctx, s->base_positions);
@@ -40,6 +43,8 @@ SFB_API void sfb_surface_destroy(sfb_surface *s) {
 /* Rough peak bytes of refining `m` to `level`: topology of the last two levels plus composed
  * stencil rows in double during construction. Used to refuse early, before any allocation
  * sized by the level. */
+static sfb_result sfb__patches_finish(sfb_surface *s);
+
 static double sfb__estimate_bytes(const sfb_mesh *m, sfb_scheme scheme, int level, int limit, double *faces_out) {
     double faces = m->base.nf, verts = m->base.nv;
     int L;
@@ -69,6 +74,12 @@ SFB_API sfb_result sfb_surface_create(sfb_context *ctx, const sfb_mesh *mesh, co
     if (cfg->refine_level > SFB_MAX_LEVEL)
         return sfb__error(ctx, SFB_LIMIT_EXCEEDED, SFB_ELEMENT_NONE, -1, "refinement level %d is over the limit of %d (SFB_MAX_LEVEL)",
                           cfg->refine_level, SFB_MAX_LEVEL);
+    if ((cfg->flags & SFB_REFINE_PATCHES) && cfg->scheme != SFB_SCHEME_CATMARK)
+        return sfb__error(ctx, SFB_UNSUPPORTED, SFB_ELEMENT_NONE, -1, "limit evaluation (SFB_REFINE_PATCHES) is built for Catmull-Clark only; scheme '%s' is not supported yet",
+                          sfb_scheme_name(cfg->scheme));
+    if ((cfg->flags & SFB_REFINE_PATCHES) && (cfg->isolation_level < 0 || cfg->isolation_level > SFB_MAX_LEVEL))
+        return sfb__error(ctx, SFB_LIMIT_EXCEEDED, SFB_ELEMENT_NONE, -1, "isolation level %d is outside 0..%d (0 = default %d)",
+                          cfg->isolation_level, SFB_MAX_LEVEL, SFB_DEFAULT_ISOLATION);
     if (cfg->scheme == SFB_SCHEME_LOOP)
         for (f = 0; f < mesh->base.nf; ++f)
             if (mesh->base.fv_off[f + 1] - mesh->base.fv_off[f] != 3)
@@ -89,6 +100,7 @@ SFB_API sfb_result sfb_surface_create(sfb_context *ctx, const sfb_mesh *mesh, co
     s->boundary = mesh->boundary; s->crease_method = mesh->crease_method;
     s->triangle_rule = mesh->triangle_rule; s->uv_interp = mesh->uv_interp;
     s->base_vertex_count = mesh->base.nv;
+    s->base_face_count = mesh->base.nf;
     s->base_positions = (float *)sfb__alloc(ctx, (size_t)mesh->base.nv * 3 * sizeof(float) + 1);
     if (!s->base_positions) { sfb_surface_destroy(s); return sfb__oom(ctx, "surface"); }
     memcpy(s->base_positions, mesh->positions, (size_t)mesh->base.nv * 3 * sizeof(float));
@@ -102,6 +114,10 @@ SFB_API sfb_result sfb_surface_create(sfb_context *ctx, const sfb_mesh *mesh, co
     opt.want_limit = (cfg->flags & SFB_REFINE_LIMIT) != 0;
     r = sfb__refine(ctx, &prep, &opt, cfg->refine_level, &s->top, &s->tables[SFB_TABLE_VERTEX],
                     opt.want_limit ? &s->tables[SFB_TABLE_LIMIT] : NULL, 0.0f, 0.8f);
+    if (r == SFB_SUCCESS && (cfg->flags & SFB_REFINE_PATCHES)) {
+        r = sfb__patches_build(ctx, &prep, &opt, cfg->isolation_level ? cfg->isolation_level : SFB_DEFAULT_ISOLATION, &s->patches);
+        if (r == SFB_SUCCESS) r = sfb__patches_finish(s);
+    }
     sfb__level_free(ctx, &prep);
     if (r != SFB_SUCCESS) { sfb_surface_destroy(s); return r; }
     s->built[SFB_TABLE_VERTEX] = 1;
@@ -154,8 +170,105 @@ SFB_API sfb_result sfb_surface_create(sfb_context *ctx, const sfb_mesh *mesh, co
             if (r != SFB_SUCCESS) { sfb_surface_destroy(s); return r; }
         }
     }
+    if (s->has_patches && ctx->backend && ctx->backend->upload_patches) {
+        s->uploaded_by = ctx->backend;
+        r = ctx->backend->upload_patches(ctx->backend_state, &s->patches, &s->backend_patches);
+        if (r != SFB_SUCCESS) { sfb_surface_destroy(s); return r; }
+    }
     *out = s;
     return SFB_SUCCESS;
+}
+
+/* Patch points for the surface's positions (ref kernel: table building, done once, the same
+ * for every backend) and the eigen structures the Stam patches use. */
+static sfb_result sfb__patches_finish(sfb_surface *s) {
+    sfb_context *ctx = s->ctx;
+    sfb__patch_table *pt = &s->patches;
+    sfb_buffer_desc d3 = {0, 3, 3};
+    int p;
+    pt->point_data = (float *)sfb__alloc(ctx, ((size_t)pt->points.rows + 1) * 3 * sizeof(float));
+    if (!pt->point_data) return sfb__oom(ctx, "patch points");
+    if (pt->points.rows)
+        sfb__backend_ref()->eval_stencils(NULL, &pt->points, NULL, 0, pt->points.rows, s->base_positions, d3, pt->point_data, d3);
+    for (p = 0; p < pt->npatch; ++p)
+        if (pt->ptype[p] == SFB__PATCH_STAM) {
+            int N = pt->pvalence[p];
+            if (!pt->eig[N]) pt->eig[N] = ctx->eigen_cc[N];
+            if (!pt->eig[N]) return sfb__error(ctx, SFB_BACKEND_ERROR, SFB_ELEMENT_NONE, -1, "missing eigen structure of valence %d", N);
+        }
+    s->has_patches = 1;
+    return SFB_SUCCESS;
+}
+
+SFB_API int sfb_surface_param_face_count(const sfb_surface *s) { return s && s->has_patches ? s->patches.nptex : 0; }
+
+SFB_API sfb_result sfb_surface_param_faces(const sfb_surface *s, int base_face, int *first, int *count) {
+    if (!s || !first || !count) return SFB_INVALID_ARGS;
+    if (!s->has_patches) return sfb__error(s->ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "the surface has no patch table (SFB_REFINE_PATCHES)");
+    if (base_face < 0 || !s->patches.face_ptex || base_face >= s->base_face_count)
+        return sfb__error(s->ctx, SFB_INVALID_VALUE, SFB_ELEMENT_FACE, base_face, "base face %d is out of range (0..%d)", base_face, s->base_face_count - 1);
+    *first = s->patches.face_ptex[base_face];
+    *count = s->patches.face_ptex[base_face + 1] - *first;
+    return SFB_SUCCESS;
+}
+
+SFB_API sfb_result sfb_surface_param_face_base(const sfb_surface *s, int pf, int *base_face, int *sub_face) {
+    if (!s || !base_face || !sub_face) return SFB_INVALID_ARGS;
+    if (!s->has_patches) return sfb__error(s->ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "the surface has no patch table (SFB_REFINE_PATCHES)");
+    if (pf < 0 || pf >= s->patches.nptex)
+        return sfb__error(s->ctx, SFB_INVALID_VALUE, SFB_ELEMENT_FACE, pf, "parametric face %d is out of range (0..%d)", pf, s->patches.nptex - 1);
+    *base_face = s->patches.ptex_face[pf];
+    *sub_face = s->patches.ptex_corner[pf];
+    return SFB_SUCCESS;
+}
+
+SFB_API sfb_result sfb_surface_patch_info(const sfb_surface *s, sfb_patch_info *o) {
+    const sfb__patch_table *pt;
+    if (!s || !o) return SFB_INVALID_ARGS;
+    memset(o, 0, sizeof *o);
+    if (!s->has_patches) return sfb__error(s->ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "the surface has no patch table (SFB_REFINE_PATCHES)");
+    pt = &s->patches;
+    o->param_faces = pt->nptex;
+    o->patches = pt->npatch;
+    o->bspline = pt->counts[SFB__PATCH_BSPLINE];
+    o->stam = pt->counts[SFB__PATCH_STAM];
+    o->end_caps = pt->counts[SFB__PATCH_ENDCAP];
+    o->max_depth = pt->max_depth;
+    o->points = pt->points.rows;
+    o->bytes = (size_t)pt->npatch * (4 * sizeof(int)) + (size_t)pt->ncv * sizeof(int) + (size_t)pt->nptex * 3 * sizeof(int) +
+               (size_t)pt->nnodes * 4 * sizeof(int) + (size_t)pt->points.rows * (2 * sizeof(int) + 3 * sizeof(float)) +
+               pt->points.entries * (sizeof(int) + sizeof(float));
+    return SFB_SUCCESS;
+}
+
+SFB_API sfb_result sfb_surface_eval(const sfb_surface *s, const sfb_location *loc, int count, const sfb_eval_output *out) {
+    sfb_context *ctx;
+    const sfb__backend_vtable *be;
+    int q;
+    if (!s) return SFB_INVALID_ARGS;
+    ctx = s->ctx;
+    if (!s->has_patches) return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "sfb_surface_eval: the surface has no patch table (create it with SFB_REFINE_PATCHES)");
+    if (count < 0 || (count > 0 && (!loc || !out)))
+        return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "sfb_surface_eval: %s", count < 0 ? "negative count" : "NULL locations or outputs");
+    for (q = 0; q < count; ++q) {
+        const sfb_location *l = &loc[q];
+        double sdum, tdum, sc;
+        if (l->face < 0 || l->face >= s->patches.nptex)
+            return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, q, "location %d: parametric face %d is out of range (0..%d)", q, l->face,
+                              s->patches.nptex - 1);
+        if (!(l->u >= 0.0f && l->u <= 1.0f && l->v >= 0.0f && l->v <= 1.0f))
+            return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, q, "location %d: (u,v) = (%g,%g) is outside [0,1]^2", q, (double)l->u,
+                              (double)l->v);
+        if (sfb__patch_locate(&s->patches, l->face, l->u, l->v, &sdum, &tdum, &sc) < 0)
+            return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, q, "location %d: parametric face %d is a hole", q, l->face);
+    }
+    if (count == 0) return SFB_SUCCESS;
+    be = ctx->backend;
+    if (!be || !(be->caps & SFB__CAP_EVAL_PATCHES) || !be->eval_patches) {
+        sfb__log(ctx, SFB_LOG_INFO, "backend %s lacks eval_patches; using ref", be ? be->name : "none");
+        return sfb__backend_ref()->eval_patches(NULL, &s->patches, NULL, loc, 0, count, out);
+    }
+    return be->eval_patches(ctx->backend_state, &s->patches, s->uploaded_by == be ? s->backend_patches : NULL, loc, 0, count, out);
 }
 
 SFB_API sfb_result sfb_surface_stencil_info(const sfb_surface *s, sfb_table t, sfb_stencil_info *out) {

@@ -1,0 +1,421 @@
+/* Eigen structures for Stam's exact evaluation of Catmull-Clark patches around one smooth
+ * extraordinary vertex (ALGORITHMS.md §1), in double precision.
+ *
+ * Point order (K = 2N+8): 0 the EV, 2i-1 edge neighbour e_i, 2i face diagonal f_i (i = 1..N),
+ * 2N+1..2N+7 the outer points at grid (2,2),(2,1),(2,0),(2,-1),(1,2),(0,2),(-1,2); the patch
+ * is (0, e_3, f_2, e_2) with u toward e_3 = (1,0) and v toward e_2 = (0,1).
+ *
+ * A = [S 0; S11 S12] is diagonalised without a general eigensolver:
+ * - S (the 2N+1 ring points) is block-circulant: frequency j of the ring gives a 2x2 block
+ *   (a 3x3 block with the EV for j = 0) whose eigenvalues are
+ *   ((5 + cos t) +- sqrt((1 + cos t)(9 + cos t)))/16, t = 2 pi j / N, and whose eigenvectors
+ *   are e_i = cos(i t) (or sin), f_i = (cos(i t) + cos((i+1) t))/(4 lambda - 1) (or sin);
+ * - an eigenvector u of S extends to [u; w] of A with (lambda I - S12) w = S11 u, solved with
+ *   full pivoting (a consistent singular system when lambda is also an eigenvalue of S12);
+ * - the 7 eigenvalues of S12 (1/8, 1/8, 1/16, 1/16, 1/32, 1/32, 1/64) give [0; z].
+ * V^-1 comes from an LU factorisation; every build checks max |A - V diag(lambda) V^-1| and
+ * refuses the valence when it is not at rounding level. The cost is O(K^3): valences up to
+ * SFB__STAM_MAX_VALENCE are supported; higher ones are isolated adaptively instead.
+ *
+ * What the kernels use: lambda (K), V^-1 (K x K, to make the eigen coefficients C^ = V^-1 C of
+ * a face as stencil rows) and Phi_k = P_k Abar V (16 x K per sub-patch k = 1..3), so that
+ * x(u,v) = sum_i lambda_i^(n-1) (b(u~,v~)^T Phi_k)_i C^_i. */
+
+static const double sfb__S11[7][8] = {
+    {1, 0, 0, 6, 36, 6, 0, 0}, {4, 0, 0, 4, 24, 24, 0, 0}, {6, 0, 0, 1, 6, 36, 6, 1}, {4, 0, 0, 0, 0, 24, 24, 4},
+    {4, 0, 0, 24, 24, 4, 0, 0}, {6, 1, 6, 36, 6, 1, 0, 0}, {4, 4, 24, 24, 0, 0, 0, 0}};
+static const double sfb__S12[7][7] = {
+    {1, 6, 1, 0, 6, 1, 0}, {0, 4, 4, 0, 0, 0, 0}, {0, 1, 6, 1, 0, 0, 0}, {0, 0, 4, 4, 0, 0, 0},
+    {0, 0, 0, 0, 4, 4, 0}, {0, 0, 0, 0, 1, 6, 1}, {0, 0, 0, 0, 0, 4, 4}};
+static const double sfb__S21[9][7] = {
+    {0, 0, 0, 0, 16, 0, 0}, {0, 0, 0, 0, 24, 4, 0}, {0, 0, 0, 0, 16, 16, 0}, {0, 0, 0, 0, 4, 24, 4},
+    {0, 0, 0, 0, 0, 16, 16}, {0, 0, 0, 4, 24, 0, 0}, {0, 0, 0, 16, 16, 0, 0}, {0, 0, 4, 24, 4, 0, 0},
+    {0, 0, 16, 16, 0, 0, 0}};
+static const double sfb__S22[9][7] = {
+    {16, 16, 0, 0, 16, 0, 0}, {4, 24, 4, 0, 4, 0, 0}, {0, 16, 16, 0, 0, 0, 0}, {0, 4, 24, 4, 0, 0, 0},
+    {0, 0, 16, 16, 0, 0, 0}, {4, 4, 0, 0, 24, 4, 0}, {0, 0, 0, 0, 16, 16, 0}, {0, 0, 0, 0, 4, 24, 4},
+    {0, 0, 0, 0, 0, 16, 16}};
+
+/* Picking vectors (ALGORITHMS.md §1.3): entry = offset + m*mult, m = 2N. */
+static int sfb__stam_pick(int N, int k, int j) {
+    static const signed char off[3][16] = {
+        {7, 6, 4, 12, 0, 5, 3, 11, 3, 4, 2, 10, 6, 5, 1, 9},
+        {0, 5, 3, 11, 3, 4, 2, 10, 6, 5, 1, 9, 15, 14, 13, 8},
+        {1, 0, 5, 3, 2, 3, 4, 2, 7, 6, 5, 1, 16, 15, 14, 13}};
+    static const unsigned char mul[3][16] = {
+        {0, 0, 1, 1, 0, 0, 1, 1, 0, 0, 1, 1, 1, 1, 1, 1},
+        {0, 0, 1, 1, 0, 0, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1},
+        {0, 0, 0, 1, 0, 0, 0, 1, 1, 1, 1, 1, 1, 1, 1, 1}};
+    int v = off[k - 1][j] + (mul[k - 1][j] ? 2 * N : 0);
+    /* N = 3: ring index 7 (e_4) is e_1 (the entries equal to m+1 are outer points) */
+    if (N == 3 && v == 7 && !mul[k - 1][j]) v = 1;
+    return v;
+}
+
+/* Dense A (K x K, row-major). */
+static void sfb__stam_matrix(int N, double *A) {
+    int K = 2 * N + 8, i, r, c;
+    double a = 1.0 - 7.0 / (4.0 * N), b = 3.0 / (2.0 * N * N), cc = 1.0 / (4.0 * N * N);
+#define SFB__E(i) (2 * ((((i) - 1) % N + N) % N + 1) - 1)
+#define SFB__F(i) (2 * ((((i) - 1) % N + N) % N + 1))
+    memset(A, 0, (size_t)K * K * sizeof(double));
+    A[0] = a;
+    for (i = 1; i <= N; ++i) { A[2 * i - 1] = b; A[2 * i] = cc; }
+    for (i = 1; i <= N; ++i) {
+        double *re = A + (size_t)SFB__E(i) * K, *rf = A + (size_t)SFB__F(i) * K;
+        re[0] += 0.375; re[SFB__E(i)] += 0.375; re[SFB__E(i - 1)] += 0.0625; re[SFB__E(i + 1)] += 0.0625;
+        re[SFB__F(i - 1)] += 0.0625; re[SFB__F(i)] += 0.0625;
+        rf[0] += 0.25; rf[SFB__E(i)] += 0.25; rf[SFB__F(i)] += 0.25; rf[SFB__E(i + 1)] += 0.25;
+    }
+#undef SFB__E
+#undef SFB__F
+    for (r = 0; r < 7; ++r) {
+        double *row = A + (size_t)(2 * N + 1 + r) * K;
+        for (c = 0; c < 8; ++c) {
+            int col = (N == 3 && c == 7) ? 1 : c; /* N = 3: e_4 is e_1 */
+            row[col] += sfb__S11[r][c] / 64.0;
+        }
+        for (c = 0; c < 7; ++c) row[2 * N + 1 + c] += sfb__S12[r][c] / 64.0;
+    }
+}
+
+/* Solves M x = y (n x n, row-major, destroyed) with full pivoting. Pivots below tol are
+ * treated as zero (their unknowns set to 0); returns the residual max |M x - y| relative to
+ * |y| + |M||x| computed on the original, which the caller passes as M0. */
+static double sfb__solve_full(int n, double *M, double *y, double *x, const double *M0, const double *y0) {
+    int piv_r[16], piv_c[16], i, j, k, rank = 0;
+    double tol = 1e-12, res = 0.0, scale = 1e-300;
+    int colperm[16];
+    for (i = 0; i < n; ++i) colperm[i] = i;
+    for (k = 0; k < n; ++k) {
+        int br = -1, bc = -1;
+        double best = tol;
+        for (i = k; i < n; ++i)
+            for (j = k; j < n; ++j)
+                if (fabs(M[i * n + j]) > best) { best = fabs(M[i * n + j]); br = i; bc = j; }
+        if (br < 0) break;
+        if (br != k) {
+            for (j = 0; j < n; ++j) { double t = M[k * n + j]; M[k * n + j] = M[br * n + j]; M[br * n + j] = t; }
+            { double t = y[k]; y[k] = y[br]; y[br] = t; }
+        }
+        if (bc != k) {
+            for (i = 0; i < n; ++i) { double t = M[i * n + k]; M[i * n + k] = M[i * n + bc]; M[i * n + bc] = t; }
+            { int t = colperm[k]; colperm[k] = colperm[bc]; colperm[bc] = t; }
+        }
+        piv_r[k] = br; piv_c[k] = bc;
+        for (i = k + 1; i < n; ++i) {
+            double f = M[i * n + k] / M[k * n + k];
+            if (f == 0.0) continue;
+            for (j = k; j < n; ++j) M[i * n + j] -= f * M[k * n + j];
+            y[i] -= f * y[k];
+        }
+        rank++;
+    }
+    {
+        double z[16];
+        for (i = n - 1; i >= 0; --i) {
+            double s = y[i];
+            if (i >= rank) { z[i] = 0.0; continue; }
+            for (j = i + 1; j < n; ++j) s -= M[i * n + j] * z[j];
+            z[i] = s / M[i * n + i];
+        }
+        for (i = 0; i < n; ++i) x[colperm[i]] = z[i];
+    }
+    for (i = 0; i < n; ++i) {
+        double s = -y0[i], a = fabs(y0[i]);
+        for (j = 0; j < n; ++j) { s += M0[i * n + j] * x[j]; a += fabs(M0[i * n + j] * x[j]); }
+        if (a > scale) scale = a;
+        if (fabs(s) > res) res = fabs(s);
+    }
+    (void)piv_r; (void)piv_c;
+    return res / scale;
+}
+
+/* Null space of the 7x7 (S12 - mu I): up to 2 vectors, by full-pivot elimination. */
+static int sfb__s12_null(double mu, double out[2][7]) {
+    double M[49];
+    int colperm[7], i, j, k, rank = 0, nfree, f;
+    for (i = 0; i < 7; ++i) {
+        colperm[i] = i;
+        for (j = 0; j < 7; ++j) M[i * 7 + j] = sfb__S12[i][j] / 64.0 - (i == j ? mu : 0.0);
+    }
+    for (k = 0; k < 7; ++k) {
+        int br = -1, bc = -1;
+        double best = 1e-12;
+        for (i = k; i < 7; ++i)
+            for (j = k; j < 7; ++j)
+                if (fabs(M[i * 7 + j]) > best) { best = fabs(M[i * 7 + j]); br = i; bc = j; }
+        if (br < 0) break;
+        for (j = 0; j < 7; ++j) { double t = M[k * 7 + j]; M[k * 7 + j] = M[br * 7 + j]; M[br * 7 + j] = t; }
+        for (i = 0; i < 7; ++i) { double t = M[i * 7 + k]; M[i * 7 + k] = M[i * 7 + bc]; M[i * 7 + bc] = t; }
+        { int t = colperm[k]; colperm[k] = colperm[bc]; colperm[bc] = t; }
+        for (i = 0; i < 7; ++i) {
+            double fct;
+            if (i == k) continue;
+            fct = M[i * 7 + k] / M[k * 7 + k];
+            if (fct == 0.0) continue;
+            for (j = k; j < 7; ++j) M[i * 7 + j] -= fct * M[k * 7 + j];
+        }
+        rank++;
+    }
+    nfree = 7 - rank;
+    if (nfree > 2) nfree = 2;
+    for (f = 0; f < nfree; ++f) {
+        double z[7];
+        int fc = rank + f;
+        for (i = 0; i < 7; ++i) z[i] = 0.0;
+        z[fc] = 1.0;
+        for (i = 0; i < rank; ++i) z[i] = -M[i * 7 + fc] / M[i * 7 + i];
+        for (i = 0; i < 7; ++i) out[f][colperm[i]] = z[i];
+    }
+    return nfree;
+}
+
+/* In-place inverse of an n x n row-major matrix by LU with partial pivoting (Gauss-Jordan).
+ * Returns 0 when singular. `work` holds n ints. */
+static int sfb__invert(int n, double *M, double *inv, int *perm) {
+    int i, j, k;
+    for (i = 0; i < n; ++i) {
+        perm[i] = i;
+        for (j = 0; j < n; ++j) inv[(size_t)i * n + j] = i == j ? 1.0 : 0.0;
+    }
+    for (k = 0; k < n; ++k) {
+        int p = k;
+        double best = fabs(M[(size_t)k * n + k]), d;
+        for (i = k + 1; i < n; ++i)
+            if (fabs(M[(size_t)i * n + k]) > best) { best = fabs(M[(size_t)i * n + k]); p = i; }
+        if (best < 1e-300) return 0;
+        if (p != k)
+            for (j = 0; j < n; ++j) {
+                double t = M[(size_t)k * n + j]; M[(size_t)k * n + j] = M[(size_t)p * n + j]; M[(size_t)p * n + j] = t;
+                t = inv[(size_t)k * n + j]; inv[(size_t)k * n + j] = inv[(size_t)p * n + j]; inv[(size_t)p * n + j] = t;
+            }
+        d = 1.0 / M[(size_t)k * n + k];
+        for (j = 0; j < n; ++j) { M[(size_t)k * n + j] *= d; inv[(size_t)k * n + j] *= d; }
+        for (i = 0; i < n; ++i) {
+            double f;
+            if (i == k) continue;
+            f = M[(size_t)i * n + k];
+            if (f == 0.0) continue;
+            for (j = k; j < n; ++j) M[(size_t)i * n + j] -= f * M[(size_t)k * n + j];
+            for (j = 0; j < n; ++j) inv[(size_t)i * n + j] -= f * inv[(size_t)k * n + j];
+        }
+    }
+    return 1;
+}
+
+void sfb__eigen_cc_free(sfb_context *ctx, sfb__eigen_cc *e) {
+    if (!e) return;
+    sfb__free(ctx, e->lambda); sfb__free(ctx, e->vinv); sfb__free(ctx, e->phi);
+    sfb__free(ctx, e->v); sfb__free(ctx, e->a);
+    sfb__free(ctx, e);
+}
+
+/* Builds the eigen structure of valence N (3..SFB__STAM_MAX_VALENCE). keep: also keep V and A
+ * (for tests). */
+sfb_result sfb__eigen_cc_build(sfb_context *ctx, int N, int keep, sfb__eigen_cc **out) {
+    sfb__eigen_cc *e;
+    int K = 2 * N + 8, col = 0, i, j, k, q;
+    double *A = NULL, *V = NULL, *W = NULL, *AV = NULL;
+    int *perm = NULL;
+    size_t KK = (size_t)K * K;
+    *out = NULL;
+    if (N < 3 || N > SFB__STAM_MAX_VALENCE)
+        return sfb__error(ctx, SFB_LIMIT_EXCEEDED, SFB_ELEMENT_NONE, -1, "no Stam eigen structure for valence %d (3..%d)", N,
+                          SFB__STAM_MAX_VALENCE);
+    e = (sfb__eigen_cc *)sfb__calloc(ctx, 1, sizeof *e);
+    A = (double *)sfb__alloc(ctx, KK * sizeof(double));
+    V = (double *)sfb__calloc(ctx, KK, sizeof(double));
+    W = (double *)sfb__alloc(ctx, KK * sizeof(double));
+    AV = (double *)sfb__alloc(ctx, (size_t)9 * K * sizeof(double));
+    perm = (int *)sfb__alloc(ctx, (size_t)K * sizeof(int));
+    if (e) {
+        e->lambda = (double *)sfb__alloc(ctx, (size_t)K * sizeof(double));
+        e->vinv = (double *)sfb__alloc(ctx, KK * sizeof(double));
+        e->phi = (double *)sfb__alloc(ctx, (size_t)48 * K * sizeof(double));
+    }
+    if (!e || !A || !V || !W || !AV || !perm || !e->lambda || !e->vinv || !e->phi) goto oom;
+    e->N = N;
+    e->K = K;
+    sfb__stam_matrix(N, A);
+    /* right eigenvectors of S, column by column of V (row-major: V[r*K + col]) */
+#define SFB__SET(r, value) (V[(size_t)(r) * K + col] = (value))
+    {
+        /* j = 0: constant ring; 3x3 block on (V, e, f) */
+        double a = A[0], bN = A[1] * N, cN = A[2] * N;
+        double B[3][3];
+        double tr, det, disc, l2, l3, lam[3];
+        B[0][0] = a; B[0][1] = bN; B[0][2] = cN;
+        B[1][0] = 0.375; B[1][1] = 0.5; B[1][2] = 0.125;
+        B[2][0] = 0.25; B[2][1] = 0.5; B[2][2] = 0.25;
+        tr = B[0][0] + B[1][1] + B[2][2];
+        det = B[0][0] * (B[1][1] * B[2][2] - B[1][2] * B[2][1]) - B[0][1] * (B[1][0] * B[2][2] - B[1][2] * B[2][0]) +
+              B[0][2] * (B[1][0] * B[2][1] - B[1][1] * B[2][0]);
+        /* the other two eigenvalues: l2 + l3 = tr - 1, l2 l3 = det */
+        disc = (tr - 1.0) * (tr - 1.0) - 4.0 * det;
+        if (disc < 0.0) disc = 0.0;
+        l2 = 0.5 * ((tr - 1.0) + sqrt(disc));
+        l3 = 0.5 * ((tr - 1.0) - sqrt(disc));
+        lam[0] = 1.0; lam[1] = l2; lam[2] = l3;
+        for (q = 0; q < 3; ++q) {
+            double M[3][3], best = -1.0, x[3] = {1, 1, 1};
+            int r1, r2;
+            if (q > 0) {
+                for (i = 0; i < 3; ++i)
+                    for (j = 0; j < 3; ++j) M[i][j] = B[i][j] - (i == j ? lam[q] : 0.0);
+                for (r1 = 0; r1 < 3; ++r1)
+                    for (r2 = r1 + 1; r2 < 3; ++r2) {
+                        double c0 = M[r1][1] * M[r2][2] - M[r1][2] * M[r2][1];
+                        double c1 = M[r1][2] * M[r2][0] - M[r1][0] * M[r2][2];
+                        double c2 = M[r1][0] * M[r2][1] - M[r1][1] * M[r2][0];
+                        double nn = c0 * c0 + c1 * c1 + c2 * c2;
+                        if (nn > best) { best = nn; x[0] = c0; x[1] = c1; x[2] = c2; }
+                    }
+                best = sqrt(best);
+                for (i = 0; i < 3; ++i) x[i] /= best;
+            }
+            SFB__SET(0, x[0]);
+            for (i = 1; i <= N; ++i) { SFB__SET(2 * i - 1, x[1]); SFB__SET(2 * i, x[2]); }
+            e->lambda[col] = lam[q];
+            if (q == 0) e->dominant = col;
+            col++;
+        }
+    }
+    for (j = 1; 2 * j < N; ++j) {
+        double t = 2.0 * SFB__PI * j / N, c = cos(t);
+        double root = sqrt((1.0 + c) * (9.0 + c));
+        double lams[2];
+        lams[0] = ((5.0 + c) + root) / 16.0;
+        lams[1] = ((5.0 + c) - root) / 16.0;
+        for (q = 0; q < 2; ++q) {
+            double d = 1.0 / (4.0 * lams[q] - 1.0);
+            int trig;
+            for (trig = 0; trig < 2; ++trig) {
+                SFB__SET(0, 0.0);
+                for (i = 1; i <= N; ++i) {
+                    double x0 = trig ? sin(i * t) : cos(i * t), x1 = trig ? sin((i + 1) * t) : cos((i + 1) * t);
+                    SFB__SET(2 * i - 1, x0);
+                    SFB__SET(2 * i, (x0 + x1) * d);
+                }
+                e->lambda[col++] = lams[q];
+            }
+        }
+    }
+    if (N % 2 == 0) {
+        for (q = 0; q < 2; ++q) {
+            SFB__SET(0, 0.0);
+            for (i = 1; i <= N; ++i) {
+                double s = (i % 2) ? -1.0 : 1.0;
+                SFB__SET(2 * i - 1, q == 0 ? s : 0.0);
+                SFB__SET(2 * i, q == 1 ? s : 0.0);
+            }
+            e->lambda[col++] = 0.25;
+        }
+    }
+    if (col != 2 * N + 1) goto defective;
+    /* extend each to A: (lambda I - S12) w = S11 u */
+    for (q = 0; q < col; ++q) {
+        double M[49], M0[49], y[7], y0[7], w[7], res;
+        for (i = 0; i < 7; ++i) {
+            double s = 0.0;
+            for (k = 0; k < 8; ++k) {
+                int src = (N == 3 && k == 7) ? 1 : k;
+                s += sfb__S11[i][k] / 64.0 * V[(size_t)src * K + q];
+            }
+            y[i] = y0[i] = s;
+            for (k = 0; k < 7; ++k) M[i * 7 + k] = M0[i * 7 + k] = (i == k ? e->lambda[q] : 0.0) - sfb__S12[i][k] / 64.0;
+        }
+        res = sfb__solve_full(7, M, y, w, M0, y0);
+        if (res > 1e-10) goto defective;
+        for (i = 0; i < 7; ++i) V[(size_t)(2 * N + 1 + i) * K + q] = w[i];
+    }
+    {
+        static const double mus[4] = {0.125, 0.0625, 0.03125, 0.015625};
+        static const int mult[4] = {2, 2, 2, 1};
+        for (q = 0; q < 4; ++q) {
+            double z[2][7];
+            int got = sfb__s12_null(mus[q], z), f;
+            if (got != mult[q]) goto defective;
+            for (f = 0; f < got; ++f) {
+                for (i = 0; i < 7; ++i) V[(size_t)(2 * N + 1 + i) * K + col] = z[f][i];
+                e->lambda[col++] = mus[q];
+            }
+        }
+    }
+#undef SFB__SET
+    if (col != K) goto defective;
+    /* V^-1 */
+    memcpy(W, V, KK * sizeof(double));
+    if (!sfb__invert(K, W, e->vinv, perm)) goto defective;
+    /* check A = V L V^-1 */
+    {
+        double err = 0.0;
+        int r, c;
+        for (r = 0; r < K; ++r)
+            for (c = 0; c < K; ++c) {
+                double s = 0.0;
+                for (k = 0; k < K; ++k) s += V[(size_t)r * K + k] * e->lambda[k] * e->vinv[(size_t)k * K + c];
+                s -= A[(size_t)r * K + c];
+                if (fabs(s) > err) err = fabs(s);
+            }
+        e->error = err;
+        if (!(err < 1e-9)) goto defective;
+    }
+    e->sub = 0.0;
+    for (i = 0; i < K; ++i)
+        if (i != e->dominant && fabs(e->lambda[i]) > e->sub) e->sub = fabs(e->lambda[i]);
+    /* rows K..K+8 of Abar V: [S21 0 S22] V */
+    for (i = 0; i < 9; ++i)
+        for (q = 0; q < K; ++q) {
+            double s = 0.0;
+            for (k = 0; k < 7; ++k) {
+                s += sfb__S21[i][k] / 64.0 * V[(size_t)k * K + q];
+                s += sfb__S22[i][k] / 64.0 * V[(size_t)(2 * N + 1 + k) * K + q];
+            }
+            AV[(size_t)i * K + q] = s;
+        }
+    /* Phi_k rows: picked rows of Abar V; rows < K of A V are rows of V L */
+    for (k = 1; k <= 3; ++k)
+        for (j = 0; j < 16; ++j) {
+            int p = sfb__stam_pick(N, k, j);
+            double *dst = e->phi + ((size_t)(k - 1) * 16 + j) * K;
+            for (q = 0; q < K; ++q) {
+                if (p < K) {
+                    double s = 0.0;
+                    int c;
+                    for (c = 0; c < K; ++c) s += A[(size_t)p * K + c] * V[(size_t)c * K + q];
+                    dst[q] = s;
+                } else {
+                    dst[q] = AV[(size_t)(p - K) * K + q];
+                }
+            }
+        }
+    if (keep) { e->v = V; e->a = A; V = A = NULL; }
+    sfb__free(ctx, A); sfb__free(ctx, V); sfb__free(ctx, W); sfb__free(ctx, AV); sfb__free(ctx, perm);
+    *out = e;
+    return SFB_SUCCESS;
+defective:
+    sfb__free(ctx, A); sfb__free(ctx, V); sfb__free(ctx, W); sfb__free(ctx, AV); sfb__free(ctx, perm);
+    sfb__eigen_cc_free(ctx, e);
+    return sfb__error(ctx, SFB_BACKEND_ERROR, SFB_ELEMENT_NONE, -1, "Stam eigen structure of valence %d failed its check", N);
+oom:
+    sfb__free(ctx, A); sfb__free(ctx, V); sfb__free(ctx, W); sfb__free(ctx, AV); sfb__free(ctx, perm);
+    sfb__eigen_cc_free(ctx, e);
+    return sfb__oom(ctx, "Stam eigen structure");
+}
+
+/* The context's cache: built on first use of a valence, kept until the context goes. */
+const sfb__eigen_cc *sfb__eigen_cc_get(sfb_context *ctx, int N) {
+    sfb__eigen_cc *e;
+    if (N < 3 || N > SFB__STAM_MAX_VALENCE) return NULL;
+    if (ctx->eigen_cc[N]) return ctx->eigen_cc[N];
+    if (ctx->eigen_cc_failed[N]) return NULL;
+    if (sfb__eigen_cc_build(ctx, N, 0, &e) != SFB_SUCCESS) {
+        ctx->eigen_cc_failed[N] = 1;
+        sfb__log(ctx, SFB_LOG_WARN, "valence %d: %s; its faces are isolated adaptively instead", N, ctx->error);
+        sfb_clear_error(ctx);
+        return NULL;
+    }
+    ctx->eigen_cc[N] = e;
+    return e;
+}
