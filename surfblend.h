@@ -337,6 +337,32 @@ typedef struct sfb_patch_info {
 } sfb_patch_info;
 SFB_API sfb_result sfb_surface_patch_info(const sfb_surface *surface, sfb_patch_info *out);
 
+/* ---- tessellation (needs SFB_REFINE_PATCHES) ---- */
+enum {
+    SFB_TESS_SPLIT_CREASES = 1u << 0  /* duplicate the vertices along infinitely sharp interior creases, one
+                                         copy per side, each with that side's normal (split normals) */
+};
+typedef struct sfb_tess_config {
+    int rate;         /* segments per parametric-face edge, 1..1024 (rate x rate quads, 2 triangles each) */
+    float tolerance;  /* 0: uniform. > 0: adaptive: each parametric face (and each edge) uses the smallest
+                         rate <= `rate` whose chordal error is within `tolerance` (model units) */
+    unsigned flags;   /* SFB_TESS_* */
+} sfb_tess_config;
+SFB_API sfb_tess_config sfb_tess_config_init(int rate);
+
+/* Indexed triangles. Watertight: a vertex on an edge shared by two parametric faces is computed
+ * once and shared (except along infinitely sharp creases with SFB_TESS_SPLIT_CREASES). */
+typedef struct sfb_tess_data {
+    int vertex_count, triangle_count;
+    float *positions, *normals;   /* xyz per vertex (unit normals) */
+    sfb_location *locations;      /* per vertex: the parametric face and (u,v) it was evaluated at */
+    int *triangles;               /* 3 vertex indices per triangle, counter-clockwise seen from the normal side */
+    int *triangle_faces;          /* parametric face of each triangle */
+    sfb_context *ctx_;            /* allocator owner */
+} sfb_tess_data;
+SFB_API sfb_result sfb_surface_tessellate(const sfb_surface *surface, const sfb_tess_config *config, sfb_tess_data *out);
+SFB_API void sfb_tess_data_free(sfb_tess_data *data);
+
 #ifdef __cplusplus
 }
 #endif
@@ -569,6 +595,8 @@ struct sfb_surface {
     int boundary, crease_method, triangle_rule, uv_interp;
     int has_patches;
     sfb__patch_table patches;    /* limit evaluation (SFB_REFINE_PATCHES) */
+    sfb__level pbase;            /* the prepared base level the patches were built from (tessellation
+                                    shares vertices along its edges) */
     void *backend_patches;       /* the backend's uploaded copy */
 };
 
@@ -3358,6 +3386,7 @@ static sfb_result sfb__ref_eval_patches(void *state, const sfb__patch_table *pt,
     }
     return SFB_SUCCESS;
 }
+#line 1 "src/tess.c"
 #line 1 "src/mesh.c"
 /* Control meshes: validation of untrusted arrays, edges, topology, creases, info. */
 
@@ -4399,6 +4428,7 @@ SFB_API void sfb_surface_destroy(sfb_surface *s) {
     if (s->backend_patches && s->uploaded_by && s->uploaded_by->release_patches)
         s->uploaded_by->release_patches(ctx->backend_state, s->backend_patches);
     sfb__patch_table_free(ctx, &s->patches);
+    sfb__level_free(ctx, &s->pbase);
     sfb__level_free(ctx, &s->top);
     sfb__level_free(ctx, &s->uv_top);
     sfb__free(ctx, s->base_positions);
@@ -4483,6 +4513,7 @@ SFB_API sfb_result sfb_surface_create(sfb_context *ctx, const sfb_mesh *mesh, co
     if (r == SFB_SUCCESS && (cfg->flags & SFB_REFINE_PATCHES)) {
         r = sfb__patches_build(ctx, &prep, &opt, cfg->isolation_level ? cfg->isolation_level : SFB_DEFAULT_ISOLATION, &s->patches);
         if (r == SFB_SUCCESS) r = sfb__patches_finish(s);
+        if (r == SFB_SUCCESS) { s->pbase = prep; memset(&prep, 0, sizeof prep); }
     }
     sfb__level_free(ctx, &prep);
     if (r != SFB_SUCCESS) { sfb_surface_destroy(s); return r; }

@@ -324,6 +324,32 @@ typedef struct sfb_patch_info {
 } sfb_patch_info;
 SFB_API sfb_result sfb_surface_patch_info(const sfb_surface *surface, sfb_patch_info *out);
 
+/* ---- tessellation (needs SFB_REFINE_PATCHES) ---- */
+enum {
+    SFB_TESS_SPLIT_CREASES = 1u << 0  /* duplicate the vertices along infinitely sharp interior creases, one
+                                         copy per side, each with that side's normal (split normals) */
+};
+typedef struct sfb_tess_config {
+    int rate;         /* segments per parametric-face edge, 1..1024 (rate x rate quads, 2 triangles each) */
+    float tolerance;  /* 0: uniform. > 0: adaptive: each parametric face (and each edge) uses the smallest
+                         rate <= `rate` whose chordal error is within `tolerance` (model units) */
+    unsigned flags;   /* SFB_TESS_* */
+} sfb_tess_config;
+SFB_API sfb_tess_config sfb_tess_config_init(int rate);
+
+/* Indexed triangles. Watertight: a vertex on an edge shared by two parametric faces is computed
+ * once and shared (except along infinitely sharp creases with SFB_TESS_SPLIT_CREASES). */
+typedef struct sfb_tess_data {
+    int vertex_count, triangle_count;
+    float *positions, *normals;   /* xyz per vertex (unit normals) */
+    sfb_location *locations;      /* per vertex: the parametric face and (u,v) it was evaluated at */
+    int *triangles;               /* 3 vertex indices per triangle, counter-clockwise seen from the normal side */
+    int *triangle_faces;          /* parametric face of each triangle */
+    sfb_context *ctx_;            /* allocator owner */
+} sfb_tess_data;
+SFB_API sfb_result sfb_surface_tessellate(const sfb_surface *surface, const sfb_tess_config *config, sfb_tess_data *out);
+SFB_API void sfb_tess_data_free(sfb_tess_data *data);
+
 #ifdef __cplusplus
 }
 #endif

@@ -222,6 +222,8 @@ struct sfb_surface {
     int boundary, crease_method, triangle_rule, uv_interp;
     int has_patches;
     sfb__patch_table patches;    /* limit evaluation (SFB_REFINE_PATCHES) */
+    sfb__level pbase;            /* the prepared base level the patches were built from (tessellation
+                                    shares vertices along its edges) */
     void *backend_patches;       /* the backend's uploaded copy */
 };
 

@@ -33,6 +33,7 @@ SFB_API void sfb_surface_destroy(sfb_surface *s) {
     if (s->backend_patches && s->uploaded_by && s->uploaded_by->release_patches)
         s->uploaded_by->release_patches(ctx->backend_state, s->backend_patches);
     sfb__patch_table_free(ctx, &s->patches);
+    sfb__level_free(ctx, &s->pbase);
     sfb__level_free(ctx, &s->top);
     sfb__level_free(ctx, &s->uv_top);
     sfb__free(ctx, s->base_positions);
@@ -117,6 +118,7 @@ SFB_API sfb_result sfb_surface_create(sfb_context *ctx, const sfb_mesh *mesh, co
     if (r == SFB_SUCCESS && (cfg->flags & SFB_REFINE_PATCHES)) {
         r = sfb__patches_build(ctx, &prep, &opt, cfg->isolation_level ? cfg->isolation_level : SFB_DEFAULT_ISOLATION, &s->patches);
         if (r == SFB_SUCCESS) r = sfb__patches_finish(s);
+        if (r == SFB_SUCCESS) { s->pbase = prep; memset(&prep, 0, sizeof prep); }
     }
     sfb__level_free(ctx, &prep);
     if (r != SFB_SUCCESS) { sfb_surface_destroy(s); return r; }
