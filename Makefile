@@ -113,7 +113,12 @@ $(BUILD)/gl_errors: tests/gl_errors.c surfblend.h $(BACKEND_HDRS)
 $(BUILD)/gl_pieces: tests/gl_pieces.c surfblend.h $(BACKEND_HDRS)
 	$(CC) $(CFLAGS) $(SAN) -I. tests/gl_pieces.c -o $@ $(LIBS)
 
-unit-build: $(BUILD)/surfblend $(BUILD)/unit $(BUILD)/osd_agree $(BUILD)/agree $(BUILD)/gl_host \
+# Limit evaluation (sfb_surface_eval) on every backend: exactness, invariance, derivatives,
+# continuity, normals at extraordinary vertices (tests/limit.c).
+$(BUILD)/limit: tests/limit.c $(BUILD)/libsfb.o
+	$(CC) $(CFLAGS) $(SAN) -I. tests/limit.c $(BUILD)/libsfb.o -o $@ $(LIBS)
+
+unit-build: $(BUILD)/surfblend $(BUILD)/unit $(BUILD)/osd_agree $(BUILD)/agree $(BUILD)/limit $(BUILD)/gl_host \
             $(BUILD)/gl_errors $(BUILD)/gl_pieces $(EXAMPLES)
 
 # On CI (CI set and not false/0) the optional backends must run, not be skipped: the suites

@@ -620,7 +620,7 @@ sfb_result sfb__level_prepare(sfb_context *ctx, const sfb__level *src, int sharp
 /* patches.c */
 void sfb__patch_table_free(sfb_context *ctx, sfb__patch_table *pt);
 sfb_result sfb__patches_build(sfb_context *ctx, const sfb__level *base, const sfb__refine_options *opt, int limit,
-                              sfb__patch_table *pt);
+                              const float *positions, sfb__patch_table *pt);
 int sfb__patch_locate(const sfb__patch_table *pt, int ptex, double u, double v, double *s, double *t, double *scale);
 #line 1 "src/context.c"
 /* Results, context, allocator with memory budget, errors, logging, progress. */
@@ -2457,8 +2457,9 @@ const sfb__eigen_cc *sfb__eigen_cc_get(sfb_context *ctx, int N) {
  * At the isolation limit (default 8; semi-sharp features continue until smooth, at most
  * SFB_MAX_LEVEL + 1) a face that is still irregular (a crease or corner vertex with an
  * extraordinary sector, a dart, a non-manifold vertex) gets the END CAP: the bilinear patch
- * through the limit positions of its four corners. Its distance to the limit surface is
- * O(h^2) with h = 2^-limit of the base face (measured in tests/agree.c and the README).
+ * through the limit positions of its four corners, with normals blended from the corners'
+ * limit normals (exact at the corners; oriented as the cap). Its distance to the limit surface is O(h^2) with
+ * h = 2^-limit of the base face (measured by tests/limit.c and quoted in the README).
  * Holes produce no patches. */
 
 enum { SFB__PATCH_BSPLINE = 0, SFB__PATCH_STAM = 1, SFB__PATCH_ENDCAP = 2 };
@@ -2868,29 +2869,33 @@ static sfb_result sfb__pb_face(sfb__pbuild *b, sfb__wlevel *w, int g, int level,
         }
     }
     if ((level >= limit && !sfb__face_semisharp(l, g)) || level >= SFB_MAX_LEVEL + 1) {
-        /* end cap: limit positions of the corners, in frame order */
+        /* end cap: limit positions of the corners in frame order (points 0..3), then the two
+         * limit tangents of each corner (points 4 + 2k, 5 + 2k) for the normals */
         int base;
         sfb__mask mp, m1, m2;
+        sfb_result er = SFB_SUCCESS;
         memset(&mp, 0, sizeof mp); memset(&m1, 0, sizeof m1); memset(&m2, 0, sizeof m2);
-        patch = sfb__pb_patch(b, SFB__PATCH_ENDCAP, par & ~(3u << 30), 0, 4);
+        patch = sfb__pb_patch(b, SFB__PATCH_ENDCAP, par & ~(3u << 30), 0, 12);
         if (patch < 0) return sfb__oom(b->ctx, "patch table");
         base = b->pt->pfirst[patch];
-        for (k = 0; k < 4; ++k) {
-            int v = l->fv[l->fv_off[g] + (rot + k) % 4], row, need = 3 * sfb__mask_need_vertex(l, v) + 8;
-            if (!sfb__mask_grow(b->ctx, &mp, need) || !sfb__mask_grow(b->ctx, &m1, need) || !sfb__mask_grow(b->ctx, &m2, need)) row = -1;
-            else {
-                sfb__limit_masks(l, v, SFB_SCHEME_CATMARK, &mp, &m1, &m2);
-                row = sfb__pb_point(b, &w->rows, &mp);
+        for (k = 0; k < 4 && er == SFB_SUCCESS; ++k) {
+            int v = l->fv[l->fv_off[g] + (rot + k) % 4], r0, r1, r2, need = 3 * sfb__mask_need_vertex(l, v) + 8;
+            if (!sfb__mask_grow(b->ctx, &mp, need) || !sfb__mask_grow(b->ctx, &m1, need) || !sfb__mask_grow(b->ctx, &m2, need)) {
+                er = sfb__oom(b->ctx, "patch points");
+                break;
             }
-            if (row < 0) {
-                sfb__free(b->ctx, mp.idx); sfb__free(b->ctx, mp.w); sfb__free(b->ctx, m1.idx); sfb__free(b->ctx, m1.w);
-                sfb__free(b->ctx, m2.idx); sfb__free(b->ctx, m2.w);
-                return sfb__oom(b->ctx, "patch points");
-            }
-            b->pt->cv[base + k] = row;
+            sfb__limit_masks(l, v, SFB_SCHEME_CATMARK, &mp, &m1, &m2);
+            r0 = sfb__pb_point(b, &w->rows, &mp);
+            r1 = sfb__pb_point(b, &w->rows, &m1);
+            r2 = sfb__pb_point(b, &w->rows, &m2);
+            if (r0 < 0 || r1 < 0 || r2 < 0) er = sfb__oom(b->ctx, "patch points");
+            b->pt->cv[base + k] = r0;
+            b->pt->cv[base + 4 + 2 * k] = r1;
+            b->pt->cv[base + 5 + 2 * k] = r2;
         }
         sfb__free(b->ctx, mp.idx); sfb__free(b->ctx, mp.w); sfb__free(b->ctx, m1.idx); sfb__free(b->ctx, m1.w);
         sfb__free(b->ctx, m2.idx); sfb__free(b->ctx, m2.w);
+        if (er != SFB_SUCCESS) return er;
         return sfb__pb_insert(b, ptex, par & ~(3u << 30), patch) ? SFB_SUCCESS : sfb__oom(b->ctx, "patch table");
     }
     *refine = 1;
@@ -2963,7 +2968,7 @@ static sfb_result sfb__pb_submesh(sfb_context *ctx, const sfb__wlevel *w, const 
 }
 
 sfb_result sfb__patches_build(sfb_context *ctx, const sfb__level *base, const sfb__refine_options *opt, int limit,
-                              sfb__patch_table *pt) {
+                              const float *positions, sfb__patch_table *pt) {
     sfb__pbuild b;
     sfb__wlevel w, nw;
     sfb_result r = SFB_SUCCESS;
@@ -3170,6 +3175,22 @@ sfb_result sfb__patches_build(sfb_context *ctx, const sfb__level *base, const sf
     }
     r = sfb__rows_to_stencils(ctx, &b.prow, base->nv, &pt->points);
     if (r == SFB_OUT_OF_MEMORY) r = sfb__oom(ctx, "patch points");
+    if (r == SFB_SUCCESS) {
+        /* The points from the double rows, not from the float stencil table: a Stam point is an
+         * eigen coefficient, a combination with weights of both signs summing to 0 whose result
+         * is small next to the coordinates; float weights would cost it its precision (normals
+         * off by ~1e-4 rad on meshes far from the origin). */
+        int row, c;
+        pt->point_data = (float *)sfb__alloc(ctx, ((size_t)b.prow.rows + 1) * 3 * sizeof(float));
+        if (!pt->point_data) r = sfb__oom(ctx, "patch points");
+        for (row = 0; r == SFB_SUCCESS && row < b.prow.rows; ++row) {
+            double acc[3] = {0.0, 0.0, 0.0};
+            size_t q;
+            for (q = b.prow.off[row]; q < b.prow.off[row + 1]; ++q)
+                for (c = 0; c < 3; ++c) acc[c] += b.prow.w[q] * positions[3 * (size_t)b.prow.idx[q] + c];
+            for (c = 0; c < 3; ++c) pt->point_data[3 * (size_t)row + c] = (float)acc[c];
+        }
+    }
     goto done;
 oom:
     r = sfb__oom(ctx, "patch table");
@@ -3249,6 +3270,37 @@ static void sfb__eval_endcap(const float *pts, const int *cv, double s, double t
         res[4][c] = (double)p0[c] - p1[c] + p2[c] - p3[c];
         res[5][c] = 0.0;
     }
+}
+
+/* End-cap normal: the bilinear blend of the corners' limit normals (from the limit tangents),
+ * so that the normal at a corner is the limit normal there. A corner whose limit normal is
+ * more than 45 degrees from the cap's own (chord) normal at that corner belongs to another
+ * sector (a corner or non-manifold vertex): that corner uses the chord normal instead. */
+static void sfb__endcap_normal(const float *pts, const int *cv, double s, double t, double nrm[3]) {
+    double wts[4], n[3] = {0, 0, 0};
+    int k, c;
+    wts[0] = (1 - s) * (1 - t); wts[1] = s * (1 - t); wts[2] = s * t; wts[3] = (1 - s) * t;
+    for (k = 0; k < 4; ++k) {
+        const float *p = pts + 3 * (size_t)cv[k], *pn = pts + 3 * (size_t)cv[(k + 1) % 4], *pp = pts + 3 * (size_t)cv[(k + 3) % 4];
+        const float *t1 = pts + 3 * (size_t)cv[4 + 2 * k], *t2 = pts + 3 * (size_t)cv[5 + 2 * k];
+        double a[3], bb[3], ch[3], ln[3], lc, ll;
+        for (c = 0; c < 3; ++c) { a[c] = (double)pn[c] - p[c]; bb[c] = (double)pp[c] - p[c]; }
+        sfb__cross(a, bb, ch);
+        for (c = 0; c < 3; ++c) { a[c] = t1[c]; bb[c] = t2[c]; }
+        sfb__cross(a, bb, ln);
+        lc = sqrt(ch[0] * ch[0] + ch[1] * ch[1] + ch[2] * ch[2]);
+        ll = sqrt(ln[0] * ln[0] + ln[1] * ln[1] + ln[2] * ln[2]);
+        if (lc > 0.0) for (c = 0; c < 3; ++c) ch[c] /= lc;
+        if (ll > 0.0) for (c = 0; c < 3; ++c) ln[c] /= ll;
+        {
+            /* the tangent masks' orientation is the vertex's, not necessarily this face's */
+            double d = ln[0] * ch[0] + ln[1] * ch[1] + ln[2] * ch[2];
+            if (d < 0.0) { ln[0] = -ln[0]; ln[1] = -ln[1]; ln[2] = -ln[2]; d = -d; }
+            if (!(ll > 0.0) || d < 0.70710678118654752) memcpy(ln, ch, sizeof ln);
+        }
+        for (c = 0; c < 3; ++c) n[c] += wts[k] * ln[c];
+    }
+    memcpy(nrm, n, sizeof n);
 }
 
 /* Stam: (s,t) in the patch, the EV at frame corner `corner`. nres[2] gets the derivatives
@@ -3340,7 +3392,7 @@ static void sfb__ref_eval_one(const sfb__patch_table *pt, const float *pts, cons
         break;
     case SFB__PATCH_ENDCAP:
         sfb__eval_endcap(pts, cv, s, t, res);
-        sfb__cross(res[1], res[2], nrm);
+        sfb__endcap_normal(pts, cv, s, t, nrm);
         break;
     default:
         sfb__eval_bspline16(pts, cv, s, t, res);
@@ -4511,7 +4563,8 @@ SFB_API sfb_result sfb_surface_create(sfb_context *ctx, const sfb_mesh *mesh, co
     r = sfb__refine(ctx, &prep, &opt, cfg->refine_level, &s->top, &s->tables[SFB_TABLE_VERTEX],
                     opt.want_limit ? &s->tables[SFB_TABLE_LIMIT] : NULL, 0.0f, 0.8f);
     if (r == SFB_SUCCESS && (cfg->flags & SFB_REFINE_PATCHES)) {
-        r = sfb__patches_build(ctx, &prep, &opt, cfg->isolation_level ? cfg->isolation_level : SFB_DEFAULT_ISOLATION, &s->patches);
+        r = sfb__patches_build(ctx, &prep, &opt, cfg->isolation_level ? cfg->isolation_level : SFB_DEFAULT_ISOLATION,
+                                s->base_positions, &s->patches);
         if (r == SFB_SUCCESS) r = sfb__patches_finish(s);
         if (r == SFB_SUCCESS) { s->pbase = prep; memset(&prep, 0, sizeof prep); }
     }
@@ -4576,17 +4629,13 @@ SFB_API sfb_result sfb_surface_create(sfb_context *ctx, const sfb_mesh *mesh, co
     return SFB_SUCCESS;
 }
 
-/* Patch points for the surface's positions (ref kernel: table building, done once, the same
- * for every backend) and the eigen structures the Stam patches use. */
+/* The eigen structures the Stam patches use (the patch points were made by the builder). */
 static sfb_result sfb__patches_finish(sfb_surface *s) {
     sfb_context *ctx = s->ctx;
     sfb__patch_table *pt = &s->patches;
     sfb_buffer_desc d3 = {0, 3, 3};
     int p;
-    pt->point_data = (float *)sfb__alloc(ctx, ((size_t)pt->points.rows + 1) * 3 * sizeof(float));
-    if (!pt->point_data) return sfb__oom(ctx, "patch points");
-    if (pt->points.rows)
-        sfb__backend_ref()->eval_stencils(NULL, &pt->points, NULL, 0, pt->points.rows, s->base_positions, d3, pt->point_data, d3);
+    (void)d3;
     for (p = 0; p < pt->npatch; ++p)
         if (pt->ptype[p] == SFB__PATCH_STAM) {
             int N = pt->pvalence[p];

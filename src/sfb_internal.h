@@ -247,5 +247,5 @@ sfb_result sfb__level_prepare(sfb_context *ctx, const sfb__level *src, int sharp
 /* patches.c */
 void sfb__patch_table_free(sfb_context *ctx, sfb__patch_table *pt);
 sfb_result sfb__patches_build(sfb_context *ctx, const sfb__level *base, const sfb__refine_options *opt, int limit,
-                              sfb__patch_table *pt);
+                              const float *positions, sfb__patch_table *pt);
 int sfb__patch_locate(const sfb__patch_table *pt, int ptex, double u, double v, double *s, double *t, double *scale);

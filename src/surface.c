@@ -116,7 +116,8 @@ SFB_API sfb_result sfb_surface_create(sfb_context *ctx, const sfb_mesh *mesh, co
     r = sfb__refine(ctx, &prep, &opt, cfg->refine_level, &s->top, &s->tables[SFB_TABLE_VERTEX],
                     opt.want_limit ? &s->tables[SFB_TABLE_LIMIT] : NULL, 0.0f, 0.8f);
     if (r == SFB_SUCCESS && (cfg->flags & SFB_REFINE_PATCHES)) {
-        r = sfb__patches_build(ctx, &prep, &opt, cfg->isolation_level ? cfg->isolation_level : SFB_DEFAULT_ISOLATION, &s->patches);
+        r = sfb__patches_build(ctx, &prep, &opt, cfg->isolation_level ? cfg->isolation_level : SFB_DEFAULT_ISOLATION,
+                                s->base_positions, &s->patches);
         if (r == SFB_SUCCESS) r = sfb__patches_finish(s);
         if (r == SFB_SUCCESS) { s->pbase = prep; memset(&prep, 0, sizeof prep); }
     }
@@ -181,17 +182,13 @@ SFB_API sfb_result sfb_surface_create(sfb_context *ctx, const sfb_mesh *mesh, co
     return SFB_SUCCESS;
 }
 
-/* Patch points for the surface's positions (ref kernel: table building, done once, the same
- * for every backend) and the eigen structures the Stam patches use. */
+/* The eigen structures the Stam patches use (the patch points were made by the builder). */
 static sfb_result sfb__patches_finish(sfb_surface *s) {
     sfb_context *ctx = s->ctx;
     sfb__patch_table *pt = &s->patches;
     sfb_buffer_desc d3 = {0, 3, 3};
     int p;
-    pt->point_data = (float *)sfb__alloc(ctx, ((size_t)pt->points.rows + 1) * 3 * sizeof(float));
-    if (!pt->point_data) return sfb__oom(ctx, "patch points");
-    if (pt->points.rows)
-        sfb__backend_ref()->eval_stencils(NULL, &pt->points, NULL, 0, pt->points.rows, s->base_positions, d3, pt->point_data, d3);
+    (void)d3;
     for (p = 0; p < pt->npatch; ++p)
         if (pt->ptype[p] == SFB__PATCH_STAM) {
             int N = pt->pvalence[p];

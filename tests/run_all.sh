@@ -85,6 +85,10 @@ fi
 if [ -d "$SHAPES" ]; then counted agree "$BUILD/agree" "$SHAPES"
 else echo "peer shapes not found at $SHAPES: agree runs without them"; counted agree "$BUILD/agree"; fi
 
+# 3b'. limit evaluation on every backend (ref included): tests/limit.c
+if [ -d "$SHAPES" ]; then counted limit "$BUILD/limit" "$SHAPES"
+else echo "peer shapes not found at $SHAPES: limit evaluation suite skipped"; add_counts limit 0 0 1; fi
+
 # 3c. the engine case: the gl backend on the host's own EGL context and GL buffers
 counted gl_host "$BUILD/gl_host"
 
