@@ -34,6 +34,9 @@
 #ifndef SFB__GL_STENCIL_SOURCE
 #define SFB__GL_STENCIL_SOURCE sfb__glsl_stencils_comp_glsl
 #endif
+#ifndef SFB__GL_PATCH_SOURCE
+#define SFB__GL_PATCH_SOURCE sfb__glsl_patches_comp_glsl
+#endif
 #ifndef SFB__EGL_LIBRARY_NAMES
 #define SFB__EGL_LIBRARY_NAMES {"libEGL.so.1", "libEGL.so", NULL}
 #endif
@@ -97,6 +100,7 @@ enum {
     X(void, UseProgram, (sfb__GLuint))                                                                \
     X(sfb__GLint, GetUniformLocation, (sfb__GLuint, const sfb__GLchar *))                             \
     X(void, Uniform1i, (sfb__GLint, sfb__GLint))                                                      \
+    X(void, Uniform1iv, (sfb__GLint, sfb__GLsizei, const sfb__GLint *))                               \
     X(void, GenBuffers, (sfb__GLsizei, sfb__GLuint *))                                                \
     X(void, DeleteBuffers, (sfb__GLsizei, const sfb__GLuint *))                                       \
     X(void, BindBuffer, (sfb__GLenum, sfb__GLuint))                                                   \
@@ -293,6 +297,8 @@ typedef struct sfb__gl {
     sfb__GLint max_groups;          /* GL_MAX_COMPUTE_WORK_GROUP_COUNT[0] */
     sfb__GLuint program[17];        /* stencil kernel per SFB_LENGTH, compiled on first use */
     sfb__GLint loc[17][8];
+    sfb__GLuint patch_program;      /* patch kernel, compiled on first use */
+    sfb__GLint patch_loc[5];
     sfb__GLuint scratch_src, scratch_dst;
     size_t scratch_src_cap, scratch_dst_cap;
     char desc[320];
@@ -467,17 +473,18 @@ static void sfb__gl_trim(char *log) {
 }
 
 /* ---- shaders ---- */
-static sfb_result sfb__gl_program(sfb__gl *g, int length, sfb__GLuint *out) {
+/* Compiles and links one compute kernel: the version header for this context, `defines`,
+ * then `source`. `label` names it in errors, which carry the driver's log. */
+static sfb_result sfb__gl_compile(sfb__gl *g, const char *defines, const char *source, const char *label, sfb__GLuint *out) {
     char header[160];
     const sfb__GLchar *parts[2];
     sfb__GLuint sh, prog;
     sfb__GLint ok = 0, len = 0;
-    int i;
-    if (g->program[length]) { *out = g->program[length]; return SFB_SUCCESS; }
-    snprintf(header, sizeof header, "%s#define SFB_LENGTH %d\n",
-             g->es ? "#version 310 es\nprecision highp float;\nprecision highp int;\n" : "#version 430 core\n", length);
+    *out = 0;
+    snprintf(header, sizeof header, "%s%s",
+             g->es ? "#version 310 es\nprecision highp float;\nprecision highp int;\n" : "#version 430 core\n", defines);
     parts[0] = header;
-    parts[1] = SFB__GL_STENCIL_SOURCE;
+    parts[1] = source;
     sh = g->gl.CreateShader(SFB__GL_COMPUTE_SHADER);
     if (!sh) {
         sfb_result r = sfb__gl_check(g, "glCreateShader(GL_COMPUTE_SHADER)");
@@ -492,8 +499,7 @@ static sfb_result sfb__gl_program(sfb__gl *g, int length, sfb__GLuint *out) {
         g->gl.GetShaderInfoLog(sh, (sfb__GLsizei)sizeof log, &len, log);
         sfb__gl_trim(log);
         g->gl.DeleteShader(sh);
-        return sfb__error(g->ctx, SFB_BACKEND_ERROR, SFB_ELEMENT_NONE, -1,
-                          "gl: stencils.comp.glsl (SFB_LENGTH %d) failed to compile: %s", length, log);
+        return sfb__error(g->ctx, SFB_BACKEND_ERROR, SFB_ELEMENT_NONE, -1, "gl: %s failed to compile: %s", label, log);
     }
     prog = g->gl.CreateProgram();
     g->gl.AttachShader(prog, sh);
@@ -506,9 +512,21 @@ static sfb_result sfb__gl_program(sfb__gl *g, int length, sfb__GLuint *out) {
         g->gl.GetProgramInfoLog(prog, (sfb__GLsizei)sizeof log, &len, log);
         sfb__gl_trim(log);
         g->gl.DeleteProgram(prog);
-        return sfb__error(g->ctx, SFB_BACKEND_ERROR, SFB_ELEMENT_NONE, -1,
-                          "gl: stencils.comp.glsl (SFB_LENGTH %d) failed to link: %s", length, log);
+        return sfb__error(g->ctx, SFB_BACKEND_ERROR, SFB_ELEMENT_NONE, -1, "gl: %s failed to link: %s", label, log);
     }
+    *out = prog;
+    return SFB_SUCCESS;
+}
+
+static sfb_result sfb__gl_program(sfb__gl *g, int length, sfb__GLuint *out) {
+    char defines[48], label[64];
+    sfb__GLuint prog;
+    sfb_result r;
+    int i;
+    if (g->program[length]) { *out = g->program[length]; return SFB_SUCCESS; }
+    snprintf(defines, sizeof defines, "#define SFB_LENGTH %d\n", length);
+    snprintf(label, sizeof label, "stencils.comp.glsl (SFB_LENGTH %d)", length);
+    if ((r = sfb__gl_compile(g, defines, SFB__GL_STENCIL_SOURCE, label, &prog)) != SFB_SUCCESS) return r;
     for (i = 0; i < 8; ++i) g->loc[length][i] = g->gl.GetUniformLocation(prog, sfb__gl_uniforms[i]);
     g->program[length] = prog;
     *out = prog;
@@ -579,6 +597,8 @@ static void sfb__gl_release_gl(sfb__gl *g) {
     int i;
     for (i = 0; i < 17; ++i)
         if (g->program[i]) g->gl.DeleteProgram(g->program[i]);
+    if (g->patch_program) g->gl.DeleteProgram(g->patch_program);
+    g->patch_program = 0;
     if (g->scratch_src) g->gl.DeleteBuffers(1, &g->scratch_src);
     if (g->scratch_dst) g->gl.DeleteBuffers(1, &g->scratch_dst);
     memset(g->program, 0, sizeof g->program);
@@ -1048,10 +1068,402 @@ done:
     return res;
 }
 
+/* ---- patch tables (limit evaluation) ---- */
+/* One piece of an uploaded patch table: patches [patch0, patch1) with the control points and
+ * eigen blocks they use, copied and renumbered so that each of its four arrays fits one
+ * shader storage block (GL_MAX_SHADER_STORAGE_BLOCK_SIZE: at least 128 MiB on real drivers,
+ * so one piece in practice; the tests shrink it to force several). */
+typedef struct sfb__gl_ppiece {
+    int patch0, patch1;
+    sfb__GLuint buf[4]; /* patch records (ivec4), cvs (piece-local rows), points (vec4), eigen blocks (vec4) */
+} sfb__gl_ppiece;
+typedef struct sfb__gl_ptable {
+    int count;
+    sfb__gl_ppiece *pieces;
+} sfb__gl_ptable;
+
+/* A location as the patch kernel reads it (std430 struct SfbQuery). */
+typedef struct sfb__gl_query {
+    int patch;           /* piece-local */
+    float s, t, scale;   /* Stam patches: (u,v) in the EV's frame instead of (s,t) */
+} sfb__gl_query;
+
+/* Patch kinds as the shader numbers them (patches.comp.glsl), independent of the core's. */
+enum { SFB__GL_KIND_BSPLINE = 0, SFB__GL_KIND_STAM = 1, SFB__GL_KIND_ENDCAP = 2 };
+enum { SFB__GL_OUTPUTS = 7 };  /* position, du, dv, normal, duu, duv, dvv */
+/* Sort keys of the queries within a piece: B-spline, end cap, then Stam by valence. */
+enum { SFB__GL_BUCKETS = SFB__STAM_MAX_VALENCE + 3 };
+static const char *const sfb__gl_patch_uniforms[5] = {"u_first", "u_last", "u_stride", "u_slot", "u_second"};
+
+/* Floats of one valence's eigen block, as vec4s (patches.comp.glsl): header (K, dominant, sub,
+ * 0), per eigenvalue (lambda, lambda/sub, at-EV tangent mask, 0), and phi (3 sub-patches x K x
+ * the 4 rows of the 4x4 B-spline coefficients), so that the kernel reads whole vec4s. */
+static size_t sfb__gl_eig_floats(const sfb__eigen_cc *e) { return 4 * (1 + 13 * (size_t)e->K); }
+
+static void sfb__gl_eig_pack(const sfb__eigen_cc *e, float *o) {
+    int K = e->K, i, k, j;
+    float *phi = o + 4 * (1 + (size_t)K);
+    /* K and the dominant index stay small integers: exact as floats */
+    o[0] = (float)K; o[1] = (float)e->dominant; o[2] = (float)e->sub; o[3] = 0.0f;
+    for (i = 0; i < K; ++i) {
+        double l = e->lambda[i];
+        float *h = o + 4 * (1 + (size_t)i);
+        h[0] = (float)l;
+        /* the ratio is formed in double so that the subdominant ones round to exactly +-1 */
+        h[1] = i == e->dominant ? 0.0f : (float)(l / e->sub);
+        /* as sfb__eval_stam at the EV: the eigenvectors that survive the normalisation */
+        h[2] = (i != e->dominant && fabs(fabs(l) - e->sub) <= 1e-12) ? 1.0f : 0.0f;
+        h[3] = 0.0f;
+    }
+    /* e->phi[((k-1)*16 + j)*K + i] -> phi[((k-1)*K + i)*16 + j]: one coefficient's 16 together */
+    for (k = 0; k < 3; ++k)
+        for (i = 0; i < K; ++i)
+            for (j = 0; j < 16; ++j)
+                phi[((size_t)k * K + i) * 16 + j] = (float)e->phi[((size_t)k * 16 + j) * K + i];
+}
+
+static void sfb__gl_ptable_free(sfb__gl *g, sfb__gl_ptable *t) {
+    int i;
+    if (!t) return;
+    for (i = 0; i < t->count; ++i) g->gl.DeleteBuffers(4, t->pieces[i].buf);
+    sfb__free(g->ctx, t->pieces);
+    sfb__free(g->ctx, t);
+}
+
+/* Uploads a patch table with the context current. Pieces are built greedily, patch after
+ * patch; a point or an eigen block shared by patches of one piece is stored once in it. */
+static sfb_result sfb__gl_patches_upload_current(sfb__gl *g, const sfb__patch_table *pt, sfb__gl_ptable **out) {
+    const char *who = g->mode == SFB__GL_OSMESA ? "osmesa" : "gl";
+    size_t cap_rec = (size_t)g->max_block / 16, cap_cv = (size_t)g->max_block / 4, cap_pts = (size_t)g->max_block / 16,
+           cap_eig = (size_t)g->max_block / 4, eig_total = 0, max_pts;
+    int rows = pt->npoints, p, count = 0, allocated = 0, stamp_id = 0, N;
+    int eig_stamp[SFB__STAM_MAX_VALENCE + 1];
+    size_t eig_at[SFB__STAM_MAX_VALENCE + 1];
+    int *stamp = NULL, *local = NULL, *rec = NULL, *cvl = NULL;
+    float *pts = NULL, *eig = NULL;
+    sfb__gl_ptable *tab;
+    sfb_result res = SFB_SUCCESS;
+    *out = NULL;
+    for (N = 0; N <= SFB__STAM_MAX_VALENCE; ++N) {
+        eig_stamp[N] = -1;
+        eig_at[N] = 0;
+        if (pt->eig[N]) eig_total += sfb__gl_eig_floats(pt->eig[N]);
+    }
+    max_pts = (size_t)pt->ncv < (size_t)rows ? (size_t)pt->ncv : (size_t)rows;
+    tab = (sfb__gl_ptable *)sfb__calloc(g->ctx, 1, sizeof *tab);
+    stamp = (int *)sfb__alloc(g->ctx, ((size_t)rows + 1) * sizeof(int));
+    local = (int *)sfb__alloc(g->ctx, ((size_t)rows + 1) * sizeof(int));
+    rec = (int *)sfb__alloc(g->ctx, ((size_t)pt->npatch + 1) * 4 * sizeof(int));
+    cvl = (int *)sfb__alloc(g->ctx, ((size_t)pt->ncv + 1) * sizeof(int));
+    pts = (float *)sfb__alloc(g->ctx, (max_pts + 1) * 4 * sizeof(float));
+    eig = (float *)sfb__alloc(g->ctx, (eig_total + 4) * sizeof(float));
+    if (!tab || !stamp || !local || !rec || !cvl || !pts || !eig) { res = sfb__oom(g->ctx, "gl patch table"); goto done; }
+    for (p = 0; p < rows; ++p) stamp[p] = -1;
+    p = 0;
+    while (p < pt->npatch) {
+        size_t nrec = 0, ncv = 0, npts = 0, neig = 0;
+        sfb__gl_ppiece *piece;
+        int p0 = p, k;
+        for (; p < pt->npatch; ++p) {
+            int first = pt->pfirst[p], n = pt->pfirst[p + 1] - first, kind, eoff = -1, fits;
+            size_t npts0 = npts, neig0 = neig;
+            const sfb__eigen_cc *e = NULL;
+            switch (pt->ptype[p]) {
+            case SFB__PATCH_BSPLINE: kind = SFB__GL_KIND_BSPLINE; fits = n == 16; break;
+            /* 4 corner positions, or those and each corner's two limit tangents (normals) */
+            case SFB__PATCH_ENDCAP: kind = SFB__GL_KIND_ENDCAP; fits = n == 4 || n == 12; eoff = n; break;
+            case SFB__PATCH_STAM:
+                kind = SFB__GL_KIND_STAM;
+                N = pt->pvalence[p];
+                e = N >= 3 && N <= SFB__STAM_MAX_VALENCE ? pt->eig[N] : NULL;
+                fits = e && n == e->K;
+                break;
+            default: kind = -1; fits = 0; break;
+            }
+            if (!fits) {
+                res = sfb__error(g->ctx, SFB_BACKEND_ERROR, SFB_ELEMENT_NONE, -1, "%s: patch %d (type %d, %d points) is malformed", who, p,
+                                 pt->ptype[p], n);
+                goto done;
+            }
+            /* its points, new to this piece */
+            for (k = 0; k < n; ++k) {
+                int row = pt->cv[first + k];
+                if (row < 0 || row >= rows) {
+                    res = sfb__error(g->ctx, SFB_BACKEND_ERROR, SFB_ELEMENT_NONE, -1, "%s: patch %d reads point %d of %d", who, p, row, rows);
+                    goto done;
+                }
+                if (stamp[row] != stamp_id) {
+                    stamp[row] = stamp_id;
+                    local[row] = (int)npts;
+                    memcpy(pts + 4 * npts, pt->point_data + 3 * (size_t)row, 3 * sizeof(float));
+                    pts[4 * npts + 3] = 0.0f;
+                    ++npts;
+                }
+                cvl[ncv + (size_t)k] = local[row];
+            }
+            if (e) {
+                if (eig_stamp[N] != stamp_id) {
+                    eig_stamp[N] = stamp_id;
+                    eig_at[N] = neig / 4; /* in vec4s */
+                    sfb__gl_eig_pack(e, eig + neig);
+                    neig += sfb__gl_eig_floats(e);
+                }
+                eoff = (int)eig_at[N];
+            }
+            if (nrec + 1 > cap_rec || ncv + (size_t)n > cap_cv || npts > cap_pts || neig > cap_eig) {
+                if (nrec == 0) {
+                    res = sfb__error(g->ctx, SFB_LIMIT_EXCEEDED, SFB_ELEMENT_NONE, -1,
+                                     "%s: patch %d (%d points%s) needs more than one shader storage block holds (%d bytes)", who, p, n,
+                                     e ? ", Stam eigen data" : "", (int)g->max_block);
+                    goto done;
+                }
+                /* this patch starts the next piece: drop what it added here (the stamps of
+                 * this piece are not looked at again) */
+                npts = npts0;
+                neig = neig0;
+                break;
+            }
+            rec[4 * nrec] = kind;
+            rec[4 * nrec + 1] = (int)ncv;
+            rec[4 * nrec + 2] = SFB__PARAM_CORNER(pt->pparam[p]);
+            rec[4 * nrec + 3] = eoff;
+            ++nrec;
+            ncv += (size_t)n;
+        }
+        if (count == allocated) {
+            int na = allocated ? allocated * 2 : 4;
+            sfb__gl_ppiece *np = (sfb__gl_ppiece *)sfb__realloc(g->ctx, tab->pieces, (size_t)na * sizeof *np);
+            if (!np) { res = sfb__oom(g->ctx, "gl patch table"); goto done; }
+            tab->pieces = np;
+            allocated = na;
+        }
+        piece = &tab->pieces[count];
+        memset(piece, 0, sizeof *piece);
+        piece->patch0 = p0;
+        piece->patch1 = p;
+        g->gl.GenBuffers(4, piece->buf);
+        tab->count = ++count;
+        /* a zero-length storage buffer cannot be bound: keep at least one element */
+        g->gl.BindBuffer(SFB__GL_SHADER_STORAGE_BUFFER, piece->buf[0]);
+        g->gl.BufferData(SFB__GL_SHADER_STORAGE_BUFFER, (sfb__GLsizeiptr)(nrec * 16), rec, SFB__GL_STATIC_DRAW);
+        g->gl.BindBuffer(SFB__GL_SHADER_STORAGE_BUFFER, piece->buf[1]);
+        g->gl.BufferData(SFB__GL_SHADER_STORAGE_BUFFER, (sfb__GLsizeiptr)((ncv ? ncv : 1) * 4), cvl, SFB__GL_STATIC_DRAW);
+        g->gl.BindBuffer(SFB__GL_SHADER_STORAGE_BUFFER, piece->buf[2]);
+        g->gl.BufferData(SFB__GL_SHADER_STORAGE_BUFFER, (sfb__GLsizeiptr)((npts ? npts : 1) * 16), pts, SFB__GL_STATIC_DRAW);
+        g->gl.BindBuffer(SFB__GL_SHADER_STORAGE_BUFFER, piece->buf[3]);
+        g->gl.BufferData(SFB__GL_SHADER_STORAGE_BUFFER, (sfb__GLsizeiptr)((neig ? neig : 4) * 4), eig, SFB__GL_STATIC_DRAW);
+        if ((res = sfb__gl_check(g, "uploading a patch table")) != SFB_SUCCESS) goto done;
+        ++stamp_id;
+    }
+done:
+    sfb__free(g->ctx, stamp); sfb__free(g->ctx, local); sfb__free(g->ctx, rec); sfb__free(g->ctx, cvl);
+    sfb__free(g->ctx, pts); sfb__free(g->ctx, eig);
+    if (res != SFB_SUCCESS) {
+        if (tab) sfb__gl_ptable_free(g, tab);
+        return res;
+    }
+    *out = tab;
+    return SFB_SUCCESS;
+}
+
+static sfb_result sfb__gl_upload_patches(void *state, const sfb__patch_table *pt, void **handle) {
+    sfb__gl *g = (sfb__gl *)state;
+    sfb__gl_saved s;
+    sfb__gl_ptable *tab = NULL;
+    sfb_result r;
+    *handle = NULL;
+    if ((r = sfb__gl_enter(g, &s)) != SFB_SUCCESS) return r;
+    r = sfb__gl_patches_upload_current(g, pt, &tab);
+    sfb__gl_leave(g, &s);
+    *handle = tab;
+    return r;
+}
+
+static void sfb__gl_release_patches(void *state, void *handle) {
+    sfb__gl *g = (sfb__gl *)state;
+    sfb__gl_saved s;
+    if (!handle) return;
+    if (sfb__gl_enter(g, &s) == SFB_SUCCESS) {
+        sfb__gl_ptable_free(g, (sfb__gl_ptable *)handle);
+        sfb__gl_leave(g, &s);
+    } else {
+        sfb__free(g->ctx, ((sfb__gl_ptable *)handle)->pieces);
+        sfb__free(g->ctx, handle);
+    }
+}
+
+static sfb_result sfb__gl_patch_program(sfb__gl *g, sfb__GLuint *out) {
+    sfb__GLuint prog;
+    sfb_result r;
+    int i;
+    if (g->patch_program) { *out = g->patch_program; return SFB_SUCCESS; }
+    if ((r = sfb__gl_compile(g, "", SFB__GL_PATCH_SOURCE, "patches.comp.glsl", &prog)) != SFB_SUCCESS) return r;
+    for (i = 0; i < 5; ++i) g->patch_loc[i] = g->gl.GetUniformLocation(prog, sfb__gl_patch_uniforms[i]);
+    g->patch_program = prog;
+    *out = prog;
+    return sfb__gl_check(g, "building the patch kernel");
+}
+
+/* Piece of a patch: pieces are consecutive patch ranges. */
+static int sfb__gl_piece_of(const sfb__gl_ptable *tab, int patch) {
+    int lo = 0, hi = tab->count - 1;
+    while (lo < hi) {
+        int mid = (lo + hi + 1) / 2;
+        if (tab->pieces[mid].patch0 <= patch) lo = mid;
+        else hi = mid - 1;
+    }
+    return lo;
+}
+
+/* Locations are located on the CPU (a quadtree walk per location, a few ns), grouped by
+ * piece, and evaluated by the kernel in batches that fit one storage block; results come back
+ * compact (only the asked outputs) and are scattered into the caller's arrays. */
+static sfb_result sfb__gl_eval_patches(void *state, const sfb__patch_table *pt, void *handle, const sfb_location *locs, int first,
+                                       int last, const sfb_eval_output *out) {
+    sfb__gl *g = (sfb__gl *)state;
+    sfb__gl_ptable *tab = (sfb__gl_ptable *)handle, *temp = NULL;
+    float *dst[SFB__GL_OUTPUTS];
+    sfb__GLint slot[SFB__GL_OUTPUTS];
+    sfb__gl_query *queries = NULL, *sorted = NULL;
+    int *order = NULL, *piece_start = NULL, *key = NULL, *bucket = NULL;
+    int count = last - first, nout = 0, o, q, i, k, stride, used = 0;
+    size_t batch, nbuckets, z;
+    long long per = (long long)g->max_groups * 64;
+    sfb__gl_saved s;
+    sfb__GLuint prog;
+    sfb_result res;
+    dst[0] = out->position; dst[1] = out->du; dst[2] = out->dv; dst[3] = out->normal;
+    dst[4] = out->duu; dst[5] = out->duv; dst[6] = out->dvv;
+    for (o = 0; o < SFB__GL_OUTPUTS; ++o) slot[o] = dst[o] ? nout++ : -1;
+    if (count <= 0 || nout == 0) return SFB_SUCCESS;
+    stride = 3 * nout;
+    batch = (size_t)g->max_block / ((size_t)stride * sizeof(float));
+    if (batch > (size_t)g->max_block / sizeof(sfb__gl_query)) batch = (size_t)g->max_block / sizeof(sfb__gl_query);
+    if (batch < 1) batch = 1;
+    if ((res = sfb__gl_enter(g, &s)) != SFB_SUCCESS) return res;
+    if (!tab) {
+        /* the surface was uploaded to another backend: a temporary copy for this call */
+        if ((res = sfb__gl_patches_upload_current(g, pt, &temp)) != SFB_SUCCESS) goto done;
+        tab = temp;
+    }
+    if ((res = sfb__gl_patch_program(g, &prog)) != SFB_SUCCESS) goto done;
+    nbuckets = (size_t)tab->count * SFB__GL_BUCKETS;
+    queries = (sfb__gl_query *)sfb__alloc(g->ctx, (size_t)count * sizeof *queries);
+    key = (int *)sfb__alloc(g->ctx, (size_t)count * sizeof(int));
+    bucket = (int *)sfb__calloc(g->ctx, nbuckets + 1, sizeof(int));
+    piece_start = (int *)sfb__alloc(g->ctx, ((size_t)tab->count + 1) * sizeof(int));
+    if (!queries || !key || !bucket || !piece_start) { res = sfb__oom(g->ctx, "gl patch evaluation"); goto done; }
+    for (q = 0; q < count; ++q) {
+        const sfb_location *l = &locs[first + q];
+        double u, v, sc;
+        int patch = sfb__patch_locate(pt, l->face, l->u, l->v, &u, &v, &sc), pc, kind;
+        if (patch < 0 || tab->count == 0) {
+            res = sfb__error(g->ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, first + q, "location %d: parametric face %d is a hole", first + q, l->face);
+            goto done;
+        }
+        kind = pt->ptype[patch] == SFB__PATCH_ENDCAP ? 1 : 0;
+        if (pt->ptype[patch] == SFB__PATCH_STAM) {
+            /* into the EV's frame here, in double: the EV is then exactly (0,0) and a small
+             * distance to it keeps its relative precision in float */
+            double s0 = u, t0 = v;
+            switch (SFB__PARAM_CORNER(pt->pparam[patch])) {
+            case 1: u = t0; v = 1.0 - s0; break;
+            case 2: u = 1.0 - s0; v = 1.0 - t0; break;
+            case 3: u = 1.0 - t0; v = s0; break;
+            default: break;
+            }
+            kind = 2 + pt->pvalence[patch];
+        }
+        pc = tab->count > 1 ? sfb__gl_piece_of(tab, patch) : 0;
+        queries[q].patch = patch - tab->pieces[pc].patch0;
+        queries[q].s = (float)u;
+        queries[q].t = (float)v;
+        queries[q].scale = (float)sc;
+        key[q] = pc * SFB__GL_BUCKETS + kind;
+        if (bucket[key[q] + 1]++ == 0) ++used;
+    }
+    for (z = 0; z < nbuckets; ++z) bucket[z + 1] += bucket[z];
+    for (i = 0; i <= tab->count; ++i) piece_start[i] = bucket[(size_t)i * SFB__GL_BUCKETS];
+    if (used > 1) {
+        /* Stable counting sort by (piece, kind, valence): one dispatch per piece, and SIMD
+         * groups that run one code path over one loop length (a GPU, and llvmpipe's SIMD
+         * lanes, pay for every path any of its invocations takes). order[] maps a sorted
+         * query back to its location. */
+        sorted = (sfb__gl_query *)sfb__alloc(g->ctx, (size_t)count * sizeof *sorted);
+        order = (int *)sfb__alloc(g->ctx, (size_t)count * sizeof(int));
+        if (!sorted || !order) { res = sfb__oom(g->ctx, "gl patch evaluation"); goto done; }
+        for (q = 0; q < count; ++q) {
+            int at = bucket[key[q]]++;
+            sorted[at] = queries[q];
+            order[at] = first + q;
+        }
+        sfb__free(g->ctx, queries);
+        queries = sorted;
+        sorted = NULL;
+    }
+    g->gl.UseProgram(prog);
+    g->gl.Uniform1i(g->patch_loc[2], stride);
+    g->gl.Uniform1iv(g->patch_loc[3], SFB__GL_OUTPUTS, slot);
+    g->gl.Uniform1i(g->patch_loc[4], dst[4] || dst[5] || dst[6]);
+    for (i = 0; i < tab->count; ++i) {
+        const sfb__gl_ppiece *pc = &tab->pieces[i];
+        int a = piece_start[i], b = piece_start[i + 1];
+        if (a >= b) continue;
+        for (k = 0; k < 4; ++k) g->gl.BindBufferBase(SFB__GL_SHADER_STORAGE_BUFFER, (sfb__GLuint)k, pc->buf[k]);
+        while (a < b) {
+            int n = (size_t)(b - a) > batch ? (int)batch : b - a, d;
+            const float *mapped;
+            size_t qbytes = (size_t)n * sizeof(sfb__gl_query), rbytes = (size_t)n * (size_t)stride * sizeof(float);
+            if ((res = sfb__gl_grow(g, &g->scratch_src, &g->scratch_src_cap, qbytes, SFB__GL_STREAM_DRAW)) != SFB_SUCCESS) goto done;
+            g->gl.BufferSubData(SFB__GL_SHADER_STORAGE_BUFFER, 0, (sfb__GLsizeiptr)qbytes, queries + a);
+            if ((res = sfb__gl_grow(g, &g->scratch_dst, &g->scratch_dst_cap, rbytes, SFB__GL_DYNAMIC_READ)) != SFB_SUCCESS) goto done;
+            g->gl.BindBufferBase(SFB__GL_SHADER_STORAGE_BUFFER, 4, g->scratch_src);
+            g->gl.BindBufferBase(SFB__GL_SHADER_STORAGE_BUFFER, 5, g->scratch_dst);
+            for (d = 0; d < n;) {
+                int m = (long long)(n - d) > per ? (int)per : n - d;
+                g->gl.Uniform1i(g->patch_loc[0], d);
+                g->gl.Uniform1i(g->patch_loc[1], d + m);
+                g->gl.DispatchCompute((sfb__GLuint)((m + 63) / 64), 1, 1);
+                d += m;
+            }
+            if ((res = sfb__gl_check(g, "the patch kernel")) != SFB_SUCCESS) goto done;
+            g->gl.MemoryBarrier(SFB__GL_BUFFER_UPDATE_BARRIER_BIT);
+            g->gl.BindBuffer(SFB__GL_SHADER_STORAGE_BUFFER, g->scratch_dst);
+            mapped = (const float *)g->gl.MapBufferRange(SFB__GL_SHADER_STORAGE_BUFFER, 0, (sfb__GLsizeiptr)rbytes, SFB__GL_MAP_READ_BIT);
+            if (!mapped) {
+                res = sfb__gl_check(g, "mapping the results");
+                if (res == SFB_SUCCESS)
+                    res = sfb__error(g->ctx, SFB_BACKEND_ERROR, SFB_ELEMENT_NONE, -1, "gl: glMapBufferRange returned NULL");
+                goto done;
+            }
+            for (q = 0; q < n; ++q) {
+                size_t at = 3 * (size_t)(order ? order[a + q] : first + a + q);
+                const float *r = mapped + (size_t)q * (size_t)stride;
+                for (o = 0; o < SFB__GL_OUTPUTS; ++o)
+                    if (dst[o]) {
+                        const float *x = r + 3 * slot[o];
+                        dst[o][at] = x[0];
+                        dst[o][at + 1] = x[1];
+                        dst[o][at + 2] = x[2];
+                    }
+            }
+            g->gl.UnmapBuffer(SFB__GL_SHADER_STORAGE_BUFFER);
+            if ((res = sfb__gl_check(g, "reading the results back")) != SFB_SUCCESS) goto done;
+            a += n;
+        }
+    }
+done:
+    sfb__free(g->ctx, queries); sfb__free(g->ctx, sorted); sfb__free(g->ctx, order);
+    sfb__free(g->ctx, piece_start); sfb__free(g->ctx, key); sfb__free(g->ctx, bucket);
+    if (temp) sfb__gl_ptable_free(g, temp);
+    sfb__gl_leave(g, &s);
+    return res;
+}
+
 static const sfb__backend_vtable sfb__gl_vtable = {
-    "gl", SFB_BACKEND_GL, SFB__CAP_EVAL_STENCILS | SFB__CAP_GL_BUFFERS,
+    "gl", SFB_BACKEND_GL, SFB__CAP_EVAL_STENCILS | SFB__CAP_GL_BUFFERS | SFB__CAP_EVAL_PATCHES,
     sfb__gl_init, sfb__gl_shutdown, sfb__gl_describe, sfb__gl_upload, sfb__gl_release, sfb__gl_eval, sfb__gl_eval_buffers,
-    NULL, NULL, NULL
+    sfb__gl_upload_patches, sfb__gl_release_patches, sfb__gl_eval_patches
 };
 
 const sfb__backend_vtable *sfb__backend_gl(void) { return &sfb__gl_vtable; }

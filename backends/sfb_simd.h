@@ -1,5 +1,6 @@
-/* backends/sfb_simd.h -- the `simd` backend: stencil tables applied with SIMD kernels on a
- * small thread pool.
+/* backends/sfb_simd.h -- the `simd` backend: stencil tables applied, and patch tables
+ * evaluated (limit evaluation, eval_patches: see "limit evaluation" below), with SIMD kernels
+ * on a small thread pool.
  *
  * Not a public header: surfblend.h compiles this file at the end of its implementation when
  * SURFBLEND_SIMD (or SURFBLEND_ALL_BACKENDS) is defined with SURFBLEND_IMPLEMENTATION. It sees
@@ -46,9 +47,10 @@
  *
  * Threads: a pool of ctx->threads - 1 workers (0: one thread per online core, at most 64;
  * 1: no pool), started in init and joined in shutdown. A call cuts its rows into 4 chunks per
- * thread of about equal entry counts (from offsets); the caller and the workers claim chunks
- * until none is left, and the caller returns once every claimed chunk is done (it never
- * waits for a worker still asleep). Calls under 32768 entries run on the caller alone, as
+ * thread of about equal entry counts (from offsets; eval_patches: equal numbers of
+ * locations); the caller and the workers claim chunks until none is left, and the caller
+ * returns once every claimed chunk is done (it never waits for a worker still asleep). Calls
+ * under 32768 entries (eval_patches: 4096 locations) run on the caller alone, as
  * do calls made while another thread's call holds the pool (pthread_mutex_trylock), so
  * concurrent calls on one backend state are safe. On _WIN32, and wherever POSIX threads are
  * not known to exist, the backend runs single-threaded (describe says "1 thread"). A process
@@ -383,6 +385,665 @@ static void sfb__simd_neon(const sfb__simd_job *j, int first, int last) {
 }
 #endif /* SFB__SIMD_NEON */
 
+/* ==== limit evaluation: eval_patches ====
+ *
+ * Data packed at upload_patches (sfb__simd_patches), read-only afterwards:
+ *   blk     xyzw points in "grids" of columns: point (i, j) (i along u, j along v) of a 4x4
+ *           B-spline control net at blk + i * cs + 4 * j (cs, the column stride, in floats), so
+ *           that the four points of a column are 64 contiguous bytes (one AVX-512 load, two
+ *           AVX2 loads, four 128-bit loads).
+ *           - a B-spline patch: its 16 points (cs = 16; 256 bytes, 64-byte aligned);
+ *           - a Stam patch (EV at frame corner c): for each level n = 1..SFB__SIMD_STAM_LEVELS
+ *             one 5 x 5 grid (cs = 20; 400 bytes) of the level-n points around the EV: the
+ *             three sub-patches k = 1, 2, 3 of that level are the 4 x 4 windows at lattice
+ *             (0,-1), (0,0), (-1,0) (the EV at (0,0)), 24 distinct points (the corner (-1,-1)
+ *             is unused). Their control points Q[j] = sum_i lambda_i^(n-1) phi_k[j][i] c_i are
+ *             computed in double once, so a location near an EV costs what a B-spline
+ *             location costs. (Upload checks that the windows agree on their shared points;
+ *             a patch whose eigen data said otherwise would be left to the ref kernel.)
+ *           Points are stored relative to the grid's origin o (the centroid, in float):
+ *           differences of nearby points then keep float's relative precision however far the
+ *           patch lies from the coordinate origin and however deep it is, which is what lets
+ *           float derivatives and normals agree with ref's double ones. The w lanes of the
+ *           window diagonal (0,0), (1,1), (2,2), (3,3) hold o.x, o.y, o.z and E, the largest
+ *           |coordinate| of the grid's relative points (the scale of float's rounding errors);
+ *           the three Stam windows have disjoint diagonals, so every window finds them there.
+ *           Other w lanes are 0; the kernels' w lanes are never stored as results.
+ *   root, node  a copy of the table's quadtree (ptex_root, nodes) whose leaves say directly
+ *           what to run: -(code + 1) with code = offset / 4 << 4 | corner << 2 | kind, kind 0
+ *           B-spline grid, 1 Stam grids, 2 the ref kernel (end caps, holes). One dependent
+ *           load less per location than going through the patch arrays.
+ * Everything is derived from the table's point_data at upload time (the table is immutable).
+ * Locations nearer an EV than level SFB__SIMD_STAM_LEVELS (a 4^-L share of a Stam patch) are
+ * evaluated from the eigen structure in double (sfb__simd_stam_far); the EV itself, end caps
+ * and degenerate normals go to the ref kernel, one location at a time.
+ *
+ * Numerics. Locating is done in float and is exact (u, v are floats; doubling, and subtracting
+ * 1 from a value in [1,2), are exact), so the patch and (s, t) are ref's; so are a Stam
+ * location's level and sub-patch (see sfb__simd_prep). The B-spline sums run in float on the
+ * relative points (errors ~1e-7 of the patch size). A normal is made from float tangents only
+ * when the estimated angle error, ~2e-7 E (|Pu| + |Pv|) / |Pu x Pv|, is below 1e-4 rad;
+ * otherwise (collapsed or nearly parallel tangents, overflow, NaN) the location goes to ref,
+ * whose double evaluation and degenerate-tangent rule then decide the normal.
+ *
+ * Kernels: avx512 (a column of 4 points per register), avx2 (2 points per register), sse2
+ * (xyz in 4 lanes per point; no FMA); these finish (scale, rotate, normal, stores) in 128-bit
+ * registers. portable and neon evaluate into a float[6][4] and finish in scalar C (double).
+ * Locations are prepared (located, grids prefetched) SFB__SIMD_AHEAD ahead of the kernel, so
+ * that the loads of several locations are in flight at once. Threads: the locations are cut
+ * into equal chunks over the pool (calls under SFB__SIMD_INLINE_LOCATIONS stay on the caller). */
+#define SFB__SIMD_STAM_LEVELS 3
+#define SFB__SIMD_INLINE_LOCATIONS 4096
+#define SFB__SIMD_AHEAD 16
+enum { SFB__SIMD_LEAF_BSPLINE = 0, SFB__SIMD_LEAF_STAM = 1, SFB__SIMD_LEAF_REF = 2 };
+
+typedef struct sfb__simd_patches {
+    int npatch, nptex;
+    int *root, *node;  /* nptex, 4 * nnodes: the quadtree with leaf codes */
+    float *blk;        /* grids, 64-byte aligned inside raw */
+    void *raw;
+    size_t bytes;      /* everything above */
+} sfb__simd_patches;
+
+/* Evaluates the 4 x 4 window at blk (column stride cs) at (s, t): r[0] position (origin
+ * added), r[1..2] d/ds, d/dt, r[3..5] second derivatives (only when `second`) in the window's
+ * own parameters; lanes 0..2. (The generic range loop's kernel: portable, neon.) */
+typedef void (*sfb__simd_bs_fn)(const float *blk, int cs, float s, float t, int second, float r[6][4]);
+
+typedef struct sfb__simd_pjob {
+    const sfb__patch_table *pt;
+    const sfb__simd_patches *h;
+    const sfb_location *locs;
+    const sfb_eval_output *out;
+    int second;        /* any of duu, duv, dvv asked */
+    sfb__simd_bs_fn bs;
+} sfb__simd_pjob;
+
+typedef void (*sfb__simd_prange_fn)(const sfb__simd_pjob *j, int first, int last);
+
+/* One location made ready for a kernel: the window, where to evaluate it, and how to map its
+ * derivatives to the parametric face's: rotate by the Stam frame corner `rot`, (Ps, Pt) =
+ * (Pu, Pv), (-Pv, Pu), (-Pu, -Pv), (Pv, -Pu) for rot 0..3 (second derivatives likewise; det 1,
+ * so the normal is unchanged), then multiply by dsc = 2^(n + depth). */
+enum { SFB__SIMD_RUN_REF = 0, SFB__SIMD_RUN_KERNEL = 1, SFB__SIMD_RUN_STAM_FAR = 2 };
+typedef struct sfb__simd_slot {
+    const float *blk;
+    float s, t, dsc;
+    int cs, rot, run;
+} sfb__simd_slot;
+
+#if defined(__GNUC__) || defined(__clang__)
+#  define SFB__SIMD_PREFETCH(p) __builtin_prefetch(p)
+#  define SFB__SIMD_FORCEINLINE __attribute__((always_inline)) inline /* kernels into each range loop */
+#else
+#  define SFB__SIMD_PREFETCH(p) ((void)0)
+#  define SFB__SIMD_FORCEINLINE inline
+#endif
+
+/* B-spline basis b_k(t) = C0[k] + C1[k] t + C2[k] t^2 + C3[k] t^3 (k = 0..3) as coefficient
+ * rows for Horner's rule; 2 C2, 3 C3 and 6 C3 for the derivatives. */
+static const float sfb__simd_bsc[5][4] = {
+    {1.0f / 6.0f, 2.0f / 3.0f, 1.0f / 6.0f, 0.0f},   /* C0 */
+    {-0.5f, 0.0f, 0.5f, 0.0f},                       /* C1 (the derivative's constant term) */
+    {0.5f, -1.0f, 0.5f, 0.0f},                       /* C2 */
+    {-1.0f / 6.0f, 0.5f, -0.5f, 1.0f / 6.0f},        /* C3 */
+    {1.0f, -2.0f, 1.0f, 0.0f}};                      /* 2 C2 */
+static const float sfb__simd_bsc3[2][4] = {
+    {-0.5f, 1.5f, -1.5f, 0.5f},                      /* 3 C3 */
+    {-1.0f, 3.0f, -3.0f, 1.0f}};                     /* 6 C3 */
+
+static void sfb__simd_basis(float t, float b[4], float d[4], float dd[4]) {
+    int k;
+    for (k = 0; k < 4; ++k) {
+        b[k] = ((sfb__simd_bsc[3][k] * t + sfb__simd_bsc[2][k]) * t + sfb__simd_bsc[1][k]) * t + sfb__simd_bsc[0][k];
+        d[k] = (sfb__simd_bsc3[0][k] * t + sfb__simd_bsc[4][k]) * t + sfb__simd_bsc[1][k];
+        dd[k] = sfb__simd_bsc3[1][k] * t + sfb__simd_bsc[4][k];
+    }
+}
+
+/* Location q on the ref kernel (rare cases; writes exactly q's three floats per output). */
+static void sfb__simd_ref_one(const sfb__simd_pjob *j, int q) {
+    sfb__backend_ref()->eval_patches(NULL, j->pt, NULL, j->locs, q, q + 1, j->out);
+}
+
+/* Writes location q (exactly three floats per asked output). */
+static void sfb__simd_write(const sfb__simd_pjob *j, int q, double res[6][3], const double nrm[3]) {
+    const sfb_eval_output *o = j->out;
+    float *dst[7];
+    const double *src[7];
+    int k, c;
+    dst[0] = o->position; dst[1] = o->du; dst[2] = o->dv; dst[3] = o->duu; dst[4] = o->duv; dst[5] = o->dvv; dst[6] = o->normal;
+    for (k = 0; k < 6; ++k) src[k] = res[k];
+    src[6] = nrm;
+    for (k = 0; k < 7; ++k)
+        if (dst[k])
+            for (c = 0; c < 3; ++c) dst[k][3 * (size_t)q + c] = (float)src[k][c];
+}
+
+static double sfb__simd_ipow(double x, int m) {
+    double r = 1.0;
+    for (; m > 0; m >>= 1, x *= x)
+        if (m & 1) r *= x;
+    return r;
+}
+
+/* A Stam location nearer the EV than the stored levels: the eigen-structure sums of ref's
+ * kernel in double (integer powers instead of pow, only the outputs asked for). The EV
+ * itself and degenerate tangents go to ref. */
+static void sfb__simd_stam_far(const sfb__simd_pjob *j, int q) {
+    const sfb__patch_table *pt = j->pt;
+    const sfb_location *l = &j->locs[q];
+    double s, t, sc, u, v, uu, vv, J[2][2], bu[4], du[4], ddu[4], bv[4], dv[4], ddv[4], w[6][16];
+    double acc[6][3], res[6][3], nres[2][3], nrm[3], len, sub, sc1, sc2;
+    const sfb__eigen_cc *e;
+    const double *phi;
+    const int *cv;
+    const int p = sfb__patch_locate(pt, l->face, l->u, l->v, &s, &t, &sc), nw = j->second ? 6 : 3;
+    int n = 1, k, i, jj, c, m;
+    if (p < 0 || pt->ptype[p] != SFB__PATCH_STAM || !(e = pt->eig[pt->pvalence[p]])) { sfb__simd_ref_one(j, q); return; }
+    switch (SFB__PARAM_CORNER(pt->pparam[p])) {
+    default: u = s; v = t; J[0][0] = 1; J[0][1] = 0; J[1][0] = 0; J[1][1] = 1; break;
+    case 1: u = t; v = 1.0 - s; J[0][0] = 0; J[0][1] = 1; J[1][0] = -1; J[1][1] = 0; break;
+    case 2: u = 1.0 - s; v = 1.0 - t; J[0][0] = -1; J[0][1] = 0; J[1][0] = 0; J[1][1] = -1; break;
+    case 3: u = 1.0 - t; v = s; J[0][0] = 0; J[0][1] = -1; J[1][0] = 1; J[1][1] = 0; break;
+    }
+    if (u == 0.0 && v == 0.0) { sfb__simd_ref_one(j, q); return; }
+    while (u < 0.5 && v < 0.5) { u *= 2.0; v *= 2.0; ++n; }
+    if (v < 0.5) { k = 1; uu = 2.0 * u - 1.0; vv = 2.0 * v; }
+    else if (u < 0.5) { k = 3; uu = 2.0 * u; vv = 2.0 * v - 1.0; }
+    else { k = 2; uu = 2.0 * u - 1.0; vv = 2.0 * v - 1.0; }
+    for (i = 0; i < 2; ++i) {
+        const double x = i ? vv : uu, x2 = x * x, x3 = x2 * x, y = 1.0 - x;
+        double *b = i ? bv : bu, *d = i ? dv : du, *dd = i ? ddv : ddu;
+        b[0] = y * y * y / 6.0; b[1] = (3.0 * x3 - 6.0 * x2 + 4.0) / 6.0; b[2] = (-3.0 * x3 + 3.0 * x2 + 3.0 * x + 1.0) / 6.0; b[3] = x3 / 6.0;
+        d[0] = -0.5 * y * y; d[1] = 1.5 * x2 - 2.0 * x; d[2] = -1.5 * x2 + x + 0.5; d[3] = 0.5 * x2;
+        dd[0] = y; dd[1] = 3.0 * x - 2.0; dd[2] = -3.0 * x + 1.0; dd[3] = x;
+    }
+    for (jj = 0; jj < 16; ++jj) {
+        const int a = jj % 4, b = jj / 4;
+        w[0][jj] = bu[a] * bv[b]; w[1][jj] = du[a] * bv[b]; w[2][jj] = bu[a] * dv[b];
+        w[3][jj] = ddu[a] * bv[b]; w[4][jj] = du[a] * dv[b]; w[5][jj] = bu[a] * ddv[b];
+    }
+    memset(acc, 0, sizeof acc);
+    sub = e->sub;
+    phi = e->phi + (size_t)(k - 1) * 16 * (size_t)e->K;
+    cv = pt->cv + pt->pfirst[p];
+    for (i = 0; i < e->K; ++i) {
+        /* position: lambda^(n-1); derivatives normalised by sub^(n-1) (finite down to the EV) */
+        const double lp = sfb__simd_ipow(e->lambda[i], n - 1), ln = i == e->dominant ? 0.0 : sfb__simd_ipow(e->lambda[i] / sub, n - 1);
+        const float *pnt = pt->point_data + 3 * (size_t)cv[i];
+        const double *ph = phi + i;
+        double f[6] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
+        /* the eigenbasis function i and its derivatives at (uu, vv); named accumulators keep
+         * the sums in registers */
+        if (nw == 3) {
+            double f0 = 0.0, f1 = 0.0, f2 = 0.0;
+            for (jj = 0; jj < 16; ++jj, ph += e->K) { f0 += w[0][jj] * *ph; f1 += w[1][jj] * *ph; f2 += w[2][jj] * *ph; }
+            f[0] = f0; f[1] = f1; f[2] = f2;
+        } else {
+            double f0 = 0.0, f1 = 0.0, f2 = 0.0, f3 = 0.0, f4 = 0.0, f5 = 0.0;
+            for (jj = 0; jj < 16; ++jj, ph += e->K) {
+                f0 += w[0][jj] * *ph; f1 += w[1][jj] * *ph; f2 += w[2][jj] * *ph;
+                f3 += w[3][jj] * *ph; f4 += w[4][jj] * *ph; f5 += w[5][jj] * *ph;
+            }
+            f[0] = f0; f[1] = f1; f[2] = f2; f[3] = f3; f[4] = f4; f[5] = f5;
+        }
+        f[0] *= lp;
+        for (m = 1; m < nw; ++m) f[m] *= ln;
+        for (m = 0; m < nw; ++m)
+            for (c = 0; c < 3; ++c) acc[m][c] += f[m] * pnt[c];
+    }
+    sc1 = sfb__simd_ipow(sub, n - 1) * ldexp(1.0, n) * sc;
+    sc2 = sfb__simd_ipow(sub, n - 1) * ldexp(1.0, 2 * n) * sc * sc;
+    for (c = 0; c < 3; ++c) {
+        nres[0][c] = acc[1][c] * J[0][0] + acc[2][c] * J[1][0];
+        nres[1][c] = acc[1][c] * J[0][1] + acc[2][c] * J[1][1];
+    }
+    nrm[0] = nres[0][1] * nres[1][2] - nres[0][2] * nres[1][1];
+    nrm[1] = nres[0][2] * nres[1][0] - nres[0][0] * nres[1][2];
+    nrm[2] = nres[0][0] * nres[1][1] - nres[0][1] * nres[1][0];
+    len = sqrt(nrm[0] * nrm[0] + nrm[1] * nrm[1] + nrm[2] * nrm[2]);
+    if (j->out->normal && !(len > 0.0 && len <= 1e300)) { sfb__simd_ref_one(j, q); return; }
+    for (c = 0; c < 3; ++c) {
+        const double Puu = acc[3][c], Puv = acc[4][c], Pvv = acc[5][c];
+        if (j->out->normal) nrm[c] /= len;
+        res[0][c] = acc[0][c];
+        res[1][c] = nres[0][c] * sc1;
+        res[2][c] = nres[1][c] * sc1;
+        if (j->second) {
+            res[3][c] = sc2 * (Puu * J[0][0] * J[0][0] + 2.0 * Puv * J[0][0] * J[1][0] + Pvv * J[1][0] * J[1][0]);
+            res[4][c] = sc2 * (Puu * J[0][0] * J[0][1] + Puv * (J[0][0] * J[1][1] + J[0][1] * J[1][0]) + Pvv * J[1][0] * J[1][1]);
+            res[5][c] = sc2 * (Puu * J[0][1] * J[0][1] + 2.0 * Puv * J[0][1] * J[1][1] + Pvv * J[1][1] * J[1][1]);
+        } else {
+            res[3][c] = res[4][c] = res[5][c] = 0.0;
+        }
+    }
+    sfb__simd_write(j, q, res, nrm);
+}
+
+/* Locates location q (in float: exact, as above) and prepares its slot; prefetches the window. */
+static void sfb__simd_prep(const sfb__simd_pjob *j, int q, sfb__simd_slot *o) {
+    const sfb__simd_patches *h = j->h;
+    const sfb_location *l = &j->locs[q];
+    int node = h->root[l->face], code;
+    float s = l->u, t = l->v, sc = 1.0f;
+    while (node >= 0) {
+        int qx, qy;
+        s += s; t += t; sc += sc;
+        qx = s >= 1.0f; qy = t >= 1.0f;
+        s -= (float)qx; /* not `if (qx)`: random quadrants would mispredict */
+        t -= (float)qy;
+        node = h->node[4 * node + qx + 2 * qy];
+    }
+    code = -node - 1;
+    o->run = SFB__SIMD_RUN_REF;
+    if ((code & 3) == SFB__SIMD_LEAF_BSPLINE) {
+        o->blk = h->blk + 4 * (size_t)(code >> 4);
+        o->s = s; o->t = t; o->dsc = sc; o->cs = 16; o->rot = 0;
+        o->run = SFB__SIMD_RUN_KERNEL;
+        SFB__SIMD_PREFETCH(o->blk);
+        SFB__SIMD_PREFETCH(o->blk + 16);
+        SFB__SIMD_PREFETCH(o->blk + 32);
+        SFB__SIMD_PREFETCH(o->blk + 48);
+    } else if ((code & 3) == SFB__SIMD_LEAF_STAM) {
+        /* Level n and sub-patch k as ref finds them, without branches (they are random here).
+         * Float is exact for these decisions: (u, v) is (s, t) turned to the EV's frame, 1 - s
+         * is exact for s >= 0.5 and >= 0.5 otherwise, doubling is exact, and n - 1 (the number
+         * of doublings that bring max(u, v) to [0.5, 1]) is read off max(u, v)'s exponent. */
+        static const float frame[4][6] = {{0, 1, 0, 0, 0, 1}, {0, 0, 1, 1, -1, 0}, {1, -1, 0, 1, 0, -1}, {1, 0, -1, 0, 1, 0}};
+        static const int window[4] = {0, 20, 4, 24}; /* (u >= 1/2) + 2 (v >= 1/2) -> sub-patch 1, 3, 2 */
+        const int corner = (code >> 2) & 3;
+        const float *f = frame[corner];
+        float u = (f[0] + f[1] * s) + f[2] * t, v = (f[3] + f[4] * s) + f[5] * t, m = u > v ? u : v, sc2;
+        uint32_t bits;
+        int n, hu, hv;
+        memcpy(&bits, &m, sizeof bits);
+        n = 127 - (int)(bits >> 23); /* m in [0.5, 1): 1; [0.25, 0.5): 2; ...; 0 and denormals: >= 127 */
+        if (n < 1) n = 1;            /* m = 1 */
+        if (n > SFB__SIMD_STAM_LEVELS) {
+            if (m > 0.0f) o->run = SFB__SIMD_RUN_STAM_FAR; /* else the EV itself: ref */
+            return;
+        }
+        sc2 = (float)(1 << (n - 1));
+        u *= sc2;
+        v *= sc2;
+        hu = u >= 0.5f;
+        hv = v >= 0.5f;
+        o->s = u + u - (float)hu;
+        o->t = v + v - (float)hv;
+        o->blk = h->blk + 4 * (size_t)(code >> 4) + (size_t)(n - 1) * 100 + (size_t)window[hu + 2 * hv];
+        o->dsc = sc * sc2 * 2.0f;
+        o->cs = 20;
+        o->rot = corner;
+        o->run = SFB__SIMD_RUN_KERNEL;
+        SFB__SIMD_PREFETCH(o->blk);
+        SFB__SIMD_PREFETCH(o->blk + 16);
+        SFB__SIMD_PREFETCH(o->blk + 32);
+        SFB__SIMD_PREFETCH(o->blk + 48);
+        SFB__SIMD_PREFETCH(o->blk + 64);
+        SFB__SIMD_PREFETCH(o->blk + 75);
+    }
+}
+
+/* Unit normal from window tangents du, dv (lanes 0..2), or 0 where float cannot be trusted to
+ * give it within ~1e-4 rad (see Numerics): |n| >= 2e-3 E (|du| + |dv|), using
+ * (|du| + |dv|)^2 <= 2 (|du|^2 + |dv|^2). */
+static int sfb__simd_unit_normal(const float *du, const float *dv, float E, double n[3]) {
+    double a = 0.0, b = 0.0, c, e = (double)E;
+    int k;
+    n[0] = (double)du[1] * dv[2] - (double)du[2] * dv[1];
+    n[1] = (double)du[2] * dv[0] - (double)du[0] * dv[2];
+    n[2] = (double)du[0] * dv[1] - (double)du[1] * dv[0];
+    for (k = 0; k < 3; ++k) { a += (double)du[k] * du[k]; b += (double)dv[k] * dv[k]; }
+    c = n[0] * n[0] + n[1] * n[1] + n[2] * n[2];
+    if (!(c > 0.0 && c >= 8e-6 * e * e * (a + b) && c <= 1e300)) return 0;
+    c = sqrt(c);
+    for (k = 0; k < 3; ++k) n[k] /= c;
+    return 1;
+}
+
+/* Finishes a window result r in double (portable, neon); returns 0, having written nothing,
+ * where the normal must come from ref. */
+static int sfb__simd_put_generic(const sfb__simd_pjob *j, int q, float r[6][4], const sfb__simd_slot *sl) {
+    double res[6][3], nrm[3] = {0.0, 0.0, 0.0};
+    const double d = sl->dsc, d2 = d * d;
+    int c;
+    if (j->out->normal && !sfb__simd_unit_normal(r[1], r[2], sl->blk[3 * sl->cs + 15], nrm)) return 0;
+    for (c = 0; c < 3; ++c) {
+        const double Pu = d * r[1][c], Pv = d * r[2][c];
+        res[0][c] = r[0][c];
+        switch (sl->rot) {
+        default: res[1][c] = Pu; res[2][c] = Pv; break;
+        case 1: res[1][c] = -Pv; res[2][c] = Pu; break;
+        case 2: res[1][c] = -Pu; res[2][c] = -Pv; break;
+        case 3: res[1][c] = Pv; res[2][c] = -Pu; break;
+        }
+        if (!j->second) {
+            res[3][c] = res[4][c] = res[5][c] = 0.0;
+        } else if (sl->rot & 1) {
+            res[3][c] = d2 * r[5][c]; res[4][c] = -d2 * r[4][c]; res[5][c] = d2 * r[3][c];
+        } else {
+            res[3][c] = d2 * r[3][c]; res[4][c] = d2 * r[4][c]; res[5][c] = d2 * r[5][c];
+        }
+    }
+    sfb__simd_write(j, q, res, nrm);
+    return 1;
+}
+
+/* ---- portable window kernel and the scalar-finishing range (portable, neon) ---- */
+static void sfb__simd_bs_portable(const float *blk, int cs, float s, float t, int second, float r[6][4]) {
+    float bu[4], du[4], ddu[4], bv[4], dv[4], ddv[4];
+    int i, jj, c, k;
+    sfb__simd_basis(s, bu, du, ddu);
+    sfb__simd_basis(t, bv, dv, ddv);
+    for (k = 0; k < 6; ++k) r[k][0] = r[k][1] = r[k][2] = r[k][3] = 0.0f;
+    for (jj = 0; jj < 4; ++jj) {
+        float rp[3] = {0.0f, 0.0f, 0.0f}, rd[3] = {0.0f, 0.0f, 0.0f}, rdd[3] = {0.0f, 0.0f, 0.0f};
+        for (i = 0; i < 4; ++i) {
+            const float *pnt = blk + i * cs + 4 * jj;
+            for (c = 0; c < 3; ++c) { rp[c] += bu[i] * pnt[c]; rd[c] += du[i] * pnt[c]; rdd[c] += ddu[i] * pnt[c]; }
+        }
+        for (c = 0; c < 3; ++c) {
+            r[0][c] += bv[jj] * rp[c]; r[1][c] += bv[jj] * rd[c]; r[2][c] += dv[jj] * rp[c];
+            if (second) { r[3][c] += bv[jj] * rdd[c]; r[4][c] += dv[jj] * rd[c]; r[5][c] += ddv[jj] * rp[c]; }
+        }
+    }
+    for (c = 0; c < 3; ++c) r[0][c] += blk[c * cs + 4 * c + 3]; /* origin: w of the diagonal */
+}
+
+static void sfb__simd_prange_generic(const sfb__simd_pjob *j, int first, int last) {
+    sfb__simd_slot ring[SFB__SIMD_AHEAD];
+    int q;
+    for (q = first; q < last && q < first + SFB__SIMD_AHEAD; ++q) sfb__simd_prep(j, q, &ring[q % SFB__SIMD_AHEAD]);
+    for (q = first; q < last; ++q) {
+        const sfb__simd_slot sl = ring[q % SFB__SIMD_AHEAD];
+        float r[6][4];
+        if (q + SFB__SIMD_AHEAD < last) sfb__simd_prep(j, q + SFB__SIMD_AHEAD, &ring[q % SFB__SIMD_AHEAD]);
+        if (sl.run == SFB__SIMD_RUN_KERNEL) {
+            j->bs(sl.blk, sl.cs, sl.s, sl.t, j->second, r);
+            if (!sfb__simd_put_generic(j, q, r, &sl)) sfb__simd_ref_one(j, q);
+        } else if (sl.run == SFB__SIMD_RUN_STAM_FAR) {
+            sfb__simd_stam_far(j, q);
+        } else {
+            sfb__simd_ref_one(j, q);
+        }
+    }
+}
+
+/* ---- sse2 (and the 128-bit finishing shared with avx2 and avx512) ---- */
+#ifdef SFB__SIMD_SSE2
+#define SFB__SIMD_BC(v, i) _mm_shuffle_ps(v, v, _MM_SHUFFLE(i, i, i, i))
+#define SFB__SIMD_YZX(v) _mm_shuffle_ps(v, v, _MM_SHUFFLE(3, 0, 2, 1))
+
+/* The window's origin from the w lanes of its diagonal (see the layout). */
+static inline __m128 sfb__simd_sse2_origin(const float *blk, int cs) {
+    const __m128 t0 = _mm_unpackhi_ps(_mm_loadu_ps(blk), _mm_loadu_ps(blk + cs + 4));               /* z0 z1 w0 w1 */
+    const __m128 t1 = _mm_unpackhi_ps(_mm_loadu_ps(blk + 2 * cs + 8), _mm_loadu_ps(blk + 3 * cs + 12)); /* z2 z3 w2 w3 */
+    return _mm_movehl_ps(t1, t0);                                                                   /* w0 w1 w2 w3 */
+}
+
+/* Four basis values at x: Horner on the coefficient rows (b), derivative (d), second (dd). */
+static inline __m128 sfb__simd_sse2_b(__m128 x) {
+    return _mm_add_ps(_mm_mul_ps(_mm_add_ps(_mm_mul_ps(_mm_add_ps(_mm_mul_ps(_mm_loadu_ps(sfb__simd_bsc[3]), x), _mm_loadu_ps(sfb__simd_bsc[2])), x),
+                                            _mm_loadu_ps(sfb__simd_bsc[1])), x), _mm_loadu_ps(sfb__simd_bsc[0]));
+}
+static inline __m128 sfb__simd_sse2_d(__m128 x) {
+    return _mm_add_ps(_mm_mul_ps(_mm_add_ps(_mm_mul_ps(_mm_loadu_ps(sfb__simd_bsc3[0]), x), _mm_loadu_ps(sfb__simd_bsc[4])), x),
+                      _mm_loadu_ps(sfb__simd_bsc[1]));
+}
+static inline __m128 sfb__simd_sse2_dd(__m128 x) {
+    return _mm_add_ps(_mm_mul_ps(_mm_loadu_ps(sfb__simd_bsc3[1]), x), _mm_loadu_ps(sfb__simd_bsc[4]));
+}
+
+/* sum_i w_i a_i with w_i = lane i of w broadcast */
+static inline __m128 sfb__simd_sse2_dot4(__m128 w, __m128 a0, __m128 a1, __m128 a2, __m128 a3) {
+    return _mm_add_ps(_mm_add_ps(_mm_mul_ps(SFB__SIMD_BC(w, 0), a0), _mm_mul_ps(SFB__SIMD_BC(w, 1), a1)),
+                      _mm_add_ps(_mm_mul_ps(SFB__SIMD_BC(w, 2), a2), _mm_mul_ps(SFB__SIMD_BC(w, 3), a3)));
+}
+
+/* Window at (s, t), one point per register: rows (fixed v index) reduced along u first. */
+static SFB__SIMD_FORCEINLINE void sfb__simd_sse2_eval(const float *blk, int cs, float s, float t, int second, __m128 r[6]) {
+    const __m128 vs = _mm_set1_ps(s), vt = _mm_set1_ps(t);
+    const __m128 Bu = sfb__simd_sse2_b(vs), Du = sfb__simd_sse2_d(vs), Bv = sfb__simd_sse2_b(vt), Dv = sfb__simd_sse2_d(vt);
+    __m128 rp[4], rd[4];
+    int jj;
+    for (jj = 0; jj < 4; ++jj) {
+        const __m128 a0 = _mm_loadu_ps(blk + 4 * jj), a1 = _mm_loadu_ps(blk + cs + 4 * jj);
+        const __m128 a2 = _mm_loadu_ps(blk + 2 * cs + 4 * jj), a3 = _mm_loadu_ps(blk + 3 * cs + 4 * jj);
+        rp[jj] = sfb__simd_sse2_dot4(Bu, a0, a1, a2, a3);
+        rd[jj] = sfb__simd_sse2_dot4(Du, a0, a1, a2, a3);
+    }
+    r[0] = _mm_add_ps(sfb__simd_sse2_dot4(Bv, rp[0], rp[1], rp[2], rp[3]), sfb__simd_sse2_origin(blk, cs));
+    r[1] = sfb__simd_sse2_dot4(Bv, rd[0], rd[1], rd[2], rd[3]);
+    r[2] = sfb__simd_sse2_dot4(Dv, rp[0], rp[1], rp[2], rp[3]);
+    if (second) {
+        const __m128 DDu = sfb__simd_sse2_dd(vs), DDv = sfb__simd_sse2_dd(vt);
+        __m128 rdd[4];
+        for (jj = 0; jj < 4; ++jj)
+            rdd[jj] = sfb__simd_sse2_dot4(DDu, _mm_loadu_ps(blk + 4 * jj), _mm_loadu_ps(blk + cs + 4 * jj), _mm_loadu_ps(blk + 2 * cs + 4 * jj),
+                                          _mm_loadu_ps(blk + 3 * cs + 4 * jj));
+        r[3] = sfb__simd_sse2_dot4(Bv, rdd[0], rdd[1], rdd[2], rdd[3]);
+        r[4] = sfb__simd_sse2_dot4(Dv, rd[0], rd[1], rd[2], rd[3]);
+        r[5] = sfb__simd_sse2_dot4(DDv, rp[0], rp[1], rp[2], rp[3]);
+    } else {
+        r[3] = r[4] = r[5] = _mm_setzero_ps();
+    }
+}
+
+/* Stores lanes 0..2 of v at dst[at..at+2]; with `full` a 4-float store, whose 4th float is the
+ * next location's x, which the same range writes afterwards. */
+static inline void sfb__simd_sse2_store3(float *dst, size_t at, __m128 v, int full) {
+    if (full) {
+        _mm_storeu_ps(dst + at, v);
+    } else {
+        _mm_storel_pi((__m64 *)(void *)(dst + at), v);
+        _mm_store_ss(dst + at + 2, _mm_movehl_ps(v, v));
+    }
+}
+
+/* Maps the derivatives (rotation, scale), makes the normal and stores location q from a window
+ * result; returns 0, having written nothing, where the normal must come from ref. */
+static SFB__SIMD_FORCEINLINE int sfb__simd_sse2_put(const sfb__simd_pjob *j, int q, int full, const __m128 r[6], const sfb__simd_slot *sl) {
+    const sfb_eval_output *o = j->out;
+    const size_t at = 3 * (size_t)q;
+    const __m128 xyz = _mm_castsi128_ps(_mm_set_epi32(0, -1, -1, -1));
+    const __m128 Pu = _mm_and_ps(r[1], xyz), Pv = _mm_and_ps(r[2], xyz), vsc = _mm_set1_ps(sl->dsc);
+    __m128 du, dv;
+    if (o->normal) {
+        const float E = sl->blk[3 * sl->cs + 15];
+        const __m128 n = SFB__SIMD_YZX(_mm_sub_ps(_mm_mul_ps(Pu, SFB__SIMD_YZX(Pv)), _mm_mul_ps(SFB__SIMD_YZX(Pu), Pv)));
+        const __m128 x = _mm_mul_ps(Pu, Pu), y = _mm_mul_ps(Pv, Pv), z = _mm_mul_ps(n, n);
+        __m128 ab = _mm_add_ps(_mm_unpacklo_ps(x, y), _mm_unpackhi_ps(x, y)); /* x0+x2 y0+y2 x1+x3 y1+y3 */
+        __m128 cc = _mm_add_ps(z, _mm_movehl_ps(z, z));
+        float a, b, c;
+        ab = _mm_add_ps(ab, _mm_movehl_ps(ab, ab));
+        cc = _mm_add_ss(cc, SFB__SIMD_BC(cc, 1));
+        a = _mm_cvtss_f32(ab);
+        b = _mm_cvtss_f32(SFB__SIMD_BC(ab, 1));
+        c = _mm_cvtss_f32(cc);
+        /* the float-trust test of sfb__simd_unit_normal, with c in float's comfortable range */
+        if (!(c > 1e-30f && c <= 1e30f && c >= 8e-6f * E * E * (a + b))) return 0;
+        sfb__simd_sse2_store3(o->normal, at, _mm_div_ps(n, _mm_sqrt_ps(SFB__SIMD_BC(cc, 0))), full);
+    }
+    {
+        /* (Ps, Pt) = (a Pu + b Pv, c Pu + d Pv) dsc, (a, b, c, d) by frame corner: a table, not
+         * a branch (B-spline and Stam locations come in random order) */
+        static const float rot[4][4] = {{1, 0, 0, 1}, {0, -1, 1, 0}, {-1, 0, 0, -1}, {0, 1, -1, 0}};
+        const __m128 k = _mm_mul_ps(_mm_loadu_ps(rot[sl->rot]), vsc);
+        du = _mm_add_ps(_mm_mul_ps(Pu, SFB__SIMD_BC(k, 0)), _mm_mul_ps(Pv, SFB__SIMD_BC(k, 1)));
+        dv = _mm_add_ps(_mm_mul_ps(Pu, SFB__SIMD_BC(k, 2)), _mm_mul_ps(Pv, SFB__SIMD_BC(k, 3)));
+    }
+    if (o->position) sfb__simd_sse2_store3(o->position, at, r[0], full);
+    if (o->du) sfb__simd_sse2_store3(o->du, at, du, full);
+    if (o->dv) sfb__simd_sse2_store3(o->dv, at, dv, full);
+    if (j->second) {
+        const __m128 sc2 = _mm_mul_ps(vsc, vsc);
+        const int odd = sl->rot & 1; /* frames turned by 90 degrees swap u and v */
+        const __m128 uu = _mm_mul_ps(odd ? r[5] : r[3], sc2), vv = _mm_mul_ps(odd ? r[3] : r[5], sc2);
+        const __m128 uv = _mm_mul_ps(r[4], odd ? _mm_xor_ps(sc2, _mm_set1_ps(-0.0f)) : sc2);
+        if (o->duu) sfb__simd_sse2_store3(o->duu, at, uu, full);
+        if (o->duv) sfb__simd_sse2_store3(o->duv, at, uv, full);
+        if (o->dvv) sfb__simd_sse2_store3(o->dvv, at, vv, full);
+    }
+    return 1;
+}
+
+/* The range loop of the 128-bit-finishing kernels. */
+#define SFB__SIMD_PATCH_RANGE(NAME, ATTR, EVAL)                                                                  \
+    ATTR static void NAME(const sfb__simd_pjob *j, int first, int last) {                                        \
+        sfb__simd_slot ring[SFB__SIMD_AHEAD];                                                                    \
+        int q;                                                                                                   \
+        for (q = first; q < last && q < first + SFB__SIMD_AHEAD; ++q) sfb__simd_prep(j, q, &ring[q % SFB__SIMD_AHEAD]); \
+        for (q = first; q < last; ++q) {                                                                         \
+            const sfb__simd_slot sl = ring[q % SFB__SIMD_AHEAD];                                                 \
+            __m128 r[6];                                                                                         \
+            if (q + SFB__SIMD_AHEAD < last) sfb__simd_prep(j, q + SFB__SIMD_AHEAD, &ring[q % SFB__SIMD_AHEAD]);  \
+            if (sl.run == SFB__SIMD_RUN_KERNEL) {                                                                \
+                EVAL(sl.blk, sl.cs, sl.s, sl.t, j->second, r);                                                   \
+                if (!sfb__simd_sse2_put(j, q, q + 1 < last, r, &sl)) sfb__simd_ref_one(j, q);                    \
+            } else if (sl.run == SFB__SIMD_RUN_STAM_FAR) {                                                       \
+                sfb__simd_stam_far(j, q);                                                                        \
+            } else {                                                                                             \
+                sfb__simd_ref_one(j, q);                                                                         \
+            }                                                                                                    \
+        }                                                                                                        \
+    }
+
+SFB__SIMD_PATCH_RANGE(sfb__simd_prange_sse2, , sfb__simd_sse2_eval)
+#endif /* SFB__SIMD_SSE2 */
+
+/* ---- avx2 + fma: two points (rows j, j+1 of one column) per register ---- */
+#ifdef SFB__SIMD_X86_DISPATCH
+SFB__SIMD_TARGET_AVX2 static inline __m128 sfb__simd_avx2_hadd(__m256 v) {
+    return _mm_add_ps(_mm256_castps256_ps128(v), _mm256_extractf128_ps(v, 1));
+}
+
+SFB__SIMD_TARGET_AVX2 static SFB__SIMD_FORCEINLINE void sfb__simd_avx2_eval(const float *blk, int cs, float s, float t, int second, __m128 r[6]) {
+    /* s in the low half, t in the high half: one Horner pass makes both bases */
+    const __m256 st = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_set1_ps(s)), _mm_set1_ps(t), 1);
+    const __m256 c0 = _mm256_broadcast_ps((const __m128 *)(const void *)sfb__simd_bsc[0]);
+    const __m256 c1 = _mm256_broadcast_ps((const __m128 *)(const void *)sfb__simd_bsc[1]);
+    const __m256 c2 = _mm256_broadcast_ps((const __m128 *)(const void *)sfb__simd_bsc[2]);
+    const __m256 c3 = _mm256_broadcast_ps((const __m128 *)(const void *)sfb__simd_bsc[3]);
+    const __m256 c22 = _mm256_broadcast_ps((const __m128 *)(const void *)sfb__simd_bsc[4]);
+    const __m256 c33 = _mm256_broadcast_ps((const __m128 *)(const void *)sfb__simd_bsc3[0]);
+    const __m256 B = _mm256_fmadd_ps(_mm256_fmadd_ps(_mm256_fmadd_ps(c3, st, c2), st, c1), st, c0);
+    const __m256 D = _mm256_fmadd_ps(_mm256_fmadd_ps(c33, st, c22), st, c1);
+    const __m256 Bu = _mm256_permute2f128_ps(B, B, 0x00), Bv = _mm256_permute2f128_ps(B, B, 0x11);
+    const __m256 Du = _mm256_permute2f128_ps(D, D, 0x00), Dv = _mm256_permute2f128_ps(D, D, 0x11);
+    const __m256i sel01 = _mm256_setr_epi32(0, 0, 0, 0, 1, 1, 1, 1), sel23 = _mm256_setr_epi32(2, 2, 2, 2, 3, 3, 3, 3);
+    const __m256 bv01 = _mm256_permutevar_ps(Bv, sel01), bv23 = _mm256_permutevar_ps(Bv, sel23);
+    const __m256 dv01 = _mm256_permutevar_ps(Dv, sel01), dv23 = _mm256_permutevar_ps(Dv, sel23);
+    __m256 y0[4], y1[4], rp0, rp1, rd0, rd1;
+    int i;
+    for (i = 0; i < 4; ++i) {
+        y0[i] = _mm256_loadu_ps(blk + i * cs);     /* points (i,0) (i,1) */
+        y1[i] = _mm256_loadu_ps(blk + i * cs + 8); /* points (i,2) (i,3) */
+    }
+#define SFB__SIMD_AVX2_COL(w, y)                                                                                   \
+    _mm256_fmadd_ps(_mm256_permute_ps(w, 0xFF), y[3],                                                              \
+                    _mm256_fmadd_ps(_mm256_permute_ps(w, 0xAA), y[2],                                              \
+                                    _mm256_fmadd_ps(_mm256_permute_ps(w, 0x55), y[1], _mm256_mul_ps(_mm256_permute_ps(w, 0x00), y[0]))))
+    rp0 = SFB__SIMD_AVX2_COL(Bu, y0);
+    rp1 = SFB__SIMD_AVX2_COL(Bu, y1);
+    rd0 = SFB__SIMD_AVX2_COL(Du, y0);
+    rd1 = SFB__SIMD_AVX2_COL(Du, y1);
+    r[0] = _mm_add_ps(sfb__simd_avx2_hadd(_mm256_fmadd_ps(rp1, bv23, _mm256_mul_ps(rp0, bv01))), sfb__simd_sse2_origin(blk, cs));
+    r[1] = sfb__simd_avx2_hadd(_mm256_fmadd_ps(rd1, bv23, _mm256_mul_ps(rd0, bv01)));
+    r[2] = sfb__simd_avx2_hadd(_mm256_fmadd_ps(rp1, dv23, _mm256_mul_ps(rp0, dv01)));
+    if (second) {
+        const __m256 DD = _mm256_fmadd_ps(_mm256_broadcast_ps((const __m128 *)(const void *)sfb__simd_bsc3[1]), st, c22);
+        const __m256 DDu = _mm256_permute2f128_ps(DD, DD, 0x00), DDv = _mm256_permute2f128_ps(DD, DD, 0x11);
+        const __m256 ddv01 = _mm256_permutevar_ps(DDv, sel01), ddv23 = _mm256_permutevar_ps(DDv, sel23);
+        const __m256 rdd0 = SFB__SIMD_AVX2_COL(DDu, y0), rdd1 = SFB__SIMD_AVX2_COL(DDu, y1);
+        r[3] = sfb__simd_avx2_hadd(_mm256_fmadd_ps(rdd1, bv23, _mm256_mul_ps(rdd0, bv01)));
+        r[4] = sfb__simd_avx2_hadd(_mm256_fmadd_ps(rd1, dv23, _mm256_mul_ps(rd0, dv01)));
+        r[5] = sfb__simd_avx2_hadd(_mm256_fmadd_ps(rp1, ddv23, _mm256_mul_ps(rp0, ddv01)));
+    } else {
+        r[3] = r[4] = r[5] = _mm_setzero_ps();
+    }
+#undef SFB__SIMD_AVX2_COL
+}
+
+SFB__SIMD_PATCH_RANGE(sfb__simd_prange_avx2, SFB__SIMD_TARGET_AVX2, sfb__simd_avx2_eval)
+
+/* ---- avx512: a whole column (4 points) per register ---- */
+/* Sum of the four 128-bit lanes. (maskz forms: see the note on GCC bug 105593 above.) */
+SFB__SIMD_TARGET_AVX512 static inline __m128 sfb__simd_avx512_hadd(__m512 v) {
+    const __m512d d = _mm512_castps_pd(v);
+    const __m256 y = _mm256_add_ps(_mm256_castpd_ps(_mm512_maskz_extractf64x4_pd((__mmask8)0xF, d, 0)),
+                                   _mm256_castpd_ps(_mm512_maskz_extractf64x4_pd((__mmask8)0xF, d, 1)));
+    return _mm_add_ps(_mm256_castps256_ps128(y), _mm256_extractf128_ps(y, 1));
+}
+
+SFB__SIMD_TARGET_AVX512 static SFB__SIMD_FORCEINLINE void sfb__simd_avx512_eval(const float *blk, int cs, float s, float t, int second, __m128 r[6]) {
+    const __mmask16 all = (__mmask16)0xFFFF;
+    const __m128 vs = _mm_set1_ps(s), vt = _mm_set1_ps(t);
+    const __m512 Bu = _mm512_castps128_ps512(sfb__simd_sse2_b(vs)), Du = _mm512_castps128_ps512(sfb__simd_sse2_d(vs));
+    const __m512 Bv = _mm512_castps128_ps512(sfb__simd_sse2_b(vt)), Dv = _mm512_castps128_ps512(sfb__simd_sse2_d(vt));
+    /* v side: basis value j in the 128-bit lane of row j (the lanes of a column register) */
+    const __m512i spread = _mm512_set_epi32(3, 3, 3, 3, 2, 2, 2, 2, 1, 1, 1, 1, 0, 0, 0, 0);
+    const __m512i i0 = _mm512_set1_epi32(0), i1 = _mm512_set1_epi32(1), i2 = _mm512_set1_epi32(2), i3 = _mm512_set1_epi32(3);
+    const __m512 vb = _mm512_maskz_permutexvar_ps(all, spread, Bv), vd = _mm512_maskz_permutexvar_ps(all, spread, Dv);
+    const __m512 z0 = _mm512_loadu_ps(blk), z1 = _mm512_loadu_ps(blk + cs), z2 = _mm512_loadu_ps(blk + 2 * cs), z3 = _mm512_loadu_ps(blk + 3 * cs);
+    __m512 rp, rd;
+#define SFB__SIMD_AVX512_COL(w)                                                                                       \
+    _mm512_fmadd_ps(_mm512_maskz_permutexvar_ps(all, i3, w), z3,                                                      \
+                    _mm512_fmadd_ps(_mm512_maskz_permutexvar_ps(all, i2, w), z2,                                      \
+                                    _mm512_fmadd_ps(_mm512_maskz_permutexvar_ps(all, i1, w), z1,                      \
+                                                    _mm512_mul_ps(_mm512_maskz_permutexvar_ps(all, i0, w), z0))))
+    rp = SFB__SIMD_AVX512_COL(Bu);
+    rd = SFB__SIMD_AVX512_COL(Du);
+    r[0] = _mm_add_ps(sfb__simd_avx512_hadd(_mm512_mul_ps(rp, vb)), sfb__simd_sse2_origin(blk, cs));
+    r[1] = sfb__simd_avx512_hadd(_mm512_mul_ps(rd, vb));
+    r[2] = sfb__simd_avx512_hadd(_mm512_mul_ps(rp, vd));
+    if (second) {
+        const __m512 DDu = _mm512_castps128_ps512(sfb__simd_sse2_dd(vs));
+        const __m512 vdd = _mm512_maskz_permutexvar_ps(all, spread, _mm512_castps128_ps512(sfb__simd_sse2_dd(vt)));
+        const __m512 rdd = SFB__SIMD_AVX512_COL(DDu);
+        r[3] = sfb__simd_avx512_hadd(_mm512_mul_ps(rdd, vb));
+        r[4] = sfb__simd_avx512_hadd(_mm512_mul_ps(rd, vd));
+        r[5] = sfb__simd_avx512_hadd(_mm512_mul_ps(rp, vdd));
+    } else {
+        r[3] = r[4] = r[5] = _mm_setzero_ps();
+    }
+#undef SFB__SIMD_AVX512_COL
+}
+
+SFB__SIMD_PATCH_RANGE(sfb__simd_prange_avx512, SFB__SIMD_TARGET_AVX512, sfb__simd_avx512_eval)
+#endif /* SFB__SIMD_X86_DISPATCH */
+
+/* ---- neon: one point per register, finished in scalar ---- */
+#ifdef SFB__SIMD_NEON
+static void sfb__simd_bs_neon(const float *blk, int cs, float s, float t, int second, float r[6][4]) {
+    float bu[4], du[4], ddu[4], bv[4], dv[4], ddv[4];
+    float32x4_t P = vdupq_n_f32(0.0f), Pu = P, Pv = P, Puu = P, Puv = P, Pvv = P;
+    int i, jj, c;
+    sfb__simd_basis(s, bu, du, ddu);
+    sfb__simd_basis(t, bv, dv, ddv);
+    for (jj = 0; jj < 4; ++jj) {
+        float32x4_t rp = vdupq_n_f32(0.0f), rd = rp, rdd = rp;
+        for (i = 0; i < 4; ++i) {
+            const float32x4_t a = vld1q_f32(blk + i * cs + 4 * jj);
+            rp = SFB__SIMD_NEON_MADD(rp, vdupq_n_f32(bu[i]), a);
+            rd = SFB__SIMD_NEON_MADD(rd, vdupq_n_f32(du[i]), a);
+            if (second) rdd = SFB__SIMD_NEON_MADD(rdd, vdupq_n_f32(ddu[i]), a);
+        }
+        P = SFB__SIMD_NEON_MADD(P, vdupq_n_f32(bv[jj]), rp);
+        Pu = SFB__SIMD_NEON_MADD(Pu, vdupq_n_f32(bv[jj]), rd);
+        Pv = SFB__SIMD_NEON_MADD(Pv, vdupq_n_f32(dv[jj]), rp);
+        if (second) {
+            Puu = SFB__SIMD_NEON_MADD(Puu, vdupq_n_f32(bv[jj]), rdd);
+            Puv = SFB__SIMD_NEON_MADD(Puv, vdupq_n_f32(dv[jj]), rd);
+            Pvv = SFB__SIMD_NEON_MADD(Pvv, vdupq_n_f32(ddv[jj]), rp);
+        }
+    }
+    vst1q_f32(r[0], P); vst1q_f32(r[1], Pu); vst1q_f32(r[2], Pv);
+    vst1q_f32(r[3], Puu); vst1q_f32(r[4], Puv); vst1q_f32(r[5], Pvv);
+    for (c = 0; c < 3; ++c) r[0][c] += blk[c * cs + 4 * c + 3]; /* origin: w of the diagonal */
+}
+#endif /* SFB__SIMD_NEON */
+
 /* ---- instruction set choice ---- */
 enum { SFB__SIMD_PORTABLE, SFB__SIMD_ISA_SSE2, SFB__SIMD_AVX2, SFB__SIMD_AVX512, SFB__SIMD_ISA_NEON, SFB__SIMD_ISA_COUNT };
 static const char *const sfb__simd_isa_names[SFB__SIMD_ISA_COUNT] = {"portable", "sse2", "avx2", "avx512", "neon"};
@@ -409,6 +1070,26 @@ static sfb__simd_kernel sfb__simd_kernel_of(int isa) {
     case SFB__SIMD_ISA_NEON: return sfb__simd_neon;
 #endif
     default: return NULL;
+    }
+}
+
+/* The eval_patches kernels of an instruction set that sfb__simd_kernel_of accepted: a range
+ * loop, and for the generic (scalar-finishing) range loop its window kernel. */
+static void sfb__simd_patch_kernels_of(int isa, sfb__simd_prange_fn *range, sfb__simd_bs_fn *bs) {
+    *range = sfb__simd_prange_generic;
+    *bs = sfb__simd_bs_portable;
+    switch (isa) {
+#ifdef SFB__SIMD_SSE2
+    case SFB__SIMD_ISA_SSE2: *range = sfb__simd_prange_sse2; break;
+#endif
+#ifdef SFB__SIMD_X86_DISPATCH
+    case SFB__SIMD_AVX2: *range = sfb__simd_prange_avx2; break;
+    case SFB__SIMD_AVX512: *range = sfb__simd_prange_avx512; break;
+#endif
+#ifdef SFB__SIMD_NEON
+    case SFB__SIMD_ISA_NEON: *bs = sfb__simd_bs_neon; break;
+#endif
+    default: break;
     }
 }
 
@@ -444,6 +1125,8 @@ typedef struct sfb__simd_state {
     sfb_context *ctx;
     int isa;
     sfb__simd_kernel kernel;
+    sfb__simd_prange_fn prange;  /* eval_patches: range loop and block evaluator of `isa` */
+    sfb__simd_bs_fn pbs;
     int threads;                 /* threads sharing one call, the caller included */
 #ifdef SFB__SIMD_THREADS
     int workers;                 /* pool threads running (threads - 1 once init succeeded) */
@@ -453,7 +1136,11 @@ typedef struct sfb__simd_state {
     pthread_cond_t wake, done;
     unsigned long generation;    /* bumped per job; idle workers wait for a change */
     int quit;
-    const sfb__simd_job *job;    /* the current job: rows [first, last) cut into `chunks` */
+    /* the current job: items [first, last) cut into `chunks`, each run by task(arg, a, b);
+     * with `offsets` (stencil rows) chunks hold about equal entry counts, else equal items */
+    void (*task)(const struct sfb__simd_state *s, const void *arg, int a, int b);
+    const void *arg;
+    const int *offsets;
     int first, last, chunks, next_chunk, chunks_done;
     size_t entry0, entries;
 #endif
@@ -471,11 +1158,13 @@ static int sfb__simd_row_at(const int *offsets, int first, int last, size_t e) {
     return lo;
 }
 
-/* First row of chunk c of the current job: chunks hold about equal numbers of entries. */
+/* First item of chunk c of the current job: chunks hold about equal numbers of entries
+ * (stencil rows) or of items. */
 static int sfb__simd_chunk_start(const sfb__simd_state *s, int c) {
     if (c <= 0) return s->first;
     if (c >= s->chunks) return s->last;
-    return sfb__simd_row_at(s->job->offsets, s->first, s->last, s->entry0 + s->entries / (size_t)s->chunks * (size_t)c);
+    if (!s->offsets) return s->first + (int)((long long)(s->last - s->first) * c / s->chunks);
+    return sfb__simd_row_at(s->offsets, s->first, s->last, s->entry0 + s->entries / (size_t)s->chunks * (size_t)c);
 }
 
 /* Runs chunks of the current job until none is left to claim. Called and returns with
@@ -485,9 +1174,10 @@ static void sfb__simd_drain(sfb__simd_state *s) {
     while (s->next_chunk < s->chunks) {
         const int c = s->next_chunk++;
         const int a = sfb__simd_chunk_start(s, c), b = sfb__simd_chunk_start(s, c + 1);
-        const sfb__simd_job *j = s->job;
+        void (*task)(const struct sfb__simd_state *, const void *, int, int) = s->task;
+        const void *arg = s->arg;
         pthread_mutex_unlock(&s->lock);
-        if (a < b) s->kernel(j, a, b);
+        if (a < b) task(s, arg, a, b);
         pthread_mutex_lock(&s->lock);
         if (++s->chunks_done == s->chunks) pthread_cond_signal(&s->done);
     }
@@ -582,6 +1272,7 @@ static sfb_result sfb__simd_init(sfb_context *ctx, void **state, char *why, size
     s->ctx = ctx;
     s->isa = sfb__simd_choose_isa(ctx);
     s->kernel = sfb__simd_kernel_of(s->isa);
+    sfb__simd_patch_kernels_of(s->isa, &s->prange, &s->pbs);
     s->threads = sfb__simd_thread_count(ctx->threads);
 #ifdef SFB__SIMD_THREADS
     if (s->threads > 1 && !sfb__simd_pool_start(s, why, why_size)) {
@@ -601,6 +1292,40 @@ static void sfb__simd_shutdown(sfb_context *ctx, void *state) {
 #endif
     sfb__free(ctx, s);
 }
+
+#ifdef SFB__SIMD_THREADS
+/* Runs task over items [first, last) on the pool (the caller takes chunks too) and returns 1,
+ * or returns 0 without running anything when there is no pool or another call holds it. */
+static int sfb__simd_pool_run(sfb__simd_state *s, void (*task)(const struct sfb__simd_state *, const void *, int, int),
+                              const void *arg, int first, int last, const int *offsets, size_t e0, size_t entries) {
+    if (s->threads <= 1 || pthread_mutex_trylock(&s->busy) != 0) return 0;
+    pthread_mutex_lock(&s->lock);
+    s->task = task;
+    s->arg = arg;
+    s->offsets = offsets;
+    s->first = first;
+    s->last = last;
+    s->entry0 = e0;
+    s->entries = entries;
+    s->chunks = 4 * s->threads; /* several per thread: a late or slow thread takes fewer */
+    s->next_chunk = 0;
+    s->chunks_done = 0;
+    ++s->generation;
+    pthread_cond_broadcast(&s->wake);
+    sfb__simd_drain(s);
+    /* wait for chunks still running on workers, not for workers still asleep */
+    while (s->chunks_done < s->chunks) pthread_cond_wait(&s->done, &s->lock);
+    s->task = NULL;
+    s->arg = NULL;
+    pthread_mutex_unlock(&s->lock);
+    pthread_mutex_unlock(&s->busy);
+    return 1;
+}
+
+static void sfb__simd_stencil_task(const sfb__simd_state *s, const void *arg, int a, int b) {
+    s->kernel((const sfb__simd_job *)arg, a, b);
+}
+#endif
 
 static void sfb__simd_describe(void *state, char *buf, size_t size) {
     const sfb__simd_state *s = (const sfb__simd_state *)state;
@@ -632,36 +1357,210 @@ static sfb_result sfb__simd_eval_stencils(void *state, const sfb__stencils *t, v
         /* offsets[rows] is not stored: the range ends where its last row's entries end */
         const size_t e0 = (size_t)t->offsets[first];
         const size_t e1 = (size_t)t->offsets[last - 1] + (size_t)t->sizes[last - 1];
-        if (s->threads > 1 && e1 - e0 >= SFB__SIMD_INLINE_ENTRIES && pthread_mutex_trylock(&s->busy) == 0) {
-            pthread_mutex_lock(&s->lock);
-            s->job = &j;
-            s->first = first;
-            s->last = last;
-            s->entry0 = e0;
-            s->entries = e1 - e0;
-            s->chunks = 4 * s->threads; /* several per thread: a late or slow thread takes fewer */
-            s->next_chunk = 0;
-            s->chunks_done = 0;
-            ++s->generation;
-            pthread_cond_broadcast(&s->wake);
-            sfb__simd_drain(s);
-            /* wait for chunks still running on workers, not for workers still asleep */
-            while (s->chunks_done < s->chunks) pthread_cond_wait(&s->done, &s->lock);
-            s->job = NULL;
-            pthread_mutex_unlock(&s->lock);
-            pthread_mutex_unlock(&s->busy);
+        if (e1 - e0 >= SFB__SIMD_INLINE_ENTRIES && sfb__simd_pool_run(s, sfb__simd_stencil_task, &j, first, last, t->offsets, e0, e1 - e0))
             return SFB_SUCCESS;
-        }
     }
 #endif
     s->kernel(&j, first, last);
     return SFB_SUCCESS;
 }
 
+/* ---- patch tables ---- */
+/* Packs the points q[gx * rows + gy] (double xyz; set[] = 0: an unused slot) of a grid with
+ * `rows` points per column into g (layout above): relative to their centroid, with o and E in
+ * the w lanes of the diagonals of the windows starting at win[k] (grid indices). Returns E. */
+static float sfb__simd_pack_grid(float *g, int cols, int rows, double (*q)[3], const unsigned char *set, const int (*win)[2],
+                                 int nwin) {
+    double o[3] = {0.0, 0.0, 0.0};
+    float of[4], E = 0.0f;
+    int k, c, cnt = 0;
+    for (k = 0; k < cols * rows; ++k)
+        if (set[k]) {
+            for (c = 0; c < 3; ++c) o[c] += q[k][c];
+            ++cnt;
+        }
+    for (c = 0; c < 3; ++c) of[c] = (float)(o[c] / (cnt ? cnt : 1));
+    for (k = 0; k < cols * rows; ++k) {
+        float *dst = g + 4 * k;
+        for (c = 0; c < 3; ++c) {
+            dst[c] = set[k] ? (float)(q[k][c] - (double)of[c]) : 0.0f;
+            if (fabsf(dst[c]) > E) E = fabsf(dst[c]);
+        }
+        dst[3] = 0.0f;
+    }
+    of[3] = E;
+    for (k = 0; k < nwin; ++k)
+        for (c = 0; c < 4; ++c) g[4 * ((win[k][0] + c) * rows + win[k][1] + c) + 3] = of[c];
+    return E;
+}
+
+/* Floats of patch p's grids: 64 (B-spline), 100 per level (Stam with its eigen structure),
+ * 0 (the ref kernel evaluates it). */
+static size_t sfb__simd_patch_floats(const sfb__patch_table *pt, int p) {
+    const int n = pt->pfirst[p + 1] - pt->pfirst[p];
+    if (pt->ptype[p] == SFB__PATCH_BSPLINE) return n == 16 ? 64 : 0;
+    if (pt->ptype[p] == SFB__PATCH_STAM) {
+        const int N = pt->pvalence[p];
+        const sfb__eigen_cc *e = N >= 3 && N <= SFB__STAM_MAX_VALENCE ? pt->eig[N] : NULL;
+        return e && e->K == n && e->lambda && e->phi ? 100 * SFB__SIMD_STAM_LEVELS : 0;
+    }
+    return 0;
+}
+
+/* The Stam grids of patch p at g; 0 where the three sub-patches of a level do not agree on
+ * the points they share (they are windows of one level-n mesh; a table whose eigen data said
+ * otherwise is left to the ref kernel). */
+static int sfb__simd_pack_stam(float *g, const sfb__patch_table *pt, int p, double *lp) {
+    static const int win[3][2] = {{1, 0}, {1, 1}, {0, 1}}; /* sub-patch k = 1, 2, 3: lattice (0,-1), (0,0), (-1,0) */
+    const sfb__eigen_cc *e = pt->eig[pt->pvalence[p]];
+    const int K = e->K, *cv = pt->cv + pt->pfirst[p];
+    double q[25][3], scale = 0.0, diff = 0.0;
+    unsigned char set[25];
+    int n, k, i, jj, c;
+    for (i = 0; i < K; ++i) lp[i] = 1.0;
+    for (n = 1; n <= SFB__SIMD_STAM_LEVELS; ++n) {
+        memset(set, 0, sizeof set);
+        for (k = 0; k < 3; ++k)
+            for (jj = 0; jj < 16; ++jj) {
+                /* control point jj = 4 b + a of sub-patch k + 1: sum_i lambda_i^(n-1) phi[jj][i] c_i */
+                const double *phi = e->phi + ((size_t)k * 16 + (size_t)jj) * (size_t)K;
+                const int slot = (win[k][0] + jj % 4) * 5 + win[k][1] + jj / 4;
+                double x[3] = {0.0, 0.0, 0.0};
+                for (i = 0; i < K; ++i) {
+                    const double w = lp[i] * phi[i];
+                    const float *c_i = pt->point_data + 3 * (size_t)cv[i];
+                    for (c = 0; c < 3; ++c) x[c] += w * c_i[c];
+                }
+                for (c = 0; c < 3; ++c) {
+                    if (set[slot] && fabs(x[c] - q[slot][c]) > diff) diff = fabs(x[c] - q[slot][c]);
+                    q[slot][c] = x[c];
+                }
+                set[slot] = 1;
+            }
+        {
+            const float E = sfb__simd_pack_grid(g + (size_t)(n - 1) * 100, 5, 5, q, set, win, 3);
+            if ((double)E > scale) scale = E;
+        }
+        for (i = 0; i < K; ++i) lp[i] *= e->lambda[i];
+    }
+    return diff <= 1e-6 * scale;
+}
+
+static void sfb__simd_release_patches(void *state, void *handle) {
+    sfb__simd_state *s = (sfb__simd_state *)state;
+    sfb__simd_patches *h = (sfb__simd_patches *)handle;
+    if (!s || !h) return;
+    sfb__free(s->ctx, h->raw);
+    sfb__free(s->ctx, h->root);
+    sfb__free(s->ctx, h->node);
+    sfb__free(s->ctx, h);
+}
+
+/* Leaf code of a table entry (>= 0 node, -1 hole, <= -2 patch -(p+2)). */
+static int sfb__simd_leaf(const int *pcode, int v) { return v >= 0 ? v : v == -1 ? -(SFB__SIMD_LEAF_REF + 1) : pcode[-v - 2]; }
+
+static sfb_result sfb__simd_upload_patches(void *state, const sfb__patch_table *pt, void **handle) {
+    sfb__simd_state *s = (sfb__simd_state *)state;
+    sfb_context *ctx;
+    sfb__simd_patches *h;
+    double *lp = NULL;
+    int *pcode = NULL;
+    size_t nf = 0, at;
+    int p, maxK = 0, pass;
+    if (!s || !pt || !handle) return SFB_INVALID_ARGS;
+    *handle = NULL;
+    ctx = s->ctx;
+    if (pt->npatch <= 0 || pt->nptex <= 0 || !pt->point_data) return SFB_SUCCESS; /* nothing to pack: eval goes to ref */
+    for (p = 0; p < pt->npatch; ++p) {
+        const size_t f = sfb__simd_patch_floats(pt, p);
+        nf += f;
+        if (f > 64 && pt->pfirst[p + 1] - pt->pfirst[p] > maxK) maxK = pt->pfirst[p + 1] - pt->pfirst[p];
+    }
+    if (nf / 4 >= ((size_t)1 << 27)) /* leaf codes hold offset / 4 in 27 bits */
+        return sfb__error(ctx, SFB_LIMIT_EXCEEDED, SFB_ELEMENT_NONE, -1, "simd: the patch table is too large to pack (%zu floats)", nf);
+    h = (sfb__simd_patches *)sfb__alloc(ctx, sizeof *h);
+    if (!h) return sfb__oom(ctx, "the simd backend's patch data");
+    memset(h, 0, sizeof *h);
+    h->npatch = pt->npatch;
+    h->nptex = pt->nptex;
+    h->root = (int *)sfb__alloc(ctx, (size_t)pt->nptex * sizeof(int));
+    h->node = (int *)sfb__alloc(ctx, ((size_t)pt->nnodes * 4 + 1) * sizeof(int));
+    h->raw = sfb__alloc(ctx, nf * sizeof(float) + 64);
+    pcode = (int *)sfb__alloc(ctx, (size_t)pt->npatch * sizeof(int));
+    if (maxK > 0) lp = (double *)sfb__alloc(ctx, (size_t)maxK * sizeof(double));
+    if (!h->root || !h->node || !h->raw || !pcode || (maxK > 0 && !lp)) {
+        sfb__free(ctx, lp);
+        sfb__free(ctx, pcode);
+        sfb__simd_release_patches(s, h);
+        return sfb__oom(ctx, "the simd backend's patch data");
+    }
+    h->bytes = sizeof *h + ((size_t)pt->nptex + (size_t)pt->nnodes * 4 + 1) * sizeof(int) + nf * sizeof(float) + 64;
+    /* 64-byte alignment: a B-spline column is then one cache line */
+    h->blk = (float *)(void *)((char *)h->raw + ((64 - ((uintptr_t)h->raw & 63)) & 63));
+    /* B-spline grids first (all 64-byte aligned), then the Stam ones */
+    at = 0;
+    for (pass = 0; pass < 2; ++pass)
+        for (p = 0; p < pt->npatch; ++p) {
+            const size_t f = sfb__simd_patch_floats(pt, p);
+            const int *cv = pt->cv + pt->pfirst[p];
+            if (pass == 0) pcode[p] = -(SFB__SIMD_LEAF_REF + 1);
+            if (f == 0 || (f == 64) != (pass == 0)) continue;
+            if (f == 64) {
+                static const int win[1][2] = {{0, 0}};
+                double q[16][3];
+                unsigned char set[16];
+                int k, c;
+                for (k = 0; k < 16; ++k) {
+                    const int slot = (k % 4) * 4 + k / 4; /* cv[4 j + i] is point (i, j) */
+                    for (c = 0; c < 3; ++c) q[slot][c] = pt->point_data[3 * (size_t)cv[k] + c];
+                    set[k] = 1;
+                }
+                sfb__simd_pack_grid(h->blk + at, 4, 4, q, set, win, 1);
+                pcode[p] = -((int)((at / 4) << 4 | SFB__SIMD_LEAF_BSPLINE) + 1);
+            } else if (sfb__simd_pack_stam(h->blk + at, pt, p, lp)) {
+                pcode[p] = -((int)((at / 4) << 4 | (size_t)SFB__PARAM_CORNER(pt->pparam[p]) << 2 | SFB__SIMD_LEAF_STAM) + 1);
+            }
+            at += f;
+        }
+    for (p = 0; p < pt->nptex; ++p) h->root[p] = sfb__simd_leaf(pcode, pt->ptex_root[p]);
+    for (p = 0; p < 4 * pt->nnodes; ++p) h->node[p] = sfb__simd_leaf(pcode, pt->nodes[p]);
+    sfb__free(ctx, lp);
+    sfb__free(ctx, pcode);
+    *handle = h;
+    return SFB_SUCCESS;
+}
+
+static void sfb__simd_patch_task(const sfb__simd_state *s, const void *arg, int a, int b) {
+    s->prange((const sfb__simd_pjob *)arg, a, b);
+}
+
+static sfb_result sfb__simd_eval_patches(void *state, const sfb__patch_table *pt, void *handle, const sfb_location *locs, int first,
+                                         int last, const sfb_eval_output *out) {
+    sfb__simd_state *s = (sfb__simd_state *)state;
+    const sfb__simd_patches *h = (const sfb__simd_patches *)handle;
+    sfb__simd_pjob j;
+    if (!s || !pt || !locs || !out || first < 0 || first > last) return SFB_INVALID_ARGS;
+    if (first == last) return SFB_SUCCESS;
+    /* no packed data (not uploaded here, or an empty table): ref evaluates the call */
+    if (!h || h->npatch != pt->npatch || h->nptex != pt->nptex) return sfb__backend_ref()->eval_patches(NULL, pt, NULL, locs, first, last, out);
+    j.pt = pt;
+    j.h = h;
+    j.locs = locs;
+    j.out = out;
+    j.second = out->duu || out->duv || out->dvv;
+    j.bs = s->pbs;
+#ifdef SFB__SIMD_THREADS
+    if (last - first >= SFB__SIMD_INLINE_LOCATIONS && sfb__simd_pool_run(s, sfb__simd_patch_task, &j, first, last, NULL, 0, 0))
+        return SFB_SUCCESS;
+#endif
+    s->prange(&j, first, last);
+    return SFB_SUCCESS;
+}
+
 static const sfb__backend_vtable sfb__simd_vtable = {
-    "simd", SFB_BACKEND_SIMD, SFB__CAP_EVAL_STENCILS,
+    "simd", SFB_BACKEND_SIMD, SFB__CAP_EVAL_STENCILS | SFB__CAP_EVAL_PATCHES,
     sfb__simd_init, sfb__simd_shutdown, sfb__simd_describe, NULL, NULL, sfb__simd_eval_stencils, NULL,
-    NULL, NULL, NULL
+    sfb__simd_upload_patches, sfb__simd_release_patches, sfb__simd_eval_patches
 };
 
 const sfb__backend_vtable *sfb__backend_simd(void) { return &sfb__simd_vtable; }

@@ -39,8 +39,7 @@ enum { SFB__CORNER_R1 = 1, SFB__CORNER_R2_D1 = 2, SFB__CORNER_R2_D2 = 3, SFB__CO
 void sfb__patch_table_free(sfb_context *ctx, sfb__patch_table *pt) {
     sfb__free(ctx, pt->ptype); sfb__free(ctx, pt->pfirst); sfb__free(ctx, pt->pparam); sfb__free(ctx, pt->pvalence);
     sfb__free(ctx, pt->cv); sfb__free(ctx, pt->ptex_face); sfb__free(ctx, pt->ptex_corner); sfb__free(ctx, pt->face_ptex);
-    sfb__free(ctx, pt->ptex_root); sfb__free(ctx, pt->nodes); sfb__free(ctx, pt->point_data); sfb__free(ctx, pt->eig_f);
-    sfb__stencils_free(ctx, &pt->points);
+    sfb__free(ctx, pt->ptex_root); sfb__free(ctx, pt->nodes); sfb__free(ctx, pt->point_data);
     memset(pt, 0, sizeof *pt);
 }
 
@@ -415,6 +414,7 @@ static sfb_result sfb__pb_face(sfb__pbuild *b, sfb__wlevel *w, int g, int level,
                     patch = sfb__pb_patch(b, SFB__PATCH_STAM, out_param, N, K);
                     if (patch < 0 || !sfb__mask_grow(b->ctx, &b->m, K)) { sfb__free(b->ctx, C); return sfb__oom(b->ctx, "patch table"); }
                     base = b->pt->pfirst[patch];
+                    b->pt->eig[N] = e; /* the context's cache outlives the surface */
                     for (i = 0; i < K; ++i) {
                         int row;
                         b->m.n = 0;
@@ -598,7 +598,6 @@ sfb_result sfb__patches_build(sfb_context *ctx, const sfb__level *base, const sf
         r = sfb__progress(ctx, 0.8f + 0.15f * (float)level / (float)(SFB_MAX_LEVEL + 2), "patches");
         if (r != SFB_SUCCESS) goto done;
         for (k = 0; k < w.l.nv; ++k) b.vrow[k] = -1;
-        if (level == 0) for (k = 0; k < w.l.nv; ++k) b.vrow[k] = -1;
         sfb__free(ctx, active);
         active = (int *)sfb__alloc(ctx, ((size_t)w.l.nf + 1) * sizeof(int));
         if (!active) goto oom;
@@ -731,16 +730,10 @@ sfb_result sfb__patches_build(sfb_context *ctx, const sfb__level *base, const sf
         }
         if (level + 1 > pt->max_depth) pt->max_depth = level + 1;
     }
-    if (b.prow.rows == 0) {
-        /* no patches at all (every face a hole): an empty table */
-        b.prow.off = (size_t *)sfb__alloc(ctx, sizeof(size_t));
-        if (!b.prow.off) goto oom;
-        b.prow.off[0] = 0;
-    }
-    r = sfb__rows_to_stencils(ctx, &b.prow, base->nv, &pt->points);
-    if (r == SFB_OUT_OF_MEMORY) r = sfb__oom(ctx, "patch points");
+    r = SFB_SUCCESS;
+    pt->npoints = b.prow.rows;
     if (r == SFB_SUCCESS) {
-        /* The points from the double rows, not from the float stencil table: a Stam point is an
+        /* The points straight from the double rows (no float stencil table): a Stam point is an
          * eigen coefficient, a combination with weights of both signs summing to 0 whose result
          * is small next to the coordinates; float weights would cost it its precision (normals
          * off by ~1e-4 rad on meshes far from the origin). */

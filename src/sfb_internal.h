@@ -115,10 +115,9 @@ typedef struct sfb__patch_table {
     int *ptex_root;        /* per param face: >= 0 node, <= -2 patch -(p+2), -1 hole */
     int *nodes;            /* 4 per quadtree node, by quadrant x + 2y, same encoding */
     int counts[3];         /* patches of each type */
-    sfb__stencils points;  /* base vertices -> patch points */
+    int npoints;           /* patch points */
     float *point_data;     /* xyz per patch point, for the surface's base positions */
     const sfb__eigen_cc *eig[SFB__STAM_MAX_VALENCE + 1]; /* valences used (the context's cache) */
-    float *eig_f;          /* reserved for backends' packed copies */
 } sfb__patch_table;
 
 /* ---- context ---- */

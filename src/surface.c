@@ -44,8 +44,6 @@ SFB_API void sfb_surface_destroy(sfb_surface *s) {
 /* Rough peak bytes of refining `m` to `level`: topology of the last two levels plus composed
  * stencil rows in double during construction. Used to refuse early, before any allocation
  * sized by the level. */
-static sfb_result sfb__patches_finish(sfb_surface *s);
-
 static double sfb__estimate_bytes(const sfb_mesh *m, sfb_scheme scheme, int level, int limit, double *faces_out) {
     double faces = m->base.nf, verts = m->base.nv;
     int L;
@@ -118,8 +116,7 @@ SFB_API sfb_result sfb_surface_create(sfb_context *ctx, const sfb_mesh *mesh, co
     if (r == SFB_SUCCESS && (cfg->flags & SFB_REFINE_PATCHES)) {
         r = sfb__patches_build(ctx, &prep, &opt, cfg->isolation_level ? cfg->isolation_level : SFB_DEFAULT_ISOLATION,
                                 s->base_positions, &s->patches);
-        if (r == SFB_SUCCESS) r = sfb__patches_finish(s);
-        if (r == SFB_SUCCESS) { s->pbase = prep; memset(&prep, 0, sizeof prep); }
+        if (r == SFB_SUCCESS) { s->has_patches = 1; s->pbase = prep; memset(&prep, 0, sizeof prep); }
     }
     sfb__level_free(ctx, &prep);
     if (r != SFB_SUCCESS) { sfb_surface_destroy(s); return r; }
@@ -182,23 +179,6 @@ SFB_API sfb_result sfb_surface_create(sfb_context *ctx, const sfb_mesh *mesh, co
     return SFB_SUCCESS;
 }
 
-/* The eigen structures the Stam patches use (the patch points were made by the builder). */
-static sfb_result sfb__patches_finish(sfb_surface *s) {
-    sfb_context *ctx = s->ctx;
-    sfb__patch_table *pt = &s->patches;
-    sfb_buffer_desc d3 = {0, 3, 3};
-    int p;
-    (void)d3;
-    for (p = 0; p < pt->npatch; ++p)
-        if (pt->ptype[p] == SFB__PATCH_STAM) {
-            int N = pt->pvalence[p];
-            if (!pt->eig[N]) pt->eig[N] = ctx->eigen_cc[N];
-            if (!pt->eig[N]) return sfb__error(ctx, SFB_BACKEND_ERROR, SFB_ELEMENT_NONE, -1, "missing eigen structure of valence %d", N);
-        }
-    s->has_patches = 1;
-    return SFB_SUCCESS;
-}
-
 SFB_API int sfb_surface_param_face_count(const sfb_surface *s) { return s && s->has_patches ? s->patches.nptex : 0; }
 
 SFB_API sfb_result sfb_surface_param_faces(const sfb_surface *s, int base_face, int *first, int *count) {
@@ -233,10 +213,9 @@ SFB_API sfb_result sfb_surface_patch_info(const sfb_surface *s, sfb_patch_info *
     o->stam = pt->counts[SFB__PATCH_STAM];
     o->end_caps = pt->counts[SFB__PATCH_ENDCAP];
     o->max_depth = pt->max_depth;
-    o->points = pt->points.rows;
+    o->points = pt->npoints;
     o->bytes = (size_t)pt->npatch * (4 * sizeof(int)) + (size_t)pt->ncv * sizeof(int) + (size_t)pt->nptex * 3 * sizeof(int) +
-               (size_t)pt->nnodes * 4 * sizeof(int) + (size_t)pt->points.rows * (2 * sizeof(int) + 3 * sizeof(float)) +
-               pt->points.entries * (sizeof(int) + sizeof(float));
+               (size_t)pt->nnodes * 4 * sizeof(int) + (size_t)pt->npoints * 3 * sizeof(float);
     return SFB_SUCCESS;
 }
 
@@ -251,14 +230,14 @@ SFB_API sfb_result sfb_surface_eval(const sfb_surface *s, const sfb_location *lo
         return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "sfb_surface_eval: %s", count < 0 ? "negative count" : "NULL locations or outputs");
     for (q = 0; q < count; ++q) {
         const sfb_location *l = &loc[q];
-        double sdum, tdum, sc;
         if (l->face < 0 || l->face >= s->patches.nptex)
             return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, q, "location %d: parametric face %d is out of range (0..%d)", q, l->face,
                               s->patches.nptex - 1);
         if (!(l->u >= 0.0f && l->u <= 1.0f && l->v >= 0.0f && l->v <= 1.0f))
             return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, q, "location %d: (u,v) = (%g,%g) is outside [0,1]^2", q, (double)l->u,
                               (double)l->v);
-        if (sfb__patch_locate(&s->patches, l->face, l->u, l->v, &sdum, &tdum, &sc) < 0)
+        /* holes are whole parametric faces (a hole is a base face), so the root says it */
+        if (s->patches.ptex_root[l->face] == -1)
             return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, q, "location %d: parametric face %d is a hole", q, l->face);
     }
     if (count == 0) return SFB_SUCCESS;

@@ -1,0 +1,561 @@
+/* Watertight tessellation of the limit surface (sfb_surface_tessellate).
+ *
+ * Every parametric face ("param face", see sfb_location) is cut into triangles in its own
+ * (u,v); the vertices are evaluated through the public sfb_surface_eval, so tessellation runs
+ * on whichever backend the context selected. A vertex on the boundary of a param face is
+ * shared with the neighbours through a canonical key, so that it is created and evaluated
+ * exactly once and the mesh has no cracks:
+ *   - a corner at a base vertex: the base vertex (with SFB_TESS_SPLIT_CREASES: the base
+ *     vertex within one sector, the faces around it reachable without crossing an infinitely
+ *     sharp interior edge);
+ *   - a point on a base edge: (edge, step along it from ev[0] to ev[1]); with
+ *     SFB_TESS_SPLIT_CREASES an infinitely sharp interior edge has one copy per incident face,
+ *     each evaluated from its own face so that it carries that side's normal;
+ *   - a point on a spoke of an n-gon (from the midpoint of edge i to the centroid, shared by
+ *     sub-faces i and i+1): (n-gon, spoke, step); the centroid: the n-gon.
+ * Segment counts belong to those shared entities, not to the faces: a base edge has S
+ * segments over its whole length, a spoke T. An n-gon's sub-face sees half of each of its
+ * base edges, so an edge an n-gon uses has an even S and its midpoint (a corner of those
+ * sub-faces) is one of its points; a quad beside it then sees 2*rate segments on that edge.
+ * The first subdivision step puts the edge point at the parametric midpoint on both sides,
+ * so step k of S is the same surface point from either face; since each point is evaluated
+ * once, the mesh is closed whatever the rounding.
+ *
+ * A param face whose interior rate r equals every boundary count is a regular r x r grid,
+ * two triangles per cell (diagonal (i,j)-(i+1,j+1)). Otherwise (adaptive rates, quads beside
+ * n-gons) it gets an inner grid of rate R = max(r,2) without its outer ring, and each side
+ * is stitched from its boundary points to the inner grid's side by a zipper strip: no
+ * T-junctions. Triangles are counter-clockwise in (u,v), which is the du x dv normal side.
+ *
+ * Adaptive mode (tolerance > 0): a param face gets the first rate c in 1, 2, 4, ... (< rate,
+ * else rate) for which the surface at the midpoints of the c x c grid's edges and diagonals
+ * is within `tolerance` of the chords; a shared edge takes the largest rate of its faces.
+ * This samples the surface: a feature narrower than a cell can be missed at that rate.
+ *
+ * Thread safety: reads the surface only; allocations, errors and progress go through the
+ * surface's context, so one call per context at a time. */
+
+#define SFB__TESS_MAX_RATE 1024
+#define SFB__TESS_MAX_SEG (2 * SFB__TESS_MAX_RATE) /* a quad edge beside an n-gon sub-face */
+#define SFB__TESS_EVAL_CHUNK 65536                 /* locations per sfb_surface_eval call */
+#define SFB__TESS_FACE_CHUNK 1024                  /* param faces between progress reports */
+
+SFB_API sfb_tess_config sfb_tess_config_init(int rate) {
+    sfb_tess_config c;
+    memset(&c, 0, sizeof c);
+    c.rate = rate;
+    return c;
+}
+
+SFB_API void sfb_tess_data_free(sfb_tess_data *d) {
+    sfb_context *ctx;
+    if (!d) return;
+    ctx = d->ctx_;
+    if (ctx) {
+        sfb__free(ctx, d->positions); sfb__free(ctx, d->normals); sfb__free(ctx, d->locations);
+        sfb__free(ctx, d->triangles); sfb__free(ctx, d->triangle_faces);
+    }
+    memset(d, 0, sizeof *d);
+}
+
+typedef struct sfb__tess {
+    sfb_context *ctx;
+    const sfb_surface *s;
+    const sfb__level *l;          /* the prepared base level the patches were built from */
+    const sfb__patch_table *pt;
+    int rate, split;
+    int *prate;                   /* per param face: interior rate, 0 = nothing (hole) */
+    int *eseg;                    /* per base edge: segments over the whole edge */
+    unsigned char *engon;         /* per base edge: an n-gon uses it (eseg is then even) */
+    int *sseg;                    /* per n-gon sub-face i (param face): segments of spoke i */
+    int *uf;                      /* split: union-find over face corners, one set per sector */
+    int *ecopy;                   /* split: per face corner slot, the ef entry of its outgoing edge */
+    int *vcorner;                 /* vertex of each base vertex (split: of each sector's root corner) */
+    int *vedge;                   /* per ef entry: first vertex of the interior points of that edge copy */
+    int *vspoke;                  /* per n-gon sub-face: first vertex of the interior points of its spoke */
+    int *vcenter;                 /* per base face: its centroid vertex (n-gons) */
+    int *ifirst;                  /* per param face: first vertex of its interior points */
+    int *bids;                    /* scratch: 4 boundary chains, then one outer and one inner chain */
+    size_t nvert, ntri;
+    /* emit pass */
+    sfb_location *loc;
+    int *tri, *tface;
+    size_t tri_at;
+} sfb__tess;
+
+static void *sfb__tess_array(sfb_context *ctx, size_t count, size_t size) {
+    size_t bytes;
+    if (!sfb__mul_size(count, size, &bytes) || bytes > ((size_t)-1) - 16) return NULL;
+    return sfb__alloc(ctx, bytes + 1); /* + 1: never a zero-size block */
+}
+
+static void sfb__tess_free_work(sfb__tess *T) {
+    sfb_context *ctx = T->ctx;
+    sfb__free(ctx, T->prate); sfb__free(ctx, T->eseg); sfb__free(ctx, T->engon); sfb__free(ctx, T->sseg);
+    sfb__free(ctx, T->uf); sfb__free(ctx, T->ecopy); sfb__free(ctx, T->vcorner); sfb__free(ctx, T->vedge);
+    sfb__free(ctx, T->vspoke); sfb__free(ctx, T->vcenter); sfb__free(ctx, T->ifirst); sfb__free(ctx, T->bids);
+    T->prate = T->eseg = T->sseg = T->uf = T->ecopy = T->vcorner = T->vedge = T->vspoke = T->vcenter = T->ifirst = T->bids = NULL;
+    T->engon = NULL;
+}
+
+static int sfb__tess_face_n(const sfb__level *l, int f) { return l->fv_off[f + 1] - l->fv_off[f]; }
+
+/* Edges whose two sides get their own vertices under SFB_TESS_SPLIT_CREASES: infinitely sharp
+ * and not on the boundary (a boundary edge has one side only). */
+static int sfb__tess_split_edge(const sfb__tess *T, int e) {
+    return T->split && T->l->es[e] >= SFB_SHARPNESS_INFINITE && !(T->l->etag[e] & SFB__TAG_BOUNDARY);
+}
+
+static int sfb__tess_find(int *uf, int x) {
+    while (uf[x] != x) {
+        uf[x] = uf[uf[x]];
+        x = uf[x];
+    }
+    return x;
+}
+
+static void sfb__tess_union(int *uf, int a, int b) {
+    a = sfb__tess_find(uf, a);
+    b = sfb__tess_find(uf, b);
+    if (a < b) uf[b] = a;
+    else if (b < a) uf[a] = b;
+}
+
+static int sfb__tess_new(sfb__tess *T, int count) {
+    int id = (int)T->nvert;
+    T->nvert += (size_t)count;
+    return id;
+}
+
+/* The location a vertex is evaluated at: the first param face that reaches it in the emit
+ * pass (for a split crease copy that is always a face on its own side). */
+static void sfb__tess_loc(sfb__tess *T, int id, int pf, double u, double v) {
+    if (T->loc && T->loc[id].face < 0) {
+        T->loc[id].face = pf;
+        T->loc[id].u = (float)u;
+        T->loc[id].v = (float)v;
+    }
+}
+
+static int sfb__tess_corner(sfb__tess *T, int f, int slot) {
+    int c = T->l->fv_off[f] + slot;
+    int key = T->split ? sfb__tess_find(T->uf, c) : T->l->fv[c];
+    if (T->vcorner[key] < 0) T->vcorner[key] = sfb__tess_new(T, 1);
+    return T->vcorner[key];
+}
+
+/* Point `fidx` of the S points of face f's edge `slot`, counted in the face's direction
+ * (fidx 0 = the face's vertex at `slot`). Shared by every face on that edge copy through the
+ * edge's own direction. */
+static int sfb__tess_epoint(sfb__tess *T, int f, int slot, int fidx) {
+    const sfb__level *l = T->l;
+    int o = l->fv_off[f], n = l->fv_off[f + 1] - o, e = l->fe[o + slot], S = T->eseg[e], copy, g;
+    if (fidx <= 0) return sfb__tess_corner(T, f, slot);
+    if (fidx >= S) return sfb__tess_corner(T, f, (slot + 1) % n);
+    copy = sfb__tess_split_edge(T, e) ? T->ecopy[o + slot] : l->ef_off[e];
+    if (T->vedge[copy] < 0) T->vedge[copy] = sfb__tess_new(T, S - 1);
+    g = l->fv[o + slot] == l->ev[2 * e] ? fidx : S - fidx;
+    return T->vedge[copy] + g - 1;
+}
+
+static int sfb__tess_center(sfb__tess *T, int f) {
+    if (T->vcenter[f] < 0) T->vcenter[f] = sfb__tess_new(T, 1);
+    return T->vcenter[f];
+}
+
+/* Point t of spoke i of n-gon f: t = 0 at the midpoint of edge i, t = T at the centroid. */
+static int sfb__tess_spoke(sfb__tess *T, int f, int i, int t) {
+    const sfb__level *l = T->l;
+    int pf = T->pt->face_ptex[f] + i, n = T->sseg[pf];
+    if (t <= 0) return sfb__tess_epoint(T, f, i, T->eseg[l->fe[l->fv_off[f] + i]] / 2);
+    if (t >= n) return sfb__tess_center(T, f);
+    if (T->vspoke[pf] < 0) T->vspoke[pf] = sfb__tess_new(T, n - 1);
+    return T->vspoke[pf] + t - 1;
+}
+
+static void sfb__tess_tri(sfb__tess *T, int a, int b, int c, int pf) {
+    size_t t = T->tri_at++;
+    T->tri[3 * t] = a;
+    T->tri[3 * t + 1] = b;
+    T->tri[3 * t + 2] = c;
+    T->tface[t] = pf;
+}
+
+/* Stitches a boundary chain (na segments, point i at i/na along the side) to the inner
+ * grid's side (nb segments, point j at (j+1)/R), both running counter-clockwise around the
+ * face. Each step adds the triangle whose new cross edge is the more nearly perpendicular to
+ * the side (positions compared in units of 1/(na R), exactly), which keeps them well shaped. */
+static void sfb__tess_zipper(sfb__tess *T, const int *outer, int na, const int *inner, int nb, int R, int pf) {
+    int i = 0, j = 0;
+    while (i < na || j < nb) {
+        long to = labs((long)(i + 1) * R - (long)(j + 1) * na); /* outer step: edge outer[i+1] - inner[j] */
+        long ti = labs((long)(j + 2) * na - (long)i * R);       /* inner step: edge outer[i] - inner[j+1] */
+        if (j >= nb || (i < na && to <= ti)) {
+            sfb__tess_tri(T, outer[i], outer[i + 1], inner[j], pf);
+            ++i;
+        } else {
+            sfb__tess_tri(T, outer[i], inner[j + 1], inner[j], pf);
+            ++j;
+        }
+    }
+}
+
+/* One param face. Count pass (emit = 0): creates the ids of every point it touches and
+ * counts its triangles. Emit pass: records the locations of points not yet located and
+ * writes the triangles. Both passes visit faces in the same order, so ids agree. */
+static void sfb__tess_face(sfb__tess *T, int pf, int emit) {
+    const sfb__level *l = T->l;
+    int f = T->pt->ptex_face[pf], sub = T->pt->ptex_corner[pf], r = T->prate[pf];
+    int o = l->fv_off[f], s[4], *b[4], *outer, *inner, k, i, j, regular, R, base;
+    if (r <= 0) return;
+    for (k = 0; k < 4; ++k) b[k] = T->bids + (size_t)k * (SFB__TESS_MAX_SEG + 1);
+    outer = T->bids + (size_t)4 * (SFB__TESS_MAX_SEG + 1);
+    inner = outer + (SFB__TESS_MAX_SEG + 1);
+    /* the four sides in natural order: v=0 and v=1 with u increasing, u=1 and u=0 with v
+     * increasing */
+    if (sub < 0) {
+        for (k = 0; k < 4; ++k) s[k] = T->eseg[l->fe[o + k]];
+        for (k = 0; k <= s[0]; ++k) b[0][k] = sfb__tess_epoint(T, f, 0, k);
+        for (k = 0; k <= s[1]; ++k) b[1][k] = sfb__tess_epoint(T, f, 1, k);
+        for (k = 0; k <= s[2]; ++k) b[2][k] = sfb__tess_epoint(T, f, 2, s[2] - k); /* slot 2 runs (1,1) -> (0,1) */
+        for (k = 0; k <= s[3]; ++k) b[3][k] = sfb__tess_epoint(T, f, 3, s[3] - k); /* slot 3 runs (0,1) -> (0,0) */
+    } else {
+        int n = sfb__tess_face_n(l, f), ip = (sub + n - 1) % n;
+        s[0] = T->eseg[l->fe[o + sub]] / 2;
+        s[1] = T->sseg[pf];
+        s[2] = T->sseg[T->pt->face_ptex[f] + ip];
+        s[3] = T->eseg[l->fe[o + ip]] / 2;
+        for (k = 0; k <= s[0]; ++k) b[0][k] = sfb__tess_epoint(T, f, sub, k);        /* v_i -> mid(v_i, v_i+1) */
+        for (k = 0; k <= s[1]; ++k) b[1][k] = sfb__tess_spoke(T, f, sub, k);         /* spoke i -> centroid */
+        for (k = 0; k <= s[2]; ++k) b[2][k] = sfb__tess_spoke(T, f, ip, k);          /* spoke i-1 -> centroid */
+        for (k = 0; k <= s[3]; ++k) b[3][k] = sfb__tess_epoint(T, f, ip, 2 * s[3] - k); /* v_i -> mid(v_i-1, v_i) */
+    }
+    regular = s[0] == r && s[1] == r && s[2] == r && s[3] == r;
+    R = regular ? r : (r < 2 ? 2 : r);
+    if (!emit) {
+        T->ifirst[pf] = sfb__tess_new(T, (R - 1) * (R - 1));
+        if (regular) T->ntri += (size_t)2 * (size_t)r * (size_t)r;
+        else T->ntri += (size_t)2 * (size_t)(R - 2) * (size_t)(R - 2) + (size_t)s[0] + (size_t)s[1] + (size_t)s[2] + (size_t)s[3] +
+                        (size_t)4 * (size_t)(R - 2);
+        return;
+    }
+    for (k = 0; k <= s[0]; ++k) sfb__tess_loc(T, b[0][k], pf, (double)k / s[0], 0.0);
+    for (k = 0; k <= s[1]; ++k) sfb__tess_loc(T, b[1][k], pf, 1.0, (double)k / s[1]);
+    for (k = 0; k <= s[2]; ++k) sfb__tess_loc(T, b[2][k], pf, (double)k / s[2], 1.0);
+    for (k = 0; k <= s[3]; ++k) sfb__tess_loc(T, b[3][k], pf, 0.0, (double)k / s[3]);
+    base = T->ifirst[pf];
+    for (j = 1; j < R; ++j)
+        for (i = 1; i < R; ++i) sfb__tess_loc(T, base + (j - 1) * (R - 1) + (i - 1), pf, (double)i / R, (double)j / R);
+#define SFB__INNER(i, j) (base + ((j) - 1) * (R - 1) + ((i) - 1))
+    if (regular) {
+        for (j = 0; j < r; ++j)
+            for (i = 0; i < r; ++i) {
+                int id[4], c;
+                for (c = 0; c < 4; ++c) {
+                    int x = i + (c == 1 || c == 2), y = j + (c >= 2);
+                    id[c] = y == 0 ? b[0][x] : x == r ? b[1][y] : y == r ? b[2][x] : x == 0 ? b[3][y] : SFB__INNER(x, y);
+                }
+                sfb__tess_tri(T, id[0], id[1], id[2], pf);
+                sfb__tess_tri(T, id[0], id[2], id[3], pf);
+            }
+        return;
+    }
+    for (j = 1; j < R - 1; ++j)
+        for (i = 1; i < R - 1; ++i) {
+            int a = SFB__INNER(i, j), bb = SFB__INNER(i + 1, j), c = SFB__INNER(i + 1, j + 1), d = SFB__INNER(i, j + 1);
+            sfb__tess_tri(T, a, bb, c, pf);
+            sfb__tess_tri(T, a, c, d, pf);
+        }
+    /* the ring, one side at a time, counter-clockwise: v=0, u=1, v=1 (reversed), u=0 (reversed) */
+    for (k = 0; k < 4; ++k) {
+        int q;
+        for (q = 0; q <= s[k]; ++q) outer[q] = (k < 2) ? b[k][q] : b[k][s[k] - q];
+        for (q = 0; q <= R - 2; ++q) {
+            int t = (k < 2) ? 1 + q : R - 1 - q; /* position along the side, inset by one cell */
+            inner[q] = k == 0 ? SFB__INNER(t, 1) : k == 1 ? SFB__INNER(R - 1, t) : k == 2 ? SFB__INNER(t, R - 1) : SFB__INNER(1, t);
+        }
+        sfb__tess_zipper(T, outer, s[k], inner, R - 2, R, pf);
+    }
+#undef SFB__INNER
+}
+
+static int sfb__tess_live(const sfb__tess *T, int pf) {
+    return !T->l->fhole[T->pt->ptex_face[pf]] && T->pt->ptex_root[pf] != -1;
+}
+
+/* Largest squared distance between the surface at the midpoints of the c x c grid's cell
+ * edges and diagonals (the (2c+1)^2 samples P) and the chords the triangles make there. */
+static double sfb__tess_chord_error(const float *P, int c) {
+    int g = 2 * c + 1, i, j, q;
+    double worst = 0.0;
+    for (j = 0; j <= c; ++j)
+        for (i = 0; i <= c; ++i) {
+            /* (mid, end a, end b) sample offsets from corner (2i, 2j): bottom edge, left edge, diagonal */
+            static const int chk[3][6] = { { 1, 0, 0, 0, 2, 0 }, { 0, 1, 0, 0, 0, 2 }, { 1, 1, 0, 0, 2, 2 } };
+            for (q = 0; q < 3; ++q) {
+                int x = 2 * i, y = 2 * j, cc;
+                const float *m, *a, *b;
+                double d2 = 0.0;
+                if ((q != 1 && i == c) || (q != 0 && j == c)) continue; /* past the far sides */
+                m = P + 3 * ((size_t)(y + chk[q][1]) * g + (size_t)(x + chk[q][0]));
+                a = P + 3 * ((size_t)(y + chk[q][3]) * g + (size_t)(x + chk[q][2]));
+                b = P + 3 * ((size_t)(y + chk[q][5]) * g + (size_t)(x + chk[q][4]));
+                for (cc = 0; cc < 3; ++cc) {
+                    double d = (double)m[cc] - 0.5 * ((double)a[cc] + (double)b[cc]);
+                    d2 += d * d;
+                }
+                if (!(d2 <= worst)) worst = d2; /* NaN propagates: such a face is refined */
+            }
+        }
+    return worst;
+}
+
+/* Adaptive rates: candidates 1, 2, 4, ... below `rate` are tested in rounds over a chunk of
+ * faces, many faces per sfb_surface_eval call; a face keeps the first candidate within
+ * tolerance, else `rate`. */
+static sfb_result sfb__tess_adaptive(sfb__tess *T, float tolerance, float p0, float p1) {
+    sfb_context *ctx = T->ctx;
+    int nptex = T->pt->nptex, maxc = 1, first, pf;
+    size_t need, cap;
+    sfb_location *loc = NULL;
+    float *pos = NULL;
+    int *list = NULL;
+    sfb_result r = SFB_SUCCESS;
+    double tol2 = (double)tolerance * (double)tolerance;
+    if (T->rate == 1) return SFB_SUCCESS;
+    while (maxc * 2 < T->rate) maxc *= 2;
+    need = (size_t)(2 * maxc + 1) * (size_t)(2 * maxc + 1);
+    cap = need > SFB__TESS_EVAL_CHUNK ? need : SFB__TESS_EVAL_CHUNK;
+    loc = (sfb_location *)sfb__tess_array(ctx, cap, sizeof *loc);
+    pos = (float *)sfb__tess_array(ctx, cap, 3 * sizeof(float));
+    list = (int *)sfb__tess_array(ctx, SFB__TESS_FACE_CHUNK, sizeof(int));
+    if (!loc || !pos || !list) { r = sfb__oom(ctx, "tessellation"); goto done; }
+    for (first = 0; first < nptex; first += SFB__TESS_FACE_CHUNK) {
+        int last = first + SFB__TESS_FACE_CHUNK < nptex ? first + SFB__TESS_FACE_CHUNK : nptex, n = 0, c;
+        r = sfb__progress(ctx, p0 + (p1 - p0) * (float)first / (float)nptex, "tessellate");
+        if (r != SFB_SUCCESS) goto done;
+        for (pf = first; pf < last; ++pf)
+            if (T->prate[pf] > 0) list[n++] = pf;
+        for (c = 1; c < T->rate && n > 0; c *= 2) {
+            int g = 2 * c + 1, a = 0, keep = 0, q;
+            size_t per = (size_t)g * (size_t)g;
+            while (a < n) {
+                int bnd = a, x, y;
+                size_t used = 0;
+                sfb_eval_output eo;
+                while (bnd < n && used + per <= cap) {
+                    for (y = 0; y < g; ++y)
+                        for (x = 0; x < g; ++x) {
+                            sfb_location *L = &loc[used++];
+                            L->face = list[bnd];
+                            L->u = (float)((double)x / (g - 1));
+                            L->v = (float)((double)y / (g - 1));
+                        }
+                    ++bnd;
+                }
+                memset(&eo, 0, sizeof eo);
+                eo.position = pos;
+                r = sfb_surface_eval(T->s, loc, (int)used, &eo);
+                if (r != SFB_SUCCESS) goto done;
+                for (q = a; q < bnd; ++q) {
+                    double err = sfb__tess_chord_error(pos + 3 * per * (size_t)(q - a), c);
+                    if (err <= tol2) T->prate[list[q]] = c;
+                    else list[keep++] = list[q];
+                }
+                a = bnd;
+            }
+            n = keep;
+        }
+    }
+done:
+    sfb__free(ctx, loc);
+    sfb__free(ctx, pos);
+    sfb__free(ctx, list);
+    return r;
+}
+
+SFB_API sfb_result sfb_surface_tessellate(const sfb_surface *s, const sfb_tess_config *cfg, sfb_tess_data *out) {
+    sfb_context *ctx;
+    sfb__tess T;
+    const sfb__level *l;
+    sfb_result r = SFB_SUCCESS;
+    int pf, f, e, i, k, nptex;
+    size_t v, done_v;
+    float p_emit, p_eval;
+    if (out) memset(out, 0, sizeof *out);
+    if (!s) return SFB_INVALID_ARGS;
+    ctx = s->ctx;
+    if (!cfg || !out) return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "sfb_surface_tessellate: NULL argument");
+    if (!s->has_patches || s->pbase.nf != s->base_face_count || !s->pbase.fe)
+        return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1,
+                          "sfb_surface_tessellate: the surface has no patch table (create it with SFB_REFINE_PATCHES)");
+    if (cfg->rate < 1 || cfg->rate > SFB__TESS_MAX_RATE)
+        return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "tessellation rate %d is outside 1..%d", cfg->rate,
+                          SFB__TESS_MAX_RATE);
+    if (!(cfg->tolerance >= 0.0f))
+        return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "tessellation tolerance %g must be >= 0 (0: uniform)",
+                          (double)cfg->tolerance);
+    if (cfg->flags & ~(unsigned)SFB_TESS_SPLIT_CREASES)
+        return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "unknown tessellation flags 0x%x", cfg->flags);
+    if ((r = sfb__progress(ctx, 0.0f, "tessellate")) != SFB_SUCCESS) return r;
+
+    memset(&T, 0, sizeof T);
+    T.ctx = ctx;
+    T.s = s;
+    T.l = l = &s->pbase;
+    T.pt = &s->patches;
+    T.rate = cfg->rate;
+    T.split = (cfg->flags & SFB_TESS_SPLIT_CREASES) != 0;
+    nptex = T.pt->nptex;
+    T.prate = (int *)sfb__tess_array(ctx, (size_t)nptex, sizeof(int));
+    T.sseg = (int *)sfb__tess_array(ctx, (size_t)nptex, sizeof(int));
+    T.vspoke = (int *)sfb__tess_array(ctx, (size_t)nptex, sizeof(int));
+    T.ifirst = (int *)sfb__tess_array(ctx, (size_t)nptex, sizeof(int));
+    T.eseg = (int *)sfb__tess_array(ctx, (size_t)l->ne, sizeof(int));
+    T.engon = (unsigned char *)sfb__tess_array(ctx, (size_t)l->ne, 1);
+    T.vedge = (int *)sfb__tess_array(ctx, (size_t)l->nfv, sizeof(int));
+    T.vcenter = (int *)sfb__tess_array(ctx, (size_t)l->nf, sizeof(int));
+    T.vcorner = (int *)sfb__tess_array(ctx, (size_t)(T.split ? l->nfv : l->nv), sizeof(int));
+    T.bids = (int *)sfb__tess_array(ctx, (size_t)6 * (SFB__TESS_MAX_SEG + 1), sizeof(int));
+    if (T.split) {
+        T.uf = (int *)sfb__tess_array(ctx, (size_t)l->nfv, sizeof(int));
+        T.ecopy = (int *)sfb__tess_array(ctx, (size_t)l->nfv, sizeof(int));
+    }
+    if (!T.prate || !T.sseg || !T.vspoke || !T.ifirst || !T.eseg || !T.engon || !T.vedge || !T.vcenter || !T.vcorner || !T.bids ||
+        (T.split && (!T.uf || !T.ecopy))) {
+        r = sfb__oom(ctx, "tessellation");
+        goto fail;
+    }
+    for (pf = 0; pf < nptex; ++pf) {
+        T.prate[pf] = sfb__tess_live(&T, pf) ? T.rate : 0;
+        T.vspoke[pf] = -1;
+        T.sseg[pf] = 0;
+    }
+    for (i = 0; i < l->nfv; ++i) T.vedge[i] = -1;
+    for (f = 0; f < l->nf; ++f) T.vcenter[f] = -1;
+    for (i = 0; i < (T.split ? l->nfv : l->nv); ++i) T.vcorner[i] = -1;
+
+    /* 1. a rate per param face */
+    p_emit = 0.0f;
+    if (cfg->tolerance > 0.0f) {
+        r = sfb__tess_adaptive(&T, cfg->tolerance, 0.0f, 0.5f);
+        if (r != SFB_SUCCESS) goto fail;
+        p_emit = 0.5f;
+    }
+    p_eval = p_emit + 0.1f;
+
+    /* 2. segments of each base edge and spoke: the largest rate of the faces on it (an n-gon
+     * sub-face covers half an edge, so it asks for twice its rate, and the count stays even) */
+    memset(T.eseg, 0, (size_t)l->ne * sizeof(int));
+    memset(T.engon, 0, (size_t)l->ne);
+    for (pf = 0; pf < nptex; ++pf) {
+        int rr = T.prate[pf], sub = T.pt->ptex_corner[pf], o, n;
+        if (rr <= 0) continue;
+        f = T.pt->ptex_face[pf];
+        o = l->fv_off[f];
+        n = sfb__tess_face_n(l, f);
+        if (sub < 0) {
+            for (k = 0; k < 4; ++k) {
+                e = l->fe[o + k];
+                if (T.eseg[e] < rr) T.eseg[e] = rr;
+            }
+        } else {
+            int ip = (sub + n - 1) % n, nx = T.pt->face_ptex[f] + (sub + 1) % n;
+            int e0 = l->fe[o + sub], e1 = l->fe[o + ip], other = T.prate[nx];
+            if (T.eseg[e0] < 2 * rr) T.eseg[e0] = 2 * rr;
+            if (T.eseg[e1] < 2 * rr) T.eseg[e1] = 2 * rr;
+            T.engon[e0] = T.engon[e1] = 1;
+            T.sseg[pf] = rr > other ? rr : other;
+        }
+    }
+    for (e = 0; e < l->ne; ++e)
+        if (T.engon[e] && (T.eseg[e] & 1)) T.eseg[e] += 1;
+
+    /* 3. sectors for split creases: corners of faces joined across every edge that is not
+     * split (holes join nothing) */
+    if (T.split) {
+        for (i = 0; i < l->nfv; ++i) T.uf[i] = i;
+        for (e = 0; e < l->ne; ++e) {
+            int a = l->ef_off[e], z = l->ef_off[e + 1], first0 = -1, first1 = -1, q;
+            for (q = a; q < z; ++q) T.ecopy[l->fv_off[l->ef[q]] + l->ef_slot[q]] = q;
+            if (sfb__tess_split_edge(&T, e)) continue;
+            for (q = a; q < z; ++q) {
+                int g = l->ef[q], o = l->fv_off[g], n = sfb__tess_face_n(l, g), sl = l->ef_slot[q];
+                int c0 = o + sl, c1 = o + (sl + 1) % n, t;
+                if (l->fhole[g]) continue;
+                if (l->fv[c0] != l->ev[2 * e]) { t = c0; c0 = c1; c1 = t; } /* c0 at ev[0], c1 at ev[1] */
+                if (first0 < 0) { first0 = c0; first1 = c1; }
+                else { sfb__tess_union(T.uf, first0, c0); sfb__tess_union(T.uf, first1, c1); }
+            }
+        }
+    }
+
+    /* 4. count pass: ids of every point, and the totals, checked before allocating */
+    for (pf = 0; pf < nptex; ++pf) {
+        sfb__tess_face(&T, pf, 0);
+        if (T.nvert > (size_t)SFB_MAX_ELEMENTS || T.ntri > (size_t)SFB_MAX_ELEMENTS) {
+            r = sfb__error(ctx, SFB_LIMIT_EXCEEDED, SFB_ELEMENT_NONE, -1,
+                           "tessellation at rate %d makes more than %d %s (SFB_MAX_ELEMENTS)", T.rate, SFB_MAX_ELEMENTS,
+                           T.nvert > (size_t)SFB_MAX_ELEMENTS ? "vertices" : "triangles");
+            goto fail;
+        }
+    }
+    out->ctx_ = ctx;
+    out->vertex_count = (int)T.nvert;
+    out->triangle_count = (int)T.ntri;
+    out->positions = (float *)sfb__tess_array(ctx, T.nvert, 3 * sizeof(float));
+    out->normals = (float *)sfb__tess_array(ctx, T.nvert, 3 * sizeof(float));
+    out->locations = (sfb_location *)sfb__tess_array(ctx, T.nvert, sizeof(sfb_location));
+    out->triangles = (int *)sfb__tess_array(ctx, T.ntri, 3 * sizeof(int));
+    out->triangle_faces = (int *)sfb__tess_array(ctx, T.ntri, sizeof(int));
+    if (!out->positions || !out->normals || !out->locations || !out->triangles || !out->triangle_faces) {
+        r = sfb__oom(ctx, "tessellation");
+        goto fail;
+    }
+    for (v = 0; v < T.nvert; ++v) {
+        out->locations[v].face = -1;
+        out->locations[v].u = out->locations[v].v = 0.0f;
+    }
+
+    /* 5. emit pass: locations and triangles */
+    T.loc = out->locations;
+    T.tri = out->triangles;
+    T.tface = out->triangle_faces;
+    for (pf = 0; pf < nptex; ++pf) {
+        if (pf % SFB__TESS_FACE_CHUNK == 0 && pf > 0) {
+            r = sfb__progress(ctx, p_emit + (p_eval - p_emit) * (float)pf / (float)nptex, "tessellate");
+            if (r != SFB_SUCCESS) goto fail;
+        }
+        sfb__tess_face(&T, pf, 1);
+    }
+    if (T.tri_at != T.ntri) {
+        r = sfb__error(ctx, SFB_BACKEND_ERROR, SFB_ELEMENT_NONE, -1, "tessellation wrote %zu triangles, counted %zu", T.tri_at, T.ntri);
+        goto fail;
+    }
+    for (v = 0; v < T.nvert; ++v)
+        if (out->locations[v].face < 0) {
+            r = sfb__error(ctx, SFB_BACKEND_ERROR, SFB_ELEMENT_NONE, -1, "tessellation vertex %zu has no location", v);
+            goto fail;
+        }
+    sfb__tess_free_work(&T);
+
+    /* 6. evaluate every vertex once, in chunks, on the context's backend */
+    for (done_v = 0; done_v < T.nvert; done_v += SFB__TESS_EVAL_CHUNK) {
+        size_t n = T.nvert - done_v < SFB__TESS_EVAL_CHUNK ? T.nvert - done_v : SFB__TESS_EVAL_CHUNK;
+        sfb_eval_output eo;
+        r = sfb__progress(ctx, p_eval + (1.0f - p_eval) * (float)done_v / (float)T.nvert, "tessellate");
+        if (r != SFB_SUCCESS) goto fail;
+        memset(&eo, 0, sizeof eo);
+        eo.position = out->positions + 3 * done_v;
+        eo.normal = out->normals + 3 * done_v;
+        r = sfb_surface_eval(s, out->locations + done_v, (int)n, &eo);
+        if (r != SFB_SUCCESS) goto fail;
+    }
+    r = sfb__progress(ctx, 1.0f, "tessellate");
+    if (r == SFB_SUCCESS) return SFB_SUCCESS;
+fail:
+    sfb__tess_free_work(&T);
+    out->ctx_ = ctx;
+    sfb_tess_data_free(out);
+    return r;
+}

@@ -1,0 +1,260 @@
+// Patch evaluation (exact limit surface of Catmull-Clark): one invocation per location.
+// The CPU has already found each location's patch and its (s,t) in it (sfb__patch_locate, a
+// quadtree walk), so this kernel only evaluates. It is the ref kernel (src/patches.c:
+// sfb__eval_bspline16, sfb__eval_stam, sfb__eval_endcap, sfb__ref_eval_one) in float.
+//
+// Buffers (one piece of the uploaded table; indices are piece-local):
+//   patches[p]  = (type, first cv, EV corner, eigen block offset (Stam) or cv count (end cap))
+//                 type 0: bicubic B-spline (16 cvs, row-major 4x4, row = v)
+//                 type 1: Stam (K = 2N+8 eigen coefficients; (s,t) arrive already turned into
+//                         the EV's frame (u,v) by the CPU, in double, so that the EV is at (0,0)
+//                         exactly and small distances to it keep their precision)
+//                 type 2: bilinear end cap: 4 corner limit positions, then (12 cvs) the two
+//                         limit tangents of each corner, whose normals are blended
+//   cvs[]       = rows of points[]
+//   points[]    = (x, y, z, 0) per point: one load each
+//   eig[o...]   = (K, dominant index, subdominant eigenvalue sub, 0), then per eigenvalue i
+//                 (lambda, lambda/sub (0 for the dominant), 1 where |lambda| = sub else 0, 0),
+//                 then phi: for sub-patch k = 1..3 and eigenvalue i, 4 vec4s, row b of the
+//                 4x4 B-spline coefficients (a = 0..3 in x..w), i.e. Phi_k[a + 4b][i]
+//   queries[q]  = (patch, s, t, 2^depth)
+//   results[]   = u_stride floats per query: output `o` (position, du, dv, normal, duu, duv, dvv)
+//                 at 3 * u_slot[o] when u_slot[o] >= 0
+// The backend prepends "#version 430 core" (desktop) or "#version 310 es" + precision
+// (GLES 3.1); the tests validate both with glslangValidator.
+
+layout(local_size_x = 64) in;
+
+struct SfbQuery { int patch_index; float s; float t; float scale; };
+
+layout(std430, binding = 0) readonly buffer SfbPatches { ivec4 patches[]; };
+layout(std430, binding = 1) readonly buffer SfbCvs { int cvs[]; };
+layout(std430, binding = 2) readonly buffer SfbPoints { vec4 points[]; };
+layout(std430, binding = 3) readonly buffer SfbEigen { vec4 eig[]; };
+layout(std430, binding = 4) readonly buffer SfbQueries { SfbQuery queries[]; };
+layout(std430, binding = 5) writeonly buffer SfbResults { float results[]; };
+
+uniform int u_first;     // first query of this dispatch
+uniform int u_last;      // one past the last query
+uniform int u_stride;    // floats per query in results[]
+uniform int u_slot[7];   // slot of position, du, dv, normal, duu, duv, dvv, or -1
+uniform int u_second;    // nonzero: second derivatives are asked for
+
+vec3 sfb_point(int row) { return points[row].xyz; }
+
+// x^e for 0 <= e < 256 by squaring: exact sign for negative eigenvalues (pow() is undefined
+// for x < 0 in GLSL) and a harmless underflow to 0 for large e. A fixed trip count keeps the
+// invocations of a SIMD group in step. (e <= 150: u >= 2^-149, the smallest float.)
+float sfb_ipow(float x, int e) {
+    float r = 1.0;
+    for (int b = 0; b < 8; ++b) {
+        if (((e >> b) & 1) != 0) r *= x;
+        x *= x;
+    }
+    return r;
+}
+
+// Uniform cubic B-spline basis, first and second derivatives.
+void sfb_basis(float t, out vec4 b, out vec4 d, out vec4 dd) {
+    float t2 = t * t, t3 = t2 * t, s = 1.0 - t;
+    b = vec4(s * s * s, 3.0 * t3 - 6.0 * t2 + 4.0, -3.0 * t3 + 3.0 * t2 + 3.0 * t + 1.0, t3) / 6.0;
+    d = vec4(-0.5 * s * s, 1.5 * t2 - 2.0 * t, -1.5 * t2 + t + 0.5, 0.5 * t2);
+    dd = vec4(s, 3.0 * t - 2.0, -3.0 * t + 1.0, t);
+}
+
+// res: P, Ps, Pt, Pss, Pst, Ptt; tg: the tangent pair whose cross product is the normal
+// direction (Ps, Pt, or Stam's derivatives normalised by sub^(n-1) 2^n, finite at the EV).
+// The points are taken relative to an inner one: the derivative weights sum to zero, so this
+// changes nothing exactly, but in float it keeps the terms at the size of the patch rather
+// than of the coordinates (a deep patch far from the origin would lose its tangents).
+void sfb_bspline(int first, float s, float t, out vec3 res[6], out vec3 tg[2]) {
+    vec4 bu, du, ddu, bv, dv, ddv;
+    sfb_basis(s, bu, du, ddu);
+    sfb_basis(t, bv, dv, ddv);
+    vec3 o = sfb_point(cvs[first + 5]);
+    for (int q = 0; q < 6; ++q) res[q] = vec3(0.0);
+    for (int j = 0; j < 4; ++j) {
+        vec3 r0 = vec3(0.0), r1 = vec3(0.0), r2 = vec3(0.0);
+        for (int i = 0; i < 4; ++i) {
+            vec3 p = sfb_point(cvs[first + 4 * j + i]) - o;
+            r0 += bu[i] * p;
+            r1 += du[i] * p;
+            r2 += ddu[i] * p;
+        }
+        res[0] += bv[j] * r0;
+        res[1] += bv[j] * r1;
+        res[2] += dv[j] * r0;
+        res[3] += bv[j] * r2;
+        res[4] += dv[j] * r1;
+        res[5] += ddv[j] * r0;
+    }
+    res[0] += o;  // the position weights sum to one
+    tg[0] = res[1];
+    tg[1] = res[2];
+}
+
+void sfb_endcap(int first, float s, float t, out vec3 res[6], out vec3 tg[2]) {
+    vec3 p0 = sfb_point(cvs[first]), p1 = sfb_point(cvs[first + 1]);
+    vec3 p2 = sfb_point(cvs[first + 2]), p3 = sfb_point(cvs[first + 3]);
+    // relative to p0 (the weights sum to one): float error at the size of the cap
+    res[0] = p0 + (s * (1.0 - t)) * (p1 - p0) + (s * t) * (p2 - p0) + ((1.0 - s) * t) * (p3 - p0);
+    res[1] = (1.0 - t) * (p1 - p0) + t * (p2 - p3);
+    res[2] = (1.0 - s) * (p3 - p0) + s * (p2 - p1);
+    res[3] = vec3(0.0);
+    res[4] = p0 - p1 + p2 - p3;
+    res[5] = vec3(0.0);
+    tg[0] = res[1];
+    tg[1] = res[2];
+}
+
+// Stam: (u,v) in the EV's frame (EV at (0,0)); corner says how that frame sits in the patch's
+// (s,t), for the chain rule. Level n and sub-patch k as in ref; the derivatives are summed with
+// (lambda_i / sub)^(n-1) <= 1 and scaled afterwards, so nothing overflows on the way.
+void sfb_stam(int first, int corner, int o, float u, float v, bool second, out vec3 res[6], out vec3 tg[2]) {
+    vec4 head = eig[o];
+    int K = int(head.x), dom = int(head.y);
+    float sub = head.z;
+    // J[a][b] = d(u,v)_a / d(s,t)_b
+    vec2 j0, j1; // rows: du/d(s,t), dv/d(s,t)
+    if (corner == 1) { j0 = vec2(0.0, 1.0); j1 = vec2(-1.0, 0.0); }
+    else if (corner == 2) { j0 = vec2(-1.0, 0.0); j1 = vec2(0.0, -1.0); }
+    else if (corner == 3) { j0 = vec2(0.0, -1.0); j1 = vec2(1.0, 0.0); }
+    else { j0 = vec2(1.0, 0.0); j1 = vec2(0.0, 1.0); }
+    bool at_ev = (u == 0.0 && v == 0.0);
+    int n = 1, k;
+    float uu, vv;
+    if (at_ev) {
+        // the limit point; tangents: the n -> infinity limit of the normalised derivatives
+        k = 2; uu = 0.0; vv = 0.0;
+    } else {
+        while (u < 0.5 && v < 0.5) { u *= 2.0; v *= 2.0; ++n; }
+        if (v < 0.5) { k = 1; uu = 2.0 * u - 1.0; vv = 2.0 * v; }
+        else if (u < 0.5) { k = 3; uu = 2.0 * u; vv = 2.0 * v - 1.0; }
+        else { k = 2; uu = 2.0 * u - 1.0; vv = 2.0 * v - 1.0; }
+    }
+    vec4 bu, du, ddu, bv, dv, ddv;
+    sfb_basis(uu, bu, du, ddu);
+    sfb_basis(vv, bv, dv, ddv);
+    int phi = o + 1 + K + 4 * K * (k - 1);
+    vec3 P = vec3(0.0), Pu = vec3(0.0), Pv = vec3(0.0), Puu = vec3(0.0), Puv = vec3(0.0), Pvv = vec3(0.0);
+    for (int i = 0; i < K; ++i) {
+        // (b(u)^T Phi_k)_i for each derivative: the rows of Phi_k first combined along v
+        vec4 r0 = eig[phi + 4 * i], r1 = eig[phi + 4 * i + 1], r2 = eig[phi + 4 * i + 2], r3 = eig[phi + 4 * i + 3];
+        vec4 A = bv.x * r0 + bv.y * r1 + bv.z * r2 + bv.w * r3;
+        vec4 D = dv.x * r0 + dv.y * r1 + dv.z * r2 + dv.w * r3;
+        float f0 = dot(bu, A), f1 = dot(du, A), f2 = dot(bu, D);
+        vec4 e = eig[o + 1 + i];
+        float lp, ln;
+        if (at_ev) {
+            lp = i == dom ? 1.0 : 0.0;
+            ln = e.z;
+        } else {
+            lp = sfb_ipow(e.x, n - 1);
+            ln = i == dom ? 0.0 : sfb_ipow(e.y, n - 1);
+        }
+        vec3 p = sfb_point(cvs[first + i]);
+        P += (lp * f0) * p;
+        Pu += (ln * f1) * p;
+        Pv += (ln * f2) * p;
+        if (second) {
+            vec4 DD = ddv.x * r0 + ddv.y * r1 + ddv.z * r2 + ddv.w * r3;
+            Puu += (ln * dot(ddu, A)) * p;
+            Puv += (ln * dot(du, D)) * p;
+            Pvv += (ln * dot(bu, DD)) * p;
+        }
+    }
+    // sub^(n-1) 2^n and sub^(n-1) 4^n, formed so that neither factor overflows alone
+    float sc1 = at_ev ? 1.0 : 2.0 * sfb_ipow(2.0 * sub, n - 1);
+    float sc2 = at_ev ? 0.0 : 4.0 * sfb_ipow(4.0 * sub, n - 1);
+    res[0] = P;
+    tg[0] = Pu * j0.x + Pv * j1.x;
+    tg[1] = Pu * j0.y + Pv * j1.y;
+    res[1] = tg[0] * sc1;
+    res[2] = tg[1] * sc1;
+    res[3] = sc2 * (Puu * (j0.x * j0.x) + Puv * (2.0 * j0.x * j1.x) + Pvv * (j1.x * j1.x));
+    res[4] = sc2 * (Puu * (j0.x * j0.y) + Puv * (j0.x * j1.y + j0.y * j1.x) + Pvv * (j1.x * j1.y));
+    res[5] = sc2 * (Puu * (j0.y * j0.y) + Puv * (2.0 * j0.y * j1.y) + Pvv * (j1.y * j1.y));
+}
+
+void sfb_eval(ivec4 rec, float s, float t, bool second, out vec3 res[6], out vec3 tg[2]) {
+    if (rec.x == 1) sfb_stam(rec.y, rec.z, rec.w, s, t, second, res, tg);
+    else if (rec.x == 2) sfb_endcap(rec.y, s, t, res, tg);
+    else sfb_bspline(rec.y, s, t, res, tg);
+}
+
+// A positive multiple of a x b, computed on the vectors scaled to a largest component of 1 so
+// that tiny or huge tangents neither underflow nor overflow in float. Zero when either is (as
+// ref, only an exactly vanishing normal sends the caller to a nearby point: a threshold would
+// also discard nearly degenerate tangents whose direction float still resolves).
+vec3 sfb_normal_dir(vec3 a, vec3 b) {
+    float ma = max(max(abs(a.x), abs(a.y)), abs(a.z)), mb = max(max(abs(b.x), abs(b.y)), abs(b.z));
+    if (!(ma > 0.0) || !(mb > 0.0) || isinf(ma) || isinf(mb)) return vec3(0.0);
+    return cross(a / ma, b / mb);
+}
+
+bool sfb_usable(vec3 n) {
+    float l = length(n);
+    return l > 0.0 && !isinf(l) && !isnan(l);
+}
+
+// End-cap normal as sfb__endcap_normal: the bilinear blend of the corners' limit normals, each
+// turned to the side of the cap's own (chord) normal at that corner, and replaced by the chord
+// normal where it is more than 45 degrees away (the corner's limit normal is another sector's).
+vec3 sfb_endcap_normal(int first, float s, float t) {
+    float w[4] = float[4]((1.0 - s) * (1.0 - t), s * (1.0 - t), s * t, (1.0 - s) * t);
+    vec3 n = vec3(0.0);
+    for (int k = 0; k < 4; ++k) {
+        vec3 p = sfb_point(cvs[first + k]);
+        vec3 pn = sfb_point(cvs[first + (k + 1) % 4]), pp = sfb_point(cvs[first + (k + 3) % 4]);
+        vec3 ch = sfb_normal_dir(pn - p, pp - p);
+        vec3 ln = sfb_normal_dir(sfb_point(cvs[first + 4 + 2 * k]), sfb_point(cvs[first + 5 + 2 * k]));
+        bool has = sfb_usable(ln);
+        ch = sfb_usable(ch) ? normalize(ch) : vec3(0.0);
+        ln = has ? normalize(ln) : vec3(0.0);
+        float d = dot(ln, ch);
+        if (d < 0.0) { ln = -ln; d = -d; }
+        if (!has || d < 0.70710678118654752) ln = ch;
+        n += w[k] * ln;
+    }
+    return n;
+}
+
+void sfb_store(int base, int slot, vec3 x) {
+    if (slot < 0) return;
+    int d = base + 3 * slot;
+    results[d] = x.x;
+    results[d + 1] = x.y;
+    results[d + 2] = x.z;
+}
+
+void main() {
+    int q = int(gl_GlobalInvocationID.x) + u_first;
+    if (q >= u_last) return;
+    SfbQuery qu = queries[q];
+    ivec4 rec = patches[qu.patch_index];
+    bool second = u_second != 0;
+    vec3 res[6], tg[2];
+    sfb_eval(rec, qu.s, qu.t, second, res, tg);
+    vec3 nrm = vec3(0.0);
+    if (u_slot[3] >= 0) {
+        nrm = rec.x == 2 && rec.w == 12 ? sfb_endcap_normal(rec.y, qu.s, qu.t) : sfb_normal_dir(tg[0], tg[1]);
+        if (!sfb_usable(nrm)) {
+            // degenerate tangents (a collapsed control net): the normal a step inside the patch,
+            // from the tangents there (end caps too, as ref)
+            vec3 r2[6], t2[2];
+            float s2 = qu.s + (qu.s < 0.5 ? 1e-3 : -1e-3), tt2 = qu.t + (qu.t < 0.5 ? 1e-3 : -1e-3);
+            sfb_eval(rec, s2, tt2, false, r2, t2);
+            nrm = sfb_normal_dir(t2[0], t2[1]);
+        }
+        nrm = sfb_usable(nrm) ? normalize(nrm) : vec3(0.0);
+    }
+    float sc = qu.scale, sc2 = sc * sc;
+    int base = q * u_stride;
+    sfb_store(base, u_slot[0], res[0]);
+    sfb_store(base, u_slot[1], res[1] * sc);
+    sfb_store(base, u_slot[2], res[2] * sc);
+    sfb_store(base, u_slot[3], nrm);
+    sfb_store(base, u_slot[4], res[3] * sc2);
+    sfb_store(base, u_slot[5], res[4] * sc2);
+    sfb_store(base, u_slot[6], res[5] * sc2);
+}
