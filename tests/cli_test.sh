@@ -21,6 +21,8 @@ contains() { # description, file, pattern
 check "no arguments is a usage error" 2 "$CLI"
 check "--help succeeds" 0 "$CLI" --help
 contains "--help shows refine" "$TMP/out" "refine"
+contains "--help shows tess" "$TMP/out" "surfblend tess"
+contains "--help shows eval" "$TMP/out" "surfblend eval"
 check "unknown command is a usage error" 2 "$CLI" frobnicate
 check "refine without -o is a usage error" 2 "$CLI" refine examples/data/creased_box.obj
 check "bad --level is a usage error" 2 "$CLI" refine --level x examples/data/creased_box.obj -o "$TMP/o.obj"
@@ -62,6 +64,83 @@ for b in simd gl osmesa; do
 done
 check "SURFBLEND_BACKEND=bogus falls back" 0 env SURFBLEND_BACKEND=bogus "$CLI" refine --level 1 examples/data/creased_box.obj -o "$TMP/o.obj"
 contains "SURFBLEND_BACKEND=bogus is reported" "$TMP/err" "bogus: unavailable (unknown backend name"
+
+# ---- tess and eval (limit surface through the patch table) ----
+# "boundary non-manifold duplicated-directed" edge counts of the triangles of an OBJ's f lines
+edge_stats() { awk '/^f /{ for (i = 2; i <= 4; ++i) { split($i, a, "/"); v[i - 1] = a[1] }
+    for (i = 1; i <= 3; ++i) { p = v[i]; q = v[i % 3 + 1]; if (d[p " " q]++) dup++; k = (p + 0 < q + 0) ? p " " q : q " " p; u[k]++ } }
+  END { b = 0; m = 0; for (k in u) { if (u[k] == 1) b++; else if (u[k] > 2) m++ } printf "%d %d %d\n", b, m, dup + 0 }' "$1"; }
+printf 'v -1 -1 1\nv 1 -1 1\nv -1 1 1\nv 1 1 1\nv -1 1 -1\nv 1 1 -1\nv -1 -1 -1\nv 1 -1 -1\nf 1 2 4 3\nf 3 4 6 5\nf 5 6 8 7\nf 7 8 2 1\nf 2 8 6 4\nf 7 1 3 5\n' > "$TMP/cube.obj"
+printf 'v 1 0 -1\nv 0.309017 0.951057 -1\nv -0.809017 0.587785 -1\nv -0.809017 -0.587785 -1\nv 0.309017 -0.951057 -1\nv 1 0 1\nv 0.309017 0.951057 1\nv -0.809017 0.587785 1\nv -0.809017 -0.587785 1\nv 0.309017 -0.951057 1\nf 6 7 8 9 10\nf 5 4 3 2 1\nf 1 2 7 6\nf 2 3 8 7\nf 3 4 9 8\nf 4 5 10 9\nf 5 1 6 10\n' > "$TMP/prism.obj"
+for r in 1 2 5; do
+  check "tess cube rate $r succeeds" 0 "$CLI" tess --rate $r "$TMP/cube.obj" -o "$TMP/t.obj"
+  st=$(edge_stats "$TMP/t.obj")
+  if [ "$st" = "0 0 0" ]; then P=$((P + 1)); echo "ok tess cube rate $r is closed"; else F=$((F + 1)); echo "FAIL tess cube rate $r is not closed: $st"; fi
+  # V = nv + ne (r-1) + nf (r-1)^2 on a quad mesh
+  got=$(grep -c '^v ' "$TMP/t.obj"); want=$((8 + 12 * (r - 1) + 6 * (r - 1) * (r - 1)))
+  if [ "$got" = "$want" ]; then P=$((P + 1)); echo "ok tess cube rate $r has $want vertices"; else F=$((F + 1)); echo "FAIL tess cube rate $r: $got vertices, wanted $want"; fi
+done
+contains "tess prints a summary with edge counts" "$TMP/err" "closed, 0 boundary"
+contains "tess writes normals" "$TMP/t.obj" "^vn "
+contains "tess writes v//vn faces" "$TMP/t.obj" "^f [0-9]*//[0-9]* "
+for shape in "$TMP/prism.obj" examples/data/creased_box.obj; do
+  check "tess $(basename "$shape") succeeds" 0 "$CLI" tess --rate 3 "$shape" -o "$TMP/t.obj"
+  st=$(edge_stats "$TMP/t.obj")
+  if [ "$st" = "0 0 0" ]; then P=$((P + 1)); echo "ok tess $(basename "$shape") is closed"; else F=$((F + 1)); echo "FAIL tess $(basename "$shape") is not closed: $st"; fi
+  check "adaptive tess $(basename "$shape") succeeds" 0 "$CLI" tess --rate 16 --tolerance 0.01 "$shape" -o "$TMP/t.obj"
+  st=$(edge_stats "$TMP/t.obj")
+  if [ "$st" = "0 0 0" ]; then P=$((P + 1)); echo "ok adaptive tess $(basename "$shape") is closed"; else F=$((F + 1)); echo "FAIL adaptive tess $(basename "$shape") is not closed: $st"; fi
+done
+# creased_box has one infinitely sharp edge: split, it opens into 2 x rate boundary edges
+check "tess --split-creases succeeds" 0 "$CLI" tess --rate 3 --split-creases examples/data/creased_box.obj -o "$TMP/t.obj"
+st=$(edge_stats "$TMP/t.obj")
+if [ "$st" = "6 0 0" ]; then P=$((P + 1)); echo "ok split creases open only the sharp edge"; else F=$((F + 1)); echo "FAIL split creases: edge stats $st, wanted 6 0 0"; fi
+check "tess --rate 0 is bad input" 1 "$CLI" tess --rate 0 "$TMP/cube.obj" -o "$TMP/t.obj"
+contains "rate message names the range" "$TMP/err" "rate 0 is outside 1..1024"
+check "tess --rate 1025 is bad input" 1 "$CLI" tess --rate 1025 "$TMP/cube.obj" -o "$TMP/t.obj"
+check "tess negative tolerance is bad input" 1 "$CLI" tess --rate 4 --tolerance -1 "$TMP/cube.obj" -o "$TMP/t.obj"
+check "tess without --rate is a usage error" 2 "$CLI" tess "$TMP/cube.obj" -o "$TMP/t.obj"
+check "tess without -o is a usage error" 2 "$CLI" tess --rate 2 "$TMP/cube.obj"
+check "tess --rate x is a usage error" 2 "$CLI" tess --rate x "$TMP/cube.obj" -o "$TMP/t.obj"
+
+check "eval --random succeeds" 0 "$CLI" eval --random 25 --seed 3 examples/data/creased_box.obj
+n=$(wc -l < "$TMP/out")
+if [ "$n" = 25 ]; then P=$((P + 1)); echo "ok eval --random 25 prints 25 lines"; else F=$((F + 1)); echo "FAIL eval --random 25 printed $n lines"; fi
+if awk 'NF != 9 { exit 1 }' "$TMP/out"; then P=$((P + 1)); echo "ok eval lines have 9 fields"; else F=$((F + 1)); echo "FAIL eval lines do not have 9 fields"; fi
+cp "$TMP/out" "$TMP/r1"
+check "eval --random -o succeeds" 0 "$CLI" eval --random 25 --seed 3 -o "$TMP/r2" examples/data/creased_box.obj
+if cmp -s "$TMP/r1" "$TMP/r2"; then P=$((P + 1)); echo "ok eval --random is deterministic for a seed"; else F=$((F + 1)); echo "FAIL eval --random differs for the same seed"; fi
+"$CLI" eval --random 25 --seed 4 examples/data/creased_box.obj > "$TMP/r3" 2>/dev/null
+if ! cmp -s "$TMP/r1" "$TMP/r3"; then P=$((P + 1)); echo "ok eval --random depends on the seed"; else F=$((F + 1)); echo "FAIL eval --random ignores the seed"; fi
+printf 'v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 2 0 0\nv 2 1 0\nf 1 2 3 4\nf 2 5 6 3\nt hole 1/0/0 1\n' > "$TMP/holed.obj"
+check "eval --random skips holes" 0 "$CLI" eval --random 40 "$TMP/holed.obj"
+if awk '$1 != 0 { exit 1 }' "$TMP/out"; then P=$((P + 1)); echo "ok eval --random uses only the face that is not a hole"; else F=$((F + 1)); echo "FAIL eval --random sampled a hole"; fi
+printf '# face u v\n0 0 0\n\n3 0.5 0.25  # a comment\n' > "$TMP/locs.txt"
+check "eval --locations --derivatives succeeds" 0 "$CLI" eval --locations "$TMP/locs.txt" --derivatives "$TMP/cube.obj"
+if [ "$(wc -l < "$TMP/out")" = 2 ] && awk 'NF != 15 { exit 1 }' "$TMP/out"; then P=$((P + 1)); echo "ok eval --derivatives prints 15 fields per location"
+else F=$((F + 1)); echo "FAIL eval --derivatives output"; head -n 3 "$TMP/out"; fi
+printf '0 0.5 0.5\n1 0.5\n' > "$TMP/badlocs.txt"
+check "eval with a malformed location line is bad input" 1 "$CLI" eval --locations "$TMP/badlocs.txt" "$TMP/cube.obj"
+contains "malformed location message names the line" "$TMP/err" "line 2"
+printf '0 0.5 0.5\n# fine\n99 0.5 0.5\n' > "$TMP/badlocs.txt"
+check "eval with a face out of range is bad input" 1 "$CLI" eval --locations "$TMP/badlocs.txt" "$TMP/cube.obj"
+contains "out-of-range message names the line" "$TMP/err" "line 3"
+contains "out-of-range message names the query" "$TMP/err" "location 1: parametric face 99 is out of range"
+printf '0 1.5 0.5\n' > "$TMP/badlocs.txt"
+check "eval with u outside [0,1] is bad input" 1 "$CLI" eval --locations "$TMP/badlocs.txt" "$TMP/cube.obj"
+contains "u outside [0,1] is reported" "$TMP/err" "outside \[0,1\]"
+check "eval without locations is a usage error" 2 "$CLI" eval "$TMP/cube.obj"
+check "eval with a missing location file is bad input" 1 "$CLI" eval --locations "$TMP/none.txt" "$TMP/cube.obj"
+"$CLI" backends > "$TMP/backends" 2>/dev/null
+"$CLI" tess --backend ref --rate 6 --split-creases examples/data/creased_box.obj -o "$TMP/tref.obj" 2>/dev/null
+for b in simd gl osmesa; do
+  if grep -q "^$b *available" "$TMP/backends"; then
+    check "tess --backend $b works" 0 "$CLI" tess --backend $b --rate 6 --split-creases examples/data/creased_box.obj -o "$TMP/t$b.obj"
+    d=$(objdiff "$TMP/tref.obj" "$TMP/t$b.obj")
+    if [ "$d" != count ] && awk -v d="$d" 'BEGIN { exit !(d < 3.5e-5) }'; then P=$((P + 1)); echo "ok tess on $b agrees with ref ($d)"
+    else F=$((F + 1)); echo "FAIL tess on $b differs from ref: $d"; fi
+  fi
+done
 
 # a machine without libOSMesa (as on Mesa 25.1+): hide it in a private mount namespace (root only)
 lib=$(ldconfig -p 2>/dev/null | awk '/libOSMesa\.so\.8 /{ print $NF; exit }')
