@@ -25,6 +25,26 @@
  * OpenSubdiv's CpuEvaluator and to ref measured in the same run, and the difference from ref
  * (OpenSubdiv's points matched as point sets). A backend that cannot run here prints
  * "unavailable: why".
+ *
+ * Then limit evaluation (SFB_REFINE_PATCHES) on a variant of the torus with extraordinary
+ * vertices (quads split into triangles: valence 5; quad pairs merged into hexagons: valence 3;
+ * some on the semi-sharp and the infinitely sharp ring; same creases and corner):
+ *   patch build  surfblend  sfb_mesh_create + sfb_surface_create(level 0, SFB_REFINE_PATCHES),
+ *                           and memory from sfb_surface_patch_info
+ *                OpenSubdiv TopologyRefinerFactory::Create + RefineAdaptive (the isolation of
+ *                           PatchTableFactory::Options, 10) + PatchTableFactory::Create (default
+ *                           options: Gregory basis end caps); then with PatchMap, the stencil
+ *                           table of all levels + AppendLocalPointStencilTable and EvalStencils
+ *                           (what evaluation needs), and memory (patch indices and params,
+ *                           stencils, points); also with useInfSharpPatch (not the default)
+ *   limit eval   1M random (parametric face, u, v), fixed seed, position + du + dv:
+ *                surfblend  sfb_surface_eval (locating included) on ref, simd 1 thread and all
+ *                           threads, gl (own EGL context), osmesa; a backend without an
+ *                           eval_patches kernel (the library then runs ref's) is "skipped"
+ *                OpenSubdiv Far::PatchMap::FindPatch + Osd::CpuEvaluator::EvalPatches, and
+ *                           EvalPatches alone; the same with Osd::OmpEvaluator
+ *   tessellate   sfb_surface_tessellate at rate 8 on ref and simd (triangles per second)
+ * Best of 3 runs after one warm-up (builds: median of 3). `bench --limit` runs this part alone.
  */
 #include "surfblend.h"
 
@@ -33,12 +53,18 @@
 #include <EGL/eglext.h>
 #include <GL/gl.h>
 
+#include <opensubdiv/far/patchMap.h>
+#include <opensubdiv/far/patchTable.h>
+#include <opensubdiv/far/patchTableFactory.h>
+#include <opensubdiv/far/ptexIndices.h>
 #include <opensubdiv/far/stencilTable.h>
 #include <opensubdiv/far/stencilTableFactory.h>
 #include <opensubdiv/far/topologyDescriptor.h>
 #include <opensubdiv/far/topologyRefinerFactory.h>
 #include <opensubdiv/osd/bufferDescriptor.h>
 #include <opensubdiv/osd/cpuEvaluator.h>
+#include <opensubdiv/osd/cpuPatchTable.h>
+#include <opensubdiv/osd/cpuVertexBuffer.h>
 #include <opensubdiv/osd/glComputeEvaluator.h>
 #include <opensubdiv/osd/glVertexBuffer.h>
 #include <opensubdiv/osd/ompEvaluator.h>
@@ -93,7 +119,8 @@ struct TorusMesh {
 
     int vid(int i, int j) const { return ((i + nu) % nu) * nv + ((j + nv) % nv); }
 
-    TorusMesh(int nu_, int nv_) : nu(nu_), nv(nv_) {
+    /* extraordinary = true: the variant for limit evaluation (see make_extraordinary) */
+    TorusMesh(int nu_, int nv_, bool extraordinary = false) : nu(nu_), nv(nv_) {
         const double R = 3.0, r = 1.0, two_pi = 6.283185307179586;
         for (int i = 0; i < nu; ++i)
             for (int j = 0; j < nv; ++j) {
@@ -121,6 +148,43 @@ struct TorusMesh {
         add_meridian(nu / 2, 2.5f);
         corner_vertices.push_back(vid(nu / 4, nv / 2));
         corner_sharpness.push_back(2.0f);
+        if (extraordinary) make_extraordinary();
+    }
+    /* Extraordinary vertices on the same creased torus (meant for nu = 100, nv = 60):
+     * - quads (i,j) with i % 8 == 3 and j % 5 == 2, and j = 19 and 39 (touching the semi-sharp
+     *   ring j = 20 and the infinitely sharp ring j = 40), split by a diagonal into two
+     *   triangles: both ends of the diagonal get valence 5 (on the rings: crease vertices with
+     *   an extraordinary sector);
+     * - quad pairs (i,j), (i,j+1) with i % 8 == 7 and j % 6 == 4 merged into a hexagon (the
+     *   shared edge, never a crease, removed): its two ends get valence 3.
+     * Creases and the corner are kept (no creased edge is removed). */
+    void make_extraordinary() {
+        std::vector<int> sizes, fv;
+        for (int i = 0; i < nu; ++i)
+            for (int j = 0; j < nv; ++j) {
+                int a = vid(i, j), b = vid(i + 1, j), c = vid(i + 1, j + 1), d = vid(i, j + 1);
+                bool split = i % 8 == 3 && (j % 5 == 2 || j == 19 || j == 39);
+                bool merge_first = i % 8 == 7 && j % 6 == 4 && j + 1 < nv, merge_second = i % 8 == 7 && j % 6 == 5;
+                if (split && (i + j) % 2 == 0) {
+                    int t[6] = {a, b, c, a, c, d};
+                    sizes.push_back(3); sizes.push_back(3);
+                    fv.insert(fv.end(), t, t + 6);
+                } else if (split) {
+                    int t[6] = {a, b, d, b, c, d};
+                    sizes.push_back(3); sizes.push_back(3);
+                    fv.insert(fv.end(), t, t + 6);
+                } else if (merge_first) {
+                    int h[6] = {a, b, c, vid(i + 1, j + 2), vid(i, j + 2), d};
+                    sizes.push_back(6);
+                    fv.insert(fv.end(), h, h + 6);
+                } else if (!merge_second) {
+                    int q[4] = {a, b, c, d};
+                    sizes.push_back(4);
+                    fv.insert(fv.end(), q, q + 4);
+                }
+            }
+        face_sizes.swap(sizes);
+        face_vertices.swap(fv);
     }
     void add_ring(int j, float s) {
         for (int i = 0; i < nu; ++i) {
@@ -346,8 +410,10 @@ struct HostGL {
     }
 };
 
-static sfb_context *eval_context(sfb_backend_kind kind, int threads, int use_current, std::string *why) {
+static sfb_context *eval_context(sfb_backend_kind kind, int threads, int use_current, std::string *why,
+                                 const sfb_logger *logger = NULL) {
     sfb_context_config cfg = sfb_context_config_init();
+    if (logger) cfg.logger = *logger;
     cfg.backends = &kind;
     cfg.backend_count = 1;
     cfg.ignore_environment = 1;
@@ -631,6 +697,494 @@ static int eval_section(const TorusMesh &torus, double diag) {
     return status;
 }
 
+/* ---- limit evaluation, patch build and tessellation (SFB_REFINE_PATCHES) ---- */
+
+/* Deterministic random numbers (splitmix64), the same on every platform. */
+struct SplitMix {
+    unsigned long long s;
+    explicit SplitMix(unsigned long long seed) : s(seed) {}
+    unsigned long long next() {
+        unsigned long long z = (s += 0x9E3779B97F4A7C15ull);
+        z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+        z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+        return z ^ (z >> 31);
+    }
+    float unit() { return (float)(next() >> 40) * (1.0f / 16777216.0f); } /* [0,1), 24 bits */
+    int below(int n) { return (int)((next() >> 11) % (unsigned long long)n); }
+};
+
+/* Collects log messages of a context (to tell when sfb_surface_eval fell back to ref). */
+struct LogCapture {
+    std::string text;
+    static void func(int level, const char *msg, void *user) {
+        (void)level;
+        LogCapture *c = (LogCapture *)user;
+        c->text += msg ? msg : "";
+        c->text += "\n";
+    }
+    sfb_logger logger() { sfb_logger l; l.func = func; l.user = this; return l; }
+};
+
+/* OpenSubdiv's feature-adaptive patch table for the same mesh, ready to evaluate. */
+struct OsdPatches {
+    Far::TopologyRefiner *refiner;
+    Far::PatchTable *table;
+    Far::PatchMap *map;
+    Far::StencilTable const *stencils; /* refined vertices + local points (end caps), over base vertices */
+    Osd::CpuVertexBuffer *points;      /* base vertices, refined vertices, local points */
+    Osd::CpuPatchTable *cpu_table;
+    int isolation;
+    OsdPatches() : refiner(NULL), table(NULL), map(NULL), stencils(NULL), points(NULL), cpu_table(NULL), isolation(0) {}
+    ~OsdPatches() { clear(); }
+    void clear() {
+        delete cpu_table; delete points; delete stencils; delete map; delete table; delete refiner;
+        cpu_table = NULL; points = NULL; stencils = NULL; map = NULL; table = NULL; refiner = NULL;
+    }
+    /* TopologyRefinerFactory::Create + RefineAdaptive (PatchTableFactory::Options' default
+     * isolation) + PatchTableFactory::Create (default options: Gregory basis end caps). */
+    bool build_patches(const TorusMesh &m, bool inf_sharp_patch = false) {
+        clear();
+        Far::TopologyDescriptor desc = m.osd_desc();
+        Sdc::Options opt;
+        opt.SetVtxBoundaryInterpolation(Sdc::Options::VTX_BOUNDARY_EDGE_ONLY);
+        opt.SetCreasingMethod(Sdc::Options::CREASE_UNIFORM);
+        opt.SetTriangleSubdivision(Sdc::Options::TRI_SUB_CATMARK);
+        typedef Far::TopologyRefinerFactory<Far::TopologyDescriptor> Factory;
+        refiner = Factory::Create(desc, Factory::Options(Sdc::SCHEME_CATMARK, opt));
+        if (!refiner) return false;
+        Far::PatchTableFactory::Options po;
+        po.useInfSharpPatch = inf_sharp_patch;
+        isolation = (int)po.maxIsolationLevel;
+        refiner->RefineAdaptive(po.GetRefineAdaptiveOptions());
+        table = Far::PatchTableFactory::Create(*refiner, po);
+        return table != NULL;
+    }
+    /* PatchMap, the stencil table (every refined vertex, then the local points), the points
+     * themselves (EvalStencils) and the Osd::CpuPatchTable. */
+    bool build_eval(const TorusMesh &m) {
+        map = new Far::PatchMap(*table);
+        Far::StencilTableFactory::Options so;
+        so.generateOffsets = true;
+        so.generateIntermediateLevels = true;
+        Far::StencilTable const *refined = Far::StencilTableFactory::Create(*refiner, so);
+        stencils = refined;
+        if (Far::StencilTable const *local = table->GetLocalPointStencilTable()) {
+            stencils = Far::StencilTableFactory::AppendLocalPointStencilTable(*refiner, refined, local);
+            delete refined;
+        }
+        if (!stencils) return false;
+        int nbase = m.vertex_count(), nall = nbase + stencils->GetNumStencils();
+        points = Osd::CpuVertexBuffer::Create(3, nall);
+        points->UpdateData(&m.positions[0], 0, nbase);
+        Osd::BufferDescriptor sd(0, 3, 3), dd(3 * nbase, 3, 3);
+        if (!Osd::CpuEvaluator::EvalStencils(points, sd, points, dd, stencils)) return false;
+        cpu_table = Osd::CpuPatchTable::Create(table);
+        return cpu_table != NULL;
+    }
+    /* rough memory: patch vertex indices and patch params, the stencil table, the points */
+    size_t bytes() const {
+        size_t b = 0;
+        if (table)
+            b += table->GetPatchControlVerticesTable().size() * sizeof(Far::Index) +
+                 table->GetPatchParamTable().size() * sizeof(Far::PatchParam);
+        if (stencils)
+            b += (stencils->GetSizes().size() + stencils->GetOffsets().size() + stencils->GetControlIndices().size()) * sizeof(int) +
+                 stencils->GetWeights().size() * sizeof(float);
+        if (points) b += (size_t)points->GetNumVertices() * 3 * sizeof(float);
+        return b;
+    }
+};
+
+struct LimitRow {
+    std::string name, note;
+    bool ran;
+    double ms;
+    double diff; /* max |position difference| from surfblend ref */
+    LimitRow(const std::string &n) : name(n), ran(false), ms(0.0), diff(0.0) {}
+};
+
+static void max_mean_diff(const std::vector<float> &a, const std::vector<float> &b, double *mx, double *mean) {
+    double m = 0.0, s = 0.0;
+    size_t n = std::min(a.size(), b.size()) / 3;
+    for (size_t i = 0; i < n; ++i) {
+        double dx = (double)a[3 * i] - b[3 * i], dy = (double)a[3 * i + 1] - b[3 * i + 1], dz = (double)a[3 * i + 2] - b[3 * i + 2];
+        double d = std::sqrt(dx * dx + dy * dy + dz * dz);
+        if (!(d <= m)) m = std::isnan(d) ? INFINITY : d;
+        s += d;
+    }
+    *mx = a.size() == b.size() ? m : INFINITY;
+    *mean = n ? s / (double)n : 0.0;
+}
+
+static int limit_section(double diag) {
+    const int npoints = 1000000, warm = 1, reps = 3, tess_rate = 8;
+    const double budget_ms = 1e300; /* always the 3 runs */
+    const double tol = 1e-5 * diag;  /* surfblend backends against ref */
+    int status = 0;
+    Clock::time_point t_sec = Clock::now();
+    long cores = sysconf(_SC_NPROCESSORS_ONLN);
+    int all_threads = cores > 0 ? (int)std::min(cores, 64L) : 1;
+
+    TorusMesh mesh(100, 60, true);
+    sfb_mesh_desc desc = mesh.sfb_desc();
+    sfb_surface_config pcfg = sfb_surface_config_init(SFB_SCHEME_CATMARK, 0);
+    pcfg.flags = SFB_REFINE_PATCHES;
+
+    /* the reference surface (ref backend): mesh statistics, parametric faces */
+    std::string why;
+    sfb_context *rctx = eval_context(SFB_BACKEND_REF, 1, 0, &why);
+    if (!rctx) { printf("\nlimit evaluation: no ref context: %s\n", why.c_str()); return 1; }
+    sfb_mesh *rmesh = NULL;
+    sfb_surface *rsurf = NULL;
+    if (sfb_mesh_create(rctx, &desc, &rmesh) != SFB_SUCCESS || sfb_surface_create(rctx, rmesh, &pcfg, &rsurf) != SFB_SUCCESS) {
+        printf("\nlimit evaluation: surfblend could not build the patch surface: %s\n", sfb_last_error(rctx));
+        sfb_mesh_destroy(rmesh);
+        sfb_context_destroy(rctx);
+        return 1;
+    }
+    sfb_mesh_info mi;
+    sfb_mesh_get_info(rmesh, &mi);
+    sfb_patch_info pi;
+    memset(&pi, 0, sizeof pi);
+    sfb_surface_patch_info(rsurf, &pi);
+    int nparam = sfb_surface_param_face_count(rsurf);
+
+    printf("\nlimit evaluation (SFB_REFINE_PATCHES, Catmull-Clark) on the torus with extraordinary vertices:\n"
+           "%d faces (%d quads, %d triangles, %d hexagons) = %d parametric faces, %d vertices, %d extraordinary\n"
+           "(valence 3 and 5, some on the semi-sharp and the infinitely sharp ring), the same %d creases and corner\n",
+           mi.face_count, mi.quads, mi.triangles, mi.ngons, nparam, mi.vertex_count, mi.extraordinary_catmark,
+           mi.sharp_edges);
+    fflush(stdout);
+
+    /* ---- patch build ---- */
+    std::vector<double> t_sfb_build, t_sfb_surf, t_osd_patch, t_osd_eval;
+    for (int rep = 0; rep < 3; ++rep) {
+        sfb_mesh *m = NULL;
+        sfb_surface *s = NULL;
+        Clock::time_point t0 = Clock::now();
+        sfb_result r = sfb_mesh_create(rctx, &desc, &m);
+        Clock::time_point t1 = Clock::now();
+        if (r == SFB_SUCCESS) r = sfb_surface_create(rctx, m, &pcfg, &s);
+        double tb = ms_since(t0), ts = ms_since(t1);
+        sfb_surface_destroy(s);
+        sfb_mesh_destroy(m);
+        if (r != SFB_SUCCESS) { printf("  sfb_surface_create failed: %s\n", sfb_last_error(rctx)); status = 1; break; }
+        t_sfb_build.push_back(tb);
+        t_sfb_surf.push_back(ts);
+    }
+    OsdPatches osd;
+    bool osd_ok = true;
+    for (int rep = 0; rep < 3 && osd_ok; ++rep) {
+        Clock::time_point t0 = Clock::now();
+        osd_ok = osd.build_patches(mesh);
+        double tp = ms_since(t0);
+        Clock::time_point t1 = Clock::now();
+        osd_ok = osd_ok && osd.build_eval(mesh);
+        t_osd_patch.push_back(tp);
+        t_osd_eval.push_back(tp + ms_since(t1));
+    }
+    auto patch_counts = [](const Far::PatchTable *t, int c[3]) {
+        c[0] = c[1] = c[2] = 0;
+        for (int a = 0; a < t->GetNumPatchArrays(); ++a) {
+            Far::PatchDescriptor::Type ty = t->GetPatchArrayDescriptor(a).GetType();
+            c[ty == Far::PatchDescriptor::REGULAR ? 0 : ty == Far::PatchDescriptor::GREGORY_BASIS ? 1 : 2] += t->GetNumPatches(a);
+        }
+    };
+    int osd_counts[3] = {0, 0, 0};
+    if (osd_ok) patch_counts(osd.table, osd_counts);
+    /* also with useInfSharpPatch (infinitely sharp creases as regular boundary patches, as
+     * surfblend does): not the default, shown for the build cost alone */
+    std::vector<double> t_osd_inf;
+    int inf_counts[3] = {0, 0, 0}, inf_total = 0;
+    if (osd_ok) {
+        OsdPatches o2;
+        for (int rep = 0; rep < 3; ++rep) {
+            Clock::time_point t0 = Clock::now();
+            if (!o2.build_patches(mesh, true)) break;
+            t_osd_inf.push_back(ms_since(t0));
+        }
+        if (o2.table) { patch_counts(o2.table, inf_counts); inf_total = o2.table->GetNumPatchesTotal(); }
+    }
+    {
+        double sb = median(t_sfb_build), ss = median(t_sfb_surf), op = median(t_osd_patch), oe = median(t_osd_eval);
+        printf("\npatch build: median of 3, milliseconds; 'x OSD' = OpenSubdiv's refine + patch table time / this\n");
+        printf("%-38s | %9s | %7s | %9s | %s\n", "patch build", "median ms", "x OSD", "memory MB", "what");
+        char what[256];
+        snprintf(what, sizeof what, "sfb_mesh_create + sfb_surface_create(level 0, SFB_REFINE_PATCHES, isolation %d)",
+                 SFB_DEFAULT_ISOLATION);
+        printf("%-38s | %9.2f | %7.2f | %9s | %s\n", "surfblend mesh + surface", sb, sb > 0 ? op / sb : 0.0, "", what);
+        snprintf(what, sizeof what, "%d patches: %d B-spline, %d Stam, %d end caps; max depth %d; %d points (patch table + points)",
+                 pi.patches, pi.bspline, pi.stam, pi.end_caps, pi.max_depth, pi.points);
+        printf("%-38s | %9.2f | %7.2f | %9.2f | %s\n", "surfblend sfb_surface_create", ss, ss > 0 ? op / ss : 0.0,
+               (double)pi.bytes / (1 << 20), what);
+        if (osd_ok) {
+            snprintf(what, sizeof what, "TopologyRefinerFactory + RefineAdaptive(isolation %d) + PatchTableFactory (Gregory basis end "
+                     "caps): %d patches, %d regular, %d Gregory basis, %d other", osd.isolation,
+                     (int)osd.table->GetNumPatchesTotal(), osd_counts[0], osd_counts[1], osd_counts[2]);
+            printf("%-38s | %9.2f | %7.2f | %9s | %s\n", "OpenSubdiv refine + patch table", op, 1.0, "", what);
+            if (!t_osd_inf.empty()) {
+                double oi = median(t_osd_inf);
+                snprintf(what, sizeof what, "the same with Options::useInfSharpPatch = true (not the default): %d patches, %d regular, "
+                         "%d Gregory basis, %d other", inf_total, inf_counts[0], inf_counts[1], inf_counts[2]);
+                printf("%-38s | %9.2f | %7.2f | %9s | %s\n", "OpenSubdiv ..., useInfSharpPatch", oi, oi > 0 ? op / oi : 0.0, "", what);
+            }
+            snprintf(what, sizeof what, "+ PatchMap, StencilTableFactory (all levels) + AppendLocalPointStencilTable, EvalStencils: "
+                     "%d points, %d local; memory = patch indices/params + stencils + points", osd.points->GetNumVertices(),
+                     osd.table->GetNumLocalPoints());
+            printf("%-38s | %9.2f | %7.2f | %9.2f | %s\n", "OpenSubdiv ... + stencils + points", oe, oe > 0 ? op / oe : 0.0,
+                   (double)osd.bytes() / (1 << 20), what);
+        } else {
+            printf("%-38s | unavailable: OpenSubdiv could not build the patch table\n", "OpenSubdiv refine + patch table");
+        }
+        fflush(stdout);
+    }
+
+    /* ---- the locations ---- */
+    std::vector<sfb_location> locs((size_t)npoints);
+    SplitMix rng(0x5eedf00dull);
+    for (int i = 0; i < npoints; ++i) {
+        locs[(size_t)i].face = rng.below(nparam);
+        locs[(size_t)i].u = rng.unit();
+        locs[(size_t)i].v = rng.unit();
+    }
+    std::vector<char> ngon_sub((size_t)nparam, 0); /* parametric face is a sub-face of an n-gon */
+    for (int f = 0; f < nparam; ++f) {
+        int bf = -1, sub = -1;
+        if (sfb_surface_param_face_base(rsurf, f, &bf, &sub) == SFB_SUCCESS) ngon_sub[(size_t)f] = sub >= 0;
+    }
+    std::vector<LimitRow> rows;
+    std::vector<float> want_p, want_du, want_dv;
+
+    /* surfblend, one surface per backend context */
+    auto run_sfb = [&](const char *name, sfb_backend_kind kind, int threads, const char *what) {
+        LimitRow row(name);
+        LogCapture log;
+        sfb_logger lg = log.logger();
+        sfb_context *c = eval_context(kind, threads, 0, &why, &lg);
+        row.note = why;
+        if (!c) { rows.push_back(row); return; }
+        if (what) row.note = std::string(what) + (why.empty() ? "" : ", ") + why;
+        sfb_mesh *m = NULL;
+        sfb_surface *s = NULL;
+        if (sfb_mesh_create(c, &desc, &m) != SFB_SUCCESS || sfb_surface_create(c, m, &pcfg, &s) != SFB_SUCCESS) {
+            row.note = std::string("error: ") + sfb_last_error(c);
+            status = 1;
+        } else {
+            std::vector<float> p((size_t)npoints * 3), du((size_t)npoints * 3), dv((size_t)npoints * 3);
+            sfb_eval_output out;
+            memset(&out, 0, sizeof out);
+            out.position = &p[0];
+            out.du = &du[0];
+            out.dv = &dv[0];
+            log.text.clear();
+            bool ok = sfb_surface_eval(s, &locs[0], npoints, &out) == SFB_SUCCESS; /* warm-up */
+            if (ok && kind != SFB_BACKEND_REF && log.text.find("lacks eval_patches") != std::string::npos) {
+                row.note = std::string("skipped: ") + sfb_backend_kind_name(kind) +
+                           " has no eval_patches kernel yet (sfb_surface_eval runs ref's)";
+            } else if (ok) {
+                row.ms = best_of(warm - 1, reps, budget_ms, [&]() { return sfb_surface_eval(s, &locs[0], npoints, &out) == SFB_SUCCESS; }, &ok);
+            }
+            if (!ok) {
+                row.note = std::string("error: ") + sfb_last_error(c);
+                status = 1;
+            } else if (row.note.compare(0, 8, "skipped:") != 0) {
+                row.ran = true;
+                if (want_p.empty()) { want_p = p; want_du = du; want_dv = dv; }
+                row.diff = max_abs_diff(p, want_p);
+                if (!(row.diff <= tol)) status = 1;
+            }
+        }
+        sfb_surface_destroy(s);
+        sfb_mesh_destroy(m);
+        sfb_context_destroy(c);
+        rows.push_back(row);
+    };
+    run_sfb("surfblend ref", SFB_BACKEND_REF, 1, "plain C, double");
+    if (!rows[0].ran) {
+        printf("  surfblend ref failed: %s\n", rows[0].note.c_str());
+        sfb_surface_destroy(rsurf);
+        sfb_mesh_destroy(rmesh);
+        sfb_context_destroy(rctx);
+        return 1;
+    }
+    run_sfb("surfblend simd, 1 thread", SFB_BACKEND_SIMD, 1, NULL);
+    run_sfb("surfblend simd, all threads", SFB_BACKEND_SIMD, 0, NULL);
+    run_sfb("surfblend gl, own EGL ctx, CPU copies", SFB_BACKEND_GL, 0, NULL);
+    run_sfb("surfblend osmesa, CPU copies", SFB_BACKEND_OSMESA, 0, NULL);
+    fprintf(stderr, "limit eval: surfblend rows done (%.1f s)\n", ms_since(t_sec) / 1000.0);
+
+    /* OpenSubdiv: the same (face, u, v) as ptex faces */
+    double osd_du_max = 0, osd_du_mean = 0, osd_dv_max = 0, osd_dv_mean = 0, osd_p_mean = 0;
+    double osd_find_ms = 0.0;
+    int osd_ptex = -1, not_found = 0;
+    if (osd_ok) {
+        Far::PtexIndices ptex(*osd.refiner);
+        osd_ptex = ptex.GetNumFaces();
+    }
+    const char *osd_names[4] = {"OpenSubdiv FindPatch + CpuEvaluator", "OpenSubdiv CpuEvaluator alone",
+                                "OpenSubdiv FindPatch + OmpEvaluator", "OpenSubdiv OmpEvaluator alone"};
+    if (!osd_ok || osd_ptex != nparam) {
+        for (int k = 0; k < 4; ++k) {
+            LimitRow row(osd_names[k]);
+            if (!osd_ok) row.note = "OpenSubdiv could not build the patch table";
+            else {
+                char b[160];
+                snprintf(b, sizeof b, "OpenSubdiv has %d ptex faces, surfblend %d parametric faces", osd_ptex, nparam);
+                row.note = b;
+                status = 1;
+            }
+            rows.push_back(row);
+        }
+    } else {
+        std::vector<Osd::PatchCoord> coords((size_t)npoints);
+        auto find_all = [&]() {
+            not_found = 0;
+            for (int i = 0; i < npoints; ++i) {
+                const sfb_location &l = locs[(size_t)i];
+                Far::PatchTable::PatchHandle const *h = osd.map->FindPatch(l.face, l.u, l.v);
+                if (h) coords[(size_t)i] = Osd::PatchCoord(*h, l.u, l.v);
+                else { coords[(size_t)i] = coords[0]; ++not_found; }
+            }
+            return true;
+        };
+        std::vector<float> p((size_t)npoints * 3), du((size_t)npoints * 3), dv((size_t)npoints * 3);
+        Osd::BufferDescriptor sd(0, 3, 3), dd(0, 3, 3);
+        const float *src = osd.points->BindCpuBuffer();
+        const Osd::PatchArray *arrays = osd.cpu_table->GetPatchArrayBuffer();
+        const int *indices = osd.cpu_table->GetPatchIndexBuffer();
+        const Osd::PatchParam *params = osd.cpu_table->GetPatchParamBuffer();
+        auto cpu_eval = [&]() {
+            return Osd::CpuEvaluator::EvalPatches(src, sd, &p[0], dd, &du[0], dd, &dv[0], dd, npoints, &coords[0], arrays, indices, params);
+        };
+        auto omp_eval = [&]() {
+            return Osd::OmpEvaluator::EvalPatches(src, sd, &p[0], dd, &du[0], dd, &dv[0], dd, npoints, &coords[0], arrays, indices, params);
+        };
+        Osd::OmpEvaluator::SetNumThreads(all_threads);
+        char note[256];
+        for (int k = 0; k < 4; ++k) {
+            LimitRow row(osd_names[k]);
+            bool ok;
+            bool omp = k >= 2, find = k % 2 == 0;
+            if (find)
+                row.ms = best_of(warm, reps, budget_ms, [&]() { return find_all() && (omp ? omp_eval() : cpu_eval()); }, &ok);
+            else
+                row.ms = best_of(warm, reps, budget_ms, [&]() { return omp ? omp_eval() : cpu_eval(); }, &ok);
+            if (k == 0) osd_find_ms = best_of(0, reps, budget_ms, find_all, &ok) ;
+            if (find)
+                snprintf(note, sizeof note, "Far::PatchMap::FindPatch per point (1 thread) + Osd::%s::EvalPatches (P, du, dv), %d thread%s",
+                         omp ? "OmpEvaluator" : "CpuEvaluator", omp ? all_threads : 1, omp && all_threads > 1 ? "s" : "");
+            else
+                snprintf(note, sizeof note, "Osd::%s::EvalPatches only (PatchCoords found beforehand), %d thread%s",
+                         omp ? "OmpEvaluator" : "CpuEvaluator", omp ? all_threads : 1, omp && all_threads > 1 ? "s" : "");
+            row.note = note;
+            if (!ok) row.note = "EvalPatches failed";
+            else {
+                row.ran = true;
+                row.diff = max_abs_diff(p, want_p);
+                if (k == 0) {
+                    /* OpenSubdiv scales derivatives by 2^depth counting the n-gon's split as a
+                     * level (PatchParam depth includes it, Normalize() does not): on n-gon
+                     * sub-faces its du, dv are twice d/du, d/dv of the parametric face. */
+                    std::vector<float> du2(du), dv2(dv);
+                    for (int i = 0; i < npoints; ++i)
+                        if (ngon_sub[(size_t)locs[(size_t)i].face])
+                            for (int c = 0; c < 3; ++c) { du2[3 * (size_t)i + c] *= 0.5f; dv2[3 * (size_t)i + c] *= 0.5f; }
+                    double mx;
+                    max_mean_diff(p, want_p, &mx, &osd_p_mean);
+                    max_mean_diff(du2, want_du, &osd_du_max, &osd_du_mean);
+                    max_mean_diff(dv2, want_dv, &osd_dv_max, &osd_dv_mean);
+                }
+            }
+            rows.push_back(row);
+        }
+    }
+
+    double osd_ms = 0.0, osd_p_max = 0.0, ref_ms = rows[0].ms;
+    for (size_t i = 0; i < rows.size(); ++i)
+        if (rows[i].name == osd_names[0] && rows[i].ran) { osd_ms = rows[i].ms; osd_p_max = rows[i].diff; }
+    printf("\nlimit evaluation: %d random locations (parametric face uniform, u and v uniform in [0,1], fixed seed),\n"
+           "position + du + dv; best of %d runs after %d warm-up run, milliseconds and million points per second;\n"
+           "'x OSD' and 'x ref' are how many times faster than OpenSubdiv's FindPatch + CpuEvaluator and than\n"
+           "surfblend's ref in this run. surfblend's time includes locating the patch (sfb_surface_eval takes\n"
+           "(face, u, v)). 'diff vs ref' is the largest position difference from ref (OpenSubdiv: its Gregory\n"
+           "end caps approximate the surface near extraordinary vertices).\n",
+           npoints, reps, warm);
+    printf("%-38s | %9s | %8s | %7s | %6s | %11s | %s\n", "limit eval", "best ms", "M pts/s", "x OSD", "x ref", "diff vs ref",
+           "what runs");
+    for (size_t i = 0; i < rows.size(); ++i) {
+        const LimitRow &r = rows[i];
+        if (!r.ran) {
+            if (r.note.compare(0, 8, "skipped:") == 0) printf("%-38s | %s\n", r.name.c_str(), r.note.c_str());
+            else printf("%-38s | unavailable: %s\n", r.name.c_str(), r.note.c_str());
+            continue;
+        }
+        printf("%-38s | %9.2f | %8.2f | %7.2f | %6.2f | %11.3g | %s\n", r.name.c_str(), r.ms, r.ms > 0 ? npoints / (r.ms * 1e3) : 0.0,
+               osd_ms > 0 ? osd_ms / r.ms : 0.0, ref_ms > 0 ? ref_ms / r.ms : 0.0, r.diff, r.note.c_str());
+    }
+    if (osd_ms > 0)
+        printf("(OpenSubdiv vs surfblend ref: position max %.3g mean %.3g, du max %.3g mean %.3g, dv max %.3g mean %.3g,\n"
+               " OpenSubdiv's du, dv halved on n-gon sub-faces, where it gives twice the parametric face's derivatives;\n"
+               " FindPatch alone %.2f ms; %d locations without an OpenSubdiv patch)\n",
+               osd_p_max, osd_p_mean, osd_du_max, osd_du_mean, osd_dv_max, osd_dv_mean, osd_find_ms,
+               not_found);
+    fflush(stdout);
+    fprintf(stderr, "limit eval done (%.1f s)\n", ms_since(t_sec) / 1000.0);
+
+    /* ---- tessellation ---- */
+    printf("\ntessellation: sfb_surface_tessellate, uniform rate %d (%d x %d quads, 2 triangles each, per parametric face),\n"
+           "positions + normals; best of %d runs after %d warm-up run\n", tess_rate, tess_rate, tess_rate, reps, warm);
+    printf("%-38s | %9s | %9s | %10s | %9s | %s\n", "tessellate", "best ms", "M tris/s", "triangles", "vertices", "what runs");
+    struct TessCase { const char *name; sfb_backend_kind kind; int threads; };
+    const TessCase tcases[3] = {{"surfblend ref", SFB_BACKEND_REF, 1}, {"surfblend simd, 1 thread", SFB_BACKEND_SIMD, 1},
+                                {"surfblend simd, all threads", SFB_BACKEND_SIMD, 0}};
+    for (int k = 0; k < 3; ++k) {
+        LogCapture log;
+        sfb_logger lg = log.logger();
+        sfb_context *c = eval_context(tcases[k].kind, tcases[k].threads, 0, &why, &lg);
+        if (!c) { printf("%-38s | unavailable: %s\n", tcases[k].name, why.c_str()); continue; }
+        if (tcases[k].kind == SFB_BACKEND_REF) why = "plain C, double";
+        sfb_mesh *m = NULL;
+        sfb_surface *s = NULL;
+        if (sfb_mesh_create(c, &desc, &m) != SFB_SUCCESS || sfb_surface_create(c, m, &pcfg, &s) != SFB_SUCCESS) {
+            printf("%-38s | error: %s\n", tcases[k].name, sfb_last_error(c));
+            status = 1;
+        } else {
+            sfb_tess_config tc = sfb_tess_config_init(tess_rate);
+            double best = 1e300;
+            int tris = 0, verts = 0;
+            bool ok = true;
+            for (int i = 0; i < warm + reps && ok; ++i) {
+                sfb_tess_data td;
+                memset(&td, 0, sizeof td);
+                Clock::time_point t0 = Clock::now();
+                ok = sfb_surface_tessellate(s, &tc, &td) == SFB_SUCCESS;
+                double t = ms_since(t0);
+                if (i >= warm) best = std::min(best, t);
+                tris = td.triangle_count;
+                verts = td.vertex_count;
+                sfb_tess_data_free(&td);
+            }
+            if (!ok) {
+                printf("%-38s | error: %s\n", tcases[k].name, sfb_last_error(c));
+                status = 1;
+            } else {
+                if (tcases[k].kind != SFB_BACKEND_REF && log.text.find("lacks eval_patches") != std::string::npos)
+                    why += "; evaluation on ref's kernel (no eval_patches kernel on this backend yet)";
+                printf("%-38s | %9.2f | %9.2f | %10d | %9d | %s\n", tcases[k].name, best, tris / (best * 1e3), tris, verts, why.c_str());
+            }
+        }
+        sfb_surface_destroy(s);
+        sfb_mesh_destroy(m);
+        sfb_context_destroy(c);
+    }
+
+    sfb_surface_destroy(rsurf);
+    sfb_mesh_destroy(rmesh);
+    sfb_context_destroy(rctx);
+    printf("(section took %.1f s)\n", ms_since(t_sec) / 1000.0);
+    return status;
+}
+
 /* ---- main ---- */
 
 struct Row {
@@ -643,10 +1197,12 @@ struct Row {
 
 int main(int argc, char **argv) {
     int max_level = 4;
+    bool limit_only = false;
     if (argc > 1) {
-        max_level = atoi(argv[1]);
-        if (max_level < 1 || max_level > 6) {
-            fprintf(stderr, "usage: bench [MAX_LEVEL 1..6, default 4]\n");
+        limit_only = strcmp(argv[1], "--limit") == 0;
+        max_level = limit_only ? 0 : atoi(argv[1]);
+        if (argc > 2 || (!limit_only && (max_level < 1 || max_level > 6))) {
+            fprintf(stderr, "usage: bench [MAX_LEVEL 1..6, default 4 | --limit (the limit evaluation section alone)]\n");
             return 2;
         }
     }
@@ -673,6 +1229,12 @@ int main(int argc, char **argv) {
         diag = std::sqrt(diag);
     }
     const double tol = 1e-6 * diag; /* as in tests/osd_agree.cpp */
+    if (limit_only) {
+        sfb_context_destroy(ctx);
+        int st = limit_section(diag);
+        printf("total time %.1f s\n", ms_since(t_start) / 1000.0);
+        return st;
+    }
 
     printf("surfblend %d.%d.%d vs OpenSubdiv 3.5, Catmull-Clark uniform refinement\n", SFB_VERSION_MAJOR,
            SFB_VERSION_MINOR, SFB_VERSION_PATCH);
@@ -814,6 +1376,7 @@ int main(int argc, char **argv) {
     }
     sfb_context_destroy(ctx);
     if (eval_section(torus, diag) != 0) status = 1;
+    if (limit_section(diag) != 0) status = 1;
     printf("total time %.1f s\n", ms_since(t_start) / 1000.0);
     return status;
 }

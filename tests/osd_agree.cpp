@@ -8,6 +8,11 @@
  *       (PASS / FAIL / REJECTED; NOTE for shapes with hierarchical edits, which both libraries
  *       ignore) and a summary "N passed, M failed[, K skipped]". Limit normals (from the limit
  *       tangent masks) are compared where the normal is unique (smooth, dart, boundary).
+ *       Then, for every catmark_ shape, limit evaluation (sfb_surface_eval on a surface made
+ *       with SFB_REFINE_PATCHES): one more line per shape, "PASS/FAIL/SKIP limit-eval NAME",
+ *       counted in the same summary (see run_eval_shape; shapes with holes, non-manifold
+ *       vertices or edges, or boundary interpolation "none" are skipped), and a closing
+ *       "limit-eval: ..." line with the largest errors.
  *       Exit status 0 iff nothing failed.
  *
  *   osd_agree --counts SHAPES_DIR LEVEL
@@ -21,9 +26,16 @@
 #include "surfblend.h"
 
 #include <opensubdiv/far/error.h>
+#include <opensubdiv/far/patchMap.h>
+#include <opensubdiv/far/patchTable.h>
+#include <opensubdiv/far/patchTableFactory.h>
 #include <opensubdiv/far/primvarRefiner.h>
+#include <opensubdiv/far/ptexIndices.h>
 #include <opensubdiv/far/topologyDescriptor.h>
 #include <opensubdiv/far/topologyRefinerFactory.h>
+#include <opensubdiv/osd/bufferDescriptor.h>
+#include <opensubdiv/osd/cpuEvaluator.h>
+#include <opensubdiv/osd/cpuPatchTable.h>
 
 #include <dirent.h>
 
@@ -166,8 +178,8 @@ struct Vec3d {
     }
 };
 
-/* Builds OpenSubdiv's refiner from exactly the topology arrays surfblend parsed. */
-static Far::TopologyRefiner *osd_refiner_from_desc(const sfb_mesh_desc &d, Sdc::SchemeType type) {
+/* OpenSubdiv's options for a mesh surfblend parsed. */
+static Sdc::Options osd_options(const sfb_mesh_desc &d) {
     Sdc::Options opt;
     switch (d.boundary) {
     case SFB_BOUNDARY_EDGE_AND_CORNER: opt.SetVtxBoundaryInterpolation(Sdc::Options::VTX_BOUNDARY_EDGE_AND_CORNER); break;
@@ -179,6 +191,12 @@ static Far::TopologyRefiner *osd_refiner_from_desc(const sfb_mesh_desc &d, Sdc::
     opt.SetTriangleSubdivision(d.triangle_rule == SFB_TRI_SMOOTH ? Sdc::Options::TRI_SUB_SMOOTH
                                                                  : Sdc::Options::TRI_SUB_CATMARK);
     opt.SetFVarLinearInterpolation(Sdc::Options::FVAR_LINEAR_ALL);
+    return opt;
+}
+
+/* Builds OpenSubdiv's refiner from exactly the topology arrays surfblend parsed. */
+static Far::TopologyRefiner *osd_refiner_from_desc(const sfb_mesh_desc &d, Sdc::SchemeType type) {
+    Sdc::Options opt = osd_options(d);
 
     /* Creases as given; the optional per-face-edge sharpness (normally folded into the creases
      * by surfblend already) is added, the highest value per edge winning. */
@@ -752,6 +770,471 @@ static Outcome run_shape(sfb_context *ctx, const std::string &dir, const std::st
     return o;
 }
 
+/* ---- limit evaluation (SFB_REFINE_PATCHES) against OpenSubdiv ---- */
+
+static const double k_eval_exact_tol = 1e-6;    /* of the diagonal: limit points from Limit() */
+static const double k_eval_converged_tol = 1e-4; /* of the diagonal: darts, valence 2 (surfblend's end caps) */
+static const double k_eval_interior_tol = 1e-2; /* of the diagonal: OpenSubdiv's patches (Gregory end caps) */
+static const int k_eval_interior_points = 64;
+
+/* Deterministic random numbers (splitmix64). */
+struct SplitMix {
+    unsigned long long s;
+    explicit SplitMix(unsigned long long seed) : s(seed) {}
+    unsigned long long next() {
+        unsigned long long z = (s += 0x9E3779B97F4A7C15ull);
+        z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+        z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+        return z ^ (z >> 31);
+    }
+    int below(int n) { return (int)((next() >> 11) % (unsigned long long)n); }
+    float open_unit() { return ((float)(next() >> 40) + 0.5f) * (1.0f / 16777216.0f); } /* (0,1) */
+};
+
+/* Exact limit positions of points of the base mesh (its vertices, and the edge and face points
+ * of its first refinement) from OpenSubdiv alone. The limit of a vertex depends only on its
+ * 1-ring and on the sharpness of its own edges and of itself, and OpenSubdiv's limit mask
+ * (PrimvarRefiner::Limit) is exact once that sharpness is 0 or infinite and the faces around are
+ * quads. So the point is followed down the levels on small sub-meshes, each refined once by
+ * OpenSubdiv: first the faces around the vertex (around the vertices of the edge or face for
+ * an edge or face point), then the faces around the followed child, until no semi-sharp
+ * sharpness is left at it; then Limit() on the last sub-mesh. (Uniform refinement of the whole
+ * shape would need up to 8 levels: catmark_rook has sharpness 7.9.) */
+class LimitOracle {
+public:
+    LimitOracle(const Far::TopologyRefiner &base, const float *positions, const Sdc::Options &opt)
+        : base_(base), opt_(opt) {
+        int n = base.GetLevel(0).GetNumVertices();
+        pos0_.resize((size_t)n);
+        for (int i = 0; i < n; ++i)
+            for (int c = 0; c < 3; ++c) pos0_[(size_t)i].p[c] = positions[3 * i + c];
+    }
+    /* kind 'v': vertex a; 'e': the edge (a, b); 'f': face a. *converged is set when the point
+     * is a dart or a smooth valence-2 vertex, where OpenSubdiv's limit mask is not the limit
+     * (a dart takes the smooth mask although its sharp edge changes the subdivision; valence 2
+     * takes the vertex itself): Limit() is then repeated on deeper levels until two successive
+     * results are within conv_tol (they converge geometrically, by 1/4 or faster per level). */
+    bool limit(char kind, int a, int b, double conv_tol, Vec3d &out, bool *converged, std::string &err) {
+        *converged = false;
+        const Far::TopologyLevel &l0 = base_.GetLevel(0);
+        std::vector<int> seeds;
+        if (kind == 'v') seeds.push_back(a);
+        else if (kind == 'e') { seeds.push_back(a); seeds.push_back(b); }
+        else {
+            Far::ConstIndexArray fv = l0.GetFaceVertices(a);
+            for (int i = 0; i < fv.size(); ++i) seeds.push_back(fv[i]);
+        }
+        std::vector<int> faces;
+        for (size_t i = 0; i < seeds.size(); ++i) {
+            Far::ConstIndexArray vf = l0.GetVertexFaces(seeds[i]);
+            for (int k = 0; k < vf.size(); ++k) faces.push_back(vf[k]);
+        }
+        if (kind == 'f') faces.push_back(a);
+        std::sort(faces.begin(), faces.end());
+        faces.erase(std::unique(faces.begin(), faces.end()), faces.end());
+        Sub sub;
+        if (!refine_faces(l0, &pos0_[0], faces, sub)) { err = "OpenSubdiv could not refine the sub-mesh"; return false; }
+        const Far::TopologyLevel &s0 = sub.r->GetLevel(0);
+        int x = -1;
+        if (kind == 'v') x = s0.GetVertexChildVertex(sub.local[a]);
+        else if (kind == 'e') {
+            Far::Index e = s0.FindEdge(sub.local[a], sub.local[b]);
+            if (e >= 0) x = s0.GetEdgeChildVertex(e);
+        } else
+            x = s0.GetFaceChildVertex((int)(std::lower_bound(faces.begin(), faces.end(), a) - faces.begin()));
+        if (x < 0) { err = "no child vertex in OpenSubdiv's sub-mesh"; return false; }
+        Vec3d prev;
+        prev.Clear();
+        bool have_prev = false;
+        for (int step = 0; step < 48; ++step) {
+            const Far::TopologyLevel &l1 = sub.r->GetLevel(1);
+            bool semi = semisharp(l1.GetVertexSharpness(x));
+            Far::ConstIndexArray ve = l1.GetVertexEdges(x);
+            for (int i = 0; i < ve.size(); ++i) semi = semi || semisharp(l1.GetEdgeSharpness(ve[i]));
+            if (!semi) {
+                std::vector<Vec3d> lim(sub.pos1.size());
+                Far::PrimvarRefinerReal<double> pr(*sub.r);
+                Vec3d *src = &sub.pos1[0], *dst = &lim[0];
+                pr.Limit(src, dst);
+                out = lim[(size_t)x];
+                Sdc::Crease::Rule rule = l1.GetVertexRule(x);
+                bool inexact = rule == Sdc::Crease::RULE_DART || (rule == Sdc::Crease::RULE_SMOOTH && ve.size() == 2);
+                if (!inexact) return true;
+                *converged = true;
+                if (have_prev) {
+                    double dx = out.p[0] - prev.p[0], dy = out.p[1] - prev.p[1], dz = out.p[2] - prev.p[2];
+                    if (std::sqrt(dx * dx + dy * dy + dz * dz) <= conv_tol) return true;
+                }
+                prev = out;
+                have_prev = true;
+            }
+            std::vector<int> ring;
+            Far::ConstIndexArray vf = l1.GetVertexFaces(x);
+            for (int k = 0; k < vf.size(); ++k) ring.push_back(vf[k]);
+            Sub next;
+            if (!refine_faces(l1, &sub.pos1[0], ring, next)) { err = "OpenSubdiv could not refine the sub-mesh"; return false; }
+            x = next.r->GetLevel(0).GetVertexChildVertex(next.local[x]);
+            std::swap(sub.r, next.r);
+            sub.pos1.swap(next.pos1);
+            sub.local.swap(next.local);
+        }
+        err = "no exact or converged limit in 48 levels";
+        return false;
+    }
+
+private:
+    struct Sub {
+        Far::TopologyRefiner *r;
+        std::vector<Vec3d> pos1;             /* level 1 */
+        std::unordered_map<int, int> local;  /* vertex of the parent level -> sub-mesh vertex */
+        Sub() : r(NULL) {}
+        ~Sub() { delete r; }
+    };
+    const Far::TopologyRefiner &base_;
+    Sdc::Options opt_;
+    std::vector<Vec3d> pos0_;
+
+    static bool semisharp(float s) { return s > 0.0f && s < Sdc::Crease::SHARPNESS_INFINITE; }
+
+    /* The faces of `lvl` as a mesh of their own (edge and vertex sharpness kept), refined once. */
+    bool refine_faces(const Far::TopologyLevel &lvl, const Vec3d *pos, const std::vector<int> &faces, Sub &sub) {
+        std::vector<int> sizes, verts, cpairs, cverts;
+        std::vector<float> cw, vw;
+        std::vector<Vec3d> p;
+        std::vector<int> edges;
+        for (size_t k = 0; k < faces.size(); ++k) {
+            Far::ConstIndexArray fv = lvl.GetFaceVertices(faces[k]), fe = lvl.GetFaceEdges(faces[k]);
+            sizes.push_back(fv.size());
+            for (int i = 0; i < fv.size(); ++i) {
+                std::unordered_map<int, int>::iterator it = sub.local.find(fv[i]);
+                if (it == sub.local.end()) {
+                    it = sub.local.insert(std::make_pair((int)fv[i], (int)p.size())).first;
+                    p.push_back(pos[fv[i]]);
+                    float s = lvl.GetVertexSharpness(fv[i]);
+                    if (s > 0.0f) { cverts.push_back(it->second); vw.push_back(s); }
+                }
+                verts.push_back(it->second);
+                edges.push_back(fe[i]);
+            }
+        }
+        std::sort(edges.begin(), edges.end());
+        edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+        for (size_t k = 0; k < edges.size(); ++k) {
+            float s = lvl.GetEdgeSharpness(edges[k]);
+            if (s <= 0.0f) continue;
+            Far::ConstIndexArray ev = lvl.GetEdgeVertices(edges[k]);
+            cpairs.push_back(sub.local[ev[0]]);
+            cpairs.push_back(sub.local[ev[1]]);
+            cw.push_back(s);
+        }
+        Far::TopologyDescriptor desc;
+        desc.numVertices = (int)p.size();
+        desc.numFaces = (int)sizes.size();
+        desc.numVertsPerFace = &sizes[0];
+        desc.vertIndicesPerFace = &verts[0];
+        desc.numCreases = (int)cw.size();
+        desc.creaseVertexIndexPairs = cpairs.empty() ? NULL : &cpairs[0];
+        desc.creaseWeights = cw.empty() ? NULL : &cw[0];
+        desc.numCorners = (int)vw.size();
+        desc.cornerVertexIndices = cverts.empty() ? NULL : &cverts[0];
+        desc.cornerWeights = vw.empty() ? NULL : &vw[0];
+        typedef Far::TopologyRefinerFactory<Far::TopologyDescriptor> Factory;
+        sub.r = Factory::Create(desc, Factory::Options(Sdc::SCHEME_CATMARK, opt_));
+        if (!sub.r) return false;
+        Far::TopologyRefiner::UniformOptions uo(1);
+        uo.fullTopologyInLastLevel = true;
+        sub.r->RefineUniform(uo);
+        sub.pos1.resize((size_t)sub.r->GetLevel(1).GetNumVertices());
+        Far::PrimvarRefinerReal<double> pr(*sub.r);
+        Vec3d *src = &p[0], *dst = &sub.pos1[0];
+        pr.Interpolate(1, src, dst);
+        return true;
+    }
+};
+
+/* OpenSubdiv's feature-adaptive patches (default PatchTableFactory options: Gregory basis end
+ * caps) evaluated with Osd::CpuEvaluator::EvalPatches at (ptex face, u, v). */
+struct OsdPatchEval {
+    Far::TopologyRefiner *r;
+    Far::PatchTable *table;
+    Far::PatchMap *map;
+    Osd::CpuPatchTable *cpu;
+    std::vector<float> points;
+    int ptex_faces;
+    OsdPatchEval() : r(NULL), table(NULL), map(NULL), cpu(NULL), ptex_faces(0) {}
+    ~OsdPatchEval() { delete cpu; delete map; delete table; delete r; }
+    bool build(const sfb_mesh_desc &d) {
+        r = osd_refiner_from_desc(d, Sdc::SCHEME_CATMARK);
+        if (!r) return false;
+        ptex_faces = Far::PtexIndices(*r).GetNumFaces();
+        Far::PatchTableFactory::Options po;
+        r->RefineAdaptive(po.GetRefineAdaptiveOptions());
+        table = Far::PatchTableFactory::Create(*r, po);
+        if (!table) return false;
+        /* the points the patches index: every level's vertices (PrimvarRefiner, level by level),
+         * then the local points of the end caps (their stencils over those vertices). Far's
+         * stencil tables would factorise every level down to the base vertices, which takes
+         * long around a valence-360 vertex isolated to level 10. */
+        int ntotal = r->GetNumVerticesTotal(), nlocal = table->GetNumLocalPoints();
+        std::vector<Vec3d> v((size_t)(ntotal + nlocal));
+        for (int i = 0; i < d.vertex_count; ++i)
+            for (int c = 0; c < 3; ++c) v[(size_t)i].p[c] = d.positions[3 * i + c];
+        Far::PrimvarRefinerReal<double> pr(*r);
+        Vec3d *src = &v[0];
+        for (int level = 1; level <= r->GetMaxLevel(); ++level) {
+            Vec3d *dst = src + r->GetLevel(level - 1).GetNumVertices();
+            pr.Interpolate(level, src, dst);
+            src = dst;
+        }
+        if (nlocal > 0) table->ComputeLocalPointValues(&v[0], &v[(size_t)ntotal]);
+        points.resize(v.size() * 3);
+        for (size_t i = 0; i < v.size(); ++i)
+            for (int c = 0; c < 3; ++c) points[3 * i + c] = (float)v[i].p[c];
+        map = new Far::PatchMap(*table);
+        cpu = Osd::CpuPatchTable::Create(table);
+        return cpu != NULL;
+    }
+    /* false when no patch covers the location (boundary faces under VTX_BOUNDARY_NONE, holes) */
+    bool eval(int face, float u, float v, double out[3]) const {
+        Far::PatchTable::PatchHandle const *h = map->FindPatch(face, u, v);
+        if (!h) return false;
+        Osd::PatchCoord pc(*h, u, v);
+        float p[3];
+        Osd::BufferDescriptor sd(0, 3, 3), dd(0, 3, 3);
+        if (!Osd::CpuEvaluator::EvalPatches(&points[0], sd, p, dd, 1, &pc, cpu->GetPatchArrayBuffer(), cpu->GetPatchIndexBuffer(),
+                                            cpu->GetPatchParamBuffer()))
+            return false;
+        for (int c = 0; c < 3; ++c) out[c] = p[c];
+        return true;
+    }
+};
+
+struct ErrStat {
+    int n;
+    double max;
+    ErrStat() : n(0), max(0.0) {}
+    void add(double e) {
+        ++n;
+        if (!(e <= max)) max = std::isnan(e) ? INFINITY : e;
+    }
+};
+
+struct EvalTotals {
+    int passed, failed, skipped;
+    double worst_corner, worst_l1, worst_conv, worst_interior; /* relative to the diagonal */
+    std::string worst_corner_shape, worst_l1_shape, worst_conv_shape, worst_interior_shape;
+    EvalTotals() : passed(0), failed(0), skipped(0), worst_corner(0), worst_l1(0), worst_conv(0), worst_interior(0) {}
+    static void note(double e, double &worst, std::string &shape, const std::string &name) {
+        if (e > worst) { worst = e; shape = name; }
+    }
+};
+
+static double dist3(const float *a, const double *b) {
+    double x = a[0] - b[0], y = a[1] - b[1], z = a[2] - b[2];
+    return std::sqrt(x * x + y * y + z * z);
+}
+
+/* sfb_surface_eval against OpenSubdiv on one Catmull-Clark shape: at every parametric face
+ * corner that is a base vertex, and at the parametric face points that are edge and face points
+ * of the first refinement (quads: edge midpoints and centre; n-gon sub-faces: (1,0), (1,1),
+ * (0,1)), the position must be the limit position of that point (LimitOracle) within 1e-6 of the
+ * diagonal; at 64 random interior locations it is compared with OpenSubdiv's EvalPatches within
+ * 1e-2 of the diagonal (its Gregory end caps approximate the surface near extraordinary vertices;
+ * a sanity check of the parametrisation, exactness is tested in tests/agree.c). */
+static Outcome run_eval_shape(sfb_context *ctx, const std::string &dir, const std::string &file, EvalTotals &tot) {
+    std::string name = file.substr(0, file.size() - 4), text;
+    std::string tag = "limit-eval " + name;
+    g_osd_messages.clear();
+    sfb_mesh *mesh = NULL;
+    if (!read_file(dir + "/" + file, text) || sfb_mesh_read_obj(ctx, text.data(), text.size(), &mesh) != SFB_SUCCESS) {
+        printf("SKIP %s: the shape cannot be read (see its refinement line)\n", tag.c_str());
+        sfb_mesh_destroy(mesh);
+        ++tot.skipped;
+        return OUT_SKIP;
+    }
+    sfb_mesh_desc d;
+    sfb_mesh_get_desc(mesh, &d);
+    sfb_mesh_info mi;
+    sfb_mesh_get_info(mesh, &mi);
+    const char *skip = NULL;
+    if (mi.holes > 0) skip = "holes (sfb_surface_eval rejects hole faces)";
+    else if (mi.nonmanifold_vertices > 0 || mi.nonmanifold_edges > 0) skip = "non-manifold vertices or edges";
+    else if (d.boundary == SFB_BOUNDARY_NONE) skip = "boundary interpolation none (boundary faces are not part of the surface)";
+    Far::TopologyRefiner *base = skip ? NULL : osd_refiner_from_desc(d, Sdc::SCHEME_CATMARK);
+    if (!skip && !base) skip = "OpenSubdiv cannot build the topology";
+    if (skip) {
+        printf("SKIP %s: %s\n", tag.c_str(), skip);
+        delete base;
+        sfb_mesh_destroy(mesh);
+        ++tot.skipped;
+        return OUT_SKIP;
+    }
+
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (int i = 0; i < d.vertex_count; ++i)
+        for (int c = 0; c < 3; ++c) {
+            lo[c] = std::min(lo[c], (double)d.positions[3 * i + c]);
+            hi[c] = std::max(hi[c], (double)d.positions[3 * i + c]);
+        }
+    double diag = std::sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) + (hi[2] - lo[2]) * (hi[2] - lo[2]));
+    if (!(diag > 0)) diag = 1.0;
+    const double exact_tol = k_eval_exact_tol * diag, converged_tol = k_eval_converged_tol * diag,
+                 interior_tol = k_eval_interior_tol * diag;
+
+    std::string fail, rep;
+    sfb_surface_config cfg = sfb_surface_config_init(SFB_SCHEME_CATMARK, 0);
+    cfg.flags = SFB_REFINE_PATCHES;
+    sfb_surface *surf = NULL;
+    if (sfb_surface_create(ctx, mesh, &cfg, &surf) != SFB_SUCCESS) {
+        printf("FAIL %s: sfb_surface_create(SFB_REFINE_PATCHES): %s\n", tag.c_str(), sfb_last_error(ctx));
+        delete base;
+        sfb_mesh_destroy(mesh);
+        ++tot.failed;
+        return OUT_FAIL;
+    }
+    int nparam = sfb_surface_param_face_count(surf);
+
+    /* the exact points: which OpenSubdiv point each location is */
+    struct Probe { sfb_location loc; char kind; int a, b; };
+    std::vector<Probe> probes;
+    for (int f = 0, off = 0; f < d.face_count && fail.empty(); off += d.face_sizes[f], ++f) {
+        int n = d.face_sizes[f], first = 0, count = 0;
+        const int *fv = d.face_vertices + off;
+        if (sfb_surface_param_faces(surf, f, &first, &count) != SFB_SUCCESS || count != (n == 4 ? 1 : n)) {
+            appendf(fail, "base face %d (%d vertices) has %d parametric faces", f, n, count);
+            break;
+        }
+        if (n == 4) {
+            static const float uv[9][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}, {0.5f, 0}, {1, 0.5f}, {0.5f, 1}, {0, 0.5f}, {0.5f, 0.5f}};
+            for (int k = 0; k < 9; ++k) {
+                Probe p = {{first, uv[k][0], uv[k][1]}, k < 4 ? 'v' : k < 8 ? 'e' : 'f', k < 4 ? fv[k] : k < 8 ? fv[k - 4] : f,
+                           k >= 4 && k < 8 ? fv[(k - 3) % 4] : -1};
+                probes.push_back(p);
+            }
+        } else {
+            for (int i = 0; i < n; ++i) {
+                int vi = fv[i], vn = fv[(i + 1) % n], vp = fv[(i + n - 1) % n];
+                Probe c0 = {{first + i, 0, 0}, 'v', vi, -1}, c1 = {{first + i, 1, 0}, 'e', vi, vn},
+                      c2 = {{first + i, 1, 1}, 'f', f, -1}, c3 = {{first + i, 0, 1}, 'e', vp, vi};
+                probes.push_back(c0); probes.push_back(c1); probes.push_back(c2); probes.push_back(c3);
+            }
+        }
+    }
+    /* three groups: base vertices and first-level points where Limit() is exact, and darts and
+     * smooth valence-2 vertices (converged limit, end-cap tolerance) */
+    ErrStat st_corner, st_l1, st_conv;
+    if (fail.empty()) {
+        std::vector<sfb_location> locs(probes.size());
+        for (size_t k = 0; k < probes.size(); ++k) locs[k] = probes[k].loc;
+        std::vector<float> pos(probes.size() * 3);
+        sfb_eval_output out;
+        memset(&out, 0, sizeof out);
+        out.position = &pos[0];
+        if (sfb_surface_eval(surf, &locs[0], (int)locs.size(), &out) != SFB_SUCCESS)
+            appendf(fail, "sfb_surface_eval at the parametric face corners: %s", sfb_last_error(ctx));
+        LimitOracle oracle(*base, d.positions, osd_options(d));
+        typedef std::pair<char, std::pair<int, int> > Key;
+        std::map<Key, std::pair<Vec3d, bool> > cache;
+        int worst = -1;
+        double worst_rel = 0.0, worst_tol = 0.0;
+        for (size_t k = 0; k < probes.size() && fail.empty(); ++k) {
+            const Probe &p = probes[k];
+            int a = p.a, b = p.b;
+            if (p.kind == 'e' && a > b) std::swap(a, b);
+            Key key(p.kind, std::make_pair(a, b));
+            std::map<Key, std::pair<Vec3d, bool> >::iterator it = cache.find(key);
+            if (it == cache.end()) {
+                Vec3d lim;
+                bool conv = false;
+                std::string err;
+                if (!oracle.limit(p.kind, a, b, 1e-3 * exact_tol, lim, &conv, err)) {
+                    appendf(fail, "OpenSubdiv limit of %s %d: %s", p.kind == 'v' ? "vertex" : p.kind == 'e' ? "edge point of" : "face point of", a,
+                            err.c_str());
+                    break;
+                }
+                it = cache.insert(std::make_pair(key, std::make_pair(lim, conv))).first;
+            }
+            double e = dist3(&pos[3 * k], it->second.first.p);
+            bool conv = it->second.second;
+            double tol = conv ? converged_tol : exact_tol;
+            (conv ? st_conv : p.kind == 'v' ? st_corner : st_l1).add(e);
+            if (!(e <= tol) && !(e / tol <= worst_rel)) { worst_rel = e / tol; worst = (int)k; worst_tol = tol; }
+        }
+        if (fail.empty() && worst >= 0) {
+            const Probe &p = probes[(size_t)worst];
+            int bf = -1, sub = -1;
+            sfb_surface_param_face_base(surf, p.loc.face, &bf, &sub);
+            appendf(fail, "parametric face %d (base face %d, sub-face %d) at (%g,%g): %s %d%s%s differs from OpenSubdiv's limit by %.3g "
+                          "(tolerance %.3g)",
+                    p.loc.face, bf, sub, (double)p.loc.u, (double)p.loc.v,
+                    p.kind == 'v' ? "vertex" : p.kind == 'e' ? "edge point of" : "face point of", p.a,
+                    p.kind == 'e' ? "-" : "", p.kind == 'e' ? std::to_string(p.b).c_str() : "", worst_rel * worst_tol, worst_tol);
+        }
+    }
+
+    /* random interior locations against OpenSubdiv's patches */
+    double interior_err = 0.0;
+    int interior = 0, no_patch = 0;
+    if (fail.empty()) {
+        OsdPatchEval osd;
+        if (!osd.build(d)) appendf(fail, "OpenSubdiv could not build its patch table");
+        else if (osd.ptex_faces != nparam)
+            appendf(fail, "OpenSubdiv has %d ptex faces, surfblend %d parametric faces", osd.ptex_faces, nparam);
+        unsigned long long seed = 1469598103934665603ull; /* FNV-1a of the name: fixed per shape */
+        for (size_t i = 0; i < name.size(); ++i) seed = (seed ^ (unsigned char)name[i]) * 1099511628211ull;
+        SplitMix rng(seed);
+        for (int k = 0; k < k_eval_interior_points && fail.empty(); ++k) {
+            sfb_location l;
+            l.face = rng.below(nparam);
+            l.u = rng.open_unit();
+            l.v = rng.open_unit();
+            float p[3];
+            sfb_eval_output out;
+            memset(&out, 0, sizeof out);
+            out.position = p;
+            double q[3];
+            bool have_osd = osd.eval(l.face, l.u, l.v, q);
+            if (!have_osd) { ++no_patch; continue; }
+            if (sfb_surface_eval(surf, &l, 1, &out) != SFB_SUCCESS) {
+                appendf(fail, "sfb_surface_eval(%d, %g, %g): %s", l.face, (double)l.u, (double)l.v, sfb_last_error(ctx));
+                break;
+            }
+            double e = dist3(p, q);
+            ++interior;
+            if (!(e <= interior_err)) interior_err = std::isnan(e) ? INFINITY : e;
+            if (!(e <= interior_tol))
+                appendf(fail, "parametric face %d at (%g,%g): (%.6g %.6g %.6g), OpenSubdiv EvalPatches (%.6g %.6g %.6g): difference %.3g "
+                              "(tolerance %.3g)",
+                        l.face, (double)l.u, (double)l.v, p[0], p[1], p[2], q[0], q[1], q[2], e, interior_tol);
+        }
+        if (fail.empty() && interior == 0) appendf(fail, "OpenSubdiv has no patch at any of the random locations");
+    }
+    sfb_surface_destroy(surf);
+    sfb_mesh_destroy(mesh);
+    delete base;
+    append_osd_messages(rep);
+
+    if (!fail.empty()) {
+        printf("FAIL %s: %s\n", tag.c_str(), fail.c_str());
+        if (g_verbose) fputs(rep.c_str(), stdout);
+        ++tot.failed;
+        return OUT_FAIL;
+    }
+    std::string conv_part;
+    if (st_conv.n) appendf(conv_part, ", %d at darts/valence 2 (converged limit) %.2g", st_conv.n, st_conv.max / diag);
+    printf("PASS %s: errors x diagonal: %d vertex corners %.2g, %d level-1 points %.2g%s; %d interior points vs EvalPatches "
+           "%.2g%s\n",
+           tag.c_str(), st_corner.n, st_corner.max / diag, st_l1.n, st_l1.max / diag, conv_part.c_str(), interior, interior_err / diag,
+           no_patch ? (" (" + std::to_string(no_patch) + " random locations without an OpenSubdiv patch)").c_str() : "");
+    if (g_verbose) fputs(rep.c_str(), stdout);
+    ++tot.passed;
+    tot.note(st_corner.max / diag, tot.worst_corner, tot.worst_corner_shape, name);
+    tot.note(st_l1.max / diag, tot.worst_l1, tot.worst_l1_shape, name);
+    tot.note(st_conv.max / diag, tot.worst_conv, tot.worst_conv_shape, name);
+    tot.note(interior_err / diag, tot.worst_interior, tot.worst_interior_shape, name);
+    return OUT_PASS;
+}
+
 /* ---- --counts mode: OpenSubdiv only, with a parser of this file ---- */
 
 /* Reads v and f lines (f tokens "v", "v/vt", "v/vt/vn", "v//vn"; negative indices count back).
@@ -909,14 +1392,26 @@ int main(int argc, char **argv) {
     if (g_verbose) printf("backend: %s\n", sfb_context_backend_name(ctx));
 
     int passed = 0, failed = 0, skipped = 0;
+    EvalTotals et;
     for (size_t k = 0; k < files.size(); ++k) {
         Outcome o = run_shape(ctx, dir, files[k]);
         if (o == OUT_PASS) ++passed;
         else if (o == OUT_FAIL) ++failed;
         else ++skipped;
         fflush(stdout);
+        if (starts_with(files[k], "catmark_")) {
+            o = run_eval_shape(ctx, dir, files[k], et);
+            if (o == OUT_PASS) ++passed;
+            else if (o == OUT_FAIL) ++failed;
+            else ++skipped;
+            fflush(stdout);
+        }
     }
     sfb_context_destroy(ctx);
+    printf("limit-eval: %d shapes passed, %d failed, %d skipped; largest errors of passing shapes (x diagonal): vertex corners "
+           "%.3g (%s), level-1 points %.3g (%s), darts/valence 2 %.3g (%s), interior vs OpenSubdiv EvalPatches %.3g (%s)\n",
+           et.passed, et.failed, et.skipped, et.worst_corner, et.worst_corner_shape.c_str(), et.worst_l1,
+           et.worst_l1_shape.c_str(), et.worst_conv, et.worst_conv_shape.c_str(), et.worst_interior, et.worst_interior_shape.c_str());
 
     if (skipped) printf("%d passed, %d failed, %d skipped\n", passed, failed, skipped);
     else printf("%d passed, %d failed\n", passed, failed);
