@@ -203,7 +203,7 @@ SFB_API void sfb_context_destroy(sfb_context *ctx) {
     if (ctx->backend && ctx->backend->shutdown) ctx->backend->shutdown(ctx, ctx->backend_state);
     {
         int n;
-        for (n = 0; n <= SFB__STAM_MAX_VALENCE; ++n) sfb__eigen_cc_free(ctx, ctx->eigen_cc[n]);
+        for (n = 0; n <= SFB__STAM_MAX_VALENCE; ++n) { sfb__eigen_cc_free(ctx, ctx->eigen_cc[n]); sfb__eigen_loop_free(ctx, ctx->eigen_loop[n]); }
     }
     a = ctx->allocator;
     a.free(ctx, a.user);

@@ -319,7 +319,9 @@ SFB_API sfb_result sfb_surface_eval(const sfb_surface *surface, const sfb_locati
                                     const sfb_eval_output *out);
 
 typedef struct sfb_patch_info {
-    int param_faces, patches, bspline, stam, end_caps, max_depth, points;
+    int param_faces, patches;
+    int bspline, bezier;   /* regular patches: bicubic B-spline (Catmull-Clark), quartic Bezier triangle (Loop) */
+    int stam, end_caps, max_depth, points;
     size_t bytes;  /* memory of the patch table and its points */
 } sfb_patch_info;
 SFB_API sfb_result sfb_surface_patch_info(const sfb_surface *surface, sfb_patch_info *out);

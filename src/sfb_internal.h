@@ -100,6 +100,18 @@ typedef struct sfb__eigen_cc {
     double *a;         /* K x K subdivision matrix, only when asked to keep it */
 } sfb__eigen_cc;
 
+typedef struct sfb__eigen_loop {
+    int N, K;          /* K = N + 6 */
+    int dominant;      /* index of lambda = 1 */
+    double sub;        /* the subdominant eigenvalue 3/8 + cos(2 pi/N)/4 */
+    double error;      /* max |A - V J V^-1| found by the build */
+    double *lambda;    /* K */
+    int *head;         /* K: the Jordan head of a block's second vector, -1 for the others */
+    double *vinv;      /* K x K */
+    double *phi;       /* 3 x 15 x K: Bezier points phi[(k*15 + j)*K + i] of sub-patch k */
+    double *v, *a;     /* V (K x K) and A with Abar's 6 extra rows ((K+6) x K), only when kept */
+} sfb__eigen_loop;
+
 
 /* ---- patch tables (patches.c) ---- */
 typedef struct sfb__patch_table {
@@ -114,10 +126,11 @@ typedef struct sfb__patch_table {
     int *face_ptex;        /* per base face + 1: first param face */
     int *ptex_root;        /* per param face: >= 0 node, <= -2 patch -(p+2), -1 hole */
     int *nodes;            /* 4 per quadtree node, by quadrant x + 2y, same encoding */
-    int counts[3];         /* patches of each type */
+    int counts[6];         /* patches of each type (SFB__PATCH_*) */
     int npoints;           /* patch points */
     float *point_data;     /* xyz per patch point, for the surface's base positions */
     const sfb__eigen_cc *eig[SFB__STAM_MAX_VALENCE + 1]; /* valences used (the context's cache) */
+    const sfb__eigen_loop *eigl[SFB__STAM_MAX_VALENCE + 1]; /* Loop: the same */
 } sfb__patch_table;
 
 /* ---- context ---- */
@@ -134,6 +147,8 @@ struct sfb_context {
     void *backend_state;
     sfb__eigen_cc *eigen_cc[SFB__STAM_MAX_VALENCE + 1]; /* per valence, built on first use */
     unsigned char eigen_cc_failed[SFB__STAM_MAX_VALENCE + 1];
+    sfb__eigen_loop *eigen_loop[SFB__STAM_MAX_VALENCE + 1];
+    unsigned char eigen_loop_failed[SFB__STAM_MAX_VALENCE + 1];
     char report[2048];
     char error[1024];
     sfb_error_info error_info;
@@ -166,6 +181,9 @@ const sfb__backend_vtable *sfb__backend_ref(void);
 void sfb__eigen_cc_free(sfb_context *ctx, sfb__eigen_cc *e);
 sfb_result sfb__eigen_cc_build(sfb_context *ctx, int N, int keep, sfb__eigen_cc **out);
 const sfb__eigen_cc *sfb__eigen_cc_get(sfb_context *ctx, int N);
+void sfb__eigen_loop_free(sfb_context *ctx, sfb__eigen_loop *e);
+sfb_result sfb__eigen_loop_build(sfb_context *ctx, int N, int keep, sfb__eigen_loop **out);
+const sfb__eigen_loop *sfb__eigen_loop_get(sfb_context *ctx, int N);
 
 /* ---- topology of one level ---- */
 enum { SFB__TAG_BOUNDARY = 1, SFB__TAG_NONMANIFOLD = 2 };

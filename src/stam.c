@@ -419,3 +419,293 @@ const sfb__eigen_cc *sfb__eigen_cc_get(sfb_context *ctx, int N) {
     ctx->eigen_cc[N] = e;
     return e;
 }
+
+/* ---- Stam's Loop evaluation, in eigen form (ALGORITHMS.md §1.5, with our own layout) ----
+ *
+ * Control set of a triangle (EV, a, b), counter-clockwise, a and b regular (valence 6). In the
+ * lattice of the regular triangulation the EV is at (0,0), a at (1,0) and b at (0,1) (the
+ * patch's (u,v) frame):
+ *   0 the EV; 1..N its ring r_0 = a, r_1 = b, r_2, ... counter-clockwise (r_2 at (-1,1),
+ *   r_{N-1} at (1,-1)); N+1 (1,1), opposite the edge ab; N+2 (2,0) and N+3 (2,-1) beyond a;
+ *   N+4 (0,2) and N+5 (-1,2) beyond b. K = N + 6.
+ * One Loop step maps these K points to the same lattice places one level finer (A, K x K);
+ * six more points of the finer lattice, (3,0) (2,1) (3,-1) (1,2) (0,3) (-1,3), complete the
+ * enlarged set (Abar) from which the three regular sub-patches of the ring are picked: the
+ * corner at a ((1,0)..(2,0)..(1,1), k = 0), the corner at b (k = 1) and the middle triangle
+ * (k = 2, corner 0 at (1,1), turned by 180 degrees). Each sub-patch is a 12-point box spline,
+ * written as a quartic Bezier triangle by ALGORITHMS.md §5.1.
+ *
+ * A = [S 0; S10 S11] is put in Jordan form without a general eigensolver:
+ * - S (EV and ring) is circulant on the ring: eigenvalues 1 and 5/8 - alpha (frequency 0) and
+ *   3/8 + cos(2 pi j/N)/4 (cos and sin vectors of frequency j);
+ * - S11 (the 5 outer points) has eigenvalues 1/8 (three) and 1/16 (two), eigenvectors known;
+ * - an eigenvector w of S extends to [w; y] with y solved in S11's eigenbasis; when its
+ *   eigenvalue is also one of S11's and the right-hand side has a component there, A is
+ *   defective (valence 3: lambda = 1/16 three times, two eigenvectors): the extension is then
+ *   the second vector of a 2 x 2 Jordan block whose head is that component.
+ * A^m V = V J^m, so the level-n points of sub-patch k are Phi_k J^(n-1) V^-1 C, with
+ * Phi_k = (Bezier of the picked rows of Abar) V (15 x K): a partner column l of a Jordan head h
+ * gets lambda^m Phi_l + m lambda^(m-1) Phi_h. */
+
+/* Index of lattice point (x,y) in the enlarged set, -1 if not in it. */
+static int sfb__loop_index(int N, int x, int y) {
+    static const signed char pts[17][3] = {{0, 0, 0}, {1, 0, 1}, {0, 1, 2}, {-1, 1, 3}, {1, -1, -1},
+                                           {1, 1, 7},  {2, 0, 8}, {2, -1, 9}, {0, 2, 10}, {-1, 2, 11},
+                                           {3, 0, 12}, {2, 1, 13}, {3, -1, 14}, {1, 2, 15}, {0, 3, 16}, {-1, 3, 17}, {99, 99, 0}};
+    int i;
+    for (i = 0; pts[i][0] != 99; ++i)
+        if (pts[i][0] == x && pts[i][1] == y) {
+            int c = pts[i][2];
+            if (c == -1) return N;           /* r_{N-1} */
+            if (c == 3) return 1 + 2 % N;     /* r_2 (r_{N-1} itself when N = 3) */
+            return c >= 7 ? N + (c - 6) : c;
+        }
+    return -1;
+}
+
+/* Sabin's rules (ALGORITHMS.md §5.1): Bezier point (i = exponent of s, j = exponent of t,
+ * our order row by row in t) from the 12 box-spline points at lattice offsets boxpt[]. */
+static const signed char sfb__box12[12][2] = {{0, -1}, {1, -1}, {2, -1}, {-1, 0}, {0, 0}, {1, 0},
+                                              {2, 0},  {-1, 1}, {0, 1},  {1, 1},  {-1, 2}, {0, 2}};
+static const unsigned char sfb__bez15_from_box[15][12] = {
+    /* row t^0 */
+    {2, 2, 0, 2, 12, 2, 0, 2, 2, 0, 0, 0}, {1, 3, 0, 0, 12, 4, 0, 1, 3, 0, 0, 0}, {0, 4, 0, 0, 8, 8, 0, 0, 4, 0, 0, 0},
+    {0, 3, 1, 0, 4, 12, 0, 0, 3, 1, 0, 0}, {0, 2, 2, 0, 2, 12, 2, 0, 2, 2, 0, 0},
+    /* t^1 */
+    {0, 1, 0, 1, 12, 3, 0, 3, 4, 0, 0, 0}, {0, 1, 0, 0, 10, 6, 0, 1, 6, 0, 0, 0}, {0, 1, 0, 0, 6, 10, 0, 0, 6, 1, 0, 0},
+    {0, 1, 0, 0, 3, 12, 1, 0, 4, 3, 0, 0},
+    /* t^2 */
+    {0, 0, 0, 0, 8, 4, 0, 4, 8, 0, 0, 0}, {0, 0, 0, 0, 6, 6, 0, 1, 10, 1, 0, 0}, {0, 0, 0, 0, 4, 8, 0, 0, 8, 4, 0, 0},
+    /* t^3 */
+    {0, 0, 0, 0, 4, 3, 0, 3, 12, 1, 1, 0}, {0, 0, 0, 0, 3, 4, 0, 1, 12, 3, 0, 1},
+    /* t^4 */
+    {0, 0, 0, 0, 2, 2, 0, 2, 12, 2, 2, 2}};
+
+void sfb__eigen_loop_free(sfb_context *ctx, sfb__eigen_loop *e) {
+    if (!e) return;
+    sfb__free(ctx, e->lambda); sfb__free(ctx, e->head); sfb__free(ctx, e->vinv); sfb__free(ctx, e->phi);
+    sfb__free(ctx, e->v); sfb__free(ctx, e->a);
+    sfb__free(ctx, e);
+}
+
+/* A (K x K) followed by the 6 extra rows of Abar: (K + 6) x K, row-major. */
+static void sfb__loop_matrix(int N, double *A) {
+    int K = N + 6, i;
+    double c = cos(2.0 * SFB__PI / N), alpha = 0.625 - (3.0 + 2.0 * c) * (3.0 + 2.0 * c) / 64.0;
+    int a = 1, b = 2, r2 = 1 + 2 % N, rl = N, o11 = N + 1, o20 = N + 2, o2m = N + 3, o02 = N + 4, om2 = N + 5;
+    memset(A, 0, (size_t)(K + 6) * K * sizeof(double));
+#define SFB__A(r, col, w) (A[(size_t)(r) * K + (col)] += (w))
+    SFB__A(0, 0, 1.0 - alpha);
+    for (i = 1; i <= N; ++i) SFB__A(0, i, alpha / N);
+    for (i = 0; i < N; ++i) {
+        SFB__A(1 + i, 0, 0.375);
+        SFB__A(1 + i, 1 + i, 0.375);
+        SFB__A(1 + i, 1 + (i + N - 1) % N, 0.125);
+        SFB__A(1 + i, 1 + (i + 1) % N, 0.125);
+    }
+    /* (1,1): edge ab */
+    SFB__A(o11, a, 0.375); SFB__A(o11, b, 0.375); SFB__A(o11, 0, 0.125); SFB__A(o11, o11, 0.125);
+    /* (2,0): vertex a (valence 6: 5/8 and 1/16 each) */
+    SFB__A(o20, a, 0.625);
+    SFB__A(o20, 0, 0.0625); SFB__A(o20, rl, 0.0625); SFB__A(o20, o2m, 0.0625); SFB__A(o20, o20, 0.0625);
+    SFB__A(o20, o11, 0.0625); SFB__A(o20, b, 0.0625);
+    /* (2,-1): edge a r_{N-1} */
+    SFB__A(o2m, a, 0.375); SFB__A(o2m, rl, 0.375); SFB__A(o2m, 0, 0.125); SFB__A(o2m, o2m, 0.125);
+    /* (0,2): vertex b */
+    SFB__A(o02, b, 0.625);
+    SFB__A(o02, 0, 0.0625); SFB__A(o02, a, 0.0625); SFB__A(o02, o11, 0.0625); SFB__A(o02, o02, 0.0625);
+    SFB__A(o02, om2, 0.0625); SFB__A(o02, r2, 0.0625);
+    /* (-1,2): edge b r_2 */
+    SFB__A(om2, b, 0.375); SFB__A(om2, r2, 0.375); SFB__A(om2, 0, 0.125); SFB__A(om2, om2, 0.125);
+    /* the enlarged set: (3,0) (2,1) (3,-1) (1,2) (0,3) (-1,3), all edge points */
+    SFB__A(K + 0, a, 0.375); SFB__A(K + 0, o20, 0.375); SFB__A(K + 0, o11, 0.125); SFB__A(K + 0, o2m, 0.125);
+    SFB__A(K + 1, a, 0.375); SFB__A(K + 1, o11, 0.375); SFB__A(K + 1, o20, 0.125); SFB__A(K + 1, b, 0.125);
+    SFB__A(K + 2, a, 0.375); SFB__A(K + 2, o2m, 0.375); SFB__A(K + 2, o20, 0.125); SFB__A(K + 2, rl, 0.125);
+    SFB__A(K + 3, b, 0.375); SFB__A(K + 3, o11, 0.375); SFB__A(K + 3, o02, 0.125); SFB__A(K + 3, a, 0.125);
+    SFB__A(K + 4, b, 0.375); SFB__A(K + 4, o02, 0.375); SFB__A(K + 4, o11, 0.125); SFB__A(K + 4, om2, 0.125);
+    SFB__A(K + 5, b, 0.375); SFB__A(K + 5, om2, 0.375); SFB__A(K + 5, o02, 0.125); SFB__A(K + 5, r2, 0.125);
+#undef SFB__A
+}
+
+sfb_result sfb__eigen_loop_build(sfb_context *ctx, int N, int keep, sfb__eigen_loop **out) {
+    /* S11's eigenvectors (outer order (1,1) (2,0) (2,-1) (0,2) (-1,2)) and eigenvalues */
+    static const double U[5][5] = {{1, 0, 0, 0, 0}, {1, 1, 0, 1, 0}, {0, 1, 0, 0, 0}, {1, 0, 1, 0, 1}, {0, 0, 1, 0, 0}};
+    static const double mu[5] = {0.125, 0.125, 0.125, 0.0625, 0.0625};
+    sfb__eigen_loop *e;
+    int K = N + 6, col = 0, i, j, k, q, l, njordan = 0;
+    double *A = NULL, *V = NULL, *W = NULL;
+    double Ui[25], Uw[25];
+    int *perm = NULL, outer_col[5];
+    size_t KK = (size_t)K * K;
+    double c1 = 0.0;
+    *out = NULL;
+    if (N < 3 || N > SFB__STAM_MAX_VALENCE)
+        return sfb__error(ctx, SFB_LIMIT_EXCEEDED, SFB_ELEMENT_NONE, -1, "no Stam-Loop eigen structure for valence %d (3..%d)", N,
+                          SFB__STAM_MAX_VALENCE);
+    e = (sfb__eigen_loop *)sfb__calloc(ctx, 1, sizeof *e);
+    A = (double *)sfb__alloc(ctx, (size_t)(K + 6) * K * sizeof(double));
+    V = (double *)sfb__calloc(ctx, KK, sizeof(double));
+    W = (double *)sfb__alloc(ctx, KK * sizeof(double));
+    perm = (int *)sfb__alloc(ctx, (size_t)K * sizeof(int));
+    if (e) {
+        e->lambda = (double *)sfb__alloc(ctx, (size_t)K * sizeof(double));
+        e->head = (int *)sfb__alloc(ctx, (size_t)K * sizeof(int));
+        e->vinv = (double *)sfb__alloc(ctx, KK * sizeof(double));
+        e->phi = (double *)sfb__alloc(ctx, (size_t)45 * K * sizeof(double));
+    }
+    if (!e || !A || !V || !W || !perm || !e->lambda || !e->head || !e->vinv || !e->phi) goto oom;
+    e->N = N;
+    e->K = K;
+    for (i = 0; i < K; ++i) e->head[i] = -1;
+    sfb__loop_matrix(N, A);
+    for (i = 0; i < 25; ++i) Uw[i] = U[i / 5][i % 5];
+    if (!sfb__invert(5, Uw, Ui, perm)) goto defective;
+    /* S's eigenvectors in the first N+1 rows of V */
+#define SFB__SET(r, value) (V[(size_t)(r) * K + col] = (value))
+    {
+        double c = cos(2.0 * SFB__PI / N), alpha = 0.625 - (3.0 + 2.0 * c) * (3.0 + 2.0 * c) / 64.0;
+        for (i = 0; i <= N; ++i) SFB__SET(i, 1.0);
+        e->lambda[col] = 1.0;
+        e->dominant = col++;
+        SFB__SET(0, -8.0 * alpha / 3.0);
+        for (i = 1; i <= N; ++i) SFB__SET(i, 1.0);
+        e->lambda[col++] = 0.625 - alpha;
+    }
+    for (j = 1; 2 * j < N; ++j) {
+        double t = 2.0 * SFB__PI * j / N;
+        int trig;
+        for (trig = 0; trig < 2; ++trig) {
+            SFB__SET(0, 0.0);
+            for (i = 0; i < N; ++i) SFB__SET(1 + i, trig ? sin(i * t) : cos(i * t));
+            e->lambda[col++] = 0.375 + 0.25 * cos(t);
+        }
+        if (j == 1) c1 = 0.375 + 0.25 * cos(t);
+    }
+    if (N % 2 == 0) {
+        SFB__SET(0, 0.0);
+        for (i = 0; i < N; ++i) SFB__SET(1 + i, (i % 2) ? -1.0 : 1.0);
+        e->lambda[col++] = 0.125;
+    }
+#undef SFB__SET
+    if (col != N + 1) goto defective;
+    /* S11's eigenvectors [0; u_l] */
+    for (l = 0; l < 5; ++l) {
+        for (i = 0; i < 5; ++i) V[(size_t)(N + 1 + i) * K + col] = U[i][l];
+        e->lambda[col] = mu[l];
+        outer_col[l] = col++;
+    }
+    /* extend S's eigenvectors: (S11 - lambda) y = -S10 w, in S11's eigenbasis */
+    for (q = 0; q <= N; ++q) {
+        double rhs[5], d[5], yh[5], best = 0.0;
+        int lstar = -1;
+        for (i = 0; i < 5; ++i) {
+            double s = 0.0;
+            for (k = 0; k <= N; ++k) s += A[(size_t)(N + 1 + i) * K + k] * V[(size_t)k * K + q];
+            rhs[i] = s;
+        }
+        for (l = 0; l < 5; ++l) {
+            double s = 0.0;
+            for (i = 0; i < 5; ++i) s += Ui[l * 5 + i] * rhs[i];
+            d[l] = s;
+        }
+        for (l = 0; l < 5; ++l) {
+            if (fabs(e->lambda[q] - mu[l]) > 1e-9) yh[l] = d[l] / (e->lambda[q] - mu[l]);
+            else {
+                yh[l] = 0.0;
+                if (fabs(d[l]) > 1e-12 && fabs(d[l]) > best) { best = fabs(d[l]); lstar = l; }
+            }
+        }
+        for (i = 0; i < 5; ++i) {
+            double s = 0.0;
+            for (l = 0; l < 5; ++l) s += U[i][l] * yh[l];
+            V[(size_t)(N + 1 + i) * K + q] = s;
+        }
+        if (lstar >= 0) {
+            /* defective: (A - lambda)[w; y] = sum over S11's lambda-eigenvectors of d_l [0; u_l].
+             * That sum replaces the column of u_lstar as the Jordan head; [w; y] is its partner. */
+            int h = outer_col[lstar];
+            if (++njordan > 1) goto defective;
+            for (i = 0; i < 5; ++i) {
+                double s = 0.0;
+                for (l = 0; l < 5; ++l)
+                    if (fabs(e->lambda[q] - mu[l]) <= 1e-9) s += d[l] * U[i][l];
+                V[(size_t)(N + 1 + i) * K + h] = s;
+            }
+            e->lambda[q] = mu[lstar];
+            e->head[q] = h;
+        }
+    }
+    /* V^-1 */
+    memcpy(W, V, KK * sizeof(double));
+    if (!sfb__invert(K, W, e->vinv, perm)) goto defective;
+    /* check A = V J V^-1 */
+    {
+        double err = 0.0;
+        int r, c;
+        for (r = 0; r < K; ++r)
+            for (c = 0; c < K; ++c) {
+                double s = 0.0;
+                for (k = 0; k < K; ++k) {
+                    double vj = V[(size_t)r * K + k] * e->lambda[k];
+                    if (e->head[k] >= 0) vj += V[(size_t)r * K + e->head[k]];
+                    s += vj * e->vinv[(size_t)k * K + c];
+                }
+                s -= A[(size_t)r * K + c];
+                if (fabs(s) > err) err = fabs(s);
+            }
+        e->error = err;
+        if (!(err < 1e-9)) goto defective;
+    }
+    e->sub = c1;
+    /* Phi_k: Bezier points of the picked rows of Abar V */
+    for (k = 0; k < 3; ++k) {
+        static const int org[3][4] = {{1, 0, 1, 0}, {0, 1, 1, 0}, {1, 1, -1, 0}}; /* origin x, y; frame sign; unused */
+        int rows[12];
+        for (j = 0; j < 12; ++j) {
+            int x = org[k][0] + org[k][2] * sfb__box12[j][0], y = org[k][1] + org[k][2] * sfb__box12[j][1];
+            rows[j] = sfb__loop_index(N, x, y);
+            if (rows[j] < 0) goto defective;
+        }
+        for (q = 0; q < K; ++q) {
+            double av[12];
+            for (j = 0; j < 12; ++j) {
+                double s = 0.0;
+                int c;
+                for (c = 0; c < K; ++c) s += A[(size_t)rows[j] * K + c] * V[(size_t)c * K + q];
+                av[j] = s;
+            }
+            for (j = 0; j < 15; ++j) {
+                double s = 0.0;
+                for (i = 0; i < 12; ++i) s += sfb__bez15_from_box[j][i] * av[i];
+                e->phi[((size_t)k * 15 + j) * K + q] = s / 24.0;
+            }
+        }
+    }
+    if (keep) { e->v = V; e->a = A; V = A = NULL; }
+    sfb__free(ctx, A); sfb__free(ctx, V); sfb__free(ctx, W); sfb__free(ctx, perm);
+    *out = e;
+    return SFB_SUCCESS;
+defective:
+    sfb__free(ctx, A); sfb__free(ctx, V); sfb__free(ctx, W); sfb__free(ctx, perm);
+    sfb__eigen_loop_free(ctx, e);
+    return sfb__error(ctx, SFB_BACKEND_ERROR, SFB_ELEMENT_NONE, -1, "Stam-Loop eigen structure of valence %d failed its check", N);
+oom:
+    sfb__free(ctx, A); sfb__free(ctx, V); sfb__free(ctx, W); sfb__free(ctx, perm);
+    sfb__eigen_loop_free(ctx, e);
+    return sfb__oom(ctx, "Stam-Loop eigen structure");
+}
+
+const sfb__eigen_loop *sfb__eigen_loop_get(sfb_context *ctx, int N) {
+    sfb__eigen_loop *e;
+    if (N < 3 || N > SFB__STAM_MAX_VALENCE) return NULL;
+    if (ctx->eigen_loop[N]) return ctx->eigen_loop[N];
+    if (ctx->eigen_loop_failed[N]) return NULL;
+    if (sfb__eigen_loop_build(ctx, N, 0, &e) != SFB_SUCCESS) {
+        ctx->eigen_loop_failed[N] = 1;
+        sfb__log(ctx, SFB_LOG_WARN, "valence %d: %s; its faces are isolated adaptively instead", N, ctx->error);
+        sfb_clear_error(ctx);
+        return NULL;
+    }
+    ctx->eigen_loop[N] = e;
+    return e;
+}

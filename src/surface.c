@@ -73,8 +73,8 @@ SFB_API sfb_result sfb_surface_create(sfb_context *ctx, const sfb_mesh *mesh, co
     if (cfg->refine_level > SFB_MAX_LEVEL)
         return sfb__error(ctx, SFB_LIMIT_EXCEEDED, SFB_ELEMENT_NONE, -1, "refinement level %d is over the limit of %d (SFB_MAX_LEVEL)",
                           cfg->refine_level, SFB_MAX_LEVEL);
-    if ((cfg->flags & SFB_REFINE_PATCHES) && cfg->scheme != SFB_SCHEME_CATMARK)
-        return sfb__error(ctx, SFB_UNSUPPORTED, SFB_ELEMENT_NONE, -1, "limit evaluation (SFB_REFINE_PATCHES) is built for Catmull-Clark only; scheme '%s' is not supported yet",
+    if ((cfg->flags & SFB_REFINE_PATCHES) && cfg->scheme != SFB_SCHEME_CATMARK && cfg->scheme != SFB_SCHEME_LOOP)
+        return sfb__error(ctx, SFB_UNSUPPORTED, SFB_ELEMENT_NONE, -1, "limit evaluation (SFB_REFINE_PATCHES) is built for Catmull-Clark and Loop; scheme '%s' is not supported",
                           sfb_scheme_name(cfg->scheme));
     if ((cfg->flags & SFB_REFINE_PATCHES) && (cfg->isolation_level < 0 || cfg->isolation_level > SFB_MAX_LEVEL))
         return sfb__error(ctx, SFB_LIMIT_EXCEEDED, SFB_ELEMENT_NONE, -1, "isolation level %d is outside 0..%d (0 = default %d)",
@@ -210,8 +210,9 @@ SFB_API sfb_result sfb_surface_patch_info(const sfb_surface *s, sfb_patch_info *
     o->param_faces = pt->nptex;
     o->patches = pt->npatch;
     o->bspline = pt->counts[SFB__PATCH_BSPLINE];
-    o->stam = pt->counts[SFB__PATCH_STAM];
-    o->end_caps = pt->counts[SFB__PATCH_ENDCAP];
+    o->bezier = pt->counts[SFB__PATCH_BEZTRI];
+    o->stam = pt->counts[SFB__PATCH_STAM] + pt->counts[SFB__PATCH_STAM_LOOP];
+    o->end_caps = pt->counts[SFB__PATCH_ENDCAP] + pt->counts[SFB__PATCH_ENDCAP_TRI];
     o->max_depth = pt->max_depth;
     o->points = pt->npoints;
     o->bytes = (size_t)pt->npatch * (4 * sizeof(int)) + (size_t)pt->ncv * sizeof(int) + (size_t)pt->nptex * 3 * sizeof(int) +
@@ -236,6 +237,9 @@ SFB_API sfb_result sfb_surface_eval(const sfb_surface *s, const sfb_location *lo
         if (!(l->u >= 0.0f && l->u <= 1.0f && l->v >= 0.0f && l->v <= 1.0f))
             return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, q, "location %d: (u,v) = (%g,%g) is outside [0,1]^2", q, (double)l->u,
                               (double)l->v);
+        if (s->patches.scheme == SFB_SCHEME_LOOP && (double)l->u + (double)l->v > 1.0)
+            return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, q, "location %d: (u,v) = (%g,%g) is outside the triangle u + v <= 1", q,
+                              (double)l->u, (double)l->v);
         /* holes are whole parametric faces (a hole is a base face), so the root says it */
         if (s->patches.ptex_root[l->face] == -1)
             return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, q, "location %d: parametric face %d is a hole", q, l->face);
