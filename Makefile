@@ -118,7 +118,12 @@ $(BUILD)/gl_pieces: tests/gl_pieces.c surfblend.h $(BACKEND_HDRS)
 $(BUILD)/limit: tests/limit.c $(BUILD)/libsfb.o
 	$(CC) $(CFLAGS) $(SAN) -I. tests/limit.c $(BUILD)/libsfb.o -o $@ $(LIBS)
 
-unit-build: $(BUILD)/surfblend $(BUILD)/unit $(BUILD)/osd_agree $(BUILD)/agree $(BUILD)/limit $(BUILD)/gl_host \
+# The Stam eigen structures, checked against the subdivision matrices: compiles its own
+# implementation to reach the builders (tests/eigen.c).
+$(BUILD)/eigen: tests/eigen.c surfblend.h
+	$(CC) $(CFLAGS) $(SAN) -I. tests/eigen.c -o $@ $(LIBS)
+
+unit-build: $(BUILD)/surfblend $(BUILD)/unit $(BUILD)/osd_agree $(BUILD)/agree $(BUILD)/limit $(BUILD)/eigen $(BUILD)/gl_host \
             $(BUILD)/gl_errors $(BUILD)/gl_pieces $(EXAMPLES)
 
 # On CI (CI set and not false/0) the optional backends must run, not be skipped: the suites

@@ -8,7 +8,7 @@
  *       (PASS / FAIL / REJECTED; NOTE for shapes with hierarchical edits, which both libraries
  *       ignore) and a summary "N passed, M failed[, K skipped]". Limit normals (from the limit
  *       tangent masks) are compared where the normal is unique (smooth, dart, boundary).
- *       Then, for every catmark_ shape, limit evaluation (sfb_surface_eval on a surface made
+ *       Then, for every catmark_ and loop_ shape, limit evaluation (sfb_surface_eval on a surface made
  *       with SFB_REFINE_PATCHES): one more line per shape, "PASS/FAIL/SKIP limit-eval NAME",
  *       counted in the same summary (see run_eval_shape; shapes with holes, non-manifold
  *       vertices or edges, or boundary interpolation "none" are skipped), and a closing
@@ -802,8 +802,8 @@ struct SplitMix {
  * shape would need up to 8 levels: catmark_rook has sharpness 7.9.) */
 class LimitOracle {
 public:
-    LimitOracle(const Far::TopologyRefiner &base, const float *positions, const Sdc::Options &opt)
-        : base_(base), opt_(opt) {
+    LimitOracle(const Far::TopologyRefiner &base, const float *positions, const Sdc::Options &opt, Sdc::SchemeType type)
+        : base_(base), opt_(opt), type_(type) {
         int n = base.GetLevel(0).GetNumVertices();
         pos0_.resize((size_t)n);
         for (int i = 0; i < n; ++i)
@@ -892,6 +892,7 @@ private:
     };
     const Far::TopologyRefiner &base_;
     Sdc::Options opt_;
+    Sdc::SchemeType type_;
     std::vector<Vec3d> pos0_;
 
     static bool semisharp(float s) { return s > 0.0f && s < Sdc::Crease::SHARPNESS_INFINITE; }
@@ -939,7 +940,7 @@ private:
         desc.cornerVertexIndices = cverts.empty() ? NULL : &cverts[0];
         desc.cornerWeights = vw.empty() ? NULL : &vw[0];
         typedef Far::TopologyRefinerFactory<Far::TopologyDescriptor> Factory;
-        sub.r = Factory::Create(desc, Factory::Options(Sdc::SCHEME_CATMARK, opt_));
+        sub.r = Factory::Create(desc, Factory::Options(type_, opt_));
         if (!sub.r) return false;
         Far::TopologyRefiner::UniformOptions uo(1);
         uo.fullTopologyInLastLevel = true;
@@ -963,8 +964,8 @@ struct OsdPatchEval {
     int ptex_faces;
     OsdPatchEval() : r(NULL), table(NULL), map(NULL), cpu(NULL), ptex_faces(0) {}
     ~OsdPatchEval() { delete cpu; delete map; delete table; delete r; }
-    bool build(const sfb_mesh_desc &d) {
-        r = osd_refiner_from_desc(d, Sdc::SCHEME_CATMARK);
+    bool build(const sfb_mesh_desc &d, Sdc::SchemeType type) {
+        r = osd_refiner_from_desc(d, type);
         if (!r) return false;
         ptex_faces = Far::PtexIndices(*r).GetNumFaces();
         Far::PatchTableFactory::Options po;
@@ -1034,7 +1035,7 @@ static double dist3(const float *a, const double *b) {
     return std::sqrt(x * x + y * y + z * z);
 }
 
-/* sfb_surface_eval against OpenSubdiv on one Catmull-Clark shape: at every parametric face
+/* sfb_surface_eval against OpenSubdiv on one Catmull-Clark or Loop shape: at every parametric face
  * corner that is a base vertex, and at the parametric face points that are edge and face points
  * of the first refinement (quads: edge midpoints and centre; n-gon sub-faces: (1,0), (1,1),
  * (0,1)), the position must be the limit position of that point (LimitOracle) within 1e-6 of the
@@ -1060,7 +1061,9 @@ static Outcome run_eval_shape(sfb_context *ctx, const std::string &dir, const st
     if (mi.holes > 0) skip = "holes (sfb_surface_eval rejects hole faces)";
     else if (mi.nonmanifold_vertices > 0 || mi.nonmanifold_edges > 0) skip = "non-manifold vertices or edges";
     else if (d.boundary == SFB_BOUNDARY_NONE) skip = "boundary interpolation none (boundary faces are not part of the surface)";
-    Far::TopologyRefiner *base = skip ? NULL : osd_refiner_from_desc(d, Sdc::SCHEME_CATMARK);
+    const bool loop = starts_with(name, "loop_");
+    const Sdc::SchemeType type = loop ? Sdc::SCHEME_LOOP : Sdc::SCHEME_CATMARK;
+    Far::TopologyRefiner *base = skip ? NULL : osd_refiner_from_desc(d, type);
     if (!skip && !base) skip = "OpenSubdiv cannot build the topology";
     if (skip) {
         printf("SKIP %s: %s\n", tag.c_str(), skip);
@@ -1082,7 +1085,7 @@ static Outcome run_eval_shape(sfb_context *ctx, const std::string &dir, const st
                  interior_tol = k_eval_interior_tol * diag;
 
     std::string fail, rep;
-    sfb_surface_config cfg = sfb_surface_config_init(SFB_SCHEME_CATMARK, 0);
+    sfb_surface_config cfg = sfb_surface_config_init(loop ? SFB_SCHEME_LOOP : SFB_SCHEME_CATMARK, 0);
     cfg.flags = SFB_REFINE_PATCHES;
     sfb_surface *surf = NULL;
     if (sfb_surface_create(ctx, mesh, &cfg, &surf) != SFB_SUCCESS) {
@@ -1100,11 +1103,18 @@ static Outcome run_eval_shape(sfb_context *ctx, const std::string &dir, const st
     for (int f = 0, off = 0; f < d.face_count && fail.empty(); off += d.face_sizes[f], ++f) {
         int n = d.face_sizes[f], first = 0, count = 0;
         const int *fv = d.face_vertices + off;
-        if (sfb_surface_param_faces(surf, f, &first, &count) != SFB_SUCCESS || count != (n == 4 ? 1 : n)) {
+        if (sfb_surface_param_faces(surf, f, &first, &count) != SFB_SUCCESS || count != ((loop || n == 4) ? 1 : n)) {
             appendf(fail, "base face %d (%d vertices) has %d parametric faces", f, n, count);
             break;
         }
-        if (n == 4) {
+        if (loop) {
+            /* a triangle: corners (0,0) (1,0) (0,1), edge midpoints (1/2,0) (1/2,1/2) (0,1/2) */
+            static const float uv[6][2] = {{0, 0}, {1, 0}, {0, 1}, {0.5f, 0}, {0.5f, 0.5f}, {0, 0.5f}};
+            for (int k = 0; k < 6; ++k) {
+                Probe p = {{first, uv[k][0], uv[k][1]}, k < 3 ? 'v' : 'e', k < 3 ? fv[k] : fv[k - 3], k < 3 ? -1 : fv[(k - 2) % 3]};
+                probes.push_back(p);
+            }
+        } else if (n == 4) {
             static const float uv[9][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}, {0.5f, 0}, {1, 0.5f}, {0.5f, 1}, {0, 0.5f}, {0.5f, 0.5f}};
             for (int k = 0; k < 9; ++k) {
                 Probe p = {{first, uv[k][0], uv[k][1]}, k < 4 ? 'v' : k < 8 ? 'e' : 'f', k < 4 ? fv[k] : k < 8 ? fv[k - 4] : f,
@@ -1132,7 +1142,7 @@ static Outcome run_eval_shape(sfb_context *ctx, const std::string &dir, const st
         out.position = &pos[0];
         if (sfb_surface_eval(surf, &locs[0], (int)locs.size(), &out) != SFB_SUCCESS)
             appendf(fail, "sfb_surface_eval at the parametric face corners: %s", sfb_last_error(ctx));
-        LimitOracle oracle(*base, d.positions, osd_options(d));
+        LimitOracle oracle(*base, d.positions, osd_options(d), type);
         typedef std::pair<char, std::pair<int, int> > Key;
         std::map<Key, std::pair<Vec3d, bool> > cache;
         int worst = -1;
@@ -1177,7 +1187,7 @@ static Outcome run_eval_shape(sfb_context *ctx, const std::string &dir, const st
     int interior = 0, no_patch = 0;
     if (fail.empty()) {
         OsdPatchEval osd;
-        if (!osd.build(d)) appendf(fail, "OpenSubdiv could not build its patch table");
+        if (!osd.build(d, type)) appendf(fail, "OpenSubdiv could not build its patch table");
         else if (osd.ptex_faces != nparam)
             appendf(fail, "OpenSubdiv has %d ptex faces, surfblend %d parametric faces", osd.ptex_faces, nparam);
         unsigned long long seed = 1469598103934665603ull; /* FNV-1a of the name: fixed per shape */
@@ -1188,6 +1198,7 @@ static Outcome run_eval_shape(sfb_context *ctx, const std::string &dir, const st
             l.face = rng.below(nparam);
             l.u = rng.open_unit();
             l.v = rng.open_unit();
+            if (loop && (double)l.u + (double)l.v > 1.0) { l.u = 1.0f - l.u; l.v = 1.0f - l.v; } /* into the triangle */
             float p[3];
             sfb_eval_output out;
             memset(&out, 0, sizeof out);
@@ -1399,7 +1410,7 @@ int main(int argc, char **argv) {
         else if (o == OUT_FAIL) ++failed;
         else ++skipped;
         fflush(stdout);
-        if (starts_with(files[k], "catmark_")) {
+        if (starts_with(files[k], "catmark_") || starts_with(files[k], "loop_")) {
             o = run_eval_shape(ctx, dir, files[k], et);
             if (o == OUT_PASS) ++passed;
             else if (o == OUT_FAIL) ++failed;

@@ -85,6 +85,9 @@ fi
 if [ -d "$SHAPES" ]; then counted agree "$BUILD/agree" "$SHAPES"
 else echo "peer shapes not found at $SHAPES: agree runs without them"; counted agree "$BUILD/agree"; fi
 
+# 3b''. the Stam eigen structures: tests/eigen.c
+counted eigen "$BUILD/eigen"
+
 # 3b'. limit evaluation on every backend (ref included): tests/limit.c
 if [ -d "$SHAPES" ]; then counted limit "$BUILD/limit" "$SHAPES"
 else echo "peer shapes not found at $SHAPES: limit evaluation suite skipped"; add_counts limit 0 0 1; fi
