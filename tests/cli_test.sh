@@ -130,6 +130,28 @@ printf '0 1.5 0.5\n' > "$TMP/badlocs.txt"
 check "eval with u outside [0,1] is bad input" 1 "$CLI" eval --locations "$TMP/badlocs.txt" "$TMP/cube.obj"
 contains "u outside [0,1] is reported" "$TMP/err" "outside \[0,1\]"
 check "eval without locations is a usage error" 2 "$CLI" eval "$TMP/cube.obj"
+# Loop: triangles, barycentric (u,v) with u + v <= 1
+printf 'v 1 1 1\nv -1 -1 1\nv -1 1 -1\nv 1 -1 -1\nf 1 2 3\nf 1 4 2\nf 1 3 4\nf 2 4 3\n' > "$TMP/tet.obj"
+check "eval --scheme loop --random succeeds" 0 "$CLI" eval --scheme loop --random 200 --seed 5 "$TMP/tet.obj"
+if awk 'NF != 9 || $1 < 0 || $1 > 3 || $2 < 0 || $3 < 0 || $2 + $3 > 1 { exit 1 }' "$TMP/out"; then P=$((P + 1)); echo "ok eval --scheme loop samples the triangles (u + v <= 1)"
+else F=$((F + 1)); echo "FAIL eval --scheme loop sampled outside the triangles"; head -n 3 "$TMP/out"; fi
+printf '0 0.25 0.25\n1 0.75 0.5\n' > "$TMP/badlocs.txt"
+check "eval --scheme loop with u + v > 1 is bad input" 1 "$CLI" eval --scheme loop --locations "$TMP/badlocs.txt" "$TMP/tet.obj"
+contains "u + v > 1 is reported with its query" "$TMP/err" "location 1: .* outside the triangle u + v <= 1"
+check "eval --scheme loop on quads is bad input" 1 "$CLI" eval --scheme loop --random 3 "$TMP/cube.obj"
+contains "Loop on quads is reported" "$TMP/err" "Loop subdivision needs triangles"
+check "eval --scheme bilinear is bad input" 1 "$CLI" eval --scheme bilinear --random 3 "$TMP/cube.obj"
+contains "bilinear limit evaluation is reported unsupported" "$TMP/err" "not supported"
+for r in 1 4; do
+  check "tess --scheme loop tetrahedron rate $r succeeds" 0 "$CLI" tess --scheme loop --rate $r "$TMP/tet.obj" -o "$TMP/t.obj"
+  st=$(edge_stats "$TMP/t.obj")
+  if [ "$st" = "0 0 0" ]; then P=$((P + 1)); echo "ok tess loop tetrahedron rate $r is closed"; else F=$((F + 1)); echo "FAIL tess loop tetrahedron rate $r is not closed: $st"; fi
+  # a triangular grid of rate r: 4 r^2 triangles, V = 4 + 6 (r-1) + 4 (r-1)(r-2)/2
+  got=$(grep -c '^f ' "$TMP/t.obj"); want=$((4 * r * r))
+  if [ "$got" = "$want" ]; then P=$((P + 1)); echo "ok tess loop tetrahedron rate $r has $want triangles"; else F=$((F + 1)); echo "FAIL tess loop tetrahedron rate $r: $got triangles, wanted $want"; fi
+  got=$(grep -c '^v ' "$TMP/t.obj"); want=$((4 + 6 * (r - 1) + 2 * (r - 1) * (r - 2)))
+  if [ "$got" = "$want" ]; then P=$((P + 1)); echo "ok tess loop tetrahedron rate $r has $want vertices"; else F=$((F + 1)); echo "FAIL tess loop tetrahedron rate $r: $got vertices, wanted $want"; fi
+done
 check "eval with a missing location file is bad input" 1 "$CLI" eval --locations "$TMP/none.txt" "$TMP/cube.obj"
 "$CLI" backends > "$TMP/backends" 2>/dev/null
 "$CLI" tess --backend ref --rate 6 --split-creases examples/data/creased_box.obj -o "$TMP/tref.obj" 2>/dev/null

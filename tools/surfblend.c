@@ -1,11 +1,12 @@
 /* surfblend command-line tool.
  *   surfblend info in.obj
  *   surfblend refine [--scheme catmark|loop|bilinear] [--level L] [--limit] [--backend NAME] in.obj -o out.obj
- *   surfblend eval [--backend NAME] (--random N [--seed S] | --locations FILE) [--derivatives] [-o OUT] in.obj
- *   surfblend tess [--backend NAME] --rate N [--tolerance T] [--split-creases] in.obj -o out.obj
+ *   surfblend eval [--scheme catmark|loop] [--backend NAME] (--random N [--seed S] | --locations FILE) [--derivatives] [-o OUT] in.obj
+ *   surfblend tess [--scheme catmark|loop] [--backend NAME] --rate N [--tolerance T] [--split-creases] in.obj -o out.obj
  *   surfblend backends
  * Exit codes: 0 success, 1 bad input (message on stderr), 2 usage error. */
 #include "surfblend.h"
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -18,14 +19,17 @@ static const char *usage_text =
     "      --level L                        uniform refinement level 0..10 (default 2)\n"
     "      --limit                          write limit positions (and limit normals as vn) instead of refined points\n"
     "      --backend NAME                   ref|simd|gl|osmesa, tried first (else SURFBLEND_BACKEND, else the default order)\n"
-    "  surfblend eval [options] IN.obj            the limit surface at parametric locations (Catmull-Clark)\n"
-    "      --locations FILE                 lines 'face u v' (parametric face, u, v in [0,1]; '#' starts a comment)\n"
+    "  surfblend eval [options] IN.obj            the limit surface at parametric locations\n"
+    "      --scheme catmark|loop            as for refine (default: from the file name prefix, else catmark)\n"
+    "      --locations FILE                 lines 'face u v' (parametric face; u, v in [0,1], and u + v <= 1 on Loop's\n"
+    "                                       triangles; '#' starts a comment)\n"
     "      --random N [--seed S]            N random locations on faces that are not holes (deterministic for a seed)\n"
     "      --derivatives                    also print du and dv\n"
     "      -o OUT                           write to OUT instead of stdout\n"
     "      --backend NAME                   as for refine\n"
     "    prints one line per location: face u v px py pz nx ny nz [dux duy duz dvx dvy dvz]\n"
     "  surfblend tess [options] IN.obj -o OUT.obj   watertight triangles of the limit surface (v, vn, f v//vn)\n"
+    "      --scheme catmark|loop            as for refine\n"
     "      --rate N                         segments per parametric-face edge, 1..1024 (required)\n"
     "      --tolerance T                    adaptive: per face the smallest rate <= N within chordal error T\n"
     "      --split-creases                  separate vertices (and normals) on each side of infinitely sharp creases\n"
@@ -191,8 +195,20 @@ static int scheme_from_name(const char *s, sfb_scheme *out) {
     return 1;
 }
 
+/* The scheme of an input: --scheme if given, else the file name's prefix (loop_, bilinear_),
+ * else Catmull-Clark. */
+static sfb_scheme scheme_for(const char *path, int have_scheme, sfb_scheme scheme) {
+    const char *base;
+    if (have_scheme) return scheme;
+    base = strrchr(path, '/');
+    base = base ? base + 1 : path;
+    if (strncmp(base, "loop_", 5) == 0) return SFB_SCHEME_LOOP;
+    if (strncmp(base, "bilinear_", 9) == 0) return SFB_SCHEME_BILINEAR;
+    return SFB_SCHEME_CATMARK;
+}
+
 static int cmd_refine(int argc, char **argv) {
-    const char *in = NULL, *outp = NULL, *backend = NULL, *base;
+    const char *in = NULL, *outp = NULL, *backend = NULL;
     sfb_scheme scheme = SFB_SCHEME_CATMARK;
     int have_scheme = 0, level = 2, limit = 0, i, rc = 1;
     sfb_context *ctx = NULL;
@@ -223,12 +239,7 @@ static int cmd_refine(int argc, char **argv) {
     }
     if (!in) return usage("refine needs an input OBJ file");
     if (!outp) return usage("refine needs -o OUT.obj");
-    if (!have_scheme) {
-        base = strrchr(in, '/');
-        base = base ? base + 1 : in;
-        if (strncmp(base, "loop_", 5) == 0) scheme = SFB_SCHEME_LOOP;
-        else if (strncmp(base, "bilinear_", 9) == 0) scheme = SFB_SCHEME_BILINEAR;
-    }
+    scheme = scheme_for(in, have_scheme, scheme);
     ctx = make_context(backend);
     if (!ctx) return 1;
     mesh = load(ctx, in);
@@ -272,9 +283,9 @@ done:
     return rc;
 }
 
-/* A Catmull-Clark surface with its patch table (limit evaluation, tessellation). */
-static sfb_surface *make_patch_surface(sfb_context *ctx, const sfb_mesh *mesh, const char *path) {
-    sfb_surface_config cfg = sfb_surface_config_init(SFB_SCHEME_CATMARK, 0);
+/* A surface with its patch table (limit evaluation, tessellation). */
+static sfb_surface *make_patch_surface(sfb_context *ctx, const sfb_mesh *mesh, const char *path, sfb_scheme scheme) {
+    sfb_surface_config cfg = sfb_surface_config_init(scheme, 0);
     sfb_surface *surf = NULL;
     sfb_result r;
     cfg.flags = SFB_REFINE_PATCHES;
@@ -390,7 +401,7 @@ static unsigned long long next_random(unsigned long long *state) {
 /* N random locations on parametric faces that are not holes. Holes are found by asking the
  * library (a face whose centre it rejects), which also covers faces that boundary mode
  * 'none' turns into holes. */
-static int random_locations(sfb_context *ctx, const sfb_surface *surf, long count, unsigned long long seed, loc_list *L) {
+static int random_locations(sfb_context *ctx, const sfb_surface *surf, int triangles, long count, unsigned long long seed, loc_list *L) {
     int np = sfb_surface_param_face_count(surf), nlive = 0, i;
     int *live = (int *)malloc(((size_t)np + 1) * sizeof(int));
     sfb_location *probe = (sfb_location *)malloc(((size_t)np + 1) * sizeof(sfb_location));
@@ -423,6 +434,12 @@ static int random_locations(sfb_context *ctx, const sfb_surface *surf, long coun
         unsigned long long a = next_random(&seed), b = next_random(&seed), c = next_random(&seed);
         /* 24 random bits each: exactly representable floats in [0,1] */
         float u = (float)(b >> 40) / 16777215.0f, v = (float)(c >> 40) / 16777215.0f;
+        if (triangles && (double)u + (double)v > 1.0) {
+            /* the other half of the square, turned into the triangle u + v <= 1 */
+            u = 1.0f - u;
+            v = 1.0f - v;
+            while ((double)u + (double)v > 1.0) v = nextafterf(v, 0.0f);
+        }
         if (!loc_push(L, live[a % (unsigned long long)nlive], u, v, 0)) { fprintf(stderr, "surfblend: out of memory\n"); goto done; }
     }
     ok = 1;
@@ -436,7 +453,8 @@ done:
 static int cmd_eval(int argc, char **argv) {
     const char *in = NULL, *outp = NULL, *backend = NULL, *locfile = NULL;
     long nrandom = -1, seed = 1;
-    int derivs = 0, i, rc = 1;
+    int derivs = 0, i, rc = 1, have_scheme = 0;
+    sfb_scheme scheme = SFB_SCHEME_CATMARK;
     sfb_context *ctx = NULL;
     sfb_mesh *mesh = NULL;
     sfb_surface *surf = NULL;
@@ -454,6 +472,9 @@ static int cmd_eval(int argc, char **argv) {
             locfile = argv[i];
         } else if (strcmp(argv[i], "--derivatives") == 0) {
             derivs = 1;
+        } else if (strcmp(argv[i], "--scheme") == 0) {
+            if (++i >= argc || !scheme_from_name(argv[i], &scheme)) return usage("--scheme needs catmark or loop");
+            have_scheme = 1;
         } else {
             int ur = common_arg(argc, argv, &i, "eval", &backend, &outp, &in);
             if (ur) return ur;
@@ -465,9 +486,12 @@ static int cmd_eval(int argc, char **argv) {
     if (!ctx) return 1;
     mesh = load(ctx, in);
     if (!mesh) goto done;
-    surf = make_patch_surface(ctx, mesh, in);
+    scheme = scheme_for(in, have_scheme, scheme);
+    surf = make_patch_surface(ctx, mesh, in, scheme);
     if (!surf) goto done;
-    if (locfile ? !read_locations(locfile, &L) : !random_locations(ctx, surf, nrandom, (unsigned long long)seed, &L)) goto done;
+    if (locfile ? !read_locations(locfile, &L)
+                : !random_locations(ctx, surf, scheme == SFB_SCHEME_LOOP, nrandom, (unsigned long long)seed, &L))
+        goto done;
     buf = (float *)malloc(((size_t)L.count + 1) * 12 * sizeof(float));
     if (!buf) { fprintf(stderr, "surfblend: out of memory\n"); goto done; }
     {
@@ -551,7 +575,8 @@ static int cmd_tess(int argc, char **argv) {
     const char *in = NULL, *outp = NULL, *backend = NULL;
     long rate = -1;
     double tolerance = 0.0;
-    int split = 0, i, rc = 1;
+    int split = 0, i, rc = 1, have_scheme = 0;
+    sfb_scheme scheme = SFB_SCHEME_CATMARK;
     sfb_context *ctx = NULL;
     sfb_mesh *mesh = NULL;
     sfb_surface *surf = NULL;
@@ -571,6 +596,9 @@ static int cmd_tess(int argc, char **argv) {
             if (end == argv[i] || *end) return usage("--tolerance needs a number");
         } else if (strcmp(argv[i], "--split-creases") == 0) {
             split = 1;
+        } else if (strcmp(argv[i], "--scheme") == 0) {
+            if (++i >= argc || !scheme_from_name(argv[i], &scheme)) return usage("--scheme needs catmark or loop");
+            have_scheme = 1;
         } else {
             int ur = common_arg(argc, argv, &i, "tess", &backend, &outp, &in);
             if (ur) return ur;
@@ -583,7 +611,7 @@ static int cmd_tess(int argc, char **argv) {
     if (!ctx) return 1;
     mesh = load(ctx, in);
     if (!mesh) goto done;
-    surf = make_patch_surface(ctx, mesh, in);
+    surf = make_patch_surface(ctx, mesh, in, scheme_for(in, have_scheme, scheme));
     if (!surf) goto done;
     tc = sfb_tess_config_init((int)rate);
     tc.tolerance = (float)tolerance;
