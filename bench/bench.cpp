@@ -44,6 +44,8 @@
  *                OpenSubdiv Far::PatchMap::FindPatch + Osd::CpuEvaluator::EvalPatches, and
  *                           EvalPatches alone; the same with Osd::OmpEvaluator
  *   tessellate   sfb_surface_tessellate at rate 8 on ref and simd (triangles per second)
+ * The same again for Loop on that torus cut into triangles (OpenSubdiv: its Loop patch table,
+ * Gregory triangle end caps).
  * Best of 3 runs after one warm-up (builds: median of 3). `bench --limit` runs this part alone.
  */
 #include "surfblend.h"
@@ -182,6 +184,21 @@ struct TorusMesh {
                     sizes.push_back(4);
                     fv.insert(fv.end(), q, q + 4);
                 }
+            }
+        face_sizes.swap(sizes);
+        face_vertices.swap(fv);
+    }
+    /* Loop's variant: every face cut into triangles (quads by the diagonal (a,c), a regular
+     * valence-6 lattice; hexagons fanned from their first vertex), creases and corner kept. The
+     * extraordinary variant's triangles and hexagon fans leave vertices of valence 3 to 9. */
+    void triangulate() {
+        std::vector<int> sizes, fv;
+        for (size_t f = 0, o = 0; f < face_sizes.size(); o += (size_t)face_sizes[f], ++f)
+            for (int k = 1; k + 1 < face_sizes[f]; ++k) {
+                sizes.push_back(3);
+                fv.push_back(face_vertices[o]);
+                fv.push_back(face_vertices[o + (size_t)k]);
+                fv.push_back(face_vertices[o + (size_t)k + 1]);
             }
         face_sizes.swap(sizes);
         face_vertices.swap(fv);
@@ -742,7 +759,7 @@ struct OsdPatches {
     }
     /* TopologyRefinerFactory::Create + RefineAdaptive (PatchTableFactory::Options' default
      * isolation) + PatchTableFactory::Create (default options: Gregory basis end caps). */
-    bool build_patches(const TorusMesh &m, bool inf_sharp_patch = false) {
+    bool build_patches(const TorusMesh &m, bool inf_sharp_patch = false, Sdc::SchemeType type = Sdc::SCHEME_CATMARK) {
         clear();
         Far::TopologyDescriptor desc = m.osd_desc();
         Sdc::Options opt;
@@ -750,7 +767,7 @@ struct OsdPatches {
         opt.SetCreasingMethod(Sdc::Options::CREASE_UNIFORM);
         opt.SetTriangleSubdivision(Sdc::Options::TRI_SUB_CATMARK);
         typedef Far::TopologyRefinerFactory<Far::TopologyDescriptor> Factory;
-        refiner = Factory::Create(desc, Factory::Options(Sdc::SCHEME_CATMARK, opt));
+        refiner = Factory::Create(desc, Factory::Options(type, opt));
         if (!refiner) return false;
         Far::PatchTableFactory::Options po;
         po.useInfSharpPatch = inf_sharp_patch;
@@ -816,7 +833,7 @@ static void max_mean_diff(const std::vector<float> &a, const std::vector<float> 
     *mean = n ? s / (double)n : 0.0;
 }
 
-static int limit_section(double diag) {
+static int limit_section(double diag, bool loop) {
     const int npoints = 1000000, warm = 1, reps = 3, tess_rate = 8;
     const double budget_ms = 1e300; /* always the 3 runs */
     const double tol = 1e-5 * diag;  /* surfblend backends against ref */
@@ -826,8 +843,11 @@ static int limit_section(double diag) {
     int all_threads = cores > 0 ? (int)std::min(cores, 64L) : 1;
 
     TorusMesh mesh(100, 60, true);
+    if (loop) mesh.triangulate();
+    const Sdc::SchemeType osd_type = loop ? Sdc::SCHEME_LOOP : Sdc::SCHEME_CATMARK;
+    const char *scheme_name = loop ? "Loop" : "Catmull-Clark";
     sfb_mesh_desc desc = mesh.sfb_desc();
-    sfb_surface_config pcfg = sfb_surface_config_init(SFB_SCHEME_CATMARK, 0);
+    sfb_surface_config pcfg = sfb_surface_config_init(loop ? SFB_SCHEME_LOOP : SFB_SCHEME_CATMARK, 0);
     pcfg.flags = SFB_REFINE_PATCHES;
 
     /* the reference surface (ref backend): mesh statistics, parametric faces */
@@ -849,10 +869,11 @@ static int limit_section(double diag) {
     sfb_surface_patch_info(rsurf, &pi);
     int nparam = sfb_surface_param_face_count(rsurf);
 
-    printf("\nlimit evaluation (SFB_REFINE_PATCHES, Catmull-Clark) on the torus with extraordinary vertices:\n"
+    printf("\n==== %s ====\nlimit evaluation (SFB_REFINE_PATCHES, %s) on the torus with extraordinary vertices%s:\n"
            "%d faces (%d quads, %d triangles, %d hexagons) = %d parametric faces, %d vertices, %d extraordinary\n"
-           "(valence 3 and 5, some on the semi-sharp and the infinitely sharp ring), the same %d creases and corner\n",
-           mi.face_count, mi.quads, mi.triangles, mi.ngons, nparam, mi.vertex_count, mi.extraordinary_catmark,
+           "(%s, some on the semi-sharp and the infinitely sharp ring), the same %d creases and corner\n",
+           scheme_name, scheme_name, loop ? ", cut into triangles" : "", mi.face_count, mi.quads, mi.triangles, mi.ngons, nparam,
+           mi.vertex_count, loop ? mi.extraordinary_loop : mi.extraordinary_catmark, loop ? "valence 3 to 9" : "valence 3 and 5",
            mi.sharp_edges);
     fflush(stdout);
 
@@ -876,7 +897,7 @@ static int limit_section(double diag) {
     bool osd_ok = true;
     for (int rep = 0; rep < 3 && osd_ok; ++rep) {
         Clock::time_point t0 = Clock::now();
-        osd_ok = osd.build_patches(mesh);
+        osd_ok = osd.build_patches(mesh, false, osd_type);
         double tp = ms_since(t0);
         Clock::time_point t1 = Clock::now();
         osd_ok = osd_ok && osd.build_eval(mesh);
@@ -900,7 +921,7 @@ static int limit_section(double diag) {
         OsdPatches o2;
         for (int rep = 0; rep < 3; ++rep) {
             Clock::time_point t0 = Clock::now();
-            if (!o2.build_patches(mesh, true)) break;
+            if (!o2.build_patches(mesh, true, osd_type)) break;
             t_osd_inf.push_back(ms_since(t0));
         }
         if (o2.table) { patch_counts(o2.table, inf_counts); inf_total = o2.table->GetNumPatchesTotal(); }
@@ -913,8 +934,9 @@ static int limit_section(double diag) {
         snprintf(what, sizeof what, "sfb_mesh_create + sfb_surface_create(level 0, SFB_REFINE_PATCHES, isolation %d)",
                  SFB_DEFAULT_ISOLATION);
         printf("%-38s | %9.2f | %7.2f | %9s | %s\n", "surfblend mesh + surface", sb, sb > 0 ? op / sb : 0.0, "", what);
-        snprintf(what, sizeof what, "%d patches: %d B-spline, %d Stam, %d end caps; max depth %d; %d points (patch table + points)",
-                 pi.patches, pi.bspline, pi.stam, pi.end_caps, pi.max_depth, pi.points);
+        snprintf(what, sizeof what, "%d patches: %d %s, %d Stam, %d end caps; max depth %d; %d points (patch table + points)",
+                 pi.patches, loop ? pi.bezier : pi.bspline, loop ? "Bezier triangles" : "B-spline", pi.stam, pi.end_caps,
+                 pi.max_depth, pi.points);
         printf("%-38s | %9.2f | %7.2f | %9.2f | %s\n", "surfblend sfb_surface_create", ss, ss > 0 ? op / ss : 0.0,
                (double)pi.bytes / (1 << 20), what);
         if (osd_ok) {
@@ -946,6 +968,11 @@ static int limit_section(double diag) {
         locs[(size_t)i].face = rng.below(nparam);
         locs[(size_t)i].u = rng.unit();
         locs[(size_t)i].v = rng.unit();
+        if (loop && (double)locs[(size_t)i].u + locs[(size_t)i].v > 1.0) {
+            /* into the triangle: the other half of the square turned over (exact for 24-bit values) */
+            locs[(size_t)i].u = 1.0f - locs[(size_t)i].u;
+            locs[(size_t)i].v = 1.0f - locs[(size_t)i].v;
+        }
     }
     std::vector<char> ngon_sub((size_t)nparam, 0); /* parametric face is a sub-face of an n-gon */
     for (int f = 0; f < nparam; ++f) {
@@ -1102,13 +1129,13 @@ static int limit_section(double diag) {
     double osd_ms = 0.0, osd_p_max = 0.0, ref_ms = rows[0].ms;
     for (size_t i = 0; i < rows.size(); ++i)
         if (rows[i].name == osd_names[0] && rows[i].ran) { osd_ms = rows[i].ms; osd_p_max = rows[i].diff; }
-    printf("\nlimit evaluation: %d random locations (parametric face uniform, u and v uniform in [0,1], fixed seed),\n"
+    printf("\nlimit evaluation (%s): %d random locations (parametric face uniform, u and v uniform in [0,1]%s, fixed seed),\n"
            "position + du + dv; best of %d runs after %d warm-up run, milliseconds and million points per second;\n"
            "'x OSD' and 'x ref' are how many times faster than OpenSubdiv's FindPatch + CpuEvaluator and than\n"
            "surfblend's ref in this run. surfblend's time includes locating the patch (sfb_surface_eval takes\n"
            "(face, u, v)). 'diff vs ref' is the largest position difference from ref (OpenSubdiv: its Gregory\n"
            "end caps approximate the surface near extraordinary vertices).\n",
-           npoints, reps, warm);
+           scheme_name, npoints, loop ? " folded into u + v <= 1" : "", reps, warm);
     printf("%-38s | %9s | %8s | %7s | %6s | %11s | %s\n", "limit eval", "best ms", "M pts/s", "x OSD", "x ref", "diff vs ref",
            "what runs");
     for (size_t i = 0; i < rows.size(); ++i) {
@@ -1131,8 +1158,12 @@ static int limit_section(double diag) {
     fprintf(stderr, "limit eval done (%.1f s)\n", ms_since(t_sec) / 1000.0);
 
     /* ---- tessellation ---- */
-    printf("\ntessellation: sfb_surface_tessellate, uniform rate %d (%d x %d quads, 2 triangles each, per parametric face),\n"
-           "positions + normals; best of %d runs after %d warm-up run\n", tess_rate, tess_rate, tess_rate, reps, warm);
+    if (loop)
+        printf("\ntessellation (Loop): sfb_surface_tessellate, uniform rate %d (a triangular grid of %d triangles per parametric\n"
+               "face), positions + normals; best of %d runs after %d warm-up run\n", tess_rate, tess_rate * tess_rate, reps, warm);
+    else
+        printf("\ntessellation: sfb_surface_tessellate, uniform rate %d (%d x %d quads, 2 triangles each, per parametric face),\n"
+               "positions + normals; best of %d runs after %d warm-up run\n", tess_rate, tess_rate, tess_rate, reps, warm);
     printf("%-38s | %9s | %9s | %10s | %9s | %s\n", "tessellate", "best ms", "M tris/s", "triangles", "vertices", "what runs");
     struct TessCase { const char *name; sfb_backend_kind kind; int threads; };
     const TessCase tcases[3] = {{"surfblend ref", SFB_BACKEND_REF, 1}, {"surfblend simd, 1 thread", SFB_BACKEND_SIMD, 1},
@@ -1231,7 +1262,8 @@ int main(int argc, char **argv) {
     const double tol = 1e-6 * diag; /* as in tests/osd_agree.cpp */
     if (limit_only) {
         sfb_context_destroy(ctx);
-        int st = limit_section(diag);
+        int st = limit_section(diag, false);
+        if (limit_section(diag, true) != 0) st = 1;
         printf("total time %.1f s\n", ms_since(t_start) / 1000.0);
         return st;
     }
@@ -1376,7 +1408,8 @@ int main(int argc, char **argv) {
     }
     sfb_context_destroy(ctx);
     if (eval_section(torus, diag) != 0) status = 1;
-    if (limit_section(diag) != 0) status = 1;
+    if (limit_section(diag, false) != 0) status = 1;
+    if (limit_section(diag, true) != 0) status = 1;
     printf("total time %.1f s\n", ms_since(t_start) / 1000.0);
     return status;
 }
