@@ -294,12 +294,14 @@ SFB_API void sfb_mesh_data_free(sfb_mesh_data *data);
 SFB_API void sfb_mesh_data_desc(const sfb_mesh_data *data, sfb_mesh_desc *out);
 
 
-/* ---- limit evaluation (SFB_REFINE_PATCHES; Catmull-Clark) ----
- * Locations are on parametric faces: a base quad is one parametric face, (u,v) in [0,1]^2 with
- * (0,0) at its first vertex, (1,0) at its second and (0,1) at its last; a face with n != 4
- * vertices is n parametric quads, sub-face i being (v_i, midpoint of v_i v_i+1, centroid,
- * midpoint of v_i-1 v_i) of the first subdivision step, (0,0) at v_i. Parametric faces are
- * numbered base face by base face (sfb_surface_param_faces). */
+/* ---- limit evaluation (SFB_REFINE_PATCHES; Catmull-Clark and Loop) ----
+ * Locations are on parametric faces. Catmull-Clark: a base quad is one parametric face, (u,v)
+ * in [0,1]^2 with (0,0) at its first vertex, (1,0) at its second and (0,1) at its last; a face
+ * with n != 4 vertices is n parametric quads, sub-face i being (v_i, midpoint of v_i v_i+1,
+ * centroid, midpoint of v_i-1 v_i) of the first subdivision step, (0,0) at v_i. Loop: a base
+ * triangle is one parametric face with barycentric (u,v), u + v <= 1: the point
+ * (1-u-v) v_0 + u v_1 + v v_2 of the parameter triangle. Parametric faces are numbered base face
+ * by base face (sfb_surface_param_faces). */
 typedef struct sfb_location { int face; float u, v; } sfb_location;
 /* Output arrays, xyz per location; NULL members are not computed. du/dv are derivatives in
  * the parametric face's (u,v); normal is unit length (du x dv normalised, and at an
@@ -313,7 +315,8 @@ SFB_API sfb_result sfb_surface_param_faces(const sfb_surface *surface, int base_
 /* The base face of a parametric face, and its sub-face index (-1 for a quad). */
 SFB_API sfb_result sfb_surface_param_face_base(const sfb_surface *surface, int param_face, int *base_face, int *sub_face);
 /* Evaluates the limit surface at `count` locations. Every location is checked first: a face
- * out of range, a hole, u or v outside [0,1] or not finite returns SFB_INVALID_VALUE naming
+ * out of range, a hole, u or v outside [0,1] or not finite, u + v > 1 on a Loop triangle
+ * (computed in double) returns SFB_INVALID_VALUE naming
  * the first bad query (element SFB_ELEMENT_NONE, index = its position) and writes nothing. */
 SFB_API sfb_result sfb_surface_eval(const sfb_surface *surface, const sfb_location *locations, int count,
                                     const sfb_eval_output *out);
@@ -332,7 +335,8 @@ enum {
                                          copy per side, each with that side's normal (split normals) */
 };
 typedef struct sfb_tess_config {
-    int rate;         /* segments per parametric-face edge, 1..1024 (rate x rate quads, 2 triangles each) */
+    int rate;         /* segments per parametric-face edge, 1..1024 (a quad: rate x rate cells, 2 triangles each;
+                         a Loop triangle: the triangular grid of rate^2 triangles) */
     float tolerance;  /* 0: uniform. > 0: adaptive: each parametric face (and each edge) uses the smallest
                          rate <= `rate` whose chordal error is within `tolerance` (model units) */
     unsigned flags;   /* SFB_TESS_* */

@@ -2,9 +2,13 @@
  *
  * Every parametric face ("param face", see sfb_location) is cut into triangles in its own
  * (u,v); the vertices are evaluated through the public sfb_surface_eval, so tessellation runs
- * on whichever backend the context selected. A vertex on the boundary of a param face is
- * shared with the neighbours through a canonical key, so that it is created and evaluated
- * exactly once and the mesh has no cracks:
+ * on whichever backend the context selected. Catmull-Clark param faces are quads (a base quad,
+ * or a sub-face of an n-gon); Loop param faces are the base triangles, (u,v) barycentric with
+ * corners (0,0), (1,0), (0,1) at the face's vertices in order, so every location has
+ * u + v <= 1 (a point on the side u + v = 1 gets its u rounded down if float rounding would
+ * put it past). A vertex on the boundary of a param face is shared with the neighbours
+ * through a canonical key, so that it is created and evaluated exactly once and the mesh has
+ * no cracks:
  *   - a corner at a base vertex: the base vertex (with SFB_TESS_SPLIT_CREASES: the base
  *     vertex within one sector, the faces around it reachable without crossing an infinitely
  *     sharp interior edge);
@@ -21,14 +25,18 @@
  * so step k of S is the same surface point from either face; since each point is evaluated
  * once, the mesh is closed whatever the rounding.
  *
- * A param face whose interior rate r equals every boundary count is a regular r x r grid,
- * two triangles per cell (diagonal (i,j)-(i+1,j+1)). Otherwise (adaptive rates, quads beside
- * n-gons) it gets an inner grid of rate R = max(r,2) without its outer ring, and each side
- * is stitched from its boundary points to the inner grid's side by a zipper strip: no
- * T-junctions. Triangles are counter-clockwise in (u,v), which is the du x dv normal side.
+ * A quad param face whose interior rate r equals every boundary count is a regular r x r
+ * grid, two triangles per cell (diagonal (i,j)-(i+1,j+1)); a triangle face with all three
+ * counts r is the triangular grid of the points (i/r, j/r), i + j <= r, r^2 triangles.
+ * Otherwise (adaptive rates, quads beside n-gons) a quad gets an inner grid of rate
+ * R = max(r,2) without its outer ring, a triangle the points of the rate R = max(r,3)
+ * triangular grid that are not on its sides (an inner triangular grid of rate R - 3), and
+ * each side is stitched from its boundary points to the inner grid's side by a zipper strip:
+ * no T-junctions. Triangles are counter-clockwise in (u,v), which is the du x dv normal side.
  *
  * Adaptive mode (tolerance > 0): a param face gets the first rate c in 1, 2, 4, ... (< rate,
- * else rate) for which the surface at the midpoints of the c x c grid's edges and diagonals
+ * else rate) for which the surface at the midpoints of the c-grid's edges (quads: the c x c
+ * grid's cell edges and diagonals; triangles: the three edges of each of its c^2 triangles)
  * is within `tolerance` of the chords; a shared edge takes the largest rate of its faces.
  * This samples the surface: a feature narrower than a cell can be missed at that rate.
  *
@@ -64,6 +72,7 @@ typedef struct sfb__tess {
     const sfb__level *l;          /* the prepared base level the patches were built from */
     const sfb__patch_table *pt;
     int rate, split;
+    int loop;                     /* Loop: every param face is a base triangle */
     int *prate;                   /* per param face: interior rate, 0 = nothing (hole) */
     int *eseg;                    /* per base edge: segments over the whole edge */
     unsigned char *engon;         /* per base edge: an n-gon uses it (eseg is then even) */
@@ -127,13 +136,24 @@ static int sfb__tess_new(sfb__tess *T, int count) {
     return id;
 }
 
+/* (u,v) as floats; on a triangle param face u is rounded down where rounding both to nearest
+ * would give u + v > 1 (points on the side u + v = 1), which evaluation refuses. */
+static void sfb__tess_uv(int tri, double u, double v, sfb_location *L) {
+    float fu = (float)u, fv = (float)v;
+    if (tri && (double)fu + (double)fv > 1.0) {
+        fu = (float)(1.0 - (double)fv);
+        while (fu > 0.0f && (double)fu + (double)fv > 1.0) fu = nextafterf(fu, 0.0f);
+    }
+    L->u = fu;
+    L->v = fv;
+}
+
 /* The location a vertex is evaluated at: the first param face that reaches it in the emit
  * pass (for a split crease copy that is always a face on its own side). */
 static void sfb__tess_loc(sfb__tess *T, int id, int pf, double u, double v) {
     if (T->loc && T->loc[id].face < 0) {
         T->loc[id].face = pf;
-        T->loc[id].u = (float)u;
-        T->loc[id].v = (float)v;
+        sfb__tess_uv(T->loop, u, v, &T->loc[id]);
     }
 }
 
@@ -182,14 +202,16 @@ static void sfb__tess_tri(sfb__tess *T, int a, int b, int c, int pf) {
 }
 
 /* Stitches a boundary chain (na segments, point i at i/na along the side) to the inner
- * grid's side (nb segments, point j at (j+1)/R), both running counter-clockwise around the
- * face. Each step adds the triangle whose new cross edge is the more nearly perpendicular to
- * the side (positions compared in units of 1/(na R), exactly), which keeps them well shaped. */
-static void sfb__tess_zipper(sfb__tess *T, const int *outer, int na, const int *inner, int nb, int R, int pf) {
+ * grid's side (nb segments, point j at (j + o2/2)/R: o2 = 2 on a quad, where the inner grid's
+ * side is inset by one cell; o2 = 3 on a triangle, where the inner triangle's corner (1,1)
+ * projects to 1.5/R along each side), both running counter-clockwise around the face. Each
+ * step adds the triangle whose new cross edge is the more nearly perpendicular to the side
+ * (positions compared in units of 1/(2 na R), exactly), which keeps them well shaped. */
+static void sfb__tess_zipper(sfb__tess *T, const int *outer, int na, const int *inner, int nb, int R, int o2, int pf) {
     int i = 0, j = 0;
     while (i < na || j < nb) {
-        long to = labs((long)(i + 1) * R - (long)(j + 1) * na); /* outer step: edge outer[i+1] - inner[j] */
-        long ti = labs((long)(j + 2) * na - (long)i * R);       /* inner step: edge outer[i] - inner[j+1] */
+        long to = labs(2L * (i + 1) * R - (long)(2 * j + o2) * na);     /* outer step: edge outer[i+1] - inner[j] */
+        long ti = labs((long)(2 * j + 2 + o2) * na - 2L * i * R);       /* inner step: edge outer[i] - inner[j+1] */
         if (j >= nb || (i < na && to <= ti)) {
             sfb__tess_tri(T, outer[i], outer[i + 1], inner[j], pf);
             ++i;
@@ -200,6 +222,62 @@ static void sfb__tess_zipper(sfb__tess *T, const int *outer, int na, const int *
     }
 }
 
+/* A triangle param face (Loop), as sfb__tess_face. Its sides, counter-clockwise in (u,v):
+ * edge 0 from P0 (0,0) to P1 (1,0), edge 1 from P1 to P2 (0,1), edge 2 from P2 to P0; point
+ * (i,j) of a rate-R grid is (i/R, j/R). The points strictly inside (i, j >= 1,
+ * i + j <= R - 1) are numbered row by row in j, row j holding i = 1 .. R-1-j. */
+static void sfb__tess_face_tri(sfb__tess *T, int pf, int emit) {
+    const sfb__level *l = T->l;
+    int f = T->pt->ptex_face[pf], r = T->prate[pf];
+    int o = l->fv_off[f], s[3], *b[3], *inner, k, q, i, j, regular, R, base;
+    if (r <= 0) return;
+    for (k = 0; k < 3; ++k) {
+        b[k] = T->bids + (size_t)k * (SFB__TESS_MAX_SEG + 1);
+        s[k] = T->eseg[l->fe[o + k]];
+        for (q = 0; q <= s[k]; ++q) b[k][q] = sfb__tess_epoint(T, f, k, q);
+    }
+    inner = T->bids + (size_t)5 * (SFB__TESS_MAX_SEG + 1);
+    regular = s[0] == r && s[1] == r && s[2] == r;
+    R = regular ? r : (r < 3 ? 3 : r);
+    if (!emit) {
+        T->ifirst[pf] = sfb__tess_new(T, (R - 1) * (R - 2) / 2);
+        if (regular) T->ntri += (size_t)r * (size_t)r;
+        else T->ntri += (size_t)(R - 3) * (size_t)(R - 3) + (size_t)s[0] + (size_t)s[1] + (size_t)s[2] + (size_t)3 * (size_t)(R - 3);
+        return;
+    }
+    for (q = 0; q <= s[0]; ++q) sfb__tess_loc(T, b[0][q], pf, (double)q / s[0], 0.0);
+    for (q = 0; q <= s[1]; ++q) sfb__tess_loc(T, b[1][q], pf, (double)(s[1] - q) / s[1], (double)q / s[1]);
+    for (q = 0; q <= s[2]; ++q) sfb__tess_loc(T, b[2][q], pf, 0.0, (double)(s[2] - q) / s[2]);
+    base = T->ifirst[pf];
+#define SFB__TRI_INNER(i, j) (base + ((j) - 1) * (R - 1) - ((j) - 1) * (j) / 2 + ((i) - 1))
+    for (j = 1; j < R - 1; ++j)
+        for (i = 1; i + j < R; ++i) sfb__tess_loc(T, SFB__TRI_INNER(i, j), pf, (double)i / R, (double)j / R);
+    if (regular) {
+#define SFB__TRI_ID(i, j) ((j) == 0 ? b[0][i] : (i) + (j) == r ? b[1][j] : (i) == 0 ? b[2][r - (j)] : SFB__TRI_INNER(i, j))
+        for (j = 0; j < r; ++j)
+            for (i = 0; i + j < r; ++i) {
+                sfb__tess_tri(T, SFB__TRI_ID(i, j), SFB__TRI_ID(i + 1, j), SFB__TRI_ID(i, j + 1), pf);
+                if (i + j + 2 <= r) sfb__tess_tri(T, SFB__TRI_ID(i + 1, j), SFB__TRI_ID(i + 1, j + 1), SFB__TRI_ID(i, j + 1), pf);
+            }
+#undef SFB__TRI_ID
+        return;
+    }
+    /* the inner triangular grid: points with i, j >= 1, i + j <= R - 1 */
+    for (j = 1; j + 2 < R; ++j)
+        for (i = 1; i + j + 2 <= R; ++i) {
+            sfb__tess_tri(T, SFB__TRI_INNER(i, j), SFB__TRI_INNER(i + 1, j), SFB__TRI_INNER(i, j + 1), pf);
+            if (i + j + 3 <= R) sfb__tess_tri(T, SFB__TRI_INNER(i + 1, j), SFB__TRI_INNER(i + 1, j + 1), SFB__TRI_INNER(i, j + 1), pf);
+        }
+    /* the ring, one side at a time, counter-clockwise; the inner side of side k runs between
+     * the inner corners (1,1), (R-2,1), (1,R-2) in the same order */
+    for (k = 0; k < 3; ++k) {
+        for (q = 0; q <= R - 3; ++q)
+            inner[q] = k == 0 ? SFB__TRI_INNER(1 + q, 1) : k == 1 ? SFB__TRI_INNER(R - 2 - q, 1 + q) : SFB__TRI_INNER(1, R - 2 - q);
+        sfb__tess_zipper(T, b[k], s[k], inner, R - 3, R, 3, pf);
+    }
+#undef SFB__TRI_INNER
+}
+
 /* One param face. Count pass (emit = 0): creates the ids of every point it touches and
  * counts its triangles. Emit pass: records the locations of points not yet located and
  * writes the triangles. Both passes visit faces in the same order, so ids agree. */
@@ -207,6 +285,10 @@ static void sfb__tess_face(sfb__tess *T, int pf, int emit) {
     const sfb__level *l = T->l;
     int f = T->pt->ptex_face[pf], sub = T->pt->ptex_corner[pf], r = T->prate[pf];
     int o = l->fv_off[f], s[4], *b[4], *outer, *inner, k, i, j, regular, R, base;
+    if (T->loop) {
+        sfb__tess_face_tri(T, pf, emit);
+        return;
+    }
     if (r <= 0) return;
     for (k = 0; k < 4; ++k) b[k] = T->bids + (size_t)k * (SFB__TESS_MAX_SEG + 1);
     outer = T->bids + (size_t)4 * (SFB__TESS_MAX_SEG + 1);
@@ -274,7 +356,7 @@ static void sfb__tess_face(sfb__tess *T, int pf, int emit) {
             int t = (k < 2) ? 1 + q : R - 1 - q; /* position along the side, inset by one cell */
             inner[q] = k == 0 ? SFB__INNER(t, 1) : k == 1 ? SFB__INNER(R - 1, t) : k == 2 ? SFB__INNER(t, R - 1) : SFB__INNER(1, t);
         }
-        sfb__tess_zipper(T, outer, s[k], inner, R - 2, R, pf);
+        sfb__tess_zipper(T, outer, s[k], inner, R - 2, R, 2, pf);
     }
 #undef SFB__INNER
 }
@@ -310,6 +392,34 @@ static double sfb__tess_chord_error(const float *P, int c) {
     return worst;
 }
 
+/* The same on a triangle param face: the samples are the points (x, y) of the rate-2c
+ * triangular grid (x + y <= 2c), row by row in y; the chords are the three edges of each of
+ * the c-grid's c (c+1) / 2 upward triangles, which are all of its edges. */
+static double sfb__tess_chord_error_tri(const float *P, int c) {
+    int g = 2 * c + 1, i, j, q;
+    double worst = 0.0;
+#define SFB__TRI_SAMPLE(x, y) (P + 3 * ((size_t)(y) * (size_t)(2 * g + 1 - (y)) / 2 + (size_t)(x)))
+    for (j = 0; j < c; ++j)
+        for (i = 0; i + j < c; ++i) {
+            /* (mid, end a, end b) offsets from corner (2i, 2j): bottom edge, left edge, slanted edge */
+            static const int chk[3][6] = { { 1, 0, 0, 0, 2, 0 }, { 0, 1, 0, 0, 0, 2 }, { 1, 1, 2, 0, 0, 2 } };
+            for (q = 0; q < 3; ++q) {
+                int x = 2 * i, y = 2 * j, cc;
+                const float *m = SFB__TRI_SAMPLE(x + chk[q][0], y + chk[q][1]);
+                const float *a = SFB__TRI_SAMPLE(x + chk[q][2], y + chk[q][3]);
+                const float *b = SFB__TRI_SAMPLE(x + chk[q][4], y + chk[q][5]);
+                double d2 = 0.0;
+                for (cc = 0; cc < 3; ++cc) {
+                    double d = (double)m[cc] - 0.5 * ((double)a[cc] + (double)b[cc]);
+                    d2 += d * d;
+                }
+                if (!(d2 <= worst)) worst = d2; /* NaN propagates: such a face is refined */
+            }
+        }
+#undef SFB__TRI_SAMPLE
+    return worst;
+}
+
 /* Adaptive rates: candidates 1, 2, 4, ... below `rate` are tested in rounds over a chunk of
  * faces, many faces per sfb_surface_eval call; a face keeps the first candidate within
  * tolerance, else `rate`. */
@@ -338,18 +448,17 @@ static sfb_result sfb__tess_adaptive(sfb__tess *T, float tolerance, float p0, fl
             if (T->prate[pf] > 0) list[n++] = pf;
         for (c = 1; c < T->rate && n > 0; c *= 2) {
             int g = 2 * c + 1, a = 0, keep = 0, q;
-            size_t per = (size_t)g * (size_t)g;
+            size_t per = T->loop ? (size_t)g * (size_t)(g + 1) / 2 : (size_t)g * (size_t)g;
             while (a < n) {
                 int bnd = a, x, y;
                 size_t used = 0;
                 sfb_eval_output eo;
                 while (bnd < n && used + per <= cap) {
                     for (y = 0; y < g; ++y)
-                        for (x = 0; x < g; ++x) {
+                        for (x = 0; x < (T->loop ? g - y : g); ++x) {
                             sfb_location *L = &loc[used++];
                             L->face = list[bnd];
-                            L->u = (float)((double)x / (g - 1));
-                            L->v = (float)((double)y / (g - 1));
+                            sfb__tess_uv(T->loop, (double)x / (g - 1), (double)y / (g - 1), L);
                         }
                     ++bnd;
                 }
@@ -358,7 +467,8 @@ static sfb_result sfb__tess_adaptive(sfb__tess *T, float tolerance, float p0, fl
                 r = sfb_surface_eval(T->s, loc, (int)used, &eo);
                 if (r != SFB_SUCCESS) goto done;
                 for (q = a; q < bnd; ++q) {
-                    double err = sfb__tess_chord_error(pos + 3 * per * (size_t)(q - a), c);
+                    const float *P = pos + 3 * per * (size_t)(q - a);
+                    double err = T->loop ? sfb__tess_chord_error_tri(P, c) : sfb__tess_chord_error(P, c);
                     if (err <= tol2) T->prate[list[q]] = c;
                     else list[keep++] = list[q];
                 }
@@ -406,6 +516,7 @@ SFB_API sfb_result sfb_surface_tessellate(const sfb_surface *s, const sfb_tess_c
     T.pt = &s->patches;
     T.rate = cfg->rate;
     T.split = (cfg->flags & SFB_TESS_SPLIT_CREASES) != 0;
+    T.loop = T.pt->scheme == SFB_SCHEME_LOOP;
     nptex = T.pt->nptex;
     T.prate = (int *)sfb__tess_array(ctx, (size_t)nptex, sizeof(int));
     T.sseg = (int *)sfb__tess_array(ctx, (size_t)nptex, sizeof(int));
@@ -454,8 +565,8 @@ SFB_API sfb_result sfb_surface_tessellate(const sfb_surface *s, const sfb_tess_c
         f = T.pt->ptex_face[pf];
         o = l->fv_off[f];
         n = sfb__tess_face_n(l, f);
-        if (sub < 0) {
-            for (k = 0; k < 4; ++k) {
+        if (sub < 0) { /* a quad, or a Loop triangle */
+            for (k = 0; k < n; ++k) {
                 e = l->fe[o + k];
                 if (T.eseg[e] < rr) T.eseg[e] = rr;
             }

@@ -1,7 +1,9 @@
 /* surfblend: tessellation tests (sfb_surface_tessellate): watertightness and orientation on
  * closed meshes (quads, n-gons, triangles, creases), split creases, open meshes and holes,
  * vertex counts, agreement with sfb_surface_eval, adaptive mode, argument checks,
- * cancellation and allocation failures without leaks. */
+ * cancellation and allocation failures without leaks; the same for Loop surfaces (suite
+ * tess_loop, on OpenSubdiv's loop_* shapes from $SHAPES or ../shared/peers/opensubdiv-shapes,
+ * skipped when absent), plus (u,v) tiling of each triangle param face. */
 #include <criterion/criterion.h>
 #include <math.h>
 #include <stdio.h>
@@ -71,6 +73,16 @@ static sfb_surface *tx_surface(sfb_context *ctx, const sfb_mesh *m)
     sfb_surface *s = NULL;
     sfb_result r = sfb_surface_create(ctx, m, &sc, &s);
     cr_assert_eq(r, SFB_SUCCESS, "surface: %s", sfb_last_error(ctx));
+    return s;
+}
+
+static sfb_surface *tx_surface_loop(sfb_context *ctx, const sfb_mesh *m)
+{
+    sfb_surface_config sc = sfb_surface_config_init(SFB_SCHEME_LOOP, 0);
+    sc.flags = SFB_REFINE_PATCHES;
+    sfb_surface *s = NULL;
+    sfb_result r = sfb_surface_create(ctx, m, &sc, &s);
+    cr_assert_eq(r, SFB_SUCCESS, "Loop surface: %s", sfb_last_error(ctx));
     return s;
 }
 
@@ -734,11 +746,12 @@ static int tx_progress(float done, const char *stage, void *user)
     return p->cancel_at && p->calls == p->cancel_at;
 }
 
-/* Builds the surface with nothing failing, then tessellates with allocation number
- * base + k failing (or the k-th progress report cancelling) for every k until the call
- * succeeds; every failure must return the expected code, leave `out` zeroed and leak
- * nothing. */
-static void failure_sweep(int cancel, float tol, unsigned flags)
+/* Builds the surface of `obj` (scheme, with patches) with nothing failing, then tessellates
+ * at `rate` with allocation number base + k failing (or the k-th progress report cancelling)
+ * for every k until the call succeeds; every failure must return the expected code, leave
+ * `out` zeroed and leak nothing. The result is closed, or with split creases open along
+ * `split_once` edges. */
+static void failure_sweep_mesh(int cancel, float tol, unsigned flags, const char *obj, sfb_scheme scheme, int rate, long split_once)
 {
     tx_alloc al = { 0, 0, 0 };
     tx_prog pr = { 0, 0, 0, 0.0f };
@@ -752,13 +765,9 @@ static void failure_sweep(int cancel, float tol, unsigned flags)
     cc.progress.user = &pr;
     sfb_context *ctx = NULL;
     cr_assert_eq(sfb_context_create(&cc, &ctx), SFB_SUCCESS);
-    size_t n = strlen(prism_obj) + strlen(prism_creased_tags) + 1;
-    char *obj = malloc(n);
-    snprintf(obj, n, "%s%s", prism_obj, prism_creased_tags);
     sfb_mesh *m = tx_mesh(ctx, obj);
-    sfb_surface *s = tx_surface(ctx, m);
-    free(obj);
-    sfb_tess_config c = sfb_tess_config_init(70); /* more vertices than one evaluation chunk */
+    sfb_surface *s = scheme == SFB_SCHEME_LOOP ? tx_surface_loop(ctx, m) : tx_surface(ctx, m);
+    sfb_tess_config c = sfb_tess_config_init(rate);
     c.tolerance = tol;
     c.flags = flags;
     int failures = 0;
@@ -775,11 +784,12 @@ static void failure_sweep(int cancel, float tol, unsigned flags)
         if (r == SFB_SUCCESS) {
             cr_expect_gt(failures, 1, "only %d failure points", failures);
             if (flags & SFB_TESS_SPLIT_CREASES) {
-                edge_stats st = stats_of(&t, NULL); /* open along the five rim edges, 2 x 70 segments a side */
-                cr_expect_eq(st.once, 2L * 5 * 2 * 70);
+                edge_stats st = stats_of(&t, NULL);
+                if (tol == 0.0f) cr_expect_eq(st.once, split_once);
+                else cr_expect_gt(st.once, 0);
                 cr_expect_eq(st.directed_dup, 0);
             } else {
-                expect_closed(&t, "after the failures", 70);
+                expect_closed(&t, "after the failures", rate);
             }
             sfb_tess_data_free(&t);
             break;
@@ -796,6 +806,17 @@ static void failure_sweep(int cancel, float tol, unsigned flags)
     sfb_mesh_destroy(m);
     sfb_context_destroy(ctx);
     cr_expect_eq(al.live, 0, "%ld blocks leaked", al.live);
+}
+
+static void failure_sweep(int cancel, float tol, unsigned flags)
+{
+    size_t n = strlen(prism_obj) + strlen(prism_creased_tags) + 1;
+    char *obj = malloc(n);
+    snprintf(obj, n, "%s%s", prism_obj, prism_creased_tags);
+    /* rate 70: more vertices than one evaluation chunk; with split creases open along the five
+     * rim edges, 2 x 70 segments a side */
+    failure_sweep_mesh(cancel, tol, flags, obj, SFB_SCHEME_CATMARK, 70, 2L * 5 * 2 * 70);
+    free(obj);
 }
 
 Test(tess, cancellation_at_every_report)
@@ -832,6 +853,641 @@ Test(tess, memory_budget_refuses)
     cr_expect_eq(sfb_surface_tessellate(s, &c, &t), SFB_LIMIT_EXCEEDED, "%s", sfb_last_error(ctx));
     cr_expect(strstr(sfb_last_error(ctx), "tessellation") != NULL, "message: %s", sfb_last_error(ctx));
     cr_expect_null(t.positions);
+    sfb_surface_destroy(s);
+    sfb_mesh_destroy(m);
+    sfb_context_destroy(ctx);
+}
+
+/* ------------------------------------------------------------------------- */
+/* Loop surfaces: every param face is a base triangle, (u,v) barycentric      */
+
+/* OpenSubdiv's regression shapes: $SHAPES (as tests/run_all.sh), else the default relative to
+ * the repository root (where the unit tests run) or to build/. */
+static char *shape_text(const char *name, size_t *size)
+{
+    const char *env = getenv("SHAPES");
+    const char *dirs[3] = { env && env[0] ? env : "../shared/peers/opensubdiv-shapes", "../shared/peers/opensubdiv-shapes",
+                            "../../shared/peers/opensubdiv-shapes" };
+    for (int k = 0; k < 3; ++k) {
+        char path[4096];
+        snprintf(path, sizeof path, "%s/%s.obj", dirs[k], name);
+        FILE *f = fopen(path, "rb");
+        if (!f) continue;
+        fseek(f, 0, SEEK_END);
+        long n = ftell(f);
+        fseek(f, 0, SEEK_SET);
+        char *buf = malloc((size_t)n + 1);
+        cr_assert_not_null(buf);
+        cr_assert_eq(fread(buf, 1, (size_t)n, f), (size_t)n);
+        fclose(f);
+        buf[n] = '\0';
+        *size = (size_t)n;
+        return buf;
+    }
+    return NULL;
+}
+
+/* a peer shape as a Loop surface; skips the test when the shapes are not there */
+static sfb_surface *loop_shape(sfb_context *ctx, const char *name, sfb_mesh **mesh)
+{
+    size_t size = 0;
+    char *text = shape_text(name, &size);
+    if (!text) {
+        sfb_context_destroy(ctx);
+        cr_skip_test("peer shape %s.obj not found (set SHAPES to opensubdiv-shapes)", name);
+    }
+    sfb_result r = sfb_mesh_read_obj(ctx, text, size, mesh);
+    free(text);
+    cr_assert_eq(r, SFB_SUCCESS, "%s: %s", name, sfb_last_error(ctx));
+    return tx_surface_loop(ctx, *mesh);
+}
+
+/* Loop locations: inside the triangle (u + v <= 1, as evaluation requires) */
+static void check_loop_locations(const sfb_tess_data *t, const char *what)
+{
+    for (int v = 0; v < t->vertex_count; ++v) {
+        const sfb_location *l = &t->locations[v];
+        cr_assert((double)l->u + (double)l->v <= 1.0, "%s: vertex %d at (%d, %.9g, %.9g): u + v > 1", what, v, l->face, l->u, l->v);
+    }
+}
+
+/* closed, consistently oriented, no degenerate triangles, V - E + F = chi */
+static void expect_closed_chi(const sfb_tess_data *t, const char *what, int rate, long chi)
+{
+    edge_stats st = stats_of(t, NULL);
+    cr_expect_eq(st.once, 0, "%s rate %d: %ld boundary edges", what, rate, st.once);
+    cr_expect_eq(st.more, 0, "%s rate %d: %ld edges used more than twice", what, rate, st.more);
+    cr_expect_eq(st.directed_dup, 0, "%s rate %d: %ld directed edges used twice (inconsistent orientation)", what, rate,
+                 st.directed_dup);
+    cr_expect_eq(st.degenerate, 0, "%s rate %d: %ld degenerate triangles", what, rate, st.degenerate);
+    cr_expect_eq((long)t->vertex_count - st.undirected + t->triangle_count, chi, "%s rate %d: V - E + F = %ld", what, rate,
+                 (long)t->vertex_count - st.undirected + t->triangle_count);
+}
+
+/* positions (and normals) are those sfb_surface_eval gives at the output's locations */
+static void expect_eval_agrees(const sfb_surface *s, sfb_context *ctx, const sfb_tess_data *t, const char *what)
+{
+    float *p = malloc(sizeof(float) * 3 * (size_t)t->vertex_count);
+    float *n = malloc(sizeof(float) * 3 * (size_t)t->vertex_count);
+    cr_assert(p && n);
+    sfb_eval_output eo;
+    memset(&eo, 0, sizeof eo);
+    eo.position = p;
+    eo.normal = n;
+    cr_assert_eq(sfb_surface_eval(s, t->locations, t->vertex_count, &eo), SFB_SUCCESS, "%s: %s", what, sfb_last_error(ctx));
+    for (int i = 0; i < 3 * t->vertex_count; ++i) {
+        cr_assert(fabsf(p[i] - t->positions[i]) <= 1e-5f, "%s: position %d: %g vs eval %g", what, i / 3, t->positions[i], p[i]);
+        cr_assert(fabsf(n[i] - t->normals[i]) <= 1e-4f, "%s: normal %d: %g vs eval %g", what, i / 3, t->normals[i], n[i]);
+    }
+    free(p);
+    free(n);
+}
+
+/* every triangle faces the side its vertices' normals point to */
+static void expect_follows_normals(const sfb_tess_data *t, const char *what)
+{
+    int bad = 0;
+    for (int i = 0; i < t->triangle_count; ++i) {
+        const int *v = t->triangles + 3 * i;
+        const float *a = t->positions + 3 * v[0], *b = t->positions + 3 * v[1], *c = t->positions + 3 * v[2];
+        double e1[3], e2[3], n[3], avg[3] = { 0, 0, 0 };
+        for (int q = 0; q < 3; ++q) {
+            e1[q] = (double)b[q] - a[q];
+            e2[q] = (double)c[q] - a[q];
+        }
+        n[0] = e1[1] * e2[2] - e1[2] * e2[1];
+        n[1] = e1[2] * e2[0] - e1[0] * e2[2];
+        n[2] = e1[0] * e2[1] - e1[1] * e2[0];
+        for (int j = 0; j < 3; ++j)
+            for (int q = 0; q < 3; ++q) avg[q] += t->normals[3 * v[j] + q];
+        double dot = n[0] * avg[0] + n[1] * avg[1] + n[2] * avg[2];
+        double len = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+        bad += !(len > 0.0 && dot / len > 0.5);
+    }
+    cr_expect_eq(bad, 0, "%s: %d of %d triangles face away from their normals", what, bad, t->triangle_count);
+}
+
+/* Where a tessellation vertex sits on the base mesh, from its location: a base vertex (a
+ * corner of its param face), a point inside a base edge (an undirected vertex pair), or
+ * inside a face. */
+typedef struct loop_where {
+    int kind; /* 0 base vertex a, 1 inside edge (a,b) with a < b, 2 inside a face */
+    int a, b;
+} loop_where;
+
+static loop_where where_of(const sfb_mesh_desc *d, const sfb_location *l)
+{
+    loop_where w = { 2, -1, -1 };
+    const int *fv = d->face_vertices + 3 * l->face; /* all faces are triangles */
+    double u = l->u, v = l->v, eps = 1e-6;
+    int s0 = fabs(v) < eps, s1 = fabs(u + v - 1.0) < eps, s2 = fabs(u) < eps;
+    if (s0 && s2) { w.kind = 0; w.a = fv[0]; }
+    else if (s0 && s1) { w.kind = 0; w.a = fv[1]; }
+    else if (s1 && s2) { w.kind = 0; w.a = fv[2]; }
+    else if (s0 || s1 || s2) {
+        int k = s0 ? 0 : s1 ? 1 : 2, a = fv[k], b = fv[(k + 1) % 3];
+        w.kind = 1;
+        w.a = a < b ? a : b;
+        w.b = a < b ? b : a;
+    }
+    return w;
+}
+
+/* Checks that each boundary edge of the tessellation lies along one base edge that `allowed`
+ * accepts (both ends inside that edge or at its end vertices); returns how many base edges
+ * carry boundary edges (through *covered: their segment counts per base edge, keyed by pair). */
+typedef int (*edge_pred)(const sfb_mesh_desc *d, int a, int b, void *user);
+
+static long expect_boundary_along(const sfb_mesh_desc *d, const sfb_tess_data *t, edge_pred allowed, void *user, const char *what)
+{
+    int *bnd = NULL;
+    edge_stats st = stats_of(t, &bnd);
+    cr_expect_eq(st.more, 0, "%s: edges used more than twice", what);
+    cr_expect_eq(st.directed_dup, 0, "%s: inconsistent orientation", what);
+    cr_expect_eq(st.degenerate, 0, "%s: degenerate triangles", what);
+    long bad = 0;
+    for (long e = 0; e < st.once; ++e) {
+        loop_where p = where_of(d, &t->locations[bnd[2 * e]]), q = where_of(d, &t->locations[bnd[2 * e + 1]]);
+        int a = -1, b = -1, ok = 1;
+        if (p.kind == 2 || q.kind == 2) ok = 0;
+        else if (p.kind == 1 && q.kind == 1) { ok = p.a == q.a && p.b == q.b; a = p.a; b = p.b; }
+        else if (p.kind == 1) { ok = q.a == p.a || q.a == p.b; a = p.a; b = p.b; }
+        else if (q.kind == 1) { ok = p.a == q.a || p.a == q.b; a = q.a; b = q.b; }
+        else { a = p.a < q.a ? p.a : q.a; b = p.a < q.a ? q.a : p.a; } /* a single segment: the whole edge */
+        if (ok) ok = allowed(d, a, b, user);
+        if (!ok && bad < 5)
+            cr_expect(0, "%s: boundary edge %d-%d is not along an allowed base edge (kinds %d,%d)", what, bnd[2 * e], bnd[2 * e + 1], p.kind,
+                      q.kind);
+        bad += !ok;
+    }
+    cr_expect_eq(bad, 0, "%s: %ld of %ld boundary edges are not along allowed base edges", what, bad, st.once);
+    free(bnd);
+    return st.once;
+}
+
+/* the number of faces of the base mesh using edge (a,b) */
+static int edge_uses(const sfb_mesh_desc *d, int a, int b)
+{
+    int n = 0;
+    for (int f = 0; f < d->face_count; ++f)
+        for (int k = 0; k < 3; ++k) {
+            int x = d->face_vertices[3 * f + k], y = d->face_vertices[3 * f + (k + 1) % 3];
+            n += (x == a && y == b) || (x == b && y == a);
+        }
+    return n;
+}
+
+static int is_base_boundary(const sfb_mesh_desc *d, int a, int b, void *user)
+{
+    (void)user;
+    return edge_uses(d, a, b) == 1;
+}
+
+static long base_boundary_edges(const sfb_mesh_desc *d)
+{
+    long n = 0;
+    for (int f = 0; f < d->face_count; ++f)
+        for (int k = 0; k < 3; ++k) n += edge_uses(d, d->face_vertices[3 * f + k], d->face_vertices[3 * f + (k + 1) % 3]) == 1;
+    return n;
+}
+
+/* (u,v) of tessellation vertex `v` in param face f's own coordinates: located on f, or on a
+ * corner or an edge f shares with the face it was located on. Returns 0 when it is neither. */
+static int uv_in_face(const sfb_mesh_desc *d, const sfb_tess_data *t, int v, int f, double *u, double *w)
+{
+    const sfb_location *l = &t->locations[v];
+    const int *ff = d->face_vertices + 3 * f, *fg = d->face_vertices + 3 * l->face;
+    static const double cu[3] = { 0, 1, 0 }, cv[3] = { 0, 0, 1 };
+    if (l->face == f) {
+        *u = l->u;
+        *w = l->v;
+        return 1;
+    }
+    loop_where p = where_of(d, l);
+    if (p.kind == 2) return 0;
+    /* the point as (1-s) A + s B on a side A -> B of the face it was located on */
+    int A, B;
+    double sp;
+    if (p.kind == 0) { A = B = p.a; sp = 0.0; }
+    else {
+        double eps = 1e-6;
+        int k = fabs((double)l->v) < eps ? 0 : fabs((double)l->u + l->v - 1.0) < eps ? 1 : 2;
+        A = fg[k];
+        B = fg[(k + 1) % 3];
+        sp = k == 0 ? l->u : k == 1 ? l->v : 1.0 - l->v;
+    }
+    int ia = -1, ib = -1;
+    for (int k = 0; k < 3; ++k) {
+        if (ff[k] == A) ia = k;
+        if (ff[k] == B) ib = k;
+    }
+    if (ia < 0 || ib < 0) return 0;
+    *u = (1.0 - sp) * cu[ia] + sp * cu[ib];
+    *w = (1.0 - sp) * cv[ia] + sp * cv[ib];
+    return 1;
+}
+
+/* The triangles of each param face tile its (u,v) triangle: every one counter-clockwise with
+ * positive area, together area 1/2. */
+static void expect_tiles_param_faces(const sfb_mesh *m, const sfb_tess_data *t, const char *what)
+{
+    sfb_mesh_desc d;
+    sfb_mesh_get_desc(m, &d);
+    double *area = calloc((size_t)d.face_count, sizeof(double));
+    int bad = 0;
+    for (int i = 0; i < t->triangle_count; ++i) {
+        int f = t->triangle_faces[i];
+        double u[3], v[3];
+        int ok = 1;
+        for (int c = 0; c < 3; ++c) ok &= uv_in_face(&d, t, t->triangles[3 * i + c], f, &u[c], &v[c]);
+        double a2 = (u[1] - u[0]) * (v[2] - v[0]) - (v[1] - v[0]) * (u[2] - u[0]);
+        if (!ok || !(a2 > 1e-9)) {
+            if (bad < 3) cr_expect(0, "%s: triangle %d of face %d: %s, twice its area %g", what, i, f, ok ? "not counter-clockwise" : "vertex not on the face", a2);
+            bad++;
+        }
+        area[f] += 0.5 * a2;
+    }
+    cr_expect_eq(bad, 0, "%s: %d bad triangles in (u,v)", what, bad);
+    for (int f = 0; f < d.face_count; ++f)
+        cr_expect(fabs(area[f] - 0.5) < 1e-5, "%s: face %d: triangles cover an area %g in (u,v), not 1/2", what, f, area[f]);
+    free(area);
+}
+
+/* The closed shapes; loop_pole8 (a valence-8 pole) is an open disc, closed everywhere but
+ * along its 8 base boundary edges. */
+static const char *loop_shapes[3] = { "loop_cube", "loop_icosahedron", "loop_pole8" };
+
+/* Structural checks of a Loop tessellation without split creases: locations inside their
+ * triangles; open only along base boundary edges (rate segments each in uniform mode,
+ * rate < 0: adaptive); consistently oriented; the base mesh's Euler characteristic. */
+static void check_loop_tess(const sfb_mesh *m, const sfb_tess_data *t, const char *what, int rate)
+{
+    sfb_mesh_desc d;
+    sfb_mesh_info mi;
+    sfb_mesh_get_desc(m, &d);
+    sfb_mesh_get_info(m, &mi);
+    check_loop_locations(t, what);
+    expect_tiles_param_faces(m, t, what);
+    long nb = base_boundary_edges(&d);
+    long once = expect_boundary_along(&d, t, is_base_boundary, NULL, what);
+    if (rate > 0) cr_expect_eq(once, nb * rate, "%s rate %d: %ld boundary edges, base boundary %ld", what, rate, once, nb);
+    else cr_expect_geq(once, nb, "%s adaptive: %ld boundary edges, base boundary %ld", what, once, nb);
+    if (nb == 0) expect_closed_chi(t, what, rate, (long)mi.vertex_count - mi.edge_count + mi.face_count);
+    else {
+        edge_stats st = stats_of(t, NULL);
+        cr_expect_eq((long)t->vertex_count - st.undirected + t->triangle_count, (long)mi.vertex_count - mi.edge_count + mi.face_count,
+                     "%s rate %d: Euler characteristic differs from the base mesh's", what, rate);
+    }
+}
+
+Test(tess_loop, closed_uniform_counts_and_orientation)
+{
+    for (int k = 0; k < 3; ++k) {
+        sfb_context *ctx = tx_ctx();
+        sfb_mesh *m = NULL;
+        sfb_surface *s = loop_shape(ctx, loop_shapes[k], &m);
+        sfb_mesh_info mi;
+        sfb_mesh_get_info(m, &mi);
+        cr_assert_eq(sfb_surface_param_face_count(s), mi.face_count, "a Loop param face is a base triangle");
+        static const int rates[] = { 1, 2, 3, 5, 8 };
+        for (int q = 0; q < 5; ++q) {
+            int r = rates[q];
+            sfb_tess_data t = tess_ok(s, ctx, r, 0.0f, 0);
+            check_loop_tess(m, &t, loop_shapes[k], r);
+            cr_expect_eq(t.triangle_count, mi.face_count * r * r, "%s rate %d: %d triangles", loop_shapes[k], r, t.triangle_count);
+            /* V = nv + ne (r-1) + nf (r-1)(r-2)/2: every base vertex, edge point and face point once */
+            cr_expect_eq(t.vertex_count, mi.vertex_count + mi.edge_count * (r - 1) + mi.face_count * (r - 1) * (r - 2) / 2,
+                         "%s rate %d: %d vertices", loop_shapes[k], r, t.vertex_count);
+            for (int i = 0; i < t.triangle_count; ++i) cr_assert_eq(t.triangle_faces[i], i / (r * r), "faces in order, r^2 each");
+            if (r == 5) {
+                expect_follows_normals(&t, loop_shapes[k]);
+                expect_eval_agrees(s, ctx, &t, loop_shapes[k]);
+            }
+            sfb_tess_data_free(&t);
+        }
+        sfb_surface_destroy(s);
+        sfb_mesh_destroy(m);
+        sfb_context_destroy(ctx);
+    }
+}
+
+/* the locations of a uniform rate-r face: exactly the points (i/r, j/r), i + j <= r */
+Test(tess_loop, uniform_grid_locations)
+{
+    sfb_context *ctx = tx_ctx();
+    sfb_mesh *m = NULL;
+    sfb_surface *s = loop_shape(ctx, "loop_icosahedron", &m);
+    int r = 7;
+    sfb_tess_data t = tess_ok(s, ctx, r, 0.0f, 0);
+    /* every triangle of face f uses vertices at grid points of f: its vertices located on f
+     * sit on the grid; the ones located on a neighbour are on a shared edge */
+    long on_grid = 0, total = 0;
+    for (int v = 0; v < t.vertex_count; ++v) {
+        const sfb_location *l = &t.locations[v];
+        double i = (double)l->u * r, j = (double)l->v * r;
+        total++;
+        on_grid += fabs(i - floor(i + 0.5)) < 1e-4 && fabs(j - floor(j + 0.5)) < 1e-4;
+    }
+    cr_expect_eq(on_grid, total, "%ld of %ld vertices off the rate-%d grid", total - on_grid, total, r);
+    /* each triangle covers area 1/(2 r^2) of its face in (u,v), counter-clockwise, when all
+     * three vertices were located on that face */
+    int checked = 0;
+    for (int i = 0; i < t.triangle_count; ++i) {
+        const int *v = t.triangles + 3 * i;
+        int f = t.triangle_faces[i];
+        if (t.locations[v[0]].face != f || t.locations[v[1]].face != f || t.locations[v[2]].face != f) continue;
+        const sfb_location *a = &t.locations[v[0]], *b = &t.locations[v[1]], *c = &t.locations[v[2]];
+        double area2 = ((double)b->u - a->u) * ((double)c->v - a->v) - ((double)b->v - a->v) * ((double)c->u - a->u);
+        cr_expect(fabs(area2 - 1.0 / (r * r)) < 1e-5, "triangle %d: twice its (u,v) area is %g", i, area2);
+        checked++;
+    }
+    cr_expect_gt(checked, t.triangle_count / 2);
+    sfb_tess_data_free(&t);
+    sfb_surface_destroy(s);
+    sfb_mesh_destroy(m);
+    sfb_context_destroy(ctx);
+}
+
+/* adaptive: the three shapes, and two whose faces get different rates (zipper strips) */
+Test(tess_loop, closed_adaptive)
+{
+    static const char *names[5] = { "loop_cube", "loop_icosahedron", "loop_pole8", "loop_cube_asymmetric", "loop_pole64" };
+    static const float tols[4] = { 1e-1f, 3e-2f, 1e-2f, 3e-3f };
+    for (int k = 0; k < 5; ++k) {
+        sfb_context *ctx = tx_ctx();
+        sfb_mesh *m = NULL;
+        sfb_surface *s = loop_shape(ctx, names[k], &m);
+        int prev = 0, mixed = 0, np = sfb_surface_param_face_count(s);
+        for (int q = 0; q < 4; ++q) {
+            sfb_tess_data t = tess_ok(s, ctx, 12, tols[q], 0);
+            check_loop_tess(m, &t, names[k], -1);
+            expect_follows_normals(&t, names[k]);
+            expect_eval_agrees(s, ctx, &t, names[k]);
+            cr_expect_geq(t.triangle_count, prev, "%s: a smaller tolerance gave fewer triangles", names[k]);
+            prev = t.triangle_count;
+            /* faces with different triangle counts: zipper strips were needed */
+            int *counts = calloc((size_t)np, sizeof(int));
+            for (int i = 0; i < t.triangle_count; ++i) counts[t.triangle_faces[i]]++;
+            for (int f = 1; f < np; ++f) mixed += counts[f] != counts[0];
+            free(counts);
+            sfb_tess_data_free(&t);
+        }
+        if (k >= 3) cr_expect_gt(mixed, 0, "%s: every face got the same count at every tolerance", names[k]);
+        /* a huge tolerance: every face at rate 1, the base triangles */
+        sfb_tess_data t = tess_ok(s, ctx, 12, 1e6f, 0);
+        sfb_tess_data one = tess_ok(s, ctx, 1, 0.0f, 0);
+        cr_expect_eq(t.triangle_count, one.triangle_count);
+        cr_expect_eq(t.vertex_count, one.vertex_count);
+        cr_expect_eq(memcmp(t.triangles, one.triangles, sizeof(int) * 3 * (size_t)t.triangle_count), 0);
+        sfb_tess_data_free(&t);
+        sfb_tess_data_free(&one);
+        /* a tolerance no face meets: uniform at the full rate */
+        t = tess_ok(s, ctx, 6, 1e-9f, 0);
+        sfb_tess_data u = tess_ok(s, ctx, 6, 0.0f, 0);
+        cr_expect_eq(t.triangle_count, u.triangle_count);
+        cr_expect_eq(t.vertex_count, u.vertex_count);
+        sfb_tess_data_free(&t);
+        sfb_tess_data_free(&u);
+        sfb_surface_destroy(s);
+        sfb_mesh_destroy(m);
+        sfb_context_destroy(ctx);
+    }
+}
+
+Test(tess_loop, open_mesh_boundary_along_base_boundary_edges)
+{
+    sfb_context *ctx = tx_ctx();
+    sfb_mesh *m = NULL;
+    sfb_surface *s = loop_shape(ctx, "loop_triangle_edgecorner", &m);
+    sfb_mesh_desc d;
+    sfb_mesh_get_desc(m, &d);
+    long nb = base_boundary_edges(&d);
+    cr_assert_gt(nb, 0);
+    for (int r = 1; r <= 6; r += (r < 3 ? 1 : 3)) {
+        for (int split = 0; split < 2; ++split) { /* boundary edges are never split */
+            sfb_tess_data t = tess_ok(s, ctx, r, 0.0f, split ? SFB_TESS_SPLIT_CREASES : 0);
+            check_loop_locations(&t, "edgecorner");
+            cr_expect_eq(t.triangle_count, d.face_count * r * r);
+            long once = expect_boundary_along(&d, &t, is_base_boundary, NULL, "loop_triangle_edgecorner");
+            cr_expect_eq(once, nb * r, "rate %d: %ld boundary edges, base boundary %ld x %d", r, once, nb, r);
+            sfb_tess_data_free(&t);
+        }
+    }
+    /* adaptive: still open only along the base boundary, every base boundary edge at least once */
+    static const float tols[2] = { 1e-2f, 1e-4f };
+    for (int q = 0; q < 2; ++q) {
+        sfb_tess_data t = tess_ok(s, ctx, 16, tols[q], 0);
+        check_loop_locations(&t, "edgecorner adaptive");
+        long once = expect_boundary_along(&d, &t, is_base_boundary, NULL, "loop_triangle_edgecorner adaptive");
+        cr_expect_geq(once, nb);
+        expect_eval_agrees(s, ctx, &t, "loop_triangle_edgecorner adaptive");
+        sfb_tess_data_free(&t);
+    }
+    sfb_surface_destroy(s);
+    sfb_mesh_destroy(m);
+    sfb_context_destroy(ctx);
+}
+
+/* infinitely sharp interior edges of the base mesh */
+static int is_inf_crease(const sfb_mesh_desc *d, int a, int b, void *user)
+{
+    (void)user;
+    for (int c = 0; c < d->crease_count; ++c) {
+        int x = d->crease_vertices[2 * c], y = d->crease_vertices[2 * c + 1];
+        if (((x == a && y == b) || (x == b && y == a)) && d->crease_sharpness[c] >= SFB_SHARPNESS_INFINITE)
+            return edge_uses(d, a, b) == 2;
+    }
+    return 0;
+}
+
+/* base vertices where exactly one infinitely sharp interior edge ends (darts: one sector) */
+static int inf_crease_count_at(const sfb_mesh_desc *d, int v)
+{
+    int n = 0;
+    for (int c = 0; c < d->crease_count; ++c) {
+        int x = d->crease_vertices[2 * c], y = d->crease_vertices[2 * c + 1];
+        if ((x == v || y == v) && is_inf_crease(d, x, y, NULL)) n++;
+    }
+    return n;
+}
+
+static void check_loop_split(const char *name, long chi)
+{
+    sfb_context *ctx = tx_ctx();
+    sfb_mesh *m = NULL;
+    sfb_surface *s = loop_shape(ctx, name, &m);
+    sfb_mesh_desc d;
+    sfb_mesh_get_desc(m, &d);
+    long ninf = 0, isolated = 0;
+    for (int c = 0; c < d.crease_count; ++c) {
+        int a = d.crease_vertices[2 * c], b = d.crease_vertices[2 * c + 1];
+        if (!is_inf_crease(&d, a, b, NULL)) continue;
+        ninf++;
+        isolated += inf_crease_count_at(&d, a) == 1 && inf_crease_count_at(&d, b) == 1;
+    }
+    cr_assert_gt(ninf, 0, "%s has no infinitely sharp interior edge", name);
+    for (int pass = 0; pass < 4; ++pass) {
+        int r = pass < 3 ? 1 + 2 * pass : 12;
+        float tol = pass < 3 ? 0.0f : 1e-2f; /* mixed rates on both shapes */
+        sfb_tess_data t = tess_ok(s, ctx, r, tol, 0);
+        expect_closed_chi(&t, name, r, chi); /* without the flag the creases are shared */
+        int plain_v = t.vertex_count;
+        sfb_tess_data_free(&t);
+        t = tess_ok(s, ctx, r, tol, SFB_TESS_SPLIT_CREASES);
+        check_loop_locations(&t, name);
+        expect_tiles_param_faces(m, &t, name);
+        expect_eval_agrees(s, ctx, &t, name);
+        long once = expect_boundary_along(&d, &t, is_inf_crease, NULL, name);
+        /* an isolated sharp edge (a dart at each end) with one segment has no point to split */
+        if (tol == 0.0f)
+            cr_expect_eq(once, 2 * ninf * r - (r == 1 ? 2 * isolated : 0), "%s rate %d: %ld boundary edges, %ld sharp edges, %ld isolated",
+                         name, r, once, ninf, isolated);
+        else cr_expect_geq(once, 2 * ninf);
+        cr_expect_gt(t.vertex_count, plain_v);
+        /* every boundary vertex has a twin at the same position across the crease, except at
+         * the end of a crease inside the surface (a dart: one sector, one vertex) */
+        int *bnd = NULL;
+        edge_stats st = stats_of(&t, &bnd);
+        unsigned char *seen = calloc((size_t)t.vertex_count, 1);
+        int lonely = 0, lonely_dart = 0;
+        for (long e = 0; e < st.once; ++e)
+            for (int c = 0; c < 2; ++c) {
+                int v = bnd[2 * e + c], twin = 0;
+                if (seen[v]) continue;
+                seen[v] = 1;
+                for (int w = 0; w < t.vertex_count && !twin; ++w) {
+                    if (w == v) continue;
+                    const float *a = t.positions + 3 * v, *b = t.positions + 3 * w;
+                    twin = fabsf(a[0] - b[0]) < 1e-5f && fabsf(a[1] - b[1]) < 1e-5f && fabsf(a[2] - b[2]) < 1e-5f;
+                }
+                if (!twin) {
+                    loop_where p = where_of(&d, &t.locations[v]);
+                    lonely++;
+                    lonely_dart += p.kind == 0 && inf_crease_count_at(&d, p.a) == 1;
+                }
+            }
+        cr_expect_eq(lonely, lonely_dart, "%s rate %d: %d boundary vertices without a twin, %d of them darts", name, r, lonely, lonely_dart);
+        free(seen);
+        free(bnd);
+        sfb_tess_data_free(&t);
+    }
+    sfb_surface_destroy(s);
+    sfb_mesh_destroy(m);
+    sfb_context_destroy(ctx);
+}
+
+Test(tess_loop, split_creases_cubes_infsharp)
+{
+    check_loop_split("loop_cubes_infsharp", 2L * 4); /* four closed cubes */
+}
+
+Test(tess_loop, split_creases_icos_infsharp)
+{
+    check_loop_split("loop_icos_infsharp", 2L * 4); /* four closed icosahedra */
+}
+
+/* an octahedron (Loop: six valence-4 extraordinary vertices) with its equator infinitely sharp */
+static const char *octa_creased_obj =
+    "v 1 0 0\nv -1 0 0\nv 0 1 0\nv 0 -1 0\nv 0 0 1\nv 0 0 -1\n"
+    "f 1 3 5\nf 3 2 5\nf 2 4 5\nf 4 1 5\nf 3 1 6\nf 2 3 6\nf 4 2 6\nf 1 4 6\n"
+    "t crease 2/1/0 0 2 10\nt crease 2/1/0 2 1 10\nt crease 2/1/0 1 3 10\nt crease 2/1/0 3 0 10\n";
+
+/* rate 130: 6 + 12 x 129 + 8 x 129 x 128 / 2 = 67602 vertices, more than one evaluation
+ * chunk; split: open along the 4 equator edges, 130 segments a side */
+#define OCTA_RATE 130
+
+Test(tess_loop, octahedron_counts)
+{
+    sfb_context *ctx = tx_ctx();
+    sfb_mesh *m = tx_mesh(ctx, octa_creased_obj);
+    sfb_surface *s = tx_surface_loop(ctx, m);
+    sfb_tess_data t = tess_ok(s, ctx, OCTA_RATE, 0.0f, 0);
+    check_loop_tess(m, &t, "octahedron", OCTA_RATE);
+    cr_expect_eq(t.vertex_count, 67602);
+    cr_expect_eq(t.triangle_count, 8 * OCTA_RATE * OCTA_RATE);
+    sfb_tess_data_free(&t);
+    t = tess_ok(s, ctx, 4, 0.0f, SFB_TESS_SPLIT_CREASES);
+    expect_follows_normals(&t, "octahedron split");
+    expect_eval_agrees(s, ctx, &t, "octahedron split");
+    /* the equator's vertices: 4 x 4 points, twice */
+    cr_expect_eq(t.vertex_count, 6 + 12 * 3 + 8 * 3 * 2 / 2 + 4 * 4);
+    sfb_tess_data_free(&t);
+    sfb_surface_destroy(s);
+    sfb_mesh_destroy(m);
+    sfb_context_destroy(ctx);
+}
+
+Test(tess_loop, cancellation_at_every_report)
+{
+    failure_sweep_mesh(1, 0.0f, SFB_TESS_SPLIT_CREASES, octa_creased_obj, SFB_SCHEME_LOOP, OCTA_RATE, 2L * 4 * OCTA_RATE);
+}
+
+Test(tess_loop, cancellation_at_every_report_adaptive)
+{
+    failure_sweep_mesh(1, 1e-3f, 0, octa_creased_obj, SFB_SCHEME_LOOP, OCTA_RATE, 0);
+}
+
+Test(tess_loop, allocation_failure_at_every_step)
+{
+    failure_sweep_mesh(0, 0.0f, 0, octa_creased_obj, SFB_SCHEME_LOOP, OCTA_RATE, 0);
+}
+
+Test(tess_loop, allocation_failure_at_every_step_adaptive)
+{
+    failure_sweep_mesh(0, 1e-3f, SFB_TESS_SPLIT_CREASES, octa_creased_obj, SFB_SCHEME_LOOP, OCTA_RATE, 2L * 4 * OCTA_RATE);
+}
+
+/* a hole in a Loop surface makes nothing; its rim (3 base edges) is a boundary */
+Test(tess_loop, holes_make_nothing)
+{
+    sfb_context *ctx = tx_ctx();
+    size_t size = 0;
+    char *text = shape_text("loop_icosahedron", &size);
+    if (!text) {
+        sfb_context_destroy(ctx);
+        cr_skip_test("peer shape loop_icosahedron.obj not found (set SHAPES to opensubdiv-shapes)");
+    }
+    text = realloc(text, size + 32);
+    size += (size_t)snprintf(text + size, 32, "\nt hole 1/0/0 3\n");
+    sfb_mesh *m = NULL;
+    cr_assert_eq(sfb_mesh_read_obj(ctx, text, size, &m), SFB_SUCCESS, "%s", sfb_last_error(ctx));
+    free(text);
+    sfb_surface *s = tx_surface_loop(ctx, m);
+    for (int q = 0; q < 2; ++q) {
+        int r = 4;
+        sfb_tess_data t = tess_ok(s, ctx, r, q ? 1e-3f : 0.0f, 0);
+        check_loop_locations(&t, "icosahedron with a hole");
+        if (!q) cr_expect_eq(t.triangle_count, 19 * r * r);
+        for (int i = 0; i < t.triangle_count; ++i) cr_expect_neq(t.triangle_faces[i], 3);
+        for (int v = 0; v < t.vertex_count; ++v) cr_expect_neq(t.locations[v].face, 3);
+        edge_stats st = stats_of(&t, NULL);
+        if (!q) cr_expect_eq(st.once, 3L * r);
+        else cr_expect_geq(st.once, 3L);
+        cr_expect_eq(st.more, 0);
+        cr_expect_eq(st.directed_dup, 0);
+        sfb_tess_data_free(&t);
+    }
+    sfb_surface_destroy(s);
+    sfb_mesh_destroy(m);
+    sfb_context_destroy(ctx);
+}
+
+/* loop_cube_creases1 has semi-sharp creases only (sharpness 5 and less): nothing is split */
+Test(tess_loop, split_creases_semisharp_only_stays_closed)
+{
+    sfb_context *ctx = tx_ctx();
+    sfb_mesh *m = NULL;
+    sfb_surface *s = loop_shape(ctx, "loop_cube_creases1", &m);
+    for (int r = 1; r <= 4; r += 3) {
+        sfb_tess_data a = tess_ok(s, ctx, r, 0.0f, 0);
+        sfb_tess_data b = tess_ok(s, ctx, r, 0.0f, SFB_TESS_SPLIT_CREASES);
+        check_loop_tess(m, &b, "loop_cube_creases1", r);
+        cr_expect_eq(a.vertex_count, b.vertex_count);
+        cr_expect_eq(a.triangle_count, b.triangle_count);
+        cr_expect_eq(memcmp(a.triangles, b.triangles, sizeof(int) * 3 * (size_t)a.triangle_count), 0);
+        sfb_tess_data_free(&a);
+        sfb_tess_data_free(&b);
+    }
     sfb_surface_destroy(s);
     sfb_mesh_destroy(m);
     sfb_context_destroy(ctx);
