@@ -297,8 +297,8 @@ typedef struct sfb__gl {
     sfb__GLint max_groups;          /* GL_MAX_COMPUTE_WORK_GROUP_COUNT[0] */
     sfb__GLuint program[17];        /* stencil kernel per SFB_LENGTH, compiled on first use */
     sfb__GLint loc[17][8];
-    sfb__GLuint patch_program;      /* patch kernel, compiled on first use */
-    sfb__GLint patch_loc[5];
+    sfb__GLuint patch_program[2];   /* patch kernels (Catmull-Clark, Loop), compiled on first use */
+    sfb__GLint patch_loc[2][5];
     sfb__GLuint scratch_src, scratch_dst;
     size_t scratch_src_cap, scratch_dst_cap;
     char desc[320];
@@ -597,8 +597,9 @@ static void sfb__gl_release_gl(sfb__gl *g) {
     int i;
     for (i = 0; i < 17; ++i)
         if (g->program[i]) g->gl.DeleteProgram(g->program[i]);
-    if (g->patch_program) g->gl.DeleteProgram(g->patch_program);
-    g->patch_program = 0;
+    for (i = 0; i < 2; ++i)
+        if (g->patch_program[i]) g->gl.DeleteProgram(g->patch_program[i]);
+    memset(g->patch_program, 0, sizeof g->patch_program);
     if (g->scratch_src) g->gl.DeleteBuffers(1, &g->scratch_src);
     if (g->scratch_dst) g->gl.DeleteBuffers(1, &g->scratch_dst);
     memset(g->program, 0, sizeof g->program);
@@ -1085,20 +1086,24 @@ typedef struct sfb__gl_ptable {
 /* A location as the patch kernel reads it (std430 struct SfbQuery). */
 typedef struct sfb__gl_query {
     int patch;           /* piece-local */
-    float s, t, scale;   /* Stam patches: (u,v) in the EV's frame instead of (s,t) */
+    float s, t;          /* Stam and Stam-Loop patches: (u,v) in the EV's frame instead of (s,t) */
+    float scale;         /* +-2^depth: negative after an odd number of middle triangles (Loop) */
 } sfb__gl_query;
 
 /* Patch kinds as the shader numbers them (patches.comp.glsl), independent of the core's. */
-enum { SFB__GL_KIND_BSPLINE = 0, SFB__GL_KIND_STAM = 1, SFB__GL_KIND_ENDCAP = 2 };
+enum { SFB__GL_KIND_BSPLINE = 0, SFB__GL_KIND_STAM = 1, SFB__GL_KIND_ENDCAP = 2, SFB__GL_KIND_BEZTRI = 3,
+       SFB__GL_KIND_STAM_LOOP = 4, SFB__GL_KIND_ENDCAP_TRI = 5 };
 enum { SFB__GL_OUTPUTS = 7 };  /* position, du, dv, normal, duu, duv, dvv */
-/* Sort keys of the queries within a piece: B-spline, end cap, then Stam by valence. */
+/* Sort keys of the queries within a piece: B-spline or Bezier triangle, end cap (quad or
+ * triangle), then Stam or Stam-Loop by valence (a table holds one scheme's kinds only). */
 enum { SFB__GL_BUCKETS = SFB__STAM_MAX_VALENCE + 3 };
 static const char *const sfb__gl_patch_uniforms[5] = {"u_first", "u_last", "u_stride", "u_slot", "u_second"};
 
 /* Floats of one valence's eigen block, as vec4s (patches.comp.glsl): header (K, dominant, sub,
  * 0), per eigenvalue (lambda, lambda/sub, at-EV tangent mask, 0), and phi (3 sub-patches x K x
- * the 4 rows of the 4x4 B-spline coefficients), so that the kernel reads whole vec4s. */
-static size_t sfb__gl_eig_floats(const sfb__eigen_cc *e) { return 4 * (1 + 13 * (size_t)e->K); }
+ * the 4 rows of the 4x4 B-spline coefficients), so that the kernel reads whole vec4s. The Loop
+ * block (sfb__gl_eigl_pack) has the same size: its phi are 15 Bezier coefficients and a 0. */
+static size_t sfb__gl_eig_floats(int K) { return 4 * (1 + 13 * (size_t)K); }
 
 static void sfb__gl_eig_pack(const sfb__eigen_cc *e, float *o) {
     int K = e->K, i, k, j;
@@ -1122,6 +1127,30 @@ static void sfb__gl_eig_pack(const sfb__eigen_cc *e, float *o) {
                 phi[((size_t)k * K + i) * 16 + j] = (float)e->phi[((size_t)k * 16 + j) * K + i];
 }
 
+/* The Stam-Loop block: header (K, dominant, sub, 0), per eigenvalue (lambda, lambda/sub (0 for
+ * the dominant), at-EV tangent mask, index of its Jordan head or -1), then per sub-patch
+ * k = 0..2 and eigenvalue i the 15 Bezier coefficients of Phi_k[.][i] and a 0. */
+static void sfb__gl_eigl_pack(const sfb__eigen_loop *e, float *o) {
+    int K = e->K, i, k, j;
+    float *phi = o + 4 * (1 + (size_t)K);
+    o[0] = (float)K; o[1] = (float)e->dominant; o[2] = (float)e->sub; o[3] = 0.0f;
+    for (i = 0; i < K; ++i) {
+        double l = e->lambda[i];
+        float *h = o + 4 * (1 + (size_t)i);
+        h[0] = (float)l;
+        h[1] = i == e->dominant ? 0.0f : (float)(l / e->sub);
+        /* as sfb__eval_stam_loop at the EV */
+        h[2] = (i != e->dominant && fabs(l - e->sub) <= 1e-12) ? 1.0f : 0.0f;
+        h[3] = e->head[i] >= 0 ? (float)e->head[i] : -1.0f;
+    }
+    /* e->phi[(k*15 + j)*K + i] -> phi[(k*K + i)*16 + j] */
+    for (k = 0; k < 3; ++k)
+        for (i = 0; i < K; ++i) {
+            for (j = 0; j < 15; ++j) phi[((size_t)k * K + i) * 16 + j] = (float)e->phi[((size_t)k * 15 + j) * K + i];
+            phi[((size_t)k * K + i) * 16 + 15] = 0.0f;
+        }
+}
+
 static void sfb__gl_ptable_free(sfb__gl *g, sfb__gl_ptable *t) {
     int i;
     if (!t) return;
@@ -1137,17 +1166,21 @@ static sfb_result sfb__gl_patches_upload_current(sfb__gl *g, const sfb__patch_ta
     size_t cap_rec = (size_t)g->max_block / 16, cap_cv = (size_t)g->max_block / 4, cap_pts = (size_t)g->max_block / 16,
            cap_eig = (size_t)g->max_block / 4, eig_total = 0, max_pts;
     int rows = pt->npoints, p, count = 0, allocated = 0, stamp_id = 0, N;
-    int eig_stamp[SFB__STAM_MAX_VALENCE + 1];
-    size_t eig_at[SFB__STAM_MAX_VALENCE + 1];
+    /* per eigen block: Catmull-Clark valence N at N, Loop at SFB__STAM_MAX_VALENCE + 1 + N */
+    int eig_stamp[2 * (SFB__STAM_MAX_VALENCE + 1)];
+    size_t eig_at[2 * (SFB__STAM_MAX_VALENCE + 1)];
     int *stamp = NULL, *local = NULL, *rec = NULL, *cvl = NULL;
     float *pts = NULL, *eig = NULL;
     sfb__gl_ptable *tab;
     sfb_result res = SFB_SUCCESS;
     *out = NULL;
-    for (N = 0; N <= SFB__STAM_MAX_VALENCE; ++N) {
+    for (N = 0; N < 2 * (SFB__STAM_MAX_VALENCE + 1); ++N) {
         eig_stamp[N] = -1;
         eig_at[N] = 0;
-        if (pt->eig[N]) eig_total += sfb__gl_eig_floats(pt->eig[N]);
+    }
+    for (N = 0; N <= SFB__STAM_MAX_VALENCE; ++N) {
+        if (pt->eig[N]) eig_total += sfb__gl_eig_floats(pt->eig[N]->K);
+        if (pt->eigl[N]) eig_total += sfb__gl_eig_floats(pt->eigl[N]->K);
     }
     max_pts = (size_t)pt->ncv < (size_t)rows ? (size_t)pt->ncv : (size_t)rows;
     tab = (sfb__gl_ptable *)sfb__calloc(g->ctx, 1, sizeof *tab);
@@ -1165,9 +1198,10 @@ static sfb_result sfb__gl_patches_upload_current(sfb__gl *g, const sfb__patch_ta
         sfb__gl_ppiece *piece;
         int p0 = p, k;
         for (; p < pt->npatch; ++p) {
-            int first = pt->pfirst[p], n = pt->pfirst[p + 1] - first, kind, eoff = -1, fits;
+            int first = pt->pfirst[p], n = pt->pfirst[p + 1] - first, kind, eoff = -1, fits, slot = -1, eK = 0;
             size_t npts0 = npts, neig0 = neig;
             const sfb__eigen_cc *e = NULL;
+            const sfb__eigen_loop *el = NULL;
             switch (pt->ptype[p]) {
             case SFB__PATCH_BSPLINE: kind = SFB__GL_KIND_BSPLINE; fits = n == 16; break;
             /* 4 corner positions, or those and each corner's two limit tangents (normals) */
@@ -1177,6 +1211,17 @@ static sfb_result sfb__gl_patches_upload_current(sfb__gl *g, const sfb__patch_ta
                 N = pt->pvalence[p];
                 e = N >= 3 && N <= SFB__STAM_MAX_VALENCE ? pt->eig[N] : NULL;
                 fits = e && n == e->K;
+                if (e) { slot = N; eK = e->K; }
+                break;
+            case SFB__PATCH_BEZTRI: kind = SFB__GL_KIND_BEZTRI; fits = n == 15; break;
+            /* 3 corner positions and each corner's two limit tangents */
+            case SFB__PATCH_ENDCAP_TRI: kind = SFB__GL_KIND_ENDCAP_TRI; fits = n == 9; eoff = n; break;
+            case SFB__PATCH_STAM_LOOP:
+                kind = SFB__GL_KIND_STAM_LOOP;
+                N = pt->pvalence[p];
+                el = N >= 3 && N <= SFB__STAM_MAX_VALENCE ? pt->eigl[N] : NULL;
+                fits = el && n == el->K;
+                if (el) { slot = SFB__STAM_MAX_VALENCE + 1 + N; eK = el->K; }
                 break;
             default: kind = -1; fits = 0; break;
             }
@@ -1201,20 +1246,21 @@ static sfb_result sfb__gl_patches_upload_current(sfb__gl *g, const sfb__patch_ta
                 }
                 cvl[ncv + (size_t)k] = local[row];
             }
-            if (e) {
-                if (eig_stamp[N] != stamp_id) {
-                    eig_stamp[N] = stamp_id;
-                    eig_at[N] = neig / 4; /* in vec4s */
-                    sfb__gl_eig_pack(e, eig + neig);
-                    neig += sfb__gl_eig_floats(e);
+            if (slot >= 0) {
+                if (eig_stamp[slot] != stamp_id) {
+                    eig_stamp[slot] = stamp_id;
+                    eig_at[slot] = neig / 4; /* in vec4s */
+                    if (e) sfb__gl_eig_pack(e, eig + neig);
+                    else sfb__gl_eigl_pack(el, eig + neig);
+                    neig += sfb__gl_eig_floats(eK);
                 }
-                eoff = (int)eig_at[N];
+                eoff = (int)eig_at[slot];
             }
             if (nrec + 1 > cap_rec || ncv + (size_t)n > cap_cv || npts > cap_pts || neig > cap_eig) {
                 if (nrec == 0) {
                     res = sfb__error(g->ctx, SFB_LIMIT_EXCEEDED, SFB_ELEMENT_NONE, -1,
                                      "%s: patch %d (%d points%s) needs more than one shader storage block holds (%d bytes)", who, p, n,
-                                     e ? ", Stam eigen data" : "", (int)g->max_block);
+                                     e ? ", Stam eigen data" : el ? ", Stam-Loop eigen data" : "", (int)g->max_block);
                     goto done;
                 }
                 /* this patch starts the next piece: drop what it added here (the stamps of
@@ -1292,14 +1338,18 @@ static void sfb__gl_release_patches(void *state, void *handle) {
     }
 }
 
-static sfb_result sfb__gl_patch_program(sfb__gl *g, sfb__GLuint *out) {
+/* The patch kernel of a scheme (loop = 0: Catmull-Clark kinds, 1: Loop kinds): one source,
+ * the other scheme's kinds left out by a define, so that neither pays the other's compile. */
+static sfb_result sfb__gl_patch_program(sfb__gl *g, int loop, sfb__GLuint *out) {
     sfb__GLuint prog;
     sfb_result r;
     int i;
-    if (g->patch_program) { *out = g->patch_program; return SFB_SUCCESS; }
-    if ((r = sfb__gl_compile(g, "", SFB__GL_PATCH_SOURCE, "patches.comp.glsl", &prog)) != SFB_SUCCESS) return r;
-    for (i = 0; i < 5; ++i) g->patch_loc[i] = g->gl.GetUniformLocation(prog, sfb__gl_patch_uniforms[i]);
-    g->patch_program = prog;
+    if (g->patch_program[loop]) { *out = g->patch_program[loop]; return SFB_SUCCESS; }
+    if ((r = sfb__gl_compile(g, loop ? "#define SFB_NO_CATMARK\n" : "#define SFB_NO_LOOP\n", SFB__GL_PATCH_SOURCE, "patches.comp.glsl",
+                             &prog)) != SFB_SUCCESS)
+        return r;
+    for (i = 0; i < 5; ++i) g->patch_loc[loop][i] = g->gl.GetUniformLocation(prog, sfb__gl_patch_uniforms[i]);
+    g->patch_program[loop] = prog;
     *out = prog;
     return sfb__gl_check(g, "building the patch kernel");
 }
@@ -1326,7 +1376,7 @@ static sfb_result sfb__gl_eval_patches(void *state, const sfb__patch_table *pt, 
     sfb__GLint slot[SFB__GL_OUTPUTS];
     sfb__gl_query *queries = NULL, *sorted = NULL;
     int *order = NULL, *piece_start = NULL, *key = NULL, *bucket = NULL;
-    int count = last - first, nout = 0, o, q, i, k, stride, used = 0;
+    int count = last - first, nout = 0, o, q, i, k, stride, used = 0, loop = pt->scheme == SFB_SCHEME_LOOP;
     size_t batch, nbuckets, z;
     long long per = (long long)g->max_groups * 64;
     sfb__gl_saved s;
@@ -1346,7 +1396,7 @@ static sfb_result sfb__gl_eval_patches(void *state, const sfb__patch_table *pt, 
         if ((res = sfb__gl_patches_upload_current(g, pt, &temp)) != SFB_SUCCESS) goto done;
         tab = temp;
     }
-    if ((res = sfb__gl_patch_program(g, &prog)) != SFB_SUCCESS) goto done;
+    if ((res = sfb__gl_patch_program(g, loop, &prog)) != SFB_SUCCESS) goto done;
     nbuckets = (size_t)tab->count * SFB__GL_BUCKETS;
     queries = (sfb__gl_query *)sfb__alloc(g->ctx, (size_t)count * sizeof *queries);
     key = (int *)sfb__alloc(g->ctx, (size_t)count * sizeof(int));
@@ -1361,8 +1411,21 @@ static sfb_result sfb__gl_eval_patches(void *state, const sfb__patch_table *pt, 
             res = sfb__error(g->ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, first + q, "location %d: parametric face %d is a hole", first + q, l->face);
             goto done;
         }
-        kind = pt->ptype[patch] == SFB__PATCH_ENDCAP ? 1 : 0;
-        if (pt->ptype[patch] == SFB__PATCH_STAM) {
+        kind = pt->ptype[patch] == SFB__PATCH_ENDCAP || pt->ptype[patch] == SFB__PATCH_ENDCAP_TRI ? 1 : 0;
+        if (pt->ptype[patch] == SFB__PATCH_STAM_LOOP) {
+            /* into the EV's frame (the EV at (0,0)) in double, as for Stam; the triangle's
+             * frame turns: corner 1 (u,v) = (t, 1-s-t), corner 2 (1-s-t, s). The scale keeps
+             * its sign: the kernel multiplies the derivatives by it. */
+            double s0 = u, t0 = v;
+            switch (SFB__PARAM_CORNER(pt->pparam[patch])) {
+            case 1: u = t0; v = 1.0 - s0 - t0; break;
+            case 2: u = 1.0 - s0 - t0; v = s0; break;
+            default: break;
+            }
+            if (u < 0.0) u = 0.0;
+            if (v < 0.0) v = 0.0;
+            kind = 2 + pt->pvalence[patch];
+        } else if (pt->ptype[patch] == SFB__PATCH_STAM) {
             /* into the EV's frame here, in double: the EV is then exactly (0,0) and a small
              * distance to it keeps its relative precision in float */
             double s0 = u, t0 = v;
@@ -1402,9 +1465,9 @@ static sfb_result sfb__gl_eval_patches(void *state, const sfb__patch_table *pt, 
         sorted = NULL;
     }
     g->gl.UseProgram(prog);
-    g->gl.Uniform1i(g->patch_loc[2], stride);
-    g->gl.Uniform1iv(g->patch_loc[3], SFB__GL_OUTPUTS, slot);
-    g->gl.Uniform1i(g->patch_loc[4], dst[4] || dst[5] || dst[6]);
+    g->gl.Uniform1i(g->patch_loc[loop][2], stride);
+    g->gl.Uniform1iv(g->patch_loc[loop][3], SFB__GL_OUTPUTS, slot);
+    g->gl.Uniform1i(g->patch_loc[loop][4], dst[4] || dst[5] || dst[6]);
     for (i = 0; i < tab->count; ++i) {
         const sfb__gl_ppiece *pc = &tab->pieces[i];
         int a = piece_start[i], b = piece_start[i + 1];
@@ -1421,8 +1484,8 @@ static sfb_result sfb__gl_eval_patches(void *state, const sfb__patch_table *pt, 
             g->gl.BindBufferBase(SFB__GL_SHADER_STORAGE_BUFFER, 5, g->scratch_dst);
             for (d = 0; d < n;) {
                 int m = (long long)(n - d) > per ? (int)per : n - d;
-                g->gl.Uniform1i(g->patch_loc[0], d);
-                g->gl.Uniform1i(g->patch_loc[1], d + m);
+                g->gl.Uniform1i(g->patch_loc[loop][0], d);
+                g->gl.Uniform1i(g->patch_loc[loop][1], d + m);
                 g->gl.DispatchCompute((sfb__GLuint)((m + 63) / 64), 1, 1);
                 d += m;
             }
