@@ -20,16 +20,20 @@
  *   B/invariance/S random locations (the same on every backend): the limit surface does not change
  *                  when the mesh is refined, so the surface of the level-L refined mesh (sharpness
  *                  carried over) evaluated at the corresponding location must give the same point:
- *                  within 1e-5 x diagonal (positions), 2e-3 rad (normals; see check_invariance).
- *                  The refined mesh is isolated L levels less, so its end caps sit at the same
- *                  absolute level and the two surfaces are the same function everywhere. This is
- *                  exact at any (u,v) and tighter than interpolating a level-8 refinement (whose
- *                  interpolation error alone is ~1e-5 x diagonal); the end-cap error (isolation
- *                  2) is measured on the same samples and printed ("# S: end caps ...").
- *   B/derivatives/S du, dv against central differences of positions (h = 1e-3) and duu, duv, dvv
- *                  against central differences of du, dv, at random locations in [0.05,0.95]^2:
- *                  within 1e-3 relative plus the float rounding of the positions divided by 2h
- *                  (first), 2e-2 relative plus 1e-3 x |du| + |dv| (second).
+ *                  within 1e-5 x diagonal (positions), 2e-3 rad (normals), or 8 times the
+ *                  normals' float limit where that is more (measure_float_limit). The locations
+ *                  are dyadic (k / 2^20), exact in float on both meshes. The refined mesh is
+ *                  isolated L levels less, so its end caps sit at the same absolute level and
+ *                  the two surfaces are the same function everywhere. This is exact at any (u,v)
+ *                  and tighter than interpolating a level-8 refinement (whose interpolation error
+ *                  alone is ~1e-5 x diagonal); the end-cap error (isolation 2) is measured on the
+ *                  same samples and printed ("# S: end caps ...").
+ *   B/derivatives/S du, dv against central differences of positions (h = 1e-3) and duu, duv
+ *                  (both ways), dvv against central differences of du, dv, at random locations in
+ *                  [0.05,0.95]^2: a difference quotient must lie in the range of the derivative
+ *                  over its step (the three values) within 1e-3 relative plus the float rounding
+ *                  of the positions divided by 2h (first), 2e-2 relative plus the jumps of float
+ *                  patches' first derivatives divided by 2h (second).
  *   B/continuity/S along every edge shared by two parametric faces in a smooth region (the edge
  *                  and its end vertices free of sharpness, neither end vertex a dart/corner/crease),
  *                  the normals from the two sides at 100 points agree within 1e-4 rad.
@@ -346,7 +350,9 @@ typedef struct shape {
     /* random locations (base) and the same points on the refined mesh's param faces */
     int nloc;
     sfb_location *loc, *rloc;
-    double *nnoise;            /* per location: the normal's float rounding noise (run_shape) */
+    double *nnoise;            /* per location: the normals' float limit (measure_float_limit) */
+    sfb_context *ref;          /* ref's context and its level-L surface (patches as level 0) */
+    const sfb_surface *sref;
 } shape;
 
 static int eval(const sfb_surface *s, const sfb_location *loc, int n, float *P, float *du, float *dv, float *N, float *duu,
@@ -442,7 +448,43 @@ static void check_exact(const backend *b, const shape *sh, const sfb_surface *s)
     free(loc); free(vert); free(P); free(N);
 }
 
-static void check_invariance(const backend *b, const shape *sh, const sfb_surface *s, const sfb_surface *sr, const sfb_surface *s_iso) {
+/* The invariance check's float limit, measured where needed (check_invariance). Patch points
+ * are floats, so where faces are tiny next to their coordinates their rounding alone turns the
+ * normals by more than 2e-3 rad (catmark_bishop: 2.2e-3 rad between the two surfaces, 1.5e-7
+ * with the mesh moved to put the point at the origin). Measured: ref's base surface against
+ * the same mesh scaled by three factors (the same normals, as exact numbers, and the same
+ * relative precision, rounded elsewhere), the largest turn per location. */
+static void measure_float_limit(shape *sh) {
+    static const double k_scales[3] = {1.2345678, 0.8765432, 1.4142136};
+    sfb_mesh_desc bd;
+    float *pp, *N1 = (float *)xmalloc(sizeof(float) * 3 * (size_t)sh->nloc + 4), *N2 = (float *)xmalloc(sizeof(float) * 3 * (size_t)sh->nloc + 4);
+    int sc, k;
+    sfb_mesh_get_desc(sh->mesh, &bd);
+    pp = (float *)xmalloc(sizeof(float) * 3 * (size_t)bd.vertex_count + 4);
+    sh->nnoise = (double *)xmalloc(sizeof(double) * (size_t)sh->nloc + 1);
+    for (k = 0; k < sh->nloc; ++k) sh->nnoise[k] = 0.0;
+    if (eval(sh->sref, sh->loc, sh->nloc, NULL, NULL, NULL, N1, NULL, NULL, NULL) != SFB_SUCCESS) sfb_clear_error(sh->ref);
+    else
+        for (sc = 0; sc < 3; ++sc) {
+            sfb_mesh_desc sd = bd;
+            sfb_mesh *pm = NULL;
+            sfb_surface *sp = NULL;
+            for (k = 0; k < 3 * bd.vertex_count; ++k) pp[k] = (float)(k_scales[sc] * bd.positions[k]);
+            sd.positions = pp;
+            if (sfb_mesh_create(sh->ref, &sd, &pm) == SFB_SUCCESS && (sp = make_surface(sh->ref, pm, 0, SFB_REFINE_PATCHES, 0, sh->tri)) != NULL &&
+                eval(sp, sh->loc, sh->nloc, NULL, NULL, NULL, N2, NULL, NULL, NULL) == SFB_SUCCESS) {
+                for (k = 0; k < sh->nloc; ++k) {
+                    double a = angle3(N1 + 3 * k, N2 + 3 * k);
+                    if (isfinite(a) && a > sh->nnoise[k]) sh->nnoise[k] = a;
+                }
+            } else sfb_clear_error(sh->ref);
+            if (sp) sfb_surface_destroy(sp);
+            if (pm) sfb_mesh_destroy(pm);
+        }
+    free(pp); free(N1); free(N2);
+}
+
+static void check_invariance(const backend *b, shape *sh, const sfb_surface *s, const sfb_surface *sr, const sfb_surface *s_iso) {
     char name[400];
     int n = sh->nloc, k, cnt = 0;
     float *P = (float *)xmalloc(sizeof(float) * 3 * (size_t)n + 4), *N = (float *)xmalloc(sizeof(float) * 3 * (size_t)n + 4);
@@ -454,10 +496,14 @@ static void check_invariance(const backend *b, const shape *sh, const sfb_surfac
         fail(name, "sfb_surface_eval: %s", sfb_last_error(b->ctx));
     } else {
         int kw = 0, kn = 0;
+        for (k = 0; k < n && !sh->nnoise; ++k) {
+            double a = angle3(N + 3 * k, M + 3 * k);
+            if (val2_shape(sh)) a = fmin(a, k_pi - a);
+            if (!(a <= 2e-3)) measure_float_limit(sh);
+        }
         for (k = 0; k < n; ++k) {
             double e = dist3(P + 3 * k, Q + 3 * k) / sh->diag, a = angle3(N + 3 * k, M + 3 * k);
-            /* normals: 2e-3 rad, or 8 times the float limit measured there (run_shape) where
-             * that is more */
+            /* normals: 2e-3 rad, or 8 times the float limit measured there where that is more */
             double tn = fmax(2e-3, sh->nnoise ? 8.0 * sh->nnoise[k] : 0.0), r;
             if (!finite3(P + 3 * k) || !finite3(N + 3 * k)) e = 1e300;
             if (val2_shape(sh)) a = fmin(a, k_pi - a); /* KNOWN GAP: see val2_shape */
@@ -962,6 +1008,7 @@ static void run_shape(const char *dir, const char *file, sfb_context *ref) {
         sh.name[len] = '\0';
     }
     sh.tri = strncmp(file, "loop_", 5) == 0;
+    sh.ref = ref;
     g_cur_shape = sh.name;
     snprintf(path, sizeof path, "%s/%s", dir, file);
     snprintf(name, sizeof name, "shape/%s", sh.name);
@@ -978,6 +1025,7 @@ static void run_shape(const char *dir, const char *file, sfb_context *ref) {
     L = mi.face_count > 400 ? 1 : g_level;
     sh.level = L;
     sref = make_surface(ref, sh.mesh, L, SFB_REFINE_LIMIT | SFB_REFINE_PATCHES, 0, sh.tri);
+    sh.sref = sref;
     /* limit normals of the base vertices from level 1: the limit masks assume quads around the
      * vertex, which holds after one step */
     s0 = make_surface(ref, sh.mesh, 1, SFB_REFINE_LIMIT, 0, sh.tri);
@@ -1143,35 +1191,6 @@ static void run_shape(const char *dir, const char *file, sfb_context *ref) {
                 }
                 if (sr && eval(sr, &sh.rloc[sh.nloc], 1, P, NULL, NULL, NULL, NULL, NULL, NULL) != SFB_SUCCESS) { sfb_clear_error(ref); continue; }
                 sh.loc[sh.nloc++] = l;
-            }
-            if (sr && sh.nloc) {
-                /* The invariance check's float limit. Patch points are floats, so where faces
-                 * are tiny next to their coordinates their rounding alone turns the normals by
-                 * more than 2e-3 rad (catmark_bishop: 2.2e-3 rad between the two surfaces, 1.5e-7
-                 * with the mesh moved to put the point at the origin). Measured: the base surface
-                 * against the same mesh scaled by 1.2345678 (the same normals, as exact numbers,
-                 * and the same relative precision, rounded elsewhere) */
-                sfb_mesh_desc bd;
-                sfb_mesh *pm = NULL;
-                sfb_surface *sp = NULL;
-                float *pp, *N1 = (float *)xmalloc(sizeof(float) * 3 * (size_t)sh.nloc), *N2 = (float *)xmalloc(sizeof(float) * 3 * (size_t)sh.nloc);
-                sfb_mesh_get_desc(sh.mesh, &bd);
-                pp = (float *)xmalloc(sizeof(float) * 3 * (size_t)bd.vertex_count + 4);
-                for (k = 0; k < 3 * bd.vertex_count; ++k) pp[k] = (float)(1.2345678 * bd.positions[k]);
-                bd.positions = pp;
-                sh.nnoise = (double *)xmalloc(sizeof(double) * (size_t)sh.nloc);
-                for (k = 0; k < sh.nloc; ++k) sh.nnoise[k] = 0.0;
-                if (sfb_mesh_create(ref, &bd, &pm) == SFB_SUCCESS && (sp = make_surface(ref, pm, 0, SFB_REFINE_PATCHES, 0, sh.tri)) != NULL &&
-                    eval(sref, sh.loc, sh.nloc, NULL, NULL, NULL, N1, NULL, NULL, NULL) == SFB_SUCCESS &&
-                    eval(sp, sh.loc, sh.nloc, NULL, NULL, NULL, N2, NULL, NULL, NULL) == SFB_SUCCESS) {
-                    for (k = 0; k < sh.nloc; ++k) {
-                        double a = angle3(N1 + 3 * k, N2 + 3 * k);
-                        sh.nnoise[k] = isfinite(a) ? a : 0.0;
-                    }
-                } else sfb_clear_error(ref);
-                if (sp) sfb_surface_destroy(sp);
-                if (pm) sfb_mesh_destroy(pm);
-                free(pp); free(N1); free(N2);
             }
             if (sr) sfb_surface_destroy(sr);
         }
