@@ -1108,6 +1108,26 @@ static void sfb__endcap_normal(const float *pts, const int *cv, int nc, double s
     memcpy(nrm, n, sizeof n);
 }
 
+/* The end of both Stam kernels: nr holds the normalised first derivatives and sr the position
+ * (row 0) and the second derivatives (rows 3..5) in the EV frame's (u,v); J = d(u,v)/d(s,t).
+ * Writes res (P, Ps, Pt, Pss, Pst, Ptt; first derivatives times sc1, second times sc2) and nres
+ * (the normalised first derivatives in (s,t)). */
+static void sfb__stam_finish(double J[2][2], double sc1, double sc2, double sr[6][3], double nr[2][3], double res[6][3],
+                             double nres[2][3]) {
+    int c;
+    for (c = 0; c < 3; ++c) {
+        double Pu = nr[0][c], Pv = nr[1][c], Puu = sr[3][c], Puv = sr[4][c], Pvv = sr[5][c];
+        res[0][c] = sr[0][c];
+        nres[0][c] = Pu * J[0][0] + Pv * J[1][0];
+        nres[1][c] = Pu * J[0][1] + Pv * J[1][1];
+        res[1][c] = nres[0][c] * sc1;
+        res[2][c] = nres[1][c] * sc1;
+        res[3][c] = sc2 * (Puu * J[0][0] * J[0][0] + 2.0 * Puv * J[0][0] * J[1][0] + Pvv * J[1][0] * J[1][0]);
+        res[4][c] = sc2 * (Puu * J[0][0] * J[0][1] + Puv * (J[0][0] * J[1][1] + J[0][1] * J[1][0]) + Pvv * J[1][0] * J[1][1]);
+        res[5][c] = sc2 * (Puu * J[0][1] * J[0][1] + 2.0 * Puv * J[0][1] * J[1][1] + Pvv * J[1][1] * J[1][1]);
+    }
+}
+
 /* Quartic Bernstein basis on a triangle, our point order (row by row in t, s rising in a
  * row): B[0..5][15] = value, d/ds, d/dt, d2/ds2, d2/dsdt, d2/dt2. */
 static double sfb__tpow(double x, int e) {
@@ -1229,21 +1249,8 @@ static void sfb__eval_stam_loop(const sfb__eigen_loop *e, const float *pts, cons
             sr[5][c] += g[5] * p[c];
         }
     }
-    {
-        double sc1 = at_ev ? 1.0 : pow(e->sub, m) * ldexp(1.0, n);
-        double sc2 = at_ev ? 0.0 : pow(e->sub, m) * ldexp(1.0, 2 * n);
-        for (c = 0; c < 3; ++c) {
-            double Pu = sign * nr[0][c], Pv = sign * nr[1][c], Puu = sr[3][c], Puv = sr[4][c], Pvv = sr[5][c];
-            res[0][c] = sr[0][c];
-            nres[0][c] = Pu * J[0][0] + Pv * J[1][0];
-            nres[1][c] = Pu * J[0][1] + Pv * J[1][1];
-            res[1][c] = nres[0][c] * sc1;
-            res[2][c] = nres[1][c] * sc1;
-            res[3][c] = sc2 * (Puu * J[0][0] * J[0][0] + 2.0 * Puv * J[0][0] * J[1][0] + Pvv * J[1][0] * J[1][0]);
-            res[4][c] = sc2 * (Puu * J[0][0] * J[0][1] + Puv * (J[0][0] * J[1][1] + J[0][1] * J[1][0]) + Pvv * J[1][0] * J[1][1]);
-            res[5][c] = sc2 * (Puu * J[0][1] * J[0][1] + 2.0 * Puv * J[0][1] * J[1][1] + Pvv * J[1][1] * J[1][1]);
-        }
-    }
+    for (c = 0; c < 3; ++c) { nr[0][c] *= sign; nr[1][c] *= sign; } /* the middle sub-patch is turned */
+    sfb__stam_finish(J, at_ev ? 1.0 : pow(e->sub, m) * ldexp(1.0, n), at_ev ? 0.0 : pow(e->sub, m) * ldexp(1.0, 2 * n), sr, nr, res, nres);
 }
 
 /* Stam: (s,t) in the patch, the EV at frame corner `corner`. nres[2] gets the derivatives
@@ -1301,21 +1308,8 @@ static void sfb__eval_stam(const sfb__eigen_cc *e, const float *pts, const int *
             sr[5][c] += ln * f[5] * p[c];
         }
     }
-    {
-        double sc1 = at_ev ? 1.0 : pow(e->sub, n - 1) * ldexp(1.0, n);
-        double sc2 = at_ev ? 0.0 : pow(e->sub, n - 1) * ldexp(1.0, 2 * n);
-        for (c = 0; c < 3; ++c) {
-            double Pu = nr[0][c], Pv = nr[1][c], Puu = sr[3][c], Puv = sr[4][c], Pvv = sr[5][c];
-            res[0][c] = sr[0][c];
-            nres[0][c] = Pu * J[0][0] + Pv * J[1][0];
-            nres[1][c] = Pu * J[0][1] + Pv * J[1][1];
-            res[1][c] = nres[0][c] * sc1;
-            res[2][c] = nres[1][c] * sc1;
-            res[3][c] = sc2 * (Puu * J[0][0] * J[0][0] + 2.0 * Puv * J[0][0] * J[1][0] + Pvv * J[1][0] * J[1][0]);
-            res[4][c] = sc2 * (Puu * J[0][0] * J[0][1] + Puv * (J[0][0] * J[1][1] + J[0][1] * J[1][0]) + Pvv * J[1][0] * J[1][1]);
-            res[5][c] = sc2 * (Puu * J[0][1] * J[0][1] + 2.0 * Puv * J[0][1] * J[1][1] + Pvv * J[1][1] * J[1][1]);
-        }
-    }
+    sfb__stam_finish(J, at_ev ? 1.0 : pow(e->sub, n - 1) * ldexp(1.0, n), at_ev ? 0.0 : pow(e->sub, n - 1) * ldexp(1.0, 2 * n), sr, nr,
+                     res, nres);
 }
 
 /* The ref kernel: one location, double precision throughout. */
