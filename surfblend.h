@@ -226,8 +226,26 @@ SFB_API const char *sfb_scheme_name(sfb_scheme s);
 enum {
     SFB_REFINE_LIMIT = 1u << 0,  /* also build limit position + limit tangent tables */
     SFB_REFINE_UVS = 1u << 1,    /* also build the face-varying UV table (when the mesh has UVs) */
-    SFB_REFINE_PATCHES = 1u << 2 /* also build the patch table: sfb_surface_eval, sfb_surface_tessellate */
+    SFB_REFINE_PATCHES = 1u << 2, /* also build the patch table: sfb_surface_eval, sfb_surface_tessellate */
+    SFB_REFINE_SHADING = 1u << 3  /* also build the subdivision-shading tables: sfb_surface_shade */
 };
+
+/* Subdivision shading (seed 001), compiled by SFB_REFINE_SHADING; zero = defaults. */
+typedef enum sfb_shade_variant {
+    SFB_SHADE_VARIANT_B = 0, /* default: sharp vertices (>= 2 sharp edges) get blend weight 0 */
+    SFB_SHADE_VARIANT_A = 1  /* sharp vertices are treated as smooth ones */
+} sfb_shade_variant;
+typedef enum sfb_shade_darts {
+    SFB_SHADE_DARTS_SMOOTH = 0, /* default: a dart is a smooth vertex for the blend weights */
+    SFB_SHADE_DARTS_SHARP = 1   /* a regular dart is a sharp vertex (weight 0 in variant B) */
+} sfb_shade_darts;
+#define SFB_SHADE_LEVEL_CONTROL (-1) /* normals_level / weights_level: start on the control mesh */
+typedef struct sfb_shading_options {
+    int variant;        /* sfb_shade_variant */
+    int darts;          /* sfb_shade_darts */
+    int normals_level;  /* level where N_S starts (face-normal averages); 0: default 1; SFB_SHADE_LEVEL_CONTROL: 0 */
+    int weights_level;  /* level where the blend weights are seeded; 0: default 1; SFB_SHADE_LEVEL_CONTROL: 0 */
+} sfb_shading_options;
 
 typedef struct sfb_surface_config {
     sfb_scheme scheme;
@@ -235,6 +253,7 @@ typedef struct sfb_surface_config {
     unsigned flags;     /* SFB_REFINE_* */
     int isolation_level;/* patches: adaptive isolation limit around irregular features, 1..SFB_MAX_LEVEL
                            (0: SFB_DEFAULT_ISOLATION); below it faces get an end cap */
+    sfb_shading_options shading; /* SFB_REFINE_SHADING */
 } sfb_surface_config;
 #define SFB_DEFAULT_ISOLATION 8
 SFB_API sfb_surface_config sfb_surface_config_init(sfb_scheme scheme, int level);
@@ -294,6 +313,13 @@ typedef struct sfb_mesh_data {
     int corner_count; int *corner_vertices; float *corner_sharpness;
     int hole_count; int *holes;
     int boundary, crease_method, triangle_rule, uv_interp;
+    /* sfb_surface_shade only (NULL otherwise); per output vertex: */
+    float *blend_weights;       /* b at the refined level */
+    float *limit_normals;       /* N_L, unit */
+    float *subdivided_normals;  /* N_S, unit; zero where it was not computed (b = 0 without SFB_SHADE_ALL_SUBDIVIDED) */
+    int *vertex_origin;         /* the refined vertex each output vertex is a copy of */
+    int refined_vertex_count;   /* vertices of the refined level before splitting */
+    int subdivided_count;       /* output vertices where N_S was computed */
     sfb_context *ctx_; /* allocator owner */
 } sfb_mesh_data;
 
@@ -303,6 +329,34 @@ SFB_API sfb_result sfb_surface_refine(const sfb_surface *surface, sfb_mesh_data 
 SFB_API sfb_result sfb_surface_refine_positions(const sfb_surface *surface, const float *base_positions,
                                                 int base_count, sfb_mesh_data *out);
 SFB_API void sfb_mesh_data_free(sfb_mesh_data *data);
+
+/* ---- subdivision shading (seed 001; needs SFB_REFINE_SHADING, Catmull-Clark or Loop) ----
+ * Returns the refined mesh with blended normals N_B = normalize((1 - b^p) N_L + b^p N_S) in
+ * `normals`: N_L the limit normals, N_S the subdivided normals (face-normal averages at the
+ * normals level, refined with the scheme's stencils, one normal per crease region), b the
+ * blend weights (1 at extraordinary vertices and their one-ring at the weights level,
+ * refined with the scheme). Vertices on infinitely sharp creases are split, one output vertex
+ * per region, so positions, limit_positions, tangents_u/v and the shade arrays are per output
+ * vertex and face_vertices index output vertices (vertex_origin maps back). Crease, corner and
+ * hole lists index refined vertices as sfb_surface_refine's. Safe to call from several threads
+ * on one surface on the ref and simd backends. */
+enum {
+    SFB_SHADE_ALL_SUBDIVIDED = 1u << 0 /* compute N_S at every vertex (pictures, tests), not only where b > 0 */
+};
+typedef struct sfb_shade_params {
+    float p;          /* blend exponent, > 0 (0: default 1) */
+    unsigned flags;   /* SFB_SHADE_* */
+} sfb_shade_params;
+SFB_API sfb_shade_params sfb_shade_params_init(void);
+SFB_API sfb_result sfb_surface_shade(const sfb_surface *surface, const sfb_shade_params *params, sfb_mesh_data *out);
+typedef struct sfb_shade_info {
+    int refined_vertices, output_vertices, split_vertices; /* split: refined vertices with more than one copy */
+    int weighted;           /* output vertices with b > 0: where N_S is computed */
+    int normals_level, weights_level, sources; /* sources: normals at the normals level (one per region) */
+    size_t bytes;           /* memory of the shading tables */
+} sfb_shade_info;
+SFB_API sfb_result sfb_surface_shade_info(const sfb_surface *surface, sfb_shade_info *out);
+
 /* A desc view of refined data (pointers into `data`), for sfb_write_obj or sfb_mesh_create. */
 SFB_API void sfb_mesh_data_desc(const sfb_mesh_data *data, sfb_mesh_desc *out);
 
@@ -402,7 +456,8 @@ typedef struct sfb__stencils {
 enum {
     SFB__CAP_EVAL_STENCILS = 1u << 0,   /* eval_stencils on caller memory */
     SFB__CAP_GL_BUFFERS = 1u << 1,      /* eval_stencils_gl on GL buffer objects (host context) */
-    SFB__CAP_EVAL_PATCHES = 1u << 2     /* eval_patches */
+    SFB__CAP_EVAL_PATCHES = 1u << 2,    /* eval_patches */
+    SFB__CAP_FINISH_NORMALS = 1u << 3   /* finish_normals */
 };
 
 /* The kernels a backend implements. Every slot but name/kind/caps/init/shutdown may be NULL;
@@ -436,6 +491,15 @@ typedef struct sfb__backend_vtable {
     void (*release_patches)(void *state, void *handle);
     sfb_result (*eval_patches)(void *state, const struct sfb__patch_table *table, void *handle,
                                const sfb_location *locations, int first, int last, const sfb_eval_output *out);
+    /* Seed 001's blend, for elements i in [first,last) (xyz arrays, stride 3):
+     *   L = tu[i] x tv[i], normalised (a zero cross product stays zero);
+     *   k = ns_index ? ns_index[i] : -1; when k >= 0 and b[i] > 0: S = ns[k] normalised (zero stays
+     *   zero), B = (1 - b[i]^p) L + b[i]^p S, else B = L; out_blend[i] = B normalised (zero stays zero).
+     * out_limit[i] = L and out_sub[i] = S (zero when k < 0) when those pointers are not NULL.
+     * b in [0,1] and p > 0 are checked by the caller; b^p is pow(b, p) (b == 1 gives exactly 1). */
+    sfb_result (*finish_normals)(void *state, int first, int last, const float *tu, const float *tv,
+                                 const float *ns, const int *ns_index, const float *b, float p,
+                                 float *out_blend, float *out_limit, float *out_sub);
 } sfb__backend_vtable;
 
 /* Optional backends (backends/sfb_*.h), compiled in by SURFBLEND_SIMD / _GL / _OSMESA or
@@ -1054,14 +1118,54 @@ static sfb_result sfb__ref_eval_stencils(void *state, const sfb__stencils *t, vo
     return SFB_SUCCESS;
 }
 
+/* Seed 001's blend N_B = normalize((1 - b^p) N_L + b^p N_S), in double (see the vtable). */
+static void sfb__ref_unit3(double *v) {
+    double len = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+    if (len > 0.0) { v[0] /= len; v[1] /= len; v[2] /= len; }
+    else v[0] = v[1] = v[2] = 0.0;
+}
+
+static sfb_result sfb__ref_finish_normals(void *state, int first, int last, const float *tu, const float *tv,
+                                          const float *ns, const int *ns_index, const float *b, float p,
+                                          float *out_blend, float *out_limit, float *out_sub) {
+    int i, c;
+    (void)state;
+    for (i = first; i < last; ++i) {
+        const float *a = tu + 3 * (size_t)i, *d = tv + 3 * (size_t)i;
+        double L[3], S[3] = {0.0, 0.0, 0.0}, B[3];
+        int k = ns_index ? ns_index[i] : -1;
+        L[0] = (double)a[1] * d[2] - (double)a[2] * d[1];
+        L[1] = (double)a[2] * d[0] - (double)a[0] * d[2];
+        L[2] = (double)a[0] * d[1] - (double)a[1] * d[0];
+        sfb__ref_unit3(L);
+        if (k >= 0) {
+            for (c = 0; c < 3; ++c) S[c] = ns[3 * (size_t)k + c];
+            sfb__ref_unit3(S);
+        }
+        if (k >= 0 && b && b[i] > 0.0f) {
+            double bp = pow((double)b[i], (double)p);
+            for (c = 0; c < 3; ++c) B[c] = (1.0 - bp) * L[c] + bp * S[c];
+            sfb__ref_unit3(B);
+        } else {
+            for (c = 0; c < 3; ++c) B[c] = L[c];
+        }
+        for (c = 0; c < 3; ++c) {
+            out_blend[3 * (size_t)i + c] = (float)B[c];
+            if (out_limit) out_limit[3 * (size_t)i + c] = (float)L[c];
+            if (out_sub) out_sub[3 * (size_t)i + c] = (float)S[c];
+        }
+    }
+    return SFB_SUCCESS;
+}
+
 /* in patches.c */
 static sfb_result sfb__ref_eval_patches(void *state, const sfb__patch_table *pt, void *handle, const sfb_location *locs, int first,
                                         int last, const sfb_eval_output *out);
 
 static const sfb__backend_vtable sfb__ref_vtable = {
-    "ref", SFB_BACKEND_REF, SFB__CAP_EVAL_STENCILS | SFB__CAP_EVAL_PATCHES,
+    "ref", SFB_BACKEND_REF, SFB__CAP_EVAL_STENCILS | SFB__CAP_EVAL_PATCHES | SFB__CAP_FINISH_NORMALS,
     sfb__ref_init, sfb__ref_shutdown, NULL, NULL, NULL, sfb__ref_eval_stencils, NULL,
-    NULL, NULL, sfb__ref_eval_patches
+    NULL, NULL, sfb__ref_eval_patches, sfb__ref_finish_normals
 };
 
 const sfb__backend_vtable *sfb__backend_ref(void) { return &sfb__ref_vtable; }
@@ -6142,6 +6246,8 @@ SFB_API void sfb_mesh_data_free(sfb_mesh_data *d) {
     sfb__free(ctx, d->face_sizes); sfb__free(ctx, d->face_vertices); sfb__free(ctx, d->face_uvs);
     sfb__free(ctx, d->crease_vertices); sfb__free(ctx, d->crease_sharpness);
     sfb__free(ctx, d->corner_vertices); sfb__free(ctx, d->corner_sharpness); sfb__free(ctx, d->holes);
+    sfb__free(ctx, d->blend_weights); sfb__free(ctx, d->limit_normals); sfb__free(ctx, d->subdivided_normals);
+    sfb__free(ctx, d->vertex_origin);
     memset(d, 0, sizeof *d);
 }
 
@@ -6249,6 +6355,30 @@ SFB_API void sfb_mesh_data_desc(const sfb_mesh_data *m, sfb_mesh_desc *d) {
     d->uv_count = m->uv_count; d->uvs = m->uvs; d->face_uvs = m->face_uvs;
     d->boundary = m->boundary; d->crease_method = m->crease_method;
     d->triangle_rule = m->triangle_rule; d->uv_interp = m->uv_interp;
+}
+#line 1 "src/shade.c"
+/* Subdivision shading (seed 001): subdivided normals N_S with crease regions, blend weights b
+ * (variants A/B, darts smooth/sharp, semi-sharp re-seeding) and the blended normals
+ * N_B = normalize((1 - b^p) N_L + b^p N_S). */
+
+SFB_API sfb_shade_params sfb_shade_params_init(void) {
+    sfb_shade_params p;
+    memset(&p, 0, sizeof p);
+    p.p = 1.0f;
+    return p;
+}
+
+SFB_API sfb_result sfb_surface_shade(const sfb_surface *s, const sfb_shade_params *params, sfb_mesh_data *out) {
+    (void)params;
+    if (out) memset(out, 0, sizeof *out);
+    if (!s) return SFB_INVALID_ARGS;
+    return sfb__error(s->ctx, SFB_UNSUPPORTED, SFB_ELEMENT_NONE, -1, "sfb_surface_shade: not built yet");
+}
+
+SFB_API sfb_result sfb_surface_shade_info(const sfb_surface *s, sfb_shade_info *out) {
+    if (out) memset(out, 0, sizeof *out);
+    if (!s) return SFB_INVALID_ARGS;
+    return sfb__error(s->ctx, SFB_UNSUPPORTED, SFB_ELEMENT_NONE, -1, "sfb_surface_shade_info: not built yet");
 }
 #line 1 "src/backends_include.c"
 /* Optional backends: their code lives in backends/ beside surfblend.h and is compiled here,

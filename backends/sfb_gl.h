@@ -1526,7 +1526,7 @@ done:
 static const sfb__backend_vtable sfb__gl_vtable = {
     "gl", SFB_BACKEND_GL, SFB__CAP_EVAL_STENCILS | SFB__CAP_GL_BUFFERS | SFB__CAP_EVAL_PATCHES,
     sfb__gl_init, sfb__gl_shutdown, sfb__gl_describe, sfb__gl_upload, sfb__gl_release, sfb__gl_eval, sfb__gl_eval_buffers,
-    sfb__gl_upload_patches, sfb__gl_release_patches, sfb__gl_eval_patches
+    sfb__gl_upload_patches, sfb__gl_release_patches, sfb__gl_eval_patches, NULL
 };
 
 const sfb__backend_vtable *sfb__backend_gl(void) { return &sfb__gl_vtable; }

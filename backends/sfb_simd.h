@@ -2058,7 +2058,7 @@ static sfb_result sfb__simd_eval_patches(void *state, const sfb__patch_table *pt
 static const sfb__backend_vtable sfb__simd_vtable = {
     "simd", SFB_BACKEND_SIMD, SFB__CAP_EVAL_STENCILS | SFB__CAP_EVAL_PATCHES,
     sfb__simd_init, sfb__simd_shutdown, sfb__simd_describe, NULL, NULL, sfb__simd_eval_stencils, NULL,
-    sfb__simd_upload_patches, sfb__simd_release_patches, sfb__simd_eval_patches
+    sfb__simd_upload_patches, sfb__simd_release_patches, sfb__simd_eval_patches, NULL
 };
 
 const sfb__backend_vtable *sfb__backend_simd(void) { return &sfb__simd_vtable; }

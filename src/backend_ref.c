@@ -31,14 +31,54 @@ static sfb_result sfb__ref_eval_stencils(void *state, const sfb__stencils *t, vo
     return SFB_SUCCESS;
 }
 
+/* Seed 001's blend N_B = normalize((1 - b^p) N_L + b^p N_S), in double (see the vtable). */
+static void sfb__ref_unit3(double *v) {
+    double len = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+    if (len > 0.0) { v[0] /= len; v[1] /= len; v[2] /= len; }
+    else v[0] = v[1] = v[2] = 0.0;
+}
+
+static sfb_result sfb__ref_finish_normals(void *state, int first, int last, const float *tu, const float *tv,
+                                          const float *ns, const int *ns_index, const float *b, float p,
+                                          float *out_blend, float *out_limit, float *out_sub) {
+    int i, c;
+    (void)state;
+    for (i = first; i < last; ++i) {
+        const float *a = tu + 3 * (size_t)i, *d = tv + 3 * (size_t)i;
+        double L[3], S[3] = {0.0, 0.0, 0.0}, B[3];
+        int k = ns_index ? ns_index[i] : -1;
+        L[0] = (double)a[1] * d[2] - (double)a[2] * d[1];
+        L[1] = (double)a[2] * d[0] - (double)a[0] * d[2];
+        L[2] = (double)a[0] * d[1] - (double)a[1] * d[0];
+        sfb__ref_unit3(L);
+        if (k >= 0) {
+            for (c = 0; c < 3; ++c) S[c] = ns[3 * (size_t)k + c];
+            sfb__ref_unit3(S);
+        }
+        if (k >= 0 && b && b[i] > 0.0f) {
+            double bp = pow((double)b[i], (double)p);
+            for (c = 0; c < 3; ++c) B[c] = (1.0 - bp) * L[c] + bp * S[c];
+            sfb__ref_unit3(B);
+        } else {
+            for (c = 0; c < 3; ++c) B[c] = L[c];
+        }
+        for (c = 0; c < 3; ++c) {
+            out_blend[3 * (size_t)i + c] = (float)B[c];
+            if (out_limit) out_limit[3 * (size_t)i + c] = (float)L[c];
+            if (out_sub) out_sub[3 * (size_t)i + c] = (float)S[c];
+        }
+    }
+    return SFB_SUCCESS;
+}
+
 /* in patches.c */
 static sfb_result sfb__ref_eval_patches(void *state, const sfb__patch_table *pt, void *handle, const sfb_location *locs, int first,
                                         int last, const sfb_eval_output *out);
 
 static const sfb__backend_vtable sfb__ref_vtable = {
-    "ref", SFB_BACKEND_REF, SFB__CAP_EVAL_STENCILS | SFB__CAP_EVAL_PATCHES,
+    "ref", SFB_BACKEND_REF, SFB__CAP_EVAL_STENCILS | SFB__CAP_EVAL_PATCHES | SFB__CAP_FINISH_NORMALS,
     sfb__ref_init, sfb__ref_shutdown, NULL, NULL, NULL, sfb__ref_eval_stencils, NULL,
-    NULL, NULL, sfb__ref_eval_patches
+    NULL, NULL, sfb__ref_eval_patches, sfb__ref_finish_normals
 };
 
 const sfb__backend_vtable *sfb__backend_ref(void) { return &sfb__ref_vtable; }

@@ -213,8 +213,26 @@ SFB_API const char *sfb_scheme_name(sfb_scheme s);
 enum {
     SFB_REFINE_LIMIT = 1u << 0,  /* also build limit position + limit tangent tables */
     SFB_REFINE_UVS = 1u << 1,    /* also build the face-varying UV table (when the mesh has UVs) */
-    SFB_REFINE_PATCHES = 1u << 2 /* also build the patch table: sfb_surface_eval, sfb_surface_tessellate */
+    SFB_REFINE_PATCHES = 1u << 2, /* also build the patch table: sfb_surface_eval, sfb_surface_tessellate */
+    SFB_REFINE_SHADING = 1u << 3  /* also build the subdivision-shading tables: sfb_surface_shade */
 };
+
+/* Subdivision shading (seed 001), compiled by SFB_REFINE_SHADING; zero = defaults. */
+typedef enum sfb_shade_variant {
+    SFB_SHADE_VARIANT_B = 0, /* default: sharp vertices (>= 2 sharp edges) get blend weight 0 */
+    SFB_SHADE_VARIANT_A = 1  /* sharp vertices are treated as smooth ones */
+} sfb_shade_variant;
+typedef enum sfb_shade_darts {
+    SFB_SHADE_DARTS_SMOOTH = 0, /* default: a dart is a smooth vertex for the blend weights */
+    SFB_SHADE_DARTS_SHARP = 1   /* a regular dart is a sharp vertex (weight 0 in variant B) */
+} sfb_shade_darts;
+#define SFB_SHADE_LEVEL_CONTROL (-1) /* normals_level / weights_level: start on the control mesh */
+typedef struct sfb_shading_options {
+    int variant;        /* sfb_shade_variant */
+    int darts;          /* sfb_shade_darts */
+    int normals_level;  /* level where N_S starts (face-normal averages); 0: default 1; SFB_SHADE_LEVEL_CONTROL: 0 */
+    int weights_level;  /* level where the blend weights are seeded; 0: default 1; SFB_SHADE_LEVEL_CONTROL: 0 */
+} sfb_shading_options;
 
 typedef struct sfb_surface_config {
     sfb_scheme scheme;
@@ -222,6 +240,7 @@ typedef struct sfb_surface_config {
     unsigned flags;     /* SFB_REFINE_* */
     int isolation_level;/* patches: adaptive isolation limit around irregular features, 1..SFB_MAX_LEVEL
                            (0: SFB_DEFAULT_ISOLATION); below it faces get an end cap */
+    sfb_shading_options shading; /* SFB_REFINE_SHADING */
 } sfb_surface_config;
 #define SFB_DEFAULT_ISOLATION 8
 SFB_API sfb_surface_config sfb_surface_config_init(sfb_scheme scheme, int level);
@@ -281,6 +300,13 @@ typedef struct sfb_mesh_data {
     int corner_count; int *corner_vertices; float *corner_sharpness;
     int hole_count; int *holes;
     int boundary, crease_method, triangle_rule, uv_interp;
+    /* sfb_surface_shade only (NULL otherwise); per output vertex: */
+    float *blend_weights;       /* b at the refined level */
+    float *limit_normals;       /* N_L, unit */
+    float *subdivided_normals;  /* N_S, unit; zero where it was not computed (b = 0 without SFB_SHADE_ALL_SUBDIVIDED) */
+    int *vertex_origin;         /* the refined vertex each output vertex is a copy of */
+    int refined_vertex_count;   /* vertices of the refined level before splitting */
+    int subdivided_count;       /* output vertices where N_S was computed */
     sfb_context *ctx_; /* allocator owner */
 } sfb_mesh_data;
 
@@ -290,6 +316,34 @@ SFB_API sfb_result sfb_surface_refine(const sfb_surface *surface, sfb_mesh_data 
 SFB_API sfb_result sfb_surface_refine_positions(const sfb_surface *surface, const float *base_positions,
                                                 int base_count, sfb_mesh_data *out);
 SFB_API void sfb_mesh_data_free(sfb_mesh_data *data);
+
+/* ---- subdivision shading (seed 001; needs SFB_REFINE_SHADING, Catmull-Clark or Loop) ----
+ * Returns the refined mesh with blended normals N_B = normalize((1 - b^p) N_L + b^p N_S) in
+ * `normals`: N_L the limit normals, N_S the subdivided normals (face-normal averages at the
+ * normals level, refined with the scheme's stencils, one normal per crease region), b the
+ * blend weights (1 at extraordinary vertices and their one-ring at the weights level,
+ * refined with the scheme). Vertices on infinitely sharp creases are split, one output vertex
+ * per region, so positions, limit_positions, tangents_u/v and the shade arrays are per output
+ * vertex and face_vertices index output vertices (vertex_origin maps back). Crease, corner and
+ * hole lists index refined vertices as sfb_surface_refine's. Safe to call from several threads
+ * on one surface on the ref and simd backends. */
+enum {
+    SFB_SHADE_ALL_SUBDIVIDED = 1u << 0 /* compute N_S at every vertex (pictures, tests), not only where b > 0 */
+};
+typedef struct sfb_shade_params {
+    float p;          /* blend exponent, > 0 (0: default 1) */
+    unsigned flags;   /* SFB_SHADE_* */
+} sfb_shade_params;
+SFB_API sfb_shade_params sfb_shade_params_init(void);
+SFB_API sfb_result sfb_surface_shade(const sfb_surface *surface, const sfb_shade_params *params, sfb_mesh_data *out);
+typedef struct sfb_shade_info {
+    int refined_vertices, output_vertices, split_vertices; /* split: refined vertices with more than one copy */
+    int weighted;           /* output vertices with b > 0: where N_S is computed */
+    int normals_level, weights_level, sources; /* sources: normals at the normals level (one per region) */
+    size_t bytes;           /* memory of the shading tables */
+} sfb_shade_info;
+SFB_API sfb_result sfb_surface_shade_info(const sfb_surface *surface, sfb_shade_info *out);
+
 /* A desc view of refined data (pointers into `data`), for sfb_write_obj or sfb_mesh_create. */
 SFB_API void sfb_mesh_data_desc(const sfb_mesh_data *data, sfb_mesh_desc *out);
 

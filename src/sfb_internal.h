@@ -23,7 +23,8 @@ typedef struct sfb__stencils {
 enum {
     SFB__CAP_EVAL_STENCILS = 1u << 0,   /* eval_stencils on caller memory */
     SFB__CAP_GL_BUFFERS = 1u << 1,      /* eval_stencils_gl on GL buffer objects (host context) */
-    SFB__CAP_EVAL_PATCHES = 1u << 2     /* eval_patches */
+    SFB__CAP_EVAL_PATCHES = 1u << 2,    /* eval_patches */
+    SFB__CAP_FINISH_NORMALS = 1u << 3   /* finish_normals */
 };
 
 /* The kernels a backend implements. Every slot but name/kind/caps/init/shutdown may be NULL;
@@ -57,6 +58,15 @@ typedef struct sfb__backend_vtable {
     void (*release_patches)(void *state, void *handle);
     sfb_result (*eval_patches)(void *state, const struct sfb__patch_table *table, void *handle,
                                const sfb_location *locations, int first, int last, const sfb_eval_output *out);
+    /* Seed 001's blend, for elements i in [first,last) (xyz arrays, stride 3):
+     *   L = tu[i] x tv[i], normalised (a zero cross product stays zero);
+     *   k = ns_index ? ns_index[i] : -1; when k >= 0 and b[i] > 0: S = ns[k] normalised (zero stays
+     *   zero), B = (1 - b[i]^p) L + b[i]^p S, else B = L; out_blend[i] = B normalised (zero stays zero).
+     * out_limit[i] = L and out_sub[i] = S (zero when k < 0) when those pointers are not NULL.
+     * b in [0,1] and p > 0 are checked by the caller; b^p is pow(b, p) (b == 1 gives exactly 1). */
+    sfb_result (*finish_normals)(void *state, int first, int last, const float *tu, const float *tv,
+                                 const float *ns, const int *ns_index, const float *b, float p,
+                                 float *out_blend, float *out_limit, float *out_sub);
 } sfb__backend_vtable;
 
 /* Optional backends (backends/sfb_*.h), compiled in by SURFBLEND_SIMD / _GL / _OSMESA or

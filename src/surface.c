@@ -319,6 +319,8 @@ SFB_API void sfb_mesh_data_free(sfb_mesh_data *d) {
     sfb__free(ctx, d->face_sizes); sfb__free(ctx, d->face_vertices); sfb__free(ctx, d->face_uvs);
     sfb__free(ctx, d->crease_vertices); sfb__free(ctx, d->crease_sharpness);
     sfb__free(ctx, d->corner_vertices); sfb__free(ctx, d->corner_sharpness); sfb__free(ctx, d->holes);
+    sfb__free(ctx, d->blend_weights); sfb__free(ctx, d->limit_normals); sfb__free(ctx, d->subdivided_normals);
+    sfb__free(ctx, d->vertex_origin);
     memset(d, 0, sizeof *d);
 }
 
