@@ -123,8 +123,18 @@ $(BUILD)/limit: tests/limit.c $(BUILD)/libsfb.o
 $(BUILD)/eigen: tests/eigen.c surfblend.h
 	$(CC) $(CFLAGS) $(SAN) -I. tests/eigen.c -o $@ $(LIBS)
 
+# Subdivision shading (sfb_surface_shade) on every backend: weights, variants, darts, split
+# normals, smoothness at extraordinary vertices (tests/shade.c).
+$(BUILD)/shade: tests/shade.c $(BUILD)/libsfb.o
+	$(CC) $(CFLAGS) $(SAN) -I. tests/shade.c $(BUILD)/libsfb.o -o $@ $(LIBS)
+
+# The finish_normals kernel of every backend against ref, degenerate inputs included: compiles
+# its own implementation to reach the backend vtables (tests/finish_normals.c).
+$(BUILD)/finish_normals: tests/finish_normals.c surfblend.h $(BACKEND_HDRS)
+	$(CC) $(CFLAGS) $(SAN) -I. tests/finish_normals.c -o $@ $(LIBS)
+
 unit-build: $(BUILD)/surfblend $(BUILD)/unit $(BUILD)/osd_agree $(BUILD)/agree $(BUILD)/limit $(BUILD)/eigen $(BUILD)/gl_host \
-            $(BUILD)/gl_errors $(BUILD)/gl_pieces $(EXAMPLES)
+            $(BUILD)/gl_errors $(BUILD)/gl_pieces $(BUILD)/shade $(BUILD)/finish_normals $(EXAMPLES)
 
 # On CI (CI set and not false/0) the optional backends must run, not be skipped: the suites
 # fail for a backend in SFB_REQUIRE_BACKENDS that is unavailable. CI has Mesa llvmpipe and

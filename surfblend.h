@@ -6380,6 +6380,8 @@ SFB_API sfb_result sfb_surface_shade_info(const sfb_surface *s, sfb_shade_info *
     if (!s) return SFB_INVALID_ARGS;
     return sfb__error(s->ctx, SFB_UNSUPPORTED, SFB_ELEMENT_NONE, -1, "sfb_surface_shade_info: not built yet");
 }
+#line 1 "src/render.c"
+/* Software pictures (no GL): a small z-buffered rasterizer for refined meshes. */
 #line 1 "src/backends_include.c"
 /* Optional backends: their code lives in backends/ beside surfblend.h and is compiled here,
  * after the core, when SURFBLEND_SIMD / SURFBLEND_GL / SURFBLEND_OSMESA (or

@@ -92,6 +92,11 @@ counted eigen "$BUILD/eigen"
 if [ -d "$SHAPES" ]; then counted limit "$BUILD/limit" "$SHAPES"
 else echo "peer shapes not found at $SHAPES: limit evaluation suite skipped"; add_counts limit 0 0 1; fi
 
+# 3b'''. subdivision shading on every backend: tests/shade.c; the finish_normals kernels: tests/finish_normals.c
+if [ -d "$SHAPES" ]; then counted shade "$BUILD/shade" "$SHAPES"
+else echo "peer shapes not found at $SHAPES: shade runs without them"; counted shade "$BUILD/shade"; fi
+counted finish_normals "$BUILD/finish_normals"
+
 # 3c. the engine case: the gl backend on the host's own EGL context and GL buffers
 counted gl_host "$BUILD/gl_host"
 

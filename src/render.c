@@ -1,0 +1,1 @@
+/* Software pictures (no GL): a small z-buffered rasterizer for refined meshes. */
