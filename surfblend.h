@@ -1884,6 +1884,62 @@ static sfb_result sfb__refine_step(sfb_context *ctx, const sfb__refine_options *
     return SFB_SUCCESS;
 }
 
+/* Limit tangent masks of a crease vertex for the side whose faces lie between its crease
+ * edges a and b (in v's edge order; b may exceed the edge count to go around an interior
+ * vertex: indices are taken modulo it): m1 along the crease (from b's end towards a's), m2
+ * into that side. The other side of an interior crease is (b, a + edge count). */
+static void sfb__crease_tangent_masks(const sfb__level *l, int v, int a, int b, int loop, sfb__mask *m1, sfb__mask *m2) {
+    int e0 = l->ve_off[v], ne = l->ve_off[v + 1] - e0;
+    int f0 = l->vf_off[v], nf = l->vf_off[v + 1] - f0;
+    double tscale = loop ? 3.0 : 1.0;
+    int i, k = b - a - 1; /* interior edges between the crease edges */
+#define SFB__E(i) sfb__other_end(l, l->ve[e0 + (i) % ne], v)
+#define SFB__HASF(i) ((i) % ne < nf)
+#define SFB__D(i) l->fv[l->fv_off[l->vf[f0 + (i) % ne]] + (l->vf_slot[f0 + (i) % ne] + 2) % (l->fv_off[l->vf[f0 + (i) % ne] + 1] - l->fv_off[l->vf[f0 + (i) % ne]])]
+    SFB__MASK_ADD(m1, SFB__E(a), 0.5 * tscale);
+    SFB__MASK_ADD(m1, SFB__E(b), -0.5 * tscale);
+    if (loop) {
+        if (k == 0) {
+            SFB__MASK_ADD(m2, v, -6.0); SFB__MASK_ADD(m2, SFB__E(a), 3.0); SFB__MASK_ADD(m2, SFB__E(b), 3.0);
+        } else if (k == 1) {
+            SFB__MASK_ADD(m2, v, -3.0); SFB__MASK_ADD(m2, SFB__E(a + 1), 3.0);
+        } else if (k == 2) {
+            double r3 = 1.73205080756887729352;
+            SFB__MASK_ADD(m2, v, -r3); SFB__MASK_ADD(m2, SFB__E(a), -r3 / 2); SFB__MASK_ADD(m2, SFB__E(b), -r3 / 2);
+            SFB__MASK_ADD(m2, SFB__E(a + 1), r3); SFB__MASK_ADD(m2, SFB__E(a + 2), r3);
+        } else {
+            double th = SFB__PI / (k + 1), cwt = -3.0 * sin(th), ec = -3.0 * 2.0 * (cos(th) - 1.0);
+            SFB__MASK_ADD(m2, SFB__E(a), cwt); SFB__MASK_ADD(m2, SFB__E(b), cwt);
+            for (i = 1; i <= k; ++i) SFB__MASK_ADD(m2, SFB__E(a + i), ec * sin(i * th));
+        }
+    } else {
+        if (k == 0) {
+            SFB__MASK_ADD(m2, v, -6.0); SFB__MASK_ADD(m2, SFB__E(a), 3.0); SFB__MASK_ADD(m2, SFB__E(b), 3.0);
+        } else if (k == 1) {
+            SFB__MASK_ADD(m2, v, -4.0 / 6.0);
+            SFB__MASK_ADD(m2, SFB__E(a), -1.0 / 6.0); SFB__MASK_ADD(m2, SFB__E(a + 1), 4.0 / 6.0);
+            SFB__MASK_ADD(m2, SFB__E(b), -1.0 / 6.0);
+            if (SFB__HASF(a)) SFB__MASK_ADD(m2, SFB__D(a), 1.0 / 6.0);
+            if (SFB__HASF(a + 1)) SFB__MASK_ADD(m2, SFB__D(a + 1), 1.0 / 6.0);
+        } else {
+            double kk = k + 1, th = SFB__PI / kk, ct = cos(th), st = sin(th);
+            double den = 1.0 / (kk * (3.0 + ct)), R = (ct + 1.0) / st;
+            SFB__MASK_ADD(m2, v, 4.0 * R * (ct - 1.0) * den);
+            SFB__MASK_ADD(m2, SFB__E(a), -R * (1.0 + 2.0 * ct) * den);
+            SFB__MASK_ADD(m2, SFB__E(b), -R * (1.0 + 2.0 * ct) * den);
+            if (SFB__HASF(a)) SFB__MASK_ADD(m2, SFB__D(a), st * den);
+            for (i = 1; i < kk; ++i) {
+                double si = sin(i * th), si1 = sin((i + 1) * th);
+                SFB__MASK_ADD(m2, SFB__E(a + i), 4.0 * si * den);
+                if (SFB__HASF(a + i)) SFB__MASK_ADD(m2, SFB__D(a + i), (si + si1) * den);
+            }
+        }
+    }
+#undef SFB__E
+#undef SFB__HASF
+#undef SFB__D
+}
+
 /* ---- limit masks at the last level ---- */
 static void sfb__limit_masks(const sfb__level *l, int v, sfb_scheme scheme, sfb__mask *mp, sfb__mask *m1, sfb__mask *m2) {
     int e0 = l->ve_off[v], ne = l->ve_off[v + 1] - e0;
@@ -1908,57 +1964,18 @@ static void sfb__limit_masks(const sfb__level *l, int v, sfb_scheme scheme, sfb_
     }
     if (rule == SFB__RULE_CREASE) {
         float sharp[SFB_MAX_VALENCE + 1];
-        int a, b, k;
+        int a, b;
         for (i = 0; i < ne && i <= SFB_MAX_VALENCE; ++i) sharp[i] = l->es[l->ve[e0 + i]];
         sfb__crease_pair(sharp, ne, &a, &b);
         SFB__MASK_ADD(mp, v, 2.0 / 3.0);
         SFB__MASK_ADD(mp, sfb__other_end(l, l->ve[e0 + a], v), 1.0 / 6.0);
         SFB__MASK_ADD(mp, sfb__other_end(l, l->ve[e0 + b], v), 1.0 / 6.0);
-        SFB__MASK_ADD(m1, sfb__other_end(l, l->ve[e0 + a], v), 0.5 * tscale);
-        SFB__MASK_ADD(m1, sfb__other_end(l, l->ve[e0 + b], v), -0.5 * tscale);
-        k = b - a - 1; /* interior edges between the crease edges */
-#define SFB__E(i) sfb__other_end(l, l->ve[e0 + (i)], v)
-#define SFB__D(i) l->fv[l->fv_off[l->vf[f0 + (i)]] + (l->vf_slot[f0 + (i)] + 2) % (l->fv_off[l->vf[f0 + (i)] + 1] - l->fv_off[l->vf[f0 + (i)]])]
-        if (loop) {
-            if (k == 0) {
-                SFB__MASK_ADD(m2, v, -6.0); SFB__MASK_ADD(m2, SFB__E(a), 3.0); SFB__MASK_ADD(m2, SFB__E(b), 3.0);
-            } else if (k == 1) {
-                SFB__MASK_ADD(m2, v, -3.0); SFB__MASK_ADD(m2, SFB__E(a + 1), 3.0);
-            } else if (k == 2) {
-                double r3 = 1.73205080756887729352;
-                SFB__MASK_ADD(m2, v, -r3); SFB__MASK_ADD(m2, SFB__E(a), -r3 / 2); SFB__MASK_ADD(m2, SFB__E(b), -r3 / 2);
-                SFB__MASK_ADD(m2, SFB__E(a + 1), r3); SFB__MASK_ADD(m2, SFB__E(a + 2), r3);
-            } else {
-                double th = SFB__PI / (k + 1), cwt = -3.0 * sin(th), ec = -3.0 * 2.0 * (cos(th) - 1.0);
-                SFB__MASK_ADD(m2, SFB__E(a), cwt); SFB__MASK_ADD(m2, SFB__E(b), cwt);
-                for (i = 1; i <= k; ++i) SFB__MASK_ADD(m2, SFB__E(a + i), ec * sin(i * th));
-            }
-        } else {
-            if (k == 0) {
-                SFB__MASK_ADD(m2, v, -6.0); SFB__MASK_ADD(m2, SFB__E(a), 3.0); SFB__MASK_ADD(m2, SFB__E(b), 3.0);
-            } else if (k == 1) {
-                SFB__MASK_ADD(m2, v, -4.0 / 6.0);
-                SFB__MASK_ADD(m2, SFB__E(a), -1.0 / 6.0); SFB__MASK_ADD(m2, SFB__E(a + 1), 4.0 / 6.0);
-                SFB__MASK_ADD(m2, SFB__E(b), -1.0 / 6.0);
-                if (a < nf) SFB__MASK_ADD(m2, SFB__D(a), 1.0 / 6.0);
-                if (a + 1 < nf) SFB__MASK_ADD(m2, SFB__D(a + 1), 1.0 / 6.0);
-            } else {
-                double kk = k + 1, th = SFB__PI / kk, ct = cos(th), st = sin(th);
-                double den = 1.0 / (kk * (3.0 + ct)), R = (ct + 1.0) / st;
-                SFB__MASK_ADD(m2, v, 4.0 * R * (ct - 1.0) * den);
-                SFB__MASK_ADD(m2, SFB__E(a), -R * (1.0 + 2.0 * ct) * den);
-                SFB__MASK_ADD(m2, SFB__E(b), -R * (1.0 + 2.0 * ct) * den);
-                if (a < nf) SFB__MASK_ADD(m2, SFB__D(a), st * den);
-                for (i = 1; i < kk; ++i) {
-                    double si = sin(i * th), si1 = sin((i + 1) * th);
-                    SFB__MASK_ADD(m2, SFB__E(a + i), 4.0 * si * den);
-                    if (a + i < nf) SFB__MASK_ADD(m2, SFB__D(a + i), (si + si1) * den);
-                }
-            }
-        }
+        sfb__crease_tangent_masks(l, v, a, b, loop, m1, m2);
         return;
     }
     /* smooth */
+#define SFB__E(i) sfb__other_end(l, l->ve[e0 + (i)], v)
+#define SFB__D(i) l->fv[l->fv_off[l->vf[f0 + (i)]] + (l->vf_slot[f0 + (i)] + 2) % (l->fv_off[l->vf[f0 + (i)] + 1] - l->fv_off[l->vf[f0 + (i)]])]
     if (loop) {
         double ew, vw;
         if (nf == 6) {
