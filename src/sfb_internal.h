@@ -233,6 +233,24 @@ struct sfb_mesh {
     int hole_count; int *holes;
 };
 
+/* ---- subdivision shading (shade.c) ---- */
+typedef struct sfb__shading {
+    int normals_level, weights_level, level, variant, darts;
+    sfb__level nlev;           /* topology at the normals level (face normals are taken there) */
+    int *nsrc_of_vf;           /* per nlev vf entry: the source (region normal) the face feeds */
+    int nsrc;                  /* sources: one normal per vertex region at the normals level */
+    int npos_mode;             /* normals-level positions: 0 base positions, 1 the npos table, 2 refined positions */
+    sfb__stencils npos;        /* base -> normals-level positions (npos_mode 1) */
+    int nout, nweighted, nsplit;
+    int *out_origin;           /* nout: refined vertex of each output vertex */
+    int *out_fv;               /* per refined face-vertex: output vertex */
+    float *b;                  /* nout: blend weight */
+    int *ns_idx_w, *ns_idx_all;/* nout: row of N_S for finish_normals (-1 where b = 0 / every row) */
+    sfb__stencils ns;          /* sources -> N_S rows, the nweighted rows with b > 0 first */
+    sfb__stencils lim[3];      /* refined positions -> limit position, tangent u, tangent v per output vertex */
+    void *handles[5];          /* the backend's uploads of npos, ns, lim[0..2] */
+    size_t bytes;
+} sfb__shading;
 /* ---- surfaces ---- */
 struct sfb_surface {
     sfb_context *ctx;
@@ -252,6 +270,7 @@ struct sfb_surface {
     sfb__level pbase;            /* the prepared base level the patches were built from (tessellation
                                     shares vertices along its edges) */
     void *backend_patches;       /* the backend's uploaded copy */
+    sfb__shading *shading;       /* SFB_REFINE_SHADING */
 };
 
 typedef struct sfb__refine_options {
@@ -270,6 +289,10 @@ void sfb__stencils_free(sfb_context *ctx, sfb__stencils *s);
 /* Copy of the base level with OpenSubdiv's boundary/non-manifold sharpening and holes applied. */
 sfb_result sfb__level_prepare(sfb_context *ctx, const sfb__level *src, int sharpen_corners, int make_boundary_holes,
                               sfb__level *dst);
+
+void sfb__shading_free(sfb_context *ctx, sfb__shading *sh);
+sfb_result sfb__shading_build(sfb_context *ctx, const sfb__level *prep, const sfb__refine_options *opt, int level,
+                              const sfb_shading_options *o, sfb__shading **out);
 
 /* patches.c */
 void sfb__patch_table_free(sfb_context *ctx, sfb__patch_table *pt);

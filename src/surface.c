@@ -33,6 +33,13 @@ SFB_API void sfb_surface_destroy(sfb_surface *s) {
     if (s->backend_patches && s->uploaded_by && s->uploaded_by->release_patches)
         s->uploaded_by->release_patches(ctx->backend_state, s->backend_patches);
     sfb__patch_table_free(ctx, &s->patches);
+    if (s->shading) {
+        int h;
+        for (h = 0; h < 5; ++h)
+            if (s->shading->handles[h] && s->uploaded_by && s->uploaded_by->release_stencils)
+                s->uploaded_by->release_stencils(ctx->backend_state, s->shading->handles[h]);
+        sfb__shading_free(ctx, s->shading);
+    }
     sfb__level_free(ctx, &s->pbase);
     sfb__level_free(ctx, &s->top);
     sfb__level_free(ctx, &s->uv_top);
@@ -76,6 +83,9 @@ SFB_API sfb_result sfb_surface_create(sfb_context *ctx, const sfb_mesh *mesh, co
     if ((cfg->flags & SFB_REFINE_PATCHES) && cfg->scheme != SFB_SCHEME_CATMARK && cfg->scheme != SFB_SCHEME_LOOP)
         return sfb__error(ctx, SFB_UNSUPPORTED, SFB_ELEMENT_NONE, -1, "limit evaluation (SFB_REFINE_PATCHES) is built for Catmull-Clark and Loop; scheme '%s' is not supported",
                           sfb_scheme_name(cfg->scheme));
+    if ((cfg->flags & SFB_REFINE_SHADING) && cfg->scheme != SFB_SCHEME_CATMARK && cfg->scheme != SFB_SCHEME_LOOP)
+        return sfb__error(ctx, SFB_UNSUPPORTED, SFB_ELEMENT_NONE, -1, "subdivision shading (SFB_REFINE_SHADING) is built for Catmull-Clark and Loop; scheme '%s' is not supported",
+                          sfb_scheme_name(cfg->scheme));
     if ((cfg->flags & SFB_REFINE_PATCHES) && (cfg->isolation_level < 0 || cfg->isolation_level > SFB_MAX_LEVEL))
         return sfb__error(ctx, SFB_LIMIT_EXCEEDED, SFB_ELEMENT_NONE, -1, "isolation level %d is outside 0..%d (0 = default %d)",
                           cfg->isolation_level, SFB_MAX_LEVEL, SFB_DEFAULT_ISOLATION);
@@ -113,6 +123,8 @@ SFB_API sfb_result sfb_surface_create(sfb_context *ctx, const sfb_mesh *mesh, co
     opt.want_limit = (cfg->flags & SFB_REFINE_LIMIT) != 0;
     r = sfb__refine(ctx, &prep, &opt, cfg->refine_level, &s->top, &s->tables[SFB_TABLE_VERTEX],
                     opt.want_limit ? &s->tables[SFB_TABLE_LIMIT] : NULL, 0.0f, 0.8f);
+    if (r == SFB_SUCCESS && (cfg->flags & SFB_REFINE_SHADING))
+        r = sfb__shading_build(ctx, &prep, &opt, cfg->refine_level, &cfg->shading, &s->shading);
     if (r == SFB_SUCCESS && (cfg->flags & SFB_REFINE_PATCHES)) {
         r = sfb__patches_build(ctx, &prep, &opt, cfg->isolation_level ? cfg->isolation_level : SFB_DEFAULT_ISOLATION,
                                 s->base_positions, &s->patches);
@@ -168,6 +180,16 @@ SFB_API sfb_result sfb_surface_create(sfb_context *ctx, const sfb_mesh *mesh, co
             if (!s->built[t] || s->tables[t].rows == 0) continue;
             r = ctx->backend->upload_stencils(ctx->backend_state, &s->tables[t], &s->backend_tables[t]);
             if (r != SFB_SUCCESS) { sfb_surface_destroy(s); return r; }
+        }
+        if (s->shading) {
+            sfb__shading *sh = s->shading;
+            const sfb__stencils *st[5];
+            st[0] = &sh->npos; st[1] = &sh->ns; st[2] = &sh->lim[0]; st[3] = &sh->lim[1]; st[4] = &sh->lim[2];
+            for (t = 0; t < 5; ++t) {
+                if (st[t]->rows == 0) continue;
+                r = ctx->backend->upload_stencils(ctx->backend_state, st[t], &sh->handles[t]);
+                if (r != SFB_SUCCESS) { sfb_surface_destroy(s); return r; }
+            }
         }
     }
     if (s->has_patches && ctx->backend && ctx->backend->upload_patches) {
@@ -324,12 +346,19 @@ SFB_API void sfb_mesh_data_free(sfb_mesh_data *d) {
     memset(d, 0, sizeof *d);
 }
 
+static sfb_result sfb__refine_output(const sfb_surface *s, const float *base, int base_count, int want_limit, sfb_mesh_data *o);
+
 SFB_API sfb_result sfb_surface_refine(const sfb_surface *s, sfb_mesh_data *out) {
     if (!s) return SFB_INVALID_ARGS;
     return sfb_surface_refine_positions(s, s->base_positions, s->base_vertex_count, out);
 }
 
 SFB_API sfb_result sfb_surface_refine_positions(const sfb_surface *s, const float *base, int base_count, sfb_mesh_data *o) {
+    return sfb__refine_output(s, base, base_count, 1, o);
+}
+
+/* The refined mesh; with want_limit the limit tables too (when built). */
+static sfb_result sfb__refine_output(const sfb_surface *s, const float *base, int base_count, int want_limit, sfb_mesh_data *o) {
     sfb_context *ctx;
     const sfb__level *l;
     sfb_buffer_desc d3 = {0, 3, 3}, d2 = {0, 2, 2};
@@ -354,7 +383,7 @@ SFB_API sfb_result sfb_surface_refine_positions(const sfb_surface *s, const floa
     if (!o->positions || !o->face_sizes || !o->face_vertices) goto oom;
     r = sfb_surface_eval_stencils(s, SFB_TABLE_VERTEX, base, d3, o->positions, d3);
     if (r != SFB_SUCCESS) { sfb_mesh_data_free(o); return r; }
-    if (s->built[SFB_TABLE_LIMIT]) {
+    if (s->built[SFB_TABLE_LIMIT] && want_limit) {
         o->limit_positions = (float *)sfb__alloc(ctx, (size_t)nv * 3 * sizeof(float) + 1);
         o->tangents_u = (float *)sfb__alloc(ctx, (size_t)nv * 3 * sizeof(float) + 1);
         o->tangents_v = (float *)sfb__alloc(ctx, (size_t)nv * 3 * sizeof(float) + 1);
