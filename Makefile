@@ -30,6 +30,8 @@ BENCH_LIBS  := -losdGPU -losdCPU $(GL_LIBS)
 PKGS_BASE := $(if $(shell command -v cc 2>/dev/null),,build-essential)
 PKGS_TEST := g++ libosd-dev libcriterion-dev pkg-config \
              libegl1 libegl-mesa0 libgl1-mesa-dri libosmesa6 libegl-dev libgl-dev glslang-tools
+# The CLI writes PNG pictures (surfblend render) with stb_image_write (libstb-dev, headers only).
+PKGS_CLI  := libstb-dev
 PKGS_FUZZ := clang libclang-rt-14-dev
 # The NEON kernels, cross-compiled for AArch64 and run under qemu user emulation (make test-neon).
 PKGS_NEON := gcc-aarch64-linux-gnu libc6-dev-arm64-cross qemu-user-static
@@ -51,9 +53,9 @@ define need_pkgs
 endef
 
 deps:
-	$(call need_pkgs,$(PKGS_BASE))
+	$(call need_pkgs,$(PKGS_BASE) $(PKGS_CLI))
 deps-test:
-	$(call need_pkgs,$(PKGS_BASE) $(PKGS_TEST))
+	$(call need_pkgs,$(PKGS_BASE) $(PKGS_CLI) $(PKGS_TEST))
 deps-fuzz:
 	$(call need_pkgs,$(PKGS_FUZZ))
 deps-neon:
@@ -77,7 +79,8 @@ $(BUILD)/libsfb.o: tools/impl.c surfblend.h $(BACKEND_HDRS)
 	@mkdir -p $(BUILD)
 	$(CC) $(CFLAGS) $(SAN) -I. -c -x c tools/impl.c -o $@
 
-$(BUILD)/surfblend: tools/surfblend.c $(BUILD)/libsfb.o
+# (order-only: the CLI needs stb_image_write from PKGS_CLI; deps installs it, or names it)
+$(BUILD)/surfblend: tools/surfblend.c $(BUILD)/libsfb.o | deps
 	$(CC) $(CFLAGS) $(SAN) -I. tools/surfblend.c $(BUILD)/libsfb.o -o $@ $(LIBS)
 
 $(BUILD)/examples/%: examples/%.c $(BUILD)/libsfb.o
@@ -89,6 +92,25 @@ run: deps $(BUILD)/surfblend
 	./$(BUILD)/surfblend info examples/data/creased_box.obj
 	./$(BUILD)/surfblend refine --scheme catmark --level 3 --limit examples/data/creased_box.obj -o out/creased_box_level3.obj
 	@echo "wrote out/creased_box_level3.obj"
+	@# subdivision shading (seed 001): the blended normals, and highlight lines of the limit normals
+	@# (before) and of the blended ones (after), seen along the diagonal of a smooth corner
+	@# (an extraordinary vertex of valence 3, at the middle of the picture)
+	./$(BUILD)/surfblend shade --scheme catmark --level 3 examples/data/creased_box.obj -o out/creased_box_shaded.obj
+	./$(BUILD)/surfblend render --highlight --normals limit --view -116.6,33.8 --zoom 1.3 --stripes 6 --size 800x600 \
+	  examples/data/creased_box.obj -o out/creased_box_before.png
+	./$(BUILD)/surfblend render --highlight --normals blended --view -116.6,33.8 --zoom 1.3 --stripes 6 --size 800x600 \
+	  examples/data/creased_box.obj -o out/creased_box_after.png
+	./$(BUILD)/surfblend render --weights --view -116.6,33.8 --size 800x600 examples/data/creased_box.obj -o out/creased_box_weights.png
+	@echo "wrote out/creased_box_shaded.obj out/creased_box_before.png out/creased_box_after.png out/creased_box_weights.png"
+	@# the same pair for OpenSubdiv's catmark_pole8 (one vertex of valence 8), seen from above
+	@if [ -d "$(SHAPES)" ]; then \
+	  for n in limit:before blended:after; do \
+	    echo "./$(BUILD)/surfblend render --level 4 --highlight --normals $${n%%:*} --view 20,60 --zoom 1.2 --size 800x600 $(SHAPES)/catmark_pole8.obj -o out/catmark_pole8_$${n##*:}.png"; \
+	    ./$(BUILD)/surfblend render --level 4 --highlight --normals $${n%%:*} --view 20,60 --zoom 1.2 --size 800x600 \
+	      $(SHAPES)/catmark_pole8.obj -o out/catmark_pole8_$${n##*:}.png || exit 1; \
+	  done; \
+	  echo "wrote out/catmark_pole8_before.png out/catmark_pole8_after.png"; \
+	else echo "peer shapes not found at $(SHAPES): the catmark_pole8 pictures are skipped"; fi
 
 # ---- tests ----
 $(BUILD)/unit: $(TEST_SRCS) $(BUILD)/libsfb.o
@@ -124,9 +146,10 @@ $(BUILD)/eigen: tests/eigen.c surfblend.h
 	$(CC) $(CFLAGS) $(SAN) -I. tests/eigen.c -o $@ $(LIBS)
 
 # Subdivision shading (sfb_surface_shade) on every backend: weights, variants, darts, split
-# normals, smoothness at extraordinary vertices (tests/shade.c).
-$(BUILD)/shade: tests/shade.c $(BUILD)/libsfb.o
-	$(CC) $(CFLAGS) $(SAN) -I. tests/shade.c $(BUILD)/libsfb.o -o $@ $(LIBS)
+# normals, smoothness at extraordinary vertices; compiles its own implementation to read the
+# refined level's vertex rules (tests/shade.c).
+$(BUILD)/shade: tests/shade.c surfblend.h $(BACKEND_HDRS)
+	$(CC) $(CFLAGS) $(SAN) -I. tests/shade.c -o $@ $(LIBS)
 
 # The finish_normals kernel of every backend against ref, degenerate inputs included: compiles
 # its own implementation to reach the backend vtables (tests/finish_normals.c).

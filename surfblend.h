@@ -423,6 +423,61 @@ typedef struct sfb_tess_data {
 SFB_API sfb_result sfb_surface_tessellate(const sfb_surface *surface, const sfb_tess_config *config, sfb_tess_data *out);
 SFB_API void sfb_tess_data_free(sfb_tess_data *data);
 
+/* ---- software pictures ----
+ * sfb_render draws a mesh (typically sfb_surface_refine's or sfb_surface_shade's output) into
+ * an RGBA picture on the CPU, without GL: polygons fan-triangulated, z-buffered, per-pixel
+ * normals interpolated and renormalised (Phong), two-sided lighting (the normal is turned
+ * toward the viewer). The camera orbits the bounding-box centre of the vertices the faces use;
+ * y is up. Faces listed in mesh->holes are not drawn; faces with a non-finite vertex are
+ * skipped (counted in sfb_image.skipped_faces). Long renders report progress (stage "render")
+ * and can be cancelled (SFB_CANCELLED, nothing kept). Reads the mesh only: several threads may
+ * render the same mesh at once, each on its own context. */
+#define SFB_RENDER_MAX_SIZE 8192 /* largest width or height in pixels */
+typedef enum sfb_render_mode {
+    SFB_RENDER_SHADED = 0,  /* neutral grey, diffuse + specular */
+    SFB_RENDER_HIGHLIGHT,   /* highlight lines: parallel light lines in a plane fixed to the camera, followed along the
+                               normal (ALGORITHMS.md section 7, Dir = N), as dark blue and cyan bands over lit grey; two
+                               renders with the same view and positions but different normals are directly comparable */
+    SFB_RENDER_WEIGHTS,     /* a per-vertex scalar in [0,1] as colour: blue (0), cyan, green, yellow, red (1), lightly shaded */
+    SFB_RENDER_NORMALS      /* the unit normal as RGB = 0.5 + 0.5 n (world axes, before the two-sided flip) */
+} sfb_render_mode;
+typedef struct sfb_render_config {
+    int width, height;       /* pixels, 1..SFB_RENDER_MAX_SIZE; 0: 640 (width), 480 (height) */
+    int mode;                /* sfb_render_mode */
+    const float *positions;  /* xyz per mesh vertex (vertex_count of them); NULL: mesh->positions */
+    const float *normals;    /* xyz per mesh vertex, need not be unit; NULL: mesh->normals; NULL there too, or a
+                                zero or non-finite normal: the polygon's flat normal */
+    const float *scalars;    /* SFB_RENDER_WEIGHTS: one per vertex, clamped to [0,1] (non-finite: 0); NULL:
+                                mesh->blend_weights (required in that mode) */
+    int view_set;            /* 0: the default view (yaw 30, pitch 25); 1: yaw and pitch below */
+    float yaw, pitch;        /* degrees: yaw turns the camera about the y axis from +z toward +x, pitch raises it */
+    float zoom;              /* > 0: magnification; 0: 1, the bounding sphere just fits the smaller side */
+    int orthographic;        /* 0: perspective (30 degree view of the bounding sphere); 1: orthographic */
+    float stripes;           /* SFB_RENDER_HIGHLIGHT: light lines per bounding-sphere diameter in the light plane;
+                                0: default 8 (more: denser lines) */
+    float light_distance;    /* SFB_RENDER_HIGHLIGHT: distance of the light plane from the centre, toward the camera,
+                                in bounding-sphere radii; 0: default 3 (farther: the lines follow the normal more) */
+    int light_at_infinity;   /* SFB_RENDER_HIGHLIGHT: 1: the light plane infinitely far away, so that the stripe
+                                depends on the normal alone (a flat face is one colour) */
+    int draw_edges;          /* 1: overlay the polygons' edges (not the triangulation's diagonals) */
+    unsigned char background[4]; /* RGBA of uncovered pixels; all 0: default opaque dark grey */
+} sfb_render_config;
+SFB_API sfb_render_config sfb_render_config_init(int mode);
+typedef struct sfb_image {
+    int width, height;
+    unsigned char *rgba;     /* width * height * 4 bytes, rows top to bottom, alpha 255 on the object */
+    int object_pixels;       /* pixels the mesh covers */
+    int skipped_faces;       /* faces not drawn because a vertex is not finite (or behind the camera) */
+    sfb_context *ctx_;       /* allocator owner */
+} sfb_image;
+/* Renders `mesh` with `config` (NULL: all defaults, SFB_RENDER_SHADED). Checks everything
+ * before allocating: sizes (SFB_INVALID_ARGS when negative, SFB_LIMIT_EXCEEDED over
+ * SFB_RENDER_MAX_SIZE or the memory budget), face sizes and vertex indices (SFB_INVALID_TOPOLOGY
+ * naming the face; also for a mesh without faces), face sizes adding up to face_vertex_count,
+ * holes in range, finite view values. On failure `out` is zeroed and nothing is kept. */
+SFB_API sfb_result sfb_render(sfb_context *ctx, const sfb_mesh_data *mesh, const sfb_render_config *config, sfb_image *out);
+SFB_API void sfb_image_free(sfb_image *img);
+
 #ifdef __cplusplus
 }
 #endif
@@ -666,6 +721,24 @@ struct sfb_mesh {
     int hole_count; int *holes;
 };
 
+/* ---- subdivision shading (shade.c) ---- */
+typedef struct sfb__shading {
+    int normals_level, weights_level, level, variant, darts;
+    sfb__level nlev;           /* topology at the normals level (face normals are taken there) */
+    int *nsrc_of_vf;           /* per nlev vf entry: the source (region normal) the face feeds */
+    int nsrc;                  /* sources: one normal per vertex region at the normals level */
+    int npos_mode;             /* normals-level positions: 0 base positions, 1 the npos table, 2 refined positions */
+    sfb__stencils npos;        /* base -> normals-level positions (npos_mode 1) */
+    int nout, nweighted, nsplit;
+    int *out_origin;           /* nout: refined vertex of each output vertex */
+    int *out_fv;               /* per refined face-vertex: output vertex */
+    float *b;                  /* nout: blend weight */
+    int *ns_idx_w, *ns_idx_all;/* nout: row of N_S for finish_normals (-1 where b = 0 / every row) */
+    sfb__stencils ns;          /* sources -> N_S rows, the nweighted rows with b > 0 first */
+    sfb__stencils lim[3];      /* refined positions -> limit position, tangent u, tangent v per output vertex */
+    void *handles[5];          /* the backend's uploads of npos, ns, lim[0..2] */
+    size_t bytes;
+} sfb__shading;
 /* ---- surfaces ---- */
 struct sfb_surface {
     sfb_context *ctx;
@@ -685,6 +758,7 @@ struct sfb_surface {
     sfb__level pbase;            /* the prepared base level the patches were built from (tessellation
                                     shares vertices along its edges) */
     void *backend_patches;       /* the backend's uploaded copy */
+    sfb__shading *shading;       /* SFB_REFINE_SHADING */
 };
 
 typedef struct sfb__refine_options {
@@ -703,6 +777,10 @@ void sfb__stencils_free(sfb_context *ctx, sfb__stencils *s);
 /* Copy of the base level with OpenSubdiv's boundary/non-manifold sharpening and holes applied. */
 sfb_result sfb__level_prepare(sfb_context *ctx, const sfb__level *src, int sharpen_corners, int make_boundary_holes,
                               sfb__level *dst);
+
+void sfb__shading_free(sfb_context *ctx, sfb__shading *sh);
+sfb_result sfb__shading_build(sfb_context *ctx, const sfb__level *prep, const sfb__refine_options *opt, int level,
+                              const sfb_shading_options *o, sfb__shading **out);
 
 /* patches.c */
 void sfb__patch_table_free(sfb_context *ctx, sfb__patch_table *pt);
@@ -5977,6 +6055,13 @@ SFB_API void sfb_surface_destroy(sfb_surface *s) {
     if (s->backend_patches && s->uploaded_by && s->uploaded_by->release_patches)
         s->uploaded_by->release_patches(ctx->backend_state, s->backend_patches);
     sfb__patch_table_free(ctx, &s->patches);
+    if (s->shading) {
+        int h;
+        for (h = 0; h < 5; ++h)
+            if (s->shading->handles[h] && s->uploaded_by && s->uploaded_by->release_stencils)
+                s->uploaded_by->release_stencils(ctx->backend_state, s->shading->handles[h]);
+        sfb__shading_free(ctx, s->shading);
+    }
     sfb__level_free(ctx, &s->pbase);
     sfb__level_free(ctx, &s->top);
     sfb__level_free(ctx, &s->uv_top);
@@ -6020,6 +6105,9 @@ SFB_API sfb_result sfb_surface_create(sfb_context *ctx, const sfb_mesh *mesh, co
     if ((cfg->flags & SFB_REFINE_PATCHES) && cfg->scheme != SFB_SCHEME_CATMARK && cfg->scheme != SFB_SCHEME_LOOP)
         return sfb__error(ctx, SFB_UNSUPPORTED, SFB_ELEMENT_NONE, -1, "limit evaluation (SFB_REFINE_PATCHES) is built for Catmull-Clark and Loop; scheme '%s' is not supported",
                           sfb_scheme_name(cfg->scheme));
+    if ((cfg->flags & SFB_REFINE_SHADING) && cfg->scheme != SFB_SCHEME_CATMARK && cfg->scheme != SFB_SCHEME_LOOP)
+        return sfb__error(ctx, SFB_UNSUPPORTED, SFB_ELEMENT_NONE, -1, "subdivision shading (SFB_REFINE_SHADING) is built for Catmull-Clark and Loop; scheme '%s' is not supported",
+                          sfb_scheme_name(cfg->scheme));
     if ((cfg->flags & SFB_REFINE_PATCHES) && (cfg->isolation_level < 0 || cfg->isolation_level > SFB_MAX_LEVEL))
         return sfb__error(ctx, SFB_LIMIT_EXCEEDED, SFB_ELEMENT_NONE, -1, "isolation level %d is outside 0..%d (0 = default %d)",
                           cfg->isolation_level, SFB_MAX_LEVEL, SFB_DEFAULT_ISOLATION);
@@ -6057,6 +6145,8 @@ SFB_API sfb_result sfb_surface_create(sfb_context *ctx, const sfb_mesh *mesh, co
     opt.want_limit = (cfg->flags & SFB_REFINE_LIMIT) != 0;
     r = sfb__refine(ctx, &prep, &opt, cfg->refine_level, &s->top, &s->tables[SFB_TABLE_VERTEX],
                     opt.want_limit ? &s->tables[SFB_TABLE_LIMIT] : NULL, 0.0f, 0.8f);
+    if (r == SFB_SUCCESS && (cfg->flags & SFB_REFINE_SHADING))
+        r = sfb__shading_build(ctx, &prep, &opt, cfg->refine_level, &cfg->shading, &s->shading);
     if (r == SFB_SUCCESS && (cfg->flags & SFB_REFINE_PATCHES)) {
         r = sfb__patches_build(ctx, &prep, &opt, cfg->isolation_level ? cfg->isolation_level : SFB_DEFAULT_ISOLATION,
                                 s->base_positions, &s->patches);
@@ -6112,6 +6202,16 @@ SFB_API sfb_result sfb_surface_create(sfb_context *ctx, const sfb_mesh *mesh, co
             if (!s->built[t] || s->tables[t].rows == 0) continue;
             r = ctx->backend->upload_stencils(ctx->backend_state, &s->tables[t], &s->backend_tables[t]);
             if (r != SFB_SUCCESS) { sfb_surface_destroy(s); return r; }
+        }
+        if (s->shading) {
+            sfb__shading *sh = s->shading;
+            const sfb__stencils *st[5];
+            st[0] = &sh->npos; st[1] = &sh->ns; st[2] = &sh->lim[0]; st[3] = &sh->lim[1]; st[4] = &sh->lim[2];
+            for (t = 0; t < 5; ++t) {
+                if (st[t]->rows == 0) continue;
+                r = ctx->backend->upload_stencils(ctx->backend_state, st[t], &sh->handles[t]);
+                if (r != SFB_SUCCESS) { sfb_surface_destroy(s); return r; }
+            }
         }
     }
     if (s->has_patches && ctx->backend && ctx->backend->upload_patches) {
@@ -6268,12 +6368,19 @@ SFB_API void sfb_mesh_data_free(sfb_mesh_data *d) {
     memset(d, 0, sizeof *d);
 }
 
+static sfb_result sfb__refine_output(const sfb_surface *s, const float *base, int base_count, int want_limit, sfb_mesh_data *o);
+
 SFB_API sfb_result sfb_surface_refine(const sfb_surface *s, sfb_mesh_data *out) {
     if (!s) return SFB_INVALID_ARGS;
     return sfb_surface_refine_positions(s, s->base_positions, s->base_vertex_count, out);
 }
 
 SFB_API sfb_result sfb_surface_refine_positions(const sfb_surface *s, const float *base, int base_count, sfb_mesh_data *o) {
+    return sfb__refine_output(s, base, base_count, 1, o);
+}
+
+/* The refined mesh; with want_limit the limit tables too (when built). */
+static sfb_result sfb__refine_output(const sfb_surface *s, const float *base, int base_count, int want_limit, sfb_mesh_data *o) {
     sfb_context *ctx;
     const sfb__level *l;
     sfb_buffer_desc d3 = {0, 3, 3}, d2 = {0, 2, 2};
@@ -6298,7 +6405,7 @@ SFB_API sfb_result sfb_surface_refine_positions(const sfb_surface *s, const floa
     if (!o->positions || !o->face_sizes || !o->face_vertices) goto oom;
     r = sfb_surface_eval_stencils(s, SFB_TABLE_VERTEX, base, d3, o->positions, d3);
     if (r != SFB_SUCCESS) { sfb_mesh_data_free(o); return r; }
-    if (s->built[SFB_TABLE_LIMIT]) {
+    if (s->built[SFB_TABLE_LIMIT] && want_limit) {
         o->limit_positions = (float *)sfb__alloc(ctx, (size_t)nv * 3 * sizeof(float) + 1);
         o->tangents_u = (float *)sfb__alloc(ctx, (size_t)nv * 3 * sizeof(float) + 1);
         o->tangents_v = (float *)sfb__alloc(ctx, (size_t)nv * 3 * sizeof(float) + 1);
@@ -6376,7 +6483,557 @@ SFB_API void sfb_mesh_data_desc(const sfb_mesh_data *m, sfb_mesh_desc *d) {
 #line 1 "src/shade.c"
 /* Subdivision shading (seed 001): subdivided normals N_S with crease regions, blend weights b
  * (variants A/B, darts smooth/sharp, semi-sharp re-seeding) and the blended normals
- * N_B = normalize((1 - b^p) N_L + b^p N_S). */
+ * N_B = normalize((1 - b^p) N_L + b^p N_S).
+ *
+ * Everything that depends on topology and sharpness only is compiled here, on the CPU, into
+ * flat tables when the surface is created (SFB_REFINE_SHADING):
+ *   - the blend weights b of every output vertex (numbers: they depend on no position);
+ *   - a stencil table from the normals-level sources (one normal per vertex region) to N_S of
+ *     the output vertices, its rows with b > 0 first, so that N_S is computed only there;
+ *   - local limit masks (limit position, two tangents) of every output vertex over the refined
+ *     vertices: one row per region at split vertices;
+ *   - the split of vertices along infinitely sharp creases (one output vertex per region).
+ * sfb_surface_shade then runs: refined positions (vertex table), normals-level positions, face
+ * normals averaged per region (CPU: one pass over the coarse level's faces), the N_S rows, the
+ * limit rows, and the backend's finish_normals kernel.
+ *
+ * Choices where the seed is silent (each tested in tests/shade.c):
+ *   - Linear averaging, normalised once at the end (in finish_normals) rather than after every
+ *     level. Renormalising a linear average only rescales it, so the direction differs from a
+ *     per-level renormalisation by the small change of the stencil weights this rescaling
+ *     makes; in exchange N_S is one linear map of the normals-level normals, which is what
+ *     lets it compile to one stencil table.
+ *   - A region is a maximal fan of a vertex's faces not separated by a sharp edge (sharpness
+ *     > 0 at that level; boundary edges are sharp). A vertex with fewer than two sharp edges, or
+ *     a non-manifold one, has one region.
+ *   - A stencil entry that reaches a parent vertex with several regions takes the parent's
+ *     region normals of the parent faces the new vertex's region lies in (the parent faces of
+ *     the child faces of that region), weighted by how many of those faces each region has.
+ *     When the new vertex lies in faces of several parent regions - a semi-sharp edge ran out
+ *     of sharpness between the levels, so the child has fewer regions than the parent - this
+ *     merges the separated regions' normals in proportion to the faces each contributes. No
+ *     face of the new vertex at the parent vertex (cannot happen for Catmull-Clark or Loop
+ *     masks): all of the parent's regions equally.
+ *   - Output regions split only along infinitely sharp edges; N_S of an output vertex is the
+ *     face-count weighted mean of the N_S regions it covers (a semi-sharp edge still sharp at
+ *     the last level separates N_S regions but does not split the vertex).
+ *   - Weights, re-seeding (seed §3.2): at the weights level b = 1 at every extraordinary vertex
+ *     that is not held and at every vertex of its incident faces (its one-ring: edge
+ *     neighbours, and for Catmull-Clark the face diagonals too), then b = 0 at every held
+ *     vertex. Held: in variant B a vertex with two or more sharp edges at that level (crease or
+ *     corner rule, boundary included) or, with sharp darts, a regular dart; in variant A no
+ *     vertex is held. After every subdivision step of the weights (the scheme's stencils,
+ *     creases included): b = 0 at every held vertex again (its sharpness has not run out); a
+ *     vertex released at this step (held before, not now: its semi-sharp edges ran out) that is
+ *     extraordinary is seeded as a smooth extraordinary vertex, it and its one-ring set to 1
+ *     (Fig. 4 of the seed); and b = 1 at every extraordinary vertex that is not held (the
+ *     vertex alone: away from held vertices this changes nothing, since a vertex whose one-ring
+ *     is all 1 keeps 1; next to held vertices it keeps the limit value 1 at the extraordinary
+ *     point, which the blended field needs to be smooth there).
+ *   - Extraordinary: Catmull-Clark an interior vertex whose face count is not 4 or with a
+ *     non-quad face, a boundary vertex whose face count is not 2; Loop 6 and 3 with triangles;
+ *     non-manifold vertices count as extraordinary. A dart that is extraordinary is
+ *     extraordinary whatever the dart option.
+ *   - Limit normals of split vertices: at a crease vertex each side uses the crease tangent
+ *     and that side's cross tangent (the limit masks of a boundary vertex on that side); at a
+ *     corner each region uses the two edges of its first face, as the corner limit masks do. */
+
+typedef struct sfb__regions {
+    int *first;   /* nv + 1: first region-vertex of each vertex */
+    int *of_vf;   /* per vf entry: region-vertex of that face at that vertex */
+    int *faces;   /* per region-vertex: number of faces */
+    int total;
+} sfb__regions;
+
+static void sfb__regions_free(sfb_context *ctx, sfb__regions *r) {
+    sfb__free(ctx, r->first); sfb__free(ctx, r->of_vf); sfb__free(ctx, r->faces);
+    memset(r, 0, sizeof *r);
+}
+
+/* Regions of every vertex: edges with sharpness > 0 separate them (>= infinite with inf_only). */
+static sfb_result sfb__regions_build(sfb_context *ctx, const sfb__level *l, int inf_only, sfb__regions *r) {
+    int v, i, nvf = l->vf_off[l->nv];
+    memset(r, 0, sizeof *r);
+    r->first = (int *)sfb__alloc(ctx, ((size_t)l->nv + 1) * sizeof(int));
+    r->of_vf = (int *)sfb__alloc(ctx, ((size_t)nvf + 1) * sizeof(int));
+    if (!r->first || !r->of_vf) { sfb__regions_free(ctx, r); return sfb__oom(ctx, "shading regions"); }
+    r->total = 0;
+    for (v = 0; v < l->nv; ++v) {
+        int e0 = l->ve_off[v], ne = l->ve_off[v + 1] - e0;
+        int f0 = l->vf_off[v], nf = l->vf_off[v + 1] - f0;
+        int sharp = 0, reg = 0, interior = nf == ne && !(l->vtag[v] & SFB__TAG_BOUNDARY);
+        r->first[v] = r->total;
+        if (!(l->vtag[v] & SFB__TAG_NONMANIFOLD) && (nf == ne || nf == ne - 1))
+            for (i = 0; i < ne; ++i) {
+                float s = l->es[l->ve[e0 + i]];
+                sharp += inf_only ? s >= SFB_SHARPNESS_INFINITE : s > 0.0f;
+            }
+        if (sharp < 2) {
+            for (i = 0; i < nf; ++i) r->of_vf[f0 + i] = r->total;
+            r->total += 1;
+            continue;
+        }
+        for (i = 0; i < nf; ++i) {
+            float s = l->es[l->ve[e0 + i]]; /* edge i precedes face i */
+            if (i > 0 && (inf_only ? s >= SFB_SHARPNESS_INFINITE : s > 0.0f)) reg++;
+            r->of_vf[f0 + i] = reg;
+        }
+        if (interior && reg > 0) {
+            float s0 = l->es[l->ve[e0]];
+            if (!(inf_only ? s0 >= SFB_SHARPNESS_INFINITE : s0 > 0.0f)) {
+                /* the fan closes through edge 0: the last run joins the first region */
+                for (i = 0; i < nf; ++i)
+                    if (r->of_vf[f0 + i] == reg) r->of_vf[f0 + i] = 0;
+                reg--;
+            }
+        }
+        for (i = 0; i < nf; ++i) r->of_vf[f0 + i] += r->total;
+        r->total += reg + 1;
+    }
+    r->first[l->nv] = r->total;
+    r->faces = (int *)sfb__calloc(ctx, (size_t)r->total + 1, sizeof(int));
+    if (!r->faces) { sfb__regions_free(ctx, r); return sfb__oom(ctx, "shading regions"); }
+    for (i = 0; i < nvf; ++i) r->faces[r->of_vf[i]]++;
+    return SFB_SUCCESS;
+}
+
+void sfb__shading_free(sfb_context *ctx, sfb__shading *sh) {
+    int t;
+    if (!sh) return;
+    sfb__level_free(ctx, &sh->nlev);
+    sfb__free(ctx, sh->nsrc_of_vf);
+    sfb__stencils_free(ctx, &sh->npos);
+    sfb__free(ctx, sh->out_origin); sfb__free(ctx, sh->out_fv); sfb__free(ctx, sh->b);
+    sfb__free(ctx, sh->ns_idx_w); sfb__free(ctx, sh->ns_idx_all);
+    sfb__stencils_free(ctx, &sh->ns);
+    for (t = 0; t < 3; ++t) sfb__stencils_free(ctx, &sh->lim[t]);
+    sfb__free(ctx, sh);
+}
+
+static int sfb__shade_extraordinary(const sfb__level *l, int v, int loop) {
+    int f0 = l->vf_off[v], nf = l->vf_off[v + 1] - f0, i, reg;
+    if (l->ve_off[v + 1] == l->ve_off[v]) return 0; /* bare vertex */
+    if (l->vtag[v] & SFB__TAG_NONMANIFOLD) return 1;
+    reg = (l->vtag[v] & SFB__TAG_BOUNDARY) ? (loop ? 3 : 2) : (loop ? 6 : 4);
+    if (nf != reg) return 1;
+    for (i = 0; i < nf; ++i) {
+        int f = l->vf[f0 + i];
+        if (l->fv_off[f + 1] - l->fv_off[f] != (loop ? 3 : 4)) return 1;
+    }
+    return 0;
+}
+
+static int sfb__shade_held(const sfb__level *l, int v, int loop, int variant, int darts) {
+    int rule = l->vrule[v];
+    if (variant != SFB_SHADE_VARIANT_B) return 0;
+    if (rule == SFB__RULE_CREASE || rule == SFB__RULE_CORNER) return 1;
+    return darts == SFB_SHADE_DARTS_SHARP && rule == SFB__RULE_DART && !sfb__shade_extraordinary(l, v, loop);
+}
+
+/* The seeding of the blend weights on level l (see the top of this file): b = 1 at every
+ * extraordinary vertex that is not held, and at its one-ring when `ring` says so (all of them
+ * with ring == NULL; else those with ring[v] set); then b = 0 at every held vertex. */
+static void sfb__shade_seed(const sfb__level *l, double *b, int loop, int variant, int darts, const unsigned char *ring) {
+    int v, i, j;
+    for (v = 0; v < l->nv; ++v) {
+        if (!sfb__shade_extraordinary(l, v, loop) || sfb__shade_held(l, v, loop, variant, darts)) continue;
+        b[v] = 1.0;
+        if (ring && !ring[v]) continue;
+        for (i = l->vf_off[v]; i < l->vf_off[v + 1]; ++i) {
+            int f = l->vf[i];
+            for (j = l->fv_off[f]; j < l->fv_off[f + 1]; ++j) b[l->fv[j]] = 1.0;
+        }
+    }
+    for (v = 0; v < l->nv; ++v)
+        if (sfb__shade_held(l, v, loop, variant, darts)) b[v] = 0.0;
+}
+
+/* Parent face of every child face of one step. */
+static int *sfb__shade_parent_faces(sfb_context *ctx, const sfb__level *p, const sfb__level *c, int loop) {
+    int *pf = (int *)sfb__alloc(ctx, ((size_t)c->nf + 1) * sizeof(int));
+    int f, i;
+    if (!pf) return NULL;
+    if (loop) {
+        for (f = 0; f < c->nf; ++f) pf[f] = f / 4;
+    } else {
+        for (f = 0; f < p->nf; ++f)
+            for (i = p->fv_off[f]; i < p->fv_off[f + 1]; ++i) pf[i] = f; /* child faces of f: its face-vertex slots */
+    }
+    return pf;
+}
+
+/* Scratch of the region masks. */
+typedef struct sfb__shade_scratch {
+    int *fset, nfset;          /* parent faces of the child region being built */
+    double *cnt;               /* per region of the parent vertex */
+    int cap;
+} sfb__shade_scratch;
+
+/* Adds scale * (the step's mask of child vertex cv, restricted to its region creg - a
+ * region-vertex of cr, or -1 for all of cv's faces) over the parent's region-vertices. */
+static int sfb__shade_region_mask(sfb_context *ctx, const sfb__level *p, const sfb__regions *pr, const sfb__level *c,
+                                  const sfb__regions *cr, const int *cparent, const sfb__stencils *T, int cv, int creg,
+                                  double scale, sfb__mask *m, sfb__shade_scratch *sc) {
+    int i, j, k, n = T->sizes[cv], o = T->offsets[cv];
+    sc->nfset = 0;
+    for (i = c->vf_off[cv]; i < c->vf_off[cv + 1]; ++i) {
+        int pf;
+        if (creg >= 0 && cr->of_vf[i] != creg) continue;
+        pf = cparent[c->vf[i]];
+        for (j = 0; j < sc->nfset && sc->fset[j] != pf; ++j) {}
+        if (j == sc->nfset) sc->fset[sc->nfset++] = pf;
+    }
+    for (k = 0; k < n; ++k) {
+        int pj = T->indices[o + k], nr = pr->first[pj + 1] - pr->first[pj];
+        double w = (double)T->weights[o + k] * scale, tot = 0.0;
+        if (!sfb__mask_grow(ctx, m, nr)) return 0;
+        if (nr == 1) { SFB__MASK_ADD(m, pr->first[pj], w); continue; }
+        for (i = 0; i < nr; ++i) sc->cnt[i] = 0.0;
+        for (i = p->vf_off[pj]; i < p->vf_off[pj + 1]; ++i)
+            for (j = 0; j < sc->nfset; ++j)
+                if (sc->fset[j] == p->vf[i]) { sc->cnt[pr->of_vf[i] - pr->first[pj]] += 1.0; tot += 1.0; break; }
+        for (i = 0; i < nr; ++i) {
+            double f = tot > 0.0 ? sc->cnt[i] / tot : 1.0 / nr;
+            if (f != 0.0) SFB__MASK_ADD(m, pr->first[pj] + i, w * f);
+        }
+    }
+    return 1;
+}
+
+/* Rows of the identity over n sources. */
+static int sfb__shade_identity(sfb_context *ctx, sfb__rows *r, int n) {
+    int i;
+    memset(r, 0, sizeof *r);
+    r->rows = n;
+    r->off = (size_t *)sfb__alloc(ctx, ((size_t)n + 1) * sizeof(size_t));
+    if (!r->off || !sfb__rows_reserve(ctx, r, (size_t)n + 1)) return 0;
+    for (i = 0; i < n; ++i) { r->off[i] = (size_t)i; r->idx[i] = i; r->w[i] = 1.0; }
+    r->off[n] = (size_t)n;
+    r->n = (size_t)n;
+    return 1;
+}
+
+/* Composed rows of level k+1 from those of level k through the step's stencils (positions). */
+static int sfb__shade_compose_step(sfb_context *ctx, sfb__accum *A, const sfb__rows *prow, const sfb__stencils *T,
+                                   sfb__mask *m, sfb__rows *out) {
+    int cv, k;
+    memset(out, 0, sizeof *out);
+    out->rows = T->rows;
+    out->off = (size_t *)sfb__alloc(ctx, ((size_t)T->rows + 1) * sizeof(size_t));
+    if (!out->off) return 0;
+    out->off[0] = 0;
+    for (cv = 0; cv < T->rows; ++cv) {
+        m->n = 0;
+        if (!sfb__mask_grow(ctx, m, T->sizes[cv])) return 0;
+        for (k = 0; k < T->sizes[cv]; ++k) SFB__MASK_ADD(m, T->indices[T->offsets[cv] + k], (double)T->weights[T->offsets[cv] + k]);
+        if (!sfb__compose_row(ctx, A, prow, m, out, cv)) return 0;
+    }
+    return 1;
+}
+
+static sfb_result sfb__shade_level_arg(sfb_context *ctx, int given, int level, const char *what, int *out) {
+    int l = given == 0 ? 1 : given == SFB_SHADE_LEVEL_CONTROL ? 0 : given;
+    if (given < SFB_SHADE_LEVEL_CONTROL || given > SFB_MAX_LEVEL)
+        return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, -1,
+                          "shading %s level %d is outside %d..%d (0 = default 1, SFB_SHADE_LEVEL_CONTROL = the control mesh)",
+                          what, given, SFB_SHADE_LEVEL_CONTROL, SFB_MAX_LEVEL);
+    *out = l < level ? l : level; /* a start level above the refinement level starts at the last level */
+    return SFB_SUCCESS;
+}
+
+sfb_result sfb__shading_build(sfb_context *ctx, const sfb__level *prep, const sfb__refine_options *opt, int L,
+                              const sfb_shading_options *o, sfb__shading **out) {
+    sfb__shading *sh = NULL;
+    sfb__level *lev = NULL;
+    sfb__stencils *T = NULL;
+    sfb__regions *reg = NULL, outreg;
+    int **parent = NULL;
+    sfb__rows prow, crow;
+    sfb__accum A;
+    sfb__mask m, mm[3];
+    sfb__shade_scratch sc;
+    double *bw = NULL, *bn = NULL;
+    int *order = NULL;
+    sfb_result r = SFB_SUCCESS;
+    int loop = opt->scheme == SFB_SCHEME_LOOP;
+    int Ln = 0, Lw = 0, k, v, i, t, maxv = 1, maxsrc;
+    const sfb__level *top;
+    *out = NULL;
+    memset(&prow, 0, sizeof prow); memset(&crow, 0, sizeof crow); memset(&A, 0, sizeof A);
+    memset(&m, 0, sizeof m); memset(mm, 0, sizeof mm); memset(&sc, 0, sizeof sc); memset(&outreg, 0, sizeof outreg);
+    if ((r = sfb__shade_level_arg(ctx, o->normals_level, L, "normals", &Ln)) != SFB_SUCCESS) return r;
+    if ((r = sfb__shade_level_arg(ctx, o->weights_level, L, "weights", &Lw)) != SFB_SUCCESS) return r;
+    if (o->variant != SFB_SHADE_VARIANT_A && o->variant != SFB_SHADE_VARIANT_B)
+        return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, -1, "shading variant %d is not SFB_SHADE_VARIANT_A or _B", o->variant);
+    if (o->darts != SFB_SHADE_DARTS_SMOOTH && o->darts != SFB_SHADE_DARTS_SHARP)
+        return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, -1, "shading darts option %d is not SFB_SHADE_DARTS_SMOOTH or _SHARP", o->darts);
+    sh = (sfb__shading *)sfb__calloc(ctx, 1, sizeof *sh);
+    lev = (sfb__level *)sfb__calloc(ctx, (size_t)L + 1, sizeof *lev);
+    T = (sfb__stencils *)sfb__calloc(ctx, (size_t)L + 1, sizeof *T);
+    reg = (sfb__regions *)sfb__calloc(ctx, (size_t)L + 1, sizeof *reg);
+    parent = (int **)sfb__calloc(ctx, (size_t)L + 1, sizeof *parent);
+    if (!sh || !lev || !T || !reg || !parent) { r = sfb__oom(ctx, "shading tables"); goto done; }
+    sh->normals_level = Ln; sh->weights_level = Lw; sh->level = L; sh->variant = o->variant; sh->darts = o->darts;
+
+    /* the levels, one step at a time, with each step's local stencils */
+    lev[0] = *prep; /* borrowed */
+    for (k = 0; k < L; ++k) {
+        r = sfb__refine(ctx, &lev[k], opt, 1, &lev[k + 1], &T[k], NULL, 0.8f, 0.8f);
+        if (r != SFB_SUCCESS) goto done;
+        parent[k + 1] = sfb__shade_parent_faces(ctx, &lev[k], &lev[k + 1], loop);
+        if (!parent[k + 1]) { r = sfb__oom(ctx, "shading tables"); goto done; }
+    }
+    top = &lev[L];
+    for (k = 0; k <= L; ++k)
+        for (v = 0; v < lev[k].nv; ++v) {
+            int n = lev[k].vf_off[v + 1] - lev[k].vf_off[v];
+            if (n + 1 > maxv) maxv = n + 1;
+        }
+    sc.cap = maxv;
+    sc.fset = (int *)sfb__alloc(ctx, (size_t)maxv * sizeof(int));
+    sc.cnt = (double *)sfb__alloc(ctx, (size_t)maxv * sizeof(double));
+    if (!sc.fset || !sc.cnt) { r = sfb__oom(ctx, "shading tables"); goto done; }
+
+    /* regions (sharpness > 0) from the normals level up */
+    for (k = Ln; k <= L; ++k)
+        if ((r = sfb__regions_build(ctx, &lev[k], 0, &reg[k])) != SFB_SUCCESS) goto done;
+    if ((r = sfb__regions_build(ctx, top, 0, &outreg)) != SFB_SUCCESS) goto done;
+
+    /* the normals level: its topology, the source of every face at every vertex, positions */
+    if (Ln == 0) r = sfb__level_prepare(ctx, prep, 0, 0, &sh->nlev);
+    else { sh->nlev = lev[Ln]; memset(&lev[Ln], 0, sizeof lev[Ln]); }
+    if (r != SFB_SUCCESS) goto done;
+    if (Ln == L) top = &sh->nlev;
+    sh->nsrc = reg[Ln].total;
+    sh->nsrc_of_vf = (int *)sfb__alloc(ctx, ((size_t)sh->nlev.vf_off[sh->nlev.nv] + 1) * sizeof(int));
+    if (!sh->nsrc_of_vf) { r = sfb__oom(ctx, "shading tables"); goto done; }
+    memcpy(sh->nsrc_of_vf, reg[Ln].of_vf, (size_t)sh->nlev.vf_off[sh->nlev.nv] * sizeof(int));
+    A.acc = (double *)sfb__alloc(ctx, ((size_t)(prep->nv > sh->nsrc ? prep->nv : sh->nsrc) + 1) * sizeof(double));
+    A.mark = (unsigned *)sfb__calloc(ctx, (size_t)(prep->nv > sh->nsrc ? prep->nv : sh->nsrc) + 1, sizeof(unsigned));
+    A.touched = (int *)sfb__alloc(ctx, ((size_t)(prep->nv > sh->nsrc ? prep->nv : sh->nsrc) + 1) * sizeof(int));
+    if (!A.acc || !A.mark || !A.touched) { r = sfb__oom(ctx, "shading tables"); goto done; }
+    sh->npos_mode = Ln == 0 ? 0 : Ln == L ? 2 : 1;
+    if (sh->npos_mode == 1) {
+        if (!sfb__shade_identity(ctx, &prow, prep->nv)) { r = sfb__oom(ctx, "shading tables"); goto done; }
+        for (k = 0; k < Ln; ++k) {
+            if (!sfb__shade_compose_step(ctx, &A, &prow, &T[k], &m, &crow)) { r = sfb__oom(ctx, "shading tables"); goto done; }
+            sfb__rows_free(ctx, &prow);
+            prow = crow;
+            memset(&crow, 0, sizeof crow);
+        }
+        r = sfb__rows_to_stencils(ctx, &prow, prep->nv, &sh->npos);
+        if (r != SFB_SUCCESS) { r = sfb__oom(ctx, "shading tables"); goto done; }
+        sfb__rows_free(ctx, &prow);
+    }
+
+    /* blend weights from the weights level to the last */
+    bw = (double *)sfb__calloc(ctx, (size_t)(Lw == Ln ? &sh->nlev : &lev[Lw])->nv + 1, sizeof(double));
+    if (!bw) { r = sfb__oom(ctx, "shading weights"); goto done; }
+    sfb__shade_seed(Lw == Ln ? &sh->nlev : &lev[Lw], bw, loop, o->variant, o->darts, NULL);
+    for (k = Lw; k < L; ++k) {
+        const sfb__stencils *S = &T[k];
+        const sfb__level *pl = k == Ln ? &sh->nlev : &lev[k], *cl = k + 1 == Ln ? &sh->nlev : &lev[k + 1];
+        unsigned char *released;
+        bn = (double *)sfb__calloc(ctx, (size_t)S->rows + 1, sizeof(double));
+        released = (unsigned char *)sfb__calloc(ctx, (size_t)S->rows + 1, 1);
+        if (!bn || !released) { sfb__free(ctx, released); r = sfb__oom(ctx, "shading weights"); goto done; }
+        for (v = 0; v < S->rows; ++v) {
+            double acc = 0.0;
+            for (i = 0; i < S->sizes[v]; ++i) acc += (double)S->weights[S->offsets[v] + i] * bw[S->indices[S->offsets[v] + i]];
+            bn[v] = acc < 0.0 ? 0.0 : acc > 1.0 ? 1.0 : acc;
+        }
+        /* vertex children whose parent was held and who are not: released at this level */
+        for (v = 0; v < pl->nv; ++v)
+            released[v] = sfb__shade_held(pl, v, loop, o->variant, o->darts) && !sfb__shade_held(cl, v, loop, o->variant, o->darts);
+        sfb__shade_seed(cl, bn, loop, o->variant, o->darts, released);
+        sfb__free(ctx, released);
+        sfb__free(ctx, bw);
+        bw = bn;
+        bn = NULL;
+    }
+
+    /* output vertices: one per region of the infinitely sharp partition */
+    sh->nout = outreg.total;
+    sh->out_origin = (int *)sfb__alloc(ctx, ((size_t)sh->nout + 1) * sizeof(int));
+    sh->out_fv = (int *)sfb__alloc(ctx, ((size_t)top->nfv + 1) * sizeof(int));
+    sh->b = (float *)sfb__alloc(ctx, ((size_t)sh->nout + 1) * sizeof(float));
+    sh->ns_idx_w = (int *)sfb__alloc(ctx, ((size_t)sh->nout + 1) * sizeof(int));
+    sh->ns_idx_all = (int *)sfb__alloc(ctx, ((size_t)sh->nout + 1) * sizeof(int));
+    order = (int *)sfb__alloc(ctx, ((size_t)sh->nout + 1) * sizeof(int));
+    if (!sh->out_origin || !sh->out_fv || !sh->b || !sh->ns_idx_w || !sh->ns_idx_all || !order) { r = sfb__oom(ctx, "shading tables"); goto done; }
+    for (v = 0; v < top->nv; ++v) {
+        int nr = outreg.first[v + 1] - outreg.first[v];
+        if (nr > 1) sh->nsplit++;
+        for (i = 0; i < nr; ++i) {
+            sh->out_origin[outreg.first[v] + i] = v;
+            sh->b[outreg.first[v] + i] = (float)bw[v];
+        }
+        for (i = top->vf_off[v]; i < top->vf_off[v + 1]; ++i) {
+            int f = top->vf[i];
+            sh->out_fv[top->fv_off[f] + top->vf_slot[i]] = outreg.of_vf[i];
+        }
+    }
+    /* N_S rows: those with b > 0 first */
+    for (v = 0, i = 0; v < sh->nout; ++v) if (sh->b[v] > 0.0f) order[i++] = v;
+    sh->nweighted = i;
+    for (v = 0; v < sh->nout; ++v) if (!(sh->b[v] > 0.0f)) order[i++] = v;
+    for (i = 0; i < sh->nout; ++i) {
+        sh->ns_idx_all[order[i]] = i;
+        sh->ns_idx_w[order[i]] = i < sh->nweighted ? i : -1;
+    }
+
+    /* N_S: region rows composed from the normals level up to the level below the last */
+    maxsrc = sh->nsrc;
+    if (!sfb__shade_identity(ctx, &prow, sh->nsrc)) { r = sfb__oom(ctx, "shading tables"); goto done; }
+    for (k = Ln; k < L - 1; ++k) {
+        const sfb__level *pl = k == Ln ? &sh->nlev : &lev[k];
+        int cv, rv;
+        memset(&crow, 0, sizeof crow);
+        crow.rows = reg[k + 1].total;
+        crow.off = (size_t *)sfb__alloc(ctx, ((size_t)crow.rows + 1) * sizeof(size_t));
+        if (!crow.off) { r = sfb__oom(ctx, "shading tables"); goto done; }
+        crow.off[0] = 0;
+        for (cv = 0; cv < lev[k + 1].nv; ++cv)
+            for (rv = reg[k + 1].first[cv]; rv < reg[k + 1].first[cv + 1]; ++rv) {
+                int creg = reg[k + 1].first[cv + 1] - reg[k + 1].first[cv] > 1 ? rv : -1;
+                m.n = 0;
+                if (!sfb__shade_region_mask(ctx, pl, &reg[k], &lev[k + 1], &reg[k + 1], parent[k + 1], &T[k], cv, creg, 1.0, &m, &sc) ||
+                    !sfb__compose_row(ctx, &A, &prow, &m, &crow, rv)) { r = sfb__oom(ctx, "shading tables"); goto done; }
+            }
+        sfb__rows_free(ctx, &prow);
+        prow = crow;
+        memset(&crow, 0, sizeof crow);
+        r = sfb__progress(ctx, 0.8f, "shading");
+        if (r != SFB_SUCCESS) goto done;
+    }
+    /* the output rows, in `order`: each the face-weighted mean of the N_S regions it covers */
+    memset(&crow, 0, sizeof crow);
+    crow.rows = sh->nout;
+    crow.off = (size_t *)sfb__alloc(ctx, ((size_t)sh->nout + 1) * sizeof(size_t));
+    if (!crow.off) { r = sfb__oom(ctx, "shading tables"); goto done; }
+    crow.off[0] = 0;
+    for (i = 0; i < sh->nout; ++i) {
+        int ov = order[i], cv = sh->out_origin[ov], rv, j;
+        int faces = outreg.faces[ov];
+        m.n = 0;
+        for (rv = reg[L].first[cv]; rv < reg[L].first[cv + 1]; ++rv) {
+            /* the output region of N_S region rv: that of any of its faces (a bare vertex has
+             * one of each) */
+            int in = faces == 0;
+            double frac;
+            int creg = reg[L].first[cv + 1] - reg[L].first[cv] > 1 ? rv : -1;
+            for (j = top->vf_off[cv]; j < top->vf_off[cv + 1]; ++j)
+                if (reg[L].of_vf[j] == rv) { in = outreg.of_vf[j] == ov; break; }
+            if (!in) continue;
+            frac = faces ? (double)reg[L].faces[rv] / faces : 1.0;
+            if (L == Ln) {
+                if (!sfb__mask_grow(ctx, &m, 1)) { r = sfb__oom(ctx, "shading tables"); goto done; }
+                SFB__MASK_ADD(&m, rv, frac);
+            } else if (!sfb__shade_region_mask(ctx, L - 1 == Ln ? &sh->nlev : &lev[L - 1], &reg[L - 1], top, &reg[L],
+                                               parent[L], &T[L - 1], cv, creg, frac, &m, &sc)) {
+                r = sfb__oom(ctx, "shading tables"); goto done;
+            }
+        }
+        if (!sfb__compose_row(ctx, &A, &prow, &m, &crow, i)) { r = sfb__oom(ctx, "shading tables"); goto done; }
+    }
+    r = sfb__rows_to_stencils(ctx, &crow, maxsrc, &sh->ns);
+    if (r != SFB_SUCCESS) { r = sfb__oom(ctx, "shading tables"); goto done; }
+    sfb__rows_free(ctx, &crow);
+    sfb__rows_free(ctx, &prow);
+
+    /* limit position and tangents of every output vertex over the refined vertices */
+    {
+        sfb__rows lr[3];
+        memset(lr, 0, sizeof lr);
+        for (t = 0; t < 3; ++t) {
+            lr[t].rows = sh->nout;
+            lr[t].off = (size_t *)sfb__alloc(ctx, ((size_t)sh->nout + 1) * sizeof(size_t));
+            if (!lr[t].off) r = sfb__oom(ctx, "shading limit tables");
+            else lr[t].off[0] = 0;
+        }
+        for (v = 0; v < top->nv && r == SFB_SUCCESS; ++v) {
+            int nr = outreg.first[v + 1] - outreg.first[v], e0 = top->ve_off[v], ne = top->ve_off[v + 1] - e0;
+            int f0 = top->vf_off[v], nf = top->vf_off[v + 1] - f0, rr;
+            int need = 3 * sfb__mask_need_vertex(top, v) + 8;
+            for (rr = 0; rr < nr && r == SFB_SUCCESS; ++rr) {
+                int ov = outreg.first[v] + rr;
+                for (t = 0; t < 3; ++t) {
+                    mm[t].n = 0;
+                    if (!sfb__mask_grow(ctx, &mm[t], need)) r = sfb__oom(ctx, "shading limit tables");
+                }
+                if (r != SFB_SUCCESS) break;
+                if (nr == 1) {
+                    sfb__limit_masks(top, v, opt->scheme, &mm[0], &mm[1], &mm[2]);
+                } else {
+                    /* the region's faces: a run first..first+len-1 around v (mod nf) */
+                    int first = -1, len = 0;
+                    for (i = 0; i < nf; ++i) {
+                        int prev = i > 0 ? outreg.of_vf[f0 + i - 1] : (nf == ne ? outreg.of_vf[f0 + nf - 1] : -1);
+                        if (outreg.of_vf[f0 + i] == ov) { len++; if (prev != ov) first = i; }
+                    }
+                    if (first < 0) first = 0;
+                    if (top->vrule[v] == SFB__RULE_CREASE) {
+                        float sharp[SFB_MAX_VALENCE + 1];
+                        int a, b;
+                        for (i = 0; i < ne && i <= SFB_MAX_VALENCE; ++i) sharp[i] = top->es[top->ve[e0 + i]];
+                        sfb__crease_pair(sharp, ne, &a, &b);
+                        SFB__MASK_ADD(&mm[0], v, 2.0 / 3.0);
+                        SFB__MASK_ADD(&mm[0], sfb__other_end(top, top->ve[e0 + a], v), 1.0 / 6.0);
+                        SFB__MASK_ADD(&mm[0], sfb__other_end(top, top->ve[e0 + b], v), 1.0 / 6.0);
+                        sfb__crease_tangent_masks(top, v, first, first + len, loop, &mm[1], &mm[2]);
+                    } else {
+                        SFB__MASK_ADD(&mm[0], v, 1.0);
+                        SFB__MASK_ADD(&mm[1], v, -1.0);
+                        SFB__MASK_ADD(&mm[1], sfb__other_end(top, top->ve[e0 + first % ne], v), 1.0);
+                        SFB__MASK_ADD(&mm[2], v, -1.0);
+                        SFB__MASK_ADD(&mm[2], sfb__other_end(top, top->ve[e0 + (first + 1) % ne], v), 1.0);
+                    }
+                }
+                for (t = 0; t < 3; ++t) {
+                    /* local rows: copy the mask (duplicates merged) */
+                    size_t at;
+                    int a2, b2;
+                    if (!sfb__rows_reserve(ctx, &lr[t], lr[t].n + (size_t)mm[t].n)) { r = sfb__oom(ctx, "shading limit tables"); break; }
+                    at = lr[t].n;
+                    for (a2 = 0; a2 < mm[t].n; ++a2) {
+                        for (b2 = (int)at; b2 < (int)lr[t].n && lr[t].idx[b2] != mm[t].idx[a2]; ++b2) {}
+                        if (b2 < (int)lr[t].n) lr[t].w[b2] += mm[t].w[a2];
+                        else { lr[t].idx[lr[t].n] = mm[t].idx[a2]; lr[t].w[lr[t].n] = mm[t].w[a2]; lr[t].n++; }
+                    }
+                    lr[t].off[ov + 1] = lr[t].n;
+                }
+            }
+        }
+        for (t = 0; t < 3; ++t) {
+            if (r == SFB_SUCCESS) {
+                r = sfb__rows_to_stencils(ctx, &lr[t], top->nv, &sh->lim[t]);
+                if (r != SFB_SUCCESS) r = sfb__oom(ctx, "shading limit tables");
+            }
+            sfb__rows_free(ctx, &lr[t]);
+        }
+        if (r != SFB_SUCCESS) goto done;
+    }
+    sh->bytes = sizeof *sh + (sh->ns.entries + sh->npos.entries + sh->lim[0].entries + sh->lim[1].entries + sh->lim[2].entries) * 8 +
+                (size_t)sh->nout * 6 * sizeof(int) + (size_t)top->nfv * sizeof(int) + (size_t)sh->nlev.nfv * 3 * sizeof(int);
+done:
+    if (lev) {
+        for (k = 1; k <= L; ++k) sfb__level_free(ctx, &lev[k]);
+        sfb__free(ctx, lev);
+    }
+    if (T) { for (k = 0; k <= L; ++k) sfb__stencils_free(ctx, &T[k]); sfb__free(ctx, T); }
+    if (reg) { for (k = 0; k <= L; ++k) sfb__regions_free(ctx, &reg[k]); sfb__free(ctx, reg); }
+    if (parent) { for (k = 0; k <= L; ++k) sfb__free(ctx, parent[k]); sfb__free(ctx, parent); }
+    sfb__regions_free(ctx, &outreg);
+    sfb__rows_free(ctx, &prow); sfb__rows_free(ctx, &crow);
+    sfb__free(ctx, A.acc); sfb__free(ctx, A.mark); sfb__free(ctx, A.touched);
+    sfb__free(ctx, m.idx); sfb__free(ctx, m.w);
+    for (t = 0; t < 3; ++t) { sfb__free(ctx, mm[t].idx); sfb__free(ctx, mm[t].w); }
+    sfb__free(ctx, sc.fset); sfb__free(ctx, sc.cnt);
+    sfb__free(ctx, bw); sfb__free(ctx, bn); sfb__free(ctx, order);
+    if (r != SFB_SUCCESS) { sfb__shading_free(ctx, sh); return r; }
+    *out = sh;
+    return SFB_SUCCESS;
+}
 
 SFB_API sfb_shade_params sfb_shade_params_init(void) {
     sfb_shade_params p;
@@ -6385,20 +7042,671 @@ SFB_API sfb_shade_params sfb_shade_params_init(void) {
     return p;
 }
 
-SFB_API sfb_result sfb_surface_shade(const sfb_surface *s, const sfb_shade_params *params, sfb_mesh_data *out) {
-    (void)params;
-    if (out) memset(out, 0, sizeof *out);
-    if (!s) return SFB_INVALID_ARGS;
-    return sfb__error(s->ctx, SFB_UNSUPPORTED, SFB_ELEMENT_NONE, -1, "sfb_surface_shade: not built yet");
+/* One shading table on the context's backend (ref when it lacks eval_stencils). */
+static sfb_result sfb__shade_apply(const sfb_surface *s, const sfb__stencils *t, void *handle, int rows, const float *src, float *dst) {
+    sfb_context *ctx = s->ctx;
+    const sfb__backend_vtable *be = ctx->backend;
+    sfb_buffer_desc d3 = {0, 3, 3};
+    if (rows <= 0) return SFB_SUCCESS;
+    if (!be || !(be->caps & SFB__CAP_EVAL_STENCILS) || !be->eval_stencils)
+        return sfb__backend_ref()->eval_stencils(NULL, t, NULL, 0, rows, src, d3, dst, d3);
+    return be->eval_stencils(ctx->backend_state, t, s->uploaded_by == be ? handle : NULL, 0, rows, src, d3, dst, d3);
+}
+
+SFB_API sfb_result sfb_surface_shade(const sfb_surface *s, const sfb_shade_params *params, sfb_mesh_data *o) {
+    sfb_context *ctx;
+    const sfb__shading *sh;
+    const sfb__backend_vtable *be;
+    sfb_shade_params prm;
+    float *refined = NULL, *npos_buf = NULL, *src = NULL, *ns = NULL, *fnrm = NULL;
+    const float *npos;
+    sfb_result r;
+    int all, rows, v, f, i, c;
+    if (!s || !o) return SFB_INVALID_ARGS;
+    memset(o, 0, sizeof *o);
+    ctx = s->ctx;
+    sh = s->shading;
+    if (!sh) return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "sfb_surface_shade: the surface was created without SFB_REFINE_SHADING");
+    prm = params ? *params : sfb_shade_params_init();
+    if (prm.p == 0.0f) prm.p = 1.0f;
+    if (!(prm.p > 0.0f) || !(prm.p < 1e6f))
+        return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, -1, "blend exponent p = %g: it must be a finite number > 0", (double)prm.p);
+    if (prm.flags & ~(unsigned)SFB_SHADE_ALL_SUBDIVIDED)
+        return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "sfb_surface_shade: unknown flags 0x%x", prm.flags & ~(unsigned)SFB_SHADE_ALL_SUBDIVIDED);
+    all = (prm.flags & SFB_SHADE_ALL_SUBDIVIDED) != 0;
+    rows = all ? sh->nout : sh->nweighted;
+
+    /* refined positions, normals-level positions */
+    r = sfb__refine_output(s, s->base_positions, s->base_vertex_count, 0, o);
+    if (r != SFB_SUCCESS) return r;
+    refined = o->positions;
+    o->positions = NULL;
+    if (sh->npos_mode == 0) npos = s->base_positions;
+    else if (sh->npos_mode == 2) npos = refined;
+    else {
+        npos_buf = (float *)sfb__alloc(ctx, (size_t)sh->npos.rows * 3 * sizeof(float) + 1);
+        if (!npos_buf) goto oom;
+        r = sfb__shade_apply(s, &sh->npos, sh->handles[0], sh->npos.rows, s->base_positions, npos_buf);
+        if (r != SFB_SUCCESS) goto fail;
+        npos = npos_buf;
+    }
+    /* face normals at the normals level (Newell), averaged per region into the sources */
+    fnrm = (float *)sfb__alloc(ctx, (size_t)sh->nlev.nf * 3 * sizeof(float) + 1);
+    src = (float *)sfb__calloc(ctx, (size_t)sh->nsrc * 3 + 1, sizeof(float));
+    if (!fnrm || !src) goto oom;
+    for (f = 0; f < sh->nlev.nf; ++f) {
+        double n[3] = {0.0, 0.0, 0.0}, len;
+        int a = sh->nlev.fv_off[f], cnt = sh->nlev.fv_off[f + 1] - a;
+        for (i = 0; i < cnt; ++i) {
+            const float *p = npos + 3 * (size_t)sh->nlev.fv[a + i], *q = npos + 3 * (size_t)sh->nlev.fv[a + (i + 1) % cnt];
+            n[0] += ((double)p[1] - q[1]) * ((double)p[2] + q[2]);
+            n[1] += ((double)p[2] - q[2]) * ((double)p[0] + q[0]);
+            n[2] += ((double)p[0] - q[0]) * ((double)p[1] + q[1]);
+        }
+        len = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+        for (c = 0; c < 3; ++c) fnrm[3 * (size_t)f + c] = len > 0.0 ? (float)(n[c] / len) : 0.0f;
+    }
+    {
+        double *acc = (double *)sfb__calloc(ctx, (size_t)sh->nsrc * 3 + 1, sizeof(double));
+        if (!acc) goto oom;
+        for (v = 0; v < sh->nlev.nv; ++v)
+            for (i = sh->nlev.vf_off[v]; i < sh->nlev.vf_off[v + 1]; ++i)
+                for (c = 0; c < 3; ++c) acc[3 * (size_t)sh->nsrc_of_vf[i] + c] += fnrm[3 * (size_t)sh->nlev.vf[i] + c];
+        for (i = 0; i < sh->nsrc; ++i) {
+            double *a = acc + 3 * (size_t)i, len = sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+            for (c = 0; c < 3; ++c) src[3 * (size_t)i + c] = len > 0.0 ? (float)(a[c] / len) : 0.0f;
+        }
+        sfb__free(ctx, acc);
+    }
+    /* output arrays */
+    o->positions = (float *)sfb__alloc(ctx, (size_t)sh->nout * 3 * sizeof(float) + 1);
+    o->limit_positions = (float *)sfb__alloc(ctx, (size_t)sh->nout * 3 * sizeof(float) + 1);
+    o->tangents_u = (float *)sfb__alloc(ctx, (size_t)sh->nout * 3 * sizeof(float) + 1);
+    o->tangents_v = (float *)sfb__alloc(ctx, (size_t)sh->nout * 3 * sizeof(float) + 1);
+    o->normals = (float *)sfb__alloc(ctx, (size_t)sh->nout * 3 * sizeof(float) + 1);
+    o->limit_normals = (float *)sfb__alloc(ctx, (size_t)sh->nout * 3 * sizeof(float) + 1);
+    o->subdivided_normals = (float *)sfb__alloc(ctx, (size_t)sh->nout * 3 * sizeof(float) + 1);
+    o->blend_weights = (float *)sfb__alloc(ctx, (size_t)sh->nout * sizeof(float) + 1);
+    o->vertex_origin = (int *)sfb__alloc(ctx, (size_t)sh->nout * sizeof(int) + 1);
+    ns = (float *)sfb__alloc(ctx, (size_t)sh->nout * 3 * sizeof(float) + 1);
+    if (!o->positions || !o->limit_positions || !o->tangents_u || !o->tangents_v || !o->normals || !o->limit_normals ||
+        !o->subdivided_normals || !o->blend_weights || !o->vertex_origin || !ns) goto oom;
+    if ((r = sfb__shade_apply(s, &sh->ns, sh->handles[1], rows, src, ns)) != SFB_SUCCESS ||
+        (r = sfb__shade_apply(s, &sh->lim[0], sh->handles[2], sh->nout, refined, o->limit_positions)) != SFB_SUCCESS ||
+        (r = sfb__shade_apply(s, &sh->lim[1], sh->handles[3], sh->nout, refined, o->tangents_u)) != SFB_SUCCESS ||
+        (r = sfb__shade_apply(s, &sh->lim[2], sh->handles[4], sh->nout, refined, o->tangents_v)) != SFB_SUCCESS)
+        goto fail;
+    be = ctx->backend;
+    if (!be || !(be->caps & SFB__CAP_FINISH_NORMALS) || !be->finish_normals) {
+        sfb__log(ctx, SFB_LOG_INFO, "backend %s lacks finish_normals; using ref", be ? be->name : "none");
+        be = sfb__backend_ref();
+    }
+    r = be->finish_normals(be == ctx->backend ? ctx->backend_state : NULL, 0, sh->nout, o->tangents_u, o->tangents_v, ns,
+                           all ? sh->ns_idx_all : sh->ns_idx_w, sh->b, prm.p, o->normals, o->limit_normals, o->subdivided_normals);
+    if (r != SFB_SUCCESS) goto fail;
+    for (v = 0; v < sh->nout; ++v) {
+        int ov = sh->out_origin[v];
+        for (c = 0; c < 3; ++c) o->positions[3 * (size_t)v + c] = refined[3 * (size_t)ov + c];
+    }
+    memcpy(o->blend_weights, sh->b, (size_t)sh->nout * sizeof(float));
+    memcpy(o->vertex_origin, sh->out_origin, (size_t)sh->nout * sizeof(int));
+    memcpy(o->face_vertices, sh->out_fv, (size_t)o->face_vertex_count * sizeof(int));
+    o->refined_vertex_count = o->vertex_count;
+    o->vertex_count = sh->nout;
+    o->subdivided_count = rows;
+    sfb__free(ctx, refined); sfb__free(ctx, npos_buf); sfb__free(ctx, src); sfb__free(ctx, ns); sfb__free(ctx, fnrm);
+    return SFB_SUCCESS;
+oom:
+    r = sfb__oom(ctx, "shading output");
+fail:
+    sfb__free(ctx, refined); sfb__free(ctx, npos_buf); sfb__free(ctx, src); sfb__free(ctx, ns); sfb__free(ctx, fnrm);
+    sfb_mesh_data_free(o);
+    return r;
 }
 
 SFB_API sfb_result sfb_surface_shade_info(const sfb_surface *s, sfb_shade_info *out) {
-    if (out) memset(out, 0, sizeof *out);
-    if (!s) return SFB_INVALID_ARGS;
-    return sfb__error(s->ctx, SFB_UNSUPPORTED, SFB_ELEMENT_NONE, -1, "sfb_surface_shade_info: not built yet");
+    const sfb__shading *sh;
+    if (!s || !out) return SFB_INVALID_ARGS;
+    memset(out, 0, sizeof *out);
+    sh = s->shading;
+    if (!sh) return sfb__error(s->ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "sfb_surface_shade_info: the surface was created without SFB_REFINE_SHADING");
+    out->refined_vertices = s->top.nv;
+    out->output_vertices = sh->nout;
+    out->split_vertices = sh->nsplit;
+    out->weighted = sh->nweighted;
+    out->normals_level = sh->normals_level;
+    out->weights_level = sh->weights_level;
+    out->sources = sh->nsrc;
+    out->bytes = sh->bytes;
+    return SFB_SUCCESS;
 }
 #line 1 "src/render.c"
-/* Software pictures (no GL): a small z-buffered rasterizer for refined meshes. */
+/* Software pictures (no GL): a small z-buffered rasterizer for refined meshes.
+ *
+ * Two passes over a G-buffer. Pass 1 fan-triangulates every polygon, projects it with an
+ * orbit camera around the bounding-box centre and keeps, per pixel, the nearest fragment's
+ * depth, perspective-correct position, normal and scalar (and its distance to the polygon's
+ * own edges, for the edge overlay). Pass 2 shades every covered pixel: the interpolated
+ * normal is renormalised (Phong) and turned toward the viewer (two-sided lighting), then
+ * coloured by the mode: diffuse + specular grey; highlight lines (ALGORITHMS.md §7, parallel
+ * light lines in a plane fixed to the camera, Dir = N); a blue-to-red scalar map; the normal
+ * as RGB. Highlight stripes are filtered by their own screen-space rate, so bands finer
+ * than a pixel fade to their average colour instead of aliasing. */
+
+#define SFB__RENDER_DEFAULT_W 640
+#define SFB__RENDER_DEFAULT_H 480
+#define SFB__RENDER_DEFAULT_YAW 30.0f
+#define SFB__RENDER_DEFAULT_PITCH 25.0f
+#define SFB__RENDER_DEFAULT_STRIPES 8.0f
+#define SFB__RENDER_DEFAULT_LIGHT_DISTANCE 3.0f
+#define SFB__RENDER_HALF_FOV 15.0           /* degrees: the bounding sphere fits a 30 degree cone */
+#define SFB__RENDER_MARGIN 0.92             /* the bounding sphere's share of the smaller side */
+#define SFB__RENDER_GB 8                    /* floats per pixel: depth, normal xyz, position xyz, scalar */
+
+SFB_API sfb_render_config sfb_render_config_init(int mode) {
+    sfb_render_config c;
+    memset(&c, 0, sizeof c);
+    c.mode = mode;
+    return c;
+}
+
+SFB_API void sfb_image_free(sfb_image *img) {
+    if (!img) return;
+    if (img->ctx_) sfb__free(img->ctx_, img->rgba);
+    memset(img, 0, sizeof *img);
+}
+
+/* The camera: an orbit around `centre` at yaw/pitch; right/up/forward unit vectors. */
+typedef struct sfb__camera {
+    double eye[3], right[3], up[3], fwd[3];
+    double focal;  /* perspective: pixels per unit of x/z; orthographic: pixels per unit */
+    double cx, cy; /* image centre in pixels */
+    int ortho;
+} sfb__camera;
+
+static double sfb__rdot(const double *a, const double *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+static void sfb__rcross(const double *a, const double *b, double *o) {
+    o[0] = a[1] * b[2] - a[2] * b[1];
+    o[1] = a[2] * b[0] - a[0] * b[2];
+    o[2] = a[0] * b[1] - a[1] * b[0];
+}
+static double sfb__rnormalize(double *a) {
+    double l = sqrt(sfb__rdot(a, a));
+    if (l > 0.0 && isfinite(l)) { a[0] /= l; a[1] /= l; a[2] /= l; }
+    return l;
+}
+static double sfb__rclamp(double x, double lo, double hi) { return x < lo ? lo : x > hi ? hi : x; }
+
+/* Integral over [0, x] of the unit-periodic indicator of the band [a, b] (0 <= a <= b <= 1). */
+static double sfb__band_integral(double x, double a, double b) {
+    double fl = floor(x), fr = x - fl;
+    return fl * (b - a) + (sfb__rclamp(fr, a, b) - a);
+}
+/* Share of the pixel footprint [w - fw/2, w + fw/2] covered by the periodic band [a, b]. */
+static double sfb__band_cover(double w, double fw, double a, double b) {
+    if (fw > 64.0) return b - a;
+    if (fw < 1e-4) {
+        double fr = w - floor(w);
+        return fr >= a && fr < b;
+    }
+    return (sfb__band_integral(w + 0.5 * fw, a, b) - sfb__band_integral(w - 0.5 * fw, a, b)) / fw;
+}
+
+/* Colour map for scalars in [0,1]: blue, cyan, green, yellow, red. */
+static void sfb__colormap(double t, double *rgb) {
+    static const double stops[5][3] = { {0.10, 0.20, 1.00}, {0.00, 0.85, 1.00}, {0.10, 0.90, 0.15},
+                                        {1.00, 0.92, 0.00}, {1.00, 0.10, 0.05} };
+    double x = sfb__rclamp(t, 0.0, 1.0) * 4.0;
+    int i = (int)x, c;
+    double f;
+    if (i > 3) i = 3;
+    f = x - i;
+    for (c = 0; c < 3; ++c) rgb[c] = stops[i][c] * (1.0 - f) + stops[i + 1][c] * f;
+}
+
+static unsigned char sfb__to_byte(double v) {
+    v = sfb__rclamp(v, 0.0, 1.0);
+    return (unsigned char)(v * 255.0 + 0.5);
+}
+
+/* Newell normal of polygon f (unnormalised; zero when degenerate or not finite). */
+static void sfb__polygon_normal(const float *pos, const int *fv, int n, double *o) {
+    int i;
+    o[0] = o[1] = o[2] = 0.0;
+    for (i = 0; i < n; ++i) {
+        const float *a = pos + 3 * (size_t)fv[i], *b = pos + 3 * (size_t)fv[(i + 1) % n];
+        o[0] += ((double)a[1] - b[1]) * ((double)a[2] + b[2]);
+        o[1] += ((double)a[2] - b[2]) * ((double)a[0] + b[0]);
+        o[2] += ((double)a[0] - b[0]) * ((double)a[1] + b[1]);
+    }
+    if (!(isfinite(o[0]) && isfinite(o[1]) && isfinite(o[2]))) o[0] = o[1] = o[2] = 0.0;
+}
+
+/* State of one render. */
+typedef struct sfb__raster {
+    int w, h;
+    float *gb;             /* SFB__RENDER_GB floats per pixel; depth +inf: empty */
+    unsigned char *edge;   /* per pixel: edge overlay coverage 0..255 */
+    const float *pos, *nrm, *scal;
+    const sfb__camera *cam;
+    int draw_edges;
+} sfb__raster;
+
+/* Projected vertex: screen x, y, view depth z, and the interpolation weight q (1/z or 1). */
+typedef struct sfb__pv { double x, y, z, q; } sfb__pv;
+
+/* Rasterizes one fan triangle of a polygon: P its projected corners, vi their vertex indices,
+ * real[k] whether the side opposite corner k is a side of the polygon (drawn by the overlay)
+ * rather than a fan diagonal. fnormal: the polygon's unit normal (used where there are no
+ * vertex normals or they vanish). */
+static void sfb__raster_tri(sfb__raster *R, const sfb__pv *P, const int *vi, const int *real, const double *fnormal) {
+    double x0 = P[0].x, y0 = P[0].y, x1 = P[1].x, y1 = P[1].y, x2 = P[2].x, y2 = P[2].y;
+    double area = (x1 - x0) * (y2 - y0) - (x2 - x0) * (y1 - y0);
+    double minx, maxx, miny, maxy, inv, elen[3];
+    int ix0, ix1, iy0, iy1, x, y, k;
+    if (!(fabs(area) > 1e-12) || !isfinite(area)) return;
+    minx = x0 < x1 ? (x0 < x2 ? x0 : x2) : (x1 < x2 ? x1 : x2);
+    maxx = x0 > x1 ? (x0 > x2 ? x0 : x2) : (x1 > x2 ? x1 : x2);
+    miny = y0 < y1 ? (y0 < y2 ? y0 : y2) : (y1 < y2 ? y1 : y2);
+    maxy = y0 > y1 ? (y0 > y2 ? y0 : y2) : (y1 > y2 ? y1 : y2);
+    /* pixel centres at i + 0.5; clamp in double before converting */
+    minx = sfb__rclamp(ceil(minx - 0.5), 0.0, (double)R->w);
+    maxx = sfb__rclamp(floor(maxx - 0.5), -1.0, (double)R->w - 1.0);
+    miny = sfb__rclamp(ceil(miny - 0.5), 0.0, (double)R->h);
+    maxy = sfb__rclamp(floor(maxy - 0.5), -1.0, (double)R->h - 1.0);
+    ix0 = (int)minx; ix1 = (int)maxx; iy0 = (int)miny; iy1 = (int)maxy;
+    if (ix0 > ix1 || iy0 > iy1) return;
+    inv = 1.0 / area;
+    /* edge k is opposite vertex k: e0 = (1,2), e1 = (2,0), e2 = (0,1) */
+    elen[0] = sqrt((x2 - x1) * (x2 - x1) + (y2 - y1) * (y2 - y1));
+    elen[1] = sqrt((x0 - x2) * (x0 - x2) + (y0 - y2) * (y0 - y2));
+    elen[2] = sqrt((x1 - x0) * (x1 - x0) + (y1 - y0) * (y1 - y0));
+    for (y = iy0; y <= iy1; ++y) {
+        double py = y + 0.5;
+        for (x = ix0; x <= ix1; ++x) {
+            double px = x + 0.5, e[3], b[3], den, z, cover = 0.0;
+            size_t pix = (size_t)y * (size_t)R->w + (size_t)x;
+            float *g = R->gb + pix * SFB__RENDER_GB;
+            e[0] = (x2 - x1) * (py - y1) - (y2 - y1) * (px - x1);
+            e[1] = (x0 - x2) * (py - y2) - (y0 - y2) * (px - x2);
+            e[2] = (x1 - x0) * (py - y0) - (y1 - y0) * (px - x0);
+            b[0] = e[0] * inv; b[1] = e[1] * inv; b[2] = e[2] * inv;
+            if (b[0] < 0.0 || b[1] < 0.0 || b[2] < 0.0) continue;
+            den = b[0] * P[0].q + b[1] * P[1].q + b[2] * P[2].q;
+            if (!(den > 0.0)) continue;
+            /* perspective: q = 1/z is affine in the picture; orthographic: q = 1 and z is */
+            z = R->cam->ortho ? b[0] * P[0].z + b[1] * P[1].z + b[2] * P[2].z : 1.0 / den;
+            if (!(z < (double)g[0])) continue;
+            /* perspective-correct weights */
+            for (k = 0; k < 3; ++k) b[k] = b[k] * P[k].q / den;
+            g[0] = (float)z;
+            {
+                double n[3] = { 0.0, 0.0, 0.0 }, p[3] = { 0.0, 0.0, 0.0 }, s = 0.0;
+                int c;
+                for (k = 0; k < 3; ++k) {
+                    const float *pp = R->pos + 3 * (size_t)vi[k];
+                    for (c = 0; c < 3; ++c) p[c] += b[k] * pp[c];
+                    if (R->nrm) {
+                        const float *nn = R->nrm + 3 * (size_t)vi[k];
+                        if (isfinite(nn[0]) && isfinite(nn[1]) && isfinite(nn[2]))
+                            for (c = 0; c < 3; ++c) n[c] += b[k] * nn[c];
+                    }
+                    if (R->scal) {
+                        float sv = R->scal[vi[k]];
+                        s += b[k] * (isfinite(sv) ? sfb__rclamp(sv, 0.0, 1.0) : 0.0);
+                    }
+                }
+                if (!R->nrm || !(sfb__rdot(n, n) > 1e-20)) { n[0] = fnormal[0]; n[1] = fnormal[1]; n[2] = fnormal[2]; }
+                for (c = 0; c < 3; ++c) { g[1 + c] = (float)n[c]; g[4 + c] = (float)p[c]; }
+                g[7] = (float)s;
+            }
+            if (R->draw_edges) {
+                for (k = 0; k < 3; ++k)
+                    if (real[k] && elen[k] > 0.0) {
+                        double d = fabs(e[k]) / elen[k], c = sfb__rclamp(1.25 - d, 0.0, 1.0);
+                        if (c > cover) cover = c;
+                    }
+                R->edge[pix] = sfb__to_byte(cover);
+            }
+        }
+    }
+}
+
+static sfb_result sfb__render_check(sfb_context *ctx, const sfb_mesh_data *m, const sfb_render_config *c,
+                                    const float **pos, const float **nrm, const float **scal, int *w, int *h) {
+    int f;
+    size_t off = 0;
+    *w = c->width ? c->width : SFB__RENDER_DEFAULT_W;
+    *h = c->height ? c->height : SFB__RENDER_DEFAULT_H;
+    if (*w < 0 || *h < 0)
+        return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "image size %d x %d is negative", *w, *h);
+    if (*w > SFB_RENDER_MAX_SIZE || *h > SFB_RENDER_MAX_SIZE)
+        return sfb__error(ctx, SFB_LIMIT_EXCEEDED, SFB_ELEMENT_NONE, -1, "image size %d x %d is over the limit of %d (SFB_RENDER_MAX_SIZE)",
+                          *w, *h, SFB_RENDER_MAX_SIZE);
+    if (c->mode < SFB_RENDER_SHADED || c->mode > SFB_RENDER_NORMALS)
+        return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "unknown render mode %d", c->mode);
+    if (!isfinite(c->yaw) || !isfinite(c->pitch) || !isfinite(c->zoom) || c->zoom < 0.0f)
+        return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "view (yaw %g, pitch %g, zoom %g): angles must be finite, zoom finite and >= 0",
+                          (double)c->yaw, (double)c->pitch, (double)c->zoom);
+    if (!isfinite(c->stripes) || c->stripes < 0.0f || c->stripes > 1e5f || !isfinite(c->light_distance) || c->light_distance < 0.0f)
+        return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "highlight stripes %g and light distance %g must be finite and >= 0 (stripes <= 1e5)",
+                          (double)c->stripes, (double)c->light_distance);
+    if (m->vertex_count < 0 || m->face_count < 0 || m->face_vertex_count < 0)
+        return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "negative element count in the mesh");
+    if (m->vertex_count > SFB_MAX_ELEMENTS || m->face_count > SFB_MAX_ELEMENTS || m->face_vertex_count > SFB_MAX_ELEMENTS)
+        return sfb__error(ctx, SFB_LIMIT_EXCEEDED, SFB_ELEMENT_NONE, -1, "element count over the limit of %d", SFB_MAX_ELEMENTS);
+    if (m->face_count == 0) return sfb__error(ctx, SFB_INVALID_TOPOLOGY, SFB_ELEMENT_NONE, -1, "mesh has no faces");
+    *pos = c->positions ? c->positions : m->positions;
+    *nrm = c->normals ? c->normals : m->normals;
+    *scal = c->scalars ? c->scalars : m->blend_weights;
+    if (!*pos || !m->face_sizes || !m->face_vertices)
+        return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "mesh lacks positions or faces");
+    if (c->mode == SFB_RENDER_WEIGHTS && !*scal)
+        return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1,
+                          "the weights picture needs scalars (config scalars or the mesh's blend_weights from sfb_surface_shade)");
+    if (m->hole_count > SFB_MAX_ELEMENTS)
+        return sfb__error(ctx, SFB_LIMIT_EXCEEDED, SFB_ELEMENT_NONE, -1, "hole count over the limit of %d", SFB_MAX_ELEMENTS);
+    if (m->hole_count < 0 || (m->hole_count > 0 && !m->holes))
+        return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "mesh has a hole count without its array");
+    for (f = 0; f < m->face_count; ++f) {
+        int n = m->face_sizes[f], i;
+        if (n < 3 || n > SFB_MAX_FACE_SIZE)
+            return sfb__error(ctx, n < 3 ? SFB_INVALID_TOPOLOGY : SFB_LIMIT_EXCEEDED, SFB_ELEMENT_FACE, f,
+                              "face has %d vertices (3..%d)", n, SFB_MAX_FACE_SIZE);
+        if ((size_t)n > (size_t)m->face_vertex_count - off)
+            return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_FACE, f, "face sizes add up to more than face_vertex_count (%d)",
+                              m->face_vertex_count);
+        for (i = 0; i < n; ++i) {
+            int v = m->face_vertices[off + (size_t)i];
+            if (v < 0 || v >= m->vertex_count)
+                return sfb__error(ctx, SFB_INVALID_TOPOLOGY, SFB_ELEMENT_FACE, f, "vertex index %d out of range (%d vertices)", v,
+                                  m->vertex_count);
+        }
+        off += (size_t)n;
+    }
+    if (off != (size_t)m->face_vertex_count)
+        return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "face sizes add up to %zu, face_vertex_count is %d", off,
+                          m->face_vertex_count);
+    for (f = 0; f < m->hole_count; ++f)
+        if (m->holes[f] < 0 || m->holes[f] >= m->face_count)
+            return sfb__error(ctx, SFB_INVALID_TOPOLOGY, SFB_ELEMENT_FACE, m->holes[f], "hole %d names a face out of range (%d faces)", f,
+                              m->face_count);
+    return SFB_SUCCESS;
+}
+
+/* Bounding box of the finite vertices that faces use; returns 0 when there is none. */
+static int sfb__render_bounds(const sfb_mesh_data *m, const float *pos, double *lo, double *hi) {
+    int i, any = 0;
+    size_t k;
+    lo[0] = lo[1] = lo[2] = HUGE_VAL;
+    hi[0] = hi[1] = hi[2] = -HUGE_VAL;
+    for (k = 0; k < (size_t)m->face_vertex_count; ++k) {
+        const float *p = pos + 3 * (size_t)m->face_vertices[k];
+        if (!(isfinite(p[0]) && isfinite(p[1]) && isfinite(p[2]))) continue;
+        for (i = 0; i < 3; ++i) {
+            if (p[i] < lo[i]) lo[i] = p[i];
+            if (p[i] > hi[i]) hi[i] = p[i];
+        }
+        any = 1;
+    }
+    return any;
+}
+
+SFB_API sfb_result sfb_render(sfb_context *ctx, const sfb_mesh_data *m, const sfb_render_config *cfg, sfb_image *out) {
+    sfb_render_config c;
+    const float *pos = NULL, *nrm = NULL, *scal = NULL;
+    int w = 0, h = 0, f, y, x, i;
+    size_t npix, bytes, gbytes, k, off;
+    sfb__camera cam;
+    sfb__raster R;
+    sfb__pv *pv = NULL;
+    unsigned char *hole = NULL, *rgba = NULL;
+    double lo[3], hi[3], centre[3], radius, yaw, pitch;
+    double light_m[3], light_e[3], light_d[3], light_a[3], spacing, lightdist;
+    double key[3], fill[3];
+    unsigned char bg[4];
+    sfb_result r = SFB_SUCCESS;
+    long object_pixels = 0;
+    int skipped = 0;
+    if (out) memset(out, 0, sizeof *out);
+    if (!ctx) return SFB_INVALID_ARGS;
+    if (!m || !out) return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "sfb_render: NULL argument");
+    c = cfg ? *cfg : sfb_render_config_init(SFB_RENDER_SHADED);
+    if ((r = sfb__render_check(ctx, m, &c, &pos, &nrm, &scal, &w, &h)) != SFB_SUCCESS) return r;
+    if (c.mode != SFB_RENDER_WEIGHTS) scal = NULL;
+    if (c.background[0] | c.background[1] | c.background[2] | c.background[3]) memcpy(bg, c.background, 4);
+    else { bg[0] = 44; bg[1] = 48; bg[2] = 56; bg[3] = 255; }
+
+    /* memory: G-buffer, edge coverage, projected vertices, hole flags, the picture */
+    npix = (size_t)w * (size_t)h;
+    if (!sfb__mul_size(npix, SFB__RENDER_GB * sizeof(float), &gbytes) || !sfb__mul_size(npix, 4, &bytes))
+        return sfb__error(ctx, SFB_LIMIT_EXCEEDED, SFB_ELEMENT_NONE, -1, "image too large");
+    if ((r = sfb__progress(ctx, 0.0f, "render")) != SFB_SUCCESS) return r;
+    R.gb = (float *)sfb__alloc(ctx, gbytes);
+    R.edge = c.draw_edges ? (unsigned char *)sfb__calloc(ctx, npix, 1) : NULL;
+    pv = (sfb__pv *)sfb__alloc(ctx, ((size_t)m->vertex_count + 1) * sizeof(sfb__pv));
+    hole = m->hole_count > 0 ? (unsigned char *)sfb__calloc(ctx, (size_t)m->face_count, 1) : NULL;
+    rgba = (unsigned char *)sfb__alloc(ctx, bytes);
+    if (!R.gb || (c.draw_edges && !R.edge) || !pv || (m->hole_count > 0 && !hole) || !rgba) {
+        r = sfb__oom(ctx, "the picture (render)");
+        goto done;
+    }
+    for (f = 0; f < m->hole_count; ++f) hole[m->holes[f]] = 1;
+    for (k = 0; k < npix; ++k) R.gb[k * SFB__RENDER_GB] = (float)HUGE_VAL;
+
+    /* camera */
+    if (!sfb__render_bounds(m, pos, lo, hi)) { lo[0] = lo[1] = lo[2] = -1.0; hi[0] = hi[1] = hi[2] = 1.0; }
+    for (i = 0; i < 3; ++i) centre[i] = 0.5 * (lo[i] + hi[i]);
+    radius = 0.5 * sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) + (hi[2] - lo[2]) * (hi[2] - lo[2]));
+    if (!(radius > 0.0) || !isfinite(radius)) radius = 1.0;
+    yaw = (c.view_set ? c.yaw : SFB__RENDER_DEFAULT_YAW) * SFB__PI / 180.0;
+    pitch = (c.view_set ? c.pitch : SFB__RENDER_DEFAULT_PITCH) * SFB__PI / 180.0;
+    memset(&cam, 0, sizeof cam);
+    cam.ortho = c.orthographic != 0;
+    {
+        double dir[3], dist = radius / sin(SFB__RENDER_HALF_FOV * SFB__PI / 180.0);
+        double zoom = c.zoom > 0.0f ? c.zoom : 1.0, half = 0.5 * (w < h ? w : h) * SFB__RENDER_MARGIN;
+        dir[0] = cos(pitch) * sin(yaw); dir[1] = sin(pitch); dir[2] = cos(pitch) * cos(yaw);
+        for (i = 0; i < 3; ++i) { cam.eye[i] = centre[i] + dist * dir[i]; cam.fwd[i] = -dir[i]; }
+        cam.right[0] = cos(yaw); cam.right[1] = 0.0; cam.right[2] = -sin(yaw);
+        sfb__rcross(cam.right, cam.fwd, cam.up);
+        sfb__rnormalize(cam.up);
+        cam.focal = cam.ortho ? half * zoom / radius : half * zoom / tan(SFB__RENDER_HALF_FOV * SFB__PI / 180.0);
+        cam.cx = 0.5 * w;
+        cam.cy = 0.5 * h;
+    }
+    /* lights, fixed to the camera: a key light from the upper left behind the viewer, a fill */
+    for (i = 0; i < 3; ++i) {
+        key[i] = -cam.fwd[i] + 0.55 * cam.up[i] - 0.45 * cam.right[i];
+        fill[i] = -cam.fwd[i] - 0.3 * cam.up[i] + 0.8 * cam.right[i];
+    }
+    sfb__rnormalize(key);
+    sfb__rnormalize(fill);
+    /* the light plane of the highlight lines: facing the object from the camera's side, lines
+     * running at 30 degrees from the picture's vertical */
+    lightdist = (c.light_distance > 0.0f ? c.light_distance : SFB__RENDER_DEFAULT_LIGHT_DISTANCE) * radius;
+    spacing = 2.0 * radius / (c.stripes > 0.0f ? c.stripes : SFB__RENDER_DEFAULT_STRIPES);
+    for (i = 0; i < 3; ++i) {
+        light_m[i] = -cam.fwd[i];
+        light_e[i] = cos(SFB__PI / 6.0) * cam.up[i] + sin(SFB__PI / 6.0) * cam.right[i];
+        light_a[i] = centre[i] + lightdist * light_m[i];
+    }
+    sfb__rcross(light_m, light_e, light_d);
+    sfb__rnormalize(light_d);
+
+    /* project the vertices */
+    for (i = 0; i < m->vertex_count; ++i) {
+        const float *p = pos + 3 * (size_t)i;
+        double d[3], xc, yc, zc;
+        if (!(isfinite(p[0]) && isfinite(p[1]) && isfinite(p[2]))) { pv[i].z = -1.0; pv[i].x = pv[i].y = pv[i].q = 0.0; continue; }
+        d[0] = p[0] - cam.eye[0]; d[1] = p[1] - cam.eye[1]; d[2] = p[2] - cam.eye[2];
+        xc = sfb__rdot(d, cam.right); yc = sfb__rdot(d, cam.up); zc = sfb__rdot(d, cam.fwd);
+        pv[i].z = zc;
+        if (cam.ortho) {
+            pv[i].q = 1.0;
+            pv[i].x = cam.cx + cam.focal * xc;
+            pv[i].y = cam.cy - cam.focal * yc;
+        } else {
+            pv[i].q = zc > 0.0 ? 1.0 / zc : 0.0;
+            pv[i].x = cam.cx + cam.focal * xc * pv[i].q;
+            pv[i].y = cam.cy - cam.focal * yc * pv[i].q;
+        }
+    }
+
+    /* pass 1: rasterize */
+    R.w = w; R.h = h; R.pos = pos; R.nrm = nrm; R.scal = scal; R.cam = &cam; R.draw_edges = c.draw_edges != 0;
+    {
+        double near_z = cam.ortho ? -HUGE_VAL : 1e-3 * radius;
+        for (f = 0, off = 0; f < m->face_count; off += (size_t)m->face_sizes[f], ++f) {
+            const int *fv = m->face_vertices + off;
+            int n = m->face_sizes[f], bad = 0, t;
+            double fn[3];
+            if ((f & 255) == 255 && (r = sfb__progress(ctx, 0.6f * (float)f / (float)m->face_count, "render")) != SFB_SUCCESS) goto done;
+            if (hole && hole[f]) continue;
+            for (i = 0; i < n; ++i) {
+                const float *p = pos + 3 * (size_t)fv[i];
+                if (!(isfinite(p[0]) && isfinite(p[1]) && isfinite(p[2]))) bad = 1;
+                else if (!(pv[fv[i]].z > near_z)) bad = 1;
+            }
+            if (bad) { ++skipped; continue; }
+            sfb__polygon_normal(pos, fv, n, fn);
+            if (!(sfb__rnormalize(fn) > 0.0)) { fn[0] = -cam.fwd[0]; fn[1] = -cam.fwd[1]; fn[2] = -cam.fwd[2]; }
+            for (t = 1; t + 1 < n; ++t) {
+                sfb__pv tri[3];
+                int vi[3], real[3];
+                vi[0] = fv[0]; vi[1] = fv[t]; vi[2] = fv[t + 1];
+                tri[0] = pv[vi[0]]; tri[1] = pv[vi[1]]; tri[2] = pv[vi[2]];
+                real[0] = 1;              /* (t, t+1) */
+                real[1] = t + 2 == n;     /* (t+1, 0): the polygon's last side */
+                real[2] = t == 1;         /* (0, 1): its first side */
+                sfb__raster_tri(&R, tri, vi, real, fn);
+            }
+        }
+    }
+
+    /* pass 2a (highlight): stripe coordinate per pixel, kept in the scalar slot */
+    if (c.mode == SFB_RENDER_HIGHLIGHT) {
+        for (k = 0; k < npix; ++k) {
+            float *g = R.gb + k * SFB__RENDER_GB;
+            double n[3], p[3], v[3], nm, wv;
+            if (!(g[0] < (float)HUGE_VAL)) continue;
+            n[0] = g[1]; n[1] = g[2]; n[2] = g[3];
+            p[0] = g[4]; p[1] = g[5]; p[2] = g[6];
+            sfb__rnormalize(n);
+            if (cam.ortho) { v[0] = -cam.fwd[0]; v[1] = -cam.fwd[1]; v[2] = -cam.fwd[2]; }
+            else { v[0] = cam.eye[0] - p[0]; v[1] = cam.eye[1] - p[1]; v[2] = cam.eye[2] - p[2]; }
+            if (sfb__rdot(n, v) < 0.0) { n[0] = -n[0]; n[1] = -n[1]; n[2] = -n[2]; }
+            nm = sfb__rdot(n, light_m);
+            if (fabs(nm) < 1e-6) { g[7] = (float)HUGE_VAL; continue; }
+            if (c.light_at_infinity) {
+                wv = lightdist * sfb__rdot(n, light_d) / nm / spacing;
+            } else {
+                double ap[3], mu, X[3];
+                for (i = 0; i < 3; ++i) ap[i] = light_a[i] - p[i];
+                mu = sfb__rdot(ap, light_m) / nm;
+                for (i = 0; i < 3; ++i) X[i] = p[i] + mu * n[i] - light_a[i];
+                wv = sfb__rdot(X, light_d) / spacing;
+            }
+            g[7] = isfinite(wv) && fabs(wv) < 1e7 ? (float)wv : (float)HUGE_VAL;
+        }
+    }
+
+    /* pass 2: shade */
+    for (y = 0; y < h; ++y) {
+        if ((y & 15) == 0 && (r = sfb__progress(ctx, 0.6f + 0.4f * (float)y / (float)h, "render")) != SFB_SUCCESS) goto done;
+        for (x = 0; x < w; ++x) {
+            size_t pix = (size_t)y * (size_t)w + (size_t)x;
+            const float *g = R.gb + pix * SFB__RENDER_GB;
+            unsigned char *o = rgba + 4 * pix;
+            double n[3], p[3], v[3], rgb[3], diff, spec, hv[3], e;
+            if (!(g[0] < (float)HUGE_VAL)) { memcpy(o, bg, 4); continue; }
+            ++object_pixels;
+            n[0] = g[1]; n[1] = g[2]; n[2] = g[3];
+            p[0] = g[4]; p[1] = g[5]; p[2] = g[6];
+            sfb__rnormalize(n);
+            if (c.mode == SFB_RENDER_NORMALS) {
+                for (i = 0; i < 3; ++i) rgb[i] = 0.5 + 0.5 * n[i];
+            } else {
+                if (cam.ortho) { v[0] = -cam.fwd[0]; v[1] = -cam.fwd[1]; v[2] = -cam.fwd[2]; }
+                else { v[0] = cam.eye[0] - p[0]; v[1] = cam.eye[1] - p[1]; v[2] = cam.eye[2] - p[2]; }
+                sfb__rnormalize(v);
+                if (sfb__rdot(n, v) < 0.0) { n[0] = -n[0]; n[1] = -n[1]; n[2] = -n[2]; }
+                diff = sfb__rdot(n, key);
+                if (diff < 0.0) diff = 0.0;
+                for (i = 0; i < 3; ++i) hv[i] = key[i] + v[i];
+                sfb__rnormalize(hv);
+                spec = sfb__rdot(n, hv);
+                spec = spec > 0.0 ? pow(spec, 48.0) : 0.0;
+                if (c.mode == SFB_RENDER_SHADED) {
+                    double fl = sfb__rdot(n, fill), lum;
+                    if (fl < 0.0) fl = 0.0;
+                    lum = 0.72 * (0.16 + 0.70 * diff + 0.18 * fl) + 0.30 * spec;
+                    rgb[0] = rgb[1] = rgb[2] = lum;
+                } else if (c.mode == SFB_RENDER_WEIGHTS) {
+                    double lum = 0.55 + 0.45 * diff;
+                    sfb__colormap(g[7], rgb);
+                    for (i = 0; i < 3; ++i) rgb[i] = rgb[i] * lum + 0.12 * spec;
+                } else {
+                    /* highlight: a lit light-grey base with a dark blue and a cyan band per period */
+                    double base = 0.42 + 0.55 * diff, wv = g[7];
+                    rgb[0] = rgb[1] = rgb[2] = base;
+                    if (wv < 1e30) {
+                        double dx = HUGE_VAL, dy = HUGE_VAL, fw, cb, cc;
+                        /* the pixel footprint in stripe periods: the smaller one-sided difference per
+                         * axis (robust at silhouettes, where one neighbour is another surface) */
+                        if (x > 0 && R.gb[(pix - 1) * SFB__RENDER_GB + 7] < 1e30f) dx = fabs(wv - R.gb[(pix - 1) * SFB__RENDER_GB + 7]);
+                        if (x + 1 < w && R.gb[(pix + 1) * SFB__RENDER_GB + 7] < 1e30f) {
+                            double d2 = fabs(wv - R.gb[(pix + 1) * SFB__RENDER_GB + 7]);
+                            if (d2 < dx) dx = d2;
+                        }
+                        if (y > 0 && R.gb[(pix - (size_t)w) * SFB__RENDER_GB + 7] < 1e30f)
+                            dy = fabs(wv - R.gb[(pix - (size_t)w) * SFB__RENDER_GB + 7]);
+                        if (y + 1 < h && R.gb[(pix + (size_t)w) * SFB__RENDER_GB + 7] < 1e30f) {
+                            double d2 = fabs(wv - R.gb[(pix + (size_t)w) * SFB__RENDER_GB + 7]);
+                            if (d2 < dy) dy = d2;
+                        }
+                        if (dx == HUGE_VAL) dx = 0.0;
+                        if (dy == HUGE_VAL) dy = 0.0;
+                        fw = dx + dy;
+                        cb = sfb__band_cover(wv, fw, 0.00, 0.22);
+                        cc = sfb__band_cover(wv, fw, 0.50, 0.72);
+                        {
+                            double lum = 0.45 + 0.55 * diff;
+                            double blue[3], cyan[3];
+                            blue[0] = 0.05 * lum; blue[1] = 0.12 * lum; blue[2] = 0.75 * lum;
+                            cyan[0] = 0.10 * lum; cyan[1] = 0.80 * lum; cyan[2] = 0.95 * lum;
+                            for (i = 0; i < 3; ++i) rgb[i] = rgb[i] * (1.0 - cb - cc) + blue[i] * cb + cyan[i] * cc;
+                        }
+                    }
+                }
+            }
+            /* a little gamma on lit colours, so that the darker half keeps detail (normals are
+             * written as they are) */
+            if (c.mode != SFB_RENDER_NORMALS)
+                for (i = 0; i < 3; ++i) rgb[i] = pow(sfb__rclamp(rgb[i], 0.0, 1.0), 1.0 / 1.6);
+            if (R.edge && R.edge[pix]) {
+                e = R.edge[pix] / 255.0 * 0.85;
+                for (i = 0; i < 3; ++i) rgb[i] = rgb[i] * (1.0 - e) + 0.08 * e;
+            }
+            o[0] = sfb__to_byte(rgb[0]); o[1] = sfb__to_byte(rgb[1]); o[2] = sfb__to_byte(rgb[2]); o[3] = 255;
+        }
+    }
+    if ((r = sfb__progress(ctx, 1.0f, "render")) != SFB_SUCCESS) goto done;
+    out->width = w;
+    out->height = h;
+    out->rgba = rgba;
+    out->object_pixels = object_pixels > 2147483647L ? 2147483647 : (int)object_pixels;
+    out->skipped_faces = skipped;
+    out->ctx_ = ctx;
+    rgba = NULL;
+done:
+    sfb__free(ctx, R.gb);
+    sfb__free(ctx, R.edge);
+    sfb__free(ctx, pv);
+    sfb__free(ctx, hole);
+    sfb__free(ctx, rgba);
+    return r;
+}
 #line 1 "src/backends_include.c"
 /* Optional backends: their code lives in backends/ beside surfblend.h and is compiled here,
  * after the core, when SURFBLEND_SIMD / SURFBLEND_GL / SURFBLEND_OSMESA (or

@@ -410,6 +410,61 @@ typedef struct sfb_tess_data {
 SFB_API sfb_result sfb_surface_tessellate(const sfb_surface *surface, const sfb_tess_config *config, sfb_tess_data *out);
 SFB_API void sfb_tess_data_free(sfb_tess_data *data);
 
+/* ---- software pictures ----
+ * sfb_render draws a mesh (typically sfb_surface_refine's or sfb_surface_shade's output) into
+ * an RGBA picture on the CPU, without GL: polygons fan-triangulated, z-buffered, per-pixel
+ * normals interpolated and renormalised (Phong), two-sided lighting (the normal is turned
+ * toward the viewer). The camera orbits the bounding-box centre of the vertices the faces use;
+ * y is up. Faces listed in mesh->holes are not drawn; faces with a non-finite vertex are
+ * skipped (counted in sfb_image.skipped_faces). Long renders report progress (stage "render")
+ * and can be cancelled (SFB_CANCELLED, nothing kept). Reads the mesh only: several threads may
+ * render the same mesh at once, each on its own context. */
+#define SFB_RENDER_MAX_SIZE 8192 /* largest width or height in pixels */
+typedef enum sfb_render_mode {
+    SFB_RENDER_SHADED = 0,  /* neutral grey, diffuse + specular */
+    SFB_RENDER_HIGHLIGHT,   /* highlight lines: parallel light lines in a plane fixed to the camera, followed along the
+                               normal (ALGORITHMS.md section 7, Dir = N), as dark blue and cyan bands over lit grey; two
+                               renders with the same view and positions but different normals are directly comparable */
+    SFB_RENDER_WEIGHTS,     /* a per-vertex scalar in [0,1] as colour: blue (0), cyan, green, yellow, red (1), lightly shaded */
+    SFB_RENDER_NORMALS      /* the unit normal as RGB = 0.5 + 0.5 n (world axes, before the two-sided flip) */
+} sfb_render_mode;
+typedef struct sfb_render_config {
+    int width, height;       /* pixels, 1..SFB_RENDER_MAX_SIZE; 0: 640 (width), 480 (height) */
+    int mode;                /* sfb_render_mode */
+    const float *positions;  /* xyz per mesh vertex (vertex_count of them); NULL: mesh->positions */
+    const float *normals;    /* xyz per mesh vertex, need not be unit; NULL: mesh->normals; NULL there too, or a
+                                zero or non-finite normal: the polygon's flat normal */
+    const float *scalars;    /* SFB_RENDER_WEIGHTS: one per vertex, clamped to [0,1] (non-finite: 0); NULL:
+                                mesh->blend_weights (required in that mode) */
+    int view_set;            /* 0: the default view (yaw 30, pitch 25); 1: yaw and pitch below */
+    float yaw, pitch;        /* degrees: yaw turns the camera about the y axis from +z toward +x, pitch raises it */
+    float zoom;              /* > 0: magnification; 0: 1, the bounding sphere just fits the smaller side */
+    int orthographic;        /* 0: perspective (30 degree view of the bounding sphere); 1: orthographic */
+    float stripes;           /* SFB_RENDER_HIGHLIGHT: light lines per bounding-sphere diameter in the light plane;
+                                0: default 8 (more: denser lines) */
+    float light_distance;    /* SFB_RENDER_HIGHLIGHT: distance of the light plane from the centre, toward the camera,
+                                in bounding-sphere radii; 0: default 3 (farther: the lines follow the normal more) */
+    int light_at_infinity;   /* SFB_RENDER_HIGHLIGHT: 1: the light plane infinitely far away, so that the stripe
+                                depends on the normal alone (a flat face is one colour) */
+    int draw_edges;          /* 1: overlay the polygons' edges (not the triangulation's diagonals) */
+    unsigned char background[4]; /* RGBA of uncovered pixels; all 0: default opaque dark grey */
+} sfb_render_config;
+SFB_API sfb_render_config sfb_render_config_init(int mode);
+typedef struct sfb_image {
+    int width, height;
+    unsigned char *rgba;     /* width * height * 4 bytes, rows top to bottom, alpha 255 on the object */
+    int object_pixels;       /* pixels the mesh covers */
+    int skipped_faces;       /* faces not drawn because a vertex is not finite (or behind the camera) */
+    sfb_context *ctx_;       /* allocator owner */
+} sfb_image;
+/* Renders `mesh` with `config` (NULL: all defaults, SFB_RENDER_SHADED). Checks everything
+ * before allocating: sizes (SFB_INVALID_ARGS when negative, SFB_LIMIT_EXCEEDED over
+ * SFB_RENDER_MAX_SIZE or the memory budget), face sizes and vertex indices (SFB_INVALID_TOPOLOGY
+ * naming the face; also for a mesh without faces), face sizes adding up to face_vertex_count,
+ * holes in range, finite view values. On failure `out` is zeroed and nothing is kept. */
+SFB_API sfb_result sfb_render(sfb_context *ctx, const sfb_mesh_data *mesh, const sfb_render_config *config, sfb_image *out);
+SFB_API void sfb_image_free(sfb_image *img);
+
 #ifdef __cplusplus
 }
 #endif

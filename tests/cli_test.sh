@@ -164,6 +164,95 @@ for b in simd gl osmesa; do
   fi
 done
 
+# ---- shade and render (subdivision shading, seed 001; software pictures) ----
+check "--help succeeds (shade, render)" 0 "$CLI" --help
+contains "--help shows shade" "$TMP/out" "surfblend shade"
+contains "--help shows render" "$TMP/out" "surfblend render"
+check "shade succeeds" 0 "$CLI" shade --level 2 examples/data/creased_box.obj -o "$TMP/sh.obj"
+contains "shade prints output and split vertices" "$TMP/err" "output vertices (.* refined, [0-9]* split)"
+contains "shade prints where N_S was computed" "$TMP/err" "N_S computed at [0-9]* vertices ([0-9.]*%)"
+nv=$(grep -c '^v ' "$TMP/sh.obj"); nn=$(grep -c '^vn ' "$TMP/sh.obj")
+if [ "$nv" -gt 0 ] && [ "$nv" = "$nn" ]; then P=$((P + 1)); echo "ok shade writes one vn per v ($nv)"; else F=$((F + 1)); echo "FAIL shade: $nv v lines, $nn vn lines"; fi
+if grep -q "($nv output vertices\|: $nv output vertices" "$TMP/err"; then P=$((P + 1)); echo "ok shade summary counts the written vertices"
+else F=$((F + 1)); echo "FAIL shade summary does not say $nv output vertices"; head -n 2 "$TMP/err"; fi
+if awk '/^f / { for (i = 2; i <= NF; ++i) { split($i, a, "/"); if (a[1] != a[3] || a[2] != "") exit 1 } n++ } END { exit !(n > 0) }' "$TMP/sh.obj"
+then P=$((P + 1)); echo "ok shade faces are v//vn with the same index"; else F=$((F + 1)); echo "FAIL shade faces are not f a//a"; grep -m 2 '^f ' "$TMP/sh.obj"; fi
+if awk -v n="$nv" '/^f / { for (i = 2; i <= NF; ++i) { split($i, a, "/"); if (a[1] < 1 || a[1] > n) exit 1 } } END { exit 0 }' "$TMP/sh.obj"
+then P=$((P + 1)); echo "ok shade face indices are in range"; else F=$((F + 1)); echo "FAIL shade face index out of range"; fi
+if awk '/^vn / { l = sqrt($2 * $2 + $3 * $3 + $4 * $4); if (l < 0.999 || l > 1.001) exit 1 }' "$TMP/sh.obj"
+then P=$((P + 1)); echo "ok shade normals are unit length"; else F=$((F + 1)); echo "FAIL shade normals are not unit length"; fi
+check "shaded output reads back" 0 "$CLI" info "$TMP/sh.obj"
+check "shade --limit succeeds" 0 "$CLI" shade --level 2 --limit examples/data/creased_box.obj -o "$TMP/shl.obj"
+if [ "$(grep -c '^v ' "$TMP/shl.obj")" = "$nv" ] && ! cmp -s <(grep '^v ' "$TMP/sh.obj") <(grep '^v ' "$TMP/shl.obj"); then
+  P=$((P + 1)); echo "ok shade --limit writes other positions, as many"; else F=$((F + 1)); echo "FAIL shade --limit positions"; fi
+check "shade --all-subdivided succeeds" 0 "$CLI" shade --level 2 --all-subdivided examples/data/creased_box.obj -o "$TMP/sha.obj"
+contains "shade --all-subdivided computes N_S everywhere" "$TMP/err" "(100.0%)"
+check "shade with every option succeeds" 0 "$CLI" shade --scheme catmark --level 2 --variant A --darts sharp --normals-level 0 \
+  --weights-level 2 --p 2.5 --backend ref examples/data/creased_box.obj -o "$TMP/sho.obj"
+if ! cmp -s "$TMP/sh.obj" "$TMP/sho.obj"; then P=$((P + 1)); echo "ok shade options change the normals"; else F=$((F + 1)); echo "FAIL shade options change nothing"; fi
+check "shade --scheme loop succeeds" 0 "$CLI" shade --scheme loop --level 2 "$TMP/tet.obj" -o "$TMP/shloop.obj"
+if [ "$(grep -c '^f ' "$TMP/shloop.obj")" = 64 ]; then P=$((P + 1)); echo "ok shade loop tetrahedron level 2 has 64 triangles"; else F=$((F + 1)); echo "FAIL shade loop face count"; fi
+check "shade without -o is a usage error" 2 "$CLI" shade examples/data/creased_box.obj
+check "shade --p 0 is a usage error" 2 "$CLI" shade --p 0 examples/data/creased_box.obj -o "$TMP/x.obj"
+contains "--p 0 message" "$TMP/err" "--p needs a number > 0"
+check "shade --p -1 is a usage error" 2 "$CLI" shade --p -1 examples/data/creased_box.obj -o "$TMP/x.obj"
+check "shade --p x is a usage error" 2 "$CLI" shade --p x examples/data/creased_box.obj -o "$TMP/x.obj"
+check "shade --level -1 is a usage error" 2 "$CLI" shade --level -1 examples/data/creased_box.obj -o "$TMP/x.obj"
+check "shade --normals-level -1 is a usage error" 2 "$CLI" shade --normals-level -1 examples/data/creased_box.obj -o "$TMP/x.obj"
+check "shade --weights-level x is a usage error" 2 "$CLI" shade --weights-level x examples/data/creased_box.obj -o "$TMP/x.obj"
+check "shade --variant C is a usage error" 2 "$CLI" shade --variant C examples/data/creased_box.obj -o "$TMP/x.obj"
+check "shade --darts blunt is a usage error" 2 "$CLI" shade --darts blunt examples/data/creased_box.obj -o "$TMP/x.obj"
+check "shade --scheme bilinear is a usage error" 2 "$CLI" shade --scheme bilinear examples/data/creased_box.obj -o "$TMP/x.obj"
+rm -f "$TMP/x.obj"
+check "shade --level 11 is bad input" 1 "$CLI" shade --level 11 examples/data/creased_box.obj -o "$TMP/x.obj"
+contains "shade level message names the limit" "$TMP/err" "limit"
+if [ ! -e "$TMP/x.obj" ]; then P=$((P + 1)); echo "ok a failed shade leaves no file"; else F=$((F + 1)); echo "FAIL a failed shade left $TMP/x.obj"; fi
+check "shade loop on quads is bad input" 1 "$CLI" shade --scheme loop examples/data/creased_box.obj -o "$TMP/x.obj"
+check "shade of a missing file is bad input" 1 "$CLI" shade "$TMP/none.obj" -o "$TMP/x.obj"
+check "shade to an unwritable path is bad input" 1 "$CLI" shade examples/data/creased_box.obj -o "$TMP/no/such/dir.obj"
+contains "unwritable path is named" "$TMP/err" "cannot write"
+
+# PNG: the 8-byte signature, then the IHDR chunk with width and height (big-endian)
+png_size() { local h; h=$(od -An -tx1 -N24 "$1" 2>/dev/null | tr -d ' \n')
+  if [ "${h:0:16}" != 89504e470d0a1a0a ] || [ "${h:24:8}" != 49484452 ]; then echo notpng; return; fi
+  echo "$((16#${h:32:8}))x$((16#${h:40:8}))"; }
+check "render succeeds" 0 "$CLI" render --level 2 examples/data/creased_box.obj -o "$TMP/r.png"
+s=$(png_size "$TMP/r.png")
+if [ "$s" = 640x480 ]; then P=$((P + 1)); echo "ok render writes a 640x480 PNG"; else F=$((F + 1)); echo "FAIL render output: $s"; fi
+contains "render prints the object pixels" "$TMP/err" "640x480 ([0-9]* object pixels)"
+for mode in --highlight --weights --normal-colors --edges; do
+  check "render $mode succeeds" 0 "$CLI" render --level 2 $mode --size 120x90 examples/data/creased_box.obj -o "$TMP/r$mode.png"
+  s=$(png_size "$TMP/r$mode.png")
+  if [ "$s" = 120x90 ]; then P=$((P + 1)); echo "ok render $mode writes a 120x90 PNG"; else F=$((F + 1)); echo "FAIL render $mode output: $s"; fi
+done
+for n in limit subdivided blended; do
+  check "render --normals $n succeeds" 0 "$CLI" render --level 2 --highlight --normals $n --size 160x120 --view 60,30 examples/data/creased_box.obj -o "$TMP/n$n.png"
+done
+if ! cmp -s "$TMP/nlimit.png" "$TMP/nblended.png" && ! cmp -s "$TMP/nsubdivided.png" "$TMP/nblended.png"; then
+  P=$((P + 1)); echo "ok the three normal fields give three pictures"; else F=$((F + 1)); echo "FAIL the normal fields give the same picture"; fi
+check "render --positions refined succeeds" 0 "$CLI" render --level 2 --positions refined --size 160x120 --view 60,30 --highlight examples/data/creased_box.obj -o "$TMP/pr.png"
+if ! cmp -s "$TMP/pr.png" "$TMP/nblended.png"; then P=$((P + 1)); echo "ok --positions refined differs from limit"; else F=$((F + 1)); echo "FAIL --positions refined changes nothing"; fi
+check "render with shading options succeeds" 0 "$CLI" render --level 2 --variant A --darts sharp --normals-level 0 --weights-level 0 --p 3 \
+  --zoom 2 --stripes 12 --backend ref --size 80x60 examples/data/creased_box.obj -o "$TMP/ro.png"
+check "render a Loop surface succeeds" 0 "$CLI" render --scheme loop --level 3 --weights --size 80x60 "$TMP/tet.obj" -o "$TMP/rl.png"
+check "render without -o is a usage error" 2 "$CLI" render examples/data/creased_box.obj
+check "render with two modes is a usage error" 2 "$CLI" render --highlight --weights examples/data/creased_box.obj -o "$TMP/x.png"
+check "render --normals bogus is a usage error" 2 "$CLI" render --normals bogus examples/data/creased_box.obj -o "$TMP/x.png"
+check "render --positions bogus is a usage error" 2 "$CLI" render --positions bogus examples/data/creased_box.obj -o "$TMP/x.png"
+check "render --size 0x10 is a usage error" 2 "$CLI" render --size 0x10 examples/data/creased_box.obj -o "$TMP/x.png"
+check "render --size 100 is a usage error" 2 "$CLI" render --size 100 examples/data/creased_box.obj -o "$TMP/x.png"
+check "render --view 30 is a usage error" 2 "$CLI" render --view 30 examples/data/creased_box.obj -o "$TMP/x.png"
+check "render --zoom 0 is a usage error" 2 "$CLI" render --zoom 0 examples/data/creased_box.obj -o "$TMP/x.png"
+check "render --p 0 is a usage error" 2 "$CLI" render --p 0 examples/data/creased_box.obj -o "$TMP/x.png"
+check "render --level -1 is a usage error" 2 "$CLI" render --level -1 examples/data/creased_box.obj -o "$TMP/x.png"
+rm -f "$TMP/x.png"
+check "render --size 9000x10 is bad input" 1 "$CLI" render --size 9000x10 examples/data/creased_box.obj -o "$TMP/x.png"
+contains "size message names the limit" "$TMP/err" "over the limit of 8192"
+check "render --level 11 is bad input" 1 "$CLI" render --level 11 examples/data/creased_box.obj -o "$TMP/x.png"
+if [ ! -e "$TMP/x.png" ]; then P=$((P + 1)); echo "ok a failed render leaves no file"; else F=$((F + 1)); echo "FAIL a failed render left $TMP/x.png"; fi
+check "render to an unwritable path is bad input" 1 "$CLI" render --size 40x30 examples/data/creased_box.obj -o "$TMP/no/such/dir.png"
+contains "unwritable picture path is named" "$TMP/err" "cannot write"
+
 # a machine without libOSMesa (as on Mesa 25.1+): hide it in a private mount namespace (root only)
 lib=$(ldconfig -p 2>/dev/null | awk '/libOSMesa\.so\.8 /{ print $NF; exit }')
 if [ "$(id -u)" = 0 ] && [ -n "$lib" ] && unshare -m --propagation private true 2>/dev/null; then

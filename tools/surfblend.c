@@ -3,15 +3,23 @@
  *   surfblend refine [--scheme catmark|loop|bilinear] [--level L] [--limit] [--backend NAME] in.obj -o out.obj
  *   surfblend eval [--scheme catmark|loop] [--backend NAME] (--random N [--seed S] | --locations FILE) [--derivatives] [-o OUT] in.obj
  *   surfblend tess [--scheme catmark|loop] [--backend NAME] --rate N [--tolerance T] [--split-creases] in.obj -o out.obj
+ *   surfblend shade [shading options] [--limit] [--backend NAME] in.obj -o out.obj
+ *   surfblend render [shading options] [--normals limit|subdivided|blended] [--highlight|--weights|--normal-colors]
+ *                    [--size WxH] [--view YAW,PITCH] [--zoom Z] [--stripes N] [--edges] [--positions refined|limit] in.obj -o out.png
  *   surfblend backends
  * Exit codes: 0 success, 1 bad input (message on stderr), 2 usage error. */
 #include "surfblend.h"
+/* PNG output (Debian libstb-dev); the library itself only returns raw RGBA */
+#define STB_IMAGE_WRITE_IMPLEMENTATION
+#define STB_IMAGE_WRITE_STATIC
+#include <stb/stb_image_write.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
-static const char *usage_text =
+/* In pieces: ISO C99 compilers need support string literals of 4095 characters only. */
+static const char *const usage_text[] = {
     "usage:\n"
     "  surfblend info IN.obj                      counts, valences, creases, extraordinary vertices, problems\n"
     "  surfblend refine [options] IN.obj -o OUT.obj\n"
@@ -34,13 +42,44 @@ static const char *usage_text =
     "      --tolerance T                    adaptive: per face the smallest rate <= N within chordal error T\n"
     "      --split-creases                  separate vertices (and normals) on each side of infinitely sharp creases\n"
     "      --backend NAME                   as for refine\n"
+    ,
+    "  surfblend shade [options] IN.obj -o OUT.obj   subdivision shading (seed 001): v, blended normals as vn, f v//vn\n"
+    "      --scheme catmark|loop            as for refine\n"
+    "      --level L                        uniform refinement level 0..10 (default 3)\n"
+    "      --variant A|B                    sharp vertices: B (default) blend weight 0, A treated as smooth ones\n"
+    "      --darts smooth|sharp             darts count as smooth (default) or sharp vertices for the weights\n"
+    "      --normals-level L                level where the subdivided normals N_S start (0: control mesh; default 1)\n"
+    "      --weights-level L                level where the blend weights are seeded (0: control mesh; default 1)\n"
+    "      --p P                            blend exponent, > 0 (default 1): N_B = (1 - b^P) N_L + b^P N_S\n"
+    "      --all-subdivided                 compute N_S at every vertex, not only where b > 0\n"
+    "      --limit                          write limit positions instead of refined points\n"
+    "      --backend NAME                   as for refine\n"
+    "    prints output vertices, split vertices (infinitely sharp creases) and where N_S was computed\n"
+    "  surfblend render [options] IN.obj -o OUT.png   a software picture of the shaded surface\n"
+    "      the shading options above (not --limit), and:\n"
+    "      --normals limit|subdivided|blended  which normal field to draw (default blended)\n"
+    "      --highlight | --weights | --normal-colors   highlight lines, blend weights (blue 0 .. red 1), normals as RGB\n"
+    "                                       (default: grey shading)\n"
+    "      --positions refined|limit        refined points or limit positions (default limit)\n"
+    "      --size WxH                       picture size, 1..8192 each (default 640x480)\n"
+    "      --view YAW,PITCH                 camera angles in degrees around the y axis and above the xz plane (default 30,25)\n"
+    "      --zoom Z                         magnification (default 1: the bounding sphere fits)\n"
+    "      --stripes N                      highlight lines per object diameter (default 8)\n"
+    "      --edges                          draw the refined mesh's edges\n"
     "  surfblend backends                         list the backends and whether each is available\n"
     "  surfblend --help | --version\n"
-    "exit codes: 0 success, 1 bad input, 2 usage error\n";
+    "exit codes: 0 success, 1 bad input, 2 usage error\n",
+    NULL
+};
+
+static void print_usage(FILE *f) {
+    int i;
+    for (i = 0; usage_text[i]; ++i) fputs(usage_text[i], f);
+}
 
 static int usage(const char *msg) {
     if (msg) fprintf(stderr, "surfblend: %s\n", msg);
-    fputs(usage_text, stderr);
+    print_usage(stderr);
     return 2;
 }
 
@@ -653,6 +692,360 @@ done:
     return rc;
 }
 
+/* ---- subdivision shading (seed 001) and software pictures ---- */
+
+/* Options shared by `shade` and `render`: the surface, the shading options, the blend. */
+typedef struct shade_opts {
+    const char *in, *outp, *backend;
+    sfb_scheme scheme;
+    int have_scheme, level, variant, darts, normals_level, weights_level, all_subdivided;
+    double p;
+} shade_opts;
+
+static void shade_opts_init(shade_opts *o, int level) {
+    memset(o, 0, sizeof *o);
+    o->scheme = SFB_SCHEME_CATMARK;
+    o->level = level;
+    o->p = 1.0;
+}
+
+/* A shading level on the command line: 0 is the control mesh (SFB_SHADE_LEVEL_CONTROL; 0 in
+ * the struct means the default, level 1). Whether it fits the refinement level is the
+ * library's to check. */
+static int parse_shade_level(const char *s, int *out) {
+    long l;
+    if (!parse_int(s, 0, 1000, &l)) return 0;
+    *out = l == 0 ? SFB_SHADE_LEVEL_CONTROL : (int)l;
+    return 1;
+}
+
+/* Consumes argv[*i] (and its value) when it is a shading option: returns 1; 0 when it is not
+ * one; a negative value -(usage status) on a bad value. */
+static int shade_arg(int argc, char **argv, int *i, shade_opts *o) {
+    const char *a = argv[*i];
+    if (strcmp(a, "--scheme") == 0) {
+        if (++*i >= argc || !scheme_from_name(argv[*i], &o->scheme) || o->scheme == SFB_SCHEME_BILINEAR)
+            return -usage("--scheme needs catmark or loop");
+        o->have_scheme = 1;
+    } else if (strcmp(a, "--level") == 0) {
+        long l;
+        if (++*i >= argc || !parse_int(argv[*i], 0, 1000, &l)) return -usage("--level needs a number >= 0");
+        o->level = (int)l;
+    } else if (strcmp(a, "--variant") == 0) {
+        if (++*i >= argc) return -usage("--variant needs A or B");
+        if (strcmp(argv[*i], "A") == 0 || strcmp(argv[*i], "a") == 0) o->variant = SFB_SHADE_VARIANT_A;
+        else if (strcmp(argv[*i], "B") == 0 || strcmp(argv[*i], "b") == 0) o->variant = SFB_SHADE_VARIANT_B;
+        else return -usage("--variant needs A or B");
+    } else if (strcmp(a, "--darts") == 0) {
+        if (++*i >= argc) return -usage("--darts needs smooth or sharp");
+        if (strcmp(argv[*i], "smooth") == 0) o->darts = SFB_SHADE_DARTS_SMOOTH;
+        else if (strcmp(argv[*i], "sharp") == 0) o->darts = SFB_SHADE_DARTS_SHARP;
+        else return -usage("--darts needs smooth or sharp");
+    } else if (strcmp(a, "--normals-level") == 0) {
+        if (++*i >= argc || !parse_shade_level(argv[*i], &o->normals_level)) return -usage("--normals-level needs a level >= 0 (0: the control mesh)");
+    } else if (strcmp(a, "--weights-level") == 0) {
+        if (++*i >= argc || !parse_shade_level(argv[*i], &o->weights_level)) return -usage("--weights-level needs a level >= 0 (0: the control mesh)");
+    } else if (strcmp(a, "--p") == 0) {
+        char *end;
+        if (++*i >= argc) return -usage("--p needs a number > 0");
+        o->p = strtod(argv[*i], &end);
+        if (end == argv[*i] || *end || !(o->p > 0.0) || !isfinite(o->p) || o->p > 1e30) return -usage("--p needs a number > 0");
+    } else if (strcmp(a, "--all-subdivided") == 0) {
+        o->all_subdivided = 1;
+    } else {
+        return 0;
+    }
+    return 1;
+}
+
+/* Builds the shading surface of o->in and shades it into *data. Returns 1 on success; on
+ * failure prints why and returns 0 (what was made is freed by the caller). */
+static int shade_mesh(sfb_context *ctx, const shade_opts *o, sfb_mesh **mesh, sfb_surface **surf, sfb_mesh_data *data) {
+    sfb_surface_config cfg;
+    sfb_shade_params sp;
+    sfb_result r;
+    *mesh = load(ctx, o->in);
+    if (!*mesh) return 0;
+    cfg = sfb_surface_config_init(scheme_for(o->in, o->have_scheme, o->scheme), o->level);
+    cfg.flags = SFB_REFINE_LIMIT | SFB_REFINE_SHADING;
+    cfg.shading.variant = o->variant;
+    cfg.shading.darts = o->darts;
+    cfg.shading.normals_level = o->normals_level;
+    cfg.shading.weights_level = o->weights_level;
+    sp = sfb_shade_params_init();
+    sp.p = (float)o->p;
+    sp.flags = o->all_subdivided ? (unsigned)SFB_SHADE_ALL_SUBDIVIDED : 0u;
+    r = sfb_surface_create(ctx, *mesh, &cfg, surf);
+    if (r == SFB_SUCCESS) r = sfb_surface_shade(*surf, &sp, data);
+    if (r != SFB_SUCCESS) {
+        fprintf(stderr, "surfblend: %s: %s: %s\n", o->in, sfb_result_string(r), sfb_last_error(ctx));
+        return 0;
+    }
+    return 1;
+}
+
+/* Output vertices, refined vertices with more than one copy, and the share of output
+ * vertices where N_S was computed. */
+static void shade_summary(const char *what, const shade_opts *o, const sfb_mesh_data *d, sfb_context *ctx, const char *outp) {
+    int split = 0, i;
+    int *copies = d->refined_vertex_count > 0 ? (int *)calloc((size_t)d->refined_vertex_count, sizeof(int)) : NULL;
+    if (copies && d->vertex_origin) {
+        for (i = 0; i < d->vertex_count; ++i) {
+            int v = d->vertex_origin[i];
+            if (v >= 0 && v < d->refined_vertex_count && ++copies[v] == 2) ++split;
+        }
+    }
+    free(copies);
+    fprintf(stderr, "surfblend: %s %s level %d: %d output vertices (%d refined, %d split), %d faces; N_S computed at %d vertices (%.1f%%) -> %s (backend %s)\n",
+            what, sfb_scheme_name(scheme_for(o->in, o->have_scheme, o->scheme)), o->level, d->vertex_count, d->refined_vertex_count,
+            split, d->face_count, d->subdivided_count, d->vertex_count > 0 ? 100.0 * d->subdivided_count / d->vertex_count : 0.0, outp,
+            sfb_context_backend_name(ctx));
+}
+
+/* Finishes an output file: closes it, and removes it when anything failed, so that no
+ * partial file is left behind. Returns rc, or 1 when closing failed. */
+static int finish_output(FILE *f, const char *outp, int rc) {
+    if (f == stdout) {
+        if (fflush(stdout) != 0 && rc == 0) { fprintf(stderr, "surfblend: writing the output failed\n"); rc = 1; }
+    } else if (f) {
+        if (fclose(f) != 0 && rc == 0) { fprintf(stderr, "surfblend: writing '%s' failed\n", outp); rc = 1; }
+        if (rc != 0) remove(outp);
+    }
+    return rc;
+}
+
+static int cmd_shade(int argc, char **argv) {
+    shade_opts o;
+    int limit = 0, i, rc = 1;
+    sfb_context *ctx = NULL;
+    sfb_mesh *mesh = NULL;
+    sfb_surface *surf = NULL;
+    sfb_mesh_data data;
+    FILE *f = NULL;
+    memset(&data, 0, sizeof data);
+    shade_opts_init(&o, 3);
+    for (i = 0; i < argc; ++i) {
+        int sr = shade_arg(argc, argv, &i, &o);
+        if (sr < 0) return -sr;
+        if (sr) continue;
+        if (strcmp(argv[i], "--limit") == 0) {
+            limit = 1;
+        } else {
+            int ur = common_arg(argc, argv, &i, "shade", &o.backend, &o.outp, &o.in);
+            if (ur) return ur;
+        }
+    }
+    if (!o.in) return usage("shade needs an input OBJ file");
+    if (!o.outp) return usage("shade needs -o OUT.obj");
+    ctx = make_context(o.backend);
+    if (!ctx) return 1;
+    if (!shade_mesh(ctx, &o, &mesh, &surf, &data)) goto done;
+    if (!data.normals || (limit && !data.limit_positions)) {
+        fprintf(stderr, "surfblend: %s: the shaded mesh lacks %s\n", o.in, data.normals ? "limit positions" : "normals");
+        goto done;
+    }
+    f = strcmp(o.outp, "-") == 0 ? stdout : fopen(o.outp, "wb");
+    if (!f) {
+        fprintf(stderr, "surfblend: cannot write '%s'\n", o.outp);
+        goto done;
+    }
+    {
+        const float *pos = limit ? data.limit_positions : data.positions;
+        size_t off = 0;
+        int ok = 1, j;
+        ok &= fprintf(f, "# surfblend shade of %s: %s level %d, variant %s, darts %s, p %g; %d vertices (%d refined), %d faces\n", o.in,
+                      sfb_scheme_name(scheme_for(o.in, o.have_scheme, o.scheme)), o.level, o.variant == SFB_SHADE_VARIANT_A ? "A" : "B",
+                      o.darts == SFB_SHADE_DARTS_SHARP ? "sharp" : "smooth", o.p, data.vertex_count, data.refined_vertex_count,
+                      data.face_count) > 0;
+        for (i = 0; i < data.vertex_count && ok; ++i)
+            ok &= fprintf(f, "v %.7g %.7g %.7g\n", pos[3 * i], pos[3 * i + 1], pos[3 * i + 2]) > 0;
+        for (i = 0; i < data.vertex_count && ok; ++i)
+            ok &= fprintf(f, "vn %.7g %.7g %.7g\n", data.normals[3 * i], data.normals[3 * i + 1], data.normals[3 * i + 2]) > 0;
+        for (i = 0; i < data.face_count && ok; ++i) {
+            ok &= fputc('f', f) != EOF;
+            for (j = 0; j < data.face_sizes[i]; ++j) {
+                int v = data.face_vertices[off + (size_t)j] + 1;
+                ok &= fprintf(f, " %d//%d", v, v) > 0;
+            }
+            ok &= fputc('\n', f) != EOF;
+            off += (size_t)data.face_sizes[i];
+        }
+        if (!ok) {
+            fprintf(stderr, "surfblend: writing '%s' failed\n", o.outp);
+            goto done;
+        }
+    }
+    shade_summary("shade", &o, &data, ctx, o.outp);
+    rc = 0;
+done:
+    rc = finish_output(f, o.outp, rc);
+    sfb_mesh_data_free(&data);
+    sfb_surface_destroy(surf);
+    sfb_mesh_destroy(mesh);
+    sfb_context_destroy(ctx);
+    return rc;
+}
+
+/* PNG bytes gathered in memory, so that a failed render leaves no file at all. */
+typedef struct png_buf { unsigned char *data; size_t size, cap; int failed; } png_buf;
+
+static void png_append(void *user, void *data, int size) {
+    png_buf *b = (png_buf *)user;
+    if (b->failed || size <= 0) return;
+    if (b->size + (size_t)size > b->cap) {
+        size_t nc = b->cap ? b->cap : 1 << 16;
+        unsigned char *nd;
+        while (nc < b->size + (size_t)size) nc *= 2;
+        nd = (unsigned char *)realloc(b->data, nc);
+        if (!nd) { b->failed = 1; return; }
+        b->data = nd;
+        b->cap = nc;
+    }
+    memcpy(b->data + b->size, data, (size_t)size);
+    b->size += (size_t)size;
+}
+
+static int cmd_render(int argc, char **argv) {
+    shade_opts o;
+    int i, rc = 1, mode = SFB_RENDER_SHADED, modes = 0, normals = 2 /* 0 limit, 1 subdivided, 2 blended */, limit_pos = 1, edges = 0;
+    long width = 640, height = 480;
+    int view_set = 0;
+    double yaw = 0.0, pitch = 0.0, zoom = 0.0, stripes = 0.0;
+    sfb_context *ctx = NULL;
+    sfb_mesh *mesh = NULL;
+    sfb_surface *surf = NULL;
+    sfb_mesh_data data;
+    sfb_image img;
+    sfb_render_config rcfg;
+    sfb_result r;
+    png_buf png;
+    FILE *f = NULL;
+    static const char *normal_names[3] = { "limit", "subdivided", "blended" };
+    memset(&data, 0, sizeof data);
+    memset(&img, 0, sizeof img);
+    memset(&png, 0, sizeof png);
+    shade_opts_init(&o, 3);
+    for (i = 0; i < argc; ++i) {
+        int sr = shade_arg(argc, argv, &i, &o);
+        if (sr < 0) return -sr;
+        if (sr) continue;
+        if (strcmp(argv[i], "--normals") == 0) {
+            if (++i >= argc) return usage("--normals needs limit, subdivided or blended");
+            for (normals = 0; normals < 3 && strcmp(argv[i], normal_names[normals]) != 0; ++normals) {}
+            if (normals == 3) return usage("--normals needs limit, subdivided or blended");
+        } else if (strcmp(argv[i], "--positions") == 0) {
+            if (++i >= argc) return usage("--positions needs refined or limit");
+            if (strcmp(argv[i], "limit") == 0) limit_pos = 1;
+            else if (strcmp(argv[i], "refined") == 0) limit_pos = 0;
+            else return usage("--positions needs refined or limit");
+        } else if (strcmp(argv[i], "--highlight") == 0) {
+            mode = SFB_RENDER_HIGHLIGHT; ++modes;
+        } else if (strcmp(argv[i], "--weights") == 0) {
+            mode = SFB_RENDER_WEIGHTS; ++modes;
+        } else if (strcmp(argv[i], "--normal-colors") == 0) {
+            mode = SFB_RENDER_NORMALS; ++modes;
+        } else if (strcmp(argv[i], "--edges") == 0) {
+            edges = 1;
+        } else if (strcmp(argv[i], "--size") == 0) {
+            char *end;
+            if (++i >= argc) return usage("--size needs WxH");
+            width = strtol(argv[i], &end, 10);
+            if (end == argv[i] || (*end != 'x' && *end != 'X')) return usage("--size needs WxH, e.g. 800x600");
+            {
+                const char *hs = end + 1;
+                height = strtol(hs, &end, 10);
+                if (end == hs || *end) return usage("--size needs WxH, e.g. 800x600");
+            }
+            /* the range (1..8192) is the library's to check and report */
+            if (width < 1 || height < 1 || width > 1000000L || height > 1000000L) return usage("--size needs positive WxH");
+        } else if (strcmp(argv[i], "--view") == 0) {
+            char *end;
+            if (++i >= argc) return usage("--view needs YAW,PITCH in degrees");
+            yaw = strtod(argv[i], &end);
+            if (end == argv[i] || *end != ',') return usage("--view needs YAW,PITCH in degrees, e.g. 30,20");
+            {
+                const char *ps = end + 1;
+                pitch = strtod(ps, &end);
+                if (end == ps || *end || !isfinite(yaw) || !isfinite(pitch)) return usage("--view needs YAW,PITCH in degrees, e.g. 30,20");
+            }
+            view_set = 1;
+        } else if (strcmp(argv[i], "--zoom") == 0) {
+            char *end;
+            if (++i >= argc) return usage("--zoom needs a number > 0");
+            zoom = strtod(argv[i], &end);
+            if (end == argv[i] || *end || !(zoom > 0.0) || zoom > 1e6) return usage("--zoom needs a number > 0");
+        } else if (strcmp(argv[i], "--stripes") == 0) {
+            char *end;
+            if (++i >= argc) return usage("--stripes needs a number > 0");
+            stripes = strtod(argv[i], &end);
+            if (end == argv[i] || *end || !(stripes > 0.0) || stripes > 1e5) return usage("--stripes needs a number in (0, 100000]");
+        } else {
+            int ur = common_arg(argc, argv, &i, "render", &o.backend, &o.outp, &o.in);
+            if (ur) return ur;
+        }
+    }
+    if (!o.in) return usage("render needs an input OBJ file");
+    if (!o.outp) return usage("render needs -o OUT.png");
+    if (modes > 1) return usage("render takes one of --highlight, --weights, --normal-colors");
+    if (normals == 1) o.all_subdivided = 1;
+    ctx = make_context(o.backend);
+    if (!ctx) return 1;
+    if (!shade_mesh(ctx, &o, &mesh, &surf, &data)) goto done;
+    rcfg = sfb_render_config_init(mode);
+    rcfg.width = (int)(width > 2147483647L ? 2147483647L : width);
+    rcfg.height = (int)(height > 2147483647L ? 2147483647L : height);
+    rcfg.positions = limit_pos ? data.limit_positions : data.positions;
+    rcfg.normals = normals == 0 ? data.limit_normals : normals == 1 ? data.subdivided_normals : data.normals;
+    rcfg.scalars = data.blend_weights;
+    rcfg.view_set = view_set;
+    rcfg.yaw = (float)yaw;
+    rcfg.pitch = (float)pitch;
+    rcfg.zoom = (float)zoom;
+    rcfg.stripes = (float)stripes;
+    rcfg.draw_edges = edges;
+    if (!rcfg.positions || (mode != SFB_RENDER_WEIGHTS && !rcfg.normals) || (mode == SFB_RENDER_WEIGHTS && !rcfg.scalars)) {
+        fprintf(stderr, "surfblend: %s: the shaded mesh lacks the %s\n", o.in,
+                !rcfg.positions ? "positions" : mode == SFB_RENDER_WEIGHTS ? "blend weights" : "normals");
+        goto done;
+    }
+    r = sfb_render(ctx, &data, &rcfg, &img);
+    if (r != SFB_SUCCESS) {
+        fprintf(stderr, "surfblend: %s: %s: %s\n", o.in, sfb_result_string(r), sfb_last_error(ctx));
+        goto done;
+    }
+    if (!stbi_write_png_to_func(png_append, &png, img.width, img.height, 4, img.rgba, img.width * 4) || png.failed) {
+        fprintf(stderr, "surfblend: encoding the PNG failed (out of memory)\n");
+        goto done;
+    }
+    f = strcmp(o.outp, "-") == 0 ? stdout : fopen(o.outp, "wb");
+    if (!f) {
+        fprintf(stderr, "surfblend: cannot write '%s'\n", o.outp);
+        goto done;
+    }
+    if (fwrite(png.data, 1, png.size, f) != png.size) {
+        fprintf(stderr, "surfblend: writing '%s' failed\n", o.outp);
+        goto done;
+    }
+    {
+        static const char *mode_names[4] = { "shading", "highlight lines", "blend weights", "normal colours" };
+        char what[256], field[64] = "";
+        if (mode != SFB_RENDER_WEIGHTS) snprintf(field, sizeof field, " of the %s normals", normal_names[normals]);
+        snprintf(what, sizeof what, "render %s%s, %dx%d (%d object pixels%s):", mode_names[mode], field, img.width, img.height,
+                 img.object_pixels, img.skipped_faces ? ", faces with non-finite positions skipped" : "");
+        shade_summary(what, &o, &data, ctx, o.outp);
+    }
+    rc = 0;
+done:
+    rc = finish_output(f, o.outp, rc);
+    free(png.data);
+    sfb_image_free(&img);
+    sfb_mesh_data_free(&data);
+    sfb_surface_destroy(surf);
+    sfb_mesh_destroy(mesh);
+    sfb_context_destroy(ctx);
+    return rc;
+}
+
 /* Probes every backend on its own: available with what it runs on, or why not. */
 static int cmd_backends(void) {
     int k;
@@ -674,7 +1067,7 @@ static int cmd_backends(void) {
 int main(int argc, char **argv) {
     if (argc < 2) return usage("missing command");
     if (strcmp(argv[1], "--help") == 0 || strcmp(argv[1], "-h") == 0 || strcmp(argv[1], "help") == 0) {
-        fputs(usage_text, stdout);
+        print_usage(stdout);
         return 0;
     }
     if (strcmp(argv[1], "--version") == 0) {
@@ -685,6 +1078,8 @@ int main(int argc, char **argv) {
     if (strcmp(argv[1], "refine") == 0) return cmd_refine(argc - 2, argv + 2);
     if (strcmp(argv[1], "eval") == 0) return cmd_eval(argc - 2, argv + 2);
     if (strcmp(argv[1], "tess") == 0) return cmd_tess(argc - 2, argv + 2);
+    if (strcmp(argv[1], "shade") == 0) return cmd_shade(argc - 2, argv + 2);
+    if (strcmp(argv[1], "render") == 0) return cmd_render(argc - 2, argv + 2);
     if (strcmp(argv[1], "backends") == 0) return argc == 2 ? cmd_backends() : usage("backends takes no arguments");
     fprintf(stderr, "surfblend: unknown command '%s'\n", argv[1]);
     return usage(NULL);
