@@ -1226,14 +1226,80 @@ struct Row {
     int unmatched;
 };
 
+/* Subdivision shading (seed 001): sfb_surface_shade against sfb_surface_refine with limit
+ * normals (SFB_REFINE_LIMIT: refined positions, limit positions, tangents, normals) on the same
+ * surface, same level, per backend; tables compiled once beforehand (not timed). */
+static int shade_section() {
+    struct Case { const char *path; int level; };
+    const Case cases[] = {{"examples/data/creased_box.obj", 5}, {"../shared/peers/opensubdiv-shapes/catmark_car.obj", 3},
+                          {"../shared/peers/opensubdiv-shapes/catmark_pole64.obj", 4}};
+    const sfb_backend_kind kinds[4] = {SFB_BACKEND_REF, SFB_BACKEND_SIMD, SFB_BACKEND_GL, SFB_BACKEND_OSMESA};
+    printf("\n== subdivision shading: sfb_surface_shade vs sfb_surface_refine (limit normals), same surface and level\n");
+    printf("%-14s %-5s %-8s %9s %9s %12s %12s %7s %10s\n", "mesh", "level", "backend", "vertices", "N_S at", "refine ms",
+           "shade ms", "ratio", "split");
+    int status = 0;
+    for (const Case &c : cases) {
+        FILE *f = fopen(c.path, "rb");
+        if (!f) { printf("%-14s skipped: %s not found\n", "", c.path); continue; }
+        std::string text;
+        char buf[65536];
+        size_t n;
+        while ((n = fread(buf, 1, sizeof buf, f)) > 0) text.append(buf, n);
+        fclose(f);
+        std::string name = c.path;
+        name = name.substr(name.find_last_of('/') + 1);
+        name = name.substr(0, name.size() - 4);
+        for (sfb_backend_kind kind : kinds) {
+            std::string why;
+            sfb_context *ctx = eval_context(kind, 0, 0, &why);
+            if (!ctx) { printf("%-14s %-5d %-8s skipped: %s\n", name.c_str(), c.level, sfb_backend_kind_name(kind), why.c_str()); continue; }
+            sfb_mesh *mesh = NULL;
+            sfb_surface *surf = NULL;
+            sfb_surface_config cfg = sfb_surface_config_init(SFB_SCHEME_CATMARK, c.level);
+            cfg.flags = SFB_REFINE_LIMIT | SFB_REFINE_SHADING;
+            if (sfb_mesh_read_obj(ctx, text.data(), text.size(), &mesh) != SFB_SUCCESS ||
+                sfb_surface_create(ctx, mesh, &cfg, &surf) != SFB_SUCCESS) {
+                printf("%-14s failed: %s\n", name.c_str(), sfb_last_error(ctx));
+                status = 1;
+            } else {
+                double tr = 1e30, ts = 1e30;
+                int nv = 0, nout = 0, nsub = 0, split = 0;
+                for (int rep = 0; rep < 7; ++rep) {
+                    sfb_mesh_data d;
+                    Clock::time_point t0 = Clock::now();
+                    if (sfb_surface_refine(surf, &d) != SFB_SUCCESS) { status = 1; break; }
+                    tr = std::min(tr, ms_since(t0));
+                    nv = d.vertex_count;
+                    sfb_mesh_data_free(&d);
+                    t0 = Clock::now();
+                    if (sfb_surface_shade(surf, NULL, &d) != SFB_SUCCESS) { status = 1; break; }
+                    ts = std::min(ts, ms_since(t0));
+                    nout = d.vertex_count; nsub = d.subdivided_count; split = d.vertex_count - d.refined_vertex_count;
+                    sfb_mesh_data_free(&d);
+                }
+                char frac[32];
+                snprintf(frac, sizeof frac, "%.1f%%", nout ? 100.0 * nsub / nout : 0.0);
+                printf("%-14s %-5d %-8s %9d %9s %12.2f %12.2f %6.2fx %10d\n", name.c_str(), c.level, sfb_backend_kind_name(kind), nv, frac, tr, ts,
+                       ts / tr, split);
+            }
+            if (surf) sfb_surface_destroy(surf);
+            if (mesh) sfb_mesh_destroy(mesh);
+            sfb_context_destroy(ctx);
+        }
+    }
+    printf("(ratio: shade time / refine time, best of 7; target <= 1.3x. N_S at: share of output vertices where the subdivided normal is computed)\n");
+    return status;
+}
+
 int main(int argc, char **argv) {
     int max_level = 4;
     bool limit_only = false;
+    if (argc > 1 && strcmp(argv[1], "--shade") == 0) return shade_section();
     if (argc > 1) {
         limit_only = strcmp(argv[1], "--limit") == 0;
         max_level = limit_only ? 0 : atoi(argv[1]);
         if (argc > 2 || (!limit_only && (max_level < 1 || max_level > 6))) {
-            fprintf(stderr, "usage: bench [MAX_LEVEL 1..6, default 4 | --limit (the limit evaluation section alone)]\n");
+            fprintf(stderr, "usage: bench [MAX_LEVEL 1..6, default 4 | --limit (the limit evaluation section alone) | --shade (the shading section alone)]\n");
             return 2;
         }
     }
@@ -1410,6 +1476,7 @@ int main(int argc, char **argv) {
     if (eval_section(torus, diag) != 0) status = 1;
     if (limit_section(diag, false) != 0) status = 1;
     if (limit_section(diag, true) != 0) status = 1;
+    if (shade_section() != 0) status = 1;
     printf("total time %.1f s\n", ms_since(t_start) / 1000.0);
     return status;
 }
