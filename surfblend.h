@@ -6317,23 +6317,26 @@ static sfb_result sfb__eval_args(const sfb_surface *s, sfb_table t, int have_buf
     return SFB_SUCCESS;
 }
 
-SFB_API sfb_result sfb_surface_eval_stencils(const sfb_surface *s, sfb_table t, const float *src, sfb_buffer_desc sd,
-                                             float *dst, sfb_buffer_desc dd) {
-    sfb_context *ctx;
-    const sfb__backend_vtable *be;
-    sfb_result r;
-    if (!s) return SFB_INVALID_ARGS;
-    ctx = s->ctx;
-    if ((r = sfb__eval_args(s, t, src && dst, sd, dd, "buffers")) != SFB_SUCCESS) return r;
-    be = ctx->backend;
+/* Rows [0, rows) of table `t` on the context's backend (`handle`: its upload of t), or on ref
+ * when the backend lacks eval_stencils. Arguments already checked. */
+static sfb_result sfb__surface_apply(const sfb_surface *s, const sfb__stencils *t, void *handle, int rows, const float *src,
+                                     sfb_buffer_desc sd, float *dst, sfb_buffer_desc dd) {
+    sfb_context *ctx = s->ctx;
+    const sfb__backend_vtable *be = ctx->backend;
     if (!be || !(be->caps & SFB__CAP_EVAL_STENCILS) || !be->eval_stencils) {
         sfb__log(ctx, SFB_LOG_INFO, "backend %s lacks eval_stencils; using ref", be ? be->name : "none");
-        be = sfb__backend_ref();
-        return be->eval_stencils(NULL, &s->tables[t], NULL, 0, s->tables[t].rows, src, sd, dst, dd);
+        return sfb__backend_ref()->eval_stencils(NULL, t, NULL, 0, rows, src, sd, dst, dd);
     }
-    if (s->tables[t].rows == 0) return SFB_SUCCESS;
-    return be->eval_stencils(ctx->backend_state, &s->tables[t], s->uploaded_by == be ? s->backend_tables[t] : NULL,
-                             0, s->tables[t].rows, src, sd, dst, dd);
+    if (rows <= 0) return SFB_SUCCESS;
+    return be->eval_stencils(ctx->backend_state, t, s->uploaded_by == be ? handle : NULL, 0, rows, src, sd, dst, dd);
+}
+
+SFB_API sfb_result sfb_surface_eval_stencils(const sfb_surface *s, sfb_table t, const float *src, sfb_buffer_desc sd,
+                                             float *dst, sfb_buffer_desc dd) {
+    sfb_result r;
+    if (!s) return SFB_INVALID_ARGS;
+    if ((r = sfb__eval_args(s, t, src && dst, sd, dd, "buffers")) != SFB_SUCCESS) return r;
+    return sfb__surface_apply(s, &s->tables[t], s->backend_tables[t], s->tables[t].rows, src, sd, dst, dd);
 }
 
 SFB_API sfb_result sfb_surface_eval_stencils_gl(const sfb_surface *s, sfb_table t, unsigned int src_buffer, sfb_buffer_desc sd,
@@ -6666,7 +6669,6 @@ static int *sfb__shade_parent_faces(sfb_context *ctx, const sfb__level *p, const
 typedef struct sfb__shade_scratch {
     int *fset, nfset;          /* parent faces of the child region being built */
     double *cnt;               /* per region of the parent vertex */
-    int cap;
 } sfb__shade_scratch;
 
 /* Adds scale * (the step's mask of child vertex cv, restricted to its region creg - a
@@ -6756,7 +6758,7 @@ sfb_result sfb__shading_build(sfb_context *ctx, const sfb__level *prep, const sf
     int *order = NULL;
     sfb_result r = SFB_SUCCESS;
     int loop = opt->scheme == SFB_SCHEME_LOOP;
-    int Ln = 0, Lw = 0, k, v, i, t, maxv = 1, maxsrc;
+    int Ln = 0, Lw = 0, k, v, i, t, maxv = 1;
     const sfb__level *top;
     *out = NULL;
     memset(&prow, 0, sizeof prow); memset(&crow, 0, sizeof crow); memset(&A, 0, sizeof A);
@@ -6789,7 +6791,6 @@ sfb_result sfb__shading_build(sfb_context *ctx, const sfb__level *prep, const sf
             int n = lev[k].vf_off[v + 1] - lev[k].vf_off[v];
             if (n + 1 > maxv) maxv = n + 1;
         }
-    sc.cap = maxv;
     sc.fset = (int *)sfb__alloc(ctx, (size_t)maxv * sizeof(int));
     sc.cnt = (double *)sfb__alloc(ctx, (size_t)maxv * sizeof(double));
     if (!sc.fset || !sc.cnt) { r = sfb__oom(ctx, "shading tables"); goto done; }
@@ -6883,7 +6884,6 @@ sfb_result sfb__shading_build(sfb_context *ctx, const sfb__level *prep, const sf
     }
 
     /* N_S: region rows composed from the normals level up to the level below the last */
-    maxsrc = sh->nsrc;
     if (!sfb__shade_identity(ctx, &prow, sh->nsrc)) { r = sfb__oom(ctx, "shading tables"); goto done; }
     for (k = Ln; k < L - 1; ++k) {
         const sfb__level *pl = k == Ln ? &sh->nlev : &lev[k];
@@ -6936,7 +6936,7 @@ sfb_result sfb__shading_build(sfb_context *ctx, const sfb__level *prep, const sf
         }
         if (!sfb__compose_row(ctx, &A, &prow, &m, &crow, i)) { r = sfb__oom(ctx, "shading tables"); goto done; }
     }
-    r = sfb__rows_to_stencils(ctx, &crow, maxsrc, &sh->ns);
+    r = sfb__rows_to_stencils(ctx, &crow, sh->nsrc, &sh->ns);
     if (r != SFB_SUCCESS) { r = sfb__oom(ctx, "shading tables"); goto done; }
     sfb__rows_free(ctx, &crow);
     sfb__rows_free(ctx, &prow);
@@ -7042,15 +7042,11 @@ SFB_API sfb_shade_params sfb_shade_params_init(void) {
     return p;
 }
 
-/* One shading table on the context's backend (ref when it lacks eval_stencils). */
+/* One shading table on the context's backend (surface.c's sfb__surface_apply), xyz rows. */
 static sfb_result sfb__shade_apply(const sfb_surface *s, const sfb__stencils *t, void *handle, int rows, const float *src, float *dst) {
-    sfb_context *ctx = s->ctx;
-    const sfb__backend_vtable *be = ctx->backend;
     sfb_buffer_desc d3 = {0, 3, 3};
     if (rows <= 0) return SFB_SUCCESS;
-    if (!be || !(be->caps & SFB__CAP_EVAL_STENCILS) || !be->eval_stencils)
-        return sfb__backend_ref()->eval_stencils(NULL, t, NULL, 0, rows, src, d3, dst, d3);
-    return be->eval_stencils(ctx->backend_state, t, s->uploaded_by == be ? handle : NULL, 0, rows, src, d3, dst, d3);
+    return sfb__surface_apply(s, t, handle, rows, src, d3, dst, d3);
 }
 
 SFB_API sfb_result sfb_surface_shade(const sfb_surface *s, const sfb_shade_params *params, sfb_mesh_data *o) {

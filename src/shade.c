@@ -183,7 +183,6 @@ static int *sfb__shade_parent_faces(sfb_context *ctx, const sfb__level *p, const
 typedef struct sfb__shade_scratch {
     int *fset, nfset;          /* parent faces of the child region being built */
     double *cnt;               /* per region of the parent vertex */
-    int cap;
 } sfb__shade_scratch;
 
 /* Adds scale * (the step's mask of child vertex cv, restricted to its region creg - a
@@ -273,7 +272,7 @@ sfb_result sfb__shading_build(sfb_context *ctx, const sfb__level *prep, const sf
     int *order = NULL;
     sfb_result r = SFB_SUCCESS;
     int loop = opt->scheme == SFB_SCHEME_LOOP;
-    int Ln = 0, Lw = 0, k, v, i, t, maxv = 1, maxsrc;
+    int Ln = 0, Lw = 0, k, v, i, t, maxv = 1;
     const sfb__level *top;
     *out = NULL;
     memset(&prow, 0, sizeof prow); memset(&crow, 0, sizeof crow); memset(&A, 0, sizeof A);
@@ -306,7 +305,6 @@ sfb_result sfb__shading_build(sfb_context *ctx, const sfb__level *prep, const sf
             int n = lev[k].vf_off[v + 1] - lev[k].vf_off[v];
             if (n + 1 > maxv) maxv = n + 1;
         }
-    sc.cap = maxv;
     sc.fset = (int *)sfb__alloc(ctx, (size_t)maxv * sizeof(int));
     sc.cnt = (double *)sfb__alloc(ctx, (size_t)maxv * sizeof(double));
     if (!sc.fset || !sc.cnt) { r = sfb__oom(ctx, "shading tables"); goto done; }
@@ -400,7 +398,6 @@ sfb_result sfb__shading_build(sfb_context *ctx, const sfb__level *prep, const sf
     }
 
     /* N_S: region rows composed from the normals level up to the level below the last */
-    maxsrc = sh->nsrc;
     if (!sfb__shade_identity(ctx, &prow, sh->nsrc)) { r = sfb__oom(ctx, "shading tables"); goto done; }
     for (k = Ln; k < L - 1; ++k) {
         const sfb__level *pl = k == Ln ? &sh->nlev : &lev[k];
@@ -453,7 +450,7 @@ sfb_result sfb__shading_build(sfb_context *ctx, const sfb__level *prep, const sf
         }
         if (!sfb__compose_row(ctx, &A, &prow, &m, &crow, i)) { r = sfb__oom(ctx, "shading tables"); goto done; }
     }
-    r = sfb__rows_to_stencils(ctx, &crow, maxsrc, &sh->ns);
+    r = sfb__rows_to_stencils(ctx, &crow, sh->nsrc, &sh->ns);
     if (r != SFB_SUCCESS) { r = sfb__oom(ctx, "shading tables"); goto done; }
     sfb__rows_free(ctx, &crow);
     sfb__rows_free(ctx, &prow);
@@ -559,15 +556,11 @@ SFB_API sfb_shade_params sfb_shade_params_init(void) {
     return p;
 }
 
-/* One shading table on the context's backend (ref when it lacks eval_stencils). */
+/* One shading table on the context's backend (surface.c's sfb__surface_apply), xyz rows. */
 static sfb_result sfb__shade_apply(const sfb_surface *s, const sfb__stencils *t, void *handle, int rows, const float *src, float *dst) {
-    sfb_context *ctx = s->ctx;
-    const sfb__backend_vtable *be = ctx->backend;
     sfb_buffer_desc d3 = {0, 3, 3};
     if (rows <= 0) return SFB_SUCCESS;
-    if (!be || !(be->caps & SFB__CAP_EVAL_STENCILS) || !be->eval_stencils)
-        return sfb__backend_ref()->eval_stencils(NULL, t, NULL, 0, rows, src, d3, dst, d3);
-    return be->eval_stencils(ctx->backend_state, t, s->uploaded_by == be ? handle : NULL, 0, rows, src, d3, dst, d3);
+    return sfb__surface_apply(s, t, handle, rows, src, d3, dst, d3);
 }
 
 SFB_API sfb_result sfb_surface_shade(const sfb_surface *s, const sfb_shade_params *params, sfb_mesh_data *o) {

@@ -295,23 +295,26 @@ static sfb_result sfb__eval_args(const sfb_surface *s, sfb_table t, int have_buf
     return SFB_SUCCESS;
 }
 
-SFB_API sfb_result sfb_surface_eval_stencils(const sfb_surface *s, sfb_table t, const float *src, sfb_buffer_desc sd,
-                                             float *dst, sfb_buffer_desc dd) {
-    sfb_context *ctx;
-    const sfb__backend_vtable *be;
-    sfb_result r;
-    if (!s) return SFB_INVALID_ARGS;
-    ctx = s->ctx;
-    if ((r = sfb__eval_args(s, t, src && dst, sd, dd, "buffers")) != SFB_SUCCESS) return r;
-    be = ctx->backend;
+/* Rows [0, rows) of table `t` on the context's backend (`handle`: its upload of t), or on ref
+ * when the backend lacks eval_stencils. Arguments already checked. */
+static sfb_result sfb__surface_apply(const sfb_surface *s, const sfb__stencils *t, void *handle, int rows, const float *src,
+                                     sfb_buffer_desc sd, float *dst, sfb_buffer_desc dd) {
+    sfb_context *ctx = s->ctx;
+    const sfb__backend_vtable *be = ctx->backend;
     if (!be || !(be->caps & SFB__CAP_EVAL_STENCILS) || !be->eval_stencils) {
         sfb__log(ctx, SFB_LOG_INFO, "backend %s lacks eval_stencils; using ref", be ? be->name : "none");
-        be = sfb__backend_ref();
-        return be->eval_stencils(NULL, &s->tables[t], NULL, 0, s->tables[t].rows, src, sd, dst, dd);
+        return sfb__backend_ref()->eval_stencils(NULL, t, NULL, 0, rows, src, sd, dst, dd);
     }
-    if (s->tables[t].rows == 0) return SFB_SUCCESS;
-    return be->eval_stencils(ctx->backend_state, &s->tables[t], s->uploaded_by == be ? s->backend_tables[t] : NULL,
-                             0, s->tables[t].rows, src, sd, dst, dd);
+    if (rows <= 0) return SFB_SUCCESS;
+    return be->eval_stencils(ctx->backend_state, t, s->uploaded_by == be ? handle : NULL, 0, rows, src, sd, dst, dd);
+}
+
+SFB_API sfb_result sfb_surface_eval_stencils(const sfb_surface *s, sfb_table t, const float *src, sfb_buffer_desc sd,
+                                             float *dst, sfb_buffer_desc dd) {
+    sfb_result r;
+    if (!s) return SFB_INVALID_ARGS;
+    if ((r = sfb__eval_args(s, t, src && dst, sd, dd, "buffers")) != SFB_SUCCESS) return r;
+    return sfb__surface_apply(s, &s->tables[t], s->backend_tables[t], s->tables[t].rows, src, sd, dst, dd);
 }
 
 SFB_API sfb_result sfb_surface_eval_stencils_gl(const sfb_surface *s, sfb_table t, unsigned int src_buffer, sfb_buffer_desc sd,

@@ -365,7 +365,6 @@ static void run_mesh(const char *name, const sfb_mesh *m, int loop, int smooth_l
     {
         sfb_surface *sd = make_surface(g_be[0].ctx, m, loop, 3, SFB_SHADE_VARIANT_B, SFB_SHADE_DARTS_SHARP);
         sfb_mesh_data dd;
-        const sfb__level *l0 = &sref->top;
         memset(&dd, 0, sizeof dd);
         snprintf(nm, sizeof nm, "ref/%s/darts sharp vs smooth differ only around regular darts", name);
         if (!sd || !shade(sd, 0, &dd)) fail(nm, "%s", sfb_last_error(g_be[0].ctx));
@@ -375,7 +374,6 @@ static void run_mesh(const char *name, const sfb_mesh *m, int loop, int smooth_l
             sfb__level prep;
             int nd = 0, far = 0, diff = 0, v, k;
             double *dp = NULL;
-            (void)l0;
             sfb_mesh_get_desc(m, &desc);
             if (sfb__level_prepare(g_be[0].ctx, &m->base, m->boundary == SFB_BOUNDARY_EDGE_AND_CORNER, 0, &prep) == SFB_SUCCESS) {
                 dp = (double *)malloc(sizeof(double) * 4 * ((size_t)prep.nv + 1));
