@@ -26,8 +26,6 @@
  * h = 2^-limit of the base face (measured by tests/limit.c and quoted in the README).
  * Holes produce no patches. */
 
-enum { SFB__PATCH_BSPLINE = 0, SFB__PATCH_STAM = 1, SFB__PATCH_ENDCAP = 2, SFB__PATCH_BEZTRI = 3, SFB__PATCH_STAM_LOOP = 4,
-       SFB__PATCH_ENDCAP_TRI = 5 };
 enum { SFB__CORNER_R1 = 1, SFB__CORNER_R2_D1 = 2, SFB__CORNER_R2_D2 = 3, SFB__CORNER_R3 = 4, SFB__CORNER_EV = 5,
        SFB__CORNER_IRREGULAR = 0 };
 
@@ -40,7 +38,7 @@ enum { SFB__CORNER_R1 = 1, SFB__CORNER_R2_D1 = 2, SFB__CORNER_R2_D2 = 3, SFB__CO
 void sfb__patch_table_free(sfb_context *ctx, sfb__patch_table *pt) {
     sfb__free(ctx, pt->ptype); sfb__free(ctx, pt->pfirst); sfb__free(ctx, pt->pparam); sfb__free(ctx, pt->pvalence);
     sfb__free(ctx, pt->cv); sfb__free(ctx, pt->ptex_face); sfb__free(ctx, pt->ptex_corner); sfb__free(ctx, pt->face_ptex);
-    sfb__free(ctx, pt->ptex_root); sfb__free(ctx, pt->nodes); sfb__free(ctx, pt->point_data);
+    sfb__free(ctx, pt->ptex_root); sfb__free(ctx, pt->nodes); sfb__free(ctx, pt->point_data); sfb__free(ctx, pt->pcorner);
     memset(pt, 0, sizeof *pt);
 }
 
@@ -1380,7 +1378,20 @@ static sfb_result sfb__ref_eval_patches(void *state, const sfb__patch_table *pt,
     for (q = first; q < last; ++q) {
         double res[6][3], nrm[3];
         size_t o = 3 * (size_t)q;
-        sfb__ref_eval_one(pt, pt->point_data, &locs[q], res, nrm);
+        if (pt->scheme == SFB_SCHEME_MANIFOLD_BLEND) {
+            /* second derivatives cost four more blends here: only when asked */
+            double s, t, sc;
+            int patch = sfb__patch_locate(pt, locs[q].face, locs[q].u, locs[q].v, &s, &t, &sc);
+            memset(res, 0, sizeof res); memset(nrm, 0, sizeof nrm);
+            if (patch >= 0) {
+                sfb__mf_eval_patch(pt, pt->point_data, patch, s, t, out->duu || out->duv || out->dvv, res, nrm);
+                for (c = 0; c < 3; ++c) {
+                    res[1][c] *= sc; res[2][c] *= sc;
+                    res[3][c] *= sc * sc; res[4][c] *= sc * sc; res[5][c] *= sc * sc;
+                }
+            }
+        } else
+            sfb__ref_eval_one(pt, pt->point_data, &locs[q], res, nrm);
         for (c = 0; c < 3; ++c) {
             if (out->position) out->position[o + c] = (float)res[0][c];
             if (out->du) out->du[o + c] = (float)res[1][c];

@@ -226,13 +226,30 @@ typedef enum sfb_shade_darts {
     SFB_SHADE_DARTS_SMOOTH = 0, /* default: a dart is a smooth vertex for the blend weights */
     SFB_SHADE_DARTS_SHARP = 1   /* a regular dart is a sharp vertex (weight 0 in variant B) */
 } sfb_shade_darts;
+typedef enum sfb_shade_averaging {
+    SFB_SHADE_AVERAGE_LINEAR = 0,      /* default: the scheme's stencils on the normals, normalised once at the end
+                                          (one composed table, run on the backend) */
+    SFB_SHADE_AVERAGE_RENORMALIZED = 1,/* the stencils one level at a time, each level's normals normalised */
+    SFB_SHADE_AVERAGE_SPHERICAL = 2    /* one level at a time, each new normal the weighted spherical mean (the
+                                          unit vector minimising the weighted sum of squared angles) */
+} sfb_shade_averaging;
 #define SFB_SHADE_LEVEL_CONTROL (-1) /* normals_level / weights_level: start on the control mesh */
 typedef struct sfb_shading_options {
     int variant;        /* sfb_shade_variant */
     int darts;          /* sfb_shade_darts */
     int normals_level;  /* level where N_S starts (face-normal averages); 0: default 1; SFB_SHADE_LEVEL_CONTROL: 0 */
     int weights_level;  /* level where the blend weights are seeded; 0: default 1; SFB_SHADE_LEVEL_CONTROL: 0 */
+    int averaging;      /* sfb_shade_averaging: how N_S averages normals from one level to the next */
 } sfb_shading_options;
+
+/* Manifold-based blending (seed 000), SFB_SCHEME_MANIFOLD_BLEND; zero = defaults. */
+typedef enum sfb_manifold_weights {
+    SFB_MANIFOLD_WEIGHTS_HERMITE = 0, /* default (the seed): eta(t) = 2t^3 - 3t^2 + 1, a C1 surface */
+    SFB_MANIFOLD_WEIGHTS_CINF = 1     /* Ying-Zorin's kind: eta flat to all orders at 0 and 1 */
+} sfb_manifold_weights;
+typedef struct sfb_manifold_options {
+    int weights;        /* sfb_manifold_weights */
+} sfb_manifold_options;
 
 typedef struct sfb_surface_config {
     sfb_scheme scheme;
@@ -241,6 +258,7 @@ typedef struct sfb_surface_config {
     int isolation_level;/* patches: adaptive isolation limit around irregular features, 1..SFB_MAX_LEVEL
                            (0: SFB_DEFAULT_ISOLATION); below it faces get an end cap */
     sfb_shading_options shading; /* SFB_REFINE_SHADING */
+    sfb_manifold_options manifold; /* SFB_SCHEME_MANIFOLD_BLEND */
 } sfb_surface_config;
 #define SFB_DEFAULT_ISOLATION 8
 SFB_API sfb_surface_config sfb_surface_config_init(sfb_scheme scheme, int level);
@@ -287,6 +305,65 @@ SFB_API sfb_result sfb_surface_eval_stencils(const sfb_surface *surface, sfb_tab
 SFB_API sfb_result sfb_surface_eval_stencils_gl(const sfb_surface *surface, sfb_table table,
                                                 unsigned int src_buffer, sfb_buffer_desc src_desc,
                                                 unsigned int dst_buffer, sfb_buffer_desc dst_desc);
+
+/* ---- drawing a manifold blending surface on the host's GL context (seed 000 section V) ----
+ * The engine case of seed 000's renderer: the gl backend with gl_use_current_context draws a
+ * SFB_SCHEME_MANIFOLD_BLEND surface (built with SFB_REFINE_PATCHES) into the host's current
+ * framebuffer. A vertex program evaluates the blend at every sample from the tables the
+ * surface uploaded (the nine coefficient rows of each vertex's local geometry in a float
+ * texture, as the seed's Fig. 8, and each patch's corner vertices and corner codes in an
+ * integer texture): the four chart parameters, Table 2's vector pairs, the blend of the four
+ * local geometries with the surface's weights, and the analytic normal, as sfb_surface_eval.
+ * Each parametric face drawn is one instance of a (rate + 1) x (rate + 1) sample grid, sample
+ * (i, j) at (u, v) = (i / rate, j / rate), drawn as 2 rate^2 indexed triangles,
+ * counter-clockwise seen from the normal side. The fragment program lights the surface from
+ * both sides (ambient 0.2 + diffuse 0.8 of `color`) and, with a trimming texture, discards the
+ * fragments whose mask value at the face's (u, v) is below 0.5: the mask is read as
+ * sfb_trim_mask describes (bilinear between texel centres, clamped at the tile's borders;
+ * atlas tile t for parametric face t, faces past the last tile untrimmed).
+ * The draw uses the host's framebuffer, viewport, depth, blend and cull state as they are.
+ * What it binds (program, vertex array, texture units 0..2 and their samplers, the active
+ * texture unit, transform feedback object and buffer, GL_RASTERIZER_DISCARD, pixel unpack
+ * state) is restored before it returns. Call it where the host's context is current, on the
+ * thread of the sfb context. */
+typedef struct sfb_gl_draw_params {
+    int rate;                   /* segments per parametric-face edge, 1..1024 (0: 16) */
+    float mvp[16];              /* clip-from-object matrix, column-major as glUniformMatrix4fv (all 0: identity) */
+    float normal_matrix[9];     /* column-major 3x3 taking object normals to the space of `light` (all 0: identity) */
+    float light[3];             /* direction toward the light (need not be unit; all 0: (0, 0, 1)) */
+    float color[4];             /* RGBA of the lit surface (all 0: (0.8, 0.8, 0.8, 1)) */
+    unsigned int trim_texture;  /* 0: untrimmed; else a 2D texture of the current context holding the mask in
+                                   its red channel, level 0 (sfb_gl_trim_texture makes one) */
+    int trim_tiles_u, trim_tiles_v; /* atlas layout as sfb_trim_mask (0/0 or 1/1: one mask for every face); the
+                                   texture's size must split into that many equal tiles */
+    unsigned int capture_buffer;/* 0: none; else a buffer object of the current context that also receives every
+                                   sample (a second pass of the same vertex program over the samples as points,
+                                   rasterization off, through transform feedback): 6 floats per sample, the
+                                   position and the unit normal in object space, sample (i, j) of the k-th face
+                                   drawn at float index 6 ((k (rate + 1) + j) (rate + 1) + i); zeros for a hole */
+    int first_face, face_count; /* parametric faces first_face .. first_face + face_count - 1 (face_count 0: all
+                                   from first_face on) */
+} sfb_gl_draw_params;
+/* The defaults: rate 16, identity matrices, light (0, 0, 1), colour (0.8, 0.8, 0.8, 1), no
+ * trimming, no capture, every face. */
+SFB_API sfb_gl_draw_params sfb_gl_draw_params_init(void);
+/* Draws `surface` as above. Errors: SFB_INVALID_ARGS for a NULL argument, a rate outside 0..1024,
+ * a face range outside the surface's parametric faces, a trim_texture that is no texture, or a
+ * capture_buffer that is no buffer or holds fewer than 24 (rate + 1)^2 bytes per face drawn;
+ * SFB_INVALID_VALUE for a matrix, light or colour value that is not finite, atlas tiles that
+ * are negative, half zero, or do not split the texture evenly; SFB_UNSUPPORTED when the context
+ * does not run the gl backend on the host's context (gl_use_current_context; also a library
+ * built without SURFBLEND_GL) or the surface is not a manifold blend with patches; GL
+ * failures as SFB_BACKEND_ERROR or SFB_OUT_OF_MEMORY. Nothing is drawn on an error. */
+SFB_API sfb_result sfb_surface_draw_gl(const sfb_surface *surface, const sfb_gl_draw_params *params);
+/* Uploads a trimming mask (struct sfb_trim_mask, declared with the tessellator below; its
+ * atlas tiles are not stored: pass them in sfb_gl_draw_params) into a new GL_R8 2D texture of
+ * the host's current context, for sfb_gl_draw_params.trim_texture; the host owns it and deletes
+ * it with glDeleteTextures. Same context requirement as sfb_surface_draw_gl (else
+ * SFB_UNSUPPORTED); SFB_INVALID_ARGS for NULL arguments, SFB_INVALID_VALUE for a mask
+ * sfb_surface_tessellate would refuse (NULL texels, a side outside 1..16384, bad tiles). */
+struct sfb_trim_mask;
+SFB_API sfb_result sfb_gl_trim_texture(sfb_context *ctx, const struct sfb_trim_mask *mask, unsigned int *texture);
 
 /* The refined mesh as plain arrays. */
 typedef struct sfb_mesh_data {
@@ -348,7 +425,10 @@ SFB_API sfb_result sfb_surface_shade_info(const sfb_surface *surface, sfb_shade_
 SFB_API void sfb_mesh_data_desc(const sfb_mesh_data *data, sfb_mesh_desc *out);
 
 
-/* ---- limit evaluation (SFB_REFINE_PATCHES; Catmull-Clark and Loop) ----
+/* ---- limit evaluation (SFB_REFINE_PATCHES; Catmull-Clark, Loop, manifold blending) ----
+ * Manifold blending (SFB_SCHEME_MANIFOLD_BLEND) uses the Catmull-Clark parametric faces: a
+ * base quad is one, (u,v) as below; on a mesh with any non-quad face the blend is built on the
+ * mesh after one Catmull-Clark step, and a base quad's square then holds its four child quads.
  * Locations are on parametric faces. Catmull-Clark: a base quad is one parametric face, (u,v)
  * in [0,1]^2 with (0,0) at its first vertex, (1,0) at its second and (0,1) at its last; a face
  * with n != 4 vertices is n parametric quads, sub-face i being (v_i, midpoint of v_i v_i+1,
@@ -379,6 +459,7 @@ typedef struct sfb_patch_info {
     int param_faces, patches;
     int bspline, bezier;   /* regular patches: bicubic B-spline (Catmull-Clark), quartic Bezier triangle (Loop) */
     int stam, end_caps, max_depth, points;
+    int manifold;          /* MANIFOLD4 blends (one per quad of the manifold mesh) */
     size_t bytes;  /* memory of the patch table and its points */
 } sfb_patch_info;
 SFB_API sfb_result sfb_surface_patch_info(const sfb_surface *surface, sfb_patch_info *out);
@@ -388,12 +469,28 @@ enum {
     SFB_TESS_SPLIT_CREASES = 1u << 0  /* duplicate the vertices along infinitely sharp interior creases, one
                                          copy per side, each with that side's normal (split normals) */
 };
+/* Trimming (seed 000 section V.5), for every scheme: a mask over each parametric face's (u,v)
+ * square [0,1]^2 (a Loop triangle uses the half u + v <= 1 of it). Texel (i, j) =
+ * texels[j * width + i] covers u in [i/width, (i+1)/width], v in [j/height, (j+1)/height] (row 0
+ * at v = 0, as a GL texture). The mask value at (u,v) is the bilinear interpolation of the
+ * texels at their centres, clamped at the borders, divided by 255; the surface is kept where it
+ * is >= 0.5 (white) and trimmed where it is below (black). An atlas: tiles_u x tiles_v equal
+ * tiles, tile t (row-major from row 0) for parametric face t; faces past the last tile are not
+ * trimmed. tiles_u = tiles_v = 0 or 1: one mask for every face. The tessellator drops trimmed
+ * triangles and cuts the ones crossing the 0.5 contour along it (new vertices evaluated on the
+ * surface at the contour's (u,v)). */
+typedef struct sfb_trim_mask {
+    int width, height;           /* texels, 1..16384 each */
+    const unsigned char *texels; /* width * height */
+    int tiles_u, tiles_v;        /* atlas layout (0/0 or 1/1: one mask for all faces) */
+} sfb_trim_mask;
 typedef struct sfb_tess_config {
     int rate;         /* segments per parametric-face edge, 1..1024 (a quad: rate x rate cells, 2 triangles each;
                          a Loop triangle: the triangular grid of rate^2 triangles) */
     float tolerance;  /* 0: uniform. > 0: adaptive: each parametric face (and each edge) uses the smallest
                          rate <= `rate` whose chordal error is within `tolerance` (model units) */
     unsigned flags;   /* SFB_TESS_* */
+    const struct sfb_trim_mask *trim; /* NULL: no trimming */
 } sfb_tess_config;
 SFB_API sfb_tess_config sfb_tess_config_init(int rate);
 

@@ -136,7 +136,9 @@ typedef struct sfb__patch_table {
     int *face_ptex;        /* per base face + 1: first param face */
     int *ptex_root;        /* per param face: >= 0 node, <= -2 patch -(p+2), -1 hole */
     int *nodes;            /* 4 per quadtree node, by quadrant x + 2y, same encoding */
-    int counts[6];         /* patches of each type (SFB__PATCH_*) */
+    int counts[8];         /* patches of each type (SFB__PATCH_*) */
+    unsigned *pcorner;     /* MANIFOLD4: 4 corner codes per patch (SFB__MF_CODE) */
+    int mf_weights;        /* MANIFOLD4: SFB_MANIFOLD_WEIGHTS_* */
     int npoints;           /* patch points */
     float *point_data;     /* xyz per patch point, for the surface's base positions */
     const sfb__eigen_cc *eig[SFB__STAM_MAX_VALENCE + 1]; /* valences used (the context's cache) */
@@ -250,6 +252,10 @@ typedef struct sfb__shading {
     sfb__stencils lim[3];      /* refined positions -> limit position, tangent u, tangent v per output vertex */
     void *handles[5];          /* the backend's uploads of npos, ns, lim[0..2] */
     size_t bytes;
+    int averaging;             /* sfb_shade_averaging */
+    int nsteps;                /* per-level N_S (averaging != linear and level > normals level): steps, else 0 and ns is used */
+    sfb__stencils *steps;      /* nsteps: region normals of level normals+k -> level normals+k+1; the last -> N_S rows in ns's order */
+    int step_rows_max, step_size_max; /* largest row count and row size over the steps (scratch) */
 } sfb__shading;
 /* ---- surfaces ---- */
 struct sfb_surface {
@@ -296,6 +302,26 @@ sfb_result sfb__shading_build(sfb_context *ctx, const sfb__level *prep, const sf
 
 /* patches.c */
 void sfb__patch_table_free(sfb_context *ctx, sfb__patch_table *pt);
+/* Patch kinds of the patch table (patches.c, manifold.c). */
+enum { SFB__PATCH_BSPLINE = 0, SFB__PATCH_STAM = 1, SFB__PATCH_ENDCAP = 2, SFB__PATCH_BEZTRI = 3, SFB__PATCH_STAM_LOOP = 4,
+       SFB__PATCH_ENDCAP_TRI = 5, SFB__PATCH_MANIFOLD4 = 6 };
+/* Manifold blending (manifold.c): a corner code packs the corner vertex's local geometry kind,
+ * its valence k and the index h of the face in its star (the chart), and for a curve the axes
+ * (1: a, 2: b, 0: not in this face) of its sharp edges e1 and e2. */
+enum { SFB__MF_PATCH = 0, SFB__MF_POINT = 1, SFB__MF_CURVE = 2 };
+#define SFB__MF_CODE(kind, k, h, a1, a2) \
+    ((unsigned)(kind) | ((unsigned)(k) << 2) | ((unsigned)(h) << 15) | ((unsigned)(a1) << 28) | ((unsigned)(a2) << 30))
+#define SFB__MF_KIND(c) ((int)((c) & 3u))
+#define SFB__MF_K(c) ((int)(((c) >> 2) & 8191u))
+#define SFB__MF_H(c) ((int)(((c) >> 15) & 8191u))
+#define SFB__MF_A1(c) ((int)(((c) >> 28) & 3u))
+#define SFB__MF_A2(c) ((int)(((c) >> 30) & 3u))
+sfb_result sfb__manifold_build(sfb_context *ctx, const sfb__level *base, int weights, const float *positions, sfb__patch_table *pt);
+void sfb__mf_eval(const float *pts, const int *cv, const unsigned *codes, int kind, double c, double d, double S[3], double Sc[3],
+                  double Sd[3]);
+void sfb__mf_eval_patch(const sfb__patch_table *pt, const float *pts, int patch, double s, double t, int want2, double res[6][3],
+                        double nrm[3]);
+sfb_result sfb__mf_pinv(sfb_context *ctx, int k, double **out);
 sfb_result sfb__patches_build(sfb_context *ctx, const sfb__level *base, const sfb__refine_options *opt, int limit,
                               const float *positions, sfb__patch_table *pt);
 int sfb__patch_locate(const sfb__patch_table *pt, int ptex, double u, double v, double *s, double *t, double *scale);

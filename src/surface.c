@@ -74,14 +74,21 @@ SFB_API sfb_result sfb_surface_create(sfb_context *ctx, const sfb_mesh *mesh, co
     if (!ctx) return SFB_INVALID_ARGS;
     if (!mesh || !cfg || !out) return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "sfb_surface_create: NULL argument");
     *out = NULL;
-    if (cfg->scheme != SFB_SCHEME_CATMARK && cfg->scheme != SFB_SCHEME_LOOP && cfg->scheme != SFB_SCHEME_BILINEAR)
+    if (cfg->scheme == SFB_SCHEME_MANIFOLD_BLEND) {
+        /* a blending surface is evaluated (sfb_surface_eval / _tessellate), not refined */
+        if (!(cfg->flags & SFB_REFINE_PATCHES) || cfg->refine_level != 0 || (cfg->flags & (SFB_REFINE_LIMIT | SFB_REFINE_SHADING)))
+            return sfb__error(ctx, SFB_UNSUPPORTED, SFB_ELEMENT_NONE, -1,
+                              "scheme 'manifold' is evaluated, not refined: use refine level 0 with SFB_REFINE_PATCHES (and neither "
+                              "SFB_REFINE_LIMIT nor SFB_REFINE_SHADING), then sfb_surface_eval or sfb_surface_tessellate");
+    } else if (cfg->scheme != SFB_SCHEME_CATMARK && cfg->scheme != SFB_SCHEME_LOOP && cfg->scheme != SFB_SCHEME_BILINEAR)
         return sfb__error(ctx, SFB_UNSUPPORTED, SFB_ELEMENT_NONE, -1, "scheme '%s' cannot be refined uniformly yet", sfb_scheme_name(cfg->scheme));
     if (cfg->refine_level < 0) return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "refinement level %d is negative", cfg->refine_level);
     if (cfg->refine_level > SFB_MAX_LEVEL)
         return sfb__error(ctx, SFB_LIMIT_EXCEEDED, SFB_ELEMENT_NONE, -1, "refinement level %d is over the limit of %d (SFB_MAX_LEVEL)",
                           cfg->refine_level, SFB_MAX_LEVEL);
-    if ((cfg->flags & SFB_REFINE_PATCHES) && cfg->scheme != SFB_SCHEME_CATMARK && cfg->scheme != SFB_SCHEME_LOOP)
-        return sfb__error(ctx, SFB_UNSUPPORTED, SFB_ELEMENT_NONE, -1, "limit evaluation (SFB_REFINE_PATCHES) is built for Catmull-Clark and Loop; scheme '%s' is not supported",
+    if ((cfg->flags & SFB_REFINE_PATCHES) && cfg->scheme != SFB_SCHEME_CATMARK && cfg->scheme != SFB_SCHEME_LOOP &&
+        cfg->scheme != SFB_SCHEME_MANIFOLD_BLEND)
+        return sfb__error(ctx, SFB_UNSUPPORTED, SFB_ELEMENT_NONE, -1, "evaluation (SFB_REFINE_PATCHES) is built for Catmull-Clark, Loop and manifold; scheme '%s' is not supported",
                           sfb_scheme_name(cfg->scheme));
     if ((cfg->flags & SFB_REFINE_SHADING) && cfg->scheme != SFB_SCHEME_CATMARK && cfg->scheme != SFB_SCHEME_LOOP)
         return sfb__error(ctx, SFB_UNSUPPORTED, SFB_ELEMENT_NONE, -1, "subdivision shading (SFB_REFINE_SHADING) is built for Catmull-Clark and Loop; scheme '%s' is not supported",
@@ -117,7 +124,7 @@ SFB_API sfb_result sfb_surface_create(sfb_context *ctx, const sfb_mesh *mesh, co
                            mesh->boundary == SFB_BOUNDARY_NONE && cfg->scheme != SFB_SCHEME_BILINEAR, &prep);
     if (r != SFB_SUCCESS) { sfb_surface_destroy(s); return r; }
     memset(&opt, 0, sizeof opt);
-    opt.scheme = cfg->scheme;
+    opt.scheme = cfg->scheme == SFB_SCHEME_MANIFOLD_BLEND ? SFB_SCHEME_CATMARK : cfg->scheme; /* manifold: level 0, the identity */
     opt.crease_method = mesh->crease_method;
     opt.triangle_rule = mesh->triangle_rule;
     opt.want_limit = (cfg->flags & SFB_REFINE_LIMIT) != 0;
@@ -125,7 +132,10 @@ SFB_API sfb_result sfb_surface_create(sfb_context *ctx, const sfb_mesh *mesh, co
                     opt.want_limit ? &s->tables[SFB_TABLE_LIMIT] : NULL, 0.0f, 0.8f);
     if (r == SFB_SUCCESS && (cfg->flags & SFB_REFINE_SHADING))
         r = sfb__shading_build(ctx, &prep, &opt, cfg->refine_level, &cfg->shading, &s->shading);
-    if (r == SFB_SUCCESS && (cfg->flags & SFB_REFINE_PATCHES)) {
+    if (r == SFB_SUCCESS && (cfg->flags & SFB_REFINE_PATCHES) && cfg->scheme == SFB_SCHEME_MANIFOLD_BLEND) {
+        r = sfb__manifold_build(ctx, &prep, cfg->manifold.weights, s->base_positions, &s->patches);
+        if (r == SFB_SUCCESS) { s->has_patches = 1; s->pbase = prep; memset(&prep, 0, sizeof prep); }
+    } else if (r == SFB_SUCCESS && (cfg->flags & SFB_REFINE_PATCHES)) {
         r = sfb__patches_build(ctx, &prep, &opt, cfg->isolation_level ? cfg->isolation_level : SFB_DEFAULT_ISOLATION,
                                 s->base_positions, &s->patches);
         if (r == SFB_SUCCESS) { s->has_patches = 1; s->pbase = prep; memset(&prep, 0, sizeof prep); }
@@ -235,10 +245,11 @@ SFB_API sfb_result sfb_surface_patch_info(const sfb_surface *s, sfb_patch_info *
     o->bezier = pt->counts[SFB__PATCH_BEZTRI];
     o->stam = pt->counts[SFB__PATCH_STAM] + pt->counts[SFB__PATCH_STAM_LOOP];
     o->end_caps = pt->counts[SFB__PATCH_ENDCAP] + pt->counts[SFB__PATCH_ENDCAP_TRI];
+    o->manifold = pt->counts[SFB__PATCH_MANIFOLD4];
     o->max_depth = pt->max_depth;
     o->points = pt->npoints;
     o->bytes = (size_t)pt->npatch * (4 * sizeof(int)) + (size_t)pt->ncv * sizeof(int) + (size_t)pt->nptex * 3 * sizeof(int) +
-               (size_t)pt->nnodes * 4 * sizeof(int) + (size_t)pt->npoints * 3 * sizeof(float);
+               (size_t)pt->nnodes * 4 * sizeof(int) + (size_t)pt->npoints * 3 * sizeof(float) + (pt->pcorner ? (size_t)pt->npatch * 4 * sizeof(unsigned) : 0);
     return SFB_SUCCESS;
 }
 
