@@ -156,8 +156,14 @@ $(BUILD)/shade: tests/shade.c surfblend.h $(BACKEND_HDRS)
 $(BUILD)/finish_normals: tests/finish_normals.c surfblend.h $(BACKEND_HDRS)
 	$(CC) $(CFLAGS) $(SAN) -I. tests/finish_normals.c -o $@ $(LIBS)
 
+# Manifold-based blending (SFB_SCHEME_MANIFOLD_BLEND) on every backend: interpolation, continuity,
+# creases/darts/corners, derivatives, agreement; compiles its own implementation to reach the
+# patch table (tests/manifold.c).
+$(BUILD)/manifold: tests/manifold.c surfblend.h $(BACKEND_HDRS)
+	$(CC) $(CFLAGS) $(SAN) -I. tests/manifold.c -o $@ $(LIBS)
+
 unit-build: $(BUILD)/surfblend $(BUILD)/unit $(BUILD)/osd_agree $(BUILD)/agree $(BUILD)/limit $(BUILD)/eigen $(BUILD)/gl_host \
-            $(BUILD)/gl_errors $(BUILD)/gl_pieces $(BUILD)/shade $(BUILD)/finish_normals $(EXAMPLES)
+            $(BUILD)/gl_errors $(BUILD)/gl_pieces $(BUILD)/shade $(BUILD)/finish_normals $(BUILD)/manifold $(EXAMPLES)
 
 # On CI (CI set and not false/0) the optional backends must run, not be skipped: the suites
 # fail for a backend in SFB_REQUIRE_BACKENDS that is unavailable. CI has Mesa llvmpipe and

@@ -95,6 +95,9 @@ else echo "peer shapes not found at $SHAPES: limit evaluation suite skipped"; ad
 # 3b'''. subdivision shading on every backend: tests/shade.c; the finish_normals kernels: tests/finish_normals.c
 if [ -d "$SHAPES" ]; then counted shade "$BUILD/shade" "$SHAPES"
 else echo "peer shapes not found at $SHAPES: shade runs without them"; counted shade "$BUILD/shade"; fi
+# manifold-based blending surfaces on every backend: tests/manifold.c
+if [ -d "$SHAPES" ]; then counted manifold "$BUILD/manifold" "$SHAPES"
+else echo "peer shapes not found at $SHAPES: manifold runs without them"; counted manifold "$BUILD/manifold"; fi
 counted finish_normals "$BUILD/finish_normals"
 
 # 3c. the engine case: the gl backend on the host's own EGL context and GL buffers
