@@ -111,6 +111,15 @@ run: deps $(BUILD)/surfblend
 	  done; \
 	  echo "wrote out/catmark_pole8_before.png out/catmark_pole8_after.png"; \
 	else echo "peer shapes not found at $(SHAPES): the catmark_pole8 pictures are skipped"; fi
+	@# manifold-based blending (seed 000): a surface with a crease loop, a corner and darts (as the
+	@# seed's Fig. 14), tessellated to OBJ and drawn; and a torus trimmed by a disc mask on every
+	@# face (as Fig. 11)
+	./$(BUILD)/surfblend tess --scheme manifold --rate 12 examples/data/manifold_features.obj -o out/manifold_features.obj
+	./$(BUILD)/surfblend render --scheme manifold --rate 16 --view 35,30 --size 800x600 examples/data/manifold_features.obj \
+	  -o out/manifold_features.png
+	./$(BUILD)/surfblend render --scheme manifold --rate 8 --trim examples/data/trim_disc.png --view 35,30 --size 800x600 \
+	  examples/data/torus.obj -o out/manifold_trimmed.png
+	@echo "wrote out/manifold_features.obj out/manifold_features.png out/manifold_trimmed.png"
 
 # ---- tests ----
 $(BUILD)/unit: $(TEST_SRCS) $(BUILD)/libsfb.o
@@ -151,6 +160,12 @@ $(BUILD)/eigen: tests/eigen.c surfblend.h
 $(BUILD)/shade: tests/shade.c surfblend.h $(BACKEND_HDRS)
 	$(CC) $(CFLAGS) $(SAN) -I. tests/shade.c -o $@ $(LIBS)
 
+# Trimming of tessellations with a mask (sfb_surface_tessellate) on every backend: kept areas,
+# the cut on the contour, watertightness, atlases, agreement, bad masks, failing allocations
+# (tests/trim.c, its own implementation like tests/shade.c).
+$(BUILD)/trim: tests/trim.c surfblend.h $(BACKEND_HDRS)
+	$(CC) $(CFLAGS) $(SAN) -I. tests/trim.c -o $@ $(LIBS)
+
 # The finish_normals kernel of every backend against ref, degenerate inputs included: compiles
 # its own implementation to reach the backend vtables (tests/finish_normals.c).
 $(BUILD)/finish_normals: tests/finish_normals.c surfblend.h $(BACKEND_HDRS)
@@ -163,7 +178,7 @@ $(BUILD)/manifold: tests/manifold.c surfblend.h $(BACKEND_HDRS)
 	$(CC) $(CFLAGS) $(SAN) -I. tests/manifold.c -o $@ $(LIBS)
 
 unit-build: $(BUILD)/surfblend $(BUILD)/unit $(BUILD)/osd_agree $(BUILD)/agree $(BUILD)/limit $(BUILD)/eigen $(BUILD)/gl_host \
-            $(BUILD)/gl_errors $(BUILD)/gl_pieces $(BUILD)/shade $(BUILD)/finish_normals $(BUILD)/manifold $(EXAMPLES)
+            $(BUILD)/gl_errors $(BUILD)/gl_pieces $(BUILD)/shade $(BUILD)/trim $(BUILD)/finish_normals $(BUILD)/manifold $(EXAMPLES)
 
 # On CI (CI set and not false/0) the optional backends must run, not be skipped: the suites
 # fail for a backend in SFB_REQUIRE_BACKENDS that is unavailable. CI has Mesa llvmpipe and

@@ -40,6 +40,37 @@
  * is within `tolerance` of the chords; a shared edge takes the largest rate of its faces.
  * This samples the surface: a feature narrower than a cell can be missed at that rate.
  *
+ * Trimming (cfg->trim, seed 000 section V.5): param face t reads tile t of the mask (every face
+ * the one mask when the atlas is 0 x 0 or 1 x 1; faces past the last tile are not trimmed)
+ * through the bilinear interpolation of its texel centres, clamped at the tile's borders; a
+ * point is kept where the value / 255 is >= 0.5. A tile whose texels are all >= 128 keeps its
+ * face whole and one whose texels are all <= 127 drops it (the bilinear value lies between its
+ * texels' extremes). Otherwise the 0.5 contour crosses the tile, and the face's rate is raised
+ * to max(tile width, tile height) (at most SFB__TESS_MAX_RATE) so that a cell is at most one
+ * texel wide: the contour is followed within one texel whatever rate was asked for. The raised
+ * rates go through the per-face rates and shared edge counts of adaptive mode, so faces of
+ * different rates still meet without cracks.
+ * Every triangle corner is then classified by its own face's mask at its (u,v) in that face:
+ * a triangle with three trimmed corners is dropped, one with three kept corners kept, and
+ * otherwise each edge whose ends differ is cut where the mask first changes sides walking from
+ * its lower vertex id. Along a segment the mask is a quadratic in the segment's parameter
+ * between the texel-centre lines it crosses; each such piece is split at its extremum into
+ * monotone parts and the first part whose ends differ is bisected on the exact bilinear value,
+ * in double precision. The kept part (a triangle, or a convex quad split along its shorter
+ * (u,v) diagonal) keeps the triangle's counter-clockwise order. Where the contour bends inside
+ * a cell the straight cut leaves a sliver of less than a cell on one side.
+ * A cut point is keyed by its tessellation edge (the two vertex ids) in a hash table, so the
+ * two triangles on an edge share one vertex and the kept mesh stays watertight. On an edge
+ * between two param faces each face cuts with its own mask: the faces share the point when
+ * they put it at the same place along the edge (within 1e-7 of its length), else each side
+ * has its own and the seam opens there, as the masks disagree. A cut within SFB__TRIM_SNAP of
+ * an end in (u,v) (a few float steps: it would round onto it) is that end, and a kept polygon
+ * that repeats a vertex loses the repeat (fewer than 3 left: nothing). Cut points are new
+ * vertices, located in the face that made them and evaluated with the others through
+ * sfb_surface_eval, so on the selected backend. Vertices that no kept triangle uses are
+ * removed and the others keep their order, so an all-white mask gives the untrimmed output
+ * exactly.
+ *
  * Thread safety: reads the surface only; allocations, errors and progress go through the
  * surface's context, so one call per context at a time. */
 
@@ -47,6 +78,8 @@
 #define SFB__TESS_MAX_SEG (2 * SFB__TESS_MAX_RATE) /* a quad edge beside an n-gon sub-face */
 #define SFB__TESS_EVAL_CHUNK 65536                 /* locations per sfb_surface_eval call */
 #define SFB__TESS_FACE_CHUNK 1024                  /* param faces between progress reports */
+#define SFB__TRIM_MAX_SIZE 16384                   /* texels on a side of a trimming mask */
+#define SFB__TRIM_SNAP 2.5e-7                      /* a cut this near an end of its edge, in (u,v), is that end */
 
 SFB_API sfb_tess_config sfb_tess_config_init(int rate) {
     sfb_tess_config c;
@@ -65,6 +98,14 @@ SFB_API void sfb_tess_data_free(sfb_tess_data *d) {
     }
     memset(d, 0, sizeof *d);
 }
+
+/* A cut point: the edge (lo << 32 | hi, vertex ids), its place t from lo to hi, the vertex
+ * and the param face that computed it. vid < 0: an empty slot. */
+typedef struct sfb__trim_cut {
+    unsigned long long key;
+    double t;
+    int vid, face;
+} sfb__trim_cut;
 
 typedef struct sfb__tess {
     sfb_context *ctx;
@@ -90,7 +131,22 @@ typedef struct sfb__tess {
     sfb_location *loc;
     int *tri, *tface;
     size_t tri_at;
+    /* trimming (NULL trim: none of these is used) */
+    const sfb_trim_mask *trim;
+    int ntiles, tiles_u, tw, th;  /* tiles in use (1: one mask for all faces), tile size in texels */
+    unsigned char *fstate;        /* per param face: SFB__TRIM_KEEP, _DROP or _CUT */
+    double *cuv;                  /* per vertex: (u,v) in the face being emitted (faces to cut) */
+    unsigned char *ckept;         /* per vertex: kept by that face's mask */
+    int *otri, *oface;            /* trimmed triangles (grown) */
+    size_t ocount, ocap;
+    sfb_location *nloc;           /* cut points: vertex nvert + i (grown) */
+    size_t nnew, ncap;
+    sfb__trim_cut *cuts;          /* hash table of cut points by tessellation edge */
+    size_t cut_cap, cut_count;
+    sfb_result err;               /* first failure inside the emit pass */
 } sfb__tess;
+
+enum { SFB__TRIM_KEEP = 0, SFB__TRIM_DROP = 1, SFB__TRIM_CUT = 2 };
 
 static void *sfb__tess_array(sfb_context *ctx, size_t count, size_t size) {
     size_t bytes;
@@ -105,6 +161,15 @@ static void sfb__tess_free_work(sfb__tess *T) {
     sfb__free(ctx, T->vspoke); sfb__free(ctx, T->vcenter); sfb__free(ctx, T->ifirst); sfb__free(ctx, T->bids);
     T->prate = T->eseg = T->sseg = T->uf = T->ecopy = T->vcorner = T->vedge = T->vspoke = T->vcenter = T->ifirst = T->bids = NULL;
     T->engon = NULL;
+    sfb__free(ctx, T->fstate); sfb__free(ctx, T->cuv); sfb__free(ctx, T->ckept); sfb__free(ctx, T->otri);
+    sfb__free(ctx, T->oface); sfb__free(ctx, T->nloc); sfb__free(ctx, T->cuts);
+    T->fstate = T->ckept = NULL;
+    T->cuv = NULL;
+    T->otri = T->oface = NULL;
+    T->nloc = NULL;
+    T->cuts = NULL;
+    if (T->trim) sfb__free(ctx, T->loc); /* trimming: the untrimmed locations are scratch */
+    T->loc = NULL;
 }
 
 static int sfb__tess_face_n(const sfb__level *l, int f) { return l->fv_off[f + 1] - l->fv_off[f]; }
@@ -148,12 +213,326 @@ static void sfb__tess_uv(int tri, double u, double v, sfb_location *L) {
     L->v = fv;
 }
 
+/* ---- trimming ---- */
+
+/* The mask tile of param face pf (its first texel; rows are the mask's width apart), or NULL
+ * for a face past the last tile of an atlas. */
+static const unsigned char *sfb__trim_tile(const sfb__tess *T, int pf) {
+    const sfb_trim_mask *m = T->trim;
+    if (T->ntiles == 1) return m->texels;
+    if (pf < 0 || pf >= T->ntiles) return NULL;
+    return m->texels + (size_t)(pf / T->tiles_u) * (size_t)T->th * (size_t)m->width + (size_t)(pf % T->tiles_u) * (size_t)T->tw;
+}
+
+/* The mask at (u,v) of a tile, in [0,1]: the bilinear interpolation of the texel centres,
+ * clamped at the tile's borders, / 255. */
+static double sfb__trim_value(const sfb__tess *T, const unsigned char *tile, double u, double v) {
+    int tw = T->tw, th = T->th, i0, j0, i1, j1;
+    size_t w = (size_t)T->trim->width;
+    double x = u * tw - 0.5, y = v * th - 0.5, fx, fy, a, b;
+    if (!(x > 0.0)) x = 0.0; /* NaN too */
+    if (x > tw - 1) x = tw - 1;
+    if (!(y > 0.0)) y = 0.0;
+    if (y > th - 1) y = th - 1;
+    i0 = (int)x;
+    j0 = (int)y;
+    if (i0 > tw - 2) i0 = tw > 1 ? tw - 2 : 0;
+    if (j0 > th - 2) j0 = th > 1 ? th - 2 : 0;
+    fx = x - i0;
+    fy = y - j0;
+    i1 = tw > 1 ? i0 + 1 : i0;
+    j1 = th > 1 ? j0 + 1 : j0;
+    a = (1.0 - fx) * tile[(size_t)j0 * w + (size_t)i0] + fx * tile[(size_t)j0 * w + (size_t)i1];
+    b = (1.0 - fx) * tile[(size_t)j1 * w + (size_t)i0] + fx * tile[(size_t)j1 * w + (size_t)i1];
+    return ((1.0 - fy) * a + fy * b) / 255.0;
+}
+
+/* Kept (1) or trimmed (0) at p0 + t (p1 - p0); t = 1 is p1 itself. */
+static int sfb__trim_kept_at(const sfb__tess *T, const unsigned char *tile, const double *p0, const double *p1, double t) {
+    double u = p1[0], v = p1[1];
+    if (t < 1.0) {
+        u = p0[0] + t * (p1[0] - p0[0]);
+        v = p0[1] + t * (p1[1] - p0[1]);
+    }
+    return sfb__trim_value(T, tile, u, v) >= 0.5;
+}
+
+static double sfb__trim_g(const sfb__tess *T, const unsigned char *tile, const double *p0, const double *p1, double t) {
+    double u = p1[0], v = p1[1];
+    if (t < 1.0) {
+        u = p0[0] + t * (p1[0] - p0[0]);
+        v = p0[1] + t * (p1[1] - p0[1]);
+    }
+    return sfb__trim_value(T, tile, u, v) - 0.5;
+}
+
+/* The texel-centre lines x = k (integers 0..n-1, where the bilinear pieces change) strictly
+ * between x0 and x0 + dx: from *k in steps *step while *k != *end. */
+static void sfb__trim_lines(double x0, double dx, int n, long *k, long *end, int *step) {
+    double x1 = x0 + dx;
+    long first, last;
+    *step = dx > 0.0 ? 1 : -1;
+    *k = *end = 0;
+    if (!(dx != 0.0)) return;
+    if (dx > 0.0) {
+        first = (long)floor(x0) + 1;
+        last = (long)ceil(x1) - 1;
+        if (first < 0) first = 0;
+        if (last > n - 1) last = n - 1;
+        if (first <= last) { *k = first; *end = last + 1; }
+    } else {
+        first = (long)ceil(x0) - 1;
+        last = (long)floor(x1) + 1;
+        if (first > n - 1) first = n - 1;
+        if (last < 0) last = 0;
+        if (first >= last) { *k = first; *end = last - 1; }
+    }
+}
+
+/* Where the mask first changes sides along p0 -> p1, whose ends are on different sides
+ * (kept0: the side of p0). Between texel-centre lines the mask is a quadratic in t; each
+ * piece is split at its extremum into monotone parts, and the first part whose ends differ
+ * is bisected on the exact value. Returns t in (0,1]. */
+static double sfb__trim_solve(const sfb__tess *T, const unsigned char *tile, const double *p0, const double *p1, int kept0) {
+    double x0 = p0[0] * T->tw - 0.5, dx = (p1[0] - p0[0]) * T->tw;
+    double y0 = p0[1] * T->th - 0.5, dy = (p1[1] - p0[1]) * T->th;
+    double ta = 0.0;
+    long kx, kx_end, ky, ky_end;
+    int sx, sy;
+    sfb__trim_lines(x0, dx, T->tw, &kx, &kx_end, &sx);
+    sfb__trim_lines(y0, dy, T->th, &ky, &ky_end, &sy);
+    for (;;) {
+        double tb = 1.0, tx = 2.0, ty = 2.0;
+        if (kx != kx_end) tx = ((double)kx - x0) / dx;
+        if (ky != ky_end) ty = ((double)ky - y0) / dy;
+        if (tx <= ty && tx < 1.0) { tb = tx; kx += sx; }
+        else if (ty < 1.0) { tb = ty; ky += sy; }
+        if (tb > ta) {
+            double ga = sfb__trim_g(T, tile, p0, p1, ta), gm = sfb__trim_g(T, tile, p0, p1, 0.5 * (ta + tb));
+            double gb = sfb__trim_g(T, tile, p0, p1, tb), c = 2.0 * (gb + ga - 2.0 * gm), b = gb - ga - c, ends[2], lo = ta;
+            int n = 0, q;
+            if (c != 0.0) {
+                double sm = -b / (2.0 * c);
+                if (sm > 0.0 && sm < 1.0) ends[n++] = ta + sm * (tb - ta);
+            }
+            ends[n++] = tb;
+            for (q = 0; q < n; ++q) {
+                double hi = ends[q];
+                if (sfb__trim_kept_at(T, tile, p0, p1, hi) != kept0) {
+                    int it;
+                    for (it = 0; it < 80; ++it) {
+                        double mid = 0.5 * (lo + hi);
+                        if (!(mid > lo && mid < hi)) break;
+                        if (sfb__trim_kept_at(T, tile, p0, p1, mid) == kept0) lo = mid;
+                        else hi = mid;
+                    }
+                    return 0.5 * (lo + hi);
+                }
+                lo = hi;
+            }
+            ta = tb;
+        }
+        if (tb >= 1.0) break;
+    }
+    return 1.0; /* not reached: p1 is on the other side */
+}
+
+static size_t sfb__trim_hash(unsigned long long key) {
+    key ^= key >> 29;
+    key *= 0x9E3779B97F4A7C15ULL;
+    return (size_t)(key ^ (key >> 32));
+}
+
+/* Grows an array to hold at least `need` elements (doubling); 0 when that fails. */
+static int sfb__trim_grow(sfb_context *ctx, void **p, size_t *cap, size_t need, size_t elem) {
+    size_t nc = *cap ? *cap : 1024, bytes;
+    void *np;
+    if (need <= *cap) return 1;
+    while (nc < need) nc *= 2;
+    if (!sfb__mul_size(nc, elem, &bytes)) return 0;
+    np = sfb__realloc(ctx, *p, bytes);
+    if (!np) return 0;
+    *p = np;
+    *cap = nc;
+    return 1;
+}
+
+static void sfb__trim_fail(sfb__tess *T, sfb_result r) {
+    if (T->err == SFB_SUCCESS) T->err = r;
+}
+
+/* Adds an entry to the cut table, growing it to stay at most half full. */
+static int sfb__trim_insert(sfb__tess *T, unsigned long long key, double t, int vid, int face) {
+    size_t i, mask;
+    if ((T->cut_count + 1) * 2 > T->cut_cap) {
+        size_t nc = T->cut_cap * 2, j;
+        sfb__trim_cut *nt = (sfb__trim_cut *)sfb__tess_array(T->ctx, nc, sizeof(sfb__trim_cut));
+        if (!nt) return 0;
+        for (j = 0; j < nc; ++j) nt[j].vid = -1;
+        for (j = 0; j < T->cut_cap; ++j)
+            if (T->cuts[j].vid >= 0) {
+                for (i = sfb__trim_hash(T->cuts[j].key) & (nc - 1); nt[i].vid >= 0; i = (i + 1) & (nc - 1)) {}
+                nt[i] = T->cuts[j];
+            }
+        sfb__free(T->ctx, T->cuts);
+        T->cuts = nt;
+        T->cut_cap = nc;
+    }
+    mask = T->cut_cap - 1;
+    for (i = sfb__trim_hash(key) & mask; T->cuts[i].vid >= 0; i = (i + 1) & mask) {}
+    T->cuts[i].key = key;
+    T->cuts[i].t = t;
+    T->cuts[i].vid = vid;
+    T->cuts[i].face = face;
+    T->cut_count++;
+    return 1;
+}
+
+/* The vertex where the edge p-q of a triangle of param face pf crosses the contour, with its
+ * (u,v) in that face; -1 (T->err set) on failure. */
+static int sfb__trim_cut_edge(sfb__tess *T, const unsigned char *tile, int p, int q, int pf, double *uv) {
+    int lo = p < q ? p : q, hi = p < q ? q : p, vid = -1, found = 0;
+    const double *a = T->cuv + 2 * (size_t)lo, *b = T->cuv + 2 * (size_t)hi;
+    unsigned long long key = (unsigned long long)(unsigned)lo << 32 | (unsigned)hi;
+    size_t mask = T->cut_cap - 1, i;
+    double t = 0.0;
+    for (i = sfb__trim_hash(key) & mask; T->cuts[i].vid >= 0; i = (i + 1) & mask)
+        if (T->cuts[i].key == key && T->cuts[i].face == pf) { /* this face cut it already */
+            t = T->cuts[i].t;
+            vid = T->cuts[i].vid;
+            found = 1;
+            break;
+        }
+    if (!found) {
+        double len = sqrt((b[0] - a[0]) * (b[0] - a[0]) + (b[1] - a[1]) * (b[1] - a[1]));
+        t = sfb__trim_solve(T, tile, a, b, T->ckept[lo]);
+        if (t <= 1e-9 || t * len <= SFB__TRIM_SNAP) vid = lo;
+        else if (t >= 1.0 - 1e-9 || (1.0 - t) * len <= SFB__TRIM_SNAP) vid = hi;
+        else
+            for (i = sfb__trim_hash(key) & mask; T->cuts[i].vid >= 0; i = (i + 1) & mask)
+                if (T->cuts[i].key == key && fabs(T->cuts[i].t - t) <= 1e-7) { /* another face cut it at the same place */
+                    vid = T->cuts[i].vid;
+                    break;
+                }
+    }
+    if (vid == lo) { uv[0] = a[0]; uv[1] = a[1]; }
+    else if (vid == hi) { uv[0] = b[0]; uv[1] = b[1]; }
+    else { uv[0] = a[0] + t * (b[0] - a[0]); uv[1] = a[1] + t * (b[1] - a[1]); }
+    if (found) return vid;
+    if (vid < 0) {
+        sfb_location *L;
+        if (T->nvert + T->nnew >= (size_t)SFB_MAX_ELEMENTS) {
+            sfb__trim_fail(T, sfb__error(T->ctx, SFB_LIMIT_EXCEEDED, SFB_ELEMENT_NONE, -1,
+                                         "trimmed tessellation makes more than %d vertices (SFB_MAX_ELEMENTS)", SFB_MAX_ELEMENTS));
+            return -1;
+        }
+        if (!sfb__trim_grow(T->ctx, (void **)&T->nloc, &T->ncap, T->nnew + 1, sizeof(sfb_location))) {
+            sfb__trim_fail(T, sfb__oom(T->ctx, "tessellation"));
+            return -1;
+        }
+        vid = (int)(T->nvert + T->nnew);
+        L = &T->nloc[T->nnew++];
+        L->face = pf;
+        sfb__tess_uv(T->loop, uv[0] < 0.0 ? 0.0 : uv[0] > 1.0 ? 1.0 : uv[0], uv[1] < 0.0 ? 0.0 : uv[1] > 1.0 ? 1.0 : uv[1], L);
+    }
+    if (!sfb__trim_insert(T, key, t, vid, pf)) {
+        sfb__trim_fail(T, sfb__oom(T->ctx, "tessellation"));
+        return -1;
+    }
+    return vid;
+}
+
+static void sfb__trim_push(sfb__tess *T, int a, int b, int c, int pf) {
+    size_t cap = T->ocap;
+    if (T->ocount >= (size_t)SFB_MAX_ELEMENTS) {
+        sfb__trim_fail(T, sfb__error(T->ctx, SFB_LIMIT_EXCEEDED, SFB_ELEMENT_NONE, -1,
+                                     "trimmed tessellation makes more than %d triangles (SFB_MAX_ELEMENTS)", SFB_MAX_ELEMENTS));
+        return;
+    }
+    if (T->ocount >= cap) { /* both arrays to twice the triangles */
+        size_t nc = cap ? 2 * cap : 1024, b1, b3;
+        int *nf = NULL, *nt = NULL;
+        if (sfb__mul_size(nc, sizeof(int), &b1) && sfb__mul_size(nc, 3 * sizeof(int), &b3)) {
+            nf = (int *)sfb__realloc(T->ctx, T->oface, b1);
+            if (nf) T->oface = nf;
+            nt = nf ? (int *)sfb__realloc(T->ctx, T->otri, b3) : NULL;
+        }
+        if (!nt) {
+            sfb__trim_fail(T, sfb__oom(T->ctx, "tessellation"));
+            return;
+        }
+        T->otri = nt;
+        T->ocap = nc;
+    }
+    T->otri[3 * T->ocount] = a;
+    T->otri[3 * T->ocount + 1] = b;
+    T->otri[3 * T->ocount + 2] = c;
+    T->oface[T->ocount++] = pf;
+}
+
+/* One triangle (counter-clockwise) of param face pf through the mask: dropped, kept, or cut
+ * to its kept part. */
+static void sfb__trim_triangle(sfb__tess *T, int a, int b, int c, int pf) {
+    const unsigned char *tile;
+    int v[3], poly[4], ids[4], n = 0, m = 0, k;
+    double puv[4][2], quv[4][2];
+    if (T->err != SFB_SUCCESS || T->fstate[pf] == SFB__TRIM_DROP) return;
+    if (T->fstate[pf] == SFB__TRIM_KEEP || (T->ckept[a] && T->ckept[b] && T->ckept[c])) {
+        sfb__trim_push(T, a, b, c, pf);
+        return;
+    }
+    if (!T->ckept[a] && !T->ckept[b] && !T->ckept[c]) return;
+    tile = sfb__trim_tile(T, pf);
+    v[0] = a; v[1] = b; v[2] = c;
+    for (k = 0; k < 3; ++k) {
+        int p = v[k], q = v[(k + 1) % 3];
+        if (T->ckept[p]) {
+            poly[n] = p;
+            puv[n][0] = T->cuv[2 * (size_t)p];
+            puv[n][1] = T->cuv[2 * (size_t)p + 1];
+            ++n;
+        }
+        if (T->ckept[p] != T->ckept[q]) {
+            int x = sfb__trim_cut_edge(T, tile, p, q, pf, puv[n]);
+            if (x < 0) return;
+            poly[n++] = x;
+        }
+    }
+    /* a cut point at a corner repeats it: drop repeats (cyclically) */
+    for (k = 0; k < n; ++k)
+        if (m == 0 || ids[m - 1] != poly[k]) {
+            ids[m] = poly[k];
+            quv[m][0] = puv[k][0];
+            quv[m][1] = puv[k][1];
+            ++m;
+        }
+    while (m > 1 && ids[m - 1] == ids[0]) --m;
+    if (m == 3) {
+        sfb__trim_push(T, ids[0], ids[1], ids[2], pf);
+    } else if (m == 4) { /* convex: split along the shorter diagonal */
+        double d02 = (quv[0][0] - quv[2][0]) * (quv[0][0] - quv[2][0]) + (quv[0][1] - quv[2][1]) * (quv[0][1] - quv[2][1]);
+        double d13 = (quv[1][0] - quv[3][0]) * (quv[1][0] - quv[3][0]) + (quv[1][1] - quv[3][1]) * (quv[1][1] - quv[3][1]);
+        if (d02 <= d13) {
+            sfb__trim_push(T, ids[0], ids[1], ids[2], pf);
+            sfb__trim_push(T, ids[0], ids[2], ids[3], pf);
+        } else {
+            sfb__trim_push(T, ids[1], ids[2], ids[3], pf);
+            sfb__trim_push(T, ids[1], ids[3], ids[0], pf);
+        }
+    }
+}
+
 /* The location a vertex is evaluated at: the first param face that reaches it in the emit
  * pass (for a split crease copy that is always a face on its own side). */
 static void sfb__tess_loc(sfb__tess *T, int id, int pf, double u, double v) {
     if (T->loc && T->loc[id].face < 0) {
         T->loc[id].face = pf;
         sfb__tess_uv(T->loop, u, v, &T->loc[id]);
+    }
+    if (T->cuv && T->fstate[pf] == SFB__TRIM_CUT) { /* trimming: where this face sees it, and its side */
+        T->cuv[2 * (size_t)id] = u;
+        T->cuv[2 * (size_t)id + 1] = v;
+        T->ckept[id] = (unsigned char)(sfb__trim_value(T, sfb__trim_tile(T, pf), u, v) >= 0.5);
     }
 }
 
@@ -194,7 +573,13 @@ static int sfb__tess_spoke(sfb__tess *T, int f, int i, int t) {
 }
 
 static void sfb__tess_tri(sfb__tess *T, int a, int b, int c, int pf) {
-    size_t t = T->tri_at++;
+    size_t t;
+    if (T->trim) {
+        T->tri_at++;
+        sfb__trim_triangle(T, a, b, c, pf);
+        return;
+    }
+    t = T->tri_at++;
     T->tri[3 * t] = a;
     T->tri[3 * t + 1] = b;
     T->tri[3 * t + 2] = c;
@@ -484,13 +869,115 @@ done:
     return r;
 }
 
+/* Which side of 0.5 a tile's texels are on: all kept, all trimmed, or both (the contour
+ * crosses it). */
+static int sfb__trim_scan(const sfb__tess *T, const unsigned char *tile) {
+    int lo = 0, hi = 0, i, j;
+    for (j = 0; j < T->th; ++j) {
+        const unsigned char *row = tile + (size_t)j * (size_t)T->trim->width;
+        for (i = 0; i < T->tw; ++i) {
+            if (row[i] >= 128) hi = 1;
+            else lo = 1;
+        }
+        if (lo && hi) return SFB__TRIM_CUT;
+    }
+    return lo ? SFB__TRIM_DROP : SFB__TRIM_KEEP;
+}
+
+/* The trimming state of every param face, and the rate of those the contour crosses raised
+ * to one cell per texel of their tile (at most SFB__TESS_MAX_RATE). */
+static sfb_result sfb__trim_rates(sfb__tess *T, float p) {
+    const sfb_trim_mask *m = T->trim;
+    int nptex = T->pt->nptex, atlas = m->tiles_u > 1 || m->tiles_v > 1, pf, need, one = SFB__TRIM_KEEP;
+    sfb_result r;
+    T->tiles_u = atlas ? m->tiles_u : 1;
+    T->ntiles = atlas ? m->tiles_u * m->tiles_v : 1;
+    T->tw = m->width / T->tiles_u;
+    T->th = m->height / (atlas ? m->tiles_v : 1);
+    need = T->tw > T->th ? T->tw : T->th;
+    if (need > SFB__TESS_MAX_RATE) need = SFB__TESS_MAX_RATE;
+    T->fstate = (unsigned char *)sfb__tess_array(T->ctx, (size_t)nptex, 1);
+    if (!T->fstate) return sfb__oom(T->ctx, "tessellation");
+    if (!atlas) one = sfb__trim_scan(T, m->texels);
+    for (pf = 0; pf < nptex; ++pf) {
+        int st = SFB__TRIM_KEEP;
+        if (atlas && pf % SFB__TESS_FACE_CHUNK == 0 && (r = sfb__progress(T->ctx, p, "tessellate")) != SFB_SUCCESS) return r;
+        if (T->prate[pf] > 0) st = atlas ? (pf < T->ntiles ? sfb__trim_scan(T, sfb__trim_tile(T, pf)) : SFB__TRIM_KEEP) : one;
+        T->fstate[pf] = (unsigned char)st;
+        if (st == SFB__TRIM_CUT && T->prate[pf] < need) T->prate[pf] = need;
+    }
+    return SFB_SUCCESS;
+}
+
+/* The emit pass with trimming: locations of the untrimmed points, triangles through the mask
+ * (sfb__trim_triangle), then the vertices no triangle uses are removed (the others keep
+ * their order) and `out` gets the compacted arrays. */
+static sfb_result sfb__trim_emit(sfb__tess *T, sfb_tess_data *out, float p0, float p1) {
+    sfb_context *ctx = T->ctx;
+    int nptex = T->pt->nptex, pf, *remap = NULL;
+    size_t v, total, nv = 0, i;
+    sfb_result r;
+    T->loc = (sfb_location *)sfb__tess_array(ctx, T->nvert, sizeof(sfb_location));
+    T->cuv = (double *)sfb__tess_array(ctx, T->nvert, 2 * sizeof(double));
+    T->ckept = (unsigned char *)sfb__tess_array(ctx, T->nvert, 1);
+    T->cut_cap = 1024;
+    T->cuts = (sfb__trim_cut *)sfb__tess_array(ctx, T->cut_cap, sizeof(sfb__trim_cut));
+    if (!T->loc || !T->cuv || !T->ckept || !T->cuts) return sfb__oom(ctx, "tessellation");
+    for (v = 0; v < T->nvert; ++v) {
+        T->loc[v].face = -1;
+        T->loc[v].u = T->loc[v].v = 0.0f;
+        T->ckept[v] = 1;
+    }
+    for (i = 0; i < T->cut_cap; ++i) T->cuts[i].vid = -1;
+    T->err = SFB_SUCCESS;
+    for (pf = 0; pf < nptex; ++pf) {
+        if (pf % SFB__TESS_FACE_CHUNK == 0 && pf > 0) {
+            r = sfb__progress(ctx, p0 + (p1 - p0) * (float)pf / (float)nptex, "tessellate");
+            if (r != SFB_SUCCESS) return r;
+        }
+        sfb__tess_face(T, pf, 1);
+        if (T->err != SFB_SUCCESS) return T->err;
+    }
+    if (T->tri_at != T->ntri)
+        return sfb__error(ctx, SFB_BACKEND_ERROR, SFB_ELEMENT_NONE, -1, "tessellation wrote %zu triangles, counted %zu", T->tri_at, T->ntri);
+    for (v = 0; v < T->nvert; ++v)
+        if (T->loc[v].face < 0)
+            return sfb__error(ctx, SFB_BACKEND_ERROR, SFB_ELEMENT_NONE, -1, "tessellation vertex %zu has no location", v);
+    /* compaction */
+    total = T->nvert + T->nnew;
+    remap = (int *)sfb__tess_array(ctx, total, sizeof(int));
+    if (!remap) return sfb__oom(ctx, "tessellation");
+    for (v = 0; v < total; ++v) remap[v] = -1;
+    for (i = 0; i < 3 * T->ocount; ++i) remap[T->otri[i]] = 0;
+    for (v = 0; v < total; ++v)
+        if (remap[v] == 0) remap[v] = (int)nv++;
+    out->vertex_count = (int)nv;
+    out->triangle_count = (int)T->ocount;
+    out->positions = (float *)sfb__tess_array(ctx, nv, 3 * sizeof(float));
+    out->normals = (float *)sfb__tess_array(ctx, nv, 3 * sizeof(float));
+    out->locations = (sfb_location *)sfb__tess_array(ctx, nv, sizeof(sfb_location));
+    if (!out->positions || !out->normals || !out->locations || (!T->otri && !(T->otri = (int *)sfb__tess_array(ctx, 1, 3 * sizeof(int)))) ||
+        (!T->oface && !(T->oface = (int *)sfb__tess_array(ctx, 1, sizeof(int))))) {
+        sfb__free(ctx, remap);
+        return sfb__oom(ctx, "tessellation");
+    }
+    for (v = 0; v < total; ++v)
+        if (remap[v] >= 0) out->locations[remap[v]] = v < T->nvert ? T->loc[v] : T->nloc[v - T->nvert];
+    for (i = 0; i < 3 * T->ocount; ++i) T->otri[i] = remap[T->otri[i]];
+    sfb__free(ctx, remap);
+    out->triangles = T->otri;
+    out->triangle_faces = T->oface;
+    T->otri = T->oface = NULL;
+    return SFB_SUCCESS;
+}
+
 SFB_API sfb_result sfb_surface_tessellate(const sfb_surface *s, const sfb_tess_config *cfg, sfb_tess_data *out) {
     sfb_context *ctx;
     sfb__tess T;
     const sfb__level *l;
     sfb_result r = SFB_SUCCESS;
     int pf, f, e, i, k, nptex;
-    size_t v, done_v;
+    size_t v, done_v, nv;
     float p_emit, p_eval;
     if (out) memset(out, 0, sizeof *out);
     if (!s) return SFB_INVALID_ARGS;
@@ -507,6 +994,23 @@ SFB_API sfb_result sfb_surface_tessellate(const sfb_surface *s, const sfb_tess_c
                           (double)cfg->tolerance);
     if (cfg->flags & ~(unsigned)SFB_TESS_SPLIT_CREASES)
         return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "unknown tessellation flags 0x%x", cfg->flags);
+    if (cfg->trim) {
+        const sfb_trim_mask *m = cfg->trim;
+        if (!m->texels) return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, -1, "trimming mask: texels is NULL");
+        if (m->width < 1 || m->width > SFB__TRIM_MAX_SIZE || m->height < 1 || m->height > SFB__TRIM_MAX_SIZE)
+            return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, -1, "trimming mask: %d x %d texels, each side must be 1..%d",
+                              m->width, m->height, SFB__TRIM_MAX_SIZE);
+        if (m->tiles_u < 0 || m->tiles_v < 0)
+            return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, -1, "trimming mask: negative atlas tiles %d x %d", m->tiles_u,
+                              m->tiles_v);
+        if ((m->tiles_u == 0) != (m->tiles_v == 0))
+            return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, -1,
+                              "trimming mask: atlas tiles %d x %d (0 x 0 or both >= 1: one zero and not the other)", m->tiles_u, m->tiles_v);
+        if (m->tiles_u > 0 && (m->width % m->tiles_u != 0 || m->height % m->tiles_v != 0))
+            return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, -1,
+                              "trimming mask: %d x %d texels do not split into %d x %d equal tiles", m->width, m->height, m->tiles_u,
+                              m->tiles_v);
+    }
     if ((r = sfb__progress(ctx, 0.0f, "tessellate")) != SFB_SUCCESS) return r;
 
     memset(&T, 0, sizeof T);
@@ -554,6 +1058,11 @@ SFB_API sfb_result sfb_surface_tessellate(const sfb_surface *s, const sfb_tess_c
         p_emit = 0.5f;
     }
     p_eval = p_emit + 0.1f;
+    if (cfg->trim) {
+        T.trim = cfg->trim;
+        r = sfb__trim_rates(&T, p_emit);
+        if (r != SFB_SUCCESS) goto fail;
+    }
 
     /* 2. segments of each base edge and spoke: the largest rate of the faces on it (an n-gon
      * sub-face covers half an edge, so it asks for twice its rate, and the count stays even) */
@@ -612,6 +1121,11 @@ SFB_API sfb_result sfb_surface_tessellate(const sfb_surface *s, const sfb_tess_c
         }
     }
     out->ctx_ = ctx;
+    if (T.trim) {
+        r = sfb__trim_emit(&T, out, p_emit, p_eval);
+        if (r != SFB_SUCCESS) goto fail;
+        goto evaluate;
+    }
     out->vertex_count = (int)T.nvert;
     out->triangle_count = (int)T.ntri;
     out->positions = (float *)sfb__tess_array(ctx, T.nvert, 3 * sizeof(float));
@@ -648,13 +1162,15 @@ SFB_API sfb_result sfb_surface_tessellate(const sfb_surface *s, const sfb_tess_c
             r = sfb__error(ctx, SFB_BACKEND_ERROR, SFB_ELEMENT_NONE, -1, "tessellation vertex %zu has no location", v);
             goto fail;
         }
+evaluate:
     sfb__tess_free_work(&T);
 
     /* 6. evaluate every vertex once, in chunks, on the context's backend */
-    for (done_v = 0; done_v < T.nvert; done_v += SFB__TESS_EVAL_CHUNK) {
-        size_t n = T.nvert - done_v < SFB__TESS_EVAL_CHUNK ? T.nvert - done_v : SFB__TESS_EVAL_CHUNK;
+    nv = (size_t)out->vertex_count;
+    for (done_v = 0; done_v < nv; done_v += SFB__TESS_EVAL_CHUNK) {
+        size_t n = nv - done_v < SFB__TESS_EVAL_CHUNK ? nv - done_v : SFB__TESS_EVAL_CHUNK;
         sfb_eval_output eo;
-        r = sfb__progress(ctx, p_eval + (1.0f - p_eval) * (float)done_v / (float)T.nvert, "tessellate");
+        r = sfb__progress(ctx, p_eval + (1.0f - p_eval) * (float)done_v / (float)nv, "tessellate");
         if (r != SFB_SUCCESS) goto fail;
         memset(&eo, 0, sizeof eo);
         eo.position = out->positions + 3 * done_v;

@@ -164,6 +164,62 @@ for b in simd gl osmesa; do
   fi
 done
 
+# ---- tess --trim: trimming masks from PNG pictures (written here with python3's zlib) ----
+# mkpng OUT W H MODE: 8-bit grey, black where MODE says: left (left half), top / bottom (that half
+# of the picture); rgb-left: the left-half picture as RGB
+mkpng() { python3 - "$@" <<'PY'
+import struct, sys, zlib
+out, w, h, mode = sys.argv[1], int(sys.argv[2]), int(sys.argv[3]), sys.argv[4]
+def black(x, y):
+    return {'left': x < w // 2, 'rgb-left': x < w // 2, 'top': y < h // 2, 'bottom': y >= h // 2}[mode]
+rgb = mode.startswith('rgb')
+raw = b''.join(b'\0' + b''.join(bytes([0 if black(x, y) else 255] * (3 if rgb else 1)) for x in range(w)) for y in range(h))
+def chunk(t, d): return struct.pack('>I', len(d)) + t + d + struct.pack('>I', zlib.crc32(t + d) & 0xffffffff)
+open(out, 'wb').write(b'\x89PNG\r\n\x1a\n' + chunk(b'IHDR', struct.pack('>IIBBBBB', w, h, 8, 2 if rgb else 0, 0, 0, 0)) +
+                      chunk(b'IDAT', zlib.compress(raw)) + chunk(b'IEND', b''))
+PY
+}
+if command -v python3 > /dev/null 2>&1 && mkpng "$TMP/left.png" 16 16 left; then
+  mkpng "$TMP/top.png" 16 16 top; mkpng "$TMP/bottom.png" 16 16 bottom; mkpng "$TMP/rgbleft.png" 16 16 rgb-left
+  check "tess --trim succeeds" 0 "$CLI" tess --rate 2 --trim "$TMP/left.png" "$TMP/cube.obj" -o "$TMP/tt.obj"
+  contains "tess --trim says it trimmed" "$TMP/err" "trimmed (16x16 mask)"
+  # the contour u = 1/2 of the 16-texel mask: each face at rate 16 (raised from 2) keeps 16 x 8 cells
+  got=$(grep -c '^f ' "$TMP/tt.obj")
+  if [ "$got" = 1536 ]; then P=$((P + 1)); echo "ok tess --trim keeps half of each face (1536 triangles)"; else F=$((F + 1)); echo "FAIL tess --trim: $got triangles, wanted 1536"; fi
+  st=$(edge_stats "$TMP/tt.obj")
+  case "$st" in "0 "*|*" "[1-9]*" "*|*" "*" "[1-9]*) F=$((F + 1)); echo "FAIL tess --trim edges: $st (boundary non-manifold duplicated)";;
+    *) P=$((P + 1)); echo "ok tess --trim has boundary edges, none non-manifold or repeated ($st)";; esac
+  check "tess --trim with an RGB picture succeeds" 0 "$CLI" tess --rate 2 --trim "$TMP/rgbleft.png" "$TMP/cube.obj" -o "$TMP/ttc.obj"
+  if cmp -s <(grep -v '^#' "$TMP/tt.obj") <(grep -v '^#' "$TMP/ttc.obj"); then P=$((P + 1)); echo "ok an RGB mask is read as its grey level"
+  else F=$((F + 1)); echo "FAIL an RGB mask gives another tessellation than the grey one"; fi
+  # a planar 3 x 3 grid: the middle face is the square [1,2]^2 with u along x, v along y
+  printf 'v 0 0 0\nv 1 0 0\nv 2 0 0\nv 3 0 0\nv 0 1 0\nv 1 1 0\nv 2 1 0\nv 3 1 0\nv 0 2 0\nv 1 2 0\nv 2 2 0\nv 3 2 0\nv 0 3 0\nv 1 3 0\nv 2 3 0\nv 3 3 0\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 5 6 10 9\nf 6 7 11 10\nf 7 8 12 11\nf 9 10 14 13\nf 10 11 15 14\nf 11 12 16 15\n' > "$TMP/grid3.obj"
+  # vertices strictly inside the upper (v > 1/2) and lower (v < 1/2) halves of the middle face
+  halves() { awk '/^v / && $2 > 1.05 && $2 < 1.95 { if ($3 > 1.55 && $3 < 1.95) up++; if ($3 > 1.05 && $3 < 1.45) lo++ } END { printf "%d %d\n", up, lo }' "$1"; }
+  check "tess --trim (picture's top half black) succeeds" 0 "$CLI" tess --rate 4 --trim "$TMP/top.png" "$TMP/grid3.obj" -o "$TMP/ttop.obj"
+  check "tess --trim (picture's bottom half black) succeeds" 0 "$CLI" tess --rate 4 --trim "$TMP/bottom.png" "$TMP/grid3.obj" -o "$TMP/tbot.obj"
+  ht=$(halves "$TMP/ttop.obj"); hb=$(halves "$TMP/tbot.obj")
+  if [ "${ht%% *}" = 0 ] && [ "${ht##* }" -gt 0 ] && [ "${hb##* }" = 0 ] && [ "${hb%% *}" -gt 0 ]; then
+    P=$((P + 1)); echo "ok the picture's top row is v = 1 (top black keeps v < 1/2: $ht; bottom black keeps v > 1/2: $hb)"
+  else F=$((F + 1)); echo "FAIL mask rows are not flipped: top black leaves '$ht', bottom black '$hb' (upper lower)"; fi
+  # a 2 x 2 atlas of the left-half picture: tiles 0 and 2 black, 1 and 3 white, faces 4 and 5 past the last tile
+  check "tess --trim-tiles 2 2 succeeds" 0 "$CLI" tess --rate 2 --trim "$TMP/left.png" --trim-tiles 2 2 "$TMP/cube.obj" -o "$TMP/tta.obj"
+  got=$(grep -c '^f ' "$TMP/tta.obj")
+  if [ "$got" = 32 ]; then P=$((P + 1)); echo "ok --trim-tiles: faces 0 and 2 dropped, 1 3 4 5 whole (32 triangles)"; else F=$((F + 1)); echo "FAIL --trim-tiles 2 2: $got triangles, wanted 32"; fi
+  check "tess --trim of a missing file is bad input" 1 "$CLI" tess --rate 2 --trim "$TMP/none.png" "$TMP/cube.obj" -o "$TMP/x.obj"
+  contains "a missing mask is named" "$TMP/err" "cannot read the trimming mask"
+  check "tess --trim of a file that is not a PNG is bad input" 1 "$CLI" tess --rate 2 --trim "$TMP/cube.obj" "$TMP/cube.obj" -o "$TMP/x.obj"
+  contains "a bad mask file is named" "$TMP/err" "cannot read the trimming mask .*cube.obj"
+  check "tess --trim-tiles 3 3 on 16 texels is bad input" 1 "$CLI" tess --rate 2 --trim "$TMP/left.png" --trim-tiles 3 3 "$TMP/cube.obj" -o "$TMP/x.obj"
+  contains "uneven tiles are reported" "$TMP/err" "do not split into 3 x 3 equal tiles"
+  check "tess --trim-tiles 2 0 is bad input" 1 "$CLI" tess --rate 2 --trim "$TMP/left.png" --trim-tiles 2 0 "$TMP/cube.obj" -o "$TMP/x.obj"
+  check "tess --trim-tiles with one number is a usage error" 2 "$CLI" tess --rate 2 --trim "$TMP/left.png" --trim-tiles 2 "$TMP/cube.obj" -o "$TMP/x.obj"
+  check "tess --trim-tiles without --trim is a usage error" 2 "$CLI" tess --rate 2 --trim-tiles 2 2 "$TMP/cube.obj" -o "$TMP/x.obj"
+  check "tess --trim without a file is a usage error" 2 "$CLI" tess --rate 2 "$TMP/cube.obj" -o "$TMP/x.obj" --trim
+else
+  S=$((S + 1)); echo "SKIP tess --trim: python3 (to write the mask PNGs) not found"
+fi
+
 # ---- shade and render (subdivision shading, seed 001; software pictures) ----
 check "--help succeeds (shade, render)" 0 "$CLI" --help
 contains "--help shows shade" "$TMP/out" "surfblend shade"
@@ -187,6 +243,13 @@ if [ "$(grep -c '^v ' "$TMP/shl.obj")" = "$nv" ] && ! cmp -s <(grep '^v ' "$TMP/
   P=$((P + 1)); echo "ok shade --limit writes other positions, as many"; else F=$((F + 1)); echo "FAIL shade --limit positions"; fi
 check "shade --all-subdivided succeeds" 0 "$CLI" shade --level 2 --all-subdivided examples/data/creased_box.obj -o "$TMP/sha.obj"
 contains "shade --all-subdivided computes N_S everywhere" "$TMP/err" "(100.0%)"
+check "shade --averaging linear succeeds" 0 "$CLI" shade --level 2 --averaging linear examples/data/creased_box.obj -o "$TMP/shlin.obj"
+if cmp -s <(grep -v '^#' "$TMP/sh.obj") <(grep -v '^#' "$TMP/shlin.obj"); then P=$((P + 1)); echo "ok --averaging linear is the default"
+else F=$((F + 1)); echo "FAIL --averaging linear differs from the default"; fi
+contains "shade output names the averaging" "$TMP/shlin.obj" "averaging linear"
+check "shade --averaging bogus is a usage error" 2 "$CLI" shade --averaging bogus examples/data/creased_box.obj -o "$TMP/x.obj"
+contains "--averaging bogus message" "$TMP/err" "--averaging needs linear, renormalized or spherical"
+check "shade --averaging without a value is a usage error" 2 "$CLI" shade examples/data/creased_box.obj -o "$TMP/x.obj" --averaging
 check "shade with every option succeeds" 0 "$CLI" shade --scheme catmark --level 2 --variant A --darts sharp --normals-level 0 \
   --weights-level 2 --p 2.5 --backend ref examples/data/creased_box.obj -o "$TMP/sho.obj"
 if ! cmp -s "$TMP/sh.obj" "$TMP/sho.obj"; then P=$((P + 1)); echo "ok shade options change the normals"; else F=$((F + 1)); echo "FAIL shade options change nothing"; fi
@@ -264,6 +327,38 @@ if [ "$(id -u)" = 0 ] && [ -n "$lib" ] && unshare -m --propagation private true 
   contains "the fall-back says why" "$TMP/err" "osmesa: unavailable (backend unavailable: libOSMesa"
 else
   S=$((S + 1)); echo "SKIP hiding libOSMesa needs root, unshare and an installed libOSMesa"
+fi
+
+# ---- manifold blending (seed 000): tess, eval and render with --scheme manifold ----
+check "tess --scheme manifold succeeds" 0 "$CLI" tess --scheme manifold --rate 4 examples/data/manifold_features.obj -o "$TMP/mf.obj"
+contains "manifold tess is closed (no boundary edge)" "$TMP/err" "(18432 closed, 0 boundary)\|closed, 0 boundary"
+got=$(grep -c '^f ' "$TMP/mf.obj")
+if [ "$got" = 3072 ]; then P=$((P + 1)); echo "ok manifold tess: 96 quads x 4 x 4 x 2 = 3072 triangles"; else F=$((F + 1)); echo "FAIL manifold tess: $got triangles, wanted 3072"; fi
+check "tess --scheme manifold --weights cinf succeeds" 0 "$CLI" tess --scheme manifold --weights cinf --rate 4 examples/data/manifold_features.obj -o "$TMP/mfc.obj"
+d=$(objdiff "$TMP/mf.obj" "$TMP/mfc.obj")
+if [ "$d" != count ] && awk -v d="$d" 'BEGIN { exit !(d > 1e-3) }'; then P=$((P + 1)); echo "ok C-infinity weights give another surface ($d)"
+else F=$((F + 1)); echo "FAIL --weights cinf changed nothing ($d)"; fi
+check "tess --weights bogus is a usage error" 2 "$CLI" tess --scheme manifold --weights bogus --rate 4 examples/data/manifold_features.obj -o "$TMP/x.obj"
+check "refine --scheme manifold is bad input" 1 "$CLI" refine --scheme manifold examples/data/manifold_features.obj -o "$TMP/x.obj"
+contains "refine --scheme manifold says why" "$TMP/err" "evaluated, not refined"
+check "eval --scheme manifold succeeds" 0 "$CLI" eval --scheme manifold --random 5 examples/data/manifold_features.obj
+got=$(grep -c . "$TMP/out")
+if [ "$got" = 5 ]; then P=$((P + 1)); echo "ok eval --scheme manifold prints 5 lines"; else F=$((F + 1)); echo "FAIL eval --scheme manifold printed $got lines"; fi
+check "render --scheme manifold succeeds" 0 "$CLI" render --scheme manifold --rate 6 --size 160x120 examples/data/manifold_features.obj -o "$TMP/mf.png"
+contains "render --scheme manifold wrote a PNG" "$TMP/mf.png" "PNG"
+check "render --rate without --scheme manifold is a usage error" 2 "$CLI" render --rate 6 examples/data/creased_box.obj -o "$TMP/x.png"
+check "render --scheme manifold --weights (picture) is a usage error" 2 "$CLI" render --scheme manifold --weights examples/data/torus.obj -o "$TMP/x.png"
+check "render --manifold-weights cinf succeeds" 0 "$CLI" render --scheme manifold --manifold-weights cinf --rate 4 --size 160x120 examples/data/torus.obj -o "$TMP/x.png"
+contains "render --manifold-weights cinf says so" "$TMP/err" "C-infinity weights"
+if [ -f "$TMP/left.png" ]; then
+  check "render --scheme manifold --trim succeeds" 0 "$CLI" render --scheme manifold --rate 4 --trim "$TMP/left.png" --size 160x120 examples/data/torus.obj -o "$TMP/mft.png"
+  contains "render --trim says it trimmed" "$TMP/err" "trimmed"
+  check "render --scheme manifold untrimmed succeeds" 0 "$CLI" render --scheme manifold --rate 4 --size 160x120 examples/data/torus.obj -o "$TMP/mfu.png"
+  a=$(grep -o "([0-9]* object pixels" "$TMP/err" | grep -o "[0-9]*")
+  "$CLI" render --scheme manifold --rate 4 --trim "$TMP/left.png" --size 160x120 examples/data/torus.obj -o "$TMP/mft.png" 2> "$TMP/err2"
+  b=$(grep -o "([0-9]* object pixels" "$TMP/err2" | grep -o "[0-9]*")
+  if [ -n "$a" ] && [ -n "$b" ] && [ "$b" -lt "$a" ]; then P=$((P + 1)); echo "ok a trimmed picture covers fewer pixels ($b < $a)"
+  else F=$((F + 1)); echo "FAIL trimmed picture pixels: '$b' vs untrimmed '$a'"; fi
 fi
 
 # vertex counts against OpenSubdiv (osd_agree --counts prints "name count" per shape)

@@ -95,6 +95,9 @@ else echo "peer shapes not found at $SHAPES: limit evaluation suite skipped"; ad
 # 3b'''. subdivision shading on every backend: tests/shade.c; the finish_normals kernels: tests/finish_normals.c
 if [ -d "$SHAPES" ]; then counted shade "$BUILD/shade" "$SHAPES"
 else echo "peer shapes not found at $SHAPES: shade runs without them"; counted shade "$BUILD/shade"; fi
+# 3b''''. trimmed tessellation on every backend: tests/trim.c (reads loop_cube.obj from the shapes when present)
+if [ -d "$SHAPES" ]; then counted trim "$BUILD/trim" "$SHAPES"
+else echo "peer shapes not found at $SHAPES: trim runs without them"; counted trim "$BUILD/trim"; fi
 # manifold-based blending surfaces on every backend: tests/manifold.c
 if [ -d "$SHAPES" ]; then counted manifold "$BUILD/manifold" "$SHAPES"
 else echo "peer shapes not found at $SHAPES: manifold runs without them"; counted manifold "$BUILD/manifold"; fi

@@ -1,18 +1,26 @@
 /* surfblend command-line tool.
  *   surfblend info in.obj
  *   surfblend refine [--scheme catmark|loop|bilinear] [--level L] [--limit] [--backend NAME] in.obj -o out.obj
- *   surfblend eval [--scheme catmark|loop] [--backend NAME] (--random N [--seed S] | --locations FILE) [--derivatives] [-o OUT] in.obj
- *   surfblend tess [--scheme catmark|loop] [--backend NAME] --rate N [--tolerance T] [--split-creases] in.obj -o out.obj
+ *   surfblend eval [--scheme catmark|loop|manifold] [--weights hermite|cinf] [--backend NAME] (--random N [--seed S] | --locations FILE)
+ *                  [--derivatives] [-o OUT] in.obj
+ *   surfblend tess [--scheme catmark|loop|manifold] [--weights hermite|cinf] [--backend NAME] --rate N [--tolerance T] [--split-creases]
+ *                  [--trim mask.png [--trim-tiles U V]] in.obj -o out.obj
  *   surfblend shade [shading options] [--limit] [--backend NAME] in.obj -o out.obj
  *   surfblend render [shading options] [--normals limit|subdivided|blended] [--highlight|--weights|--normal-colors]
  *                    [--size WxH] [--view YAW,PITCH] [--zoom Z] [--stripes N] [--edges] [--positions refined|limit] in.obj -o out.png
+ *   surfblend render --scheme manifold [--manifold-weights hermite|cinf] [--rate N] [--trim mask.png [--trim-tiles U V]] [picture options]
+ *                    in.obj -o out.png
  *   surfblend backends
  * Exit codes: 0 success, 1 bad input (message on stderr), 2 usage error. */
 #include "surfblend.h"
-/* PNG output (Debian libstb-dev); the library itself only returns raw RGBA */
+/* PNG output and trimming-mask input (Debian libstb-dev); the library itself only takes and
+ * returns raw pixel buffers */
 #define STB_IMAGE_WRITE_IMPLEMENTATION
 #define STB_IMAGE_WRITE_STATIC
 #include <stb/stb_image_write.h>
+#define STB_IMAGE_IMPLEMENTATION
+#define STBI_ONLY_PNG
+#include <stb/stb_image.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -28,7 +36,8 @@ static const char *const usage_text[] = {
     "      --limit                          write limit positions (and limit normals as vn) instead of refined points\n"
     "      --backend NAME                   ref|simd|gl|osmesa, tried first (else SURFBLEND_BACKEND, else the default order)\n"
     "  surfblend eval [options] IN.obj            the limit surface at parametric locations\n"
-    "      --scheme catmark|loop            as for refine (default: from the file name prefix, else catmark)\n"
+    "      --scheme catmark|loop|manifold   as for refine, or the manifold blending surface (seed 000)\n"
+    "      --weights hermite|cinf           manifold blend weights: Hermite (default) or C-infinity\n"
     "      --locations FILE                 lines 'face u v' (parametric face; u, v in [0,1], and u + v <= 1 on Loop's\n"
     "                                       triangles; '#' starts a comment)\n"
     "      --random N [--seed S]            N random locations on faces that are not holes (deterministic for a seed)\n"
@@ -37,10 +46,15 @@ static const char *const usage_text[] = {
     "      --backend NAME                   as for refine\n"
     "    prints one line per location: face u v px py pz nx ny nz [dux duy duz dvx dvy dvz]\n"
     "  surfblend tess [options] IN.obj -o OUT.obj   watertight triangles of the limit surface (v, vn, f v//vn)\n"
-    "      --scheme catmark|loop            as for refine\n"
+    "      --scheme catmark|loop|manifold   as for eval\n"
+    "      --weights hermite|cinf           as for eval\n"
     "      --rate N                         segments per parametric-face edge, 1..1024 (required)\n"
     "      --tolerance T                    adaptive: per face the smallest rate <= N within chordal error T\n"
     "      --split-creases                  separate vertices (and normals) on each side of infinitely sharp creases\n"
+    "      --trim MASK.png                  trim with a mask over each parametric face's (u,v) square (seed 000 V.5):\n"
+    "                                       grey level >= 50% kept, darker trimmed; the picture's top row is v = 1\n"
+    "      --trim-tiles U V                 the mask is an atlas of U x V tiles, tile t (row-major from v = 0) for\n"
+    "                                       parametric face t; later faces untrimmed (default: one mask for all)\n"
     "      --backend NAME                   as for refine\n"
     ,
     "  surfblend shade [options] IN.obj -o OUT.obj   subdivision shading (seed 001): v, blended normals as vn, f v//vn\n"
@@ -51,6 +65,7 @@ static const char *const usage_text[] = {
     "      --normals-level L                level where the subdivided normals N_S start (0: control mesh; default 1)\n"
     "      --weights-level L                level where the blend weights are seeded (0: control mesh; default 1)\n"
     "      --p P                            blend exponent, > 0 (default 1): N_B = (1 - b^P) N_L + b^P N_S\n"
+    "      --averaging linear|renormalized|spherical   how N_S is averaged from one level to the next (default linear)\n"
     "      --all-subdivided                 compute N_S at every vertex, not only where b > 0\n"
     "      --limit                          write limit positions instead of refined points\n"
     "      --backend NAME                   as for refine\n"
@@ -66,6 +81,8 @@ static const char *const usage_text[] = {
     "      --zoom Z                         magnification (default 1: the bounding sphere fits)\n"
     "      --stripes N                      highlight lines per object diameter (default 8)\n"
     "      --edges                          draw the refined mesh's edges\n"
+    "      --scheme manifold                draw the manifold blending surface (seed 000) tessellated instead, with:\n"
+    "        --manifold-weights hermite|cinf (tess's --weights), --rate N (default 16), --trim MASK.png [--trim-tiles U V]\n"
     "  surfblend backends                         list the backends and whether each is available\n"
     "  surfblend --help | --version\n"
     "exit codes: 0 success, 1 bad input, 2 usage error\n",
@@ -230,6 +247,7 @@ static int scheme_from_name(const char *s, sfb_scheme *out) {
     if (strcmp(s, "catmark") == 0 || strcmp(s, "catmull-clark") == 0) *out = SFB_SCHEME_CATMARK;
     else if (strcmp(s, "loop") == 0) *out = SFB_SCHEME_LOOP;
     else if (strcmp(s, "bilinear") == 0) *out = SFB_SCHEME_BILINEAR;
+    else if (strcmp(s, "manifold") == 0) *out = SFB_SCHEME_MANIFOLD_BLEND;
     else return 0;
     return 1;
 }
@@ -323,11 +341,20 @@ done:
 }
 
 /* A surface with its patch table (limit evaluation, tessellation). */
-static sfb_surface *make_patch_surface(sfb_context *ctx, const sfb_mesh *mesh, const char *path, sfb_scheme scheme) {
+/* --weights hermite|cinf of the manifold scheme */
+static int weights_from_name(const char *s, int *out) {
+    if (strcmp(s, "hermite") == 0) *out = SFB_MANIFOLD_WEIGHTS_HERMITE;
+    else if (strcmp(s, "cinf") == 0) *out = SFB_MANIFOLD_WEIGHTS_CINF;
+    else return 0;
+    return 1;
+}
+
+static sfb_surface *make_patch_surface(sfb_context *ctx, const sfb_mesh *mesh, const char *path, sfb_scheme scheme, int weights) {
     sfb_surface_config cfg = sfb_surface_config_init(scheme, 0);
     sfb_surface *surf = NULL;
     sfb_result r;
     cfg.flags = SFB_REFINE_PATCHES;
+    cfg.manifold.weights = weights;
     r = sfb_surface_create(ctx, mesh, &cfg, &surf);
     if (r != SFB_SUCCESS) {
         fprintf(stderr, "surfblend: %s: %s: %s\n", path, sfb_result_string(r), sfb_last_error(ctx));
@@ -492,7 +519,7 @@ done:
 static int cmd_eval(int argc, char **argv) {
     const char *in = NULL, *outp = NULL, *backend = NULL, *locfile = NULL;
     long nrandom = -1, seed = 1;
-    int derivs = 0, i, rc = 1, have_scheme = 0;
+    int derivs = 0, i, rc = 1, have_scheme = 0, weights = SFB_MANIFOLD_WEIGHTS_HERMITE;
     sfb_scheme scheme = SFB_SCHEME_CATMARK;
     sfb_context *ctx = NULL;
     sfb_mesh *mesh = NULL;
@@ -511,8 +538,10 @@ static int cmd_eval(int argc, char **argv) {
             locfile = argv[i];
         } else if (strcmp(argv[i], "--derivatives") == 0) {
             derivs = 1;
+        } else if (strcmp(argv[i], "--weights") == 0) {
+            if (++i >= argc || !weights_from_name(argv[i], &weights)) return usage("--weights needs hermite or cinf");
         } else if (strcmp(argv[i], "--scheme") == 0) {
-            if (++i >= argc || !scheme_from_name(argv[i], &scheme)) return usage("--scheme needs catmark or loop");
+            if (++i >= argc || !scheme_from_name(argv[i], &scheme)) return usage("--scheme needs catmark, loop or manifold");
             have_scheme = 1;
         } else {
             int ur = common_arg(argc, argv, &i, "eval", &backend, &outp, &in);
@@ -526,7 +555,7 @@ static int cmd_eval(int argc, char **argv) {
     mesh = load(ctx, in);
     if (!mesh) goto done;
     scheme = scheme_for(in, have_scheme, scheme);
-    surf = make_patch_surface(ctx, mesh, in, scheme);
+    surf = make_patch_surface(ctx, mesh, in, scheme, weights);
     if (!surf) goto done;
     if (locfile ? !read_locations(locfile, &L)
                 : !random_locations(ctx, surf, scheme == SFB_SCHEME_LOOP, nrandom, (unsigned long long)seed, &L))
@@ -610,11 +639,42 @@ static int edge_counts(const sfb_tess_data *t, long *total, long *closed, long *
     return 1;
 }
 
+/* A trimming mask from a PNG: 8-bit grey (luminance of colour pictures; alpha ignored), rows
+ * flipped so that the picture's top row is v = 1 (the mask's row 0 is v = 0). Returns the
+ * texels (free them), or NULL with a message printed. */
+static unsigned char *load_mask(const char *path, int *w, int *h) {
+    int n = 0, j;
+    size_t row;
+    unsigned char *px = stbi_load(path, w, h, &n, 1), *tmp;
+    if (!px) {
+        fprintf(stderr, "surfblend: cannot read the trimming mask '%s': %s\n", path, stbi_failure_reason());
+        return NULL;
+    }
+    row = (size_t)*w;
+    tmp = (unsigned char *)malloc(row ? row : 1);
+    if (!tmp) {
+        fprintf(stderr, "surfblend: out of memory reading '%s'\n", path);
+        stbi_image_free(px);
+        return NULL;
+    }
+    for (j = 0; j < *h / 2; ++j) {
+        unsigned char *a = px + (size_t)j * row, *b = px + (size_t)(*h - 1 - j) * row;
+        memcpy(tmp, a, row);
+        memcpy(a, b, row);
+        memcpy(b, tmp, row);
+    }
+    free(tmp);
+    return px;
+}
+
 static int cmd_tess(int argc, char **argv) {
-    const char *in = NULL, *outp = NULL, *backend = NULL;
-    long rate = -1;
+    const char *in = NULL, *outp = NULL, *backend = NULL, *trim_path = NULL;
+    long rate = -1, tiles_u = 0, tiles_v = 0;
+    int have_tiles = 0;
+    unsigned char *texels = NULL;
+    sfb_trim_mask mask;
     double tolerance = 0.0;
-    int split = 0, i, rc = 1, have_scheme = 0;
+    int split = 0, i, rc = 1, have_scheme = 0, weights = SFB_MANIFOLD_WEIGHTS_HERMITE;
     sfb_scheme scheme = SFB_SCHEME_CATMARK;
     sfb_context *ctx = NULL;
     sfb_mesh *mesh = NULL;
@@ -636,8 +696,20 @@ static int cmd_tess(int argc, char **argv) {
         } else if (strcmp(argv[i], "--split-creases") == 0) {
             split = 1;
         } else if (strcmp(argv[i], "--scheme") == 0) {
-            if (++i >= argc || !scheme_from_name(argv[i], &scheme)) return usage("--scheme needs catmark or loop");
+            if (++i >= argc || !scheme_from_name(argv[i], &scheme)) return usage("--scheme needs catmark, loop or manifold");
             have_scheme = 1;
+        } else if (strcmp(argv[i], "--weights") == 0) {
+            if (++i >= argc || !weights_from_name(argv[i], &weights)) return usage("--weights needs hermite or cinf");
+        } else if (strcmp(argv[i], "--trim") == 0) {
+            if (++i >= argc) return usage("--trim needs a PNG file");
+            trim_path = argv[i];
+        } else if (strcmp(argv[i], "--trim-tiles") == 0) {
+            /* the counts are the library's to check against the mask */
+            if (i + 2 >= argc || !parse_int(argv[i + 1], -2147483647L, 2147483647L, &tiles_u) ||
+                !parse_int(argv[i + 2], -2147483647L, 2147483647L, &tiles_v))
+                return usage("--trim-tiles needs two numbers U V");
+            i += 2;
+            have_tiles = 1;
         } else {
             int ur = common_arg(argc, argv, &i, "tess", &backend, &outp, &in);
             if (ur) return ur;
@@ -646,15 +718,25 @@ static int cmd_tess(int argc, char **argv) {
     if (!in) return usage("tess needs an input OBJ file");
     if (!outp) return usage("tess needs -o OUT.obj");
     if (rate == -1) return usage("tess needs --rate N");
+    if (have_tiles && !trim_path) return usage("--trim-tiles needs --trim MASK.png");
+    memset(&mask, 0, sizeof mask);
+    if (trim_path) {
+        texels = load_mask(trim_path, &mask.width, &mask.height);
+        if (!texels) return 1;
+        mask.texels = texels;
+        mask.tiles_u = (int)tiles_u;
+        mask.tiles_v = (int)tiles_v;
+    }
     ctx = make_context(backend);
-    if (!ctx) return 1;
+    if (!ctx) { stbi_image_free(texels); return 1; }
     mesh = load(ctx, in);
     if (!mesh) goto done;
-    surf = make_patch_surface(ctx, mesh, in, scheme_for(in, have_scheme, scheme));
+    surf = make_patch_surface(ctx, mesh, in, scheme_for(in, have_scheme, scheme), weights);
     if (!surf) goto done;
     tc = sfb_tess_config_init((int)rate);
     tc.tolerance = (float)tolerance;
     tc.flags = split ? (unsigned)SFB_TESS_SPLIT_CREASES : 0u;
+    tc.trim = trim_path ? &mask : NULL;
     r = sfb_surface_tessellate(surf, &tc, &td);
     if (r != SFB_SUCCESS) {
         fprintf(stderr, "surfblend: %s: %s: %s\n", in, sfb_result_string(r), sfb_last_error(ctx));
@@ -665,8 +747,8 @@ static int cmd_tess(int argc, char **argv) {
         fprintf(stderr, "surfblend: cannot write '%s'\n", outp);
         goto done;
     }
-    fprintf(f, "# surfblend tess of %s: rate %ld%s%s, %d vertices, %d triangles\n", in, rate, tolerance > 0.0 ? " adaptive" : "",
-            split ? " split creases" : "", td.vertex_count, td.triangle_count);
+    fprintf(f, "# surfblend tess of %s: rate %ld%s%s%s%s, %d vertices, %d triangles\n", in, rate, tolerance > 0.0 ? " adaptive" : "",
+            split ? " split creases" : "", trim_path ? " trimmed by " : "", trim_path ? trim_path : "", td.vertex_count, td.triangle_count);
     for (i = 0; i < td.vertex_count; ++i)
         fprintf(f, "v %.7g %.7g %.7g\n", td.positions[3 * i], td.positions[3 * i + 1], td.positions[3 * i + 2]);
     for (i = 0; i < td.vertex_count; ++i)
@@ -678,8 +760,10 @@ static int cmd_tess(int argc, char **argv) {
     {
         long total, closed, boundary, more;
         if (!edge_counts(&td, &total, &closed, &boundary, &more)) { fprintf(stderr, "surfblend: out of memory\n"); goto done; }
-        fprintf(stderr, "surfblend: tess rate %ld%s: %d vertices, %d triangles, %ld edges (%ld closed, %ld boundary%s) -> %s (backend %s)\n",
-                rate, tolerance > 0.0 ? " adaptive" : "", td.vertex_count, td.triangle_count, total, closed, boundary,
+        char trimmed[64] = "";
+        if (trim_path) snprintf(trimmed, sizeof trimmed, " trimmed (%dx%d mask)", mask.width, mask.height);
+        fprintf(stderr, "surfblend: tess rate %ld%s%s: %d vertices, %d triangles, %ld edges (%ld closed, %ld boundary%s) -> %s (backend %s)\n",
+                rate, tolerance > 0.0 ? " adaptive" : "", trimmed, td.vertex_count, td.triangle_count, total, closed, boundary,
                 more ? ", some non-manifold" : "", outp, sfb_context_backend_name(ctx));
     }
     rc = 0;
@@ -689,6 +773,7 @@ done:
     sfb_surface_destroy(surf);
     sfb_mesh_destroy(mesh);
     sfb_context_destroy(ctx);
+    stbi_image_free(texels);
     return rc;
 }
 
@@ -698,7 +783,7 @@ done:
 typedef struct shade_opts {
     const char *in, *outp, *backend;
     sfb_scheme scheme;
-    int have_scheme, level, variant, darts, normals_level, weights_level, all_subdivided;
+    int have_scheme, level, variant, darts, normals_level, weights_level, all_subdivided, averaging;
     double p;
 } shade_opts;
 
@@ -750,6 +835,12 @@ static int shade_arg(int argc, char **argv, int *i, shade_opts *o) {
         if (++*i >= argc) return -usage("--p needs a number > 0");
         o->p = strtod(argv[*i], &end);
         if (end == argv[*i] || *end || !(o->p > 0.0) || !isfinite(o->p) || o->p > 1e30) return -usage("--p needs a number > 0");
+    } else if (strcmp(a, "--averaging") == 0) {
+        if (++*i >= argc) return -usage("--averaging needs linear, renormalized or spherical");
+        if (strcmp(argv[*i], "linear") == 0) o->averaging = SFB_SHADE_AVERAGE_LINEAR;
+        else if (strcmp(argv[*i], "renormalized") == 0) o->averaging = SFB_SHADE_AVERAGE_RENORMALIZED;
+        else if (strcmp(argv[*i], "spherical") == 0) o->averaging = SFB_SHADE_AVERAGE_SPHERICAL;
+        else return -usage("--averaging needs linear, renormalized or spherical");
     } else if (strcmp(a, "--all-subdivided") == 0) {
         o->all_subdivided = 1;
     } else {
@@ -772,6 +863,7 @@ static int shade_mesh(sfb_context *ctx, const shade_opts *o, sfb_mesh **mesh, sf
     cfg.shading.darts = o->darts;
     cfg.shading.normals_level = o->normals_level;
     cfg.shading.weights_level = o->weights_level;
+    cfg.shading.averaging = o->averaging;
     sp = sfb_shade_params_init();
     sp.p = (float)o->p;
     sp.flags = o->all_subdivided ? (unsigned)SFB_SHADE_ALL_SUBDIVIDED : 0u;
@@ -853,10 +945,11 @@ static int cmd_shade(int argc, char **argv) {
         const float *pos = limit ? data.limit_positions : data.positions;
         size_t off = 0;
         int ok = 1, j;
-        ok &= fprintf(f, "# surfblend shade of %s: %s level %d, variant %s, darts %s, p %g; %d vertices (%d refined), %d faces\n", o.in,
-                      sfb_scheme_name(scheme_for(o.in, o.have_scheme, o.scheme)), o.level, o.variant == SFB_SHADE_VARIANT_A ? "A" : "B",
-                      o.darts == SFB_SHADE_DARTS_SHARP ? "sharp" : "smooth", o.p, data.vertex_count, data.refined_vertex_count,
-                      data.face_count) > 0;
+        static const char *averaging_names[3] = { "linear", "renormalized", "spherical" };
+        ok &= fprintf(f, "# surfblend shade of %s: %s level %d, variant %s, darts %s, averaging %s, p %g; %d vertices (%d refined), %d faces\n",
+                      o.in, sfb_scheme_name(scheme_for(o.in, o.have_scheme, o.scheme)), o.level, o.variant == SFB_SHADE_VARIANT_A ? "A" : "B",
+                      o.darts == SFB_SHADE_DARTS_SHARP ? "sharp" : "smooth", averaging_names[o.averaging], o.p, data.vertex_count,
+                      data.refined_vertex_count, data.face_count) > 0;
         for (i = 0; i < data.vertex_count && ok; ++i)
             ok &= fprintf(f, "v %.7g %.7g %.7g\n", pos[3 * i], pos[3 * i + 1], pos[3 * i + 2]) > 0;
         for (i = 0; i < data.vertex_count && ok; ++i)
@@ -909,7 +1002,12 @@ static int cmd_render(int argc, char **argv) {
     shade_opts o;
     int i, rc = 1, mode = SFB_RENDER_SHADED, modes = 0, normals = 2 /* 0 limit, 1 subdivided, 2 blended */, limit_pos = 1, edges = 0;
     long width = 640, height = 480;
-    int view_set = 0;
+    int view_set = 0, weights = SFB_MANIFOLD_WEIGHTS_HERMITE, have_rate = 0, have_tiles = 0;
+    long rate = 16, tiles_u = 0, tiles_v = 0;
+    const char *trim_path = NULL;
+    unsigned char *texels = NULL;
+    sfb_trim_mask mask;
+    sfb_tess_data td;
     double yaw = 0.0, pitch = 0.0, zoom = 0.0, stripes = 0.0;
     sfb_context *ctx = NULL;
     sfb_mesh *mesh = NULL;
@@ -922,6 +1020,8 @@ static int cmd_render(int argc, char **argv) {
     FILE *f = NULL;
     static const char *normal_names[3] = { "limit", "subdivided", "blended" };
     memset(&data, 0, sizeof data);
+    memset(&td, 0, sizeof td);
+    memset(&mask, 0, sizeof mask);
     memset(&img, 0, sizeof img);
     memset(&png, 0, sizeof png);
     shade_opts_init(&o, 3);
@@ -938,6 +1038,21 @@ static int cmd_render(int argc, char **argv) {
             if (strcmp(argv[i], "limit") == 0) limit_pos = 1;
             else if (strcmp(argv[i], "refined") == 0) limit_pos = 0;
             else return usage("--positions needs refined or limit");
+        } else if (strcmp(argv[i], "--rate") == 0) {
+            /* the range (1..1024) is the library's to check and report */
+            if (++i >= argc || !parse_int(argv[i], -2147483647L, 2147483647L, &rate)) return usage("--rate needs a number");
+            have_rate = 1;
+        } else if (strcmp(argv[i], "--manifold-weights") == 0) {
+            if (++i >= argc || !weights_from_name(argv[i], &weights)) return usage("--manifold-weights needs hermite or cinf");
+        } else if (strcmp(argv[i], "--trim") == 0) {
+            if (++i >= argc) return usage("--trim needs a PNG file");
+            trim_path = argv[i];
+        } else if (strcmp(argv[i], "--trim-tiles") == 0) {
+            if (i + 2 >= argc || !parse_int(argv[i + 1], -2147483647L, 2147483647L, &tiles_u) ||
+                !parse_int(argv[i + 2], -2147483647L, 2147483647L, &tiles_v))
+                return usage("--trim-tiles needs two numbers U V");
+            i += 2;
+            have_tiles = 1;
         } else if (strcmp(argv[i], "--highlight") == 0) {
             mode = SFB_RENDER_HIGHLIGHT; ++modes;
         } else if (strcmp(argv[i], "--weights") == 0) {
@@ -988,9 +1103,42 @@ static int cmd_render(int argc, char **argv) {
     if (!o.outp) return usage("render needs -o OUT.png");
     if (modes > 1) return usage("render takes one of --highlight, --weights, --normal-colors");
     if (normals == 1) o.all_subdivided = 1;
+    if (o.scheme != SFB_SCHEME_MANIFOLD_BLEND && (have_rate || trim_path))
+        return usage("--rate and --trim belong to --scheme manifold (the subdivision schemes render their shaded refinement)");
+    if (have_tiles && !trim_path) return usage("--trim-tiles needs --trim MASK.png");
+    if (o.scheme == SFB_SCHEME_MANIFOLD_BLEND && mode == SFB_RENDER_WEIGHTS) return usage("--weights pictures belong to subdivision shading");
+    if (trim_path) {
+        texels = load_mask(trim_path, &mask.width, &mask.height);
+        if (!texels) return 1;
+        mask.texels = texels;
+        mask.tiles_u = (int)tiles_u;
+        mask.tiles_v = (int)tiles_v;
+    }
     ctx = make_context(o.backend);
-    if (!ctx) return 1;
-    if (!shade_mesh(ctx, &o, &mesh, &surf, &data)) goto done;
+    if (!ctx) { stbi_image_free(texels); return 1; }
+    if (o.scheme == SFB_SCHEME_MANIFOLD_BLEND) {
+        /* the blending surface, tessellated (and trimmed): the triangles with their normals */
+        sfb_tess_config tc = sfb_tess_config_init((int)(rate > 2147483647L ? 2147483647L : rate < -2147483647L ? -2147483647L : rate));
+        mesh = load(ctx, o.in);
+        if (!mesh) goto done;
+        surf = make_patch_surface(ctx, mesh, o.in, o.scheme, weights);
+        if (!surf) goto done;
+        tc.trim = trim_path ? &mask : NULL;
+        r = sfb_surface_tessellate(surf, &tc, &td);
+        if (r != SFB_SUCCESS) {
+            fprintf(stderr, "surfblend: %s: %s: %s\n", o.in, sfb_result_string(r), sfb_last_error(ctx));
+            goto done;
+        }
+        data.vertex_count = td.vertex_count;
+        data.face_count = td.triangle_count;
+        data.face_vertex_count = 3 * td.triangle_count;
+        data.positions = data.limit_positions = td.positions;
+        data.normals = data.limit_normals = data.subdivided_normals = td.normals;
+        data.face_vertices = td.triangles;
+        data.face_sizes = (int *)malloc(sizeof(int) * ((size_t)td.triangle_count + 1));
+        if (!data.face_sizes) { fprintf(stderr, "surfblend: out of memory\n"); goto done; }
+        for (i = 0; i < td.triangle_count; ++i) data.face_sizes[i] = 3;
+    } else if (!shade_mesh(ctx, &o, &mesh, &surf, &data)) goto done;
     rcfg = sfb_render_config_init(mode);
     rcfg.width = (int)(width > 2147483647L ? 2147483647L : width);
     rcfg.height = (int)(height > 2147483647L ? 2147483647L : height);
@@ -1029,16 +1177,22 @@ static int cmd_render(int argc, char **argv) {
     {
         static const char *mode_names[4] = { "shading", "highlight lines", "blend weights", "normal colours" };
         char what[256], field[64] = "";
-        if (mode != SFB_RENDER_WEIGHTS) snprintf(field, sizeof field, " of the %s normals", normal_names[normals]);
+        if (mode != SFB_RENDER_WEIGHTS && o.scheme != SFB_SCHEME_MANIFOLD_BLEND) snprintf(field, sizeof field, " of the %s normals", normal_names[normals]);
         snprintf(what, sizeof what, "render %s%s, %dx%d (%d object pixels%s):", mode_names[mode], field, img.width, img.height,
                  img.object_pixels, img.skipped_faces ? ", faces with non-finite positions skipped" : "");
-        shade_summary(what, &o, &data, ctx, o.outp);
+        if (o.scheme == SFB_SCHEME_MANIFOLD_BLEND)
+            fprintf(stderr, "surfblend: %s manifold blend (%s weights) tessellated at rate %ld%s: %d triangles -> %s (backend %s)\n", what,
+                    weights ? "C-infinity" : "Hermite", rate, trim_path ? ", trimmed" : "", td.triangle_count, o.outp, sfb_context_backend_name(ctx));
+        else shade_summary(what, &o, &data, ctx, o.outp);
     }
     rc = 0;
 done:
     rc = finish_output(f, o.outp, rc);
     free(png.data);
     sfb_image_free(&img);
+    if (o.scheme == SFB_SCHEME_MANIFOLD_BLEND) { free(data.face_sizes); memset(&data, 0, sizeof data); }
+    sfb_tess_data_free(&td);
+    stbi_image_free(texels);
     sfb_mesh_data_free(&data);
     sfb_surface_destroy(surf);
     sfb_mesh_destroy(mesh);
