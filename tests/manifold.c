@@ -603,6 +603,84 @@ static void agreement(const char *name, const sfb_mesh *m, int weights, const sf
     free(L);
 }
 
+/* A planar n x n grid of unit quads, u along +x and v along +y in every face. */
+static sfb_mesh *grid(sfb_context *ctx, int n) {
+    float *p = (float *)malloc(sizeof(float) * 3 * (size_t)(n + 1) * (n + 1));
+    int *fv = (int *)malloc(sizeof(int) * 4 * (size_t)n * n), *sz = (int *)malloc(sizeof(int) * (size_t)n * n), i, j;
+    sfb_mesh_desc d;
+    sfb_mesh *m = NULL;
+    for (j = 0; j <= n; ++j)
+        for (i = 0; i <= n; ++i) { p[3 * (j * (n + 1) + i)] = (float)i; p[3 * (j * (n + 1) + i) + 1] = (float)j; p[3 * (j * (n + 1) + i) + 2] = 0.0f; }
+    for (j = 0; j < n; ++j)
+        for (i = 0; i < n; ++i) {
+            int *q = fv + 4 * (j * n + i);
+            q[0] = j * (n + 1) + i; q[1] = q[0] + 1; q[2] = q[1] + n + 1; q[3] = q[0] + n + 1;
+            sz[j * n + i] = 4;
+        }
+    memset(&d, 0, sizeof d);
+    d.vertex_count = (n + 1) * (n + 1); d.positions = p; d.face_count = n * n; d.face_sizes = sz; d.face_vertices = fv;
+    if (sfb_mesh_create(ctx, &d, &m) != SFB_SUCCESS) m = NULL;
+    free(p); free(fv); free(sz);
+    return m;
+}
+
+/* Trimming a manifold surface (seed V.5) on every backend. On a planar regular grid the blend of a
+ * face whose four corners are interior vertices is an affine image of its (u,v) square (each
+ * corner's fitted patch reproduces the plane), so 3-D areas there are parameter areas: a mask
+ * whose left half (u < 1/2) is black keeps half of each such face within one texel's worth, and
+ * nothing is kept left of the contour by more than one texel. */
+static void trimming(void) {
+    enum { W = 32, N = 6 };
+    unsigned char tex[W * W];
+    sfb_trim_mask mask;
+    sfb_mesh *m = grid(g_be[0].ctx, N);
+    int b, i, j;
+    if (!m) { fail("trim/grid", "mesh"); return; }
+    for (j = 0; j < W; ++j)
+        for (i = 0; i < W; ++i) tex[j * W + i] = i < W / 2 ? 0 : 255;
+    memset(&mask, 0, sizeof mask);
+    mask.width = mask.height = W; mask.texels = tex;
+    for (b = 0; b < g_nbe; ++b) {
+        char nm[1024];
+        sfb_surface *s;
+        sfb_tess_config tc = sfb_tess_config_init(4);
+        sfb_tess_data td;
+        snprintf(nm, sizeof nm, "%s/grid6/trim: a half-black mask keeps half of every inner face, nothing left of the contour", g_be[b].name);
+        if (!g_be[b].available) {
+            if (g_be[b].required) fail(nm, "required backend unavailable: %s", g_be[b].why);
+            else skip(nm, g_be[b].why);
+            continue;
+        }
+        s = make_surface(g_be[b].ctx, m, 0);
+        tc.trim = &mask;
+        if (!s || sfb_surface_tessellate(s, &tc, &td) != SFB_SUCCESS) { fail(nm, "%s", sfb_last_error(g_be[b].ctx)); if (s) sfb_surface_destroy(s); continue; }
+        {
+            double area[N * N], worst = 0.0, worst_left = 0.0;
+            int t, inner = 0;
+            memset(area, 0, sizeof area);
+            for (t = 0; t < td.triangle_count; ++t) {
+                const float *a = td.positions + 3 * td.triangles[3 * t], *c1 = td.positions + 3 * td.triangles[3 * t + 1], *c2 = td.positions + 3 * td.triangles[3 * t + 2];
+                int f = td.triangle_faces[t];
+                if (f >= 0 && f < N * N) area[f] += 0.5 * fabs(((double)c1[0] - a[0]) * ((double)c2[1] - a[1]) - ((double)c2[0] - a[0]) * ((double)c1[1] - a[1]));
+                for (i = 0; i < 3; ++i) {
+                    const float *q = td.positions + 3 * td.triangles[3 * t + i];
+                    double fx = q[0] - floor(q[0]);
+                    int col = (int)floor(q[0]), row = (int)floor(q[1]);
+                    /* inside an inner face, away from its left edge: left of x = col + 1/2 is trimmed */
+                    if (col >= 1 && col < N - 1 && row >= 1 && row < N - 1 && fx > 1e-4 && fx < 0.5) worst_left = fmax(worst_left, 0.5 - fx);
+                }
+            }
+            for (j = 1; j < N - 1; ++j)
+                for (i = 1; i < N - 1; ++i) { worst = fmax(worst, fabs(area[j * N + i] - 0.5)); inner++; }
+            check(inner > 0 && worst <= 1.0 / W && worst_left <= 1.0 / W, nm, "max |kept area - 1/2| %g over %d faces (tol %g); kept %g left of the contour",
+                  worst, inner, 1.0 / W, worst_left);
+        }
+        sfb_tess_data_free(&td);
+        sfb_surface_destroy(s);
+    }
+    sfb_mesh_destroy(m);
+}
+
 static void bad_configs(sfb_context *ctx, const sfb_mesh *m) {
     sfb_surface_config c = sfb_surface_config_init(SFB_SCHEME_MANIFOLD_BLEND, 0);
     sfb_surface *s = NULL;
@@ -696,6 +774,7 @@ int main(int argc, char **argv) {
     }
     if (!g_be[0].available) { printf("FAIL probe/ref: %s\n0 passed, 1 failed, 0 skipped\n", g_be[0].why); return 1; }
     weights_unit();
+    trimming();
     {
         sfb_mesh *m;
         if ((m = cube(g_be[0].ctx, 3, 0, CUBE_SMOOTH)) != NULL) { run_mesh("cube3_smooth", m, 1); bad_configs(g_be[0].ctx, m); sfb_mesh_destroy(m); }
