@@ -14,12 +14,37 @@
  * normals averaged per region (CPU: one pass over the coarse level's faces), the N_S rows, the
  * limit rows, and the backend's finish_normals kernel.
  *
+ * Averaging (sfb_shading_options.averaging): LINEAR, the default, is the above: N_S is one
+ * composed table run by the backend. RENORMALIZED and SPHERICAL compute N_S one level at a
+ * time instead, because a normalisation (or a spherical mean) between the levels is not linear
+ * and cannot be folded into one table: the build keeps one region table per step instead of
+ * the composed one (the same region masks the composed table is made of, each over the level
+ * below alone; the last step's rows are the output rows, in the composed table's order) and
+ * sfb_surface_shade runs them in the core, on the CPU in double, for every backend - each new
+ * normal is normalize(sum w_i n_i) (RENORMALIZED) or the weighted spherical mean of the n_i
+ * (SPHERICAL: see sfb__shade_spherical_mean). The limit tables and finish_normals still run on
+ * the backend. Only the last step is restricted to the rows needed (b > 0, or all with
+ * SFB_SHADE_ALL_SUBDIVIDED); the earlier levels are computed in full: the rows of level L-1 a
+ * restricted last step reads are the support of its rows (and of the levels below, theirs),
+ * different for the two row sets, so restricting would take per-level marks kept at build time
+ * for each, while a level has about a quarter of the next one's vertices (Catmull-Clark and
+ * Loop quadruple the faces per step): all earlier steps together cost about a third of the last
+ * one, and near the extraordinary vertices, where b > 0, most of their rows are in that support
+ * anyway. When the normals level is the last level there is no step: the output rows are the
+ * face-weighted region means (the composed table) in every mode. Cost: on catmark_car at
+ * level 3 on ref, sfb_surface_shade takes about as long with RENORMALIZED as with LINEAR and
+ * about 6-8x as long with SPHERICAL (a few iterations per row, an atan2 per entry and
+ * iteration where the angle is not small).
+ *
  * Choices where the seed is silent (each tested in tests/shade.c):
- *   - Linear averaging, normalised once at the end (in finish_normals) rather than after every
- *     level. Renormalising a linear average only rescales it, so the direction differs from a
- *     per-level renormalisation by the small change of the stencil weights this rescaling
- *     makes; in exchange N_S is one linear map of the normals-level normals, which is what
- *     lets it compile to one stencil table.
+ *   - Linear averaging by default (the seed's choice, §2.3), normalised once at the end (in
+ *     finish_normals) rather than after every level. Renormalising a linear average only
+ *     rescales it, so the direction differs from a per-level renormalisation by the small
+ *     change of the stencil weights this rescaling makes; in exchange N_S is one linear map of
+ *     the normals-level normals, which is what lets it compile to one stencil table run on the
+ *     backend. Per-level renormalised and spherical averaging (the original subdivision
+ *     shading's) are options, computed in the core (above): they differ from linear by small
+ *     angles (tests/shade.c measures them) and cost a CPU pass per level.
  *   - A region is a maximal fan of a vertex's faces not separated by a sharp edge (sharpness
  *     > 0 at that level; boundary edges are sharp). A vertex with fewer than two sharp edges, or
  *     a non-manifold one, has one region.
@@ -124,6 +149,10 @@ void sfb__shading_free(sfb_context *ctx, sfb__shading *sh) {
     sfb__free(ctx, sh->ns_idx_w); sfb__free(ctx, sh->ns_idx_all);
     sfb__stencils_free(ctx, &sh->ns);
     for (t = 0; t < 3; ++t) sfb__stencils_free(ctx, &sh->lim[t]);
+    if (sh->steps) {
+        for (t = 0; t < sh->nsteps; ++t) sfb__stencils_free(ctx, &sh->steps[t]);
+        sfb__free(ctx, sh->steps);
+    }
     sfb__free(ctx, sh);
 }
 
@@ -272,7 +301,7 @@ sfb_result sfb__shading_build(sfb_context *ctx, const sfb__level *prep, const sf
     int *order = NULL;
     sfb_result r = SFB_SUCCESS;
     int loop = opt->scheme == SFB_SCHEME_LOOP;
-    int Ln = 0, Lw = 0, k, v, i, t, maxv = 1;
+    int Ln = 0, Lw = 0, k, v, i, t, maxv = 1, per_level = 0, asz;
     const sfb__level *top;
     *out = NULL;
     memset(&prow, 0, sizeof prow); memset(&crow, 0, sizeof crow); memset(&A, 0, sizeof A);
@@ -283,6 +312,9 @@ sfb_result sfb__shading_build(sfb_context *ctx, const sfb__level *prep, const sf
         return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, -1, "shading variant %d is not SFB_SHADE_VARIANT_A or _B", o->variant);
     if (o->darts != SFB_SHADE_DARTS_SMOOTH && o->darts != SFB_SHADE_DARTS_SHARP)
         return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, -1, "shading darts option %d is not SFB_SHADE_DARTS_SMOOTH or _SHARP", o->darts);
+    if (o->averaging != SFB_SHADE_AVERAGE_LINEAR && o->averaging != SFB_SHADE_AVERAGE_RENORMALIZED && o->averaging != SFB_SHADE_AVERAGE_SPHERICAL)
+        return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, -1,
+                          "shading averaging %d is not SFB_SHADE_AVERAGE_LINEAR, _RENORMALIZED or _SPHERICAL", o->averaging);
     sh = (sfb__shading *)sfb__calloc(ctx, 1, sizeof *sh);
     lev = (sfb__level *)sfb__calloc(ctx, (size_t)L + 1, sizeof *lev);
     T = (sfb__stencils *)sfb__calloc(ctx, (size_t)L + 1, sizeof *T);
@@ -290,6 +322,8 @@ sfb_result sfb__shading_build(sfb_context *ctx, const sfb__level *prep, const sf
     parent = (int **)sfb__calloc(ctx, (size_t)L + 1, sizeof *parent);
     if (!sh || !lev || !T || !reg || !parent) { r = sfb__oom(ctx, "shading tables"); goto done; }
     sh->normals_level = Ln; sh->weights_level = Lw; sh->level = L; sh->variant = o->variant; sh->darts = o->darts;
+    sh->averaging = o->averaging;
+    per_level = o->averaging != SFB_SHADE_AVERAGE_LINEAR && L > Ln;
 
     /* the levels, one step at a time, with each step's local stencils */
     lev[0] = *prep; /* borrowed */
@@ -323,9 +357,12 @@ sfb_result sfb__shading_build(sfb_context *ctx, const sfb__level *prep, const sf
     sh->nsrc_of_vf = (int *)sfb__alloc(ctx, ((size_t)sh->nlev.vf_off[sh->nlev.nv] + 1) * sizeof(int));
     if (!sh->nsrc_of_vf) { r = sfb__oom(ctx, "shading tables"); goto done; }
     memcpy(sh->nsrc_of_vf, reg[Ln].of_vf, (size_t)sh->nlev.vf_off[sh->nlev.nv] * sizeof(int));
-    A.acc = (double *)sfb__alloc(ctx, ((size_t)(prep->nv > sh->nsrc ? prep->nv : sh->nsrc) + 1) * sizeof(double));
-    A.mark = (unsigned *)sfb__calloc(ctx, (size_t)(prep->nv > sh->nsrc ? prep->nv : sh->nsrc) + 1, sizeof(unsigned));
-    A.touched = (int *)sfb__alloc(ctx, ((size_t)(prep->nv > sh->nsrc ? prep->nv : sh->nsrc) + 1) * sizeof(int));
+    asz = prep->nv > sh->nsrc ? prep->nv : sh->nsrc;
+    for (k = Ln; per_level && k < L; ++k)
+        if (reg[k].total > asz) asz = reg[k].total; /* per level: rows over each level's regions */
+    A.acc = (double *)sfb__alloc(ctx, ((size_t)asz + 1) * sizeof(double));
+    A.mark = (unsigned *)sfb__calloc(ctx, (size_t)asz + 1, sizeof(unsigned));
+    A.touched = (int *)sfb__alloc(ctx, ((size_t)asz + 1) * sizeof(int));
     if (!A.acc || !A.mark || !A.touched) { r = sfb__oom(ctx, "shading tables"); goto done; }
     sh->npos_mode = Ln == 0 ? 0 : Ln == L ? 2 : 1;
     if (sh->npos_mode == 1) {
@@ -397,7 +434,14 @@ sfb_result sfb__shading_build(sfb_context *ctx, const sfb__level *prep, const sf
         sh->ns_idx_w[order[i]] = i < sh->nweighted ? i : -1;
     }
 
-    /* N_S: region rows composed from the normals level up to the level below the last */
+    /* N_S: region rows composed from the normals level up to the level below the last. Per
+     * level (averaging not linear): each step's rows over the regions of the level below alone
+     * (composed with an identity, which merges repeated sources), kept as a table of its own. */
+    if (per_level) {
+        sh->steps = (sfb__stencils *)sfb__calloc(ctx, (size_t)(L - Ln), sizeof *sh->steps);
+        if (!sh->steps) { r = sfb__oom(ctx, "shading tables"); goto done; }
+        sh->nsteps = L - Ln;
+    }
     if (!sfb__shade_identity(ctx, &prow, sh->nsrc)) { r = sfb__oom(ctx, "shading tables"); goto done; }
     for (k = Ln; k < L - 1; ++k) {
         const sfb__level *pl = k == Ln ? &sh->nlev : &lev[k];
@@ -415,7 +459,14 @@ sfb_result sfb__shading_build(sfb_context *ctx, const sfb__level *prep, const sf
                     !sfb__compose_row(ctx, &A, &prow, &m, &crow, rv)) { r = sfb__oom(ctx, "shading tables"); goto done; }
             }
         sfb__rows_free(ctx, &prow);
-        prow = crow;
+        if (per_level) {
+            r = sfb__rows_to_stencils(ctx, &crow, reg[k].total, &sh->steps[k - Ln]);
+            if (r != SFB_SUCCESS) { if (r == SFB_OUT_OF_MEMORY) r = sfb__oom(ctx, "shading tables"); goto done; }
+            sfb__rows_free(ctx, &crow);
+            if (!sfb__shade_identity(ctx, &prow, reg[k + 1].total)) { r = sfb__oom(ctx, "shading tables"); goto done; }
+        } else {
+            prow = crow;
+        }
         memset(&crow, 0, sizeof crow);
         r = sfb__progress(ctx, 0.8f, "shading");
         if (r != SFB_SUCCESS) goto done;
@@ -450,8 +501,20 @@ sfb_result sfb__shading_build(sfb_context *ctx, const sfb__level *prep, const sf
         }
         if (!sfb__compose_row(ctx, &A, &prow, &m, &crow, i)) { r = sfb__oom(ctx, "shading tables"); goto done; }
     }
-    r = sfb__rows_to_stencils(ctx, &crow, sh->nsrc, &sh->ns);
-    if (r != SFB_SUCCESS) { r = sfb__oom(ctx, "shading tables"); goto done; }
+    if (per_level) {
+        r = sfb__rows_to_stencils(ctx, &crow, reg[L - 1].total, &sh->steps[sh->nsteps - 1]);
+        if (r != SFB_SUCCESS) { if (r == SFB_OUT_OF_MEMORY) r = sfb__oom(ctx, "shading tables"); goto done; }
+        for (k = 0; k < sh->nsteps; ++k) {
+            const sfb__stencils *S = &sh->steps[k];
+            if (S->rows > sh->step_rows_max) sh->step_rows_max = S->rows;
+            if (S->sources > sh->step_rows_max) sh->step_rows_max = S->sources;
+            for (i = 0; i < S->rows; ++i)
+                if (S->sizes[i] > sh->step_size_max) sh->step_size_max = S->sizes[i];
+        }
+    } else {
+        r = sfb__rows_to_stencils(ctx, &crow, sh->nsrc, &sh->ns);
+        if (r != SFB_SUCCESS) { r = sfb__oom(ctx, "shading tables"); goto done; }
+    }
     sfb__rows_free(ctx, &crow);
     sfb__rows_free(ctx, &prow);
 
@@ -529,6 +592,7 @@ sfb_result sfb__shading_build(sfb_context *ctx, const sfb__level *prep, const sf
     }
     sh->bytes = sizeof *sh + (sh->ns.entries + sh->npos.entries + sh->lim[0].entries + sh->lim[1].entries + sh->lim[2].entries) * 8 +
                 (size_t)sh->nout * 6 * sizeof(int) + (size_t)top->nfv * sizeof(int) + (size_t)sh->nlev.nfv * 3 * sizeof(int);
+    for (k = 0; k < sh->nsteps; ++k) sh->bytes += sizeof *sh->steps + sh->steps[k].entries * 8 + (size_t)sh->steps[k].rows * 2 * sizeof(int);
 done:
     if (lev) {
         for (k = 1; k <= L; ++k) sfb__level_free(ctx, &lev[k]);
@@ -563,12 +627,121 @@ static sfb_result sfb__shade_apply(const sfb_surface *s, const sfb__stencils *t,
     return sfb__surface_apply(s, t, handle, rows, src, d3, dst, d3);
 }
 
+/* The weighted spherical mean of `count` vectors n (xyz, unit length expected) with weights w:
+ * the unit vector q minimising sum w_i angle(q, n_i)^2, where sum w_i log_q(n_i) = 0. Start at
+ * the normalised linear average, then q <- exp_q(sum (w_i / W) log_q(n_i)), W = sum w_i, until
+ * the step is shorter than 1e-12 or after 32 iterations, with
+ *   log_q(n) = (n - (q.n) q) theta / sin(theta), theta = angle(q, n)  (the tangent at q towards n),
+ *   exp_q(t) = cos|t| q + sin|t| t / |t|                                (walk |t| along t).
+ * A zero linear average gives zero (as linear averaging does). A zero input with a nonzero
+ * weight, a weight sum <= 0, an input within 1e-6 rad of -q (log_q undefined there) or a
+ * non-finite iterate give the normalised linear average instead. Returns the iterations taken
+ * (>= 1), 0 for the zero result, -1 where the linear average was returned. Pure: safe from any
+ * thread. */
+static int sfb__shade_spherical_mean(int count, const double *n, const double *w, double out[3]) {
+    double s[3] = {0.0, 0.0, 0.0}, q[3], W = 0.0, len;
+    int i, c, it, degenerate = 0;
+    for (i = 0; i < count; ++i) {
+        const double *v = n + 3 * (size_t)i;
+        for (c = 0; c < 3; ++c) s[c] += w[i] * v[c];
+        W += w[i];
+        if (w[i] != 0.0 && v[0] == 0.0 && v[1] == 0.0 && v[2] == 0.0) degenerate = 1;
+    }
+    out[0] = out[1] = out[2] = 0.0;
+    len = sqrt(s[0] * s[0] + s[1] * s[1] + s[2] * s[2]);
+    if (!(len > 0.0)) return 0;
+    for (c = 0; c < 3; ++c) out[c] = q[c] = s[c] / len;
+    if (degenerate || !(W > 0.0)) return -1;
+    for (it = 1;; ++it) {
+        double t[3] = {0.0, 0.0, 0.0}, tl, st;
+        for (i = 0; i < count; ++i) {
+            const double *v = n + 3 * (size_t)i;
+            double vl = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]), d, u[3], sv, theta, f;
+            if (w[i] == 0.0) continue;
+            d = (q[0] * v[0] + q[1] * v[1] + q[2] * v[2]) / vl;
+            for (c = 0; c < 3; ++c) u[c] = v[c] / vl - d * q[c];
+            sv = sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+            if (d > 0.0 && sv < 0.03) {
+                /* theta / sin(theta) = asin(s) / s = 1 + s^2/6 + 3 s^4/40 + 5 s^6/112 + O(s^8):
+                 * below s = 0.03 the rest is under 1e-14 of it (most entries: neighbouring
+                 * normals), and no atan2 is needed */
+                const double s2 = sv * sv;
+                f = 1.0 + s2 * (1.0 / 6.0 + s2 * (3.0 / 40.0 + s2 * (5.0 / 112.0)));
+            } else {
+                theta = atan2(sv, d);
+                if (theta > SFB__PI - 1e-6) return -1; /* nearly opposite q: no tangent towards it */
+                f = theta / sv;
+            }
+            for (c = 0; c < 3; ++c) t[c] += (w[i] / W) * f * u[c];
+        }
+        tl = sqrt(t[0] * t[0] + t[1] * t[1] + t[2] * t[2]);
+        if (tl < 1e-12) break;
+        st = sin(tl) / tl;
+        tl = cos(tl);
+        for (c = 0; c < 3; ++c) q[c] = tl * q[c] + st * t[c];
+        len = sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2]);
+        if (!(len > 0.5) || !(len < 2.0)) return -1; /* not finite */
+        for (c = 0; c < 3; ++c) q[c] /= len;
+        if (it == 32) break;
+    }
+    for (c = 0; c < 3; ++c) out[c] = q[c];
+    return it;
+}
+
+/* N_S one level at a time (averaging renormalised or spherical), on the CPU in double: `src`
+ * holds the normals-level region normals (nsh->nsrc xyz); each step's rows average the
+ * previous level's normals (RENORMALIZED: normalize(sum w_i n_i); SPHERICAL: the weighted
+ * spherical mean); the last step's rows [0, rows) go to ns as floats. */
+static sfb_result sfb__shade_levels(sfb_context *ctx, const sfb__shading *sh, const double *src, int rows, float *ns) {
+    size_t nrow = (size_t)sh->step_rows_max * 3 + 1, nsz = (size_t)sh->step_size_max + 1;
+    double *a = (double *)sfb__alloc(ctx, nrow * sizeof(double)), *b = (double *)sfb__alloc(ctx, nrow * sizeof(double));
+    double *vec = (double *)sfb__alloc(ctx, nsz * 3 * sizeof(double)), *w = (double *)sfb__alloc(ctx, nsz * sizeof(double));
+    const double *cur = src;
+    int k, i, j, c;
+    if (!a || !b || !vec || !w) {
+        sfb__free(ctx, a); sfb__free(ctx, b); sfb__free(ctx, vec); sfb__free(ctx, w);
+        return sfb__oom(ctx, "shading normals");
+    }
+    for (k = 0; k < sh->nsteps; ++k) {
+        const sfb__stencils *T = &sh->steps[k];
+        const int last = k == sh->nsteps - 1, n = last ? rows : T->rows;
+        double *nx = cur == a ? b : a;
+        for (i = 0; i < n; ++i) {
+            const int o = T->offsets[i], cnt = T->sizes[i];
+            double q[3];
+            if (sh->averaging == SFB_SHADE_AVERAGE_SPHERICAL) {
+                for (j = 0; j < cnt; ++j) {
+                    const double *p = cur + 3 * (size_t)T->indices[o + j];
+                    w[j] = (double)T->weights[o + j];
+                    vec[3 * j] = p[0]; vec[3 * j + 1] = p[1]; vec[3 * j + 2] = p[2];
+                }
+                sfb__shade_spherical_mean(cnt, vec, w, q);
+            } else {
+                double len;
+                q[0] = q[1] = q[2] = 0.0;
+                for (j = 0; j < cnt; ++j) {
+                    const double *p = cur + 3 * (size_t)T->indices[o + j], wj = (double)T->weights[o + j];
+                    for (c = 0; c < 3; ++c) q[c] += wj * p[c];
+                }
+                len = sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2]);
+                for (c = 0; c < 3; ++c) q[c] = len > 0.0 ? q[c] / len : 0.0;
+            }
+            if (last) for (c = 0; c < 3; ++c) ns[3 * (size_t)i + c] = (float)q[c];
+            else for (c = 0; c < 3; ++c) nx[3 * (size_t)i + c] = q[c];
+        }
+        cur = nx;
+    }
+    sfb__free(ctx, a); sfb__free(ctx, b); sfb__free(ctx, vec); sfb__free(ctx, w);
+    return SFB_SUCCESS;
+}
+
 SFB_API sfb_result sfb_surface_shade(const sfb_surface *s, const sfb_shade_params *params, sfb_mesh_data *o) {
     sfb_context *ctx;
     const sfb__shading *sh;
     const sfb__backend_vtable *be;
     sfb_shade_params prm;
     float *refined = NULL, *npos_buf = NULL, *src = NULL, *ns = NULL, *fnrm = NULL;
+    double *srcd = NULL; /* the sources in double (per-level averaging) */
     const float *npos;
     sfb_result r;
     int all, rows, v, f, i, c;
@@ -624,9 +797,13 @@ SFB_API sfb_result sfb_surface_shade(const sfb_surface *s, const sfb_shade_param
                 for (c = 0; c < 3; ++c) acc[3 * (size_t)sh->nsrc_of_vf[i] + c] += fnrm[3 * (size_t)sh->nlev.vf[i] + c];
         for (i = 0; i < sh->nsrc; ++i) {
             double *a = acc + 3 * (size_t)i, len = sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
-            for (c = 0; c < 3; ++c) src[3 * (size_t)i + c] = len > 0.0 ? (float)(a[c] / len) : 0.0f;
+            for (c = 0; c < 3; ++c) {
+                a[c] = len > 0.0 ? a[c] / len : 0.0;
+                src[3 * (size_t)i + c] = (float)a[c];
+            }
         }
-        sfb__free(ctx, acc);
+        if (sh->nsteps > 0) srcd = acc;
+        else sfb__free(ctx, acc);
     }
     /* output arrays */
     o->positions = (float *)sfb__alloc(ctx, (size_t)sh->nout * 3 * sizeof(float) + 1);
@@ -641,7 +818,7 @@ SFB_API sfb_result sfb_surface_shade(const sfb_surface *s, const sfb_shade_param
     ns = (float *)sfb__alloc(ctx, (size_t)sh->nout * 3 * sizeof(float) + 1);
     if (!o->positions || !o->limit_positions || !o->tangents_u || !o->tangents_v || !o->normals || !o->limit_normals ||
         !o->subdivided_normals || !o->blend_weights || !o->vertex_origin || !ns) goto oom;
-    if ((r = sfb__shade_apply(s, &sh->ns, sh->handles[1], rows, src, ns)) != SFB_SUCCESS ||
+    if ((r = sh->nsteps > 0 ? sfb__shade_levels(ctx, sh, srcd, rows, ns) : sfb__shade_apply(s, &sh->ns, sh->handles[1], rows, src, ns)) != SFB_SUCCESS ||
         (r = sfb__shade_apply(s, &sh->lim[0], sh->handles[2], sh->nout, refined, o->limit_positions)) != SFB_SUCCESS ||
         (r = sfb__shade_apply(s, &sh->lim[1], sh->handles[3], sh->nout, refined, o->tangents_u)) != SFB_SUCCESS ||
         (r = sfb__shade_apply(s, &sh->lim[2], sh->handles[4], sh->nout, refined, o->tangents_v)) != SFB_SUCCESS)
@@ -664,12 +841,12 @@ SFB_API sfb_result sfb_surface_shade(const sfb_surface *s, const sfb_shade_param
     o->refined_vertex_count = o->vertex_count;
     o->vertex_count = sh->nout;
     o->subdivided_count = rows;
-    sfb__free(ctx, refined); sfb__free(ctx, npos_buf); sfb__free(ctx, src); sfb__free(ctx, ns); sfb__free(ctx, fnrm);
+    sfb__free(ctx, refined); sfb__free(ctx, npos_buf); sfb__free(ctx, src); sfb__free(ctx, ns); sfb__free(ctx, fnrm); sfb__free(ctx, srcd);
     return SFB_SUCCESS;
 oom:
     r = sfb__oom(ctx, "shading output");
 fail:
-    sfb__free(ctx, refined); sfb__free(ctx, npos_buf); sfb__free(ctx, src); sfb__free(ctx, ns); sfb__free(ctx, fnrm);
+    sfb__free(ctx, refined); sfb__free(ctx, npos_buf); sfb__free(ctx, src); sfb__free(ctx, ns); sfb__free(ctx, fnrm); sfb__free(ctx, srcd);
     sfb_mesh_data_free(o);
     return r;
 }

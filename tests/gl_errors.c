@@ -1,12 +1,20 @@
 /* Failure paths of the gl and osmesa backends, for real: this program compiles the library
- * with a kernel source the GL compiler must reject, and with libOSMesa looked up under names
+ * with kernel sources the GL compiler must reject, and with libOSMesa looked up under names
  * that do not exist (as on Mesa 25.1+, which ships none). Checks that each comes back as a
  * result with the reason (the driver's compile log for gl) and that selection falls through to
- * the next backend. Prints PASS/FAIL/SKIP lines and "N passed, N failed, N skipped". */
+ * the next backend. The stencil kernel is compiled when the backend starts, so a broken one
+ * makes gl unavailable; the normals kernel (finish_normals, seed 001's blend) is compiled on
+ * first use, so a broken one makes sfb_surface_shade fail with the log while the backend and
+ * its other kernels keep working. Which source is broken is switched at run time (the source
+ * macros read the flags below). Prints PASS/FAIL/SKIP lines and "N passed, N failed, N skipped". */
 #define SURFBLEND_IMPLEMENTATION
 #define SURFBLEND_GL
 #define SURFBLEND_OSMESA
-#define SFB__GL_STENCIL_SOURCE "layout(local_size_x = 64) in;\nvoid main() { undeclared_thing = 1; }\n"
+static int g_break_stencils = 1, g_break_normals = 0;
+#define SFB__GL_STENCIL_SOURCE \
+    (g_break_stencils ? "layout(local_size_x = 64) in;\nvoid main() { undeclared_thing = 1; }\n" : sfb__glsl_stencils_comp_glsl)
+#define SFB__GL_NORMALS_SOURCE \
+    (g_break_normals ? "layout(local_size_x = 64) in;\nvoid main() { undeclared_normal = 1; }\n" : sfb__glsl_normals_comp_glsl)
 #define SFB__OSMESA_LIBRARY_NAMES {"libOSMesa-absent.so.8", "libOSMesa-absent.so.6", NULL}
 #include "surfblend.h"
 #include <stdio.h>
@@ -67,6 +75,59 @@ int main(void) {
             check(strstr(report, "gl: unavailable (backend error: gl: stencils.comp.glsl") != NULL, "gl-compile-error-report", report);
             sfb_context_destroy(ctx);
         }
+    }
+
+    /* gl: a normals kernel the driver rejects (intact stencil kernel) */
+    g_break_stencils = 0;
+    g_break_normals = 1;
+    r = sfb_backend_probe(SFB_BACKEND_GL, NULL, info, sizeof info);
+    if (r != SFB_SUCCESS && !required("gl")) {
+        printf("SKIP gl-normals-compile-error: no GL 4.3 context here (%s)\n", info);
+        ++skipped;
+    } else {
+        static const float P[8 * 3] = {-1, -1, 1, 1, -1, 1, -1, 1, 1, 1, 1, 1, -1, 1, -1, 1, 1, -1, -1, -1, -1, 1, -1, -1};
+        static const int Q[6 * 4] = {0, 1, 3, 2, 2, 3, 5, 4, 4, 5, 7, 6, 6, 7, 1, 0, 1, 7, 5, 3, 6, 0, 2, 4};
+        static const int FS[6] = {4, 4, 4, 4, 4, 4};
+        sfb_mesh_desc desc;
+        sfb_mesh *m = NULL;
+        sfb_surface *s = NULL;
+        sfb_surface_config sc = sfb_surface_config_init(SFB_SCHEME_CATMARK, 2);
+        sfb_mesh_data d;
+        const char *err;
+        check(r == SFB_SUCCESS, "gl-normals-compile-error-backend-starts", info);
+        order[0] = SFB_BACKEND_GL;
+        cfg.backend_count = 1;
+        r = sfb_context_create(&cfg, &ctx);
+        check(r == SFB_SUCCESS && strcmp(sfb_context_backend_name(ctx), "gl") == 0, "gl-normals-compile-error-gl-selected", sfb_result_string(r));
+        memset(&desc, 0, sizeof desc);
+        desc.vertex_count = 8; desc.positions = P; desc.face_count = 6; desc.face_sizes = FS; desc.face_vertices = Q;
+        sc.flags = SFB_REFINE_SHADING;
+        memset(&d, 0, sizeof d);
+        if (!ctx || sfb_mesh_create(ctx, &desc, &m) != SFB_SUCCESS || sfb_surface_create(ctx, m, &sc, &s) != SFB_SUCCESS) {
+            check(0, "gl-normals-compile-error-surface", ctx ? sfb_last_error(ctx) : "no context");
+        } else {
+            r = sfb_surface_shade(s, NULL, &d);
+            err = sfb_last_error(ctx);
+            printf("# %s\n", err);
+            check(r == SFB_BACKEND_ERROR, "gl-normals-compile-error-result", sfb_result_string(r));
+            check(strstr(err, "failed to compile") != NULL && strstr(err, "normals.comp.glsl") != NULL, "gl-normals-compile-error-names-the-shader",
+                  err);
+            check(strstr(err, "undeclared_normal") != NULL || strstr(err, "rror") != NULL, "gl-normals-compile-error-driver-log", err);
+            check(d.positions == NULL && d.normals == NULL && d.vertex_count == 0, "gl-normals-compile-error-no-output", "output left behind");
+            /* the failure is not cached: the next call compiles again and fails the same way */
+            r = sfb_surface_shade(s, NULL, &d);
+            check(r == SFB_BACKEND_ERROR && strstr(sfb_last_error(ctx), "normals.comp.glsl") != NULL, "gl-normals-compile-error-again",
+                  sfb_last_error(ctx));
+            /* the backend's other kernels still run */
+            r = sfb_surface_refine(s, &d);
+            check(r == SFB_SUCCESS && d.vertex_count == 98 && strcmp(sfb_context_backend_name(ctx), "gl") == 0, "gl-normals-compile-error-stencils-still-run",
+                  sfb_last_error(ctx));
+            sfb_mesh_data_free(&d);
+        }
+        if (s) sfb_surface_destroy(s);
+        if (m) sfb_mesh_destroy(m);
+        if (ctx) sfb_context_destroy(ctx);
+        ctx = NULL;
     }
     printf("%d passed, %d failed, %d skipped\n", passed, failed, skipped);
     return failed ? 1 : 0;

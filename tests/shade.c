@@ -26,7 +26,15 @@
  *     angle between the normals of the two ends of a face edge divided by the edge's length is
  *     lower with N_B than with N_L (both printed per shape). Edges with a sharp end (crease or
  *     corner rule) are left out: the normal field is meant to jump there;
- *   - bad options and failing allocations.
+ *   - averaging (sfb_shading_options.averaging): RENORMALIZED and SPHERICAL give unit N_S and N_B
+ *     on peer shapes of both schemes on every backend, agreeing with ref as above; planar
+ *     regions keep their plane normal in all three modes; on catmark_cube and loop_cube the
+ *     modes differ from each other by small nonzero angles; the spherical mean itself (two
+ *     vectors: on their arc at the weighted angle, which the normalised linear average is
+ *     not; more vectors: sum w_i log_q(n_i) = 0; rotation equivariance; degenerate inputs).
+ *     Printed, not checked: the level-4 smoothness of N_B with each mode, and on shapes where
+ *     it is not lowered, which modes and normals levels 1..3 lower it;
+ *   - bad options and failing allocations (each averaging mode).
  * A backend that is unavailable SKIPs (FAILs when listed in SFB_REQUIRE_BACKENDS). */
 #define SURFBLEND_IMPLEMENTATION
 #define SURFBLEND_ALL_BACKENDS
@@ -116,6 +124,20 @@ static sfb_surface *make_surface(sfb_context *ctx, const sfb_mesh *m, int loop, 
     return s;
 }
 
+/* Variant B, smooth darts, the given averaging and normals level (0: default). */
+static sfb_surface *make_surface_avg(sfb_context *ctx, const sfb_mesh *m, int loop, int level, int averaging, int normals_level) {
+    sfb_surface_config c = sfb_surface_config_init(loop ? SFB_SCHEME_LOOP : SFB_SCHEME_CATMARK, level);
+    sfb_surface *s = NULL;
+    c.flags = SFB_REFINE_SHADING;
+    c.shading.variant = SFB_SHADE_VARIANT_B;
+    c.shading.darts = SFB_SHADE_DARTS_SMOOTH;
+    c.shading.averaging = averaging;
+    c.shading.normals_level = normals_level;
+    if (sfb_surface_create(ctx, m, &c, &s) != SFB_SUCCESS) return NULL;
+    return s;
+}
+static const char *const g_avg_name[3] = {"linear", "renormalized", "spherical"};
+
 static int shade(const sfb_surface *s, int all, sfb_mesh_data *d) {
     sfb_shade_params p = sfb_shade_params_init();
     if (all) p.flags = SFB_SHADE_ALL_SUBDIVIDED;
@@ -170,6 +192,69 @@ static double diag_of(const sfb_mesh *m) {
     sfb_mesh_get_info(m, &info);
     dx = info.bbox_max[0] - info.bbox_min[0]; dy = info.bbox_max[1] - info.bbox_min[1]; dz = info.bbox_max[2] - info.bbox_min[2];
     return sqrt(dx * dx + dy * dy + dz * dz);
+}
+
+/* Largest errors of a backend's shade output d against ref's r of the same surface options
+ * (tolerances at the top of this file): position / diagonal (wp), and N_B, N_L, N_S as multiples
+ * of their tolerances (wn, wl, ws); nill counts the vertices left out. */
+typedef struct agree_stats { double wp, wn, wl, ws; int nill; } agree_stats;
+static void compare_to_ref(const sfb_surface *sref, const sfb_mesh_data *r, const sfb_mesh_data *d, double diag, int nonmanifold_edges,
+                           agree_stats *st) {
+    int i;
+    /* the backend's position error, which the tangent masks carry into the normals */
+    double eps = 1e-7 * diag;
+    for (i = 0; i < 3 * d->vertex_count; ++i)
+        if (fabs((double)d->positions[i] - r->positions[i]) > eps) eps = fabs((double)d->positions[i] - r->positions[i]);
+    for (i = 0; i < d->vertex_count; ++i) {
+        int c;
+        double an, tu = 0.0, tv = 0.0, cr;
+        const float *A = r->tangents_u + 3 * i, *B = r->tangents_v + 3 * i;
+        double X = (double)A[1] * B[2] - (double)A[2] * B[1], Y = (double)A[2] * B[0] - (double)A[0] * B[2];
+        double Z = (double)A[0] * B[1] - (double)A[1] * B[0];
+        for (c = 0; c < 3; ++c) { tu += (double)A[c] * A[c]; tv += (double)B[c] * B[c]; }
+        tu = sqrt(tu); tv = sqrt(tv); cr = sqrt(X * X + Y * Y + Z * Z);
+        /* normals of ill-conditioned tangent pairs (nearly parallel, or tiny against the
+         * mesh: float positions carry ~1e-7 x diagonal of noise into the local masks)
+         * are not compared */
+        if (!(cr > 1e-2 * tu * tv) || tu < 1e-3 * diag || tv < 1e-3 * diag) { st->nill++; continue; }
+        for (c = 0; c < 3; ++c) {
+            double dp = fabs((double)d->limit_positions[3 * i + c] - r->limit_positions[3 * i + c]) / diag;
+            if (dp > st->wp) st->wp = dp;
+        }
+        {
+            /* the position tolerance (1e-5 x diagonal) carried through a tangent mask
+             * (weights summing to about 4 in magnitude) into the normal's direction */
+            const sfb__stencils *Tu = &sref->shading->lim[1], *Tv = &sref->shading->lim[2];
+            double l1u = 0.0, l1v = 0.0, tol, rel;
+            const float *S0 = r->subdivided_normals + 3 * i, *S1 = d->subdivided_normals + 3 * i;
+            int q;
+            for (q = 0; q < Tu->sizes[i]; ++q) l1u += fabs(Tu->weights[Tu->offsets[i] + q]);
+            for (q = 0; q < Tv->sizes[i]; ++q) l1v += fabs(Tv->weights[Tv->offsets[i] + q]);
+            tol = 1e-4 + 2.0 * eps * (l1u / tu + l1v / tv) * (tu * tv / cr);
+            if (sref->top.vtag[r->vertex_origin[i]] & SFB__TAG_NONMANIFOLD) { st->nill++; continue; }
+            if ((S0[0] == 0.0f && S0[1] == 0.0f && S0[2] == 0.0f) || (S1[0] == 0.0f && S1[1] == 0.0f && S1[2] == 0.0f)) {
+                /* N_S of a region whose face normals cancel (back-to-back faces) is noise */
+                st->nill++;
+                continue;
+            }
+            if ((rel = angle3(d->normals + 3 * i, r->normals + 3 * i) / tol) > st->wn) st->wn = rel;
+            if ((rel = angle3(d->limit_normals + 3 * i, r->limit_normals + 3 * i) / tol) > st->wl) st->wl = rel;
+            if (!nonmanifold_edges && (an = angle3(S1, S0) / 1e-3) > st->ws) st->ws = an;
+        }
+    }
+}
+
+/* The smoothness measure of N_B with the given averaging and normals level (-1 on failure). */
+static double smooth_of(const sfb_mesh *m, int loop, int level, int averaging, int normals_level) {
+    sfb_surface *s = make_surface_avg(g_be[0].ctx, m, loop, level, averaging, normals_level);
+    sfb_mesh_data d;
+    double r = -1.0;
+    int nev = 0;
+    memset(&d, 0, sizeof d);
+    if (s && shade(s, 1, &d)) r = smoothness(s, &d, d.normals, loop, &nev);
+    if (s) sfb_surface_destroy(s);
+    sfb_mesh_data_free(&d);
+    return r;
 }
 
 /* Every check of one shape. `smooth_level`: the level of the smoothness measure (0: none). */
@@ -238,14 +323,16 @@ static void run_mesh(const char *name, const sfb_mesh *m, int loop, int smooth_l
         backend *b = &g_be[e];
         sfb_surface *s;
         sfb_mesh_data d;
-        double wp = 0.0, wn = 0.0, wl = 0.0, ws = 0.0, wev = 0.0, wbev = 0.0;
-        int a, ok = 1, nev = 0, nill = 0;
+        double wev = 0.0, wbev = 0.0;
+        agree_stats st;
+        int a, ok = 1, nev = 0;
         if (!b->available) {
             snprintf(nm, sizeof nm, "%s/%s", b->name, name);
             if (b->required) fail(nm, "%s unavailable: %s (required by SFB_REQUIRE_BACKENDS)", b->name, b->why);
             else skip(nm, b->why);
             continue;
         }
+        memset(&st, 0, sizeof st);
         for (a = 0; a < 2; ++a) {
             s = e == 0 ? sref : make_surface(b->ctx, m, loop, 3, SFB_SHADE_VARIANT_B, SFB_SHADE_DARTS_SMOOTH);
             snprintf(nm, sizeof nm, "%s/%s/%s", b->name, name, a ? "all" : "weighted");
@@ -258,47 +345,7 @@ static void run_mesh(const char *name, const sfb_mesh *m, int loop, int smooth_l
                 fail(nm, "output topology or weights differ from ref");
                 ok = 0;
             } else {
-                /* the backend's position error, which the tangent masks carry into the normals */
-                double eps = 1e-7 * diag;
-                for (i = 0; i < 3 * d.vertex_count; ++i)
-                    if (fabs((double)d.positions[i] - ref[a].positions[i]) > eps) eps = fabs((double)d.positions[i] - ref[a].positions[i]);
-                for (i = 0; i < d.vertex_count; ++i) {
-                    int c;
-                    double an, tu = 0.0, tv = 0.0, cr;
-                    const float *A = ref[a].tangents_u + 3 * i, *B = ref[a].tangents_v + 3 * i;
-                    double X = (double)A[1] * B[2] - (double)A[2] * B[1], Y = (double)A[2] * B[0] - (double)A[0] * B[2];
-                    double Z = (double)A[0] * B[1] - (double)A[1] * B[0];
-                    for (c = 0; c < 3; ++c) { tu += (double)A[c] * A[c]; tv += (double)B[c] * B[c]; }
-                    tu = sqrt(tu); tv = sqrt(tv); cr = sqrt(X * X + Y * Y + Z * Z);
-                    /* normals of ill-conditioned tangent pairs (nearly parallel, or tiny against the
-                     * mesh: float positions carry ~1e-7 x diagonal of noise into the local masks)
-                     * are not compared */
-                    if (!(cr > 1e-2 * tu * tv) || tu < 1e-3 * diag || tv < 1e-3 * diag) { nill++; continue; }
-                    for (c = 0; c < 3; ++c) {
-                        double dp = fabs((double)d.limit_positions[3 * i + c] - ref[a].limit_positions[3 * i + c]) / diag;
-                        if (dp > wp) wp = dp;
-                    }
-                    {
-                        /* the position tolerance (1e-5 x diagonal) carried through a tangent mask
-                         * (weights summing to about 4 in magnitude) into the normal's direction */
-                        const sfb__stencils *Tu = &sref->shading->lim[1], *Tv = &sref->shading->lim[2];
-                        double l1u = 0.0, l1v = 0.0, tol, rel;
-                        const float *S0 = ref[a].subdivided_normals + 3 * i, *S1 = d.subdivided_normals + 3 * i;
-                        int q;
-                        for (q = 0; q < Tu->sizes[i]; ++q) l1u += fabs(Tu->weights[Tu->offsets[i] + q]);
-                        for (q = 0; q < Tv->sizes[i]; ++q) l1v += fabs(Tv->weights[Tv->offsets[i] + q]);
-                        tol = 1e-4 + 2.0 * eps * (l1u / tu + l1v / tv) * (tu * tv / cr);
-                        if (sref->top.vtag[ref[a].vertex_origin[i]] & SFB__TAG_NONMANIFOLD) { nill++; continue; }
-                        if ((S0[0] == 0.0f && S0[1] == 0.0f && S0[2] == 0.0f) || (S1[0] == 0.0f && S1[1] == 0.0f && S1[2] == 0.0f)) {
-                            /* N_S of a region whose face normals cancel (back-to-back faces) is noise */
-                            nill++;
-                            continue;
-                        }
-                        if ((rel = angle3(d.normals + 3 * i, ref[a].normals + 3 * i) / tol) > wn) wn = rel;
-                        if ((rel = angle3(d.limit_normals + 3 * i, ref[a].limit_normals + 3 * i) / tol) > wl) wl = rel;
-                        if (!info.nonmanifold_edges && (an = angle3(S1, S0) / 1e-3) > ws) ws = an;
-                    }
-                }
+                compare_to_ref(sref, &ref[a], &d, diag, info.nonmanifold_edges, &st);
                 if (a == 1) {
                     /* smooth EVs at the last level: b == 1, N_B == N_S */
                     for (i = 0; i < d.vertex_count; ++i) {
@@ -316,8 +363,9 @@ static void run_mesh(const char *name, const sfb_mesh *m, int loop, int smooth_l
             sfb_mesh_data_free(&d);
         }
         snprintf(nm, sizeof nm, "%s/%s/agree", b->name, name);
-        if (ok) check(wp <= 1e-5 && wn <= 1.0 && wl <= 1.0 && ws <= 1.0, nm, "position %.3g x diag, N_B %.3g, N_L %.3g, N_S %.3g x tolerance (%d ill-conditioned left out)",
-                      wp, wn, wl, ws, nill);
+        if (ok) check(st.wp <= 1e-5 && st.wn <= 1.0 && st.wl <= 1.0 && st.ws <= 1.0, nm,
+                      "position %.3g x diag, N_B %.3g, N_L %.3g, N_S %.3g x tolerance (%d ill-conditioned left out)", st.wp, st.wn, st.wl,
+                      st.ws, st.nill);
         if (nev) {
             snprintf(nm, sizeof nm, "%s/%s/EV: b = 1 and N_B = N_S (%d vertices)", b->name, name, nev);
             check(wbev == 0.0 && wev <= 1e-5, nm, "max |b - 1| %g, max angle(N_B, N_S) %g rad", wbev, wev);
@@ -423,11 +471,23 @@ static void run_mesh(const char *name, const sfb_mesh *m, int loop, int smooth_l
             double mb = smoothness(s4, &d4, d4.normals, loop, &nev), ml = smoothness(s4, &d4, d4.limit_normals, loop, &nev);
             if (nev == 0) skip(nm, "no extraordinary vertex in a smooth region");
             else {
-                double ms = smoothness(s4, &d4, d4.subdivided_normals, loop, &nev);
-                int nw = 0;
+                double ms = smoothness(s4, &d4, d4.subdivided_normals, loop, &nev), mbm[3][3];
+                int nw = 0, k, unlowered;
+                for (k = 0; k < 9; ++k) mbm[k / 3][k % 3] = -1.0; /* -1: not computed */
                 for (i = 0; i < d4.vertex_count; ++i) nw += d4.blend_weights[i] > 0.0f;
                 printf("# smoothness %s: N_L %.4g, N_B %.4g, N_S %.4g rad per unit (%d EVs, N_S needed at %.1f%% of %d vertices)\n", name, ml, mb,
                        ms, nev, 100.0 * nw / d4.vertex_count, d4.vertex_count);
+                /* N_B with each averaging mode (normals level 1), and where linear does not lower
+                 * the measure, which modes and normals levels 1..3 do: information, not checks */
+                unlowered = ml != 0.0 && !(info.nonmanifold_edges > 0 || info.nonmanifold_vertices > 0) && !(mb < ml);
+                mbm[0][0] = mb;
+                for (k = 1; k < 9; ++k) {
+                    const int avg = k % 3, nl = k / 3 + 1;
+                    if (k >= 3 && !unlowered) continue;
+                    mbm[nl - 1][avg] = smooth_of(m, loop, smooth_level, avg, nl);
+                }
+                printf("# smoothness %s level %d N_B: linear %.4g, renormalized %.4g, spherical %.4g (N_L %.4g)\n", name, smooth_level, mbm[0][0],
+                       mbm[0][1], mbm[0][2], ml);
                 if (ml == 0.0) skip(nm, "N_L does not turn at all in the two-rings (planar): nothing to lower");
                 else if (info.nonmanifold_edges > 0 || info.nonmanifold_vertices > 0) skip(nm, "non-manifold: normals of the sheets are not comparable");
                 else if (mb < ml) pass(nm);
@@ -436,9 +496,18 @@ static void run_mesh(const char *name, const sfb_mesh *m, int loop, int smooth_l
                      * subdivided field turns faster than the limit normals near the corners of
                      * cube-like shapes, so this measure (a turning rate, not a continuity
                      * measure) is not lowered there. Reported, not counted as passed. */
-                    char why[256];
+                    char why[256], list[512];
+                    size_t at = 0;
                     snprintf(why, sizeof why, "smoothness measure not lowered: N_B %.4g >= N_L %.4g (open problem, see the issue note)", mb, ml);
                     skip(nm, why);
+                    list[0] = 0;
+                    for (k = 0; k < 9 && at < sizeof list; ++k)
+                        if (mbm[k / 3][k % 3] >= 0.0 && mbm[k / 3][k % 3] < ml)
+                            at += (size_t)snprintf(list + at, sizeof list - at, "%s%s/normals level %d (%.4g)", at ? ", " : "", g_avg_name[k % 3],
+                                                   k / 3 + 1, mbm[k / 3][k % 3]);
+                    printf("# smoothness not lowered on %s (N_L %.4g): normals level 1: linear %.4g, renormalized %.4g, spherical %.4g; level 2: "
+                           "%.4g, %.4g, %.4g; level 3: %.4g, %.4g, %.4g; lowered by: %s\n", name, ml, mbm[0][0], mbm[0][1], mbm[0][2], mbm[1][0],
+                           mbm[1][1], mbm[1][2], mbm[2][0], mbm[2][1], mbm[2][2], list[0] ? list : "none");
                 }
             }
         }
@@ -509,17 +578,22 @@ static sfb_mesh *torus(sfb_context *ctx, int loop) {
 
 /* Split normals on a creased cube: every normal of a face's corner equals the face's plane. */
 static void planar_check(const char *name, const sfb_mesh *m, int loop, int level) {
-    int e;
+    int run;
     char nm[256];
-    for (e = 0; e < g_nbe; ++e) {
+    for (run = 0; run < 3 * g_nbe; ++run) { /* each averaging mode on each backend */
+        const int avg = run / g_nbe, e = run % g_nbe;
         backend *b = &g_be[e];
         sfb_surface *s;
         sfb_mesh_data d;
         double worst = 0.0;
         int f, j, splits = 0;
         if (!b->available) continue;
-        s = make_surface(b->ctx, m, loop, level, SFB_SHADE_VARIANT_B, SFB_SHADE_DARTS_SMOOTH);
-        snprintf(nm, sizeof nm, "%s/%s level %d/planar regions: N_B = N_L = N_S = plane normal", b->name, name, level);
+        s = make_surface_avg(b->ctx, m, loop, level, avg, 0);
+        if (avg == SFB_SHADE_AVERAGE_LINEAR)
+            snprintf(nm, sizeof nm, "%s/%s level %d/planar regions: N_B = N_L = N_S = plane normal", b->name, name, level);
+        else
+            snprintf(nm, sizeof nm, "%s/%s level %d/planar regions, %s averaging: N_B = N_L = N_S = plane normal", b->name, name, level,
+                     g_avg_name[avg]);
         memset(&d, 0, sizeof d);
         if (!s || !shade(s, 1, &d)) { fail(nm, "%s", sfb_last_error(b->ctx)); if (s) sfb_surface_destroy(s); continue; }
         for (f = 0; f < d.face_count; ++f) {
@@ -557,8 +631,9 @@ static void *fa_alloc(size_t n, void *u) { fa *a = (fa *)u; void *p; if (a->n++ 
 static void *fa_realloc(void *p, size_t n, void *u) { fa *a = (fa *)u; void *q; if (a->n++ == a->fail_at) return NULL; q = realloc(p, n); if (q && !p) a->live++; return q; }
 static void fa_free(void *p, void *u) { fa *a = (fa *)u; if (p) { a->live--; free(p); } }
 
-static void failing_allocations(void) {
+static void failing_allocations(int averaging) {
     long k, bad = 0, tried = 0;
+    char nm[128];
     for (k = 0; k < 100000; ++k) {
         fa a;
         sfb_context_config cfg = sfb_context_config_init();
@@ -575,8 +650,10 @@ static void failing_allocations(void) {
         m = creased_cube(ctx, 0);
         memset(&d, 0, sizeof d);
         if (m) {
-            sfb_surface_config c = sfb_surface_config_init(SFB_SCHEME_CATMARK, 2);
+            /* per-level averaging at level 3: two steps, the first over a whole level */
+            sfb_surface_config c = sfb_surface_config_init(SFB_SCHEME_CATMARK, averaging == SFB_SHADE_AVERAGE_LINEAR ? 2 : 3);
             c.flags = SFB_REFINE_SHADING;
+            c.shading.averaging = averaging;
             r = sfb_surface_create(ctx, m, &c, &s);
             if (r == SFB_SUCCESS) {
                 r = sfb_surface_shade(s, NULL, &d);
@@ -591,7 +668,9 @@ static void failing_allocations(void) {
         if (a.live != 0) bad++;
         if (a.n <= k) break; /* every allocation succeeded: done */
     }
-    check(bad == 0 && tried > 10, "ref/failing allocations: OUT_OF_MEMORY, nothing leaked", "%ld bad of %ld", bad, tried);
+    if (averaging == SFB_SHADE_AVERAGE_LINEAR) snprintf(nm, sizeof nm, "ref/failing allocations: OUT_OF_MEMORY, nothing leaked");
+    else snprintf(nm, sizeof nm, "ref/failing allocations, %s averaging: OUT_OF_MEMORY, nothing leaked", g_avg_name[averaging]);
+    check(bad == 0 && tried > 10, nm, "%ld bad of %ld", bad, tried);
 }
 
 static void bad_options(void) {
@@ -608,7 +687,13 @@ static void bad_options(void) {
     check(sfb_surface_create(ctx, m, &c, &s) == SFB_INVALID_VALUE, "ref/bad/variant 7", "%s", sfb_last_error(ctx));
     c.shading.variant = 0; c.shading.darts = -1;
     check(sfb_surface_create(ctx, m, &c, &s) == SFB_INVALID_VALUE, "ref/bad/darts -1", "%s", sfb_last_error(ctx));
-    c.shading.darts = 0; c.scheme = SFB_SCHEME_BILINEAR;
+    c.shading.darts = 0; c.shading.averaging = 3;
+    check(sfb_surface_create(ctx, m, &c, &s) == SFB_INVALID_VALUE && strstr(sfb_last_error(ctx), "averaging") != NULL, "ref/bad/averaging 3", "%s",
+          sfb_last_error(ctx));
+    c.shading.averaging = -1;
+    check(sfb_surface_create(ctx, m, &c, &s) == SFB_INVALID_VALUE && strstr(sfb_last_error(ctx), "averaging") != NULL, "ref/bad/averaging -1", "%s",
+          sfb_last_error(ctx));
+    c.shading.averaging = 0; c.scheme = SFB_SCHEME_BILINEAR;
     check(sfb_surface_create(ctx, m, &c, &s) == SFB_UNSUPPORTED, "ref/bad/bilinear shading", "%s", sfb_last_error(ctx));
     c.scheme = SFB_SCHEME_CATMARK; c.flags = 0;
     if (sfb_surface_create(ctx, m, &c, &s) == SFB_SUCCESS) {
@@ -632,6 +717,224 @@ static void bad_options(void) {
     sfb_mesh_destroy(m);
 }
 
+/* ---- averaging modes (sfb_shading_options.averaging) ---- */
+
+/* log_q(n) of the unit sphere: the tangent at q towards n, as long as the angle. */
+static void sphere_log(const double q[3], const double n[3], double t[3]) {
+    double d = q[0] * n[0] + q[1] * n[1] + q[2] * n[2], u[3], sv, th;
+    int c;
+    for (c = 0; c < 3; ++c) u[c] = n[c] - d * q[c];
+    sv = sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+    th = atan2(sv, d);
+    for (c = 0; c < 3; ++c) t[c] = sv > 0.0 ? u[c] * th / sv : 0.0;
+}
+
+static double rnd(unsigned *state) { *state = *state * 1664525u + 1013904223u; return (double)(*state >> 8) / 16777216.0; }
+
+static void normalize3(double *v) {
+    double l = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+    v[0] /= l; v[1] /= l; v[2] /= l;
+}
+
+/* The spherical mean itself (src/shade.c's sfb__shade_spherical_mean). */
+static void spherical_mean_tests(void) {
+    static const double as[4] = {0.05, 0.3, 1.0, 1.5}, ws[3] = {0.2, 0.5, 0.8};
+    double worst = 0.0, lin, resid = 0.0, unit = 0.0, equi = 0.0, q[3], n[3 * 8], w[8];
+    int i, j, c, trial, fallbacks = 0, maxit = 0;
+    unsigned seed = 12345u;
+    /* two unit vectors at angle 2a, weights w and 1 - w: the mean lies on their arc at (1 - w) 2a */
+    for (i = 0; i < 4; ++i)
+        for (j = 0; j < 3; ++j) {
+            double a = as[i], e;
+            n[0] = 1.0; n[1] = 0.0; n[2] = 0.0;
+            n[3] = cos(2.0 * a); n[4] = sin(2.0 * a); n[5] = 0.0;
+            w[0] = ws[j]; w[1] = 1.0 - ws[j];
+            if (sfb__shade_spherical_mean(2, n, w, q) < 1) { fallbacks++; continue; }
+            e = fabs(atan2(q[1], q[0]) - (1.0 - ws[j]) * 2.0 * a) + fabs(q[2]) + fabs(sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2]) - 1.0);
+            if (e > worst) worst = e;
+        }
+    check(worst <= 1e-9 && fallbacks == 0, "spherical mean/two vectors at angle 2a, weights w, 1-w: at (1-w) 2a from the first",
+          "error %.3g, %d fallbacks", worst, fallbacks);
+    /* the normalised linear average is not there: a = 1 rad, w = 0.2 */
+    n[0] = 1.0; n[1] = 0.0; n[2] = 0.0; n[3] = cos(2.0); n[4] = sin(2.0); n[5] = 0.0;
+    w[0] = 0.2; w[1] = 0.8;
+    sfb__shade_spherical_mean(2, n, w, q);
+    lin = atan2(0.2 * n[1] + 0.8 * n[4], 0.2 * n[0] + 0.8 * n[3]);
+    check(fabs(lin - 1.6) > 1e-4 && fabs(atan2(q[1], q[0]) - 1.6) <= 1e-9, "spherical mean/the linear average differs (a = 1, w = 0.2)",
+          "linear at %.9g rad, spherical at %.12g, expected 1.6", lin, atan2(q[1], q[0]));
+    /* three to eight vectors in caps of several sizes (up to about 1 rad from their mean, wider
+     * than the neighbouring normals a stencil mixes; around nearly opposite vectors the iteration
+     * converges more slowly and may stop at its 32 iterations before the 1e-12 step):
+     * sum w_i log_q(n_i) = 0; rotation equivariance */
+    for (trial = 0; trial < 300; ++trial) {
+        int cnt = 3 + trial % 6, it;
+        double ctr[3], spread = trial % 3 == 0 ? 0.1 : trial % 3 == 1 ? 0.3 : 0.5, g[3] = {0.0, 0.0, 0.0}, W = 0.0, l;
+        double axis[3], ang, R[9], rn[3 * 8], rq[3], Rq[3];
+        for (c = 0; c < 3; ++c) ctr[c] = rnd(&seed) * 2.0 - 1.0;
+        normalize3(ctr);
+        for (i = 0; i < cnt; ++i) {
+            for (c = 0; c < 3; ++c) n[3 * i + c] = ctr[c] + spread * (rnd(&seed) * 2.0 - 1.0);
+            normalize3(n + 3 * i);
+            w[i] = 0.05 + rnd(&seed);
+            W += w[i];
+        }
+        it = sfb__shade_spherical_mean(cnt, n, w, q);
+        if (it < 1) { fallbacks++; continue; }
+        if (it > maxit) maxit = it;
+        for (i = 0; i < cnt; ++i) {
+            double t[3];
+            sphere_log(q, n + 3 * i, t);
+            for (c = 0; c < 3; ++c) g[c] += w[i] / W * t[c];
+        }
+        l = sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]);
+        if (l > resid) resid = l;
+        l = fabs(sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2]) - 1.0);
+        if (l > unit) unit = l;
+        /* a rotation R (axis, angle; Rodrigues): mean(R n_i) = R mean(n_i) */
+        for (c = 0; c < 3; ++c) axis[c] = rnd(&seed) * 2.0 - 1.0;
+        normalize3(axis);
+        ang = 6.0 * rnd(&seed);
+        {
+            double cs = cos(ang), sn = sin(ang), x = axis[0], y = axis[1], z = axis[2];
+            R[0] = cs + x * x * (1 - cs); R[1] = x * y * (1 - cs) - z * sn; R[2] = x * z * (1 - cs) + y * sn;
+            R[3] = y * x * (1 - cs) + z * sn; R[4] = cs + y * y * (1 - cs); R[5] = y * z * (1 - cs) - x * sn;
+            R[6] = z * x * (1 - cs) - y * sn; R[7] = z * y * (1 - cs) + x * sn; R[8] = cs + z * z * (1 - cs);
+        }
+        for (i = 0; i < cnt; ++i)
+            for (c = 0; c < 3; ++c) rn[3 * i + c] = R[3 * c] * n[3 * i] + R[3 * c + 1] * n[3 * i + 1] + R[3 * c + 2] * n[3 * i + 2];
+        if (sfb__shade_spherical_mean(cnt, rn, w, rq) < 1) { fallbacks++; continue; }
+        for (c = 0; c < 3; ++c) Rq[c] = R[3 * c] * q[0] + R[3 * c + 1] * q[1] + R[3 * c + 2] * q[2];
+        l = sqrt((rq[0] - Rq[0]) * (rq[0] - Rq[0]) + (rq[1] - Rq[1]) * (rq[1] - Rq[1]) + (rq[2] - Rq[2]) * (rq[2] - Rq[2]));
+        if (l > equi) equi = l;
+    }
+    check(resid <= 1e-9 && unit <= 1e-12 && fallbacks == 0, "spherical mean/3-8 vectors: sum w_i log_q(n_i) = 0",
+          "residual %.3g, |q| - 1 %.3g, %d fallbacks, up to %d iterations", resid, unit, fallbacks, maxit);
+    check(equi <= 1e-9 && fallbacks == 0, "spherical mean/rotation equivariance", "|mean(R n) - R mean(n)| %.3g", equi);
+    printf("# spherical mean: residual %.3g, equivariance %.3g, up to %d iterations (300 sets of 3-8 vectors)\n", resid, equi, maxit);
+    /* degenerate inputs: a zero linear average stays zero; an input opposite q gives the linear average */
+    n[0] = 0.0; n[1] = 0.0; n[2] = 1.0; n[3] = 0.0; n[4] = 0.0; n[5] = -1.0;
+    w[0] = 0.5; w[1] = 0.5;
+    i = sfb__shade_spherical_mean(2, n, w, q);
+    check(i == 0 && q[0] == 0.0 && q[1] == 0.0 && q[2] == 0.0, "spherical mean/zero average stays zero", "returned %d, (%g %g %g)", i, q[0], q[1],
+          q[2]);
+    w[0] = 0.7; w[1] = 0.3;
+    i = sfb__shade_spherical_mean(2, n, w, q);
+    check(i == -1 && q[2] == 1.0, "spherical mean/opposite input: the linear average", "returned %d, (%g %g %g)", i, q[0], q[1], q[2]);
+}
+
+/* RENORMALIZED and SPHERICAL on every backend: N_S and N_B unit length, agreement with ref
+ * (the tolerances of run_mesh), same topology and weights as linear. */
+static void averaging_check(const char *name, const sfb_mesh *m, int loop) {
+    sfb_mesh_info info;
+    double diag = diag_of(m);
+    int avg, e, a, i;
+    char nm[512];
+    sfb_mesh_get_info(m, &info);
+    for (avg = SFB_SHADE_AVERAGE_RENORMALIZED; avg <= SFB_SHADE_AVERAGE_SPHERICAL; ++avg) {
+        sfb_mesh_data ref[2];
+        sfb_surface *sref = make_surface_avg(g_be[0].ctx, m, loop, 3, avg, 0);
+        memset(ref, 0, sizeof ref);
+        snprintf(nm, sizeof nm, "ref/%s/%s averaging", name, g_avg_name[avg]);
+        if (!sref || !shade(sref, 0, &ref[0]) || !shade(sref, 1, &ref[1])) {
+            fail(nm, "%s", sfb_last_error(g_be[0].ctx));
+            if (sref) sfb_surface_destroy(sref);
+            sfb_mesh_data_free(&ref[0]); sfb_mesh_data_free(&ref[1]);
+            continue;
+        }
+        for (e = 0; e < g_nbe; ++e) {
+            backend *b = &g_be[e];
+            agree_stats st;
+            double wu = 0.0;
+            int ok = 1, nunit = 0;
+            snprintf(nm, sizeof nm, "%s/%s/%s averaging: unit N_S and N_B, agree with ref", b->name, name, g_avg_name[avg]);
+            if (!b->available) {
+                if (b->required) fail(nm, "%s unavailable: %s (required by SFB_REQUIRE_BACKENDS)", b->name, b->why);
+                else skip(nm, b->why);
+                continue;
+            }
+            memset(&st, 0, sizeof st);
+            for (a = 0; a < 2 && ok; ++a) {
+                sfb_surface *s = e == 0 ? sref : make_surface_avg(b->ctx, m, loop, 3, avg, 0);
+                sfb_mesh_data d;
+                memset(&d, 0, sizeof d);
+                if (!s || !shade(s, a, &d)) { fail(nm, "%s", sfb_last_error(b->ctx)); ok = 0; }
+                else if (d.vertex_count != ref[a].vertex_count || d.face_vertex_count != ref[a].face_vertex_count ||
+                         memcmp(d.face_vertices, ref[a].face_vertices, sizeof(int) * (size_t)d.face_vertex_count) ||
+                         memcmp(d.blend_weights, ref[a].blend_weights, sizeof(float) * (size_t)d.vertex_count) ||
+                         d.subdivided_count != ref[a].subdivided_count) {
+                    fail(nm, "output topology or weights differ from ref");
+                    ok = 0;
+                } else {
+                    compare_to_ref(sref, &ref[a], &d, diag, info.nonmanifold_edges, &st);
+                    for (i = 0; i < d.vertex_count; ++i) {
+                        const float *B = d.normals + 3 * i, *S = d.subdivided_normals + 3 * i;
+                        double lb = sqrt((double)B[0] * B[0] + (double)B[1] * B[1] + (double)B[2] * B[2]);
+                        double ls = sqrt((double)S[0] * S[0] + (double)S[1] * S[1] + (double)S[2] * S[2]);
+                        if (fabs(lb - 1.0) > wu) wu = fabs(lb - 1.0);
+                        /* N_S is computed at every vertex with SFB_SHADE_ALL_SUBDIVIDED, else where b > 0 */
+                        if (a == 1 || d.blend_weights[i] > 0.0f) {
+                            if (fabs(ls - 1.0) > wu) wu = fabs(ls - 1.0);
+                            nunit++;
+                        }
+                    }
+                }
+                if (s && s != sref) sfb_surface_destroy(s);
+                sfb_mesh_data_free(&d);
+            }
+            if (ok)
+                check(wu <= 1e-5 && nunit > 0 && st.wp <= 1e-5 && st.wn <= 1.0 && st.wl <= 1.0 && st.ws <= 1.0, nm,
+                      "max ||N| - 1| %.3g (%d N_S), position %.3g x diag, N_B %.3g, N_L %.3g, N_S %.3g x tolerance (%d left out)", wu, nunit, st.wp,
+                      st.wn, st.wl, st.ws, st.nill);
+        }
+        sfb_surface_destroy(sref);
+        sfb_mesh_data_free(&ref[0]); sfb_mesh_data_free(&ref[1]);
+    }
+}
+
+/* On a curved shape the three modes differ by small, nonzero angles (N_S and N_B). */
+static void averaging_differ(const char *name, const sfb_mesh *m, int loop) {
+    sfb_mesh_data d[3];
+    sfb_surface *s[3];
+    double ds[3] = {0.0, 0.0, 0.0}, db[3] = {0.0, 0.0, 0.0};
+    int avg, i, ok = 1;
+    char nm[512];
+    static const int pa[3] = {0, 0, 1}, pb[3] = {1, 2, 2};
+    memset(d, 0, sizeof d);
+    for (avg = 0; avg < 3; ++avg) {
+        s[avg] = make_surface_avg(g_be[0].ctx, m, loop, 3, avg, 0);
+        if (!s[avg] || !shade(s[avg], 1, &d[avg])) ok = 0;
+    }
+    snprintf(nm, sizeof nm, "ref/%s/averaging modes differ by small nonzero angles", name);
+    if (!ok || d[0].vertex_count != d[1].vertex_count || d[0].vertex_count != d[2].vertex_count) fail(nm, "%s", sfb_last_error(g_be[0].ctx));
+    else {
+        int k;
+        for (k = 0; k < 3; ++k)
+            for (i = 0; i < d[0].vertex_count; ++i) {
+                double an = angle3(d[pa[k]].subdivided_normals + 3 * i, d[pb[k]].subdivided_normals + 3 * i);
+                if (an > ds[k]) ds[k] = an;
+                an = angle3(d[pa[k]].normals + 3 * i, d[pb[k]].normals + 3 * i);
+                if (an > db[k]) db[k] = an;
+            }
+        printf("# %s level 3, max angle between modes: N_S linear-renormalized %.3g, linear-spherical %.3g, renormalized-spherical %.3g; "
+               "N_B %.3g, %.3g, %.3g rad\n", name, ds[0], ds[1], ds[2], db[0], db[1], db[2]);
+        snprintf(nm, sizeof nm, "ref/%s/renormalized vs linear: 1e-6 < max angle(N_S) < 0.05", name);
+        check(ds[0] > 1e-6 && ds[0] < 0.05 && db[0] > 1e-6 && db[0] < 0.05, nm, "N_S %.3g, N_B %.3g rad", ds[0], db[0]);
+        snprintf(nm, sizeof nm, "ref/%s/spherical vs linear: 1e-6 < max angle(N_S) < 0.05", name);
+        check(ds[1] > 1e-6 && ds[1] < 0.05 && db[1] > 1e-6 && db[1] < 0.05, nm, "N_S %.3g, N_B %.3g rad", ds[1], db[1]);
+        snprintf(nm, sizeof nm, "ref/%s/spherical vs renormalized: 1e-6 < max angle(N_S) < 0.05", name);
+        check(ds[2] > 1e-6 && ds[2] < 0.05, nm, "N_S %.3g rad", ds[2]);
+    }
+    for (avg = 0; avg < 3; ++avg) {
+        if (s[avg]) sfb_surface_destroy(s[avg]);
+        sfb_mesh_data_free(&d[avg]);
+    }
+}
+
+/* Peer shapes of the averaging checks: smooth, semi-sharp, infinitely sharp, boundary; both schemes. */
+static const char *const g_avg_shapes[] = {"catmark_cube.obj",   "catmark_cube_creases1.obj", "catmark_pyramid_creases0.obj",
+                                           "catmark_xord_boundary.obj", "catmark_cubes_infsharp.obj", "loop_cube.obj",
+                                           "loop_cubes_semisharp.obj", "loop_icos_infsharp.obj", "loop_xord_interior.obj"};
+
 static int cmp_str(const void *a, const void *b) { return strcmp(*(const char *const *)a, *(const char *const *)b); }
 
 int main(int argc, char **argv) {
@@ -640,7 +943,7 @@ int main(int argc, char **argv) {
     DIR *dp;
     struct dirent *de;
     char **names = NULL;
-    int n = 0, i;
+    int n = 0, i, k;
     for (i = 0; i < 4; ++i) {
         backend *b = &g_be[g_nbe];
         memset(b, 0, sizeof *b);
@@ -671,7 +974,10 @@ int main(int argc, char **argv) {
         } else fail("creased cube", "mesh");
     }
     bad_options();
-    failing_allocations();
+    failing_allocations(SFB_SHADE_AVERAGE_LINEAR);
+    failing_allocations(SFB_SHADE_AVERAGE_RENORMALIZED);
+    failing_allocations(SFB_SHADE_AVERAGE_SPHERICAL);
+    spherical_mean_tests();
     dp = dir ? opendir(dir) : NULL;
     if (!dp) { printf("SKIP shapes: directory not found (%s)\n", dir ? dir : "none given"); g_skip++; }
     while (dp && (de = readdir(dp)) != NULL) {
@@ -707,6 +1013,9 @@ int main(int argc, char **argv) {
             } else {
                 sfb_surface_destroy(probe);
                 run_mesh(names[i], m, loop, 4);
+                for (k = 0; k < (int)(sizeof g_avg_shapes / sizeof *g_avg_shapes); ++k)
+                    if (!strcmp(names[i], g_avg_shapes[k])) averaging_check(names[i], m, loop);
+                if (!strcmp(names[i], "catmark_cube.obj") || !strcmp(names[i], "loop_cube.obj")) averaging_differ(names[i], m, loop);
                 if (!strcmp(names[i], "catmark_cube_creases0.obj")) {
                     /* sharpness 2: at level 1 the cube's edges are still sharp */
                     char nm[600];
