@@ -157,13 +157,13 @@ $(BUILD)/eigen: tests/eigen.c surfblend.h
 # Subdivision shading (sfb_surface_shade) on every backend: weights, variants, darts, split
 # normals, smoothness at extraordinary vertices; compiles its own implementation to read the
 # refined level's vertex rules (tests/shade.c).
-$(BUILD)/shade: tests/shade.c surfblend.h $(BACKEND_HDRS)
+$(BUILD)/shade: tests/shade.c tests/harness.h surfblend.h $(BACKEND_HDRS)
 	$(CC) $(CFLAGS) $(SAN) -I. tests/shade.c -o $@ $(LIBS)
 
 # Trimming of tessellations with a mask (sfb_surface_tessellate) on every backend: kept areas,
 # the cut on the contour, watertightness, atlases, agreement, bad masks, failing allocations
 # (tests/trim.c, its own implementation like tests/shade.c).
-$(BUILD)/trim: tests/trim.c surfblend.h $(BACKEND_HDRS)
+$(BUILD)/trim: tests/trim.c tests/harness.h surfblend.h $(BACKEND_HDRS)
 	$(CC) $(CFLAGS) $(SAN) -I. tests/trim.c -o $@ $(LIBS)
 
 # The finish_normals kernel of every backend against ref, degenerate inputs included: compiles
@@ -174,7 +174,7 @@ $(BUILD)/finish_normals: tests/finish_normals.c surfblend.h $(BACKEND_HDRS)
 # Manifold-based blending (SFB_SCHEME_MANIFOLD_BLEND) on every backend: interpolation, continuity,
 # creases/darts/corners, derivatives, agreement; compiles its own implementation to reach the
 # patch table (tests/manifold.c).
-$(BUILD)/manifold: tests/manifold.c surfblend.h $(BACKEND_HDRS)
+$(BUILD)/manifold: tests/manifold.c tests/harness.h surfblend.h $(BACKEND_HDRS)
 	$(CC) $(CFLAGS) $(SAN) -I. tests/manifold.c -o $@ $(LIBS)
 
 unit-build: $(BUILD)/surfblend $(BUILD)/unit $(BUILD)/osd_agree $(BUILD)/agree $(BUILD)/limit $(BUILD)/eigen $(BUILD)/gl_host \

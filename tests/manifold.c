@@ -27,63 +27,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-static int g_pass, g_fail, g_skip;
-
-static void pass(const char *name) { g_pass++; printf("PASS %s\n", name); }
-static void fail(const char *name, const char *fmt, ...) {
-    va_list ap;
-    g_fail++;
-    printf("FAIL %s: ", name);
-    va_start(ap, fmt); vprintf(fmt, ap); va_end(ap);
-    printf("\n");
-}
-static void skip(const char *name, const char *why) { g_skip++; printf("SKIP %s: %s\n", name, why); }
-static void check(int ok, const char *name, const char *fmt, ...) {
-    va_list ap;
-    if (ok) { pass(name); return; }
-    g_fail++;
-    printf("FAIL %s: ", name);
-    va_start(ap, fmt); vprintf(fmt, ap); va_end(ap);
-    printf("\n");
-}
-
-typedef struct backend { sfb_backend_kind kind; const char *name; sfb_context *ctx; int available, required; char why[512]; } backend;
-static backend g_be[4];
-static int g_nbe;
-
-static int listed(const char *list, const char *name) {
-    size_t n = strlen(name);
-    const char *p = list;
-    while (p && *p) {
-        if (!strncmp(p, name, n) && (p[n] == 0 || p[n] == ',')) return 1;
-        p = strchr(p, ',');
-        if (p) p++;
-    }
-    return 0;
-}
-
-static sfb_context *make_context(sfb_backend_kind kind) {
-    sfb_context_config cfg = sfb_context_config_init();
-    sfb_context *ctx = NULL;
-    cfg.backends = &kind;
-    cfg.backend_count = 1;
-    cfg.ignore_environment = 1;
-    if (sfb_context_create(&cfg, &ctx) != SFB_SUCCESS) return NULL;
-    return ctx;
-}
-
-static char *slurp(const char *path, size_t *n) {
-    FILE *f = fopen(path, "rb");
-    char *b;
-    long len;
-    if (!f) return NULL;
-    fseek(f, 0, SEEK_END); len = ftell(f); fseek(f, 0, SEEK_SET);
-    b = (char *)malloc((size_t)len + 1);
-    if (!b || fread(b, 1, (size_t)len, f) != (size_t)len) { fclose(f); free(b); return NULL; }
-    fclose(f);
-    *n = (size_t)len;
-    return b;
-}
+#include "harness.h"
 
 /* Angle between two vectors, accurate for small angles. */
 static double angle3(const float *a, const float *b) {
@@ -568,11 +512,7 @@ static void agreement(const char *name, const sfb_mesh *m, int weights, const sf
         evals eb;
         double wp = 0.0, wn = 0.0, wd = 0.0, wdd = 0.0;
         snprintf(nm, sizeof nm, "%s/%s/%s agrees with ref at %d locations", g_be[b].name, name, weights ? "cinf" : "hermite", n);
-        if (!g_be[b].available) {
-            if (g_be[b].required) fail(nm, "required backend unavailable: %s", g_be[b].why);
-            else skip(nm, g_be[b].why);
-            continue;
-        }
+        if (!g_be[b].available) { backend_missing(&g_be[b], nm); continue; }
         s = make_surface(g_be[b].ctx, m, weights);
         if (!s) { fail(nm, "create: %s", sfb_last_error(g_be[b].ctx)); continue; }
         if (!eval_all(s, L, n, 1, &eb)) { fail(nm, "eval: %s", sfb_last_error(g_be[b].ctx)); sfb_surface_destroy(s); evals_free(&eb); continue; }
@@ -646,11 +586,7 @@ static void trimming(void) {
         sfb_tess_config tc = sfb_tess_config_init(4);
         sfb_tess_data td;
         snprintf(nm, sizeof nm, "%s/grid6/trim: a half-black mask keeps half of every inner face, nothing left of the contour", g_be[b].name);
-        if (!g_be[b].available) {
-            if (g_be[b].required) fail(nm, "required backend unavailable: %s", g_be[b].why);
-            else skip(nm, g_be[b].why);
-            continue;
-        }
+        if (!g_be[b].available) { backend_missing(&g_be[b], nm); continue; }
         s = make_surface(g_be[b].ctx, m, 0);
         tc.trim = &mask;
         if (!s || sfb_surface_tessellate(s, &tc, &td) != SFB_SUCCESS) { fail(nm, "%s", sfb_last_error(g_be[b].ctx)); if (s) sfb_surface_destroy(s); continue; }
@@ -754,25 +690,12 @@ static void run_mesh(const char *name, const sfb_mesh *m, int features) {
 }
 
 int main(int argc, char **argv) {
-    static const sfb_backend_kind kinds[4] = {SFB_BACKEND_REF, SFB_BACKEND_SIMD, SFB_BACKEND_GL, SFB_BACKEND_OSMESA};
-    const char *dir = argc > 1 ? argv[1] : NULL, *req = getenv("SFB_REQUIRE_BACKENDS"), *match = argc > 2 ? argv[2] : NULL;
+    const char *dir = argc > 1 ? argv[1] : NULL, *match = argc > 2 ? argv[2] : NULL;
     DIR *dp;
     struct dirent *de;
     char **names = NULL;
     int n = 0, i;
-    for (i = 0; i < 4; ++i) {
-        backend *b = &g_be[g_nbe];
-        memset(b, 0, sizeof *b);
-        b->kind = kinds[i];
-        b->name = sfb_backend_kind_name(kinds[i]);
-        b->required = req && listed(req, b->name);
-        if (sfb_backend_probe(b->kind, NULL, b->why, sizeof b->why) == SFB_SUCCESS && (b->ctx = make_context(b->kind)) != NULL &&
-            !strcmp(sfb_context_backend_name(b->ctx), b->name))
-            b->available = 1;
-        printf("# %s: %s\n", b->name, b->available ? "available" : b->why);
-        g_nbe++;
-    }
-    if (!g_be[0].available) { printf("FAIL probe/ref: %s\n0 passed, 1 failed, 0 skipped\n", g_be[0].why); return 1; }
+    if (!probe_backends()) return 1;
     weights_unit();
     trimming();
     {
@@ -819,8 +742,5 @@ int main(int argc, char **argv) {
         fflush(stdout);
     }
     free(names);
-    for (i = 0; i < g_nbe; ++i)
-        if (g_be[i].ctx) sfb_context_destroy(g_be[i].ctx);
-    printf("%d passed, %d failed, %d skipped\n", g_pass, g_fail, g_skip);
-    return g_fail ? 1 : 0;
+    return finish_tests();
 }

@@ -39,64 +39,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-static int g_pass, g_fail, g_skip;
-
-static void pass(const char *name) { g_pass++; printf("PASS %s\n", name); }
-static void fail(const char *name, const char *fmt, ...) {
-    va_list ap;
-    g_fail++;
-    printf("FAIL %s: ", name);
-    va_start(ap, fmt); vprintf(fmt, ap); va_end(ap);
-    printf("\n");
-}
-static void skip(const char *name, const char *why) { g_skip++; printf("SKIP %s: %s\n", name, why); }
-static void check(int ok, const char *name, const char *fmt, ...) {
-    va_list ap;
-    if (ok) { pass(name); return; }
-    g_fail++;
-    printf("FAIL %s: ", name);
-    va_start(ap, fmt); vprintf(fmt, ap); va_end(ap);
-    printf("\n");
-}
-
-typedef struct backend { sfb_backend_kind kind; const char *name; sfb_context *ctx; int available, required; char why[512]; } backend;
-static backend g_be[4];
-static int g_nbe;
+#include "harness.h"
 static double g_agree_pos[4], g_agree_nrm[4]; /* largest differences from ref, per backend (position / diagonal, rad) */
-
-static int listed(const char *list, const char *name) {
-    size_t n = strlen(name);
-    const char *p = list;
-    while (p && *p) {
-        if (!strncmp(p, name, n) && (p[n] == 0 || p[n] == ',')) return 1;
-        p = strchr(p, ',');
-        if (p) p++;
-    }
-    return 0;
-}
-
-static sfb_context *make_context(sfb_backend_kind kind) {
-    sfb_context_config cfg = sfb_context_config_init();
-    sfb_context *ctx = NULL;
-    cfg.backends = &kind;
-    cfg.backend_count = 1;
-    cfg.ignore_environment = 1;
-    if (sfb_context_create(&cfg, &ctx) != SFB_SUCCESS) return NULL;
-    return ctx;
-}
-
-static char *slurp(const char *path, size_t *n) {
-    FILE *f = fopen(path, "rb");
-    char *b;
-    long len;
-    if (!f) return NULL;
-    fseek(f, 0, SEEK_END); len = ftell(f); fseek(f, 0, SEEK_SET);
-    b = (char *)malloc((size_t)len + 1);
-    if (!b || fread(b, 1, (size_t)len, f) != (size_t)len) { fclose(f); free(b); return NULL; }
-    fclose(f);
-    *n = (size_t)len;
-    return b;
-}
 
 /* ---- masks, as sfb_api.h documents them ---- */
 
@@ -1040,24 +984,11 @@ out:
 }
 
 int main(int argc, char **argv) {
-    static const sfb_backend_kind kinds[4] = {SFB_BACKEND_REF, SFB_BACKEND_SIMD, SFB_BACKEND_GL, SFB_BACKEND_OSMESA};
-    const char *dir = argc > 1 ? argv[1] : NULL, *req = getenv("SFB_REQUIRE_BACKENDS");
+    const char *dir = argc > 1 ? argv[1] : NULL;
     sfb_mesh *grid6 = NULL, *grid3 = NULL, *cube = NULL, *prism = NULL, *octa = NULL, *lcube = NULL, *creased = NULL;
     char *g6, *g3;
     int i;
-    for (i = 0; i < 4; ++i) {
-        backend *b = &g_be[g_nbe];
-        memset(b, 0, sizeof *b);
-        b->kind = kinds[i];
-        b->name = sfb_backend_kind_name(kinds[i]);
-        b->required = req && listed(req, b->name);
-        if (sfb_backend_probe(b->kind, NULL, b->why, sizeof b->why) == SFB_SUCCESS && (b->ctx = make_context(b->kind)) != NULL &&
-            !strcmp(sfb_context_backend_name(b->ctx), b->name))
-            b->available = 1;
-        printf("# %s: %s\n", b->name, b->available ? "available" : b->why);
-        g_nbe++;
-    }
-    if (!g_be[0].available) { printf("FAIL probe/ref: %s\n0 passed, 1 failed, 0 skipped\n", g_be[0].why); return 1; }
+    if (!probe_backends()) return 1;
     g6 = grid_obj(6);
     g3 = grid_obj(3);
     grid6 = mesh_of(g_be[0].ctx, g6);
@@ -1128,8 +1059,5 @@ out:
         if (g_be[i].available)
             printf("# %s against ref: largest position difference %.3g x diagonal, normal %.3g rad\n", g_be[i].name, g_agree_pos[i],
                    g_agree_nrm[i]);
-    for (i = 0; i < g_nbe; ++i)
-        if (g_be[i].ctx) sfb_context_destroy(g_be[i].ctx);
-    printf("%d passed, %d failed, %d skipped\n", g_pass, g_fail, g_skip);
-    return g_fail ? 1 : 0;
+    return finish_tests();
 }
