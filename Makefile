@@ -177,8 +177,13 @@ $(BUILD)/finish_normals: tests/finish_normals.c surfblend.h $(BACKEND_HDRS)
 $(BUILD)/manifold: tests/manifold.c tests/harness.h surfblend.h $(BACKEND_HDRS)
 	$(CC) $(CFLAGS) $(SAN) -I. tests/manifold.c -o $@ $(LIBS)
 
+# Manifold blending on gl/osmesa and the vertex-shader draw path (with trimming) on a GL context
+# the test owns (links EGL/GL as gl_host) (tests/gl_manifold.c).
+$(BUILD)/gl_manifold: tests/gl_manifold.c $(BUILD)/libsfb.o
+	$(CC) $(CFLAGS) $(SAN) -I. tests/gl_manifold.c $(BUILD)/libsfb.o -o $@ $(GL_LIBS) $(LIBS)
+
 unit-build: $(BUILD)/surfblend $(BUILD)/unit $(BUILD)/osd_agree $(BUILD)/agree $(BUILD)/limit $(BUILD)/eigen $(BUILD)/gl_host \
-            $(BUILD)/gl_errors $(BUILD)/gl_pieces $(BUILD)/shade $(BUILD)/trim $(BUILD)/finish_normals $(BUILD)/manifold $(EXAMPLES)
+            $(BUILD)/gl_errors $(BUILD)/gl_pieces $(BUILD)/shade $(BUILD)/trim $(BUILD)/finish_normals $(BUILD)/manifold $(BUILD)/gl_manifold $(EXAMPLES)
 
 # On CI (CI set and not false/0) the optional backends must run, not be skipped: the suites
 # fail for a backend in SFB_REQUIRE_BACKENDS that is unavailable. CI has Mesa llvmpipe and

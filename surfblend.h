@@ -239,13 +239,30 @@ typedef enum sfb_shade_darts {
     SFB_SHADE_DARTS_SMOOTH = 0, /* default: a dart is a smooth vertex for the blend weights */
     SFB_SHADE_DARTS_SHARP = 1   /* a regular dart is a sharp vertex (weight 0 in variant B) */
 } sfb_shade_darts;
+typedef enum sfb_shade_averaging {
+    SFB_SHADE_AVERAGE_LINEAR = 0,      /* default: the scheme's stencils on the normals, normalised once at the end
+                                          (one composed table, run on the backend) */
+    SFB_SHADE_AVERAGE_RENORMALIZED = 1,/* the stencils one level at a time, each level's normals normalised */
+    SFB_SHADE_AVERAGE_SPHERICAL = 2    /* one level at a time, each new normal the weighted spherical mean (the
+                                          unit vector minimising the weighted sum of squared angles) */
+} sfb_shade_averaging;
 #define SFB_SHADE_LEVEL_CONTROL (-1) /* normals_level / weights_level: start on the control mesh */
 typedef struct sfb_shading_options {
     int variant;        /* sfb_shade_variant */
     int darts;          /* sfb_shade_darts */
     int normals_level;  /* level where N_S starts (face-normal averages); 0: default 1; SFB_SHADE_LEVEL_CONTROL: 0 */
     int weights_level;  /* level where the blend weights are seeded; 0: default 1; SFB_SHADE_LEVEL_CONTROL: 0 */
+    int averaging;      /* sfb_shade_averaging: how N_S averages normals from one level to the next */
 } sfb_shading_options;
+
+/* Manifold-based blending (seed 000), SFB_SCHEME_MANIFOLD_BLEND; zero = defaults. */
+typedef enum sfb_manifold_weights {
+    SFB_MANIFOLD_WEIGHTS_HERMITE = 0, /* default (the seed): eta(t) = 2t^3 - 3t^2 + 1, a C1 surface */
+    SFB_MANIFOLD_WEIGHTS_CINF = 1     /* Ying-Zorin's kind: eta flat to all orders at 0 and 1 */
+} sfb_manifold_weights;
+typedef struct sfb_manifold_options {
+    int weights;        /* sfb_manifold_weights */
+} sfb_manifold_options;
 
 typedef struct sfb_surface_config {
     sfb_scheme scheme;
@@ -254,6 +271,7 @@ typedef struct sfb_surface_config {
     int isolation_level;/* patches: adaptive isolation limit around irregular features, 1..SFB_MAX_LEVEL
                            (0: SFB_DEFAULT_ISOLATION); below it faces get an end cap */
     sfb_shading_options shading; /* SFB_REFINE_SHADING */
+    sfb_manifold_options manifold; /* SFB_SCHEME_MANIFOLD_BLEND */
 } sfb_surface_config;
 #define SFB_DEFAULT_ISOLATION 8
 SFB_API sfb_surface_config sfb_surface_config_init(sfb_scheme scheme, int level);
@@ -300,6 +318,65 @@ SFB_API sfb_result sfb_surface_eval_stencils(const sfb_surface *surface, sfb_tab
 SFB_API sfb_result sfb_surface_eval_stencils_gl(const sfb_surface *surface, sfb_table table,
                                                 unsigned int src_buffer, sfb_buffer_desc src_desc,
                                                 unsigned int dst_buffer, sfb_buffer_desc dst_desc);
+
+/* ---- drawing a manifold blending surface on the host's GL context (seed 000 section V) ----
+ * The engine case of seed 000's renderer: the gl backend with gl_use_current_context draws a
+ * SFB_SCHEME_MANIFOLD_BLEND surface (built with SFB_REFINE_PATCHES) into the host's current
+ * framebuffer. A vertex program evaluates the blend at every sample from the tables the
+ * surface uploaded (the nine coefficient rows of each vertex's local geometry in a float
+ * texture, as the seed's Fig. 8, and each patch's corner vertices and corner codes in an
+ * integer texture): the four chart parameters, Table 2's vector pairs, the blend of the four
+ * local geometries with the surface's weights, and the analytic normal, as sfb_surface_eval.
+ * Each parametric face drawn is one instance of a (rate + 1) x (rate + 1) sample grid, sample
+ * (i, j) at (u, v) = (i / rate, j / rate), drawn as 2 rate^2 indexed triangles,
+ * counter-clockwise seen from the normal side. The fragment program lights the surface from
+ * both sides (ambient 0.2 + diffuse 0.8 of `color`) and, with a trimming texture, discards the
+ * fragments whose mask value at the face's (u, v) is below 0.5: the mask is read as
+ * sfb_trim_mask describes (bilinear between texel centres, clamped at the tile's borders;
+ * atlas tile t for parametric face t, faces past the last tile untrimmed).
+ * The draw uses the host's framebuffer, viewport, depth, blend and cull state as they are.
+ * What it binds (program, vertex array, texture units 0..2 and their samplers, the active
+ * texture unit, transform feedback object and buffer, GL_RASTERIZER_DISCARD, pixel unpack
+ * state) is restored before it returns. Call it where the host's context is current, on the
+ * thread of the sfb context. */
+typedef struct sfb_gl_draw_params {
+    int rate;                   /* segments per parametric-face edge, 1..1024 (0: 16) */
+    float mvp[16];              /* clip-from-object matrix, column-major as glUniformMatrix4fv (all 0: identity) */
+    float normal_matrix[9];     /* column-major 3x3 taking object normals to the space of `light` (all 0: identity) */
+    float light[3];             /* direction toward the light (need not be unit; all 0: (0, 0, 1)) */
+    float color[4];             /* RGBA of the lit surface (all 0: (0.8, 0.8, 0.8, 1)) */
+    unsigned int trim_texture;  /* 0: untrimmed; else a 2D texture of the current context holding the mask in
+                                   its red channel, level 0 (sfb_gl_trim_texture makes one) */
+    int trim_tiles_u, trim_tiles_v; /* atlas layout as sfb_trim_mask (0/0 or 1/1: one mask for every face); the
+                                   texture's size must split into that many equal tiles */
+    unsigned int capture_buffer;/* 0: none; else a buffer object of the current context that also receives every
+                                   sample (a second pass of the same vertex program over the samples as points,
+                                   rasterization off, through transform feedback): 6 floats per sample, the
+                                   position and the unit normal in object space, sample (i, j) of the k-th face
+                                   drawn at float index 6 ((k (rate + 1) + j) (rate + 1) + i); zeros for a hole */
+    int first_face, face_count; /* parametric faces first_face .. first_face + face_count - 1 (face_count 0: all
+                                   from first_face on) */
+} sfb_gl_draw_params;
+/* The defaults: rate 16, identity matrices, light (0, 0, 1), colour (0.8, 0.8, 0.8, 1), no
+ * trimming, no capture, every face. */
+SFB_API sfb_gl_draw_params sfb_gl_draw_params_init(void);
+/* Draws `surface` as above. Errors: SFB_INVALID_ARGS for a NULL argument, a rate outside 0..1024,
+ * a face range outside the surface's parametric faces, a trim_texture that is no texture, or a
+ * capture_buffer that is no buffer or holds fewer than 24 (rate + 1)^2 bytes per face drawn;
+ * SFB_INVALID_VALUE for a matrix, light or colour value that is not finite, atlas tiles that
+ * are negative, half zero, or do not split the texture evenly; SFB_UNSUPPORTED when the context
+ * does not run the gl backend on the host's context (gl_use_current_context; also a library
+ * built without SURFBLEND_GL) or the surface is not a manifold blend with patches; GL
+ * failures as SFB_BACKEND_ERROR or SFB_OUT_OF_MEMORY. Nothing is drawn on an error. */
+SFB_API sfb_result sfb_surface_draw_gl(const sfb_surface *surface, const sfb_gl_draw_params *params);
+/* Uploads a trimming mask (struct sfb_trim_mask, declared with the tessellator below; its
+ * atlas tiles are not stored: pass them in sfb_gl_draw_params) into a new GL_R8 2D texture of
+ * the host's current context, for sfb_gl_draw_params.trim_texture; the host owns it and deletes
+ * it with glDeleteTextures. Same context requirement as sfb_surface_draw_gl (else
+ * SFB_UNSUPPORTED); SFB_INVALID_ARGS for NULL arguments, SFB_INVALID_VALUE for a mask
+ * sfb_surface_tessellate would refuse (NULL texels, a side outside 1..16384, bad tiles). */
+struct sfb_trim_mask;
+SFB_API sfb_result sfb_gl_trim_texture(sfb_context *ctx, const struct sfb_trim_mask *mask, unsigned int *texture);
 
 /* The refined mesh as plain arrays. */
 typedef struct sfb_mesh_data {
@@ -361,7 +438,10 @@ SFB_API sfb_result sfb_surface_shade_info(const sfb_surface *surface, sfb_shade_
 SFB_API void sfb_mesh_data_desc(const sfb_mesh_data *data, sfb_mesh_desc *out);
 
 
-/* ---- limit evaluation (SFB_REFINE_PATCHES; Catmull-Clark and Loop) ----
+/* ---- limit evaluation (SFB_REFINE_PATCHES; Catmull-Clark, Loop, manifold blending) ----
+ * Manifold blending (SFB_SCHEME_MANIFOLD_BLEND) uses the Catmull-Clark parametric faces: a
+ * base quad is one, (u,v) as below; on a mesh with any non-quad face the blend is built on the
+ * mesh after one Catmull-Clark step, and a base quad's square then holds its four child quads.
  * Locations are on parametric faces. Catmull-Clark: a base quad is one parametric face, (u,v)
  * in [0,1]^2 with (0,0) at its first vertex, (1,0) at its second and (0,1) at its last; a face
  * with n != 4 vertices is n parametric quads, sub-face i being (v_i, midpoint of v_i v_i+1,
@@ -392,6 +472,7 @@ typedef struct sfb_patch_info {
     int param_faces, patches;
     int bspline, bezier;   /* regular patches: bicubic B-spline (Catmull-Clark), quartic Bezier triangle (Loop) */
     int stam, end_caps, max_depth, points;
+    int manifold;          /* MANIFOLD4 blends (one per quad of the manifold mesh) */
     size_t bytes;  /* memory of the patch table and its points */
 } sfb_patch_info;
 SFB_API sfb_result sfb_surface_patch_info(const sfb_surface *surface, sfb_patch_info *out);
@@ -401,12 +482,28 @@ enum {
     SFB_TESS_SPLIT_CREASES = 1u << 0  /* duplicate the vertices along infinitely sharp interior creases, one
                                          copy per side, each with that side's normal (split normals) */
 };
+/* Trimming (seed 000 section V.5), for every scheme: a mask over each parametric face's (u,v)
+ * square [0,1]^2 (a Loop triangle uses the half u + v <= 1 of it). Texel (i, j) =
+ * texels[j * width + i] covers u in [i/width, (i+1)/width], v in [j/height, (j+1)/height] (row 0
+ * at v = 0, as a GL texture). The mask value at (u,v) is the bilinear interpolation of the
+ * texels at their centres, clamped at the borders, divided by 255; the surface is kept where it
+ * is >= 0.5 (white) and trimmed where it is below (black). An atlas: tiles_u x tiles_v equal
+ * tiles, tile t (row-major from row 0) for parametric face t; faces past the last tile are not
+ * trimmed. tiles_u = tiles_v = 0 or 1: one mask for every face. The tessellator drops trimmed
+ * triangles and cuts the ones crossing the 0.5 contour along it (new vertices evaluated on the
+ * surface at the contour's (u,v)). */
+typedef struct sfb_trim_mask {
+    int width, height;           /* texels, 1..16384 each */
+    const unsigned char *texels; /* width * height */
+    int tiles_u, tiles_v;        /* atlas layout (0/0 or 1/1: one mask for all faces) */
+} sfb_trim_mask;
 typedef struct sfb_tess_config {
     int rate;         /* segments per parametric-face edge, 1..1024 (a quad: rate x rate cells, 2 triangles each;
                          a Loop triangle: the triangular grid of rate^2 triangles) */
     float tolerance;  /* 0: uniform. > 0: adaptive: each parametric face (and each edge) uses the smallest
                          rate <= `rate` whose chordal error is within `tolerance` (model units) */
     unsigned flags;   /* SFB_TESS_* */
+    const struct sfb_trim_mask *trim; /* NULL: no trimming */
 } sfb_tess_config;
 SFB_API sfb_tess_config sfb_tess_config_init(int rate);
 
@@ -624,7 +721,9 @@ typedef struct sfb__patch_table {
     int *face_ptex;        /* per base face + 1: first param face */
     int *ptex_root;        /* per param face: >= 0 node, <= -2 patch -(p+2), -1 hole */
     int *nodes;            /* 4 per quadtree node, by quadrant x + 2y, same encoding */
-    int counts[6];         /* patches of each type (SFB__PATCH_*) */
+    int counts[8];         /* patches of each type (SFB__PATCH_*) */
+    unsigned *pcorner;     /* MANIFOLD4: 4 corner codes per patch (SFB__MF_CODE) */
+    int mf_weights;        /* MANIFOLD4: SFB_MANIFOLD_WEIGHTS_* */
     int npoints;           /* patch points */
     float *point_data;     /* xyz per patch point, for the surface's base positions */
     const sfb__eigen_cc *eig[SFB__STAM_MAX_VALENCE + 1]; /* valences used (the context's cache) */
@@ -738,6 +837,10 @@ typedef struct sfb__shading {
     sfb__stencils lim[3];      /* refined positions -> limit position, tangent u, tangent v per output vertex */
     void *handles[5];          /* the backend's uploads of npos, ns, lim[0..2] */
     size_t bytes;
+    int averaging;             /* sfb_shade_averaging */
+    int nsteps;                /* per-level N_S (averaging != linear and level > normals level): steps, else 0 and ns is used */
+    sfb__stencils *steps;      /* nsteps: region normals of level normals+k -> level normals+k+1; the last -> N_S rows in ns's order */
+    int step_rows_max, step_size_max; /* largest row count and row size over the steps (scratch) */
 } sfb__shading;
 /* ---- surfaces ---- */
 struct sfb_surface {
@@ -784,6 +887,26 @@ sfb_result sfb__shading_build(sfb_context *ctx, const sfb__level *prep, const sf
 
 /* patches.c */
 void sfb__patch_table_free(sfb_context *ctx, sfb__patch_table *pt);
+/* Patch kinds of the patch table (patches.c, manifold.c). */
+enum { SFB__PATCH_BSPLINE = 0, SFB__PATCH_STAM = 1, SFB__PATCH_ENDCAP = 2, SFB__PATCH_BEZTRI = 3, SFB__PATCH_STAM_LOOP = 4,
+       SFB__PATCH_ENDCAP_TRI = 5, SFB__PATCH_MANIFOLD4 = 6 };
+/* Manifold blending (manifold.c): a corner code packs the corner vertex's local geometry kind,
+ * its valence k and the index h of the face in its star (the chart), and for a curve the axes
+ * (1: a, 2: b, 0: not in this face) of its sharp edges e1 and e2. */
+enum { SFB__MF_PATCH = 0, SFB__MF_POINT = 1, SFB__MF_CURVE = 2 };
+#define SFB__MF_CODE(kind, k, h, a1, a2) \
+    ((unsigned)(kind) | ((unsigned)(k) << 2) | ((unsigned)(h) << 15) | ((unsigned)(a1) << 28) | ((unsigned)(a2) << 30))
+#define SFB__MF_KIND(c) ((int)((c) & 3u))
+#define SFB__MF_K(c) ((int)(((c) >> 2) & 8191u))
+#define SFB__MF_H(c) ((int)(((c) >> 15) & 8191u))
+#define SFB__MF_A1(c) ((int)(((c) >> 28) & 3u))
+#define SFB__MF_A2(c) ((int)(((c) >> 30) & 3u))
+sfb_result sfb__manifold_build(sfb_context *ctx, const sfb__level *base, int weights, const float *positions, sfb__patch_table *pt);
+void sfb__mf_eval(const float *pts, const int *cv, const unsigned *codes, int kind, double c, double d, double S[3], double Sc[3],
+                  double Sd[3]);
+void sfb__mf_eval_patch(const sfb__patch_table *pt, const float *pts, int patch, double s, double t, int want2, double res[6][3],
+                        double nrm[3]);
+sfb_result sfb__mf_pinv(sfb_context *ctx, int k, double **out);
 sfb_result sfb__patches_build(sfb_context *ctx, const sfb__level *base, const sfb__refine_options *opt, int limit,
                               const float *positions, sfb__patch_table *pt);
 int sfb__patch_locate(const sfb__patch_table *pt, int ptex, double u, double v, double *s, double *t, double *scale);
@@ -1162,6 +1285,36 @@ SFB_API sfb_result sfb_backend_probe(sfb_backend_kind kind, const sfb_context_co
     sfb_context_destroy(ctx);
     return SFB_SUCCESS;
 }
+
+/* The manifold draw path (sfb_surface_draw_gl, sfb_gl_trim_texture) lives in backends/sfb_gl.h;
+ * its parameters' defaults are here so that they exist in every build, and without the gl
+ * backend the calls link and answer SFB_UNSUPPORTED. */
+SFB_API sfb_gl_draw_params sfb_gl_draw_params_init(void) {
+    sfb_gl_draw_params p;
+    memset(&p, 0, sizeof p);
+    p.rate = 16;
+    p.mvp[0] = p.mvp[5] = p.mvp[10] = p.mvp[15] = 1.0f;
+    p.normal_matrix[0] = p.normal_matrix[4] = p.normal_matrix[8] = 1.0f;
+    p.light[2] = 1.0f;
+    p.color[0] = p.color[1] = p.color[2] = 0.8f;
+    p.color[3] = 1.0f;
+    return p;
+}
+#ifndef SURFBLEND_GL
+SFB_API sfb_result sfb_surface_draw_gl(const sfb_surface *surface, const sfb_gl_draw_params *params) {
+    (void)params;
+    if (!surface) return SFB_INVALID_ARGS;
+    return sfb__error(surface->ctx, SFB_UNSUPPORTED, SFB_ELEMENT_NONE, -1,
+                      "sfb_surface_draw_gl: this build has no gl backend (define SURFBLEND_GL or SURFBLEND_ALL_BACKENDS)");
+}
+SFB_API sfb_result sfb_gl_trim_texture(sfb_context *ctx, const struct sfb_trim_mask *mask, unsigned int *texture) {
+    (void)mask;
+    if (texture) *texture = 0;
+    if (!ctx) return SFB_INVALID_ARGS;
+    return sfb__error(ctx, SFB_UNSUPPORTED, SFB_ELEMENT_NONE, -1,
+                      "sfb_gl_trim_texture: this build has no gl backend (define SURFBLEND_GL or SURFBLEND_ALL_BACKENDS)");
+}
+#endif
 #line 1 "src/backend_ref.c"
 /* The `ref` backend: plain C, the numeric oracle. Float storage, double accumulation in
  * table order (row by row, entries in stored order). */
@@ -2974,8 +3127,6 @@ const sfb__eigen_loop *sfb__eigen_loop_get(sfb_context *ctx, int N) {
  * h = 2^-limit of the base face (measured by tests/limit.c and quoted in the README).
  * Holes produce no patches. */
 
-enum { SFB__PATCH_BSPLINE = 0, SFB__PATCH_STAM = 1, SFB__PATCH_ENDCAP = 2, SFB__PATCH_BEZTRI = 3, SFB__PATCH_STAM_LOOP = 4,
-       SFB__PATCH_ENDCAP_TRI = 5 };
 enum { SFB__CORNER_R1 = 1, SFB__CORNER_R2_D1 = 2, SFB__CORNER_R2_D2 = 3, SFB__CORNER_R3 = 4, SFB__CORNER_EV = 5,
        SFB__CORNER_IRREGULAR = 0 };
 
@@ -2988,7 +3139,7 @@ enum { SFB__CORNER_R1 = 1, SFB__CORNER_R2_D1 = 2, SFB__CORNER_R2_D2 = 3, SFB__CO
 void sfb__patch_table_free(sfb_context *ctx, sfb__patch_table *pt) {
     sfb__free(ctx, pt->ptype); sfb__free(ctx, pt->pfirst); sfb__free(ctx, pt->pparam); sfb__free(ctx, pt->pvalence);
     sfb__free(ctx, pt->cv); sfb__free(ctx, pt->ptex_face); sfb__free(ctx, pt->ptex_corner); sfb__free(ctx, pt->face_ptex);
-    sfb__free(ctx, pt->ptex_root); sfb__free(ctx, pt->nodes); sfb__free(ctx, pt->point_data);
+    sfb__free(ctx, pt->ptex_root); sfb__free(ctx, pt->nodes); sfb__free(ctx, pt->point_data); sfb__free(ctx, pt->pcorner);
     memset(pt, 0, sizeof *pt);
 }
 
@@ -4328,7 +4479,20 @@ static sfb_result sfb__ref_eval_patches(void *state, const sfb__patch_table *pt,
     for (q = first; q < last; ++q) {
         double res[6][3], nrm[3];
         size_t o = 3 * (size_t)q;
-        sfb__ref_eval_one(pt, pt->point_data, &locs[q], res, nrm);
+        if (pt->scheme == SFB_SCHEME_MANIFOLD_BLEND) {
+            /* second derivatives cost four more blends here: only when asked */
+            double s, t, sc;
+            int patch = sfb__patch_locate(pt, locs[q].face, locs[q].u, locs[q].v, &s, &t, &sc);
+            memset(res, 0, sizeof res); memset(nrm, 0, sizeof nrm);
+            if (patch >= 0) {
+                sfb__mf_eval_patch(pt, pt->point_data, patch, s, t, out->duu || out->duv || out->dvv, res, nrm);
+                for (c = 0; c < 3; ++c) {
+                    res[1][c] *= sc; res[2][c] *= sc;
+                    res[3][c] *= sc * sc; res[4][c] *= sc * sc; res[5][c] *= sc * sc;
+                }
+            }
+        } else
+            sfb__ref_eval_one(pt, pt->point_data, &locs[q], res, nrm);
         for (c = 0; c < 3; ++c) {
             if (out->position) out->position[o + c] = (float)res[0][c];
             if (out->du) out->du[o + c] = (float)res[1][c];
@@ -4340,6 +4504,490 @@ static sfb_result sfb__ref_eval_patches(void *state, const sfb__patch_table *pt,
         }
     }
     return SFB_SUCCESS;
+}
+#line 1 "src/manifold.c"
+/* Manifold-based blending surfaces with darts, creases and corners (seed 000, after Ying and
+ * Zorin): the MANIFOLD4 patch family of the patch table (scheme SFB_SCHEME_MANIFOLD_BLEND).
+ *
+ * The manifold mesh. A mesh of quads is used as it is. Any other mesh first takes one
+ * Catmull-Clark step: edges with sharpness > 0 are made infinitely sharp for that step (so
+ * their children are crease edges and stay sharp), vertices with sharpness > 0 likewise
+ * (corners). A base quad is then one parametric face made of its four child quads (quadrants
+ * of its (u,v) square, one level of the patch quadtree); an n-gon's sub-face i is its child
+ * quad i, as for Catmull-Clark limit evaluation.
+ *
+ * Charts and local coordinates. In a quad with corners V0..V3 (counter-clockwise) the face
+ * coordinates (c,d) in [0,1]^2 put V0 at (0,0), V1 at (1,0) and V3 at (0,1). Corner j sees the
+ * point at its own coordinates (a_j, b_j), a along the edge to its next corner, b along the
+ * edge to its previous one:
+ *     j = 0: (c, d)    j = 1: (d, 1 - c)    j = 2: (1 - c, 1 - d)    j = 3: (1 - d, c).
+ * Around a manifold vertex of valence k, face h lies between edge h (its a axis) and edge h + 1
+ * (its b axis), counter-clockwise. The chart of the vertex maps the point of face h with
+ * zeta = a + i b to z = zeta^(4/k) e^(2 pi i h / k) (seed section III.1): face h covers the
+ * sector [2 pi h / k, 2 pi (h + 1) / k], the neighbour across edge h sits at e^(2 pi i h / k),
+ * the far corner of face h at 2^(2/k) e^(i (2 pi h + pi) / k).
+ *
+ * Local geometry by the number n of sharp edges at the vertex (Table 1; an edge is sharp when
+ * its sharpness is > 0; boundary and non-manifold edges are infinitely sharp once the mesh is
+ * prepared, so they count):
+ *   - n = 0 at an interior manifold vertex: the bi-quadratic patch of eq. 2,
+ *     P(u + iv) = [1 u u^2] C [1 v v^2]^T, C_00 = the vertex (the constraint P(0) = v_i), the
+ *     other eight coefficient vectors fitted by least squares to the 2k one-ring vertices (k
+ *     edge neighbours and k far corners) at their chart positions. The system only depends on
+ *     k; its pseudo-inverse (8 x 2k) is computed once per valence. Choice where the fit is
+ *     under-determined (k = 2 and k = 3: 4 and 6 equations for 8 unknowns) or rank-deficient:
+ *     the minimum-norm solution (eigenvalues of A^T A below 1e-12 of the largest are dropped).
+ *     With k = 4 the fit interpolates the 3 x 3 grid.
+ *   - n = 1 (dart), n >= 3 (corner), a vertex with sharpness > 0, a non-manifold or bare
+ *     vertex: the vertex itself (a point).
+ *   - n = 2 (crease; a boundary vertex whose only sharp edges are its two boundary edges is
+ *     one): the quadratic Bezier curve q0 = the far end of the first sharp edge e1 (in the
+ *     vertex's counter-clockwise edge order), q1 = the vertex, q2 = the far end of e2, at the
+ *     curve parameter sigma = (1 - p1 + p2) / 2, p1 = the point's coordinate along e1 when e1
+ *     is an edge of the face (a or b), else 0, p2 the same for e2. Choice: the seed's eq. 4
+ *     reads 0.5 -/+ |z| cos(theta); we halve the projection so that the neighbours at the far
+ *     ends of e1 and e2 sit at sigma = 0 and 1, the curve's ends: with evenly spaced collinear
+ *     crease vertices the blended crease is then the straight segment at uniform speed (linear
+ *     precision), which the unhalved form does not give. A face that holds both e1 and e2 (a
+ *     boundary corner) gets both terms.
+ *   Half-disk charts: a boundary vertex has two sharp (boundary) edges, so its local geometry
+ *   is a curve or a point, neither of which reads the chart; no boundary chart is needed.
+ *
+ * Blending (eq. 5): S = sum_j w_j P_j(z_j), w_j = eta(a_j) eta(b_j). Hermite (the seed):
+ * eta(t) = 2t^3 - 3t^2 + 1; C-infinity (Ying-Zorin's kind): eta(t) = g(1-t) / (g(t) + g(1-t)),
+ * g(x) = exp(-1/x) for x > 0, else 0, flat to all orders at 0 and 1. Both satisfy
+ * eta(t) + eta(1-t) = 1, so the four weights of a face sum to 1 exactly and no division is
+ * needed. Derivatives are analytic: the chain rule through the corner coordinates and the
+ * conformal chart (dz/dzeta = (4/k) zeta^(4/k - 1) e^(2 pi i h / k)). At a patch vertex itself
+ * (zeta = 0), where that derivative vanishes (k < 4) or diverges (k > 4), du and dv are the
+ * chart derivatives with (4/k) e^(2 pi i h / k) in its place: their cross product has the
+ * direction of the surface normal there (the chart is conformal and keeps orientation).
+ * Second derivatives are central differences of the analytic first derivatives (step 2^-17,
+ * one-sided at the face border).
+ *
+ * Tables (seed section V.1): point_data holds nine xyz rows per manifold vertex (the texture
+ * of Fig. 8): the patch's C_mn in row 3m + n; a point in row 0; a curve's q0, q1, q2 in rows
+ * 0, 1, 2. Per patch: cv = the four corner vertices (row base = 9 * vertex), pcorner = the four
+ * corner codes (SFB__MF_CODE: kind, k, h, the axes of e1 and e2 in that face). A kernel then
+ * forms Table 2's vector pair per corner ([1 u u^2]/[1 v v^2], [1 0 0]/[1 0 0],
+ * [1 0 0]/Bernstein(sigma)) and blends the four points. */
+
+static double sfb__mf_g(double x) { return x > 0.0 ? exp(-1.0 / x) : 0.0; }
+
+/* eta and its derivative (kind: SFB_MANIFOLD_WEIGHTS_*). */
+static double sfb__mf_eta(int kind, double t, double *dt) {
+    if (kind == SFB_MANIFOLD_WEIGHTS_CINF) {
+        double a, b, da, db, s;
+        if (t <= 0.0) { *dt = 0.0; return 1.0; }
+        if (t >= 1.0) { *dt = 0.0; return 0.0; }
+        a = sfb__mf_g(1.0 - t); b = sfb__mf_g(t);
+        da = a > 0.0 ? -a / ((1.0 - t) * (1.0 - t)) : 0.0; /* d/dt g(1-t) */
+        db = b > 0.0 ? b / (t * t) : 0.0;
+        s = a + b;
+        *dt = (da * b - a * db) / (s * s); /* = (da s - a (da + db)) / s^2 without the cancellation near 0 and 1 */
+        return a / s;
+    }
+    *dt = 6.0 * t * t - 6.0 * t;
+    return (2.0 * t - 3.0) * t * t + 1.0;
+}
+
+/* One corner's local geometry at its coordinates (a,b): P and dP/da, dP/db. */
+static void sfb__mf_local(const float *C, unsigned code, double a, double b, double P[3], double Pa[3], double Pb[3]) {
+    int kind = SFB__MF_KIND(code), c;
+    if (kind == SFB__MF_POINT) {
+        for (c = 0; c < 3; ++c) { P[c] = C[c]; Pa[c] = Pb[c] = 0.0; }
+    } else if (kind == SFB__MF_CURVE) {
+        int a1 = SFB__MF_A1(code), a2 = SFB__MF_A2(code);
+        double p1 = a1 == 1 ? a : a1 == 2 ? b : 0.0, p2 = a2 == 1 ? a : a2 == 2 ? b : 0.0;
+        double s = 0.5 * (1.0 - p1 + p2);
+        double dsa = 0.5 * ((a2 == 1) - (a1 == 1)), dsb = 0.5 * ((a2 == 2) - (a1 == 2));
+        double b0 = (1.0 - s) * (1.0 - s), b1 = 2.0 * s * (1.0 - s), b2 = s * s;
+        for (c = 0; c < 3; ++c) {
+            double d = 2.0 * ((1.0 - s) * ((double)C[3 + c] - C[c]) + s * ((double)C[6 + c] - C[3 + c]));
+            P[c] = b0 * C[c] + b1 * C[3 + c] + b2 * C[6 + c];
+            Pa[c] = d * dsa; Pb[c] = d * dsb;
+        }
+    } else {
+        int k = SFB__MF_K(code), h = SFB__MF_H(code), m, n;
+        double e = 4.0 / k, phi = 2.0 * SFB__PI * h / k, r = sqrt(a * a + b * b), u, v, Ar, Ai;
+        double um[3], vm[3], dum[3], dvm[3], Pu[3], Pv[3];
+        if (r > 0.0) {
+            double th = atan2(b, a), rz = pow(r, e), ang = e * th + phi, ra = e * pow(r, e - 1.0), angd = (e - 1.0) * th + phi;
+            u = rz * cos(ang); v = rz * sin(ang);
+            Ar = ra * cos(angd); Ai = ra * sin(angd);
+        } else {
+            u = v = 0.0;
+            Ar = e * cos(phi); Ai = e * sin(phi);
+        }
+        um[0] = 1.0; um[1] = u; um[2] = u * u; dum[0] = 0.0; dum[1] = 1.0; dum[2] = 2.0 * u;
+        vm[0] = 1.0; vm[1] = v; vm[2] = v * v; dvm[0] = 0.0; dvm[1] = 1.0; dvm[2] = 2.0 * v;
+        for (c = 0; c < 3; ++c) P[c] = Pu[c] = Pv[c] = 0.0;
+        for (m = 0; m < 3; ++m)
+            for (n = 0; n < 3; ++n) {
+                const float *q = C + 3 * (3 * m + n);
+                for (c = 0; c < 3; ++c) {
+                    P[c] += um[m] * vm[n] * q[c];
+                    Pu[c] += dum[m] * vm[n] * q[c];
+                    Pv[c] += um[m] * dvm[n] * q[c];
+                }
+            }
+        /* conformal: d(u,v)/da = (Re A, Im A), d(u,v)/db = (-Im A, Re A) */
+        for (c = 0; c < 3; ++c) {
+            Pa[c] = Pu[c] * Ar + Pv[c] * Ai;
+            Pb[c] = -Pu[c] * Ai + Pv[c] * Ar;
+        }
+    }
+}
+
+/* The blend at face coordinates (c,d): S, dS/dc, dS/dd. pts: point_data; cv: the four corner
+ * vertices; codes: their corner codes; kind: SFB_MANIFOLD_WEIGHTS_*. */
+void sfb__mf_eval(const float *pts, const int *cv, const unsigned *codes, int kind, double c, double d, double S[3], double Sc[3],
+                  double Sd[3]) {
+    /* corner j: (a_j, b_j) = o_j + J_j (c, d); J rows (da/dc, da/dd), (db/dc, db/dd) */
+    static const double J[4][4] = {{1, 0, 0, 1}, {0, 1, -1, 0}, {-1, 0, 0, -1}, {0, -1, 1, 0}};
+    static const double O[4][2] = {{0, 0}, {0, 1}, {1, 1}, {1, 0}};
+    int j, x;
+    for (x = 0; x < 3; ++x) S[x] = Sc[x] = Sd[x] = 0.0;
+    for (j = 0; j < 4; ++j) {
+        double a = O[j][0] + J[j][0] * c + J[j][1] * d, b = O[j][1] + J[j][2] * c + J[j][3] * d;
+        double ea, eb, dea, deb, w, wa, wb, P[3], Pa[3], Pb[3];
+        ea = sfb__mf_eta(kind, a, &dea);
+        eb = sfb__mf_eta(kind, b, &deb);
+        w = ea * eb; wa = dea * eb; wb = ea * deb;
+        if (w == 0.0 && wa == 0.0 && wb == 0.0) continue;
+        sfb__mf_local(pts + 27 * (size_t)cv[j], codes[j], a, b, P, Pa, Pb);
+        for (x = 0; x < 3; ++x) {
+            double ga = wa * P[x] + w * Pa[x], gb = wb * P[x] + w * Pb[x];
+            S[x] += w * P[x];
+            Sc[x] += ga * J[j][0] + gb * J[j][2];
+            Sd[x] += ga * J[j][1] + gb * J[j][3];
+        }
+    }
+}
+
+/* The ref kernel's MANIFOLD4 evaluation at the patch's (s,t): res[0] position, res[1..2] first
+ * derivatives, res[3..5] second derivatives when want2, and the unit normal. */
+void sfb__mf_eval_patch(const sfb__patch_table *pt, const float *pts, int patch, double s, double t, int want2, double res[6][3],
+                        double nrm[3]) {
+    const int *cv = pt->cv + pt->pfirst[patch];
+    const unsigned *codes = pt->pcorner + 4 * (size_t)patch;
+    int x;
+    double len;
+    sfb__mf_eval(pts, cv, codes, pt->mf_weights, s, t, res[0], res[1], res[2]);
+    nrm[0] = res[1][1] * res[2][2] - res[1][2] * res[2][1];
+    nrm[1] = res[1][2] * res[2][0] - res[1][0] * res[2][2];
+    nrm[2] = res[1][0] * res[2][1] - res[1][1] * res[2][0];
+    len = sqrt(nrm[0] * nrm[0] + nrm[1] * nrm[1] + nrm[2] * nrm[2]);
+    if (!(len > 1e-300) || !isfinite(len)) {
+        /* degenerate tangents: at a point or curve corner, and along edges between point or
+         * curve geometries, where the derivative across the edge vanishes (eta'(0) = 0): the
+         * normal a step inside the face, 1e-4, or 1e-2 when the C-infinity weights are still
+         * flat to double precision there (exp(-1/1e-4) underflows) */
+        static const double steps[2] = {1e-4, 1e-2};
+        int k;
+        for (k = 0; k < 2 && !(len > 1e-300 && isfinite(len)); ++k) {
+            double h = steps[k], s2 = s + (s < 0.5 ? h : -h), t2 = t + (t < 0.5 ? h : -h), P[3], A[3], B[3];
+            sfb__mf_eval(pts, cv, codes, pt->mf_weights, s2, t2, P, A, B);
+            nrm[0] = A[1] * B[2] - A[2] * B[1];
+            nrm[1] = A[2] * B[0] - A[0] * B[2];
+            nrm[2] = A[0] * B[1] - A[1] * B[0];
+            len = sqrt(nrm[0] * nrm[0] + nrm[1] * nrm[1] + nrm[2] * nrm[2]);
+        }
+    }
+    if (len > 0.0 && isfinite(len)) for (x = 0; x < 3; ++x) nrm[x] /= len;
+    else nrm[0] = nrm[1] = nrm[2] = 0.0;
+    for (x = 0; x < 3; ++x) res[3][x] = res[4][x] = res[5][x] = 0.0;
+    if (want2) {
+        const double h = 1.0 / 131072.0;
+        double s0 = s - h < 0.0 ? s : s - h, s1 = s + h > 1.0 ? s : s + h;
+        double t0 = t - h < 0.0 ? t : t - h, t1 = t + h > 1.0 ? t : t + h;
+        double P[3], A0[3], B0[3], A1[3], B1[3], C0[3], D0[3], C1[3], D1[3];
+        sfb__mf_eval(pts, cv, codes, pt->mf_weights, s0, t, P, A0, B0);
+        sfb__mf_eval(pts, cv, codes, pt->mf_weights, s1, t, P, A1, B1);
+        sfb__mf_eval(pts, cv, codes, pt->mf_weights, s, t0, P, C0, D0);
+        sfb__mf_eval(pts, cv, codes, pt->mf_weights, s, t1, P, C1, D1);
+        for (x = 0; x < 3; ++x) {
+            res[3][x] = (A1[x] - A0[x]) / (s1 - s0);
+            res[4][x] = 0.5 * ((B1[x] - B0[x]) / (s1 - s0) + (C1[x] - C0[x]) / (t1 - t0));
+            res[5][x] = (D1[x] - D0[x]) / (t1 - t0);
+        }
+    }
+}
+
+/* ---- construction ---- */
+
+/* Symmetric eigen decomposition of an n x n matrix (Jacobi rotations): a is destroyed, its
+ * diagonal the eigenvalues; vec columns the eigenvectors. */
+static void sfb__mf_jacobi(double *a, double *vec, int n) {
+    int sweep, p, q, i;
+    for (i = 0; i < n * n; ++i) vec[i] = (i % (n + 1)) == 0 ? 1.0 : 0.0;
+    for (sweep = 0; sweep < 64; ++sweep) {
+        double off = 0.0;
+        for (p = 0; p < n; ++p) for (q = p + 1; q < n; ++q) off += a[p * n + q] * a[p * n + q];
+        if (off < 1e-30) break;
+        for (p = 0; p < n; ++p)
+            for (q = p + 1; q < n; ++q) {
+                double apq = a[p * n + q], th, tt, cs, sn;
+                if (fabs(apq) < 1e-300) continue;
+                th = (a[q * n + q] - a[p * n + p]) / (2.0 * apq);
+                tt = (th >= 0.0 ? 1.0 : -1.0) / (fabs(th) + sqrt(th * th + 1.0));
+                cs = 1.0 / sqrt(tt * tt + 1.0); sn = tt * cs;
+                for (i = 0; i < n; ++i) { /* columns p, q */
+                    double x = a[i * n + p], y = a[i * n + q];
+                    a[i * n + p] = cs * x - sn * y; a[i * n + q] = sn * x + cs * y;
+                }
+                for (i = 0; i < n; ++i) { /* rows p, q */
+                    double x = a[p * n + i], y = a[q * n + i];
+                    a[p * n + i] = cs * x - sn * y; a[q * n + i] = sn * x + cs * y;
+                }
+                for (i = 0; i < n; ++i) {
+                    double x = vec[i * n + p], y = vec[i * n + q];
+                    vec[i * n + p] = cs * x - sn * y; vec[i * n + q] = sn * x + cs * y;
+                }
+            }
+    }
+}
+
+/* The chart position of one-ring point l (0..2k-1: edge neighbour l/2 when l is even, far
+ * corner of face l/2 when odd) of a valence-k vertex. */
+static void sfb__mf_ring_pos(int k, int l, double *u, double *v) {
+    double r = (l & 1) ? pow(2.0, 2.0 / k) : 1.0, ang = 2.0 * SFB__PI * (l / 2) / k + ((l & 1) ? SFB__PI / k : 0.0);
+    *u = r * cos(ang); *v = r * sin(ang);
+}
+
+/* Pseudo-inverse (8 x 2k, row-major) of the eq. 2 fit of a valence-k vertex: coefficient
+ * C_mn (index 3m + n - 1) = sum_l pinv[(3m+n-1) * 2k + l] (p_l - v). Minimum norm where the
+ * system is under-determined or rank-deficient. */
+sfb_result sfb__mf_pinv(sfb_context *ctx, int k, double **out) {
+    int rows = 2 * k, i, j, l, q;
+    double *A = NULL, *pinv = NULL, ata[64], vec[64], lmax = 0.0;
+    *out = NULL;
+    A = (double *)sfb__alloc(ctx, (size_t)rows * 8 * sizeof(double));
+    pinv = (double *)sfb__calloc(ctx, (size_t)rows * 8, sizeof(double));
+    if (!A || !pinv) { sfb__free(ctx, A); sfb__free(ctx, pinv); return sfb__oom(ctx, "manifold fit"); }
+    for (l = 0; l < rows; ++l) {
+        double u, v, um[3], vm[3];
+        sfb__mf_ring_pos(k, l, &u, &v);
+        um[0] = 1.0; um[1] = u; um[2] = u * u; vm[0] = 1.0; vm[1] = v; vm[2] = v * v;
+        for (q = 1; q < 9; ++q) A[l * 8 + q - 1] = um[q / 3] * vm[q % 3];
+    }
+    for (i = 0; i < 8; ++i)
+        for (j = 0; j < 8; ++j) {
+            double s = 0.0;
+            for (l = 0; l < rows; ++l) s += A[l * 8 + i] * A[l * 8 + j];
+            ata[i * 8 + j] = s;
+        }
+    sfb__mf_jacobi(ata, vec, 8);
+    for (i = 0; i < 8; ++i) if (ata[i * 9] > lmax) lmax = ata[i * 9];
+    /* pinv = V diag(1/lambda) V^T A^T over the kept eigenvalues */
+    for (q = 0; q < 8; ++q) {
+        double lam = ata[q * 9];
+        if (!(lam > 1e-12 * lmax)) continue;
+        for (l = 0; l < rows; ++l) {
+            double proj = 0.0; /* (V^T A^T)_{q,l} = sum_i vec[i][q] A[l][i] */
+            for (i = 0; i < 8; ++i) proj += vec[i * 8 + q] * A[l * 8 + i];
+            proj /= lam;
+            for (i = 0; i < 8; ++i) pinv[i * rows + l] += vec[i * 8 + q] * proj;
+        }
+    }
+    sfb__free(ctx, A);
+    *out = pinv;
+    return SFB_SUCCESS;
+}
+
+/* Vertex classes. */
+static int sfb__mf_vertex_kind(const sfb__level *l, int v, int *e1, int *e2) {
+    int e0 = l->ve_off[v], ne = l->ve_off[v + 1] - e0, nf = l->vf_off[v + 1] - l->vf_off[v], i, n = 0;
+    *e1 = *e2 = -1;
+    if (nf == 0 || ne == 0 || (l->vtag[v] & SFB__TAG_NONMANIFOLD) || !(nf == ne || nf == ne - 1) || l->vs[v] > 0.0f) return SFB__MF_POINT;
+    for (i = 0; i < ne; ++i)
+        if (l->es[l->ve[e0 + i]] > 0.0f) {
+            if (n == 0) *e1 = i;
+            else if (n == 1) *e2 = i;
+            n++;
+        }
+    if (n == 0) return nf == ne && !(l->vtag[v] & SFB__TAG_BOUNDARY) ? SFB__MF_PATCH : SFB__MF_POINT;
+    if (n == 2) return SFB__MF_CURVE;
+    return SFB__MF_POINT;
+}
+
+/* The corner code of slot `slot` of face f. */
+static unsigned sfb__mf_corner_code(const sfb__level *l, const unsigned char *kind, const int *ev1, const int *ev2, int f, int slot) {
+    int v = l->fv[l->fv_off[f] + slot], i, h = -1, k, ne, a1 = 0, a2 = 0;
+    for (i = l->vf_off[v]; i < l->vf_off[v + 1]; ++i)
+        if (l->vf[i] == f && l->vf_slot[i] == slot) { h = i - l->vf_off[v]; break; }
+    k = l->vf_off[v + 1] - l->vf_off[v];
+    ne = l->ve_off[v + 1] - l->ve_off[v];
+    if (kind[v] == SFB__MF_POINT || h < 0) return SFB__MF_CODE(SFB__MF_POINT, 0, 0, 0, 0);
+    if (kind[v] == SFB__MF_CURVE) {
+        int ea = h, eb = (h + 1) % ne; /* edges of face h: its a and b axes */
+        a1 = ev1[v] == ea ? 1 : ev1[v] == eb ? 2 : 0;
+        a2 = ev2[v] == ea ? 1 : ev2[v] == eb ? 2 : 0;
+        return SFB__MF_CODE(SFB__MF_CURVE, k, h, a1, a2);
+    }
+    return SFB__MF_CODE(SFB__MF_PATCH, k, h, 0, 0);
+}
+
+sfb_result sfb__manifold_build(sfb_context *ctx, const sfb__level *base, int weights, const float *positions, sfb__patch_table *pt) {
+    sfb__level work, lev1, *L = NULL;
+    sfb__stencils T;
+    double *P = NULL, **pinv = NULL;
+    unsigned char *kind = NULL;
+    int *ev1 = NULL, *ev2 = NULL;
+    int quads = 1, f, v, i, j, c, refined = 0, nptex = 0, npatch = 0, nnodes = 0;
+    sfb_result r = SFB_SUCCESS;
+    memset(pt, 0, sizeof *pt);
+    memset(&work, 0, sizeof work); memset(&lev1, 0, sizeof lev1); memset(&T, 0, sizeof T);
+    if (weights != SFB_MANIFOLD_WEIGHTS_HERMITE && weights != SFB_MANIFOLD_WEIGHTS_CINF)
+        return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, -1, "manifold weights %d are not SFB_MANIFOLD_WEIGHTS_HERMITE or _CINF", weights);
+    pt->scheme = SFB_SCHEME_MANIFOLD_BLEND;
+    pt->mf_weights = weights;
+    for (f = 0; f < base->nf; ++f) if (base->fv_off[f + 1] - base->fv_off[f] != 4) quads = 0;
+    if (quads) {
+        L = (sfb__level *)base;
+        P = (double *)sfb__alloc(ctx, ((size_t)base->nv + 1) * 3 * sizeof(double));
+        if (!P) goto oom;
+        for (i = 0; i < 3 * base->nv; ++i) P[i] = positions[i];
+    } else {
+        /* one Catmull-Clark step, sharp edges and vertices carried as infinitely sharp */
+        sfb__refine_options o;
+        int e;
+        refined = 1;
+        if ((r = sfb__level_prepare(ctx, base, 0, 0, &work)) != SFB_SUCCESS) goto done;
+        for (e = 0; e < work.ne; ++e) if (work.es[e] > 0.0f) work.es[e] = SFB_SHARPNESS_INFINITE;
+        for (v = 0; v < work.nv; ++v) if (work.vs[v] > 0.0f) work.vs[v] = SFB_SHARPNESS_INFINITE;
+        sfb__level_compute_rules(&work);
+        memset(&o, 0, sizeof o);
+        o.scheme = SFB_SCHEME_CATMARK;
+        if ((r = sfb__refine(ctx, &work, &o, 1, &lev1, &T, NULL, 0.0f, 0.5f)) != SFB_SUCCESS) goto done;
+        L = &lev1;
+        P = (double *)sfb__calloc(ctx, ((size_t)L->nv + 1) * 3, sizeof(double));
+        if (!P) goto oom;
+        for (v = 0; v < T.rows; ++v)
+            for (i = 0; i < T.sizes[v]; ++i) {
+                int src = T.indices[T.offsets[v] + i];
+                double w = T.weights[T.offsets[v] + i];
+                for (c = 0; c < 3; ++c) P[3 * (size_t)v + c] += w * positions[3 * (size_t)src + c];
+            }
+    }
+    /* local geometries */
+    kind = (unsigned char *)sfb__alloc(ctx, (size_t)L->nv + 1);
+    ev1 = (int *)sfb__alloc(ctx, ((size_t)L->nv + 1) * sizeof(int));
+    ev2 = (int *)sfb__alloc(ctx, ((size_t)L->nv + 1) * sizeof(int));
+    pt->point_data = (float *)sfb__calloc(ctx, (size_t)L->nv * 27 + 1, sizeof(float));
+    pinv = (double **)sfb__calloc(ctx, SFB_MAX_VALENCE + 1, sizeof(double *));
+    if (!kind || !ev1 || !ev2 || !pt->point_data || !pinv) goto oom;
+    pt->npoints = 9 * L->nv;
+    for (v = 0; v < L->nv; ++v) {
+        float *C = pt->point_data + 27 * (size_t)v;
+        int k = L->vf_off[v + 1] - L->vf_off[v], e0 = L->ve_off[v];
+        kind[v] = (unsigned char)sfb__mf_vertex_kind(L, v, &ev1[v], &ev2[v]);
+        for (c = 0; c < 3; ++c) C[c] = (float)P[3 * (size_t)v + c];
+        if (kind[v] == SFB__MF_CURVE) {
+            int qa = sfb__other_end(L, L->ve[e0 + ev1[v]], v), qb = sfb__other_end(L, L->ve[e0 + ev2[v]], v);
+            for (c = 0; c < 3; ++c) {
+                C[c] = (float)P[3 * (size_t)qa + c];
+                C[3 + c] = (float)P[3 * (size_t)v + c];
+                C[6 + c] = (float)P[3 * (size_t)qb + c];
+            }
+        } else if (kind[v] == SFB__MF_PATCH) {
+            const double *M;
+            int q;
+            if (k > SFB_MAX_VALENCE) { kind[v] = SFB__MF_POINT; continue; }
+            if (!pinv[k] && (r = sfb__mf_pinv(ctx, k, &pinv[k])) != SFB_SUCCESS) goto done;
+            M = pinv[k];
+            for (q = 1; q < 9; ++q) {
+                double acc[3] = {0.0, 0.0, 0.0};
+                for (i = 0; i < 2 * k; ++i) {
+                    int g = L->vf[L->vf_off[v] + i / 2], gs = L->vf_slot[L->vf_off[v] + i / 2];
+                    int nb = (i & 1) ? L->fv[L->fv_off[g] + (gs + 2) % 4] : sfb__other_end(L, L->ve[e0 + i / 2], v);
+                    for (c = 0; c < 3; ++c) acc[c] += M[(q - 1) * 2 * k + i] * (P[3 * (size_t)nb + c] - P[3 * (size_t)v + c]);
+                }
+                for (c = 0; c < 3; ++c) C[3 * q + c] = (float)acc[c];
+            }
+        }
+    }
+    /* param faces and patches */
+    pt->face_ptex = (int *)sfb__alloc(ctx, ((size_t)base->nf + 1) * sizeof(int));
+    if (!pt->face_ptex) goto oom;
+    for (f = 0; f < base->nf; ++f) {
+        int n = base->fv_off[f + 1] - base->fv_off[f];
+        pt->face_ptex[f] = nptex;
+        nptex += n == 4 ? 1 : n;
+        if (!base->fhole[f]) { npatch += refined ? n : 1; nnodes += refined && n == 4; }
+    }
+    pt->face_ptex[base->nf] = nptex;
+    pt->nptex = nptex; pt->npatch = npatch; pt->nnodes = nnodes; pt->ncv = 4 * npatch;
+    pt->max_depth = refined && nnodes > 0 ? 1 : 0;
+    pt->ptex_face = (int *)sfb__alloc(ctx, ((size_t)nptex + 1) * sizeof(int));
+    pt->ptex_corner = (int *)sfb__alloc(ctx, ((size_t)nptex + 1) * sizeof(int));
+    pt->ptex_root = (int *)sfb__alloc(ctx, ((size_t)nptex + 1) * sizeof(int));
+    pt->nodes = (int *)sfb__alloc(ctx, ((size_t)nnodes + 1) * 4 * sizeof(int));
+    pt->ptype = (int *)sfb__alloc(ctx, ((size_t)npatch + 1) * sizeof(int));
+    pt->pfirst = (int *)sfb__alloc(ctx, ((size_t)npatch + 1) * sizeof(int));
+    pt->pparam = (unsigned *)sfb__alloc(ctx, ((size_t)npatch + 1) * sizeof(unsigned));
+    pt->pvalence = (int *)sfb__calloc(ctx, (size_t)npatch + 1, sizeof(int));
+    pt->cv = (int *)sfb__alloc(ctx, ((size_t)npatch + 1) * 4 * sizeof(int));
+    pt->pcorner = (unsigned *)sfb__alloc(ctx, ((size_t)npatch + 1) * 4 * sizeof(unsigned));
+    if (!pt->ptex_face || !pt->ptex_corner || !pt->ptex_root || !pt->nodes || !pt->ptype || !pt->pfirst || !pt->pparam || !pt->pvalence ||
+        !pt->cv || !pt->pcorner)
+        goto oom;
+    {
+        int p = 0, node = 0;
+        for (f = 0; f < base->nf; ++f) {
+            int n = base->fv_off[f + 1] - base->fv_off[f], k0 = pt->face_ptex[f];
+            for (i = 0; i < (n == 4 ? 1 : n); ++i) {
+                pt->ptex_face[k0 + i] = f;
+                pt->ptex_corner[k0 + i] = n == 4 ? -1 : i;
+                pt->ptex_root[k0 + i] = -1;
+            }
+            if (base->fhole[f]) continue;
+            if (!refined) {
+                pt->ptex_root[k0] = -(p + 2);
+                pt->pparam[p] = SFB__PARAM(0, 0, 0, 0);
+                for (j = 0; j < 4; ++j) {
+                    pt->cv[4 * p + j] = L->fv[L->fv_off[f] + j];
+                    pt->pcorner[4 * p + j] = sfb__mf_corner_code(L, kind, ev1, ev2, f, j);
+                }
+                pt->ptype[p] = SFB__PATCH_MANIFOLD4; pt->pfirst[p] = 4 * p;
+                p++;
+                continue;
+            }
+            /* child quad i of base face f is refined face fv_off[f] + i, its slot 0 at the
+             * corner v_i (v_i, mid(v_i,v_i+1), centroid, mid(v_i-1,v_i)) */
+            if (n == 4) pt->ptex_root[k0] = node;
+            for (i = 0; i < n; ++i) {
+                int g = base->fv_off[f] + i, s0 = n == 4 ? (4 - i) % 4 : 0;
+                static const int qx[4] = {0, 1, 1, 0}, qy[4] = {0, 0, 1, 1};
+                if (n == 4) {
+                    pt->nodes[4 * node + qx[i] + 2 * qy[i]] = -(p + 2);
+                    pt->pparam[p] = SFB__PARAM(1, qx[i], qy[i], 0);
+                } else {
+                    pt->ptex_root[k0 + i] = -(p + 2);
+                    pt->pparam[p] = SFB__PARAM(0, 0, 0, 0);
+                }
+                for (j = 0; j < 4; ++j) {
+                    int slot = (s0 + j) % 4;
+                    pt->cv[4 * p + j] = L->fv[L->fv_off[g] + slot];
+                    pt->pcorner[4 * p + j] = sfb__mf_corner_code(L, kind, ev1, ev2, g, slot);
+                }
+                pt->ptype[p] = SFB__PATCH_MANIFOLD4; pt->pfirst[p] = 4 * p;
+                p++;
+            }
+            if (n == 4) node++;
+        }
+        pt->pfirst[npatch] = 4 * npatch;
+    }
+    pt->counts[SFB__PATCH_MANIFOLD4] = npatch;
+    goto done;
+oom:
+    r = sfb__oom(ctx, "manifold patch table");
+done:
+    if (pinv) { for (i = 0; i <= SFB_MAX_VALENCE; ++i) sfb__free(ctx, pinv[i]); sfb__free(ctx, pinv); }
+    sfb__free(ctx, kind); sfb__free(ctx, ev1); sfb__free(ctx, ev2); sfb__free(ctx, P);
+    sfb__level_free(ctx, &work); sfb__level_free(ctx, &lev1); sfb__stencils_free(ctx, &T);
+    if (r != SFB_SUCCESS) sfb__patch_table_free(ctx, pt);
+    return r;
 }
 #line 1 "src/tess.c"
 /* Watertight tessellation of the limit surface (sfb_surface_tessellate).
@@ -4384,6 +5032,37 @@ static sfb_result sfb__ref_eval_patches(void *state, const sfb__patch_table *pt,
  * is within `tolerance` of the chords; a shared edge takes the largest rate of its faces.
  * This samples the surface: a feature narrower than a cell can be missed at that rate.
  *
+ * Trimming (cfg->trim, seed 000 section V.5): param face t reads tile t of the mask (every face
+ * the one mask when the atlas is 0 x 0 or 1 x 1; faces past the last tile are not trimmed)
+ * through the bilinear interpolation of its texel centres, clamped at the tile's borders; a
+ * point is kept where the value / 255 is >= 0.5. A tile whose texels are all >= 128 keeps its
+ * face whole and one whose texels are all <= 127 drops it (the bilinear value lies between its
+ * texels' extremes). Otherwise the 0.5 contour crosses the tile, and the face's rate is raised
+ * to max(tile width, tile height) (at most SFB__TESS_MAX_RATE) so that a cell is at most one
+ * texel wide: the contour is followed within one texel whatever rate was asked for. The raised
+ * rates go through the per-face rates and shared edge counts of adaptive mode, so faces of
+ * different rates still meet without cracks.
+ * Every triangle corner is then classified by its own face's mask at its (u,v) in that face:
+ * a triangle with three trimmed corners is dropped, one with three kept corners kept, and
+ * otherwise each edge whose ends differ is cut where the mask first changes sides walking from
+ * its lower vertex id. Along a segment the mask is a quadratic in the segment's parameter
+ * between the texel-centre lines it crosses; each such piece is split at its extremum into
+ * monotone parts and the first part whose ends differ is bisected on the exact bilinear value,
+ * in double precision. The kept part (a triangle, or a convex quad split along its shorter
+ * (u,v) diagonal) keeps the triangle's counter-clockwise order. Where the contour bends inside
+ * a cell the straight cut leaves a sliver of less than a cell on one side.
+ * A cut point is keyed by its tessellation edge (the two vertex ids) in a hash table, so the
+ * two triangles on an edge share one vertex and the kept mesh stays watertight. On an edge
+ * between two param faces each face cuts with its own mask: the faces share the point when
+ * they put it at the same place along the edge (within 1e-7 of its length), else each side
+ * has its own and the seam opens there, as the masks disagree. A cut within SFB__TRIM_SNAP of
+ * an end in (u,v) (a few float steps: it would round onto it) is that end, and a kept polygon
+ * that repeats a vertex loses the repeat (fewer than 3 left: nothing). Cut points are new
+ * vertices, located in the face that made them and evaluated with the others through
+ * sfb_surface_eval, so on the selected backend. Vertices that no kept triangle uses are
+ * removed and the others keep their order, so an all-white mask gives the untrimmed output
+ * exactly.
+ *
  * Thread safety: reads the surface only; allocations, errors and progress go through the
  * surface's context, so one call per context at a time. */
 
@@ -4391,6 +5070,8 @@ static sfb_result sfb__ref_eval_patches(void *state, const sfb__patch_table *pt,
 #define SFB__TESS_MAX_SEG (2 * SFB__TESS_MAX_RATE) /* a quad edge beside an n-gon sub-face */
 #define SFB__TESS_EVAL_CHUNK 65536                 /* locations per sfb_surface_eval call */
 #define SFB__TESS_FACE_CHUNK 1024                  /* param faces between progress reports */
+#define SFB__TRIM_MAX_SIZE 16384                   /* texels on a side of a trimming mask */
+#define SFB__TRIM_SNAP 2.5e-7                      /* a cut this near an end of its edge, in (u,v), is that end */
 
 SFB_API sfb_tess_config sfb_tess_config_init(int rate) {
     sfb_tess_config c;
@@ -4409,6 +5090,14 @@ SFB_API void sfb_tess_data_free(sfb_tess_data *d) {
     }
     memset(d, 0, sizeof *d);
 }
+
+/* A cut point: the edge (lo << 32 | hi, vertex ids), its place t from lo to hi, the vertex
+ * and the param face that computed it. vid < 0: an empty slot. */
+typedef struct sfb__trim_cut {
+    unsigned long long key;
+    double t;
+    int vid, face;
+} sfb__trim_cut;
 
 typedef struct sfb__tess {
     sfb_context *ctx;
@@ -4434,7 +5123,22 @@ typedef struct sfb__tess {
     sfb_location *loc;
     int *tri, *tface;
     size_t tri_at;
+    /* trimming (NULL trim: none of these is used) */
+    const sfb_trim_mask *trim;
+    int ntiles, tiles_u, tw, th;  /* tiles in use (1: one mask for all faces), tile size in texels */
+    unsigned char *fstate;        /* per param face: SFB__TRIM_KEEP, _DROP or _CUT */
+    double *cuv;                  /* per vertex: (u,v) in the face being emitted (faces to cut) */
+    unsigned char *ckept;         /* per vertex: kept by that face's mask */
+    int *otri, *oface;            /* trimmed triangles (grown) */
+    size_t ocount, ocap;
+    sfb_location *nloc;           /* cut points: vertex nvert + i (grown) */
+    size_t nnew, ncap;
+    sfb__trim_cut *cuts;          /* hash table of cut points by tessellation edge */
+    size_t cut_cap, cut_count;
+    sfb_result err;               /* first failure inside the emit pass */
 } sfb__tess;
+
+enum { SFB__TRIM_KEEP = 0, SFB__TRIM_DROP = 1, SFB__TRIM_CUT = 2 };
 
 static void *sfb__tess_array(sfb_context *ctx, size_t count, size_t size) {
     size_t bytes;
@@ -4449,6 +5153,15 @@ static void sfb__tess_free_work(sfb__tess *T) {
     sfb__free(ctx, T->vspoke); sfb__free(ctx, T->vcenter); sfb__free(ctx, T->ifirst); sfb__free(ctx, T->bids);
     T->prate = T->eseg = T->sseg = T->uf = T->ecopy = T->vcorner = T->vedge = T->vspoke = T->vcenter = T->ifirst = T->bids = NULL;
     T->engon = NULL;
+    sfb__free(ctx, T->fstate); sfb__free(ctx, T->cuv); sfb__free(ctx, T->ckept); sfb__free(ctx, T->otri);
+    sfb__free(ctx, T->oface); sfb__free(ctx, T->nloc); sfb__free(ctx, T->cuts);
+    T->fstate = T->ckept = NULL;
+    T->cuv = NULL;
+    T->otri = T->oface = NULL;
+    T->nloc = NULL;
+    T->cuts = NULL;
+    if (T->trim) sfb__free(ctx, T->loc); /* trimming: the untrimmed locations are scratch */
+    T->loc = NULL;
 }
 
 static int sfb__tess_face_n(const sfb__level *l, int f) { return l->fv_off[f + 1] - l->fv_off[f]; }
@@ -4492,12 +5205,326 @@ static void sfb__tess_uv(int tri, double u, double v, sfb_location *L) {
     L->v = fv;
 }
 
+/* ---- trimming ---- */
+
+/* The mask tile of param face pf (its first texel; rows are the mask's width apart), or NULL
+ * for a face past the last tile of an atlas. */
+static const unsigned char *sfb__trim_tile(const sfb__tess *T, int pf) {
+    const sfb_trim_mask *m = T->trim;
+    if (T->ntiles == 1) return m->texels;
+    if (pf < 0 || pf >= T->ntiles) return NULL;
+    return m->texels + (size_t)(pf / T->tiles_u) * (size_t)T->th * (size_t)m->width + (size_t)(pf % T->tiles_u) * (size_t)T->tw;
+}
+
+/* The mask at (u,v) of a tile, in [0,1]: the bilinear interpolation of the texel centres,
+ * clamped at the tile's borders, / 255. */
+static double sfb__trim_value(const sfb__tess *T, const unsigned char *tile, double u, double v) {
+    int tw = T->tw, th = T->th, i0, j0, i1, j1;
+    size_t w = (size_t)T->trim->width;
+    double x = u * tw - 0.5, y = v * th - 0.5, fx, fy, a, b;
+    if (!(x > 0.0)) x = 0.0; /* NaN too */
+    if (x > tw - 1) x = tw - 1;
+    if (!(y > 0.0)) y = 0.0;
+    if (y > th - 1) y = th - 1;
+    i0 = (int)x;
+    j0 = (int)y;
+    if (i0 > tw - 2) i0 = tw > 1 ? tw - 2 : 0;
+    if (j0 > th - 2) j0 = th > 1 ? th - 2 : 0;
+    fx = x - i0;
+    fy = y - j0;
+    i1 = tw > 1 ? i0 + 1 : i0;
+    j1 = th > 1 ? j0 + 1 : j0;
+    a = (1.0 - fx) * tile[(size_t)j0 * w + (size_t)i0] + fx * tile[(size_t)j0 * w + (size_t)i1];
+    b = (1.0 - fx) * tile[(size_t)j1 * w + (size_t)i0] + fx * tile[(size_t)j1 * w + (size_t)i1];
+    return ((1.0 - fy) * a + fy * b) / 255.0;
+}
+
+/* Kept (1) or trimmed (0) at p0 + t (p1 - p0); t = 1 is p1 itself. */
+static int sfb__trim_kept_at(const sfb__tess *T, const unsigned char *tile, const double *p0, const double *p1, double t) {
+    double u = p1[0], v = p1[1];
+    if (t < 1.0) {
+        u = p0[0] + t * (p1[0] - p0[0]);
+        v = p0[1] + t * (p1[1] - p0[1]);
+    }
+    return sfb__trim_value(T, tile, u, v) >= 0.5;
+}
+
+static double sfb__trim_g(const sfb__tess *T, const unsigned char *tile, const double *p0, const double *p1, double t) {
+    double u = p1[0], v = p1[1];
+    if (t < 1.0) {
+        u = p0[0] + t * (p1[0] - p0[0]);
+        v = p0[1] + t * (p1[1] - p0[1]);
+    }
+    return sfb__trim_value(T, tile, u, v) - 0.5;
+}
+
+/* The texel-centre lines x = k (integers 0..n-1, where the bilinear pieces change) strictly
+ * between x0 and x0 + dx: from *k in steps *step while *k != *end. */
+static void sfb__trim_lines(double x0, double dx, int n, long *k, long *end, int *step) {
+    double x1 = x0 + dx;
+    long first, last;
+    *step = dx > 0.0 ? 1 : -1;
+    *k = *end = 0;
+    if (!(dx != 0.0)) return;
+    if (dx > 0.0) {
+        first = (long)floor(x0) + 1;
+        last = (long)ceil(x1) - 1;
+        if (first < 0) first = 0;
+        if (last > n - 1) last = n - 1;
+        if (first <= last) { *k = first; *end = last + 1; }
+    } else {
+        first = (long)ceil(x0) - 1;
+        last = (long)floor(x1) + 1;
+        if (first > n - 1) first = n - 1;
+        if (last < 0) last = 0;
+        if (first >= last) { *k = first; *end = last - 1; }
+    }
+}
+
+/* Where the mask first changes sides along p0 -> p1, whose ends are on different sides
+ * (kept0: the side of p0). Between texel-centre lines the mask is a quadratic in t; each
+ * piece is split at its extremum into monotone parts, and the first part whose ends differ
+ * is bisected on the exact value. Returns t in (0,1]. */
+static double sfb__trim_solve(const sfb__tess *T, const unsigned char *tile, const double *p0, const double *p1, int kept0) {
+    double x0 = p0[0] * T->tw - 0.5, dx = (p1[0] - p0[0]) * T->tw;
+    double y0 = p0[1] * T->th - 0.5, dy = (p1[1] - p0[1]) * T->th;
+    double ta = 0.0;
+    long kx, kx_end, ky, ky_end;
+    int sx, sy;
+    sfb__trim_lines(x0, dx, T->tw, &kx, &kx_end, &sx);
+    sfb__trim_lines(y0, dy, T->th, &ky, &ky_end, &sy);
+    for (;;) {
+        double tb = 1.0, tx = 2.0, ty = 2.0;
+        if (kx != kx_end) tx = ((double)kx - x0) / dx;
+        if (ky != ky_end) ty = ((double)ky - y0) / dy;
+        if (tx <= ty && tx < 1.0) { tb = tx; kx += sx; }
+        else if (ty < 1.0) { tb = ty; ky += sy; }
+        if (tb > ta) {
+            double ga = sfb__trim_g(T, tile, p0, p1, ta), gm = sfb__trim_g(T, tile, p0, p1, 0.5 * (ta + tb));
+            double gb = sfb__trim_g(T, tile, p0, p1, tb), c = 2.0 * (gb + ga - 2.0 * gm), b = gb - ga - c, ends[2], lo = ta;
+            int n = 0, q;
+            if (c != 0.0) {
+                double sm = -b / (2.0 * c);
+                if (sm > 0.0 && sm < 1.0) ends[n++] = ta + sm * (tb - ta);
+            }
+            ends[n++] = tb;
+            for (q = 0; q < n; ++q) {
+                double hi = ends[q];
+                if (sfb__trim_kept_at(T, tile, p0, p1, hi) != kept0) {
+                    int it;
+                    for (it = 0; it < 80; ++it) {
+                        double mid = 0.5 * (lo + hi);
+                        if (!(mid > lo && mid < hi)) break;
+                        if (sfb__trim_kept_at(T, tile, p0, p1, mid) == kept0) lo = mid;
+                        else hi = mid;
+                    }
+                    return 0.5 * (lo + hi);
+                }
+                lo = hi;
+            }
+            ta = tb;
+        }
+        if (tb >= 1.0) break;
+    }
+    return 1.0; /* not reached: p1 is on the other side */
+}
+
+static size_t sfb__trim_hash(unsigned long long key) {
+    key ^= key >> 29;
+    key *= 0x9E3779B97F4A7C15ULL;
+    return (size_t)(key ^ (key >> 32));
+}
+
+/* Grows an array to hold at least `need` elements (doubling); 0 when that fails. */
+static int sfb__trim_grow(sfb_context *ctx, void **p, size_t *cap, size_t need, size_t elem) {
+    size_t nc = *cap ? *cap : 1024, bytes;
+    void *np;
+    if (need <= *cap) return 1;
+    while (nc < need) nc *= 2;
+    if (!sfb__mul_size(nc, elem, &bytes)) return 0;
+    np = sfb__realloc(ctx, *p, bytes);
+    if (!np) return 0;
+    *p = np;
+    *cap = nc;
+    return 1;
+}
+
+static void sfb__trim_fail(sfb__tess *T, sfb_result r) {
+    if (T->err == SFB_SUCCESS) T->err = r;
+}
+
+/* Adds an entry to the cut table, growing it to stay at most half full. */
+static int sfb__trim_insert(sfb__tess *T, unsigned long long key, double t, int vid, int face) {
+    size_t i, mask;
+    if ((T->cut_count + 1) * 2 > T->cut_cap) {
+        size_t nc = T->cut_cap * 2, j;
+        sfb__trim_cut *nt = (sfb__trim_cut *)sfb__tess_array(T->ctx, nc, sizeof(sfb__trim_cut));
+        if (!nt) return 0;
+        for (j = 0; j < nc; ++j) nt[j].vid = -1;
+        for (j = 0; j < T->cut_cap; ++j)
+            if (T->cuts[j].vid >= 0) {
+                for (i = sfb__trim_hash(T->cuts[j].key) & (nc - 1); nt[i].vid >= 0; i = (i + 1) & (nc - 1)) {}
+                nt[i] = T->cuts[j];
+            }
+        sfb__free(T->ctx, T->cuts);
+        T->cuts = nt;
+        T->cut_cap = nc;
+    }
+    mask = T->cut_cap - 1;
+    for (i = sfb__trim_hash(key) & mask; T->cuts[i].vid >= 0; i = (i + 1) & mask) {}
+    T->cuts[i].key = key;
+    T->cuts[i].t = t;
+    T->cuts[i].vid = vid;
+    T->cuts[i].face = face;
+    T->cut_count++;
+    return 1;
+}
+
+/* The vertex where the edge p-q of a triangle of param face pf crosses the contour, with its
+ * (u,v) in that face; -1 (T->err set) on failure. */
+static int sfb__trim_cut_edge(sfb__tess *T, const unsigned char *tile, int p, int q, int pf, double *uv) {
+    int lo = p < q ? p : q, hi = p < q ? q : p, vid = -1, found = 0;
+    const double *a = T->cuv + 2 * (size_t)lo, *b = T->cuv + 2 * (size_t)hi;
+    unsigned long long key = (unsigned long long)(unsigned)lo << 32 | (unsigned)hi;
+    size_t mask = T->cut_cap - 1, i;
+    double t = 0.0;
+    for (i = sfb__trim_hash(key) & mask; T->cuts[i].vid >= 0; i = (i + 1) & mask)
+        if (T->cuts[i].key == key && T->cuts[i].face == pf) { /* this face cut it already */
+            t = T->cuts[i].t;
+            vid = T->cuts[i].vid;
+            found = 1;
+            break;
+        }
+    if (!found) {
+        double len = sqrt((b[0] - a[0]) * (b[0] - a[0]) + (b[1] - a[1]) * (b[1] - a[1]));
+        t = sfb__trim_solve(T, tile, a, b, T->ckept[lo]);
+        if (t <= 1e-9 || t * len <= SFB__TRIM_SNAP) vid = lo;
+        else if (t >= 1.0 - 1e-9 || (1.0 - t) * len <= SFB__TRIM_SNAP) vid = hi;
+        else
+            for (i = sfb__trim_hash(key) & mask; T->cuts[i].vid >= 0; i = (i + 1) & mask)
+                if (T->cuts[i].key == key && fabs(T->cuts[i].t - t) <= 1e-7) { /* another face cut it at the same place */
+                    vid = T->cuts[i].vid;
+                    break;
+                }
+    }
+    if (vid == lo) { uv[0] = a[0]; uv[1] = a[1]; }
+    else if (vid == hi) { uv[0] = b[0]; uv[1] = b[1]; }
+    else { uv[0] = a[0] + t * (b[0] - a[0]); uv[1] = a[1] + t * (b[1] - a[1]); }
+    if (found) return vid;
+    if (vid < 0) {
+        sfb_location *L;
+        if (T->nvert + T->nnew >= (size_t)SFB_MAX_ELEMENTS) {
+            sfb__trim_fail(T, sfb__error(T->ctx, SFB_LIMIT_EXCEEDED, SFB_ELEMENT_NONE, -1,
+                                         "trimmed tessellation makes more than %d vertices (SFB_MAX_ELEMENTS)", SFB_MAX_ELEMENTS));
+            return -1;
+        }
+        if (!sfb__trim_grow(T->ctx, (void **)&T->nloc, &T->ncap, T->nnew + 1, sizeof(sfb_location))) {
+            sfb__trim_fail(T, sfb__oom(T->ctx, "tessellation"));
+            return -1;
+        }
+        vid = (int)(T->nvert + T->nnew);
+        L = &T->nloc[T->nnew++];
+        L->face = pf;
+        sfb__tess_uv(T->loop, uv[0] < 0.0 ? 0.0 : uv[0] > 1.0 ? 1.0 : uv[0], uv[1] < 0.0 ? 0.0 : uv[1] > 1.0 ? 1.0 : uv[1], L);
+    }
+    if (!sfb__trim_insert(T, key, t, vid, pf)) {
+        sfb__trim_fail(T, sfb__oom(T->ctx, "tessellation"));
+        return -1;
+    }
+    return vid;
+}
+
+static void sfb__trim_push(sfb__tess *T, int a, int b, int c, int pf) {
+    size_t cap = T->ocap;
+    if (T->ocount >= (size_t)SFB_MAX_ELEMENTS) {
+        sfb__trim_fail(T, sfb__error(T->ctx, SFB_LIMIT_EXCEEDED, SFB_ELEMENT_NONE, -1,
+                                     "trimmed tessellation makes more than %d triangles (SFB_MAX_ELEMENTS)", SFB_MAX_ELEMENTS));
+        return;
+    }
+    if (T->ocount >= cap) { /* both arrays to twice the triangles */
+        size_t nc = cap ? 2 * cap : 1024, b1, b3;
+        int *nf = NULL, *nt = NULL;
+        if (sfb__mul_size(nc, sizeof(int), &b1) && sfb__mul_size(nc, 3 * sizeof(int), &b3)) {
+            nf = (int *)sfb__realloc(T->ctx, T->oface, b1);
+            if (nf) T->oface = nf;
+            nt = nf ? (int *)sfb__realloc(T->ctx, T->otri, b3) : NULL;
+        }
+        if (!nt) {
+            sfb__trim_fail(T, sfb__oom(T->ctx, "tessellation"));
+            return;
+        }
+        T->otri = nt;
+        T->ocap = nc;
+    }
+    T->otri[3 * T->ocount] = a;
+    T->otri[3 * T->ocount + 1] = b;
+    T->otri[3 * T->ocount + 2] = c;
+    T->oface[T->ocount++] = pf;
+}
+
+/* One triangle (counter-clockwise) of param face pf through the mask: dropped, kept, or cut
+ * to its kept part. */
+static void sfb__trim_triangle(sfb__tess *T, int a, int b, int c, int pf) {
+    const unsigned char *tile;
+    int v[3], poly[4], ids[4], n = 0, m = 0, k;
+    double puv[4][2], quv[4][2];
+    if (T->err != SFB_SUCCESS || T->fstate[pf] == SFB__TRIM_DROP) return;
+    if (T->fstate[pf] == SFB__TRIM_KEEP || (T->ckept[a] && T->ckept[b] && T->ckept[c])) {
+        sfb__trim_push(T, a, b, c, pf);
+        return;
+    }
+    if (!T->ckept[a] && !T->ckept[b] && !T->ckept[c]) return;
+    tile = sfb__trim_tile(T, pf);
+    v[0] = a; v[1] = b; v[2] = c;
+    for (k = 0; k < 3; ++k) {
+        int p = v[k], q = v[(k + 1) % 3];
+        if (T->ckept[p]) {
+            poly[n] = p;
+            puv[n][0] = T->cuv[2 * (size_t)p];
+            puv[n][1] = T->cuv[2 * (size_t)p + 1];
+            ++n;
+        }
+        if (T->ckept[p] != T->ckept[q]) {
+            int x = sfb__trim_cut_edge(T, tile, p, q, pf, puv[n]);
+            if (x < 0) return;
+            poly[n++] = x;
+        }
+    }
+    /* a cut point at a corner repeats it: drop repeats (cyclically) */
+    for (k = 0; k < n; ++k)
+        if (m == 0 || ids[m - 1] != poly[k]) {
+            ids[m] = poly[k];
+            quv[m][0] = puv[k][0];
+            quv[m][1] = puv[k][1];
+            ++m;
+        }
+    while (m > 1 && ids[m - 1] == ids[0]) --m;
+    if (m == 3) {
+        sfb__trim_push(T, ids[0], ids[1], ids[2], pf);
+    } else if (m == 4) { /* convex: split along the shorter diagonal */
+        double d02 = (quv[0][0] - quv[2][0]) * (quv[0][0] - quv[2][0]) + (quv[0][1] - quv[2][1]) * (quv[0][1] - quv[2][1]);
+        double d13 = (quv[1][0] - quv[3][0]) * (quv[1][0] - quv[3][0]) + (quv[1][1] - quv[3][1]) * (quv[1][1] - quv[3][1]);
+        if (d02 <= d13) {
+            sfb__trim_push(T, ids[0], ids[1], ids[2], pf);
+            sfb__trim_push(T, ids[0], ids[2], ids[3], pf);
+        } else {
+            sfb__trim_push(T, ids[1], ids[2], ids[3], pf);
+            sfb__trim_push(T, ids[1], ids[3], ids[0], pf);
+        }
+    }
+}
+
 /* The location a vertex is evaluated at: the first param face that reaches it in the emit
  * pass (for a split crease copy that is always a face on its own side). */
 static void sfb__tess_loc(sfb__tess *T, int id, int pf, double u, double v) {
     if (T->loc && T->loc[id].face < 0) {
         T->loc[id].face = pf;
         sfb__tess_uv(T->loop, u, v, &T->loc[id]);
+    }
+    if (T->cuv && T->fstate[pf] == SFB__TRIM_CUT) { /* trimming: where this face sees it, and its side */
+        T->cuv[2 * (size_t)id] = u;
+        T->cuv[2 * (size_t)id + 1] = v;
+        T->ckept[id] = (unsigned char)(sfb__trim_value(T, sfb__trim_tile(T, pf), u, v) >= 0.5);
     }
 }
 
@@ -4538,7 +5565,13 @@ static int sfb__tess_spoke(sfb__tess *T, int f, int i, int t) {
 }
 
 static void sfb__tess_tri(sfb__tess *T, int a, int b, int c, int pf) {
-    size_t t = T->tri_at++;
+    size_t t;
+    if (T->trim) {
+        T->tri_at++;
+        sfb__trim_triangle(T, a, b, c, pf);
+        return;
+    }
+    t = T->tri_at++;
     T->tri[3 * t] = a;
     T->tri[3 * t + 1] = b;
     T->tri[3 * t + 2] = c;
@@ -4828,13 +5861,115 @@ done:
     return r;
 }
 
+/* Which side of 0.5 a tile's texels are on: all kept, all trimmed, or both (the contour
+ * crosses it). */
+static int sfb__trim_scan(const sfb__tess *T, const unsigned char *tile) {
+    int lo = 0, hi = 0, i, j;
+    for (j = 0; j < T->th; ++j) {
+        const unsigned char *row = tile + (size_t)j * (size_t)T->trim->width;
+        for (i = 0; i < T->tw; ++i) {
+            if (row[i] >= 128) hi = 1;
+            else lo = 1;
+        }
+        if (lo && hi) return SFB__TRIM_CUT;
+    }
+    return lo ? SFB__TRIM_DROP : SFB__TRIM_KEEP;
+}
+
+/* The trimming state of every param face, and the rate of those the contour crosses raised
+ * to one cell per texel of their tile (at most SFB__TESS_MAX_RATE). */
+static sfb_result sfb__trim_rates(sfb__tess *T, float p) {
+    const sfb_trim_mask *m = T->trim;
+    int nptex = T->pt->nptex, atlas = m->tiles_u > 1 || m->tiles_v > 1, pf, need, one = SFB__TRIM_KEEP;
+    sfb_result r;
+    T->tiles_u = atlas ? m->tiles_u : 1;
+    T->ntiles = atlas ? m->tiles_u * m->tiles_v : 1;
+    T->tw = m->width / T->tiles_u;
+    T->th = m->height / (atlas ? m->tiles_v : 1);
+    need = T->tw > T->th ? T->tw : T->th;
+    if (need > SFB__TESS_MAX_RATE) need = SFB__TESS_MAX_RATE;
+    T->fstate = (unsigned char *)sfb__tess_array(T->ctx, (size_t)nptex, 1);
+    if (!T->fstate) return sfb__oom(T->ctx, "tessellation");
+    if (!atlas) one = sfb__trim_scan(T, m->texels);
+    for (pf = 0; pf < nptex; ++pf) {
+        int st = SFB__TRIM_KEEP;
+        if (atlas && pf % SFB__TESS_FACE_CHUNK == 0 && (r = sfb__progress(T->ctx, p, "tessellate")) != SFB_SUCCESS) return r;
+        if (T->prate[pf] > 0) st = atlas ? (pf < T->ntiles ? sfb__trim_scan(T, sfb__trim_tile(T, pf)) : SFB__TRIM_KEEP) : one;
+        T->fstate[pf] = (unsigned char)st;
+        if (st == SFB__TRIM_CUT && T->prate[pf] < need) T->prate[pf] = need;
+    }
+    return SFB_SUCCESS;
+}
+
+/* The emit pass with trimming: locations of the untrimmed points, triangles through the mask
+ * (sfb__trim_triangle), then the vertices no triangle uses are removed (the others keep
+ * their order) and `out` gets the compacted arrays. */
+static sfb_result sfb__trim_emit(sfb__tess *T, sfb_tess_data *out, float p0, float p1) {
+    sfb_context *ctx = T->ctx;
+    int nptex = T->pt->nptex, pf, *remap = NULL;
+    size_t v, total, nv = 0, i;
+    sfb_result r;
+    T->loc = (sfb_location *)sfb__tess_array(ctx, T->nvert, sizeof(sfb_location));
+    T->cuv = (double *)sfb__tess_array(ctx, T->nvert, 2 * sizeof(double));
+    T->ckept = (unsigned char *)sfb__tess_array(ctx, T->nvert, 1);
+    T->cut_cap = 1024;
+    T->cuts = (sfb__trim_cut *)sfb__tess_array(ctx, T->cut_cap, sizeof(sfb__trim_cut));
+    if (!T->loc || !T->cuv || !T->ckept || !T->cuts) return sfb__oom(ctx, "tessellation");
+    for (v = 0; v < T->nvert; ++v) {
+        T->loc[v].face = -1;
+        T->loc[v].u = T->loc[v].v = 0.0f;
+        T->ckept[v] = 1;
+    }
+    for (i = 0; i < T->cut_cap; ++i) T->cuts[i].vid = -1;
+    T->err = SFB_SUCCESS;
+    for (pf = 0; pf < nptex; ++pf) {
+        if (pf % SFB__TESS_FACE_CHUNK == 0 && pf > 0) {
+            r = sfb__progress(ctx, p0 + (p1 - p0) * (float)pf / (float)nptex, "tessellate");
+            if (r != SFB_SUCCESS) return r;
+        }
+        sfb__tess_face(T, pf, 1);
+        if (T->err != SFB_SUCCESS) return T->err;
+    }
+    if (T->tri_at != T->ntri)
+        return sfb__error(ctx, SFB_BACKEND_ERROR, SFB_ELEMENT_NONE, -1, "tessellation wrote %zu triangles, counted %zu", T->tri_at, T->ntri);
+    for (v = 0; v < T->nvert; ++v)
+        if (T->loc[v].face < 0)
+            return sfb__error(ctx, SFB_BACKEND_ERROR, SFB_ELEMENT_NONE, -1, "tessellation vertex %zu has no location", v);
+    /* compaction */
+    total = T->nvert + T->nnew;
+    remap = (int *)sfb__tess_array(ctx, total, sizeof(int));
+    if (!remap) return sfb__oom(ctx, "tessellation");
+    for (v = 0; v < total; ++v) remap[v] = -1;
+    for (i = 0; i < 3 * T->ocount; ++i) remap[T->otri[i]] = 0;
+    for (v = 0; v < total; ++v)
+        if (remap[v] == 0) remap[v] = (int)nv++;
+    out->vertex_count = (int)nv;
+    out->triangle_count = (int)T->ocount;
+    out->positions = (float *)sfb__tess_array(ctx, nv, 3 * sizeof(float));
+    out->normals = (float *)sfb__tess_array(ctx, nv, 3 * sizeof(float));
+    out->locations = (sfb_location *)sfb__tess_array(ctx, nv, sizeof(sfb_location));
+    if (!out->positions || !out->normals || !out->locations || (!T->otri && !(T->otri = (int *)sfb__tess_array(ctx, 1, 3 * sizeof(int)))) ||
+        (!T->oface && !(T->oface = (int *)sfb__tess_array(ctx, 1, sizeof(int))))) {
+        sfb__free(ctx, remap);
+        return sfb__oom(ctx, "tessellation");
+    }
+    for (v = 0; v < total; ++v)
+        if (remap[v] >= 0) out->locations[remap[v]] = v < T->nvert ? T->loc[v] : T->nloc[v - T->nvert];
+    for (i = 0; i < 3 * T->ocount; ++i) T->otri[i] = remap[T->otri[i]];
+    sfb__free(ctx, remap);
+    out->triangles = T->otri;
+    out->triangle_faces = T->oface;
+    T->otri = T->oface = NULL;
+    return SFB_SUCCESS;
+}
+
 SFB_API sfb_result sfb_surface_tessellate(const sfb_surface *s, const sfb_tess_config *cfg, sfb_tess_data *out) {
     sfb_context *ctx;
     sfb__tess T;
     const sfb__level *l;
     sfb_result r = SFB_SUCCESS;
     int pf, f, e, i, k, nptex;
-    size_t v, done_v;
+    size_t v, done_v, nv;
     float p_emit, p_eval;
     if (out) memset(out, 0, sizeof *out);
     if (!s) return SFB_INVALID_ARGS;
@@ -4851,6 +5986,23 @@ SFB_API sfb_result sfb_surface_tessellate(const sfb_surface *s, const sfb_tess_c
                           (double)cfg->tolerance);
     if (cfg->flags & ~(unsigned)SFB_TESS_SPLIT_CREASES)
         return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "unknown tessellation flags 0x%x", cfg->flags);
+    if (cfg->trim) {
+        const sfb_trim_mask *m = cfg->trim;
+        if (!m->texels) return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, -1, "trimming mask: texels is NULL");
+        if (m->width < 1 || m->width > SFB__TRIM_MAX_SIZE || m->height < 1 || m->height > SFB__TRIM_MAX_SIZE)
+            return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, -1, "trimming mask: %d x %d texels, each side must be 1..%d",
+                              m->width, m->height, SFB__TRIM_MAX_SIZE);
+        if (m->tiles_u < 0 || m->tiles_v < 0)
+            return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, -1, "trimming mask: negative atlas tiles %d x %d", m->tiles_u,
+                              m->tiles_v);
+        if ((m->tiles_u == 0) != (m->tiles_v == 0))
+            return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, -1,
+                              "trimming mask: atlas tiles %d x %d (0 x 0 or both >= 1: one zero and not the other)", m->tiles_u, m->tiles_v);
+        if (m->tiles_u > 0 && (m->width % m->tiles_u != 0 || m->height % m->tiles_v != 0))
+            return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, -1,
+                              "trimming mask: %d x %d texels do not split into %d x %d equal tiles", m->width, m->height, m->tiles_u,
+                              m->tiles_v);
+    }
     if ((r = sfb__progress(ctx, 0.0f, "tessellate")) != SFB_SUCCESS) return r;
 
     memset(&T, 0, sizeof T);
@@ -4898,6 +6050,11 @@ SFB_API sfb_result sfb_surface_tessellate(const sfb_surface *s, const sfb_tess_c
         p_emit = 0.5f;
     }
     p_eval = p_emit + 0.1f;
+    if (cfg->trim) {
+        T.trim = cfg->trim;
+        r = sfb__trim_rates(&T, p_emit);
+        if (r != SFB_SUCCESS) goto fail;
+    }
 
     /* 2. segments of each base edge and spoke: the largest rate of the faces on it (an n-gon
      * sub-face covers half an edge, so it asks for twice its rate, and the count stays even) */
@@ -4956,6 +6113,11 @@ SFB_API sfb_result sfb_surface_tessellate(const sfb_surface *s, const sfb_tess_c
         }
     }
     out->ctx_ = ctx;
+    if (T.trim) {
+        r = sfb__trim_emit(&T, out, p_emit, p_eval);
+        if (r != SFB_SUCCESS) goto fail;
+        goto evaluate;
+    }
     out->vertex_count = (int)T.nvert;
     out->triangle_count = (int)T.ntri;
     out->positions = (float *)sfb__tess_array(ctx, T.nvert, 3 * sizeof(float));
@@ -4992,13 +6154,15 @@ SFB_API sfb_result sfb_surface_tessellate(const sfb_surface *s, const sfb_tess_c
             r = sfb__error(ctx, SFB_BACKEND_ERROR, SFB_ELEMENT_NONE, -1, "tessellation vertex %zu has no location", v);
             goto fail;
         }
+evaluate:
     sfb__tess_free_work(&T);
 
     /* 6. evaluate every vertex once, in chunks, on the context's backend */
-    for (done_v = 0; done_v < T.nvert; done_v += SFB__TESS_EVAL_CHUNK) {
-        size_t n = T.nvert - done_v < SFB__TESS_EVAL_CHUNK ? T.nvert - done_v : SFB__TESS_EVAL_CHUNK;
+    nv = (size_t)out->vertex_count;
+    for (done_v = 0; done_v < nv; done_v += SFB__TESS_EVAL_CHUNK) {
+        size_t n = nv - done_v < SFB__TESS_EVAL_CHUNK ? nv - done_v : SFB__TESS_EVAL_CHUNK;
         sfb_eval_output eo;
-        r = sfb__progress(ctx, p_eval + (1.0f - p_eval) * (float)done_v / (float)T.nvert, "tessellate");
+        r = sfb__progress(ctx, p_eval + (1.0f - p_eval) * (float)done_v / (float)nv, "tessellate");
         if (r != SFB_SUCCESS) goto fail;
         memset(&eo, 0, sizeof eo);
         eo.position = out->positions + 3 * done_v;
@@ -6096,14 +7260,21 @@ SFB_API sfb_result sfb_surface_create(sfb_context *ctx, const sfb_mesh *mesh, co
     if (!ctx) return SFB_INVALID_ARGS;
     if (!mesh || !cfg || !out) return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "sfb_surface_create: NULL argument");
     *out = NULL;
-    if (cfg->scheme != SFB_SCHEME_CATMARK && cfg->scheme != SFB_SCHEME_LOOP && cfg->scheme != SFB_SCHEME_BILINEAR)
+    if (cfg->scheme == SFB_SCHEME_MANIFOLD_BLEND) {
+        /* a blending surface is evaluated (sfb_surface_eval / _tessellate), not refined */
+        if (!(cfg->flags & SFB_REFINE_PATCHES) || cfg->refine_level != 0 || (cfg->flags & (SFB_REFINE_LIMIT | SFB_REFINE_SHADING)))
+            return sfb__error(ctx, SFB_UNSUPPORTED, SFB_ELEMENT_NONE, -1,
+                              "scheme 'manifold' is evaluated, not refined: use refine level 0 with SFB_REFINE_PATCHES (and neither "
+                              "SFB_REFINE_LIMIT nor SFB_REFINE_SHADING), then sfb_surface_eval or sfb_surface_tessellate");
+    } else if (cfg->scheme != SFB_SCHEME_CATMARK && cfg->scheme != SFB_SCHEME_LOOP && cfg->scheme != SFB_SCHEME_BILINEAR)
         return sfb__error(ctx, SFB_UNSUPPORTED, SFB_ELEMENT_NONE, -1, "scheme '%s' cannot be refined uniformly yet", sfb_scheme_name(cfg->scheme));
     if (cfg->refine_level < 0) return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "refinement level %d is negative", cfg->refine_level);
     if (cfg->refine_level > SFB_MAX_LEVEL)
         return sfb__error(ctx, SFB_LIMIT_EXCEEDED, SFB_ELEMENT_NONE, -1, "refinement level %d is over the limit of %d (SFB_MAX_LEVEL)",
                           cfg->refine_level, SFB_MAX_LEVEL);
-    if ((cfg->flags & SFB_REFINE_PATCHES) && cfg->scheme != SFB_SCHEME_CATMARK && cfg->scheme != SFB_SCHEME_LOOP)
-        return sfb__error(ctx, SFB_UNSUPPORTED, SFB_ELEMENT_NONE, -1, "limit evaluation (SFB_REFINE_PATCHES) is built for Catmull-Clark and Loop; scheme '%s' is not supported",
+    if ((cfg->flags & SFB_REFINE_PATCHES) && cfg->scheme != SFB_SCHEME_CATMARK && cfg->scheme != SFB_SCHEME_LOOP &&
+        cfg->scheme != SFB_SCHEME_MANIFOLD_BLEND)
+        return sfb__error(ctx, SFB_UNSUPPORTED, SFB_ELEMENT_NONE, -1, "evaluation (SFB_REFINE_PATCHES) is built for Catmull-Clark, Loop and manifold; scheme '%s' is not supported",
                           sfb_scheme_name(cfg->scheme));
     if ((cfg->flags & SFB_REFINE_SHADING) && cfg->scheme != SFB_SCHEME_CATMARK && cfg->scheme != SFB_SCHEME_LOOP)
         return sfb__error(ctx, SFB_UNSUPPORTED, SFB_ELEMENT_NONE, -1, "subdivision shading (SFB_REFINE_SHADING) is built for Catmull-Clark and Loop; scheme '%s' is not supported",
@@ -6139,7 +7310,7 @@ SFB_API sfb_result sfb_surface_create(sfb_context *ctx, const sfb_mesh *mesh, co
                            mesh->boundary == SFB_BOUNDARY_NONE && cfg->scheme != SFB_SCHEME_BILINEAR, &prep);
     if (r != SFB_SUCCESS) { sfb_surface_destroy(s); return r; }
     memset(&opt, 0, sizeof opt);
-    opt.scheme = cfg->scheme;
+    opt.scheme = cfg->scheme == SFB_SCHEME_MANIFOLD_BLEND ? SFB_SCHEME_CATMARK : cfg->scheme; /* manifold: level 0, the identity */
     opt.crease_method = mesh->crease_method;
     opt.triangle_rule = mesh->triangle_rule;
     opt.want_limit = (cfg->flags & SFB_REFINE_LIMIT) != 0;
@@ -6147,7 +7318,10 @@ SFB_API sfb_result sfb_surface_create(sfb_context *ctx, const sfb_mesh *mesh, co
                     opt.want_limit ? &s->tables[SFB_TABLE_LIMIT] : NULL, 0.0f, 0.8f);
     if (r == SFB_SUCCESS && (cfg->flags & SFB_REFINE_SHADING))
         r = sfb__shading_build(ctx, &prep, &opt, cfg->refine_level, &cfg->shading, &s->shading);
-    if (r == SFB_SUCCESS && (cfg->flags & SFB_REFINE_PATCHES)) {
+    if (r == SFB_SUCCESS && (cfg->flags & SFB_REFINE_PATCHES) && cfg->scheme == SFB_SCHEME_MANIFOLD_BLEND) {
+        r = sfb__manifold_build(ctx, &prep, cfg->manifold.weights, s->base_positions, &s->patches);
+        if (r == SFB_SUCCESS) { s->has_patches = 1; s->pbase = prep; memset(&prep, 0, sizeof prep); }
+    } else if (r == SFB_SUCCESS && (cfg->flags & SFB_REFINE_PATCHES)) {
         r = sfb__patches_build(ctx, &prep, &opt, cfg->isolation_level ? cfg->isolation_level : SFB_DEFAULT_ISOLATION,
                                 s->base_positions, &s->patches);
         if (r == SFB_SUCCESS) { s->has_patches = 1; s->pbase = prep; memset(&prep, 0, sizeof prep); }
@@ -6257,10 +7431,11 @@ SFB_API sfb_result sfb_surface_patch_info(const sfb_surface *s, sfb_patch_info *
     o->bezier = pt->counts[SFB__PATCH_BEZTRI];
     o->stam = pt->counts[SFB__PATCH_STAM] + pt->counts[SFB__PATCH_STAM_LOOP];
     o->end_caps = pt->counts[SFB__PATCH_ENDCAP] + pt->counts[SFB__PATCH_ENDCAP_TRI];
+    o->manifold = pt->counts[SFB__PATCH_MANIFOLD4];
     o->max_depth = pt->max_depth;
     o->points = pt->npoints;
     o->bytes = (size_t)pt->npatch * (4 * sizeof(int)) + (size_t)pt->ncv * sizeof(int) + (size_t)pt->nptex * 3 * sizeof(int) +
-               (size_t)pt->nnodes * 4 * sizeof(int) + (size_t)pt->npoints * 3 * sizeof(float);
+               (size_t)pt->nnodes * 4 * sizeof(int) + (size_t)pt->npoints * 3 * sizeof(float) + (pt->pcorner ? (size_t)pt->npatch * 4 * sizeof(unsigned) : 0);
     return SFB_SUCCESS;
 }
 
@@ -6500,12 +7675,37 @@ SFB_API void sfb_mesh_data_desc(const sfb_mesh_data *m, sfb_mesh_desc *d) {
  * normals averaged per region (CPU: one pass over the coarse level's faces), the N_S rows, the
  * limit rows, and the backend's finish_normals kernel.
  *
+ * Averaging (sfb_shading_options.averaging): LINEAR, the default, is the above: N_S is one
+ * composed table run by the backend. RENORMALIZED and SPHERICAL compute N_S one level at a
+ * time instead, because a normalisation (or a spherical mean) between the levels is not linear
+ * and cannot be folded into one table: the build keeps one region table per step instead of
+ * the composed one (the same region masks the composed table is made of, each over the level
+ * below alone; the last step's rows are the output rows, in the composed table's order) and
+ * sfb_surface_shade runs them in the core, on the CPU in double, for every backend - each new
+ * normal is normalize(sum w_i n_i) (RENORMALIZED) or the weighted spherical mean of the n_i
+ * (SPHERICAL: see sfb__shade_spherical_mean). The limit tables and finish_normals still run on
+ * the backend. Only the last step is restricted to the rows needed (b > 0, or all with
+ * SFB_SHADE_ALL_SUBDIVIDED); the earlier levels are computed in full: the rows of level L-1 a
+ * restricted last step reads are the support of its rows (and of the levels below, theirs),
+ * different for the two row sets, so restricting would take per-level marks kept at build time
+ * for each, while a level has about a quarter of the next one's vertices (Catmull-Clark and
+ * Loop quadruple the faces per step): all earlier steps together cost about a third of the last
+ * one, and near the extraordinary vertices, where b > 0, most of their rows are in that support
+ * anyway. When the normals level is the last level there is no step: the output rows are the
+ * face-weighted region means (the composed table) in every mode. Cost: on catmark_car at
+ * level 3 on ref, sfb_surface_shade takes about as long with RENORMALIZED as with LINEAR and
+ * about 6-8x as long with SPHERICAL (a few iterations per row, an atan2 per entry and
+ * iteration where the angle is not small).
+ *
  * Choices where the seed is silent (each tested in tests/shade.c):
- *   - Linear averaging, normalised once at the end (in finish_normals) rather than after every
- *     level. Renormalising a linear average only rescales it, so the direction differs from a
- *     per-level renormalisation by the small change of the stencil weights this rescaling
- *     makes; in exchange N_S is one linear map of the normals-level normals, which is what
- *     lets it compile to one stencil table.
+ *   - Linear averaging by default (the seed's choice, §2.3), normalised once at the end (in
+ *     finish_normals) rather than after every level. Renormalising a linear average only
+ *     rescales it, so the direction differs from a per-level renormalisation by the small
+ *     change of the stencil weights this rescaling makes; in exchange N_S is one linear map of
+ *     the normals-level normals, which is what lets it compile to one stencil table run on the
+ *     backend. Per-level renormalised and spherical averaging (the original subdivision
+ *     shading's) are options, computed in the core (above): they differ from linear by small
+ *     angles (tests/shade.c measures them) and cost a CPU pass per level.
  *   - A region is a maximal fan of a vertex's faces not separated by a sharp edge (sharpness
  *     > 0 at that level; boundary edges are sharp). A vertex with fewer than two sharp edges, or
  *     a non-manifold one, has one region.
@@ -6610,6 +7810,10 @@ void sfb__shading_free(sfb_context *ctx, sfb__shading *sh) {
     sfb__free(ctx, sh->ns_idx_w); sfb__free(ctx, sh->ns_idx_all);
     sfb__stencils_free(ctx, &sh->ns);
     for (t = 0; t < 3; ++t) sfb__stencils_free(ctx, &sh->lim[t]);
+    if (sh->steps) {
+        for (t = 0; t < sh->nsteps; ++t) sfb__stencils_free(ctx, &sh->steps[t]);
+        sfb__free(ctx, sh->steps);
+    }
     sfb__free(ctx, sh);
 }
 
@@ -6758,7 +7962,7 @@ sfb_result sfb__shading_build(sfb_context *ctx, const sfb__level *prep, const sf
     int *order = NULL;
     sfb_result r = SFB_SUCCESS;
     int loop = opt->scheme == SFB_SCHEME_LOOP;
-    int Ln = 0, Lw = 0, k, v, i, t, maxv = 1;
+    int Ln = 0, Lw = 0, k, v, i, t, maxv = 1, per_level = 0, asz;
     const sfb__level *top;
     *out = NULL;
     memset(&prow, 0, sizeof prow); memset(&crow, 0, sizeof crow); memset(&A, 0, sizeof A);
@@ -6769,6 +7973,9 @@ sfb_result sfb__shading_build(sfb_context *ctx, const sfb__level *prep, const sf
         return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, -1, "shading variant %d is not SFB_SHADE_VARIANT_A or _B", o->variant);
     if (o->darts != SFB_SHADE_DARTS_SMOOTH && o->darts != SFB_SHADE_DARTS_SHARP)
         return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, -1, "shading darts option %d is not SFB_SHADE_DARTS_SMOOTH or _SHARP", o->darts);
+    if (o->averaging != SFB_SHADE_AVERAGE_LINEAR && o->averaging != SFB_SHADE_AVERAGE_RENORMALIZED && o->averaging != SFB_SHADE_AVERAGE_SPHERICAL)
+        return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, -1,
+                          "shading averaging %d is not SFB_SHADE_AVERAGE_LINEAR, _RENORMALIZED or _SPHERICAL", o->averaging);
     sh = (sfb__shading *)sfb__calloc(ctx, 1, sizeof *sh);
     lev = (sfb__level *)sfb__calloc(ctx, (size_t)L + 1, sizeof *lev);
     T = (sfb__stencils *)sfb__calloc(ctx, (size_t)L + 1, sizeof *T);
@@ -6776,6 +7983,8 @@ sfb_result sfb__shading_build(sfb_context *ctx, const sfb__level *prep, const sf
     parent = (int **)sfb__calloc(ctx, (size_t)L + 1, sizeof *parent);
     if (!sh || !lev || !T || !reg || !parent) { r = sfb__oom(ctx, "shading tables"); goto done; }
     sh->normals_level = Ln; sh->weights_level = Lw; sh->level = L; sh->variant = o->variant; sh->darts = o->darts;
+    sh->averaging = o->averaging;
+    per_level = o->averaging != SFB_SHADE_AVERAGE_LINEAR && L > Ln;
 
     /* the levels, one step at a time, with each step's local stencils */
     lev[0] = *prep; /* borrowed */
@@ -6809,9 +8018,12 @@ sfb_result sfb__shading_build(sfb_context *ctx, const sfb__level *prep, const sf
     sh->nsrc_of_vf = (int *)sfb__alloc(ctx, ((size_t)sh->nlev.vf_off[sh->nlev.nv] + 1) * sizeof(int));
     if (!sh->nsrc_of_vf) { r = sfb__oom(ctx, "shading tables"); goto done; }
     memcpy(sh->nsrc_of_vf, reg[Ln].of_vf, (size_t)sh->nlev.vf_off[sh->nlev.nv] * sizeof(int));
-    A.acc = (double *)sfb__alloc(ctx, ((size_t)(prep->nv > sh->nsrc ? prep->nv : sh->nsrc) + 1) * sizeof(double));
-    A.mark = (unsigned *)sfb__calloc(ctx, (size_t)(prep->nv > sh->nsrc ? prep->nv : sh->nsrc) + 1, sizeof(unsigned));
-    A.touched = (int *)sfb__alloc(ctx, ((size_t)(prep->nv > sh->nsrc ? prep->nv : sh->nsrc) + 1) * sizeof(int));
+    asz = prep->nv > sh->nsrc ? prep->nv : sh->nsrc;
+    for (k = Ln; per_level && k < L; ++k)
+        if (reg[k].total > asz) asz = reg[k].total; /* per level: rows over each level's regions */
+    A.acc = (double *)sfb__alloc(ctx, ((size_t)asz + 1) * sizeof(double));
+    A.mark = (unsigned *)sfb__calloc(ctx, (size_t)asz + 1, sizeof(unsigned));
+    A.touched = (int *)sfb__alloc(ctx, ((size_t)asz + 1) * sizeof(int));
     if (!A.acc || !A.mark || !A.touched) { r = sfb__oom(ctx, "shading tables"); goto done; }
     sh->npos_mode = Ln == 0 ? 0 : Ln == L ? 2 : 1;
     if (sh->npos_mode == 1) {
@@ -6883,7 +8095,14 @@ sfb_result sfb__shading_build(sfb_context *ctx, const sfb__level *prep, const sf
         sh->ns_idx_w[order[i]] = i < sh->nweighted ? i : -1;
     }
 
-    /* N_S: region rows composed from the normals level up to the level below the last */
+    /* N_S: region rows composed from the normals level up to the level below the last. Per
+     * level (averaging not linear): each step's rows over the regions of the level below alone
+     * (composed with an identity, which merges repeated sources), kept as a table of its own. */
+    if (per_level) {
+        sh->steps = (sfb__stencils *)sfb__calloc(ctx, (size_t)(L - Ln), sizeof *sh->steps);
+        if (!sh->steps) { r = sfb__oom(ctx, "shading tables"); goto done; }
+        sh->nsteps = L - Ln;
+    }
     if (!sfb__shade_identity(ctx, &prow, sh->nsrc)) { r = sfb__oom(ctx, "shading tables"); goto done; }
     for (k = Ln; k < L - 1; ++k) {
         const sfb__level *pl = k == Ln ? &sh->nlev : &lev[k];
@@ -6901,7 +8120,14 @@ sfb_result sfb__shading_build(sfb_context *ctx, const sfb__level *prep, const sf
                     !sfb__compose_row(ctx, &A, &prow, &m, &crow, rv)) { r = sfb__oom(ctx, "shading tables"); goto done; }
             }
         sfb__rows_free(ctx, &prow);
-        prow = crow;
+        if (per_level) {
+            r = sfb__rows_to_stencils(ctx, &crow, reg[k].total, &sh->steps[k - Ln]);
+            if (r != SFB_SUCCESS) { if (r == SFB_OUT_OF_MEMORY) r = sfb__oom(ctx, "shading tables"); goto done; }
+            sfb__rows_free(ctx, &crow);
+            if (!sfb__shade_identity(ctx, &prow, reg[k + 1].total)) { r = sfb__oom(ctx, "shading tables"); goto done; }
+        } else {
+            prow = crow;
+        }
         memset(&crow, 0, sizeof crow);
         r = sfb__progress(ctx, 0.8f, "shading");
         if (r != SFB_SUCCESS) goto done;
@@ -6936,8 +8162,20 @@ sfb_result sfb__shading_build(sfb_context *ctx, const sfb__level *prep, const sf
         }
         if (!sfb__compose_row(ctx, &A, &prow, &m, &crow, i)) { r = sfb__oom(ctx, "shading tables"); goto done; }
     }
-    r = sfb__rows_to_stencils(ctx, &crow, sh->nsrc, &sh->ns);
-    if (r != SFB_SUCCESS) { r = sfb__oom(ctx, "shading tables"); goto done; }
+    if (per_level) {
+        r = sfb__rows_to_stencils(ctx, &crow, reg[L - 1].total, &sh->steps[sh->nsteps - 1]);
+        if (r != SFB_SUCCESS) { if (r == SFB_OUT_OF_MEMORY) r = sfb__oom(ctx, "shading tables"); goto done; }
+        for (k = 0; k < sh->nsteps; ++k) {
+            const sfb__stencils *S = &sh->steps[k];
+            if (S->rows > sh->step_rows_max) sh->step_rows_max = S->rows;
+            if (S->sources > sh->step_rows_max) sh->step_rows_max = S->sources;
+            for (i = 0; i < S->rows; ++i)
+                if (S->sizes[i] > sh->step_size_max) sh->step_size_max = S->sizes[i];
+        }
+    } else {
+        r = sfb__rows_to_stencils(ctx, &crow, sh->nsrc, &sh->ns);
+        if (r != SFB_SUCCESS) { r = sfb__oom(ctx, "shading tables"); goto done; }
+    }
     sfb__rows_free(ctx, &crow);
     sfb__rows_free(ctx, &prow);
 
@@ -7015,6 +8253,7 @@ sfb_result sfb__shading_build(sfb_context *ctx, const sfb__level *prep, const sf
     }
     sh->bytes = sizeof *sh + (sh->ns.entries + sh->npos.entries + sh->lim[0].entries + sh->lim[1].entries + sh->lim[2].entries) * 8 +
                 (size_t)sh->nout * 6 * sizeof(int) + (size_t)top->nfv * sizeof(int) + (size_t)sh->nlev.nfv * 3 * sizeof(int);
+    for (k = 0; k < sh->nsteps; ++k) sh->bytes += sizeof *sh->steps + sh->steps[k].entries * 8 + (size_t)sh->steps[k].rows * 2 * sizeof(int);
 done:
     if (lev) {
         for (k = 1; k <= L; ++k) sfb__level_free(ctx, &lev[k]);
@@ -7049,12 +8288,121 @@ static sfb_result sfb__shade_apply(const sfb_surface *s, const sfb__stencils *t,
     return sfb__surface_apply(s, t, handle, rows, src, d3, dst, d3);
 }
 
+/* The weighted spherical mean of `count` vectors n (xyz, unit length expected) with weights w:
+ * the unit vector q minimising sum w_i angle(q, n_i)^2, where sum w_i log_q(n_i) = 0. Start at
+ * the normalised linear average, then q <- exp_q(sum (w_i / W) log_q(n_i)), W = sum w_i, until
+ * the step is shorter than 1e-12 or after 32 iterations, with
+ *   log_q(n) = (n - (q.n) q) theta / sin(theta), theta = angle(q, n)  (the tangent at q towards n),
+ *   exp_q(t) = cos|t| q + sin|t| t / |t|                                (walk |t| along t).
+ * A zero linear average gives zero (as linear averaging does). A zero input with a nonzero
+ * weight, a weight sum <= 0, an input within 1e-6 rad of -q (log_q undefined there) or a
+ * non-finite iterate give the normalised linear average instead. Returns the iterations taken
+ * (>= 1), 0 for the zero result, -1 where the linear average was returned. Pure: safe from any
+ * thread. */
+static int sfb__shade_spherical_mean(int count, const double *n, const double *w, double out[3]) {
+    double s[3] = {0.0, 0.0, 0.0}, q[3], W = 0.0, len;
+    int i, c, it, degenerate = 0;
+    for (i = 0; i < count; ++i) {
+        const double *v = n + 3 * (size_t)i;
+        for (c = 0; c < 3; ++c) s[c] += w[i] * v[c];
+        W += w[i];
+        if (w[i] != 0.0 && v[0] == 0.0 && v[1] == 0.0 && v[2] == 0.0) degenerate = 1;
+    }
+    out[0] = out[1] = out[2] = 0.0;
+    len = sqrt(s[0] * s[0] + s[1] * s[1] + s[2] * s[2]);
+    if (!(len > 0.0)) return 0;
+    for (c = 0; c < 3; ++c) out[c] = q[c] = s[c] / len;
+    if (degenerate || !(W > 0.0)) return -1;
+    for (it = 1;; ++it) {
+        double t[3] = {0.0, 0.0, 0.0}, tl, st;
+        for (i = 0; i < count; ++i) {
+            const double *v = n + 3 * (size_t)i;
+            double vl = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]), d, u[3], sv, theta, f;
+            if (w[i] == 0.0) continue;
+            d = (q[0] * v[0] + q[1] * v[1] + q[2] * v[2]) / vl;
+            for (c = 0; c < 3; ++c) u[c] = v[c] / vl - d * q[c];
+            sv = sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+            if (d > 0.0 && sv < 0.03) {
+                /* theta / sin(theta) = asin(s) / s = 1 + s^2/6 + 3 s^4/40 + 5 s^6/112 + O(s^8):
+                 * below s = 0.03 the rest is under 1e-14 of it (most entries: neighbouring
+                 * normals), and no atan2 is needed */
+                const double s2 = sv * sv;
+                f = 1.0 + s2 * (1.0 / 6.0 + s2 * (3.0 / 40.0 + s2 * (5.0 / 112.0)));
+            } else {
+                theta = atan2(sv, d);
+                if (theta > SFB__PI - 1e-6) return -1; /* nearly opposite q: no tangent towards it */
+                f = theta / sv;
+            }
+            for (c = 0; c < 3; ++c) t[c] += (w[i] / W) * f * u[c];
+        }
+        tl = sqrt(t[0] * t[0] + t[1] * t[1] + t[2] * t[2]);
+        if (tl < 1e-12) break;
+        st = sin(tl) / tl;
+        tl = cos(tl);
+        for (c = 0; c < 3; ++c) q[c] = tl * q[c] + st * t[c];
+        len = sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2]);
+        if (!(len > 0.5) || !(len < 2.0)) return -1; /* not finite */
+        for (c = 0; c < 3; ++c) q[c] /= len;
+        if (it == 32) break;
+    }
+    for (c = 0; c < 3; ++c) out[c] = q[c];
+    return it;
+}
+
+/* N_S one level at a time (averaging renormalised or spherical), on the CPU in double: `src`
+ * holds the normals-level region normals (nsh->nsrc xyz); each step's rows average the
+ * previous level's normals (RENORMALIZED: normalize(sum w_i n_i); SPHERICAL: the weighted
+ * spherical mean); the last step's rows [0, rows) go to ns as floats. */
+static sfb_result sfb__shade_levels(sfb_context *ctx, const sfb__shading *sh, const double *src, int rows, float *ns) {
+    size_t nrow = (size_t)sh->step_rows_max * 3 + 1, nsz = (size_t)sh->step_size_max + 1;
+    double *a = (double *)sfb__alloc(ctx, nrow * sizeof(double)), *b = (double *)sfb__alloc(ctx, nrow * sizeof(double));
+    double *vec = (double *)sfb__alloc(ctx, nsz * 3 * sizeof(double)), *w = (double *)sfb__alloc(ctx, nsz * sizeof(double));
+    const double *cur = src;
+    int k, i, j, c;
+    if (!a || !b || !vec || !w) {
+        sfb__free(ctx, a); sfb__free(ctx, b); sfb__free(ctx, vec); sfb__free(ctx, w);
+        return sfb__oom(ctx, "shading normals");
+    }
+    for (k = 0; k < sh->nsteps; ++k) {
+        const sfb__stencils *T = &sh->steps[k];
+        const int last = k == sh->nsteps - 1, n = last ? rows : T->rows;
+        double *nx = cur == a ? b : a;
+        for (i = 0; i < n; ++i) {
+            const int o = T->offsets[i], cnt = T->sizes[i];
+            double q[3];
+            if (sh->averaging == SFB_SHADE_AVERAGE_SPHERICAL) {
+                for (j = 0; j < cnt; ++j) {
+                    const double *p = cur + 3 * (size_t)T->indices[o + j];
+                    w[j] = (double)T->weights[o + j];
+                    vec[3 * j] = p[0]; vec[3 * j + 1] = p[1]; vec[3 * j + 2] = p[2];
+                }
+                sfb__shade_spherical_mean(cnt, vec, w, q);
+            } else {
+                double len;
+                q[0] = q[1] = q[2] = 0.0;
+                for (j = 0; j < cnt; ++j) {
+                    const double *p = cur + 3 * (size_t)T->indices[o + j], wj = (double)T->weights[o + j];
+                    for (c = 0; c < 3; ++c) q[c] += wj * p[c];
+                }
+                len = sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2]);
+                for (c = 0; c < 3; ++c) q[c] = len > 0.0 ? q[c] / len : 0.0;
+            }
+            if (last) for (c = 0; c < 3; ++c) ns[3 * (size_t)i + c] = (float)q[c];
+            else for (c = 0; c < 3; ++c) nx[3 * (size_t)i + c] = q[c];
+        }
+        cur = nx;
+    }
+    sfb__free(ctx, a); sfb__free(ctx, b); sfb__free(ctx, vec); sfb__free(ctx, w);
+    return SFB_SUCCESS;
+}
+
 SFB_API sfb_result sfb_surface_shade(const sfb_surface *s, const sfb_shade_params *params, sfb_mesh_data *o) {
     sfb_context *ctx;
     const sfb__shading *sh;
     const sfb__backend_vtable *be;
     sfb_shade_params prm;
     float *refined = NULL, *npos_buf = NULL, *src = NULL, *ns = NULL, *fnrm = NULL;
+    double *srcd = NULL; /* the sources in double (per-level averaging) */
     const float *npos;
     sfb_result r;
     int all, rows, v, f, i, c;
@@ -7110,9 +8458,13 @@ SFB_API sfb_result sfb_surface_shade(const sfb_surface *s, const sfb_shade_param
                 for (c = 0; c < 3; ++c) acc[3 * (size_t)sh->nsrc_of_vf[i] + c] += fnrm[3 * (size_t)sh->nlev.vf[i] + c];
         for (i = 0; i < sh->nsrc; ++i) {
             double *a = acc + 3 * (size_t)i, len = sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
-            for (c = 0; c < 3; ++c) src[3 * (size_t)i + c] = len > 0.0 ? (float)(a[c] / len) : 0.0f;
+            for (c = 0; c < 3; ++c) {
+                a[c] = len > 0.0 ? a[c] / len : 0.0;
+                src[3 * (size_t)i + c] = (float)a[c];
+            }
         }
-        sfb__free(ctx, acc);
+        if (sh->nsteps > 0) srcd = acc;
+        else sfb__free(ctx, acc);
     }
     /* output arrays */
     o->positions = (float *)sfb__alloc(ctx, (size_t)sh->nout * 3 * sizeof(float) + 1);
@@ -7127,7 +8479,7 @@ SFB_API sfb_result sfb_surface_shade(const sfb_surface *s, const sfb_shade_param
     ns = (float *)sfb__alloc(ctx, (size_t)sh->nout * 3 * sizeof(float) + 1);
     if (!o->positions || !o->limit_positions || !o->tangents_u || !o->tangents_v || !o->normals || !o->limit_normals ||
         !o->subdivided_normals || !o->blend_weights || !o->vertex_origin || !ns) goto oom;
-    if ((r = sfb__shade_apply(s, &sh->ns, sh->handles[1], rows, src, ns)) != SFB_SUCCESS ||
+    if ((r = sh->nsteps > 0 ? sfb__shade_levels(ctx, sh, srcd, rows, ns) : sfb__shade_apply(s, &sh->ns, sh->handles[1], rows, src, ns)) != SFB_SUCCESS ||
         (r = sfb__shade_apply(s, &sh->lim[0], sh->handles[2], sh->nout, refined, o->limit_positions)) != SFB_SUCCESS ||
         (r = sfb__shade_apply(s, &sh->lim[1], sh->handles[3], sh->nout, refined, o->tangents_u)) != SFB_SUCCESS ||
         (r = sfb__shade_apply(s, &sh->lim[2], sh->handles[4], sh->nout, refined, o->tangents_v)) != SFB_SUCCESS)
@@ -7150,12 +8502,12 @@ SFB_API sfb_result sfb_surface_shade(const sfb_surface *s, const sfb_shade_param
     o->refined_vertex_count = o->vertex_count;
     o->vertex_count = sh->nout;
     o->subdivided_count = rows;
-    sfb__free(ctx, refined); sfb__free(ctx, npos_buf); sfb__free(ctx, src); sfb__free(ctx, ns); sfb__free(ctx, fnrm);
+    sfb__free(ctx, refined); sfb__free(ctx, npos_buf); sfb__free(ctx, src); sfb__free(ctx, ns); sfb__free(ctx, fnrm); sfb__free(ctx, srcd);
     return SFB_SUCCESS;
 oom:
     r = sfb__oom(ctx, "shading output");
 fail:
-    sfb__free(ctx, refined); sfb__free(ctx, npos_buf); sfb__free(ctx, src); sfb__free(ctx, ns); sfb__free(ctx, fnrm);
+    sfb__free(ctx, refined); sfb__free(ctx, npos_buf); sfb__free(ctx, src); sfb__free(ctx, ns); sfb__free(ctx, fnrm); sfb__free(ctx, srcd);
     sfb_mesh_data_free(o);
     return r;
 }

@@ -13,8 +13,16 @@
  *  - the host's context (sfb_context_config.gl_use_current_context): the engine case. The
  *    host's EGL or GLX context must be current on the calling thread for every call, from
  *    sfb_context_create to sfb_context_destroy. What a call binds (program, generic and
- *    indexed SSBO bindings 0..5) is saved first and restored after, and
- *    sfb_surface_eval_stencils_gl writes straight into the host's buffer objects.
+ *    indexed SSBO bindings 0..5; for manifold tables also texture units 0..2 with their
+ *    samplers, the active unit and the pixel unpack state) is saved first and restored after,
+ *    and sfb_surface_eval_stencils_gl writes straight into the host's buffer objects. Here
+ *    alone sfb_surface_draw_gl draws manifold blending surfaces (seed 000's vertex and
+ *    fragment programs) into the host's framebuffer.
+ *
+ * Patch tables: Catmull-Clark and Loop tables as storage buffers in pieces (patches.comp.glsl);
+ * MANIFOLD4 tables (seed 000) as two textures, the seed's Fig. 8 coefficient texture and an
+ * integer one of face and patch records, read by manifold.comp.glsl's compute stage
+ * (sfb_surface_eval) and its vertex stage (the draw path) alike.
  *
  * GL, EGL (and, in sfb_osmesa.h, OSMesa) are loaded at run time with dlopen, reusing a
  * library the process already loaded; nothing links -lGL or -lEGL. Types and constants are
@@ -39,6 +47,12 @@
 #endif
 #ifndef SFB__GL_NORMALS_SOURCE
 #define SFB__GL_NORMALS_SOURCE sfb__glsl_normals_comp_glsl
+#endif
+#ifndef SFB__GL_MANIFOLD_SOURCE
+#define SFB__GL_MANIFOLD_SOURCE sfb__glsl_manifold_comp_glsl
+#endif
+#ifndef SFB__GL_MANIFOLD_FRAG_SOURCE
+#define SFB__GL_MANIFOLD_FRAG_SOURCE sfb__glsl_manifold_draw_frag_glsl
 #endif
 #ifndef SFB__EGL_LIBRARY_NAMES
 #define SFB__EGL_LIBRARY_NAMES {"libEGL.so.1", "libEGL.so", NULL}
@@ -76,7 +90,24 @@ enum {
     SFB__GL_SHADER_STORAGE_BUFFER_START = 0x90D4, SFB__GL_SHADER_STORAGE_BUFFER_SIZE = 0x90D5,
     SFB__GL_MAX_SHADER_STORAGE_BLOCK_SIZE = 0x90DE, SFB__GL_MAX_COMPUTE_WORK_GROUP_COUNT = 0x91BE,
     SFB__GL_STATIC_DRAW = 0x88E4, SFB__GL_STREAM_DRAW = 0x88E0, SFB__GL_DYNAMIC_READ = 0x88E9,
-    SFB__GL_MAP_READ_BIT = 0x0001, SFB__GL_BUFFER_SIZE = 0x8764
+    SFB__GL_MAP_READ_BIT = 0x0001, SFB__GL_BUFFER_SIZE = 0x8764,
+    /* the manifold tables' textures and the draw path (sfb_surface_draw_gl) */
+    SFB__GL_VERTEX_SHADER = 0x8B31, SFB__GL_FRAGMENT_SHADER = 0x8B30,
+    SFB__GL_TEXTURE_2D = 0x0DE1, SFB__GL_TEXTURE0 = 0x84C0, SFB__GL_ACTIVE_TEXTURE = 0x84E0,
+    SFB__GL_TEXTURE_BINDING_2D = 0x8069, SFB__GL_SAMPLER_BINDING = 0x8919, SFB__GL_MAX_TEXTURE_SIZE = 0x0D33,
+    SFB__GL_TEXTURE_MIN_FILTER = 0x2801, SFB__GL_TEXTURE_MAG_FILTER = 0x2800, SFB__GL_NEAREST = 0x2600,
+    SFB__GL_TEXTURE_WRAP_S = 0x2802, SFB__GL_TEXTURE_WRAP_T = 0x2803, SFB__GL_CLAMP_TO_EDGE = 0x812F,
+    SFB__GL_TEXTURE_BASE_LEVEL = 0x813C, SFB__GL_TEXTURE_MAX_LEVEL = 0x813D,
+    SFB__GL_TEXTURE_WIDTH = 0x1000, SFB__GL_TEXTURE_HEIGHT = 0x1001,
+    SFB__GL_RGBA32F = 0x8814, SFB__GL_RGBA32I = 0x8D82, SFB__GL_RGBA_INTEGER = 0x8D99, SFB__GL_R8 = 0x8229, SFB__GL_RED = 0x1903,
+    SFB__GL_FLOAT = 0x1406, SFB__GL_INT = 0x1404, SFB__GL_UNSIGNED_INT = 0x1405,
+    SFB__GL_UNPACK_ALIGNMENT = 0x0CF5, SFB__GL_UNPACK_ROW_LENGTH = 0x0CF2, SFB__GL_UNPACK_SKIP_ROWS = 0x0CF3,
+    SFB__GL_UNPACK_SKIP_PIXELS = 0x0CF4, SFB__GL_PIXEL_UNPACK_BUFFER = 0x88EC, SFB__GL_PIXEL_UNPACK_BUFFER_BINDING = 0x88EF,
+    SFB__GL_ELEMENT_ARRAY_BUFFER = 0x8893, SFB__GL_VERTEX_ARRAY_BINDING = 0x85B5,
+    SFB__GL_POINTS = 0x0000, SFB__GL_TRIANGLES = 0x0004,
+    SFB__GL_TRANSFORM_FEEDBACK = 0x8E22, SFB__GL_TRANSFORM_FEEDBACK_BINDING = 0x8E25,
+    SFB__GL_TRANSFORM_FEEDBACK_BUFFER = 0x8C8E, SFB__GL_TRANSFORM_FEEDBACK_BUFFER_BINDING = 0x8C8F,
+    SFB__GL_INTERLEAVED_ATTRIBS = 0x8C8C, SFB__GL_RASTERIZER_DISCARD = 0x8C89
 };
 #define SFB__GL_ALL_BARRIER_BITS 0xFFFFFFFFu
 #define SFB__GL_BUFFER_UPDATE_BARRIER_BIT 0x00000200u
@@ -117,7 +148,40 @@ enum {
     X(sfb__GLboolean, UnmapBuffer, (sfb__GLenum))                                                     \
     X(void, DispatchCompute, (sfb__GLuint, sfb__GLuint, sfb__GLuint))                                 \
     X(void, MemoryBarrier, (sfb__GLbitfield))                                                         \
-    X(void, Finish, (void))
+    X(void, Finish, (void))                                                                           \
+    X(void, GenTextures, (sfb__GLsizei, sfb__GLuint *))                                               \
+    X(void, DeleteTextures, (sfb__GLsizei, const sfb__GLuint *))                                      \
+    X(void, BindTexture, (sfb__GLenum, sfb__GLuint))                                                  \
+    X(void, ActiveTexture, (sfb__GLenum))                                                             \
+    X(sfb__GLboolean, IsTexture, (sfb__GLuint))                                                       \
+    X(void, TexParameteri, (sfb__GLenum, sfb__GLenum, sfb__GLint))                                    \
+    X(void, TexImage2D, (sfb__GLenum, sfb__GLint, sfb__GLint, sfb__GLsizei, sfb__GLsizei, sfb__GLint, sfb__GLenum, sfb__GLenum, const void *)) \
+    X(void, GetTexLevelParameteriv, (sfb__GLenum, sfb__GLint, sfb__GLenum, sfb__GLint *))             \
+    X(void, PixelStorei, (sfb__GLenum, sfb__GLint))                                                   \
+    X(void, GenSamplers, (sfb__GLsizei, sfb__GLuint *))                                               \
+    X(void, DeleteSamplers, (sfb__GLsizei, const sfb__GLuint *))                                      \
+    X(void, BindSampler, (sfb__GLuint, sfb__GLuint))                                                  \
+    X(void, SamplerParameteri, (sfb__GLuint, sfb__GLenum, sfb__GLint))                                \
+    X(sfb__GLboolean, IsBuffer, (sfb__GLuint))                                                        \
+    X(sfb__GLboolean, IsEnabled, (sfb__GLenum))                                                       \
+    X(void, Enable, (sfb__GLenum))                                                                    \
+    X(void, Disable, (sfb__GLenum))                                                                   \
+    X(void, GenVertexArrays, (sfb__GLsizei, sfb__GLuint *))                                           \
+    X(void, DeleteVertexArrays, (sfb__GLsizei, const sfb__GLuint *))                                  \
+    X(void, BindVertexArray, (sfb__GLuint))                                                           \
+    X(void, DrawElementsInstanced, (sfb__GLenum, sfb__GLsizei, sfb__GLenum, const void *, sfb__GLsizei)) \
+    X(void, DrawArraysInstanced, (sfb__GLenum, sfb__GLint, sfb__GLsizei, sfb__GLsizei))               \
+    X(void, TransformFeedbackVaryings, (sfb__GLuint, sfb__GLsizei, const sfb__GLchar *const *, sfb__GLenum)) \
+    X(void, GenTransformFeedbacks, (sfb__GLsizei, sfb__GLuint *))                                     \
+    X(void, DeleteTransformFeedbacks, (sfb__GLsizei, const sfb__GLuint *))                            \
+    X(void, BindTransformFeedback, (sfb__GLenum, sfb__GLuint))                                        \
+    X(void, BeginTransformFeedback, (sfb__GLenum))                                                    \
+    X(void, EndTransformFeedback, (void))                                                             \
+    X(void, Uniform2i, (sfb__GLint, sfb__GLint, sfb__GLint))                                          \
+    X(void, Uniform3f, (sfb__GLint, float, float, float))                                             \
+    X(void, Uniform4f, (sfb__GLint, float, float, float, float))                                      \
+    X(void, UniformMatrix3fv, (sfb__GLint, sfb__GLsizei, sfb__GLboolean, const float *))              \
+    X(void, UniformMatrix4fv, (sfb__GLint, sfb__GLsizei, sfb__GLboolean, const float *))
 
 typedef struct sfb__glfns {
 #define SFB__GL_MEMBER(ret, name, args) ret(SFB__GLAPI *name) args;
@@ -309,6 +373,16 @@ typedef struct sfb__gl {
     sfb__GLint normals_loc[8];
     sfb__GLuint normals_buf[5];     /* finish_normals inputs: tu, tv, ns, ns_index, b */
     size_t normals_cap[5];
+    sfb__GLint max_texture;         /* GL_MAX_TEXTURE_SIZE */
+    sfb__GLuint mf_program;         /* manifold.comp.glsl's compute stage, compiled on first use */
+    sfb__GLint mf_loc[10];
+    sfb__GLuint sampler;            /* nearest, clamped: the tables' textures and the trimming mask */
+    /* the draw path (sfb_surface_draw_gl, host's context): manifold.comp.glsl's vertex stage with
+     * manifold_draw.frag.glsl, the index buffer of one face's sample grid, a transform feedback
+     * object for the capture; made on first use */
+    sfb__GLuint draw_program, draw_vao, draw_ibo, draw_tfo;
+    sfb__GLint draw_loc[16];
+    int draw_rate;                  /* the grid draw_ibo holds */
     char desc[320];
 } sfb__gl;
 
@@ -481,22 +555,27 @@ static void sfb__gl_trim(char *log) {
 }
 
 /* ---- shaders ---- */
-/* Compiles and links one compute kernel: the version header for this context, `defines`,
- * then `source`. `label` names it in errors, which carry the driver's log. */
-static sfb_result sfb__gl_compile(sfb__gl *g, const char *defines, const char *source, const char *label, sfb__GLuint *out) {
+/* Compiles one shader of `type`: the version header for this context, `defines`, then
+ * `source`. `label` names it in errors, which carry the driver's log. */
+static sfb_result sfb__gl_shader(sfb__gl *g, sfb__GLenum type, const char *defines, const char *source, const char *label,
+                                 sfb__GLuint *out) {
     char header[160];
     const sfb__GLchar *parts[2];
-    sfb__GLuint sh, prog;
+    sfb__GLuint sh;
     sfb__GLint ok = 0, len = 0;
+    const char *what = type == SFB__GL_COMPUTE_SHADER ? "GL_COMPUTE_SHADER" : type == SFB__GL_VERTEX_SHADER ? "GL_VERTEX_SHADER" : "GL_FRAGMENT_SHADER";
     *out = 0;
     snprintf(header, sizeof header, "%s%s",
              g->es ? "#version 310 es\nprecision highp float;\nprecision highp int;\n" : "#version 430 core\n", defines);
     parts[0] = header;
     parts[1] = source;
-    sh = g->gl.CreateShader(SFB__GL_COMPUTE_SHADER);
+    sh = g->gl.CreateShader(type);
     if (!sh) {
-        sfb_result r = sfb__gl_check(g, "glCreateShader(GL_COMPUTE_SHADER)");
-        return r != SFB_SUCCESS ? r : sfb__error(g->ctx, SFB_BACKEND_ERROR, SFB_ELEMENT_NONE, -1, "gl: glCreateShader(GL_COMPUTE_SHADER) returned 0");
+        char op[64];
+        sfb_result r;
+        snprintf(op, sizeof op, "glCreateShader(%s)", what);
+        r = sfb__gl_check(g, op);
+        return r != SFB_SUCCESS ? r : sfb__error(g->ctx, SFB_BACKEND_ERROR, SFB_ELEMENT_NONE, -1, "gl: glCreateShader(%s) returned 0", what);
     }
     g->gl.ShaderSource(sh, 2, parts, NULL);
     g->gl.CompileShader(sh);
@@ -509,10 +588,22 @@ static sfb_result sfb__gl_compile(sfb__gl *g, const char *defines, const char *s
         g->gl.DeleteShader(sh);
         return sfb__error(g->ctx, SFB_BACKEND_ERROR, SFB_ELEMENT_NONE, -1, "gl: %s failed to compile: %s", label, log);
     }
-    prog = g->gl.CreateProgram();
-    g->gl.AttachShader(prog, sh);
+    *out = sh;
+    return SFB_SUCCESS;
+}
+
+/* Links the shaders (deleted here, linked or not) into a program; `varyings` (NULL: none) are
+ * captured interleaved by transform feedback. */
+static sfb_result sfb__gl_link(sfb__gl *g, const sfb__GLuint *shaders, int count, const char *const *varyings, int nvaryings,
+                               const char *label, sfb__GLuint *out) {
+    sfb__GLuint prog = g->gl.CreateProgram();
+    sfb__GLint ok = 0, len = 0;
+    int i;
+    *out = 0;
+    for (i = 0; i < count; ++i) g->gl.AttachShader(prog, shaders[i]);
+    if (varyings) g->gl.TransformFeedbackVaryings(prog, nvaryings, varyings, SFB__GL_INTERLEAVED_ATTRIBS);
     g->gl.LinkProgram(prog);
-    g->gl.DeleteShader(sh);
+    for (i = 0; i < count; ++i) g->gl.DeleteShader(shaders[i]);
     g->gl.GetProgramiv(prog, SFB__GL_LINK_STATUS, &ok);
     if (!ok) {
         char log[768];
@@ -524,6 +615,15 @@ static sfb_result sfb__gl_compile(sfb__gl *g, const char *defines, const char *s
     }
     *out = prog;
     return SFB_SUCCESS;
+}
+
+/* Compiles and links one compute kernel (see sfb__gl_shader). */
+static sfb_result sfb__gl_compile(sfb__gl *g, const char *defines, const char *source, const char *label, sfb__GLuint *out) {
+    sfb__GLuint sh;
+    sfb_result r = sfb__gl_shader(g, SFB__GL_COMPUTE_SHADER, defines, source, label, &sh);
+    *out = 0;
+    if (r != SFB_SUCCESS) return r;
+    return sfb__gl_link(g, &sh, 1, NULL, 0, label, out);
 }
 
 static sfb_result sfb__gl_program(sfb__gl *g, int length, sfb__GLuint *out) {
@@ -579,6 +679,8 @@ static sfb_result sfb__gl_setup(sfb__gl *g, sfb__glproc (*getproc)(const char *)
     }
     g->gl.GetIntegerv(SFB__GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &g->max_block);
     g->gl.GetIntegeri_v(SFB__GL_MAX_COMPUTE_WORK_GROUP_COUNT, 0, &g->max_groups);
+    g->gl.GetIntegerv(SFB__GL_MAX_TEXTURE_SIZE, &g->max_texture);
+    if (g->max_texture < 2048) g->max_texture = 2048; /* the minimum GLES 3 guarantees */
     if (g->max_block < (1 << 16)) g->max_block = 1 << 16;     /* the minimum GL guarantees is 2^27 */
     if (g->max_groups < 1) g->max_groups = 65535;
 #ifdef SFB__GL_TEST_MAX_BLOCK /* tests/gl_pieces.c: small limits force tables into pieces */
@@ -616,6 +718,14 @@ static void sfb__gl_release_gl(sfb__gl *g) {
     memset(g->normals_cap, 0, sizeof g->normals_cap);
     if (g->scratch_src) g->gl.DeleteBuffers(1, &g->scratch_src);
     if (g->scratch_dst) g->gl.DeleteBuffers(1, &g->scratch_dst);
+    if (g->mf_program) g->gl.DeleteProgram(g->mf_program);
+    if (g->sampler) g->gl.DeleteSamplers(1, &g->sampler);
+    if (g->draw_program) g->gl.DeleteProgram(g->draw_program);
+    if (g->draw_vao) g->gl.DeleteVertexArrays(1, &g->draw_vao);
+    if (g->draw_ibo) g->gl.DeleteBuffers(1, &g->draw_ibo);
+    if (g->draw_tfo) g->gl.DeleteTransformFeedbacks(1, &g->draw_tfo);
+    g->mf_program = g->sampler = g->draw_program = g->draw_vao = g->draw_ibo = g->draw_tfo = 0;
+    g->draw_rate = 0;
     memset(g->program, 0, sizeof g->program);
     g->scratch_src = g->scratch_dst = 0;
 }
@@ -1095,6 +1205,11 @@ typedef struct sfb__gl_ppiece {
 typedef struct sfb__gl_ptable {
     int count;
     sfb__gl_ppiece *pieces;
+    /* a MANIFOLD4 table (no pieces): its two textures (manifold.comp.glsl), their row width,
+     * and the first patch texel of the integer one */
+    int manifold;
+    sfb__GLuint mf_tex[2];
+    int mf_width, mf_patch_base;
 } sfb__gl_ptable;
 
 /* A location as the patch kernel reads it (std430 struct SfbQuery). */
@@ -1168,6 +1283,8 @@ static void sfb__gl_eigl_pack(const sfb__eigen_loop *e, float *o) {
 static void sfb__gl_ptable_free(sfb__gl *g, sfb__gl_ptable *t) {
     int i;
     if (!t) return;
+    for (i = 0; i < 2; ++i)
+        if (t->mf_tex[i]) g->gl.DeleteTextures(1, &t->mf_tex[i]);
     for (i = 0; i < t->count; ++i) g->gl.DeleteBuffers(4, t->pieces[i].buf);
     sfb__free(g->ctx, t->pieces);
     sfb__free(g->ctx, t);
@@ -1326,6 +1443,8 @@ done:
     return SFB_SUCCESS;
 }
 
+static sfb_result sfb__gl_mf_upload_current(sfb__gl *g, const sfb__patch_table *pt, sfb__gl_ptable **out);
+
 static sfb_result sfb__gl_upload_patches(void *state, const sfb__patch_table *pt, void **handle) {
     sfb__gl *g = (sfb__gl *)state;
     sfb__gl_saved s;
@@ -1333,7 +1452,8 @@ static sfb_result sfb__gl_upload_patches(void *state, const sfb__patch_table *pt
     sfb_result r;
     *handle = NULL;
     if ((r = sfb__gl_enter(g, &s)) != SFB_SUCCESS) return r;
-    r = sfb__gl_patches_upload_current(g, pt, &tab);
+    if (pt->scheme == SFB_SCHEME_MANIFOLD_BLEND) r = sfb__gl_mf_upload_current(g, pt, &tab);
+    else r = sfb__gl_patches_upload_current(g, pt, &tab);
     sfb__gl_leave(g, &s);
     *handle = tab;
     return r;
@@ -1379,6 +1499,346 @@ static int sfb__gl_piece_of(const sfb__gl_ptable *tab, int patch) {
     return lo;
 }
 
+/* ---- MANIFOLD4 tables (seed 000): textures, and the compute kernel of manifold.comp.glsl ---- */
+/* Texture units the manifold kernels use: 0 coefficients, 1 patch records, 2 trimming mask. */
+enum { SFB__GL_MF_UNITS = 3 };
+
+/* GL state a manifold call binds besides the program and storage buffers (sfb__gl_enter):
+ * texture units with their samplers, the active unit, and the pixel unpack state uploads use. */
+typedef struct sfb__gl_texstate {
+    sfb__GLint active, tex[SFB__GL_MF_UNITS], sampler[SFB__GL_MF_UNITS];
+    sfb__GLint unpack_buffer, align, row_length, skip_rows, skip_pixels;
+} sfb__gl_texstate;
+
+static void sfb__gl_tex_save(sfb__gl *g, sfb__gl_texstate *t) {
+    int i;
+    g->gl.GetIntegerv(SFB__GL_ACTIVE_TEXTURE, &t->active);
+    for (i = 0; i < SFB__GL_MF_UNITS; ++i) {
+        g->gl.ActiveTexture(SFB__GL_TEXTURE0 + (sfb__GLenum)i);
+        g->gl.GetIntegerv(SFB__GL_TEXTURE_BINDING_2D, &t->tex[i]);
+        g->gl.GetIntegerv(SFB__GL_SAMPLER_BINDING, &t->sampler[i]);
+    }
+    g->gl.GetIntegerv(SFB__GL_PIXEL_UNPACK_BUFFER_BINDING, &t->unpack_buffer);
+    g->gl.GetIntegerv(SFB__GL_UNPACK_ALIGNMENT, &t->align);
+    g->gl.GetIntegerv(SFB__GL_UNPACK_ROW_LENGTH, &t->row_length);
+    g->gl.GetIntegerv(SFB__GL_UNPACK_SKIP_ROWS, &t->skip_rows);
+    g->gl.GetIntegerv(SFB__GL_UNPACK_SKIP_PIXELS, &t->skip_pixels);
+    g->gl.ActiveTexture((sfb__GLenum)t->active);
+}
+
+static void sfb__gl_tex_restore(sfb__gl *g, const sfb__gl_texstate *t) {
+    int i;
+    for (i = 0; i < SFB__GL_MF_UNITS; ++i) {
+        g->gl.ActiveTexture(SFB__GL_TEXTURE0 + (sfb__GLenum)i);
+        g->gl.BindTexture(SFB__GL_TEXTURE_2D, (sfb__GLuint)t->tex[i]);
+        g->gl.BindSampler((sfb__GLuint)i, (sfb__GLuint)t->sampler[i]);
+    }
+    g->gl.ActiveTexture((sfb__GLenum)t->active);
+    g->gl.BindBuffer(SFB__GL_PIXEL_UNPACK_BUFFER, (sfb__GLuint)t->unpack_buffer);
+    g->gl.PixelStorei(SFB__GL_UNPACK_ALIGNMENT, t->align);
+    g->gl.PixelStorei(SFB__GL_UNPACK_ROW_LENGTH, t->row_length);
+    g->gl.PixelStorei(SFB__GL_UNPACK_SKIP_ROWS, t->skip_rows);
+    g->gl.PixelStorei(SFB__GL_UNPACK_SKIP_PIXELS, t->skip_pixels);
+}
+
+/* Tightly packed rows from client memory, whatever the host set. */
+static void sfb__gl_unpack_plain(sfb__gl *g, int align) {
+    g->gl.BindBuffer(SFB__GL_PIXEL_UNPACK_BUFFER, 0);
+    g->gl.PixelStorei(SFB__GL_UNPACK_ALIGNMENT, align);
+    g->gl.PixelStorei(SFB__GL_UNPACK_ROW_LENGTH, 0);
+    g->gl.PixelStorei(SFB__GL_UNPACK_SKIP_ROWS, 0);
+    g->gl.PixelStorei(SFB__GL_UNPACK_SKIP_PIXELS, 0);
+}
+
+/* Our sampler object (nearest, clamped): bound beside our textures, it makes them complete
+ * whatever their own filter state (a host's mask texture may ask for mipmaps it lacks) and
+ * keeps a host's sampler object off our units. */
+static sfb_result sfb__gl_mf_sampler(sfb__gl *g) {
+    if (g->sampler) return SFB_SUCCESS;
+    g->gl.GenSamplers(1, &g->sampler);
+    g->gl.SamplerParameteri(g->sampler, SFB__GL_TEXTURE_MIN_FILTER, SFB__GL_NEAREST);
+    g->gl.SamplerParameteri(g->sampler, SFB__GL_TEXTURE_MAG_FILTER, SFB__GL_NEAREST);
+    g->gl.SamplerParameteri(g->sampler, SFB__GL_TEXTURE_WRAP_S, SFB__GL_CLAMP_TO_EDGE);
+    g->gl.SamplerParameteri(g->sampler, SFB__GL_TEXTURE_WRAP_T, SFB__GL_CLAMP_TO_EDGE);
+    return sfb__gl_check(g, "making the manifold sampler");
+}
+
+/* A 2D texture of `width` x `height` texels (one level, nearest) from tightly packed `data`,
+ * made on the active unit (whose binding the caller restores). */
+static sfb__GLuint sfb__gl_mf_texture(sfb__gl *g, sfb__GLint internal, int width, int height, sfb__GLenum format, sfb__GLenum type,
+                                      const void *data) {
+    sfb__GLuint tex = 0;
+    g->gl.GenTextures(1, &tex);
+    g->gl.BindTexture(SFB__GL_TEXTURE_2D, tex);
+    g->gl.TexParameteri(SFB__GL_TEXTURE_2D, SFB__GL_TEXTURE_MIN_FILTER, SFB__GL_NEAREST);
+    g->gl.TexParameteri(SFB__GL_TEXTURE_2D, SFB__GL_TEXTURE_MAG_FILTER, SFB__GL_NEAREST);
+    g->gl.TexParameteri(SFB__GL_TEXTURE_2D, SFB__GL_TEXTURE_WRAP_S, SFB__GL_CLAMP_TO_EDGE);
+    g->gl.TexParameteri(SFB__GL_TEXTURE_2D, SFB__GL_TEXTURE_WRAP_T, SFB__GL_CLAMP_TO_EDGE);
+    g->gl.TexParameteri(SFB__GL_TEXTURE_2D, SFB__GL_TEXTURE_BASE_LEVEL, 0);
+    g->gl.TexParameteri(SFB__GL_TEXTURE_2D, SFB__GL_TEXTURE_MAX_LEVEL, 0);
+    g->gl.TexImage2D(SFB__GL_TEXTURE_2D, 0, internal, width, height, 0, format, type, data);
+    return tex;
+}
+
+/* Uploads a MANIFOLD4 table with the context current: the seed's Fig. 8 coefficient texture
+ * with one 9-row column per patch corner (RGBA32F, 37 texels per patch: its origin, then the
+ * corners' rows, position rows relative to the origin, formed in double) and the RGBA32I
+ * texture of parametric face records and corner codes (layout in manifold.comp.glsl). Texel n
+ * sits at (n % W, n / W) with W = min(4096, GL_MAX_TEXTURE_SIZE). Per-patch origins, rather
+ * than the shared per-vertex texture of the seed, keep float's error at the size of a patch:
+ * the tangents near a point corner are differences of nearly equal local geometries, which
+ * absolute positions would drown. A curve's rows 1 and 2 are positions too. */
+static sfb_result sfb__gl_mf_upload_current(sfb__gl *g, const sfb__patch_table *pt, sfb__gl_ptable **out) {
+    const char *who = g->mode == SFB__GL_OSMESA ? "osmesa" : "gl";
+    int nv = pt->npoints / 9, np = pt->npatch, nf = pt->nptex, W = g->max_texture < 4096 ? g->max_texture : 4096, p, f, j, c, r;
+    size_t ncoef = 37 * (size_t)np, nint = (size_t)nf + (size_t)np, hc = (ncoef + (size_t)W - 1) / (size_t)W,
+           hi = (nint + (size_t)W - 1) / (size_t)W;
+    float *coef = NULL;
+    unsigned *recs = NULL;
+    sfb__gl_ptable *tab = NULL;
+    sfb__gl_texstate ts;
+    sfb_result res = SFB_SUCCESS;
+    *out = NULL;
+    if (hc < 1) hc = 1;
+    if (hi < 1) hi = 1;
+    if (pt->npoints % 9 != 0 || !pt->pcorner || !pt->ptex_root || (pt->max_depth > 1))
+        return sfb__error(g->ctx, SFB_BACKEND_ERROR, SFB_ELEMENT_NONE, -1, "%s: malformed manifold table (%d points, depth %d)", who,
+                          pt->npoints, pt->max_depth);
+    if (hc > (size_t)g->max_texture || hi > (size_t)g->max_texture)
+        return sfb__error(g->ctx, SFB_LIMIT_EXCEEDED, SFB_ELEMENT_NONE, -1,
+                          "%s: a manifold table of %d patches needs textures of %zu and %zu rows of %d texels (GL_MAX_TEXTURE_SIZE %d)",
+                          who, np, hc, hi, W, (int)g->max_texture);
+    coef = (float *)sfb__calloc(g->ctx, hc * (size_t)W * 4, sizeof(float));
+    recs = (unsigned *)sfb__calloc(g->ctx, hi * (size_t)W * 4, sizeof(unsigned));
+    tab = (sfb__gl_ptable *)sfb__calloc(g->ctx, 1, sizeof *tab);
+    if (!coef || !recs || !tab) { res = sfb__oom(g->ctx, "gl manifold table"); goto done; }
+    for (p = 0; p < np; ++p) {
+        int first = pt->pfirst[p], nrow[4];
+        double lo[3], hi3[3], origin[3];
+        float *blk = coef + 4 * 37 * (size_t)p;
+        if (pt->ptype[p] != SFB__PATCH_MANIFOLD4 || pt->pfirst[p + 1] - first != 4) {
+            res = sfb__error(g->ctx, SFB_BACKEND_ERROR, SFB_ELEMENT_NONE, -1, "%s: manifold patch %d (type %d, %d points) is malformed", who, p,
+                             pt->ptype[p], pt->pfirst[p + 1] - first);
+            goto done;
+        }
+        for (c = 0; c < 3; ++c) { lo[c] = HUGE_VAL; hi3[c] = -HUGE_VAL; }
+        for (j = 0; j < 4; ++j) {
+            unsigned code = pt->pcorner[4 * (size_t)p + (size_t)j];
+            int kind = SFB__MF_KIND(code), v = pt->cv[first + j];
+            if (v < 0 || v >= nv || kind > SFB__MF_CURVE || (kind == SFB__MF_PATCH && SFB__MF_K(code) < 1)) {
+                res = sfb__error(g->ctx, SFB_BACKEND_ERROR, SFB_ELEMENT_NONE, -1, "%s: manifold patch %d corner %d (vertex %d of %d, code 0x%x) is malformed",
+                                 who, p, j, v, nv, code);
+                goto done;
+            }
+            nrow[j] = kind == SFB__MF_CURVE ? 3 : 1; /* rows holding positions */
+            for (r = 0; r < nrow[j]; ++r)
+                for (c = 0; c < 3; ++c) {
+                    double x = pt->point_data[27 * (size_t)v + 3 * (size_t)r + (size_t)c];
+                    if (x < lo[c]) lo[c] = x;
+                    if (x > hi3[c]) hi3[c] = x;
+                }
+        }
+        /* the origin: the centre of the patch's positions, as a float (exactly what is added back) */
+        for (c = 0; c < 3; ++c) {
+            origin[c] = isfinite(lo[c]) && isfinite(hi3[c]) ? (double)(float)(0.5 * (lo[c] + hi3[c])) : 0.0;
+            blk[c] = (float)origin[c];
+        }
+        for (j = 0; j < 4; ++j) {
+            const float *src = pt->point_data + 27 * (size_t)pt->cv[first + j];
+            for (r = 0; r < 9; ++r)
+                for (c = 0; c < 3; ++c)
+                    blk[4 * (1 + 9 * j + r) + c] = (float)(r < nrow[j] ? (double)src[3 * r + c] - origin[c] : (double)src[3 * r + c]);
+        }
+        for (j = 0; j < 4; ++j) recs[4 * ((size_t)nf + (size_t)p) + (size_t)j] = pt->pcorner[4 * (size_t)p + (size_t)j];
+    }
+    /* face records: a hole, one patch, or the patches of the four quadrants */
+    for (f = 0; f < nf; ++f) {
+        int root = pt->ptex_root[f], q;
+        unsigned *o = recs + 4 * (size_t)f;
+        if (root == -1) {
+            for (q = 0; q < 4; ++q) o[q] = (unsigned)-1;
+        } else if (root <= -2) {
+            o[0] = (unsigned)(-root - 2);
+            o[1] = o[2] = o[3] = (unsigned)-2;
+        } else {
+            for (q = 0; q < 4; ++q) {
+                int ch = root < pt->nnodes ? pt->nodes[4 * root + q] : 0;
+                if (ch >= 0) {
+                    res = sfb__error(g->ctx, SFB_BACKEND_ERROR, SFB_ELEMENT_NONE, -1, "%s: manifold face %d is refined deeper than one level", who, f);
+                    goto done;
+                }
+                o[q] = ch == -1 ? (unsigned)-1 : (unsigned)(-ch - 2);
+            }
+        }
+    }
+    tab->manifold = 1;
+    tab->mf_width = W;
+    tab->mf_patch_base = nf;
+    sfb__gl_tex_save(g, &ts);
+    sfb__gl_unpack_plain(g, 4);
+    g->gl.ActiveTexture(SFB__GL_TEXTURE0);
+    tab->mf_tex[0] = sfb__gl_mf_texture(g, SFB__GL_RGBA32F, W, (int)hc, SFB__GL_RGBA, SFB__GL_FLOAT, coef);
+    tab->mf_tex[1] = sfb__gl_mf_texture(g, SFB__GL_RGBA32I, W, (int)hi, SFB__GL_RGBA_INTEGER, SFB__GL_INT, recs);
+    res = sfb__gl_check(g, "uploading a manifold table");
+    sfb__gl_tex_restore(g, &ts);
+done:
+    sfb__free(g->ctx, coef); sfb__free(g->ctx, recs);
+    if (res != SFB_SUCCESS) {
+        if (tab) sfb__gl_ptable_free(g, tab);
+        return res;
+    }
+    *out = tab;
+    return SFB_SUCCESS;
+}
+
+/* Uniforms of manifold.comp.glsl shared by both stages, at these indices of a location table. */
+static const char *const sfb__gl_mf_common_uniforms[5] = {"u_coef", "u_index", "u_width", "u_patch_base", "u_weights"};
+
+/* With `prog` in use: the table's textures on units 0 and 1 with our sampler, and the shared
+ * uniforms (loc: their locations). */
+static void sfb__gl_mf_bind(sfb__gl *g, const sfb__gl_ptable *tab, int weights, const sfb__GLint *loc) {
+    int i;
+    for (i = 0; i < 2; ++i) {
+        g->gl.ActiveTexture(SFB__GL_TEXTURE0 + (sfb__GLenum)i);
+        g->gl.BindTexture(SFB__GL_TEXTURE_2D, tab->mf_tex[i]);
+        g->gl.BindSampler((sfb__GLuint)i, g->sampler);
+    }
+    g->gl.Uniform1i(loc[0], 0);
+    g->gl.Uniform1i(loc[1], 1);
+    g->gl.Uniform1i(loc[2], tab->mf_width);
+    g->gl.Uniform1i(loc[3], tab->mf_patch_base);
+    g->gl.Uniform1i(loc[4], weights);
+}
+
+static sfb_result sfb__gl_mf_program(sfb__gl *g, sfb__GLuint *out) {
+    static const char *const own[4] = {"u_first", "u_last", "u_stride", "u_slot"};
+    sfb__GLuint prog;
+    sfb_result r;
+    int i;
+    if (g->mf_program) { *out = g->mf_program; return SFB_SUCCESS; }
+    if ((r = sfb__gl_mf_sampler(g)) != SFB_SUCCESS) return r;
+    if ((r = sfb__gl_compile(g, "", SFB__GL_MANIFOLD_SOURCE, "manifold.comp.glsl", &prog)) != SFB_SUCCESS) return r;
+    for (i = 0; i < 5; ++i) g->mf_loc[i] = g->gl.GetUniformLocation(prog, sfb__gl_mf_common_uniforms[i]);
+    for (i = 0; i < 4; ++i) g->mf_loc[5 + i] = g->gl.GetUniformLocation(prog, own[i]);
+    g->mf_program = prog;
+    *out = prog;
+    return sfb__gl_check(g, "building the manifold kernel");
+}
+
+/* sfb_surface_eval on a MANIFOLD4 table: located on the CPU (sfb__patch_locate), evaluated by
+ * manifold.comp.glsl in batches that fit one storage block (position, du, dv, normal). Second
+ * derivatives are formed on the CPU, as ref forms them (sfb__mf_eval_patch: central differences
+ * of the analytic first derivatives, step 2^-17, in double): in float a difference quotient
+ * of that step would keep no digits, and a wider one would no longer be ref's function. */
+static sfb_result sfb__gl_mf_eval(sfb__gl *g, const sfb__patch_table *pt, sfb__gl_ptable *tab, const sfb_location *locs, int first,
+                                  int last, const sfb_eval_output *out) {
+    float *dst[4];
+    sfb__GLint slot[4];
+    sfb__gl_query *queries = NULL;
+    sfb__gl_ptable *temp = NULL;
+    int count = last - first, nout = 0, o, q, stride;
+    size_t batch;
+    long long per = (long long)g->max_groups * 64;
+    sfb__gl_saved s;
+    sfb__gl_texstate ts;
+    sfb__GLuint prog;
+    sfb_result res;
+    dst[0] = out->position; dst[1] = out->du; dst[2] = out->dv; dst[3] = out->normal;
+    for (o = 0; o < 4; ++o) slot[o] = dst[o] ? nout++ : -1;
+    if (count <= 0) return SFB_SUCCESS;
+    for (q = 0; q < count; ++q) {
+        double u, v, sc;
+        const sfb_location *l = &locs[first + q];
+        if (sfb__patch_locate(pt, l->face, l->u, l->v, &u, &v, &sc) < 0)
+            return sfb__error(g->ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, first + q, "location %d: parametric face %d is a hole", first + q, l->face);
+    }
+    if (out->duu || out->duv || out->dvv)
+        for (q = first; q < last; ++q) {
+            double u, v, sc, res2[6][3], nrm[3];
+            int patch = sfb__patch_locate(pt, locs[q].face, locs[q].u, locs[q].v, &u, &v, &sc), c;
+            sfb__mf_eval_patch(pt, pt->point_data, patch, u, v, 1, res2, nrm);
+            for (c = 0; c < 3; ++c) {
+                size_t at = 3 * (size_t)q + (size_t)c;
+                if (out->duu) out->duu[at] = (float)(res2[3][c] * sc * sc);
+                if (out->duv) out->duv[at] = (float)(res2[4][c] * sc * sc);
+                if (out->dvv) out->dvv[at] = (float)(res2[5][c] * sc * sc);
+            }
+        }
+    if (nout == 0) return SFB_SUCCESS;
+    stride = 3 * nout;
+    batch = (size_t)g->max_block / ((size_t)stride * sizeof(float));
+    if (batch > (size_t)g->max_block / sizeof(sfb__gl_query)) batch = (size_t)g->max_block / sizeof(sfb__gl_query);
+    if (batch < 1) batch = 1;
+    if ((res = sfb__gl_enter(g, &s)) != SFB_SUCCESS) return res;
+    sfb__gl_tex_save(g, &ts);
+    if (!tab || !tab->manifold) {
+        /* the surface was uploaded to another backend: a temporary copy for this call */
+        if ((res = sfb__gl_mf_upload_current(g, pt, &temp)) != SFB_SUCCESS) goto done;
+        tab = temp;
+    }
+    if ((res = sfb__gl_mf_program(g, &prog)) != SFB_SUCCESS) goto done;
+    queries = (sfb__gl_query *)sfb__alloc(g->ctx, (size_t)count * sizeof *queries);
+    if (!queries) { res = sfb__oom(g->ctx, "gl manifold evaluation"); goto done; }
+    for (q = 0; q < count; ++q) {
+        const sfb_location *l = &locs[first + q];
+        double u, v, sc;
+        queries[q].patch = sfb__patch_locate(pt, l->face, l->u, l->v, &u, &v, &sc);
+        queries[q].s = (float)u; /* exact: u, 2u or 2u - 1 of a float */
+        queries[q].t = (float)v;
+        queries[q].scale = (float)sc;
+    }
+    g->gl.UseProgram(prog);
+    sfb__gl_mf_bind(g, tab, pt->mf_weights, g->mf_loc);
+    g->gl.Uniform1i(g->mf_loc[7], stride);
+    g->gl.Uniform1iv(g->mf_loc[8], 4, slot);
+    for (q = 0; q < count;) {
+        int n = (size_t)(count - q) > batch ? (int)batch : count - q, d, k;
+        const float *mapped;
+        size_t qbytes = (size_t)n * sizeof(sfb__gl_query), rbytes = (size_t)n * (size_t)stride * sizeof(float);
+        if ((res = sfb__gl_grow(g, &g->scratch_src, &g->scratch_src_cap, qbytes, SFB__GL_STREAM_DRAW)) != SFB_SUCCESS) goto done;
+        g->gl.BufferSubData(SFB__GL_SHADER_STORAGE_BUFFER, 0, (sfb__GLsizeiptr)qbytes, queries + q);
+        if ((res = sfb__gl_grow(g, &g->scratch_dst, &g->scratch_dst_cap, rbytes, SFB__GL_DYNAMIC_READ)) != SFB_SUCCESS) goto done;
+        g->gl.BindBufferBase(SFB__GL_SHADER_STORAGE_BUFFER, 4, g->scratch_src);
+        g->gl.BindBufferBase(SFB__GL_SHADER_STORAGE_BUFFER, 5, g->scratch_dst);
+        for (d = 0; d < n;) {
+            int m = (long long)(n - d) > per ? (int)per : n - d;
+            g->gl.Uniform1i(g->mf_loc[5], d);
+            g->gl.Uniform1i(g->mf_loc[6], d + m);
+            g->gl.DispatchCompute((sfb__GLuint)((m + 63) / 64), 1, 1);
+            d += m;
+        }
+        if ((res = sfb__gl_check(g, "the manifold kernel")) != SFB_SUCCESS) goto done;
+        g->gl.MemoryBarrier(SFB__GL_BUFFER_UPDATE_BARRIER_BIT);
+        g->gl.BindBuffer(SFB__GL_SHADER_STORAGE_BUFFER, g->scratch_dst);
+        mapped = (const float *)g->gl.MapBufferRange(SFB__GL_SHADER_STORAGE_BUFFER, 0, (sfb__GLsizeiptr)rbytes, SFB__GL_MAP_READ_BIT);
+        if (!mapped) {
+            res = sfb__gl_check(g, "mapping the results");
+            if (res == SFB_SUCCESS) res = sfb__error(g->ctx, SFB_BACKEND_ERROR, SFB_ELEMENT_NONE, -1, "gl: glMapBufferRange returned NULL");
+            goto done;
+        }
+        for (k = 0; k < n; ++k) {
+            size_t at = 3 * ((size_t)first + (size_t)q + (size_t)k);
+            const float *r = mapped + (size_t)k * (size_t)stride;
+            for (o = 0; o < 4; ++o)
+                if (dst[o]) {
+                    const float *x = r + 3 * slot[o];
+                    dst[o][at] = x[0];
+                    dst[o][at + 1] = x[1];
+                    dst[o][at + 2] = x[2];
+                }
+        }
+        g->gl.UnmapBuffer(SFB__GL_SHADER_STORAGE_BUFFER);
+        if ((res = sfb__gl_check(g, "reading the results back")) != SFB_SUCCESS) goto done;
+        q += n;
+    }
+done:
+    sfb__free(g->ctx, queries);
+    if (temp) sfb__gl_ptable_free(g, temp);
+    sfb__gl_tex_restore(g, &ts);
+    sfb__gl_leave(g, &s);
+    return res;
+}
+
 /* Locations are located on the CPU (a quadtree walk per location, a few ns), grouped by
  * piece, and evaluated by the kernel in batches that fit one storage block; results come back
  * compact (only the asked outputs) and are scattered into the caller's arrays. */
@@ -1396,6 +1856,7 @@ static sfb_result sfb__gl_eval_patches(void *state, const sfb__patch_table *pt, 
     sfb__gl_saved s;
     sfb__GLuint prog;
     sfb_result res;
+    if (pt->scheme == SFB_SCHEME_MANIFOLD_BLEND) return sfb__gl_mf_eval(g, pt, tab, locs, first, last, out);
     dst[0] = out->position; dst[1] = out->du; dst[2] = out->dv; dst[3] = out->normal;
     dst[4] = out->duu; dst[5] = out->duv; dst[6] = out->dvv;
     for (o = 0; o < SFB__GL_OUTPUTS; ++o) slot[o] = dst[o] ? nout++ : -1;
@@ -1700,5 +2161,295 @@ static const sfb__backend_vtable sfb__gl_vtable = {
 };
 
 const sfb__backend_vtable *sfb__backend_gl(void) { return &sfb__gl_vtable; }
+
+/* ---- the draw path: seed 000's vertex and fragment programs (sfb_surface_draw_gl) ---- */
+/* Uniforms of the draw program: manifold.comp.glsl's shared five (sfb__gl_mf_common_uniforms),
+ * then these. */
+static const char *const sfb__gl_draw_uniforms[9] = {"u_mvp", "u_normal_matrix", "u_rate", "u_first_face", "u_trim",
+                                                     "u_trim_on", "u_tiles", "u_light", "u_color"};
+
+/* The gl state of `ctx` when it runs the gl backend on the host's context; else the error
+ * (SFB_UNSUPPORTED, naming `fn` and what the context runs). */
+static sfb_result sfb__gl_host_of(sfb_context *ctx, const char *fn, sfb__gl **out) {
+    const sfb__backend_vtable *be = ctx->backend;
+    sfb__gl *g = be == &sfb__gl_vtable ? (sfb__gl *)ctx->backend_state : NULL;
+    *out = NULL;
+    if (!g || g->mode != SFB__GL_HOST)
+        return sfb__error(ctx, SFB_UNSUPPORTED, SFB_ELEMENT_NONE, -1,
+                          "%s needs the gl backend on the host's current context (gl_use_current_context); this context runs %s%s", fn,
+                          be ? be->name : "no backend", g ? " on its own context" : "");
+    *out = g;
+    return SFB_SUCCESS;
+}
+
+/* GL state the draw binds besides sfb__gl_enter's: texture units, vertex array, transform
+ * feedback object and generic buffer, rasterizer discard. */
+typedef struct sfb__gl_drawstate {
+    sfb__gl_texstate tex;
+    sfb__GLint vao, tfo, tf_buffer;
+    sfb__GLboolean discard;
+} sfb__gl_drawstate;
+
+static void sfb__gl_draw_save(sfb__gl *g, sfb__gl_drawstate *d) {
+    sfb__gl_tex_save(g, &d->tex);
+    g->gl.GetIntegerv(SFB__GL_VERTEX_ARRAY_BINDING, &d->vao);
+    g->gl.GetIntegerv(SFB__GL_TRANSFORM_FEEDBACK_BINDING, &d->tfo);
+    g->gl.GetIntegerv(SFB__GL_TRANSFORM_FEEDBACK_BUFFER_BINDING, &d->tf_buffer);
+    d->discard = g->gl.IsEnabled(SFB__GL_RASTERIZER_DISCARD);
+}
+
+static void sfb__gl_draw_restore(sfb__gl *g, const sfb__gl_drawstate *d) {
+    if (d->discard) g->gl.Enable(SFB__GL_RASTERIZER_DISCARD);
+    else g->gl.Disable(SFB__GL_RASTERIZER_DISCARD);
+    g->gl.BindTransformFeedback(SFB__GL_TRANSFORM_FEEDBACK, (sfb__GLuint)d->tfo);
+    g->gl.BindBuffer(SFB__GL_TRANSFORM_FEEDBACK_BUFFER, (sfb__GLuint)d->tf_buffer);
+    g->gl.BindVertexArray((sfb__GLuint)d->vao);
+    sfb__gl_tex_restore(g, &d->tex);
+}
+
+/* The draw program, with its vertex array (no attributes: the vertex program reads
+ * gl_VertexID and gl_InstanceID), index buffer and transform feedback object. */
+static sfb_result sfb__gl_draw_program(sfb__gl *g) {
+    static const char *const varyings[2] = {"v_cap_pos", "v_cap_nrm"};
+    sfb__GLuint sh[2], prog;
+    sfb_result r;
+    int i;
+    if (g->draw_program) return SFB_SUCCESS;
+    if ((r = sfb__gl_mf_sampler(g)) != SFB_SUCCESS) return r;
+    if ((r = sfb__gl_shader(g, SFB__GL_VERTEX_SHADER, "#define SFB_MF_VERTEX\n", SFB__GL_MANIFOLD_SOURCE, "manifold.comp.glsl (vertex stage)",
+                            &sh[0])) != SFB_SUCCESS)
+        return r;
+    if ((r = sfb__gl_shader(g, SFB__GL_FRAGMENT_SHADER, "", SFB__GL_MANIFOLD_FRAG_SOURCE, "manifold_draw.frag.glsl", &sh[1])) != SFB_SUCCESS) {
+        g->gl.DeleteShader(sh[0]);
+        return r;
+    }
+    if ((r = sfb__gl_link(g, sh, 2, varyings, 2, "the manifold draw program", &prog)) != SFB_SUCCESS) return r;
+    for (i = 0; i < 5; ++i) g->draw_loc[i] = g->gl.GetUniformLocation(prog, sfb__gl_mf_common_uniforms[i]);
+    for (i = 0; i < 9; ++i) g->draw_loc[5 + i] = g->gl.GetUniformLocation(prog, sfb__gl_draw_uniforms[i]);
+    g->draw_program = prog;
+    g->gl.GenVertexArrays(1, &g->draw_vao);
+    g->gl.GenBuffers(1, &g->draw_ibo);
+    g->gl.GenTransformFeedbacks(1, &g->draw_tfo);
+    g->draw_rate = 0;
+    return sfb__gl_check(g, "building the manifold draw program");
+}
+
+/* Binds the draw vertex array with the index buffer of a rate x rate cell grid: cell (i, j)
+ * as the triangles (00, 10, 11) and (00, 11, 01), counter-clockwise in (u,v). */
+static sfb_result sfb__gl_draw_grid(sfb__gl *g, int rate) {
+    g->gl.BindVertexArray(g->draw_vao);
+    g->gl.BindBuffer(SFB__GL_ELEMENT_ARRAY_BUFFER, g->draw_ibo);
+    if (g->draw_rate != rate) {
+        size_t cells = (size_t)rate * (size_t)rate;
+        unsigned *idx = (unsigned *)sfb__alloc(g->ctx, cells * 6 * sizeof(unsigned));
+        int i, j, n = rate + 1;
+        if (!idx) return sfb__oom(g->ctx, "gl draw grid");
+        for (j = 0; j < rate; ++j)
+            for (i = 0; i < rate; ++i) {
+                unsigned *o = idx + 6 * ((size_t)j * (size_t)rate + (size_t)i), v00 = (unsigned)(j * n + i);
+                o[0] = v00; o[1] = v00 + 1; o[2] = v00 + 1 + (unsigned)n;
+                o[3] = v00; o[4] = v00 + 1 + (unsigned)n; o[5] = v00 + (unsigned)n;
+            }
+        g->gl.BufferData(SFB__GL_ELEMENT_ARRAY_BUFFER, (sfb__GLsizeiptr)(cells * 6 * sizeof(unsigned)), idx, SFB__GL_STATIC_DRAW);
+        sfb__free(g->ctx, idx);
+        g->draw_rate = 0;
+        if (g->gl.GetError() != SFB__GL_NO_ERROR) {
+            while (g->gl.GetError() != SFB__GL_NO_ERROR) {}
+            return sfb__error(g->ctx, SFB_OUT_OF_MEMORY, SFB_ELEMENT_NONE, -1, "gl: the index buffer of a %d x %d sample grid could not be made", rate, rate);
+        }
+        g->draw_rate = rate;
+    }
+    return SFB_SUCCESS;
+}
+
+static int sfb__gl_all_finite(const float *v, int n) {
+    int i;
+    for (i = 0; i < n; ++i)
+        if (!isfinite(v[i])) return 0;
+    return 1;
+}
+
+static int sfb__gl_all_zero(const float *v, int n) {
+    int i;
+    for (i = 0; i < n; ++i)
+        if (v[i] != 0.0f) return 0;
+    return 1;
+}
+
+SFB_API sfb_result sfb_surface_draw_gl(const sfb_surface *surface, const sfb_gl_draw_params *params) {
+    static const float ident4[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1}, ident3[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+    static const float grey[4] = {0.8f, 0.8f, 0.8f, 1.0f};
+    sfb_context *ctx;
+    sfb__gl *g = NULL;
+    sfb_gl_draw_params p;
+    const sfb__patch_table *pt;
+    sfb__gl_ptable *tab, *temp = NULL;
+    sfb__gl_saved saved;
+    sfb__gl_drawstate ds;
+    const float *mvp, *nm, *color;
+    float light[3] = {0.0f, 0.0f, 1.0f};
+    int rate, n, first, count, nptex;
+    size_t cap_bytes = 0;
+    sfb_result r;
+    if (!surface) return SFB_INVALID_ARGS;
+    ctx = surface->ctx;
+    if (!params) return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "sfb_surface_draw_gl: params is NULL");
+    if ((r = sfb__gl_host_of(ctx, "sfb_surface_draw_gl", &g)) != SFB_SUCCESS) return r;
+    pt = &surface->patches;
+    if (!surface->has_patches || pt->scheme != SFB_SCHEME_MANIFOLD_BLEND)
+        return sfb__error(ctx, SFB_UNSUPPORTED, SFB_ELEMENT_NONE, -1,
+                          "sfb_surface_draw_gl draws manifold blending surfaces (SFB_SCHEME_MANIFOLD_BLEND with SFB_REFINE_PATCHES); this surface is %s%s",
+                          sfb_scheme_name(surface->config.scheme), surface->has_patches ? "" : " without patches");
+    p = *params;
+    rate = p.rate == 0 ? 16 : p.rate;
+    if (rate < 1 || rate > 1024)
+        return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "sfb_surface_draw_gl: rate %d is outside 1..1024 (0: 16)", p.rate);
+    nptex = pt->nptex;
+    first = p.first_face;
+    count = p.face_count;
+    if (first < 0 || count < 0 || first > nptex || count > nptex - first)
+        return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1,
+                          "sfb_surface_draw_gl: faces %d (+%d) are outside the surface's %d parametric faces", first, count, nptex);
+    if (count == 0) count = nptex - first;
+    if (!sfb__gl_all_finite(p.mvp, 16) || !sfb__gl_all_finite(p.normal_matrix, 9) || !sfb__gl_all_finite(p.light, 3) ||
+        !sfb__gl_all_finite(p.color, 4))
+        return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, -1, "sfb_surface_draw_gl: a matrix, light or colour value is not finite");
+    if (p.trim_tiles_u < 0 || p.trim_tiles_v < 0 || (p.trim_tiles_u == 0) != (p.trim_tiles_v == 0))
+        return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, -1,
+                          "sfb_surface_draw_gl: trimming atlas tiles %d x %d (0 x 0, or both >= 1)", p.trim_tiles_u, p.trim_tiles_v);
+    mvp = sfb__gl_all_zero(p.mvp, 16) ? ident4 : p.mvp;
+    nm = sfb__gl_all_zero(p.normal_matrix, 9) ? ident3 : p.normal_matrix;
+    color = sfb__gl_all_zero(p.color, 4) ? grey : p.color;
+    if (!sfb__gl_all_zero(p.light, 3)) {
+        /* in double: a tiny or huge light direction neither under- nor overflows */
+        double lx = p.light[0], ly = p.light[1], lz = p.light[2], l = sqrt(lx * lx + ly * ly + lz * lz);
+        light[0] = (float)(lx / l); light[1] = (float)(ly / l); light[2] = (float)(lz / l);
+    }
+    n = rate + 1;
+    if (p.capture_buffer) cap_bytes = (size_t)count * (size_t)n * (size_t)n * 6 * sizeof(float);
+    if (count == 0) return SFB_SUCCESS;
+    if ((r = sfb__gl_enter(g, &saved)) != SFB_SUCCESS) return r;
+    sfb__gl_draw_save(g, &ds);
+    /* the host's objects */
+    if (p.trim_texture) {
+        sfb__GLint w = 0, h = 0;
+        if (!g->gl.IsTexture(p.trim_texture)) {
+            r = sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "sfb_surface_draw_gl: trim_texture %u is not a texture of the current context",
+                           p.trim_texture);
+            goto done;
+        }
+        g->gl.ActiveTexture(SFB__GL_TEXTURE0 + 2);
+        g->gl.BindTexture(SFB__GL_TEXTURE_2D, p.trim_texture);
+        g->gl.GetTexLevelParameteriv(SFB__GL_TEXTURE_2D, 0, SFB__GL_TEXTURE_WIDTH, &w);
+        g->gl.GetTexLevelParameteriv(SFB__GL_TEXTURE_2D, 0, SFB__GL_TEXTURE_HEIGHT, &h);
+        if (g->gl.GetError() != SFB__GL_NO_ERROR || w < 1 || h < 1) {
+            while (g->gl.GetError() != SFB__GL_NO_ERROR) {}
+            r = sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "sfb_surface_draw_gl: trim_texture %u is not a 2D texture with a level-0 image",
+                           p.trim_texture);
+            goto done;
+        }
+        if (p.trim_tiles_u > 0 && (w % p.trim_tiles_u != 0 || h % p.trim_tiles_v != 0)) {
+            r = sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, -1, "sfb_surface_draw_gl: the %d x %d trimming texture does not split into %d x %d equal tiles",
+                           (int)w, (int)h, p.trim_tiles_u, p.trim_tiles_v);
+            goto done;
+        }
+    }
+    if (p.capture_buffer) {
+        sfb__GLint size = 0;
+        if (!g->gl.IsBuffer(p.capture_buffer)) {
+            r = sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "sfb_surface_draw_gl: capture_buffer %u is not a buffer object of the current context",
+                           p.capture_buffer);
+            goto done;
+        }
+        g->gl.BindBuffer(SFB__GL_SHADER_STORAGE_BUFFER, p.capture_buffer);
+        g->gl.GetBufferParameteriv(SFB__GL_SHADER_STORAGE_BUFFER, SFB__GL_BUFFER_SIZE, &size);
+        if (size < 0 || (size_t)size < cap_bytes) {
+            r = sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1,
+                           "sfb_surface_draw_gl: capture_buffer %u has %d bytes; %d faces at rate %d need %zu", p.capture_buffer, (int)size, count,
+                           rate, cap_bytes);
+            goto done;
+        }
+    }
+    tab = surface->uploaded_by == &sfb__gl_vtable ? (sfb__gl_ptable *)surface->backend_patches : NULL;
+    if (!tab || !tab->manifold) {
+        if ((r = sfb__gl_mf_upload_current(g, pt, &temp)) != SFB_SUCCESS) goto done;
+        tab = temp;
+    }
+    if ((r = sfb__gl_draw_program(g)) != SFB_SUCCESS) goto done;
+    if ((r = sfb__gl_draw_grid(g, rate)) != SFB_SUCCESS) goto done;
+    g->gl.UseProgram(g->draw_program);
+    sfb__gl_mf_bind(g, tab, pt->mf_weights, g->draw_loc);
+    g->gl.ActiveTexture(SFB__GL_TEXTURE0 + 2);
+    if (p.trim_texture) g->gl.BindTexture(SFB__GL_TEXTURE_2D, p.trim_texture);
+    g->gl.BindSampler(2, g->sampler);
+    g->gl.UniformMatrix4fv(g->draw_loc[5], 1, 0, mvp);
+    g->gl.UniformMatrix3fv(g->draw_loc[6], 1, 0, nm);
+    g->gl.Uniform1i(g->draw_loc[7], rate);
+    g->gl.Uniform1i(g->draw_loc[8], first);
+    g->gl.Uniform1i(g->draw_loc[9], 2);
+    g->gl.Uniform1i(g->draw_loc[10], p.trim_texture != 0);
+    g->gl.Uniform2i(g->draw_loc[11], p.trim_tiles_u, p.trim_tiles_v);
+    g->gl.Uniform3f(g->draw_loc[12], light[0], light[1], light[2]);
+    g->gl.Uniform4f(g->draw_loc[13], color[0], color[1], color[2], color[3]);
+    if ((r = sfb__gl_check(g, "setting up the manifold draw")) != SFB_SUCCESS) goto done;
+    if (p.capture_buffer) {
+        /* the samples once each, as points, into the capture buffer */
+        g->gl.BindTransformFeedback(SFB__GL_TRANSFORM_FEEDBACK, g->draw_tfo);
+        g->gl.BindBufferRange(SFB__GL_TRANSFORM_FEEDBACK_BUFFER, 0, p.capture_buffer, 0, (sfb__GLsizeiptr)cap_bytes);
+        g->gl.Enable(SFB__GL_RASTERIZER_DISCARD);
+        g->gl.BeginTransformFeedback(SFB__GL_POINTS);
+        g->gl.DrawArraysInstanced(SFB__GL_POINTS, 0, n * n, count);
+        g->gl.EndTransformFeedback();
+        if (!ds.discard) g->gl.Disable(SFB__GL_RASTERIZER_DISCARD);
+        g->gl.BindTransformFeedback(SFB__GL_TRANSFORM_FEEDBACK, (sfb__GLuint)ds.tfo);
+        if ((r = sfb__gl_check(g, "capturing the manifold samples")) != SFB_SUCCESS) goto done;
+    }
+    g->gl.DrawElementsInstanced(SFB__GL_TRIANGLES, 6 * rate * rate, SFB__GL_UNSIGNED_INT, NULL, count);
+    r = sfb__gl_check(g, "drawing the manifold surface");
+    /* the host may read the capture (map, copy, draw from it) next */
+    if (r == SFB_SUCCESS && p.capture_buffer) g->gl.MemoryBarrier(SFB__GL_ALL_BARRIER_BITS);
+done:
+    if (temp) sfb__gl_ptable_free(g, temp);
+    sfb__gl_draw_restore(g, &ds);
+    sfb__gl_leave(g, &saved);
+    return r;
+}
+
+SFB_API sfb_result sfb_gl_trim_texture(sfb_context *ctx, const struct sfb_trim_mask *mask, unsigned int *texture) {
+    sfb__gl *g = NULL;
+    sfb__gl_saved saved;
+    sfb__gl_texstate ts;
+    sfb__GLuint tex = 0;
+    sfb_result r;
+    if (texture) *texture = 0;
+    if (!ctx) return SFB_INVALID_ARGS;
+    if (!mask || !texture) return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "sfb_gl_trim_texture: %s is NULL", mask ? "texture" : "mask");
+    if ((r = sfb__gl_host_of(ctx, "sfb_gl_trim_texture", &g)) != SFB_SUCCESS) return r;
+    /* as sfb_surface_tessellate checks a mask */
+    if (!mask->texels) return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, -1, "trimming mask: texels is NULL");
+    if (mask->width < 1 || mask->width > 16384 || mask->height < 1 || mask->height > 16384)
+        return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, -1, "trimming mask: %d x %d texels, each side must be 1..16384", mask->width,
+                          mask->height);
+    if (mask->tiles_u < 0 || mask->tiles_v < 0 || (mask->tiles_u == 0) != (mask->tiles_v == 0))
+        return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, -1, "trimming mask: atlas tiles %d x %d (0 x 0, or both >= 1)", mask->tiles_u,
+                          mask->tiles_v);
+    if (mask->tiles_u > 0 && (mask->width % mask->tiles_u != 0 || mask->height % mask->tiles_v != 0))
+        return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, -1, "trimming mask: %d x %d texels do not split into %d x %d equal tiles",
+                          mask->width, mask->height, mask->tiles_u, mask->tiles_v);
+    if (mask->width > g->max_texture || mask->height > g->max_texture)
+        return sfb__error(ctx, SFB_LIMIT_EXCEEDED, SFB_ELEMENT_NONE, -1, "trimming mask: %d x %d texels exceed GL_MAX_TEXTURE_SIZE (%d)", mask->width,
+                          mask->height, (int)g->max_texture);
+    if ((r = sfb__gl_enter(g, &saved)) != SFB_SUCCESS) return r;
+    sfb__gl_tex_save(g, &ts);
+    sfb__gl_unpack_plain(g, 1);
+    g->gl.ActiveTexture(SFB__GL_TEXTURE0 + 2);
+    tex = sfb__gl_mf_texture(g, SFB__GL_R8, mask->width, mask->height, SFB__GL_RED, SFB__GL_UNSIGNED_BYTE, mask->texels);
+    r = sfb__gl_check(g, "uploading a trimming mask");
+    if (r != SFB_SUCCESS && tex) g->gl.DeleteTextures(1, &tex);
+    else *texture = tex;
+    sfb__gl_tex_restore(g, &ts);
+    sfb__gl_leave(g, &saved);
+    return r;
+}
 
 #endif /* SFB__GL_H */

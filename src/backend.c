@@ -144,3 +144,33 @@ SFB_API sfb_result sfb_backend_probe(sfb_backend_kind kind, const sfb_context_co
     sfb_context_destroy(ctx);
     return SFB_SUCCESS;
 }
+
+/* The manifold draw path (sfb_surface_draw_gl, sfb_gl_trim_texture) lives in backends/sfb_gl.h;
+ * its parameters' defaults are here so that they exist in every build, and without the gl
+ * backend the calls link and answer SFB_UNSUPPORTED. */
+SFB_API sfb_gl_draw_params sfb_gl_draw_params_init(void) {
+    sfb_gl_draw_params p;
+    memset(&p, 0, sizeof p);
+    p.rate = 16;
+    p.mvp[0] = p.mvp[5] = p.mvp[10] = p.mvp[15] = 1.0f;
+    p.normal_matrix[0] = p.normal_matrix[4] = p.normal_matrix[8] = 1.0f;
+    p.light[2] = 1.0f;
+    p.color[0] = p.color[1] = p.color[2] = 0.8f;
+    p.color[3] = 1.0f;
+    return p;
+}
+#ifndef SURFBLEND_GL
+SFB_API sfb_result sfb_surface_draw_gl(const sfb_surface *surface, const sfb_gl_draw_params *params) {
+    (void)params;
+    if (!surface) return SFB_INVALID_ARGS;
+    return sfb__error(surface->ctx, SFB_UNSUPPORTED, SFB_ELEMENT_NONE, -1,
+                      "sfb_surface_draw_gl: this build has no gl backend (define SURFBLEND_GL or SURFBLEND_ALL_BACKENDS)");
+}
+SFB_API sfb_result sfb_gl_trim_texture(sfb_context *ctx, const struct sfb_trim_mask *mask, unsigned int *texture) {
+    (void)mask;
+    if (texture) *texture = 0;
+    if (!ctx) return SFB_INVALID_ARGS;
+    return sfb__error(ctx, SFB_UNSUPPORTED, SFB_ELEMENT_NONE, -1,
+                      "sfb_gl_trim_texture: this build has no gl backend (define SURFBLEND_GL or SURFBLEND_ALL_BACKENDS)");
+}
+#endif

@@ -76,7 +76,7 @@ static double sfb__mf_eta(int kind, double t, double *dt) {
         da = a > 0.0 ? -a / ((1.0 - t) * (1.0 - t)) : 0.0; /* d/dt g(1-t) */
         db = b > 0.0 ? b / (t * t) : 0.0;
         s = a + b;
-        *dt = (da * s - a * (da + db)) / (s * s);
+        *dt = (da * b - a * db) / (s * s); /* = (da s - a (da + db)) / s^2 without the cancellation near 0 and 1 */
         return a / s;
     }
     *dt = 6.0 * t * t - 6.0 * t;

@@ -101,6 +101,7 @@ else echo "peer shapes not found at $SHAPES: trim runs without them"; counted tr
 # manifold-based blending surfaces on every backend: tests/manifold.c
 if [ -d "$SHAPES" ]; then counted manifold "$BUILD/manifold" "$SHAPES"
 else echo "peer shapes not found at $SHAPES: manifold runs without them"; counted manifold "$BUILD/manifold"; fi
+counted gl_manifold "$BUILD/gl_manifold" "$SHAPES"
 counted finish_normals "$BUILD/finish_normals"
 
 # 3c. the engine case: the gl backend on the host's own EGL context and GL buffers
