@@ -1310,8 +1310,10 @@ static void sfb__eval_stam(const sfb__eigen_cc *e, const float *pts, const int *
                      res, nres);
 }
 
-/* The ref kernel: one location, double precision throughout. */
-static void sfb__ref_eval_one(const sfb__patch_table *pt, const float *pts, const sfb_location *loc, double res[6][3], double nrm[3]) {
+/* The ref kernel: one location, double precision throughout. want2: the second derivatives are
+ * asked for (a manifold blend only forms them then: they cost it four more blends). */
+static void sfb__ref_eval_one(const sfb__patch_table *pt, const float *pts, const sfb_location *loc, int want2, double res[6][3],
+                              double nrm[3]) {
     double s, t, sc, nres[2][3];
     int patch = sfb__patch_locate(pt, loc->face, loc->u, loc->v, &s, &t, &sc), c;
     const int *cv;
@@ -1321,6 +1323,9 @@ static void sfb__ref_eval_one(const sfb__patch_table *pt, const float *pts, cons
     if (patch < 0) return;
     cv = pt->cv + pt->pfirst[patch];
     switch (pt->ptype[patch]) {
+    case SFB__PATCH_MANIFOLD4:
+        sfb__mf_eval_patch(pt, pts, patch, s, t, want2, res, nrm); /* its normal is final (manifold.c) */
+        goto scale;
     case SFB__PATCH_STAM:
         sfb__eval_stam(pt->eig[pt->pvalence[patch]], pts, cv, SFB__PARAM_CORNER(pt->pparam[patch]), s, t, res, nres);
         sfb__cross(nres[0], nres[1], nrm);
@@ -1365,6 +1370,7 @@ static void sfb__ref_eval_one(const sfb__patch_table *pt, const float *pts, cons
     }
     if (len > 0.0 && isfinite(len)) for (c = 0; c < 3; ++c) nrm[c] /= len;
     else nrm[0] = nrm[1] = nrm[2] = 0.0;
+scale:
     for (c = 0; c < 3; ++c) {
         res[1][c] *= sc; res[2][c] *= sc;
         res[3][c] *= sc * sc; res[4][c] *= sc * sc; res[5][c] *= sc * sc;
@@ -1378,20 +1384,7 @@ static sfb_result sfb__ref_eval_patches(void *state, const sfb__patch_table *pt,
     for (q = first; q < last; ++q) {
         double res[6][3], nrm[3];
         size_t o = 3 * (size_t)q;
-        if (pt->scheme == SFB_SCHEME_MANIFOLD_BLEND) {
-            /* second derivatives cost four more blends here: only when asked */
-            double s, t, sc;
-            int patch = sfb__patch_locate(pt, locs[q].face, locs[q].u, locs[q].v, &s, &t, &sc);
-            memset(res, 0, sizeof res); memset(nrm, 0, sizeof nrm);
-            if (patch >= 0) {
-                sfb__mf_eval_patch(pt, pt->point_data, patch, s, t, out->duu || out->duv || out->dvv, res, nrm);
-                for (c = 0; c < 3; ++c) {
-                    res[1][c] *= sc; res[2][c] *= sc;
-                    res[3][c] *= sc * sc; res[4][c] *= sc * sc; res[5][c] *= sc * sc;
-                }
-            }
-        } else
-            sfb__ref_eval_one(pt, pt->point_data, &locs[q], res, nrm);
+        sfb__ref_eval_one(pt, pt->point_data, &locs[q], out->duu || out->duv || out->dvv, res, nrm);
         for (c = 0; c < 3; ++c) {
             if (out->position) out->position[o + c] = (float)res[0][c];
             if (out->du) out->du[o + c] = (float)res[1][c];
