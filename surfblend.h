@@ -605,19 +605,14 @@ typedef struct sfb__stencils {
     size_t entries;
 } sfb__stencils;
 
-enum {
-    SFB__CAP_EVAL_STENCILS = 1u << 0,   /* eval_stencils on caller memory */
-    SFB__CAP_GL_BUFFERS = 1u << 1,      /* eval_stencils_gl on GL buffer objects (host context) */
-    SFB__CAP_EVAL_PATCHES = 1u << 2,    /* eval_patches */
-    SFB__CAP_FINISH_NORMALS = 1u << 3   /* finish_normals */
-};
-
-/* The kernels a backend implements. Every slot but name/kind/caps/init/shutdown may be NULL;
- * a NULL kernel with its capability bit cleared makes the core fall back to `ref` for it. */
+/* The kernels a backend implements, filled by NAME in the backend's bind function
+ * (sfb__ref_bind, sfb__simd_bind, sfb__gl_bind, sfb__osmesa_bind) on a zeroed table: a backend
+ * that lacks a kernel writes nothing for it, and a NULL kernel slot makes the core run `ref`'s
+ * (with a log line). Every slot but name/kind/init/shutdown may be NULL. A context keeps its
+ * own copy of the bound table (no global state). */
 typedef struct sfb__backend_vtable {
     const char *name;
     sfb_backend_kind kind;
-    unsigned caps;
     /* Returns SFB_SUCCESS and a state, or an error with `why` filled. The backend reads its
      * settings (threads, gl_use_current_context) from ctx and may keep ctx for errors/allocs. */
     sfb_result (*init)(sfb_context *ctx, void **state, char *why, size_t why_size);
@@ -670,15 +665,28 @@ typedef struct sfb__backend_vtable {
 #if defined(SURFBLEND_OSMESA) && !defined(SURFBLEND_GL)
 #  define SURFBLEND_GL /* osmesa runs the gl kernels */
 #endif
+/* Each fills the slots its backend implements (see sfb__backend_vtable). */
+typedef void (*sfb__backend_bind_fn)(sfb__backend_vtable *vt);
+void sfb__ref_bind(sfb__backend_vtable *vt);
+/* Zeroes *vt and binds the backend `kind` into it; 0 when that backend is not built in. */
+int sfb__backend_bind(sfb_backend_kind kind, sfb__backend_vtable *vt);
 #ifdef SURFBLEND_SIMD
-const sfb__backend_vtable *sfb__backend_simd(void);
+void sfb__simd_bind(sfb__backend_vtable *vt);
 #endif
 #ifdef SURFBLEND_GL
-const sfb__backend_vtable *sfb__backend_gl(void);
+void sfb__gl_bind(sfb__backend_vtable *vt);
 #endif
 #ifdef SURFBLEND_OSMESA
-const sfb__backend_vtable *sfb__backend_osmesa(void);
+void sfb__osmesa_bind(sfb__backend_vtable *vt);
 #endif
+/* The ref kernels, callable directly (the oracle; other backends hand it what they cannot do). */
+sfb_result sfb__ref_eval_stencils(void *state, const sfb__stencils *t, void *handle, int first, int last, const float *src,
+                                  sfb_buffer_desc sd, float *dst, sfb_buffer_desc dd);
+struct sfb__patch_table;
+sfb_result sfb__ref_eval_patches(void *state, const struct sfb__patch_table *pt, void *handle, const sfb_location *locs, int first,
+                                 int last, const sfb_eval_output *out);
+sfb_result sfb__ref_finish_normals(void *state, int first, int last, const float *tu, const float *tv, const float *ns,
+                                   const int *ns_index, const float *b, float p, float *out_blend, float *out_limit, float *out_sub);
 
 /* ---- Stam eigen structures (stam.c) ---- */
 #define SFB__STAM_MAX_VALENCE 256
@@ -709,8 +717,26 @@ typedef struct sfb__eigen_loop {
 
 
 /* ---- patch tables (patches.c) ---- */
+/* Patch kinds of the patch table (patches.c, manifold.c). */
+enum { SFB__PATCH_BSPLINE = 0, SFB__PATCH_STAM = 1, SFB__PATCH_ENDCAP = 2, SFB__PATCH_BEZTRI = 3, SFB__PATCH_STAM_LOOP = 4,
+       SFB__PATCH_ENDCAP_TRI = 5, SFB__PATCH_MANIFOLD4 = 6, SFB__PATCH_TYPE_COUNT = 7 };
+/* Kernel families: the record types one backend kernel evaluates together (one file per backend
+ * each, docs/ARCHITECTURE.md). */
+enum { SFB__FAMILY_QUAD = 0,     /* BSPLINE16, STAM, ENDCAP: polynomial quad patches */
+       SFB__FAMILY_TRI = 1,      /* BEZTRI15, STAM_LOOP, ENDCAP_TRI: polynomial triangle patches */
+       SFB__FAMILY_MANIFOLD = 2, /* MANIFOLD4: seed 000's blend of chart geometries */
+       SFB__FAMILY_COUNT = 3 };
+static inline int sfb__patch_family(int type) {
+    return type <= SFB__PATCH_ENDCAP ? SFB__FAMILY_QUAD : type <= SFB__PATCH_ENDCAP_TRI ? SFB__FAMILY_TRI : SFB__FAMILY_MANIFOLD;
+}
+/* What a patch table is, for its readers (locate, evaluation kernels, tessellation): the
+ * parametric DOMAIN of its faces, and per record a kernel FAMILY (from the record's type,
+ * sfb__patch_family). Only the scheme builders know the scheme; nothing reading a table asks it. */
+enum { SFB__DOMAIN_QUAD = 0,   /* (u,v) in [0,1]^2, quadtree sub-patches */
+       SFB__DOMAIN_TRI = 1 };  /* barycentric (u,v), u + v <= 1, triangle-tree sub-patches */
 typedef struct sfb__patch_table {
-    int scheme, isolation, max_depth;
+    int domain;            /* SFB__DOMAIN_*, set by the builder */
+    int isolation, max_depth;
     int npatch, ncv, nptex, nnodes;
     int *ptype;            /* SFB__PATCH_* per patch */
     int *pfirst;           /* npatch + 1: first control point of each patch in cv */
@@ -721,7 +747,7 @@ typedef struct sfb__patch_table {
     int *face_ptex;        /* per base face + 1: first param face */
     int *ptex_root;        /* per param face: >= 0 node, <= -2 patch -(p+2), -1 hole */
     int *nodes;            /* 4 per quadtree node, by quadrant x + 2y, same encoding */
-    int counts[8];         /* patches of each type (SFB__PATCH_*) */
+    int counts[SFB__PATCH_TYPE_COUNT]; /* patches of each type (SFB__PATCH_*) */
     unsigned *pcorner;     /* MANIFOLD4: 4 corner codes per patch (SFB__MF_CODE) */
     int mf_weights;        /* MANIFOLD4: SFB_MANIFOLD_WEIGHTS_* */
     int npoints;           /* patch points */
@@ -740,8 +766,10 @@ struct sfb_context {
     int threads, gl_use_current_context;
     sfb_backend_kind order[SFB_BACKEND_KIND_COUNT_];
     int order_count;
-    const sfb__backend_vtable *backend;
+    const sfb__backend_vtable *backend; /* &backend_vt once a backend is selected, else NULL */
     void *backend_state;
+    sfb__backend_vtable backend_vt;     /* the selected backend's bound table */
+    sfb__backend_vtable ref_vt;         /* ref's, for the kernels the selected backend lacks */
     sfb__eigen_cc *eigen_cc[SFB__STAM_MAX_VALENCE + 1]; /* per valence, built on first use */
     unsigned char eigen_cc_failed[SFB__STAM_MAX_VALENCE + 1];
     sfb__eigen_loop *eigen_loop[SFB__STAM_MAX_VALENCE + 1];
@@ -774,7 +802,6 @@ sfb_result sfb__oom(sfb_context *ctx, const char *what);
 sfb_result sfb__progress(sfb_context *ctx, float done, const char *stage);
 sfb_result sfb__select_backend(sfb_context *ctx, const char *env_override);
 sfb_result sfb__context_create_reporting(const sfb_context_config *config, sfb_context **out, char *report, size_t size);
-const sfb__backend_vtable *sfb__backend_ref(void);
 void sfb__eigen_cc_free(sfb_context *ctx, sfb__eigen_cc *e);
 sfb_result sfb__eigen_cc_build(sfb_context *ctx, int N, int keep, sfb__eigen_cc **out);
 const sfb__eigen_cc *sfb__eigen_cc_get(sfb_context *ctx, int N);
@@ -887,9 +914,14 @@ sfb_result sfb__shading_build(sfb_context *ctx, const sfb__level *prep, const sf
 
 /* patches.c */
 void sfb__patch_table_free(sfb_context *ctx, sfb__patch_table *pt);
-/* Patch kinds of the patch table (patches.c, manifold.c). */
-enum { SFB__PATCH_BSPLINE = 0, SFB__PATCH_STAM = 1, SFB__PATCH_ENDCAP = 2, SFB__PATCH_BEZTRI = 3, SFB__PATCH_STAM_LOOP = 4,
-       SFB__PATCH_ENDCAP_TRI = 5, SFB__PATCH_MANIFOLD4 = 6 };
+/* The families present in a table, as bits 1 << SFB__FAMILY_*. */
+static inline unsigned sfb__patch_families(const sfb__patch_table *pt) {
+    unsigned m = 0;
+    int t;
+    for (t = 0; t < SFB__PATCH_TYPE_COUNT; ++t)
+        if (pt->counts[t] > 0) m |= 1u << sfb__patch_family(t);
+    return m;
+}
 /* Manifold blending (manifold.c): a corner code packs the corner vertex's local geometry kind,
  * its valence k and the index h of the face in its star (the chart), and for a curve the axes
  * (1: a, 2: b, 0: not in this face) of its sharp edges e1 and e2. */
@@ -1165,22 +1197,32 @@ SFB_API sfb_backend_kind sfb_backend_kind_parse(const char *name) {
     return SFB_BACKEND_DEFAULT;
 }
 
-/* Optional backends live in backends/sfb_NAME.h, compiled in by SURFBLEND_NAME (see
- * sfb_internal.h). Those not compiled in report "not built in". */
-static const sfb__backend_vtable *sfb__backend_lookup(sfb_backend_kind kind) {
+/* Optional backends live in backends/ (sfb_NAME.h), compiled in by SURFBLEND_NAME (see
+ * sfb_internal.h). Those not compiled in report "not built in". A backend is its bind function:
+ * it fills the named slots it implements in a zeroed table. */
+static sfb__backend_bind_fn sfb__backend_binder(sfb_backend_kind kind) {
     switch (kind) {
-    case SFB_BACKEND_REF: return sfb__backend_ref();
+    case SFB_BACKEND_REF: return sfb__ref_bind;
 #ifdef SURFBLEND_SIMD
-    case SFB_BACKEND_SIMD: return sfb__backend_simd();
+    case SFB_BACKEND_SIMD: return sfb__simd_bind;
 #endif
 #ifdef SURFBLEND_GL
-    case SFB_BACKEND_GL: return sfb__backend_gl();
+    case SFB_BACKEND_GL: return sfb__gl_bind;
 #endif
 #ifdef SURFBLEND_OSMESA
-    case SFB_BACKEND_OSMESA: return sfb__backend_osmesa();
+    case SFB_BACKEND_OSMESA: return sfb__osmesa_bind;
 #endif
     default: return NULL;
     }
+}
+
+/* The table of `kind` bound into `vt` (zeroed first); 0 when the backend is not built in. */
+int sfb__backend_bind(sfb_backend_kind kind, sfb__backend_vtable *vt) {
+    sfb__backend_bind_fn bind = sfb__backend_binder(kind);
+    memset(vt, 0, sizeof *vt);
+    if (!bind) return 0;
+    bind(vt);
+    return vt->name != NULL && vt->init != NULL && vt->shutdown != NULL;
 }
 
 static void sfb__report_add(sfb_context *ctx, const char *fmt, ...) {
@@ -1193,11 +1235,12 @@ static void sfb__report_add(sfb_context *ctx, const char *fmt, ...) {
 }
 
 static int sfb__try_backend(sfb_context *ctx, sfb_backend_kind kind) {
-    const sfb__backend_vtable *vt = sfb__backend_lookup(kind);
+    sfb__backend_vtable table;
+    const sfb__backend_vtable *vt = &table;
     char why[512];
     void *state = NULL;
     sfb_result r;
-    if (!vt) {
+    if (!sfb__backend_bind(kind, &table)) {
         sfb__report_add(ctx, "%s: unavailable (not built in: define SURFBLEND_%s or SURFBLEND_ALL_BACKENDS with SURFBLEND_IMPLEMENTATION)\n",
                         sfb_backend_kind_name(kind), kind == SFB_BACKEND_SIMD ? "SIMD" : kind == SFB_BACKEND_GL ? "GL" : "OSMESA");
         sfb__log(ctx, SFB_LOG_INFO, "backend %s not built in, trying the next", sfb_backend_kind_name(kind));
@@ -1210,7 +1253,8 @@ static int sfb__try_backend(sfb_context *ctx, sfb_backend_kind kind) {
         sfb__log(ctx, SFB_LOG_INFO, "backend %s failed to initialise (%s), trying the next", vt->name, why);
         return 0;
     }
-    ctx->backend = vt;
+    ctx->backend_vt = table;
+    ctx->backend = vt = &ctx->backend_vt;
     ctx->backend_state = state;
     why[0] = 0;
     if (vt->describe) vt->describe(state, why, sizeof why);
@@ -1223,6 +1267,7 @@ static int sfb__try_backend(sfb_context *ctx, sfb_backend_kind kind) {
 sfb_result sfb__select_backend(sfb_context *ctx, const char *env) {
     int i;
     ctx->report[0] = 0;
+    sfb__backend_bind(SFB_BACKEND_REF, &ctx->ref_vt);
     if (env && *env) {
         sfb_backend_kind k = sfb_backend_kind_parse(env);
         if (k == SFB_BACKEND_DEFAULT) {
@@ -1262,14 +1307,13 @@ SFB_API sfb_result sfb_context_backend_info(const sfb_context *ctx, char *buf, s
 }
 
 SFB_API sfb_result sfb_backend_probe(sfb_backend_kind kind, const sfb_context_config *config, char *info, size_t size) {
-    const sfb__backend_vtable *vt;
+    sfb__backend_vtable vt;
     sfb_context_config c = config ? *config : sfb_context_config_init();
     sfb_context *ctx = NULL;
     sfb_result r;
     if (!info || size == 0 || (int)kind <= SFB_BACKEND_DEFAULT || kind >= SFB_BACKEND_KIND_COUNT_) return SFB_INVALID_ARGS;
     info[0] = 0;
-    vt = sfb__backend_lookup(kind);
-    if (!vt) {
+    if (!sfb__backend_bind(kind, &vt)) {
         snprintf(info, size, "not built in: define SURFBLEND_%s or SURFBLEND_ALL_BACKENDS with SURFBLEND_IMPLEMENTATION",
                  kind == SFB_BACKEND_SIMD ? "SIMD" : kind == SFB_BACKEND_GL ? "GL" : kind == SFB_BACKEND_OSMESA ? "OSMESA" : "REF");
         return SFB_BACKEND_UNAVAILABLE;
@@ -1281,7 +1325,7 @@ SFB_API sfb_result sfb_backend_probe(sfb_backend_kind kind, const sfb_context_co
     r = sfb__context_create_reporting(&c, &ctx, info, size);
     if (r != SFB_SUCCESS) return r == SFB_NO_BACKEND ? SFB_BACKEND_UNAVAILABLE : r;
     info[0] = 0;
-    if (vt->describe) vt->describe(ctx->backend_state, info, size);
+    if (vt.describe) vt.describe(ctx->backend_state, info, size);
     sfb_context_destroy(ctx);
     return SFB_SUCCESS;
 }
@@ -1327,7 +1371,7 @@ static sfb_result sfb__ref_init(sfb_context *ctx, void **state, char *why, size_
 
 static void sfb__ref_shutdown(sfb_context *ctx, void *state) { (void)ctx; (void)state; }
 
-static sfb_result sfb__ref_eval_stencils(void *state, const sfb__stencils *t, void *handle, int first, int last,
+sfb_result sfb__ref_eval_stencils(void *state, const sfb__stencils *t, void *handle, int first, int last,
                                          const float *src, sfb_buffer_desc sd, float *dst, sfb_buffer_desc dd) {
     int r, c, k;
     double acc[16];
@@ -1356,7 +1400,7 @@ static void sfb__ref_unit3(double *v) {
     else v[0] = v[1] = v[2] = 0.0;
 }
 
-static sfb_result sfb__ref_finish_normals(void *state, int first, int last, const float *tu, const float *tv,
+sfb_result sfb__ref_finish_normals(void *state, int first, int last, const float *tu, const float *tv,
                                           const float *ns, const int *ns_index, const float *b, float p,
                                           float *out_blend, float *out_limit, float *out_sub) {
     int i, c;
@@ -1389,17 +1433,16 @@ static sfb_result sfb__ref_finish_normals(void *state, int first, int last, cons
     return SFB_SUCCESS;
 }
 
-/* in patches.c */
-static sfb_result sfb__ref_eval_patches(void *state, const sfb__patch_table *pt, void *handle, const sfb_location *locs, int first,
-                                        int last, const sfb_eval_output *out);
-
-static const sfb__backend_vtable sfb__ref_vtable = {
-    "ref", SFB_BACKEND_REF, SFB__CAP_EVAL_STENCILS | SFB__CAP_EVAL_PATCHES | SFB__CAP_FINISH_NORMALS,
-    sfb__ref_init, sfb__ref_shutdown, NULL, NULL, NULL, sfb__ref_eval_stencils, NULL,
-    NULL, NULL, sfb__ref_eval_patches, sfb__ref_finish_normals
-};
-
-const sfb__backend_vtable *sfb__backend_ref(void) { return &sfb__ref_vtable; }
+/* Every kernel (sfb__ref_eval_patches is in patches.c). */
+void sfb__ref_bind(sfb__backend_vtable *vt) {
+    vt->name = "ref";
+    vt->kind = SFB_BACKEND_REF;
+    vt->init = sfb__ref_init;
+    vt->shutdown = sfb__ref_shutdown;
+    vt->eval_stencils = sfb__ref_eval_stencils;
+    vt->eval_patches = sfb__ref_eval_patches;
+    vt->finish_normals = sfb__ref_finish_normals;
+}
 #line 1 "src/topology.c"
 /* Topology of one level: adjacency, counter-clockwise ordering around manifold vertices,
  * boundary and non-manifold tags, vertex rules. */
@@ -3864,9 +3907,9 @@ sfb_result sfb__patches_build(sfb_context *ctx, const sfb__level *base, const sf
     memset(pt, 0, sizeof *pt);
     b.ctx = ctx;
     b.pt = pt;
-    pt->scheme = opt->scheme;
-    pt->isolation = limit;
     tri = opt->scheme == SFB_SCHEME_LOOP;
+    pt->domain = tri ? SFB__DOMAIN_TRI : SFB__DOMAIN_QUAD;
+    pt->isolation = limit;
     /* param faces */
     pt->face_ptex = (int *)sfb__alloc(ctx, ((size_t)base->nf + 1) * sizeof(int));
     if (!pt->face_ptex) goto oom;
@@ -4102,7 +4145,7 @@ done:
 int sfb__patch_locate(const sfb__patch_table *pt, int ptex, double u, double v, double *s, double *t, double *scale) {
     int node = pt->ptex_root[ptex];
     double sc = 1.0;
-    if (pt->scheme == SFB_SCHEME_LOOP) {
+    if (pt->domain == SFB__DOMAIN_TRI) {
         /* triangles: *scale is negative after an odd number of middle children */
         while (node >= 0) {
             int c;
@@ -4456,7 +4499,7 @@ static void sfb__ref_eval_one(const sfb__patch_table *pt, const float *pts, cons
     if (!(len > 0.0) || !isfinite(len)) {
         /* degenerate tangents (a collapsed control net): the normal a step inside the patch */
         double r2[6][3];
-        int ty = pt->ptype[patch], tri = pt->scheme == SFB_SCHEME_LOOP;
+        int ty = pt->ptype[patch], tri = pt->domain == SFB__DOMAIN_TRI;
         double s2 = s + (s < 0.5 ? 1e-3 : -1e-3), t2 = t + (t < 0.5 ? 1e-3 : -1e-3);
         if (tri && s2 + t2 > 1.0) { s2 = s - 1e-3; t2 = t - 1e-3; }
         if (tri && s + t < 2e-3) { s2 = s + 1e-3; t2 = t + 1e-3; }
@@ -4478,7 +4521,7 @@ scale:
     }
 }
 
-static sfb_result sfb__ref_eval_patches(void *state, const sfb__patch_table *pt, void *handle, const sfb_location *locs, int first,
+sfb_result sfb__ref_eval_patches(void *state, const sfb__patch_table *pt, void *handle, const sfb_location *locs, int first,
                                         int last, const sfb_eval_output *out) {
     int q, c;
     (void)state; (void)handle;
@@ -4833,7 +4876,7 @@ sfb_result sfb__manifold_build(sfb_context *ctx, const sfb__level *base, int wei
     memset(&work, 0, sizeof work); memset(&lev1, 0, sizeof lev1); memset(&T, 0, sizeof T);
     if (weights != SFB_MANIFOLD_WEIGHTS_HERMITE && weights != SFB_MANIFOLD_WEIGHTS_CINF)
         return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, -1, "manifold weights %d are not SFB_MANIFOLD_WEIGHTS_HERMITE or _CINF", weights);
-    pt->scheme = SFB_SCHEME_MANIFOLD_BLEND;
+    pt->domain = SFB__DOMAIN_QUAD;
     pt->mf_weights = weights;
     for (f = 0; f < base->nf; ++f) if (base->fv_off[f + 1] - base->fv_off[f] != 4) quads = 0;
     if (quads) {
@@ -6005,7 +6048,7 @@ SFB_API sfb_result sfb_surface_tessellate(const sfb_surface *s, const sfb_tess_c
     T.pt = &s->patches;
     T.rate = cfg->rate;
     T.split = (cfg->flags & SFB_TESS_SPLIT_CREASES) != 0;
-    T.loop = T.pt->scheme == SFB_SCHEME_LOOP;
+    T.loop = T.pt->domain == SFB__DOMAIN_TRI;
     nptex = T.pt->nptex;
     T.prate = (int *)sfb__tess_array(ctx, (size_t)nptex, sizeof(int));
     T.sseg = (int *)sfb__tess_array(ctx, (size_t)nptex, sizeof(int));
@@ -7449,7 +7492,7 @@ SFB_API sfb_result sfb_surface_eval(const sfb_surface *s, const sfb_location *lo
         if (!(l->u >= 0.0f && l->u <= 1.0f && l->v >= 0.0f && l->v <= 1.0f))
             return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, q, "location %d: (u,v) = (%g,%g) is outside [0,1]^2", q, (double)l->u,
                               (double)l->v);
-        if (s->patches.scheme == SFB_SCHEME_LOOP && (double)l->u + (double)l->v > 1.0)
+        if (s->patches.domain == SFB__DOMAIN_TRI && (double)l->u + (double)l->v > 1.0)
             return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, q, "location %d: (u,v) = (%g,%g) is outside the triangle u + v <= 1", q,
                               (double)l->u, (double)l->v);
         /* holes are whole parametric faces (a hole is a base face), so the root says it */
@@ -7458,9 +7501,9 @@ SFB_API sfb_result sfb_surface_eval(const sfb_surface *s, const sfb_location *lo
     }
     if (count == 0) return SFB_SUCCESS;
     be = ctx->backend;
-    if (!be || !(be->caps & SFB__CAP_EVAL_PATCHES) || !be->eval_patches) {
+    if (!be || !be->eval_patches) {
         sfb__log(ctx, SFB_LOG_INFO, "backend %s lacks eval_patches; using ref", be ? be->name : "none");
-        return sfb__backend_ref()->eval_patches(NULL, &s->patches, NULL, loc, 0, count, out);
+        return sfb__ref_eval_patches(NULL, &s->patches, NULL, loc, 0, count, out);
     }
     return be->eval_patches(ctx->backend_state, &s->patches, s->uploaded_by == be ? s->backend_patches : NULL, loc, 0, count, out);
 }
@@ -7491,9 +7534,9 @@ static sfb_result sfb__surface_apply(const sfb_surface *s, const sfb__stencils *
                                      sfb_buffer_desc sd, float *dst, sfb_buffer_desc dd) {
     sfb_context *ctx = s->ctx;
     const sfb__backend_vtable *be = ctx->backend;
-    if (!be || !(be->caps & SFB__CAP_EVAL_STENCILS) || !be->eval_stencils) {
+    if (!be || !be->eval_stencils) {
         sfb__log(ctx, SFB_LOG_INFO, "backend %s lacks eval_stencils; using ref", be ? be->name : "none");
-        return sfb__backend_ref()->eval_stencils(NULL, t, NULL, 0, rows, src, sd, dst, dd);
+        return sfb__ref_eval_stencils(NULL, t, NULL, 0, rows, src, sd, dst, dd);
     }
     if (rows <= 0) return SFB_SUCCESS;
     return be->eval_stencils(ctx->backend_state, t, s->uploaded_by == be ? handle : NULL, 0, rows, src, sd, dst, dd);
@@ -7516,7 +7559,7 @@ SFB_API sfb_result sfb_surface_eval_stencils_gl(const sfb_surface *s, sfb_table 
     ctx = s->ctx;
     if ((r = sfb__eval_args(s, t, src_buffer && dst_buffer, sd, dd, "GL buffers")) != SFB_SUCCESS) return r;
     be = ctx->backend;
-    if (!be || !(be->caps & SFB__CAP_GL_BUFFERS) || !be->eval_stencils_gl)
+    if (!be || !be->eval_stencils_gl)
         return sfb__error(ctx, SFB_UNSUPPORTED, SFB_ELEMENT_NONE, -1,
                           "sfb_surface_eval_stencils_gl needs the gl backend on the host's context (gl_use_current_context); this context runs %s",
                           be ? be->name : "no backend");
@@ -8478,9 +8521,9 @@ SFB_API sfb_result sfb_surface_shade(const sfb_surface *s, const sfb_shade_param
         (r = sfb__shade_apply(s, &sh->lim[2], sh->handles[4], sh->nout, refined, o->tangents_v)) != SFB_SUCCESS)
         goto fail;
     be = ctx->backend;
-    if (!be || !(be->caps & SFB__CAP_FINISH_NORMALS) || !be->finish_normals) {
+    if (!be || !be->finish_normals) {
         sfb__log(ctx, SFB_LOG_INFO, "backend %s lacks finish_normals; using ref", be ? be->name : "none");
-        be = sfb__backend_ref();
+        be = &ctx->ref_vt;
     }
     r = be->finish_normals(be == ctx->backend ? ctx->backend_state : NULL, 0, sh->nout, o->tangents_u, o->tangents_v, ns,
                            all ? sh->ns_idx_all : sh->ns_idx_w, sh->b, prm.p, o->normals, o->limit_normals, o->subdivided_normals);

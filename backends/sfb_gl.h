@@ -1452,7 +1452,7 @@ static sfb_result sfb__gl_upload_patches(void *state, const sfb__patch_table *pt
     sfb_result r;
     *handle = NULL;
     if ((r = sfb__gl_enter(g, &s)) != SFB_SUCCESS) return r;
-    if (pt->scheme == SFB_SCHEME_MANIFOLD_BLEND) r = sfb__gl_mf_upload_current(g, pt, &tab);
+    if (sfb__patch_families(pt) & (1u << SFB__FAMILY_MANIFOLD)) r = sfb__gl_mf_upload_current(g, pt, &tab);
     else r = sfb__gl_patches_upload_current(g, pt, &tab);
     sfb__gl_leave(g, &s);
     *handle = tab;
@@ -1472,8 +1472,9 @@ static void sfb__gl_release_patches(void *state, void *handle) {
     }
 }
 
-/* The patch kernel of a scheme (loop = 0: Catmull-Clark kinds, 1: Loop kinds): one source,
- * the other scheme's kinds left out by a define, so that neither pays the other's compile. */
+/* The patch kernel of a family (loop = 0: the quad family's kinds, 1: the triangle family's):
+ * one source, the other family's kinds left out by a define, so that neither pays the other's
+ * compile. */
 static sfb_result sfb__gl_patch_program(sfb__gl *g, int loop, sfb__GLuint *out) {
     sfb__GLuint prog;
     sfb_result r;
@@ -1850,13 +1851,13 @@ static sfb_result sfb__gl_eval_patches(void *state, const sfb__patch_table *pt, 
     sfb__GLint slot[SFB__GL_OUTPUTS];
     sfb__gl_query *queries = NULL, *sorted = NULL;
     int *order = NULL, *piece_start = NULL, *key = NULL, *bucket = NULL;
-    int count = last - first, nout = 0, o, q, i, k, stride, used = 0, loop = pt->scheme == SFB_SCHEME_LOOP;
+    int count = last - first, nout = 0, o, q, i, k, stride, used = 0, loop = pt->domain == SFB__DOMAIN_TRI;
     size_t batch, nbuckets, z;
     long long per = (long long)g->max_groups * 64;
     sfb__gl_saved s;
     sfb__GLuint prog;
     sfb_result res;
-    if (pt->scheme == SFB_SCHEME_MANIFOLD_BLEND) return sfb__gl_mf_eval(g, pt, tab, locs, first, last, out);
+    if (sfb__patch_families(pt) & (1u << SFB__FAMILY_MANIFOLD)) return sfb__gl_mf_eval(g, pt, tab, locs, first, last, out);
     dst[0] = out->position; dst[1] = out->du; dst[2] = out->dv; dst[3] = out->normal;
     dst[4] = out->duu; dst[5] = out->duv; dst[6] = out->dvv;
     for (o = 0; o < SFB__GL_OUTPUTS; ++o) slot[o] = dst[o] ? nout++ : -1;
@@ -2154,13 +2155,26 @@ done:
     return res;
 }
 
-static const sfb__backend_vtable sfb__gl_vtable = {
-    "gl", SFB_BACKEND_GL, SFB__CAP_EVAL_STENCILS | SFB__CAP_GL_BUFFERS | SFB__CAP_EVAL_PATCHES | SFB__CAP_FINISH_NORMALS,
-    sfb__gl_init, sfb__gl_shutdown, sfb__gl_describe, sfb__gl_upload, sfb__gl_release, sfb__gl_eval, sfb__gl_eval_buffers,
-    sfb__gl_upload_patches, sfb__gl_release_patches, sfb__gl_eval_patches, sfb__gl_finish_normals
-};
+/* The kernels gl and osmesa share (osmesa binds these, then its own init and no host buffers). */
+static void sfb__gl_bind_kernels(sfb__backend_vtable *vt) {
+    vt->shutdown = sfb__gl_shutdown;
+    vt->describe = sfb__gl_describe;
+    vt->upload_stencils = sfb__gl_upload;
+    vt->release_stencils = sfb__gl_release;
+    vt->eval_stencils = sfb__gl_eval;
+    vt->upload_patches = sfb__gl_upload_patches;
+    vt->release_patches = sfb__gl_release_patches;
+    vt->eval_patches = sfb__gl_eval_patches;
+    vt->finish_normals = sfb__gl_finish_normals;
+}
 
-const sfb__backend_vtable *sfb__backend_gl(void) { return &sfb__gl_vtable; }
+void sfb__gl_bind(sfb__backend_vtable *vt) {
+    vt->name = "gl";
+    vt->kind = SFB_BACKEND_GL;
+    vt->init = sfb__gl_init;
+    sfb__gl_bind_kernels(vt);
+    vt->eval_stencils_gl = sfb__gl_eval_buffers;
+}
 
 /* ---- the draw path: seed 000's vertex and fragment programs (sfb_surface_draw_gl) ---- */
 /* Uniforms of the draw program: manifold.comp.glsl's shared five (sfb__gl_mf_common_uniforms),
@@ -2172,7 +2186,7 @@ static const char *const sfb__gl_draw_uniforms[9] = {"u_mvp", "u_normal_matrix",
  * (SFB_UNSUPPORTED, naming `fn` and what the context runs). */
 static sfb_result sfb__gl_host_of(sfb_context *ctx, const char *fn, sfb__gl **out) {
     const sfb__backend_vtable *be = ctx->backend;
-    sfb__gl *g = be == &sfb__gl_vtable ? (sfb__gl *)ctx->backend_state : NULL;
+    sfb__gl *g = be && be->kind == SFB_BACKEND_GL ? (sfb__gl *)ctx->backend_state : NULL;
     *out = NULL;
     if (!g || g->mode != SFB__GL_HOST)
         return sfb__error(ctx, SFB_UNSUPPORTED, SFB_ELEMENT_NONE, -1,
@@ -2296,7 +2310,7 @@ SFB_API sfb_result sfb_surface_draw_gl(const sfb_surface *surface, const sfb_gl_
     if (!params) return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "sfb_surface_draw_gl: params is NULL");
     if ((r = sfb__gl_host_of(ctx, "sfb_surface_draw_gl", &g)) != SFB_SUCCESS) return r;
     pt = &surface->patches;
-    if (!surface->has_patches || pt->scheme != SFB_SCHEME_MANIFOLD_BLEND)
+    if (!surface->has_patches || !(sfb__patch_families(pt) & (1u << SFB__FAMILY_MANIFOLD)))
         return sfb__error(ctx, SFB_UNSUPPORTED, SFB_ELEMENT_NONE, -1,
                           "sfb_surface_draw_gl draws manifold blending surfaces (SFB_SCHEME_MANIFOLD_BLEND with SFB_REFINE_PATCHES); this surface is %s%s",
                           sfb_scheme_name(surface->config.scheme), surface->has_patches ? "" : " without patches");
@@ -2370,7 +2384,7 @@ SFB_API sfb_result sfb_surface_draw_gl(const sfb_surface *surface, const sfb_gl_
             goto done;
         }
     }
-    tab = surface->uploaded_by == &sfb__gl_vtable ? (sfb__gl_ptable *)surface->backend_patches : NULL;
+    tab = surface->uploaded_by && surface->uploaded_by->kind == SFB_BACKEND_GL ? (sfb__gl_ptable *)surface->backend_patches : NULL;
     if (!tab || !tab->manifold) {
         if ((r = sfb__gl_mf_upload_current(g, pt, &temp)) != SFB_SUCCESS) goto done;
         tab = temp;

@@ -92,12 +92,11 @@ static sfb_result sfb__osmesa_init(sfb_context *ctx, void **state, char *why, si
     return SFB_SUCCESS;
 }
 
-static const sfb__backend_vtable sfb__osmesa_vtable = {
-    "osmesa", SFB_BACKEND_OSMESA, SFB__CAP_EVAL_STENCILS | SFB__CAP_EVAL_PATCHES | SFB__CAP_FINISH_NORMALS,
-    sfb__osmesa_init, sfb__gl_shutdown, sfb__gl_describe, sfb__gl_upload, sfb__gl_release, sfb__gl_eval, NULL,
-    sfb__gl_upload_patches, sfb__gl_release_patches, sfb__gl_eval_patches, sfb__gl_finish_normals
-};
-
-const sfb__backend_vtable *sfb__backend_osmesa(void) { return &sfb__osmesa_vtable; }
+void sfb__osmesa_bind(sfb__backend_vtable *vt) {
+    vt->name = "osmesa";
+    vt->kind = SFB_BACKEND_OSMESA;
+    sfb__gl_bind_kernels(vt);
+    vt->init = sfb__osmesa_init;
+}
 
 #endif /* SFB__OSMESA_H */

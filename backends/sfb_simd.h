@@ -542,7 +542,7 @@ static void sfb__simd_basis(float t, float b[4], float d[4], float dd[4]) {
 
 /* Location q on the ref kernel (rare cases; writes exactly q's three floats per output). */
 static void sfb__simd_ref_one(const sfb__simd_pjob *j, int q) {
-    sfb__backend_ref()->eval_patches(NULL, j->pt, NULL, j->locs, q, q + 1, j->out);
+    sfb__ref_eval_patches(NULL, j->pt, NULL, j->locs, q, q + 1, j->out);
 }
 
 /* Writes location q (exactly three floats per asked output). */
@@ -3084,7 +3084,7 @@ static sfb_result sfb__simd_upload_patches(void *state, const sfb__patch_table *
     *handle = NULL;
     ctx = s->ctx;
     if (pt->npatch <= 0 || pt->nptex <= 0 || !pt->point_data) return SFB_SUCCESS; /* nothing to pack: eval goes to ref */
-    if (pt->scheme == SFB_SCHEME_MANIFOLD_BLEND) return sfb__simd_upload_mf(s, pt, handle);
+    if (sfb__patch_families(pt) & (1u << SFB__FAMILY_MANIFOLD)) return sfb__simd_upload_mf(s, pt, handle);
     for (p = 0; p < pt->npatch; ++p) {
         const size_t f = sfb__simd_patch_floats(pt, p);
         nf += f;
@@ -3154,7 +3154,7 @@ static sfb_result sfb__simd_upload_patches(void *state, const sfb__patch_table *
 
 /* Locations [first, last) on the ref kernel (manifold tables with second derivatives asked). */
 static void sfb__simd_ref_range(const sfb__simd_pjob *j, int first, int last) {
-    sfb__backend_ref()->eval_patches(NULL, j->pt, NULL, j->locs, first, last, j->out);
+    sfb__ref_eval_patches(NULL, j->pt, NULL, j->locs, first, last, j->out);
 }
 
 static void sfb__simd_patch_task(const sfb__simd_state *s, const void *arg, int a, int b) {
@@ -3171,13 +3171,13 @@ static sfb_result sfb__simd_eval_patches(void *state, const sfb__patch_table *pt
     if (!s || !pt || !locs || !out || first < 0 || first > last) return SFB_INVALID_ARGS;
     if (first == last) return SFB_SUCCESS;
     /* no packed data (not uploaded here, or an empty table): ref evaluates the call */
-    if (!h || h->npatch != pt->npatch || h->nptex != pt->nptex) return sfb__backend_ref()->eval_patches(NULL, pt, NULL, locs, first, last, out);
+    if (!h || h->npatch != pt->npatch || h->nptex != pt->nptex) return sfb__ref_eval_patches(NULL, pt, NULL, locs, first, last, out);
     j.pt = pt;
     j.h = h;
     j.locs = locs;
     j.out = out;
     j.second = out->duu || out->duv || out->dvv;
-    j.tri = pt->scheme == SFB_SCHEME_LOOP;
+    j.tri = pt->domain == SFB__DOMAIN_TRI;
     j.bs = s->pbs;
     j.tri_eval = s->ptri;
     j.range = s->prange;
@@ -3222,12 +3222,17 @@ static sfb_result sfb__simd_finish_normals(void *state, int first, int last, con
     return SFB_SUCCESS;
 }
 
-static const sfb__backend_vtable sfb__simd_vtable = {
-    "simd", SFB_BACKEND_SIMD, SFB__CAP_EVAL_STENCILS | SFB__CAP_EVAL_PATCHES | SFB__CAP_FINISH_NORMALS,
-    sfb__simd_init, sfb__simd_shutdown, sfb__simd_describe, NULL, NULL, sfb__simd_eval_stencils, NULL,
-    sfb__simd_upload_patches, sfb__simd_release_patches, sfb__simd_eval_patches, sfb__simd_finish_normals
-};
-
-const sfb__backend_vtable *sfb__backend_simd(void) { return &sfb__simd_vtable; }
+void sfb__simd_bind(sfb__backend_vtable *vt) {
+    vt->name = "simd";
+    vt->kind = SFB_BACKEND_SIMD;
+    vt->init = sfb__simd_init;
+    vt->shutdown = sfb__simd_shutdown;
+    vt->describe = sfb__simd_describe;
+    vt->eval_stencils = sfb__simd_eval_stencils;
+    vt->upload_patches = sfb__simd_upload_patches;
+    vt->release_patches = sfb__simd_release_patches;
+    vt->eval_patches = sfb__simd_eval_patches;
+    vt->finish_normals = sfb__simd_finish_normals;
+}
 
 #endif /* SFB__SIMD_H */

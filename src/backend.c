@@ -24,22 +24,32 @@ SFB_API sfb_backend_kind sfb_backend_kind_parse(const char *name) {
     return SFB_BACKEND_DEFAULT;
 }
 
-/* Optional backends live in backends/sfb_NAME.h, compiled in by SURFBLEND_NAME (see
- * sfb_internal.h). Those not compiled in report "not built in". */
-static const sfb__backend_vtable *sfb__backend_lookup(sfb_backend_kind kind) {
+/* Optional backends live in backends/ (sfb_NAME.h), compiled in by SURFBLEND_NAME (see
+ * sfb_internal.h). Those not compiled in report "not built in". A backend is its bind function:
+ * it fills the named slots it implements in a zeroed table. */
+static sfb__backend_bind_fn sfb__backend_binder(sfb_backend_kind kind) {
     switch (kind) {
-    case SFB_BACKEND_REF: return sfb__backend_ref();
+    case SFB_BACKEND_REF: return sfb__ref_bind;
 #ifdef SURFBLEND_SIMD
-    case SFB_BACKEND_SIMD: return sfb__backend_simd();
+    case SFB_BACKEND_SIMD: return sfb__simd_bind;
 #endif
 #ifdef SURFBLEND_GL
-    case SFB_BACKEND_GL: return sfb__backend_gl();
+    case SFB_BACKEND_GL: return sfb__gl_bind;
 #endif
 #ifdef SURFBLEND_OSMESA
-    case SFB_BACKEND_OSMESA: return sfb__backend_osmesa();
+    case SFB_BACKEND_OSMESA: return sfb__osmesa_bind;
 #endif
     default: return NULL;
     }
+}
+
+/* The table of `kind` bound into `vt` (zeroed first); 0 when the backend is not built in. */
+int sfb__backend_bind(sfb_backend_kind kind, sfb__backend_vtable *vt) {
+    sfb__backend_bind_fn bind = sfb__backend_binder(kind);
+    memset(vt, 0, sizeof *vt);
+    if (!bind) return 0;
+    bind(vt);
+    return vt->name != NULL && vt->init != NULL && vt->shutdown != NULL;
 }
 
 static void sfb__report_add(sfb_context *ctx, const char *fmt, ...) {
@@ -52,11 +62,12 @@ static void sfb__report_add(sfb_context *ctx, const char *fmt, ...) {
 }
 
 static int sfb__try_backend(sfb_context *ctx, sfb_backend_kind kind) {
-    const sfb__backend_vtable *vt = sfb__backend_lookup(kind);
+    sfb__backend_vtable table;
+    const sfb__backend_vtable *vt = &table;
     char why[512];
     void *state = NULL;
     sfb_result r;
-    if (!vt) {
+    if (!sfb__backend_bind(kind, &table)) {
         sfb__report_add(ctx, "%s: unavailable (not built in: define SURFBLEND_%s or SURFBLEND_ALL_BACKENDS with SURFBLEND_IMPLEMENTATION)\n",
                         sfb_backend_kind_name(kind), kind == SFB_BACKEND_SIMD ? "SIMD" : kind == SFB_BACKEND_GL ? "GL" : "OSMESA");
         sfb__log(ctx, SFB_LOG_INFO, "backend %s not built in, trying the next", sfb_backend_kind_name(kind));
@@ -69,7 +80,8 @@ static int sfb__try_backend(sfb_context *ctx, sfb_backend_kind kind) {
         sfb__log(ctx, SFB_LOG_INFO, "backend %s failed to initialise (%s), trying the next", vt->name, why);
         return 0;
     }
-    ctx->backend = vt;
+    ctx->backend_vt = table;
+    ctx->backend = vt = &ctx->backend_vt;
     ctx->backend_state = state;
     why[0] = 0;
     if (vt->describe) vt->describe(state, why, sizeof why);
@@ -82,6 +94,7 @@ static int sfb__try_backend(sfb_context *ctx, sfb_backend_kind kind) {
 sfb_result sfb__select_backend(sfb_context *ctx, const char *env) {
     int i;
     ctx->report[0] = 0;
+    sfb__backend_bind(SFB_BACKEND_REF, &ctx->ref_vt);
     if (env && *env) {
         sfb_backend_kind k = sfb_backend_kind_parse(env);
         if (k == SFB_BACKEND_DEFAULT) {
@@ -121,14 +134,13 @@ SFB_API sfb_result sfb_context_backend_info(const sfb_context *ctx, char *buf, s
 }
 
 SFB_API sfb_result sfb_backend_probe(sfb_backend_kind kind, const sfb_context_config *config, char *info, size_t size) {
-    const sfb__backend_vtable *vt;
+    sfb__backend_vtable vt;
     sfb_context_config c = config ? *config : sfb_context_config_init();
     sfb_context *ctx = NULL;
     sfb_result r;
     if (!info || size == 0 || (int)kind <= SFB_BACKEND_DEFAULT || kind >= SFB_BACKEND_KIND_COUNT_) return SFB_INVALID_ARGS;
     info[0] = 0;
-    vt = sfb__backend_lookup(kind);
-    if (!vt) {
+    if (!sfb__backend_bind(kind, &vt)) {
         snprintf(info, size, "not built in: define SURFBLEND_%s or SURFBLEND_ALL_BACKENDS with SURFBLEND_IMPLEMENTATION",
                  kind == SFB_BACKEND_SIMD ? "SIMD" : kind == SFB_BACKEND_GL ? "GL" : kind == SFB_BACKEND_OSMESA ? "OSMESA" : "REF");
         return SFB_BACKEND_UNAVAILABLE;
@@ -140,7 +152,7 @@ SFB_API sfb_result sfb_backend_probe(sfb_backend_kind kind, const sfb_context_co
     r = sfb__context_create_reporting(&c, &ctx, info, size);
     if (r != SFB_SUCCESS) return r == SFB_NO_BACKEND ? SFB_BACKEND_UNAVAILABLE : r;
     info[0] = 0;
-    if (vt->describe) vt->describe(ctx->backend_state, info, size);
+    if (vt.describe) vt.describe(ctx->backend_state, info, size);
     sfb_context_destroy(ctx);
     return SFB_SUCCESS;
 }

@@ -9,7 +9,7 @@ static sfb_result sfb__ref_init(sfb_context *ctx, void **state, char *why, size_
 
 static void sfb__ref_shutdown(sfb_context *ctx, void *state) { (void)ctx; (void)state; }
 
-static sfb_result sfb__ref_eval_stencils(void *state, const sfb__stencils *t, void *handle, int first, int last,
+sfb_result sfb__ref_eval_stencils(void *state, const sfb__stencils *t, void *handle, int first, int last,
                                          const float *src, sfb_buffer_desc sd, float *dst, sfb_buffer_desc dd) {
     int r, c, k;
     double acc[16];
@@ -38,7 +38,7 @@ static void sfb__ref_unit3(double *v) {
     else v[0] = v[1] = v[2] = 0.0;
 }
 
-static sfb_result sfb__ref_finish_normals(void *state, int first, int last, const float *tu, const float *tv,
+sfb_result sfb__ref_finish_normals(void *state, int first, int last, const float *tu, const float *tv,
                                           const float *ns, const int *ns_index, const float *b, float p,
                                           float *out_blend, float *out_limit, float *out_sub) {
     int i, c;
@@ -71,14 +71,13 @@ static sfb_result sfb__ref_finish_normals(void *state, int first, int last, cons
     return SFB_SUCCESS;
 }
 
-/* in patches.c */
-static sfb_result sfb__ref_eval_patches(void *state, const sfb__patch_table *pt, void *handle, const sfb_location *locs, int first,
-                                        int last, const sfb_eval_output *out);
-
-static const sfb__backend_vtable sfb__ref_vtable = {
-    "ref", SFB_BACKEND_REF, SFB__CAP_EVAL_STENCILS | SFB__CAP_EVAL_PATCHES | SFB__CAP_FINISH_NORMALS,
-    sfb__ref_init, sfb__ref_shutdown, NULL, NULL, NULL, sfb__ref_eval_stencils, NULL,
-    NULL, NULL, sfb__ref_eval_patches, sfb__ref_finish_normals
-};
-
-const sfb__backend_vtable *sfb__backend_ref(void) { return &sfb__ref_vtable; }
+/* Every kernel (sfb__ref_eval_patches is in patches.c). */
+void sfb__ref_bind(sfb__backend_vtable *vt) {
+    vt->name = "ref";
+    vt->kind = SFB_BACKEND_REF;
+    vt->init = sfb__ref_init;
+    vt->shutdown = sfb__ref_shutdown;
+    vt->eval_stencils = sfb__ref_eval_stencils;
+    vt->eval_patches = sfb__ref_eval_patches;
+    vt->finish_normals = sfb__ref_finish_normals;
+}

@@ -332,7 +332,7 @@ sfb_result sfb__manifold_build(sfb_context *ctx, const sfb__level *base, int wei
     memset(&work, 0, sizeof work); memset(&lev1, 0, sizeof lev1); memset(&T, 0, sizeof T);
     if (weights != SFB_MANIFOLD_WEIGHTS_HERMITE && weights != SFB_MANIFOLD_WEIGHTS_CINF)
         return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, -1, "manifold weights %d are not SFB_MANIFOLD_WEIGHTS_HERMITE or _CINF", weights);
-    pt->scheme = SFB_SCHEME_MANIFOLD_BLEND;
+    pt->domain = SFB__DOMAIN_QUAD;
     pt->mf_weights = weights;
     for (f = 0; f < base->nf; ++f) if (base->fv_off[f + 1] - base->fv_off[f] != 4) quads = 0;
     if (quads) {

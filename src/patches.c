@@ -763,9 +763,9 @@ sfb_result sfb__patches_build(sfb_context *ctx, const sfb__level *base, const sf
     memset(pt, 0, sizeof *pt);
     b.ctx = ctx;
     b.pt = pt;
-    pt->scheme = opt->scheme;
-    pt->isolation = limit;
     tri = opt->scheme == SFB_SCHEME_LOOP;
+    pt->domain = tri ? SFB__DOMAIN_TRI : SFB__DOMAIN_QUAD;
+    pt->isolation = limit;
     /* param faces */
     pt->face_ptex = (int *)sfb__alloc(ctx, ((size_t)base->nf + 1) * sizeof(int));
     if (!pt->face_ptex) goto oom;
@@ -1001,7 +1001,7 @@ done:
 int sfb__patch_locate(const sfb__patch_table *pt, int ptex, double u, double v, double *s, double *t, double *scale) {
     int node = pt->ptex_root[ptex];
     double sc = 1.0;
-    if (pt->scheme == SFB_SCHEME_LOOP) {
+    if (pt->domain == SFB__DOMAIN_TRI) {
         /* triangles: *scale is negative after an odd number of middle children */
         while (node >= 0) {
             int c;
@@ -1355,7 +1355,7 @@ static void sfb__ref_eval_one(const sfb__patch_table *pt, const float *pts, cons
     if (!(len > 0.0) || !isfinite(len)) {
         /* degenerate tangents (a collapsed control net): the normal a step inside the patch */
         double r2[6][3];
-        int ty = pt->ptype[patch], tri = pt->scheme == SFB_SCHEME_LOOP;
+        int ty = pt->ptype[patch], tri = pt->domain == SFB__DOMAIN_TRI;
         double s2 = s + (s < 0.5 ? 1e-3 : -1e-3), t2 = t + (t < 0.5 ? 1e-3 : -1e-3);
         if (tri && s2 + t2 > 1.0) { s2 = s - 1e-3; t2 = t - 1e-3; }
         if (tri && s + t < 2e-3) { s2 = s + 1e-3; t2 = t + 1e-3; }
@@ -1377,7 +1377,7 @@ scale:
     }
 }
 
-static sfb_result sfb__ref_eval_patches(void *state, const sfb__patch_table *pt, void *handle, const sfb_location *locs, int first,
+sfb_result sfb__ref_eval_patches(void *state, const sfb__patch_table *pt, void *handle, const sfb_location *locs, int first,
                                         int last, const sfb_eval_output *out) {
     int q, c;
     (void)state; (void)handle;

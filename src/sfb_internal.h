@@ -20,19 +20,14 @@ typedef struct sfb__stencils {
     size_t entries;
 } sfb__stencils;
 
-enum {
-    SFB__CAP_EVAL_STENCILS = 1u << 0,   /* eval_stencils on caller memory */
-    SFB__CAP_GL_BUFFERS = 1u << 1,      /* eval_stencils_gl on GL buffer objects (host context) */
-    SFB__CAP_EVAL_PATCHES = 1u << 2,    /* eval_patches */
-    SFB__CAP_FINISH_NORMALS = 1u << 3   /* finish_normals */
-};
-
-/* The kernels a backend implements. Every slot but name/kind/caps/init/shutdown may be NULL;
- * a NULL kernel with its capability bit cleared makes the core fall back to `ref` for it. */
+/* The kernels a backend implements, filled by NAME in the backend's bind function
+ * (sfb__ref_bind, sfb__simd_bind, sfb__gl_bind, sfb__osmesa_bind) on a zeroed table: a backend
+ * that lacks a kernel writes nothing for it, and a NULL kernel slot makes the core run `ref`'s
+ * (with a log line). Every slot but name/kind/init/shutdown may be NULL. A context keeps its
+ * own copy of the bound table (no global state). */
 typedef struct sfb__backend_vtable {
     const char *name;
     sfb_backend_kind kind;
-    unsigned caps;
     /* Returns SFB_SUCCESS and a state, or an error with `why` filled. The backend reads its
      * settings (threads, gl_use_current_context) from ctx and may keep ctx for errors/allocs. */
     sfb_result (*init)(sfb_context *ctx, void **state, char *why, size_t why_size);
@@ -85,15 +80,28 @@ typedef struct sfb__backend_vtable {
 #if defined(SURFBLEND_OSMESA) && !defined(SURFBLEND_GL)
 #  define SURFBLEND_GL /* osmesa runs the gl kernels */
 #endif
+/* Each fills the slots its backend implements (see sfb__backend_vtable). */
+typedef void (*sfb__backend_bind_fn)(sfb__backend_vtable *vt);
+void sfb__ref_bind(sfb__backend_vtable *vt);
+/* Zeroes *vt and binds the backend `kind` into it; 0 when that backend is not built in. */
+int sfb__backend_bind(sfb_backend_kind kind, sfb__backend_vtable *vt);
 #ifdef SURFBLEND_SIMD
-const sfb__backend_vtable *sfb__backend_simd(void);
+void sfb__simd_bind(sfb__backend_vtable *vt);
 #endif
 #ifdef SURFBLEND_GL
-const sfb__backend_vtable *sfb__backend_gl(void);
+void sfb__gl_bind(sfb__backend_vtable *vt);
 #endif
 #ifdef SURFBLEND_OSMESA
-const sfb__backend_vtable *sfb__backend_osmesa(void);
+void sfb__osmesa_bind(sfb__backend_vtable *vt);
 #endif
+/* The ref kernels, callable directly (the oracle; other backends hand it what they cannot do). */
+sfb_result sfb__ref_eval_stencils(void *state, const sfb__stencils *t, void *handle, int first, int last, const float *src,
+                                  sfb_buffer_desc sd, float *dst, sfb_buffer_desc dd);
+struct sfb__patch_table;
+sfb_result sfb__ref_eval_patches(void *state, const struct sfb__patch_table *pt, void *handle, const sfb_location *locs, int first,
+                                 int last, const sfb_eval_output *out);
+sfb_result sfb__ref_finish_normals(void *state, int first, int last, const float *tu, const float *tv, const float *ns,
+                                   const int *ns_index, const float *b, float p, float *out_blend, float *out_limit, float *out_sub);
 
 /* ---- Stam eigen structures (stam.c) ---- */
 #define SFB__STAM_MAX_VALENCE 256
@@ -124,8 +132,26 @@ typedef struct sfb__eigen_loop {
 
 
 /* ---- patch tables (patches.c) ---- */
+/* Patch kinds of the patch table (patches.c, manifold.c). */
+enum { SFB__PATCH_BSPLINE = 0, SFB__PATCH_STAM = 1, SFB__PATCH_ENDCAP = 2, SFB__PATCH_BEZTRI = 3, SFB__PATCH_STAM_LOOP = 4,
+       SFB__PATCH_ENDCAP_TRI = 5, SFB__PATCH_MANIFOLD4 = 6, SFB__PATCH_TYPE_COUNT = 7 };
+/* Kernel families: the record types one backend kernel evaluates together (one file per backend
+ * each, docs/ARCHITECTURE.md). */
+enum { SFB__FAMILY_QUAD = 0,     /* BSPLINE16, STAM, ENDCAP: polynomial quad patches */
+       SFB__FAMILY_TRI = 1,      /* BEZTRI15, STAM_LOOP, ENDCAP_TRI: polynomial triangle patches */
+       SFB__FAMILY_MANIFOLD = 2, /* MANIFOLD4: seed 000's blend of chart geometries */
+       SFB__FAMILY_COUNT = 3 };
+static inline int sfb__patch_family(int type) {
+    return type <= SFB__PATCH_ENDCAP ? SFB__FAMILY_QUAD : type <= SFB__PATCH_ENDCAP_TRI ? SFB__FAMILY_TRI : SFB__FAMILY_MANIFOLD;
+}
+/* What a patch table is, for its readers (locate, evaluation kernels, tessellation): the
+ * parametric DOMAIN of its faces, and per record a kernel FAMILY (from the record's type,
+ * sfb__patch_family). Only the scheme builders know the scheme; nothing reading a table asks it. */
+enum { SFB__DOMAIN_QUAD = 0,   /* (u,v) in [0,1]^2, quadtree sub-patches */
+       SFB__DOMAIN_TRI = 1 };  /* barycentric (u,v), u + v <= 1, triangle-tree sub-patches */
 typedef struct sfb__patch_table {
-    int scheme, isolation, max_depth;
+    int domain;            /* SFB__DOMAIN_*, set by the builder */
+    int isolation, max_depth;
     int npatch, ncv, nptex, nnodes;
     int *ptype;            /* SFB__PATCH_* per patch */
     int *pfirst;           /* npatch + 1: first control point of each patch in cv */
@@ -136,7 +162,7 @@ typedef struct sfb__patch_table {
     int *face_ptex;        /* per base face + 1: first param face */
     int *ptex_root;        /* per param face: >= 0 node, <= -2 patch -(p+2), -1 hole */
     int *nodes;            /* 4 per quadtree node, by quadrant x + 2y, same encoding */
-    int counts[8];         /* patches of each type (SFB__PATCH_*) */
+    int counts[SFB__PATCH_TYPE_COUNT]; /* patches of each type (SFB__PATCH_*) */
     unsigned *pcorner;     /* MANIFOLD4: 4 corner codes per patch (SFB__MF_CODE) */
     int mf_weights;        /* MANIFOLD4: SFB_MANIFOLD_WEIGHTS_* */
     int npoints;           /* patch points */
@@ -155,8 +181,10 @@ struct sfb_context {
     int threads, gl_use_current_context;
     sfb_backend_kind order[SFB_BACKEND_KIND_COUNT_];
     int order_count;
-    const sfb__backend_vtable *backend;
+    const sfb__backend_vtable *backend; /* &backend_vt once a backend is selected, else NULL */
     void *backend_state;
+    sfb__backend_vtable backend_vt;     /* the selected backend's bound table */
+    sfb__backend_vtable ref_vt;         /* ref's, for the kernels the selected backend lacks */
     sfb__eigen_cc *eigen_cc[SFB__STAM_MAX_VALENCE + 1]; /* per valence, built on first use */
     unsigned char eigen_cc_failed[SFB__STAM_MAX_VALENCE + 1];
     sfb__eigen_loop *eigen_loop[SFB__STAM_MAX_VALENCE + 1];
@@ -189,7 +217,6 @@ sfb_result sfb__oom(sfb_context *ctx, const char *what);
 sfb_result sfb__progress(sfb_context *ctx, float done, const char *stage);
 sfb_result sfb__select_backend(sfb_context *ctx, const char *env_override);
 sfb_result sfb__context_create_reporting(const sfb_context_config *config, sfb_context **out, char *report, size_t size);
-const sfb__backend_vtable *sfb__backend_ref(void);
 void sfb__eigen_cc_free(sfb_context *ctx, sfb__eigen_cc *e);
 sfb_result sfb__eigen_cc_build(sfb_context *ctx, int N, int keep, sfb__eigen_cc **out);
 const sfb__eigen_cc *sfb__eigen_cc_get(sfb_context *ctx, int N);
@@ -302,9 +329,14 @@ sfb_result sfb__shading_build(sfb_context *ctx, const sfb__level *prep, const sf
 
 /* patches.c */
 void sfb__patch_table_free(sfb_context *ctx, sfb__patch_table *pt);
-/* Patch kinds of the patch table (patches.c, manifold.c). */
-enum { SFB__PATCH_BSPLINE = 0, SFB__PATCH_STAM = 1, SFB__PATCH_ENDCAP = 2, SFB__PATCH_BEZTRI = 3, SFB__PATCH_STAM_LOOP = 4,
-       SFB__PATCH_ENDCAP_TRI = 5, SFB__PATCH_MANIFOLD4 = 6 };
+/* The families present in a table, as bits 1 << SFB__FAMILY_*. */
+static inline unsigned sfb__patch_families(const sfb__patch_table *pt) {
+    unsigned m = 0;
+    int t;
+    for (t = 0; t < SFB__PATCH_TYPE_COUNT; ++t)
+        if (pt->counts[t] > 0) m |= 1u << sfb__patch_family(t);
+    return m;
+}
 /* Manifold blending (manifold.c): a corner code packs the corner vertex's local geometry kind,
  * its valence k and the index h of the face in its star (the chart), and for a curve the axes
  * (1: a, 2: b, 0: not in this face) of its sharp edges e1 and e2. */

@@ -824,9 +824,9 @@ SFB_API sfb_result sfb_surface_shade(const sfb_surface *s, const sfb_shade_param
         (r = sfb__shade_apply(s, &sh->lim[2], sh->handles[4], sh->nout, refined, o->tangents_v)) != SFB_SUCCESS)
         goto fail;
     be = ctx->backend;
-    if (!be || !(be->caps & SFB__CAP_FINISH_NORMALS) || !be->finish_normals) {
+    if (!be || !be->finish_normals) {
         sfb__log(ctx, SFB_LOG_INFO, "backend %s lacks finish_normals; using ref", be ? be->name : "none");
-        be = sfb__backend_ref();
+        be = &ctx->ref_vt;
     }
     r = be->finish_normals(be == ctx->backend ? ctx->backend_state : NULL, 0, sh->nout, o->tangents_u, o->tangents_v, ns,
                            all ? sh->ns_idx_all : sh->ns_idx_w, sh->b, prm.p, o->normals, o->limit_normals, o->subdivided_normals);

@@ -270,7 +270,7 @@ SFB_API sfb_result sfb_surface_eval(const sfb_surface *s, const sfb_location *lo
         if (!(l->u >= 0.0f && l->u <= 1.0f && l->v >= 0.0f && l->v <= 1.0f))
             return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, q, "location %d: (u,v) = (%g,%g) is outside [0,1]^2", q, (double)l->u,
                               (double)l->v);
-        if (s->patches.scheme == SFB_SCHEME_LOOP && (double)l->u + (double)l->v > 1.0)
+        if (s->patches.domain == SFB__DOMAIN_TRI && (double)l->u + (double)l->v > 1.0)
             return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, q, "location %d: (u,v) = (%g,%g) is outside the triangle u + v <= 1", q,
                               (double)l->u, (double)l->v);
         /* holes are whole parametric faces (a hole is a base face), so the root says it */
@@ -279,9 +279,9 @@ SFB_API sfb_result sfb_surface_eval(const sfb_surface *s, const sfb_location *lo
     }
     if (count == 0) return SFB_SUCCESS;
     be = ctx->backend;
-    if (!be || !(be->caps & SFB__CAP_EVAL_PATCHES) || !be->eval_patches) {
+    if (!be || !be->eval_patches) {
         sfb__log(ctx, SFB_LOG_INFO, "backend %s lacks eval_patches; using ref", be ? be->name : "none");
-        return sfb__backend_ref()->eval_patches(NULL, &s->patches, NULL, loc, 0, count, out);
+        return sfb__ref_eval_patches(NULL, &s->patches, NULL, loc, 0, count, out);
     }
     return be->eval_patches(ctx->backend_state, &s->patches, s->uploaded_by == be ? s->backend_patches : NULL, loc, 0, count, out);
 }
@@ -312,9 +312,9 @@ static sfb_result sfb__surface_apply(const sfb_surface *s, const sfb__stencils *
                                      sfb_buffer_desc sd, float *dst, sfb_buffer_desc dd) {
     sfb_context *ctx = s->ctx;
     const sfb__backend_vtable *be = ctx->backend;
-    if (!be || !(be->caps & SFB__CAP_EVAL_STENCILS) || !be->eval_stencils) {
+    if (!be || !be->eval_stencils) {
         sfb__log(ctx, SFB_LOG_INFO, "backend %s lacks eval_stencils; using ref", be ? be->name : "none");
-        return sfb__backend_ref()->eval_stencils(NULL, t, NULL, 0, rows, src, sd, dst, dd);
+        return sfb__ref_eval_stencils(NULL, t, NULL, 0, rows, src, sd, dst, dd);
     }
     if (rows <= 0) return SFB_SUCCESS;
     return be->eval_stencils(ctx->backend_state, t, s->uploaded_by == be ? handle : NULL, 0, rows, src, sd, dst, dd);
@@ -337,7 +337,7 @@ SFB_API sfb_result sfb_surface_eval_stencils_gl(const sfb_surface *s, sfb_table 
     ctx = s->ctx;
     if ((r = sfb__eval_args(s, t, src_buffer && dst_buffer, sd, dd, "GL buffers")) != SFB_SUCCESS) return r;
     be = ctx->backend;
-    if (!be || !(be->caps & SFB__CAP_GL_BUFFERS) || !be->eval_stencils_gl)
+    if (!be || !be->eval_stencils_gl)
         return sfb__error(ctx, SFB_UNSUPPORTED, SFB_ELEMENT_NONE, -1,
                           "sfb_surface_eval_stencils_gl needs the gl backend on the host's context (gl_use_current_context); this context runs %s",
                           be ? be->name : "no backend");

@@ -1020,7 +1020,7 @@ SFB_API sfb_result sfb_surface_tessellate(const sfb_surface *s, const sfb_tess_c
     T.pt = &s->patches;
     T.rate = cfg->rate;
     T.split = (cfg->flags & SFB_TESS_SPLIT_CREASES) != 0;
-    T.loop = T.pt->scheme == SFB_SCHEME_LOOP;
+    T.loop = T.pt->domain == SFB__DOMAIN_TRI;
     nptex = T.pt->nptex;
     T.prate = (int *)sfb__tess_array(ctx, (size_t)nptex, sizeof(int));
     T.sseg = (int *)sfb__tess_array(ctx, (size_t)nptex, sizeof(int));

@@ -8,7 +8,7 @@
  * Targets: ref itself (the properties below hold for the oracle too); simd once per instruction
  * set the CPU and build have (simd-ISA; only the one SURFBLEND_SIMD_ISA names when it is set),
  * each with threads 1 and 2 (simd-ISA/tT); gl; osmesa. Checks, per target T:
- *   T/caps            the vtable has the kernel and SFB__CAP_FINISH_NORMALS
+ *   T/caps            the bound vtable has the kernel
  *   T/random/pP       10^5 random elements (p = 1, 0.5, 3, 2.2): tangents of random lengths at
  *                     least ~6 degrees apart, normals ns of random lengths, indices random (1 in 8
  *                     is -1), b random with exact 0s and 1s mixed in; elements whose blend would
@@ -245,7 +245,7 @@ static int run(const target *t, const data *d, int first, int last, const float 
 
 /* Runs ref on the whole data set. */
 static void run_ref(const data *d, const float *ns, const int *idx, const float *b, float p, outputs *o) {
-    sfb__backend_ref()->finish_normals(NULL, 0, d->n, d->tu, d->tv, ns, idx, b, p, o->blend, o->limit, o->sub);
+    sfb__ref_finish_normals(NULL, 0, d->n, d->tu, d->tv, ns, idx, b, p, o->blend, o->limit, o->sub);
 }
 
 /* Largest |got - want| over components [3 first, 3 last) (NaN counts as infinite); the
@@ -329,7 +329,7 @@ static const float k_ps[4] = {1.0f, 0.5f, 3.0f, 2.2f};
 static void check_caps(const target *t) {
     char name[128];
     snprintf(name, sizeof name, "%s/caps", t->name);
-    if (!(t->vt->caps & SFB__CAP_FINISH_NORMALS) || !t->vt->finish_normals) fail(name, "%s has no finish_normals kernel (caps 0x%x)", t->vt->name, t->vt->caps);
+    if (!t->vt->finish_normals) fail(name, "%s has no finish_normals kernel", t->vt->name);
     else pass(name);
 }
 
@@ -882,6 +882,7 @@ int main(int argc, char **argv) {
     const char *req = getenv("SFB_REQUIRE_BACKENDS");
     suite S;
     target ref;
+    sfb__backend_vtable ref_vt;
     int i, bench_n = 0;
     g_seed = (unsigned long long)time(NULL);
     if (getenv("SFB_SEED")) g_seed = strtoull(getenv("SFB_SEED"), NULL, 10);
@@ -905,7 +906,8 @@ int main(int argc, char **argv) {
 
     memset(&ref, 0, sizeof ref);
     snprintf(ref.name, sizeof ref.name, "ref");
-    ref.vt = sfb__backend_ref();
+    sfb__backend_bind(SFB_BACKEND_REF, &ref_vt);
+    ref.vt = &ref_vt;
     run_target(&ref, &S);
     run_simd(&S, req && name_listed(req, "simd"));
     run_gl(&S, SFB_BACKEND_GL, req && name_listed(req, "gl"));
