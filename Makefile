@@ -13,7 +13,7 @@ SHAPES  ?= ../shared/peers/opensubdiv-shapes
 
 SRC_MODULES := src/sfb_api.h src/sfb_internal.h $(wildcard src/*.c)
 TEST_SRCS   := $(wildcard tests/test_*.c)
-BACKEND_HDRS:= $(wildcard backends/*.h)
+BACKEND_HDRS:= $(wildcard backends/*.h backends/*/*.h backends/*/glsl/*.glsl)
 EXAMPLES    := $(patsubst examples/%.c,$(BUILD)/examples/%,$(wildcard examples/*.c))
 # Test programs that play a GL host link EGL and GL themselves (the library never does).
 GL_LIBS     := -lEGL -lGL
