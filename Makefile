@@ -36,7 +36,7 @@ PKGS_FUZZ := clang libclang-rt-14-dev
 # The NEON kernels, cross-compiled for AArch64 and run under qemu user emulation (make test-neon).
 PKGS_NEON := gcc-aarch64-linux-gnu libc6-dev-arm64-cross qemu-user-static
 
-.PHONY: all run test test-neon deps-neon bench fuzz asan amalgamate amalgamate-check embed-glsl deps deps-test deps-fuzz clean unit-build
+.PHONY: all run test check-modules test-neon deps-neon bench fuzz asan amalgamate amalgamate-check embed-glsl deps deps-test deps-fuzz clean unit-build
 
 all: $(BUILD)/surfblend
 
@@ -68,6 +68,12 @@ amalgamate:
 # GLSL sources of the gl backend embedded as C strings (tools/check_glsl.sh checks it is current)
 embed-glsl:
 	./tools/embed_glsl.sh > backends/sfb_gl_shaders.h.tmp && mv backends/sfb_gl_shaders.h.tmp backends/sfb_gl_shaders.h
+
+# The library from src/*.c as separate translation units (C99 and C++), linked with the examples
+# and run: module interfaces are declared in src/sfb_internal.h, the amalgamation order is not
+# load-bearing (tools/check_modules.sh; part of make test).
+check-modules:
+	CC="$(CC)" CXX="$(CXX)" ./tools/check_modules.sh $(BUILD)
 
 amalgamate-check:
 	@./tools/amalgamate.sh > $${TMPDIR:-/tmp}/surfblend.h.check && \

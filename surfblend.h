@@ -729,6 +729,17 @@ enum { SFB__FAMILY_QUAD = 0,     /* BSPLINE16, STAM, ENDCAP: polynomial quad pat
 static inline int sfb__patch_family(int type) {
     return type <= SFB__PATCH_ENDCAP ? SFB__FAMILY_QUAD : type <= SFB__PATCH_ENDCAP_TRI ? SFB__FAMILY_TRI : SFB__FAMILY_MANIFOLD;
 }
+/* A patch's sub-square of its parametric face: depth | i << 4 | j << 17 | corner << 30. */
+#define SFB__PARAM(depth, i, j, corner) ((unsigned)(depth) | ((unsigned)(i) << 4) | ((unsigned)(j) << 17) | ((unsigned)(corner) << 30))
+#define SFB__PARAM_DEPTH(p) ((int)((p) & 15u))
+#define SFB__PARAM_I(p) ((int)(((p) >> 4) & 8191u))
+#define SFB__PARAM_J(p) ((int)(((p) >> 17) & 8191u))
+#define SFB__PARAM_CORNER(p) ((int)(((p) >> 30) & 3u))
+/* Sabin's rules (stam.c): the 12 box-spline points' lattice offsets and the quartic Bezier
+ * points from them (ALGORITHMS.md 5.1). */
+extern const signed char sfb__box12[12][2];
+extern const unsigned char sfb__bez15_from_box[15][12];
+
 /* What a patch table is, for its readers (locate, evaluation kernels, tessellation): the
  * parametric DOMAIN of its faces, and per record a kernel FAMILY (from the record's type,
  * sfb__patch_family). Only the scheme builders know the scheme; nothing reading a table asks it. */
@@ -830,8 +841,58 @@ sfb_result sfb__level_complete(sfb_context *ctx, sfb__level *l);
 /* Sharpness/rule helpers shared by refinement and info. */
 int sfb__rule_from(float vertex_sharpness, int sharp_edge_count);
 void sfb__level_compute_rules(sfb__level *l);
+/* The end of edge e that is not v (topology.c). */
+int sfb__other_end(const sfb__level *l, int e, int v);
 
-/* ---- mesh ---- */
+/* ---- the stencil algebra (stencil.c) ---- */
+/* Composed rows (double weights): row r holds entries [off[r], off[r+1]) of idx/w. */
+typedef struct sfb__rows {
+    int rows;
+    size_t *off;   /* rows + 1 */
+    int *idx;
+    double *w;
+    size_t n, cap;
+} sfb__rows;
+/* A local mask: (vertex, weight) pairs, duplicates allowed. */
+typedef struct sfb__mask {
+    int *idx;
+    double *w;
+    int n, cap;
+} sfb__mask;
+#define SFB__MASK_ADD(m, i, wt) do { (m)->idx[(m)->n] = (i); (m)->w[(m)->n] = (wt); (m)->n++; } while (0)
+/* A dense accumulator over source vertices, for composing masks with rows. */
+typedef struct sfb__accum {
+    double *acc;
+    unsigned *mark;
+    int *touched;
+    unsigned stamp;
+} sfb__accum;
+void sfb__rows_free(sfb_context *ctx, sfb__rows *r);
+/* Room for `need` entries in all; 0 on allocation failure. */
+int sfb__rows_reserve(sfb_context *ctx, sfb__rows *r, size_t need);
+/* Room for `need` more pairs; 0 on allocation failure. */
+int sfb__mask_grow(sfb_context *ctx, sfb__mask *m, int need);
+/* Adds w * (face centroid of f). */
+void sfb__mask_face(sfb__mask *m, const sfb__level *l, int f, double w);
+/* An upper bound of the pairs a vertex rule of v adds. */
+int sfb__mask_need_vertex(const sfb__level *l, int v);
+/* Row `row` of `out` = mask m composed with the parent rows prow; 0 on allocation failure or when
+ * the accumulator's stamp wrapped (the caller resets it). */
+int sfb__compose_row(sfb_context *ctx, sfb__accum *A, const sfb__rows *prow, const sfb__mask *m, sfb__rows *out, int row);
+/* The float stencil table of r (over `sources` source elements). */
+sfb_result sfb__rows_to_stencils(sfb_context *ctx, const sfb__rows *r, int sources, sfb__stencils *s);
+
+/* ---- mesh (mesh.c) ---- */
+/* Line numbers of OBJ statements, so that errors found while building the mesh can name the
+ * line they came from. Internal: sfb_mesh_read_obj passes it, sfb_mesh_create does not. */
+typedef struct sfb__src_lines {
+    const int *face, *crease, *corner, *hole;
+} sfb__src_lines;
+/* Builds a level (topology only, zero sharpness) from faces; validates indices. */
+sfb_result sfb__level_from_faces(sfb_context *ctx, int nv, int nf, const int *sizes, const int *fvin, const sfb__src_lines *lines,
+                                 sfb_element_kind vkind, sfb__level *l);
+/* sfb_mesh_create with OBJ line numbers for the errors (lines may be NULL). */
+sfb_result sfb__mesh_create(sfb_context *ctx, const sfb_mesh_desc *d, const sfb__src_lines *lines, sfb_mesh **out);
 struct sfb_mesh {
     sfb_context *ctx;
     sfb__level base;            /* topology, with user sharpness (not yet boundary-sharpened) */
@@ -904,9 +965,26 @@ sfb_result sfb__refine(sfb_context *ctx, const sfb__level *base, const sfb__refi
                        sfb__level *top, sfb__stencils *vertex_table, sfb__stencils *limit_tables /* [3] or NULL */,
                        float progress_from, float progress_to);
 void sfb__stencils_free(sfb_context *ctx, sfb__stencils *s);
+/* One refinement step of `p` (composed rows prow) into `c` (composed rows crow); A, m, ps, cs are
+ * the caller's scratch; progress from p0 over dp. */
+sfb_result sfb__refine_step(sfb_context *ctx, const sfb__refine_options *opt, const sfb__level *p, const sfb__rows *prow,
+                            sfb__level *c, sfb__rows *crow, sfb__accum *A, sfb__mask *m, float *ps, float *cs, float p0, float dp);
+/* The crease pair of a vertex: first and last incident edge with sharpness > 0 in ve order. */
+void sfb__crease_pair(const float *sharp, int n, int *a, int *b);
+/* Crease limit tangent masks at v between its crease edges a and b (either order; loop: Loop's scale). */
+void sfb__crease_tangent_masks(const sfb__level *l, int v, int a, int b, int loop, sfb__mask *m1, sfb__mask *m2);
+/* Limit position and tangent masks of vertex v by its rule. */
+void sfb__limit_masks(const sfb__level *l, int v, sfb_scheme scheme, sfb__mask *mp, sfb__mask *m1, sfb__mask *m2);
 /* Copy of the base level with OpenSubdiv's boundary/non-manifold sharpening and holes applied. */
 sfb_result sfb__level_prepare(sfb_context *ctx, const sfb__level *src, int sharpen_corners, int make_boundary_holes,
                               sfb__level *dst);
+
+/* Rows [0, rows) of table t on the context's backend (handle: its upload of t), or on ref when
+ * the backend lacks eval_stencils (surface.c). */
+sfb_result sfb__surface_apply(const sfb_surface *s, const sfb__stencils *t, void *handle, int rows, const float *src,
+                              sfb_buffer_desc sd, float *dst, sfb_buffer_desc dd);
+/* The refined (or limit) mesh of a surface into o (surface.c). */
+sfb_result sfb__refine_output(const sfb_surface *s, const float *base, int base_count, int want_limit, sfb_mesh_data *o);
 
 void sfb__shading_free(sfb_context *ctx, sfb__shading *sh);
 sfb_result sfb__shading_build(sfb_context *ctx, const sfb__level *prep, const sfb__refine_options *opt, int level,
@@ -1681,6 +1759,141 @@ sfb_result sfb__level_prepare(sfb_context *ctx, const sfb__level *s, int sharpen
     sfb__level_compute_rules(d);
     return SFB_SUCCESS;
 }
+
+/* The end of edge e that is not v. */
+int sfb__other_end(const sfb__level *l, int e, int v) {
+    return l->ev[2 * e] == v ? l->ev[2 * e + 1] : l->ev[2 * e];
+}
+#line 1 "src/stencil.c"
+/* The stencil algebra every table builder shares (declared in sfb_internal.h): composed rows
+ * of double weights over source vertices (sfb__rows), local masks of (vertex, weight) pairs
+ * (sfb__mask), the composition of a mask with its parents' rows through a dense accumulator
+ * (sfb__compose_row), and the conversion of rows into a backend's float stencil table
+ * (sfb__rows_to_stencils). Refinement (refine.c), patch points (patches.c), shading (shade.c)
+ * and manifold blending (manifold.c) build their tables with it. */
+
+/* ---- composed rows (double weights) ---- */
+
+void sfb__rows_free(sfb_context *ctx, sfb__rows *r) {
+    sfb__free(ctx, r->off); sfb__free(ctx, r->idx); sfb__free(ctx, r->w);
+    memset(r, 0, sizeof *r);
+}
+
+int sfb__rows_reserve(sfb_context *ctx, sfb__rows *r, size_t need) {
+    size_t cap;
+    int *ni;
+    double *nw;
+    if (need <= r->cap) return 1;
+    cap = r->cap ? r->cap : 1024;
+    while (cap < need) {
+        if (cap > ((size_t)-1) / 4) return 0;
+        cap = cap + cap / 2 + 16;
+    }
+    ni = (int *)sfb__realloc(ctx, r->idx, cap * sizeof(int));
+    if (!ni) return 0;
+    r->idx = ni;
+    nw = (double *)sfb__realloc(ctx, r->w, cap * sizeof(double));
+    if (!nw) return 0;
+    r->w = nw;
+    r->cap = cap;
+    return 1;
+}
+
+/* ---- local masks: (parent vertex, weight) pairs, duplicates allowed ---- */
+
+
+int sfb__mask_grow(sfb_context *ctx, sfb__mask *m, int need) {
+    int cap;
+    int *ni;
+    double *nw;
+    if (m->n + need <= m->cap) return 1;
+    cap = (m->cap ? m->cap * 2 : 64);
+    while (cap < m->n + need) cap *= 2;
+    ni = (int *)sfb__realloc(ctx, m->idx, (size_t)cap * sizeof(int));
+    if (!ni) return 0;
+    m->idx = ni;
+    nw = (double *)sfb__realloc(ctx, m->w, (size_t)cap * sizeof(double));
+    if (!nw) return 0;
+    m->w = nw;
+    m->cap = cap;
+    return 1;
+}
+
+
+/* Adds w * (face centroid of f). */
+void sfb__mask_face(sfb__mask *m, const sfb__level *l, int f, double w) {
+    int i, n = l->fv_off[f + 1] - l->fv_off[f];
+    for (i = 0; i < n; ++i) SFB__MASK_ADD(m, l->fv[l->fv_off[f] + i], w / n);
+}
+
+int sfb__mask_need_vertex(const sfb__level *l, int v) {
+    int need = 1 + 2 * (l->ve_off[v + 1] - l->ve_off[v]), i;
+    for (i = l->vf_off[v]; i < l->vf_off[v + 1]; ++i) need += l->fv_off[l->vf[i] + 1] - l->fv_off[l->vf[i]];
+    return need;
+}
+
+/* Composes local masks with the parent's composed rows using a dense accumulator. */
+
+
+int sfb__compose_row(sfb_context *ctx, sfb__accum *A, const sfb__rows *prow, const sfb__mask *m, sfb__rows *out, int row) {
+    int i, nt = 0;
+    size_t k;
+    A->stamp++;
+    if (A->stamp == 0) return 0; /* wrapped: caller resets */
+    for (i = 0; i < m->n; ++i) {
+        int j = m->idx[i];
+        double wj = m->w[i];
+        if (wj == 0.0) continue;
+        for (k = prow->off[j]; k < prow->off[j + 1]; ++k) {
+            int b = prow->idx[k];
+            if (A->mark[b] != A->stamp) { A->mark[b] = A->stamp; A->acc[b] = 0.0; A->touched[nt++] = b; }
+            A->acc[b] += wj * prow->w[k];
+        }
+    }
+    if (!sfb__rows_reserve(ctx, out, out->n + (size_t)nt)) return 0;
+    for (i = 0; i < nt; ++i) {
+        int b = A->touched[i];
+        if (A->acc[b] == 0.0) continue;
+        out->idx[out->n] = b;
+        out->w[out->n] = A->acc[b];
+        out->n++;
+    }
+    out->off[row + 1] = out->n;
+    return 1;
+}
+
+void sfb__stencils_free(sfb_context *ctx, sfb__stencils *s) {
+    sfb__free(ctx, s->sizes); sfb__free(ctx, s->offsets); sfb__free(ctx, s->indices); sfb__free(ctx, s->weights);
+    memset(s, 0, sizeof *s);
+}
+
+sfb_result sfb__rows_to_stencils(sfb_context *ctx, const sfb__rows *r, int sources, sfb__stencils *s) {
+    int i;
+    size_t k;
+    memset(s, 0, sizeof *s);
+    if (r->n > 0x7fffffff)
+        return sfb__error(ctx, SFB_LIMIT_EXCEEDED, SFB_ELEMENT_NONE, -1, "stencil table of %zu entries is over the limit", r->n);
+    s->rows = r->rows;
+    s->sources = sources;
+    s->entries = r->n;
+    s->sizes = (int *)sfb__alloc(ctx, ((size_t)r->rows + 1) * sizeof(int));
+    s->offsets = (int *)sfb__alloc(ctx, ((size_t)r->rows + 1) * sizeof(int));
+    s->indices = (int *)sfb__alloc(ctx, (r->n + 1) * sizeof(int));
+    s->weights = (float *)sfb__alloc(ctx, (r->n + 1) * sizeof(float));
+    if (!s->sizes || !s->offsets || !s->indices || !s->weights) {
+        sfb__stencils_free(ctx, s);
+        return SFB_OUT_OF_MEMORY;
+    }
+    for (i = 0; i < r->rows; ++i) {
+        s->offsets[i] = (int)r->off[i];
+        s->sizes[i] = (int)(r->off[i + 1] - r->off[i]);
+    }
+    s->offsets[r->rows] = (int)r->n; /* end marker: offsets[rows] == entries */
+    s->sizes[r->rows] = 0;
+    if (r->n) memcpy(s->indices, r->idx, r->n * sizeof(int));
+    for (k = 0; k < r->n; ++k) s->weights[k] = (float)r->w[k];
+    return SFB_SUCCESS;
+}
 #line 1 "src/refine.c"
 /* Uniform refinement: Catmull-Clark, Loop and bilinear with semi-sharp creases (DeRose et al.,
  * with OpenSubdiv 3.5's rules: fractional edge/vertex blending, uniform or Chaikin sharpness
@@ -1713,85 +1926,9 @@ static float sfb__sub_edge_at_vertex(float s, int chaikin, int vertex_edges, flo
     return s > 0.0f ? s : 0.0f;
 }
 
-/* ---- composed rows (double weights) ---- */
-typedef struct sfb__rows {
-    int rows;
-    size_t *off;   /* rows + 1 */
-    int *idx;
-    double *w;
-    size_t n, cap;
-} sfb__rows;
-
-static void sfb__rows_free(sfb_context *ctx, sfb__rows *r) {
-    sfb__free(ctx, r->off); sfb__free(ctx, r->idx); sfb__free(ctx, r->w);
-    memset(r, 0, sizeof *r);
-}
-
-static int sfb__rows_reserve(sfb_context *ctx, sfb__rows *r, size_t need) {
-    size_t cap;
-    int *ni;
-    double *nw;
-    if (need <= r->cap) return 1;
-    cap = r->cap ? r->cap : 1024;
-    while (cap < need) {
-        if (cap > ((size_t)-1) / 4) return 0;
-        cap = cap + cap / 2 + 16;
-    }
-    ni = (int *)sfb__realloc(ctx, r->idx, cap * sizeof(int));
-    if (!ni) return 0;
-    r->idx = ni;
-    nw = (double *)sfb__realloc(ctx, r->w, cap * sizeof(double));
-    if (!nw) return 0;
-    r->w = nw;
-    r->cap = cap;
-    return 1;
-}
-
-/* ---- local masks: (parent vertex, weight) pairs, duplicates allowed ---- */
-typedef struct sfb__mask {
-    int *idx;
-    double *w;
-    int n, cap;
-} sfb__mask;
-
-static int sfb__mask_grow(sfb_context *ctx, sfb__mask *m, int need) {
-    int cap;
-    int *ni;
-    double *nw;
-    if (m->n + need <= m->cap) return 1;
-    cap = (m->cap ? m->cap * 2 : 64);
-    while (cap < m->n + need) cap *= 2;
-    ni = (int *)sfb__realloc(ctx, m->idx, (size_t)cap * sizeof(int));
-    if (!ni) return 0;
-    m->idx = ni;
-    nw = (double *)sfb__realloc(ctx, m->w, (size_t)cap * sizeof(double));
-    if (!nw) return 0;
-    m->w = nw;
-    m->cap = cap;
-    return 1;
-}
-
-#define SFB__MASK_ADD(m, i, wt) do { (m)->idx[(m)->n] = (i); (m)->w[(m)->n] = (wt); (m)->n++; } while (0)
-
-static int sfb__other_end(const sfb__level *l, int e, int v) {
-    return l->ev[2 * e] == v ? l->ev[2 * e + 1] : l->ev[2 * e];
-}
-
-/* Adds w * (face centroid of f). */
-static void sfb__mask_face(sfb__mask *m, const sfb__level *l, int f, double w) {
-    int i, n = l->fv_off[f + 1] - l->fv_off[f];
-    for (i = 0; i < n; ++i) SFB__MASK_ADD(m, l->fv[l->fv_off[f] + i], w / n);
-}
-
-static int sfb__mask_need_vertex(const sfb__level *l, int v) {
-    int need = 1 + 2 * (l->ve_off[v + 1] - l->ve_off[v]), i;
-    for (i = l->vf_off[v]; i < l->vf_off[v + 1]; ++i) need += l->fv_off[l->vf[i] + 1] - l->fv_off[l->vf[i]];
-    return need;
-}
-
 /* The crease pair of a vertex: first and last incident edge with sharpness > 0 in the
  * vertex's edge order (OpenSubdiv's GetSharpEdgePairOfCrease). `sharp` is per incident edge. */
-static void sfb__crease_pair(const float *sharp, int n, int *a, int *b) {
+void sfb__crease_pair(const float *sharp, int n, int *a, int *b) {
     int i = 0, j = n - 1;
     while (i < n - 1 && sharp[i] <= 0.0f) ++i;
     while (j > 0 && sharp[j] <= 0.0f) --j;
@@ -2087,44 +2224,9 @@ static int sfb__child_mask(sfb__step *st, int cv, sfb__mask *m, float *ps, float
     }
 }
 
-/* Composes local masks with the parent's composed rows using a dense accumulator. */
-typedef struct sfb__accum {
-    double *acc;
-    unsigned *mark;
-    int *touched;
-    unsigned stamp;
-} sfb__accum;
-
-static int sfb__compose_row(sfb_context *ctx, sfb__accum *A, const sfb__rows *prow, const sfb__mask *m, sfb__rows *out, int row) {
-    int i, nt = 0;
-    size_t k;
-    A->stamp++;
-    if (A->stamp == 0) return 0; /* wrapped: caller resets */
-    for (i = 0; i < m->n; ++i) {
-        int j = m->idx[i];
-        double wj = m->w[i];
-        if (wj == 0.0) continue;
-        for (k = prow->off[j]; k < prow->off[j + 1]; ++k) {
-            int b = prow->idx[k];
-            if (A->mark[b] != A->stamp) { A->mark[b] = A->stamp; A->acc[b] = 0.0; A->touched[nt++] = b; }
-            A->acc[b] += wj * prow->w[k];
-        }
-    }
-    if (!sfb__rows_reserve(ctx, out, out->n + (size_t)nt)) return 0;
-    for (i = 0; i < nt; ++i) {
-        int b = A->touched[i];
-        if (A->acc[b] == 0.0) continue;
-        out->idx[out->n] = b;
-        out->w[out->n] = A->acc[b];
-        out->n++;
-    }
-    out->off[row + 1] = out->n;
-    return 1;
-}
-
 /* One step: refines `p` (whose vertices have composed rows `prow`) into `c`, with the
  * composed rows of c's vertices in `crow`. Progress is reported from p0 over a span of dp. */
-static sfb_result sfb__refine_step(sfb_context *ctx, const sfb__refine_options *opt, const sfb__level *p, const sfb__rows *prow,
+sfb_result sfb__refine_step(sfb_context *ctx, const sfb__refine_options *opt, const sfb__level *p, const sfb__rows *prow,
                                    sfb__level *c, sfb__rows *crow, sfb__accum *A, sfb__mask *m, float *ps, float *cs,
                                    float p0, float dp) {
     sfb__step st;
@@ -2162,7 +2264,7 @@ static sfb_result sfb__refine_step(sfb_context *ctx, const sfb__refine_options *
  * edges a and b (in v's edge order; b may exceed the edge count to go around an interior
  * vertex: indices are taken modulo it): m1 along the crease (from b's end towards a's), m2
  * into that side. The other side of an interior crease is (b, a + edge count). */
-static void sfb__crease_tangent_masks(const sfb__level *l, int v, int a, int b, int loop, sfb__mask *m1, sfb__mask *m2) {
+void sfb__crease_tangent_masks(const sfb__level *l, int v, int a, int b, int loop, sfb__mask *m1, sfb__mask *m2) {
     int e0 = l->ve_off[v], ne = l->ve_off[v + 1] - e0;
     int f0 = l->vf_off[v], nf = l->vf_off[v + 1] - f0;
     double tscale = loop ? 3.0 : 1.0;
@@ -2215,7 +2317,7 @@ static void sfb__crease_tangent_masks(const sfb__level *l, int v, int a, int b, 
 }
 
 /* ---- limit masks at the last level ---- */
-static void sfb__limit_masks(const sfb__level *l, int v, sfb_scheme scheme, sfb__mask *mp, sfb__mask *m1, sfb__mask *m2) {
+void sfb__limit_masks(const sfb__level *l, int v, sfb_scheme scheme, sfb__mask *mp, sfb__mask *m1, sfb__mask *m2) {
     int e0 = l->ve_off[v], ne = l->ve_off[v + 1] - e0;
     int f0 = l->vf_off[v], nf = l->vf_off[v + 1] - f0;
     int rule = l->vrule[v], i;
@@ -2296,39 +2398,6 @@ static void sfb__limit_masks(const sfb__level *l, int v, sfb_scheme scheme, sfb_
     }
 #undef SFB__E
 #undef SFB__D
-}
-
-void sfb__stencils_free(sfb_context *ctx, sfb__stencils *s) {
-    sfb__free(ctx, s->sizes); sfb__free(ctx, s->offsets); sfb__free(ctx, s->indices); sfb__free(ctx, s->weights);
-    memset(s, 0, sizeof *s);
-}
-
-static sfb_result sfb__rows_to_stencils(sfb_context *ctx, const sfb__rows *r, int sources, sfb__stencils *s) {
-    int i;
-    size_t k;
-    memset(s, 0, sizeof *s);
-    if (r->n > 0x7fffffff)
-        return sfb__error(ctx, SFB_LIMIT_EXCEEDED, SFB_ELEMENT_NONE, -1, "stencil table of %zu entries is over the limit", r->n);
-    s->rows = r->rows;
-    s->sources = sources;
-    s->entries = r->n;
-    s->sizes = (int *)sfb__alloc(ctx, ((size_t)r->rows + 1) * sizeof(int));
-    s->offsets = (int *)sfb__alloc(ctx, ((size_t)r->rows + 1) * sizeof(int));
-    s->indices = (int *)sfb__alloc(ctx, (r->n + 1) * sizeof(int));
-    s->weights = (float *)sfb__alloc(ctx, (r->n + 1) * sizeof(float));
-    if (!s->sizes || !s->offsets || !s->indices || !s->weights) {
-        sfb__stencils_free(ctx, s);
-        return SFB_OUT_OF_MEMORY;
-    }
-    for (i = 0; i < r->rows; ++i) {
-        s->offsets[i] = (int)r->off[i];
-        s->sizes[i] = (int)(r->off[i + 1] - r->off[i]);
-    }
-    s->offsets[r->rows] = (int)r->n; /* end marker: offsets[rows] == entries */
-    s->sizes[r->rows] = 0;
-    if (r->n) memcpy(s->indices, r->idx, r->n * sizeof(int));
-    for (k = 0; k < r->n; ++k) s->weights[k] = (float)r->w[k];
-    return SFB_SUCCESS;
 }
 
 
@@ -2897,9 +2966,9 @@ static int sfb__loop_index(int N, int x, int y) {
 
 /* Sabin's rules (ALGORITHMS.md §5.1): Bezier point (i = exponent of s, j = exponent of t,
  * our order row by row in t) from the 12 box-spline points at lattice offsets boxpt[]. */
-static const signed char sfb__box12[12][2] = {{0, -1}, {1, -1}, {2, -1}, {-1, 0}, {0, 0}, {1, 0},
+const signed char sfb__box12[12][2] = {{0, -1}, {1, -1}, {2, -1}, {-1, 0}, {0, 0}, {1, 0},
                                               {2, 0},  {-1, 1}, {0, 1},  {1, 1},  {-1, 2}, {0, 2}};
-static const unsigned char sfb__bez15_from_box[15][12] = {
+const unsigned char sfb__bez15_from_box[15][12] = {
     /* row t^0 */
     {2, 2, 0, 2, 12, 2, 0, 2, 2, 0, 0, 0}, {1, 3, 0, 0, 12, 4, 0, 1, 3, 0, 0, 0}, {0, 4, 0, 0, 8, 8, 0, 0, 4, 0, 0, 0},
     {0, 3, 1, 0, 4, 12, 0, 0, 3, 1, 0, 0}, {0, 2, 2, 0, 2, 12, 2, 0, 2, 2, 0, 0},
@@ -3173,11 +3242,6 @@ const sfb__eigen_loop *sfb__eigen_loop_get(sfb_context *ctx, int N) {
 enum { SFB__CORNER_R1 = 1, SFB__CORNER_R2_D1 = 2, SFB__CORNER_R2_D2 = 3, SFB__CORNER_R3 = 4, SFB__CORNER_EV = 5,
        SFB__CORNER_IRREGULAR = 0 };
 
-#define SFB__PARAM(depth, i, j, corner) ((unsigned)(depth) | ((unsigned)(i) << 4) | ((unsigned)(j) << 17) | ((unsigned)(corner) << 30))
-#define SFB__PARAM_DEPTH(p) ((int)((p) & 15u))
-#define SFB__PARAM_I(p) ((int)(((p) >> 4) & 8191u))
-#define SFB__PARAM_J(p) ((int)(((p) >> 17) & 8191u))
-#define SFB__PARAM_CORNER(p) ((int)(((p) >> 30) & 3u))
 
 void sfb__patch_table_free(sfb_context *ctx, sfb__patch_table *pt) {
     sfb__free(ctx, pt->ptype); sfb__free(ctx, pt->pfirst); sfb__free(ctx, pt->pparam); sfb__free(ctx, pt->pvalence);
@@ -6217,11 +6281,6 @@ fail:
 #line 1 "src/mesh.c"
 /* Control meshes: validation of untrusted arrays, edges, topology, creases, info. */
 
-/* Line numbers of OBJ statements, so that errors found while building the mesh can name the
- * line they came from. Internal: sfb_mesh_read_obj passes it, sfb_mesh_create does not. */
-typedef struct sfb__src_lines {
-    const int *face, *crease, *corner, *hole;
-} sfb__src_lines;
 
 static sfb_result sfb__elem_error(sfb_context *ctx, sfb_result r, const sfb__src_lines *lines, const int *line_of,
                                   sfb_element_kind kind, long index, const char *what, long what_index, const char *detail) {
@@ -6304,7 +6363,7 @@ static int sfb__find_edge(const sfb__level *l, int a, int b) {
 static int sfb__finite3(const float *p) { return isfinite(p[0]) && isfinite(p[1]) && isfinite(p[2]); }
 
 /* Builds a level (topology only, zero sharpness) from faces; validates indices. */
-static sfb_result sfb__level_from_faces(sfb_context *ctx, int nv, int nf, const int *sizes, const int *fvin,
+sfb_result sfb__level_from_faces(sfb_context *ctx, int nv, int nf, const int *sizes, const int *fvin,
                                         const sfb__src_lines *lines, sfb_element_kind vkind, sfb__level *l) {
     int f, i;
     size_t nfv = 0;
@@ -6370,7 +6429,7 @@ static sfb_result sfb__check_sharpness(sfb_context *ctx, float s, const sfb__src
 
 void sfb_mesh_destroy(sfb_mesh *mesh);
 
-static sfb_result sfb__mesh_create(sfb_context *ctx, const sfb_mesh_desc *d, const sfb__src_lines *lines, sfb_mesh **out) {
+sfb_result sfb__mesh_create(sfb_context *ctx, const sfb_mesh_desc *d, const sfb__src_lines *lines, sfb_mesh **out) {
     sfb_mesh *m;
     sfb_result r;
     int i, v, e;
@@ -7530,7 +7589,7 @@ static sfb_result sfb__eval_args(const sfb_surface *s, sfb_table t, int have_buf
 
 /* Rows [0, rows) of table `t` on the context's backend (`handle`: its upload of t), or on ref
  * when the backend lacks eval_stencils. Arguments already checked. */
-static sfb_result sfb__surface_apply(const sfb_surface *s, const sfb__stencils *t, void *handle, int rows, const float *src,
+sfb_result sfb__surface_apply(const sfb_surface *s, const sfb__stencils *t, void *handle, int rows, const float *src,
                                      sfb_buffer_desc sd, float *dst, sfb_buffer_desc dd) {
     sfb_context *ctx = s->ctx;
     const sfb__backend_vtable *be = ctx->backend;
@@ -7582,7 +7641,6 @@ SFB_API void sfb_mesh_data_free(sfb_mesh_data *d) {
     memset(d, 0, sizeof *d);
 }
 
-static sfb_result sfb__refine_output(const sfb_surface *s, const float *base, int base_count, int want_limit, sfb_mesh_data *o);
 
 SFB_API sfb_result sfb_surface_refine(const sfb_surface *s, sfb_mesh_data *out) {
     if (!s) return SFB_INVALID_ARGS;
@@ -7594,7 +7652,7 @@ SFB_API sfb_result sfb_surface_refine_positions(const sfb_surface *s, const floa
 }
 
 /* The refined mesh; with want_limit the limit tables too (when built). */
-static sfb_result sfb__refine_output(const sfb_surface *s, const float *base, int base_count, int want_limit, sfb_mesh_data *o) {
+sfb_result sfb__refine_output(const sfb_surface *s, const float *base, int base_count, int want_limit, sfb_mesh_data *o) {
     sfb_context *ctx;
     const sfb__level *l;
     sfb_buffer_desc d3 = {0, 3, 3}, d2 = {0, 2, 2};

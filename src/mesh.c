@@ -1,10 +1,5 @@
 /* Control meshes: validation of untrusted arrays, edges, topology, creases, info. */
 
-/* Line numbers of OBJ statements, so that errors found while building the mesh can name the
- * line they came from. Internal: sfb_mesh_read_obj passes it, sfb_mesh_create does not. */
-typedef struct sfb__src_lines {
-    const int *face, *crease, *corner, *hole;
-} sfb__src_lines;
 
 static sfb_result sfb__elem_error(sfb_context *ctx, sfb_result r, const sfb__src_lines *lines, const int *line_of,
                                   sfb_element_kind kind, long index, const char *what, long what_index, const char *detail) {
@@ -87,7 +82,7 @@ static int sfb__find_edge(const sfb__level *l, int a, int b) {
 static int sfb__finite3(const float *p) { return isfinite(p[0]) && isfinite(p[1]) && isfinite(p[2]); }
 
 /* Builds a level (topology only, zero sharpness) from faces; validates indices. */
-static sfb_result sfb__level_from_faces(sfb_context *ctx, int nv, int nf, const int *sizes, const int *fvin,
+sfb_result sfb__level_from_faces(sfb_context *ctx, int nv, int nf, const int *sizes, const int *fvin,
                                         const sfb__src_lines *lines, sfb_element_kind vkind, sfb__level *l) {
     int f, i;
     size_t nfv = 0;
@@ -153,7 +148,7 @@ static sfb_result sfb__check_sharpness(sfb_context *ctx, float s, const sfb__src
 
 void sfb_mesh_destroy(sfb_mesh *mesh);
 
-static sfb_result sfb__mesh_create(sfb_context *ctx, const sfb_mesh_desc *d, const sfb__src_lines *lines, sfb_mesh **out) {
+sfb_result sfb__mesh_create(sfb_context *ctx, const sfb_mesh_desc *d, const sfb__src_lines *lines, sfb_mesh **out) {
     sfb_mesh *m;
     sfb_result r;
     int i, v, e;

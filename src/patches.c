@@ -29,11 +29,6 @@
 enum { SFB__CORNER_R1 = 1, SFB__CORNER_R2_D1 = 2, SFB__CORNER_R2_D2 = 3, SFB__CORNER_R3 = 4, SFB__CORNER_EV = 5,
        SFB__CORNER_IRREGULAR = 0 };
 
-#define SFB__PARAM(depth, i, j, corner) ((unsigned)(depth) | ((unsigned)(i) << 4) | ((unsigned)(j) << 17) | ((unsigned)(corner) << 30))
-#define SFB__PARAM_DEPTH(p) ((int)((p) & 15u))
-#define SFB__PARAM_I(p) ((int)(((p) >> 4) & 8191u))
-#define SFB__PARAM_J(p) ((int)(((p) >> 17) & 8191u))
-#define SFB__PARAM_CORNER(p) ((int)(((p) >> 30) & 3u))
 
 void sfb__patch_table_free(sfb_context *ctx, sfb__patch_table *pt) {
     sfb__free(ctx, pt->ptype); sfb__free(ctx, pt->pfirst); sfb__free(ctx, pt->pparam); sfb__free(ctx, pt->pvalence);

@@ -29,85 +29,9 @@ static float sfb__sub_edge_at_vertex(float s, int chaikin, int vertex_edges, flo
     return s > 0.0f ? s : 0.0f;
 }
 
-/* ---- composed rows (double weights) ---- */
-typedef struct sfb__rows {
-    int rows;
-    size_t *off;   /* rows + 1 */
-    int *idx;
-    double *w;
-    size_t n, cap;
-} sfb__rows;
-
-static void sfb__rows_free(sfb_context *ctx, sfb__rows *r) {
-    sfb__free(ctx, r->off); sfb__free(ctx, r->idx); sfb__free(ctx, r->w);
-    memset(r, 0, sizeof *r);
-}
-
-static int sfb__rows_reserve(sfb_context *ctx, sfb__rows *r, size_t need) {
-    size_t cap;
-    int *ni;
-    double *nw;
-    if (need <= r->cap) return 1;
-    cap = r->cap ? r->cap : 1024;
-    while (cap < need) {
-        if (cap > ((size_t)-1) / 4) return 0;
-        cap = cap + cap / 2 + 16;
-    }
-    ni = (int *)sfb__realloc(ctx, r->idx, cap * sizeof(int));
-    if (!ni) return 0;
-    r->idx = ni;
-    nw = (double *)sfb__realloc(ctx, r->w, cap * sizeof(double));
-    if (!nw) return 0;
-    r->w = nw;
-    r->cap = cap;
-    return 1;
-}
-
-/* ---- local masks: (parent vertex, weight) pairs, duplicates allowed ---- */
-typedef struct sfb__mask {
-    int *idx;
-    double *w;
-    int n, cap;
-} sfb__mask;
-
-static int sfb__mask_grow(sfb_context *ctx, sfb__mask *m, int need) {
-    int cap;
-    int *ni;
-    double *nw;
-    if (m->n + need <= m->cap) return 1;
-    cap = (m->cap ? m->cap * 2 : 64);
-    while (cap < m->n + need) cap *= 2;
-    ni = (int *)sfb__realloc(ctx, m->idx, (size_t)cap * sizeof(int));
-    if (!ni) return 0;
-    m->idx = ni;
-    nw = (double *)sfb__realloc(ctx, m->w, (size_t)cap * sizeof(double));
-    if (!nw) return 0;
-    m->w = nw;
-    m->cap = cap;
-    return 1;
-}
-
-#define SFB__MASK_ADD(m, i, wt) do { (m)->idx[(m)->n] = (i); (m)->w[(m)->n] = (wt); (m)->n++; } while (0)
-
-static int sfb__other_end(const sfb__level *l, int e, int v) {
-    return l->ev[2 * e] == v ? l->ev[2 * e + 1] : l->ev[2 * e];
-}
-
-/* Adds w * (face centroid of f). */
-static void sfb__mask_face(sfb__mask *m, const sfb__level *l, int f, double w) {
-    int i, n = l->fv_off[f + 1] - l->fv_off[f];
-    for (i = 0; i < n; ++i) SFB__MASK_ADD(m, l->fv[l->fv_off[f] + i], w / n);
-}
-
-static int sfb__mask_need_vertex(const sfb__level *l, int v) {
-    int need = 1 + 2 * (l->ve_off[v + 1] - l->ve_off[v]), i;
-    for (i = l->vf_off[v]; i < l->vf_off[v + 1]; ++i) need += l->fv_off[l->vf[i] + 1] - l->fv_off[l->vf[i]];
-    return need;
-}
-
 /* The crease pair of a vertex: first and last incident edge with sharpness > 0 in the
  * vertex's edge order (OpenSubdiv's GetSharpEdgePairOfCrease). `sharp` is per incident edge. */
-static void sfb__crease_pair(const float *sharp, int n, int *a, int *b) {
+void sfb__crease_pair(const float *sharp, int n, int *a, int *b) {
     int i = 0, j = n - 1;
     while (i < n - 1 && sharp[i] <= 0.0f) ++i;
     while (j > 0 && sharp[j] <= 0.0f) --j;
@@ -403,44 +327,9 @@ static int sfb__child_mask(sfb__step *st, int cv, sfb__mask *m, float *ps, float
     }
 }
 
-/* Composes local masks with the parent's composed rows using a dense accumulator. */
-typedef struct sfb__accum {
-    double *acc;
-    unsigned *mark;
-    int *touched;
-    unsigned stamp;
-} sfb__accum;
-
-static int sfb__compose_row(sfb_context *ctx, sfb__accum *A, const sfb__rows *prow, const sfb__mask *m, sfb__rows *out, int row) {
-    int i, nt = 0;
-    size_t k;
-    A->stamp++;
-    if (A->stamp == 0) return 0; /* wrapped: caller resets */
-    for (i = 0; i < m->n; ++i) {
-        int j = m->idx[i];
-        double wj = m->w[i];
-        if (wj == 0.0) continue;
-        for (k = prow->off[j]; k < prow->off[j + 1]; ++k) {
-            int b = prow->idx[k];
-            if (A->mark[b] != A->stamp) { A->mark[b] = A->stamp; A->acc[b] = 0.0; A->touched[nt++] = b; }
-            A->acc[b] += wj * prow->w[k];
-        }
-    }
-    if (!sfb__rows_reserve(ctx, out, out->n + (size_t)nt)) return 0;
-    for (i = 0; i < nt; ++i) {
-        int b = A->touched[i];
-        if (A->acc[b] == 0.0) continue;
-        out->idx[out->n] = b;
-        out->w[out->n] = A->acc[b];
-        out->n++;
-    }
-    out->off[row + 1] = out->n;
-    return 1;
-}
-
 /* One step: refines `p` (whose vertices have composed rows `prow`) into `c`, with the
  * composed rows of c's vertices in `crow`. Progress is reported from p0 over a span of dp. */
-static sfb_result sfb__refine_step(sfb_context *ctx, const sfb__refine_options *opt, const sfb__level *p, const sfb__rows *prow,
+sfb_result sfb__refine_step(sfb_context *ctx, const sfb__refine_options *opt, const sfb__level *p, const sfb__rows *prow,
                                    sfb__level *c, sfb__rows *crow, sfb__accum *A, sfb__mask *m, float *ps, float *cs,
                                    float p0, float dp) {
     sfb__step st;
@@ -478,7 +367,7 @@ static sfb_result sfb__refine_step(sfb_context *ctx, const sfb__refine_options *
  * edges a and b (in v's edge order; b may exceed the edge count to go around an interior
  * vertex: indices are taken modulo it): m1 along the crease (from b's end towards a's), m2
  * into that side. The other side of an interior crease is (b, a + edge count). */
-static void sfb__crease_tangent_masks(const sfb__level *l, int v, int a, int b, int loop, sfb__mask *m1, sfb__mask *m2) {
+void sfb__crease_tangent_masks(const sfb__level *l, int v, int a, int b, int loop, sfb__mask *m1, sfb__mask *m2) {
     int e0 = l->ve_off[v], ne = l->ve_off[v + 1] - e0;
     int f0 = l->vf_off[v], nf = l->vf_off[v + 1] - f0;
     double tscale = loop ? 3.0 : 1.0;
@@ -531,7 +420,7 @@ static void sfb__crease_tangent_masks(const sfb__level *l, int v, int a, int b, 
 }
 
 /* ---- limit masks at the last level ---- */
-static void sfb__limit_masks(const sfb__level *l, int v, sfb_scheme scheme, sfb__mask *mp, sfb__mask *m1, sfb__mask *m2) {
+void sfb__limit_masks(const sfb__level *l, int v, sfb_scheme scheme, sfb__mask *mp, sfb__mask *m1, sfb__mask *m2) {
     int e0 = l->ve_off[v], ne = l->ve_off[v + 1] - e0;
     int f0 = l->vf_off[v], nf = l->vf_off[v + 1] - f0;
     int rule = l->vrule[v], i;
@@ -612,39 +501,6 @@ static void sfb__limit_masks(const sfb__level *l, int v, sfb_scheme scheme, sfb_
     }
 #undef SFB__E
 #undef SFB__D
-}
-
-void sfb__stencils_free(sfb_context *ctx, sfb__stencils *s) {
-    sfb__free(ctx, s->sizes); sfb__free(ctx, s->offsets); sfb__free(ctx, s->indices); sfb__free(ctx, s->weights);
-    memset(s, 0, sizeof *s);
-}
-
-static sfb_result sfb__rows_to_stencils(sfb_context *ctx, const sfb__rows *r, int sources, sfb__stencils *s) {
-    int i;
-    size_t k;
-    memset(s, 0, sizeof *s);
-    if (r->n > 0x7fffffff)
-        return sfb__error(ctx, SFB_LIMIT_EXCEEDED, SFB_ELEMENT_NONE, -1, "stencil table of %zu entries is over the limit", r->n);
-    s->rows = r->rows;
-    s->sources = sources;
-    s->entries = r->n;
-    s->sizes = (int *)sfb__alloc(ctx, ((size_t)r->rows + 1) * sizeof(int));
-    s->offsets = (int *)sfb__alloc(ctx, ((size_t)r->rows + 1) * sizeof(int));
-    s->indices = (int *)sfb__alloc(ctx, (r->n + 1) * sizeof(int));
-    s->weights = (float *)sfb__alloc(ctx, (r->n + 1) * sizeof(float));
-    if (!s->sizes || !s->offsets || !s->indices || !s->weights) {
-        sfb__stencils_free(ctx, s);
-        return SFB_OUT_OF_MEMORY;
-    }
-    for (i = 0; i < r->rows; ++i) {
-        s->offsets[i] = (int)r->off[i];
-        s->sizes[i] = (int)(r->off[i + 1] - r->off[i]);
-    }
-    s->offsets[r->rows] = (int)r->n; /* end marker: offsets[rows] == entries */
-    s->sizes[r->rows] = 0;
-    if (r->n) memcpy(s->indices, r->idx, r->n * sizeof(int));
-    for (k = 0; k < r->n; ++k) s->weights[k] = (float)r->w[k];
-    return SFB_SUCCESS;
 }
 
 

@@ -144,6 +144,17 @@ enum { SFB__FAMILY_QUAD = 0,     /* BSPLINE16, STAM, ENDCAP: polynomial quad pat
 static inline int sfb__patch_family(int type) {
     return type <= SFB__PATCH_ENDCAP ? SFB__FAMILY_QUAD : type <= SFB__PATCH_ENDCAP_TRI ? SFB__FAMILY_TRI : SFB__FAMILY_MANIFOLD;
 }
+/* A patch's sub-square of its parametric face: depth | i << 4 | j << 17 | corner << 30. */
+#define SFB__PARAM(depth, i, j, corner) ((unsigned)(depth) | ((unsigned)(i) << 4) | ((unsigned)(j) << 17) | ((unsigned)(corner) << 30))
+#define SFB__PARAM_DEPTH(p) ((int)((p) & 15u))
+#define SFB__PARAM_I(p) ((int)(((p) >> 4) & 8191u))
+#define SFB__PARAM_J(p) ((int)(((p) >> 17) & 8191u))
+#define SFB__PARAM_CORNER(p) ((int)(((p) >> 30) & 3u))
+/* Sabin's rules (stam.c): the 12 box-spline points' lattice offsets and the quartic Bezier
+ * points from them (ALGORITHMS.md 5.1). */
+extern const signed char sfb__box12[12][2];
+extern const unsigned char sfb__bez15_from_box[15][12];
+
 /* What a patch table is, for its readers (locate, evaluation kernels, tessellation): the
  * parametric DOMAIN of its faces, and per record a kernel FAMILY (from the record's type,
  * sfb__patch_family). Only the scheme builders know the scheme; nothing reading a table asks it. */
@@ -245,8 +256,58 @@ sfb_result sfb__level_complete(sfb_context *ctx, sfb__level *l);
 /* Sharpness/rule helpers shared by refinement and info. */
 int sfb__rule_from(float vertex_sharpness, int sharp_edge_count);
 void sfb__level_compute_rules(sfb__level *l);
+/* The end of edge e that is not v (topology.c). */
+int sfb__other_end(const sfb__level *l, int e, int v);
 
-/* ---- mesh ---- */
+/* ---- the stencil algebra (stencil.c) ---- */
+/* Composed rows (double weights): row r holds entries [off[r], off[r+1]) of idx/w. */
+typedef struct sfb__rows {
+    int rows;
+    size_t *off;   /* rows + 1 */
+    int *idx;
+    double *w;
+    size_t n, cap;
+} sfb__rows;
+/* A local mask: (vertex, weight) pairs, duplicates allowed. */
+typedef struct sfb__mask {
+    int *idx;
+    double *w;
+    int n, cap;
+} sfb__mask;
+#define SFB__MASK_ADD(m, i, wt) do { (m)->idx[(m)->n] = (i); (m)->w[(m)->n] = (wt); (m)->n++; } while (0)
+/* A dense accumulator over source vertices, for composing masks with rows. */
+typedef struct sfb__accum {
+    double *acc;
+    unsigned *mark;
+    int *touched;
+    unsigned stamp;
+} sfb__accum;
+void sfb__rows_free(sfb_context *ctx, sfb__rows *r);
+/* Room for `need` entries in all; 0 on allocation failure. */
+int sfb__rows_reserve(sfb_context *ctx, sfb__rows *r, size_t need);
+/* Room for `need` more pairs; 0 on allocation failure. */
+int sfb__mask_grow(sfb_context *ctx, sfb__mask *m, int need);
+/* Adds w * (face centroid of f). */
+void sfb__mask_face(sfb__mask *m, const sfb__level *l, int f, double w);
+/* An upper bound of the pairs a vertex rule of v adds. */
+int sfb__mask_need_vertex(const sfb__level *l, int v);
+/* Row `row` of `out` = mask m composed with the parent rows prow; 0 on allocation failure or when
+ * the accumulator's stamp wrapped (the caller resets it). */
+int sfb__compose_row(sfb_context *ctx, sfb__accum *A, const sfb__rows *prow, const sfb__mask *m, sfb__rows *out, int row);
+/* The float stencil table of r (over `sources` source elements). */
+sfb_result sfb__rows_to_stencils(sfb_context *ctx, const sfb__rows *r, int sources, sfb__stencils *s);
+
+/* ---- mesh (mesh.c) ---- */
+/* Line numbers of OBJ statements, so that errors found while building the mesh can name the
+ * line they came from. Internal: sfb_mesh_read_obj passes it, sfb_mesh_create does not. */
+typedef struct sfb__src_lines {
+    const int *face, *crease, *corner, *hole;
+} sfb__src_lines;
+/* Builds a level (topology only, zero sharpness) from faces; validates indices. */
+sfb_result sfb__level_from_faces(sfb_context *ctx, int nv, int nf, const int *sizes, const int *fvin, const sfb__src_lines *lines,
+                                 sfb_element_kind vkind, sfb__level *l);
+/* sfb_mesh_create with OBJ line numbers for the errors (lines may be NULL). */
+sfb_result sfb__mesh_create(sfb_context *ctx, const sfb_mesh_desc *d, const sfb__src_lines *lines, sfb_mesh **out);
 struct sfb_mesh {
     sfb_context *ctx;
     sfb__level base;            /* topology, with user sharpness (not yet boundary-sharpened) */
@@ -319,9 +380,26 @@ sfb_result sfb__refine(sfb_context *ctx, const sfb__level *base, const sfb__refi
                        sfb__level *top, sfb__stencils *vertex_table, sfb__stencils *limit_tables /* [3] or NULL */,
                        float progress_from, float progress_to);
 void sfb__stencils_free(sfb_context *ctx, sfb__stencils *s);
+/* One refinement step of `p` (composed rows prow) into `c` (composed rows crow); A, m, ps, cs are
+ * the caller's scratch; progress from p0 over dp. */
+sfb_result sfb__refine_step(sfb_context *ctx, const sfb__refine_options *opt, const sfb__level *p, const sfb__rows *prow,
+                            sfb__level *c, sfb__rows *crow, sfb__accum *A, sfb__mask *m, float *ps, float *cs, float p0, float dp);
+/* The crease pair of a vertex: first and last incident edge with sharpness > 0 in ve order. */
+void sfb__crease_pair(const float *sharp, int n, int *a, int *b);
+/* Crease limit tangent masks at v between its crease edges a and b (either order; loop: Loop's scale). */
+void sfb__crease_tangent_masks(const sfb__level *l, int v, int a, int b, int loop, sfb__mask *m1, sfb__mask *m2);
+/* Limit position and tangent masks of vertex v by its rule. */
+void sfb__limit_masks(const sfb__level *l, int v, sfb_scheme scheme, sfb__mask *mp, sfb__mask *m1, sfb__mask *m2);
 /* Copy of the base level with OpenSubdiv's boundary/non-manifold sharpening and holes applied. */
 sfb_result sfb__level_prepare(sfb_context *ctx, const sfb__level *src, int sharpen_corners, int make_boundary_holes,
                               sfb__level *dst);
+
+/* Rows [0, rows) of table t on the context's backend (handle: its upload of t), or on ref when
+ * the backend lacks eval_stencils (surface.c). */
+sfb_result sfb__surface_apply(const sfb_surface *s, const sfb__stencils *t, void *handle, int rows, const float *src,
+                              sfb_buffer_desc sd, float *dst, sfb_buffer_desc dd);
+/* The refined (or limit) mesh of a surface into o (surface.c). */
+sfb_result sfb__refine_output(const sfb_surface *s, const float *base, int base_count, int want_limit, sfb_mesh_data *o);
 
 void sfb__shading_free(sfb_context *ctx, sfb__shading *sh);
 sfb_result sfb__shading_build(sfb_context *ctx, const sfb__level *prep, const sfb__refine_options *opt, int level,

@@ -465,9 +465,9 @@ static int sfb__loop_index(int N, int x, int y) {
 
 /* Sabin's rules (ALGORITHMS.md §5.1): Bezier point (i = exponent of s, j = exponent of t,
  * our order row by row in t) from the 12 box-spline points at lattice offsets boxpt[]. */
-static const signed char sfb__box12[12][2] = {{0, -1}, {1, -1}, {2, -1}, {-1, 0}, {0, 0}, {1, 0},
+const signed char sfb__box12[12][2] = {{0, -1}, {1, -1}, {2, -1}, {-1, 0}, {0, 0}, {1, 0},
                                               {2, 0},  {-1, 1}, {0, 1},  {1, 1},  {-1, 2}, {0, 2}};
-static const unsigned char sfb__bez15_from_box[15][12] = {
+const unsigned char sfb__bez15_from_box[15][12] = {
     /* row t^0 */
     {2, 2, 0, 2, 12, 2, 0, 2, 2, 0, 0, 0}, {1, 3, 0, 0, 12, 4, 0, 1, 3, 0, 0, 0}, {0, 4, 0, 0, 8, 8, 0, 0, 4, 0, 0, 0},
     {0, 3, 1, 0, 4, 12, 0, 0, 3, 1, 0, 0}, {0, 2, 2, 0, 2, 12, 2, 0, 2, 2, 0, 0},

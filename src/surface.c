@@ -308,7 +308,7 @@ static sfb_result sfb__eval_args(const sfb_surface *s, sfb_table t, int have_buf
 
 /* Rows [0, rows) of table `t` on the context's backend (`handle`: its upload of t), or on ref
  * when the backend lacks eval_stencils. Arguments already checked. */
-static sfb_result sfb__surface_apply(const sfb_surface *s, const sfb__stencils *t, void *handle, int rows, const float *src,
+sfb_result sfb__surface_apply(const sfb_surface *s, const sfb__stencils *t, void *handle, int rows, const float *src,
                                      sfb_buffer_desc sd, float *dst, sfb_buffer_desc dd) {
     sfb_context *ctx = s->ctx;
     const sfb__backend_vtable *be = ctx->backend;
@@ -360,7 +360,6 @@ SFB_API void sfb_mesh_data_free(sfb_mesh_data *d) {
     memset(d, 0, sizeof *d);
 }
 
-static sfb_result sfb__refine_output(const sfb_surface *s, const float *base, int base_count, int want_limit, sfb_mesh_data *o);
 
 SFB_API sfb_result sfb_surface_refine(const sfb_surface *s, sfb_mesh_data *out) {
     if (!s) return SFB_INVALID_ARGS;
@@ -372,7 +371,7 @@ SFB_API sfb_result sfb_surface_refine_positions(const sfb_surface *s, const floa
 }
 
 /* The refined mesh; with want_limit the limit tables too (when built). */
-static sfb_result sfb__refine_output(const sfb_surface *s, const float *base, int base_count, int want_limit, sfb_mesh_data *o) {
+sfb_result sfb__refine_output(const sfb_surface *s, const float *base, int base_count, int want_limit, sfb_mesh_data *o) {
     sfb_context *ctx;
     const sfb__level *l;
     sfb_buffer_desc d3 = {0, 3, 3}, d2 = {0, 2, 2};

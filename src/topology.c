@@ -235,3 +235,8 @@ sfb_result sfb__level_prepare(sfb_context *ctx, const sfb__level *s, int sharpen
     sfb__level_compute_rules(d);
     return SFB_SUCCESS;
 }
+
+/* The end of edge e that is not v. */
+int sfb__other_end(const sfb__level *l, int e, int v) {
+    return l->ev[2 * e] == v ? l->ev[2 * e + 1] : l->ev[2 * e];
+}

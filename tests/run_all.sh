@@ -47,6 +47,9 @@ single() { # name, command...: one test, passes iff the command exits 0
 single compile-c99 $CC -std=c99 -pedantic -Wall -Wextra -Werror -c -x c tools/impl.c -I. -o "$LOG/impl_c99.o"
 single compile-cxx $CXX -std=c++11 -Wall -Wextra -Werror -c -x c++ tools/impl.c -I. -o "$LOG/impl_cxx.o"
 
+# 1b. the modules of src/ as separate translation units, linked with the examples (make check-modules)
+single check-modules env CC="$CC" CXX="$CXX" ./tools/check_modules.sh "$BUILD"
+
 # 2. unit tests (Criterion)
 out=$("$BUILD/unit" --jobs 2 2>&1); rc=$?
 echo "$out" > "$LOG/unit.log"

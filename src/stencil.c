@@ -1,0 +1,129 @@
+/* The stencil algebra every table builder shares (declared in sfb_internal.h): composed rows
+ * of double weights over source vertices (sfb__rows), local masks of (vertex, weight) pairs
+ * (sfb__mask), the composition of a mask with its parents' rows through a dense accumulator
+ * (sfb__compose_row), and the conversion of rows into a backend's float stencil table
+ * (sfb__rows_to_stencils). Refinement (refine.c), patch points (patches.c), shading (shade.c)
+ * and manifold blending (manifold.c) build their tables with it. */
+
+/* ---- composed rows (double weights) ---- */
+
+void sfb__rows_free(sfb_context *ctx, sfb__rows *r) {
+    sfb__free(ctx, r->off); sfb__free(ctx, r->idx); sfb__free(ctx, r->w);
+    memset(r, 0, sizeof *r);
+}
+
+int sfb__rows_reserve(sfb_context *ctx, sfb__rows *r, size_t need) {
+    size_t cap;
+    int *ni;
+    double *nw;
+    if (need <= r->cap) return 1;
+    cap = r->cap ? r->cap : 1024;
+    while (cap < need) {
+        if (cap > ((size_t)-1) / 4) return 0;
+        cap = cap + cap / 2 + 16;
+    }
+    ni = (int *)sfb__realloc(ctx, r->idx, cap * sizeof(int));
+    if (!ni) return 0;
+    r->idx = ni;
+    nw = (double *)sfb__realloc(ctx, r->w, cap * sizeof(double));
+    if (!nw) return 0;
+    r->w = nw;
+    r->cap = cap;
+    return 1;
+}
+
+/* ---- local masks: (parent vertex, weight) pairs, duplicates allowed ---- */
+
+
+int sfb__mask_grow(sfb_context *ctx, sfb__mask *m, int need) {
+    int cap;
+    int *ni;
+    double *nw;
+    if (m->n + need <= m->cap) return 1;
+    cap = (m->cap ? m->cap * 2 : 64);
+    while (cap < m->n + need) cap *= 2;
+    ni = (int *)sfb__realloc(ctx, m->idx, (size_t)cap * sizeof(int));
+    if (!ni) return 0;
+    m->idx = ni;
+    nw = (double *)sfb__realloc(ctx, m->w, (size_t)cap * sizeof(double));
+    if (!nw) return 0;
+    m->w = nw;
+    m->cap = cap;
+    return 1;
+}
+
+
+/* Adds w * (face centroid of f). */
+void sfb__mask_face(sfb__mask *m, const sfb__level *l, int f, double w) {
+    int i, n = l->fv_off[f + 1] - l->fv_off[f];
+    for (i = 0; i < n; ++i) SFB__MASK_ADD(m, l->fv[l->fv_off[f] + i], w / n);
+}
+
+int sfb__mask_need_vertex(const sfb__level *l, int v) {
+    int need = 1 + 2 * (l->ve_off[v + 1] - l->ve_off[v]), i;
+    for (i = l->vf_off[v]; i < l->vf_off[v + 1]; ++i) need += l->fv_off[l->vf[i] + 1] - l->fv_off[l->vf[i]];
+    return need;
+}
+
+/* Composes local masks with the parent's composed rows using a dense accumulator. */
+
+
+int sfb__compose_row(sfb_context *ctx, sfb__accum *A, const sfb__rows *prow, const sfb__mask *m, sfb__rows *out, int row) {
+    int i, nt = 0;
+    size_t k;
+    A->stamp++;
+    if (A->stamp == 0) return 0; /* wrapped: caller resets */
+    for (i = 0; i < m->n; ++i) {
+        int j = m->idx[i];
+        double wj = m->w[i];
+        if (wj == 0.0) continue;
+        for (k = prow->off[j]; k < prow->off[j + 1]; ++k) {
+            int b = prow->idx[k];
+            if (A->mark[b] != A->stamp) { A->mark[b] = A->stamp; A->acc[b] = 0.0; A->touched[nt++] = b; }
+            A->acc[b] += wj * prow->w[k];
+        }
+    }
+    if (!sfb__rows_reserve(ctx, out, out->n + (size_t)nt)) return 0;
+    for (i = 0; i < nt; ++i) {
+        int b = A->touched[i];
+        if (A->acc[b] == 0.0) continue;
+        out->idx[out->n] = b;
+        out->w[out->n] = A->acc[b];
+        out->n++;
+    }
+    out->off[row + 1] = out->n;
+    return 1;
+}
+
+void sfb__stencils_free(sfb_context *ctx, sfb__stencils *s) {
+    sfb__free(ctx, s->sizes); sfb__free(ctx, s->offsets); sfb__free(ctx, s->indices); sfb__free(ctx, s->weights);
+    memset(s, 0, sizeof *s);
+}
+
+sfb_result sfb__rows_to_stencils(sfb_context *ctx, const sfb__rows *r, int sources, sfb__stencils *s) {
+    int i;
+    size_t k;
+    memset(s, 0, sizeof *s);
+    if (r->n > 0x7fffffff)
+        return sfb__error(ctx, SFB_LIMIT_EXCEEDED, SFB_ELEMENT_NONE, -1, "stencil table of %zu entries is over the limit", r->n);
+    s->rows = r->rows;
+    s->sources = sources;
+    s->entries = r->n;
+    s->sizes = (int *)sfb__alloc(ctx, ((size_t)r->rows + 1) * sizeof(int));
+    s->offsets = (int *)sfb__alloc(ctx, ((size_t)r->rows + 1) * sizeof(int));
+    s->indices = (int *)sfb__alloc(ctx, (r->n + 1) * sizeof(int));
+    s->weights = (float *)sfb__alloc(ctx, (r->n + 1) * sizeof(float));
+    if (!s->sizes || !s->offsets || !s->indices || !s->weights) {
+        sfb__stencils_free(ctx, s);
+        return SFB_OUT_OF_MEMORY;
+    }
+    for (i = 0; i < r->rows; ++i) {
+        s->offsets[i] = (int)r->off[i];
+        s->sizes[i] = (int)(r->off[i + 1] - r->off[i]);
+    }
+    s->offsets[r->rows] = (int)r->n; /* end marker: offsets[rows] == entries */
+    s->sizes[r->rows] = 0;
+    if (r->n) memcpy(s->indices, r->idx, r->n * sizeof(int));
+    for (k = 0; k < r->n; ++k) s->weights[k] = (float)r->w[k];
+    return SFB_SUCCESS;
+}
