@@ -11,7 +11,7 @@ BUILD   ?= build
 LIBS    := -lm -lpthread -ldl
 SHAPES  ?= ../shared/peers/opensubdiv-shapes
 
-SRC_MODULES := src/sfb_api.h src/sfb_internal.h $(wildcard src/*.c)
+SRC_MODULES := src/sfb_api.h src/sfb_internal.h $(wildcard src/*.c src/patch/*.c)
 TEST_SRCS   := $(wildcard tests/test_*.c)
 BACKEND_HDRS:= $(wildcard backends/*.h backends/*/*.h backends/*/glsl/*.glsl)
 EXAMPLES    := $(patsubst examples/%.c,$(BUILD)/examples/%,$(wildcard examples/*.c))

@@ -688,7 +688,7 @@ sfb_result sfb__ref_eval_patches(void *state, const struct sfb__patch_table *pt,
 sfb_result sfb__ref_finish_normals(void *state, int first, int last, const float *tu, const float *tv, const float *ns,
                                    const int *ns_index, const float *b, float p, float *out_blend, float *out_limit, float *out_sub);
 
-/* ---- Stam eigen structures (stam.c) ---- */
+/* ---- Stam eigen structures (patch/eigen.c) ---- */
 #define SFB__STAM_MAX_VALENCE 256
 
 typedef struct sfb__eigen_cc {
@@ -716,7 +716,7 @@ typedef struct sfb__eigen_loop {
 } sfb__eigen_loop;
 
 
-/* ---- patch tables (patches.c) ---- */
+/* ---- patch tables (patch/table.c reads them, the scheme builders write them) ---- */
 /* Patch kinds of the patch table (patches.c, manifold.c). */
 enum { SFB__PATCH_BSPLINE = 0, SFB__PATCH_STAM = 1, SFB__PATCH_ENDCAP = 2, SFB__PATCH_BEZTRI = 3, SFB__PATCH_STAM_LOOP = 4,
        SFB__PATCH_ENDCAP_TRI = 5, SFB__PATCH_MANIFOLD4 = 6, SFB__PATCH_TYPE_COUNT = 7 };
@@ -990,7 +990,7 @@ void sfb__shading_free(sfb_context *ctx, sfb__shading *sh);
 sfb_result sfb__shading_build(sfb_context *ctx, const sfb__level *prep, const sfb__refine_options *opt, int level,
                               const sfb_shading_options *o, sfb__shading **out);
 
-/* patches.c */
+/* ---- patch tables (patch/) ---- */
 void sfb__patch_table_free(sfb_context *ctx, sfb__patch_table *pt);
 /* The families present in a table, as bits 1 << SFB__FAMILY_*. */
 static inline unsigned sfb__patch_families(const sfb__patch_table *pt) {
@@ -1000,7 +1000,7 @@ static inline unsigned sfb__patch_families(const sfb__patch_table *pt) {
         if (pt->counts[t] > 0) m |= 1u << sfb__patch_family(t);
     return m;
 }
-/* Manifold blending (manifold.c): a corner code packs the corner vertex's local geometry kind,
+/* Manifold blending (patch/manifold.c): a corner code packs the corner vertex's local geometry kind,
  * its valence k and the index h of the face in its star (the chart), and for a curve the axes
  * (1: a, 2: b, 0: not in this face) of its sharp edges e1 and e2. */
 enum { SFB__MF_PATCH = 0, SFB__MF_POINT = 1, SFB__MF_CURVE = 2 };
@@ -1019,7 +1019,101 @@ void sfb__mf_eval_patch(const sfb__patch_table *pt, const float *pts, int patch,
 sfb_result sfb__mf_pinv(sfb_context *ctx, int k, double **out);
 sfb_result sfb__patches_build(sfb_context *ctx, const sfb__level *base, const sfb__refine_options *opt, int limit,
                               const float *positions, sfb__patch_table *pt);
+/* Patch index (or -1: a hole) and local (s,t) of a valid location; *scale = 2^depth, negative
+ * after an odd number of middle triangle children (patch/table.c). */
 int sfb__patch_locate(const sfb__patch_table *pt, int ptex, double u, double v, double *s, double *t, double *scale);
+
+/* ---- reading records (patch/table.c) and the record kinds (patch/quad.c, patch/tri.c) ---- */
+/* A record type's ref evaluation: res = P, Ps, Pt, Pss, Pst, Ptt in the record's (s,t) (before
+ * the sub-patch scale), dir = two tangent directions whose cross product gives the normal's
+ * direction; `normal`, when not NULL, gives the normal direction instead (end caps). */
+typedef void (*sfb__patch_eval_fn)(const sfb__patch_table *pt, const float *pts, int patch, const int *cv, double s, double t,
+                                   double res[6][3], double dir[2][3]);
+typedef struct sfb__patch_kind {
+    sfb__patch_eval_fn eval;
+    void (*normal)(const float *pts, const int *cv, double s, double t, double nrm[3]);
+} sfb__patch_kind;
+/* The ref evaluator of a (non-MANIFOLD4) record type. */
+sfb__patch_kind sfb__patch_kind_of(int type);
+void sfb__kind_bspline16(const sfb__patch_table *pt, const float *pts, int patch, const int *cv, double s, double t, double res[6][3],
+                         double dir[2][3]);
+void sfb__kind_stam(const sfb__patch_table *pt, const float *pts, int patch, const int *cv, double s, double t, double res[6][3],
+                    double dir[2][3]);
+void sfb__kind_endcap(const sfb__patch_table *pt, const float *pts, int patch, const int *cv, double s, double t, double res[6][3],
+                      double dir[2][3]);
+void sfb__kind_endcap_normal(const float *pts, const int *cv, double s, double t, double nrm[3]);
+void sfb__kind_beztri(const sfb__patch_table *pt, const float *pts, int patch, const int *cv, double s, double t, double res[6][3],
+                      double dir[2][3]);
+void sfb__kind_stam_loop(const sfb__patch_table *pt, const float *pts, int patch, const int *cv, double s, double t, double res[6][3],
+                         double dir[2][3]);
+void sfb__kind_endcap_tri(const sfb__patch_table *pt, const float *pts, int patch, const int *cv, double s, double t, double res[6][3],
+                          double dir[2][3]);
+void sfb__kind_endcap_tri_normal(const float *pts, const int *cv, double s, double t, double nrm[3]);
+/* The record evaluations themselves (res as above; the Stam kinds' nres: the first derivatives
+ * divided by their scale, a finite tangent frame down to the extraordinary vertex). */
+void sfb__bspline_basis(double t, double *b, double *d, double *dd);   /* uniform cubic B-spline: value, d, d2 */
+void sfb__bez15_basis(double s, double t, double B[6][15]);           /* quartic Bernstein on a triangle */
+void sfb__eval_bspline16(const float *pts, const int *cv, double s, double t, double res[6][3]);
+void sfb__eval_endcap(const float *pts, const int *cv, double s, double t, double res[6][3]);
+void sfb__eval_stam(const sfb__eigen_cc *e, const float *pts, const int *cv, int corner, double s, double t, double res[6][3],
+                    double nres[2][3]);
+void sfb__eval_beztri(const float *pts, const int *cv, double s, double t, double res[6][3]);
+void sfb__eval_endcap_tri(const float *pts, const int *cv, double s, double t, double res[6][3]);
+void sfb__eval_stam_loop(const sfb__eigen_loop *e, const float *pts, const int *cv, int corner, double s, double t, double res[6][3],
+                         double nres[2][3]);
+/* Shared by the kinds (patch/table.c): c = a x b; an end cap's normal (nc = 3 or 4 corners); the
+ * end of both Stam kernels (the EV frame's derivatives mapped to (s,t) through J, scaled). */
+void sfb__cross3(const double *a, const double *b, double *c);
+void sfb__endcap_normal(const float *pts, const int *cv, int nc, double s, double t, double nrm[3]);
+void sfb__stam_finish(double J[2][2], double sc1, double sc2, double sr[6][3], double nr[2][3], double res[6][3], double nres[2][3]);
+
+/* ---- building records (patch/build.c), for the scheme builders ---- */
+/* Classes of a face's corner for the regular records. */
+enum { SFB__CORNER_R1 = 1, SFB__CORNER_R2_D1 = 2, SFB__CORNER_R2_D2 = 3, SFB__CORNER_R3 = 4, SFB__CORNER_EV = 5,
+       SFB__CORNER_IRREGULAR = 0 };
+/* The builder: the table under construction and the rows of its points over base vertices. */
+typedef struct sfb__pbuild {
+    sfb_context *ctx;
+    sfb__patch_table *pt;
+    int cap_patch, cap_cv, cap_nodes;
+    sfb__rows prow;          /* patch point rows over base vertices */
+    size_t cap_rows;
+    sfb__accum A;
+    sfb__mask m;
+    int *vrow;               /* point row of each vertex of the working level, -1 if none yet */
+} sfb__pbuild;
+/* A working level of feature-adaptive isolation: its topology, the composed rows of its
+ * vertices, and its candidate faces. */
+typedef struct sfb__wlevel {
+    sfb__level l;
+    sfb__rows rows;
+    int *fptex;          /* param face of a candidate face, -1 otherwise */
+    unsigned *fparam;    /* depth, i, j and rotation (in the corner bits) of candidates */
+    unsigned char *vcomp, *ecomp;
+    int owns_level;
+} sfb__wlevel;
+/* A grid cell's mask: up to 4 (vertex, weight) terms. */
+typedef struct sfb__cell { int n, real; int v[4]; double w[4]; } sfb__cell;
+int sfb__is_inf(float s);                                          /* s is SFB_SHARPNESS_INFINITE */
+int sfb__face_n(const sfb__level *l, int f);                       /* corners of face f */
+int sfb__fan_pos(const sfb__level *l, int v, int g, int slot);     /* g's position around v, or -1 */
+int sfb__face_semisharp(const sfb__level *l, int g);               /* something at g's corners still decays */
+/* A point row = mask m over working-level vertices composed with their rows (a single vertex
+ * with weight 1 is shared); -1 on allocation failure. */
+int sfb__pb_point(sfb__pbuild *b, const sfb__rows *wrows, const sfb__mask *m);
+/* A new record of `type` with ncv points; its index, or -1 on allocation failure. */
+int sfb__pb_patch(sfb__pbuild *b, int type, unsigned param, int valence, int ncv);
+/* Inserts record `patch` (-1: a hole) at (ptex, depth, i, j of param) in the tree; 0 on failure. */
+int sfb__pb_insert(sfb__pbuild *b, int ptex, unsigned param, int patch);
+void sfb__wlevel_free(sfb_context *ctx, sfb__wlevel *w);
+/* The end cap of face g (n = 3 or 4 corners, frame corner 0 at slot rot). */
+sfb_result sfb__pb_endcap(sfb__pbuild *b, sfb__wlevel *w, int g, int rot, int n, unsigned param);
+/* A Stam-kind record of K eigen-coefficient points over the vertices C (freed). */
+sfb_result sfb__pb_eigen_patch(sfb__pbuild *b, sfb__wlevel *w, int type, int ptex, unsigned param, int N, int K, const double *vinv,
+                               int *C);
+/* Classifies candidate g of the working level: adds its record, or sets *refine. */
+sfb_result sfb__pb_face_quad(sfb__pbuild *b, sfb__wlevel *w, int g, int level, int limit, int *refine);
+sfb_result sfb__pb_face_tri(sfb__pbuild *b, sfb__wlevel *w, int g, int level, int limit, int *refine);
 #line 1 "src/context.c"
 /* Results, context, allocator with memory budget, errors, logging, progress. */
 
@@ -2498,7 +2592,7 @@ done:
     }
     return r;
 }
-#line 1 "src/stam.c"
+#line 1 "src/patch/eigen.c"
 /* Eigen structures for Stam's exact evaluation of Catmull-Clark patches around one smooth
  * extraordinary vertex (ALGORITHMS.md §1), in double precision.
  *
@@ -3210,38 +3304,12 @@ const sfb__eigen_loop *sfb__eigen_loop_get(sfb_context *ctx, int N) {
     ctx->eigen_loop[N] = e;
     return e;
 }
-#line 1 "src/patches.c"
-/* Patch tables for exact limit evaluation (Catmull-Clark), built by feature-adaptive
- * isolation, and the ref kernel that evaluates them.
- *
- * Parametric faces ("param faces", as OpenSubdiv's ptex faces): a base quad is one, with
- * (u,v) = (0,0) at its first vertex, (1,0) at the second, (0,1) at the last; an n-gon (n != 4)
- * is n of them, sub-face i being the quad (v_i, mid(v_i,v_i+1), centroid, mid(v_i-1,v_i)) of the
- * first Catmull-Clark step, in that corner order.
- *
- * Isolation. Level 0 is the prepared base mesh. A quad face becomes a patch when
- * - all four corners are regular for it: smooth valence 4 with no sharp edge (R1), a crease
- *   vertex with two infinitely sharp edges and two faces on this face's side (R2), or a corner
- *   (infinitely sharp) alone in its sector (R3) -> BSPLINE16, missing points mirrored
- *   (phantoms) across the crease/boundary, which is exact: the crease is then the uniform
- *   cubic B-spline of its vertices, as the crease rules make it;
- * - one corner is a smooth extraordinary vertex with no sharp edge (valence 3..256) and the
- *   other three are R1 -> STAM (eigen form, stam.c);
- * - otherwise it is refined: the next level is built only for these faces and the faces
- *   around them (the 1-ring whose vertices the masks read), and its children are classified
- *   in turn. Semi-sharp sharpness decays by one per level, so after ceil(s) levels the region
- *   is smooth and becomes exact patches.
- * At the isolation limit (default 8; semi-sharp features continue until smooth, at most
- * SFB_MAX_LEVEL + 1) a face that is still irregular (a crease or corner vertex with an
- * extraordinary sector, a dart, a non-manifold vertex) gets the END CAP: the bilinear patch
- * through the limit positions of its four corners, with normals blended from the corners'
- * limit normals (exact at the corners; oriented as the cap). Its distance to the limit surface is O(h^2) with
- * h = 2^-limit of the base face (measured by tests/limit.c and quoted in the README).
- * Holes produce no patches. */
-
-enum { SFB__CORNER_R1 = 1, SFB__CORNER_R2_D1 = 2, SFB__CORNER_R2_D2 = 3, SFB__CORNER_R3 = 4, SFB__CORNER_EV = 5,
-       SFB__CORNER_IRREGULAR = 0 };
-
+#line 1 "src/patch/table.c"
+/* Reading a patch table (any scheme's): freeing it, the one locate (parametric face and (u,v)
+ * to record and local (s,t) through the quadtree or triangle tree), the record kinds' registry
+ * (sfb__patch_kind_of: which ref evaluator a record type has), and the ref kernel
+ * (sfb__ref_eval_patches) that dispatches to them. Nothing here knows the scheme: the table's
+ * domain says how to locate, a record's type says how to evaluate. */
 
 void sfb__patch_table_free(sfb_context *ctx, sfb__patch_table *pt) {
     sfb__free(ctx, pt->ptype); sfb__free(ctx, pt->pfirst); sfb__free(ctx, pt->pparam); sfb__free(ctx, pt->pvalence);
@@ -3257,17 +3325,228 @@ void sfb__patch_table_free(sfb_context *ctx, sfb__patch_table *pt) {
  * (2u, 2v-1); 3 the middle, turned by 180 degrees: (1-2u, 1-2v), so its derivatives change
  * sign. The corner bits of the code give the face slot of the child's param corner 0. */
 
-/* ---- builder state ---- */
-typedef struct sfb__pbuild {
-    sfb_context *ctx;
-    sfb__patch_table *pt;
-    int cap_patch, cap_cv, cap_nodes;
-    sfb__rows prow;          /* patch point rows over base vertices */
-    size_t cap_rows;
-    sfb__accum A;
-    sfb__mask m;
-    int *vrow;               /* point row of each vertex of the working level, -1 if none yet */
-} sfb__pbuild;
+/* Patch index (or -1: hole) and local (s,t) of a valid location; *scale = 2^depth. */
+int sfb__patch_locate(const sfb__patch_table *pt, int ptex, double u, double v, double *s, double *t, double *scale) {
+    int node = pt->ptex_root[ptex];
+    double sc = 1.0;
+    if (pt->domain == SFB__DOMAIN_TRI) {
+        /* triangles: *scale is negative after an odd number of middle children */
+        while (node >= 0) {
+            int c;
+            sc *= 2.0;
+            if (u >= 0.5) { c = 1; u = 2.0 * u - 1.0; v = 2.0 * v; }
+            else if (v >= 0.5) { c = 2; u = 2.0 * u; v = 2.0 * v - 1.0; }
+            else if (u + v < 0.5) { c = 0; u = 2.0 * u; v = 2.0 * v; }
+            else { c = 3; u = 1.0 - 2.0 * u; v = 1.0 - 2.0 * v; sc = -sc; }
+            node = pt->nodes[4 * node + c];
+        }
+        *s = u; *t = v; *scale = sc;
+        return node <= -2 ? -node - 2 : -1;
+    }
+    while (node >= 0) {
+        int qx, qy;
+        u *= 2.0; v *= 2.0; sc *= 2.0;
+        qx = u >= 1.0; qy = v >= 1.0;
+        if (qx) u -= 1.0;
+        if (qy) v -= 1.0;
+        node = pt->nodes[4 * node + qx + 2 * qy];
+    }
+    *s = u; *t = v; *scale = sc;
+    return node <= -2 ? -node - 2 : -1;
+}
+
+void sfb__cross3(const double *a, const double *b, double *c) {
+    c[0] = a[1] * b[2] - a[2] * b[1];
+    c[1] = a[2] * b[0] - a[0] * b[2];
+    c[2] = a[0] * b[1] - a[1] * b[0];
+}
+
+/* End-cap normal: the bilinear blend of the corners' limit normals (from the limit tangents),
+ * so that the normal at a corner is the limit normal there. A corner whose limit normal is
+ * more than 45 degrees from the cap's own (chord) normal at that corner belongs to another
+ * sector (a corner or non-manifold vertex): that corner uses the chord normal instead. */
+void sfb__endcap_normal(const float *pts, const int *cv, int nc, double s, double t, double nrm[3]) {
+    double wts[4], n[3] = {0, 0, 0};
+    int k, c;
+    if (nc == 3) { wts[0] = 1 - s - t; wts[1] = s; wts[2] = t; }
+    else { wts[0] = (1 - s) * (1 - t); wts[1] = s * (1 - t); wts[2] = s * t; wts[3] = (1 - s) * t; }
+    for (k = 0; k < nc; ++k) {
+        const float *p = pts + 3 * (size_t)cv[k], *pn = pts + 3 * (size_t)cv[(k + 1) % nc], *pp = pts + 3 * (size_t)cv[(k + nc - 1) % nc];
+        const float *t1 = pts + 3 * (size_t)cv[nc + 2 * k], *t2 = pts + 3 * (size_t)cv[nc + 1 + 2 * k];
+        double a[3], bb[3], ch[3], ln[3], lc, ll;
+        for (c = 0; c < 3; ++c) { a[c] = (double)pn[c] - p[c]; bb[c] = (double)pp[c] - p[c]; }
+        sfb__cross3(a, bb, ch);
+        for (c = 0; c < 3; ++c) { a[c] = t1[c]; bb[c] = t2[c]; }
+        sfb__cross3(a, bb, ln);
+        lc = sqrt(ch[0] * ch[0] + ch[1] * ch[1] + ch[2] * ch[2]);
+        ll = sqrt(ln[0] * ln[0] + ln[1] * ln[1] + ln[2] * ln[2]);
+        if (lc > 0.0) for (c = 0; c < 3; ++c) ch[c] /= lc;
+        if (ll > 0.0) for (c = 0; c < 3; ++c) ln[c] /= ll;
+        {
+            /* the tangent masks' orientation is the vertex's, not necessarily this face's */
+            double d = ln[0] * ch[0] + ln[1] * ch[1] + ln[2] * ch[2];
+            if (d < 0.0) { ln[0] = -ln[0]; ln[1] = -ln[1]; ln[2] = -ln[2]; d = -d; }
+            if (!(ll > 0.0) || d < 0.70710678118654752) memcpy(ln, ch, sizeof ln);
+        }
+        for (c = 0; c < 3; ++c) n[c] += wts[k] * ln[c];
+    }
+    memcpy(nrm, n, sizeof n);
+}
+
+/* The end of both Stam kernels: nr holds the normalised first derivatives and sr the position
+ * (row 0) and the second derivatives (rows 3..5) in the EV frame's (u,v); J = d(u,v)/d(s,t).
+ * Writes res (P, Ps, Pt, Pss, Pst, Ptt; first derivatives times sc1, second times sc2) and nres
+ * (the normalised first derivatives in (s,t)). */
+void sfb__stam_finish(double J[2][2], double sc1, double sc2, double sr[6][3], double nr[2][3], double res[6][3],
+                             double nres[2][3]) {
+    int c;
+    for (c = 0; c < 3; ++c) {
+        double Pu = nr[0][c], Pv = nr[1][c], Puu = sr[3][c], Puv = sr[4][c], Pvv = sr[5][c];
+        res[0][c] = sr[0][c];
+        nres[0][c] = Pu * J[0][0] + Pv * J[1][0];
+        nres[1][c] = Pu * J[0][1] + Pv * J[1][1];
+        res[1][c] = nres[0][c] * sc1;
+        res[2][c] = nres[1][c] * sc1;
+        res[3][c] = sc2 * (Puu * J[0][0] * J[0][0] + 2.0 * Puv * J[0][0] * J[1][0] + Pvv * J[1][0] * J[1][0]);
+        res[4][c] = sc2 * (Puu * J[0][0] * J[0][1] + Puv * (J[0][0] * J[1][1] + J[0][1] * J[1][0]) + Pvv * J[1][0] * J[1][1]);
+        res[5][c] = sc2 * (Puu * J[0][1] * J[0][1] + 2.0 * Puv * J[0][1] * J[1][1] + Pvv * J[1][1] * J[1][1]);
+    }
+}
+
+/* The ref evaluator of a record type: one line per kind. MANIFOLD4 records are evaluated by
+ * patch/manifold.c's sfb__mf_eval_patch (their normal is final), see sfb__ref_eval_one. */
+sfb__patch_kind sfb__patch_kind_of(int type) {
+    sfb__patch_kind k;
+    k.normal = NULL;
+    switch (type) {
+    case SFB__PATCH_STAM: k.eval = sfb__kind_stam; break;
+    case SFB__PATCH_ENDCAP: k.eval = sfb__kind_endcap; k.normal = sfb__kind_endcap_normal; break;
+    case SFB__PATCH_BEZTRI: k.eval = sfb__kind_beztri; break;
+    case SFB__PATCH_STAM_LOOP: k.eval = sfb__kind_stam_loop; break;
+    case SFB__PATCH_ENDCAP_TRI: k.eval = sfb__kind_endcap_tri; k.normal = sfb__kind_endcap_tri_normal; break;
+    default: k.eval = sfb__kind_bspline16; break;
+    }
+    return k;
+}
+
+/* The ref kernel: one location, double precision throughout. want2: the second derivatives are
+ * asked for (a manifold blend only forms them then: they cost it four more blends). */
+static void sfb__ref_eval_one(const sfb__patch_table *pt, const float *pts, const sfb_location *loc, int want2, double res[6][3],
+                              double nrm[3]) {
+    double s, t, sc, dir[2][3], len;
+    int patch = sfb__patch_locate(pt, loc->face, loc->u, loc->v, &s, &t, &sc), c;
+    const int *cv;
+    sfb__patch_kind kind;
+    memset(res, 0, sizeof(double) * 18);
+    nrm[0] = nrm[1] = nrm[2] = 0.0;
+    if (patch < 0) return;
+    cv = pt->cv + pt->pfirst[patch];
+    if (sfb__patch_family(pt->ptype[patch]) == SFB__FAMILY_MANIFOLD) {
+        sfb__mf_eval_patch(pt, pts, patch, s, t, want2, res, nrm); /* its normal is final (patch/manifold.c) */
+    } else {
+        kind = sfb__patch_kind_of(pt->ptype[patch]);
+        kind.eval(pt, pts, patch, cv, s, t, res, dir);
+        if (kind.normal) kind.normal(pts, cv, s, t, nrm);
+        else sfb__cross3(dir[0], dir[1], nrm);
+        len = sqrt(nrm[0] * nrm[0] + nrm[1] * nrm[1] + nrm[2] * nrm[2]);
+        if (!(len > 0.0) || !isfinite(len)) {
+            /* degenerate tangents (a collapsed control net): the normal a step inside the patch */
+            double r2[6][3];
+            int tri = pt->domain == SFB__DOMAIN_TRI;
+            double s2 = s + (s < 0.5 ? 1e-3 : -1e-3), t2 = t + (t < 0.5 ? 1e-3 : -1e-3);
+            if (tri && s2 + t2 > 1.0) { s2 = s - 1e-3; t2 = t - 1e-3; }
+            if (tri && s + t < 2e-3) { s2 = s + 1e-3; t2 = t + 1e-3; }
+            kind.eval(pt, pts, patch, cv, s2, t2, r2, dir);
+            sfb__cross3(dir[0], dir[1], nrm);
+            len = sqrt(nrm[0] * nrm[0] + nrm[1] * nrm[1] + nrm[2] * nrm[2]);
+        }
+        if (len > 0.0 && isfinite(len)) for (c = 0; c < 3; ++c) nrm[c] /= len;
+        else nrm[0] = nrm[1] = nrm[2] = 0.0;
+    }
+    for (c = 0; c < 3; ++c) {
+        res[1][c] *= sc; res[2][c] *= sc;
+        res[3][c] *= sc * sc; res[4][c] *= sc * sc; res[5][c] *= sc * sc;
+    }
+}
+
+sfb_result sfb__ref_eval_patches(void *state, const sfb__patch_table *pt, void *handle, const sfb_location *locs, int first,
+                                        int last, const sfb_eval_output *out) {
+    int q, c;
+    (void)state; (void)handle;
+    for (q = first; q < last; ++q) {
+        double res[6][3], nrm[3];
+        size_t o = 3 * (size_t)q;
+        sfb__ref_eval_one(pt, pt->point_data, &locs[q], out->duu || out->duv || out->dvv, res, nrm);
+        for (c = 0; c < 3; ++c) {
+            if (out->position) out->position[o + c] = (float)res[0][c];
+            if (out->du) out->du[o + c] = (float)res[1][c];
+            if (out->dv) out->dv[o + c] = (float)res[2][c];
+            if (out->duu) out->duu[o + c] = (float)res[3][c];
+            if (out->duv) out->duv[o + c] = (float)res[4][c];
+            if (out->dvv) out->dvv[o + c] = (float)res[5][c];
+            if (out->normal) out->normal[o + c] = (float)nrm[c];
+        }
+    }
+    return SFB_SUCCESS;
+}
+#line 1 "src/patch/build.c"
+/* The Catmull-Clark and Loop scheme builders' common part: the patch-table builder (records,
+ * points composed through the stencil algebra, the quadtree), the shared corner helpers, and
+ * feature-adaptive isolation (sfb__patches_build). The record kinds themselves are built and
+ * evaluated in patch/quad.c (BSPLINE16, STAM, ENDCAP) and patch/tri.c (BEZTRI15, STAM_LOOP,
+ * ENDCAP_TRI); patch/table.c reads a finished table.
+ *
+ * Parametric faces ("param faces", as OpenSubdiv's ptex faces): a base quad is one, with
+ * (u,v) = (0,0) at its first vertex, (1,0) at the second, (0,1) at the last; an n-gon (n != 4)
+ * is n of them, sub-face i being the quad (v_i, mid(v_i,v_i+1), centroid, mid(v_i-1,v_i)) of the
+ * first Catmull-Clark step, in that corner order.
+ *
+ * Isolation. Level 0 is the prepared base mesh. A quad face becomes a patch when
+ * - all four corners are regular for it: smooth valence 4 with no sharp edge (R1), a crease
+ *   vertex with two infinitely sharp edges and two faces on this face's side (R2), or a corner
+ *   (infinitely sharp) alone in its sector (R3) -> BSPLINE16, missing points mirrored
+ *   (phantoms) across the crease/boundary, which is exact: the crease is then the uniform
+ *   cubic B-spline of its vertices, as the crease rules make it;
+ * - one corner is a smooth extraordinary vertex with no sharp edge (valence 3..256) and the
+ *   other three are R1 -> STAM (eigen form, patch/eigen.c);
+ * - otherwise it is refined: the next level is built only for these faces and the faces
+ *   around them (the 1-ring whose vertices the masks read), and its children are classified
+ *   in turn. Semi-sharp sharpness decays by one per level, so after ceil(s) levels the region
+ *   is smooth and becomes exact patches.
+ * At the isolation limit (default 8; semi-sharp features continue until smooth, at most
+ * SFB_MAX_LEVEL + 1) a face that is still irregular (a crease or corner vertex with an
+ * extraordinary sector, a dart, a non-manifold vertex) gets the END CAP: the bilinear patch
+ * through the limit positions of its four corners, with normals blended from the corners'
+ * limit normals (exact at the corners; oriented as the cap). Its distance to the limit surface is O(h^2) with
+ * h = 2^-limit of the base face (measured by tests/limit.c and quoted in the README).
+ * Holes produce no patches. */
+
+
+int sfb__is_inf(float s) { return s >= SFB_SHARPNESS_INFINITE; }
+
+/* Fan position of face g (corner slot `slot`) around vertex v, or -1. */
+int sfb__fan_pos(const sfb__level *l, int v, int g, int slot) {
+    int i;
+    for (i = l->vf_off[v]; i < l->vf_off[v + 1]; ++i)
+        if (l->vf[i] == g && l->vf_slot[i] == slot) return i - l->vf_off[v];
+    return -1;
+}
+
+int sfb__face_n(const sfb__level *l, int f) { return l->fv_off[f + 1] - l->fv_off[f]; }
+
+/* Does anything at g's corners still have to decay (semi-sharp edge or vertex)? */
+int sfb__face_semisharp(const sfb__level *l, int g) {
+    int k, i;
+    for (k = l->fv_off[g]; k < l->fv_off[g + 1]; ++k) {
+        int v = l->fv[k];
+        if (l->vs[v] > 0.0f && !sfb__is_inf(l->vs[v])) return 1;
+        for (i = l->ve_off[v]; i < l->ve_off[v + 1]; ++i) {
+            float s = l->es[l->ve[i]];
+            if (s > 0.0f && !sfb__is_inf(s)) return 1;
+        }
+    }
+    return 0;
+}
 
 static int sfb__pb_grow_int(sfb_context *ctx, int **a, int *cap, int need) {
     int nc;
@@ -3284,7 +3563,7 @@ static int sfb__pb_grow_int(sfb_context *ctx, int **a, int *cap, int need) {
 
 /* Adds a point row = mask over working-level vertices composed with their rows. A single
  * vertex with weight 1 is shared through vrow. Returns the row or -1 on allocation failure. */
-static int sfb__pb_point(sfb__pbuild *b, const sfb__rows *wrows, const sfb__mask *m) {
+int sfb__pb_point(sfb__pbuild *b, const sfb__rows *wrows, const sfb__mask *m) {
     int row;
     if (m->n == 1 && m->w[0] == 1.0 && b->vrow[m->idx[0]] >= 0) return b->vrow[m->idx[0]];
     row = b->prow.rows;
@@ -3302,18 +3581,475 @@ static int sfb__pb_point(sfb__pbuild *b, const sfb__rows *wrows, const sfb__mask
     return row;
 }
 
-/* ---- corner classification ---- */
-static int sfb__is_inf(float s) { return s >= SFB_SHARPNESS_INFINITE; }
-
-/* Fan position of face g (corner slot `slot`) around vertex v, or -1. */
-static int sfb__fan_pos(const sfb__level *l, int v, int g, int slot) {
-    int i;
-    for (i = l->vf_off[v]; i < l->vf_off[v + 1]; ++i)
-        if (l->vf[i] == g && l->vf_slot[i] == slot) return i - l->vf_off[v];
-    return -1;
+int sfb__pb_patch(sfb__pbuild *b, int type, unsigned param, int valence, int ncv) {
+    sfb__patch_table *pt = b->pt;
+    int n = pt->npatch;
+    if (n + 1 > b->cap_patch) {
+        int nc = b->cap_patch ? b->cap_patch * 2 : 256;
+        int *t1 = (int *)sfb__realloc(b->ctx, pt->ptype, (size_t)nc * sizeof(int));
+        if (!t1) return -1;
+        pt->ptype = t1;
+        t1 = (int *)sfb__realloc(b->ctx, pt->pfirst, (size_t)(nc + 1) * sizeof(int));
+        if (!t1) return -1;
+        pt->pfirst = t1;
+        t1 = (int *)sfb__realloc(b->ctx, pt->pvalence, (size_t)nc * sizeof(int));
+        if (!t1) return -1;
+        pt->pvalence = t1;
+        {
+            unsigned *t2 = (unsigned *)sfb__realloc(b->ctx, pt->pparam, (size_t)nc * sizeof(unsigned));
+            if (!t2) return -1;
+            pt->pparam = t2;
+        }
+        b->cap_patch = nc;
+    }
+    if (!sfb__pb_grow_int(b->ctx, &pt->cv, &b->cap_cv, pt->ncv + ncv)) return -1;
+    pt->ptype[n] = type;
+    pt->pfirst[n] = pt->ncv;
+    pt->pparam[n] = param;
+    pt->pvalence[n] = valence;
+    pt->ncv += ncv;
+    pt->pfirst[n + 1] = pt->ncv;
+    pt->npatch = n + 1;
+    pt->counts[type]++;
+    return n;
 }
 
-static int sfb__face_n(const sfb__level *l, int f) { return l->fv_off[f + 1] - l->fv_off[f]; }
+/* Inserts patch `patch` (or -1 for a hole) at (ptex, depth, i, j) in the quadtree. */
+int sfb__pb_insert(sfb__pbuild *b, int ptex, unsigned param, int patch) {
+    sfb__patch_table *pt = b->pt;
+    int depth = SFB__PARAM_DEPTH(param), pi = SFB__PARAM_I(param), pj = SFB__PARAM_J(param);
+    int *slot = &pt->ptex_root[ptex], d;
+    for (d = 0; d < depth; ++d) {
+        int qx = (pi >> (depth - 1 - d)) & 1, qy = (pj >> (depth - 1 - d)) & 1, node;
+        if (*slot < 0) {
+            /* a new internal node (its slot may only be empty: -1) */
+            int k;
+            ptrdiff_t off = slot - pt->nodes;
+            int in_nodes = pt->nodes && slot >= pt->nodes && slot < pt->nodes + 4 * (size_t)pt->nnodes;
+            if (!sfb__pb_grow_int(b->ctx, &pt->nodes, &b->cap_nodes, 4 * (pt->nnodes + 1))) return 0;
+            if (in_nodes) slot = pt->nodes + off;
+            node = pt->nnodes++;
+            for (k = 0; k < 4; ++k) pt->nodes[4 * node + k] = -1;
+            *slot = node;
+        }
+        node = *slot;
+        slot = &pt->nodes[4 * node + qx + 2 * qy];
+    }
+    *slot = patch >= 0 ? -(patch + 2) : -1;
+    return 1;
+}
+
+void sfb__wlevel_free(sfb_context *ctx, sfb__wlevel *w) {
+    if (w->owns_level) sfb__level_free(ctx, &w->l);
+    sfb__rows_free(ctx, &w->rows);
+    sfb__free(ctx, w->fptex); sfb__free(ctx, w->fparam); sfb__free(ctx, w->vcomp); sfb__free(ctx, w->ecomp);
+    memset(w, 0, sizeof *w);
+}
+
+/* End cap of face g (n = 3 or 4 corners, frame corner 0 at slot rot): the limit positions of
+ * the corners in frame order (points 0..n-1), then the two limit tangents of each corner
+ * (points n + 2k, n + 2k + 1) for the normals. */
+sfb_result sfb__pb_endcap(sfb__pbuild *b, sfb__wlevel *w, int g, int rot, int n, unsigned param) {
+    const sfb__level *l = &w->l;
+    int base, k, patch;
+    sfb__mask mp, m1, m2;
+    sfb_result er = SFB_SUCCESS;
+    patch = sfb__pb_patch(b, n == 4 ? SFB__PATCH_ENDCAP : SFB__PATCH_ENDCAP_TRI, param, 0, 3 * n);
+    if (patch < 0) return sfb__oom(b->ctx, "patch table");
+    memset(&mp, 0, sizeof mp); memset(&m1, 0, sizeof m1); memset(&m2, 0, sizeof m2);
+    base = b->pt->pfirst[patch];
+    for (k = 0; k < n && er == SFB_SUCCESS; ++k) {
+        int v = l->fv[l->fv_off[g] + (rot + k) % n], r0, r1, r2, need = 3 * sfb__mask_need_vertex(l, v) + 8;
+        if (!sfb__mask_grow(b->ctx, &mp, need) || !sfb__mask_grow(b->ctx, &m1, need) || !sfb__mask_grow(b->ctx, &m2, need)) {
+            er = sfb__oom(b->ctx, "patch points");
+            break;
+        }
+        sfb__limit_masks(l, v, n == 4 ? SFB_SCHEME_CATMARK : SFB_SCHEME_LOOP, &mp, &m1, &m2);
+        r0 = sfb__pb_point(b, &w->rows, &mp);
+        r1 = sfb__pb_point(b, &w->rows, &m1);
+        r2 = sfb__pb_point(b, &w->rows, &m2);
+        if (r0 < 0 || r1 < 0 || r2 < 0) er = sfb__oom(b->ctx, "patch points");
+        b->pt->cv[base + k] = r0;
+        b->pt->cv[base + n + 2 * k] = r1;
+        b->pt->cv[base + n + 1 + 2 * k] = r2;
+    }
+    sfb__free(b->ctx, mp.idx); sfb__free(b->ctx, mp.w); sfb__free(b->ctx, m1.idx); sfb__free(b->ctx, m1.w);
+    sfb__free(b->ctx, m2.idx); sfb__free(b->ctx, m2.w);
+    if (er != SFB_SUCCESS) return er;
+    return sfb__pb_insert(b, w->fptex[g], param, patch) ? SFB_SUCCESS : sfb__oom(b->ctx, "patch table");
+}
+
+/* A Stam-kind record (type STAM or STAM_LOOP, valence N) of K eigen-coefficient points, point i
+ * = sum_m vinv[i K + m] C[m] over working-level vertices C; inserted at (ptex, param). Frees C. */
+sfb_result sfb__pb_eigen_patch(sfb__pbuild *b, sfb__wlevel *w, int type, int ptex, unsigned param, int N, int K, const double *vinv,
+                               int *C) {
+    int patch = sfb__pb_patch(b, type, param, N, K), base, i, m;
+    if (patch < 0 || !sfb__mask_grow(b->ctx, &b->m, K)) { sfb__free(b->ctx, C); return sfb__oom(b->ctx, "patch table"); }
+    base = b->pt->pfirst[patch];
+    for (i = 0; i < K; ++i) {
+        int row;
+        b->m.n = 0;
+        for (m = 0; m < K; ++m) {
+            double wgt = vinv[(size_t)i * K + m];
+            if (wgt != 0.0) SFB__MASK_ADD(&b->m, C[m], wgt);
+        }
+        row = sfb__pb_point(b, &w->rows, &b->m);
+        if (row < 0) { sfb__free(b->ctx, C); return sfb__oom(b->ctx, "patch points"); }
+        b->pt->cv[base + i] = row;
+    }
+    sfb__free(b->ctx, C);
+    return sfb__pb_insert(b, ptex, param, patch) ? SFB_SUCCESS : sfb__oom(b->ctx, "patch table");
+}
+
+/* The sub-mesh to refine: `mark` faces (active and their 1-ring), renumbered. */
+static sfb_result sfb__pb_submesh(sfb_context *ctx, const sfb__wlevel *w, const unsigned char *mark, sfb__level *sub,
+                                  int *vmap, int *emap, int *fmap, unsigned char *vcomp, unsigned char *ecomp) {
+    const sfb__level *l = &w->l;
+    int f, k, nv = 0, ne = 0, nf = 0, nfv = 0;
+    sfb_result r;
+    memset(sub, 0, sizeof *sub);
+    for (k = 0; k < l->nv; ++k) vmap[k] = -1;
+    for (k = 0; k < l->ne; ++k) emap[k] = -1;
+    for (f = 0; f < l->nf; ++f) {
+        fmap[f] = -1;
+        if (!mark[f]) continue;
+        fmap[f] = nf++;
+        for (k = l->fv_off[f]; k < l->fv_off[f + 1]; ++k) {
+            if (vmap[l->fv[k]] < 0) vmap[l->fv[k]] = nv++;
+            if (emap[l->fe[k]] < 0) emap[l->fe[k]] = ne++;
+            nfv++;
+        }
+    }
+    sub->nv = nv; sub->ne = ne; sub->nf = nf; sub->nfv = nfv;
+    sub->fv_off = (int *)sfb__alloc(ctx, ((size_t)nf + 1) * sizeof(int));
+    sub->fv = (int *)sfb__alloc(ctx, ((size_t)nfv + 1) * sizeof(int));
+    sub->fe = (int *)sfb__alloc(ctx, ((size_t)nfv + 1) * sizeof(int));
+    sub->ev = (int *)sfb__alloc(ctx, ((size_t)ne * 2 + 1) * sizeof(int));
+    sub->es = (float *)sfb__alloc(ctx, ((size_t)ne + 1) * sizeof(float));
+    sub->vs = (float *)sfb__alloc(ctx, ((size_t)nv + 1) * sizeof(float));
+    sub->fhole = (unsigned char *)sfb__calloc(ctx, (size_t)nf + 1, 1);
+    if (!sub->fv_off || !sub->fv || !sub->fe || !sub->ev || !sub->es || !sub->vs || !sub->fhole) {
+        sfb__level_free(ctx, sub);
+        return sfb__oom(ctx, "adaptive refinement");
+    }
+    nfv = 0;
+    for (f = 0; f < l->nf; ++f) {
+        int sf = fmap[f];
+        if (sf < 0) continue;
+        sub->fv_off[sf] = nfv;
+        sub->fhole[sf] = l->fhole[f];
+        for (k = l->fv_off[f]; k < l->fv_off[f + 1]; ++k) {
+            sub->fv[nfv] = vmap[l->fv[k]];
+            sub->fe[nfv] = emap[l->fe[k]];
+            nfv++;
+        }
+    }
+    sub->fv_off[nf] = nfv;
+    for (k = 0; k < l->ne; ++k)
+        if (emap[k] >= 0) {
+            sub->ev[2 * emap[k]] = vmap[l->ev[2 * k]];
+            sub->ev[2 * emap[k] + 1] = vmap[l->ev[2 * k + 1]];
+            sub->es[emap[k]] = l->es[k];
+        }
+    for (k = 0; k < l->nv; ++k)
+        if (vmap[k] >= 0) sub->vs[vmap[k]] = l->vs[k];
+    r = sfb__level_complete(ctx, sub);
+    if (r != SFB_SUCCESS) { sfb__level_free(ctx, sub); return r; }
+    sfb__level_compute_rules(sub);
+    /* complete in the sub-mesh: complete before and nothing around it left out */
+    for (k = 0; k < l->nv; ++k)
+        if (vmap[k] >= 0)
+            vcomp[vmap[k]] = w->vcomp[k] && (sub->vf_off[vmap[k] + 1] - sub->vf_off[vmap[k]] == l->vf_off[k + 1] - l->vf_off[k]);
+    for (k = 0; k < l->ne; ++k)
+        if (emap[k] >= 0)
+            ecomp[emap[k]] = w->ecomp[k] && (sub->ef_off[emap[k] + 1] - sub->ef_off[emap[k]] == l->ef_off[k + 1] - l->ef_off[k]);
+    return SFB_SUCCESS;
+}
+
+/* ---- the isolation driver ---- */
+
+/* Parametric faces of the base level: one per quad (or triangle, tri), n per other n-gon. */
+static sfb_result sfb__pb_param_faces(sfb_context *ctx, const sfb__level *base, int tri, sfb__patch_table *pt) {
+    int f, k, nptex = 0;
+    pt->face_ptex = (int *)sfb__alloc(ctx, ((size_t)base->nf + 1) * sizeof(int));
+    if (!pt->face_ptex) return sfb__oom(ctx, "patch table");
+    for (f = 0; f < base->nf; ++f) {
+        pt->face_ptex[f] = nptex;
+        nptex += (tri || sfb__face_n(base, f) == 4) ? 1 : sfb__face_n(base, f);
+    }
+    pt->face_ptex[base->nf] = nptex;
+    pt->nptex = nptex;
+    pt->ptex_face = (int *)sfb__alloc(ctx, ((size_t)nptex + 1) * sizeof(int));
+    pt->ptex_corner = (int *)sfb__alloc(ctx, ((size_t)nptex + 1) * sizeof(int));
+    pt->ptex_root = (int *)sfb__alloc(ctx, ((size_t)nptex + 1) * sizeof(int));
+    if (!pt->ptex_face || !pt->ptex_corner || !pt->ptex_root) return sfb__oom(ctx, "patch table");
+    for (f = 0; f < base->nf; ++f)
+        for (k = pt->face_ptex[f]; k < pt->face_ptex[f + 1]; ++k) {
+            pt->ptex_face[k] = f;
+            pt->ptex_corner[k] = (tri || sfb__face_n(base, f) == 4) ? -1 : k - pt->face_ptex[f];
+            pt->ptex_root[k] = -1;
+        }
+    return SFB_SUCCESS;
+}
+
+/* Level 0: the base level with identity rows, its faces the candidates, and the builder's
+ * scratch (accumulator, mask, vertex rows; ps/cs for the refinement steps). */
+static sfb_result sfb__pb_start(sfb__pbuild *b, sfb__wlevel *w, const sfb__level *base, int tri, float **ps, float **cs) {
+    sfb_context *ctx = b->ctx;
+    int f, k;
+    w->l = *base;
+    w->owns_level = 0;
+    w->rows.rows = base->nv;
+    w->rows.off = (size_t *)sfb__alloc(ctx, ((size_t)base->nv + 1) * sizeof(size_t));
+    w->fptex = (int *)sfb__alloc(ctx, ((size_t)base->nf + 1) * sizeof(int));
+    w->fparam = (unsigned *)sfb__calloc(ctx, (size_t)base->nf + 1, sizeof(unsigned));
+    w->vcomp = (unsigned char *)sfb__alloc(ctx, (size_t)base->nv + 1);
+    w->ecomp = (unsigned char *)sfb__alloc(ctx, (size_t)base->ne + 1);
+    b->A.acc = (double *)sfb__alloc(ctx, ((size_t)base->nv + 1) * sizeof(double));
+    b->A.mark = (unsigned *)sfb__calloc(ctx, (size_t)base->nv + 1, sizeof(unsigned));
+    b->A.touched = (int *)sfb__alloc(ctx, ((size_t)base->nv + 1) * sizeof(int));
+    *ps = (float *)sfb__alloc(ctx, (SFB_MAX_VALENCE + 2) * sizeof(float));
+    *cs = (float *)sfb__alloc(ctx, (SFB_MAX_VALENCE + 2) * sizeof(float));
+    b->vrow = (int *)sfb__alloc(ctx, ((size_t)base->nv + 1) * sizeof(int));
+    if (!w->rows.off || !w->fptex || !w->fparam || !w->vcomp || !w->ecomp || !b->A.acc || !b->A.mark || !b->A.touched || !*ps || !*cs ||
+        !b->vrow || !sfb__rows_reserve(ctx, &w->rows, (size_t)base->nv + 1) || !sfb__mask_grow(ctx, &b->m, 64))
+        return sfb__oom(ctx, "patch table");
+    for (k = 0; k < base->nv; ++k) { w->rows.off[k] = (size_t)k; w->rows.idx[k] = k; w->rows.w[k] = 1.0; }
+    w->rows.off[base->nv] = (size_t)base->nv;
+    w->rows.n = (size_t)base->nv;
+    memset(w->vcomp, 1, (size_t)base->nv + 1);
+    memset(w->ecomp, 1, (size_t)base->ne + 1);
+    for (f = 0; f < base->nf; ++f) w->fptex[f] = (tri || sfb__face_n(base, f) == 4) ? b->pt->face_ptex[f] : -1;
+    return SFB_SUCCESS;
+}
+
+/* Classifies every candidate of the working level (patches added); the faces to refine go to
+ * active[0 .. *nactive). At level 0 a Catmull-Clark n-gon is refined into its n quads. */
+static sfb_result sfb__pb_classify(sfb__pbuild *b, sfb__wlevel *w, int level, int limit, int tri, int *active, int *nactive) {
+    int f;
+    sfb_result r;
+    *nactive = 0;
+    for (f = 0; f < w->l.nf; ++f) {
+        int refine = 0;
+        if (!tri && level == 0 && sfb__face_n(&w->l, f) != 4) {
+            if (!w->l.fhole[f]) active[(*nactive)++] = f;
+            continue;
+        }
+        if (w->fptex[f] < 0) continue;
+        r = tri ? sfb__pb_face_tri(b, w, f, level, limit, &refine) : sfb__pb_face_quad(b, w, f, level, limit, &refine);
+        if (r != SFB_SUCCESS) return r;
+        if (refine) active[(*nactive)++] = f;
+    }
+    return SFB_SUCCESS;
+}
+
+/* Marks the active faces and their 1-ring (the faces the next level's masks read). */
+static sfb_result sfb__pb_mark_ring(sfb_context *ctx, const sfb__wlevel *w, const int *active, int nactive, unsigned char *mark) {
+    int k, q, i;
+    for (k = 0; k < nactive; ++k) {
+        int g = active[k];
+        mark[g] = 1;
+        for (q = w->l.fv_off[g]; q < w->l.fv_off[g + 1]; ++q) {
+            int v = w->l.fv[q];
+            if (!w->vcomp[v]) return sfb__error(ctx, SFB_BACKEND_ERROR, SFB_ELEMENT_NONE, -1, "adaptive isolation reached an incomplete vertex");
+            for (i = w->l.vf_off[v]; i < w->l.vf_off[v + 1]; ++i) mark[w->l.vf[i]] = 1;
+        }
+    }
+    return SFB_SUCCESS;
+}
+
+/* The composed rows of the sub-mesh's vertices (vmap: working-level vertex -> sub-mesh vertex). */
+static sfb_result sfb__pb_sub_rows(sfb_context *ctx, const sfb__wlevel *w, const int *vmap, int nsub, sfb__rows *subrows) {
+    int v, *inv;
+    sfb_result r = SFB_SUCCESS;
+    memset(subrows, 0, sizeof *subrows);
+    subrows->rows = nsub;
+    subrows->off = (size_t *)sfb__alloc(ctx, ((size_t)nsub + 1) * sizeof(size_t));
+    if (!subrows->off) return sfb__oom(ctx, "adaptive refinement");
+    subrows->off[0] = 0;
+    inv = (int *)sfb__alloc(ctx, ((size_t)nsub + 1) * sizeof(int));
+    if (!inv) return sfb__oom(ctx, "adaptive refinement");
+    for (v = 0; v < w->l.nv; ++v)
+        if (vmap[v] >= 0) inv[vmap[v]] = v;
+    for (v = 0; v < nsub; ++v) {
+        size_t a = w->rows.off[inv[v]], z = w->rows.off[inv[v] + 1];
+        if (!sfb__rows_reserve(ctx, subrows, subrows->n + (z - a))) { r = sfb__oom(ctx, "adaptive refinement"); break; }
+        memcpy(subrows->idx + subrows->n, w->rows.idx + a, (z - a) * sizeof(int));
+        memcpy(subrows->w + subrows->n, w->rows.w + a, (z - a) * sizeof(double));
+        subrows->n += z - a;
+        subrows->off[v + 1] = subrows->n;
+    }
+    sfb__free(ctx, inv);
+    return r;
+}
+
+/* Completeness flags and candidates of the child level nw of sub-mesh p: the children of the
+ * active faces, with their parametric face and sub-square (see sfb__patch_locate). */
+static sfb_result sfb__pb_children(sfb_context *ctx, const sfb__patch_table *pt, const sfb__wlevel *w, const sfb__level *p,
+                                   sfb__wlevel *nw, const int *active, int nactive, const int *fmap, const unsigned char *vc,
+                                   const unsigned char *ec, int level, int tri) {
+    int v, e, f, k, nvf = tri ? 0 : p->nf; /* Loop has no face points */
+    nw->fptex = (int *)sfb__alloc(ctx, ((size_t)nw->l.nf + 1) * sizeof(int));
+    nw->fparam = (unsigned *)sfb__calloc(ctx, (size_t)nw->l.nf + 1, sizeof(unsigned));
+    nw->vcomp = (unsigned char *)sfb__calloc(ctx, (size_t)nw->l.nv + 1, 1);
+    nw->ecomp = (unsigned char *)sfb__calloc(ctx, (size_t)nw->l.ne + 1, 1);
+    if (!nw->fptex || !nw->fparam || !nw->vcomp || !nw->ecomp) return sfb__oom(ctx, "adaptive refinement");
+    for (v = 0; v < p->nv; ++v) nw->vcomp[v] = vc[v];
+    for (f = 0; f < nvf; ++f) nw->vcomp[p->nv + f] = 1;
+    for (e = 0; e < p->ne; ++e) {
+        nw->vcomp[p->nv + nvf + e] = ec[e];
+        nw->ecomp[2 * e] = nw->ecomp[2 * e + 1] = ec[e];
+    }
+    for (e = 2 * p->ne; e < nw->l.ne; ++e) nw->ecomp[e] = 1;
+    for (f = 0; f < nw->l.nf; ++f) nw->fptex[f] = -1;
+    for (k = 0; k < nactive; ++k) {
+        int g = active[k], sf = fmap[g], o = p->fv_off[sf], n = p->fv_off[sf + 1] - o, i;
+        unsigned par = w->fparam[g];
+        if (tri) {
+            /* children 4 sf + i: the corner at slot i (i < 3), the middle (i = 3) */
+            int rot = SFB__PARAM_CORNER(par);
+            for (i = 0; i < 4; ++i) {
+                int c = i == 3 ? 3 : (i - rot + 3) % 3;
+                int crot = i == 3 ? (rot + 1) % 3 : c == 0 ? 0 : c == 1 ? 2 : 1;
+                nw->fptex[4 * sf + i] = w->fptex[g];
+                nw->fparam[4 * sf + i] = SFB__PARAM(SFB__PARAM_DEPTH(par) + 1, 2 * SFB__PARAM_I(par) + (c & 1),
+                                                    2 * SFB__PARAM_J(par) + (c >> 1), crot);
+            }
+            continue;
+        }
+        for (i = 0; i < n; ++i) {
+            int cf = o + i;
+            if (level == 0 && sfb__face_n(&w->l, g) != 4) {
+                nw->fptex[cf] = pt->face_ptex[g] + i;
+                nw->fparam[cf] = 0;
+            } else {
+                int rot = SFB__PARAM_CORNER(par), c = ((i - rot) % 4 + 4) % 4;
+                int ox = (c == 1 || c == 2), oy = (c >= 2);
+                nw->fptex[cf] = w->fptex[g];
+                nw->fparam[cf] = SFB__PARAM(SFB__PARAM_DEPTH(par) + 1, 2 * SFB__PARAM_I(par) + ox, 2 * SFB__PARAM_J(par) + oy,
+                                            ((rot - i) % 4 + 4) % 4);
+            }
+        }
+    }
+    return SFB_SUCCESS;
+}
+
+/* The next working level nw: the active faces and their 1-ring refined one step (rows composed
+ * through the step), with the children of the active faces as its candidates. */
+static sfb_result sfb__pb_next_level(sfb__pbuild *b, const sfb__refine_options *opt, const sfb__wlevel *w, sfb__wlevel *nw,
+                                     const int *active, int nactive, int level, int tri, float *ps, float *cs) {
+    sfb_context *ctx = b->ctx;
+    const sfb__level *l = &w->l;
+    unsigned char *mark, *vc, *ec;
+    int *vmap, *emap, *fmap;
+    sfb__level sub;
+    sfb__rows subrows;
+    sfb_result r;
+    memset(&sub, 0, sizeof sub);
+    memset(&subrows, 0, sizeof subrows);
+    mark = (unsigned char *)sfb__calloc(ctx, (size_t)l->nf + 1, 1);
+    vmap = (int *)sfb__alloc(ctx, ((size_t)l->nv + 1) * sizeof(int));
+    emap = (int *)sfb__alloc(ctx, ((size_t)l->ne + 1) * sizeof(int));
+    fmap = (int *)sfb__alloc(ctx, ((size_t)l->nf + 1) * sizeof(int));
+    vc = (unsigned char *)sfb__alloc(ctx, (size_t)l->nv + 1);
+    ec = (unsigned char *)sfb__alloc(ctx, (size_t)l->ne + 1);
+    if (!mark || !vmap || !emap || !fmap || !vc || !ec) r = sfb__oom(ctx, "patch table");
+    else r = sfb__pb_mark_ring(ctx, w, active, nactive, mark);
+    if (r == SFB_SUCCESS) r = sfb__pb_submesh(ctx, w, mark, &sub, vmap, emap, fmap, vc, ec);
+    if (r == SFB_SUCCESS) r = sfb__pb_sub_rows(ctx, w, vmap, sub.nv, &subrows);
+    if (r == SFB_SUCCESS) {
+        memset(nw, 0, sizeof *nw);
+        r = sfb__refine_step(ctx, opt, &sub, &subrows, &nw->l, &nw->rows, &b->A, &b->m, ps, cs, 0.0f, 0.0f);
+        nw->owns_level = 1;
+    }
+    if (r == SFB_SUCCESS) r = sfb__pb_children(ctx, b->pt, w, &sub, nw, active, nactive, fmap, vc, ec, level, tri);
+    sfb__rows_free(ctx, &subrows);
+    sfb__level_free(ctx, &sub);
+    sfb__free(ctx, mark); sfb__free(ctx, vmap); sfb__free(ctx, emap); sfb__free(ctx, fmap); sfb__free(ctx, vc); sfb__free(ctx, ec);
+    return r;
+}
+
+/* The points straight from the double rows (no float stencil table): a Stam point is an eigen
+ * coefficient, a combination with weights of both signs summing to 0 whose result is small next
+ * to the coordinates; float weights would cost it its precision (normals off by ~1e-4 rad on
+ * meshes far from the origin). */
+static sfb_result sfb__pb_points(sfb_context *ctx, const sfb__rows *prow, const float *positions, sfb__patch_table *pt) {
+    int row, c;
+    pt->npoints = prow->rows;
+    pt->point_data = (float *)sfb__alloc(ctx, ((size_t)prow->rows + 1) * 3 * sizeof(float));
+    if (!pt->point_data) return sfb__oom(ctx, "patch points");
+    for (row = 0; row < prow->rows; ++row) {
+        double acc[3] = {0.0, 0.0, 0.0};
+        size_t q;
+        for (q = prow->off[row]; q < prow->off[row + 1]; ++q)
+            for (c = 0; c < 3; ++c) acc[c] += prow->w[q] * positions[3 * (size_t)prow->idx[q] + c];
+        for (c = 0; c < 3; ++c) pt->point_data[3 * (size_t)row + c] = (float)acc[c];
+    }
+    return SFB_SUCCESS;
+}
+
+/* Catmull-Clark and Loop patch tables by feature-adaptive isolation (see the top of this file):
+ * classify the working level's candidates, refine the ones left around them, repeat. */
+sfb_result sfb__patches_build(sfb_context *ctx, const sfb__level *base, const sfb__refine_options *opt, int limit,
+                              const float *positions, sfb__patch_table *pt) {
+    sfb__pbuild b;
+    sfb__wlevel w, nw;
+    sfb_result r;
+    float *ps = NULL, *cs = NULL;
+    int level, *active = NULL, nactive = 0, tri = opt->scheme == SFB_SCHEME_LOOP;
+    memset(&b, 0, sizeof b);
+    memset(&w, 0, sizeof w);
+    memset(&nw, 0, sizeof nw);
+    memset(pt, 0, sizeof *pt);
+    b.ctx = ctx;
+    b.pt = pt;
+    pt->domain = tri ? SFB__DOMAIN_TRI : SFB__DOMAIN_QUAD;
+    pt->isolation = limit;
+    r = sfb__pb_param_faces(ctx, base, tri, pt);
+    if (r == SFB_SUCCESS) r = sfb__pb_start(&b, &w, base, tri, &ps, &cs);
+    for (level = 0; r == SFB_SUCCESS; ++level) {
+        int k, *nv;
+        r = sfb__progress(ctx, 0.8f + 0.15f * (float)level / (float)(SFB_MAX_LEVEL + 2), "patches");
+        if (r != SFB_SUCCESS) break;
+        for (k = 0; k < w.l.nv; ++k) b.vrow[k] = -1;
+        sfb__free(ctx, active);
+        active = (int *)sfb__alloc(ctx, ((size_t)w.l.nf + 1) * sizeof(int));
+        if (!active) { r = sfb__oom(ctx, "patch table"); break; }
+        r = sfb__pb_classify(&b, &w, level, limit, tri, active, &nactive);
+        if (r != SFB_SUCCESS || nactive == 0) break;
+        if (level > SFB_MAX_LEVEL + 1) {
+            r = sfb__error(ctx, SFB_BACKEND_ERROR, SFB_ELEMENT_NONE, -1, "adaptive isolation did not terminate");
+            break;
+        }
+        r = sfb__pb_next_level(&b, opt, &w, &nw, active, nactive, level, tri, ps, cs);
+        if (r != SFB_SUCCESS) break;
+        sfb__wlevel_free(ctx, &w);
+        w = nw;
+        memset(&nw, 0, sizeof nw);
+        nv = (int *)sfb__realloc(ctx, b.vrow, ((size_t)w.l.nv + 1) * sizeof(int));
+        if (!nv) { r = sfb__oom(ctx, "patch table"); break; }
+        b.vrow = nv;
+        if (level + 1 > pt->max_depth) pt->max_depth = level + 1;
+    }
+    if (r == SFB_SUCCESS) r = sfb__pb_points(ctx, &b.prow, positions, pt);
+    sfb__wlevel_free(ctx, &w);
+    sfb__wlevel_free(ctx, &nw);
+    sfb__rows_free(ctx, &b.prow);
+    sfb__free(ctx, b.A.acc); sfb__free(ctx, b.A.mark); sfb__free(ctx, b.A.touched);
+    sfb__free(ctx, b.m.idx); sfb__free(ctx, b.m.w);
+    sfb__free(ctx, b.vrow);
+    sfb__free(ctx, ps); sfb__free(ctx, cs);
+    sfb__free(ctx, active);
+    if (r != SFB_SUCCESS) sfb__patch_table_free(ctx, pt);
+    return r;
+}
+#line 1 "src/patch/quad.c"
+/* The quad family's records (SFB__FAMILY_QUAD): BSPLINE16 (a regular quad, phantoms mirrored
+ * across infinitely sharp creases), STAM (one smooth extraordinary corner, eigen form) and
+ * ENDCAP (the bilinear cap at the isolation limit) -- how a candidate quad becomes one
+ * (sfb__pb_face_quad, called by the isolation driver in patch/build.c) and their ref evaluation
+ * (the sfb__kind_* evaluators that patch/table.c dispatches to). The GLSL kernel
+ * (backends/glsl/patches.comp.glsl) and the simd kernels evaluate the same records in float. */
 
 /* Class of vertex v as a corner of quad g; *pos = g's fan position. */
 static int sfb__corner_class(const sfb__level *l, int v, int g, int slot, int *pos) {
@@ -3370,26 +4106,10 @@ static int sfb__corner_class(const sfb__level *l, int v, int g, int slot, int *p
     return SFB__CORNER_IRREGULAR;
 }
 
-/* Does anything at g's corners still have to decay (semi-sharp edge or vertex)? */
-static int sfb__face_semisharp(const sfb__level *l, int g) {
-    int k, i;
-    for (k = l->fv_off[g]; k < l->fv_off[g + 1]; ++k) {
-        int v = l->fv[k];
-        if (l->vs[v] > 0.0f && !sfb__is_inf(l->vs[v])) return 1;
-        for (i = l->ve_off[v]; i < l->ve_off[v + 1]; ++i) {
-            float s = l->es[l->ve[i]];
-            if (s > 0.0f && !sfb__is_inf(s)) return 1;
-        }
-    }
-    return 0;
-}
-
-/* ---- gathering ---- */
-/* A grid cell's mask: up to 4 (vertex, weight) terms. */
-typedef struct sfb__cell { int n, real; int v[4]; double w[4]; } sfb__cell;
-
 static const int sfb__corner_pos[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+
 static const int sfb__corner_d1[4][2] = {{1, 0}, {0, 1}, {-1, 0}, {0, -1}};
+
 static const int sfb__corner_d2[4][2] = {{0, 1}, {-1, 0}, {0, -1}, {1, 0}};
 
 static int sfb__diag(const sfb__level *l, int f, int v) {
@@ -3488,116 +4208,8 @@ static int sfb__gather(const sfb__level *l, int g, int rot, const int cls[4], co
     return 1;
 }
 
-/* ---- the table ---- */
-static int sfb__pb_patch(sfb__pbuild *b, int type, unsigned param, int valence, int ncv) {
-    sfb__patch_table *pt = b->pt;
-    int n = pt->npatch;
-    if (n + 1 > b->cap_patch) {
-        int nc = b->cap_patch ? b->cap_patch * 2 : 256;
-        int *t1 = (int *)sfb__realloc(b->ctx, pt->ptype, (size_t)nc * sizeof(int));
-        if (!t1) return -1;
-        pt->ptype = t1;
-        t1 = (int *)sfb__realloc(b->ctx, pt->pfirst, (size_t)(nc + 1) * sizeof(int));
-        if (!t1) return -1;
-        pt->pfirst = t1;
-        t1 = (int *)sfb__realloc(b->ctx, pt->pvalence, (size_t)nc * sizeof(int));
-        if (!t1) return -1;
-        pt->pvalence = t1;
-        {
-            unsigned *t2 = (unsigned *)sfb__realloc(b->ctx, pt->pparam, (size_t)nc * sizeof(unsigned));
-            if (!t2) return -1;
-            pt->pparam = t2;
-        }
-        b->cap_patch = nc;
-    }
-    if (!sfb__pb_grow_int(b->ctx, &pt->cv, &b->cap_cv, pt->ncv + ncv)) return -1;
-    pt->ptype[n] = type;
-    pt->pfirst[n] = pt->ncv;
-    pt->pparam[n] = param;
-    pt->pvalence[n] = valence;
-    pt->ncv += ncv;
-    pt->pfirst[n + 1] = pt->ncv;
-    pt->npatch = n + 1;
-    pt->counts[type]++;
-    return n;
-}
-
-/* Inserts patch `patch` (or -1 for a hole) at (ptex, depth, i, j) in the quadtree. */
-static int sfb__pb_insert(sfb__pbuild *b, int ptex, unsigned param, int patch) {
-    sfb__patch_table *pt = b->pt;
-    int depth = SFB__PARAM_DEPTH(param), pi = SFB__PARAM_I(param), pj = SFB__PARAM_J(param);
-    int *slot = &pt->ptex_root[ptex], d;
-    for (d = 0; d < depth; ++d) {
-        int qx = (pi >> (depth - 1 - d)) & 1, qy = (pj >> (depth - 1 - d)) & 1, node;
-        if (*slot < 0) {
-            /* a new internal node (its slot may only be empty: -1) */
-            int k;
-            ptrdiff_t off = slot - pt->nodes;
-            int in_nodes = pt->nodes && slot >= pt->nodes && slot < pt->nodes + 4 * (size_t)pt->nnodes;
-            if (!sfb__pb_grow_int(b->ctx, &pt->nodes, &b->cap_nodes, 4 * (pt->nnodes + 1))) return 0;
-            if (in_nodes) slot = pt->nodes + off;
-            node = pt->nnodes++;
-            for (k = 0; k < 4; ++k) pt->nodes[4 * node + k] = -1;
-            *slot = node;
-        }
-        node = *slot;
-        slot = &pt->nodes[4 * node + qx + 2 * qy];
-    }
-    *slot = patch >= 0 ? -(patch + 2) : -1;
-    return 1;
-}
-
-typedef struct sfb__wlevel {
-    sfb__level l;
-    sfb__rows rows;
-    int *fptex;          /* param face of a candidate face, -1 otherwise */
-    unsigned *fparam;    /* depth, i, j and rotation (in the corner bits) of candidates */
-    unsigned char *vcomp, *ecomp;
-    int owns_level;
-} sfb__wlevel;
-
-static void sfb__wlevel_free(sfb_context *ctx, sfb__wlevel *w) {
-    if (w->owns_level) sfb__level_free(ctx, &w->l);
-    sfb__rows_free(ctx, &w->rows);
-    sfb__free(ctx, w->fptex); sfb__free(ctx, w->fparam); sfb__free(ctx, w->vcomp); sfb__free(ctx, w->ecomp);
-    memset(w, 0, sizeof *w);
-}
-
-/* End cap of face g (n = 3 or 4 corners, frame corner 0 at slot rot): the limit positions of
- * the corners in frame order (points 0..n-1), then the two limit tangents of each corner
- * (points n + 2k, n + 2k + 1) for the normals. */
-static sfb_result sfb__pb_endcap(sfb__pbuild *b, sfb__wlevel *w, int g, int rot, int n, unsigned param) {
-    const sfb__level *l = &w->l;
-    int base, k, patch;
-    sfb__mask mp, m1, m2;
-    sfb_result er = SFB_SUCCESS;
-    patch = sfb__pb_patch(b, n == 4 ? SFB__PATCH_ENDCAP : SFB__PATCH_ENDCAP_TRI, param, 0, 3 * n);
-    if (patch < 0) return sfb__oom(b->ctx, "patch table");
-    memset(&mp, 0, sizeof mp); memset(&m1, 0, sizeof m1); memset(&m2, 0, sizeof m2);
-    base = b->pt->pfirst[patch];
-    for (k = 0; k < n && er == SFB_SUCCESS; ++k) {
-        int v = l->fv[l->fv_off[g] + (rot + k) % n], r0, r1, r2, need = 3 * sfb__mask_need_vertex(l, v) + 8;
-        if (!sfb__mask_grow(b->ctx, &mp, need) || !sfb__mask_grow(b->ctx, &m1, need) || !sfb__mask_grow(b->ctx, &m2, need)) {
-            er = sfb__oom(b->ctx, "patch points");
-            break;
-        }
-        sfb__limit_masks(l, v, n == 4 ? SFB_SCHEME_CATMARK : SFB_SCHEME_LOOP, &mp, &m1, &m2);
-        r0 = sfb__pb_point(b, &w->rows, &mp);
-        r1 = sfb__pb_point(b, &w->rows, &m1);
-        r2 = sfb__pb_point(b, &w->rows, &m2);
-        if (r0 < 0 || r1 < 0 || r2 < 0) er = sfb__oom(b->ctx, "patch points");
-        b->pt->cv[base + k] = r0;
-        b->pt->cv[base + n + 2 * k] = r1;
-        b->pt->cv[base + n + 1 + 2 * k] = r2;
-    }
-    sfb__free(b->ctx, mp.idx); sfb__free(b->ctx, mp.w); sfb__free(b->ctx, m1.idx); sfb__free(b->ctx, m1.w);
-    sfb__free(b->ctx, m2.idx); sfb__free(b->ctx, m2.w);
-    if (er != SFB_SUCCESS) return er;
-    return sfb__pb_insert(b, w->fptex[g], param, patch) ? SFB_SUCCESS : sfb__oom(b->ctx, "patch table");
-}
-
 /* Classifies candidate g; adds its patch, or returns 1 in *refine. */
-static sfb_result sfb__pb_face(sfb__pbuild *b, sfb__wlevel *w, int g, int level, int limit, int *refine) {
+sfb_result sfb__pb_face_quad(sfb__pbuild *b, sfb__wlevel *w, int g, int level, int limit, int *refine) {
     const sfb__level *l = &w->l;
     unsigned par = w->fparam[g];
     int rot = SFB__PARAM_CORNER(par), ptex = w->fptex[g];
@@ -3640,7 +4252,7 @@ static sfb_result sfb__pb_face(sfb__pbuild *b, sfb__wlevel *w, int g, int level,
             /* gather in the Stam frame: corner 0 = the EV */
             for (k = 0; k < 4; ++k) { scls[k] = cls[(evk + k) % 4]; spos[k] = pos[(evk + k) % 4]; }
             if (sfb__gather(l, g, (rot + evk) % 4, scls, spos, 0, grid)) {
-                int K = e->K, i, m, pE = spos[0], e0 = l->ve_off[ev], f0 = l->vf_off[ev], base;
+                int K = e->K, i, pE = spos[0], e0 = l->ve_off[ev], f0 = l->vf_off[ev];
                 int *C = (int *)sfb__alloc(b->ctx, (size_t)K * sizeof(int));
                 static const int outer[7][2] = {{2, 2}, {2, 1}, {2, 0}, {2, -1}, {1, 2}, {0, 2}, {-1, 2}};
                 if (!C) return sfb__oom(b->ctx, "patch table");
@@ -3658,23 +4270,8 @@ static sfb_result sfb__pb_face(sfb__pbuild *b, sfb__wlevel *w, int g, int level,
                     if (C[i] < 0) { sfb__free(b->ctx, C); C = NULL; break; }
                 if (C) {
                     out_param = SFB__PARAM(SFB__PARAM_DEPTH(par), SFB__PARAM_I(par), SFB__PARAM_J(par), evk);
-                    patch = sfb__pb_patch(b, SFB__PATCH_STAM, out_param, N, K);
-                    if (patch < 0 || !sfb__mask_grow(b->ctx, &b->m, K)) { sfb__free(b->ctx, C); return sfb__oom(b->ctx, "patch table"); }
-                    base = b->pt->pfirst[patch];
                     b->pt->eig[N] = e; /* the context's cache outlives the surface */
-                    for (i = 0; i < K; ++i) {
-                        int row;
-                        b->m.n = 0;
-                        for (m = 0; m < K; ++m) {
-                            double wgt = e->vinv[(size_t)i * K + m];
-                            if (wgt != 0.0) SFB__MASK_ADD(&b->m, C[m], wgt);
-                        }
-                        row = sfb__pb_point(b, &w->rows, &b->m);
-                        if (row < 0) { sfb__free(b->ctx, C); return sfb__oom(b->ctx, "patch points"); }
-                        b->pt->cv[base + i] = row;
-                    }
-                    sfb__free(b->ctx, C);
-                    return sfb__pb_insert(b, ptex, out_param, patch) ? SFB_SUCCESS : sfb__oom(b->ctx, "patch table");
+                    return sfb__pb_eigen_patch(b, w, SFB__PATCH_STAM, ptex, out_param, N, K, e->vinv, C);
                 }
             }
         }
@@ -3685,7 +4282,139 @@ static sfb_result sfb__pb_face(sfb__pbuild *b, sfb__wlevel *w, int g, int level,
     return SFB_SUCCESS;
 }
 
-/* ---- triangles (Loop) ----
+/* ---- ref evaluation ---- */
+
+void sfb__bspline_basis(double t, double *b, double *d, double *dd) {
+    double t2 = t * t, t3 = t2 * t, s = 1.0 - t;
+    b[0] = s * s * s / 6.0; b[1] = (3.0 * t3 - 6.0 * t2 + 4.0) / 6.0; b[2] = (-3.0 * t3 + 3.0 * t2 + 3.0 * t + 1.0) / 6.0; b[3] = t3 / 6.0;
+    d[0] = -0.5 * s * s; d[1] = 1.5 * t2 - 2.0 * t; d[2] = -1.5 * t2 + t + 0.5; d[3] = 0.5 * t2;
+    dd[0] = s; dd[1] = 3.0 * t - 2.0; dd[2] = -3.0 * t + 1.0; dd[3] = t;
+}
+
+/* res[0..5]: P, Ps, Pt, Pss, Pst, Ptt in the patch's (s,t); nrm: an unnormalised normal
+ * direction (a positive multiple of Ps x Pt, finite where Ps x Pt under- or overflows). */
+void sfb__eval_bspline16(const float *pts, const int *cv, double s, double t, double res[6][3]) {
+    double bu[4], du[4], ddu[4], bv[4], dv[4], ddv[4];
+    int i, j, c;
+    sfb__bspline_basis(s, bu, du, ddu);
+    sfb__bspline_basis(t, bv, dv, ddv);
+    memset(res, 0, sizeof(double) * 18);
+    for (j = 0; j < 4; ++j)
+        for (i = 0; i < 4; ++i) {
+            const float *p = pts + 3 * (size_t)cv[4 * j + i];
+            double w[6];
+            w[0] = bu[i] * bv[j]; w[1] = du[i] * bv[j]; w[2] = bu[i] * dv[j];
+            w[3] = ddu[i] * bv[j]; w[4] = du[i] * dv[j]; w[5] = bu[i] * ddv[j];
+            for (c = 0; c < 3; ++c) {
+                int q;
+                for (q = 0; q < 6; ++q) res[q][c] += w[q] * p[c];
+            }
+        }
+}
+
+void sfb__eval_endcap(const float *pts, const int *cv, double s, double t, double res[6][3]) {
+    const float *p0 = pts + 3 * (size_t)cv[0], *p1 = pts + 3 * (size_t)cv[1], *p2 = pts + 3 * (size_t)cv[2], *p3 = pts + 3 * (size_t)cv[3];
+    int c;
+    for (c = 0; c < 3; ++c) {
+        res[0][c] = (1 - s) * (1 - t) * p0[c] + s * (1 - t) * p1[c] + s * t * p2[c] + (1 - s) * t * p3[c];
+        res[1][c] = (1 - t) * ((double)p1[c] - p0[c]) + t * ((double)p2[c] - p3[c]);
+        res[2][c] = (1 - s) * ((double)p3[c] - p0[c]) + s * ((double)p2[c] - p1[c]);
+        res[3][c] = 0.0;
+        res[4][c] = (double)p0[c] - p1[c] + p2[c] - p3[c];
+        res[5][c] = 0.0;
+    }
+}
+
+/* Stam: (s,t) in the patch, the EV at frame corner `corner`. nres[2] gets the derivatives
+ * divided by sub^(n-1) 2^n (a finite tangent frame down to the EV). */
+void sfb__eval_stam(const sfb__eigen_cc *e, const float *pts, const int *cv, int corner, double s, double t, double res[6][3],
+                           double nres[2][3]) {
+    int K = e->K, i, j, c, k, n = 1, at_ev;
+    double u, v, J[2][2], bu[4], du[4], ddu[4], bv[4], dv[4], ddv[4], uu, vv;
+    double sr[6][3], nr[2][3];
+    const double *phi;
+    switch (corner) {
+    default: u = s; v = t; J[0][0] = 1; J[0][1] = 0; J[1][0] = 0; J[1][1] = 1; break;
+    case 1: u = t; v = 1.0 - s; J[0][0] = 0; J[0][1] = 1; J[1][0] = -1; J[1][1] = 0; break;
+    case 2: u = 1.0 - s; v = 1.0 - t; J[0][0] = -1; J[0][1] = 0; J[1][0] = 0; J[1][1] = -1; break;
+    case 3: u = 1.0 - t; v = s; J[0][0] = 0; J[0][1] = -1; J[1][0] = 1; J[1][1] = 0; break;
+    }
+    /* J[a][b] = d(u,v)_a / d(s,t)_b */
+    memset(sr, 0, sizeof sr);
+    memset(nr, 0, sizeof nr);
+    at_ev = (u == 0.0 && v == 0.0);
+    if (at_ev) {
+        /* the limit point; tangents: the n -> infinity limit of the normalised derivatives */
+        k = 2; uu = 0.0; vv = 0.0;
+    } else {
+        while (u < 0.5 && v < 0.5) { u *= 2.0; v *= 2.0; ++n; }
+        if (v < 0.5) { k = 1; uu = 2.0 * u - 1.0; vv = 2.0 * v; }
+        else if (u < 0.5) { k = 3; uu = 2.0 * u; vv = 2.0 * v - 1.0; }
+        else { k = 2; uu = 2.0 * u - 1.0; vv = 2.0 * v - 1.0; }
+    }
+    sfb__bspline_basis(uu, bu, du, ddu);
+    sfb__bspline_basis(vv, bv, dv, ddv);
+    phi = e->phi + (size_t)(k - 1) * 16 * K;
+    for (i = 0; i < K; ++i) {
+        double f[6] = {0, 0, 0, 0, 0, 0}, lp, ln;
+        const float *p = pts + 3 * (size_t)cv[i];
+        for (j = 0; j < 16; ++j) {
+            double ph = phi[(size_t)j * K + i];
+            int a = j % 4, b = j / 4;
+            f[0] += bu[a] * bv[b] * ph; f[1] += du[a] * bv[b] * ph; f[2] += bu[a] * dv[b] * ph;
+            f[3] += ddu[a] * bv[b] * ph; f[4] += du[a] * dv[b] * ph; f[5] += bu[a] * ddv[b] * ph;
+        }
+        if (at_ev) {
+            lp = i == e->dominant ? 1.0 : 0.0;
+            ln = (i != e->dominant && fabs(fabs(e->lambda[i]) - e->sub) <= 1e-12) ? 1.0 : 0.0;
+        } else {
+            lp = pow(e->lambda[i], n - 1);
+            ln = i == e->dominant ? 0.0 : pow(e->lambda[i] / e->sub, n - 1);
+        }
+        for (c = 0; c < 3; ++c) {
+            sr[0][c] += lp * f[0] * p[c];
+            nr[0][c] += ln * f[1] * p[c];
+            nr[1][c] += ln * f[2] * p[c];
+            sr[3][c] += ln * f[3] * p[c];
+            sr[4][c] += ln * f[4] * p[c];
+            sr[5][c] += ln * f[5] * p[c];
+        }
+    }
+    sfb__stam_finish(J, at_ev ? 1.0 : pow(e->sub, n - 1) * ldexp(1.0, n), at_ev ? 0.0 : pow(e->sub, n - 1) * ldexp(1.0, 2 * n), sr, nr,
+                     res, nres);
+}
+
+/* The kinds' evaluators (sfb__patch_kind, patch/table.c). */
+void sfb__kind_bspline16(const sfb__patch_table *pt, const float *pts, int patch, const int *cv, double s, double t, double res[6][3],
+                         double dir[2][3]) {
+    (void)pt; (void)patch;
+    sfb__eval_bspline16(pts, cv, s, t, res);
+    memcpy(dir[0], res[1], sizeof dir[0]);
+    memcpy(dir[1], res[2], sizeof dir[1]);
+}
+
+void sfb__kind_stam(const sfb__patch_table *pt, const float *pts, int patch, const int *cv, double s, double t, double res[6][3],
+                    double dir[2][3]) {
+    sfb__eval_stam(pt->eig[pt->pvalence[patch]], pts, cv, SFB__PARAM_CORNER(pt->pparam[patch]), s, t, res, dir);
+}
+
+void sfb__kind_endcap(const sfb__patch_table *pt, const float *pts, int patch, const int *cv, double s, double t, double res[6][3],
+                      double dir[2][3]) {
+    (void)pt; (void)patch;
+    sfb__eval_endcap(pts, cv, s, t, res);
+    memcpy(dir[0], res[1], sizeof dir[0]);
+    memcpy(dir[1], res[2], sizeof dir[1]);
+}
+
+void sfb__kind_endcap_normal(const float *pts, const int *cv, double s, double t, double nrm[3]) {
+    sfb__endcap_normal(pts, cv, 4, s, t, nrm);
+}
+#line 1 "src/patch/tri.c"
+/* The triangle family's records (SFB__FAMILY_TRI): BEZTRI15 (a regular triangle: its box
+ * spline as a quartic Bezier triangle by Sabin's rules), STAM_LOOP (one smooth extraordinary
+ * corner, eigen form) and ENDCAP_TRI (the linear cap at the isolation limit) -- how a candidate
+ * triangle becomes one (sfb__pb_face_tri) and their ref evaluation (sfb__kind_*).
+ *
  * A corner of a triangle is R1 (smooth valence 6, no sharp edge), EV (smooth, valence 3..256,
  * no sharp edge), R2 (a crease vertex, two infinitely sharp edges, whose sector on this face's
  * side has 3 triangles) or R3 (a corner whose sector is this triangle alone). In the lattice of
@@ -3695,7 +4424,9 @@ static sfb_result sfb__pb_face(sfb__pbuild *b, sfb__wlevel *w, int g, int level,
  * the real triangle (A,B,C) across the edge AB from X, and X = 2A - B opposite a real neighbour B
  * at a corner (the points that make the box spline's boundary the crease's cubic B-spline, as
  * for OpenSubdiv's regular Loop boundary patches). */
+
 static const int sfb__hexdir[6][2] = {{1, 0}, {0, 1}, {-1, 1}, {-1, 0}, {0, -1}, {1, -1}};
+
 static const int sfb__tri_origin[3][2] = {{0, 0}, {1, 0}, {0, 1}};
 
 /* Class of vertex v as a corner of triangle g; *pos = g's fan position; *sec = offset (from
@@ -3816,7 +4547,7 @@ static int sfb__pb_bez_point(sfb__pbuild *b, const sfb__rows *rows, sfb__cell gr
 }
 
 /* Classifies candidate triangle g; adds its patch, or returns 1 in *refine. */
-static sfb_result sfb__pb_face_tri(sfb__pbuild *b, sfb__wlevel *w, int g, int level, int limit, int *refine) {
+sfb_result sfb__pb_face_tri(sfb__pbuild *b, sfb__wlevel *w, int g, int level, int limit, int *refine) {
     const sfb__level *l = &w->l;
     unsigned par = w->fparam[g], plain = par & ~(3u << 30);
     int rot = SFB__PARAM_CORNER(par), ptex = w->fptex[g];
@@ -3850,7 +4581,7 @@ static sfb_result sfb__pb_face_tri(sfb__pbuild *b, sfb__wlevel *w, int g, int le
         for (k = 0; k < 3; ++k) { scls[k] = cls[(evk + k) % 3]; spos[k] = pos[(evk + k) % 3]; ssec[k] = sec[(evk + k) % 3]; }
         if (e && sfb__gather_tri(l, g, (rot + evk) % 3, scls, spos, ssec, 0, grid)) {
             static const int outer[5][2] = {{1, 1}, {2, 0}, {2, -1}, {0, 2}, {-1, 2}};
-            int K = e->K, i, m, e0 = l->ve_off[ev], ok = 1;
+            int K = e->K, i, e0 = l->ve_off[ev], ok = 1;
             int *C = (int *)sfb__alloc(b->ctx, (size_t)K * sizeof(int));
             unsigned sp = SFB__PARAM(SFB__PARAM_DEPTH(par), SFB__PARAM_I(par), SFB__PARAM_J(par), evk);
             if (!C) return sfb__oom(b->ctx, "patch table");
@@ -3865,23 +4596,8 @@ static sfb_result sfb__pb_face_tri(sfb__pbuild *b, sfb__wlevel *w, int g, int le
             ok &= grid[1][1].real && grid[1][1].v[0] == ev && grid[1][2].v[0] == C[1] && grid[2][1].v[0] == C[2] &&
                   grid[0][2].real && grid[0][2].v[0] == C[N] && grid[2][0].real && grid[2][0].v[0] == C[1 + 2 % N];
             if (ok) {
-                patch = sfb__pb_patch(b, SFB__PATCH_STAM_LOOP, sp, N, K);
-                if (patch < 0 || !sfb__mask_grow(b->ctx, &b->m, K)) { sfb__free(b->ctx, C); return sfb__oom(b->ctx, "patch table"); }
-                base = b->pt->pfirst[patch];
                 b->pt->eigl[N] = e;
-                for (i = 0; i < K; ++i) {
-                    int row;
-                    b->m.n = 0;
-                    for (m = 0; m < K; ++m) {
-                        double wgt = e->vinv[(size_t)i * K + m];
-                        if (wgt != 0.0) SFB__MASK_ADD(&b->m, C[m], wgt);
-                    }
-                    row = sfb__pb_point(b, &w->rows, &b->m);
-                    if (row < 0) { sfb__free(b->ctx, C); return sfb__oom(b->ctx, "patch points"); }
-                    b->pt->cv[base + i] = row;
-                }
-                sfb__free(b->ctx, C);
-                return sfb__pb_insert(b, ptex, sp, patch) ? SFB_SUCCESS : sfb__oom(b->ctx, "patch table");
+                return sfb__pb_eigen_patch(b, w, SFB__PATCH_STAM_LOOP, ptex, sp, N, K, e->vinv, C);
             }
             sfb__free(b->ctx, C);
         }
@@ -3892,447 +4608,7 @@ static sfb_result sfb__pb_face_tri(sfb__pbuild *b, sfb__wlevel *w, int g, int le
     return SFB_SUCCESS;
 }
 
-/* The sub-mesh to refine: `mark` faces (active and their 1-ring), renumbered. */
-static sfb_result sfb__pb_submesh(sfb_context *ctx, const sfb__wlevel *w, const unsigned char *mark, sfb__level *sub,
-                                  int *vmap, int *emap, int *fmap, unsigned char *vcomp, unsigned char *ecomp) {
-    const sfb__level *l = &w->l;
-    int f, k, nv = 0, ne = 0, nf = 0, nfv = 0;
-    sfb_result r;
-    memset(sub, 0, sizeof *sub);
-    for (k = 0; k < l->nv; ++k) vmap[k] = -1;
-    for (k = 0; k < l->ne; ++k) emap[k] = -1;
-    for (f = 0; f < l->nf; ++f) {
-        fmap[f] = -1;
-        if (!mark[f]) continue;
-        fmap[f] = nf++;
-        for (k = l->fv_off[f]; k < l->fv_off[f + 1]; ++k) {
-            if (vmap[l->fv[k]] < 0) vmap[l->fv[k]] = nv++;
-            if (emap[l->fe[k]] < 0) emap[l->fe[k]] = ne++;
-            nfv++;
-        }
-    }
-    sub->nv = nv; sub->ne = ne; sub->nf = nf; sub->nfv = nfv;
-    sub->fv_off = (int *)sfb__alloc(ctx, ((size_t)nf + 1) * sizeof(int));
-    sub->fv = (int *)sfb__alloc(ctx, ((size_t)nfv + 1) * sizeof(int));
-    sub->fe = (int *)sfb__alloc(ctx, ((size_t)nfv + 1) * sizeof(int));
-    sub->ev = (int *)sfb__alloc(ctx, ((size_t)ne * 2 + 1) * sizeof(int));
-    sub->es = (float *)sfb__alloc(ctx, ((size_t)ne + 1) * sizeof(float));
-    sub->vs = (float *)sfb__alloc(ctx, ((size_t)nv + 1) * sizeof(float));
-    sub->fhole = (unsigned char *)sfb__calloc(ctx, (size_t)nf + 1, 1);
-    if (!sub->fv_off || !sub->fv || !sub->fe || !sub->ev || !sub->es || !sub->vs || !sub->fhole) {
-        sfb__level_free(ctx, sub);
-        return sfb__oom(ctx, "adaptive refinement");
-    }
-    nfv = 0;
-    for (f = 0; f < l->nf; ++f) {
-        int sf = fmap[f];
-        if (sf < 0) continue;
-        sub->fv_off[sf] = nfv;
-        sub->fhole[sf] = l->fhole[f];
-        for (k = l->fv_off[f]; k < l->fv_off[f + 1]; ++k) {
-            sub->fv[nfv] = vmap[l->fv[k]];
-            sub->fe[nfv] = emap[l->fe[k]];
-            nfv++;
-        }
-    }
-    sub->fv_off[nf] = nfv;
-    for (k = 0; k < l->ne; ++k)
-        if (emap[k] >= 0) {
-            sub->ev[2 * emap[k]] = vmap[l->ev[2 * k]];
-            sub->ev[2 * emap[k] + 1] = vmap[l->ev[2 * k + 1]];
-            sub->es[emap[k]] = l->es[k];
-        }
-    for (k = 0; k < l->nv; ++k)
-        if (vmap[k] >= 0) sub->vs[vmap[k]] = l->vs[k];
-    r = sfb__level_complete(ctx, sub);
-    if (r != SFB_SUCCESS) { sfb__level_free(ctx, sub); return r; }
-    sfb__level_compute_rules(sub);
-    /* complete in the sub-mesh: complete before and nothing around it left out */
-    for (k = 0; k < l->nv; ++k)
-        if (vmap[k] >= 0)
-            vcomp[vmap[k]] = w->vcomp[k] && (sub->vf_off[vmap[k] + 1] - sub->vf_off[vmap[k]] == l->vf_off[k + 1] - l->vf_off[k]);
-    for (k = 0; k < l->ne; ++k)
-        if (emap[k] >= 0)
-            ecomp[emap[k]] = w->ecomp[k] && (sub->ef_off[emap[k] + 1] - sub->ef_off[emap[k]] == l->ef_off[k + 1] - l->ef_off[k]);
-    return SFB_SUCCESS;
-}
-
-sfb_result sfb__patches_build(sfb_context *ctx, const sfb__level *base, const sfb__refine_options *opt, int limit,
-                              const float *positions, sfb__patch_table *pt) {
-    sfb__pbuild b;
-    sfb__wlevel w, nw;
-    sfb_result r = SFB_SUCCESS;
-    float *ps = NULL, *cs = NULL;
-    int f, k, level, nptex = 0;
-    int *active = NULL, nactive = 0, tri;
-    memset(&b, 0, sizeof b);
-    memset(&w, 0, sizeof w);
-    memset(&nw, 0, sizeof nw);
-    memset(pt, 0, sizeof *pt);
-    b.ctx = ctx;
-    b.pt = pt;
-    tri = opt->scheme == SFB_SCHEME_LOOP;
-    pt->domain = tri ? SFB__DOMAIN_TRI : SFB__DOMAIN_QUAD;
-    pt->isolation = limit;
-    /* param faces */
-    pt->face_ptex = (int *)sfb__alloc(ctx, ((size_t)base->nf + 1) * sizeof(int));
-    if (!pt->face_ptex) goto oom;
-    for (f = 0; f < base->nf; ++f) {
-        pt->face_ptex[f] = nptex;
-        nptex += (tri || sfb__face_n(base, f) == 4) ? 1 : sfb__face_n(base, f);
-    }
-    pt->face_ptex[base->nf] = nptex;
-    pt->nptex = nptex;
-    pt->ptex_face = (int *)sfb__alloc(ctx, ((size_t)nptex + 1) * sizeof(int));
-    pt->ptex_corner = (int *)sfb__alloc(ctx, ((size_t)nptex + 1) * sizeof(int));
-    pt->ptex_root = (int *)sfb__alloc(ctx, ((size_t)nptex + 1) * sizeof(int));
-    if (!pt->ptex_face || !pt->ptex_corner || !pt->ptex_root) goto oom;
-    for (f = 0; f < base->nf; ++f)
-        for (k = pt->face_ptex[f]; k < pt->face_ptex[f + 1]; ++k) {
-            pt->ptex_face[k] = f;
-            pt->ptex_corner[k] = (tri || sfb__face_n(base, f) == 4) ? -1 : k - pt->face_ptex[f];
-            pt->ptex_root[k] = -1;
-        }
-    /* level 0 */
-    w.l = *base;
-    w.owns_level = 0;
-    w.rows.rows = base->nv;
-    w.rows.off = (size_t *)sfb__alloc(ctx, ((size_t)base->nv + 1) * sizeof(size_t));
-    w.fptex = (int *)sfb__alloc(ctx, ((size_t)base->nf + 1) * sizeof(int));
-    w.fparam = (unsigned *)sfb__calloc(ctx, (size_t)base->nf + 1, sizeof(unsigned));
-    w.vcomp = (unsigned char *)sfb__alloc(ctx, (size_t)base->nv + 1);
-    w.ecomp = (unsigned char *)sfb__alloc(ctx, (size_t)base->ne + 1);
-    b.A.acc = (double *)sfb__alloc(ctx, ((size_t)base->nv + 1) * sizeof(double));
-    b.A.mark = (unsigned *)sfb__calloc(ctx, (size_t)base->nv + 1, sizeof(unsigned));
-    b.A.touched = (int *)sfb__alloc(ctx, ((size_t)base->nv + 1) * sizeof(int));
-    ps = (float *)sfb__alloc(ctx, (SFB_MAX_VALENCE + 2) * sizeof(float));
-    cs = (float *)sfb__alloc(ctx, (SFB_MAX_VALENCE + 2) * sizeof(float));
-    b.vrow = (int *)sfb__alloc(ctx, ((size_t)base->nv + 1) * sizeof(int));
-    if (!w.rows.off || !w.fptex || !w.fparam || !w.vcomp || !w.ecomp || !b.A.acc || !b.A.mark || !b.A.touched || !ps || !cs ||
-        !b.vrow || !sfb__rows_reserve(ctx, &w.rows, (size_t)base->nv + 1) || !sfb__mask_grow(ctx, &b.m, 64))
-        goto oom;
-    for (k = 0; k < base->nv; ++k) { w.rows.off[k] = (size_t)k; w.rows.idx[k] = k; w.rows.w[k] = 1.0; }
-    w.rows.off[base->nv] = (size_t)base->nv;
-    w.rows.n = (size_t)base->nv;
-    memset(w.vcomp, 1, (size_t)base->nv + 1);
-    memset(w.ecomp, 1, (size_t)base->ne + 1);
-    for (f = 0; f < base->nf; ++f) w.fptex[f] = (tri || sfb__face_n(base, f) == 4) ? pt->face_ptex[f] : -1;
-    for (level = 0;; ++level) {
-        unsigned char *mark = NULL, *vc = NULL, *ec = NULL;
-        int *vmap = NULL, *emap = NULL, *fmap = NULL;
-        sfb__level sub;
-        sfb__rows subrows;
-        r = sfb__progress(ctx, 0.8f + 0.15f * (float)level / (float)(SFB_MAX_LEVEL + 2), "patches");
-        if (r != SFB_SUCCESS) goto done;
-        for (k = 0; k < w.l.nv; ++k) b.vrow[k] = -1;
-        sfb__free(ctx, active);
-        active = (int *)sfb__alloc(ctx, ((size_t)w.l.nf + 1) * sizeof(int));
-        if (!active) goto oom;
-        nactive = 0;
-        for (f = 0; f < w.l.nf; ++f) {
-            int refine = 0;
-            if (!tri && level == 0 && sfb__face_n(&w.l, f) != 4) {
-                if (!w.l.fhole[f]) active[nactive++] = f;
-                continue;
-            }
-            if (w.fptex[f] < 0) continue;
-            r = tri ? sfb__pb_face_tri(&b, &w, f, level, limit, &refine) : sfb__pb_face(&b, &w, f, level, limit, &refine);
-            if (r != SFB_SUCCESS) goto done;
-            if (refine) active[nactive++] = f;
-        }
-        if (nactive == 0) break;
-        if (level > SFB_MAX_LEVEL + 1) {
-            r = sfb__error(ctx, SFB_BACKEND_ERROR, SFB_ELEMENT_NONE, -1, "adaptive isolation did not terminate");
-            goto done;
-        }
-        /* mark the active faces and their 1-ring */
-        mark = (unsigned char *)sfb__calloc(ctx, (size_t)w.l.nf + 1, 1);
-        vmap = (int *)sfb__alloc(ctx, ((size_t)w.l.nv + 1) * sizeof(int));
-        emap = (int *)sfb__alloc(ctx, ((size_t)w.l.ne + 1) * sizeof(int));
-        fmap = (int *)sfb__alloc(ctx, ((size_t)w.l.nf + 1) * sizeof(int));
-        vc = (unsigned char *)sfb__alloc(ctx, (size_t)w.l.nv + 1);
-        ec = (unsigned char *)sfb__alloc(ctx, (size_t)w.l.ne + 1);
-        if (!mark || !vmap || !emap || !fmap || !vc || !ec) {
-            sfb__free(ctx, mark); sfb__free(ctx, vmap); sfb__free(ctx, emap); sfb__free(ctx, fmap); sfb__free(ctx, vc); sfb__free(ctx, ec);
-            goto oom;
-        }
-        for (k = 0; k < nactive; ++k) {
-            int g = active[k], q, i;
-            mark[g] = 1;
-            for (q = w.l.fv_off[g]; q < w.l.fv_off[g + 1]; ++q) {
-                int v = w.l.fv[q];
-                if (!w.vcomp[v]) {
-                    r = sfb__error(ctx, SFB_BACKEND_ERROR, SFB_ELEMENT_NONE, -1, "adaptive isolation reached an incomplete vertex");
-                    sfb__free(ctx, mark); sfb__free(ctx, vmap); sfb__free(ctx, emap); sfb__free(ctx, fmap); sfb__free(ctx, vc); sfb__free(ctx, ec);
-                    goto done;
-                }
-                for (i = w.l.vf_off[v]; i < w.l.vf_off[v + 1]; ++i) mark[w.l.vf[i]] = 1;
-            }
-        }
-        r = sfb__pb_submesh(ctx, &w, mark, &sub, vmap, emap, fmap, vc, ec);
-        if (r != SFB_SUCCESS) {
-            sfb__free(ctx, mark); sfb__free(ctx, vmap); sfb__free(ctx, emap); sfb__free(ctx, fmap); sfb__free(ctx, vc); sfb__free(ctx, ec);
-            goto done;
-        }
-        /* rows of the sub-mesh's vertices */
-        memset(&subrows, 0, sizeof subrows);
-        subrows.rows = sub.nv;
-        subrows.off = (size_t *)sfb__alloc(ctx, ((size_t)sub.nv + 1) * sizeof(size_t));
-        r = SFB_SUCCESS;
-        if (!subrows.off) r = sfb__oom(ctx, "adaptive refinement");
-        else {
-            int v;
-            subrows.off[0] = 0;
-            {
-                int *inv = (int *)sfb__alloc(ctx, ((size_t)sub.nv + 1) * sizeof(int));
-                if (!inv) r = sfb__oom(ctx, "adaptive refinement");
-                else {
-                    for (v = 0; v < w.l.nv; ++v)
-                        if (vmap[v] >= 0) inv[vmap[v]] = v;
-                    for (v = 0; v < sub.nv && r == SFB_SUCCESS; ++v) {
-                        size_t a = w.rows.off[inv[v]], z = w.rows.off[inv[v] + 1];
-                        if (!sfb__rows_reserve(ctx, &subrows, subrows.n + (z - a))) { r = sfb__oom(ctx, "adaptive refinement"); break; }
-                        memcpy(subrows.idx + subrows.n, w.rows.idx + a, (z - a) * sizeof(int));
-                        memcpy(subrows.w + subrows.n, w.rows.w + a, (z - a) * sizeof(double));
-                        subrows.n += z - a;
-                        subrows.off[v + 1] = subrows.n;
-                    }
-                    sfb__free(ctx, inv);
-                }
-            }
-        }
-        if (r == SFB_SUCCESS) {
-            memset(&nw, 0, sizeof nw);
-            r = sfb__refine_step(ctx, opt, &sub, &subrows, &nw.l, &nw.rows, &b.A, &b.m, ps, cs, 0.0f, 0.0f);
-            nw.owns_level = 1;
-        }
-        if (r == SFB_SUCCESS) {
-            /* flags and candidates of the child level */
-            const sfb__level *p = &sub;
-            nw.fptex = (int *)sfb__alloc(ctx, ((size_t)nw.l.nf + 1) * sizeof(int));
-            nw.fparam = (unsigned *)sfb__calloc(ctx, (size_t)nw.l.nf + 1, sizeof(unsigned));
-            nw.vcomp = (unsigned char *)sfb__calloc(ctx, (size_t)nw.l.nv + 1, 1);
-            nw.ecomp = (unsigned char *)sfb__calloc(ctx, (size_t)nw.l.ne + 1, 1);
-            if (!nw.fptex || !nw.fparam || !nw.vcomp || !nw.ecomp) r = sfb__oom(ctx, "adaptive refinement");
-            else {
-                int v, e, nvf = tri ? 0 : p->nf; /* Loop has no face points */
-                for (v = 0; v < p->nv; ++v) nw.vcomp[v] = vc[v];
-                for (f = 0; f < nvf; ++f) nw.vcomp[p->nv + f] = 1;
-                for (e = 0; e < p->ne; ++e) {
-                    nw.vcomp[p->nv + nvf + e] = ec[e];
-                    nw.ecomp[2 * e] = nw.ecomp[2 * e + 1] = ec[e];
-                }
-                for (e = 2 * p->ne; e < nw.l.ne; ++e) nw.ecomp[e] = 1;
-                for (f = 0; f < nw.l.nf; ++f) nw.fptex[f] = -1;
-                for (k = 0; k < nactive; ++k) {
-                    int g = active[k], sf = fmap[g], o = p->fv_off[sf], n = p->fv_off[sf + 1] - o, i;
-                    unsigned par = w.fparam[g];
-                    if (tri) {
-                        /* children 4 sf + i: the corner at slot i (i < 3), the middle (i = 3) */
-                        int rot = SFB__PARAM_CORNER(par);
-                        for (i = 0; i < 4; ++i) {
-                            int c = i == 3 ? 3 : (i - rot + 3) % 3;
-                            int crot = i == 3 ? (rot + 1) % 3 : c == 0 ? 0 : c == 1 ? 2 : 1;
-                            nw.fptex[4 * sf + i] = w.fptex[g];
-                            nw.fparam[4 * sf + i] = SFB__PARAM(SFB__PARAM_DEPTH(par) + 1, 2 * SFB__PARAM_I(par) + (c & 1),
-                                                               2 * SFB__PARAM_J(par) + (c >> 1), crot);
-                        }
-                        continue;
-                    }
-                    for (i = 0; i < n; ++i) {
-                        int cf = o + i;
-                        if (level == 0 && sfb__face_n(&w.l, g) != 4) {
-                            nw.fptex[cf] = pt->face_ptex[g] + i;
-                            nw.fparam[cf] = 0;
-                        } else {
-                            int rot = SFB__PARAM_CORNER(par), c = ((i - rot) % 4 + 4) % 4;
-                            int ox = (c == 1 || c == 2), oy = (c >= 2);
-                            nw.fptex[cf] = w.fptex[g];
-                            nw.fparam[cf] = SFB__PARAM(SFB__PARAM_DEPTH(par) + 1, 2 * SFB__PARAM_I(par) + ox, 2 * SFB__PARAM_J(par) + oy,
-                                                       ((rot - i) % 4 + 4) % 4);
-                        }
-                    }
-                }
-            }
-        }
-        sfb__rows_free(ctx, &subrows);
-        sfb__level_free(ctx, &sub);
-        sfb__free(ctx, mark); sfb__free(ctx, vmap); sfb__free(ctx, emap); sfb__free(ctx, fmap); sfb__free(ctx, vc); sfb__free(ctx, ec);
-        if (r != SFB_SUCCESS) { sfb__wlevel_free(ctx, &nw); goto done; }
-        sfb__wlevel_free(ctx, &w);
-        w = nw;
-        memset(&nw, 0, sizeof nw);
-        {
-            int *nv = (int *)sfb__realloc(ctx, b.vrow, ((size_t)w.l.nv + 1) * sizeof(int));
-            if (!nv) goto oom;
-            b.vrow = nv;
-        }
-        if (level + 1 > pt->max_depth) pt->max_depth = level + 1;
-    }
-    r = SFB_SUCCESS;
-    pt->npoints = b.prow.rows;
-    if (r == SFB_SUCCESS) {
-        /* The points straight from the double rows (no float stencil table): a Stam point is an
-         * eigen coefficient, a combination with weights of both signs summing to 0 whose result
-         * is small next to the coordinates; float weights would cost it its precision (normals
-         * off by ~1e-4 rad on meshes far from the origin). */
-        int row, c;
-        pt->point_data = (float *)sfb__alloc(ctx, ((size_t)b.prow.rows + 1) * 3 * sizeof(float));
-        if (!pt->point_data) r = sfb__oom(ctx, "patch points");
-        for (row = 0; r == SFB_SUCCESS && row < b.prow.rows; ++row) {
-            double acc[3] = {0.0, 0.0, 0.0};
-            size_t q;
-            for (q = b.prow.off[row]; q < b.prow.off[row + 1]; ++q)
-                for (c = 0; c < 3; ++c) acc[c] += b.prow.w[q] * positions[3 * (size_t)b.prow.idx[q] + c];
-            for (c = 0; c < 3; ++c) pt->point_data[3 * (size_t)row + c] = (float)acc[c];
-        }
-    }
-    goto done;
-oom:
-    r = sfb__oom(ctx, "patch table");
-done:
-    sfb__wlevel_free(ctx, &w);
-    sfb__wlevel_free(ctx, &nw);
-    sfb__rows_free(ctx, &b.prow);
-    sfb__free(ctx, b.A.acc); sfb__free(ctx, b.A.mark); sfb__free(ctx, b.A.touched);
-    sfb__free(ctx, b.m.idx); sfb__free(ctx, b.m.w);
-    sfb__free(ctx, b.vrow);
-    sfb__free(ctx, ps); sfb__free(ctx, cs);
-    sfb__free(ctx, active);
-    if (r != SFB_SUCCESS) sfb__patch_table_free(ctx, pt);
-    return r;
-}
-
-/* ---- locating and evaluating ---- */
-
-/* Patch index (or -1: hole) and local (s,t) of a valid location; *scale = 2^depth. */
-int sfb__patch_locate(const sfb__patch_table *pt, int ptex, double u, double v, double *s, double *t, double *scale) {
-    int node = pt->ptex_root[ptex];
-    double sc = 1.0;
-    if (pt->domain == SFB__DOMAIN_TRI) {
-        /* triangles: *scale is negative after an odd number of middle children */
-        while (node >= 0) {
-            int c;
-            sc *= 2.0;
-            if (u >= 0.5) { c = 1; u = 2.0 * u - 1.0; v = 2.0 * v; }
-            else if (v >= 0.5) { c = 2; u = 2.0 * u; v = 2.0 * v - 1.0; }
-            else if (u + v < 0.5) { c = 0; u = 2.0 * u; v = 2.0 * v; }
-            else { c = 3; u = 1.0 - 2.0 * u; v = 1.0 - 2.0 * v; sc = -sc; }
-            node = pt->nodes[4 * node + c];
-        }
-        *s = u; *t = v; *scale = sc;
-        return node <= -2 ? -node - 2 : -1;
-    }
-    while (node >= 0) {
-        int qx, qy;
-        u *= 2.0; v *= 2.0; sc *= 2.0;
-        qx = u >= 1.0; qy = v >= 1.0;
-        if (qx) u -= 1.0;
-        if (qy) v -= 1.0;
-        node = pt->nodes[4 * node + qx + 2 * qy];
-    }
-    *s = u; *t = v; *scale = sc;
-    return node <= -2 ? -node - 2 : -1;
-}
-
-static void sfb__bspline_basis(double t, double *b, double *d, double *dd) {
-    double t2 = t * t, t3 = t2 * t, s = 1.0 - t;
-    b[0] = s * s * s / 6.0; b[1] = (3.0 * t3 - 6.0 * t2 + 4.0) / 6.0; b[2] = (-3.0 * t3 + 3.0 * t2 + 3.0 * t + 1.0) / 6.0; b[3] = t3 / 6.0;
-    d[0] = -0.5 * s * s; d[1] = 1.5 * t2 - 2.0 * t; d[2] = -1.5 * t2 + t + 0.5; d[3] = 0.5 * t2;
-    dd[0] = s; dd[1] = 3.0 * t - 2.0; dd[2] = -3.0 * t + 1.0; dd[3] = t;
-}
-
-static void sfb__cross(const double *a, const double *b, double *c) {
-    c[0] = a[1] * b[2] - a[2] * b[1];
-    c[1] = a[2] * b[0] - a[0] * b[2];
-    c[2] = a[0] * b[1] - a[1] * b[0];
-}
-
-/* res[0..5]: P, Ps, Pt, Pss, Pst, Ptt in the patch's (s,t); nrm: an unnormalised normal
- * direction (a positive multiple of Ps x Pt, finite where Ps x Pt under- or overflows). */
-static void sfb__eval_bspline16(const float *pts, const int *cv, double s, double t, double res[6][3]) {
-    double bu[4], du[4], ddu[4], bv[4], dv[4], ddv[4];
-    int i, j, c;
-    sfb__bspline_basis(s, bu, du, ddu);
-    sfb__bspline_basis(t, bv, dv, ddv);
-    memset(res, 0, sizeof(double) * 18);
-    for (j = 0; j < 4; ++j)
-        for (i = 0; i < 4; ++i) {
-            const float *p = pts + 3 * (size_t)cv[4 * j + i];
-            double w[6];
-            w[0] = bu[i] * bv[j]; w[1] = du[i] * bv[j]; w[2] = bu[i] * dv[j];
-            w[3] = ddu[i] * bv[j]; w[4] = du[i] * dv[j]; w[5] = bu[i] * ddv[j];
-            for (c = 0; c < 3; ++c) {
-                int q;
-                for (q = 0; q < 6; ++q) res[q][c] += w[q] * p[c];
-            }
-        }
-}
-
-static void sfb__eval_endcap(const float *pts, const int *cv, double s, double t, double res[6][3]) {
-    const float *p0 = pts + 3 * (size_t)cv[0], *p1 = pts + 3 * (size_t)cv[1], *p2 = pts + 3 * (size_t)cv[2], *p3 = pts + 3 * (size_t)cv[3];
-    int c;
-    for (c = 0; c < 3; ++c) {
-        res[0][c] = (1 - s) * (1 - t) * p0[c] + s * (1 - t) * p1[c] + s * t * p2[c] + (1 - s) * t * p3[c];
-        res[1][c] = (1 - t) * ((double)p1[c] - p0[c]) + t * ((double)p2[c] - p3[c]);
-        res[2][c] = (1 - s) * ((double)p3[c] - p0[c]) + s * ((double)p2[c] - p1[c]);
-        res[3][c] = 0.0;
-        res[4][c] = (double)p0[c] - p1[c] + p2[c] - p3[c];
-        res[5][c] = 0.0;
-    }
-}
-
-/* End-cap normal: the bilinear blend of the corners' limit normals (from the limit tangents),
- * so that the normal at a corner is the limit normal there. A corner whose limit normal is
- * more than 45 degrees from the cap's own (chord) normal at that corner belongs to another
- * sector (a corner or non-manifold vertex): that corner uses the chord normal instead. */
-static void sfb__endcap_normal(const float *pts, const int *cv, int nc, double s, double t, double nrm[3]) {
-    double wts[4], n[3] = {0, 0, 0};
-    int k, c;
-    if (nc == 3) { wts[0] = 1 - s - t; wts[1] = s; wts[2] = t; }
-    else { wts[0] = (1 - s) * (1 - t); wts[1] = s * (1 - t); wts[2] = s * t; wts[3] = (1 - s) * t; }
-    for (k = 0; k < nc; ++k) {
-        const float *p = pts + 3 * (size_t)cv[k], *pn = pts + 3 * (size_t)cv[(k + 1) % nc], *pp = pts + 3 * (size_t)cv[(k + nc - 1) % nc];
-        const float *t1 = pts + 3 * (size_t)cv[nc + 2 * k], *t2 = pts + 3 * (size_t)cv[nc + 1 + 2 * k];
-        double a[3], bb[3], ch[3], ln[3], lc, ll;
-        for (c = 0; c < 3; ++c) { a[c] = (double)pn[c] - p[c]; bb[c] = (double)pp[c] - p[c]; }
-        sfb__cross(a, bb, ch);
-        for (c = 0; c < 3; ++c) { a[c] = t1[c]; bb[c] = t2[c]; }
-        sfb__cross(a, bb, ln);
-        lc = sqrt(ch[0] * ch[0] + ch[1] * ch[1] + ch[2] * ch[2]);
-        ll = sqrt(ln[0] * ln[0] + ln[1] * ln[1] + ln[2] * ln[2]);
-        if (lc > 0.0) for (c = 0; c < 3; ++c) ch[c] /= lc;
-        if (ll > 0.0) for (c = 0; c < 3; ++c) ln[c] /= ll;
-        {
-            /* the tangent masks' orientation is the vertex's, not necessarily this face's */
-            double d = ln[0] * ch[0] + ln[1] * ch[1] + ln[2] * ch[2];
-            if (d < 0.0) { ln[0] = -ln[0]; ln[1] = -ln[1]; ln[2] = -ln[2]; d = -d; }
-            if (!(ll > 0.0) || d < 0.70710678118654752) memcpy(ln, ch, sizeof ln);
-        }
-        for (c = 0; c < 3; ++c) n[c] += wts[k] * ln[c];
-    }
-    memcpy(nrm, n, sizeof n);
-}
-
-/* The end of both Stam kernels: nr holds the normalised first derivatives and sr the position
- * (row 0) and the second derivatives (rows 3..5) in the EV frame's (u,v); J = d(u,v)/d(s,t).
- * Writes res (P, Ps, Pt, Pss, Pst, Ptt; first derivatives times sc1, second times sc2) and nres
- * (the normalised first derivatives in (s,t)). */
-static void sfb__stam_finish(double J[2][2], double sc1, double sc2, double sr[6][3], double nr[2][3], double res[6][3],
-                             double nres[2][3]) {
-    int c;
-    for (c = 0; c < 3; ++c) {
-        double Pu = nr[0][c], Pv = nr[1][c], Puu = sr[3][c], Puv = sr[4][c], Pvv = sr[5][c];
-        res[0][c] = sr[0][c];
-        nres[0][c] = Pu * J[0][0] + Pv * J[1][0];
-        nres[1][c] = Pu * J[0][1] + Pv * J[1][1];
-        res[1][c] = nres[0][c] * sc1;
-        res[2][c] = nres[1][c] * sc1;
-        res[3][c] = sc2 * (Puu * J[0][0] * J[0][0] + 2.0 * Puv * J[0][0] * J[1][0] + Pvv * J[1][0] * J[1][0]);
-        res[4][c] = sc2 * (Puu * J[0][0] * J[0][1] + Puv * (J[0][0] * J[1][1] + J[0][1] * J[1][0]) + Pvv * J[1][0] * J[1][1]);
-        res[5][c] = sc2 * (Puu * J[0][1] * J[0][1] + 2.0 * Puv * J[0][1] * J[1][1] + Pvv * J[1][1] * J[1][1]);
-    }
-}
+/* ---- ref evaluation ---- */
 
 /* Quartic Bernstein basis on a triangle, our point order (row by row in t, s rising in a
  * row): B[0..5][15] = value, d/ds, d/dt, d2/ds2, d2/dsdt, d2/dt2. */
@@ -4343,7 +4619,7 @@ static double sfb__tpow(double x, int e) {
     return r;
 }
 
-static void sfb__bez15_basis(double s, double t, double B[6][15]) {
+void sfb__bez15_basis(double s, double t, double B[6][15]) {
     static const double fact[5] = {1, 1, 2, 6, 24};
     double w = 1.0 - s - t;
     int i, j, q = 0;
@@ -4363,7 +4639,7 @@ static void sfb__bez15_basis(double s, double t, double B[6][15]) {
         }
 }
 
-static void sfb__eval_beztri(const float *pts, const int *cv, double s, double t, double res[6][3]) {
+void sfb__eval_beztri(const float *pts, const int *cv, double s, double t, double res[6][3]) {
     double B[6][15];
     int j, q, c;
     sfb__bez15_basis(s, t, B);
@@ -4375,7 +4651,7 @@ static void sfb__eval_beztri(const float *pts, const int *cv, double s, double t
     }
 }
 
-static void sfb__eval_endcap_tri(const float *pts, const int *cv, double s, double t, double res[6][3]) {
+void sfb__eval_endcap_tri(const float *pts, const int *cv, double s, double t, double res[6][3]) {
     const float *p0 = pts + 3 * (size_t)cv[0], *p1 = pts + 3 * (size_t)cv[1], *p2 = pts + 3 * (size_t)cv[2];
     int c;
     memset(res, 0, sizeof(double) * 18);
@@ -4387,7 +4663,7 @@ static void sfb__eval_endcap_tri(const float *pts, const int *cv, double s, doub
 }
 
 /* Stam-Loop: (s,t) in the patch, the EV at frame corner `corner`; nres as sfb__eval_stam. */
-static void sfb__eval_stam_loop(const sfb__eigen_loop *e, const float *pts, const int *cv, int corner, double s, double t,
+void sfb__eval_stam_loop(const sfb__eigen_loop *e, const float *pts, const int *cv, int corner, double s, double t,
                                 double res[6][3], double nres[2][3]) {
     int K = e->K, i, j, c, k, n = 1, at_ev, m;
     double u, v, J[2][2], B[6][15], ss, tt, sign = 1.0;
@@ -4459,153 +4735,32 @@ static void sfb__eval_stam_loop(const sfb__eigen_loop *e, const float *pts, cons
     sfb__stam_finish(J, at_ev ? 1.0 : pow(e->sub, m) * ldexp(1.0, n), at_ev ? 0.0 : pow(e->sub, m) * ldexp(1.0, 2 * n), sr, nr, res, nres);
 }
 
-/* Stam: (s,t) in the patch, the EV at frame corner `corner`. nres[2] gets the derivatives
- * divided by sub^(n-1) 2^n (a finite tangent frame down to the EV). */
-static void sfb__eval_stam(const sfb__eigen_cc *e, const float *pts, const int *cv, int corner, double s, double t, double res[6][3],
-                           double nres[2][3]) {
-    int K = e->K, i, j, c, k, n = 1, at_ev;
-    double u, v, J[2][2], bu[4], du[4], ddu[4], bv[4], dv[4], ddv[4], uu, vv;
-    double sr[6][3], nr[2][3];
-    const double *phi;
-    switch (corner) {
-    default: u = s; v = t; J[0][0] = 1; J[0][1] = 0; J[1][0] = 0; J[1][1] = 1; break;
-    case 1: u = t; v = 1.0 - s; J[0][0] = 0; J[0][1] = 1; J[1][0] = -1; J[1][1] = 0; break;
-    case 2: u = 1.0 - s; v = 1.0 - t; J[0][0] = -1; J[0][1] = 0; J[1][0] = 0; J[1][1] = -1; break;
-    case 3: u = 1.0 - t; v = s; J[0][0] = 0; J[0][1] = -1; J[1][0] = 1; J[1][1] = 0; break;
-    }
-    /* J[a][b] = d(u,v)_a / d(s,t)_b */
-    memset(sr, 0, sizeof sr);
-    memset(nr, 0, sizeof nr);
-    at_ev = (u == 0.0 && v == 0.0);
-    if (at_ev) {
-        /* the limit point; tangents: the n -> infinity limit of the normalised derivatives */
-        k = 2; uu = 0.0; vv = 0.0;
-    } else {
-        while (u < 0.5 && v < 0.5) { u *= 2.0; v *= 2.0; ++n; }
-        if (v < 0.5) { k = 1; uu = 2.0 * u - 1.0; vv = 2.0 * v; }
-        else if (u < 0.5) { k = 3; uu = 2.0 * u; vv = 2.0 * v - 1.0; }
-        else { k = 2; uu = 2.0 * u - 1.0; vv = 2.0 * v - 1.0; }
-    }
-    sfb__bspline_basis(uu, bu, du, ddu);
-    sfb__bspline_basis(vv, bv, dv, ddv);
-    phi = e->phi + (size_t)(k - 1) * 16 * K;
-    for (i = 0; i < K; ++i) {
-        double f[6] = {0, 0, 0, 0, 0, 0}, lp, ln;
-        const float *p = pts + 3 * (size_t)cv[i];
-        for (j = 0; j < 16; ++j) {
-            double ph = phi[(size_t)j * K + i];
-            int a = j % 4, b = j / 4;
-            f[0] += bu[a] * bv[b] * ph; f[1] += du[a] * bv[b] * ph; f[2] += bu[a] * dv[b] * ph;
-            f[3] += ddu[a] * bv[b] * ph; f[4] += du[a] * dv[b] * ph; f[5] += bu[a] * ddv[b] * ph;
-        }
-        if (at_ev) {
-            lp = i == e->dominant ? 1.0 : 0.0;
-            ln = (i != e->dominant && fabs(fabs(e->lambda[i]) - e->sub) <= 1e-12) ? 1.0 : 0.0;
-        } else {
-            lp = pow(e->lambda[i], n - 1);
-            ln = i == e->dominant ? 0.0 : pow(e->lambda[i] / e->sub, n - 1);
-        }
-        for (c = 0; c < 3; ++c) {
-            sr[0][c] += lp * f[0] * p[c];
-            nr[0][c] += ln * f[1] * p[c];
-            nr[1][c] += ln * f[2] * p[c];
-            sr[3][c] += ln * f[3] * p[c];
-            sr[4][c] += ln * f[4] * p[c];
-            sr[5][c] += ln * f[5] * p[c];
-        }
-    }
-    sfb__stam_finish(J, at_ev ? 1.0 : pow(e->sub, n - 1) * ldexp(1.0, n), at_ev ? 0.0 : pow(e->sub, n - 1) * ldexp(1.0, 2 * n), sr, nr,
-                     res, nres);
+/* The kinds' evaluators (sfb__patch_kind, patch/table.c). */
+void sfb__kind_beztri(const sfb__patch_table *pt, const float *pts, int patch, const int *cv, double s, double t, double res[6][3],
+                      double dir[2][3]) {
+    (void)pt; (void)patch;
+    sfb__eval_beztri(pts, cv, s, t, res);
+    memcpy(dir[0], res[1], sizeof dir[0]);
+    memcpy(dir[1], res[2], sizeof dir[1]);
 }
 
-/* The ref kernel: one location, double precision throughout. want2: the second derivatives are
- * asked for (a manifold blend only forms them then: they cost it four more blends). */
-static void sfb__ref_eval_one(const sfb__patch_table *pt, const float *pts, const sfb_location *loc, int want2, double res[6][3],
-                              double nrm[3]) {
-    double s, t, sc, nres[2][3];
-    int patch = sfb__patch_locate(pt, loc->face, loc->u, loc->v, &s, &t, &sc), c;
-    const int *cv;
-    double len;
-    memset(res, 0, sizeof(double) * 18);
-    nrm[0] = nrm[1] = nrm[2] = 0.0;
-    if (patch < 0) return;
-    cv = pt->cv + pt->pfirst[patch];
-    switch (pt->ptype[patch]) {
-    case SFB__PATCH_MANIFOLD4:
-        sfb__mf_eval_patch(pt, pts, patch, s, t, want2, res, nrm); /* its normal is final (manifold.c) */
-        goto scale;
-    case SFB__PATCH_STAM:
-        sfb__eval_stam(pt->eig[pt->pvalence[patch]], pts, cv, SFB__PARAM_CORNER(pt->pparam[patch]), s, t, res, nres);
-        sfb__cross(nres[0], nres[1], nrm);
-        break;
-    case SFB__PATCH_ENDCAP:
-        sfb__eval_endcap(pts, cv, s, t, res);
-        sfb__endcap_normal(pts, cv, 4, s, t, nrm);
-        break;
-    case SFB__PATCH_ENDCAP_TRI:
-        sfb__eval_endcap_tri(pts, cv, s, t, res);
-        sfb__endcap_normal(pts, cv, 3, s, t, nrm);
-        break;
-    case SFB__PATCH_STAM_LOOP:
-        sfb__eval_stam_loop(pt->eigl[pt->pvalence[patch]], pts, cv, SFB__PARAM_CORNER(pt->pparam[patch]), s, t, res, nres);
-        sfb__cross(nres[0], nres[1], nrm);
-        break;
-    case SFB__PATCH_BEZTRI:
-        sfb__eval_beztri(pts, cv, s, t, res);
-        sfb__cross(res[1], res[2], nrm);
-        break;
-    default:
-        sfb__eval_bspline16(pts, cv, s, t, res);
-        sfb__cross(res[1], res[2], nrm);
-        break;
-    }
-    len = sqrt(nrm[0] * nrm[0] + nrm[1] * nrm[1] + nrm[2] * nrm[2]);
-    if (!(len > 0.0) || !isfinite(len)) {
-        /* degenerate tangents (a collapsed control net): the normal a step inside the patch */
-        double r2[6][3];
-        int ty = pt->ptype[patch], tri = pt->domain == SFB__DOMAIN_TRI;
-        double s2 = s + (s < 0.5 ? 1e-3 : -1e-3), t2 = t + (t < 0.5 ? 1e-3 : -1e-3);
-        if (tri && s2 + t2 > 1.0) { s2 = s - 1e-3; t2 = t - 1e-3; }
-        if (tri && s + t < 2e-3) { s2 = s + 1e-3; t2 = t + 1e-3; }
-        if (ty == SFB__PATCH_BSPLINE) sfb__eval_bspline16(pts, cv, s2, t2, r2);
-        else if (ty == SFB__PATCH_ENDCAP) sfb__eval_endcap(pts, cv, s2, t2, r2);
-        else if (ty == SFB__PATCH_BEZTRI) sfb__eval_beztri(pts, cv, s2, t2, r2);
-        else if (ty == SFB__PATCH_ENDCAP_TRI) sfb__eval_endcap_tri(pts, cv, s2, t2, r2);
-        else if (ty == SFB__PATCH_STAM_LOOP) { sfb__eval_stam_loop(pt->eigl[pt->pvalence[patch]], pts, cv, SFB__PARAM_CORNER(pt->pparam[patch]), s2, t2, r2, nres); memcpy(r2[1], nres[0], sizeof nres[0]); memcpy(r2[2], nres[1], sizeof nres[1]); }
-        else { sfb__eval_stam(pt->eig[pt->pvalence[patch]], pts, cv, SFB__PARAM_CORNER(pt->pparam[patch]), s2, t2, r2, nres); memcpy(r2[1], nres[0], sizeof nres[0]); memcpy(r2[2], nres[1], sizeof nres[1]); }
-        sfb__cross(r2[1], r2[2], nrm);
-        len = sqrt(nrm[0] * nrm[0] + nrm[1] * nrm[1] + nrm[2] * nrm[2]);
-    }
-    if (len > 0.0 && isfinite(len)) for (c = 0; c < 3; ++c) nrm[c] /= len;
-    else nrm[0] = nrm[1] = nrm[2] = 0.0;
-scale:
-    for (c = 0; c < 3; ++c) {
-        res[1][c] *= sc; res[2][c] *= sc;
-        res[3][c] *= sc * sc; res[4][c] *= sc * sc; res[5][c] *= sc * sc;
-    }
+void sfb__kind_stam_loop(const sfb__patch_table *pt, const float *pts, int patch, const int *cv, double s, double t, double res[6][3],
+                         double dir[2][3]) {
+    sfb__eval_stam_loop(pt->eigl[pt->pvalence[patch]], pts, cv, SFB__PARAM_CORNER(pt->pparam[patch]), s, t, res, dir);
 }
 
-sfb_result sfb__ref_eval_patches(void *state, const sfb__patch_table *pt, void *handle, const sfb_location *locs, int first,
-                                        int last, const sfb_eval_output *out) {
-    int q, c;
-    (void)state; (void)handle;
-    for (q = first; q < last; ++q) {
-        double res[6][3], nrm[3];
-        size_t o = 3 * (size_t)q;
-        sfb__ref_eval_one(pt, pt->point_data, &locs[q], out->duu || out->duv || out->dvv, res, nrm);
-        for (c = 0; c < 3; ++c) {
-            if (out->position) out->position[o + c] = (float)res[0][c];
-            if (out->du) out->du[o + c] = (float)res[1][c];
-            if (out->dv) out->dv[o + c] = (float)res[2][c];
-            if (out->duu) out->duu[o + c] = (float)res[3][c];
-            if (out->duv) out->duv[o + c] = (float)res[4][c];
-            if (out->dvv) out->dvv[o + c] = (float)res[5][c];
-            if (out->normal) out->normal[o + c] = (float)nrm[c];
-        }
-    }
-    return SFB_SUCCESS;
+void sfb__kind_endcap_tri(const sfb__patch_table *pt, const float *pts, int patch, const int *cv, double s, double t, double res[6][3],
+                          double dir[2][3]) {
+    (void)pt; (void)patch;
+    sfb__eval_endcap_tri(pts, cv, s, t, res);
+    memcpy(dir[0], res[1], sizeof dir[0]);
+    memcpy(dir[1], res[2], sizeof dir[1]);
 }
-#line 1 "src/manifold.c"
+
+void sfb__kind_endcap_tri_normal(const float *pts, const int *cv, double s, double t, double nrm[3]) {
+    sfb__endcap_normal(pts, cv, 3, s, t, nrm);
+}
+#line 1 "src/patch/manifold.c"
 /* Manifold-based blending surfaces with darts, creases and corners (seed 000, after Ying and
  * Zorin): the MANIFOLD4 patch family of the patch table (scheme SFB_SCHEME_MANIFOLD_BLEND).
  *

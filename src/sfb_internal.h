@@ -103,7 +103,7 @@ sfb_result sfb__ref_eval_patches(void *state, const struct sfb__patch_table *pt,
 sfb_result sfb__ref_finish_normals(void *state, int first, int last, const float *tu, const float *tv, const float *ns,
                                    const int *ns_index, const float *b, float p, float *out_blend, float *out_limit, float *out_sub);
 
-/* ---- Stam eigen structures (stam.c) ---- */
+/* ---- Stam eigen structures (patch/eigen.c) ---- */
 #define SFB__STAM_MAX_VALENCE 256
 
 typedef struct sfb__eigen_cc {
@@ -131,7 +131,7 @@ typedef struct sfb__eigen_loop {
 } sfb__eigen_loop;
 
 
-/* ---- patch tables (patches.c) ---- */
+/* ---- patch tables (patch/table.c reads them, the scheme builders write them) ---- */
 /* Patch kinds of the patch table (patches.c, manifold.c). */
 enum { SFB__PATCH_BSPLINE = 0, SFB__PATCH_STAM = 1, SFB__PATCH_ENDCAP = 2, SFB__PATCH_BEZTRI = 3, SFB__PATCH_STAM_LOOP = 4,
        SFB__PATCH_ENDCAP_TRI = 5, SFB__PATCH_MANIFOLD4 = 6, SFB__PATCH_TYPE_COUNT = 7 };
@@ -405,7 +405,7 @@ void sfb__shading_free(sfb_context *ctx, sfb__shading *sh);
 sfb_result sfb__shading_build(sfb_context *ctx, const sfb__level *prep, const sfb__refine_options *opt, int level,
                               const sfb_shading_options *o, sfb__shading **out);
 
-/* patches.c */
+/* ---- patch tables (patch/) ---- */
 void sfb__patch_table_free(sfb_context *ctx, sfb__patch_table *pt);
 /* The families present in a table, as bits 1 << SFB__FAMILY_*. */
 static inline unsigned sfb__patch_families(const sfb__patch_table *pt) {
@@ -415,7 +415,7 @@ static inline unsigned sfb__patch_families(const sfb__patch_table *pt) {
         if (pt->counts[t] > 0) m |= 1u << sfb__patch_family(t);
     return m;
 }
-/* Manifold blending (manifold.c): a corner code packs the corner vertex's local geometry kind,
+/* Manifold blending (patch/manifold.c): a corner code packs the corner vertex's local geometry kind,
  * its valence k and the index h of the face in its star (the chart), and for a curve the axes
  * (1: a, 2: b, 0: not in this face) of its sharp edges e1 and e2. */
 enum { SFB__MF_PATCH = 0, SFB__MF_POINT = 1, SFB__MF_CURVE = 2 };
@@ -434,4 +434,98 @@ void sfb__mf_eval_patch(const sfb__patch_table *pt, const float *pts, int patch,
 sfb_result sfb__mf_pinv(sfb_context *ctx, int k, double **out);
 sfb_result sfb__patches_build(sfb_context *ctx, const sfb__level *base, const sfb__refine_options *opt, int limit,
                               const float *positions, sfb__patch_table *pt);
+/* Patch index (or -1: a hole) and local (s,t) of a valid location; *scale = 2^depth, negative
+ * after an odd number of middle triangle children (patch/table.c). */
 int sfb__patch_locate(const sfb__patch_table *pt, int ptex, double u, double v, double *s, double *t, double *scale);
+
+/* ---- reading records (patch/table.c) and the record kinds (patch/quad.c, patch/tri.c) ---- */
+/* A record type's ref evaluation: res = P, Ps, Pt, Pss, Pst, Ptt in the record's (s,t) (before
+ * the sub-patch scale), dir = two tangent directions whose cross product gives the normal's
+ * direction; `normal`, when not NULL, gives the normal direction instead (end caps). */
+typedef void (*sfb__patch_eval_fn)(const sfb__patch_table *pt, const float *pts, int patch, const int *cv, double s, double t,
+                                   double res[6][3], double dir[2][3]);
+typedef struct sfb__patch_kind {
+    sfb__patch_eval_fn eval;
+    void (*normal)(const float *pts, const int *cv, double s, double t, double nrm[3]);
+} sfb__patch_kind;
+/* The ref evaluator of a (non-MANIFOLD4) record type. */
+sfb__patch_kind sfb__patch_kind_of(int type);
+void sfb__kind_bspline16(const sfb__patch_table *pt, const float *pts, int patch, const int *cv, double s, double t, double res[6][3],
+                         double dir[2][3]);
+void sfb__kind_stam(const sfb__patch_table *pt, const float *pts, int patch, const int *cv, double s, double t, double res[6][3],
+                    double dir[2][3]);
+void sfb__kind_endcap(const sfb__patch_table *pt, const float *pts, int patch, const int *cv, double s, double t, double res[6][3],
+                      double dir[2][3]);
+void sfb__kind_endcap_normal(const float *pts, const int *cv, double s, double t, double nrm[3]);
+void sfb__kind_beztri(const sfb__patch_table *pt, const float *pts, int patch, const int *cv, double s, double t, double res[6][3],
+                      double dir[2][3]);
+void sfb__kind_stam_loop(const sfb__patch_table *pt, const float *pts, int patch, const int *cv, double s, double t, double res[6][3],
+                         double dir[2][3]);
+void sfb__kind_endcap_tri(const sfb__patch_table *pt, const float *pts, int patch, const int *cv, double s, double t, double res[6][3],
+                          double dir[2][3]);
+void sfb__kind_endcap_tri_normal(const float *pts, const int *cv, double s, double t, double nrm[3]);
+/* The record evaluations themselves (res as above; the Stam kinds' nres: the first derivatives
+ * divided by their scale, a finite tangent frame down to the extraordinary vertex). */
+void sfb__bspline_basis(double t, double *b, double *d, double *dd);   /* uniform cubic B-spline: value, d, d2 */
+void sfb__bez15_basis(double s, double t, double B[6][15]);           /* quartic Bernstein on a triangle */
+void sfb__eval_bspline16(const float *pts, const int *cv, double s, double t, double res[6][3]);
+void sfb__eval_endcap(const float *pts, const int *cv, double s, double t, double res[6][3]);
+void sfb__eval_stam(const sfb__eigen_cc *e, const float *pts, const int *cv, int corner, double s, double t, double res[6][3],
+                    double nres[2][3]);
+void sfb__eval_beztri(const float *pts, const int *cv, double s, double t, double res[6][3]);
+void sfb__eval_endcap_tri(const float *pts, const int *cv, double s, double t, double res[6][3]);
+void sfb__eval_stam_loop(const sfb__eigen_loop *e, const float *pts, const int *cv, int corner, double s, double t, double res[6][3],
+                         double nres[2][3]);
+/* Shared by the kinds (patch/table.c): c = a x b; an end cap's normal (nc = 3 or 4 corners); the
+ * end of both Stam kernels (the EV frame's derivatives mapped to (s,t) through J, scaled). */
+void sfb__cross3(const double *a, const double *b, double *c);
+void sfb__endcap_normal(const float *pts, const int *cv, int nc, double s, double t, double nrm[3]);
+void sfb__stam_finish(double J[2][2], double sc1, double sc2, double sr[6][3], double nr[2][3], double res[6][3], double nres[2][3]);
+
+/* ---- building records (patch/build.c), for the scheme builders ---- */
+/* Classes of a face's corner for the regular records. */
+enum { SFB__CORNER_R1 = 1, SFB__CORNER_R2_D1 = 2, SFB__CORNER_R2_D2 = 3, SFB__CORNER_R3 = 4, SFB__CORNER_EV = 5,
+       SFB__CORNER_IRREGULAR = 0 };
+/* The builder: the table under construction and the rows of its points over base vertices. */
+typedef struct sfb__pbuild {
+    sfb_context *ctx;
+    sfb__patch_table *pt;
+    int cap_patch, cap_cv, cap_nodes;
+    sfb__rows prow;          /* patch point rows over base vertices */
+    size_t cap_rows;
+    sfb__accum A;
+    sfb__mask m;
+    int *vrow;               /* point row of each vertex of the working level, -1 if none yet */
+} sfb__pbuild;
+/* A working level of feature-adaptive isolation: its topology, the composed rows of its
+ * vertices, and its candidate faces. */
+typedef struct sfb__wlevel {
+    sfb__level l;
+    sfb__rows rows;
+    int *fptex;          /* param face of a candidate face, -1 otherwise */
+    unsigned *fparam;    /* depth, i, j and rotation (in the corner bits) of candidates */
+    unsigned char *vcomp, *ecomp;
+    int owns_level;
+} sfb__wlevel;
+/* A grid cell's mask: up to 4 (vertex, weight) terms. */
+typedef struct sfb__cell { int n, real; int v[4]; double w[4]; } sfb__cell;
+int sfb__is_inf(float s);                                          /* s is SFB_SHARPNESS_INFINITE */
+int sfb__face_n(const sfb__level *l, int f);                       /* corners of face f */
+int sfb__fan_pos(const sfb__level *l, int v, int g, int slot);     /* g's position around v, or -1 */
+int sfb__face_semisharp(const sfb__level *l, int g);               /* something at g's corners still decays */
+/* A point row = mask m over working-level vertices composed with their rows (a single vertex
+ * with weight 1 is shared); -1 on allocation failure. */
+int sfb__pb_point(sfb__pbuild *b, const sfb__rows *wrows, const sfb__mask *m);
+/* A new record of `type` with ncv points; its index, or -1 on allocation failure. */
+int sfb__pb_patch(sfb__pbuild *b, int type, unsigned param, int valence, int ncv);
+/* Inserts record `patch` (-1: a hole) at (ptex, depth, i, j of param) in the tree; 0 on failure. */
+int sfb__pb_insert(sfb__pbuild *b, int ptex, unsigned param, int patch);
+void sfb__wlevel_free(sfb_context *ctx, sfb__wlevel *w);
+/* The end cap of face g (n = 3 or 4 corners, frame corner 0 at slot rot). */
+sfb_result sfb__pb_endcap(sfb__pbuild *b, sfb__wlevel *w, int g, int rot, int n, unsigned param);
+/* A Stam-kind record of K eigen-coefficient points over the vertices C (freed). */
+sfb_result sfb__pb_eigen_patch(sfb__pbuild *b, sfb__wlevel *w, int type, int ptex, unsigned param, int N, int K, const double *vinv,
+                               int *C);
+/* Classifies candidate g of the working level: adds its record, or sets *refine. */
+sfb_result sfb__pb_face_quad(sfb__pbuild *b, sfb__wlevel *w, int g, int level, int limit, int *refine);
+sfb_result sfb__pb_face_tri(sfb__pbuild *b, sfb__wlevel *w, int g, int level, int limit, int *refine);

@@ -1,0 +1,184 @@
+/* Reading a patch table (any scheme's): freeing it, the one locate (parametric face and (u,v)
+ * to record and local (s,t) through the quadtree or triangle tree), the record kinds' registry
+ * (sfb__patch_kind_of: which ref evaluator a record type has), and the ref kernel
+ * (sfb__ref_eval_patches) that dispatches to them. Nothing here knows the scheme: the table's
+ * domain says how to locate, a record's type says how to evaluate. */
+
+void sfb__patch_table_free(sfb_context *ctx, sfb__patch_table *pt) {
+    sfb__free(ctx, pt->ptype); sfb__free(ctx, pt->pfirst); sfb__free(ctx, pt->pparam); sfb__free(ctx, pt->pvalence);
+    sfb__free(ctx, pt->cv); sfb__free(ctx, pt->ptex_face); sfb__free(ctx, pt->ptex_corner); sfb__free(ctx, pt->face_ptex);
+    sfb__free(ctx, pt->ptex_root); sfb__free(ctx, pt->nodes); sfb__free(ctx, pt->point_data); sfb__free(ctx, pt->pcorner);
+    memset(pt, 0, sizeof *pt);
+}
+
+/* Triangle param faces (Loop). A triangle's (u,v) is barycentric: the point is
+ * (1-u-v) P0 + u P1 + v P2 for its corners in face order. One Loop step splits it into four
+ * children, numbered like quadrants of a quadtree node (x + 2y bits of the param code):
+ * 0 the corner at P0, (2u, 2v); 1 the corner at P1, (2u-1, 2v); 2 the corner at P2,
+ * (2u, 2v-1); 3 the middle, turned by 180 degrees: (1-2u, 1-2v), so its derivatives change
+ * sign. The corner bits of the code give the face slot of the child's param corner 0. */
+
+/* Patch index (or -1: hole) and local (s,t) of a valid location; *scale = 2^depth. */
+int sfb__patch_locate(const sfb__patch_table *pt, int ptex, double u, double v, double *s, double *t, double *scale) {
+    int node = pt->ptex_root[ptex];
+    double sc = 1.0;
+    if (pt->domain == SFB__DOMAIN_TRI) {
+        /* triangles: *scale is negative after an odd number of middle children */
+        while (node >= 0) {
+            int c;
+            sc *= 2.0;
+            if (u >= 0.5) { c = 1; u = 2.0 * u - 1.0; v = 2.0 * v; }
+            else if (v >= 0.5) { c = 2; u = 2.0 * u; v = 2.0 * v - 1.0; }
+            else if (u + v < 0.5) { c = 0; u = 2.0 * u; v = 2.0 * v; }
+            else { c = 3; u = 1.0 - 2.0 * u; v = 1.0 - 2.0 * v; sc = -sc; }
+            node = pt->nodes[4 * node + c];
+        }
+        *s = u; *t = v; *scale = sc;
+        return node <= -2 ? -node - 2 : -1;
+    }
+    while (node >= 0) {
+        int qx, qy;
+        u *= 2.0; v *= 2.0; sc *= 2.0;
+        qx = u >= 1.0; qy = v >= 1.0;
+        if (qx) u -= 1.0;
+        if (qy) v -= 1.0;
+        node = pt->nodes[4 * node + qx + 2 * qy];
+    }
+    *s = u; *t = v; *scale = sc;
+    return node <= -2 ? -node - 2 : -1;
+}
+
+void sfb__cross3(const double *a, const double *b, double *c) {
+    c[0] = a[1] * b[2] - a[2] * b[1];
+    c[1] = a[2] * b[0] - a[0] * b[2];
+    c[2] = a[0] * b[1] - a[1] * b[0];
+}
+
+/* End-cap normal: the bilinear blend of the corners' limit normals (from the limit tangents),
+ * so that the normal at a corner is the limit normal there. A corner whose limit normal is
+ * more than 45 degrees from the cap's own (chord) normal at that corner belongs to another
+ * sector (a corner or non-manifold vertex): that corner uses the chord normal instead. */
+void sfb__endcap_normal(const float *pts, const int *cv, int nc, double s, double t, double nrm[3]) {
+    double wts[4], n[3] = {0, 0, 0};
+    int k, c;
+    if (nc == 3) { wts[0] = 1 - s - t; wts[1] = s; wts[2] = t; }
+    else { wts[0] = (1 - s) * (1 - t); wts[1] = s * (1 - t); wts[2] = s * t; wts[3] = (1 - s) * t; }
+    for (k = 0; k < nc; ++k) {
+        const float *p = pts + 3 * (size_t)cv[k], *pn = pts + 3 * (size_t)cv[(k + 1) % nc], *pp = pts + 3 * (size_t)cv[(k + nc - 1) % nc];
+        const float *t1 = pts + 3 * (size_t)cv[nc + 2 * k], *t2 = pts + 3 * (size_t)cv[nc + 1 + 2 * k];
+        double a[3], bb[3], ch[3], ln[3], lc, ll;
+        for (c = 0; c < 3; ++c) { a[c] = (double)pn[c] - p[c]; bb[c] = (double)pp[c] - p[c]; }
+        sfb__cross3(a, bb, ch);
+        for (c = 0; c < 3; ++c) { a[c] = t1[c]; bb[c] = t2[c]; }
+        sfb__cross3(a, bb, ln);
+        lc = sqrt(ch[0] * ch[0] + ch[1] * ch[1] + ch[2] * ch[2]);
+        ll = sqrt(ln[0] * ln[0] + ln[1] * ln[1] + ln[2] * ln[2]);
+        if (lc > 0.0) for (c = 0; c < 3; ++c) ch[c] /= lc;
+        if (ll > 0.0) for (c = 0; c < 3; ++c) ln[c] /= ll;
+        {
+            /* the tangent masks' orientation is the vertex's, not necessarily this face's */
+            double d = ln[0] * ch[0] + ln[1] * ch[1] + ln[2] * ch[2];
+            if (d < 0.0) { ln[0] = -ln[0]; ln[1] = -ln[1]; ln[2] = -ln[2]; d = -d; }
+            if (!(ll > 0.0) || d < 0.70710678118654752) memcpy(ln, ch, sizeof ln);
+        }
+        for (c = 0; c < 3; ++c) n[c] += wts[k] * ln[c];
+    }
+    memcpy(nrm, n, sizeof n);
+}
+
+/* The end of both Stam kernels: nr holds the normalised first derivatives and sr the position
+ * (row 0) and the second derivatives (rows 3..5) in the EV frame's (u,v); J = d(u,v)/d(s,t).
+ * Writes res (P, Ps, Pt, Pss, Pst, Ptt; first derivatives times sc1, second times sc2) and nres
+ * (the normalised first derivatives in (s,t)). */
+void sfb__stam_finish(double J[2][2], double sc1, double sc2, double sr[6][3], double nr[2][3], double res[6][3],
+                             double nres[2][3]) {
+    int c;
+    for (c = 0; c < 3; ++c) {
+        double Pu = nr[0][c], Pv = nr[1][c], Puu = sr[3][c], Puv = sr[4][c], Pvv = sr[5][c];
+        res[0][c] = sr[0][c];
+        nres[0][c] = Pu * J[0][0] + Pv * J[1][0];
+        nres[1][c] = Pu * J[0][1] + Pv * J[1][1];
+        res[1][c] = nres[0][c] * sc1;
+        res[2][c] = nres[1][c] * sc1;
+        res[3][c] = sc2 * (Puu * J[0][0] * J[0][0] + 2.0 * Puv * J[0][0] * J[1][0] + Pvv * J[1][0] * J[1][0]);
+        res[4][c] = sc2 * (Puu * J[0][0] * J[0][1] + Puv * (J[0][0] * J[1][1] + J[0][1] * J[1][0]) + Pvv * J[1][0] * J[1][1]);
+        res[5][c] = sc2 * (Puu * J[0][1] * J[0][1] + 2.0 * Puv * J[0][1] * J[1][1] + Pvv * J[1][1] * J[1][1]);
+    }
+}
+
+/* The ref evaluator of a record type: one line per kind. MANIFOLD4 records are evaluated by
+ * patch/manifold.c's sfb__mf_eval_patch (their normal is final), see sfb__ref_eval_one. */
+sfb__patch_kind sfb__patch_kind_of(int type) {
+    sfb__patch_kind k;
+    k.normal = NULL;
+    switch (type) {
+    case SFB__PATCH_STAM: k.eval = sfb__kind_stam; break;
+    case SFB__PATCH_ENDCAP: k.eval = sfb__kind_endcap; k.normal = sfb__kind_endcap_normal; break;
+    case SFB__PATCH_BEZTRI: k.eval = sfb__kind_beztri; break;
+    case SFB__PATCH_STAM_LOOP: k.eval = sfb__kind_stam_loop; break;
+    case SFB__PATCH_ENDCAP_TRI: k.eval = sfb__kind_endcap_tri; k.normal = sfb__kind_endcap_tri_normal; break;
+    default: k.eval = sfb__kind_bspline16; break;
+    }
+    return k;
+}
+
+/* The ref kernel: one location, double precision throughout. want2: the second derivatives are
+ * asked for (a manifold blend only forms them then: they cost it four more blends). */
+static void sfb__ref_eval_one(const sfb__patch_table *pt, const float *pts, const sfb_location *loc, int want2, double res[6][3],
+                              double nrm[3]) {
+    double s, t, sc, dir[2][3], len;
+    int patch = sfb__patch_locate(pt, loc->face, loc->u, loc->v, &s, &t, &sc), c;
+    const int *cv;
+    sfb__patch_kind kind;
+    memset(res, 0, sizeof(double) * 18);
+    nrm[0] = nrm[1] = nrm[2] = 0.0;
+    if (patch < 0) return;
+    cv = pt->cv + pt->pfirst[patch];
+    if (sfb__patch_family(pt->ptype[patch]) == SFB__FAMILY_MANIFOLD) {
+        sfb__mf_eval_patch(pt, pts, patch, s, t, want2, res, nrm); /* its normal is final (patch/manifold.c) */
+    } else {
+        kind = sfb__patch_kind_of(pt->ptype[patch]);
+        kind.eval(pt, pts, patch, cv, s, t, res, dir);
+        if (kind.normal) kind.normal(pts, cv, s, t, nrm);
+        else sfb__cross3(dir[0], dir[1], nrm);
+        len = sqrt(nrm[0] * nrm[0] + nrm[1] * nrm[1] + nrm[2] * nrm[2]);
+        if (!(len > 0.0) || !isfinite(len)) {
+            /* degenerate tangents (a collapsed control net): the normal a step inside the patch */
+            double r2[6][3];
+            int tri = pt->domain == SFB__DOMAIN_TRI;
+            double s2 = s + (s < 0.5 ? 1e-3 : -1e-3), t2 = t + (t < 0.5 ? 1e-3 : -1e-3);
+            if (tri && s2 + t2 > 1.0) { s2 = s - 1e-3; t2 = t - 1e-3; }
+            if (tri && s + t < 2e-3) { s2 = s + 1e-3; t2 = t + 1e-3; }
+            kind.eval(pt, pts, patch, cv, s2, t2, r2, dir);
+            sfb__cross3(dir[0], dir[1], nrm);
+            len = sqrt(nrm[0] * nrm[0] + nrm[1] * nrm[1] + nrm[2] * nrm[2]);
+        }
+        if (len > 0.0 && isfinite(len)) for (c = 0; c < 3; ++c) nrm[c] /= len;
+        else nrm[0] = nrm[1] = nrm[2] = 0.0;
+    }
+    for (c = 0; c < 3; ++c) {
+        res[1][c] *= sc; res[2][c] *= sc;
+        res[3][c] *= sc * sc; res[4][c] *= sc * sc; res[5][c] *= sc * sc;
+    }
+}
+
+sfb_result sfb__ref_eval_patches(void *state, const sfb__patch_table *pt, void *handle, const sfb_location *locs, int first,
+                                        int last, const sfb_eval_output *out) {
+    int q, c;
+    (void)state; (void)handle;
+    for (q = first; q < last; ++q) {
+        double res[6][3], nrm[3];
+        size_t o = 3 * (size_t)q;
+        sfb__ref_eval_one(pt, pt->point_data, &locs[q], out->duu || out->duv || out->dvv, res, nrm);
+        for (c = 0; c < 3; ++c) {
+            if (out->position) out->position[o + c] = (float)res[0][c];
+            if (out->du) out->du[o + c] = (float)res[1][c];
+            if (out->dv) out->dv[o + c] = (float)res[2][c];
+            if (out->duu) out->duu[o + c] = (float)res[3][c];
+            if (out->duv) out->duv[o + c] = (float)res[4][c];
+            if (out->dvv) out->dvv[o + c] = (float)res[5][c];
+            if (out->normal) out->normal[o + c] = (float)nrm[c];
+        }
+    }
+    return SFB_SUCCESS;
+}
