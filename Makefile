@@ -79,9 +79,14 @@ $(BUILD)/libsfb.o: tools/impl.c surfblend.h $(BACKEND_HDRS)
 	@mkdir -p $(BUILD)
 	$(CC) $(CFLAGS) $(SAN) -I. -c -x c tools/impl.c -o $@
 
+# What the command-line tools share (tools/cli_common.h: C99 and C++14).
+$(BUILD)/cli_common.o: tools/cli_common.c tools/cli_common.h surfblend.h
+	@mkdir -p $(BUILD)
+	$(CC) $(CFLAGS) $(SAN) -I. -c tools/cli_common.c -o $@
+
 # (order-only: the CLI needs stb_image_write from PKGS_CLI; deps installs it, or names it)
-$(BUILD)/surfblend: tools/surfblend.c $(BUILD)/libsfb.o | deps
-	$(CC) $(CFLAGS) $(SAN) -I. tools/surfblend.c $(BUILD)/libsfb.o -o $@ $(LIBS)
+$(BUILD)/surfblend: tools/surfblend.c tools/cli_common.h $(BUILD)/cli_common.o $(BUILD)/libsfb.o | deps
+	$(CC) $(CFLAGS) $(SAN) -I. tools/surfblend.c $(BUILD)/cli_common.o $(BUILD)/libsfb.o -o $@ $(LIBS)
 
 $(BUILD)/examples/%: examples/%.c $(BUILD)/libsfb.o
 	@mkdir -p $(BUILD)/examples
