@@ -105,7 +105,7 @@ run: deps $(BUILD)/surfblend
 	  examples/data/creased_box.obj -o out/creased_box_before.png
 	./$(BUILD)/surfblend render --highlight --normals blended --view -116.6,33.8 --zoom 1.3 --stripes 6 --size 800x600 \
 	  examples/data/creased_box.obj -o out/creased_box_after.png
-	./$(BUILD)/surfblend render --weights --view -116.6,33.8 --size 800x600 examples/data/creased_box.obj -o out/creased_box_weights.png
+	./$(BUILD)/surfblend render --blend-weights --view -116.6,33.8 --size 800x600 examples/data/creased_box.obj -o out/creased_box_weights.png
 	@echo "wrote out/creased_box_shaded.obj out/creased_box_before.png out/creased_box_after.png out/creased_box_weights.png"
 	@# the same pair for OpenSubdiv's catmark_pole8 (one vertex of valence 8), seen from above
 	@if [ -d "$(SHAPES)" ]; then \
