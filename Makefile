@@ -85,9 +85,14 @@ $(BUILD)/libsfb.o: tools/impl.c surfblend.h $(BACKEND_HDRS)
 	@mkdir -p $(BUILD)
 	$(CC) $(CFLAGS) $(SAN) -I. -c -x c tools/impl.c -o $@
 
+# What the command-line tools share (tools/cli_common.h: C99 and C++14).
+$(BUILD)/cli_common.o: tools/cli_common.c tools/cli_common.h surfblend.h
+	@mkdir -p $(BUILD)
+	$(CC) $(CFLAGS) $(SAN) -I. -c tools/cli_common.c -o $@
+
 # (order-only: the CLI needs stb_image_write from PKGS_CLI; deps installs it, or names it)
-$(BUILD)/surfblend: tools/surfblend.c $(BUILD)/libsfb.o | deps
-	$(CC) $(CFLAGS) $(SAN) -I. tools/surfblend.c $(BUILD)/libsfb.o -o $@ $(LIBS)
+$(BUILD)/surfblend: tools/surfblend.c tools/cli_common.h $(BUILD)/cli_common.o $(BUILD)/libsfb.o | deps
+	$(CC) $(CFLAGS) $(SAN) -I. tools/surfblend.c $(BUILD)/cli_common.o $(BUILD)/libsfb.o -o $@ $(LIBS)
 
 $(BUILD)/examples/%: examples/%.c $(BUILD)/libsfb.o
 	@mkdir -p $(BUILD)/examples
@@ -106,7 +111,7 @@ run: deps $(BUILD)/surfblend
 	  examples/data/creased_box.obj -o out/creased_box_before.png
 	./$(BUILD)/surfblend render --highlight --normals blended --view -116.6,33.8 --zoom 1.3 --stripes 6 --size 800x600 \
 	  examples/data/creased_box.obj -o out/creased_box_after.png
-	./$(BUILD)/surfblend render --weights --view -116.6,33.8 --size 800x600 examples/data/creased_box.obj -o out/creased_box_weights.png
+	./$(BUILD)/surfblend render --blend-weights --view -116.6,33.8 --size 800x600 examples/data/creased_box.obj -o out/creased_box_weights.png
 	@echo "wrote out/creased_box_shaded.obj out/creased_box_before.png out/creased_box_after.png out/creased_box_weights.png"
 	@# the same pair for OpenSubdiv's catmark_pole8 (one vertex of valence 8), seen from above
 	@if [ -d "$(SHAPES)" ]; then \

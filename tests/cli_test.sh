@@ -24,6 +24,43 @@ contains "--help shows refine" "$TMP/out" "refine"
 contains "--help shows tess" "$TMP/out" "surfblend tess"
 contains "--help shows eval" "$TMP/out" "surfblend eval"
 check "unknown command is a usage error" 2 "$CLI" frobnicate
+# usage: printed from the option table, on stdout with exit 0 when asked for
+for h in -h help; do
+  check "$h succeeds" 0 "$CLI" $h
+  if [ -s "$TMP/out" ] && [ ! -s "$TMP/err" ]; then P=$((P + 1)); echo "ok $h prints on stdout only"; else F=$((F + 1)); echo "FAIL $h output: stdout/stderr"; fi
+  contains "$h shows render" "$TMP/out" "surfblend render"
+done
+contains "--help names the option spelling" "$TMP/out" "--manifold-weights"
+# each command's options (some of them) as its --help must show them
+cmd_opts() { case $1 in
+  info) echo "-h, --help" ;; backends) echo "-h, --help" ;;
+  refine) echo "--scheme --level --limit --backend -o, --output" ;;
+  eval) echo "--manifold-weights, --weights --locations --random --seed --derivatives --backend" ;;
+  tess) echo "--manifold-weights, --weights --rate --tolerance --split-creases --trim --trim-tiles" ;;
+  shade) echo "--variant --darts --normals-level --weights-level --p --averaging --all-subdivided --limit" ;;
+  render) echo "--normals --highlight --blend-weights, --weights --normal-colors --positions --size --view --zoom --stripes --edges --rate --manifold-weights --trim" ;;
+  esac; }
+for c in info refine eval tess shade render backends; do
+  check "$c --help succeeds" 0 "$CLI" $c --help
+  if [ -s "$TMP/out" ] && [ ! -s "$TMP/err" ]; then P=$((P + 1)); echo "ok $c --help prints on stdout only"; else F=$((F + 1)); echo "FAIL $c --help: empty stdout or output on stderr"; fi
+  contains "$c --help shows the command" "$TMP/out" "^  surfblend $c"
+  if [ "$(grep -c '^  surfblend ' "$TMP/out")" = 1 ]; then P=$((P + 1)); echo "ok $c --help shows that command only"; else F=$((F + 1)); echo "FAIL $c --help shows other commands"; fi
+  missing=""
+  IFS=' ' read -r -a want <<< "$(cmd_opts $c | sed 's/, /,_/g')"
+  for o in "${want[@]}"; do grep -q -- "^      ${o//,_/, }\( \|$\)" "$TMP/out" || missing="$missing ${o//,_/, }"; done
+  if [ -z "$missing" ]; then P=$((P + 1)); echo "ok $c --help lists its options"; else F=$((F + 1)); echo "FAIL $c --help lacks:$missing"; fi
+  cp "$TMP/out" "$TMP/help_$c"
+  check "$c -h succeeds" 0 "$CLI" $c -h
+  check "help $c succeeds" 0 "$CLI" help $c
+  if cmp -s "$TMP/out" "$TMP/help_$c"; then P=$((P + 1)); echo "ok help $c is $c --help"; else F=$((F + 1)); echo "FAIL help $c differs from $c --help"; fi
+  check "$c with an unknown option is a usage error" 2 "$CLI" $c --frobnicate examples/data/creased_box.obj -o "$TMP/x.out"
+  contains "$c names the unknown option" "$TMP/err" "unknown option '--frobnicate'"
+done
+check "help of an unknown command is a usage error" 2 "$CLI" help frobnicate
+check "tess --help after other options succeeds" 0 "$CLI" tess --rate 3 --help
+contains "tess --help shows tess" "$TMP/out" "surfblend tess"
+check "refine --weights (an option of other commands) is a usage error" 2 "$CLI" refine --weights cinf examples/data/creased_box.obj -o "$TMP/x.obj"
+check "shade --blend-weights (render's) is a usage error" 2 "$CLI" shade --blend-weights examples/data/creased_box.obj -o "$TMP/x.obj"
 check "refine without -o is a usage error" 2 "$CLI" refine examples/data/creased_box.obj
 check "bad --level is a usage error" 2 "$CLI" refine --level x examples/data/creased_box.obj -o "$TMP/o.obj"
 check "missing file is bad input" 1 "$CLI" info "$TMP/does-not-exist.obj"
@@ -350,6 +387,23 @@ check "render --rate without --scheme manifold is a usage error" 2 "$CLI" render
 check "render --scheme manifold --weights (picture) is a usage error" 2 "$CLI" render --scheme manifold --weights examples/data/torus.obj -o "$TMP/x.png"
 check "render --manifold-weights cinf succeeds" 0 "$CLI" render --scheme manifold --manifold-weights cinf --rate 4 --size 160x120 examples/data/torus.obj -o "$TMP/x.png"
 contains "render --manifold-weights cinf says so" "$TMP/err" "C-infinity weights"
+# one spelling: --manifold-weights everywhere; the old --weights is an alias (eval, tess: the
+# manifold weights; render: the blend-weights picture, there --blend-weights)
+check "tess --manifold-weights cinf succeeds" 0 "$CLI" tess --scheme manifold --manifold-weights cinf --rate 4 examples/data/manifold_features.obj -o "$TMP/mfm.obj"
+if cmp -s "$TMP/mfc.obj" "$TMP/mfm.obj"; then P=$((P + 1)); echo "ok tess --weights cinf is --manifold-weights cinf"; else F=$((F + 1)); echo "FAIL tess --weights and --manifold-weights differ"; fi
+"$CLI" eval --scheme manifold --weights cinf --random 7 examples/data/manifold_features.obj > "$TMP/ew1" 2>/dev/null
+check "eval --manifold-weights cinf succeeds" 0 "$CLI" eval --scheme manifold --manifold-weights cinf --random 7 -o "$TMP/ew2" examples/data/manifold_features.obj
+if [ -s "$TMP/ew1" ] && cmp -s "$TMP/ew1" "$TMP/ew2"; then P=$((P + 1)); echo "ok eval --weights cinf is --manifold-weights cinf"; else F=$((F + 1)); echo "FAIL eval --weights and --manifold-weights differ"; fi
+"$CLI" eval --scheme manifold --random 7 examples/data/manifold_features.obj > "$TMP/ew3" 2>/dev/null
+if ! cmp -s "$TMP/ew1" "$TMP/ew3"; then P=$((P + 1)); echo "ok eval --manifold-weights cinf changes the surface"; else F=$((F + 1)); echo "FAIL eval --manifold-weights cinf changes nothing"; fi
+check "eval --manifold-weights bogus is a usage error" 2 "$CLI" eval --manifold-weights bogus --random 2 examples/data/manifold_features.obj
+contains "--manifold-weights bogus message" "$TMP/err" "--manifold-weights needs hermite or cinf"
+check "render --blend-weights succeeds" 0 "$CLI" render --level 2 --blend-weights --size 120x90 examples/data/creased_box.obj -o "$TMP/rbw.png"
+if cmp -s "$TMP/rbw.png" "$TMP/r--weights.png"; then P=$((P + 1)); echo "ok render --weights is --blend-weights"; else F=$((F + 1)); echo "FAIL render --weights and --blend-weights differ"; fi
+contains "render --blend-weights draws blend weights" "$TMP/err" "render blend weights"
+check "render --scheme manifold --blend-weights is a usage error" 2 "$CLI" render --scheme manifold --blend-weights examples/data/torus.obj -o "$TMP/x.png"
+contains "the manifold --blend-weights message names --manifold-weights" "$TMP/err" "--manifold-weights"
+check "render --highlight --blend-weights is a usage error" 2 "$CLI" render --highlight --blend-weights examples/data/creased_box.obj -o "$TMP/x.png"
 if [ -f "$TMP/left.png" ]; then
   check "render --scheme manifold --trim succeeds" 0 "$CLI" render --scheme manifold --rate 4 --trim "$TMP/left.png" --size 160x120 examples/data/torus.obj -o "$TMP/mft.png"
   contains "render --trim says it trimmed" "$TMP/err" "trimmed"
@@ -360,6 +414,40 @@ if [ -f "$TMP/left.png" ]; then
   if [ -n "$a" ] && [ -n "$b" ] && [ "$b" -lt "$a" ]; then P=$((P + 1)); echo "ok a trimmed picture covers fewer pixels ($b < $a)"
   else F=$((F + 1)); echo "FAIL trimmed picture pixels: '$b' vs untrimmed '$a'"; fi
 fi
+
+# ---- output files are written atomically: a failed command leaves no partial file, and an
+# existing file at the output path untouched ----
+printf 'keep\n' > "$TMP/keep.obj"
+check "refine --level 11 over an existing file is bad input" 1 "$CLI" refine --level 11 examples/data/creased_box.obj -o "$TMP/keep.obj"
+if [ "$(cat "$TMP/keep.obj")" = keep ]; then P=$((P + 1)); echo "ok a failed refine leaves the existing file"; else F=$((F + 1)); echo "FAIL a failed refine changed the existing file"; fi
+# a failure while writing: a file size limit (SIGXFSZ ignored, so the write fails with EFBIG)
+limited() { bash -c 'trap "" XFSZ; ulimit -f 16 && exec "$@"' limited "$@"; }
+if limited true 2>/dev/null; then
+  for c in "tess --rate 32 examples/data/creased_box.obj" "refine --level 5 examples/data/creased_box.obj" \
+           "shade --level 4 examples/data/creased_box.obj" "render --size 1200x900 --normal-colors examples/data/creased_box.obj" \
+           "eval --random 2000 examples/data/creased_box.obj"; do
+    name=${c%% *}
+    rm -f "$TMP/big.out"*
+    check "$name failing while writing is bad input" 1 limited "$CLI" $c -o "$TMP/big.out"
+    contains "$name says the write failed" "$TMP/err" "writing '$TMP/big.out' failed"
+    left=$(ls "$TMP" | grep -c '^big\.out')
+    if [ "$left" = 0 ]; then P=$((P + 1)); echo "ok $name failing while writing leaves no file"; else F=$((F + 1)); echo "FAIL $name left $(ls "$TMP" | grep '^big\.out')"; fi
+    printf 'keep\n' > "$TMP/keep.out"
+    limited "$CLI" $c -o "$TMP/keep.out" > /dev/null 2>&1
+    if [ "$(cat "$TMP/keep.out")" = keep ] && [ "$(ls "$TMP" | grep -c '^keep\.out')" = 1 ]; then P=$((P + 1)); echo "ok $name failing while writing leaves the existing file"
+    else F=$((F + 1)); echo "FAIL $name failing while writing changed the existing file"; fi
+  done
+else
+  S=$((S + 1)); echo "SKIP a file size limit (ulimit -f) is not available"
+fi
+check "refine -o /dev/null (not a regular file) succeeds" 0 "$CLI" refine --level 1 examples/data/creased_box.obj -o /dev/null
+if [ -c /dev/null ]; then P=$((P + 1)); echo "ok /dev/null is still a device"; else F=$((F + 1)); echo "FAIL -o /dev/null replaced /dev/null"; fi
+check "refine -o - writes standard output" 0 "$CLI" refine --level 1 examples/data/creased_box.obj -o -
+contains "refine -o - wrote the OBJ" "$TMP/out" "^v "
+if [ "$(ls "$TMP" | grep -c '\.tmp')" = 0 ]; then P=$((P + 1)); echo "ok no temporary files are left"; else F=$((F + 1)); echo "FAIL temporary files left: $(ls "$TMP" | grep '\.tmp')"; fi
+touch "$TMP/perm.ref"; "$CLI" refine --level 1 examples/data/creased_box.obj -o "$TMP/perm.obj" 2>/dev/null
+if [ "$(stat -c %a "$TMP/perm.obj")" = "$(stat -c %a "$TMP/perm.ref")" ]; then P=$((P + 1)); echo "ok an output file gets the usual permissions"
+else F=$((F + 1)); echo "FAIL output permissions $(stat -c %a "$TMP/perm.obj"), a new file gets $(stat -c %a "$TMP/perm.ref")"; fi
 
 # vertex counts against OpenSubdiv (osd_agree --counts prints "name count" per shape)
 if [ -d "$SHAPES" ] && [ -x "$BUILD/osd_agree" ]; then

@@ -1,18 +1,10 @@
-/* surfblend command-line tool.
- *   surfblend info in.obj
- *   surfblend refine [--scheme catmark|loop|bilinear] [--level L] [--limit] [--backend NAME] in.obj -o out.obj
- *   surfblend eval [--scheme catmark|loop|manifold] [--weights hermite|cinf] [--backend NAME] (--random N [--seed S] | --locations FILE)
- *                  [--derivatives] [-o OUT] in.obj
- *   surfblend tess [--scheme catmark|loop|manifold] [--weights hermite|cinf] [--backend NAME] --rate N [--tolerance T] [--split-creases]
- *                  [--trim mask.png [--trim-tiles U V]] in.obj -o out.obj
- *   surfblend shade [shading options] [--limit] [--backend NAME] in.obj -o out.obj
- *   surfblend render [shading options] [--normals limit|subdivided|blended] [--highlight|--weights|--normal-colors]
- *                    [--size WxH] [--view YAW,PITCH] [--zoom Z] [--stripes N] [--edges] [--positions refined|limit] in.obj -o out.png
- *   surfblend render --scheme manifold [--manifold-weights hermite|cinf] [--rate N] [--trim mask.png [--trim-tiles U V]] [picture options]
- *                    in.obj -o out.png
- *   surfblend backends
+/* surfblend command-line tool: `surfblend --help` lists the commands, `surfblend CMD --help` one
+ * command's options. Every option is one row of the table `options` below (its name, value,
+ * commands, help text and where it is stored); one parser (parse_args) reads every command's
+ * arguments from it and the usage text is printed from it.
  * Exit codes: 0 success, 1 bad input (message on stderr), 2 usage error. */
 #include "surfblend.h"
+#include "tools/cli_common.h"
 /* PNG output and trimming-mask input (Debian libstb-dev); the library itself only takes and
  * returns raw pixel buffers */
 #define STB_IMAGE_WRITE_IMPLEMENTATION
@@ -22,333 +14,438 @@
 #define STBI_ONLY_PNG
 #include <stb/stb_image.h>
 #include <math.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
-/* In pieces: ISO C99 compilers need support string literals of 4095 characters only. */
-static const char *const usage_text[] = {
-    "usage:\n"
-    "  surfblend info IN.obj                      counts, valences, creases, extraordinary vertices, problems\n"
-    "  surfblend refine [options] IN.obj -o OUT.obj\n"
-    "      --scheme catmark|loop|bilinear   subdivision scheme (default: from the file name prefix, else catmark)\n"
-    "      --level L                        uniform refinement level 0..10 (default 2)\n"
-    "      --limit                          write limit positions (and limit normals as vn) instead of refined points\n"
-    "      --backend NAME                   ref|simd|gl|osmesa, tried first (else SURFBLEND_BACKEND, else the default order)\n"
-    "  surfblend eval [options] IN.obj            the limit surface at parametric locations\n"
-    "      --scheme catmark|loop|manifold   as for refine, or the manifold blending surface (seed 000)\n"
-    "      --weights hermite|cinf           manifold blend weights: Hermite (default) or C-infinity\n"
-    "      --locations FILE                 lines 'face u v' (parametric face; u, v in [0,1], and u + v <= 1 on Loop's\n"
-    "                                       triangles; '#' starts a comment)\n"
-    "      --random N [--seed S]            N random locations on faces that are not holes (deterministic for a seed)\n"
-    "      --derivatives                    also print du and dv\n"
-    "      -o OUT                           write to OUT instead of stdout\n"
-    "      --backend NAME                   as for refine\n"
-    "    prints one line per location: face u v px py pz nx ny nz [dux duy duz dvx dvy dvz]\n"
-    "  surfblend tess [options] IN.obj -o OUT.obj   watertight triangles of the limit surface (v, vn, f v//vn)\n"
-    "      --scheme catmark|loop|manifold   as for eval\n"
-    "      --weights hermite|cinf           as for eval\n"
-    "      --rate N                         segments per parametric-face edge, 1..1024 (required)\n"
-    "      --tolerance T                    adaptive: per face the smallest rate <= N within chordal error T\n"
-    "      --split-creases                  separate vertices (and normals) on each side of infinitely sharp creases\n"
-    "      --trim MASK.png                  trim with a mask over each parametric face's (u,v) square (seed 000 V.5):\n"
-    "                                       grey level >= 50% kept, darker trimmed; the picture's top row is v = 1\n"
-    "      --trim-tiles U V                 the mask is an atlas of U x V tiles, tile t (row-major from v = 0) for\n"
-    "                                       parametric face t; later faces untrimmed (default: one mask for all)\n"
-    "      --backend NAME                   as for refine\n"
-    ,
-    "  surfblend shade [options] IN.obj -o OUT.obj   subdivision shading (seed 001): v, blended normals as vn, f v//vn\n"
-    "      --scheme catmark|loop            as for refine\n"
-    "      --level L                        uniform refinement level 0..10 (default 3)\n"
-    "      --variant A|B                    sharp vertices: B (default) blend weight 0, A treated as smooth ones\n"
-    "      --darts smooth|sharp             darts count as smooth (default) or sharp vertices for the weights\n"
-    "      --normals-level L                level where the subdivided normals N_S start (0: control mesh; default 1)\n"
-    "      --weights-level L                level where the blend weights are seeded (0: control mesh; default 1)\n"
-    "      --p P                            blend exponent, > 0 (default 1): N_B = (1 - b^P) N_L + b^P N_S\n"
-    "      --averaging linear|renormalized|spherical   how N_S is averaged from one level to the next (default linear)\n"
-    "      --all-subdivided                 compute N_S at every vertex, not only where b > 0\n"
-    "      --limit                          write limit positions instead of refined points\n"
-    "      --backend NAME                   as for refine\n"
-    "    prints output vertices, split vertices (infinitely sharp creases) and where N_S was computed\n"
-    "  surfblend render [options] IN.obj -o OUT.png   a software picture of the shaded surface\n"
-    "      the shading options above (not --limit), and:\n"
-    "      --normals limit|subdivided|blended  which normal field to draw (default blended)\n"
-    "      --highlight | --weights | --normal-colors   highlight lines, blend weights (blue 0 .. red 1), normals as RGB\n"
-    "                                       (default: grey shading)\n"
-    "      --positions refined|limit        refined points or limit positions (default limit)\n"
-    "      --size WxH                       picture size, 1..8192 each (default 640x480)\n"
-    "      --view YAW,PITCH                 camera angles in degrees around the y axis and above the xz plane (default 30,25)\n"
-    "      --zoom Z                         magnification (default 1: the bounding sphere fits)\n"
-    "      --stripes N                      highlight lines per object diameter (default 8)\n"
-    "      --edges                          draw the refined mesh's edges\n"
-    "      --scheme manifold                draw the manifold blending surface (seed 000) tessellated instead, with:\n"
-    "        --manifold-weights hermite|cinf (tess's --weights), --rate N (default 16), --trim MASK.png [--trim-tiles U V]\n"
-    "  surfblend backends                         list the backends and whether each is available\n"
-    "  surfblend --help | --version\n"
-    "exit codes: 0 success, 1 bad input, 2 usage error\n",
-    NULL
+/* ---- the options ---- */
+
+/* What the parser counts per option (o->seen[id]: how often it was given); several rows may
+ * share one id (one option spelt per command, or the three picture modes). */
+enum {
+    O_HELP, O_BACKEND, O_OUTPUT, O_SCHEME, O_LEVEL, O_LIMIT, O_WEIGHTS, O_LOCATIONS, O_RANDOM, O_SEED, O_DERIVATIVES,
+    O_RATE, O_TOLERANCE, O_SPLIT, O_TRIM, O_TILES, O_VARIANT, O_DARTS, O_NORMALS_LEVEL, O_WEIGHTS_LEVEL, O_P,
+    O_AVERAGING, O_ALL_SUBDIVIDED, O_NORMALS, O_POSITIONS, O_MODE, O_EDGES, O_SIZE, O_VIEW, O_ZOOM, O_STRIPES,
+    O_COUNT_
 };
 
-static void print_usage(FILE *f) {
-    int i;
-    for (i = 0; usage_text[i]; ++i) fputs(usage_text[i], f);
+struct cli_command;
+
+/* Every command's options, in one place; what a command does not take keeps its default. */
+typedef struct cli_opts {
+    const struct cli_command *cmd;
+    const char *in, *outp, *backend;
+    int scheme, level, limit, weights;                      /* weights: manifold blend weights */
+    const char *locfile;                                    /* eval */
+    long nrandom, seed;
+    int derivatives;
+    long rate, tiles[2];                                    /* tess, render --scheme manifold */
+    double tolerance;
+    int split;
+    const char *trim;
+    int variant, darts, normals_level, weights_level, all_subdivided, averaging; /* shade, render */
+    double p;
+    int normals, limit_pos, mode, edges;                    /* render */
+    long size[2];
+    double view[2], zoom, stripes;
+    int seen[O_COUNT_];
+} cli_opts;
+
+/* Command bits: which commands take an option. */
+enum {
+    C_INFO = 1, C_REFINE = 2, C_EVAL = 4, C_TESS = 8, C_SHADE = 16, C_RENDER = 32, C_BACKENDS = 64,
+    C_ALL = 127, C_SURFACE = C_REFINE | C_EVAL | C_TESS | C_SHADE | C_RENDER, C_SHADING = C_SHADE | C_RENDER
+};
+
+typedef enum opt_kind {
+    K_HELP,     /* print the command's usage, exit 0 */
+    K_SET,      /* no value: stores .value (int) */
+    K_STRING,   /* const char * */
+    K_INT,      /* int in [.lo, .hi] */
+    K_LONG,     /* long in [.lo, .hi] */
+    K_LONG2,    /* two values, long[2] in [.lo, .hi] */
+    K_DOUBLE,   /* any number */
+    K_POSITIVE, /* a number in (0, .hi] */
+    K_CHOICE,   /* one of .choices: int */
+    K_SCHEME,   /* a scheme name (cli_scheme_from_name) not in the mask .value: int */
+    K_LEVEL,    /* a shading level >= 0 (int; 0: SFB_SHADE_LEVEL_CONTROL) */
+    K_SIZE,     /* WxH, long[2] each 1..1000000 */
+    K_VIEW      /* YAW,PITCH in degrees, double[2] */
+} opt_kind;
+
+typedef struct opt_choice { const char *name; int value, hidden; } opt_choice;
+
+typedef struct opt_spec {
+    const char *name, *alias; /* alias: another spelling (shown after the name) */
+    opt_kind kind;
+    unsigned cmds;            /* C_* */
+    int id;                   /* O_* */
+    size_t offset;            /* where the value goes in cli_opts */
+    const char *metavar;      /* NULL: from .choices */
+    const opt_choice *choices;
+    double lo, hi;
+    int value;
+    const char *needs;        /* "--NAME needs ...": NULL: from .choices */
+    const char *help;         /* '\n' continues on the next line */
+} opt_spec;
+
+static const opt_choice weight_choices[] = { { "hermite", SFB_MANIFOLD_WEIGHTS_HERMITE, 0 }, { "cinf", SFB_MANIFOLD_WEIGHTS_CINF, 0 }, { NULL, 0, 0 } };
+static const opt_choice variant_choices[] = {
+    { "A", SFB_SHADE_VARIANT_A, 0 }, { "B", SFB_SHADE_VARIANT_B, 0 }, { "a", SFB_SHADE_VARIANT_A, 1 }, { "b", SFB_SHADE_VARIANT_B, 1 }, { NULL, 0, 0 }
+};
+static const opt_choice darts_choices[] = { { "smooth", SFB_SHADE_DARTS_SMOOTH, 0 }, { "sharp", SFB_SHADE_DARTS_SHARP, 0 }, { NULL, 0, 0 } };
+static const opt_choice averaging_choices[] = {
+    { "linear", SFB_SHADE_AVERAGE_LINEAR, 0 }, { "renormalized", SFB_SHADE_AVERAGE_RENORMALIZED, 0 },
+    { "spherical", SFB_SHADE_AVERAGE_SPHERICAL, 0 }, { NULL, 0, 0 }
+};
+/* render --normals: the values index normal_names */
+static const opt_choice normals_choices[] = { { "limit", 0, 0 }, { "subdivided", 1, 0 }, { "blended", 2, 0 }, { NULL, 0, 0 } };
+static const char *const normal_names[3] = { "limit", "subdivided", "blended" };
+static const opt_choice positions_choices[] = { { "refined", 0, 0 }, { "limit", 1, 0 }, { NULL, 0, 0 } };
+
+#define AT(field) offsetof(cli_opts, field)
+#define ANY_INT -2147483647.0, 2147483647.0
+#define NO_BILINEAR (1 << SFB_SCHEME_BILINEAR)
+
+/* The order of the rows is the order of the usage text. */
+static const opt_spec options[] = {
+    { "--scheme", NULL, K_SCHEME, C_REFINE, O_SCHEME, AT(scheme), "catmark|loop|bilinear", NULL, 0, 0, 0,
+      "catmark, loop or bilinear", "subdivision scheme (default: from the file name prefix loop_ or bilinear_, else catmark)" },
+    { "--scheme", NULL, K_SCHEME, C_EVAL | C_TESS, O_SCHEME, AT(scheme), "catmark|loop|manifold", NULL, 0, 0, 0,
+      "catmark, loop or manifold", "a subdivision limit surface or the manifold blending surface (seed 000)\n"
+      "(default: from the file name prefix loop_ or bilinear_, else catmark)" },
+    { "--scheme", NULL, K_SCHEME, C_SHADE, O_SCHEME, AT(scheme), "catmark|loop", NULL, 0, 0, NO_BILINEAR,
+      "catmark or loop", "subdivision scheme (default: from the file name prefix loop_, else catmark)" },
+    { "--scheme", NULL, K_SCHEME, C_RENDER, O_SCHEME, AT(scheme), "catmark|loop|manifold", NULL, 0, 0, NO_BILINEAR,
+      "catmark, loop or manifold", "subdivision scheme (default: from the file name prefix loop_, else catmark);\n"
+      "manifold: draw the manifold blending surface (seed 000) tessellated instead" },
+    { "--level", NULL, K_INT, C_REFINE, O_LEVEL, AT(level), "L", NULL, 0, 1000, 0, "a number >= 0",
+      "uniform refinement level 0..10 (default 2)" },
+    { "--level", NULL, K_INT, C_SHADING, O_LEVEL, AT(level), "L", NULL, 0, 1000, 0, "a number >= 0",
+      "uniform refinement level 0..10 (default 3)" },
+    { "--limit", NULL, K_SET, C_REFINE, O_LIMIT, AT(limit), NULL, NULL, 0, 0, 1, NULL,
+      "write limit positions (and limit normals as vn) instead of refined points" },
+    { "--manifold-weights", "--weights", K_CHOICE, C_EVAL | C_TESS, O_WEIGHTS, AT(weights), NULL, weight_choices, 0, 0, 0, NULL,
+      "manifold blend weights: Hermite (default) or C-infinity (--weights: the old spelling)" },
+    { "--locations", NULL, K_STRING, C_EVAL, O_LOCATIONS, AT(locfile), "FILE", NULL, 0, 0, 0, "a file name",
+      "lines 'face u v' (parametric face; u, v in [0,1], and u + v <= 1 on Loop's\ntriangles; '#' starts a comment)" },
+    { "--random", NULL, K_LONG, C_EVAL, O_RANDOM, AT(nrandom), "N", NULL, 0, 10000000.0, 0, "a count 0..10000000",
+      "N random locations on faces that are not holes (deterministic for a seed)" },
+    { "--seed", NULL, K_LONG, C_EVAL, O_SEED, AT(seed), "S", NULL, 0, 2147483647.0, 0, "a number >= 0",
+      "the seed of --random (default 1)" },
+    { "--derivatives", NULL, K_SET, C_EVAL, O_DERIVATIVES, AT(derivatives), NULL, NULL, 0, 0, 1, NULL, "also print du and dv" },
+    /* the range (1..1024) is the library's to check and report */
+    { "--rate", NULL, K_LONG, C_TESS, O_RATE, AT(rate), "N", NULL, ANY_INT, 0, "a number",
+      "segments per parametric-face edge, 1..1024 (required)" },
+    { "--tolerance", NULL, K_DOUBLE, C_TESS, O_TOLERANCE, AT(tolerance), "T", NULL, 0, 0, 0, "a number",
+      "adaptive: per face the smallest rate <= N within chordal error T" },
+    { "--split-creases", NULL, K_SET, C_TESS, O_SPLIT, AT(split), NULL, NULL, 0, 0, 1, NULL,
+      "separate vertices (and normals) on each side of infinitely sharp creases" },
+    { "--variant", NULL, K_CHOICE, C_SHADING, O_VARIANT, AT(variant), NULL, variant_choices, 0, 0, 0, NULL,
+      "sharp vertices: B (default) blend weight 0, A treated as smooth ones" },
+    { "--darts", NULL, K_CHOICE, C_SHADING, O_DARTS, AT(darts), NULL, darts_choices, 0, 0, 0, NULL,
+      "darts count as smooth (default) or sharp vertices for the weights" },
+    { "--normals-level", NULL, K_LEVEL, C_SHADING, O_NORMALS_LEVEL, AT(normals_level), "L", NULL, 0, 1000, 0,
+      "a level >= 0 (0: the control mesh)", "level where the subdivided normals N_S start (0: control mesh; default 1)" },
+    { "--weights-level", NULL, K_LEVEL, C_SHADING, O_WEIGHTS_LEVEL, AT(weights_level), "L", NULL, 0, 1000, 0,
+      "a level >= 0 (0: the control mesh)", "level where the blend weights are seeded (0: control mesh; default 1)" },
+    { "--p", NULL, K_POSITIVE, C_SHADING, O_P, AT(p), "P", NULL, 0, 1e30, 0, "a number > 0",
+      "blend exponent, > 0 (default 1): N_B = (1 - b^P) N_L + b^P N_S" },
+    { "--averaging", NULL, K_CHOICE, C_SHADING, O_AVERAGING, AT(averaging), NULL, averaging_choices, 0, 0, 0, NULL,
+      "how N_S is averaged from one level to the next (default linear)" },
+    { "--all-subdivided", NULL, K_SET, C_SHADING, O_ALL_SUBDIVIDED, AT(all_subdivided), NULL, NULL, 0, 0, 1, NULL,
+      "compute N_S at every vertex, not only where b > 0" },
+    { "--limit", NULL, K_SET, C_SHADE, O_LIMIT, AT(limit), NULL, NULL, 0, 0, 1, NULL, "write limit positions instead of refined points" },
+    { "--normals", NULL, K_CHOICE, C_RENDER, O_NORMALS, AT(normals), NULL, normals_choices, 0, 0, 0, NULL,
+      "which normal field to draw (default blended)" },
+    { "--highlight", NULL, K_SET, C_RENDER, O_MODE, AT(mode), NULL, NULL, 0, 0, SFB_RENDER_HIGHLIGHT, NULL,
+      "draw highlight lines (default: grey shading)" },
+    { "--blend-weights", "--weights", K_SET, C_RENDER, O_MODE, AT(mode), NULL, NULL, 0, 0, SFB_RENDER_WEIGHTS, NULL,
+      "draw the shading's blend weights (blue 0 .. red 1) (--weights: the old spelling)" },
+    { "--normal-colors", NULL, K_SET, C_RENDER, O_MODE, AT(mode), NULL, NULL, 0, 0, SFB_RENDER_NORMALS, NULL, "draw normals as RGB" },
+    { "--positions", NULL, K_CHOICE, C_RENDER, O_POSITIONS, AT(limit_pos), NULL, positions_choices, 0, 0, 0, NULL,
+      "refined points or limit positions (default limit)" },
+    /* the range (1..8192) is the library's to check and report */
+    { "--size", NULL, K_SIZE, C_RENDER, O_SIZE, AT(size), "WxH", NULL, 0, 0, 0, "positive WxH, e.g. 800x600",
+      "picture size, 1..8192 each (default 640x480)" },
+    { "--view", NULL, K_VIEW, C_RENDER, O_VIEW, AT(view), "YAW,PITCH", NULL, 0, 0, 0, "YAW,PITCH in degrees, e.g. 30,20",
+      "camera angles in degrees around the y axis and above the xz plane (default 30,25)" },
+    { "--zoom", NULL, K_POSITIVE, C_RENDER, O_ZOOM, AT(zoom), "Z", NULL, 0, 1e6, 0, "a number > 0",
+      "magnification (default 1: the bounding sphere fits)" },
+    { "--stripes", NULL, K_POSITIVE, C_RENDER, O_STRIPES, AT(stripes), "N", NULL, 0, 1e5, 0, "a number in (0, 100000]",
+      "highlight lines per object diameter (default 8)" },
+    { "--edges", NULL, K_SET, C_RENDER, O_EDGES, AT(edges), NULL, NULL, 0, 0, 1, NULL, "draw the refined mesh's edges" },
+    { "--rate", NULL, K_LONG, C_RENDER, O_RATE, AT(rate), "N", NULL, ANY_INT, 0, "a number",
+      "--scheme manifold: segments per parametric-face edge, 1..1024 (default 16)" },
+    { "--manifold-weights", NULL, K_CHOICE, C_RENDER, O_WEIGHTS, AT(weights), NULL, weight_choices, 0, 0, 0, NULL,
+      "--scheme manifold: blend weights Hermite (default) or C-infinity" },
+    { "--trim", NULL, K_STRING, C_TESS | C_RENDER, O_TRIM, AT(trim), "MASK.png", NULL, 0, 0, 0, "a PNG file",
+      "trim with a mask over each parametric face's (u,v) square (seed 000 V.5):\n"
+      "grey level >= 50% kept, darker trimmed; the picture's top row is v = 1" },
+    /* the counts are the library's to check against the mask */
+    { "--trim-tiles", NULL, K_LONG2, C_TESS | C_RENDER, O_TILES, AT(tiles), "U V", NULL, ANY_INT, 0, "two numbers U V",
+      "the mask is an atlas of U x V tiles, tile t (row-major from v = 0) for\n"
+      "parametric face t; later faces untrimmed (default: one mask for all)" },
+    { "--backend", NULL, K_STRING, C_SURFACE, O_BACKEND, AT(backend), "NAME", NULL, 0, 0, 0, "a name",
+      "ref|simd|gl|osmesa, tried first (else SURFBLEND_BACKEND, else the default order)" },
+    { "-o", "--output", K_STRING, C_SURFACE, O_OUTPUT, AT(outp), "FILE", NULL, 0, 0, 0, "a file name",
+      "the output file ('-': standard output)" },
+    { "-h", "--help", K_HELP, C_ALL, O_HELP, 0, NULL, NULL, 0, 0, 0, NULL, "print this command's usage and exit" },
+};
+#define OPTION_COUNT (sizeof options / sizeof options[0])
+
+/* A command: its synopsis, what it does, how it runs. */
+typedef struct cli_command {
+    const char *name;
+    unsigned bit;             /* C_* */
+    const char *args;         /* the synopsis after the name */
+    const char *summary;
+    const char *notes;        /* after the options; NULL: none */
+    int inputs;               /* input files: 1 or 0 */
+    const char *output;       /* -o is required and names this ("OUT.obj"); NULL: optional */
+    int (*run)(cli_opts *o);
+} cli_command;
+
+/* ---- usage, printed from the tables ---- */
+
+/* The values of a choice (or the schemes of a K_SCHEME row), joined with sep and last. */
+static void choice_list(const opt_spec *s, char *buf, size_t cap, const char *sep, const char *last) {
+    const opt_choice *c;
+    size_t n = 0, shown = 0, k = 0;
+    buf[0] = 0;
+    for (c = s->choices; c && c->name; ++c) shown += !c->hidden;
+    for (c = s->choices; c && c->name; ++c) {
+        if (c->hidden) continue;
+        n += (size_t)snprintf(buf + n, n < cap ? cap - n : 0, "%s%s", k == 0 ? "" : k + 1 == shown ? last : sep, c->name);
+        ++k;
+        if (n >= cap) { buf[cap - 1] = 0; return; }
+    }
 }
 
-static int usage(const char *msg) {
-    if (msg) fprintf(stderr, "surfblend: %s\n", msg);
-    print_usage(stderr);
+static void print_option(FILE *f, const opt_spec *s) {
+    char col[160], meta[96];
+    const char *h;
+    if (s->metavar) snprintf(meta, sizeof meta, "%s", s->metavar);
+    else choice_list(s, meta, sizeof meta, "|", "|");
+    snprintf(col, sizeof col, "%s%s%s%s%s", s->name, s->alias ? ", " : "", s->alias ? s->alias : "", meta[0] ? " " : "", meta);
+    if (strlen(col) <= 32) fprintf(f, "      %-32s ", col);
+    else fprintf(f, "      %s\n%39s", col, "");
+    for (h = s->help; *h; ++h) {
+        fputc(*h, f);
+        if (*h == '\n') fprintf(f, "%39s", "");
+    }
+    fputc('\n', f);
+}
+
+/* One command: the synopsis, its options (without -h in the list of all commands), notes. */
+static void print_command(FILE *f, const cli_command *c, int with_help) {
+    char line[160];
+    size_t i;
+    int n = snprintf(line, sizeof line, "  surfblend %s%s%s", c->name, c->args[0] ? " " : "", c->args);
+    fprintf(f, "%s%*s%s\n", line, n < 44 ? 45 - n : 3, "", c->summary);
+    for (i = 0; i < OPTION_COUNT; ++i)
+        if ((options[i].cmds & c->bit) && (with_help || options[i].kind != K_HELP)) print_option(f, &options[i]);
+    if (c->notes) fprintf(f, "    %s\n", c->notes);
+}
+
+static const char names_note[] =
+    "option names: the manifold blend weights are --manifold-weights (eval, tess, render) and render's\n"
+    "picture of the shading's blend weights is --blend-weights; the old spelling --weights still works\n"
+    "where it is unambiguous: for --manifold-weights on eval and tess, for --blend-weights on render\n";
+static const char exit_note[] = "exit codes: 0 success, 1 bad input, 2 usage error\n";
+
+static void print_command_usage(FILE *f, const cli_command *c) {
+    fputs("usage:\n", f);
+    print_command(f, c, 1);
+    fputs(exit_note, f);
+}
+
+/* A usage error of command c (NULL: before a command): the message, then the usage, on stderr;
+ * returns 2. */
+static void print_usage(FILE *f);
+static int usage_error(const cli_command *c, const char *msg) {
+    if (msg) cli_error("%s", msg);
+    if (c) {
+        print_command_usage(stderr, c);
+        fprintf(stderr, "(surfblend --help lists every command)\n");
+    } else {
+        print_usage(stderr);
+    }
     return 2;
 }
 
-/* The arguments every command that reads one OBJ shares: --backend NAME, -o/--output FILE,
- * the input file; anything else starting with '-' is an unknown option. Consumes argv[*i]
- * (and its value); returns 0, or usage()'s status. */
-static int common_arg(int argc, char **argv, int *i, const char *cmd, const char **backend, const char **outp, const char **in) {
-    char msg[64];
-    if (strcmp(argv[*i], "--backend") == 0) {
-        if (++*i >= argc) return usage("--backend needs a name");
-        *backend = argv[*i];
-    } else if (strcmp(argv[*i], "-o") == 0 || strcmp(argv[*i], "--output") == 0) {
-        if (++*i >= argc) return usage("-o needs a file name");
-        *outp = argv[*i];
-    } else if (argv[*i][0] == '-' && argv[*i][1]) {
-        fprintf(stderr, "surfblend: unknown option '%s'\n", argv[*i]);
-        return usage(NULL);
-    } else if (!*in) {
-        *in = argv[*i];
-    } else {
-        snprintf(msg, sizeof msg, "%s takes one input file", cmd);
-        return usage(msg);
-    }
-    return 0;
-}
+/* ---- the parser ---- */
 
-static char *read_file(const char *path, size_t *size) {
-    FILE *f = strcmp(path, "-") == 0 ? stdin : fopen(path, "rb");
-    char *buf = NULL;
-    size_t cap = 0, n = 0;
-    if (!f) return NULL;
-    for (;;) {
-        size_t got;
-        if (n == cap) {
-            char *nb;
-            cap = cap ? cap * 2 : 1 << 16;
-            if (cap > ((size_t)1 << 32)) { free(buf); buf = NULL; break; }
-            nb = (char *)realloc(buf, cap);
-            if (!nb) { free(buf); buf = NULL; break; }
-            buf = nb;
-        }
-        got = fread(buf + n, 1, cap - n, f);
-        n += got;
-        if (got == 0) break;
-    }
-    if (f != stdin) fclose(f);
-    *size = n;
-    return buf;
-}
-
-static int file_write(const void *data, size_t size, void *user) {
-    return fwrite(data, 1, size, (FILE *)user) != size;
-}
-
-/* --backend NAME is tried first; if it cannot initialise, the default order follows and the
- * reason is printed (the same fall-through a library user gets). */
-static sfb_context *make_context(const char *backend) {
-    sfb_context_config cfg = sfb_context_config_init();
-    sfb_backend_kind kinds[3];
-    sfb_context *ctx = NULL;
-    sfb_result r;
-    char report[2048];
-    if (backend) {
-        kinds[0] = sfb_backend_kind_parse(backend);
-        if (kinds[0] == SFB_BACKEND_DEFAULT) {
-            fprintf(stderr, "surfblend: unknown backend '%s' (ref, simd, gl, osmesa)\n", backend);
-            return NULL;
-        }
-        kinds[1] = SFB_BACKEND_SIMD;
-        kinds[2] = SFB_BACKEND_REF;
-        cfg.backends = kinds;
-        cfg.backend_count = 3;
-        cfg.ignore_environment = 1;
-    }
-    r = sfb_context_create(&cfg, &ctx);
-    if (r != SFB_SUCCESS) {
-        fprintf(stderr, "surfblend: no backend could be initialised (%s)\n", sfb_result_string(r));
-        return NULL;
-    }
-    if ((backend && sfb_backend_kind_parse(sfb_context_backend_name(ctx)) != kinds[0]) ||
-        (!backend && getenv("SURFBLEND_BACKEND") && *getenv("SURFBLEND_BACKEND") &&
-         sfb_backend_kind_parse(sfb_context_backend_name(ctx)) != sfb_backend_kind_parse(getenv("SURFBLEND_BACKEND")))) {
-        sfb_context_backend_report(ctx, report, sizeof report);
-        fprintf(stderr, "surfblend: the requested backend is unavailable; using %s. Backends tried:\n%s",
-                sfb_context_backend_name(ctx), report);
-    }
-    return ctx;
-}
-
-static sfb_mesh *load(sfb_context *ctx, const char *path) {
-    size_t size = 0;
-    char *text = read_file(path, &size);
-    sfb_mesh *mesh = NULL;
-    sfb_result r;
-    if (!text) {
-        fprintf(stderr, "surfblend: cannot read '%s'\n", path);
-        return NULL;
-    }
-    r = sfb_mesh_read_obj(ctx, text, size, &mesh);
-    free(text);
-    if (r != SFB_SUCCESS) {
-        fprintf(stderr, "surfblend: %s: %s: %s\n", path, sfb_result_string(r), sfb_last_error(ctx));
-        return NULL;
-    }
-    return mesh;
-}
-
-static int cmd_info(int argc, char **argv) {
-    sfb_context *ctx;
-    sfb_mesh *mesh;
-    sfb_mesh_info in;
-    int hist[33], over, i, problems = 0;
-    if (argc != 1) return usage("info takes one OBJ file");
-    ctx = make_context(NULL);
-    if (!ctx) return 1;
-    mesh = load(ctx, argv[0]);
-    if (!mesh) { sfb_context_destroy(ctx); return 1; }
-    sfb_mesh_get_info(mesh, &in);
-    printf("file:        %s\n", argv[0]);
-    printf("vertices:    %d\nfaces:       %d (%d triangles, %d quads, %d n-gons, largest %d)\n", in.vertex_count, in.face_count,
-           in.triangles, in.quads, in.ngons, in.max_face_size);
-    printf("edges:       %d (%d boundary)\nuvs:         %d\n", in.edge_count, in.boundary_edges, in.uv_count);
-    printf("creases:     %d sharp edges (%d semi-sharp, %d infinitely sharp), %d corner vertices tagged, %d holes\n",
-           in.sharp_edges, in.semisharp_edges, in.infsharp_edges, in.corners, in.holes);
-    printf("rules:       %d darts, %d crease vertices, %d corner vertices\n", in.darts, in.crease_vertices, in.corner_vertices);
-    printf("extraordinary vertices: %d for Catmull-Clark, %d for Loop\n", in.extraordinary_catmark, in.extraordinary_loop);
-    printf("bbox:        (%g %g %g) - (%g %g %g)\n", in.bbox_min[0], in.bbox_min[1], in.bbox_min[2], in.bbox_max[0],
-           in.bbox_max[1], in.bbox_max[2]);
-    over = sfb_mesh_valence_histogram(mesh, hist, 33);
-    printf("valence histogram (edges per vertex):");
-    for (i = 0; i < 33; ++i)
-        if (hist[i]) printf(" %d:%d", i, hist[i]);
-    if (over) printf(" >32:%d", over);
-    printf("\nmax valence: %d\n", in.max_valence);
-    printf("problems:   ");
-    if (in.nonmanifold_edges) { printf(" %d non-manifold edges;", in.nonmanifold_edges); problems++; }
-    if (in.nonmanifold_vertices) { printf(" %d non-manifold vertices (treated as corners);", in.nonmanifold_vertices); problems++; }
-    if (in.bare_vertices) { printf(" %d vertices in no face;", in.bare_vertices); problems++; }
-    if (in.triangles + in.ngons > 0 && in.quads > 0) { printf(" mixed face sizes (Loop needs all triangles);"); problems++; }
-    if (!problems) printf(" none");
-    printf("\n");
-    sfb_mesh_destroy(mesh);
-    sfb_context_destroy(ctx);
-    return 0;
-}
-
-static int scheme_from_name(const char *s, sfb_scheme *out) {
-    if (strcmp(s, "catmark") == 0 || strcmp(s, "catmull-clark") == 0) *out = SFB_SCHEME_CATMARK;
-    else if (strcmp(s, "loop") == 0) *out = SFB_SCHEME_LOOP;
-    else if (strcmp(s, "bilinear") == 0) *out = SFB_SCHEME_BILINEAR;
-    else if (strcmp(s, "manifold") == 0) *out = SFB_SCHEME_MANIFOLD_BLEND;
-    else return 0;
+static int parse_long(const char *s, long lo, long hi, long *out) {
+    char *end;
+    long v = strtol(s, &end, 10);
+    if (end == s || *end || v < lo || v > hi) return 0;
+    *out = v;
     return 1;
 }
 
-/* The scheme of an input: --scheme if given, else the file name's prefix (loop_, bilinear_),
- * else Catmull-Clark. */
-static sfb_scheme scheme_for(const char *path, int have_scheme, sfb_scheme scheme) {
-    const char *base;
-    if (have_scheme) return scheme;
-    base = strrchr(path, '/');
-    base = base ? base + 1 : path;
-    if (strncmp(base, "loop_", 5) == 0) return SFB_SCHEME_LOOP;
-    if (strncmp(base, "bilinear_", 9) == 0) return SFB_SCHEME_BILINEAR;
-    return SFB_SCHEME_CATMARK;
+static int parse_number(const char *s, double *out) {
+    char *end;
+    *out = strtod(s, &end);
+    return end != s && !*end;
 }
 
-static int cmd_refine(int argc, char **argv) {
-    const char *in = NULL, *outp = NULL, *backend = NULL;
-    sfb_scheme scheme = SFB_SCHEME_CATMARK;
-    int have_scheme = 0, level = 2, limit = 0, i, rc = 1;
-    sfb_context *ctx = NULL;
-    sfb_mesh *mesh = NULL;
-    sfb_surface *surf = NULL;
-    sfb_surface_config cfg;
-    sfb_mesh_data data;
-    sfb_result r;
-    FILE *f = NULL;
-    memset(&data, 0, sizeof data);
-    for (i = 0; i < argc; ++i) {
-        if (strcmp(argv[i], "--scheme") == 0) {
-            if (++i >= argc || !scheme_from_name(argv[i], &scheme)) return usage("--scheme needs catmark, loop or bilinear");
-            have_scheme = 1;
-        } else if (strcmp(argv[i], "--level") == 0) {
-            char *end;
-            long l;
-            if (++i >= argc) return usage("--level needs a number");
-            l = strtol(argv[i], &end, 10);
-            if (*end || end == argv[i] || l < 0 || l > 1000) return usage("--level needs a number >= 0");
-            level = (int)l;
-        } else if (strcmp(argv[i], "--limit") == 0) {
-            limit = 1;
-        } else {
-            int ur = common_arg(argc, argv, &i, "refine", &backend, &outp, &in);
-            if (ur) return ur;
-        }
-    }
-    if (!in) return usage("refine needs an input OBJ file");
-    if (!outp) return usage("refine needs -o OUT.obj");
-    scheme = scheme_for(in, have_scheme, scheme);
-    ctx = make_context(backend);
-    if (!ctx) return 1;
-    mesh = load(ctx, in);
-    if (!mesh) goto done;
-    cfg = sfb_surface_config_init(scheme, level);
-    cfg.flags = SFB_REFINE_UVS | (limit ? SFB_REFINE_LIMIT : 0u);
-    r = sfb_surface_create(ctx, mesh, &cfg, &surf);
-    if (r == SFB_SUCCESS) r = sfb_surface_refine(surf, &data);
-    if (r != SFB_SUCCESS) {
-        fprintf(stderr, "surfblend: %s: %s: %s\n", in, sfb_result_string(r), sfb_last_error(ctx));
-        goto done;
-    }
-    f = strcmp(outp, "-") == 0 ? stdout : fopen(outp, "wb");
-    if (!f) {
-        fprintf(stderr, "surfblend: cannot write '%s'\n", outp);
-        goto done;
-    }
-    {
-        sfb_mesh_desc d;
-        sfb_mesh_data_desc(&data, &d);
-        if (limit) {
-            d.positions = data.limit_positions;
-            for (i = 0; i < data.vertex_count; ++i)
-                fprintf(f, "vn %.7g %.7g %.7g\n", data.normals[3 * i], data.normals[3 * i + 1], data.normals[3 * i + 2]);
-        }
-        r = sfb_write_obj(&d, file_write, f);
-        if (r != SFB_SUCCESS) {
-            fprintf(stderr, "surfblend: writing '%s' failed: %s\n", outp, sfb_result_string(r));
-            goto done;
-        }
-    }
-    fprintf(stderr, "surfblend: %s level %d: %d vertices, %d faces -> %s (backend %s)\n", sfb_scheme_name(scheme), level,
-            data.vertex_count, data.face_count, outp, sfb_context_backend_name(ctx));
-    rc = 0;
-done:
-    if (f && f != stdout && fclose(f) != 0 && rc == 0) { fprintf(stderr, "surfblend: writing '%s' failed\n", outp); rc = 1; }
-    sfb_mesh_data_free(&data);
-    sfb_surface_destroy(surf);
-    sfb_mesh_destroy(mesh);
-    sfb_context_destroy(ctx);
-    return rc;
+/* WxH, each 1..1000000 */
+static int parse_size(const char *s, long *wh) {
+    char *end;
+    const char *hs;
+    wh[0] = strtol(s, &end, 10);
+    if (end == s || (*end != 'x' && *end != 'X')) return 0;
+    hs = end + 1;
+    wh[1] = strtol(hs, &end, 10);
+    if (end == hs || *end) return 0;
+    return wh[0] >= 1 && wh[1] >= 1 && wh[0] <= 1000000L && wh[1] <= 1000000L;
 }
+
+/* YAW,PITCH, finite */
+static int parse_view(const char *s, double *yp) {
+    char *end;
+    const char *ps;
+    yp[0] = strtod(s, &end);
+    if (end == s || *end != ',') return 0;
+    ps = end + 1;
+    yp[1] = strtod(ps, &end);
+    return end != ps && !*end && isfinite(yp[0]) && isfinite(yp[1]);
+}
+
+static int value_count(opt_kind k) { return k == K_HELP || k == K_SET ? 0 : k == K_LONG2 ? 2 : 1; }
+
+/* Stores the value(s) v of option s into *o; 0 when they are not what s needs. */
+static int store_value(const opt_spec *s, char **v, cli_opts *o) {
+    char *p = (char *)o + s->offset;
+    long l;
+    double d;
+    sfb_scheme scheme;
+    const opt_choice *c;
+    switch (s->kind) {
+    case K_HELP: return 1;
+    case K_SET: *(int *)p = s->value; return 1;
+    case K_STRING: *(const char **)p = v[0]; return 1;
+    case K_INT:
+        if (!parse_long(v[0], (long)s->lo, (long)s->hi, &l)) return 0;
+        *(int *)p = (int)l;
+        return 1;
+    case K_LONG: return parse_long(v[0], (long)s->lo, (long)s->hi, (long *)p);
+    case K_LONG2: return parse_long(v[0], (long)s->lo, (long)s->hi, (long *)p) && parse_long(v[1], (long)s->lo, (long)s->hi, (long *)p + 1);
+    case K_DOUBLE: return parse_number(v[0], (double *)p);
+    case K_POSITIVE:
+        if (!parse_number(v[0], &d) || !(d > 0.0) || !(d <= s->hi)) return 0;
+        *(double *)p = d;
+        return 1;
+    case K_CHOICE:
+        for (c = s->choices; c->name; ++c)
+            if (strcmp(v[0], c->name) == 0) { *(int *)p = c->value; return 1; }
+        return 0;
+    case K_SCHEME:
+        if (!cli_scheme_from_name(v[0], &scheme) || (s->value >> scheme & 1)) return 0;
+        *(int *)p = (int)scheme;
+        return 1;
+    case K_LEVEL:
+        if (!parse_long(v[0], (long)s->lo, (long)s->hi, &l)) return 0;
+        *(int *)p = l == 0 ? SFB_SHADE_LEVEL_CONTROL : (int)l;
+        return 1;
+    case K_SIZE: return parse_size(v[0], (long *)p);
+    case K_VIEW: return parse_view(v[0], (double *)p);
+    }
+    return 0;
+}
+
+static const opt_spec *find_option(const cli_command *c, const char *arg) {
+    size_t i;
+    for (i = 0; i < OPTION_COUNT; ++i)
+        if ((options[i].cmds & c->bit) && (strcmp(arg, options[i].name) == 0 || (options[i].alias && strcmp(arg, options[i].alias) == 0)))
+            return &options[i];
+    return NULL;
+}
+
+/* The name (or alias) that two rows of one command share, or NULL: a table that the parser
+ * cannot read unambiguously (checked at every start; a test runs the tool). */
+static const char *option_clash(void) {
+    size_t i, j;
+    for (i = 0; i < OPTION_COUNT; ++i)
+        for (j = i + 1; j < OPTION_COUNT; ++j) {
+            const opt_spec *a = &options[i], *b = &options[j];
+            if (!(a->cmds & b->cmds)) continue;
+            if (strcmp(a->name, b->name) == 0 || (b->alias && strcmp(a->name, b->alias) == 0)) return a->name;
+            if (a->alias && (strcmp(a->alias, b->name) == 0 || (b->alias && strcmp(a->alias, b->alias) == 0))) return a->alias;
+        }
+    return NULL;
+}
+
+/* Every command's defaults. */
+static void opts_init(cli_opts *o, const cli_command *c) {
+    memset(o, 0, sizeof *o);
+    o->cmd = c;
+    o->scheme = SFB_SCHEME_CATMARK;
+    o->weights = SFB_MANIFOLD_WEIGHTS_HERMITE;
+    o->level = c->bit & C_SHADING ? 3 : 2;
+    o->nrandom = -1;
+    o->seed = 1;
+    o->rate = c->bit & C_TESS ? -1 : 16;
+    o->p = 1.0;
+    o->normals = 2; /* blended */
+    o->limit_pos = 1;
+    o->mode = SFB_RENDER_SHADED;
+    o->size[0] = 640;
+    o->size[1] = 480;
+}
+
+/* Reads command c's arguments into *o. Returns 0; 2 after a usage error (printed); -1 after
+ * --help (the usage printed on stdout). */
+static int parse_args(const cli_command *c, int argc, char **argv, cli_opts *o) {
+    char msg[160];
+    int i;
+    opts_init(o, c);
+    for (i = 0; i < argc; ++i) {
+        const char *a = argv[i];
+        const opt_spec *s;
+        int n;
+        if (a[0] != '-' || !a[1]) { /* an input file ("-": standard input) */
+            if (o->in || !c->inputs) {
+                snprintf(msg, sizeof msg, c->inputs ? "%s takes one input file" : "%s takes no arguments", c->name);
+                return usage_error(c, msg);
+            }
+            o->in = a;
+            continue;
+        }
+        s = find_option(c, a);
+        if (!s) {
+            snprintf(msg, sizeof msg, "unknown option '%s'", a);
+            return usage_error(c, msg);
+        }
+        n = value_count(s->kind);
+        if (i + n >= argc || !store_value(s, argv + i + 1, o)) {
+            char list[96];
+            if (!s->needs) choice_list(s, list, sizeof list, ", ", " or ");
+            snprintf(msg, sizeof msg, "%s needs %s", a, s->needs ? s->needs : list);
+            return usage_error(c, msg);
+        }
+        o->seen[s->id]++;
+        i += n;
+        if (s->kind == K_HELP) {
+            print_command_usage(stdout, c);
+            return -1;
+        }
+    }
+    if (c->inputs && !o->in) {
+        snprintf(msg, sizeof msg, "%s needs an input OBJ file", c->name);
+        return usage_error(c, msg);
+    }
+    if (c->output && !o->outp) {
+        snprintf(msg, sizeof msg, "%s needs -o %s", c->name, c->output);
+        return usage_error(c, msg);
+    }
+    return 0;
+}
+/* ---- eval and tess: the limit surface through the patch table ---- */
 
 /* A surface with its patch table (limit evaluation, tessellation). */
-/* --weights hermite|cinf of the manifold scheme */
-static int weights_from_name(const char *s, int *out) {
-    if (strcmp(s, "hermite") == 0) *out = SFB_MANIFOLD_WEIGHTS_HERMITE;
-    else if (strcmp(s, "cinf") == 0) *out = SFB_MANIFOLD_WEIGHTS_CINF;
-    else return 0;
-    return 1;
-}
-
 static sfb_surface *make_patch_surface(sfb_context *ctx, const sfb_mesh *mesh, const char *path, sfb_scheme scheme, int weights) {
     sfb_surface_config cfg = sfb_surface_config_init(scheme, 0);
     sfb_surface *surf = NULL;
@@ -357,18 +454,10 @@ static sfb_surface *make_patch_surface(sfb_context *ctx, const sfb_mesh *mesh, c
     cfg.manifold.weights = weights;
     r = sfb_surface_create(ctx, mesh, &cfg, &surf);
     if (r != SFB_SUCCESS) {
-        fprintf(stderr, "surfblend: %s: %s: %s\n", path, sfb_result_string(r), sfb_last_error(ctx));
+        cli_error("%s: %s: %s", path, sfb_result_string(r), sfb_last_error(ctx));
         return NULL;
     }
     return surf;
-}
-
-static int parse_int(const char *s, long lo, long hi, long *out) {
-    char *end;
-    long v = strtol(s, &end, 10);
-    if (end == s || *end || v < lo || v > hi) return 0;
-    *out = v;
-    return 1;
 }
 
 /* Growable list of locations with the file line each came from (0: generated). */
@@ -404,10 +493,10 @@ static int loc_push(loc_list *L, int face, float u, float v, long line) {
  * (sfb_surface_eval names the bad query; the caller maps it back to its line). */
 static int read_locations(const char *path, loc_list *L) {
     size_t size = 0, i = 0;
-    char *text = read_file(path, &size);
+    char *text = cli_read_file(path, &size);
     long line = 0;
     if (!text) {
-        fprintf(stderr, "surfblend: cannot read '%s'\n", path);
+        cli_error("cannot read '%s'", path);
         return 0;
     }
     while (i < size) {
@@ -423,7 +512,7 @@ static int read_locations(const char *path, loc_list *L) {
         ++i;
         buf[n] = 0;
         if (n + 1 >= sizeof buf) {
-            fprintf(stderr, "surfblend: %s: line %ld: line too long\n", path, line);
+            cli_error("%s: line %ld: line too long", path, line);
             free(text);
             return 0;
         }
@@ -441,13 +530,13 @@ static int read_locations(const char *path, loc_list *L) {
         for (p = end; *p == ' ' || *p == '\t' || *p == '\r'; ++p) {}
         if (*p) goto bad;
         if (!loc_push(L, (int)face, (float)u, (float)v, line)) {
-            fprintf(stderr, "surfblend: %s: too many locations\n", path);
+            cli_error("%s: too many locations", path);
             free(text);
             return 0;
         }
         continue;
     bad:
-        fprintf(stderr, "surfblend: %s: line %ld: expected 'face u v' (an integer and two numbers)\n", path, line);
+        cli_error("%s: line %ld: expected 'face u v' (an integer and two numbers)", path, line);
         free(text);
         return 0;
     }
@@ -484,7 +573,7 @@ static int random_locations(sfb_context *ctx, const sfb_surface *surf, int trian
         r = sfb_surface_eval(surf, probe, nlive, &eo);
         if (r == SFB_SUCCESS) break;
         if (r != SFB_INVALID_VALUE || sfb_last_error_info(ctx).index < 0 || sfb_last_error_info(ctx).index >= nlive) {
-            fprintf(stderr, "surfblend: %s: %s\n", sfb_result_string(r), sfb_last_error(ctx));
+            cli_error("%s: %s", sfb_result_string(r), sfb_last_error(ctx));
             goto done;
         }
         i = (int)sfb_last_error_info(ctx).index;
@@ -493,7 +582,7 @@ static int random_locations(sfb_context *ctx, const sfb_surface *surf, int trian
     }
     sfb_clear_error(ctx);
     if (nlive == 0 && count > 0) {
-        fprintf(stderr, "surfblend: the surface has no parametric face to sample (every face is a hole)\n");
+        cli_error("the surface has no parametric face to sample (every face is a hole)");
         goto done;
     }
     for (i = 0; i < count; ++i) {
@@ -506,7 +595,7 @@ static int random_locations(sfb_context *ctx, const sfb_surface *surf, int trian
             v = 1.0f - v;
             while ((double)u + (double)v > 1.0) v = nextafterf(v, 0.0f);
         }
-        if (!loc_push(L, live[a % (unsigned long long)nlive], u, v, 0)) { fprintf(stderr, "surfblend: out of memory\n"); goto done; }
+        if (!loc_push(L, live[a % (unsigned long long)nlive], u, v, 0)) { cli_error("out of memory"); goto done; }
     }
     ok = 1;
 done:
@@ -514,98 +603,6 @@ done:
     free(probe);
     free(pos);
     return ok;
-}
-
-static int cmd_eval(int argc, char **argv) {
-    const char *in = NULL, *outp = NULL, *backend = NULL, *locfile = NULL;
-    long nrandom = -1, seed = 1;
-    int derivs = 0, i, rc = 1, have_scheme = 0, weights = SFB_MANIFOLD_WEIGHTS_HERMITE;
-    sfb_scheme scheme = SFB_SCHEME_CATMARK;
-    sfb_context *ctx = NULL;
-    sfb_mesh *mesh = NULL;
-    sfb_surface *surf = NULL;
-    loc_list L;
-    float *buf = NULL;
-    FILE *f = NULL;
-    memset(&L, 0, sizeof L);
-    for (i = 0; i < argc; ++i) {
-        if (strcmp(argv[i], "--random") == 0) {
-            if (++i >= argc || !parse_int(argv[i], 0, 10000000L, &nrandom)) return usage("--random needs a count 0..10000000");
-        } else if (strcmp(argv[i], "--seed") == 0) {
-            if (++i >= argc || !parse_int(argv[i], 0, 2147483647L, &seed)) return usage("--seed needs a number >= 0");
-        } else if (strcmp(argv[i], "--locations") == 0) {
-            if (++i >= argc) return usage("--locations needs a file name");
-            locfile = argv[i];
-        } else if (strcmp(argv[i], "--derivatives") == 0) {
-            derivs = 1;
-        } else if (strcmp(argv[i], "--weights") == 0) {
-            if (++i >= argc || !weights_from_name(argv[i], &weights)) return usage("--weights needs hermite or cinf");
-        } else if (strcmp(argv[i], "--scheme") == 0) {
-            if (++i >= argc || !scheme_from_name(argv[i], &scheme)) return usage("--scheme needs catmark, loop or manifold");
-            have_scheme = 1;
-        } else {
-            int ur = common_arg(argc, argv, &i, "eval", &backend, &outp, &in);
-            if (ur) return ur;
-        }
-    }
-    if (!in) return usage("eval needs an input OBJ file");
-    if ((nrandom >= 0) == (locfile != NULL)) return usage("eval needs either --random N or --locations FILE");
-    ctx = make_context(backend);
-    if (!ctx) return 1;
-    mesh = load(ctx, in);
-    if (!mesh) goto done;
-    scheme = scheme_for(in, have_scheme, scheme);
-    surf = make_patch_surface(ctx, mesh, in, scheme, weights);
-    if (!surf) goto done;
-    if (locfile ? !read_locations(locfile, &L)
-                : !random_locations(ctx, surf, scheme == SFB_SCHEME_LOOP, nrandom, (unsigned long long)seed, &L))
-        goto done;
-    buf = (float *)malloc(((size_t)L.count + 1) * 12 * sizeof(float));
-    if (!buf) { fprintf(stderr, "surfblend: out of memory\n"); goto done; }
-    {
-        sfb_eval_output eo;
-        sfb_result r;
-        size_t n = (size_t)L.count;
-        memset(&eo, 0, sizeof eo);
-        eo.position = buf;
-        eo.normal = buf + 3 * n;
-        if (derivs) { eo.du = buf + 6 * n; eo.dv = buf + 9 * n; }
-        r = sfb_surface_eval(surf, L.loc, L.count, &eo);
-        if (r != SFB_SUCCESS) {
-            sfb_error_info e = sfb_last_error_info(ctx);
-            if (locfile && e.index >= 0 && e.index < L.count)
-                fprintf(stderr, "surfblend: %s: line %ld: %s: %s\n", locfile, L.line[e.index], sfb_result_string(r), sfb_last_error(ctx));
-            else
-                fprintf(stderr, "surfblend: %s: %s: %s\n", in, sfb_result_string(r), sfb_last_error(ctx));
-            goto done;
-        }
-        f = (!outp || strcmp(outp, "-") == 0) ? stdout : fopen(outp, "wb");
-        if (!f) {
-            fprintf(stderr, "surfblend: cannot write '%s'\n", outp);
-            goto done;
-        }
-        for (i = 0; i < L.count; ++i) {
-            const float *p = buf + 3 * (size_t)i, *nn = eo.normal + 3 * (size_t)i;
-            fprintf(f, "%d %.9g %.9g %.9g %.9g %.9g %.9g %.9g %.9g", L.loc[i].face, L.loc[i].u, L.loc[i].v, p[0], p[1], p[2], nn[0],
-                    nn[1], nn[2]);
-            if (derivs) {
-                const float *a = eo.du + 3 * (size_t)i, *b = eo.dv + 3 * (size_t)i;
-                fprintf(f, " %.9g %.9g %.9g %.9g %.9g %.9g", a[0], a[1], a[2], b[0], b[1], b[2]);
-            }
-            fputc('\n', f);
-        }
-    }
-    rc = 0;
-done:
-    if (f && f != stdout && fclose(f) != 0 && rc == 0) { fprintf(stderr, "surfblend: writing '%s' failed\n", outp); rc = 1; }
-    if (f == stdout && fflush(stdout) != 0 && rc == 0) { fprintf(stderr, "surfblend: writing the output failed\n"); rc = 1; }
-    free(buf);
-    free(L.loc);
-    free(L.line);
-    sfb_surface_destroy(surf);
-    sfb_mesh_destroy(mesh);
-    sfb_context_destroy(ctx);
-    return rc;
 }
 
 static int cmp_u64(const void *a, const void *b) {
@@ -647,13 +644,13 @@ static unsigned char *load_mask(const char *path, int *w, int *h) {
     size_t row;
     unsigned char *px = stbi_load(path, w, h, &n, 1), *tmp;
     if (!px) {
-        fprintf(stderr, "surfblend: cannot read the trimming mask '%s': %s\n", path, stbi_failure_reason());
+        cli_error("cannot read the trimming mask '%s': %s", path, stbi_failure_reason());
         return NULL;
     }
     row = (size_t)*w;
     tmp = (unsigned char *)malloc(row ? row : 1);
     if (!tmp) {
-        fprintf(stderr, "surfblend: out of memory reading '%s'\n", path);
+        cli_error("out of memory reading '%s'", path);
         stbi_image_free(px);
         return NULL;
     }
@@ -667,108 +664,245 @@ static unsigned char *load_mask(const char *path, int *w, int *h) {
     return px;
 }
 
-static int cmd_tess(int argc, char **argv) {
-    const char *in = NULL, *outp = NULL, *backend = NULL, *trim_path = NULL;
-    long rate = -1, tiles_u = 0, tiles_v = 0;
-    int have_tiles = 0;
+/* The trimming mask of --trim (with --trim-tiles) into *mask; 1, or 0 with a message printed.
+ * *texels is what to free (stbi_image_free). */
+static int load_trim(const cli_opts *o, sfb_trim_mask *mask, unsigned char **texels) {
+    memset(mask, 0, sizeof *mask);
+    *texels = NULL;
+    if (!o->trim) return 1;
+    *texels = load_mask(o->trim, &mask->width, &mask->height);
+    if (!*texels) return 0;
+    mask->texels = *texels;
+    mask->tiles_u = (int)o->tiles[0];
+    mask->tiles_v = (int)o->tiles[1];
+    return 1;
+}
+
+/* ---- the commands ---- */
+
+static int cmd_info(cli_opts *o) {
+    sfb_context *ctx;
+    sfb_mesh *mesh;
+    sfb_mesh_info in;
+    int hist[33], over, i, problems = 0;
+    ctx = cli_make_context(NULL);
+    if (!ctx) return 1;
+    mesh = cli_load_obj(ctx, o->in);
+    if (!mesh) { sfb_context_destroy(ctx); return 1; }
+    sfb_mesh_get_info(mesh, &in);
+    printf("file:        %s\n", o->in);
+    printf("vertices:    %d\nfaces:       %d (%d triangles, %d quads, %d n-gons, largest %d)\n", in.vertex_count, in.face_count,
+           in.triangles, in.quads, in.ngons, in.max_face_size);
+    printf("edges:       %d (%d boundary)\nuvs:         %d\n", in.edge_count, in.boundary_edges, in.uv_count);
+    printf("creases:     %d sharp edges (%d semi-sharp, %d infinitely sharp), %d corner vertices tagged, %d holes\n",
+           in.sharp_edges, in.semisharp_edges, in.infsharp_edges, in.corners, in.holes);
+    printf("rules:       %d darts, %d crease vertices, %d corner vertices\n", in.darts, in.crease_vertices, in.corner_vertices);
+    printf("extraordinary vertices: %d for Catmull-Clark, %d for Loop\n", in.extraordinary_catmark, in.extraordinary_loop);
+    printf("bbox:        (%g %g %g) - (%g %g %g)\n", in.bbox_min[0], in.bbox_min[1], in.bbox_min[2], in.bbox_max[0],
+           in.bbox_max[1], in.bbox_max[2]);
+    over = sfb_mesh_valence_histogram(mesh, hist, 33);
+    printf("valence histogram (edges per vertex):");
+    for (i = 0; i < 33; ++i)
+        if (hist[i]) printf(" %d:%d", i, hist[i]);
+    if (over) printf(" >32:%d", over);
+    printf("\nmax valence: %d\n", in.max_valence);
+    printf("problems:   ");
+    if (in.nonmanifold_edges) { printf(" %d non-manifold edges;", in.nonmanifold_edges); problems++; }
+    if (in.nonmanifold_vertices) { printf(" %d non-manifold vertices (treated as corners);", in.nonmanifold_vertices); problems++; }
+    if (in.bare_vertices) { printf(" %d vertices in no face;", in.bare_vertices); problems++; }
+    if (in.triangles + in.ngons > 0 && in.quads > 0) { printf(" mixed face sizes (Loop needs all triangles);"); problems++; }
+    if (!problems) printf(" none");
+    printf("\n");
+    sfb_mesh_destroy(mesh);
+    sfb_context_destroy(ctx);
+    return 0;
+}
+
+static int cmd_refine(cli_opts *o) {
+    sfb_scheme scheme = cli_scheme_for(o->in, o->seen[O_SCHEME], (sfb_scheme)o->scheme);
+    int i, rc = 1;
+    sfb_context *ctx = NULL;
+    sfb_mesh *mesh = NULL;
+    sfb_surface *surf = NULL;
+    sfb_surface_config cfg;
+    sfb_mesh_data data;
+    sfb_mesh_desc d;
+    sfb_result r;
+    cli_output out;
+    memset(&data, 0, sizeof data);
+    memset(&out, 0, sizeof out);
+    ctx = cli_make_context(o->backend);
+    if (!ctx) return 1;
+    mesh = cli_load_obj(ctx, o->in);
+    if (!mesh) goto done;
+    cfg = sfb_surface_config_init(scheme, o->level);
+    cfg.flags = SFB_REFINE_UVS | (o->limit ? SFB_REFINE_LIMIT : 0u);
+    r = sfb_surface_create(ctx, mesh, &cfg, &surf);
+    if (r == SFB_SUCCESS) r = sfb_surface_refine(surf, &data);
+    if (r != SFB_SUCCESS) {
+        cli_error("%s: %s: %s", o->in, sfb_result_string(r), sfb_last_error(ctx));
+        goto done;
+    }
+    if (!cli_output_open(&out, o->outp)) goto done;
+    sfb_mesh_data_desc(&data, &d);
+    if (o->limit) {
+        d.positions = data.limit_positions;
+        for (i = 0; i < data.vertex_count; ++i)
+            fprintf(out.f, "vn %.7g %.7g %.7g\n", data.normals[3 * i], data.normals[3 * i + 1], data.normals[3 * i + 2]);
+    }
+    r = sfb_write_obj(&d, cli_file_write, out.f);
+    if (r != SFB_SUCCESS) {
+        cli_error("writing '%s' failed: %s", o->outp, sfb_result_string(r));
+        goto done;
+    }
+    cli_error("%s level %d: %d vertices, %d faces -> %s (backend %s)", sfb_scheme_name(scheme), o->level, data.vertex_count,
+              data.face_count, o->outp, sfb_context_backend_name(ctx));
+    rc = 0;
+done:
+    rc = cli_output_finish(&out, rc);
+    sfb_mesh_data_free(&data);
+    sfb_surface_destroy(surf);
+    sfb_mesh_destroy(mesh);
+    sfb_context_destroy(ctx);
+    return rc;
+}
+
+/* eval's locations: from --locations, or --random on the faces that are not holes. */
+static int eval_locations(sfb_context *ctx, const sfb_surface *surf, const cli_opts *o, sfb_scheme scheme, loc_list *L) {
+    if (o->locfile) return read_locations(o->locfile, L);
+    return random_locations(ctx, surf, scheme == SFB_SCHEME_LOOP, o->nrandom, (unsigned long long)o->seed, L);
+}
+
+/* One line per location: face u v, position, normal[, du, dv]. */
+static void eval_print(FILE *f, const loc_list *L, const sfb_eval_output *eo) {
+    int i;
+    for (i = 0; i < L->count; ++i) {
+        const float *p = eo->position + 3 * (size_t)i, *nn = eo->normal + 3 * (size_t)i;
+        fprintf(f, "%d %.9g %.9g %.9g %.9g %.9g %.9g %.9g %.9g", L->loc[i].face, L->loc[i].u, L->loc[i].v, p[0], p[1], p[2], nn[0],
+                nn[1], nn[2]);
+        if (eo->du) {
+            const float *a = eo->du + 3 * (size_t)i, *b = eo->dv + 3 * (size_t)i;
+            fprintf(f, " %.9g %.9g %.9g %.9g %.9g %.9g", a[0], a[1], a[2], b[0], b[1], b[2]);
+        }
+        fputc('\n', f);
+    }
+}
+
+static int cmd_eval(cli_opts *o) {
+    int rc = 1;
+    sfb_scheme scheme = cli_scheme_for(o->in, o->seen[O_SCHEME], (sfb_scheme)o->scheme);
+    sfb_context *ctx = NULL;
+    sfb_mesh *mesh = NULL;
+    sfb_surface *surf = NULL;
+    loc_list L;
+    float *buf = NULL;
+    sfb_eval_output eo;
+    sfb_result r;
+    size_t n;
+    cli_output out;
+    memset(&L, 0, sizeof L);
+    memset(&eo, 0, sizeof eo);
+    memset(&out, 0, sizeof out);
+    if ((o->nrandom >= 0) == (o->locfile != NULL)) return usage_error(o->cmd, "eval needs either --random N or --locations FILE");
+    ctx = cli_make_context(o->backend);
+    if (!ctx) return 1;
+    mesh = cli_load_obj(ctx, o->in);
+    if (!mesh) goto done;
+    surf = make_patch_surface(ctx, mesh, o->in, scheme, o->weights);
+    if (!surf || !eval_locations(ctx, surf, o, scheme, &L)) goto done;
+    n = (size_t)L.count;
+    buf = (float *)malloc((n + 1) * 12 * sizeof(float));
+    if (!buf) { cli_error("out of memory"); goto done; }
+    eo.position = buf;
+    eo.normal = buf + 3 * n;
+    if (o->derivatives) { eo.du = buf + 6 * n; eo.dv = buf + 9 * n; }
+    r = sfb_surface_eval(surf, L.loc, L.count, &eo);
+    if (r != SFB_SUCCESS) {
+        sfb_error_info e = sfb_last_error_info(ctx);
+        if (o->locfile && e.index >= 0 && e.index < L.count)
+            cli_error("%s: line %ld: %s: %s", o->locfile, L.line[e.index], sfb_result_string(r), sfb_last_error(ctx));
+        else
+            cli_error("%s: %s: %s", o->in, sfb_result_string(r), sfb_last_error(ctx));
+        goto done;
+    }
+    if (!cli_output_open(&out, o->outp)) goto done;
+    eval_print(out.f, &L, &eo);
+    rc = 0;
+done:
+    rc = cli_output_finish(&out, rc);
+    free(buf);
+    free(L.loc);
+    free(L.line);
+    sfb_surface_destroy(surf);
+    sfb_mesh_destroy(mesh);
+    sfb_context_destroy(ctx);
+    return rc;
+}
+
+/* The tessellation as OBJ: v, vn, f v//vn. */
+static void tess_print(FILE *f, const cli_opts *o, const sfb_tess_data *td) {
+    int i;
+    fprintf(f, "# surfblend tess of %s: rate %ld%s%s%s%s, %d vertices, %d triangles\n", o->in, o->rate, o->tolerance > 0.0 ? " adaptive" : "",
+            o->split ? " split creases" : "", o->trim ? " trimmed by " : "", o->trim ? o->trim : "", td->vertex_count, td->triangle_count);
+    for (i = 0; i < td->vertex_count; ++i)
+        fprintf(f, "v %.7g %.7g %.7g\n", td->positions[3 * i], td->positions[3 * i + 1], td->positions[3 * i + 2]);
+    for (i = 0; i < td->vertex_count; ++i)
+        fprintf(f, "vn %.7g %.7g %.7g\n", td->normals[3 * i], td->normals[3 * i + 1], td->normals[3 * i + 2]);
+    for (i = 0; i < td->triangle_count; ++i) {
+        int a = td->triangles[3 * i] + 1, b = td->triangles[3 * i + 1] + 1, c = td->triangles[3 * i + 2] + 1;
+        fprintf(f, "f %d//%d %d//%d %d//%d\n", a, a, b, b, c, c);
+    }
+}
+
+/* The summary line on stderr, with the edge counts; 0 when out of memory (printed). */
+static int tess_summary(const cli_opts *o, const sfb_tess_data *td, const sfb_trim_mask *mask, sfb_context *ctx) {
+    long total, closed, boundary, more;
+    char trimmed[64] = "";
+    if (!edge_counts(td, &total, &closed, &boundary, &more)) { cli_error("out of memory"); return 0; }
+    if (o->trim) snprintf(trimmed, sizeof trimmed, " trimmed (%dx%d mask)", mask->width, mask->height);
+    cli_error("tess rate %ld%s%s: %d vertices, %d triangles, %ld edges (%ld closed, %ld boundary%s) -> %s (backend %s)", o->rate,
+              o->tolerance > 0.0 ? " adaptive" : "", trimmed, td->vertex_count, td->triangle_count, total, closed, boundary,
+              more ? ", some non-manifold" : "", o->outp, sfb_context_backend_name(ctx));
+    return 1;
+}
+
+static int cmd_tess(cli_opts *o) {
     unsigned char *texels = NULL;
     sfb_trim_mask mask;
-    double tolerance = 0.0;
-    int split = 0, i, rc = 1, have_scheme = 0, weights = SFB_MANIFOLD_WEIGHTS_HERMITE;
-    sfb_scheme scheme = SFB_SCHEME_CATMARK;
+    int rc = 1;
     sfb_context *ctx = NULL;
     sfb_mesh *mesh = NULL;
     sfb_surface *surf = NULL;
     sfb_tess_config tc;
     sfb_tess_data td;
     sfb_result r;
-    FILE *f = NULL;
+    cli_output out;
     memset(&td, 0, sizeof td);
-    for (i = 0; i < argc; ++i) {
-        if (strcmp(argv[i], "--rate") == 0) {
-            /* the range (1..1024) is the library's to check and report */
-            if (++i >= argc || !parse_int(argv[i], -2147483647L, 2147483647L, &rate)) return usage("--rate needs a number");
-        } else if (strcmp(argv[i], "--tolerance") == 0) {
-            char *end;
-            if (++i >= argc) return usage("--tolerance needs a number");
-            tolerance = strtod(argv[i], &end);
-            if (end == argv[i] || *end) return usage("--tolerance needs a number");
-        } else if (strcmp(argv[i], "--split-creases") == 0) {
-            split = 1;
-        } else if (strcmp(argv[i], "--scheme") == 0) {
-            if (++i >= argc || !scheme_from_name(argv[i], &scheme)) return usage("--scheme needs catmark, loop or manifold");
-            have_scheme = 1;
-        } else if (strcmp(argv[i], "--weights") == 0) {
-            if (++i >= argc || !weights_from_name(argv[i], &weights)) return usage("--weights needs hermite or cinf");
-        } else if (strcmp(argv[i], "--trim") == 0) {
-            if (++i >= argc) return usage("--trim needs a PNG file");
-            trim_path = argv[i];
-        } else if (strcmp(argv[i], "--trim-tiles") == 0) {
-            /* the counts are the library's to check against the mask */
-            if (i + 2 >= argc || !parse_int(argv[i + 1], -2147483647L, 2147483647L, &tiles_u) ||
-                !parse_int(argv[i + 2], -2147483647L, 2147483647L, &tiles_v))
-                return usage("--trim-tiles needs two numbers U V");
-            i += 2;
-            have_tiles = 1;
-        } else {
-            int ur = common_arg(argc, argv, &i, "tess", &backend, &outp, &in);
-            if (ur) return ur;
-        }
-    }
-    if (!in) return usage("tess needs an input OBJ file");
-    if (!outp) return usage("tess needs -o OUT.obj");
-    if (rate == -1) return usage("tess needs --rate N");
-    if (have_tiles && !trim_path) return usage("--trim-tiles needs --trim MASK.png");
-    memset(&mask, 0, sizeof mask);
-    if (trim_path) {
-        texels = load_mask(trim_path, &mask.width, &mask.height);
-        if (!texels) return 1;
-        mask.texels = texels;
-        mask.tiles_u = (int)tiles_u;
-        mask.tiles_v = (int)tiles_v;
-    }
-    ctx = make_context(backend);
+    memset(&out, 0, sizeof out);
+    if (!o->seen[O_RATE]) return usage_error(o->cmd, "tess needs --rate N");
+    if (o->seen[O_TILES] && !o->trim) return usage_error(o->cmd, "--trim-tiles needs --trim MASK.png");
+    if (!load_trim(o, &mask, &texels)) return 1;
+    ctx = cli_make_context(o->backend);
     if (!ctx) { stbi_image_free(texels); return 1; }
-    mesh = load(ctx, in);
+    mesh = cli_load_obj(ctx, o->in);
     if (!mesh) goto done;
-    surf = make_patch_surface(ctx, mesh, in, scheme_for(in, have_scheme, scheme), weights);
+    surf = make_patch_surface(ctx, mesh, o->in, cli_scheme_for(o->in, o->seen[O_SCHEME], (sfb_scheme)o->scheme), o->weights);
     if (!surf) goto done;
-    tc = sfb_tess_config_init((int)rate);
-    tc.tolerance = (float)tolerance;
-    tc.flags = split ? (unsigned)SFB_TESS_SPLIT_CREASES : 0u;
-    tc.trim = trim_path ? &mask : NULL;
+    tc = sfb_tess_config_init((int)o->rate);
+    tc.tolerance = (float)o->tolerance;
+    tc.flags = o->split ? (unsigned)SFB_TESS_SPLIT_CREASES : 0u;
+    tc.trim = o->trim ? &mask : NULL;
     r = sfb_surface_tessellate(surf, &tc, &td);
     if (r != SFB_SUCCESS) {
-        fprintf(stderr, "surfblend: %s: %s: %s\n", in, sfb_result_string(r), sfb_last_error(ctx));
+        cli_error("%s: %s: %s", o->in, sfb_result_string(r), sfb_last_error(ctx));
         goto done;
     }
-    f = strcmp(outp, "-") == 0 ? stdout : fopen(outp, "wb");
-    if (!f) {
-        fprintf(stderr, "surfblend: cannot write '%s'\n", outp);
-        goto done;
-    }
-    fprintf(f, "# surfblend tess of %s: rate %ld%s%s%s%s, %d vertices, %d triangles\n", in, rate, tolerance > 0.0 ? " adaptive" : "",
-            split ? " split creases" : "", trim_path ? " trimmed by " : "", trim_path ? trim_path : "", td.vertex_count, td.triangle_count);
-    for (i = 0; i < td.vertex_count; ++i)
-        fprintf(f, "v %.7g %.7g %.7g\n", td.positions[3 * i], td.positions[3 * i + 1], td.positions[3 * i + 2]);
-    for (i = 0; i < td.vertex_count; ++i)
-        fprintf(f, "vn %.7g %.7g %.7g\n", td.normals[3 * i], td.normals[3 * i + 1], td.normals[3 * i + 2]);
-    for (i = 0; i < td.triangle_count; ++i) {
-        int a = td.triangles[3 * i] + 1, b = td.triangles[3 * i + 1] + 1, c = td.triangles[3 * i + 2] + 1;
-        fprintf(f, "f %d//%d %d//%d %d//%d\n", a, a, b, b, c, c);
-    }
-    {
-        long total, closed, boundary, more;
-        if (!edge_counts(&td, &total, &closed, &boundary, &more)) { fprintf(stderr, "surfblend: out of memory\n"); goto done; }
-        char trimmed[64] = "";
-        if (trim_path) snprintf(trimmed, sizeof trimmed, " trimmed (%dx%d mask)", mask.width, mask.height);
-        fprintf(stderr, "surfblend: tess rate %ld%s%s: %d vertices, %d triangles, %ld edges (%ld closed, %ld boundary%s) -> %s (backend %s)\n",
-                rate, tolerance > 0.0 ? " adaptive" : "", trimmed, td.vertex_count, td.triangle_count, total, closed, boundary,
-                more ? ", some non-manifold" : "", outp, sfb_context_backend_name(ctx));
-    }
+    if (!cli_output_open(&out, o->outp)) goto done;
+    tess_print(out.f, o, &td);
+    if (!tess_summary(o, &td, &mask, ctx)) goto done;
     rc = 0;
 done:
-    if (f && f != stdout && fclose(f) != 0 && rc == 0) { fprintf(stderr, "surfblend: writing '%s' failed\n", outp); rc = 1; }
+    rc = cli_output_finish(&out, rc);
     sfb_tess_data_free(&td);
     sfb_surface_destroy(surf);
     sfb_mesh_destroy(mesh);
@@ -779,98 +913,28 @@ done:
 
 /* ---- subdivision shading (seed 001) and software pictures ---- */
 
-/* Options shared by `shade` and `render`: the surface, the shading options, the blend. */
-typedef struct shade_opts {
-    const char *in, *outp, *backend;
-    sfb_scheme scheme;
-    int have_scheme, level, variant, darts, normals_level, weights_level, all_subdivided, averaging;
-    double p;
-} shade_opts;
-
-static void shade_opts_init(shade_opts *o, int level) {
-    memset(o, 0, sizeof *o);
-    o->scheme = SFB_SCHEME_CATMARK;
-    o->level = level;
-    o->p = 1.0;
-}
-
-/* A shading level on the command line: 0 is the control mesh (SFB_SHADE_LEVEL_CONTROL; 0 in
- * the struct means the default, level 1). Whether it fits the refinement level is the
- * library's to check. */
-static int parse_shade_level(const char *s, int *out) {
-    long l;
-    if (!parse_int(s, 0, 1000, &l)) return 0;
-    *out = l == 0 ? SFB_SHADE_LEVEL_CONTROL : (int)l;
-    return 1;
-}
-
-/* Consumes argv[*i] (and its value) when it is a shading option: returns 1; 0 when it is not
- * one; a negative value -(usage status) on a bad value. */
-static int shade_arg(int argc, char **argv, int *i, shade_opts *o) {
-    const char *a = argv[*i];
-    if (strcmp(a, "--scheme") == 0) {
-        if (++*i >= argc || !scheme_from_name(argv[*i], &o->scheme) || o->scheme == SFB_SCHEME_BILINEAR)
-            return -usage("--scheme needs catmark or loop");
-        o->have_scheme = 1;
-    } else if (strcmp(a, "--level") == 0) {
-        long l;
-        if (++*i >= argc || !parse_int(argv[*i], 0, 1000, &l)) return -usage("--level needs a number >= 0");
-        o->level = (int)l;
-    } else if (strcmp(a, "--variant") == 0) {
-        if (++*i >= argc) return -usage("--variant needs A or B");
-        if (strcmp(argv[*i], "A") == 0 || strcmp(argv[*i], "a") == 0) o->variant = SFB_SHADE_VARIANT_A;
-        else if (strcmp(argv[*i], "B") == 0 || strcmp(argv[*i], "b") == 0) o->variant = SFB_SHADE_VARIANT_B;
-        else return -usage("--variant needs A or B");
-    } else if (strcmp(a, "--darts") == 0) {
-        if (++*i >= argc) return -usage("--darts needs smooth or sharp");
-        if (strcmp(argv[*i], "smooth") == 0) o->darts = SFB_SHADE_DARTS_SMOOTH;
-        else if (strcmp(argv[*i], "sharp") == 0) o->darts = SFB_SHADE_DARTS_SHARP;
-        else return -usage("--darts needs smooth or sharp");
-    } else if (strcmp(a, "--normals-level") == 0) {
-        if (++*i >= argc || !parse_shade_level(argv[*i], &o->normals_level)) return -usage("--normals-level needs a level >= 0 (0: the control mesh)");
-    } else if (strcmp(a, "--weights-level") == 0) {
-        if (++*i >= argc || !parse_shade_level(argv[*i], &o->weights_level)) return -usage("--weights-level needs a level >= 0 (0: the control mesh)");
-    } else if (strcmp(a, "--p") == 0) {
-        char *end;
-        if (++*i >= argc) return -usage("--p needs a number > 0");
-        o->p = strtod(argv[*i], &end);
-        if (end == argv[*i] || *end || !(o->p > 0.0) || !isfinite(o->p) || o->p > 1e30) return -usage("--p needs a number > 0");
-    } else if (strcmp(a, "--averaging") == 0) {
-        if (++*i >= argc) return -usage("--averaging needs linear, renormalized or spherical");
-        if (strcmp(argv[*i], "linear") == 0) o->averaging = SFB_SHADE_AVERAGE_LINEAR;
-        else if (strcmp(argv[*i], "renormalized") == 0) o->averaging = SFB_SHADE_AVERAGE_RENORMALIZED;
-        else if (strcmp(argv[*i], "spherical") == 0) o->averaging = SFB_SHADE_AVERAGE_SPHERICAL;
-        else return -usage("--averaging needs linear, renormalized or spherical");
-    } else if (strcmp(a, "--all-subdivided") == 0) {
-        o->all_subdivided = 1;
-    } else {
-        return 0;
-    }
-    return 1;
-}
-
 /* Builds the shading surface of o->in and shades it into *data. Returns 1 on success; on
  * failure prints why and returns 0 (what was made is freed by the caller). */
-static int shade_mesh(sfb_context *ctx, const shade_opts *o, sfb_mesh **mesh, sfb_surface **surf, sfb_mesh_data *data) {
+static int shade_mesh(sfb_context *ctx, const cli_opts *o, sfb_mesh **mesh, sfb_surface **surf, sfb_mesh_data *data) {
     sfb_surface_config cfg;
     sfb_shade_params sp;
     sfb_result r;
-    *mesh = load(ctx, o->in);
+    *mesh = cli_load_obj(ctx, o->in);
     if (!*mesh) return 0;
-    cfg = sfb_surface_config_init(scheme_for(o->in, o->have_scheme, o->scheme), o->level);
+    cfg = sfb_surface_config_init(cli_scheme_for(o->in, o->seen[O_SCHEME], (sfb_scheme)o->scheme), o->level);
     cfg.flags = SFB_REFINE_LIMIT | SFB_REFINE_SHADING;
-    cfg.shading.variant = o->variant;
-    cfg.shading.darts = o->darts;
+    cfg.shading.variant = (sfb_shade_variant)o->variant;
+    cfg.shading.darts = (sfb_shade_darts)o->darts;
     cfg.shading.normals_level = o->normals_level;
     cfg.shading.weights_level = o->weights_level;
-    cfg.shading.averaging = o->averaging;
+    cfg.shading.averaging = (sfb_shade_averaging)o->averaging;
     sp = sfb_shade_params_init();
     sp.p = (float)o->p;
     sp.flags = o->all_subdivided ? (unsigned)SFB_SHADE_ALL_SUBDIVIDED : 0u;
     r = sfb_surface_create(ctx, *mesh, &cfg, surf);
     if (r == SFB_SUCCESS) r = sfb_surface_shade(*surf, &sp, data);
     if (r != SFB_SUCCESS) {
-        fprintf(stderr, "surfblend: %s: %s: %s\n", o->in, sfb_result_string(r), sfb_last_error(ctx));
+        cli_error("%s: %s: %s", o->in, sfb_result_string(r), sfb_last_error(ctx));
         return 0;
     }
     return 1;
@@ -878,7 +942,7 @@ static int shade_mesh(sfb_context *ctx, const shade_opts *o, sfb_mesh **mesh, sf
 
 /* Output vertices, refined vertices with more than one copy, and the share of output
  * vertices where N_S was computed. */
-static void shade_summary(const char *what, const shade_opts *o, const sfb_mesh_data *d, sfb_context *ctx, const char *outp) {
+static void shade_summary(const char *what, const cli_opts *o, const sfb_mesh_data *d, sfb_context *ctx) {
     int split = 0, i;
     int *copies = d->refined_vertex_count > 0 ? (int *)calloc((size_t)d->refined_vertex_count, sizeof(int)) : NULL;
     if (copies && d->vertex_origin) {
@@ -888,90 +952,57 @@ static void shade_summary(const char *what, const shade_opts *o, const sfb_mesh_
         }
     }
     free(copies);
-    fprintf(stderr, "surfblend: %s %s level %d: %d output vertices (%d refined, %d split), %d faces; N_S computed at %d vertices (%.1f%%) -> %s (backend %s)\n",
-            what, sfb_scheme_name(scheme_for(o->in, o->have_scheme, o->scheme)), o->level, d->vertex_count, d->refined_vertex_count,
-            split, d->face_count, d->subdivided_count, d->vertex_count > 0 ? 100.0 * d->subdivided_count / d->vertex_count : 0.0, outp,
-            sfb_context_backend_name(ctx));
+    cli_error("%s %s level %d: %d output vertices (%d refined, %d split), %d faces; N_S computed at %d vertices (%.1f%%) -> %s (backend %s)",
+              what, sfb_scheme_name(cli_scheme_for(o->in, o->seen[O_SCHEME], (sfb_scheme)o->scheme)), o->level, d->vertex_count,
+              d->refined_vertex_count, split, d->face_count, d->subdivided_count,
+              d->vertex_count > 0 ? 100.0 * d->subdivided_count / d->vertex_count : 0.0, o->outp, sfb_context_backend_name(ctx));
 }
 
-/* Finishes an output file: closes it, and removes it when anything failed, so that no
- * partial file is left behind. Returns rc, or 1 when closing failed. */
-static int finish_output(FILE *f, const char *outp, int rc) {
-    if (f == stdout) {
-        if (fflush(stdout) != 0 && rc == 0) { fprintf(stderr, "surfblend: writing the output failed\n"); rc = 1; }
-    } else if (f) {
-        if (fclose(f) != 0 && rc == 0) { fprintf(stderr, "surfblend: writing '%s' failed\n", outp); rc = 1; }
-        if (rc != 0) remove(outp);
+/* The shaded mesh as OBJ: a comment with the options, v, vn (N_B), f v//vn. */
+static void shade_print(FILE *f, const cli_opts *o, const sfb_mesh_data *data) {
+    const float *pos = o->limit ? data->limit_positions : data->positions;
+    size_t off = 0;
+    int i, j;
+    fprintf(f, "# surfblend shade of %s: %s level %d, variant %s, darts %s, averaging %s, p %g; %d vertices (%d refined), %d faces\n",
+            o->in, sfb_scheme_name(cli_scheme_for(o->in, o->seen[O_SCHEME], (sfb_scheme)o->scheme)), o->level,
+            o->variant == SFB_SHADE_VARIANT_A ? "A" : "B", o->darts == SFB_SHADE_DARTS_SHARP ? "sharp" : "smooth",
+            averaging_choices[o->averaging].name, o->p, data->vertex_count, data->refined_vertex_count, data->face_count);
+    for (i = 0; i < data->vertex_count; ++i) fprintf(f, "v %.7g %.7g %.7g\n", pos[3 * i], pos[3 * i + 1], pos[3 * i + 2]);
+    for (i = 0; i < data->vertex_count; ++i)
+        fprintf(f, "vn %.7g %.7g %.7g\n", data->normals[3 * i], data->normals[3 * i + 1], data->normals[3 * i + 2]);
+    for (i = 0; i < data->face_count; ++i) {
+        fputc('f', f);
+        for (j = 0; j < data->face_sizes[i]; ++j) {
+            int v = data->face_vertices[off + (size_t)j] + 1;
+            fprintf(f, " %d//%d", v, v);
+        }
+        fputc('\n', f);
+        off += (size_t)data->face_sizes[i];
     }
-    return rc;
 }
 
-static int cmd_shade(int argc, char **argv) {
-    shade_opts o;
-    int limit = 0, i, rc = 1;
+static int cmd_shade(cli_opts *o) {
+    int rc = 1;
     sfb_context *ctx = NULL;
     sfb_mesh *mesh = NULL;
     sfb_surface *surf = NULL;
     sfb_mesh_data data;
-    FILE *f = NULL;
+    cli_output out;
     memset(&data, 0, sizeof data);
-    shade_opts_init(&o, 3);
-    for (i = 0; i < argc; ++i) {
-        int sr = shade_arg(argc, argv, &i, &o);
-        if (sr < 0) return -sr;
-        if (sr) continue;
-        if (strcmp(argv[i], "--limit") == 0) {
-            limit = 1;
-        } else {
-            int ur = common_arg(argc, argv, &i, "shade", &o.backend, &o.outp, &o.in);
-            if (ur) return ur;
-        }
-    }
-    if (!o.in) return usage("shade needs an input OBJ file");
-    if (!o.outp) return usage("shade needs -o OUT.obj");
-    ctx = make_context(o.backend);
+    memset(&out, 0, sizeof out);
+    ctx = cli_make_context(o->backend);
     if (!ctx) return 1;
-    if (!shade_mesh(ctx, &o, &mesh, &surf, &data)) goto done;
-    if (!data.normals || (limit && !data.limit_positions)) {
-        fprintf(stderr, "surfblend: %s: the shaded mesh lacks %s\n", o.in, data.normals ? "limit positions" : "normals");
+    if (!shade_mesh(ctx, o, &mesh, &surf, &data)) goto done;
+    if (!data.normals || (o->limit && !data.limit_positions)) {
+        cli_error("%s: the shaded mesh lacks %s", o->in, data.normals ? "limit positions" : "normals");
         goto done;
     }
-    f = strcmp(o.outp, "-") == 0 ? stdout : fopen(o.outp, "wb");
-    if (!f) {
-        fprintf(stderr, "surfblend: cannot write '%s'\n", o.outp);
-        goto done;
-    }
-    {
-        const float *pos = limit ? data.limit_positions : data.positions;
-        size_t off = 0;
-        int ok = 1, j;
-        static const char *averaging_names[3] = { "linear", "renormalized", "spherical" };
-        ok &= fprintf(f, "# surfblend shade of %s: %s level %d, variant %s, darts %s, averaging %s, p %g; %d vertices (%d refined), %d faces\n",
-                      o.in, sfb_scheme_name(scheme_for(o.in, o.have_scheme, o.scheme)), o.level, o.variant == SFB_SHADE_VARIANT_A ? "A" : "B",
-                      o.darts == SFB_SHADE_DARTS_SHARP ? "sharp" : "smooth", averaging_names[o.averaging], o.p, data.vertex_count,
-                      data.refined_vertex_count, data.face_count) > 0;
-        for (i = 0; i < data.vertex_count && ok; ++i)
-            ok &= fprintf(f, "v %.7g %.7g %.7g\n", pos[3 * i], pos[3 * i + 1], pos[3 * i + 2]) > 0;
-        for (i = 0; i < data.vertex_count && ok; ++i)
-            ok &= fprintf(f, "vn %.7g %.7g %.7g\n", data.normals[3 * i], data.normals[3 * i + 1], data.normals[3 * i + 2]) > 0;
-        for (i = 0; i < data.face_count && ok; ++i) {
-            ok &= fputc('f', f) != EOF;
-            for (j = 0; j < data.face_sizes[i]; ++j) {
-                int v = data.face_vertices[off + (size_t)j] + 1;
-                ok &= fprintf(f, " %d//%d", v, v) > 0;
-            }
-            ok &= fputc('\n', f) != EOF;
-            off += (size_t)data.face_sizes[i];
-        }
-        if (!ok) {
-            fprintf(stderr, "surfblend: writing '%s' failed\n", o.outp);
-            goto done;
-        }
-    }
-    shade_summary("shade", &o, &data, ctx, o.outp);
+    if (!cli_output_open(&out, o->outp)) goto done;
+    shade_print(out.f, o, &data);
+    shade_summary("shade", o, &data, ctx);
     rc = 0;
 done:
-    rc = finish_output(f, o.outp, rc);
+    rc = cli_output_finish(&out, rc);
     sfb_mesh_data_free(&data);
     sfb_surface_destroy(surf);
     sfb_mesh_destroy(mesh);
@@ -979,231 +1010,145 @@ done:
     return rc;
 }
 
-/* PNG bytes gathered in memory, so that a failed render leaves no file at all. */
-typedef struct png_buf { unsigned char *data; size_t size, cap; int failed; } png_buf;
+/* What render makes and frees. */
+typedef struct render_state {
+    sfb_context *ctx;
+    sfb_mesh *mesh;
+    sfb_surface *surf;
+    sfb_mesh_data data; /* the shaded mesh, or (--scheme manifold) a view of td */
+    sfb_tess_data td;
+    int *face_sizes;    /* --scheme manifold: data.face_sizes, all 3 */
+    unsigned char *texels;
+    sfb_trim_mask mask;
+    sfb_image img;
+} render_state;
 
-static void png_append(void *user, void *data, int size) {
-    png_buf *b = (png_buf *)user;
-    if (b->failed || size <= 0) return;
-    if (b->size + (size_t)size > b->cap) {
-        size_t nc = b->cap ? b->cap : 1 << 16;
-        unsigned char *nd;
-        while (nc < b->size + (size_t)size) nc *= 2;
-        nd = (unsigned char *)realloc(b->data, nc);
-        if (!nd) { b->failed = 1; return; }
-        b->data = nd;
-        b->cap = nc;
-    }
-    memcpy(b->data + b->size, data, (size_t)size);
-    b->size += (size_t)size;
+/* The option combinations render refuses: 0, or usage_error()'s status. */
+static int render_check(cli_opts *o) {
+    int manifold = o->scheme == SFB_SCHEME_MANIFOLD_BLEND;
+    if (o->seen[O_MODE] > 1) return usage_error(o->cmd, "render takes one of --highlight, --blend-weights, --normal-colors");
+    if (!manifold && (o->seen[O_RATE] || o->trim))
+        return usage_error(o->cmd, "--rate and --trim belong to --scheme manifold (the subdivision schemes render their shaded refinement)");
+    if (o->seen[O_TILES] && !o->trim) return usage_error(o->cmd, "--trim-tiles needs --trim MASK.png");
+    if (manifold && o->mode == SFB_RENDER_WEIGHTS)
+        return usage_error(o->cmd, "--blend-weights pictures belong to subdivision shading (the manifold blend's are --manifold-weights)");
+    if (o->normals == 1) o->all_subdivided = 1;
+    return 0;
 }
 
-static int cmd_render(int argc, char **argv) {
-    shade_opts o;
-    int i, rc = 1, mode = SFB_RENDER_SHADED, modes = 0, normals = 2 /* 0 limit, 1 subdivided, 2 blended */, limit_pos = 1, edges = 0;
-    long width = 640, height = 480;
-    int view_set = 0, weights = SFB_MANIFOLD_WEIGHTS_HERMITE, have_rate = 0, have_tiles = 0;
-    long rate = 16, tiles_u = 0, tiles_v = 0;
-    const char *trim_path = NULL;
-    unsigned char *texels = NULL;
-    sfb_trim_mask mask;
-    sfb_tess_data td;
-    double yaw = 0.0, pitch = 0.0, zoom = 0.0, stripes = 0.0;
-    sfb_context *ctx = NULL;
-    sfb_mesh *mesh = NULL;
-    sfb_surface *surf = NULL;
-    sfb_mesh_data data;
-    sfb_image img;
-    sfb_render_config rcfg;
+/* --scheme manifold: the blending surface, tessellated (and trimmed), as the triangles of
+ * s->data with their normals. 1, or 0 with the reason printed. */
+static int render_manifold_mesh(const cli_opts *o, render_state *s) {
+    sfb_tess_config tc = sfb_tess_config_init((int)(o->rate > 2147483647L ? 2147483647L : o->rate < -2147483647L ? -2147483647L : o->rate));
     sfb_result r;
-    png_buf png;
-    FILE *f = NULL;
-    static const char *normal_names[3] = { "limit", "subdivided", "blended" };
-    memset(&data, 0, sizeof data);
-    memset(&td, 0, sizeof td);
-    memset(&mask, 0, sizeof mask);
-    memset(&img, 0, sizeof img);
-    memset(&png, 0, sizeof png);
-    shade_opts_init(&o, 3);
-    for (i = 0; i < argc; ++i) {
-        int sr = shade_arg(argc, argv, &i, &o);
-        if (sr < 0) return -sr;
-        if (sr) continue;
-        if (strcmp(argv[i], "--normals") == 0) {
-            if (++i >= argc) return usage("--normals needs limit, subdivided or blended");
-            for (normals = 0; normals < 3 && strcmp(argv[i], normal_names[normals]) != 0; ++normals) {}
-            if (normals == 3) return usage("--normals needs limit, subdivided or blended");
-        } else if (strcmp(argv[i], "--positions") == 0) {
-            if (++i >= argc) return usage("--positions needs refined or limit");
-            if (strcmp(argv[i], "limit") == 0) limit_pos = 1;
-            else if (strcmp(argv[i], "refined") == 0) limit_pos = 0;
-            else return usage("--positions needs refined or limit");
-        } else if (strcmp(argv[i], "--rate") == 0) {
-            /* the range (1..1024) is the library's to check and report */
-            if (++i >= argc || !parse_int(argv[i], -2147483647L, 2147483647L, &rate)) return usage("--rate needs a number");
-            have_rate = 1;
-        } else if (strcmp(argv[i], "--manifold-weights") == 0) {
-            if (++i >= argc || !weights_from_name(argv[i], &weights)) return usage("--manifold-weights needs hermite or cinf");
-        } else if (strcmp(argv[i], "--trim") == 0) {
-            if (++i >= argc) return usage("--trim needs a PNG file");
-            trim_path = argv[i];
-        } else if (strcmp(argv[i], "--trim-tiles") == 0) {
-            if (i + 2 >= argc || !parse_int(argv[i + 1], -2147483647L, 2147483647L, &tiles_u) ||
-                !parse_int(argv[i + 2], -2147483647L, 2147483647L, &tiles_v))
-                return usage("--trim-tiles needs two numbers U V");
-            i += 2;
-            have_tiles = 1;
-        } else if (strcmp(argv[i], "--highlight") == 0) {
-            mode = SFB_RENDER_HIGHLIGHT; ++modes;
-        } else if (strcmp(argv[i], "--weights") == 0) {
-            mode = SFB_RENDER_WEIGHTS; ++modes;
-        } else if (strcmp(argv[i], "--normal-colors") == 0) {
-            mode = SFB_RENDER_NORMALS; ++modes;
-        } else if (strcmp(argv[i], "--edges") == 0) {
-            edges = 1;
-        } else if (strcmp(argv[i], "--size") == 0) {
-            char *end;
-            if (++i >= argc) return usage("--size needs WxH");
-            width = strtol(argv[i], &end, 10);
-            if (end == argv[i] || (*end != 'x' && *end != 'X')) return usage("--size needs WxH, e.g. 800x600");
-            {
-                const char *hs = end + 1;
-                height = strtol(hs, &end, 10);
-                if (end == hs || *end) return usage("--size needs WxH, e.g. 800x600");
-            }
-            /* the range (1..8192) is the library's to check and report */
-            if (width < 1 || height < 1 || width > 1000000L || height > 1000000L) return usage("--size needs positive WxH");
-        } else if (strcmp(argv[i], "--view") == 0) {
-            char *end;
-            if (++i >= argc) return usage("--view needs YAW,PITCH in degrees");
-            yaw = strtod(argv[i], &end);
-            if (end == argv[i] || *end != ',') return usage("--view needs YAW,PITCH in degrees, e.g. 30,20");
-            {
-                const char *ps = end + 1;
-                pitch = strtod(ps, &end);
-                if (end == ps || *end || !isfinite(yaw) || !isfinite(pitch)) return usage("--view needs YAW,PITCH in degrees, e.g. 30,20");
-            }
-            view_set = 1;
-        } else if (strcmp(argv[i], "--zoom") == 0) {
-            char *end;
-            if (++i >= argc) return usage("--zoom needs a number > 0");
-            zoom = strtod(argv[i], &end);
-            if (end == argv[i] || *end || !(zoom > 0.0) || zoom > 1e6) return usage("--zoom needs a number > 0");
-        } else if (strcmp(argv[i], "--stripes") == 0) {
-            char *end;
-            if (++i >= argc) return usage("--stripes needs a number > 0");
-            stripes = strtod(argv[i], &end);
-            if (end == argv[i] || *end || !(stripes > 0.0) || stripes > 1e5) return usage("--stripes needs a number in (0, 100000]");
-        } else {
-            int ur = common_arg(argc, argv, &i, "render", &o.backend, &o.outp, &o.in);
-            if (ur) return ur;
-        }
-    }
-    if (!o.in) return usage("render needs an input OBJ file");
-    if (!o.outp) return usage("render needs -o OUT.png");
-    if (modes > 1) return usage("render takes one of --highlight, --weights, --normal-colors");
-    if (normals == 1) o.all_subdivided = 1;
-    if (o.scheme != SFB_SCHEME_MANIFOLD_BLEND && (have_rate || trim_path))
-        return usage("--rate and --trim belong to --scheme manifold (the subdivision schemes render their shaded refinement)");
-    if (have_tiles && !trim_path) return usage("--trim-tiles needs --trim MASK.png");
-    if (o.scheme == SFB_SCHEME_MANIFOLD_BLEND && mode == SFB_RENDER_WEIGHTS) return usage("--weights pictures belong to subdivision shading");
-    if (trim_path) {
-        texels = load_mask(trim_path, &mask.width, &mask.height);
-        if (!texels) return 1;
-        mask.texels = texels;
-        mask.tiles_u = (int)tiles_u;
-        mask.tiles_v = (int)tiles_v;
-    }
-    ctx = make_context(o.backend);
-    if (!ctx) { stbi_image_free(texels); return 1; }
-    if (o.scheme == SFB_SCHEME_MANIFOLD_BLEND) {
-        /* the blending surface, tessellated (and trimmed): the triangles with their normals */
-        sfb_tess_config tc = sfb_tess_config_init((int)(rate > 2147483647L ? 2147483647L : rate < -2147483647L ? -2147483647L : rate));
-        mesh = load(ctx, o.in);
-        if (!mesh) goto done;
-        surf = make_patch_surface(ctx, mesh, o.in, o.scheme, weights);
-        if (!surf) goto done;
-        tc.trim = trim_path ? &mask : NULL;
-        r = sfb_surface_tessellate(surf, &tc, &td);
-        if (r != SFB_SUCCESS) {
-            fprintf(stderr, "surfblend: %s: %s: %s\n", o.in, sfb_result_string(r), sfb_last_error(ctx));
-            goto done;
-        }
-        data.vertex_count = td.vertex_count;
-        data.face_count = td.triangle_count;
-        data.face_vertex_count = 3 * td.triangle_count;
-        data.positions = data.limit_positions = td.positions;
-        data.normals = data.limit_normals = data.subdivided_normals = td.normals;
-        data.face_vertices = td.triangles;
-        data.face_sizes = (int *)malloc(sizeof(int) * ((size_t)td.triangle_count + 1));
-        if (!data.face_sizes) { fprintf(stderr, "surfblend: out of memory\n"); goto done; }
-        for (i = 0; i < td.triangle_count; ++i) data.face_sizes[i] = 3;
-    } else if (!shade_mesh(ctx, &o, &mesh, &surf, &data)) goto done;
-    rcfg = sfb_render_config_init(mode);
-    rcfg.width = (int)(width > 2147483647L ? 2147483647L : width);
-    rcfg.height = (int)(height > 2147483647L ? 2147483647L : height);
-    rcfg.positions = limit_pos ? data.limit_positions : data.positions;
-    rcfg.normals = normals == 0 ? data.limit_normals : normals == 1 ? data.subdivided_normals : data.normals;
-    rcfg.scalars = data.blend_weights;
-    rcfg.view_set = view_set;
-    rcfg.yaw = (float)yaw;
-    rcfg.pitch = (float)pitch;
-    rcfg.zoom = (float)zoom;
-    rcfg.stripes = (float)stripes;
-    rcfg.draw_edges = edges;
-    if (!rcfg.positions || (mode != SFB_RENDER_WEIGHTS && !rcfg.normals) || (mode == SFB_RENDER_WEIGHTS && !rcfg.scalars)) {
-        fprintf(stderr, "surfblend: %s: the shaded mesh lacks the %s\n", o.in,
-                !rcfg.positions ? "positions" : mode == SFB_RENDER_WEIGHTS ? "blend weights" : "normals");
-        goto done;
-    }
-    r = sfb_render(ctx, &data, &rcfg, &img);
+    int i;
+    s->mesh = cli_load_obj(s->ctx, o->in);
+    if (!s->mesh) return 0;
+    s->surf = make_patch_surface(s->ctx, s->mesh, o->in, (sfb_scheme)o->scheme, o->weights);
+    if (!s->surf) return 0;
+    tc.trim = o->trim ? &s->mask : NULL;
+    r = sfb_surface_tessellate(s->surf, &tc, &s->td);
     if (r != SFB_SUCCESS) {
-        fprintf(stderr, "surfblend: %s: %s: %s\n", o.in, sfb_result_string(r), sfb_last_error(ctx));
+        cli_error("%s: %s: %s", o->in, sfb_result_string(r), sfb_last_error(s->ctx));
+        return 0;
+    }
+    s->face_sizes = (int *)malloc(sizeof(int) * ((size_t)s->td.triangle_count + 1));
+    if (!s->face_sizes) { cli_error("out of memory"); return 0; }
+    for (i = 0; i < s->td.triangle_count; ++i) s->face_sizes[i] = 3;
+    s->data.vertex_count = s->td.vertex_count;
+    s->data.face_count = s->td.triangle_count;
+    s->data.face_vertex_count = 3 * s->td.triangle_count;
+    s->data.positions = s->data.limit_positions = s->td.positions;
+    s->data.normals = s->data.limit_normals = s->data.subdivided_normals = s->td.normals;
+    s->data.face_vertices = s->td.triangles;
+    s->data.face_sizes = s->face_sizes;
+    return 1;
+}
+
+/* Draws s->data into s->img as the options say. 1, or 0 with the reason printed. */
+static int render_draw(const cli_opts *o, render_state *s) {
+    sfb_render_config rcfg = sfb_render_config_init((sfb_render_mode)o->mode);
+    const sfb_mesh_data *d = &s->data;
+    sfb_result r;
+    rcfg.width = (int)(o->size[0] > 2147483647L ? 2147483647L : o->size[0]);
+    rcfg.height = (int)(o->size[1] > 2147483647L ? 2147483647L : o->size[1]);
+    rcfg.positions = o->limit_pos ? d->limit_positions : d->positions;
+    rcfg.normals = o->normals == 0 ? d->limit_normals : o->normals == 1 ? d->subdivided_normals : d->normals;
+    rcfg.scalars = d->blend_weights;
+    rcfg.view_set = o->seen[O_VIEW] > 0;
+    rcfg.yaw = (float)o->view[0];
+    rcfg.pitch = (float)o->view[1];
+    rcfg.zoom = (float)o->zoom;
+    rcfg.stripes = (float)o->stripes;
+    rcfg.draw_edges = o->edges;
+    if (!rcfg.positions || (o->mode != SFB_RENDER_WEIGHTS && !rcfg.normals) || (o->mode == SFB_RENDER_WEIGHTS && !rcfg.scalars)) {
+        cli_error("%s: the shaded mesh lacks the %s", o->in,
+                  !rcfg.positions ? "positions" : o->mode == SFB_RENDER_WEIGHTS ? "blend weights" : "normals");
+        return 0;
+    }
+    r = sfb_render(s->ctx, d, &rcfg, &s->img);
+    if (r != SFB_SUCCESS) {
+        cli_error("%s: %s: %s", o->in, sfb_result_string(r), sfb_last_error(s->ctx));
+        return 0;
+    }
+    return 1;
+}
+
+static void png_to_file(void *user, void *data, int size) {
+    if (size > 0) fwrite(data, 1, (size_t)size, (FILE *)user);
+}
+
+static void render_summary(const cli_opts *o, const render_state *s) {
+    static const char *mode_names[4] = { "shading", "highlight lines", "blend weights", "normal colours" };
+    char what[256], field[64] = "";
+    int manifold = o->scheme == SFB_SCHEME_MANIFOLD_BLEND;
+    if (o->mode != SFB_RENDER_WEIGHTS && !manifold) snprintf(field, sizeof field, " of the %s normals", normal_names[o->normals]);
+    snprintf(what, sizeof what, "render %s%s, %dx%d (%d object pixels%s):", mode_names[o->mode], field, s->img.width, s->img.height,
+             s->img.object_pixels, s->img.skipped_faces ? ", faces with non-finite positions skipped" : "");
+    if (manifold)
+        cli_error("%s manifold blend (%s weights) tessellated at rate %ld%s: %d triangles -> %s (backend %s)", what,
+                  o->weights ? "C-infinity" : "Hermite", o->rate, o->trim ? ", trimmed" : "", s->td.triangle_count, o->outp,
+                  sfb_context_backend_name(s->ctx));
+    else shade_summary(what, o, &s->data, s->ctx);
+}
+
+static int cmd_render(cli_opts *o) {
+    render_state s;
+    int rc = render_check(o);
+    cli_output out;
+    if (rc) return rc;
+    rc = 1;
+    memset(&s, 0, sizeof s);
+    memset(&out, 0, sizeof out);
+    if (!load_trim(o, &s.mask, &s.texels)) return 1;
+    s.ctx = cli_make_context(o->backend);
+    if (!s.ctx) goto done;
+    if (o->scheme == SFB_SCHEME_MANIFOLD_BLEND ? !render_manifold_mesh(o, &s) : !shade_mesh(s.ctx, o, &s.mesh, &s.surf, &s.data)) goto done;
+    if (!render_draw(o, &s) || !cli_output_open(&out, o->outp)) goto done;
+    if (!stbi_write_png_to_func(png_to_file, out.f, s.img.width, s.img.height, 4, s.img.rgba, s.img.width * 4)) {
+        cli_error("encoding the PNG failed (out of memory)");
         goto done;
     }
-    if (!stbi_write_png_to_func(png_append, &png, img.width, img.height, 4, img.rgba, img.width * 4) || png.failed) {
-        fprintf(stderr, "surfblend: encoding the PNG failed (out of memory)\n");
-        goto done;
-    }
-    f = strcmp(o.outp, "-") == 0 ? stdout : fopen(o.outp, "wb");
-    if (!f) {
-        fprintf(stderr, "surfblend: cannot write '%s'\n", o.outp);
-        goto done;
-    }
-    if (fwrite(png.data, 1, png.size, f) != png.size) {
-        fprintf(stderr, "surfblend: writing '%s' failed\n", o.outp);
-        goto done;
-    }
-    {
-        static const char *mode_names[4] = { "shading", "highlight lines", "blend weights", "normal colours" };
-        char what[256], field[64] = "";
-        if (mode != SFB_RENDER_WEIGHTS && o.scheme != SFB_SCHEME_MANIFOLD_BLEND) snprintf(field, sizeof field, " of the %s normals", normal_names[normals]);
-        snprintf(what, sizeof what, "render %s%s, %dx%d (%d object pixels%s):", mode_names[mode], field, img.width, img.height,
-                 img.object_pixels, img.skipped_faces ? ", faces with non-finite positions skipped" : "");
-        if (o.scheme == SFB_SCHEME_MANIFOLD_BLEND)
-            fprintf(stderr, "surfblend: %s manifold blend (%s weights) tessellated at rate %ld%s: %d triangles -> %s (backend %s)\n", what,
-                    weights ? "C-infinity" : "Hermite", rate, trim_path ? ", trimmed" : "", td.triangle_count, o.outp, sfb_context_backend_name(ctx));
-        else shade_summary(what, &o, &data, ctx, o.outp);
-    }
+    render_summary(o, &s);
     rc = 0;
 done:
-    rc = finish_output(f, o.outp, rc);
-    free(png.data);
-    sfb_image_free(&img);
-    if (o.scheme == SFB_SCHEME_MANIFOLD_BLEND) { free(data.face_sizes); memset(&data, 0, sizeof data); }
-    sfb_tess_data_free(&td);
-    stbi_image_free(texels);
-    sfb_mesh_data_free(&data);
-    sfb_surface_destroy(surf);
-    sfb_mesh_destroy(mesh);
-    sfb_context_destroy(ctx);
+    rc = cli_output_finish(&out, rc);
+    sfb_image_free(&s.img);
+    if (s.face_sizes) { free(s.face_sizes); memset(&s.data, 0, sizeof s.data); }
+    sfb_tess_data_free(&s.td);
+    stbi_image_free(s.texels);
+    sfb_mesh_data_free(&s.data);
+    sfb_surface_destroy(s.surf);
+    sfb_mesh_destroy(s.mesh);
+    sfb_context_destroy(s.ctx);
     return rc;
 }
 
 /* Probes every backend on its own: available with what it runs on, or why not. */
-static int cmd_backends(void) {
+static int cmd_backends(cli_opts *o) {
     int k;
     const char *env = getenv("SURFBLEND_BACKEND");
+    (void)o;
     printf("default order: simd, ref%s%s%s\n", env && *env ? "  (SURFBLEND_BACKEND=" : "", env && *env ? env : "",
            env && *env ? " forces one)" : "");
     for (k = SFB_BACKEND_REF; k < SFB_BACKEND_KIND_COUNT_; ++k) {
@@ -1218,23 +1163,72 @@ static int cmd_backends(void) {
     return 0;
 }
 
+/* ---- the commands' table, main ---- */
+
+static const cli_command commands[] = {
+    { "info", C_INFO, "IN.obj", "counts, valences, creases, extraordinary vertices, problems", NULL, 1, NULL, cmd_info },
+    { "refine", C_REFINE, "[options] IN.obj -o OUT.obj", "uniform refinement, written as OBJ", NULL, 1, "OUT.obj", cmd_refine },
+    { "eval", C_EVAL, "[options] IN.obj", "the limit surface at parametric locations (--random N or --locations FILE)",
+      "prints one line per location (to standard output without -o):\n"
+      "    face u v px py pz nx ny nz [dux duy duz dvx dvy dvz]", 1, NULL, cmd_eval },
+    { "tess", C_TESS, "[options] IN.obj -o OUT.obj", "watertight triangles of the limit surface (v, vn, f v//vn)", NULL, 1, "OUT.obj",
+      cmd_tess },
+    { "shade", C_SHADE, "[options] IN.obj -o OUT.obj", "subdivision shading (seed 001): v, blended normals as vn, f v//vn",
+      "prints output vertices, split vertices (infinitely sharp creases) and where N_S was computed", 1, "OUT.obj", cmd_shade },
+    { "render", C_RENDER, "[options] IN.obj -o OUT.png", "a software picture of the shaded surface (PNG)",
+      "one of --highlight, --blend-weights, --normal-colors (default grey shading); --rate, --manifold-weights\n"
+      "    and --trim belong to --scheme manifold, the shading options and --blend-weights to the other schemes",
+      1, "OUT.png", cmd_render },
+    { "backends", C_BACKENDS, "", "list the backends and whether each is available", NULL, 0, NULL, cmd_backends },
+};
+#define COMMAND_COUNT (sizeof commands / sizeof commands[0])
+
+static void print_usage(FILE *f) {
+    size_t i;
+    fputs("usage:\n", f);
+    for (i = 0; i < COMMAND_COUNT; ++i) print_command(f, &commands[i], 0);
+    fputs("  surfblend --help | -h | help [COMMAND]     this text, or one command's (also: surfblend COMMAND --help)\n"
+          "  surfblend --version\n",
+          f);
+    fputs(names_note, f);
+    fputs(exit_note, f);
+}
+
+static const cli_command *find_command(const char *name) {
+    size_t i;
+    for (i = 0; i < COMMAND_COUNT; ++i)
+        if (strcmp(name, commands[i].name) == 0) return &commands[i];
+    return NULL;
+}
+
 int main(int argc, char **argv) {
-    if (argc < 2) return usage("missing command");
+    const cli_command *c;
+    cli_opts o;
+    int rc;
+    if (option_clash()) {
+        cli_error("internal error: option %s is in the table twice for one command", option_clash());
+        return 2;
+    }
+    if (argc < 2) return usage_error(NULL, "missing command");
     if (strcmp(argv[1], "--help") == 0 || strcmp(argv[1], "-h") == 0 || strcmp(argv[1], "help") == 0) {
-        print_usage(stdout);
+        if (argc > 2 && !(c = find_command(argv[2]))) {
+            cli_error("unknown command '%s'", argv[2]);
+            return usage_error(NULL, NULL);
+        }
+        if (argc > 2) print_command_usage(stdout, c);
+        else print_usage(stdout);
         return 0;
     }
     if (strcmp(argv[1], "--version") == 0) {
         printf("surfblend %d.%d.%d\n", SFB_VERSION_MAJOR, SFB_VERSION_MINOR, SFB_VERSION_PATCH);
         return 0;
     }
-    if (strcmp(argv[1], "info") == 0) return cmd_info(argc - 2, argv + 2);
-    if (strcmp(argv[1], "refine") == 0) return cmd_refine(argc - 2, argv + 2);
-    if (strcmp(argv[1], "eval") == 0) return cmd_eval(argc - 2, argv + 2);
-    if (strcmp(argv[1], "tess") == 0) return cmd_tess(argc - 2, argv + 2);
-    if (strcmp(argv[1], "shade") == 0) return cmd_shade(argc - 2, argv + 2);
-    if (strcmp(argv[1], "render") == 0) return cmd_render(argc - 2, argv + 2);
-    if (strcmp(argv[1], "backends") == 0) return argc == 2 ? cmd_backends() : usage("backends takes no arguments");
-    fprintf(stderr, "surfblend: unknown command '%s'\n", argv[1]);
-    return usage(NULL);
+    c = find_command(argv[1]);
+    if (!c) {
+        cli_error("unknown command '%s'", argv[1]);
+        return usage_error(NULL, NULL);
+    }
+    rc = parse_args(c, argc - 2, argv + 2, &o);
+    if (rc) return rc < 0 ? 0 : rc;
+    return c->run(&o);
 }

@@ -1,0 +1,214 @@
+/* What the command-line tools share: see tools/cli_common.h. C99 and C++14. */
+#if !defined(_WIN32) && !defined(_POSIX_C_SOURCE)
+#define _POSIX_C_SOURCE 200809L /* mkstemp, fdopen, fchmod, umask, stat */
+#endif
+#include "cli_common.h"
+
+#include <errno.h>
+#include <stdarg.h>
+#include <stdlib.h>
+#include <string.h>
+#ifndef _WIN32
+#include <sys/stat.h>
+#include <sys/types.h>
+#include <unistd.h>
+#endif
+
+const char *cli_program = "surfblend";
+
+void cli_error(const char *fmt, ...) {
+    va_list ap;
+    fprintf(stderr, "%s: ", cli_program);
+    va_start(ap, fmt);
+    vfprintf(stderr, fmt, ap);
+    va_end(ap);
+    fputc('\n', stderr);
+}
+
+char *cli_read_file(const char *path, size_t *size) {
+    FILE *f = strcmp(path, "-") == 0 ? stdin : fopen(path, "rb");
+    char *buf = NULL;
+    size_t cap = 0, n = 0;
+    if (!f) return NULL;
+    for (;;) {
+        size_t got;
+        if (n == cap) {
+            char *nb;
+            cap = cap ? cap * 2 : 1 << 16;
+            if (cap > ((size_t)1 << 32)) { free(buf); buf = NULL; break; }
+            nb = (char *)realloc(buf, cap);
+            if (!nb) { free(buf); buf = NULL; break; }
+            buf = nb;
+        }
+        got = fread(buf + n, 1, cap - n, f);
+        n += got;
+        if (got == 0) break;
+    }
+    if (f != stdin) fclose(f);
+    *size = n;
+    return buf;
+}
+
+sfb_context *cli_make_context(const char *backend) {
+    sfb_context_config cfg = sfb_context_config_init();
+    sfb_backend_kind kinds[3];
+    sfb_context *ctx = NULL;
+    sfb_result r;
+    const char *env = getenv("SURFBLEND_BACKEND");
+    char report[2048];
+    if (backend) {
+        kinds[0] = sfb_backend_kind_parse(backend);
+        if (kinds[0] == SFB_BACKEND_DEFAULT) {
+            cli_error("unknown backend '%s' (ref, simd, gl, osmesa)", backend);
+            return NULL;
+        }
+        kinds[1] = SFB_BACKEND_SIMD;
+        kinds[2] = SFB_BACKEND_REF;
+        cfg.backends = kinds;
+        cfg.backend_count = 3;
+        cfg.ignore_environment = 1;
+    }
+    r = sfb_context_create(&cfg, &ctx);
+    if (r != SFB_SUCCESS) {
+        cli_error("no backend could be initialised (%s)", sfb_result_string(r));
+        return NULL;
+    }
+    if ((backend && sfb_backend_kind_parse(sfb_context_backend_name(ctx)) != kinds[0]) ||
+        (!backend && env && *env && sfb_backend_kind_parse(sfb_context_backend_name(ctx)) != sfb_backend_kind_parse(env))) {
+        sfb_context_backend_report(ctx, report, sizeof report);
+        fprintf(stderr, "%s: the requested backend is unavailable; using %s. Backends tried:\n%s", cli_program,
+                sfb_context_backend_name(ctx), report);
+    }
+    return ctx;
+}
+
+sfb_mesh *cli_load_obj(sfb_context *ctx, const char *path) {
+    size_t size = 0;
+    char *text = cli_read_file(path, &size);
+    sfb_mesh *mesh = NULL;
+    sfb_result r;
+    if (!text) {
+        cli_error("cannot read '%s'", path);
+        return NULL;
+    }
+    r = sfb_mesh_read_obj(ctx, text, size, &mesh);
+    free(text);
+    if (r != SFB_SUCCESS) {
+        cli_error("%s: %s: %s", path, sfb_result_string(r), sfb_last_error(ctx));
+        return NULL;
+    }
+    return mesh;
+}
+
+int cli_scheme_from_name(const char *s, sfb_scheme *out) {
+    if (strcmp(s, "catmark") == 0 || strcmp(s, "catmull-clark") == 0) *out = SFB_SCHEME_CATMARK;
+    else if (strcmp(s, "loop") == 0) *out = SFB_SCHEME_LOOP;
+    else if (strcmp(s, "bilinear") == 0) *out = SFB_SCHEME_BILINEAR;
+    else if (strcmp(s, "manifold") == 0) *out = SFB_SCHEME_MANIFOLD_BLEND;
+    else return 0;
+    return 1;
+}
+
+sfb_scheme cli_scheme_for(const char *path, int have_scheme, sfb_scheme scheme) {
+    const char *base;
+    if (have_scheme) return scheme;
+    base = strrchr(path, '/');
+    base = base ? base + 1 : path;
+    if (strncmp(base, "loop_", 5) == 0) return SFB_SCHEME_LOOP;
+    if (strncmp(base, "bilinear_", 9) == 0) return SFB_SCHEME_BILINEAR;
+    return SFB_SCHEME_CATMARK;
+}
+
+/* ---- atomic output ---- */
+
+/* A temporary file beside `path`, created new (PATH.tmpXXXXXX, with the permissions a plain
+ * fopen would give); NULL on failure, errno set. */
+static FILE *open_temporary(const char *path, char **tmp_name) {
+    size_t n = strlen(path);
+    char *name = (char *)malloc(n + 12);
+    FILE *f = NULL;
+    if (!name) { errno = ENOMEM; return NULL; }
+    memcpy(name, path, n);
+#ifdef _WIN32
+    memcpy(name + n, ".tmp", 5);
+    f = fopen(name, "wb");
+#else
+    memcpy(name + n, ".tmpXXXXXX", 11);
+    {
+        int fd = mkstemp(name);
+        if (fd >= 0) {
+            mode_t mask = umask(0);
+            umask(mask);
+            (void)fchmod(fd, (mode_t)(0666 & ~mask));
+            f = fdopen(fd, "wb");
+            if (!f) {
+                int e = errno;
+                close(fd);
+                remove(name);
+                errno = e;
+            }
+        }
+    }
+#endif
+    if (!f) { free(name); return NULL; }
+    *tmp_name = name;
+    return f;
+}
+
+/* Whether `path` names something that exists and is not a regular file (a device, a pipe). */
+static int is_special(const char *path) {
+#ifdef _WIN32
+    (void)path;
+    return 0;
+#else
+    struct stat st;
+    return stat(path, &st) == 0 && !S_ISREG(st.st_mode);
+#endif
+}
+
+FILE *cli_output_open(cli_output *out, const char *path) {
+    out->f = NULL;
+    out->tmp = NULL;
+    out->path = path && strcmp(path, "-") != 0 ? path : NULL;
+    if (!out->path) out->f = stdout;
+    else if (is_special(path)) out->f = fopen(path, "wb");
+    else out->f = open_temporary(path, &out->tmp);
+    if (!out->f) cli_error("cannot write '%s': %s", path, strerror(errno));
+    return out->f;
+}
+
+int cli_output_finish(cli_output *out, int rc) {
+    FILE *f = out->f;
+    const char *shown = out->path ? out->path : "the output";
+    if (!f) return rc;
+    out->f = NULL;
+    if (f == stdout) {
+        if ((fflush(stdout) != 0 || ferror(stdout)) && rc == 0) { cli_error("writing the output failed"); rc = 1; }
+        return rc;
+    }
+    if (rc == 0 && (fflush(f) != 0 || ferror(f))) { cli_error("writing '%s' failed: %s", shown, strerror(errno)); rc = 1; }
+    if (fclose(f) != 0 && rc == 0) { cli_error("writing '%s' failed: %s", shown, strerror(errno)); rc = 1; }
+    if (out->tmp) {
+#ifdef _WIN32
+        if (rc == 0) remove(out->path);
+#endif
+        if (rc == 0 && rename(out->tmp, out->path) != 0) { cli_error("cannot write '%s': %s", out->path, strerror(errno)); rc = 1; }
+        if (rc != 0) remove(out->tmp);
+        free(out->tmp);
+        out->tmp = NULL;
+    }
+    return rc;
+}
+
+int cli_write_file(const char *path, const void *data, size_t size) {
+    cli_output out;
+    int rc;
+    if (!cli_output_open(&out, path)) return 1;
+    rc = fwrite(data, 1, size, out.f) != size;
+    if (rc) cli_error("writing '%s' failed: %s", path, strerror(errno));
+    return cli_output_finish(&out, rc);
+}
+
+int cli_file_write(const void *data, size_t size, void *user) {
+    return fwrite(data, 1, size, (FILE *)user) != size;
+}
