@@ -198,21 +198,33 @@ unit-build: $(BUILD)/surfblend $(BUILD)/unit $(BUILD)/osd_agree $(BUILD)/agree $
 
 # On CI (CI set and not false/0) the optional backends must run, not be skipped: the suites
 # fail for a backend in SFB_REQUIRE_BACKENDS that is unavailable. CI has Mesa llvmpipe and
-# OSMesa but no GPU. A value already in the environment wins.
+# OSMesa but no GPU. A value already in the environment wins. The programs build JOBS at a time
+# and the suites run JOBS side by side (tests/run_all.sh prints each one's wall time).
+JOBS ?= $(shell nproc 2>/dev/null || echo 2)
 test: deps-test amalgamate-check
-	$(MAKE) --no-print-directory unit-build
+	$(MAKE) --no-print-directory -j$(JOBS) unit-build
 	@if [ -n "$${CI:-}" ] && [ "$${CI}" != false ] && [ "$${CI}" != 0 ]; then \
 	  export SFB_REQUIRE_BACKENDS="$${SFB_REQUIRE_BACKENDS:-simd,gl,osmesa}"; \
 	  echo "CI=$${CI}: SFB_REQUIRE_BACKENDS=$${SFB_REQUIRE_BACKENDS}"; \
 	fi; \
-	BUILD=$(BUILD) SHAPES=$(SHAPES) CC="$(CC)" CXX="$(CXX)" ./tests/run_all.sh
+	BUILD=$(BUILD) SHAPES=$(SHAPES) CC="$(CC)" CXX="$(CXX)" JOBS=$(JOBS) ./tests/run_all.sh
 
-# The whole suite again under AddressSanitizer + UndefinedBehaviorSanitizer. LeakSanitizer
-# reports inside the GL drivers (Mesa, LLVM) are suppressed by tests/lsan.supp, which names
-# driver libraries only, never surfblend's code.
+# The suites again under AddressSanitizer + UndefinedBehaviorSanitizer, on the reduced but
+# complete profile: every suite and code path, on the peer shapes of tests/sanitize_shapes.txt
+# (the large and repetitive ones run unsanitized in make test), without the checks that only
+# compile (SFB_TEST_PROFILE=sanitize, tests/run_all.sh). LeakSanitizer reports inside the GL
+# drivers (Mesa, LLVM) are suppressed by tests/lsan.supp, which names driver libraries only,
+# never surfblend's code.
+ASAN_BUILD ?= build-asan
 asan:
+	@rm -rf $(ASAN_BUILD)/sanitize-shapes && mkdir -p $(ASAN_BUILD)/sanitize-shapes && \
+	for s in $$(grep -v '^#' tests/sanitize_shapes.txt); do \
+	  [ -f "$(SHAPES)/$$s.obj" ] && ln -s "$(abspath $(SHAPES))/$$s.obj" $(ASAN_BUILD)/sanitize-shapes/; \
+	done; true
 	LSAN_OPTIONS="suppressions=$(CURDIR)/tests/lsan.supp:print_suppressions=0$${LSAN_OPTIONS:+:$$LSAN_OPTIONS}" \
-	$(MAKE) --no-print-directory test BUILD=build-asan OPT=-O1 \
+	SFB_TEST_PROFILE=sanitize \
+	$(MAKE) --no-print-directory test BUILD=$(ASAN_BUILD) OPT=-O1 \
+	  SHAPES=$$([ -d "$(SHAPES)" ] && echo $(ASAN_BUILD)/sanitize-shapes || echo $(SHAPES)) \
 	  SAN="-fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined"
 
 # The simd backend's NEON kernels against ref, on AArch64 under qemu (tests/neon.sh).
@@ -240,7 +252,8 @@ fuzz: deps-fuzz $(FUZZ_TARGETS)
 	@for t in $(FUZZ_TARGETS); do \
 	  name=$$(basename $$t); work=$(BUILD)/fuzz/corpus-$$name; mkdir -p $$work; \
 	  echo "== $$name for $(FUZZ_TIME) s"; \
-	  ./$$t -max_total_time=$(FUZZ_TIME) -dict=fuzz/obj.dict -print_final_stats=1 $$work fuzz/corpus 2>&1 | tail -n 12 || exit 1; \
+	  ./$$t -max_total_time=$(FUZZ_TIME) -dict=fuzz/obj.dict -print_final_stats=1 $$work fuzz/corpus > $$work.log 2>&1; rc=$$?; \
+	  tail -n 12 $$work.log; [ $$rc -eq 0 ] || { echo "$$name FAILED (exit $$rc; log: $$work.log)"; exit 1; }; \
 	done
 
 clean:

@@ -1,140 +1,143 @@
 #!/bin/bash
 # Runs every test suite and prints one closing line: "N passed, N failed, N skipped".
 # Each suite reports its own counts; a suite that crashes or prints no counts is one failure.
+# Independent suites run side by side, JOBS at a time (default: one per core); each suite's
+# output goes to $BUILD/test-logs/NAME.log and its summary line, with its wall time, is printed
+# in a fixed order once all have ended, then the total wall time and the slowest suite.
+#
+# SFB_TEST_PROFILE=sanitize (make asan): the suites that run library code only, on the shapes
+# the caller passes (make asan passes a smaller set, tests/sanitize_shapes.txt); the checks that
+# only compile (C99/C++ header, separate modules) or validate GLSL are not run again there.
 set -u
 BUILD=${BUILD:-build}
 SHAPES=${SHAPES:-../shared/peers/opensubdiv-shapes}
 CC=${CC:-cc}
 CXX=${CXX:-c++}
-PASS=0; FAIL=0; SKIP=0
+JOBS=${JOBS:-$(nproc 2>/dev/null || echo 2)}
+PROFILE=${SFB_TEST_PROFILE:-full}
 LOG=$BUILD/test-logs
+RES=$LOG/results
 mkdir -p "$LOG"
+rm -rf "$RES"; mkdir -p "$RES"
+T0=$(date +%s.%N)
+ORDER=()
 
-add_counts() { # name, passed, failed, skipped
-  echo "== $1: $2 passed, $3 failed, $4 skipped"
-  PASS=$((PASS + $2)); FAIL=$((FAIL + $3)); SKIP=$((SKIP + $4))
+now() { date +%s.%N; }
+elapsed() { awk -v a="$1" -v b="$(now)" 'BEGIN { printf "%.1f", b - a }'; }
+
+# result NAME PASSED FAILED SKIPPED SECONDS [NOTE]: what the summary prints for a suite
+result() { printf '%s %s %s %s %s\n' "$2" "$3" "$4" "$5" "${6:-}" > "$RES/$1.res"; }
+
+# counts LOGFILE: "P F S" from the last "N passed, N failed[, N skipped]" line, or nothing
+counts() {
+  local line
+  line=$(grep -E "^[0-9]+ passed, [0-9]+ failed" "$1" | tail -n 1)
+  [ -n "$line" ] || return 1
+  echo "$(echo "$line" | sed -E 's/^([0-9]+) passed.*/\1/') $(echo "$line" | sed -E 's/.* ([0-9]+) failed.*/\1/') \
+$(echo "$line" | grep -oE "[0-9]+ skipped" | grep -oE "[0-9]+" || echo 0)"
 }
 
-counted() { # name, command...: a suite that prints PASS/FAIL/SKIP lines and closes with
-  # "N passed, N failed[, N skipped]"; adds its counts (no closing line: one failure; a non-zero
-  # exit with no failure counted: one more). Shows FAIL lines, and SKIP lines grouped by reason.
+# counted NAME COMMAND...: a suite that closes with "N passed, N failed[, N skipped]" (no such
+# line: one failure; a non-zero exit with no failure counted: one more).
+counted() {
   local name=$1; shift
-  local out rc line p f s
-  out=$("$@" 2>&1); rc=$?
-  echo "$out" > "$LOG/$name.log"
-  echo "$out" | grep -E "^FAIL " | head -n 40
-  echo "$out" | grep -E "^SKIP " | sed -E 's/^SKIP [^:]*: //' | sort | uniq -c | sort -rn | head -n 8 |
-    sed -E 's/^ *([0-9]+) (.*)/   (\1 skipped: \2)/'
-  line=$(echo "$out" | grep -E "^[0-9]+ passed, [0-9]+ failed" | tail -n 1)
-  if [ -n "$line" ]; then
-    p=$(echo "$line" | sed -E 's/^([0-9]+) passed.*/\1/'); f=$(echo "$line" | sed -E 's/.* ([0-9]+) failed.*/\1/')
-    s=$(echo "$line" | grep -oE "[0-9]+ skipped" | grep -oE "[0-9]+" || echo 0)
-    add_counts "$name" "$p" "$f" "${s:-0}"
-    [ "$rc" -eq 0 ] || [ "$f" -gt 0 ] || add_counts "$name-exit" 0 1 0
+  local t rc c p f s
+  t=$(now)
+  "$@" > "$LOG/$name.log" 2>&1; rc=$?
+  if c=$(counts "$LOG/$name.log"); then
+    read -r p f s <<< "$c"
+    [ "$rc" -eq 0 ] || [ "$f" -gt 0 ] || f=$((f + 1))
+    result "$name" "$p" "$f" "$s" "$(elapsed "$t")" "$([ "$rc" -ne 0 ] && echo "exit $rc")"
   else
-    echo "--- $name printed no closing line (exit $rc); log tail:"; echo "$out" | tail -n 20
-    add_counts "$name" 0 1 0
+    result "$name" 0 1 0 "$(elapsed "$t")" "no closing line (exit $rc)"
   fi
 }
 
-single() { # name, command...: one test, passes iff the command exits 0
+# single NAME COMMAND...: one check, passes iff the command exits 0
+single() {
   local name=$1; shift
-  if "$@" > "$LOG/$name.log" 2>&1; then add_counts "$name" 1 0 0
-  else echo "--- $name failed; log:"; tail -n 30 "$LOG/$name.log"; add_counts "$name" 0 1 0; fi
+  local t rc
+  t=$(now)
+  "$@" > "$LOG/$name.log" 2>&1; rc=$?
+  if [ "$rc" -eq 0 ]; then result "$name" 1 0 0 "$(elapsed "$t")"; else result "$name" 0 1 0 "$(elapsed "$t")" "exit $rc"; fi
 }
 
-# 1. the header compiles as C99 and as C++ (with the implementation), warnings as errors
-single compile-c99 $CC -std=c99 -pedantic -Wall -Wextra -Werror -c -x c tools/impl.c -I. -o "$LOG/impl_c99.o"
-single compile-cxx $CXX -std=c++11 -Wall -Wextra -Werror -c -x c++ tools/impl.c -I. -o "$LOG/impl_cxx.o"
-
-# 1b. the modules of src/ as separate translation units, linked with the examples (make check-modules)
-single check-modules env CC="$CC" CXX="$CXX" ./tools/check_modules.sh "$BUILD"
-
-# 2. unit tests (Criterion)
-out=$("$BUILD/unit" --jobs 2 2>&1); rc=$?
-echo "$out" > "$LOG/unit.log"
-echo "$out" | grep -E "^\[(FAIL|----)\]|Synthesis" | tail -n 40
-syn=$(echo "$out" | grep -E "Synthesis: Tested:" | tail -n 1 | sed 's/\x1b\[[0-9;]*m//g')
-if [ -n "$syn" ]; then
-  t=$(echo "$syn" | sed -E 's/.*Tested: ([0-9]+).*/\1/'); p=$(echo "$syn" | sed -E 's/.*Passing: ([0-9]+).*/\1/')
-  f=$(echo "$syn" | sed -E 's/.*Failing: ([0-9]+).*/\1/'); c=$(echo "$syn" | sed -E 's/.*Crashing: ([0-9]+).*/\1/')
-  add_counts unit "$p" "$((f))" 0
-  [ "$rc" -eq 0 ] || [ "$f" -gt 0 ] || add_counts unit-exit 0 1 0
-else
-  echo "$out" | tail -n 20; add_counts unit 0 1 0
-fi
-
-# 3. agreement with OpenSubdiv 3.5 over the peer shapes
-if [ -d "$SHAPES" ]; then
-  out=$("$BUILD/osd_agree" "$SHAPES" 2>&1); rc=$?
-  echo "$out" > "$LOG/osd_agree.log"
-  echo "$out" | grep -vE "^PASS " | tail -n 40
-  line=$(echo "$out" | grep -E "^[0-9]+ passed, [0-9]+ failed" | tail -n 1)
-  if [ -n "$line" ]; then
-    p=$(echo "$line" | sed -E 's/^([0-9]+) passed.*/\1/'); f=$(echo "$line" | sed -E 's/.* ([0-9]+) failed.*/\1/')
-    s=$(echo "$line" | grep -oE "[0-9]+ skipped" | grep -oE "[0-9]+" || echo 0)
-    add_counts osd_agree "$p" "$f" "${s:-0}"
-    [ "$rc" -eq 0 ] || [ "$f" -gt 0 ] || add_counts osd_agree-exit 0 1 0
+# criterion NAME COMMAND...: a Criterion runner (its "Synthesis" line)
+criterion() {
+  local name=$1; shift
+  local t rc syn p f
+  t=$(now)
+  "$@" > "$LOG/$name.log" 2>&1; rc=$?
+  syn=$(grep -E "Synthesis: Tested:" "$LOG/$name.log" | tail -n 1 | sed 's/\x1b\[[0-9;]*m//g')
+  if [ -n "$syn" ]; then
+    p=$(echo "$syn" | sed -E 's/.*Passing: ([0-9]+).*/\1/'); f=$(echo "$syn" | sed -E 's/.*Failing: ([0-9]+).*/\1/')
+    [ "$rc" -eq 0 ] || [ "$f" -gt 0 ] || f=$((f + 1))
+    result "$name" "$p" "$f" 0 "$(elapsed "$t")"
   else
-    add_counts osd_agree 0 1 0
+    result "$name" 0 1 0 "$(elapsed "$t")" "no Synthesis line (exit $rc)"
   fi
-else
-  echo "peer shapes not found at $SHAPES: OpenSubdiv agreement skipped"; add_counts osd_agree 0 0 1
+}
+
+# skipped NAME WHY: a suite that cannot run here (counted as one skip, never as passed)
+skipped() { ORDER+=("$1"); result "$1" 0 0 1 0 "$2"; }
+
+# suite KIND NAME COMMAND...: queue it; at most JOBS run at once
+suite() {
+  local kind=$1 name=$2; shift 2
+  ORDER+=("$name")
+  while [ "$(jobs -rp | wc -l)" -ge "$JOBS" ]; do wait -n 2>/dev/null || true; done
+  "$kind" "$name" "$@" &
+}
+
+HAVE_SHAPES=0; [ -d "$SHAPES" ] && HAVE_SHAPES=1
+with_shapes() { if [ "$HAVE_SHAPES" = 1 ]; then echo "$SHAPES"; fi; }
+
+# The slowest first, so that the pool stays full to the end.
+[ "$HAVE_SHAPES" = 1 ] && suite counted limit "$BUILD/limit" "$SHAPES" || skipped limit "peer shapes not found at $SHAPES"
+suite counted shade "$BUILD/shade" $(with_shapes)
+[ "$HAVE_SHAPES" = 1 ] && suite counted osd_agree "$BUILD/osd_agree" "$SHAPES" || skipped osd_agree "peer shapes not found at $SHAPES"
+suite counted manifold "$BUILD/manifold" $(with_shapes)
+suite counted trim "$BUILD/trim" $(with_shapes)
+suite counted agree "$BUILD/agree" $(with_shapes)
+suite counted gl_manifold "$BUILD/gl_manifold" "$SHAPES"
+suite counted cli env BUILD="$BUILD" SHAPES="$SHAPES" ./tests/cli_test.sh
+suite criterion unit "$BUILD/unit" --jobs 1
+suite counted finish_normals "$BUILD/finish_normals"
+suite counted eigen "$BUILD/eigen"
+# the engine case: the gl backend on the host's own EGL context and GL buffers
+suite counted gl_host "$BUILD/gl_host"
+# failure paths of the gl/osmesa backends (broken kernel, missing libOSMesa), table pieces
+suite counted gl_errors "$BUILD/gl_errors"
+suite counted gl_pieces "$BUILD/gl_pieces"
+if [ "$PROFILE" != sanitize ]; then
+  # the header compiles as C99 and as C++ (with the implementation), warnings as errors
+  suite single compile-c99 $CC -std=c99 -pedantic -Wall -Wextra -Werror -c -x c tools/impl.c -I. -o "$LOG/impl_c99.o"
+  suite single compile-cxx $CXX -std=c++11 -Wall -Wextra -Werror -c -x c++ tools/impl.c -I. -o "$LOG/impl_cxx.o"
+  # the modules of src/ as separate translation units, linked with the examples (make check-modules)
+  suite single check-modules env CC="$CC" CXX="$CXX" ./tools/check_modules.sh "$BUILD"
+  # the GLSL kernels validated with glslangValidator, embedded copies up to date
+  suite counted glsl bash tools/check_glsl.sh
 fi
-
-# 3b. every optional backend (simd, gl, osmesa) against ref: peer shapes, random creased meshes,
-#     buffer layouts, threads. A backend listed in SFB_REQUIRE_BACKENDS (set by `make test` on CI)
-#     fails its checks when unavailable instead of skipping them.
-if [ -d "$SHAPES" ]; then counted agree "$BUILD/agree" "$SHAPES"
-else echo "peer shapes not found at $SHAPES: agree runs without them"; counted agree "$BUILD/agree"; fi
-
-# 3b''. the Stam eigen structures: tests/eigen.c
-counted eigen "$BUILD/eigen"
-
-# 3b'. limit evaluation on every backend (ref included): tests/limit.c
-if [ -d "$SHAPES" ]; then counted limit "$BUILD/limit" "$SHAPES"
-else echo "peer shapes not found at $SHAPES: limit evaluation suite skipped"; add_counts limit 0 0 1; fi
-
-# 3b'''. subdivision shading on every backend: tests/shade.c; the finish_normals kernels: tests/finish_normals.c
-if [ -d "$SHAPES" ]; then counted shade "$BUILD/shade" "$SHAPES"
-else echo "peer shapes not found at $SHAPES: shade runs without them"; counted shade "$BUILD/shade"; fi
-# 3b''''. trimmed tessellation on every backend: tests/trim.c (reads loop_cube.obj from the shapes when present)
-if [ -d "$SHAPES" ]; then counted trim "$BUILD/trim" "$SHAPES"
-else echo "peer shapes not found at $SHAPES: trim runs without them"; counted trim "$BUILD/trim"; fi
-# manifold-based blending surfaces on every backend: tests/manifold.c
-if [ -d "$SHAPES" ]; then counted manifold "$BUILD/manifold" "$SHAPES"
-else echo "peer shapes not found at $SHAPES: manifold runs without them"; counted manifold "$BUILD/manifold"; fi
-counted gl_manifold "$BUILD/gl_manifold" "$SHAPES"
-counted finish_normals "$BUILD/finish_normals"
-
-# 3c. the engine case: the gl backend on the host's own EGL context and GL buffers
-counted gl_host "$BUILD/gl_host"
-
-# 3d. failure paths of the gl/osmesa backends (broken kernel, missing libOSMesa)
-counted gl_errors "$BUILD/gl_errors"
-counted gl_pieces "$BUILD/gl_pieces"
-
-# 3e. the GLSL kernels validated with glslangValidator, embedded copies up to date
-[ -f tools/check_glsl.sh ] && counted glsl bash tools/check_glsl.sh
-
-# 4. command-line tool
-out=$(BUILD=$BUILD SHAPES=$SHAPES ./tests/cli_test.sh 2>&1)
-echo "$out" > "$LOG/cli.log"
-echo "$out" | grep -E "^(FAIL|SKIP)" | tail -n 20
-line=$(echo "$out" | grep -E "^[0-9]+ passed, [0-9]+ failed" | tail -n 1)
-if [ -n "$line" ]; then
-  p=$(echo "$line" | sed -E 's/^([0-9]+) passed.*/\1/'); f=$(echo "$line" | sed -E 's/.* ([0-9]+) failed.*/\1/')
-  s=$(echo "$line" | grep -oE "[0-9]+ skipped" | grep -oE "[0-9]+" || echo 0)
-  add_counts cli "$p" "$f" "${s:-0}"
-else
-  echo "$out" | tail -n 20; add_counts cli 0 1 0
-fi
-
-# 5. examples build and run
+# the examples build and run
 for ex in "$BUILD"/examples/*; do
-  [ -x "$ex" ] && single "example-$(basename "$ex")" "$ex"
+  [ -x "$ex" ] && suite single "example-$(basename "$ex")" "$ex"
 done
+wait
 
+PASS=0; FAIL=0; SKIP=0; SLOW=""; SLOWT=0
+for name in "${ORDER[@]}"; do
+  read -r p f s t note < "$RES/$name.res" || { p=0; f=1; s=0; t=0; note="no result"; }
+  printf '== %s: %s passed, %s failed, %s skipped (%s s)%s\n' "$name" "$p" "$f" "$s" "$t" "${note:+ [$note]}"
+  if [ "$f" -gt 0 ] && [ -f "$LOG/$name.log" ]; then
+    grep -E "^FAIL|^\[FAIL\]" "$LOG/$name.log" | head -n 20 | sed 's/^/   /'
+    grep -qE "^FAIL|^\[FAIL\]" "$LOG/$name.log" || tail -n 15 "$LOG/$name.log" | sed 's/^/   /'
+  fi
+  [ -f "$LOG/$name.log" ] && grep -E "^SKIP " "$LOG/$name.log" | sed -E 's/^SKIP [^:]*: //' | sort | uniq -c | sort -rn | head -n 5 |
+    sed -E 's/^ *([0-9]+) (.*)/   (\1 skipped: \2)/'
+  PASS=$((PASS + p)); FAIL=$((FAIL + f)); SKIP=$((SKIP + s))
+  if awk -v a="$t" -v b="$SLOWT" 'BEGIN { exit !(a > b) }'; then SLOW=$name; SLOWT=$t; fi
+done
+echo "suites: ${#ORDER[@]}, $JOBS at a time, $(elapsed "$T0") s in all; slowest: $SLOW ($SLOWT s)"
 echo
 echo "$PASS passed, $FAIL failed, $SKIP skipped"
 [ "$FAIL" -eq 0 ]
