@@ -1024,31 +1024,24 @@ sfb_result sfb__patches_build(sfb_context *ctx, const sfb__level *base, const sf
 int sfb__patch_locate(const sfb__patch_table *pt, int ptex, double u, double v, double *s, double *t, double *scale);
 
 /* ---- reading records (patch/table.c) and the record kinds (patch/quad.c, patch/tri.c) ---- */
-/* A record type's ref evaluation: res = P, Ps, Pt, Pss, Pst, Ptt in the record's (s,t) (before
- * the sub-patch scale), dir = two tangent directions whose cross product gives the normal's
- * direction; `normal`, when not NULL, gives the normal direction instead (end caps). */
+/* A record type's ref evaluation. res = P, Ps, Pt, Pss, Pst, Ptt in the record's (s,t) (before
+ * the sub-patch scale). A polynomial kind gives `poly` (the normal's direction is Ps x Pt); a
+ * Stam kind gives `eval`, which also returns the normalised tangent frame dir (the normal's
+ * direction is dir[0] x dir[1], finite down to the extraordinary vertex). An end cap's normal
+ * blends its cap_corners corners' limit normals (sfb__endcap_normal). */
 typedef void (*sfb__patch_eval_fn)(const sfb__patch_table *pt, const float *pts, int patch, const int *cv, double s, double t,
                                    double res[6][3], double dir[2][3]);
 typedef struct sfb__patch_kind {
+    void (*poly)(const float *pts, const int *cv, double s, double t, double res[6][3]);
     sfb__patch_eval_fn eval;
-    void (*normal)(const float *pts, const int *cv, double s, double t, double nrm[3]);
+    int cap_corners;
 } sfb__patch_kind;
 /* The ref evaluator of a (non-MANIFOLD4) record type. */
 sfb__patch_kind sfb__patch_kind_of(int type);
-void sfb__kind_bspline16(const sfb__patch_table *pt, const float *pts, int patch, const int *cv, double s, double t, double res[6][3],
-                         double dir[2][3]);
 void sfb__kind_stam(const sfb__patch_table *pt, const float *pts, int patch, const int *cv, double s, double t, double res[6][3],
                     double dir[2][3]);
-void sfb__kind_endcap(const sfb__patch_table *pt, const float *pts, int patch, const int *cv, double s, double t, double res[6][3],
-                      double dir[2][3]);
-void sfb__kind_endcap_normal(const float *pts, const int *cv, double s, double t, double nrm[3]);
-void sfb__kind_beztri(const sfb__patch_table *pt, const float *pts, int patch, const int *cv, double s, double t, double res[6][3],
-                      double dir[2][3]);
 void sfb__kind_stam_loop(const sfb__patch_table *pt, const float *pts, int patch, const int *cv, double s, double t, double res[6][3],
                          double dir[2][3]);
-void sfb__kind_endcap_tri(const sfb__patch_table *pt, const float *pts, int patch, const int *cv, double s, double t, double res[6][3],
-                          double dir[2][3]);
-void sfb__kind_endcap_tri_normal(const float *pts, const int *cv, double s, double t, double nrm[3]);
 /* The record evaluations themselves (res as above; the Stam kinds' nres: the first derivatives
  * divided by their scale, a finite tangent frame down to the extraordinary vertex). */
 void sfb__bspline_basis(double t, double *b, double *d, double *dd);   /* uniform cubic B-spline: value, d, d2 */
@@ -3417,16 +3410,25 @@ void sfb__stam_finish(double J[2][2], double sc1, double sc2, double sr[6][3], d
  * patch/manifold.c's sfb__mf_eval_patch (their normal is final), see sfb__ref_eval_one. */
 sfb__patch_kind sfb__patch_kind_of(int type) {
     sfb__patch_kind k;
-    k.normal = NULL;
+    memset(&k, 0, sizeof k);
     switch (type) {
     case SFB__PATCH_STAM: k.eval = sfb__kind_stam; break;
-    case SFB__PATCH_ENDCAP: k.eval = sfb__kind_endcap; k.normal = sfb__kind_endcap_normal; break;
-    case SFB__PATCH_BEZTRI: k.eval = sfb__kind_beztri; break;
+    case SFB__PATCH_ENDCAP: k.poly = sfb__eval_endcap; k.cap_corners = 4; break;
+    case SFB__PATCH_BEZTRI: k.poly = sfb__eval_beztri; break;
     case SFB__PATCH_STAM_LOOP: k.eval = sfb__kind_stam_loop; break;
-    case SFB__PATCH_ENDCAP_TRI: k.eval = sfb__kind_endcap_tri; k.normal = sfb__kind_endcap_tri_normal; break;
-    default: k.eval = sfb__kind_bspline16; break;
+    case SFB__PATCH_ENDCAP_TRI: k.poly = sfb__eval_endcap_tri; k.cap_corners = 3; break;
+    default: k.poly = sfb__eval_bspline16; break;
     }
     return k;
+}
+
+/* res and the tangent directions dir of kind k at (s,t). */
+static void sfb__kind_eval(const sfb__patch_kind *k, const sfb__patch_table *pt, const float *pts, int patch, const int *cv, double s,
+                           double t, double res[6][3], double dir[2][3]) {
+    if (!k->poly) { k->eval(pt, pts, patch, cv, s, t, res, dir); return; }
+    k->poly(pts, cv, s, t, res);
+    memcpy(dir[0], res[1], sizeof dir[0]);
+    memcpy(dir[1], res[2], sizeof dir[1]);
 }
 
 /* The ref kernel: one location, double precision throughout. want2: the second derivatives are
@@ -3445,8 +3447,8 @@ static void sfb__ref_eval_one(const sfb__patch_table *pt, const float *pts, cons
         sfb__mf_eval_patch(pt, pts, patch, s, t, want2, res, nrm); /* its normal is final (patch/manifold.c) */
     } else {
         kind = sfb__patch_kind_of(pt->ptype[patch]);
-        kind.eval(pt, pts, patch, cv, s, t, res, dir);
-        if (kind.normal) kind.normal(pts, cv, s, t, nrm);
+        sfb__kind_eval(&kind, pt, pts, patch, cv, s, t, res, dir);
+        if (kind.cap_corners) sfb__endcap_normal(pts, cv, kind.cap_corners, s, t, nrm);
         else sfb__cross3(dir[0], dir[1], nrm);
         len = sqrt(nrm[0] * nrm[0] + nrm[1] * nrm[1] + nrm[2] * nrm[2]);
         if (!(len > 0.0) || !isfinite(len)) {
@@ -3456,7 +3458,7 @@ static void sfb__ref_eval_one(const sfb__patch_table *pt, const float *pts, cons
             double s2 = s + (s < 0.5 ? 1e-3 : -1e-3), t2 = t + (t < 0.5 ? 1e-3 : -1e-3);
             if (tri && s2 + t2 > 1.0) { s2 = s - 1e-3; t2 = t - 1e-3; }
             if (tri && s + t < 2e-3) { s2 = s + 1e-3; t2 = t + 1e-3; }
-            kind.eval(pt, pts, patch, cv, s2, t2, r2, dir);
+            sfb__kind_eval(&kind, pt, pts, patch, cv, s2, t2, r2, dir);
             sfb__cross3(dir[0], dir[1], nrm);
             len = sqrt(nrm[0] * nrm[0] + nrm[1] * nrm[1] + nrm[2] * nrm[2]);
         }
@@ -4384,30 +4386,10 @@ void sfb__eval_stam(const sfb__eigen_cc *e, const float *pts, const int *cv, int
                      res, nres);
 }
 
-/* The kinds' evaluators (sfb__patch_kind, patch/table.c). */
-void sfb__kind_bspline16(const sfb__patch_table *pt, const float *pts, int patch, const int *cv, double s, double t, double res[6][3],
-                         double dir[2][3]) {
-    (void)pt; (void)patch;
-    sfb__eval_bspline16(pts, cv, s, t, res);
-    memcpy(dir[0], res[1], sizeof dir[0]);
-    memcpy(dir[1], res[2], sizeof dir[1]);
-}
-
+/* The Stam kind's evaluator (sfb__patch_kind, patch/table.c): res and the normalised tangent frame. */
 void sfb__kind_stam(const sfb__patch_table *pt, const float *pts, int patch, const int *cv, double s, double t, double res[6][3],
                     double dir[2][3]) {
     sfb__eval_stam(pt->eig[pt->pvalence[patch]], pts, cv, SFB__PARAM_CORNER(pt->pparam[patch]), s, t, res, dir);
-}
-
-void sfb__kind_endcap(const sfb__patch_table *pt, const float *pts, int patch, const int *cv, double s, double t, double res[6][3],
-                      double dir[2][3]) {
-    (void)pt; (void)patch;
-    sfb__eval_endcap(pts, cv, s, t, res);
-    memcpy(dir[0], res[1], sizeof dir[0]);
-    memcpy(dir[1], res[2], sizeof dir[1]);
-}
-
-void sfb__kind_endcap_normal(const float *pts, const int *cv, double s, double t, double nrm[3]) {
-    sfb__endcap_normal(pts, cv, 4, s, t, nrm);
 }
 #line 1 "src/patch/tri.c"
 /* The triangle family's records (SFB__FAMILY_TRI): BEZTRI15 (a regular triangle: its box
@@ -4735,30 +4717,10 @@ void sfb__eval_stam_loop(const sfb__eigen_loop *e, const float *pts, const int *
     sfb__stam_finish(J, at_ev ? 1.0 : pow(e->sub, m) * ldexp(1.0, n), at_ev ? 0.0 : pow(e->sub, m) * ldexp(1.0, 2 * n), sr, nr, res, nres);
 }
 
-/* The kinds' evaluators (sfb__patch_kind, patch/table.c). */
-void sfb__kind_beztri(const sfb__patch_table *pt, const float *pts, int patch, const int *cv, double s, double t, double res[6][3],
-                      double dir[2][3]) {
-    (void)pt; (void)patch;
-    sfb__eval_beztri(pts, cv, s, t, res);
-    memcpy(dir[0], res[1], sizeof dir[0]);
-    memcpy(dir[1], res[2], sizeof dir[1]);
-}
-
+/* The Stam kind's evaluator (sfb__patch_kind, patch/table.c): res and the normalised tangent frame. */
 void sfb__kind_stam_loop(const sfb__patch_table *pt, const float *pts, int patch, const int *cv, double s, double t, double res[6][3],
                          double dir[2][3]) {
     sfb__eval_stam_loop(pt->eigl[pt->pvalence[patch]], pts, cv, SFB__PARAM_CORNER(pt->pparam[patch]), s, t, res, dir);
-}
-
-void sfb__kind_endcap_tri(const sfb__patch_table *pt, const float *pts, int patch, const int *cv, double s, double t, double res[6][3],
-                          double dir[2][3]) {
-    (void)pt; (void)patch;
-    sfb__eval_endcap_tri(pts, cv, s, t, res);
-    memcpy(dir[0], res[1], sizeof dir[0]);
-    memcpy(dir[1], res[2], sizeof dir[1]);
-}
-
-void sfb__kind_endcap_tri_normal(const float *pts, const int *cv, double s, double t, double nrm[3]) {
-    sfb__endcap_normal(pts, cv, 3, s, t, nrm);
 }
 #line 1 "src/patch/manifold.c"
 /* Manifold-based blending surfaces with darts, creases and corners (seed 000, after Ying and

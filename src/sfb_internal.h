@@ -439,31 +439,24 @@ sfb_result sfb__patches_build(sfb_context *ctx, const sfb__level *base, const sf
 int sfb__patch_locate(const sfb__patch_table *pt, int ptex, double u, double v, double *s, double *t, double *scale);
 
 /* ---- reading records (patch/table.c) and the record kinds (patch/quad.c, patch/tri.c) ---- */
-/* A record type's ref evaluation: res = P, Ps, Pt, Pss, Pst, Ptt in the record's (s,t) (before
- * the sub-patch scale), dir = two tangent directions whose cross product gives the normal's
- * direction; `normal`, when not NULL, gives the normal direction instead (end caps). */
+/* A record type's ref evaluation. res = P, Ps, Pt, Pss, Pst, Ptt in the record's (s,t) (before
+ * the sub-patch scale). A polynomial kind gives `poly` (the normal's direction is Ps x Pt); a
+ * Stam kind gives `eval`, which also returns the normalised tangent frame dir (the normal's
+ * direction is dir[0] x dir[1], finite down to the extraordinary vertex). An end cap's normal
+ * blends its cap_corners corners' limit normals (sfb__endcap_normal). */
 typedef void (*sfb__patch_eval_fn)(const sfb__patch_table *pt, const float *pts, int patch, const int *cv, double s, double t,
                                    double res[6][3], double dir[2][3]);
 typedef struct sfb__patch_kind {
+    void (*poly)(const float *pts, const int *cv, double s, double t, double res[6][3]);
     sfb__patch_eval_fn eval;
-    void (*normal)(const float *pts, const int *cv, double s, double t, double nrm[3]);
+    int cap_corners;
 } sfb__patch_kind;
 /* The ref evaluator of a (non-MANIFOLD4) record type. */
 sfb__patch_kind sfb__patch_kind_of(int type);
-void sfb__kind_bspline16(const sfb__patch_table *pt, const float *pts, int patch, const int *cv, double s, double t, double res[6][3],
-                         double dir[2][3]);
 void sfb__kind_stam(const sfb__patch_table *pt, const float *pts, int patch, const int *cv, double s, double t, double res[6][3],
                     double dir[2][3]);
-void sfb__kind_endcap(const sfb__patch_table *pt, const float *pts, int patch, const int *cv, double s, double t, double res[6][3],
-                      double dir[2][3]);
-void sfb__kind_endcap_normal(const float *pts, const int *cv, double s, double t, double nrm[3]);
-void sfb__kind_beztri(const sfb__patch_table *pt, const float *pts, int patch, const int *cv, double s, double t, double res[6][3],
-                      double dir[2][3]);
 void sfb__kind_stam_loop(const sfb__patch_table *pt, const float *pts, int patch, const int *cv, double s, double t, double res[6][3],
                          double dir[2][3]);
-void sfb__kind_endcap_tri(const sfb__patch_table *pt, const float *pts, int patch, const int *cv, double s, double t, double res[6][3],
-                          double dir[2][3]);
-void sfb__kind_endcap_tri_normal(const float *pts, const int *cv, double s, double t, double nrm[3]);
 /* The record evaluations themselves (res as above; the Stam kinds' nres: the first derivatives
  * divided by their scale, a finite tangent frame down to the extraordinary vertex). */
 void sfb__bspline_basis(double t, double *b, double *d, double *dd);   /* uniform cubic B-spline: value, d, d2 */

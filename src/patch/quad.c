@@ -338,28 +338,8 @@ void sfb__eval_stam(const sfb__eigen_cc *e, const float *pts, const int *cv, int
                      res, nres);
 }
 
-/* The kinds' evaluators (sfb__patch_kind, patch/table.c). */
-void sfb__kind_bspline16(const sfb__patch_table *pt, const float *pts, int patch, const int *cv, double s, double t, double res[6][3],
-                         double dir[2][3]) {
-    (void)pt; (void)patch;
-    sfb__eval_bspline16(pts, cv, s, t, res);
-    memcpy(dir[0], res[1], sizeof dir[0]);
-    memcpy(dir[1], res[2], sizeof dir[1]);
-}
-
+/* The Stam kind's evaluator (sfb__patch_kind, patch/table.c): res and the normalised tangent frame. */
 void sfb__kind_stam(const sfb__patch_table *pt, const float *pts, int patch, const int *cv, double s, double t, double res[6][3],
                     double dir[2][3]) {
     sfb__eval_stam(pt->eig[pt->pvalence[patch]], pts, cv, SFB__PARAM_CORNER(pt->pparam[patch]), s, t, res, dir);
-}
-
-void sfb__kind_endcap(const sfb__patch_table *pt, const float *pts, int patch, const int *cv, double s, double t, double res[6][3],
-                      double dir[2][3]) {
-    (void)pt; (void)patch;
-    sfb__eval_endcap(pts, cv, s, t, res);
-    memcpy(dir[0], res[1], sizeof dir[0]);
-    memcpy(dir[1], res[2], sizeof dir[1]);
-}
-
-void sfb__kind_endcap_normal(const float *pts, const int *cv, double s, double t, double nrm[3]) {
-    sfb__endcap_normal(pts, cv, 4, s, t, nrm);
 }

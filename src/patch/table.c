@@ -110,16 +110,25 @@ void sfb__stam_finish(double J[2][2], double sc1, double sc2, double sr[6][3], d
  * patch/manifold.c's sfb__mf_eval_patch (their normal is final), see sfb__ref_eval_one. */
 sfb__patch_kind sfb__patch_kind_of(int type) {
     sfb__patch_kind k;
-    k.normal = NULL;
+    memset(&k, 0, sizeof k);
     switch (type) {
     case SFB__PATCH_STAM: k.eval = sfb__kind_stam; break;
-    case SFB__PATCH_ENDCAP: k.eval = sfb__kind_endcap; k.normal = sfb__kind_endcap_normal; break;
-    case SFB__PATCH_BEZTRI: k.eval = sfb__kind_beztri; break;
+    case SFB__PATCH_ENDCAP: k.poly = sfb__eval_endcap; k.cap_corners = 4; break;
+    case SFB__PATCH_BEZTRI: k.poly = sfb__eval_beztri; break;
     case SFB__PATCH_STAM_LOOP: k.eval = sfb__kind_stam_loop; break;
-    case SFB__PATCH_ENDCAP_TRI: k.eval = sfb__kind_endcap_tri; k.normal = sfb__kind_endcap_tri_normal; break;
-    default: k.eval = sfb__kind_bspline16; break;
+    case SFB__PATCH_ENDCAP_TRI: k.poly = sfb__eval_endcap_tri; k.cap_corners = 3; break;
+    default: k.poly = sfb__eval_bspline16; break;
     }
     return k;
+}
+
+/* res and the tangent directions dir of kind k at (s,t). */
+static void sfb__kind_eval(const sfb__patch_kind *k, const sfb__patch_table *pt, const float *pts, int patch, const int *cv, double s,
+                           double t, double res[6][3], double dir[2][3]) {
+    if (!k->poly) { k->eval(pt, pts, patch, cv, s, t, res, dir); return; }
+    k->poly(pts, cv, s, t, res);
+    memcpy(dir[0], res[1], sizeof dir[0]);
+    memcpy(dir[1], res[2], sizeof dir[1]);
 }
 
 /* The ref kernel: one location, double precision throughout. want2: the second derivatives are
@@ -138,8 +147,8 @@ static void sfb__ref_eval_one(const sfb__patch_table *pt, const float *pts, cons
         sfb__mf_eval_patch(pt, pts, patch, s, t, want2, res, nrm); /* its normal is final (patch/manifold.c) */
     } else {
         kind = sfb__patch_kind_of(pt->ptype[patch]);
-        kind.eval(pt, pts, patch, cv, s, t, res, dir);
-        if (kind.normal) kind.normal(pts, cv, s, t, nrm);
+        sfb__kind_eval(&kind, pt, pts, patch, cv, s, t, res, dir);
+        if (kind.cap_corners) sfb__endcap_normal(pts, cv, kind.cap_corners, s, t, nrm);
         else sfb__cross3(dir[0], dir[1], nrm);
         len = sqrt(nrm[0] * nrm[0] + nrm[1] * nrm[1] + nrm[2] * nrm[2]);
         if (!(len > 0.0) || !isfinite(len)) {
@@ -149,7 +158,7 @@ static void sfb__ref_eval_one(const sfb__patch_table *pt, const float *pts, cons
             double s2 = s + (s < 0.5 ? 1e-3 : -1e-3), t2 = t + (t < 0.5 ? 1e-3 : -1e-3);
             if (tri && s2 + t2 > 1.0) { s2 = s - 1e-3; t2 = t - 1e-3; }
             if (tri && s + t < 2e-3) { s2 = s + 1e-3; t2 = t + 1e-3; }
-            kind.eval(pt, pts, patch, cv, s2, t2, r2, dir);
+            sfb__kind_eval(&kind, pt, pts, patch, cv, s2, t2, r2, dir);
             sfb__cross3(dir[0], dir[1], nrm);
             len = sqrt(nrm[0] * nrm[0] + nrm[1] * nrm[1] + nrm[2] * nrm[2]);
         }

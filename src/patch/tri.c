@@ -323,28 +323,8 @@ void sfb__eval_stam_loop(const sfb__eigen_loop *e, const float *pts, const int *
     sfb__stam_finish(J, at_ev ? 1.0 : pow(e->sub, m) * ldexp(1.0, n), at_ev ? 0.0 : pow(e->sub, m) * ldexp(1.0, 2 * n), sr, nr, res, nres);
 }
 
-/* The kinds' evaluators (sfb__patch_kind, patch/table.c). */
-void sfb__kind_beztri(const sfb__patch_table *pt, const float *pts, int patch, const int *cv, double s, double t, double res[6][3],
-                      double dir[2][3]) {
-    (void)pt; (void)patch;
-    sfb__eval_beztri(pts, cv, s, t, res);
-    memcpy(dir[0], res[1], sizeof dir[0]);
-    memcpy(dir[1], res[2], sizeof dir[1]);
-}
-
+/* The Stam kind's evaluator (sfb__patch_kind, patch/table.c): res and the normalised tangent frame. */
 void sfb__kind_stam_loop(const sfb__patch_table *pt, const float *pts, int patch, const int *cv, double s, double t, double res[6][3],
                          double dir[2][3]) {
     sfb__eval_stam_loop(pt->eigl[pt->pvalence[patch]], pts, cv, SFB__PARAM_CORNER(pt->pparam[patch]), s, t, res, dir);
-}
-
-void sfb__kind_endcap_tri(const sfb__patch_table *pt, const float *pts, int patch, const int *cv, double s, double t, double res[6][3],
-                          double dir[2][3]) {
-    (void)pt; (void)patch;
-    sfb__eval_endcap_tri(pts, cv, s, t, res);
-    memcpy(dir[0], res[1], sizeof dir[0]);
-    memcpy(dir[1], res[2], sizeof dir[1]);
-}
-
-void sfb__kind_endcap_tri_normal(const float *pts, const int *cv, double s, double t, double nrm[3]) {
-    sfb__endcap_normal(pts, cv, 3, s, t, nrm);
 }
