@@ -35,7 +35,7 @@
 #if !defined(_WIN32)
 #include <dlfcn.h>
 #endif
-#include "sfb_gl_shaders.h"
+#include "gl/shaders.h"
 
 /* Build-time overrides, used by tests/gl_errors.c to exercise the failure paths for real: the
  * kernel source, and the library names tried by dlopen (NULL-terminated initialisers). */

@@ -1,4 +1,4 @@
-/* GENERATED from backends/glsl/ by `make embed-glsl`; edit the .glsl sources instead. */
+/* GENERATED from backends/gl/glsl/ by `make embed-glsl`; edit the .glsl sources instead. */
 
 /* A kernel may be longer than the 4095 characters C99 promises for one string literal; GCC,
  * Clang and MSVC (64 KiB) take far more, so -pedantic's warning is silenced here only. */
@@ -7,7 +7,7 @@
 #pragma GCC diagnostic ignored "-Woverlength-strings"
 #endif
 
-/* backends/glsl/manifold.comp.glsl */
+/* backends/gl/glsl/manifold.comp.glsl */
 static const char sfb__glsl_manifold_comp_glsl[] =
     "// Manifold-based blending surfaces (seed 000 sections V.1-V.4; the MANIFOLD4 patch family): the\n"
     "// blend of four chart local geometries, in float. It is the ref kernel of src/manifold.c\n"
@@ -324,7 +324,7 @@ static const char sfb__glsl_manifold_comp_glsl[] =
     "#endif\n"
     ;
 
-/* backends/glsl/manifold_draw.frag.glsl */
+/* backends/gl/glsl/manifold_draw.frag.glsl */
 static const char sfb__glsl_manifold_draw_frag_glsl[] =
     "// The fragment program of sfb_surface_draw_gl (seed 000 section V.5): two-sided lighting of the\n"
     "// manifold surface drawn by manifold.comp.glsl's vertex stage, and trimming: with u_trim_on the\n"
@@ -380,7 +380,7 @@ static const char sfb__glsl_manifold_draw_frag_glsl[] =
     "}\n"
     ;
 
-/* backends/glsl/normals.comp.glsl */
+/* backends/gl/glsl/normals.comp.glsl */
 static const char sfb__glsl_normals_comp_glsl[] =
     "// Seed 001's normal blend (the backend vtable's finish_normals; the ref kernel is\n"
     "// sfb__ref_finish_normals in src/backend_ref.c), one invocation per element, in float:\n"
@@ -473,7 +473,7 @@ static const char sfb__glsl_normals_comp_glsl[] =
     "}\n"
     ;
 
-/* backends/glsl/patches.comp.glsl */
+/* backends/gl/glsl/patches.comp.glsl */
 static const char sfb__glsl_patches_comp_glsl[] =
     "// Patch evaluation (exact limit surface of Catmull-Clark and Loop): one invocation per location.\n"
     "// The CPU has already found each location's patch and its (s,t) in it (sfb__patch_locate, a\n"
@@ -974,7 +974,7 @@ static const char sfb__glsl_patches_comp_glsl[] =
     "}\n"
     ;
 
-/* backends/glsl/stencils.comp.glsl */
+/* backends/gl/glsl/stencils.comp.glsl */
 static const char sfb__glsl_stencils_comp_glsl[] =
     "// Stencil evaluation: one invocation per destination row.\n"
     "//   dst[dst_offset + (row_base + r) * dst_stride + c] =\n"
