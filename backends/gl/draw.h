@@ -120,20 +120,151 @@ static int sfb__gl_all_zero(const float *v, int n) {
     return 1;
 }
 
-SFB_API sfb_result sfb_surface_draw_gl(const sfb_surface *surface, const sfb_gl_draw_params *params) {
+/* A draw call's parameters, checked, with the defaults filled in. */
+typedef struct sfb__gl_draw {
+    sfb_gl_draw_params p;
+    const float *mvp, *nm, *color;
+    float light[3];
+    int rate, n, first, count; /* n = rate + 1 samples a side; faces first .. first + count - 1 */
+    size_t cap_bytes;          /* what the capture writes (capture_buffer set) */
+} sfb__gl_draw;
+
+static sfb_result sfb__gl_draw_settle(sfb_context *ctx, const sfb__patch_table *pt, const sfb_gl_draw_params *params, sfb__gl_draw *d) {
     static const float ident4[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1}, ident3[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
     static const float grey[4] = {0.8f, 0.8f, 0.8f, 1.0f};
+    const sfb_gl_draw_params *p = &d->p;
+    int nptex;
+    d->p = *params;
+    d->light[0] = 0.0f; d->light[1] = 0.0f; d->light[2] = 1.0f;
+    d->cap_bytes = 0;
+    d->rate = p->rate == 0 ? 16 : p->rate;
+    if (d->rate < 1 || d->rate > 1024)
+        return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "sfb_surface_draw_gl: rate %d is outside 1..1024 (0: 16)", p->rate);
+    nptex = pt->nptex;
+    d->first = p->first_face;
+    d->count = p->face_count;
+    if (d->first < 0 || d->count < 0 || d->first > nptex || d->count > nptex - d->first)
+        return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1,
+                          "sfb_surface_draw_gl: faces %d (+%d) are outside the surface's %d parametric faces", d->first, d->count, nptex);
+    if (d->count == 0) d->count = nptex - d->first;
+    if (!sfb__gl_all_finite(p->mvp, 16) || !sfb__gl_all_finite(p->normal_matrix, 9) || !sfb__gl_all_finite(p->light, 3) ||
+        !sfb__gl_all_finite(p->color, 4))
+        return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, -1, "sfb_surface_draw_gl: a matrix, light or colour value is not finite");
+    if (p->trim_tiles_u < 0 || p->trim_tiles_v < 0 || (p->trim_tiles_u == 0) != (p->trim_tiles_v == 0))
+        return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, -1,
+                          "sfb_surface_draw_gl: trimming atlas tiles %d x %d (0 x 0, or both >= 1)", p->trim_tiles_u, p->trim_tiles_v);
+    d->mvp = sfb__gl_all_zero(p->mvp, 16) ? ident4 : p->mvp;
+    d->nm = sfb__gl_all_zero(p->normal_matrix, 9) ? ident3 : p->normal_matrix;
+    d->color = sfb__gl_all_zero(p->color, 4) ? grey : p->color;
+    if (!sfb__gl_all_zero(p->light, 3)) {
+        /* in double: a tiny or huge light direction neither under- nor overflows */
+        double lx = p->light[0], ly = p->light[1], lz = p->light[2], l = sqrt(lx * lx + ly * ly + lz * lz);
+        d->light[0] = (float)(lx / l); d->light[1] = (float)(ly / l); d->light[2] = (float)(lz / l);
+    }
+    d->n = d->rate + 1;
+    if (p->capture_buffer) d->cap_bytes = (size_t)d->count * (size_t)d->n * (size_t)d->n * 6 * sizeof(float);
+    return SFB_SUCCESS;
+}
+
+/* The host's objects the draw names: the trimming texture and the capture buffer. */
+static sfb_result sfb__gl_draw_host_objects(sfb__gl *g, const sfb__gl_draw *d) {
+    sfb_context *ctx = g->ctx;
+    const sfb_gl_draw_params *p = &d->p;
+    if (p->trim_texture) {
+        sfb__GLint w = 0, h = 0;
+        if (!g->gl.IsTexture(p->trim_texture))
+            return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "sfb_surface_draw_gl: trim_texture %u is not a texture of the current context",
+                              p->trim_texture);
+        g->gl.ActiveTexture(SFB__GL_TEXTURE0 + 2);
+        g->gl.BindTexture(SFB__GL_TEXTURE_2D, p->trim_texture);
+        g->gl.GetTexLevelParameteriv(SFB__GL_TEXTURE_2D, 0, SFB__GL_TEXTURE_WIDTH, &w);
+        g->gl.GetTexLevelParameteriv(SFB__GL_TEXTURE_2D, 0, SFB__GL_TEXTURE_HEIGHT, &h);
+        if (g->gl.GetError() != SFB__GL_NO_ERROR || w < 1 || h < 1) {
+            while (g->gl.GetError() != SFB__GL_NO_ERROR) {}
+            return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "sfb_surface_draw_gl: trim_texture %u is not a 2D texture with a level-0 image",
+                              p->trim_texture);
+        }
+        if (p->trim_tiles_u > 0 && (w % p->trim_tiles_u != 0 || h % p->trim_tiles_v != 0))
+            return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, -1, "sfb_surface_draw_gl: the %d x %d trimming texture does not split into %d x %d equal tiles",
+                              (int)w, (int)h, p->trim_tiles_u, p->trim_tiles_v);
+    }
+    if (p->capture_buffer) {
+        sfb__GLint size = 0;
+        if (!g->gl.IsBuffer(p->capture_buffer))
+            return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "sfb_surface_draw_gl: capture_buffer %u is not a buffer object of the current context",
+                              p->capture_buffer);
+        g->gl.BindBuffer(SFB__GL_SHADER_STORAGE_BUFFER, p->capture_buffer);
+        g->gl.GetBufferParameteriv(SFB__GL_SHADER_STORAGE_BUFFER, SFB__GL_BUFFER_SIZE, &size);
+        if (size < 0 || (size_t)size < d->cap_bytes)
+            return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1,
+                              "sfb_surface_draw_gl: capture_buffer %u has %d bytes; %d faces at rate %d need %zu", p->capture_buffer, (int)size, d->count,
+                              d->rate, d->cap_bytes);
+    }
+    return SFB_SUCCESS;
+}
+
+/* With the draw program in use: the table's textures, the trimming mask on unit 2, and the
+ * draw's uniforms. */
+static void sfb__gl_draw_uniforms_set(sfb__gl *g, const sfb__gl_ptable *tab, int weights, const sfb__gl_draw *d) {
+    g->gl.UseProgram(g->draw_program);
+    sfb__gl_mf_bind(g, tab, weights, g->draw_loc);
+    g->gl.ActiveTexture(SFB__GL_TEXTURE0 + 2);
+    if (d->p.trim_texture) g->gl.BindTexture(SFB__GL_TEXTURE_2D, d->p.trim_texture);
+    g->gl.BindSampler(2, g->sampler);
+    g->gl.UniformMatrix4fv(g->draw_loc[5], 1, 0, d->mvp);
+    g->gl.UniformMatrix3fv(g->draw_loc[6], 1, 0, d->nm);
+    g->gl.Uniform1i(g->draw_loc[7], d->rate);
+    g->gl.Uniform1i(g->draw_loc[8], d->first);
+    g->gl.Uniform1i(g->draw_loc[9], 2);
+    g->gl.Uniform1i(g->draw_loc[10], d->p.trim_texture != 0);
+    g->gl.Uniform2i(g->draw_loc[11], d->p.trim_tiles_u, d->p.trim_tiles_v);
+    g->gl.Uniform3f(g->draw_loc[12], d->light[0], d->light[1], d->light[2]);
+    g->gl.Uniform4f(g->draw_loc[13], d->color[0], d->color[1], d->color[2], d->color[3]);
+}
+
+/* The capture (when asked) and the draw, on the surface's manifold table (`tab`: its upload
+ * to this backend, or NULL). `ds` is the host's state, saved. */
+static sfb_result sfb__gl_draw_run(sfb__gl *g, const sfb__patch_table *pt, sfb__gl_ptable *tab, const sfb__gl_draw *d,
+                                   const sfb__gl_drawstate *ds) {
+    sfb__gl_ptable *temp = NULL;
+    sfb_result r;
+    if (!tab || tab->family != SFB__FAMILY_MANIFOLD) {
+        if ((r = sfb__gl_mf_upload_current(g, pt, &temp)) != SFB_SUCCESS) return r;
+        tab = temp;
+    }
+    if ((r = sfb__gl_draw_program(g)) != SFB_SUCCESS) goto done;
+    if ((r = sfb__gl_draw_grid(g, d->rate)) != SFB_SUCCESS) goto done;
+    sfb__gl_draw_uniforms_set(g, tab, pt->mf_weights, d);
+    if ((r = sfb__gl_check(g, "setting up the manifold draw")) != SFB_SUCCESS) goto done;
+    if (d->p.capture_buffer) {
+        /* the samples once each, as points, into the capture buffer */
+        g->gl.BindTransformFeedback(SFB__GL_TRANSFORM_FEEDBACK, g->draw_tfo);
+        g->gl.BindBufferRange(SFB__GL_TRANSFORM_FEEDBACK_BUFFER, 0, d->p.capture_buffer, 0, (sfb__GLsizeiptr)d->cap_bytes);
+        g->gl.Enable(SFB__GL_RASTERIZER_DISCARD);
+        g->gl.BeginTransformFeedback(SFB__GL_POINTS);
+        g->gl.DrawArraysInstanced(SFB__GL_POINTS, 0, d->n * d->n, d->count);
+        g->gl.EndTransformFeedback();
+        if (!ds->discard) g->gl.Disable(SFB__GL_RASTERIZER_DISCARD);
+        g->gl.BindTransformFeedback(SFB__GL_TRANSFORM_FEEDBACK, (sfb__GLuint)ds->tfo);
+        if ((r = sfb__gl_check(g, "capturing the manifold samples")) != SFB_SUCCESS) goto done;
+    }
+    g->gl.DrawElementsInstanced(SFB__GL_TRIANGLES, 6 * d->rate * d->rate, SFB__GL_UNSIGNED_INT, NULL, d->count);
+    r = sfb__gl_check(g, "drawing the manifold surface");
+    /* the host may read the capture (map, copy, draw from it) next */
+    if (r == SFB_SUCCESS && d->p.capture_buffer) g->gl.MemoryBarrier(SFB__GL_ALL_BARRIER_BITS);
+done:
+    if (temp) sfb__gl_mf_free(g, temp);
+    return r;
+}
+
+SFB_API sfb_result sfb_surface_draw_gl(const sfb_surface *surface, const sfb_gl_draw_params *params) {
     sfb_context *ctx;
     sfb__gl *g = NULL;
-    sfb_gl_draw_params p;
     const sfb__patch_table *pt;
-    sfb__gl_ptable *tab, *temp = NULL;
+    sfb__gl_ptable *tab;
     sfb__gl_saved saved;
     sfb__gl_drawstate ds;
-    const float *mvp, *nm, *color;
-    float light[3] = {0.0f, 0.0f, 1.0f};
-    int rate, n, first, count, nptex;
-    size_t cap_bytes = 0;
+    sfb__gl_draw d;
     sfb_result r;
     if (!surface) return SFB_INVALID_ARGS;
     ctx = surface->ctx;
@@ -142,118 +273,17 @@ SFB_API sfb_result sfb_surface_draw_gl(const sfb_surface *surface, const sfb_gl_
     pt = &surface->patches;
     if (!surface->has_patches || !(sfb__patch_families(pt) & (1u << SFB__FAMILY_MANIFOLD)))
         return sfb__error(ctx, SFB_UNSUPPORTED, SFB_ELEMENT_NONE, -1,
-                          "sfb_surface_draw_gl draws manifold blending surfaces (SFB_SCHEME_MANIFOLD_BLEND with SFB_REFINE_PATCHES); this surface is %s%s",
-                          sfb_scheme_name(surface->config.scheme), surface->has_patches ? "" : " without patches");
-    p = *params;
-    rate = p.rate == 0 ? 16 : p.rate;
-    if (rate < 1 || rate > 1024)
-        return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "sfb_surface_draw_gl: rate %d is outside 1..1024 (0: 16)", p.rate);
-    nptex = pt->nptex;
-    first = p.first_face;
-    count = p.face_count;
-    if (first < 0 || count < 0 || first > nptex || count > nptex - first)
-        return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1,
-                          "sfb_surface_draw_gl: faces %d (+%d) are outside the surface's %d parametric faces", first, count, nptex);
-    if (count == 0) count = nptex - first;
-    if (!sfb__gl_all_finite(p.mvp, 16) || !sfb__gl_all_finite(p.normal_matrix, 9) || !sfb__gl_all_finite(p.light, 3) ||
-        !sfb__gl_all_finite(p.color, 4))
-        return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, -1, "sfb_surface_draw_gl: a matrix, light or colour value is not finite");
-    if (p.trim_tiles_u < 0 || p.trim_tiles_v < 0 || (p.trim_tiles_u == 0) != (p.trim_tiles_v == 0))
-        return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, -1,
-                          "sfb_surface_draw_gl: trimming atlas tiles %d x %d (0 x 0, or both >= 1)", p.trim_tiles_u, p.trim_tiles_v);
-    mvp = sfb__gl_all_zero(p.mvp, 16) ? ident4 : p.mvp;
-    nm = sfb__gl_all_zero(p.normal_matrix, 9) ? ident3 : p.normal_matrix;
-    color = sfb__gl_all_zero(p.color, 4) ? grey : p.color;
-    if (!sfb__gl_all_zero(p.light, 3)) {
-        /* in double: a tiny or huge light direction neither under- nor overflows */
-        double lx = p.light[0], ly = p.light[1], lz = p.light[2], l = sqrt(lx * lx + ly * ly + lz * lz);
-        light[0] = (float)(lx / l); light[1] = (float)(ly / l); light[2] = (float)(lz / l);
-    }
-    n = rate + 1;
-    if (p.capture_buffer) cap_bytes = (size_t)count * (size_t)n * (size_t)n * 6 * sizeof(float);
-    if (count == 0) return SFB_SUCCESS;
+                          "sfb_surface_draw_gl needs a MANIFOLD4 patch table (SFB_SCHEME_MANIFOLD_BLEND with SFB_REFINE_PATCHES); this surface has %s",
+                          !surface->has_patches ? "no patch table" : sfb__patch_families(pt) & (1u << SFB__FAMILY_TRI) ? "a table of triangle patches"
+                          : sfb__patch_families(pt) ? "a table of quad patches" : "an empty patch table");
+    if ((r = sfb__gl_draw_settle(ctx, pt, params, &d)) != SFB_SUCCESS) return r;
+    if (d.count == 0) return SFB_SUCCESS;
     if ((r = sfb__gl_enter(g, &saved)) != SFB_SUCCESS) return r;
     sfb__gl_draw_save(g, &ds);
-    /* the host's objects */
-    if (p.trim_texture) {
-        sfb__GLint w = 0, h = 0;
-        if (!g->gl.IsTexture(p.trim_texture)) {
-            r = sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "sfb_surface_draw_gl: trim_texture %u is not a texture of the current context",
-                           p.trim_texture);
-            goto done;
-        }
-        g->gl.ActiveTexture(SFB__GL_TEXTURE0 + 2);
-        g->gl.BindTexture(SFB__GL_TEXTURE_2D, p.trim_texture);
-        g->gl.GetTexLevelParameteriv(SFB__GL_TEXTURE_2D, 0, SFB__GL_TEXTURE_WIDTH, &w);
-        g->gl.GetTexLevelParameteriv(SFB__GL_TEXTURE_2D, 0, SFB__GL_TEXTURE_HEIGHT, &h);
-        if (g->gl.GetError() != SFB__GL_NO_ERROR || w < 1 || h < 1) {
-            while (g->gl.GetError() != SFB__GL_NO_ERROR) {}
-            r = sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "sfb_surface_draw_gl: trim_texture %u is not a 2D texture with a level-0 image",
-                           p.trim_texture);
-            goto done;
-        }
-        if (p.trim_tiles_u > 0 && (w % p.trim_tiles_u != 0 || h % p.trim_tiles_v != 0)) {
-            r = sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, -1, "sfb_surface_draw_gl: the %d x %d trimming texture does not split into %d x %d equal tiles",
-                           (int)w, (int)h, p.trim_tiles_u, p.trim_tiles_v);
-            goto done;
-        }
+    if ((r = sfb__gl_draw_host_objects(g, &d)) == SFB_SUCCESS) {
+        tab = surface->uploaded_by && surface->uploaded_by->kind == SFB_BACKEND_GL ? (sfb__gl_ptable *)surface->backend_patches : NULL;
+        r = sfb__gl_draw_run(g, pt, tab, &d, &ds);
     }
-    if (p.capture_buffer) {
-        sfb__GLint size = 0;
-        if (!g->gl.IsBuffer(p.capture_buffer)) {
-            r = sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "sfb_surface_draw_gl: capture_buffer %u is not a buffer object of the current context",
-                           p.capture_buffer);
-            goto done;
-        }
-        g->gl.BindBuffer(SFB__GL_SHADER_STORAGE_BUFFER, p.capture_buffer);
-        g->gl.GetBufferParameteriv(SFB__GL_SHADER_STORAGE_BUFFER, SFB__GL_BUFFER_SIZE, &size);
-        if (size < 0 || (size_t)size < cap_bytes) {
-            r = sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1,
-                           "sfb_surface_draw_gl: capture_buffer %u has %d bytes; %d faces at rate %d need %zu", p.capture_buffer, (int)size, count,
-                           rate, cap_bytes);
-            goto done;
-        }
-    }
-    tab = surface->uploaded_by && surface->uploaded_by->kind == SFB_BACKEND_GL ? (sfb__gl_ptable *)surface->backend_patches : NULL;
-    if (!tab || !tab->manifold) {
-        if ((r = sfb__gl_mf_upload_current(g, pt, &temp)) != SFB_SUCCESS) goto done;
-        tab = temp;
-    }
-    if ((r = sfb__gl_draw_program(g)) != SFB_SUCCESS) goto done;
-    if ((r = sfb__gl_draw_grid(g, rate)) != SFB_SUCCESS) goto done;
-    g->gl.UseProgram(g->draw_program);
-    sfb__gl_mf_bind(g, tab, pt->mf_weights, g->draw_loc);
-    g->gl.ActiveTexture(SFB__GL_TEXTURE0 + 2);
-    if (p.trim_texture) g->gl.BindTexture(SFB__GL_TEXTURE_2D, p.trim_texture);
-    g->gl.BindSampler(2, g->sampler);
-    g->gl.UniformMatrix4fv(g->draw_loc[5], 1, 0, mvp);
-    g->gl.UniformMatrix3fv(g->draw_loc[6], 1, 0, nm);
-    g->gl.Uniform1i(g->draw_loc[7], rate);
-    g->gl.Uniform1i(g->draw_loc[8], first);
-    g->gl.Uniform1i(g->draw_loc[9], 2);
-    g->gl.Uniform1i(g->draw_loc[10], p.trim_texture != 0);
-    g->gl.Uniform2i(g->draw_loc[11], p.trim_tiles_u, p.trim_tiles_v);
-    g->gl.Uniform3f(g->draw_loc[12], light[0], light[1], light[2]);
-    g->gl.Uniform4f(g->draw_loc[13], color[0], color[1], color[2], color[3]);
-    if ((r = sfb__gl_check(g, "setting up the manifold draw")) != SFB_SUCCESS) goto done;
-    if (p.capture_buffer) {
-        /* the samples once each, as points, into the capture buffer */
-        g->gl.BindTransformFeedback(SFB__GL_TRANSFORM_FEEDBACK, g->draw_tfo);
-        g->gl.BindBufferRange(SFB__GL_TRANSFORM_FEEDBACK_BUFFER, 0, p.capture_buffer, 0, (sfb__GLsizeiptr)cap_bytes);
-        g->gl.Enable(SFB__GL_RASTERIZER_DISCARD);
-        g->gl.BeginTransformFeedback(SFB__GL_POINTS);
-        g->gl.DrawArraysInstanced(SFB__GL_POINTS, 0, n * n, count);
-        g->gl.EndTransformFeedback();
-        if (!ds.discard) g->gl.Disable(SFB__GL_RASTERIZER_DISCARD);
-        g->gl.BindTransformFeedback(SFB__GL_TRANSFORM_FEEDBACK, (sfb__GLuint)ds.tfo);
-        if ((r = sfb__gl_check(g, "capturing the manifold samples")) != SFB_SUCCESS) goto done;
-    }
-    g->gl.DrawElementsInstanced(SFB__GL_TRIANGLES, 6 * rate * rate, SFB__GL_UNSIGNED_INT, NULL, count);
-    r = sfb__gl_check(g, "drawing the manifold surface");
-    /* the host may read the capture (map, copy, draw from it) next */
-    if (r == SFB_SUCCESS && p.capture_buffer) g->gl.MemoryBarrier(SFB__GL_ALL_BARRIER_BITS);
-done:
-    if (temp) sfb__gl_ptable_free(g, temp);
     sfb__gl_draw_restore(g, &ds);
     sfb__gl_leave(g, &saved);
     return r;

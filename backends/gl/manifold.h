@@ -97,6 +97,15 @@ static sfb__GLuint sfb__gl_mf_texture(sfb__gl *g, sfb__GLint internal, int width
     return tex;
 }
 
+static void sfb__gl_mf_free(sfb__gl *g, sfb__gl_ptable *t) {
+    int i;
+    if (!t) return;
+    for (i = 0; i < 2; ++i)
+        if (t->mf_tex[i]) g->gl.DeleteTextures(1, &t->mf_tex[i]);
+    sfb__free(g->ctx, t->pieces);
+    sfb__free(g->ctx, t);
+}
+
 /* Uploads a MANIFOLD4 table with the context current: the seed's Fig. 8 coefficient texture
  * with one 9-row column per patch corner (RGBA32F, 37 texels per patch: its origin, then the
  * corners' rows, position rows relative to the origin, formed in double) and the RGBA32I
@@ -188,7 +197,7 @@ static sfb_result sfb__gl_mf_upload_current(sfb__gl *g, const sfb__patch_table *
             }
         }
     }
-    tab->manifold = 1;
+    tab->family = SFB__FAMILY_MANIFOLD;
     tab->mf_width = W;
     tab->mf_patch_base = nf;
     sfb__gl_tex_save(g, &ts);
@@ -201,7 +210,7 @@ static sfb_result sfb__gl_mf_upload_current(sfb__gl *g, const sfb__patch_table *
 done:
     sfb__free(g->ctx, coef); sfb__free(g->ctx, recs);
     if (res != SFB_SUCCESS) {
-        if (tab) sfb__gl_ptable_free(g, tab);
+        if (tab) sfb__gl_mf_free(g, tab);
         return res;
     }
     *out = tab;
@@ -242,6 +251,45 @@ static sfb_result sfb__gl_mf_program(sfb__gl *g, sfb__GLuint *out) {
     return sfb__gl_check(g, "building the manifold kernel");
 }
 
+/* The second derivatives of locations [first, last), on the CPU as ref forms them. */
+static void sfb__gl_mf_second(const sfb__patch_table *pt, const sfb_location *locs, int first, int last, const sfb_eval_output *out) {
+    int q;
+    for (q = first; q < last; ++q) {
+        double u, v, sc, res2[6][3], nrm[3];
+        int patch = sfb__patch_locate(pt, locs[q].face, locs[q].u, locs[q].v, &u, &v, &sc), c;
+        sfb__mf_eval_patch(pt, pt->point_data, patch, u, v, 1, res2, nrm);
+        for (c = 0; c < 3; ++c) {
+            size_t at = 3 * (size_t)q + (size_t)c;
+            if (out->duu) out->duu[at] = (float)(res2[3][c] * sc * sc);
+            if (out->duv) out->duv[at] = (float)(res2[4][c] * sc * sc);
+            if (out->dvv) out->dvv[at] = (float)(res2[5][c] * sc * sc);
+        }
+    }
+}
+
+/* Runs the manifold kernel (in use, bound to the table) over `count` located queries in
+ * batches that fit one storage block, and scatters the results into dst[] from location
+ * `first` on. */
+static sfb_result sfb__gl_mf_run(sfb__gl *g, const sfb__gl_query *queries, int count, int first, float *const *dst, const sfb__GLint *slot,
+                                 int stride) {
+    size_t batch = sfb__gl_query_batch(g, stride);
+    int q;
+    sfb_result res;
+    for (q = 0; q < count;) {
+        int n = (size_t)(count - q) > batch ? (int)batch : count - q;
+        const float *mapped;
+        size_t qbytes = (size_t)n * sizeof(sfb__gl_query), rbytes = (size_t)n * (size_t)stride * sizeof(float);
+        if ((res = sfb__gl_query_buffers(g, queries + q, qbytes, rbytes)) != SFB_SUCCESS) return res;
+        sfb__gl_dispatch_range(g, g->mf_loc[5], g->mf_loc[6], 0, n);
+        if ((res = sfb__gl_check(g, "the manifold kernel")) != SFB_SUCCESS) return res;
+        if ((res = sfb__gl_map_results(g, rbytes, &mapped)) != SFB_SUCCESS) return res;
+        sfb__gl_scatter(dst, slot, 4, mapped, stride, n, NULL, first + q);
+        if ((res = sfb__gl_unmap_results(g)) != SFB_SUCCESS) return res;
+        q += n;
+    }
+    return SFB_SUCCESS;
+}
+
 /* sfb_surface_eval on a MANIFOLD4 table: located on the CPU (sfb__patch_locate), evaluated by
  * manifold.comp.glsl in batches that fit one storage block (position, du, dv, normal). Second
  * derivatives are formed on the CPU, as ref forms them (sfb__mf_eval_patch: central differences
@@ -254,8 +302,6 @@ static sfb_result sfb__gl_mf_eval(sfb__gl *g, const sfb__patch_table *pt, sfb__g
     sfb__gl_query *queries = NULL;
     sfb__gl_ptable *temp = NULL;
     int count = last - first, nout = 0, o, q, stride;
-    size_t batch;
-    long long per = (long long)g->max_groups * 64;
     sfb__gl_saved s;
     sfb__gl_texstate ts;
     sfb__GLuint prog;
@@ -269,26 +315,12 @@ static sfb_result sfb__gl_mf_eval(sfb__gl *g, const sfb__patch_table *pt, sfb__g
         if (sfb__patch_locate(pt, l->face, l->u, l->v, &u, &v, &sc) < 0)
             return sfb__error(g->ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, first + q, "location %d: parametric face %d is a hole", first + q, l->face);
     }
-    if (out->duu || out->duv || out->dvv)
-        for (q = first; q < last; ++q) {
-            double u, v, sc, res2[6][3], nrm[3];
-            int patch = sfb__patch_locate(pt, locs[q].face, locs[q].u, locs[q].v, &u, &v, &sc), c;
-            sfb__mf_eval_patch(pt, pt->point_data, patch, u, v, 1, res2, nrm);
-            for (c = 0; c < 3; ++c) {
-                size_t at = 3 * (size_t)q + (size_t)c;
-                if (out->duu) out->duu[at] = (float)(res2[3][c] * sc * sc);
-                if (out->duv) out->duv[at] = (float)(res2[4][c] * sc * sc);
-                if (out->dvv) out->dvv[at] = (float)(res2[5][c] * sc * sc);
-            }
-        }
+    if (out->duu || out->duv || out->dvv) sfb__gl_mf_second(pt, locs, first, last, out);
     if (nout == 0) return SFB_SUCCESS;
     stride = 3 * nout;
-    batch = (size_t)g->max_block / ((size_t)stride * sizeof(float));
-    if (batch > (size_t)g->max_block / sizeof(sfb__gl_query)) batch = (size_t)g->max_block / sizeof(sfb__gl_query);
-    if (batch < 1) batch = 1;
     if ((res = sfb__gl_enter(g, &s)) != SFB_SUCCESS) return res;
     sfb__gl_tex_save(g, &ts);
-    if (!tab || !tab->manifold) {
+    if (!tab || tab->family != SFB__FAMILY_MANIFOLD) {
         /* the surface was uploaded to another backend: a temporary copy for this call */
         if ((res = sfb__gl_mf_upload_current(g, pt, &temp)) != SFB_SUCCESS) goto done;
         tab = temp;
@@ -308,52 +340,20 @@ static sfb_result sfb__gl_mf_eval(sfb__gl *g, const sfb__patch_table *pt, sfb__g
     sfb__gl_mf_bind(g, tab, pt->mf_weights, g->mf_loc);
     g->gl.Uniform1i(g->mf_loc[7], stride);
     g->gl.Uniform1iv(g->mf_loc[8], 4, slot);
-    for (q = 0; q < count;) {
-        int n = (size_t)(count - q) > batch ? (int)batch : count - q, d, k;
-        const float *mapped;
-        size_t qbytes = (size_t)n * sizeof(sfb__gl_query), rbytes = (size_t)n * (size_t)stride * sizeof(float);
-        if ((res = sfb__gl_grow(g, &g->scratch_src, &g->scratch_src_cap, qbytes, SFB__GL_STREAM_DRAW)) != SFB_SUCCESS) goto done;
-        g->gl.BufferSubData(SFB__GL_SHADER_STORAGE_BUFFER, 0, (sfb__GLsizeiptr)qbytes, queries + q);
-        if ((res = sfb__gl_grow(g, &g->scratch_dst, &g->scratch_dst_cap, rbytes, SFB__GL_DYNAMIC_READ)) != SFB_SUCCESS) goto done;
-        g->gl.BindBufferBase(SFB__GL_SHADER_STORAGE_BUFFER, 4, g->scratch_src);
-        g->gl.BindBufferBase(SFB__GL_SHADER_STORAGE_BUFFER, 5, g->scratch_dst);
-        for (d = 0; d < n;) {
-            int m = (long long)(n - d) > per ? (int)per : n - d;
-            g->gl.Uniform1i(g->mf_loc[5], d);
-            g->gl.Uniform1i(g->mf_loc[6], d + m);
-            g->gl.DispatchCompute((sfb__GLuint)((m + 63) / 64), 1, 1);
-            d += m;
-        }
-        if ((res = sfb__gl_check(g, "the manifold kernel")) != SFB_SUCCESS) goto done;
-        g->gl.MemoryBarrier(SFB__GL_BUFFER_UPDATE_BARRIER_BIT);
-        g->gl.BindBuffer(SFB__GL_SHADER_STORAGE_BUFFER, g->scratch_dst);
-        mapped = (const float *)g->gl.MapBufferRange(SFB__GL_SHADER_STORAGE_BUFFER, 0, (sfb__GLsizeiptr)rbytes, SFB__GL_MAP_READ_BIT);
-        if (!mapped) {
-            res = sfb__gl_check(g, "mapping the results");
-            if (res == SFB_SUCCESS) res = sfb__error(g->ctx, SFB_BACKEND_ERROR, SFB_ELEMENT_NONE, -1, "gl: glMapBufferRange returned NULL");
-            goto done;
-        }
-        for (k = 0; k < n; ++k) {
-            size_t at = 3 * ((size_t)first + (size_t)q + (size_t)k);
-            const float *r = mapped + (size_t)k * (size_t)stride;
-            for (o = 0; o < 4; ++o)
-                if (dst[o]) {
-                    const float *x = r + 3 * slot[o];
-                    dst[o][at] = x[0];
-                    dst[o][at + 1] = x[1];
-                    dst[o][at + 2] = x[2];
-                }
-        }
-        g->gl.UnmapBuffer(SFB__GL_SHADER_STORAGE_BUFFER);
-        if ((res = sfb__gl_check(g, "reading the results back")) != SFB_SUCCESS) goto done;
-        q += n;
-    }
+    res = sfb__gl_mf_run(g, queries, count, first, dst, slot, stride);
 done:
     sfb__free(g->ctx, queries);
-    if (temp) sfb__gl_ptable_free(g, temp);
+    if (temp) sfb__gl_mf_free(g, temp);
     sfb__gl_tex_restore(g, &ts);
     sfb__gl_leave(g, &s);
     return res;
+}
+
+/* The patch-table slots, for MANIFOLD4 tables (vtable.h hands them their tables). */
+static void sfb__gl_manifold_bind(sfb__backend_vtable *vt) {
+    vt->upload_patches = sfb__gl_upload_patches;
+    vt->release_patches = sfb__gl_release_patches;
+    vt->eval_patches = sfb__gl_eval_patches;
 }
 
 #endif /* SFB__GL_MANIFOLD_H */

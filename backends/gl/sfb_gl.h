@@ -413,24 +413,12 @@ static void sfb__gl_release_gl(sfb__gl *g) {
 }
 
 /* ---- the own headless EGL context ---- */
-static sfb_result sfb__gl_egl_open(sfb__gl *g, char *why, size_t why_size) {
-    static const char *const egl_names[] = SFB__EGL_LIBRARY_NAMES;
-    const char *client;
-    sfb__EGLint major = 0, minor = 0, n = 0;
-    sfb__EGLConfig config = NULL;
-    const char *platform = "default display";
+/* Opens an EGL display: the device platform (a hardware device first), then Mesa's surfaceless
+ * platform, then the default display; *platform names the one found. */
+static sfb_result sfb__gl_egl_display(sfb__gl *g, const char **platform, sfb__EGLint *major, sfb__EGLint *minor, char *why,
+                                      size_t why_size) {
+    const char *client = g->egl.QueryString(NULL, SFB__EGL_EXTENSIONS);
     int attempt;
-    char err[256] = "";
-    g->libegl = sfb__gl_dlopen(egl_names, err, sizeof err);
-    if (!g->libegl) {
-        snprintf(why, why_size, "libEGL.so.1 not found (Debian: libegl1 and a driver, e.g. libegl-mesa0): %s", err);
-        return SFB_BACKEND_UNAVAILABLE;
-    }
-    if (!sfb__egl_load(g->libegl, &g->egl)) {
-        snprintf(why, why_size, "libEGL lacks EGL 1.4 entry points");
-        return SFB_BACKEND_UNAVAILABLE;
-    }
-    client = g->egl.QueryString(NULL, SFB__EGL_EXTENSIONS);
     /* Displays are shared process-wide; terminate ours only where EGL counts references. */
     g->terminate_display = sfb__has_word(client, "EGL_KHR_display_reference");
     for (attempt = 0; attempt < 3 && !g->dpy; ++attempt) {
@@ -449,54 +437,79 @@ static sfb_result sfb__gl_egl_open(sfb__gl *g, char *why, size_t why_size) {
                         break;
                     }
                 d = g->egl.GetPlatformDisplayEXT(SFB__EGL_PLATFORM_DEVICE_EXT, devs[pick], attrs);
-                platform = "EGL device platform";
+                *platform = "EGL device platform";
             }
         } else if (attempt == 1 && g->egl.GetPlatformDisplayEXT && sfb__has_word(client, "EGL_MESA_platform_surfaceless")) {
             d = g->egl.GetPlatformDisplayEXT(SFB__EGL_PLATFORM_SURFACELESS_MESA, NULL, attrs);
-            platform = "EGL surfaceless platform";
+            *platform = "EGL surfaceless platform";
         } else if (attempt == 2) {
             d = g->egl.GetDisplay(NULL);
-            platform = "EGL default display";
+            *platform = "EGL default display";
             g->terminate_display = 0;
         }
-        if (d && g->egl.Initialize(d, &major, &minor)) g->dpy = d;
+        if (d && g->egl.Initialize(d, major, minor)) g->dpy = d;
     }
     if (!g->dpy) {
         snprintf(why, why_size, "no EGL display could be initialised (device, surfaceless and default; EGL error 0x%x)",
                  (unsigned)g->egl.GetError());
         return SFB_BACKEND_UNAVAILABLE;
     }
-    {
-        const char *ext = g->egl.QueryString(g->dpy, SFB__EGL_EXTENSIONS);
-        sfb__EGLenum prev_api = g->egl.QueryAPI();
-        int es;
-        if (!sfb__has_word(ext, "EGL_KHR_surfaceless_context")) {
-            snprintf(why, why_size, "the EGL display lacks EGL_KHR_surfaceless_context");
-            return SFB_BACKEND_UNAVAILABLE;
-        }
-        /* desktop OpenGL 4.3 core first, then GLES 3.1 */
-        for (es = 0; es < 2 && !g->egl_ctx; ++es) {
-            sfb__EGLint cattrs[] = {SFB__EGL_RENDERABLE_TYPE, es ? SFB__EGL_OPENGL_ES3_BIT : SFB__EGL_OPENGL_BIT, SFB__EGL_NONE};
-            sfb__EGLint gl_attrs[] = {SFB__EGL_CONTEXT_MAJOR_VERSION, 4, SFB__EGL_CONTEXT_MINOR_VERSION, 3,
-                                      SFB__EGL_CONTEXT_OPENGL_PROFILE_MASK, SFB__EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT, SFB__EGL_NONE};
-            sfb__EGLint es_attrs[] = {SFB__EGL_CONTEXT_MAJOR_VERSION, 3, SFB__EGL_CONTEXT_MINOR_VERSION, 1, SFB__EGL_NONE};
-            sfb__EGLenum api = es ? SFB__EGL_OPENGL_ES_API : SFB__EGL_OPENGL_API;
-            if (!g->egl.BindAPI(api)) continue;
-            config = NULL;
-            n = 0;
-            if (!sfb__has_word(ext, "EGL_KHR_no_config_context") && !sfb__has_word(ext, "EGL_MESA_configless_context")) {
-                if (!g->egl.ChooseConfig(g->dpy, cattrs, &config, 1, &n) || n < 1) continue;
-            }
-            g->egl_ctx = g->egl.CreateContext(g->dpy, config, NULL, es ? es_attrs : gl_attrs);
-            if (g->egl_ctx) g->egl_api = api;
-        }
-        g->egl.BindAPI(prev_api);
-        if (!g->egl_ctx) {
-            snprintf(why, why_size, "%s (EGL %d.%d, %s): no OpenGL 4.3 core or GLES 3.1 context (EGL error 0x%x)", platform,
-                     (int)major, (int)minor, g->egl.QueryString(g->dpy, SFB__EGL_VENDOR), (unsigned)g->egl.GetError());
-            return SFB_BACKEND_UNAVAILABLE;
-        }
+    return SFB_SUCCESS;
+}
+
+/* Creates the context on the display: desktop OpenGL 4.3 core first, then GLES 3.1. */
+static sfb_result sfb__gl_egl_context(sfb__gl *g, const char *platform, sfb__EGLint major, sfb__EGLint minor, char *why, size_t why_size) {
+    const char *ext = g->egl.QueryString(g->dpy, SFB__EGL_EXTENSIONS);
+    sfb__EGLenum prev_api = g->egl.QueryAPI();
+    int es;
+    sfb__EGLint n = 0;
+    sfb__EGLConfig config = NULL;
+    if (!sfb__has_word(ext, "EGL_KHR_surfaceless_context")) {
+        snprintf(why, why_size, "the EGL display lacks EGL_KHR_surfaceless_context");
+        return SFB_BACKEND_UNAVAILABLE;
     }
+    /* desktop OpenGL 4.3 core first, then GLES 3.1 */
+    for (es = 0; es < 2 && !g->egl_ctx; ++es) {
+        sfb__EGLint cattrs[] = {SFB__EGL_RENDERABLE_TYPE, es ? SFB__EGL_OPENGL_ES3_BIT : SFB__EGL_OPENGL_BIT, SFB__EGL_NONE};
+        sfb__EGLint gl_attrs[] = {SFB__EGL_CONTEXT_MAJOR_VERSION, 4, SFB__EGL_CONTEXT_MINOR_VERSION, 3,
+                                  SFB__EGL_CONTEXT_OPENGL_PROFILE_MASK, SFB__EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT, SFB__EGL_NONE};
+        sfb__EGLint es_attrs[] = {SFB__EGL_CONTEXT_MAJOR_VERSION, 3, SFB__EGL_CONTEXT_MINOR_VERSION, 1, SFB__EGL_NONE};
+        sfb__EGLenum api = es ? SFB__EGL_OPENGL_ES_API : SFB__EGL_OPENGL_API;
+        if (!g->egl.BindAPI(api)) continue;
+        config = NULL;
+        n = 0;
+        if (!sfb__has_word(ext, "EGL_KHR_no_config_context") && !sfb__has_word(ext, "EGL_MESA_configless_context")) {
+            if (!g->egl.ChooseConfig(g->dpy, cattrs, &config, 1, &n) || n < 1) continue;
+        }
+        g->egl_ctx = g->egl.CreateContext(g->dpy, config, NULL, es ? es_attrs : gl_attrs);
+        if (g->egl_ctx) g->egl_api = api;
+    }
+    g->egl.BindAPI(prev_api);
+    if (!g->egl_ctx) {
+        snprintf(why, why_size, "%s (EGL %d.%d, %s): no OpenGL 4.3 core or GLES 3.1 context (EGL error 0x%x)", platform,
+                 (int)major, (int)minor, g->egl.QueryString(g->dpy, SFB__EGL_VENDOR), (unsigned)g->egl.GetError());
+        return SFB_BACKEND_UNAVAILABLE;
+    }
+    return SFB_SUCCESS;
+}
+
+static sfb_result sfb__gl_egl_open(sfb__gl *g, char *why, size_t why_size) {
+    static const char *const egl_names[] = SFB__EGL_LIBRARY_NAMES;
+    sfb__EGLint major = 0, minor = 0;
+    const char *platform = "default display";
+    char err[256] = "";
+    sfb_result r0;
+    g->libegl = sfb__gl_dlopen(egl_names, err, sizeof err);
+    if (!g->libegl) {
+        snprintf(why, why_size, "libEGL.so.1 not found (Debian: libegl1 and a driver, e.g. libegl-mesa0): %s", err);
+        return SFB_BACKEND_UNAVAILABLE;
+    }
+    if (!sfb__egl_load(g->libegl, &g->egl)) {
+        snprintf(why, why_size, "libEGL lacks EGL 1.4 entry points");
+        return SFB_BACKEND_UNAVAILABLE;
+    }
+    if ((r0 = sfb__gl_egl_display(g, &platform, &major, &minor, why, why_size)) != SFB_SUCCESS) return r0;
+    if ((r0 = sfb__gl_egl_context(g, platform, major, minor, why, why_size)) != SFB_SUCCESS) return r0;
     g->mode = SFB__GL_OWN_EGL;
     {
         size_t used;
@@ -651,41 +664,104 @@ static sfb_result sfb__gl_grow(sfb__gl *g, sfb__GLuint *buf, size_t *cap, size_t
     return sfb__gl_check(g, "allocating a scratch buffer");
 }
 
-/* ---- patch tables (limit evaluation) ---- */
-/* One piece of an uploaded patch table: patches [patch0, patch1) with the control points and
- * eigen blocks they use, copied and renumbered so that each of its four arrays fits one
- * shader storage block (GL_MAX_SHADER_STORAGE_BLOCK_SIZE: at least 128 MiB on real drivers,
- * so one piece in practice; the tests shrink it to force several). */
-typedef struct sfb__gl_ppiece {
-    int patch0, patch1;
-    sfb__GLuint buf[4]; /* patch records (ivec4), cvs (piece-local rows), points (vec4), eigen blocks (vec4) */
-} sfb__gl_ppiece;
+/* Runs the program in use over invocations [a, b), in dispatches of at most
+ * GL_MAX_COMPUTE_WORK_GROUP_COUNT groups of 64, each told its range by the uniforms at
+ * loc_first and loc_last. */
+static void sfb__gl_dispatch_range(sfb__gl *g, sfb__GLint loc_first, sfb__GLint loc_last, int a, int b) {
+    long long per = (long long)g->max_groups * 64;
+    while (a < b) {
+        int n = (long long)(b - a) > per ? (int)per : b - a;
+        g->gl.Uniform1i(loc_first, a);
+        g->gl.Uniform1i(loc_last, a + n);
+        g->gl.DispatchCompute((sfb__GLuint)((n + 63) / 64), 1, 1);
+        a += n;
+    }
+}
+
+/* Waits for the `bytes` of results a kernel wrote into the scratch destination and maps them
+ * for reading; sfb__gl_unmap_results ends the read. */
+static sfb_result sfb__gl_map_results(sfb__gl *g, size_t bytes, const float **mapped) {
+    g->gl.MemoryBarrier(SFB__GL_BUFFER_UPDATE_BARRIER_BIT);
+    g->gl.BindBuffer(SFB__GL_SHADER_STORAGE_BUFFER, g->scratch_dst);
+    *mapped = (const float *)g->gl.MapBufferRange(SFB__GL_SHADER_STORAGE_BUFFER, 0, (sfb__GLsizeiptr)bytes, SFB__GL_MAP_READ_BIT);
+    if (!*mapped) {
+        sfb_result res = sfb__gl_check(g, "mapping the results");
+        return res != SFB_SUCCESS ? res : sfb__error(g->ctx, SFB_BACKEND_ERROR, SFB_ELEMENT_NONE, -1, "gl: glMapBufferRange returned NULL");
+    }
+    return SFB_SUCCESS;
+}
+
+static sfb_result sfb__gl_unmap_results(sfb__gl *g) {
+    g->gl.UnmapBuffer(SFB__GL_SHADER_STORAGE_BUFFER);
+    return sfb__gl_check(g, "reading the results back");
+}
+
+/* ---- patch tables: what the families share (their kernels: patches.h, manifold.h) ---- */
+/* An uploaded patch table, the handle upload_patches returns. `family` (SFB__FAMILY_*) says
+ * which family's kernel reads it, and so which members it fills. */
 typedef struct sfb__gl_ptable {
+    int family;
+    /* the polynomial families (patches.h): consecutive patch ranges, each fitting the storage
+     * blocks */
     int count;
-    sfb__gl_ppiece *pieces;
-    /* a MANIFOLD4 table (no pieces): its two textures (manifold.comp.glsl), their row width,
-     * and the first patch texel of the integer one */
-    int manifold;
+    struct sfb__gl_ppiece *pieces;
+    /* MANIFOLD4 (manifold.h, no pieces): its two textures (manifold.comp.glsl), their row
+     * width, and the first patch texel of the integer one */
     sfb__GLuint mf_tex[2];
     int mf_width, mf_patch_base;
 } sfb__gl_ptable;
 
-/* A location as the patch kernel reads it (std430 struct SfbQuery). */
+/* A location as the patch kernels read it (std430 struct SfbQuery). */
 typedef struct sfb__gl_query {
     int patch;           /* piece-local */
     float s, t;          /* Stam and Stam-Loop patches: (u,v) in the EV's frame instead of (s,t) */
     float scale;         /* +-2^depth: negative after an odd number of middle triangles (Loop) */
 } sfb__gl_query;
 
-
-static void sfb__gl_ptable_free(sfb__gl *g, sfb__gl_ptable *t) {
-    int i;
-    if (!t) return;
-    for (i = 0; i < 2; ++i)
-        if (t->mf_tex[i]) g->gl.DeleteTextures(1, &t->mf_tex[i]);
-    for (i = 0; i < t->count; ++i) g->gl.DeleteBuffers(4, t->pieces[i].buf);
-    sfb__free(g->ctx, t->pieces);
-    sfb__free(g->ctx, t);
+/* Queries per batch: a batch's queries, and its results of `stride` floats each, fit one
+ * storage block. */
+static size_t sfb__gl_query_batch(const sfb__gl *g, int stride) {
+    size_t batch = (size_t)g->max_block / ((size_t)stride * sizeof(float));
+    if (batch > (size_t)g->max_block / sizeof(sfb__gl_query)) batch = (size_t)g->max_block / sizeof(sfb__gl_query);
+    return batch < 1 ? 1 : batch;
 }
+
+/* A batch's `qbytes` of queries into the scratch source (binding 4), and room for its `rbytes`
+ * of results in the scratch destination (binding 5). */
+static sfb_result sfb__gl_query_buffers(sfb__gl *g, const sfb__gl_query *queries, size_t qbytes, size_t rbytes) {
+    sfb_result res;
+    if ((res = sfb__gl_grow(g, &g->scratch_src, &g->scratch_src_cap, qbytes, SFB__GL_STREAM_DRAW)) != SFB_SUCCESS) return res;
+    g->gl.BufferSubData(SFB__GL_SHADER_STORAGE_BUFFER, 0, (sfb__GLsizeiptr)qbytes, queries);
+    if ((res = sfb__gl_grow(g, &g->scratch_dst, &g->scratch_dst_cap, rbytes, SFB__GL_DYNAMIC_READ)) != SFB_SUCCESS) return res;
+    g->gl.BindBufferBase(SFB__GL_SHADER_STORAGE_BUFFER, 4, g->scratch_src);
+    g->gl.BindBufferBase(SFB__GL_SHADER_STORAGE_BUFFER, 5, g->scratch_dst);
+    return SFB_SUCCESS;
+}
+
+/* Copies n compact result rows of `stride` floats (output o's xyz at 3 * slot[o]) into the
+ * caller's arrays dst[o] that are not NULL, row k at location order[k] (base + k without an
+ * order). */
+static void sfb__gl_scatter(float *const *dst, const sfb__GLint *slot, int outputs, const float *mapped, int stride, int n,
+                            const int *order, int base) {
+    int k, o;
+    for (k = 0; k < n; ++k) {
+        size_t at = 3 * (size_t)(order ? order[k] : base + k);
+        const float *r = mapped + (size_t)k * (size_t)stride;
+        for (o = 0; o < outputs; ++o)
+            if (dst[o]) {
+                const float *x = r + 3 * slot[o];
+                dst[o][at] = x[0];
+                dst[o][at + 1] = x[1];
+                dst[o][at + 2] = x[2];
+            }
+    }
+}
+
+/* vtable.h: the patch-table slots, which hand a table to its family's kernels (the families'
+ * binds point the slots here). */
+static sfb_result sfb__gl_upload_patches(void *state, const sfb__patch_table *pt, void **handle);
+static void sfb__gl_release_patches(void *state, void *handle);
+static sfb_result sfb__gl_eval_patches(void *state, const sfb__patch_table *pt, void *handle, const sfb_location *locs, int first,
+                                       int last, const sfb_eval_output *out);
 
 #endif /* SFB__GL_RUNTIME_H */

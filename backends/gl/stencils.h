@@ -41,7 +41,6 @@ static sfb_result sfb__gl_program(sfb__gl *g, int length, sfb__GLuint *out) {
     return sfb__gl_check(g, "building the stencil kernel");
 }
 
-
 /* ---- tables ---- */
 static void sfb__gl_table_free(sfb__gl *g, sfb__gl_table *t) {
     int i;
@@ -155,22 +154,14 @@ static sfb_result sfb__gl_dispatch(sfb__gl *g, const sfb__gl_table *tab, int fir
     for (i = 0; i < tab->count; ++i) {
         const sfb__gl_piece *p = &tab->pieces[i];
         int a = first > p->row0 ? first : p->row0, b = last < p->row1 ? last : p->row1, k;
-        long long per = (long long)g->max_groups * 64;
         if (a >= b) continue;
         for (k = 0; k < 4; ++k) g->gl.BindBufferBase(SFB__GL_SHADER_STORAGE_BUFFER, (sfb__GLuint)k, p->buf[k]);
         g->gl.Uniform1i(loc[2], p->entry0);
         g->gl.Uniform1i(loc[3], p->row0);
-        while (a < b) {
-            int n = (long long)(b - a) > per ? (int)per : b - a;
-            g->gl.Uniform1i(loc[0], a - p->row0);
-            g->gl.Uniform1i(loc[1], a - p->row0 + n);
-            g->gl.DispatchCompute((sfb__GLuint)((n + 63) / 64), 1, 1);
-            a += n;
-        }
+        sfb__gl_dispatch_range(g, loc[0], loc[1], a - p->row0, b - p->row0);
     }
     return sfb__gl_check(g, "the stencil kernel");
 }
-
 
 static sfb_result sfb__gl_eval(void *state, const sfb__stencils *t, void *handle, int first, int last, const float *src,
                                sfb_buffer_desc sd, float *dst, sfb_buffer_desc dd) {
@@ -200,22 +191,13 @@ static sfb_result sfb__gl_eval(void *state, const sfb__stencils *t, void *handle
     if ((res = sfb__gl_grow(g, &g->scratch_dst, &g->scratch_dst_cap, dst_bytes, SFB__GL_DYNAMIC_READ)) != SFB_SUCCESS) goto done;
     res = sfb__gl_dispatch(g, tab, first, last, g->scratch_src, 0, sd.stride, g->scratch_dst, -first * length, length, length);
     if (res != SFB_SUCCESS) goto done;
-    g->gl.MemoryBarrier(SFB__GL_BUFFER_UPDATE_BARRIER_BIT);
-    g->gl.BindBuffer(SFB__GL_SHADER_STORAGE_BUFFER, g->scratch_dst);
-    mapped = (const float *)g->gl.MapBufferRange(SFB__GL_SHADER_STORAGE_BUFFER, 0, (sfb__GLsizeiptr)dst_bytes, SFB__GL_MAP_READ_BIT);
-    if (!mapped) {
-        res = sfb__gl_check(g, "mapping the results");
-        if (res == SFB_SUCCESS)
-            res = sfb__error(g->ctx, SFB_BACKEND_ERROR, SFB_ELEMENT_NONE, -1, "gl: glMapBufferRange returned NULL");
-        goto done;
-    }
+    if ((res = sfb__gl_map_results(g, dst_bytes, &mapped)) != SFB_SUCCESS) goto done;
     for (r = 0; r < rows; ++r) {
         float *o = dst + dd.offset + (size_t)(first + r) * (size_t)dd.stride;
         const float *i = mapped + (size_t)r * (size_t)length;
         for (c = 0; c < length; ++c) o[c] = i[c];
     }
-    g->gl.UnmapBuffer(SFB__GL_SHADER_STORAGE_BUFFER);
-    res = sfb__gl_check(g, "reading the results back");
+    res = sfb__gl_unmap_results(g);
 done:
     if (temp) sfb__gl_table_free(g, temp);
     sfb__gl_leave(g, &s);
@@ -265,6 +247,13 @@ done:
     if (temp) sfb__gl_table_free(g, temp);
     sfb__gl_leave(g, &s);
     return res;
+}
+
+/* The stencil slots (both gl and osmesa; eval_stencils_gl, on the host's buffers, is gl's alone). */
+static void sfb__gl_stencils_bind(sfb__backend_vtable *vt) {
+    vt->upload_stencils = sfb__gl_upload;
+    vt->release_stencils = sfb__gl_release;
+    vt->eval_stencils = sfb__gl_eval;
 }
 
 #endif /* SFB__GL_STENCILS_H */
