@@ -67,7 +67,7 @@ amalgamate:
 
 # GLSL sources of the gl backend embedded as C strings (tools/check_glsl.sh checks it is current)
 embed-glsl:
-	./tools/embed_glsl.sh > backends/sfb_gl_shaders.h.tmp && mv backends/sfb_gl_shaders.h.tmp backends/sfb_gl_shaders.h
+	./tools/embed_glsl.sh > backends/gl/shaders.h.tmp && mv backends/gl/shaders.h.tmp backends/gl/shaders.h
 
 # The library from src/*.c as separate translation units (C99 and C++), linked with the examples
 # and run: module interfaces are declared in src/sfb_internal.h, the amalgamation order is not

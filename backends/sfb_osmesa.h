@@ -1,4 +1,4 @@
-/* backends/sfb_osmesa.h -- the `osmesa` backend: the gl kernels (sfb_gl.h) in an off-screen
+/* backends/sfb_osmesa.h -- the `osmesa` backend: the gl kernels (backends/gl/) in an off-screen
  * Mesa context, with no window system and no GPU (servers, CI).
  *
  * Compiled by surfblend.h's implementation when SURFBLEND_OSMESA (or SURFBLEND_ALL_BACKENDS)
@@ -13,6 +13,11 @@
  */
 #ifndef SFB__OSMESA_H
 #define SFB__OSMESA_H
+
+/* The library names tried by dlopen, NULL-terminated (tests/gl_errors.c overrides them). */
+#ifndef SFB__OSMESA_LIBRARY_NAMES
+#define SFB__OSMESA_LIBRARY_NAMES {"libOSMesa.so.8", "libOSMesa.so.6", "libOSMesa.so", NULL}
+#endif
 
 enum {
     SFB__OSMESA_FORMAT = 0x22, SFB__OSMESA_DEPTH_BITS = 0x30, SFB__OSMESA_STENCIL_BITS = 0x31,

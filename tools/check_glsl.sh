@@ -1,20 +1,20 @@
 #!/bin/bash
-# Validates every shader in backends/glsl/ with glslangValidator as the backend compiles it:
+# Validates every shader in backends/gl/glsl/ with glslangValidator as the backend compiles it:
 # desktop GLSL 4.30 core and GLSL ES 3.10 (a shader that uses SFB_LENGTH: for each value the
-# backend may use, 1..16), and checks that backends/sfb_gl_shaders.h is up to date. Closing line: "N passed, N failed, N skipped".
+# backend may use, 1..16), and checks that backends/gl/shaders.h is up to date. Closing line: "N passed, N failed, N skipped".
 set -u
 cd "$(dirname "$0")/.."
 PASS=0; FAIL=0; SKIP=0
 TMP=$(mktemp -d); trap 'rm -rf "$TMP"' EXIT
-if tools/embed_glsl.sh > "$TMP/shaders.h" && cmp -s "$TMP/shaders.h" backends/sfb_gl_shaders.h; then
+if tools/embed_glsl.sh > "$TMP/shaders.h" && cmp -s "$TMP/shaders.h" backends/gl/shaders.h; then
   echo "PASS embedded shaders up to date"; PASS=$((PASS + 1))
 else
-  echo "FAIL backends/sfb_gl_shaders.h is stale against backends/glsl/ (run 'make embed-glsl')"; FAIL=$((FAIL + 1))
+  echo "FAIL backends/gl/shaders.h is stale against backends/gl/glsl/ (run 'make embed-glsl')"; FAIL=$((FAIL + 1))
 fi
 if ! command -v glslangValidator >/dev/null; then
   echo "SKIP glslangValidator not installed (Debian package glslang-tools)"; SKIP=$((SKIP + 1))
 else
-  for f in backends/glsl/*.glsl; do
+  for f in backends/gl/glsl/*.glsl; do
     stage=$(basename "$f" .glsl); stage=${stage##*.}
     lengths=-
     if grep -q SFB_LENGTH "$f"; then lengths="1 2 3 4 7 16"; fi

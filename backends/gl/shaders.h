@@ -1,4 +1,4 @@
-/* GENERATED from backends/glsl/ by `make embed-glsl`; edit the .glsl sources instead. */
+/* GENERATED from backends/gl/glsl/ by `make embed-glsl`; edit the .glsl sources instead. */
 
 /* A kernel may be longer than the 4095 characters C99 promises for one string literal; GCC,
  * Clang and MSVC (64 KiB) take far more, so -pedantic's warning is silenced here only. */
@@ -7,7 +7,7 @@
 #pragma GCC diagnostic ignored "-Woverlength-strings"
 #endif
 
-/* backends/glsl/manifold.comp.glsl */
+/* backends/gl/glsl/manifold.comp.glsl */
 static const char sfb__glsl_manifold_comp_glsl[] =
     "// Manifold-based blending surfaces (seed 000 sections V.1-V.4; the MANIFOLD4 patch family): the\n"
     "// blend of four chart local geometries, in float. It is the ref kernel of src/manifold.c\n"
@@ -16,7 +16,7 @@ static const char sfb__glsl_manifold_comp_glsl[] =
     "// One source, two stages:\n"
     "//  - compute (default): one invocation per query of sfb_surface_eval. The CPU has located each\n"
     "//    query (quadtree walk, depth 0 or 1) and passes the patch, its (s,t) and the scale 2^depth.\n"
-    "//    Second derivatives are not computed here (the backend forms them on the CPU, see sfb_gl.h).\n"
+    "//    Second derivatives are not computed here (the backend forms them on the CPU, see gl/manifold.h).\n"
     "//  - vertex (SFB_MF_VERTEX defined): the seed's vertex program, for sfb_surface_draw_gl. The\n"
     "//    sample of instance k (parametric face u_first_face + k) and vertex id i + (u_rate + 1) j is\n"
     "//    (u, v) = (i, j) / u_rate; the program locates it in the face's patch itself.\n"
@@ -324,7 +324,7 @@ static const char sfb__glsl_manifold_comp_glsl[] =
     "#endif\n"
     ;
 
-/* backends/glsl/manifold_draw.frag.glsl */
+/* backends/gl/glsl/manifold_draw.frag.glsl */
 static const char sfb__glsl_manifold_draw_frag_glsl[] =
     "// The fragment program of sfb_surface_draw_gl (seed 000 section V.5): two-sided lighting of the\n"
     "// manifold surface drawn by manifold.comp.glsl's vertex stage, and trimming: with u_trim_on the\n"
@@ -380,7 +380,7 @@ static const char sfb__glsl_manifold_draw_frag_glsl[] =
     "}\n"
     ;
 
-/* backends/glsl/normals.comp.glsl */
+/* backends/gl/glsl/normals.comp.glsl */
 static const char sfb__glsl_normals_comp_glsl[] =
     "// Seed 001's normal blend (the backend vtable's finish_normals; the ref kernel is\n"
     "// sfb__ref_finish_normals in src/backend_ref.c), one invocation per element, in float:\n"
@@ -473,7 +473,7 @@ static const char sfb__glsl_normals_comp_glsl[] =
     "}\n"
     ;
 
-/* backends/glsl/patches.comp.glsl */
+/* backends/gl/glsl/patches.comp.glsl */
 static const char sfb__glsl_patches_comp_glsl[] =
     "// Patch evaluation (exact limit surface of Catmull-Clark and Loop): one invocation per location.\n"
     "// The CPU has already found each location's patch and its (s,t) in it (sfb__patch_locate, a\n"
@@ -509,7 +509,7 @@ static const char sfb__glsl_patches_comp_glsl[] =
     "//   results[]   = u_stride floats per query: output `o` (position, du, dv, normal, duu, duv, dvv)\n"
     "//                 at 3 * u_slot[o] when u_slot[o] >= 0\n"
     "// The backend prepends \"#version 430 core\" (desktop) or \"#version 310 es\" + precision\n"
-    "// (GLES 3.1), and SFB_NO_LOOP or SFB_NO_CATMARK (the kinds of the table's scheme only); the\n"
+    "// (GLES 3.1), and SFB_NO_LOOP or SFB_NO_CATMARK (the kinds of the table's family only); the\n"
     "// tests validate both versions, with neither define (every kind), with glslangValidator.\n"
     "\n"
     "layout(local_size_x = 64) in;\n"
@@ -543,7 +543,7 @@ static const char sfb__glsl_patches_comp_glsl[] =
     "    return r;\n"
     "}\n"
     "\n"
-    "// The backend compiles one program per scheme: SFB_NO_LOOP leaves out the Loop kinds (3..5),\n"
+    "// The backend compiles one program per patch family: SFB_NO_LOOP leaves out the Loop kinds (3..5),\n"
     "// SFB_NO_CATMARK the Catmull-Clark ones (0..2), so neither pays the other's compile time.\n"
     "#ifndef SFB_NO_CATMARK\n"
     "// Uniform cubic B-spline basis, first and second derivatives.\n"
@@ -974,7 +974,7 @@ static const char sfb__glsl_patches_comp_glsl[] =
     "}\n"
     ;
 
-/* backends/glsl/stencils.comp.glsl */
+/* backends/gl/glsl/stencils.comp.glsl */
 static const char sfb__glsl_stencils_comp_glsl[] =
     "// Stencil evaluation: one invocation per destination row.\n"
     "//   dst[dst_offset + (row_base + r) * dst_stride + c] =\n"

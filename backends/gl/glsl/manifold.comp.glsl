@@ -5,7 +5,7 @@
 // One source, two stages:
 //  - compute (default): one invocation per query of sfb_surface_eval. The CPU has located each
 //    query (quadtree walk, depth 0 or 1) and passes the patch, its (s,t) and the scale 2^depth.
-//    Second derivatives are not computed here (the backend forms them on the CPU, see sfb_gl.h).
+//    Second derivatives are not computed here (the backend forms them on the CPU, see gl/manifold.h).
 //  - vertex (SFB_MF_VERTEX defined): the seed's vertex program, for sfb_surface_draw_gl. The
 //    sample of instance k (parametric face u_first_face + k) and vertex id i + (u_rate + 1) j is
 //    (u, v) = (i, j) / u_rate; the program locates it in the face's patch itself.

@@ -32,7 +32,7 @@
 //   results[]   = u_stride floats per query: output `o` (position, du, dv, normal, duu, duv, dvv)
 //                 at 3 * u_slot[o] when u_slot[o] >= 0
 // The backend prepends "#version 430 core" (desktop) or "#version 310 es" + precision
-// (GLES 3.1), and SFB_NO_LOOP or SFB_NO_CATMARK (the kinds of the table's scheme only); the
+// (GLES 3.1), and SFB_NO_LOOP or SFB_NO_CATMARK (the kinds of the table's family only); the
 // tests validate both versions, with neither define (every kind), with glslangValidator.
 
 layout(local_size_x = 64) in;
@@ -66,7 +66,7 @@ float sfb_ipow(float x, int e) {
     return r;
 }
 
-// The backend compiles one program per scheme: SFB_NO_LOOP leaves out the Loop kinds (3..5),
+// The backend compiles one program per patch family: SFB_NO_LOOP leaves out the Loop kinds (3..5),
 // SFB_NO_CATMARK the Catmull-Clark ones (0..2), so neither pays the other's compile time.
 #ifndef SFB_NO_CATMARK
 // Uniform cubic B-spline basis, first and second derivatives.
