@@ -8,8 +8,9 @@
  *      bit before normalising), S = ns[k] (0 when k < 0), and w = b^p where the blend applies
  *      (k >= 0, b given, b > 0), else -1 (sfb__simd_bpow: b = 1 gives exactly 1, and b = 0
  *      never blends);
- *   2. the instruction set's vector pass (2 lanes sse2 and AArch64 neon, 4 avx2, 8 avx512, 1
- *      portable and 32-bit neon) normalises L and S, forms B = (1 - w) L + w S and normalises
+ *   2. the vector pass, written once on the double lanes of sfb_simd.h's vector operations
+ *      (2 lanes sse2 and AArch64 neon, 4 avx2, 8 avx512, 1 portable and 32-bit neon),
+ *      normalises L and S, forms B = (1 - w) L + w S and normalises
  *      it, and keeps B = L where w < 0. A vector is normalised as v * (1 / |v|) where ref
  *      divides each component by |v| (at most an ulp of double apart), and a zero vector (|v|
  *      not > 0) stays zero;
@@ -97,187 +98,80 @@ static void sfb__simd_normals_scatter(const sfb__simd_njob *j, int i0, int n, co
             for (c = 0; c < 3; ++c) j->sub[o + 3 * (size_t)m + (size_t)c] = (float)blk[(SFB__SIMD_NSX + c) * SFB__SIMD_NBLOCK + m];
 }
 
-/* Pass 2 of one instruction set, W lanes of type V (comparison masks of type M) per step, with
- * the operations SFB__SIMD_N_LD/ST/SET1/ADD/SUB/MUL/DIV/SQRT/GT/SEL(mask, if set, if clear)
- * defined around the instantiation. */
-#define SFB__SIMD_NUNIT(V, M, x, y, z)                                                                 \
-    do {                                                                                           \
-        const V len_ = SFB__SIMD_N_SQRT(SFB__SIMD_N_ADD(SFB__SIMD_N_ADD(SFB__SIMD_N_MUL(x, x), SFB__SIMD_N_MUL(y, y)), \
-                                                        SFB__SIMD_N_MUL(z, z)));                   \
-        const M nz_ = SFB__SIMD_N_GT(len_, zero);                                                  \
-        const V inv_ = SFB__SIMD_N_DIV(one, SFB__SIMD_N_SEL(nz_, len_, one));                      \
-        x = SFB__SIMD_N_SEL(nz_, SFB__SIMD_N_MUL(x, inv_), zero);                                  \
-        y = SFB__SIMD_N_SEL(nz_, SFB__SIMD_N_MUL(y, inv_), zero);                                  \
-        z = SFB__SIMD_N_SEL(nz_, SFB__SIMD_N_MUL(z, inv_), zero);                                  \
+/* Pass 2, written once on the double lanes of the vector operations (sfb_simd.h): X##_W lanes
+ * per step. */
+#define SFB__SIMD_NUNIT(X, x, y, z)                                                                      \
+    do {                                                                                                 \
+        const X##_v len_ = X##_sqrt(X##_add(X##_add(X##_mul(x, x), X##_mul(y, y)), X##_mul(z, z)));      \
+        const X##_m nz_ = X##_gt(len_, zero);                                                            \
+        const X##_v inv_ = X##_div(one, X##_sel(nz_, len_, one));                                        \
+        x = X##_sel(nz_, X##_mul(x, inv_), zero);                                                        \
+        y = X##_sel(nz_, X##_mul(y, inv_), zero);                                                        \
+        z = X##_sel(nz_, X##_mul(z, inv_), zero);                                                        \
     } while (0)
-#define SFB__SIMD_NORMALS_VEC(NAME, ATTR, W, V, M)                                                  \
-    ATTR static void NAME(double *blk, int count) {                                                 \
-        const V zero = SFB__SIMD_N_SET1(0.0), one = SFB__SIMD_N_SET1(1.0), nob = SFB__SIMD_N_SET1(-0.5); \
-        int m;                                                                                      \
-        for (m = 0; m < count; m += (W)) {                                                          \
-            double *at = blk + m;                                                                   \
-            V lx = SFB__SIMD_N_LD(at + SFB__SIMD_NLX * SFB__SIMD_NBLOCK);                           \
-            V ly = SFB__SIMD_N_LD(at + SFB__SIMD_NLY * SFB__SIMD_NBLOCK);                           \
-            V lz = SFB__SIMD_N_LD(at + SFB__SIMD_NLZ * SFB__SIMD_NBLOCK);                           \
-            V sx = SFB__SIMD_N_LD(at + SFB__SIMD_NSX * SFB__SIMD_NBLOCK);                           \
-            V sy = SFB__SIMD_N_LD(at + SFB__SIMD_NSY * SFB__SIMD_NBLOCK);                           \
-            V sz = SFB__SIMD_N_LD(at + SFB__SIMD_NSZ * SFB__SIMD_NBLOCK);                           \
-            const V wb = SFB__SIMD_N_LD(at + SFB__SIMD_NW * SFB__SIMD_NBLOCK);                      \
-            const M blend = SFB__SIMD_N_GT(wb, nob);                                               \
-            const V w = SFB__SIMD_N_SEL(blend, wb, zero), w1 = SFB__SIMD_N_SUB(one, w);             \
-            V bx, by, bz;                                                                           \
-            SFB__SIMD_NUNIT(V, M, lx, ly, lz);                                                   \
-            SFB__SIMD_NUNIT(V, M, sx, sy, sz);                                                   \
-            bx = SFB__SIMD_N_ADD(SFB__SIMD_N_MUL(w1, lx), SFB__SIMD_N_MUL(w, sx));                  \
-            by = SFB__SIMD_N_ADD(SFB__SIMD_N_MUL(w1, ly), SFB__SIMD_N_MUL(w, sy));                  \
-            bz = SFB__SIMD_N_ADD(SFB__SIMD_N_MUL(w1, lz), SFB__SIMD_N_MUL(w, sz));                  \
-            SFB__SIMD_NUNIT(V, M, bx, by, bz);                                                   \
-            SFB__SIMD_N_ST(at + SFB__SIMD_NLX * SFB__SIMD_NBLOCK, lx);                              \
-            SFB__SIMD_N_ST(at + SFB__SIMD_NLY * SFB__SIMD_NBLOCK, ly);                              \
-            SFB__SIMD_N_ST(at + SFB__SIMD_NLZ * SFB__SIMD_NBLOCK, lz);                              \
-            SFB__SIMD_N_ST(at + SFB__SIMD_NSX * SFB__SIMD_NBLOCK, sx);                              \
-            SFB__SIMD_N_ST(at + SFB__SIMD_NSY * SFB__SIMD_NBLOCK, sy);                              \
-            SFB__SIMD_N_ST(at + SFB__SIMD_NSZ * SFB__SIMD_NBLOCK, sz);                              \
-            SFB__SIMD_N_ST(at + SFB__SIMD_NBX * SFB__SIMD_NBLOCK, SFB__SIMD_N_SEL(blend, bx, lx));  \
-            SFB__SIMD_N_ST(at + SFB__SIMD_NBY * SFB__SIMD_NBLOCK, SFB__SIMD_N_SEL(blend, by, ly));  \
-            SFB__SIMD_N_ST(at + SFB__SIMD_NBZ * SFB__SIMD_NBLOCK, SFB__SIMD_N_SEL(blend, bz, lz));  \
-        }                                                                                           \
+#define SFB__SIMD_NORMALS_DEFINE(X, ATTR)                                                               \
+    ATTR static void X##_normals_vec(double *blk, int count) {                                          \
+        const X##_v zero = X##_set1(0.0), one = X##_set1(1.0), nob = X##_set1(-0.5);                   \
+        int m;                                                                                          \
+        for (m = 0; m < count; m += X##_W) {                                                            \
+            double *at = blk + m;                                                                       \
+            X##_v lx = X##_loadu(at + SFB__SIMD_NLX * SFB__SIMD_NBLOCK);                                \
+            X##_v ly = X##_loadu(at + SFB__SIMD_NLY * SFB__SIMD_NBLOCK);                                \
+            X##_v lz = X##_loadu(at + SFB__SIMD_NLZ * SFB__SIMD_NBLOCK);                                \
+            X##_v sx = X##_loadu(at + SFB__SIMD_NSX * SFB__SIMD_NBLOCK);                                \
+            X##_v sy = X##_loadu(at + SFB__SIMD_NSY * SFB__SIMD_NBLOCK);                                \
+            X##_v sz = X##_loadu(at + SFB__SIMD_NSZ * SFB__SIMD_NBLOCK);                                \
+            const X##_v wb = X##_loadu(at + SFB__SIMD_NW * SFB__SIMD_NBLOCK);                           \
+            const X##_m blend = X##_gt(wb, nob);                                                        \
+            const X##_v w = X##_sel(blend, wb, zero), w1 = X##_sub(one, w);                             \
+            X##_v bx, by, bz;                                                                           \
+            SFB__SIMD_NUNIT(X, lx, ly, lz);                                                             \
+            SFB__SIMD_NUNIT(X, sx, sy, sz);                                                             \
+            bx = X##_add(X##_mul(w1, lx), X##_mul(w, sx));                                              \
+            by = X##_add(X##_mul(w1, ly), X##_mul(w, sy));                                              \
+            bz = X##_add(X##_mul(w1, lz), X##_mul(w, sz));                                              \
+            SFB__SIMD_NUNIT(X, bx, by, bz);                                                             \
+            X##_storeu(at + SFB__SIMD_NLX * SFB__SIMD_NBLOCK, lx);                                      \
+            X##_storeu(at + SFB__SIMD_NLY * SFB__SIMD_NBLOCK, ly);                                      \
+            X##_storeu(at + SFB__SIMD_NLZ * SFB__SIMD_NBLOCK, lz);                                      \
+            X##_storeu(at + SFB__SIMD_NSX * SFB__SIMD_NBLOCK, sx);                                      \
+            X##_storeu(at + SFB__SIMD_NSY * SFB__SIMD_NBLOCK, sy);                                      \
+            X##_storeu(at + SFB__SIMD_NSZ * SFB__SIMD_NBLOCK, sz);                                      \
+            X##_storeu(at + SFB__SIMD_NBX * SFB__SIMD_NBLOCK, X##_sel(blend, bx, lx));                  \
+            X##_storeu(at + SFB__SIMD_NBY * SFB__SIMD_NBLOCK, X##_sel(blend, by, ly));                  \
+            X##_storeu(at + SFB__SIMD_NBZ * SFB__SIMD_NBLOCK, X##_sel(blend, bz, lz));                  \
+        }                                                                                               \
     }
 
-/* portable (and 32-bit neon): one double per step */
-#define SFB__SIMD_N_LD(p) (*(p))
-#define SFB__SIMD_N_ST(p, v) (*(p) = (v))
-#define SFB__SIMD_N_SET1(x) (x)
-#define SFB__SIMD_N_ADD(a, b) ((a) + (b))
-#define SFB__SIMD_N_SUB(a, b) ((a) - (b))
-#define SFB__SIMD_N_MUL(a, b) ((a) * (b))
-#define SFB__SIMD_N_DIV(a, b) ((a) / (b))
-#define SFB__SIMD_N_SQRT(a) sqrt(a)
-#define SFB__SIMD_N_GT(a, b) ((a) > (b))
-#define SFB__SIMD_N_SEL(m, a, b) ((m) ? (a) : (b))
-SFB__SIMD_NORMALS_VEC(sfb__simd_nvec_portable, , 1, double, int)
-#undef SFB__SIMD_N_LD
-#undef SFB__SIMD_N_ST
-#undef SFB__SIMD_N_SET1
-#undef SFB__SIMD_N_ADD
-#undef SFB__SIMD_N_SUB
-#undef SFB__SIMD_N_MUL
-#undef SFB__SIMD_N_DIV
-#undef SFB__SIMD_N_SQRT
-#undef SFB__SIMD_N_GT
-#undef SFB__SIMD_N_SEL
-
+/* portable (and 32-bit neon): one double per step; sse2 and AArch64 neon 2, avx2 4, avx512 8 */
+SFB__SIMD_NORMALS_DEFINE(sfb__vpd, )
 #ifdef SFB__SIMD_SSE2
-#define SFB__SIMD_N_LD(p) _mm_loadu_pd(p)
-#define SFB__SIMD_N_ST(p, v) _mm_storeu_pd(p, v)
-#define SFB__SIMD_N_SET1(x) _mm_set1_pd(x)
-#define SFB__SIMD_N_ADD(a, b) _mm_add_pd(a, b)
-#define SFB__SIMD_N_SUB(a, b) _mm_sub_pd(a, b)
-#define SFB__SIMD_N_MUL(a, b) _mm_mul_pd(a, b)
-#define SFB__SIMD_N_DIV(a, b) _mm_div_pd(a, b)
-#define SFB__SIMD_N_SQRT(a) _mm_sqrt_pd(a)
-#define SFB__SIMD_N_GT(a, b) _mm_cmpgt_pd(a, b)
-#define SFB__SIMD_N_SEL(m, a, b) _mm_or_pd(_mm_and_pd(m, a), _mm_andnot_pd(m, b))
-SFB__SIMD_NORMALS_VEC(sfb__simd_nvec_sse2, , 2, __m128d, __m128d)
-#undef SFB__SIMD_N_LD
-#undef SFB__SIMD_N_ST
-#undef SFB__SIMD_N_SET1
-#undef SFB__SIMD_N_ADD
-#undef SFB__SIMD_N_SUB
-#undef SFB__SIMD_N_MUL
-#undef SFB__SIMD_N_DIV
-#undef SFB__SIMD_N_SQRT
-#undef SFB__SIMD_N_GT
-#undef SFB__SIMD_N_SEL
+SFB__SIMD_NORMALS_DEFINE(sfb__vsd, )
 #endif
-
 #ifdef SFB__SIMD_X86_DISPATCH
-#define SFB__SIMD_N_LD(p) _mm256_loadu_pd(p)
-#define SFB__SIMD_N_ST(p, v) _mm256_storeu_pd(p, v)
-#define SFB__SIMD_N_SET1(x) _mm256_set1_pd(x)
-#define SFB__SIMD_N_ADD(a, b) _mm256_add_pd(a, b)
-#define SFB__SIMD_N_SUB(a, b) _mm256_sub_pd(a, b)
-#define SFB__SIMD_N_MUL(a, b) _mm256_mul_pd(a, b)
-#define SFB__SIMD_N_DIV(a, b) _mm256_div_pd(a, b)
-#define SFB__SIMD_N_SQRT(a) _mm256_sqrt_pd(a)
-#define SFB__SIMD_N_GT(a, b) _mm256_cmp_pd(a, b, _CMP_GT_OQ)
-#define SFB__SIMD_N_SEL(m, a, b) _mm256_blendv_pd(b, a, m)
-SFB__SIMD_NORMALS_VEC(sfb__simd_nvec_avx2, SFB__SIMD_TARGET_AVX2, 4, __m256d, __m256d)
-#undef SFB__SIMD_N_LD
-#undef SFB__SIMD_N_ST
-#undef SFB__SIMD_N_SET1
-#undef SFB__SIMD_N_ADD
-#undef SFB__SIMD_N_SUB
-#undef SFB__SIMD_N_MUL
-#undef SFB__SIMD_N_DIV
-#undef SFB__SIMD_N_SQRT
-#undef SFB__SIMD_N_GT
-#undef SFB__SIMD_N_SEL
-
-#define SFB__SIMD_N_LD(p) _mm512_loadu_pd(p)
-#define SFB__SIMD_N_ST(p, v) _mm512_storeu_pd(p, v)
-#define SFB__SIMD_N_SET1(x) _mm512_set1_pd(x)
-#define SFB__SIMD_N_ADD(a, b) _mm512_add_pd(a, b)
-#define SFB__SIMD_N_SUB(a, b) _mm512_sub_pd(a, b)
-#define SFB__SIMD_N_MUL(a, b) _mm512_mul_pd(a, b)
-#define SFB__SIMD_N_DIV(a, b) _mm512_div_pd(a, b)
-#define SFB__SIMD_N_SQRT(a) _mm512_sqrt_pd(a)
-#define SFB__SIMD_N_GT(a, b) _mm512_cmp_pd_mask(a, b, _CMP_GT_OQ)
-#define SFB__SIMD_N_SEL(m, a, b) _mm512_mask_blend_pd(m, b, a)
-SFB__SIMD_NORMALS_VEC(sfb__simd_nvec_avx512, SFB__SIMD_TARGET_AVX512, 8, __m512d, __mmask8)
-#undef SFB__SIMD_N_LD
-#undef SFB__SIMD_N_ST
-#undef SFB__SIMD_N_SET1
-#undef SFB__SIMD_N_ADD
-#undef SFB__SIMD_N_SUB
-#undef SFB__SIMD_N_MUL
-#undef SFB__SIMD_N_DIV
-#undef SFB__SIMD_N_SQRT
-#undef SFB__SIMD_N_GT
-#undef SFB__SIMD_N_SEL
-#endif /* SFB__SIMD_X86_DISPATCH */
-
-#if defined(SFB__SIMD_NEON) && defined(__aarch64__)
-#define SFB__SIMD_NEON_F64 1
-#define SFB__SIMD_N_LD(p) vld1q_f64(p)
-#define SFB__SIMD_N_ST(p, v) vst1q_f64(p, v)
-#define SFB__SIMD_N_SET1(x) vdupq_n_f64(x)
-#define SFB__SIMD_N_ADD(a, b) vaddq_f64(a, b)
-#define SFB__SIMD_N_SUB(a, b) vsubq_f64(a, b)
-#define SFB__SIMD_N_MUL(a, b) vmulq_f64(a, b)
-#define SFB__SIMD_N_DIV(a, b) vdivq_f64(a, b)
-#define SFB__SIMD_N_SQRT(a) vsqrtq_f64(a)
-#define SFB__SIMD_N_GT(a, b) vcgtq_f64(a, b)
-#define SFB__SIMD_N_SEL(m, a, b) vbslq_f64(m, a, b)
-SFB__SIMD_NORMALS_VEC(sfb__simd_nvec_neon, , 2, float64x2_t, uint64x2_t)
-#undef SFB__SIMD_N_LD
-#undef SFB__SIMD_N_ST
-#undef SFB__SIMD_N_SET1
-#undef SFB__SIMD_N_ADD
-#undef SFB__SIMD_N_SUB
-#undef SFB__SIMD_N_MUL
-#undef SFB__SIMD_N_DIV
-#undef SFB__SIMD_N_SQRT
-#undef SFB__SIMD_N_GT
-#undef SFB__SIMD_N_SEL
+SFB__SIMD_NORMALS_DEFINE(sfb__vad, SFB__SIMD_TARGET_AVX2)
+SFB__SIMD_NORMALS_DEFINE(sfb__vzd, SFB__SIMD_TARGET_AVX512)
 #endif
-#undef SFB__SIMD_NORMALS_VEC
+#ifdef SFB__SIMD_VN
+SFB__SIMD_NORMALS_DEFINE(sfb__vnd, )
+#endif
+#undef SFB__SIMD_NORMALS_DEFINE
 #undef SFB__SIMD_NUNIT
 
 /* The vector pass of the state's instruction set. */
 static sfb__simd_nvec_fn sfb__simd_normals_select(int isa) {
     switch (isa) {
 #ifdef SFB__SIMD_SSE2
-    case SFB__SIMD_ISA_SSE2: return sfb__simd_nvec_sse2;
+    case SFB__SIMD_ISA_SSE2: return sfb__vsd_normals_vec;
 #endif
 #ifdef SFB__SIMD_X86_DISPATCH
-    case SFB__SIMD_AVX2: return sfb__simd_nvec_avx2;
-    case SFB__SIMD_AVX512: return sfb__simd_nvec_avx512;
+    case SFB__SIMD_AVX2: return sfb__vad_normals_vec;
+    case SFB__SIMD_AVX512: return sfb__vzd_normals_vec;
 #endif
-#ifdef SFB__SIMD_NEON_F64
-    case SFB__SIMD_ISA_NEON: return sfb__simd_nvec_neon;
+#ifdef SFB__SIMD_VN
+    case SFB__SIMD_ISA_NEON: return sfb__vnd_normals_vec;
 #endif
-    default: return sfb__simd_nvec_portable;
+    default: return sfb__vpd_normals_vec;
     }
 }
 

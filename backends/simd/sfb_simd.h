@@ -9,7 +9,7 @@
  *
  * Files. This one is the runtime: what can be compiled here, the instruction set chosen at
  * init (CPU detection, SURFBLEND_SIMD_ISA), the thread pool, the vector operations the kernels
- * are written on (below: one set of X##_op per instruction set), the
+ * are written on (below: one set of X##_op per instruction set, float and double lanes), the
  * backend state, init / shutdown / describe, and what the patch families share (the packed
  * table handle, a call's job). Then one file per kernel family, each holding its kernels for
  * every instruction set, its choice of them for the state's instruction set (a select
@@ -358,13 +358,17 @@ static void sfb__simd_runtime_bind(sfb__backend_vtable *vt) {
  * Kernels that keep one location or element per vector lane (structure of arrays) are written
  * once over these operations, X##_op with X an instruction set's prefix, each a line or two of
  * intrinsics (the families instantiate them, e.g. SFB__SIMD_MF_DEFINE(X, ATTR) in manifold.h,
- * with ATTR the target attribute): sfb__vp portable (1 lane), sfb__vs sse2 (4), sfb__va
- * avx2 + fma (8), sfb__vz avx512 (16), sfb__vn neon on AArch64 (4; SFB__SIMD_VN). Each has the
- * types X##_v (a vector of floats), X##_m (a comparison mask), X##_i (lane indices for
- * gathers) and the lane count X##_W. fma(a, b, c) is a b + c, fused where the
+ * SFB__SIMD_NORMALS_DEFINE(X, ATTR) in normals.h, with ATTR the target attribute):
+ *   float lanes:  sfb__vp portable (1 lane), sfb__vs sse2 (4), sfb__va avx2 + fma (8),
+ *                 sfb__vz avx512 (16), sfb__vn neon on AArch64 (4; SFB__SIMD_VN)
+ *   double lanes: sfb__vpd portable (1), sfb__vsd sse2 (2), sfb__vad avx2 (4), sfb__vzd
+ *                 avx512 (8), sfb__vnd neon on AArch64 (2)
+ * Each has the types X##_v (a vector), X##_m (a comparison mask), X##_i (float lanes: lane
+ * indices for gathers) and the lane count X##_W. fma(a, b, c) is a b + c, fused where the
  * instruction set has it (avx2, avx512, AArch64 neon), a rounded product then a sum
  * elsewhere; fnma(a, b, c) is c - a b; sel(m, a, b) is a where m is set, else b. Comparisons
- * are ordered (false on NaN). Intrinsic-level layouts (the stencils' entries
+ * are ordered (false on NaN). Double lanes have only what their kernels use (loadu, storeu,
+ * set1, add, sub, mul, div, sqrt, gt, sel). Intrinsic-level layouts (the stencils' entries
  * side by side in 256- and 512-bit registers, the B-spline windows' points per register) are
  * not expressible here and stay in their families' files. */
 
@@ -410,6 +414,19 @@ static inline void sfb__vp_store3(float *dst, float x, float y, float z, int n) 
     (void)n;
     dst[0] = x; dst[1] = y; dst[2] = z;
 }
+typedef double sfb__vpd_v;
+typedef int sfb__vpd_m;
+enum { sfb__vpd_W = 1 };
+static inline double sfb__vpd_loadu(const double *p) { return *p; }
+static inline void sfb__vpd_storeu(double *p, double v) { *p = v; }
+static inline double sfb__vpd_set1(double x) { return x; }
+static inline double sfb__vpd_add(double a, double b) { return a + b; }
+static inline double sfb__vpd_sub(double a, double b) { return a - b; }
+static inline double sfb__vpd_mul(double a, double b) { return a * b; }
+static inline double sfb__vpd_div(double a, double b) { return a / b; }
+static inline double sfb__vpd_sqrt(double a) { return sqrt(a); }
+static inline int sfb__vpd_gt(double a, double b) { return a > b; }
+static inline double sfb__vpd_sel(int m, double a, double b) { return m ? a : b; }
 
 #ifdef SFB__SIMD_SSE2
 /* sse2: 4 lanes, no fused multiply-add */
@@ -474,6 +491,20 @@ static inline void sfb__vs_store3(float *dst, __m128 x, __m128 y, __m128 z, int 
         }
     }
 }
+/* sse2, double lanes: 2 */
+typedef __m128d sfb__vsd_v;
+typedef __m128d sfb__vsd_m;
+enum { sfb__vsd_W = 2 };
+static inline __m128d sfb__vsd_loadu(const double *p) { return _mm_loadu_pd(p); }
+static inline void sfb__vsd_storeu(double *p, __m128d v) { _mm_storeu_pd(p, v); }
+static inline __m128d sfb__vsd_set1(double x) { return _mm_set1_pd(x); }
+static inline __m128d sfb__vsd_add(__m128d a, __m128d b) { return _mm_add_pd(a, b); }
+static inline __m128d sfb__vsd_sub(__m128d a, __m128d b) { return _mm_sub_pd(a, b); }
+static inline __m128d sfb__vsd_mul(__m128d a, __m128d b) { return _mm_mul_pd(a, b); }
+static inline __m128d sfb__vsd_div(__m128d a, __m128d b) { return _mm_div_pd(a, b); }
+static inline __m128d sfb__vsd_sqrt(__m128d a) { return _mm_sqrt_pd(a); }
+static inline __m128d sfb__vsd_gt(__m128d a, __m128d b) { return _mm_cmpgt_pd(a, b); }
+static inline __m128d sfb__vsd_sel(__m128d m, __m128d a, __m128d b) { return _mm_or_pd(_mm_and_pd(m, a), _mm_andnot_pd(m, b)); }
 #endif /* SFB__SIMD_SSE2 */
 
 #ifdef SFB__SIMD_X86_DISPATCH
@@ -529,6 +560,20 @@ SFB__VA void sfb__va_store3(float *dst, __m256 x, __m256 y, __m256 z, int n) {
     sfb__vs_store3(dst, _mm256_castps256_ps128(x), _mm256_castps256_ps128(y), _mm256_castps256_ps128(z), n < 4 ? n : 4);
     if (n > 4) sfb__vs_store3(dst + 12, _mm256_extractf128_ps(x, 1), _mm256_extractf128_ps(y, 1), _mm256_extractf128_ps(z, 1), n - 4);
 }
+/* avx2, double lanes: 4 */
+typedef __m256d sfb__vad_v;
+typedef __m256d sfb__vad_m;
+enum { sfb__vad_W = 4 };
+SFB__VA __m256d sfb__vad_loadu(const double *p) { return _mm256_loadu_pd(p); }
+SFB__VA void sfb__vad_storeu(double *p, __m256d v) { _mm256_storeu_pd(p, v); }
+SFB__VA __m256d sfb__vad_set1(double x) { return _mm256_set1_pd(x); }
+SFB__VA __m256d sfb__vad_add(__m256d a, __m256d b) { return _mm256_add_pd(a, b); }
+SFB__VA __m256d sfb__vad_sub(__m256d a, __m256d b) { return _mm256_sub_pd(a, b); }
+SFB__VA __m256d sfb__vad_mul(__m256d a, __m256d b) { return _mm256_mul_pd(a, b); }
+SFB__VA __m256d sfb__vad_div(__m256d a, __m256d b) { return _mm256_div_pd(a, b); }
+SFB__VA __m256d sfb__vad_sqrt(__m256d a) { return _mm256_sqrt_pd(a); }
+SFB__VA __m256d sfb__vad_gt(__m256d a, __m256d b) { return _mm256_cmp_pd(a, b, _CMP_GT_OQ); }
+SFB__VA __m256d sfb__vad_sel(__m256d m, __m256d a, __m256d b) { return _mm256_blendv_pd(b, a, m); }
 #undef SFB__VA
 
 /* avx512: 16 lanes, masks in mask registers */
@@ -594,6 +639,20 @@ SFB__VZ void sfb__vz_store3(float *dst, __m512 x, __m512 y, __m512 z, int n) {
         else if (cnt > 0) _mm512_mask_storeu_ps(dst + 16 * k, (__mmask16)((1u << cnt) - 1u), r);
     }
 }
+/* avx512, double lanes: 8 */
+typedef __m512d sfb__vzd_v;
+typedef __mmask8 sfb__vzd_m;
+enum { sfb__vzd_W = 8 };
+SFB__VZ __m512d sfb__vzd_loadu(const double *p) { return _mm512_loadu_pd(p); }
+SFB__VZ void sfb__vzd_storeu(double *p, __m512d v) { _mm512_storeu_pd(p, v); }
+SFB__VZ __m512d sfb__vzd_set1(double x) { return _mm512_set1_pd(x); }
+SFB__VZ __m512d sfb__vzd_add(__m512d a, __m512d b) { return _mm512_add_pd(a, b); }
+SFB__VZ __m512d sfb__vzd_sub(__m512d a, __m512d b) { return _mm512_sub_pd(a, b); }
+SFB__VZ __m512d sfb__vzd_mul(__m512d a, __m512d b) { return _mm512_mul_pd(a, b); }
+SFB__VZ __m512d sfb__vzd_div(__m512d a, __m512d b) { return _mm512_div_pd(a, b); }
+SFB__VZ __m512d sfb__vzd_sqrt(__m512d a) { return _mm512_sqrt_pd(a); }
+SFB__VZ __mmask8 sfb__vzd_gt(__m512d a, __m512d b) { return _mm512_cmp_pd_mask(a, b, _CMP_GT_OQ); }
+SFB__VZ __m512d sfb__vzd_sel(__mmask8 m, __m512d a, __m512d b) { return _mm512_mask_blend_pd(m, b, a); }
 #undef SFB__VZ
 #endif /* SFB__SIMD_X86_DISPATCH */
 
@@ -660,6 +719,20 @@ static inline void sfb__vn_store3(float *dst, float32x4_t x, float32x4_t y, floa
         for (l = 0; l < 3 * n; ++l) dst[l] = t[l];
     }
 }
+/* neon (AArch64), double lanes: 2 */
+typedef float64x2_t sfb__vnd_v;
+typedef uint64x2_t sfb__vnd_m;
+enum { sfb__vnd_W = 2 };
+static inline float64x2_t sfb__vnd_loadu(const double *p) { return vld1q_f64(p); }
+static inline void sfb__vnd_storeu(double *p, float64x2_t v) { vst1q_f64(p, v); }
+static inline float64x2_t sfb__vnd_set1(double x) { return vdupq_n_f64(x); }
+static inline float64x2_t sfb__vnd_add(float64x2_t a, float64x2_t b) { return vaddq_f64(a, b); }
+static inline float64x2_t sfb__vnd_sub(float64x2_t a, float64x2_t b) { return vsubq_f64(a, b); }
+static inline float64x2_t sfb__vnd_mul(float64x2_t a, float64x2_t b) { return vmulq_f64(a, b); }
+static inline float64x2_t sfb__vnd_div(float64x2_t a, float64x2_t b) { return vdivq_f64(a, b); }
+static inline float64x2_t sfb__vnd_sqrt(float64x2_t a) { return vsqrtq_f64(a); }
+static inline uint64x2_t sfb__vnd_gt(float64x2_t a, float64x2_t b) { return vcgtq_f64(a, b); }
+static inline float64x2_t sfb__vnd_sel(uint64x2_t m, float64x2_t a, float64x2_t b) { return vbslq_f64(m, a, b); }
 #endif
 
 /* ==== patch tables: what the patch families share ====
