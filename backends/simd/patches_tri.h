@@ -1,0 +1,417 @@
+/* backends/simd/patches_tri.h -- the triangle family of backends/simd/patches.h (BEZTRI15,
+ * STAM_LOOP; ENDCAP_TRI runs the ref kernel): locating, the Stam-Loop locations beyond the
+ * packed levels, the quartic Bezier triangle kernels per instruction set (in double), and
+ * packing the triangles. Layout and numerics: patches.h. */
+
+/* Quartic Bernstein basis on a triangle in double, the table's point order (row j by row in
+ * t, s rising in a row): B[0..5][15] = value, d/ds, d/dt, d2/ds2, d2/dsdt, d2/dt2 (the last three
+ * only when nw = 6). Powers up to 4 of s, t and w = 1 - s - t, and the binomial weights. */
+static void sfb__simd_bez15(double s, double t, int nw, double B[6][15]) {
+    static const double mult[15] = {1, 4, 6, 4, 1, 4, 12, 12, 4, 6, 12, 6, 4, 4, 1};
+    double ps[5], pt[5], pw[5];
+    int i, j, q = 0;
+    const double w = 1.0 - s - t;
+    ps[0] = pt[0] = pw[0] = 1.0;
+    for (i = 1; i < 5; ++i) { ps[i] = ps[i - 1] * s; pt[i] = pt[i - 1] * t; pw[i] = pw[i - 1] * w; }
+    for (j = 0; j <= 4; ++j)
+        for (i = 0; i + j <= 4; ++i, ++q) {
+            const int k = 4 - i - j;
+            const double c = mult[q];
+            /* s^a t^b w^c with negative exponents as 0 */
+#define SFB__SIMD_M(a, b, e) ((a) < 0 || (b) < 0 || (e) < 0 ? 0.0 : ps[(a) < 0 ? 0 : (a)] * pt[(b) < 0 ? 0 : (b)] * pw[(e) < 0 ? 0 : (e)])
+            B[0][q] = c * SFB__SIMD_M(i, j, k);
+            B[1][q] = c * (i * SFB__SIMD_M(i - 1, j, k) - k * SFB__SIMD_M(i, j, k - 1));
+            B[2][q] = c * (j * SFB__SIMD_M(i, j - 1, k) - k * SFB__SIMD_M(i, j, k - 1));
+            if (nw > 3) {
+                B[3][q] = c * (i * (i - 1) * SFB__SIMD_M(i - 2, j, k) - 2 * i * k * SFB__SIMD_M(i - 1, j, k - 1) + k * (k - 1) * SFB__SIMD_M(i, j, k - 2));
+                B[4][q] = c * (i * j * SFB__SIMD_M(i - 1, j - 1, k) - i * k * SFB__SIMD_M(i - 1, j, k - 1) - j * k * SFB__SIMD_M(i, j - 1, k - 1) +
+                               k * (k - 1) * SFB__SIMD_M(i, j, k - 2));
+                B[5][q] = c * (j * (j - 1) * SFB__SIMD_M(i, j - 2, k) - 2 * j * k * SFB__SIMD_M(i, j - 1, k - 1) + k * (k - 1) * SFB__SIMD_M(i, j, k - 2));
+            }
+#undef SFB__SIMD_M
+        }
+}
+
+/* A Stam-Loop location nearer the EV than the packed levels: ref's eigen-structure sums in
+ * double (integer powers, the Jordan term of valence 3, only the outputs asked for). The EV
+ * itself and degenerate tangents go to ref. */
+static void sfb__simd_loop_far(const sfb__simd_pjob *j, int q) {
+    const sfb__patch_table *pt = j->pt;
+    const sfb_location *l = &j->locs[q];
+    double s, t, sc, u, v, ss, tt, J[2][2], B[6][15], f[SFB__STAM_MAX_VALENCE + 6][6];
+    double acc[6][3], res[6][3], nres[2][3], nrm[3], len, sub, subm, sign = 1.0, sc1, sc2;
+    const sfb__eigen_loop *e;
+    const double *phi;
+    const int *cv;
+    const int p = sfb__patch_locate(pt, l->face, l->u, l->v, &s, &t, &sc), nw = j->second ? 6 : 3;
+    int n = 1, k, i, jj, c, m, w;
+    if (p < 0 || pt->ptype[p] != SFB__PATCH_STAM_LOOP || !(e = pt->eigl[pt->pvalence[p]]) || e->K > SFB__STAM_MAX_VALENCE + 6) {
+        sfb__simd_ref_one(j, q);
+        return;
+    }
+    switch (SFB__PARAM_CORNER(pt->pparam[p])) {
+    default: u = s; v = t; J[0][0] = 1; J[0][1] = 0; J[1][0] = 0; J[1][1] = 1; break;
+    case 1: u = t; v = 1.0 - s - t; J[0][0] = 0; J[0][1] = 1; J[1][0] = -1; J[1][1] = -1; break;
+    case 2: u = 1.0 - s - t; v = s; J[0][0] = -1; J[0][1] = -1; J[1][0] = 1; J[1][1] = 0; break;
+    }
+    if (u < 0.0) u = 0.0;
+    if (v < 0.0) v = 0.0;
+    if (u + v == 0.0) { sfb__simd_ref_one(j, q); return; }
+    while (u + v < 0.5) { u *= 2.0; v *= 2.0; ++n; }
+    if (u >= 0.5) { k = 0; ss = 2.0 * u - 1.0; tt = 2.0 * v; }
+    else if (v >= 0.5) { k = 1; ss = 2.0 * u; tt = 2.0 * v - 1.0; }
+    else { k = 2; ss = 1.0 - 2.0 * u; tt = 1.0 - 2.0 * v; sign = -1.0; }
+    m = n - 1;
+    sfb__simd_bez15(ss, tt, nw, B);
+    phi = e->phi + (size_t)k * 15 * (size_t)e->K;
+    for (i = 0; i < e->K; ++i) {
+        /* eigenbasis function i and its derivatives at (ss, tt); named accumulators keep the
+         * sums in registers */
+        const double *ph = phi + i;
+        double f0 = 0.0, f1 = 0.0, f2 = 0.0, f3 = 0.0, f4 = 0.0, f5 = 0.0;
+        if (nw == 3) {
+            for (jj = 0; jj < 15; ++jj, ph += e->K) { f0 += B[0][jj] * *ph; f1 += B[1][jj] * *ph; f2 += B[2][jj] * *ph; }
+        } else {
+            for (jj = 0; jj < 15; ++jj, ph += e->K) {
+                f0 += B[0][jj] * *ph; f1 += B[1][jj] * *ph; f2 += B[2][jj] * *ph;
+                f3 += B[3][jj] * *ph; f4 += B[4][jj] * *ph; f5 += B[5][jj] * *ph;
+            }
+        }
+        f[i][0] = f0; f[i][1] = f1; f[i][2] = f2; f[i][3] = f3; f[i][4] = f4; f[i][5] = f5;
+    }
+    memset(acc, 0, sizeof acc);
+    sub = e->sub;
+    subm = sfb__simd_ipow(sub, m);
+    cv = pt->cv + pt->pfirst[p];
+    for (i = 0; i < e->K; ++i) {
+        /* position: lambda^m; derivatives normalised by sub^m (finite down to the EV) */
+        const float *pnt = pt->point_data + 3 * (size_t)cv[i];
+        const double lp = sfb__simd_ipow(e->lambda[i], m), ln = i == e->dominant ? 0.0 : sfb__simd_ipow(e->lambda[i] / sub, m);
+        double g[6];
+        for (w = 0; w < nw; ++w) g[w] = (w ? ln : lp) * f[i][w];
+        if (e->head[i] >= 0 && m > 0) {
+            /* the second vector of a Jordan block: m lambda^(m-1) of its head's function */
+            const int hd = e->head[i];
+            const double jl = m * sfb__simd_ipow(e->lambda[i], m - 1), jn = jl / subm;
+            for (w = 0; w < nw; ++w) g[w] += (w ? jn : jl) * f[hd][w];
+        }
+        {
+            const double x = pnt[0], y = pnt[1], z = pnt[2];
+            for (w = 0; w < nw; ++w) { acc[w][0] += g[w] * x; acc[w][1] += g[w] * y; acc[w][2] += g[w] * z; }
+        }
+    }
+    sc1 = subm * ldexp(1.0, n) * sc;
+    sc2 = subm * ldexp(1.0, 2 * n) * sc * sc;
+    for (c = 0; c < 3; ++c) {
+        const double Pu = sign * acc[1][c], Pv = sign * acc[2][c];
+        nres[0][c] = Pu * J[0][0] + Pv * J[1][0];
+        nres[1][c] = Pu * J[0][1] + Pv * J[1][1];
+    }
+    nrm[0] = nres[0][1] * nres[1][2] - nres[0][2] * nres[1][1];
+    nrm[1] = nres[0][2] * nres[1][0] - nres[0][0] * nres[1][2];
+    nrm[2] = nres[0][0] * nres[1][1] - nres[0][1] * nres[1][0];
+    len = sqrt(nrm[0] * nrm[0] + nrm[1] * nrm[1] + nrm[2] * nrm[2]);
+    if (j->out->normal && !(len > 0.0 && len <= 1e300)) { sfb__simd_ref_one(j, q); return; }
+    for (c = 0; c < 3; ++c) {
+        const double Puu = acc[3][c], Puv = acc[4][c], Pvv = acc[5][c];
+        if (j->out->normal) nrm[c] /= len;
+        res[0][c] = acc[0][c];
+        res[1][c] = nres[0][c] * sc1;
+        res[2][c] = nres[1][c] * sc1;
+        if (j->second) {
+            res[3][c] = sc2 * (Puu * J[0][0] * J[0][0] + 2.0 * Puv * J[0][0] * J[1][0] + Pvv * J[1][0] * J[1][0]);
+            res[4][c] = sc2 * (Puu * J[0][0] * J[0][1] + Puv * (J[0][0] * J[1][1] + J[0][1] * J[1][0]) + Pvv * J[1][0] * J[1][1]);
+            res[5][c] = sc2 * (Puu * J[0][1] * J[0][1] + 2.0 * Puv * J[0][1] * J[1][1] + Pvv * J[1][1] * J[1][1]);
+        } else {
+            res[3][c] = res[4][c] = res[5][c] = 0.0;
+        }
+    }
+    sfb__simd_write(j, q, res, nrm);
+}
+
+/* prep for a Loop table: the triangle descent of sfb__patch_locate, in double with ref's very
+ * operations (so the patch, (s, t) and the Stam-Loop level and sub-patch are ref's), without
+ * branches on the child (random here): child c's (u, v) is sg (2u - a_u, 2v - a_v) with
+ * sg = -1 for the middle child, whose 1 - 2u is -(2u - 1) exactly. */
+static void sfb__simd_prep_tri(const sfb__simd_pjob *j, int q, sfb__simd_slot *o) {
+    const sfb__simd_patches *h = j->h;
+    const sfb_location *l = &j->locs[q];
+    int node = h->root[l->face], code;
+    double s = l->u, t = l->v, sc = 1.0;
+    while (node >= 0) {
+        const int c1 = s >= 0.5, c2 = !c1 & (t >= 0.5), c3 = !c1 & !c2 & !(s + t < 0.5);
+        const double sg = c3 ? -1.0 : 1.0;
+        s = (s + s - (double)(c1 | c3)) * sg;
+        t = (t + t - (double)(c2 | c3)) * sg;
+        sc = (sc + sc) * sg;
+        node = h->node[4 * node + (c1 | 2 * c2 | 3 * c3)];
+    }
+    code = -node - 1;
+    o->run = SFB__SIMD_RUN_REF;
+    if ((code & 3) == SFB__SIMD_LEAF_TRI) {
+        o->blk = h->blk + 4 * (size_t)(code >> 4);
+        o->s = (float)s; o->t = (float)t; o->dsc = (float)sc; o->cs = 16; o->rot = 0;
+        o->run = SFB__SIMD_RUN_TRI;
+        SFB__SIMD_PREFETCH(o->blk);
+        SFB__SIMD_PREFETCH(o->blk + 16);
+        SFB__SIMD_PREFETCH(o->blk + 32);
+        SFB__SIMD_PREFETCH(o->blk + 48);
+    } else if ((code & 3) == SFB__SIMD_LEAF_STAM) {
+        /* ref's frame turn ((1 - s) - t written as 1 + (-1) s + (-1) t, exactly the same), its
+         * level n (n - 1 doublings bring u + v to [1/2, 1]: read off the exponent of u + v,
+         * which doubling scales exactly) and sub-patch k (0: u >= 1/2, 1: v >= 1/2, 2: the
+         * middle, turned). The corner is 0..2 (upload checks). */
+        static const double frame[3][6] = {{0, 1, 0, 0, 0, 1}, {0, 0, 1, 1, -1, -1}, {1, -1, -1, 0, 1, 0}};
+        const int corner = (code >> 2) & 3;
+        const double *f = frame[corner];
+        double u = (f[0] + f[1] * s) + f[2] * t, v = (f[3] + f[4] * s) + f[5] * t, sum, sg, lv;
+        uint64_t bits;
+        int n, c0, c1, c2;
+        if (u < 0.0) u = 0.0;
+        if (v < 0.0) v = 0.0;
+        sum = u + v;
+        if (!(sum >= 1.0 / (double)(1 << SFB__SIMD_LOOP_LEVELS))) {
+            if (sum > 0.0) o->run = SFB__SIMD_RUN_LOOP_FAR; /* else the EV itself: ref */
+            return;
+        }
+        memcpy(&bits, &sum, sizeof bits);
+        n = 1022 - (int)((bits >> 52) & 0x7FF); /* sum in [1/2, 1): 0 doublings; [1/4, 1/2): 1 ... */
+        if (n < 0) n = 0;
+        lv = (double)(1 << n);
+        u *= lv;
+        v *= lv;
+        ++n;
+        c0 = u >= 0.5;
+        c1 = !c0 & (v >= 0.5);
+        c2 = !c0 & !c1;
+        sg = c2 ? -1.0 : 1.0;
+        o->s = (float)((u + u - (double)(c0 | c2)) * sg);
+        o->t = (float)((v + v - (double)(c1 | c2)) * sg);
+        o->blk = h->blk + 4 * (size_t)(code >> 4) + (size_t)(n - 1) * 192 + (size_t)(c1 + 2 * c2) * 64;
+        o->dsc = (float)(sc * sg * lv * 2.0);
+        o->cs = 16;
+        o->rot = corner ? corner + 3 : 0;
+        o->run = SFB__SIMD_RUN_TRI;
+        SFB__SIMD_PREFETCH(o->blk);
+        SFB__SIMD_PREFETCH(o->blk + 16);
+        SFB__SIMD_PREFETCH(o->blk + 32);
+        SFB__SIMD_PREFETCH(o->blk + 48);
+    }
+}
+
+/* Quartic Bezier triangle at (s, t) (a triangle of the layout in patches.h), in double: de Casteljau
+ * steps on the points (convex combinations, weights w = 1 - s - t, s, t of the points (i, j),
+ * (i + 1, j), (i, j + 1) of the row layout, in place) from degree 4 down: at degree 2 the
+ * second derivatives are 12 x second differences, at degree 1 the first derivatives
+ * 4 x differences, at degree 0 the point, to which the origin is added. The step lists
+ * SFB__SIMD_DC4/3/2(X), X(to, from, above), are shared by every triangle kernel. */
+#define SFB__SIMD_DC4(X) X(0, 0, 5) X(1, 1, 6) X(2, 2, 7) X(3, 3, 8) X(4, 5, 9) X(5, 6, 10) X(6, 7, 11) X(7, 9, 12) X(8, 10, 13) X(9, 12, 14)
+#define SFB__SIMD_DC3(X) X(0, 0, 4) X(1, 1, 5) X(2, 2, 6) X(3, 4, 7) X(4, 5, 8) X(5, 7, 9)
+#define SFB__SIMD_DC2(X) X(0, 0, 3) X(1, 1, 4) X(2, 3, 5)
+static void sfb__simd_tri_portable(const float *blk, float s, float t, int second, float r[6][4]) {
+    const double w = (1.0 - s) - t;
+    double p[15][3];
+    int a, c;
+    for (a = 0; a < 15; ++a)
+        for (c = 0; c < 3; ++c) p[a][c] = blk[4 * a + c];
+    for (a = 0; a < 6; ++a) r[a][3] = 0.0f;
+    for (c = 0; c < 3; ++c) {
+#define SFB__SIMD_DC_SCALAR(to, from, above) p[to][c] = t * p[above][c] + (s * p[(from) + 1][c] + w * p[from][c]);
+        SFB__SIMD_DC4(SFB__SIMD_DC_SCALAR)
+        SFB__SIMD_DC3(SFB__SIMD_DC_SCALAR)
+        if (second) {
+            r[3][c] = (float)(12.0 * ((p[2][c] - p[1][c]) - (p[1][c] - p[0][c])));
+            r[4][c] = (float)(12.0 * ((p[4][c] - p[3][c]) - (p[1][c] - p[0][c])));
+            r[5][c] = (float)(12.0 * ((p[5][c] - p[3][c]) - (p[3][c] - p[0][c])));
+        } else {
+            r[3][c] = r[4][c] = r[5][c] = 0.0f;
+        }
+        SFB__SIMD_DC2(SFB__SIMD_DC_SCALAR)
+#undef SFB__SIMD_DC_SCALAR
+        r[1][c] = (float)(4.0 * (p[1][c] - p[0][c]));
+        r[2][c] = (float)(4.0 * (p[2][c] - p[0][c]));
+        r[0][c] = (float)((t * p[2][c] + (s * p[1][c] + w * p[0][c])) + blk[60 + c]);
+    }
+}
+
+#ifdef SFB__SIMD_SSE2
+/* The quartic triangle kernel (see sfb__simd_tri_portable) in double, each point as two
+ * registers (xy, zw); the signature of the window kernels (cs unused). */
+static SFB__SIMD_FORCEINLINE void sfb__simd_sse2_tri(const float *blk, int cs, float s, float t, int second, __m128 r[6]) {
+    const double sd = s, td = t;
+    const __m128d vs = _mm_set1_pd(sd), vt = _mm_set1_pd(td), vw = _mm_set1_pd((1.0 - sd) - td);
+    __m128d pl[15], ph[15];
+    int a;
+    (void)cs;
+    for (a = 0; a < 15; ++a) {
+        const __m128 v = _mm_loadu_ps(blk + 4 * a);
+        pl[a] = _mm_cvtps_pd(v);
+        ph[a] = _mm_cvtps_pd(_mm_movehl_ps(v, v));
+    }
+#define SFB__SIMD_DC_SSE2(to, from, above)                                                                          \
+    pl[to] = _mm_add_pd(_mm_mul_pd(vt, pl[above]), _mm_add_pd(_mm_mul_pd(vs, pl[(from) + 1]), _mm_mul_pd(vw, pl[from]))); \
+    ph[to] = _mm_add_pd(_mm_mul_pd(vt, ph[above]), _mm_add_pd(_mm_mul_pd(vs, ph[(from) + 1]), _mm_mul_pd(vw, ph[from])));
+#define SFB__SIMD_PS2(lo, hi) _mm_movelh_ps(_mm_cvtpd_ps(lo), _mm_cvtpd_ps(hi))
+    SFB__SIMD_DC4(SFB__SIMD_DC_SSE2)
+    SFB__SIMD_DC3(SFB__SIMD_DC_SSE2)
+    if (second) {
+        const __m128d twelve = _mm_set1_pd(12.0);
+#define SFB__SIMD_D2_SSE2(x, y, z, w) _mm_mul_pd(twelve, _mm_sub_pd(_mm_sub_pd(x, y), _mm_sub_pd(z, w)))
+        r[3] = SFB__SIMD_PS2(SFB__SIMD_D2_SSE2(pl[2], pl[1], pl[1], pl[0]), SFB__SIMD_D2_SSE2(ph[2], ph[1], ph[1], ph[0]));
+        r[4] = SFB__SIMD_PS2(SFB__SIMD_D2_SSE2(pl[4], pl[3], pl[1], pl[0]), SFB__SIMD_D2_SSE2(ph[4], ph[3], ph[1], ph[0]));
+        r[5] = SFB__SIMD_PS2(SFB__SIMD_D2_SSE2(pl[5], pl[3], pl[3], pl[0]), SFB__SIMD_D2_SSE2(ph[5], ph[3], ph[3], ph[0]));
+#undef SFB__SIMD_D2_SSE2
+    } else {
+        r[3] = r[4] = r[5] = _mm_setzero_ps();
+    }
+    SFB__SIMD_DC2(SFB__SIMD_DC_SSE2)
+    {
+        const __m128d four = _mm_set1_pd(4.0);
+        const __m128 o = _mm_loadu_ps(blk + 60);
+        r[1] = SFB__SIMD_PS2(_mm_mul_pd(four, _mm_sub_pd(pl[1], pl[0])), _mm_mul_pd(four, _mm_sub_pd(ph[1], ph[0])));
+        r[2] = SFB__SIMD_PS2(_mm_mul_pd(four, _mm_sub_pd(pl[2], pl[0])), _mm_mul_pd(four, _mm_sub_pd(ph[2], ph[0])));
+        r[0] = SFB__SIMD_PS2(_mm_add_pd(_mm_add_pd(_mm_mul_pd(vt, pl[2]), _mm_add_pd(_mm_mul_pd(vs, pl[1]), _mm_mul_pd(vw, pl[0]))), _mm_cvtps_pd(o)),
+                             _mm_add_pd(_mm_add_pd(_mm_mul_pd(vt, ph[2]), _mm_add_pd(_mm_mul_pd(vs, ph[1]), _mm_mul_pd(vw, ph[0]))),
+                                        _mm_cvtps_pd(_mm_movehl_ps(o, o))));
+    }
+#undef SFB__SIMD_DC_SSE2
+#undef SFB__SIMD_PS2
+}
+#endif /* SFB__SIMD_SSE2 */
+
+#ifdef SFB__SIMD_X86_DISPATCH
+/* The quartic triangle kernel (see sfb__simd_tri_portable) in double, one point (xyzw) per
+ * 256-bit register: as many instructions as in float. Shared with avx512. */
+#define SFB__SIMD_TRI_PD(NAME, ATTR)                                                                                 \
+    ATTR static SFB__SIMD_FORCEINLINE void NAME(const float *blk, int cs, float s, float t, int second, __m128 r[6]) { \
+        const double sd = s, td = t;                                                                                 \
+        const __m256d vs = _mm256_set1_pd(sd), vt = _mm256_set1_pd(td), vw = _mm256_set1_pd((1.0 - sd) - td);      \
+        __m256d p[15];                                                                                               \
+        int a;                                                                                                       \
+        (void)cs;                                                                                                    \
+        for (a = 0; a < 15; ++a) p[a] = _mm256_cvtps_pd(_mm_loadu_ps(blk + 4 * a));                                 \
+        SFB__SIMD_DC4(SFB__SIMD_DC_PD)                                                                               \
+        SFB__SIMD_DC3(SFB__SIMD_DC_PD)                                                                               \
+        if (second) {                                                                                                \
+            const __m256d twelve = _mm256_set1_pd(12.0), d10 = _mm256_sub_pd(p[1], p[0]), d30 = _mm256_sub_pd(p[3], p[0]); \
+            r[3] = _mm256_cvtpd_ps(_mm256_mul_pd(twelve, _mm256_sub_pd(_mm256_sub_pd(p[2], p[1]), d10)));            \
+            r[4] = _mm256_cvtpd_ps(_mm256_mul_pd(twelve, _mm256_sub_pd(_mm256_sub_pd(p[4], p[3]), d10)));            \
+            r[5] = _mm256_cvtpd_ps(_mm256_mul_pd(twelve, _mm256_sub_pd(_mm256_sub_pd(p[5], p[3]), d30)));            \
+        } else {                                                                                                     \
+            r[3] = r[4] = r[5] = _mm_setzero_ps();                                                                   \
+        }                                                                                                            \
+        SFB__SIMD_DC2(SFB__SIMD_DC_PD)                                                                               \
+        r[1] = _mm256_cvtpd_ps(_mm256_mul_pd(_mm256_set1_pd(4.0), _mm256_sub_pd(p[1], p[0])));                      \
+        r[2] = _mm256_cvtpd_ps(_mm256_mul_pd(_mm256_set1_pd(4.0), _mm256_sub_pd(p[2], p[0])));                      \
+        r[0] = _mm256_cvtpd_ps(_mm256_add_pd(_mm256_fmadd_pd(vt, p[2], _mm256_fmadd_pd(vs, p[1], _mm256_mul_pd(vw, p[0]))), \
+                                             _mm256_cvtps_pd(_mm_loadu_ps(blk + 60))));                              \
+    }
+#define SFB__SIMD_DC_PD(to, from, above) p[to] = _mm256_fmadd_pd(vt, p[above], _mm256_fmadd_pd(vs, p[(from) + 1], _mm256_mul_pd(vw, p[from])));
+SFB__SIMD_TRI_PD(sfb__simd_avx2_tri, SFB__SIMD_TARGET_AVX2)
+SFB__SIMD_TRI_PD(sfb__simd_avx512_tri, SFB__SIMD_TARGET_AVX512)
+#endif /* SFB__SIMD_X86_DISPATCH */
+
+#ifdef SFB__SIMD_NEON
+#if defined(__aarch64__)
+#define SFB__SIMD_TRI_NEON 1
+/* The quartic triangle kernel (see sfb__simd_tri_portable) in double, each point as two
+ * registers (xy, zw). (32-bit ARM, without double vectors, runs the portable one.) */
+static void sfb__simd_tri_neon(const float *blk, float s, float t, int second, float r[6][4]) {
+    const double sd = s, td = t;
+    const float64x2_t vs = vdupq_n_f64(sd), vt = vdupq_n_f64(td), vw = vdupq_n_f64((1.0 - sd) - td);
+    float64x2_t pl[15], ph[15];
+    int a;
+    for (a = 0; a < 15; ++a) {
+        const float32x4_t v = vld1q_f32(blk + 4 * a);
+        pl[a] = vcvt_f64_f32(vget_low_f32(v));
+        ph[a] = vcvt_high_f64_f32(v);
+    }
+#define SFB__SIMD_DC_NEON(to, from, above)                                        \
+    pl[to] = vfmaq_f64(vfmaq_f64(vmulq_f64(vw, pl[from]), vs, pl[(from) + 1]), vt, pl[above]); \
+    ph[to] = vfmaq_f64(vfmaq_f64(vmulq_f64(vw, ph[from]), vs, ph[(from) + 1]), vt, ph[above]);
+#define SFB__SIMD_ST2(dst, lo, hi) vst1q_f32(dst, vcvt_high_f32_f64(vcvt_f32_f64(lo), hi))
+    SFB__SIMD_DC4(SFB__SIMD_DC_NEON)
+    SFB__SIMD_DC3(SFB__SIMD_DC_NEON)
+    if (second) {
+#define SFB__SIMD_D2_NEON(x, y, z, w) vmulq_n_f64(vsubq_f64(vsubq_f64(x, y), vsubq_f64(z, w)), 12.0)
+        SFB__SIMD_ST2(r[3], SFB__SIMD_D2_NEON(pl[2], pl[1], pl[1], pl[0]), SFB__SIMD_D2_NEON(ph[2], ph[1], ph[1], ph[0]));
+        SFB__SIMD_ST2(r[4], SFB__SIMD_D2_NEON(pl[4], pl[3], pl[1], pl[0]), SFB__SIMD_D2_NEON(ph[4], ph[3], ph[1], ph[0]));
+        SFB__SIMD_ST2(r[5], SFB__SIMD_D2_NEON(pl[5], pl[3], pl[3], pl[0]), SFB__SIMD_D2_NEON(ph[5], ph[3], ph[3], ph[0]));
+#undef SFB__SIMD_D2_NEON
+    } else {
+        vst1q_f32(r[3], vdupq_n_f32(0.0f)); vst1q_f32(r[4], vdupq_n_f32(0.0f)); vst1q_f32(r[5], vdupq_n_f32(0.0f));
+    }
+    SFB__SIMD_DC2(SFB__SIMD_DC_NEON)
+    {
+        const float32x4_t o = vld1q_f32(blk + 60);
+        SFB__SIMD_ST2(r[1], vmulq_n_f64(vsubq_f64(pl[1], pl[0]), 4.0), vmulq_n_f64(vsubq_f64(ph[1], ph[0]), 4.0));
+        SFB__SIMD_ST2(r[2], vmulq_n_f64(vsubq_f64(pl[2], pl[0]), 4.0), vmulq_n_f64(vsubq_f64(ph[2], ph[0]), 4.0));
+        SFB__SIMD_ST2(r[0], vaddq_f64(vfmaq_f64(vfmaq_f64(vmulq_f64(vw, pl[0]), vs, pl[1]), vt, pl[2]), vcvt_f64_f32(vget_low_f32(o))),
+                      vaddq_f64(vfmaq_f64(vfmaq_f64(vmulq_f64(vw, ph[0]), vs, ph[1]), vt, ph[2]), vcvt_high_f64_f32(o)));
+    }
+#undef SFB__SIMD_DC_NEON
+#undef SFB__SIMD_ST2
+}
+#endif
+#endif /* SFB__SIMD_NEON */
+
+/* Packs a quartic Bezier triangle (15 double xyz points, the table's order) into g (64 floats):
+ * the points relative to their centroid o, then (o, E x SFB__SIMD_TRI_EFACTOR) as point 15
+ * (so E is at g[63], where the square windows of cs = 16 keep it too). Returns E. */
+static float sfb__simd_pack_tri(float *g, double (*q)[3]) {
+    double o[3] = {0.0, 0.0, 0.0};
+    float E = 0.0f;
+    int k, c;
+    for (k = 0; k < 15; ++k)
+        for (c = 0; c < 3; ++c) o[c] += q[k][c] / 15.0;
+    for (c = 0; c < 3; ++c) g[60 + c] = (float)o[c];
+    for (k = 0; k < 15; ++k) {
+        for (c = 0; c < 3; ++c) {
+            g[4 * k + c] = (float)(q[k][c] - (double)g[60 + c]);
+            if (fabsf(g[4 * k + c]) > E) E = fabsf(g[4 * k + c]);
+        }
+        g[4 * k + 3] = 0.0f;
+    }
+    g[63] = E * SFB__SIMD_TRI_EFACTOR;
+    return E;
+}
+
+/* The Stam-Loop triangles of patch p at g: for each level n = 1..SFB__SIMD_LOOP_LEVELS the
+ * three sub-patches k = 0, 1, 2 (64 floats each, as sfb__simd_pack_tri), control points
+ * Q[j] = sum_i (lambda_i^m phi_k[j][i] + m lambda_i^(m-1) phi_k[j][head_i]) c_i, m = n - 1 (the
+ * second term only for the second vector of a Jordan block). 0 where the sub-patches of a
+ * level do not agree on their shared edges (sub-patch 0's edge s = 0 is the middle's s = 0
+ * reversed, sub-patch 1's edge t = 0 the middle's t = 0 reversed): such a table is left to ref. */
+static int sfb__simd_pack_stam_loop(float *g, const sfb__patch_table *pt, int p) {
+    const sfb__eigen_loop *e = pt->eigl[pt->pvalence[p]];
+    const int K = e->K, *cv = pt->cv + pt->pfirst[p];
+    double q[3][15][3], scale = 0.0, diff = 0.0;
+    int n, k, i, jj, c;
+    for (n = 1; n <= SFB__SIMD_LOOP_LEVELS; ++n) {
+        const int m = n - 1;
+        for (k = 0; k < 3; ++k)
+            for (jj = 0; jj < 15; ++jj) {
+                const double *phi = e->phi + ((size_t)k * 15 + (size_t)jj) * (size_t)K;
+                for (c = 0; c < 3; ++c) q[k][jj][c] = 0.0;
+                for (i = 0; i < K; ++i) {
+                    const float *c_i = pt->point_data + 3 * (size_t)cv[i];
+                    double w = sfb__simd_ipow(e->lambda[i], m) * phi[i];
+                    if (e->head[i] >= 0 && e->head[i] < K && m > 0) w += m * sfb__simd_ipow(e->lambda[i], m - 1) * phi[e->head[i]];
+                    for (c = 0; c < 3; ++c) q[k][jj][c] += w * c_i[c];
+                }
+            }
+        for (jj = 0; jj < 5; ++jj) {
+            /* row index of (i, j): j (11 - j) / 2 + i */
+            const int e0 = jj * (11 - jj) / 2, e2 = (4 - jj) * (11 - (4 - jj)) / 2; /* (0, jj), (0, 4 - jj) */
+            for (c = 0; c < 3; ++c) {
+                diff = fmax(diff, fabs(q[0][e0][c] - q[2][e2][c]));
+                diff = fmax(diff, fabs(q[1][jj][c] - q[2][4 - jj][c]));
+            }
+        }
+        for (k = 0; k < 3; ++k) {
+            const float E = sfb__simd_pack_tri(g + (size_t)(n - 1) * 192 + (size_t)k * 64, q[k]);
+            if ((double)E > scale) scale = E;
+        }
+    }
+    return diff <= 1e-6 * scale;
+}
