@@ -1,4 +1,28 @@
-/* backends/sfb_simd.h -- the `simd` backend, kept at this path for readers and includers of
- * the old single file: its code is in backends/simd/ (sfb_simd.h: the runtime, then one file
- * per kernel family). Not a public header; surfblend.h compiles it under SURFBLEND_SIMD. */
+/* backends/sfb_simd.h -- the `simd` backend: the kernels vectorised (portable, SSE2, AVX2+FMA,
+ * AVX-512, NEON; chosen at init by CPU detection) over a small thread pool.
+ *
+ * Compiled by surfblend.h's implementation when SURFBLEND_SIMD (or SURFBLEND_ALL_BACKENDS) is
+ * defined next to SURFBLEND_IMPLEMENTATION; do not include it directly. It sees the core's
+ * private declarations (src/sfb_internal.h).
+ *
+ * The backend is cut by kernel family, one file each under backends/simd/, included here in
+ * order (backends/simd/sfb_simd.h says what each holds):
+ *   simd/sfb_simd.h   the runtime: ISA availability and detection, the thread pool, the vector
+ *                     operations every family is written on, the state, init/shutdown/describe
+ *   simd/stencils.h   eval_stencils
+ *   simd/patches.h    the polynomial patch families (simd/patches_quad.h, simd/patches_tri.h)
+ *   simd/manifold.h   MANIFOLD4 (seed 000)
+ *   simd/normals.h    finish_normals (seed 001)
+ *   simd/vtable.h     patch slots dispatched by the table's families; sfb__simd_bind
+ */
+#ifndef SFB__SIMD_BACKEND_H
+#define SFB__SIMD_BACKEND_H
+
 #include "simd/sfb_simd.h"
+#include "simd/stencils.h"
+#include "simd/patches.h"
+#include "simd/manifold.h"
+#include "simd/normals.h"
+#include "simd/vtable.h"
+
+#endif /* SFB__SIMD_BACKEND_H */

@@ -2,7 +2,7 @@
  * after the core, when SURFBLEND_SIMD / SURFBLEND_GL / SURFBLEND_OSMESA (or
  * SURFBLEND_ALL_BACKENDS) are defined with SURFBLEND_IMPLEMENTATION (see sfb_internal.h). */
 #ifdef SURFBLEND_SIMD
-#include "backends/simd/sfb_simd.h"
+#include "backends/sfb_simd.h"
 #endif
 #ifdef SURFBLEND_GL
 #include "backends/sfb_gl.h"

@@ -22,8 +22,9 @@
  *   normals.h    finish_normals
  *   vtable.h     upload/release/eval_patches dispatched by the families a table holds, and
  *                sfb__simd_bind: one line per family.
- * A new kernel family is a new file, its #include at the end of this one and its line in
- * vtable.h (sfb__simd_bind, or sfb__simd_patch_families for a patch family).
+ * backends/sfb_simd.h includes this runtime, then the family files in that order. A new kernel
+ * family is a new file, its #include there and its line in vtable.h (sfb__simd_bind, or
+ * sfb__simd_patch_families for a patch family).
  *
  * Kernels (one instruction set per backend state, chosen at init):
  *   portable  plain C, any compiler and CPU
@@ -809,11 +810,5 @@ static void sfb__simd_release_patches(void *state, void *handle) {
 /* Leaf code of a table entry (>= 0 node, -1 hole, <= -2 patch -(p+2)). */
 static int sfb__simd_leaf(const int *pcode, int v) { return v >= 0 ? v : v == -1 ? -(SFB__SIMD_LEAF_REF + 1) : pcode[-v - 2]; }
 
-/* ==== the kernel families ==== */
-#include "stencils.h"
-#include "patches.h"
-#include "manifold.h"
-#include "normals.h"
-#include "vtable.h"
 
 #endif /* SFB__SIMD_H */
