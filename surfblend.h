@@ -2799,34 +2799,36 @@ void sfb__eigen_cc_free(sfb_context *ctx, sfb__eigen_cc *e) {
     sfb__free(ctx, e);
 }
 
-/* Builds the eigen structure of valence N (3..SFB__STAM_MAX_VALENCE). keep: also keep V and A
- * (for tests). */
-sfb_result sfb__eigen_cc_build(sfb_context *ctx, int N, int keep, sfb__eigen_cc **out) {
-    sfb__eigen_cc *e;
-    int K = 2 * N + 8, col = 0, i, j, k, q;
-    double *A = NULL, *V = NULL, *W = NULL, *AV = NULL;
-    int *perm = NULL;
+/* V^-1 into vinv (V copied to the scratch W; perm holds K ints) and *err = max |A - V J V^-1|,
+ * J = diag(lambda) plus, where head (NULL: none) gives a Jordan head h for column k, a 1 at
+ * (h, k). Returns 0 when V is singular or the error is not at rounding level. */
+static int sfb__eigen_invert_check(int K, const double *A, const double *V, const double *lambda, const int *head, double *W,
+                                   int *perm, double *vinv, double *err_out) {
     size_t KK = (size_t)K * K;
-    *out = NULL;
-    if (N < 3 || N > SFB__STAM_MAX_VALENCE)
-        return sfb__error(ctx, SFB_LIMIT_EXCEEDED, SFB_ELEMENT_NONE, -1, "no Stam eigen structure for valence %d (3..%d)", N,
-                          SFB__STAM_MAX_VALENCE);
-    e = (sfb__eigen_cc *)sfb__calloc(ctx, 1, sizeof *e);
-    A = (double *)sfb__alloc(ctx, KK * sizeof(double));
-    V = (double *)sfb__calloc(ctx, KK, sizeof(double));
-    W = (double *)sfb__alloc(ctx, KK * sizeof(double));
-    AV = (double *)sfb__alloc(ctx, (size_t)9 * K * sizeof(double));
-    perm = (int *)sfb__alloc(ctx, (size_t)K * sizeof(int));
-    if (e) {
-        e->lambda = (double *)sfb__alloc(ctx, (size_t)K * sizeof(double));
-        e->vinv = (double *)sfb__alloc(ctx, KK * sizeof(double));
-        e->phi = (double *)sfb__alloc(ctx, (size_t)48 * K * sizeof(double));
-    }
-    if (!e || !A || !V || !W || !AV || !perm || !e->lambda || !e->vinv || !e->phi) goto oom;
-    e->N = N;
-    e->K = K;
-    sfb__stam_matrix(N, A);
-    /* right eigenvectors of S, column by column of V (row-major: V[r*K + col]) */
+    double err = 0.0;
+    int r, c, k;
+    memcpy(W, V, KK * sizeof(double));
+    if (!sfb__invert(K, W, vinv, perm)) return 0;
+    for (r = 0; r < K; ++r)
+        for (c = 0; c < K; ++c) {
+            double s = 0.0;
+            for (k = 0; k < K; ++k) {
+                double vj = V[(size_t)r * K + k] * lambda[k];
+                if (head && head[k] >= 0) vj += V[(size_t)r * K + head[k]];
+                s += vj * vinv[(size_t)k * K + c];
+            }
+            s -= A[(size_t)r * K + c];
+            if (fabs(s) > err) err = fabs(s);
+        }
+    *err_out = err;
+    return err < 1e-9;
+}
+
+/* The 2N+1 right eigenvectors of S (the ring points; frequency 0 as the 3x3 block on (V, e,
+ * f)) in the first rows of V's columns, their eigenvalues in lambda, the index of lambda = 1 in
+ * *dominant. Returns the number of columns made. */
+static int sfb__eigen_cc_ring(int N, const double *A, double *V, double *lambda, int *dominant) {
+    int K = 2 * N + 8, col = 0, i, j, q;
 #define SFB__SET(r, value) (V[(size_t)(r) * K + col] = (value))
     {
         /* j = 0: constant ring; 3x3 block on (V, e, f) */
@@ -2864,8 +2866,8 @@ sfb_result sfb__eigen_cc_build(sfb_context *ctx, int N, int keep, sfb__eigen_cc 
             }
             SFB__SET(0, x[0]);
             for (i = 1; i <= N; ++i) { SFB__SET(2 * i - 1, x[1]); SFB__SET(2 * i, x[2]); }
-            e->lambda[col] = lam[q];
-            if (q == 0) e->dominant = col;
+            lambda[col] = lam[q];
+            if (q == 0) *dominant = col;
             col++;
         }
     }
@@ -2885,7 +2887,7 @@ sfb_result sfb__eigen_cc_build(sfb_context *ctx, int N, int keep, sfb__eigen_cc 
                     SFB__SET(2 * i - 1, x0);
                     SFB__SET(2 * i, (x0 + x1) * d);
                 }
-                e->lambda[col++] = lams[q];
+                lambda[col++] = lams[q];
             }
         }
     }
@@ -2897,11 +2899,20 @@ sfb_result sfb__eigen_cc_build(sfb_context *ctx, int N, int keep, sfb__eigen_cc 
                 SFB__SET(2 * i - 1, q == 0 ? s : 0.0);
                 SFB__SET(2 * i, q == 1 ? s : 0.0);
             }
-            e->lambda[col++] = 0.25;
+            lambda[col++] = 0.25;
         }
     }
-    if (col != 2 * N + 1) goto defective;
-    /* extend each to A: (lambda I - S12) w = S11 u */
+#undef SFB__SET
+    return col;
+}
+
+/* Extends the `col` eigenvectors of S to A ((lambda I - S12) w = S11 u, in the outer rows of V)
+ * and appends [0; z] for the null vectors z of S12 - mu I. Returns the number of columns, -1
+ * when a system or a null space is not as expected. */
+static int sfb__eigen_cc_extend(int N, double *V, double *lambda, int col) {
+    static const double mus[4] = {0.125, 0.0625, 0.03125, 0.015625};
+    static const int mult[4] = {2, 2, 2, 1};
+    int K = 2 * N + 8, i, k, q;
     for (q = 0; q < col; ++q) {
         double M[49], M0[49], y[7], y0[7], w[7], res;
         for (i = 0; i < 7; ++i) {
@@ -2911,47 +2922,28 @@ sfb_result sfb__eigen_cc_build(sfb_context *ctx, int N, int keep, sfb__eigen_cc 
                 s += sfb__S11[i][k] / 64.0 * V[(size_t)src * K + q];
             }
             y[i] = y0[i] = s;
-            for (k = 0; k < 7; ++k) M[i * 7 + k] = M0[i * 7 + k] = (i == k ? e->lambda[q] : 0.0) - sfb__S12[i][k] / 64.0;
+            for (k = 0; k < 7; ++k) M[i * 7 + k] = M0[i * 7 + k] = (i == k ? lambda[q] : 0.0) - sfb__S12[i][k] / 64.0;
         }
         res = sfb__solve_full(7, M, y, w, M0, y0);
-        if (res > 1e-10) goto defective;
+        if (res > 1e-10) return -1;
         for (i = 0; i < 7; ++i) V[(size_t)(2 * N + 1 + i) * K + q] = w[i];
     }
-    {
-        static const double mus[4] = {0.125, 0.0625, 0.03125, 0.015625};
-        static const int mult[4] = {2, 2, 2, 1};
-        for (q = 0; q < 4; ++q) {
-            double z[2][7];
-            int got = sfb__s12_null(mus[q], z), f;
-            if (got != mult[q]) goto defective;
-            for (f = 0; f < got; ++f) {
-                for (i = 0; i < 7; ++i) V[(size_t)(2 * N + 1 + i) * K + col] = z[f][i];
-                e->lambda[col++] = mus[q];
-            }
+    for (q = 0; q < 4; ++q) {
+        double z[2][7];
+        int got = sfb__s12_null(mus[q], z), f;
+        if (got != mult[q]) return -1;
+        for (f = 0; f < got; ++f) {
+            for (i = 0; i < 7; ++i) V[(size_t)(2 * N + 1 + i) * K + col] = z[f][i];
+            lambda[col++] = mus[q];
         }
     }
-#undef SFB__SET
-    if (col != K) goto defective;
-    /* V^-1 */
-    memcpy(W, V, KK * sizeof(double));
-    if (!sfb__invert(K, W, e->vinv, perm)) goto defective;
-    /* check A = V L V^-1 */
-    {
-        double err = 0.0;
-        int r, c;
-        for (r = 0; r < K; ++r)
-            for (c = 0; c < K; ++c) {
-                double s = 0.0;
-                for (k = 0; k < K; ++k) s += V[(size_t)r * K + k] * e->lambda[k] * e->vinv[(size_t)k * K + c];
-                s -= A[(size_t)r * K + c];
-                if (fabs(s) > err) err = fabs(s);
-            }
-        e->error = err;
-        if (!(err < 1e-9)) goto defective;
-    }
-    e->sub = 0.0;
-    for (i = 0; i < K; ++i)
-        if (i != e->dominant && fabs(e->lambda[i]) > e->sub) e->sub = fabs(e->lambda[i]);
+    return col;
+}
+
+/* Phi_k = P_k Abar V (16 x K per sub-patch k = 1..3) into phi: the picked rows of Abar V, rows
+ * < K of it being rows of A V, rows K..K+8 [S21 0 S22] V (computed into the scratch AV, 9 x K). */
+static void sfb__eigen_cc_phi(int N, const double *A, const double *V, double *AV, double *phi) {
+    int K = 2 * N + 8, i, j, k, q;
     /* rows K..K+8 of Abar V: [S21 0 S22] V */
     for (i = 0; i < 9; ++i)
         for (q = 0; q < K; ++q) {
@@ -2966,7 +2958,7 @@ sfb_result sfb__eigen_cc_build(sfb_context *ctx, int N, int keep, sfb__eigen_cc 
     for (k = 1; k <= 3; ++k)
         for (j = 0; j < 16; ++j) {
             int p = sfb__stam_pick(N, k, j);
-            double *dst = e->phi + ((size_t)(k - 1) * 16 + j) * K;
+            double *dst = phi + ((size_t)(k - 1) * 16 + j) * K;
             for (q = 0; q < K; ++q) {
                 if (p < K) {
                     double s = 0.0;
@@ -2978,6 +2970,47 @@ sfb_result sfb__eigen_cc_build(sfb_context *ctx, int N, int keep, sfb__eigen_cc 
                 }
             }
         }
+}
+
+/* Builds the eigen structure of valence N (3..SFB__STAM_MAX_VALENCE). keep: also keep V and A
+ * (for tests). */
+sfb_result sfb__eigen_cc_build(sfb_context *ctx, int N, int keep, sfb__eigen_cc **out) {
+    sfb__eigen_cc *e;
+    int K = 2 * N + 8, col, i;
+    double *A = NULL, *V = NULL, *W = NULL, *AV = NULL;
+    int *perm = NULL;
+    size_t KK = (size_t)K * K;
+    *out = NULL;
+    if (N < 3 || N > SFB__STAM_MAX_VALENCE)
+        return sfb__error(ctx, SFB_LIMIT_EXCEEDED, SFB_ELEMENT_NONE, -1, "no Stam eigen structure for valence %d (3..%d)", N,
+                          SFB__STAM_MAX_VALENCE);
+    e = (sfb__eigen_cc *)sfb__calloc(ctx, 1, sizeof *e);
+    A = (double *)sfb__alloc(ctx, KK * sizeof(double));
+    V = (double *)sfb__calloc(ctx, KK, sizeof(double));
+    W = (double *)sfb__alloc(ctx, KK * sizeof(double));
+    AV = (double *)sfb__alloc(ctx, (size_t)9 * K * sizeof(double));
+    perm = (int *)sfb__alloc(ctx, (size_t)K * sizeof(int));
+    if (e) {
+        e->lambda = (double *)sfb__alloc(ctx, (size_t)K * sizeof(double));
+        e->vinv = (double *)sfb__alloc(ctx, KK * sizeof(double));
+        e->phi = (double *)sfb__alloc(ctx, (size_t)48 * K * sizeof(double));
+    }
+    if (!e || !A || !V || !W || !AV || !perm || !e->lambda || !e->vinv || !e->phi) goto oom;
+    e->N = N;
+    e->K = K;
+    sfb__stam_matrix(N, A);
+    /* right eigenvectors of S, column by column of V (row-major: V[r*K + col]) */
+    col = sfb__eigen_cc_ring(N, A, V, e->lambda, &e->dominant);
+    if (col != 2 * N + 1) goto defective;
+    /* extend each to A: (lambda I - S12) w = S11 u; then S12's own eigenvectors */
+    col = sfb__eigen_cc_extend(N, V, e->lambda, col);
+    if (col != K) goto defective;
+    /* V^-1, and the check A = V L V^-1 */
+    if (!sfb__eigen_invert_check(K, A, V, e->lambda, NULL, W, perm, e->vinv, &e->error)) goto defective;
+    e->sub = 0.0;
+    for (i = 0; i < K; ++i)
+        if (i != e->dominant && fabs(e->lambda[i]) > e->sub) e->sub = fabs(e->lambda[i]);
+    sfb__eigen_cc_phi(N, A, V, AV, e->phi);
     if (keep) { e->v = V; e->a = A; V = A = NULL; }
     sfb__free(ctx, A); sfb__free(ctx, V); sfb__free(ctx, W); sfb__free(ctx, AV); sfb__free(ctx, perm);
     *out = e;
@@ -3115,12 +3148,127 @@ static void sfb__loop_matrix(int N, double *A) {
 #undef SFB__A
 }
 
+/* S11's eigenvectors (outer order (1,1) (2,0) (2,-1) (0,2) (-1,2)) and eigenvalues */
+static const double sfb__loop_U[5][5] = {{1, 0, 0, 0, 0}, {1, 1, 0, 1, 0}, {0, 1, 0, 0, 0}, {1, 0, 1, 0, 1}, {0, 0, 1, 0, 0}};
+static const double sfb__loop_mu[5] = {0.125, 0.125, 0.125, 0.0625, 0.0625};
+
+/* S's eigenvectors in the first N+1 rows of V's columns, their eigenvalues in lambda, the
+ * index of lambda = 1 in *dominant and the eigenvalue of frequency 1 in *c1. Returns the
+ * number of columns made. */
+static int sfb__eigen_loop_ring(int N, double *V, double *lambda, int *dominant, double *c1) {
+    int K = N + 6, col = 0, i, j;
+#define SFB__SET(r, value) (V[(size_t)(r) * K + col] = (value))
+    {
+        double c = cos(2.0 * SFB__PI / N), alpha = 0.625 - (3.0 + 2.0 * c) * (3.0 + 2.0 * c) / 64.0;
+        for (i = 0; i <= N; ++i) SFB__SET(i, 1.0);
+        lambda[col] = 1.0;
+        *dominant = col++;
+        SFB__SET(0, -8.0 * alpha / 3.0);
+        for (i = 1; i <= N; ++i) SFB__SET(i, 1.0);
+        lambda[col++] = 0.625 - alpha;
+    }
+    for (j = 1; 2 * j < N; ++j) {
+        double t = 2.0 * SFB__PI * j / N;
+        int trig;
+        for (trig = 0; trig < 2; ++trig) {
+            SFB__SET(0, 0.0);
+            for (i = 0; i < N; ++i) SFB__SET(1 + i, trig ? sin(i * t) : cos(i * t));
+            lambda[col++] = 0.375 + 0.25 * cos(t);
+        }
+        if (j == 1) *c1 = 0.375 + 0.25 * cos(t);
+    }
+    if (N % 2 == 0) {
+        SFB__SET(0, 0.0);
+        for (i = 0; i < N; ++i) SFB__SET(1 + i, (i % 2) ? -1.0 : 1.0);
+        lambda[col++] = 0.125;
+    }
+#undef SFB__SET
+    return col;
+}
+
+/* Extends S's N+1 eigenvectors to A: (S11 - lambda) y = -S10 w, solved in S11's eigenbasis (Ui
+ * its inverse; outer_col the columns of S11's eigenvectors). Where A is defective the column
+ * becomes the partner of a Jordan head (head[q]). Returns 0 when it is defective more than
+ * once. */
+static int sfb__eigen_loop_extend(int N, const double *A, double *V, const double *Ui, const int *outer_col, double *lambda,
+                                  int *head) {
+    int K = N + 6, i, k, q, l, njordan = 0;
+    for (q = 0; q <= N; ++q) {
+        double rhs[5], d[5], yh[5], best = 0.0;
+        int lstar = -1;
+        for (i = 0; i < 5; ++i) {
+            double s = 0.0;
+            for (k = 0; k <= N; ++k) s += A[(size_t)(N + 1 + i) * K + k] * V[(size_t)k * K + q];
+            rhs[i] = s;
+        }
+        for (l = 0; l < 5; ++l) {
+            double s = 0.0;
+            for (i = 0; i < 5; ++i) s += Ui[l * 5 + i] * rhs[i];
+            d[l] = s;
+        }
+        for (l = 0; l < 5; ++l) {
+            if (fabs(lambda[q] - sfb__loop_mu[l]) > 1e-9) yh[l] = d[l] / (lambda[q] - sfb__loop_mu[l]);
+            else {
+                yh[l] = 0.0;
+                if (fabs(d[l]) > 1e-12 && fabs(d[l]) > best) { best = fabs(d[l]); lstar = l; }
+            }
+        }
+        for (i = 0; i < 5; ++i) {
+            double s = 0.0;
+            for (l = 0; l < 5; ++l) s += sfb__loop_U[i][l] * yh[l];
+            V[(size_t)(N + 1 + i) * K + q] = s;
+        }
+        if (lstar >= 0) {
+            /* defective: (A - lambda)[w; y] = sum over S11's lambda-eigenvectors of d_l [0; u_l].
+             * That sum replaces the column of u_lstar as the Jordan head; [w; y] is its partner. */
+            int h = outer_col[lstar];
+            if (++njordan > 1) return 0;
+            for (i = 0; i < 5; ++i) {
+                double s = 0.0;
+                for (l = 0; l < 5; ++l)
+                    if (fabs(lambda[q] - sfb__loop_mu[l]) <= 1e-9) s += d[l] * sfb__loop_U[i][l];
+                V[(size_t)(N + 1 + i) * K + h] = s;
+            }
+            lambda[q] = sfb__loop_mu[lstar];
+            head[q] = h;
+        }
+    }
+    return 1;
+}
+
+/* Phi_k into phi (15 x K per sub-patch k = 0..2): the Bezier points of the picked rows of
+ * Abar V. Returns 0 when a picked point is not in the enlarged set. */
+static int sfb__eigen_loop_phi(int N, const double *A, const double *V, double *phi) {
+    int K = N + 6, i, j, k, q;
+    for (k = 0; k < 3; ++k) {
+        static const int org[3][4] = {{1, 0, 1, 0}, {0, 1, 1, 0}, {1, 1, -1, 0}}; /* origin x, y; frame sign; unused */
+        int rows[12];
+        for (j = 0; j < 12; ++j) {
+            int x = org[k][0] + org[k][2] * sfb__box12[j][0], y = org[k][1] + org[k][2] * sfb__box12[j][1];
+            rows[j] = sfb__loop_index(N, x, y);
+            if (rows[j] < 0) return 0;
+        }
+        for (q = 0; q < K; ++q) {
+            double av[12];
+            for (j = 0; j < 12; ++j) {
+                double s = 0.0;
+                int c;
+                for (c = 0; c < K; ++c) s += A[(size_t)rows[j] * K + c] * V[(size_t)c * K + q];
+                av[j] = s;
+            }
+            for (j = 0; j < 15; ++j) {
+                double s = 0.0;
+                for (i = 0; i < 12; ++i) s += sfb__bez15_from_box[j][i] * av[i];
+                phi[((size_t)k * 15 + j) * K + q] = s / 24.0;
+            }
+        }
+    }
+    return 1;
+}
+
 sfb_result sfb__eigen_loop_build(sfb_context *ctx, int N, int keep, sfb__eigen_loop **out) {
-    /* S11's eigenvectors (outer order (1,1) (2,0) (2,-1) (0,2) (-1,2)) and eigenvalues */
-    static const double U[5][5] = {{1, 0, 0, 0, 0}, {1, 1, 0, 1, 0}, {0, 1, 0, 0, 0}, {1, 0, 1, 0, 1}, {0, 0, 1, 0, 0}};
-    static const double mu[5] = {0.125, 0.125, 0.125, 0.0625, 0.0625};
     sfb__eigen_loop *e;
-    int K = N + 6, col = 0, i, j, k, q, l, njordan = 0;
+    int K = N + 6, col, i, l;
     double *A = NULL, *V = NULL, *W = NULL;
     double Ui[25], Uw[25];
     int *perm = NULL, outer_col[5];
@@ -3146,129 +3294,24 @@ sfb_result sfb__eigen_loop_build(sfb_context *ctx, int N, int keep, sfb__eigen_l
     e->K = K;
     for (i = 0; i < K; ++i) e->head[i] = -1;
     sfb__loop_matrix(N, A);
-    for (i = 0; i < 25; ++i) Uw[i] = U[i / 5][i % 5];
+    for (i = 0; i < 25; ++i) Uw[i] = sfb__loop_U[i / 5][i % 5];
     if (!sfb__invert(5, Uw, Ui, perm)) goto defective;
     /* S's eigenvectors in the first N+1 rows of V */
-#define SFB__SET(r, value) (V[(size_t)(r) * K + col] = (value))
-    {
-        double c = cos(2.0 * SFB__PI / N), alpha = 0.625 - (3.0 + 2.0 * c) * (3.0 + 2.0 * c) / 64.0;
-        for (i = 0; i <= N; ++i) SFB__SET(i, 1.0);
-        e->lambda[col] = 1.0;
-        e->dominant = col++;
-        SFB__SET(0, -8.0 * alpha / 3.0);
-        for (i = 1; i <= N; ++i) SFB__SET(i, 1.0);
-        e->lambda[col++] = 0.625 - alpha;
-    }
-    for (j = 1; 2 * j < N; ++j) {
-        double t = 2.0 * SFB__PI * j / N;
-        int trig;
-        for (trig = 0; trig < 2; ++trig) {
-            SFB__SET(0, 0.0);
-            for (i = 0; i < N; ++i) SFB__SET(1 + i, trig ? sin(i * t) : cos(i * t));
-            e->lambda[col++] = 0.375 + 0.25 * cos(t);
-        }
-        if (j == 1) c1 = 0.375 + 0.25 * cos(t);
-    }
-    if (N % 2 == 0) {
-        SFB__SET(0, 0.0);
-        for (i = 0; i < N; ++i) SFB__SET(1 + i, (i % 2) ? -1.0 : 1.0);
-        e->lambda[col++] = 0.125;
-    }
-#undef SFB__SET
+    col = sfb__eigen_loop_ring(N, V, e->lambda, &e->dominant, &c1);
     if (col != N + 1) goto defective;
     /* S11's eigenvectors [0; u_l] */
     for (l = 0; l < 5; ++l) {
-        for (i = 0; i < 5; ++i) V[(size_t)(N + 1 + i) * K + col] = U[i][l];
-        e->lambda[col] = mu[l];
+        for (i = 0; i < 5; ++i) V[(size_t)(N + 1 + i) * K + col] = sfb__loop_U[i][l];
+        e->lambda[col] = sfb__loop_mu[l];
         outer_col[l] = col++;
     }
     /* extend S's eigenvectors: (S11 - lambda) y = -S10 w, in S11's eigenbasis */
-    for (q = 0; q <= N; ++q) {
-        double rhs[5], d[5], yh[5], best = 0.0;
-        int lstar = -1;
-        for (i = 0; i < 5; ++i) {
-            double s = 0.0;
-            for (k = 0; k <= N; ++k) s += A[(size_t)(N + 1 + i) * K + k] * V[(size_t)k * K + q];
-            rhs[i] = s;
-        }
-        for (l = 0; l < 5; ++l) {
-            double s = 0.0;
-            for (i = 0; i < 5; ++i) s += Ui[l * 5 + i] * rhs[i];
-            d[l] = s;
-        }
-        for (l = 0; l < 5; ++l) {
-            if (fabs(e->lambda[q] - mu[l]) > 1e-9) yh[l] = d[l] / (e->lambda[q] - mu[l]);
-            else {
-                yh[l] = 0.0;
-                if (fabs(d[l]) > 1e-12 && fabs(d[l]) > best) { best = fabs(d[l]); lstar = l; }
-            }
-        }
-        for (i = 0; i < 5; ++i) {
-            double s = 0.0;
-            for (l = 0; l < 5; ++l) s += U[i][l] * yh[l];
-            V[(size_t)(N + 1 + i) * K + q] = s;
-        }
-        if (lstar >= 0) {
-            /* defective: (A - lambda)[w; y] = sum over S11's lambda-eigenvectors of d_l [0; u_l].
-             * That sum replaces the column of u_lstar as the Jordan head; [w; y] is its partner. */
-            int h = outer_col[lstar];
-            if (++njordan > 1) goto defective;
-            for (i = 0; i < 5; ++i) {
-                double s = 0.0;
-                for (l = 0; l < 5; ++l)
-                    if (fabs(e->lambda[q] - mu[l]) <= 1e-9) s += d[l] * U[i][l];
-                V[(size_t)(N + 1 + i) * K + h] = s;
-            }
-            e->lambda[q] = mu[lstar];
-            e->head[q] = h;
-        }
-    }
-    /* V^-1 */
-    memcpy(W, V, KK * sizeof(double));
-    if (!sfb__invert(K, W, e->vinv, perm)) goto defective;
-    /* check A = V J V^-1 */
-    {
-        double err = 0.0;
-        int r, c;
-        for (r = 0; r < K; ++r)
-            for (c = 0; c < K; ++c) {
-                double s = 0.0;
-                for (k = 0; k < K; ++k) {
-                    double vj = V[(size_t)r * K + k] * e->lambda[k];
-                    if (e->head[k] >= 0) vj += V[(size_t)r * K + e->head[k]];
-                    s += vj * e->vinv[(size_t)k * K + c];
-                }
-                s -= A[(size_t)r * K + c];
-                if (fabs(s) > err) err = fabs(s);
-            }
-        e->error = err;
-        if (!(err < 1e-9)) goto defective;
-    }
+    if (!sfb__eigen_loop_extend(N, A, V, Ui, outer_col, e->lambda, e->head)) goto defective;
+    /* V^-1, and the check A = V J V^-1 */
+    if (!sfb__eigen_invert_check(K, A, V, e->lambda, e->head, W, perm, e->vinv, &e->error)) goto defective;
     e->sub = c1;
     /* Phi_k: Bezier points of the picked rows of Abar V */
-    for (k = 0; k < 3; ++k) {
-        static const int org[3][4] = {{1, 0, 1, 0}, {0, 1, 1, 0}, {1, 1, -1, 0}}; /* origin x, y; frame sign; unused */
-        int rows[12];
-        for (j = 0; j < 12; ++j) {
-            int x = org[k][0] + org[k][2] * sfb__box12[j][0], y = org[k][1] + org[k][2] * sfb__box12[j][1];
-            rows[j] = sfb__loop_index(N, x, y);
-            if (rows[j] < 0) goto defective;
-        }
-        for (q = 0; q < K; ++q) {
-            double av[12];
-            for (j = 0; j < 12; ++j) {
-                double s = 0.0;
-                int c;
-                for (c = 0; c < K; ++c) s += A[(size_t)rows[j] * K + c] * V[(size_t)c * K + q];
-                av[j] = s;
-            }
-            for (j = 0; j < 15; ++j) {
-                double s = 0.0;
-                for (i = 0; i < 12; ++i) s += sfb__bez15_from_box[j][i] * av[i];
-                e->phi[((size_t)k * 15 + j) * K + q] = s / 24.0;
-            }
-        }
-    }
+    if (!sfb__eigen_loop_phi(N, A, V, e->phi)) goto defective;
     if (keep) { e->v = V; e->a = A; V = A = NULL; }
     sfb__free(ctx, A); sfb__free(ctx, V); sfb__free(ctx, W); sfb__free(ctx, perm);
     *out = e;
@@ -5045,56 +5088,53 @@ static unsigned sfb__mf_corner_code(const sfb__level *l, const unsigned char *ki
     return SFB__MF_CODE(SFB__MF_PATCH, k, h, 0, 0);
 }
 
-sfb_result sfb__manifold_build(sfb_context *ctx, const sfb__level *base, int weights, const float *positions, sfb__patch_table *pt) {
-    sfb__level work, lev1, *L = NULL;
-    sfb__stencils T;
-    double *P = NULL, **pinv = NULL;
-    unsigned char *kind = NULL;
-    int *ev1 = NULL, *ev2 = NULL;
-    int quads = 1, f, v, i, j, c, refined = 0, nptex = 0, npatch = 0, nnodes = 0;
-    sfb_result r = SFB_SUCCESS;
-    memset(pt, 0, sizeof *pt);
-    memset(&work, 0, sizeof work); memset(&lev1, 0, sizeof lev1); memset(&T, 0, sizeof T);
-    if (weights != SFB_MANIFOLD_WEIGHTS_HERMITE && weights != SFB_MANIFOLD_WEIGHTS_CINF)
-        return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, -1, "manifold weights %d are not SFB_MANIFOLD_WEIGHTS_HERMITE or _CINF", weights);
-    pt->domain = SFB__DOMAIN_QUAD;
-    pt->mf_weights = weights;
+/* The manifold mesh L and its positions P (double, xyz): the base itself when every face is a
+ * quad, else one Catmull-Clark step of it into work/lev1/T with sharp edges and vertices
+ * carried as infinitely sharp (*refined = 1). */
+static sfb_result sfb__mf_manifold_mesh(sfb_context *ctx, const sfb__level *base, const float *positions, sfb__level *work,
+                                        sfb__level *lev1, sfb__stencils *T, const sfb__level **L_out, double **P_out, int *refined) {
+    const sfb__level *L;
+    double *P;
+    sfb_result r;
+    int quads = 1, f, v, i, c;
     for (f = 0; f < base->nf; ++f) if (base->fv_off[f + 1] - base->fv_off[f] != 4) quads = 0;
     if (quads) {
-        L = (sfb__level *)base;
-        P = (double *)sfb__alloc(ctx, ((size_t)base->nv + 1) * 3 * sizeof(double));
-        if (!P) goto oom;
+        *L_out = base;
+        P = *P_out = (double *)sfb__alloc(ctx, ((size_t)base->nv + 1) * 3 * sizeof(double));
+        if (!P) return sfb__oom(ctx, "manifold patch table");
         for (i = 0; i < 3 * base->nv; ++i) P[i] = positions[i];
     } else {
         /* one Catmull-Clark step, sharp edges and vertices carried as infinitely sharp */
         sfb__refine_options o;
         int e;
-        refined = 1;
-        if ((r = sfb__level_prepare(ctx, base, 0, 0, &work)) != SFB_SUCCESS) goto done;
-        for (e = 0; e < work.ne; ++e) if (work.es[e] > 0.0f) work.es[e] = SFB_SHARPNESS_INFINITE;
-        for (v = 0; v < work.nv; ++v) if (work.vs[v] > 0.0f) work.vs[v] = SFB_SHARPNESS_INFINITE;
-        sfb__level_compute_rules(&work);
+        *refined = 1;
+        if ((r = sfb__level_prepare(ctx, base, 0, 0, work)) != SFB_SUCCESS) return r;
+        for (e = 0; e < work->ne; ++e) if (work->es[e] > 0.0f) work->es[e] = SFB_SHARPNESS_INFINITE;
+        for (v = 0; v < work->nv; ++v) if (work->vs[v] > 0.0f) work->vs[v] = SFB_SHARPNESS_INFINITE;
+        sfb__level_compute_rules(work);
         memset(&o, 0, sizeof o);
         o.scheme = SFB_SCHEME_CATMARK;
-        if ((r = sfb__refine(ctx, &work, &o, 1, &lev1, &T, NULL, 0.0f, 0.5f)) != SFB_SUCCESS) goto done;
-        L = &lev1;
-        P = (double *)sfb__calloc(ctx, ((size_t)L->nv + 1) * 3, sizeof(double));
-        if (!P) goto oom;
-        for (v = 0; v < T.rows; ++v)
-            for (i = 0; i < T.sizes[v]; ++i) {
-                int src = T.indices[T.offsets[v] + i];
-                double w = T.weights[T.offsets[v] + i];
+        if ((r = sfb__refine(ctx, work, &o, 1, lev1, T, NULL, 0.0f, 0.5f)) != SFB_SUCCESS) return r;
+        L = *L_out = lev1;
+        P = *P_out = (double *)sfb__calloc(ctx, ((size_t)L->nv + 1) * 3, sizeof(double));
+        if (!P) return sfb__oom(ctx, "manifold patch table");
+        for (v = 0; v < T->rows; ++v)
+            for (i = 0; i < T->sizes[v]; ++i) {
+                int src = T->indices[T->offsets[v] + i];
+                double w = T->weights[T->offsets[v] + i];
                 for (c = 0; c < 3; ++c) P[3 * (size_t)v + c] += w * positions[3 * (size_t)src + c];
             }
     }
-    /* local geometries */
-    kind = (unsigned char *)sfb__alloc(ctx, (size_t)L->nv + 1);
-    ev1 = (int *)sfb__alloc(ctx, ((size_t)L->nv + 1) * sizeof(int));
-    ev2 = (int *)sfb__alloc(ctx, ((size_t)L->nv + 1) * sizeof(int));
-    pt->point_data = (float *)sfb__calloc(ctx, (size_t)L->nv * 27 + 1, sizeof(float));
-    pinv = (double **)sfb__calloc(ctx, SFB_MAX_VALENCE + 1, sizeof(double *));
-    if (!kind || !ev1 || !ev2 || !pt->point_data || !pinv) goto oom;
-    pt->npoints = 9 * L->nv;
+    return SFB_SUCCESS;
+}
+
+/* The local geometry of every vertex of L into pt->point_data (nine xyz rows each: a point, a
+ * crease curve or the fitted bi-quadratic patch), its kind and sharp edges into kind/ev1/ev2;
+ * pinv caches the pseudo-inverse of each valence. */
+static sfb_result sfb__mf_local_geometry(sfb_context *ctx, const sfb__level *L, const double *P, unsigned char *kind, int *ev1,
+                                         int *ev2, double **pinv, sfb__patch_table *pt) {
+    sfb_result r;
+    int v, i, c;
     for (v = 0; v < L->nv; ++v) {
         float *C = pt->point_data + 27 * (size_t)v;
         int k = L->vf_off[v + 1] - L->vf_off[v], e0 = L->ve_off[v];
@@ -5111,7 +5151,7 @@ sfb_result sfb__manifold_build(sfb_context *ctx, const sfb__level *base, int wei
             const double *M;
             int q;
             if (k > SFB_MAX_VALENCE) { kind[v] = SFB__MF_POINT; continue; }
-            if (!pinv[k] && (r = sfb__mf_pinv(ctx, k, &pinv[k])) != SFB_SUCCESS) goto done;
+            if (!pinv[k] && (r = sfb__mf_pinv(ctx, k, &pinv[k])) != SFB_SUCCESS) return r;
             M = pinv[k];
             for (q = 1; q < 9; ++q) {
                 double acc[3] = {0.0, 0.0, 0.0};
@@ -5124,9 +5164,15 @@ sfb_result sfb__manifold_build(sfb_context *ctx, const sfb__level *base, int wei
             }
         }
     }
-    /* param faces and patches */
+    return SFB_SUCCESS;
+}
+
+/* Counts the param faces, patches and quadtree nodes of the base faces and allocates the
+ * patch table's arrays for them. */
+static sfb_result sfb__mf_alloc_patches(sfb_context *ctx, const sfb__level *base, int refined, sfb__patch_table *pt) {
+    int f, nptex = 0, npatch = 0, nnodes = 0;
     pt->face_ptex = (int *)sfb__alloc(ctx, ((size_t)base->nf + 1) * sizeof(int));
-    if (!pt->face_ptex) goto oom;
+    if (!pt->face_ptex) return sfb__oom(ctx, "manifold patch table");
     for (f = 0; f < base->nf; ++f) {
         int n = base->fv_off[f + 1] - base->fv_off[f];
         pt->face_ptex[f] = nptex;
@@ -5148,57 +5194,89 @@ sfb_result sfb__manifold_build(sfb_context *ctx, const sfb__level *base, int wei
     pt->pcorner = (unsigned *)sfb__alloc(ctx, ((size_t)npatch + 1) * 4 * sizeof(unsigned));
     if (!pt->ptex_face || !pt->ptex_corner || !pt->ptex_root || !pt->nodes || !pt->ptype || !pt->pfirst || !pt->pparam || !pt->pvalence ||
         !pt->cv || !pt->pcorner)
-        goto oom;
-    {
-        int p = 0, node = 0;
-        for (f = 0; f < base->nf; ++f) {
-            int n = base->fv_off[f + 1] - base->fv_off[f], k0 = pt->face_ptex[f];
-            for (i = 0; i < (n == 4 ? 1 : n); ++i) {
-                pt->ptex_face[k0 + i] = f;
-                pt->ptex_corner[k0 + i] = n == 4 ? -1 : i;
-                pt->ptex_root[k0 + i] = -1;
-            }
-            if (base->fhole[f]) continue;
-            if (!refined) {
-                pt->ptex_root[k0] = -(p + 2);
-                pt->pparam[p] = SFB__PARAM(0, 0, 0, 0);
-                for (j = 0; j < 4; ++j) {
-                    pt->cv[4 * p + j] = L->fv[L->fv_off[f] + j];
-                    pt->pcorner[4 * p + j] = sfb__mf_corner_code(L, kind, ev1, ev2, f, j);
-                }
-                pt->ptype[p] = SFB__PATCH_MANIFOLD4; pt->pfirst[p] = 4 * p;
-                p++;
-                continue;
-            }
-            /* child quad i of base face f is refined face fv_off[f] + i, its slot 0 at the
-             * corner v_i (v_i, mid(v_i,v_i+1), centroid, mid(v_i-1,v_i)) */
-            if (n == 4) pt->ptex_root[k0] = node;
-            for (i = 0; i < n; ++i) {
-                int g = base->fv_off[f] + i, s0 = n == 4 ? (4 - i) % 4 : 0;
-                static const int qx[4] = {0, 1, 1, 0}, qy[4] = {0, 0, 1, 1};
-                if (n == 4) {
-                    pt->nodes[4 * node + qx[i] + 2 * qy[i]] = -(p + 2);
-                    pt->pparam[p] = SFB__PARAM(1, qx[i], qy[i], 0);
-                } else {
-                    pt->ptex_root[k0 + i] = -(p + 2);
-                    pt->pparam[p] = SFB__PARAM(0, 0, 0, 0);
-                }
-                for (j = 0; j < 4; ++j) {
-                    int slot = (s0 + j) % 4;
-                    pt->cv[4 * p + j] = L->fv[L->fv_off[g] + slot];
-                    pt->pcorner[4 * p + j] = sfb__mf_corner_code(L, kind, ev1, ev2, g, slot);
-                }
-                pt->ptype[p] = SFB__PATCH_MANIFOLD4; pt->pfirst[p] = 4 * p;
-                p++;
-            }
-            if (n == 4) node++;
+        return sfb__oom(ctx, "manifold patch table");
+    return SFB_SUCCESS;
+}
+
+/* Fills the param faces, quadtree nodes and MANIFOLD4 patches (control vertices and corner
+ * codes) of every base face: one patch per quad, or one per child quad when L is refined. */
+static void sfb__mf_fill_patches(const sfb__level *base, const sfb__level *L, int refined, const unsigned char *kind, const int *ev1,
+                                 const int *ev2, sfb__patch_table *pt) {
+    int p = 0, node = 0, f, i, j, npatch = pt->npatch;
+    for (f = 0; f < base->nf; ++f) {
+        int n = base->fv_off[f + 1] - base->fv_off[f], k0 = pt->face_ptex[f];
+        for (i = 0; i < (n == 4 ? 1 : n); ++i) {
+            pt->ptex_face[k0 + i] = f;
+            pt->ptex_corner[k0 + i] = n == 4 ? -1 : i;
+            pt->ptex_root[k0 + i] = -1;
         }
-        pt->pfirst[npatch] = 4 * npatch;
+        if (base->fhole[f]) continue;
+        if (!refined) {
+            pt->ptex_root[k0] = -(p + 2);
+            pt->pparam[p] = SFB__PARAM(0, 0, 0, 0);
+            for (j = 0; j < 4; ++j) {
+                pt->cv[4 * p + j] = L->fv[L->fv_off[f] + j];
+                pt->pcorner[4 * p + j] = sfb__mf_corner_code(L, kind, ev1, ev2, f, j);
+            }
+            pt->ptype[p] = SFB__PATCH_MANIFOLD4; pt->pfirst[p] = 4 * p;
+            p++;
+            continue;
+        }
+        /* child quad i of base face f is refined face fv_off[f] + i, its slot 0 at the
+         * corner v_i (v_i, mid(v_i,v_i+1), centroid, mid(v_i-1,v_i)) */
+        if (n == 4) pt->ptex_root[k0] = node;
+        for (i = 0; i < n; ++i) {
+            int g = base->fv_off[f] + i, s0 = n == 4 ? (4 - i) % 4 : 0;
+            static const int qx[4] = {0, 1, 1, 0}, qy[4] = {0, 0, 1, 1};
+            if (n == 4) {
+                pt->nodes[4 * node + qx[i] + 2 * qy[i]] = -(p + 2);
+                pt->pparam[p] = SFB__PARAM(1, qx[i], qy[i], 0);
+            } else {
+                pt->ptex_root[k0 + i] = -(p + 2);
+                pt->pparam[p] = SFB__PARAM(0, 0, 0, 0);
+            }
+            for (j = 0; j < 4; ++j) {
+                int slot = (s0 + j) % 4;
+                pt->cv[4 * p + j] = L->fv[L->fv_off[g] + slot];
+                pt->pcorner[4 * p + j] = sfb__mf_corner_code(L, kind, ev1, ev2, g, slot);
+            }
+            pt->ptype[p] = SFB__PATCH_MANIFOLD4; pt->pfirst[p] = 4 * p;
+            p++;
+        }
+        if (n == 4) node++;
     }
-    pt->counts[SFB__PATCH_MANIFOLD4] = npatch;
-    goto done;
-oom:
-    r = sfb__oom(ctx, "manifold patch table");
+    pt->pfirst[npatch] = 4 * npatch;
+}
+
+sfb_result sfb__manifold_build(sfb_context *ctx, const sfb__level *base, int weights, const float *positions, sfb__patch_table *pt) {
+    sfb__level work, lev1;
+    const sfb__level *L = NULL;
+    sfb__stencils T;
+    double *P = NULL, **pinv = NULL;
+    unsigned char *kind = NULL;
+    int *ev1 = NULL, *ev2 = NULL;
+    int i, refined = 0;
+    sfb_result r = SFB_SUCCESS;
+    memset(pt, 0, sizeof *pt);
+    memset(&work, 0, sizeof work); memset(&lev1, 0, sizeof lev1); memset(&T, 0, sizeof T);
+    if (weights != SFB_MANIFOLD_WEIGHTS_HERMITE && weights != SFB_MANIFOLD_WEIGHTS_CINF)
+        return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, -1, "manifold weights %d are not SFB_MANIFOLD_WEIGHTS_HERMITE or _CINF", weights);
+    pt->domain = SFB__DOMAIN_QUAD;
+    pt->mf_weights = weights;
+    if ((r = sfb__mf_manifold_mesh(ctx, base, positions, &work, &lev1, &T, &L, &P, &refined)) != SFB_SUCCESS) goto done;
+    /* local geometries */
+    kind = (unsigned char *)sfb__alloc(ctx, (size_t)L->nv + 1);
+    ev1 = (int *)sfb__alloc(ctx, ((size_t)L->nv + 1) * sizeof(int));
+    ev2 = (int *)sfb__alloc(ctx, ((size_t)L->nv + 1) * sizeof(int));
+    pt->point_data = (float *)sfb__calloc(ctx, (size_t)L->nv * 27 + 1, sizeof(float));
+    pinv = (double **)sfb__calloc(ctx, SFB_MAX_VALENCE + 1, sizeof(double *));
+    if (!kind || !ev1 || !ev2 || !pt->point_data || !pinv) { r = sfb__oom(ctx, "manifold patch table"); goto done; }
+    pt->npoints = 9 * L->nv;
+    if ((r = sfb__mf_local_geometry(ctx, L, P, kind, ev1, ev2, pinv, pt)) != SFB_SUCCESS) goto done;
+    /* param faces and patches */
+    if ((r = sfb__mf_alloc_patches(ctx, base, refined, pt)) != SFB_SUCCESS) goto done;
+    sfb__mf_fill_patches(base, L, refined, kind, ev1, ev2, pt);
+    pt->counts[SFB__PATCH_MANIFOLD4] = pt->npatch;
 done:
     if (pinv) { for (i = 0; i <= SFB_MAX_VALENCE; ++i) sfb__free(ctx, pinv[i]); sfb__free(ctx, pinv); }
     sfb__free(ctx, kind); sfb__free(ctx, ev1); sfb__free(ctx, ev2); sfb__free(ctx, P);
@@ -6180,18 +6258,9 @@ static sfb_result sfb__trim_emit(sfb__tess *T, sfb_tess_data *out, float p0, flo
     return SFB_SUCCESS;
 }
 
-SFB_API sfb_result sfb_surface_tessellate(const sfb_surface *s, const sfb_tess_config *cfg, sfb_tess_data *out) {
-    sfb_context *ctx;
-    sfb__tess T;
-    const sfb__level *l;
-    sfb_result r = SFB_SUCCESS;
-    int pf, f, e, i, k, nptex;
-    size_t v, done_v, nv;
-    float p_emit, p_eval;
-    if (out) memset(out, 0, sizeof *out);
-    if (!s) return SFB_INVALID_ARGS;
-    ctx = s->ctx;
-    if (!cfg || !out) return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "sfb_surface_tessellate: NULL argument");
+/* Refuses a surface without a patch table and a rate, tolerance, flag set or trimming mask
+ * out of range, before any allocation. */
+static sfb_result sfb__tess_check(sfb_context *ctx, const sfb_surface *s, const sfb_tess_config *cfg) {
     if (!s->has_patches || s->pbase.nf != s->base_face_count || !s->pbase.fe)
         return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1,
                           "sfb_surface_tessellate: the surface has no patch table (create it with SFB_REFINE_PATCHES)");
@@ -6220,44 +6289,188 @@ SFB_API sfb_result sfb_surface_tessellate(const sfb_surface *s, const sfb_tess_c
                               "trimming mask: %d x %d texels do not split into %d x %d equal tiles", m->width, m->height, m->tiles_u,
                               m->tiles_v);
     }
-    if ((r = sfb__progress(ctx, 0.0f, "tessellate")) != SFB_SUCCESS) return r;
+    return SFB_SUCCESS;
+}
 
-    memset(&T, 0, sizeof T);
-    T.ctx = ctx;
-    T.s = s;
-    T.l = l = &s->pbase;
-    T.pt = &s->patches;
-    T.rate = cfg->rate;
-    T.split = (cfg->flags & SFB_TESS_SPLIT_CREASES) != 0;
-    T.loop = T.pt->domain == SFB__DOMAIN_TRI;
-    nptex = T.pt->nptex;
-    T.prate = (int *)sfb__tess_array(ctx, (size_t)nptex, sizeof(int));
-    T.sseg = (int *)sfb__tess_array(ctx, (size_t)nptex, sizeof(int));
-    T.vspoke = (int *)sfb__tess_array(ctx, (size_t)nptex, sizeof(int));
-    T.ifirst = (int *)sfb__tess_array(ctx, (size_t)nptex, sizeof(int));
-    T.eseg = (int *)sfb__tess_array(ctx, (size_t)l->ne, sizeof(int));
-    T.engon = (unsigned char *)sfb__tess_array(ctx, (size_t)l->ne, 1);
-    T.vedge = (int *)sfb__tess_array(ctx, (size_t)l->nfv, sizeof(int));
-    T.vcenter = (int *)sfb__tess_array(ctx, (size_t)l->nf, sizeof(int));
-    T.vcorner = (int *)sfb__tess_array(ctx, (size_t)(T.split ? l->nfv : l->nv), sizeof(int));
-    T.bids = (int *)sfb__tess_array(ctx, (size_t)6 * (SFB__TESS_MAX_SEG + 1), sizeof(int));
-    if (T.split) {
-        T.uf = (int *)sfb__tess_array(ctx, (size_t)l->nfv, sizeof(int));
-        T.ecopy = (int *)sfb__tess_array(ctx, (size_t)l->nfv, sizeof(int));
+/* Zeroes T and sets it up for s and cfg: the work arrays, the uniform rate on every live param
+ * face, no vertex ids yet. On failure T holds what was allocated (sfb__tess_free_work). */
+static sfb_result sfb__tess_init(sfb__tess *T, const sfb_surface *s, const sfb_tess_config *cfg) {
+    sfb_context *ctx = s->ctx;
+    const sfb__level *l;
+    int pf, f, i, nptex;
+    memset(T, 0, sizeof *T);
+    T->ctx = ctx;
+    T->s = s;
+    T->l = l = &s->pbase;
+    T->pt = &s->patches;
+    T->rate = cfg->rate;
+    T->split = (cfg->flags & SFB_TESS_SPLIT_CREASES) != 0;
+    T->loop = T->pt->domain == SFB__DOMAIN_TRI;
+    nptex = T->pt->nptex;
+    T->prate = (int *)sfb__tess_array(ctx, (size_t)nptex, sizeof(int));
+    T->sseg = (int *)sfb__tess_array(ctx, (size_t)nptex, sizeof(int));
+    T->vspoke = (int *)sfb__tess_array(ctx, (size_t)nptex, sizeof(int));
+    T->ifirst = (int *)sfb__tess_array(ctx, (size_t)nptex, sizeof(int));
+    T->eseg = (int *)sfb__tess_array(ctx, (size_t)l->ne, sizeof(int));
+    T->engon = (unsigned char *)sfb__tess_array(ctx, (size_t)l->ne, 1);
+    T->vedge = (int *)sfb__tess_array(ctx, (size_t)l->nfv, sizeof(int));
+    T->vcenter = (int *)sfb__tess_array(ctx, (size_t)l->nf, sizeof(int));
+    T->vcorner = (int *)sfb__tess_array(ctx, (size_t)(T->split ? l->nfv : l->nv), sizeof(int));
+    T->bids = (int *)sfb__tess_array(ctx, (size_t)6 * (SFB__TESS_MAX_SEG + 1), sizeof(int));
+    if (T->split) {
+        T->uf = (int *)sfb__tess_array(ctx, (size_t)l->nfv, sizeof(int));
+        T->ecopy = (int *)sfb__tess_array(ctx, (size_t)l->nfv, sizeof(int));
     }
-    if (!T.prate || !T.sseg || !T.vspoke || !T.ifirst || !T.eseg || !T.engon || !T.vedge || !T.vcenter || !T.vcorner || !T.bids ||
-        (T.split && (!T.uf || !T.ecopy))) {
-        r = sfb__oom(ctx, "tessellation");
-        goto fail;
-    }
+    if (!T->prate || !T->sseg || !T->vspoke || !T->ifirst || !T->eseg || !T->engon || !T->vedge || !T->vcenter || !T->vcorner ||
+        !T->bids || (T->split && (!T->uf || !T->ecopy)))
+        return sfb__oom(ctx, "tessellation");
     for (pf = 0; pf < nptex; ++pf) {
-        T.prate[pf] = sfb__tess_live(&T, pf) ? T.rate : 0;
-        T.vspoke[pf] = -1;
-        T.sseg[pf] = 0;
+        T->prate[pf] = sfb__tess_live(T, pf) ? T->rate : 0;
+        T->vspoke[pf] = -1;
+        T->sseg[pf] = 0;
     }
-    for (i = 0; i < l->nfv; ++i) T.vedge[i] = -1;
-    for (f = 0; f < l->nf; ++f) T.vcenter[f] = -1;
-    for (i = 0; i < (T.split ? l->nfv : l->nv); ++i) T.vcorner[i] = -1;
+    for (i = 0; i < l->nfv; ++i) T->vedge[i] = -1;
+    for (f = 0; f < l->nf; ++f) T->vcenter[f] = -1;
+    for (i = 0; i < (T->split ? l->nfv : l->nv); ++i) T->vcorner[i] = -1;
+    return SFB_SUCCESS;
+}
+
+/* Segments of each base edge and spoke: the largest rate of the faces on it (an n-gon sub-face
+ * covers half an edge, so it asks for twice its rate, and the count stays even). */
+static void sfb__tess_edge_segments(sfb__tess *T) {
+    const sfb__level *l = T->l;
+    int pf, f, e, k, nptex = T->pt->nptex;
+    memset(T->eseg, 0, (size_t)l->ne * sizeof(int));
+    memset(T->engon, 0, (size_t)l->ne);
+    for (pf = 0; pf < nptex; ++pf) {
+        int rr = T->prate[pf], sub = T->pt->ptex_corner[pf], o, n;
+        if (rr <= 0) continue;
+        f = T->pt->ptex_face[pf];
+        o = l->fv_off[f];
+        n = sfb__tess_face_n(l, f);
+        if (sub < 0) { /* a quad, or a Loop triangle */
+            for (k = 0; k < n; ++k) {
+                e = l->fe[o + k];
+                if (T->eseg[e] < rr) T->eseg[e] = rr;
+            }
+        } else {
+            int ip = (sub + n - 1) % n, nx = T->pt->face_ptex[f] + (sub + 1) % n;
+            int e0 = l->fe[o + sub], e1 = l->fe[o + ip], other = T->prate[nx];
+            if (T->eseg[e0] < 2 * rr) T->eseg[e0] = 2 * rr;
+            if (T->eseg[e1] < 2 * rr) T->eseg[e1] = 2 * rr;
+            T->engon[e0] = T->engon[e1] = 1;
+            T->sseg[pf] = rr > other ? rr : other;
+        }
+    }
+    for (e = 0; e < l->ne; ++e)
+        if (T->engon[e] && (T->eseg[e] & 1)) T->eseg[e] += 1;
+}
+
+/* Sectors for split creases: corners of faces joined across every edge that is not split
+ * (holes join nothing), in the union-find T->uf. */
+static void sfb__tess_sectors(sfb__tess *T) {
+    const sfb__level *l = T->l;
+    int i, e;
+    for (i = 0; i < l->nfv; ++i) T->uf[i] = i;
+    for (e = 0; e < l->ne; ++e) {
+        int a = l->ef_off[e], z = l->ef_off[e + 1], first0 = -1, first1 = -1, q;
+        for (q = a; q < z; ++q) T->ecopy[l->fv_off[l->ef[q]] + l->ef_slot[q]] = q;
+        if (sfb__tess_split_edge(T, e)) continue;
+        for (q = a; q < z; ++q) {
+            int g = l->ef[q], o = l->fv_off[g], n = sfb__tess_face_n(l, g), sl = l->ef_slot[q];
+            int c0 = o + sl, c1 = o + (sl + 1) % n, t;
+            if (l->fhole[g]) continue;
+            if (l->fv[c0] != l->ev[2 * e]) { t = c0; c0 = c1; c1 = t; } /* c0 at ev[0], c1 at ev[1] */
+            if (first0 < 0) { first0 = c0; first1 = c1; }
+            else { sfb__tess_union(T->uf, first0, c0); sfb__tess_union(T->uf, first1, c1); }
+        }
+    }
+}
+
+/* The count pass: ids of every point, and the totals, checked against SFB_MAX_ELEMENTS before
+ * anything is allocated for them. */
+static sfb_result sfb__tess_count(sfb__tess *T) {
+    int pf, nptex = T->pt->nptex;
+    for (pf = 0; pf < nptex; ++pf) {
+        sfb__tess_face(T, pf, 0);
+        if (T->nvert > (size_t)SFB_MAX_ELEMENTS || T->ntri > (size_t)SFB_MAX_ELEMENTS)
+            return sfb__error(T->ctx, SFB_LIMIT_EXCEEDED, SFB_ELEMENT_NONE, -1,
+                              "tessellation at rate %d makes more than %d %s (SFB_MAX_ELEMENTS)", T->rate, SFB_MAX_ELEMENTS,
+                              T->nvert > (size_t)SFB_MAX_ELEMENTS ? "vertices" : "triangles");
+    }
+    return SFB_SUCCESS;
+}
+
+/* The emit pass without trimming: `out`'s arrays, then the locations and triangles of every
+ * param face written straight into them (progress from p0 to p1). */
+static sfb_result sfb__tess_emit(sfb__tess *T, sfb_tess_data *out, float p0, float p1) {
+    sfb_context *ctx = T->ctx;
+    int pf, nptex = T->pt->nptex;
+    size_t v;
+    sfb_result r;
+    out->vertex_count = (int)T->nvert;
+    out->triangle_count = (int)T->ntri;
+    out->positions = (float *)sfb__tess_array(ctx, T->nvert, 3 * sizeof(float));
+    out->normals = (float *)sfb__tess_array(ctx, T->nvert, 3 * sizeof(float));
+    out->locations = (sfb_location *)sfb__tess_array(ctx, T->nvert, sizeof(sfb_location));
+    out->triangles = (int *)sfb__tess_array(ctx, T->ntri, 3 * sizeof(int));
+    out->triangle_faces = (int *)sfb__tess_array(ctx, T->ntri, sizeof(int));
+    if (!out->positions || !out->normals || !out->locations || !out->triangles || !out->triangle_faces)
+        return sfb__oom(ctx, "tessellation");
+    for (v = 0; v < T->nvert; ++v) {
+        out->locations[v].face = -1;
+        out->locations[v].u = out->locations[v].v = 0.0f;
+    }
+    T->loc = out->locations;
+    T->tri = out->triangles;
+    T->tface = out->triangle_faces;
+    for (pf = 0; pf < nptex; ++pf) {
+        if (pf % SFB__TESS_FACE_CHUNK == 0 && pf > 0) {
+            r = sfb__progress(ctx, p0 + (p1 - p0) * (float)pf / (float)nptex, "tessellate");
+            if (r != SFB_SUCCESS) return r;
+        }
+        sfb__tess_face(T, pf, 1);
+    }
+    if (T->tri_at != T->ntri)
+        return sfb__error(ctx, SFB_BACKEND_ERROR, SFB_ELEMENT_NONE, -1, "tessellation wrote %zu triangles, counted %zu", T->tri_at, T->ntri);
+    for (v = 0; v < T->nvert; ++v)
+        if (out->locations[v].face < 0)
+            return sfb__error(ctx, SFB_BACKEND_ERROR, SFB_ELEMENT_NONE, -1, "tessellation vertex %zu has no location", v);
+    return SFB_SUCCESS;
+}
+
+/* Evaluates every vertex of `out` once, in chunks, on the context's backend (progress from p0
+ * to 1). */
+static sfb_result sfb__tess_evaluate(const sfb_surface *s, sfb_tess_data *out, float p0) {
+    sfb_context *ctx = s->ctx;
+    size_t done_v, nv = (size_t)out->vertex_count;
+    sfb_result r;
+    for (done_v = 0; done_v < nv; done_v += SFB__TESS_EVAL_CHUNK) {
+        size_t n = nv - done_v < SFB__TESS_EVAL_CHUNK ? nv - done_v : SFB__TESS_EVAL_CHUNK;
+        sfb_eval_output eo;
+        r = sfb__progress(ctx, p0 + (1.0f - p0) * (float)done_v / (float)nv, "tessellate");
+        if (r != SFB_SUCCESS) return r;
+        memset(&eo, 0, sizeof eo);
+        eo.position = out->positions + 3 * done_v;
+        eo.normal = out->normals + 3 * done_v;
+        r = sfb_surface_eval(s, out->locations + done_v, (int)n, &eo);
+        if (r != SFB_SUCCESS) return r;
+    }
+    return sfb__progress(ctx, 1.0f, "tessellate");
+}
+
+SFB_API sfb_result sfb_surface_tessellate(const sfb_surface *s, const sfb_tess_config *cfg, sfb_tess_data *out) {
+    sfb_context *ctx;
+    sfb__tess T;
+    sfb_result r = SFB_SUCCESS;
+    float p_emit, p_eval;
+    if (out) memset(out, 0, sizeof *out);
+    if (!s) return SFB_INVALID_ARGS;
+    ctx = s->ctx;
+    if (!cfg || !out) return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "sfb_surface_tessellate: NULL argument");
+    if ((r = sfb__tess_check(ctx, s, cfg)) != SFB_SUCCESS) return r;
+    if ((r = sfb__progress(ctx, 0.0f, "tessellate")) != SFB_SUCCESS) return r;
+    if ((r = sfb__tess_init(&T, s, cfg)) != SFB_SUCCESS) goto fail;
 
     /* 1. a rate per param face */
     p_emit = 0.0f;
@@ -6272,122 +6485,18 @@ SFB_API sfb_result sfb_surface_tessellate(const sfb_surface *s, const sfb_tess_c
         r = sfb__trim_rates(&T, p_emit);
         if (r != SFB_SUCCESS) goto fail;
     }
-
-    /* 2. segments of each base edge and spoke: the largest rate of the faces on it (an n-gon
-     * sub-face covers half an edge, so it asks for twice its rate, and the count stays even) */
-    memset(T.eseg, 0, (size_t)l->ne * sizeof(int));
-    memset(T.engon, 0, (size_t)l->ne);
-    for (pf = 0; pf < nptex; ++pf) {
-        int rr = T.prate[pf], sub = T.pt->ptex_corner[pf], o, n;
-        if (rr <= 0) continue;
-        f = T.pt->ptex_face[pf];
-        o = l->fv_off[f];
-        n = sfb__tess_face_n(l, f);
-        if (sub < 0) { /* a quad, or a Loop triangle */
-            for (k = 0; k < n; ++k) {
-                e = l->fe[o + k];
-                if (T.eseg[e] < rr) T.eseg[e] = rr;
-            }
-        } else {
-            int ip = (sub + n - 1) % n, nx = T.pt->face_ptex[f] + (sub + 1) % n;
-            int e0 = l->fe[o + sub], e1 = l->fe[o + ip], other = T.prate[nx];
-            if (T.eseg[e0] < 2 * rr) T.eseg[e0] = 2 * rr;
-            if (T.eseg[e1] < 2 * rr) T.eseg[e1] = 2 * rr;
-            T.engon[e0] = T.engon[e1] = 1;
-            T.sseg[pf] = rr > other ? rr : other;
-        }
-    }
-    for (e = 0; e < l->ne; ++e)
-        if (T.engon[e] && (T.eseg[e] & 1)) T.eseg[e] += 1;
-
-    /* 3. sectors for split creases: corners of faces joined across every edge that is not
-     * split (holes join nothing) */
-    if (T.split) {
-        for (i = 0; i < l->nfv; ++i) T.uf[i] = i;
-        for (e = 0; e < l->ne; ++e) {
-            int a = l->ef_off[e], z = l->ef_off[e + 1], first0 = -1, first1 = -1, q;
-            for (q = a; q < z; ++q) T.ecopy[l->fv_off[l->ef[q]] + l->ef_slot[q]] = q;
-            if (sfb__tess_split_edge(&T, e)) continue;
-            for (q = a; q < z; ++q) {
-                int g = l->ef[q], o = l->fv_off[g], n = sfb__tess_face_n(l, g), sl = l->ef_slot[q];
-                int c0 = o + sl, c1 = o + (sl + 1) % n, t;
-                if (l->fhole[g]) continue;
-                if (l->fv[c0] != l->ev[2 * e]) { t = c0; c0 = c1; c1 = t; } /* c0 at ev[0], c1 at ev[1] */
-                if (first0 < 0) { first0 = c0; first1 = c1; }
-                else { sfb__tess_union(T.uf, first0, c0); sfb__tess_union(T.uf, first1, c1); }
-            }
-        }
-    }
-
-    /* 4. count pass: ids of every point, and the totals, checked before allocating */
-    for (pf = 0; pf < nptex; ++pf) {
-        sfb__tess_face(&T, pf, 0);
-        if (T.nvert > (size_t)SFB_MAX_ELEMENTS || T.ntri > (size_t)SFB_MAX_ELEMENTS) {
-            r = sfb__error(ctx, SFB_LIMIT_EXCEEDED, SFB_ELEMENT_NONE, -1,
-                           "tessellation at rate %d makes more than %d %s (SFB_MAX_ELEMENTS)", T.rate, SFB_MAX_ELEMENTS,
-                           T.nvert > (size_t)SFB_MAX_ELEMENTS ? "vertices" : "triangles");
-            goto fail;
-        }
-    }
-    out->ctx_ = ctx;
-    if (T.trim) {
-        r = sfb__trim_emit(&T, out, p_emit, p_eval);
-        if (r != SFB_SUCCESS) goto fail;
-        goto evaluate;
-    }
-    out->vertex_count = (int)T.nvert;
-    out->triangle_count = (int)T.ntri;
-    out->positions = (float *)sfb__tess_array(ctx, T.nvert, 3 * sizeof(float));
-    out->normals = (float *)sfb__tess_array(ctx, T.nvert, 3 * sizeof(float));
-    out->locations = (sfb_location *)sfb__tess_array(ctx, T.nvert, sizeof(sfb_location));
-    out->triangles = (int *)sfb__tess_array(ctx, T.ntri, 3 * sizeof(int));
-    out->triangle_faces = (int *)sfb__tess_array(ctx, T.ntri, sizeof(int));
-    if (!out->positions || !out->normals || !out->locations || !out->triangles || !out->triangle_faces) {
-        r = sfb__oom(ctx, "tessellation");
-        goto fail;
-    }
-    for (v = 0; v < T.nvert; ++v) {
-        out->locations[v].face = -1;
-        out->locations[v].u = out->locations[v].v = 0.0f;
-    }
-
+    /* 2. segments of each base edge and spoke; 3. sectors for split creases */
+    sfb__tess_edge_segments(&T);
+    if (T.split) sfb__tess_sectors(&T);
+    /* 4. count pass */
+    if ((r = sfb__tess_count(&T)) != SFB_SUCCESS) goto fail;
     /* 5. emit pass: locations and triangles */
-    T.loc = out->locations;
-    T.tri = out->triangles;
-    T.tface = out->triangle_faces;
-    for (pf = 0; pf < nptex; ++pf) {
-        if (pf % SFB__TESS_FACE_CHUNK == 0 && pf > 0) {
-            r = sfb__progress(ctx, p_emit + (p_eval - p_emit) * (float)pf / (float)nptex, "tessellate");
-            if (r != SFB_SUCCESS) goto fail;
-        }
-        sfb__tess_face(&T, pf, 1);
-    }
-    if (T.tri_at != T.ntri) {
-        r = sfb__error(ctx, SFB_BACKEND_ERROR, SFB_ELEMENT_NONE, -1, "tessellation wrote %zu triangles, counted %zu", T.tri_at, T.ntri);
-        goto fail;
-    }
-    for (v = 0; v < T.nvert; ++v)
-        if (out->locations[v].face < 0) {
-            r = sfb__error(ctx, SFB_BACKEND_ERROR, SFB_ELEMENT_NONE, -1, "tessellation vertex %zu has no location", v);
-            goto fail;
-        }
-evaluate:
+    out->ctx_ = ctx;
+    r = T.trim ? sfb__trim_emit(&T, out, p_emit, p_eval) : sfb__tess_emit(&T, out, p_emit, p_eval);
+    if (r != SFB_SUCCESS) goto fail;
     sfb__tess_free_work(&T);
-
     /* 6. evaluate every vertex once, in chunks, on the context's backend */
-    nv = (size_t)out->vertex_count;
-    for (done_v = 0; done_v < nv; done_v += SFB__TESS_EVAL_CHUNK) {
-        size_t n = nv - done_v < SFB__TESS_EVAL_CHUNK ? nv - done_v : SFB__TESS_EVAL_CHUNK;
-        sfb_eval_output eo;
-        r = sfb__progress(ctx, p_eval + (1.0f - p_eval) * (float)done_v / (float)nv, "tessellate");
-        if (r != SFB_SUCCESS) goto fail;
-        memset(&eo, 0, sizeof eo);
-        eo.position = out->positions + 3 * done_v;
-        eo.normal = out->normals + 3 * done_v;
-        r = sfb_surface_eval(s, out->locations + done_v, (int)n, &eo);
-        if (r != SFB_SUCCESS) goto fail;
-    }
-    r = sfb__progress(ctx, 1.0f, "tessellate");
+    r = sfb__tess_evaluate(s, out, p_eval);
     if (r == SFB_SUCCESS) return SFB_SUCCESS;
 fail:
     sfb__tess_free_work(&T);
@@ -6546,14 +6655,10 @@ static sfb_result sfb__check_sharpness(sfb_context *ctx, float s, const sfb__src
 
 void sfb_mesh_destroy(sfb_mesh *mesh);
 
-sfb_result sfb__mesh_create(sfb_context *ctx, const sfb_mesh_desc *d, const sfb__src_lines *lines, sfb_mesh **out) {
-    sfb_mesh *m;
-    sfb_result r;
-    int i, v, e;
-    char msg[256];
-    if (!ctx) return SFB_INVALID_ARGS;
-    if (!d || !out) return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "sfb_mesh_create: NULL argument");
-    *out = NULL;
+/* Refuses a mesh description with bad counts, missing arrays, unknown options or non-finite
+ * positions, before any allocation. */
+static sfb_result sfb__mesh_check_desc(sfb_context *ctx, const sfb_mesh_desc *d) {
+    int v;
     if (d->vertex_count < 0 || d->face_count < 0 || d->crease_count < 0 || d->corner_count < 0 || d->hole_count < 0 ||
         d->uv_count < 0)
         return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "negative element count in the mesh description");
@@ -6573,27 +6678,27 @@ sfb_result sfb__mesh_create(sfb_context *ctx, const sfb_mesh_desc *d, const sfb_
     for (v = 0; v < d->vertex_count; ++v)
         if (!sfb__finite3(d->positions + 3 * (size_t)v))
             return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_VERTEX, v, "coordinate is not finite (NaN or inf)");
-    m = (sfb_mesh *)sfb__calloc(ctx, 1, sizeof(sfb_mesh));
-    if (!m) return sfb__oom(ctx, "mesh");
-    m->ctx = ctx;
-    m->boundary = d->boundary; m->crease_method = d->crease_method;
-    m->triangle_rule = d->triangle_rule; m->uv_interp = d->uv_interp;
-    r = sfb__level_from_faces(ctx, d->vertex_count, d->face_count, d->face_sizes, d->face_vertices, lines, SFB_ELEMENT_VERTEX, &m->base);
-    if (r != SFB_SUCCESS) { sfb_mesh_destroy(m); return r; }
-    for (v = 0; v < m->base.nv; ++v) {
-        int val = m->base.ve_off[v + 1] - m->base.ve_off[v];
-        int fal = m->base.vf_off[v + 1] - m->base.vf_off[v];
-        if (val > SFB_MAX_VALENCE || fal > SFB_MAX_VALENCE) {
-            sfb_mesh_destroy(m);
+    return SFB_SUCCESS;
+}
+
+/* Refuses a vertex of the base level with more edges or faces than SFB_MAX_VALENCE. */
+static sfb_result sfb__mesh_check_valence(sfb_context *ctx, const sfb__level *l) {
+    int v;
+    for (v = 0; v < l->nv; ++v) {
+        int val = l->ve_off[v + 1] - l->ve_off[v];
+        int fal = l->vf_off[v + 1] - l->vf_off[v];
+        if (val > SFB_MAX_VALENCE || fal > SFB_MAX_VALENCE)
             return sfb__error(ctx, SFB_LIMIT_EXCEEDED, SFB_ELEMENT_VERTEX, v, "valence %d is over the limit of %d (SFB_MAX_VALENCE)",
                               val > fal ? val : fal, SFB_MAX_VALENCE);
-        }
     }
-    m->positions = (float *)sfb__alloc(ctx, (size_t)d->vertex_count * 3 * sizeof(float) + 1);
-    m->face_sizes = (int *)sfb__alloc(ctx, (size_t)d->face_count * sizeof(int));
-    if (!m->positions || !m->face_sizes) { sfb_mesh_destroy(m); return sfb__oom(ctx, "mesh"); }
-    memcpy(m->positions, d->positions, (size_t)d->vertex_count * 3 * sizeof(float));
-    memcpy(m->face_sizes, d->face_sizes, (size_t)d->face_count * sizeof(int));
+    return SFB_SUCCESS;
+}
+
+/* Edge sharpness from the crease list and the per-face edge sharpness of the description. */
+static sfb_result sfb__mesh_apply_creases(sfb_context *ctx, sfb_mesh *m, const sfb_mesh_desc *d, const sfb__src_lines *lines) {
+    sfb_result r;
+    int i, e;
+    char msg[256];
     /* creases: later entries override earlier ones on the same edge (as OpenSubdiv) */
     for (i = 0; i < d->crease_count; ++i) {
         int a = d->crease_vertices[2 * i], b = d->crease_vertices[2 * i + 1];
@@ -6602,15 +6707,13 @@ sfb_result sfb__mesh_create(sfb_context *ctx, const sfb_mesh_desc *d, const sfb_
         if (a < 0 || a >= d->vertex_count || b < 0 || b >= d->vertex_count) {
             snprintf(msg, sizeof msg, "crease names vertex index %d out of range (%d vertices)",
                      (a < 0 || a >= d->vertex_count) ? a : b, d->vertex_count);
-            sfb_mesh_destroy(m);
             return sfb__elem_error(ctx, SFB_INVALID_TOPOLOGY, lines, lo, SFB_ELEMENT_EDGE, i, "crease", i, msg);
         }
         r = sfb__check_sharpness(ctx, s, lines, lo, "crease", i);
-        if (r != SFB_SUCCESS) { sfb_mesh_destroy(m); return r; }
+        if (r != SFB_SUCCESS) return r;
         e = sfb__find_edge(&m->base, a, b);
         if (e < 0) {
             snprintf(msg, sizeof msg, "crease between vertices %d and %d is not an edge of the mesh", a, b);
-            sfb_mesh_destroy(m);
             return sfb__elem_error(ctx, SFB_INVALID_TOPOLOGY, lines, lo, SFB_ELEMENT_EDGE, i, "crease", i, msg);
         }
         m->base.es[e] = s;
@@ -6623,7 +6726,6 @@ sfb_result sfb__mesh_create(sfb_context *ctx, const sfb_mesh_desc *d, const sfb_
                 float s = d->face_edge_sharpness[o + i];
                 if (isnan(s) || s < 0.0f) {
                     snprintf(msg, sizeof msg, "per-face edge sharpness %g is invalid: sharpness must be a number >= 0", (double)s);
-                    sfb_mesh_destroy(m);
                     return sfb__elem_error(ctx, SFB_INVALID_VALUE, lines, lines ? lines->face : NULL, SFB_ELEMENT_FACE, f, "face", f, msg);
                 }
                 /* seed 001: where two faces give an edge different values, the highest wins */
@@ -6631,81 +6733,125 @@ sfb_result sfb__mesh_create(sfb_context *ctx, const sfb_mesh_desc *d, const sfb_
             }
         }
     }
+    return SFB_SUCCESS;
+}
+
+/* Vertex sharpness from the corner list and face holes from the hole list of the description. */
+static sfb_result sfb__mesh_apply_corners_holes(sfb_context *ctx, sfb_mesh *m, const sfb_mesh_desc *d, const sfb__src_lines *lines) {
+    sfb_result r;
+    int i;
+    char msg[256];
     for (i = 0; i < d->corner_count; ++i) {
         int a = d->corner_vertices[i];
         const int *lo = lines ? lines->corner : NULL;
         if (a < 0 || a >= d->vertex_count) {
             snprintf(msg, sizeof msg, "corner names vertex index %d out of range (%d vertices)", a, d->vertex_count);
-            sfb_mesh_destroy(m);
             return sfb__elem_error(ctx, SFB_INVALID_TOPOLOGY, lines, lo, SFB_ELEMENT_VERTEX, a, "corner", i, msg);
         }
         r = sfb__check_sharpness(ctx, d->corner_sharpness[i], lines, lo, "corner", i);
-        if (r != SFB_SUCCESS) { sfb_mesh_destroy(m); return r; }
+        if (r != SFB_SUCCESS) return r;
         m->base.vs[a] = d->corner_sharpness[i];
     }
     for (i = 0; i < d->hole_count; ++i) {
         int f = d->holes[i];
         if (f < 0 || f >= d->face_count) {
             snprintf(msg, sizeof msg, "hole names face index %d out of range (%d faces)", f, d->face_count);
-            sfb_mesh_destroy(m);
             return sfb__elem_error(ctx, SFB_INVALID_TOPOLOGY, lines, lines ? lines->hole : NULL, SFB_ELEMENT_FACE, f, "hole", i, msg);
         }
         m->base.fhole[f] = 1;
     }
+    return SFB_SUCCESS;
+}
+
+/* Refuses non-finite UVs and face UV indices out of range (the UVs are copied by the caller). */
+static sfb_result sfb__mesh_check_uvs(sfb_context *ctx, const sfb_mesh *m, const sfb_mesh_desc *d, const sfb__src_lines *lines) {
+    size_t nfv = (size_t)m->base.nfv;
+    int i;
+    char msg[256];
+    for (i = 0; i < d->uv_count; ++i)
+        if (!isfinite(d->uvs[2 * i]) || !isfinite(d->uvs[2 * i + 1]))
+            return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_UV, i, "uv coordinate is not finite (NaN or inf)");
+    for (i = 0; (size_t)i < nfv; ++i)
+        if (d->face_uvs[i] < 0 || d->face_uvs[i] >= d->uv_count) {
+            int f = 0;
+            while (m->base.fv_off[f + 1] <= i) ++f;
+            snprintf(msg, sizeof msg, "uv index %d out of range (%d uvs)", d->face_uvs[i], d->uv_count);
+            return sfb__elem_error(ctx, SFB_INVALID_TOPOLOGY, lines, lines ? lines->face : NULL, SFB_ELEMENT_FACE, f, "face", f, msg);
+        }
+    return SFB_SUCCESS;
+}
+
+/* The description view (sfb_mesh_get_desc): per-edge creases, corners and holes as lists.
+ * Returns 0 when an allocation failed. */
+static int sfb__mesh_desc_view(sfb_context *ctx, sfb_mesh *m) {
+    int nc = 0, nk = 0, nh = 0, f, e, v;
+    for (e = 0; e < m->base.ne; ++e) nc += m->base.es[e] > 0.0f;
+    for (v = 0; v < m->base.nv; ++v) nk += m->base.vs[v] > 0.0f;
+    for (f = 0; f < m->base.nf; ++f) nh += m->base.fhole[f] != 0;
+    m->crease_vertices = (int *)sfb__alloc(ctx, (size_t)nc * 2 * sizeof(int) + 1);
+    m->crease_sharpness = (float *)sfb__alloc(ctx, (size_t)nc * sizeof(float) + 1);
+    m->corner_vertices = (int *)sfb__alloc(ctx, (size_t)nk * sizeof(int) + 1);
+    m->corner_sharpness = (float *)sfb__alloc(ctx, (size_t)nk * sizeof(float) + 1);
+    m->holes = (int *)sfb__alloc(ctx, (size_t)nh * sizeof(int) + 1);
+    if (!m->crease_vertices || !m->crease_sharpness || !m->corner_vertices || !m->corner_sharpness || !m->holes) return 0;
+    for (e = 0; e < m->base.ne; ++e)
+        if (m->base.es[e] > 0.0f) {
+            m->crease_vertices[2 * m->crease_count] = m->base.ev[2 * e];
+            m->crease_vertices[2 * m->crease_count + 1] = m->base.ev[2 * e + 1];
+            m->crease_sharpness[m->crease_count++] = m->base.es[e];
+        }
+    for (v = 0; v < m->base.nv; ++v)
+        if (m->base.vs[v] > 0.0f) {
+            m->corner_vertices[m->corner_count] = v;
+            m->corner_sharpness[m->corner_count++] = m->base.vs[v];
+        }
+    for (f = 0; f < m->base.nf; ++f)
+        if (m->base.fhole[f]) m->holes[m->hole_count++] = f;
+    return 1;
+}
+
+sfb_result sfb__mesh_create(sfb_context *ctx, const sfb_mesh_desc *d, const sfb__src_lines *lines, sfb_mesh **out) {
+    sfb_mesh *m;
+    sfb_result r;
+    const char *oom = NULL;
+    if (!ctx) return SFB_INVALID_ARGS;
+    if (!d || !out) return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "sfb_mesh_create: NULL argument");
+    *out = NULL;
+    if ((r = sfb__mesh_check_desc(ctx, d)) != SFB_SUCCESS) return r;
+    m = (sfb_mesh *)sfb__calloc(ctx, 1, sizeof(sfb_mesh));
+    if (!m) return sfb__oom(ctx, "mesh");
+    m->ctx = ctx;
+    m->boundary = d->boundary; m->crease_method = d->crease_method;
+    m->triangle_rule = d->triangle_rule; m->uv_interp = d->uv_interp;
+    r = sfb__level_from_faces(ctx, d->vertex_count, d->face_count, d->face_sizes, d->face_vertices, lines, SFB_ELEMENT_VERTEX, &m->base);
+    if (r != SFB_SUCCESS) goto fail;
+    if ((r = sfb__mesh_check_valence(ctx, &m->base)) != SFB_SUCCESS) goto fail;
+    m->positions = (float *)sfb__alloc(ctx, (size_t)d->vertex_count * 3 * sizeof(float) + 1);
+    m->face_sizes = (int *)sfb__alloc(ctx, (size_t)d->face_count * sizeof(int));
+    if (!m->positions || !m->face_sizes) { oom = "mesh"; goto fail; }
+    memcpy(m->positions, d->positions, (size_t)d->vertex_count * 3 * sizeof(float));
+    memcpy(m->face_sizes, d->face_sizes, (size_t)d->face_count * sizeof(int));
+    if ((r = sfb__mesh_apply_creases(ctx, m, d, lines)) != SFB_SUCCESS) goto fail;
+    if ((r = sfb__mesh_apply_corners_holes(ctx, m, d, lines)) != SFB_SUCCESS) goto fail;
     if (d->uv_count > 0) {
         size_t nfv = (size_t)m->base.nfv;
-        for (i = 0; i < d->uv_count; ++i)
-            if (!isfinite(d->uvs[2 * i]) || !isfinite(d->uvs[2 * i + 1])) {
-                sfb_mesh_destroy(m);
-                return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_UV, i, "uv coordinate is not finite (NaN or inf)");
-            }
-        for (i = 0; (size_t)i < nfv; ++i)
-            if (d->face_uvs[i] < 0 || d->face_uvs[i] >= d->uv_count) {
-                int f = 0;
-                while (m->base.fv_off[f + 1] <= i) ++f;
-                snprintf(msg, sizeof msg, "uv index %d out of range (%d uvs)", d->face_uvs[i], d->uv_count);
-                sfb_mesh_destroy(m);
-                return sfb__elem_error(ctx, SFB_INVALID_TOPOLOGY, lines, lines ? lines->face : NULL, SFB_ELEMENT_FACE, f, "face", f, msg);
-            }
+        if ((r = sfb__mesh_check_uvs(ctx, m, d, lines)) != SFB_SUCCESS) goto fail;
         m->uv_count = d->uv_count;
         m->uvs = (float *)sfb__alloc(ctx, (size_t)d->uv_count * 2 * sizeof(float));
         m->face_uvs = (int *)sfb__alloc(ctx, nfv * sizeof(int));
-        if (!m->uvs || !m->face_uvs) { sfb_mesh_destroy(m); return sfb__oom(ctx, "mesh uvs"); }
+        if (!m->uvs || !m->face_uvs) { oom = "mesh uvs"; goto fail; }
         memcpy(m->uvs, d->uvs, (size_t)d->uv_count * 2 * sizeof(float));
         memcpy(m->face_uvs, d->face_uvs, nfv * sizeof(int));
     }
-    /* desc view: per-edge creases, corners, holes */
-    {
-        int nc = 0, nk = 0, nh = 0, f;
-        for (e = 0; e < m->base.ne; ++e) nc += m->base.es[e] > 0.0f;
-        for (v = 0; v < m->base.nv; ++v) nk += m->base.vs[v] > 0.0f;
-        for (f = 0; f < m->base.nf; ++f) nh += m->base.fhole[f] != 0;
-        m->crease_vertices = (int *)sfb__alloc(ctx, (size_t)nc * 2 * sizeof(int) + 1);
-        m->crease_sharpness = (float *)sfb__alloc(ctx, (size_t)nc * sizeof(float) + 1);
-        m->corner_vertices = (int *)sfb__alloc(ctx, (size_t)nk * sizeof(int) + 1);
-        m->corner_sharpness = (float *)sfb__alloc(ctx, (size_t)nk * sizeof(float) + 1);
-        m->holes = (int *)sfb__alloc(ctx, (size_t)nh * sizeof(int) + 1);
-        if (!m->crease_vertices || !m->crease_sharpness || !m->corner_vertices || !m->corner_sharpness || !m->holes) {
-            sfb_mesh_destroy(m);
-            return sfb__oom(ctx, "mesh");
-        }
-        for (e = 0; e < m->base.ne; ++e)
-            if (m->base.es[e] > 0.0f) {
-                m->crease_vertices[2 * m->crease_count] = m->base.ev[2 * e];
-                m->crease_vertices[2 * m->crease_count + 1] = m->base.ev[2 * e + 1];
-                m->crease_sharpness[m->crease_count++] = m->base.es[e];
-            }
-        for (v = 0; v < m->base.nv; ++v)
-            if (m->base.vs[v] > 0.0f) {
-                m->corner_vertices[m->corner_count] = v;
-                m->corner_sharpness[m->corner_count++] = m->base.vs[v];
-            }
-        for (f = 0; f < m->base.nf; ++f)
-            if (m->base.fhole[f]) m->holes[m->hole_count++] = f;
-    }
+    if (!sfb__mesh_desc_view(ctx, m)) { oom = "mesh"; goto fail; }
     sfb__level_compute_rules(&m->base);
     *out = m;
     return SFB_SUCCESS;
+fail:
+    /* an allocation failure is reported after the mesh is gone (the message gives the bytes
+     * still in use) */
+    sfb_mesh_destroy(m);
+    return oom ? sfb__oom(ctx, oom) : r;
 }
 
 SFB_API sfb_result sfb_mesh_create(sfb_context *ctx, const sfb_mesh_desc *desc, sfb_mesh **out) {
@@ -7462,16 +7608,11 @@ static double sfb__estimate_bytes(const sfb_mesh *m, sfb_scheme scheme, int leve
     return faces * 4.0 * 40.0 + verts * 16.0 * 12.0 * (limit ? 3.0 : 1.5);
 }
 
-SFB_API sfb_result sfb_surface_create(sfb_context *ctx, const sfb_mesh *mesh, const sfb_surface_config *cfg, sfb_surface **out) {
-    sfb_surface *s;
-    sfb__level prep;
-    sfb__refine_options opt;
-    sfb_result r;
+/* Refuses a scheme, level, flag set or mesh that sfb_surface_create cannot build, before any
+ * allocation (the size estimate against SFB_MAX_ELEMENTS and the memory budget included). */
+static sfb_result sfb__surface_check(sfb_context *ctx, const sfb_mesh *mesh, const sfb_surface_config *cfg) {
     double faces, bytes;
     int f;
-    if (!ctx) return SFB_INVALID_ARGS;
-    if (!mesh || !cfg || !out) return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "sfb_surface_create: NULL argument");
-    *out = NULL;
     if (cfg->scheme == SFB_SCHEME_MANIFOLD_BLEND) {
         /* a blending surface is evaluated (sfb_surface_eval / _tessellate), not refined */
         if (!(cfg->flags & SFB_REFINE_PATCHES) || cfg->refine_level != 0 || (cfg->flags & (SFB_REFINE_LIMIT | SFB_REFINE_SHADING)))
@@ -7507,20 +7648,19 @@ SFB_API sfb_result sfb_surface_create(sfb_context *ctx, const sfb_mesh *mesh, co
         return sfb__error(ctx, SFB_LIMIT_EXCEEDED, SFB_ELEMENT_NONE, -1,
                           "refining to level %d needs about %.0f MiB, over the memory budget of %.1f MiB",
                           cfg->refine_level, bytes / 1048576.0, (double)ctx->budget / 1048576.0);
-    s = (sfb_surface *)sfb__calloc(ctx, 1, sizeof *s);
-    if (!s) return sfb__oom(ctx, "surface");
-    s->ctx = ctx;
-    s->config = *cfg;
-    s->boundary = mesh->boundary; s->crease_method = mesh->crease_method;
-    s->triangle_rule = mesh->triangle_rule; s->uv_interp = mesh->uv_interp;
-    s->base_vertex_count = mesh->base.nv;
-    s->base_face_count = mesh->base.nf;
-    s->base_positions = (float *)sfb__alloc(ctx, (size_t)mesh->base.nv * 3 * sizeof(float) + 1);
-    if (!s->base_positions) { sfb_surface_destroy(s); return sfb__oom(ctx, "surface"); }
-    memcpy(s->base_positions, mesh->positions, (size_t)mesh->base.nv * 3 * sizeof(float));
+    return SFB_SUCCESS;
+}
+
+/* Refines the vertex mesh into s: the vertex (and limit) tables, the shading tables and the
+ * patch table the flags ask for (s keeps the prepared base level of a patch table). */
+static sfb_result sfb__surface_build_vertex(sfb_surface *s, const sfb_mesh *mesh, const sfb_surface_config *cfg) {
+    sfb_context *ctx = s->ctx;
+    sfb__level prep;
+    sfb__refine_options opt;
+    sfb_result r;
     r = sfb__level_prepare(ctx, &mesh->base, mesh->boundary == SFB_BOUNDARY_EDGE_AND_CORNER,
                            mesh->boundary == SFB_BOUNDARY_NONE && cfg->scheme != SFB_SCHEME_BILINEAR, &prep);
-    if (r != SFB_SUCCESS) { sfb_surface_destroy(s); return r; }
+    if (r != SFB_SUCCESS) return r;
     memset(&opt, 0, sizeof opt);
     opt.scheme = cfg->scheme == SFB_SCHEME_MANIFOLD_BLEND ? SFB_SCHEME_CATMARK : cfg->scheme; /* manifold: level 0, the identity */
     opt.crease_method = mesh->crease_method;
@@ -7539,55 +7679,62 @@ SFB_API sfb_result sfb_surface_create(sfb_context *ctx, const sfb_mesh *mesh, co
         if (r == SFB_SUCCESS) { s->has_patches = 1; s->pbase = prep; memset(&prep, 0, sizeof prep); }
     }
     sfb__level_free(ctx, &prep);
-    if (r != SFB_SUCCESS) { sfb_surface_destroy(s); return r; }
+    if (r != SFB_SUCCESS) return r;
     s->built[SFB_TABLE_VERTEX] = 1;
     if (opt.want_limit) s->built[SFB_TABLE_LIMIT] = s->built[SFB_TABLE_TANGENT_U] = s->built[SFB_TABLE_TANGENT_V] = 1;
-    if ((cfg->flags & SFB_REFINE_UVS) && mesh->uv_count > 0) {
-        /* The UV layout is refined as a mesh of its own: its vertices are the UV values, so a
-         * seam (an edge whose two faces disagree on a UV) is a boundary of the layout. It keeps
-         * the vertex mesh's creases and corners; its own corners (one face, two edges) are
-         * pinned, as OpenSubdiv's "linear corners only" face-varying mode. SFB_UV_LINEAR uses
-         * bilinear masks on the same face split. */
-        sfb__level uvl, uvp;
-        sfb__stencils dummy;
-        int o, i;
-        r = sfb__level_from_faces(ctx, mesh->uv_count, mesh->base.nf, mesh->face_sizes, mesh->face_uvs, NULL, SFB_ELEMENT_UV, &uvl);
-        if (r != SFB_SUCCESS) { sfb_surface_destroy(s); return r; }
-        for (f = 0; f < mesh->base.nf; ++f)
-            for (o = mesh->base.fv_off[f], i = 0; o + i < mesh->base.fv_off[f + 1]; ++i) {
-                int ue = uvl.fe[o + i], e = mesh->base.fe[o + i], uvv = mesh->face_uvs[o + i], vv = mesh->base.fv[o + i];
-                if (mesh->base.es[e] > uvl.es[ue]) uvl.es[ue] = mesh->base.es[e];
-                if (mesh->base.vs[vv] > uvl.vs[uvv]) uvl.vs[uvv] = mesh->base.vs[vv];
-            }
-        r = sfb__level_prepare(ctx, &uvl, 1, 0, &uvp);
-        sfb__level_free(ctx, &uvl);
-        if (r != SFB_SUCCESS) { sfb_surface_destroy(s); return r; }
-        memset(&opt, 0, sizeof opt);
-        opt.scheme = cfg->scheme;
-        opt.crease_method = mesh->crease_method;
-        opt.triangle_rule = mesh->triangle_rule;
-        opt.linear = mesh->uv_interp == SFB_UV_LINEAR;
-        memset(&dummy, 0, sizeof dummy);
-        r = sfb__refine(ctx, &uvp, &opt, cfg->refine_level, &s->uv_top, &s->tables[SFB_TABLE_UV], NULL, 0.8f, 1.0f);
-        sfb__level_free(ctx, &uvp);
-        if (r != SFB_SUCCESS) { sfb_surface_destroy(s); return r; }
-        s->built[SFB_TABLE_UV] = 1;
-        s->has_uvs = 1;
-        s->base_uv_count = mesh->uv_count;
-        s->base_uvs = (float *)sfb__alloc(ctx, (size_t)mesh->uv_count * 2 * sizeof(float));
-        if (!s->base_uvs) { sfb_surface_destroy(s); return sfb__oom(ctx, "surface"); }
-        memcpy(s->base_uvs, mesh->uvs, (size_t)mesh->uv_count * 2 * sizeof(float));
-    }
-    r = sfb__progress(ctx, 1.0f, "refine");
-    if (r != SFB_SUCCESS) { sfb_surface_destroy(s); return r; }
-    /* Hand the tables to the backend once (device upload); failures come back here. */
+    return SFB_SUCCESS;
+}
+
+/* The UV layout is refined as a mesh of its own: its vertices are the UV values, so a seam (an
+ * edge whose two faces disagree on a UV) is a boundary of the layout. It keeps the vertex
+ * mesh's creases and corners; its own corners (one face, two edges) are pinned, as
+ * OpenSubdiv's "linear corners only" face-varying mode. SFB_UV_LINEAR uses bilinear masks on
+ * the same face split. Builds the UV table into s (the base UVs are copied by the caller). */
+static sfb_result sfb__surface_build_uvs(sfb_surface *s, const sfb_mesh *mesh, const sfb_surface_config *cfg) {
+    sfb_context *ctx = s->ctx;
+    sfb__level uvl, uvp;
+    sfb__refine_options opt;
+    sfb__stencils dummy;
+    sfb_result r;
+    int f, o, i;
+    r = sfb__level_from_faces(ctx, mesh->uv_count, mesh->base.nf, mesh->face_sizes, mesh->face_uvs, NULL, SFB_ELEMENT_UV, &uvl);
+    if (r != SFB_SUCCESS) return r;
+    for (f = 0; f < mesh->base.nf; ++f)
+        for (o = mesh->base.fv_off[f], i = 0; o + i < mesh->base.fv_off[f + 1]; ++i) {
+            int ue = uvl.fe[o + i], e = mesh->base.fe[o + i], uvv = mesh->face_uvs[o + i], vv = mesh->base.fv[o + i];
+            if (mesh->base.es[e] > uvl.es[ue]) uvl.es[ue] = mesh->base.es[e];
+            if (mesh->base.vs[vv] > uvl.vs[uvv]) uvl.vs[uvv] = mesh->base.vs[vv];
+        }
+    r = sfb__level_prepare(ctx, &uvl, 1, 0, &uvp);
+    sfb__level_free(ctx, &uvl);
+    if (r != SFB_SUCCESS) return r;
+    memset(&opt, 0, sizeof opt);
+    opt.scheme = cfg->scheme;
+    opt.crease_method = mesh->crease_method;
+    opt.triangle_rule = mesh->triangle_rule;
+    opt.linear = mesh->uv_interp == SFB_UV_LINEAR;
+    memset(&dummy, 0, sizeof dummy);
+    r = sfb__refine(ctx, &uvp, &opt, cfg->refine_level, &s->uv_top, &s->tables[SFB_TABLE_UV], NULL, 0.8f, 1.0f);
+    sfb__level_free(ctx, &uvp);
+    if (r != SFB_SUCCESS) return r;
+    s->built[SFB_TABLE_UV] = 1;
+    s->has_uvs = 1;
+    s->base_uv_count = mesh->uv_count;
+    return SFB_SUCCESS;
+}
+
+/* Hands the built tables (stencils, shading, patches) to the context's backend once (device
+ * upload); failures come back here. */
+static sfb_result sfb__surface_upload(sfb_surface *s) {
+    sfb_context *ctx = s->ctx;
+    sfb_result r;
     if (ctx->backend && ctx->backend->upload_stencils) {
         int t;
         s->uploaded_by = ctx->backend;
         for (t = 0; t < SFB_TABLE_COUNT_; ++t) {
             if (!s->built[t] || s->tables[t].rows == 0) continue;
             r = ctx->backend->upload_stencils(ctx->backend_state, &s->tables[t], &s->backend_tables[t]);
-            if (r != SFB_SUCCESS) { sfb_surface_destroy(s); return r; }
+            if (r != SFB_SUCCESS) return r;
         }
         if (s->shading) {
             sfb__shading *sh = s->shading;
@@ -7596,17 +7743,53 @@ SFB_API sfb_result sfb_surface_create(sfb_context *ctx, const sfb_mesh *mesh, co
             for (t = 0; t < 5; ++t) {
                 if (st[t]->rows == 0) continue;
                 r = ctx->backend->upload_stencils(ctx->backend_state, st[t], &sh->handles[t]);
-                if (r != SFB_SUCCESS) { sfb_surface_destroy(s); return r; }
+                if (r != SFB_SUCCESS) return r;
             }
         }
     }
     if (s->has_patches && ctx->backend && ctx->backend->upload_patches) {
         s->uploaded_by = ctx->backend;
         r = ctx->backend->upload_patches(ctx->backend_state, &s->patches, &s->backend_patches);
-        if (r != SFB_SUCCESS) { sfb_surface_destroy(s); return r; }
+        if (r != SFB_SUCCESS) return r;
     }
+    return SFB_SUCCESS;
+}
+
+SFB_API sfb_result sfb_surface_create(sfb_context *ctx, const sfb_mesh *mesh, const sfb_surface_config *cfg, sfb_surface **out) {
+    sfb_surface *s;
+    sfb_result r;
+    int oom = 0;
+    if (!ctx) return SFB_INVALID_ARGS;
+    if (!mesh || !cfg || !out) return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "sfb_surface_create: NULL argument");
+    *out = NULL;
+    if ((r = sfb__surface_check(ctx, mesh, cfg)) != SFB_SUCCESS) return r;
+    s = (sfb_surface *)sfb__calloc(ctx, 1, sizeof *s);
+    if (!s) return sfb__oom(ctx, "surface");
+    s->ctx = ctx;
+    s->config = *cfg;
+    s->boundary = mesh->boundary; s->crease_method = mesh->crease_method;
+    s->triangle_rule = mesh->triangle_rule; s->uv_interp = mesh->uv_interp;
+    s->base_vertex_count = mesh->base.nv;
+    s->base_face_count = mesh->base.nf;
+    s->base_positions = (float *)sfb__alloc(ctx, (size_t)mesh->base.nv * 3 * sizeof(float) + 1);
+    if (!s->base_positions) { oom = 1; goto fail; }
+    memcpy(s->base_positions, mesh->positions, (size_t)mesh->base.nv * 3 * sizeof(float));
+    if ((r = sfb__surface_build_vertex(s, mesh, cfg)) != SFB_SUCCESS) goto fail;
+    if ((cfg->flags & SFB_REFINE_UVS) && mesh->uv_count > 0) {
+        if ((r = sfb__surface_build_uvs(s, mesh, cfg)) != SFB_SUCCESS) goto fail;
+        s->base_uvs = (float *)sfb__alloc(ctx, (size_t)mesh->uv_count * 2 * sizeof(float));
+        if (!s->base_uvs) { oom = 1; goto fail; }
+        memcpy(s->base_uvs, mesh->uvs, (size_t)mesh->uv_count * 2 * sizeof(float));
+    }
+    if ((r = sfb__progress(ctx, 1.0f, "refine")) != SFB_SUCCESS) goto fail;
+    if ((r = sfb__surface_upload(s)) != SFB_SUCCESS) goto fail;
     *out = s;
     return SFB_SUCCESS;
+fail:
+    /* the one cleanup path: everything s holds; an allocation failure is reported after it (the
+     * message gives the bytes still in use) */
+    sfb_surface_destroy(s);
+    return oom ? sfb__oom(ctx, "surface") : r;
 }
 
 SFB_API int sfb_surface_param_face_count(const sfb_surface *s) { return s && s->has_patches ? s->patches.nptex : 0; }
@@ -8158,28 +8341,56 @@ static sfb_result sfb__shade_level_arg(sfb_context *ctx, int given, int level, c
     return SFB_SUCCESS;
 }
 
-sfb_result sfb__shading_build(sfb_context *ctx, const sfb__level *prep, const sfb__refine_options *opt, int L,
-                              const sfb_shading_options *o, sfb__shading **out) {
-    sfb__shading *sh = NULL;
-    sfb__level *lev = NULL;
-    sfb__stencils *T = NULL;
-    sfb__regions *reg = NULL, outreg;
-    int **parent = NULL;
+/* The working state of sfb__shading_build: the levels one step apart with their local
+ * stencils, regions and parent faces, the output regions, and the scratch of composing rows. */
+typedef struct sfb__shade_build {
+    sfb_context *ctx;
+    const sfb__level *prep;
+    const sfb__refine_options *opt;
+    const sfb_shading_options *o;
+    sfb__shading *sh;
+    int L, Ln, Lw;         /* last, normals and weights level */
+    int loop, per_level;   /* Loop scheme; N_S one level at a time (averaging not linear) */
+    sfb__level *lev;       /* L + 1 levels: lev[0] borrowed (prep), lev[Ln] moved to sh->nlev */
+    sfb__stencils *T;      /* L + 1: T[k] the step from level k to k + 1 */
+    sfb__regions *reg;     /* L + 1: regions (sharpness > 0) from the normals level up */
+    sfb__regions outreg;   /* regions of the last level split by infinitely sharp edges only */
+    int **parent;          /* L + 1: parent face of every face of level k (k >= 1) */
+    const sfb__level *top; /* the last level */
     sfb__rows prow, crow;
     sfb__accum A;
     sfb__mask m, mm[3];
     sfb__shade_scratch sc;
-    double *bw = NULL, *bn = NULL;
-    int *order = NULL;
-    sfb_result r = SFB_SUCCESS;
-    int loop = opt->scheme == SFB_SCHEME_LOOP;
-    int Ln = 0, Lw = 0, k, v, i, t, maxv = 1, per_level = 0, asz;
-    const sfb__level *top;
-    *out = NULL;
-    memset(&prow, 0, sizeof prow); memset(&crow, 0, sizeof crow); memset(&A, 0, sizeof A);
-    memset(&m, 0, sizeof m); memset(mm, 0, sizeof mm); memset(&sc, 0, sizeof sc); memset(&outreg, 0, sizeof outreg);
-    if ((r = sfb__shade_level_arg(ctx, o->normals_level, L, "normals", &Ln)) != SFB_SUCCESS) return r;
-    if ((r = sfb__shade_level_arg(ctx, o->weights_level, L, "weights", &Lw)) != SFB_SUCCESS) return r;
+    double *bw, *bn;       /* blend weights of the current and the next level */
+    int *order;            /* output vertices in N_S row order (b > 0 first) */
+} sfb__shade_build;
+
+/* Frees the working state of sfb__shading_build (not the shading it builds). */
+static void sfb__shade_build_free(sfb__shade_build *B) {
+    sfb_context *ctx = B->ctx;
+    int k, t, L = B->L;
+    if (B->lev) {
+        for (k = 1; k <= L; ++k) sfb__level_free(ctx, &B->lev[k]);
+        sfb__free(ctx, B->lev);
+    }
+    if (B->T) { for (k = 0; k <= L; ++k) sfb__stencils_free(ctx, &B->T[k]); sfb__free(ctx, B->T); }
+    if (B->reg) { for (k = 0; k <= L; ++k) sfb__regions_free(ctx, &B->reg[k]); sfb__free(ctx, B->reg); }
+    if (B->parent) { for (k = 0; k <= L; ++k) sfb__free(ctx, B->parent[k]); sfb__free(ctx, B->parent); }
+    sfb__regions_free(ctx, &B->outreg);
+    sfb__rows_free(ctx, &B->prow); sfb__rows_free(ctx, &B->crow);
+    sfb__free(ctx, B->A.acc); sfb__free(ctx, B->A.mark); sfb__free(ctx, B->A.touched);
+    sfb__free(ctx, B->m.idx); sfb__free(ctx, B->m.w);
+    for (t = 0; t < 3; ++t) { sfb__free(ctx, B->mm[t].idx); sfb__free(ctx, B->mm[t].w); }
+    sfb__free(ctx, B->sc.fset); sfb__free(ctx, B->sc.cnt);
+    sfb__free(ctx, B->bw); sfb__free(ctx, B->bn); sfb__free(ctx, B->order);
+}
+
+/* Checks the shading options against refinement level L; the normals and weights levels they
+ * give into *Ln and *Lw. */
+static sfb_result sfb__shade_check_options(sfb_context *ctx, const sfb_shading_options *o, int L, int *Ln, int *Lw) {
+    sfb_result r;
+    if ((r = sfb__shade_level_arg(ctx, o->normals_level, L, "normals", Ln)) != SFB_SUCCESS) return r;
+    if ((r = sfb__shade_level_arg(ctx, o->weights_level, L, "weights", Lw)) != SFB_SUCCESS) return r;
     if (o->variant != SFB_SHADE_VARIANT_A && o->variant != SFB_SHADE_VARIANT_B)
         return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, -1, "shading variant %d is not SFB_SHADE_VARIANT_A or _B", o->variant);
     if (o->darts != SFB_SHADE_DARTS_SMOOTH && o->darts != SFB_SHADE_DARTS_SHARP)
@@ -8187,114 +8398,156 @@ sfb_result sfb__shading_build(sfb_context *ctx, const sfb__level *prep, const sf
     if (o->averaging != SFB_SHADE_AVERAGE_LINEAR && o->averaging != SFB_SHADE_AVERAGE_RENORMALIZED && o->averaging != SFB_SHADE_AVERAGE_SPHERICAL)
         return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, -1,
                           "shading averaging %d is not SFB_SHADE_AVERAGE_LINEAR, _RENORMALIZED or _SPHERICAL", o->averaging);
-    sh = (sfb__shading *)sfb__calloc(ctx, 1, sizeof *sh);
-    lev = (sfb__level *)sfb__calloc(ctx, (size_t)L + 1, sizeof *lev);
-    T = (sfb__stencils *)sfb__calloc(ctx, (size_t)L + 1, sizeof *T);
-    reg = (sfb__regions *)sfb__calloc(ctx, (size_t)L + 1, sizeof *reg);
-    parent = (int **)sfb__calloc(ctx, (size_t)L + 1, sizeof *parent);
-    if (!sh || !lev || !T || !reg || !parent) { r = sfb__oom(ctx, "shading tables"); goto done; }
-    sh->normals_level = Ln; sh->weights_level = Lw; sh->level = L; sh->variant = o->variant; sh->darts = o->darts;
+    return SFB_SUCCESS;
+}
+
+/* Allocates the shading and the per-level arrays, then the levels one step at a time with each
+ * step's local stencils and parent faces, the region-mask scratch, the regions from the
+ * normals level up and the output regions of the last level. */
+static sfb_result sfb__shade_build_levels(sfb__shade_build *B) {
+    sfb_context *ctx = B->ctx;
+    const sfb_shading_options *o = B->o;
+    sfb__shading *sh;
+    sfb__level *lev;
+    sfb_result r;
+    int L = B->L, k, v, maxv = 1;
+    sh = B->sh = (sfb__shading *)sfb__calloc(ctx, 1, sizeof *sh);
+    lev = B->lev = (sfb__level *)sfb__calloc(ctx, (size_t)L + 1, sizeof *lev);
+    B->T = (sfb__stencils *)sfb__calloc(ctx, (size_t)L + 1, sizeof *B->T);
+    B->reg = (sfb__regions *)sfb__calloc(ctx, (size_t)L + 1, sizeof *B->reg);
+    B->parent = (int **)sfb__calloc(ctx, (size_t)L + 1, sizeof *B->parent);
+    if (!sh || !lev || !B->T || !B->reg || !B->parent) return sfb__oom(ctx, "shading tables");
+    sh->normals_level = B->Ln; sh->weights_level = B->Lw; sh->level = L; sh->variant = o->variant; sh->darts = o->darts;
     sh->averaging = o->averaging;
-    per_level = o->averaging != SFB_SHADE_AVERAGE_LINEAR && L > Ln;
+    B->per_level = o->averaging != SFB_SHADE_AVERAGE_LINEAR && L > B->Ln;
 
     /* the levels, one step at a time, with each step's local stencils */
-    lev[0] = *prep; /* borrowed */
+    lev[0] = *B->prep; /* borrowed */
     for (k = 0; k < L; ++k) {
-        r = sfb__refine(ctx, &lev[k], opt, 1, &lev[k + 1], &T[k], NULL, 0.8f, 0.8f);
-        if (r != SFB_SUCCESS) goto done;
-        parent[k + 1] = sfb__shade_parent_faces(ctx, &lev[k], &lev[k + 1], loop);
-        if (!parent[k + 1]) { r = sfb__oom(ctx, "shading tables"); goto done; }
+        r = sfb__refine(ctx, &lev[k], B->opt, 1, &lev[k + 1], &B->T[k], NULL, 0.8f, 0.8f);
+        if (r != SFB_SUCCESS) return r;
+        B->parent[k + 1] = sfb__shade_parent_faces(ctx, &lev[k], &lev[k + 1], B->loop);
+        if (!B->parent[k + 1]) return sfb__oom(ctx, "shading tables");
     }
-    top = &lev[L];
+    B->top = &lev[L];
     for (k = 0; k <= L; ++k)
         for (v = 0; v < lev[k].nv; ++v) {
             int n = lev[k].vf_off[v + 1] - lev[k].vf_off[v];
             if (n + 1 > maxv) maxv = n + 1;
         }
-    sc.fset = (int *)sfb__alloc(ctx, (size_t)maxv * sizeof(int));
-    sc.cnt = (double *)sfb__alloc(ctx, (size_t)maxv * sizeof(double));
-    if (!sc.fset || !sc.cnt) { r = sfb__oom(ctx, "shading tables"); goto done; }
+    B->sc.fset = (int *)sfb__alloc(ctx, (size_t)maxv * sizeof(int));
+    B->sc.cnt = (double *)sfb__alloc(ctx, (size_t)maxv * sizeof(double));
+    if (!B->sc.fset || !B->sc.cnt) return sfb__oom(ctx, "shading tables");
 
     /* regions (sharpness > 0) from the normals level up */
-    for (k = Ln; k <= L; ++k)
-        if ((r = sfb__regions_build(ctx, &lev[k], 0, &reg[k])) != SFB_SUCCESS) goto done;
-    if ((r = sfb__regions_build(ctx, top, 0, &outreg)) != SFB_SUCCESS) goto done;
+    for (k = B->Ln; k <= L; ++k)
+        if ((r = sfb__regions_build(ctx, &lev[k], 0, &B->reg[k])) != SFB_SUCCESS) return r;
+    return sfb__regions_build(ctx, B->top, 0, &B->outreg);
+}
 
-    /* the normals level: its topology, the source of every face at every vertex, positions */
+/* The normals level: its topology (sh->nlev: prepared from the base, or moved out of lev[Ln]),
+ * the source of every face at every vertex, the composing accumulator and, when it lies between
+ * the base and the last level, the table of its positions over the base vertices (sh->npos). */
+static sfb_result sfb__shade_normals_level(sfb__shade_build *B) {
+    sfb_context *ctx = B->ctx;
+    sfb__shading *sh = B->sh;
+    const sfb__level *prep = B->prep;
+    sfb_result r = SFB_SUCCESS;
+    int L = B->L, Ln = B->Ln, k, asz;
     if (Ln == 0) r = sfb__level_prepare(ctx, prep, 0, 0, &sh->nlev);
-    else { sh->nlev = lev[Ln]; memset(&lev[Ln], 0, sizeof lev[Ln]); }
-    if (r != SFB_SUCCESS) goto done;
-    if (Ln == L) top = &sh->nlev;
-    sh->nsrc = reg[Ln].total;
+    else { sh->nlev = B->lev[Ln]; memset(&B->lev[Ln], 0, sizeof B->lev[Ln]); }
+    if (r != SFB_SUCCESS) return r;
+    if (Ln == L) B->top = &sh->nlev;
+    sh->nsrc = B->reg[Ln].total;
     sh->nsrc_of_vf = (int *)sfb__alloc(ctx, ((size_t)sh->nlev.vf_off[sh->nlev.nv] + 1) * sizeof(int));
-    if (!sh->nsrc_of_vf) { r = sfb__oom(ctx, "shading tables"); goto done; }
-    memcpy(sh->nsrc_of_vf, reg[Ln].of_vf, (size_t)sh->nlev.vf_off[sh->nlev.nv] * sizeof(int));
+    if (!sh->nsrc_of_vf) return sfb__oom(ctx, "shading tables");
+    memcpy(sh->nsrc_of_vf, B->reg[Ln].of_vf, (size_t)sh->nlev.vf_off[sh->nlev.nv] * sizeof(int));
     asz = prep->nv > sh->nsrc ? prep->nv : sh->nsrc;
-    for (k = Ln; per_level && k < L; ++k)
-        if (reg[k].total > asz) asz = reg[k].total; /* per level: rows over each level's regions */
-    A.acc = (double *)sfb__alloc(ctx, ((size_t)asz + 1) * sizeof(double));
-    A.mark = (unsigned *)sfb__calloc(ctx, (size_t)asz + 1, sizeof(unsigned));
-    A.touched = (int *)sfb__alloc(ctx, ((size_t)asz + 1) * sizeof(int));
-    if (!A.acc || !A.mark || !A.touched) { r = sfb__oom(ctx, "shading tables"); goto done; }
+    for (k = Ln; B->per_level && k < L; ++k)
+        if (B->reg[k].total > asz) asz = B->reg[k].total; /* per level: rows over each level's regions */
+    B->A.acc = (double *)sfb__alloc(ctx, ((size_t)asz + 1) * sizeof(double));
+    B->A.mark = (unsigned *)sfb__calloc(ctx, (size_t)asz + 1, sizeof(unsigned));
+    B->A.touched = (int *)sfb__alloc(ctx, ((size_t)asz + 1) * sizeof(int));
+    if (!B->A.acc || !B->A.mark || !B->A.touched) return sfb__oom(ctx, "shading tables");
     sh->npos_mode = Ln == 0 ? 0 : Ln == L ? 2 : 1;
     if (sh->npos_mode == 1) {
-        if (!sfb__shade_identity(ctx, &prow, prep->nv)) { r = sfb__oom(ctx, "shading tables"); goto done; }
+        if (!sfb__shade_identity(ctx, &B->prow, prep->nv)) return sfb__oom(ctx, "shading tables");
         for (k = 0; k < Ln; ++k) {
-            if (!sfb__shade_compose_step(ctx, &A, &prow, &T[k], &m, &crow)) { r = sfb__oom(ctx, "shading tables"); goto done; }
-            sfb__rows_free(ctx, &prow);
-            prow = crow;
-            memset(&crow, 0, sizeof crow);
+            if (!sfb__shade_compose_step(ctx, &B->A, &B->prow, &B->T[k], &B->m, &B->crow)) return sfb__oom(ctx, "shading tables");
+            sfb__rows_free(ctx, &B->prow);
+            B->prow = B->crow;
+            memset(&B->crow, 0, sizeof B->crow);
         }
-        r = sfb__rows_to_stencils(ctx, &prow, prep->nv, &sh->npos);
-        if (r != SFB_SUCCESS) { r = sfb__oom(ctx, "shading tables"); goto done; }
-        sfb__rows_free(ctx, &prow);
+        r = sfb__rows_to_stencils(ctx, &B->prow, prep->nv, &sh->npos);
+        if (r != SFB_SUCCESS) return sfb__oom(ctx, "shading tables");
+        sfb__rows_free(ctx, &B->prow);
     }
+    return SFB_SUCCESS;
+}
 
-    /* blend weights from the weights level to the last */
-    bw = (double *)sfb__calloc(ctx, (size_t)(Lw == Ln ? &sh->nlev : &lev[Lw])->nv + 1, sizeof(double));
-    if (!bw) { r = sfb__oom(ctx, "shading weights"); goto done; }
-    sfb__shade_seed(Lw == Ln ? &sh->nlev : &lev[Lw], bw, loop, o->variant, o->darts, NULL);
+/* The blend weights from the weights level to the last (B->bw): seeded, then one subdivision
+ * step at a time, the held vertices and those released at the step seeded again. */
+static sfb_result sfb__shade_weights(sfb__shade_build *B) {
+    sfb_context *ctx = B->ctx;
+    const sfb_shading_options *o = B->o;
+    sfb__shading *sh = B->sh;
+    const sfb__level *lev = B->lev;
+    int L = B->L, Ln = B->Ln, Lw = B->Lw, loop = B->loop, k, v, i;
+    B->bw = (double *)sfb__calloc(ctx, (size_t)(Lw == Ln ? &sh->nlev : &lev[Lw])->nv + 1, sizeof(double));
+    if (!B->bw) return sfb__oom(ctx, "shading weights");
+    sfb__shade_seed(Lw == Ln ? &sh->nlev : &lev[Lw], B->bw, loop, o->variant, o->darts, NULL);
     for (k = Lw; k < L; ++k) {
-        const sfb__stencils *S = &T[k];
+        const sfb__stencils *S = &B->T[k];
         const sfb__level *pl = k == Ln ? &sh->nlev : &lev[k], *cl = k + 1 == Ln ? &sh->nlev : &lev[k + 1];
         unsigned char *released;
-        bn = (double *)sfb__calloc(ctx, (size_t)S->rows + 1, sizeof(double));
+        B->bn = (double *)sfb__calloc(ctx, (size_t)S->rows + 1, sizeof(double));
         released = (unsigned char *)sfb__calloc(ctx, (size_t)S->rows + 1, 1);
-        if (!bn || !released) { sfb__free(ctx, released); r = sfb__oom(ctx, "shading weights"); goto done; }
+        if (!B->bn || !released) { sfb__free(ctx, released); return sfb__oom(ctx, "shading weights"); }
         for (v = 0; v < S->rows; ++v) {
             double acc = 0.0;
-            for (i = 0; i < S->sizes[v]; ++i) acc += (double)S->weights[S->offsets[v] + i] * bw[S->indices[S->offsets[v] + i]];
-            bn[v] = acc < 0.0 ? 0.0 : acc > 1.0 ? 1.0 : acc;
+            for (i = 0; i < S->sizes[v]; ++i) acc += (double)S->weights[S->offsets[v] + i] * B->bw[S->indices[S->offsets[v] + i]];
+            B->bn[v] = acc < 0.0 ? 0.0 : acc > 1.0 ? 1.0 : acc;
         }
         /* vertex children whose parent was held and who are not: released at this level */
         for (v = 0; v < pl->nv; ++v)
             released[v] = sfb__shade_held(pl, v, loop, o->variant, o->darts) && !sfb__shade_held(cl, v, loop, o->variant, o->darts);
-        sfb__shade_seed(cl, bn, loop, o->variant, o->darts, released);
+        sfb__shade_seed(cl, B->bn, loop, o->variant, o->darts, released);
         sfb__free(ctx, released);
-        sfb__free(ctx, bw);
-        bw = bn;
-        bn = NULL;
+        sfb__free(ctx, B->bw);
+        B->bw = B->bn;
+        B->bn = NULL;
     }
+    return SFB_SUCCESS;
+}
 
-    /* output vertices: one per region of the infinitely sharp partition */
-    sh->nout = outreg.total;
+/* The output vertices, one per region of the infinitely sharp partition of the last level:
+ * their origin, face-vertex slots and blend weight, and the order of the N_S rows (those with
+ * b > 0 first, B->order). */
+static sfb_result sfb__shade_outputs(sfb__shade_build *B) {
+    sfb_context *ctx = B->ctx;
+    sfb__shading *sh = B->sh;
+    const sfb__level *top = B->top;
+    const sfb__regions *outreg = &B->outreg;
+    int *order;
+    int v, i;
+    sh->nout = outreg->total;
     sh->out_origin = (int *)sfb__alloc(ctx, ((size_t)sh->nout + 1) * sizeof(int));
     sh->out_fv = (int *)sfb__alloc(ctx, ((size_t)top->nfv + 1) * sizeof(int));
     sh->b = (float *)sfb__alloc(ctx, ((size_t)sh->nout + 1) * sizeof(float));
     sh->ns_idx_w = (int *)sfb__alloc(ctx, ((size_t)sh->nout + 1) * sizeof(int));
     sh->ns_idx_all = (int *)sfb__alloc(ctx, ((size_t)sh->nout + 1) * sizeof(int));
-    order = (int *)sfb__alloc(ctx, ((size_t)sh->nout + 1) * sizeof(int));
-    if (!sh->out_origin || !sh->out_fv || !sh->b || !sh->ns_idx_w || !sh->ns_idx_all || !order) { r = sfb__oom(ctx, "shading tables"); goto done; }
+    order = B->order = (int *)sfb__alloc(ctx, ((size_t)sh->nout + 1) * sizeof(int));
+    if (!sh->out_origin || !sh->out_fv || !sh->b || !sh->ns_idx_w || !sh->ns_idx_all || !order) return sfb__oom(ctx, "shading tables");
     for (v = 0; v < top->nv; ++v) {
-        int nr = outreg.first[v + 1] - outreg.first[v];
+        int nr = outreg->first[v + 1] - outreg->first[v];
         if (nr > 1) sh->nsplit++;
         for (i = 0; i < nr; ++i) {
-            sh->out_origin[outreg.first[v] + i] = v;
-            sh->b[outreg.first[v] + i] = (float)bw[v];
+            sh->out_origin[outreg->first[v] + i] = v;
+            sh->b[outreg->first[v] + i] = (float)B->bw[v];
         }
         for (i = top->vf_off[v]; i < top->vf_off[v + 1]; ++i) {
             int f = top->vf[i];
-            sh->out_fv[top->fv_off[f] + top->vf_slot[i]] = outreg.of_vf[i];
+            sh->out_fv[top->fv_off[f] + top->vf_slot[i]] = outreg->of_vf[i];
         }
     }
     /* N_S rows: those with b > 0 first */
@@ -8305,54 +8558,77 @@ sfb_result sfb__shading_build(sfb_context *ctx, const sfb__level *prep, const sf
         sh->ns_idx_all[order[i]] = i;
         sh->ns_idx_w[order[i]] = i < sh->nweighted ? i : -1;
     }
+    return SFB_SUCCESS;
+}
 
-    /* N_S: region rows composed from the normals level up to the level below the last. Per
-     * level (averaging not linear): each step's rows over the regions of the level below alone
-     * (composed with an identity, which merges repeated sources), kept as a table of its own. */
-    if (per_level) {
+/* N_S: region rows composed from the normals level up to the level below the last (B->prow).
+ * Per level (averaging not linear): each step's rows over the regions of the level below alone
+ * (composed with an identity, which merges repeated sources), kept as a table of its own. */
+static sfb_result sfb__shade_ns_steps(sfb__shade_build *B) {
+    sfb_context *ctx = B->ctx;
+    sfb__shading *sh = B->sh;
+    const sfb__level *lev = B->lev;
+    const sfb__regions *reg = B->reg;
+    sfb_result r;
+    int L = B->L, Ln = B->Ln, k;
+    if (B->per_level) {
         sh->steps = (sfb__stencils *)sfb__calloc(ctx, (size_t)(L - Ln), sizeof *sh->steps);
-        if (!sh->steps) { r = sfb__oom(ctx, "shading tables"); goto done; }
+        if (!sh->steps) return sfb__oom(ctx, "shading tables");
         sh->nsteps = L - Ln;
     }
-    if (!sfb__shade_identity(ctx, &prow, sh->nsrc)) { r = sfb__oom(ctx, "shading tables"); goto done; }
+    if (!sfb__shade_identity(ctx, &B->prow, sh->nsrc)) return sfb__oom(ctx, "shading tables");
     for (k = Ln; k < L - 1; ++k) {
         const sfb__level *pl = k == Ln ? &sh->nlev : &lev[k];
         int cv, rv;
-        memset(&crow, 0, sizeof crow);
-        crow.rows = reg[k + 1].total;
-        crow.off = (size_t *)sfb__alloc(ctx, ((size_t)crow.rows + 1) * sizeof(size_t));
-        if (!crow.off) { r = sfb__oom(ctx, "shading tables"); goto done; }
-        crow.off[0] = 0;
+        memset(&B->crow, 0, sizeof B->crow);
+        B->crow.rows = reg[k + 1].total;
+        B->crow.off = (size_t *)sfb__alloc(ctx, ((size_t)B->crow.rows + 1) * sizeof(size_t));
+        if (!B->crow.off) return sfb__oom(ctx, "shading tables");
+        B->crow.off[0] = 0;
         for (cv = 0; cv < lev[k + 1].nv; ++cv)
             for (rv = reg[k + 1].first[cv]; rv < reg[k + 1].first[cv + 1]; ++rv) {
                 int creg = reg[k + 1].first[cv + 1] - reg[k + 1].first[cv] > 1 ? rv : -1;
-                m.n = 0;
-                if (!sfb__shade_region_mask(ctx, pl, &reg[k], &lev[k + 1], &reg[k + 1], parent[k + 1], &T[k], cv, creg, 1.0, &m, &sc) ||
-                    !sfb__compose_row(ctx, &A, &prow, &m, &crow, rv)) { r = sfb__oom(ctx, "shading tables"); goto done; }
+                B->m.n = 0;
+                if (!sfb__shade_region_mask(ctx, pl, &reg[k], &lev[k + 1], &reg[k + 1], B->parent[k + 1], &B->T[k], cv, creg, 1.0, &B->m,
+                                            &B->sc) ||
+                    !sfb__compose_row(ctx, &B->A, &B->prow, &B->m, &B->crow, rv))
+                    return sfb__oom(ctx, "shading tables");
             }
-        sfb__rows_free(ctx, &prow);
-        if (per_level) {
-            r = sfb__rows_to_stencils(ctx, &crow, reg[k].total, &sh->steps[k - Ln]);
-            if (r != SFB_SUCCESS) { if (r == SFB_OUT_OF_MEMORY) r = sfb__oom(ctx, "shading tables"); goto done; }
-            sfb__rows_free(ctx, &crow);
-            if (!sfb__shade_identity(ctx, &prow, reg[k + 1].total)) { r = sfb__oom(ctx, "shading tables"); goto done; }
+        sfb__rows_free(ctx, &B->prow);
+        if (B->per_level) {
+            r = sfb__rows_to_stencils(ctx, &B->crow, reg[k].total, &sh->steps[k - Ln]);
+            if (r != SFB_SUCCESS) { if (r == SFB_OUT_OF_MEMORY) r = sfb__oom(ctx, "shading tables"); return r; }
+            sfb__rows_free(ctx, &B->crow);
+            if (!sfb__shade_identity(ctx, &B->prow, reg[k + 1].total)) return sfb__oom(ctx, "shading tables");
         } else {
-            prow = crow;
+            B->prow = B->crow;
         }
-        memset(&crow, 0, sizeof crow);
+        memset(&B->crow, 0, sizeof B->crow);
         r = sfb__progress(ctx, 0.8f, "shading");
-        if (r != SFB_SUCCESS) goto done;
+        if (r != SFB_SUCCESS) return r;
     }
-    /* the output rows, in `order`: each the face-weighted mean of the N_S regions it covers */
-    memset(&crow, 0, sizeof crow);
-    crow.rows = sh->nout;
-    crow.off = (size_t *)sfb__alloc(ctx, ((size_t)sh->nout + 1) * sizeof(size_t));
-    if (!crow.off) { r = sfb__oom(ctx, "shading tables"); goto done; }
-    crow.off[0] = 0;
+    return SFB_SUCCESS;
+}
+
+/* The output rows of N_S, in B->order: each the face-weighted mean of the N_S regions of the
+ * last level it covers; then the N_S table (sh->ns), or per level the last step's table and the
+ * sizes of the steps. */
+static sfb_result sfb__shade_ns_output(sfb__shade_build *B) {
+    sfb_context *ctx = B->ctx;
+    sfb__shading *sh = B->sh;
+    const sfb__level *top = B->top;
+    const sfb__regions *reg = B->reg, *outreg = &B->outreg;
+    sfb_result r;
+    int L = B->L, Ln = B->Ln, i, k;
+    memset(&B->crow, 0, sizeof B->crow);
+    B->crow.rows = sh->nout;
+    B->crow.off = (size_t *)sfb__alloc(ctx, ((size_t)sh->nout + 1) * sizeof(size_t));
+    if (!B->crow.off) return sfb__oom(ctx, "shading tables");
+    B->crow.off[0] = 0;
     for (i = 0; i < sh->nout; ++i) {
-        int ov = order[i], cv = sh->out_origin[ov], rv, j;
-        int faces = outreg.faces[ov];
-        m.n = 0;
+        int ov = B->order[i], cv = sh->out_origin[ov], rv, j;
+        int faces = outreg->faces[ov];
+        B->m.n = 0;
         for (rv = reg[L].first[cv]; rv < reg[L].first[cv + 1]; ++rv) {
             /* the output region of N_S region rv: that of any of its faces (a bare vertex has
              * one of each) */
@@ -8360,22 +8636,22 @@ sfb_result sfb__shading_build(sfb_context *ctx, const sfb__level *prep, const sf
             double frac;
             int creg = reg[L].first[cv + 1] - reg[L].first[cv] > 1 ? rv : -1;
             for (j = top->vf_off[cv]; j < top->vf_off[cv + 1]; ++j)
-                if (reg[L].of_vf[j] == rv) { in = outreg.of_vf[j] == ov; break; }
+                if (reg[L].of_vf[j] == rv) { in = outreg->of_vf[j] == ov; break; }
             if (!in) continue;
             frac = faces ? (double)reg[L].faces[rv] / faces : 1.0;
             if (L == Ln) {
-                if (!sfb__mask_grow(ctx, &m, 1)) { r = sfb__oom(ctx, "shading tables"); goto done; }
-                SFB__MASK_ADD(&m, rv, frac);
-            } else if (!sfb__shade_region_mask(ctx, L - 1 == Ln ? &sh->nlev : &lev[L - 1], &reg[L - 1], top, &reg[L],
-                                               parent[L], &T[L - 1], cv, creg, frac, &m, &sc)) {
-                r = sfb__oom(ctx, "shading tables"); goto done;
+                if (!sfb__mask_grow(ctx, &B->m, 1)) return sfb__oom(ctx, "shading tables");
+                SFB__MASK_ADD(&B->m, rv, frac);
+            } else if (!sfb__shade_region_mask(ctx, L - 1 == Ln ? &sh->nlev : &B->lev[L - 1], &reg[L - 1], top, &reg[L],
+                                               B->parent[L], &B->T[L - 1], cv, creg, frac, &B->m, &B->sc)) {
+                return sfb__oom(ctx, "shading tables");
             }
         }
-        if (!sfb__compose_row(ctx, &A, &prow, &m, &crow, i)) { r = sfb__oom(ctx, "shading tables"); goto done; }
+        if (!sfb__compose_row(ctx, &B->A, &B->prow, &B->m, &B->crow, i)) return sfb__oom(ctx, "shading tables");
     }
-    if (per_level) {
-        r = sfb__rows_to_stencils(ctx, &crow, reg[L - 1].total, &sh->steps[sh->nsteps - 1]);
-        if (r != SFB_SUCCESS) { if (r == SFB_OUT_OF_MEMORY) r = sfb__oom(ctx, "shading tables"); goto done; }
+    if (B->per_level) {
+        r = sfb__rows_to_stencils(ctx, &B->crow, reg[L - 1].total, &sh->steps[sh->nsteps - 1]);
+        if (r != SFB_SUCCESS) { if (r == SFB_OUT_OF_MEMORY) r = sfb__oom(ctx, "shading tables"); return r; }
         for (k = 0; k < sh->nsteps; ++k) {
             const sfb__stencils *S = &sh->steps[k];
             if (S->rows > sh->step_rows_max) sh->step_rows_max = S->rows;
@@ -8384,104 +8660,134 @@ sfb_result sfb__shading_build(sfb_context *ctx, const sfb__level *prep, const sf
                 if (S->sizes[i] > sh->step_size_max) sh->step_size_max = S->sizes[i];
         }
     } else {
-        r = sfb__rows_to_stencils(ctx, &crow, sh->nsrc, &sh->ns);
-        if (r != SFB_SUCCESS) { r = sfb__oom(ctx, "shading tables"); goto done; }
+        r = sfb__rows_to_stencils(ctx, &B->crow, sh->nsrc, &sh->ns);
+        if (r != SFB_SUCCESS) return sfb__oom(ctx, "shading tables");
     }
-    sfb__rows_free(ctx, &crow);
-    sfb__rows_free(ctx, &prow);
+    sfb__rows_free(ctx, &B->crow);
+    sfb__rows_free(ctx, &B->prow);
+    return SFB_SUCCESS;
+}
 
-    /* limit position and tangents of every output vertex over the refined vertices */
-    {
-        sfb__rows lr[3];
-        memset(lr, 0, sizeof lr);
-        for (t = 0; t < 3; ++t) {
-            lr[t].rows = sh->nout;
-            lr[t].off = (size_t *)sfb__alloc(ctx, ((size_t)sh->nout + 1) * sizeof(size_t));
-            if (!lr[t].off) r = sfb__oom(ctx, "shading limit tables");
-            else lr[t].off[0] = 0;
-        }
-        for (v = 0; v < top->nv && r == SFB_SUCCESS; ++v) {
-            int nr = outreg.first[v + 1] - outreg.first[v], e0 = top->ve_off[v], ne = top->ve_off[v + 1] - e0;
-            int f0 = top->vf_off[v], nf = top->vf_off[v + 1] - f0, rr;
-            int need = 3 * sfb__mask_need_vertex(top, v) + 8;
-            for (rr = 0; rr < nr && r == SFB_SUCCESS; ++rr) {
-                int ov = outreg.first[v] + rr;
-                for (t = 0; t < 3; ++t) {
-                    mm[t].n = 0;
-                    if (!sfb__mask_grow(ctx, &mm[t], need)) r = sfb__oom(ctx, "shading limit tables");
-                }
-                if (r != SFB_SUCCESS) break;
-                if (nr == 1) {
-                    sfb__limit_masks(top, v, opt->scheme, &mm[0], &mm[1], &mm[2]);
-                } else {
-                    /* the region's faces: a run first..first+len-1 around v (mod nf) */
-                    int first = -1, len = 0;
-                    for (i = 0; i < nf; ++i) {
-                        int prev = i > 0 ? outreg.of_vf[f0 + i - 1] : (nf == ne ? outreg.of_vf[f0 + nf - 1] : -1);
-                        if (outreg.of_vf[f0 + i] == ov) { len++; if (prev != ov) first = i; }
-                    }
-                    if (first < 0) first = 0;
-                    if (top->vrule[v] == SFB__RULE_CREASE) {
-                        float sharp[SFB_MAX_VALENCE + 1];
-                        int a, b;
-                        for (i = 0; i < ne && i <= SFB_MAX_VALENCE; ++i) sharp[i] = top->es[top->ve[e0 + i]];
-                        sfb__crease_pair(sharp, ne, &a, &b);
-                        SFB__MASK_ADD(&mm[0], v, 2.0 / 3.0);
-                        SFB__MASK_ADD(&mm[0], sfb__other_end(top, top->ve[e0 + a], v), 1.0 / 6.0);
-                        SFB__MASK_ADD(&mm[0], sfb__other_end(top, top->ve[e0 + b], v), 1.0 / 6.0);
-                        sfb__crease_tangent_masks(top, v, first, first + len, loop, &mm[1], &mm[2]);
-                    } else {
-                        SFB__MASK_ADD(&mm[0], v, 1.0);
-                        SFB__MASK_ADD(&mm[1], v, -1.0);
-                        SFB__MASK_ADD(&mm[1], sfb__other_end(top, top->ve[e0 + first % ne], v), 1.0);
-                        SFB__MASK_ADD(&mm[2], v, -1.0);
-                        SFB__MASK_ADD(&mm[2], sfb__other_end(top, top->ve[e0 + (first + 1) % ne], v), 1.0);
-                    }
-                }
-                for (t = 0; t < 3; ++t) {
-                    /* local rows: copy the mask (duplicates merged) */
-                    size_t at;
-                    int a2, b2;
-                    if (!sfb__rows_reserve(ctx, &lr[t], lr[t].n + (size_t)mm[t].n)) { r = sfb__oom(ctx, "shading limit tables"); break; }
-                    at = lr[t].n;
-                    for (a2 = 0; a2 < mm[t].n; ++a2) {
-                        for (b2 = (int)at; b2 < (int)lr[t].n && lr[t].idx[b2] != mm[t].idx[a2]; ++b2) {}
-                        if (b2 < (int)lr[t].n) lr[t].w[b2] += mm[t].w[a2];
-                        else { lr[t].idx[lr[t].n] = mm[t].idx[a2]; lr[t].w[lr[t].n] = mm[t].w[a2]; lr[t].n++; }
-                    }
-                    lr[t].off[ov + 1] = lr[t].n;
-                }
-            }
-        }
-        for (t = 0; t < 3; ++t) {
-            if (r == SFB_SUCCESS) {
-                r = sfb__rows_to_stencils(ctx, &lr[t], top->nv, &sh->lim[t]);
-                if (r != SFB_SUCCESS) r = sfb__oom(ctx, "shading limit tables");
-            }
-            sfb__rows_free(ctx, &lr[t]);
-        }
-        if (r != SFB_SUCCESS) goto done;
+/* The limit masks (position, two tangents) into mm of output vertex ov, one of the regions of
+ * split vertex v of the last level: at a crease vertex the crease tangent and that side's cross
+ * tangent, at a corner the two edges of the region's first face. */
+static void sfb__shade_split_limit_masks(const sfb__level *top, const sfb__regions *outreg, int v, int ov, int loop, sfb__mask *mm) {
+    int e0 = top->ve_off[v], ne = top->ve_off[v + 1] - e0;
+    int f0 = top->vf_off[v], nf = top->vf_off[v + 1] - f0, i;
+    /* the region's faces: a run first..first+len-1 around v (mod nf) */
+    int first = -1, len = 0;
+    for (i = 0; i < nf; ++i) {
+        int prev = i > 0 ? outreg->of_vf[f0 + i - 1] : (nf == ne ? outreg->of_vf[f0 + nf - 1] : -1);
+        if (outreg->of_vf[f0 + i] == ov) { len++; if (prev != ov) first = i; }
     }
+    if (first < 0) first = 0;
+    if (top->vrule[v] == SFB__RULE_CREASE) {
+        float sharp[SFB_MAX_VALENCE + 1];
+        int a, b;
+        for (i = 0; i < ne && i <= SFB_MAX_VALENCE; ++i) sharp[i] = top->es[top->ve[e0 + i]];
+        sfb__crease_pair(sharp, ne, &a, &b);
+        SFB__MASK_ADD(&mm[0], v, 2.0 / 3.0);
+        SFB__MASK_ADD(&mm[0], sfb__other_end(top, top->ve[e0 + a], v), 1.0 / 6.0);
+        SFB__MASK_ADD(&mm[0], sfb__other_end(top, top->ve[e0 + b], v), 1.0 / 6.0);
+        sfb__crease_tangent_masks(top, v, first, first + len, loop, &mm[1], &mm[2]);
+    } else {
+        SFB__MASK_ADD(&mm[0], v, 1.0);
+        SFB__MASK_ADD(&mm[1], v, -1.0);
+        SFB__MASK_ADD(&mm[1], sfb__other_end(top, top->ve[e0 + first % ne], v), 1.0);
+        SFB__MASK_ADD(&mm[2], v, -1.0);
+        SFB__MASK_ADD(&mm[2], sfb__other_end(top, top->ve[e0 + (first + 1) % ne], v), 1.0);
+    }
+}
+
+/* Appends mask mk to the local rows lr as row ov (duplicates merged); 0 when out of memory. */
+static int sfb__shade_rows_append(sfb_context *ctx, sfb__rows *lr, const sfb__mask *mk, int ov) {
+    size_t at;
+    int a2, b2;
+    if (!sfb__rows_reserve(ctx, lr, lr->n + (size_t)mk->n)) return 0;
+    at = lr->n;
+    for (a2 = 0; a2 < mk->n; ++a2) {
+        for (b2 = (int)at; b2 < (int)lr->n && lr->idx[b2] != mk->idx[a2]; ++b2) {}
+        if (b2 < (int)lr->n) lr->w[b2] += mk->w[a2];
+        else { lr->idx[lr->n] = mk->idx[a2]; lr->w[lr->n] = mk->w[a2]; lr->n++; }
+    }
+    lr->off[ov + 1] = lr->n;
+    return 1;
+}
+
+/* Limit position and tangents of every output vertex over the refined vertices of the last
+ * level (sh->lim[0..2]): local rows, one region of a split vertex at a time. */
+static sfb_result sfb__shade_limits(sfb__shade_build *B) {
+    sfb_context *ctx = B->ctx;
+    sfb__shading *sh = B->sh;
+    const sfb__level *top = B->top;
+    const sfb__regions *outreg = &B->outreg;
+    sfb__mask *mm = B->mm;
+    sfb__rows lr[3];
+    sfb_result r = SFB_SUCCESS;
+    int v, t;
+    memset(lr, 0, sizeof lr);
+    for (t = 0; t < 3; ++t) {
+        lr[t].rows = sh->nout;
+        lr[t].off = (size_t *)sfb__alloc(ctx, ((size_t)sh->nout + 1) * sizeof(size_t));
+        if (!lr[t].off) r = sfb__oom(ctx, "shading limit tables");
+        else lr[t].off[0] = 0;
+    }
+    for (v = 0; v < top->nv && r == SFB_SUCCESS; ++v) {
+        int nr = outreg->first[v + 1] - outreg->first[v], rr;
+        int need = 3 * sfb__mask_need_vertex(top, v) + 8;
+        for (rr = 0; rr < nr && r == SFB_SUCCESS; ++rr) {
+            int ov = outreg->first[v] + rr;
+            for (t = 0; t < 3; ++t) {
+                mm[t].n = 0;
+                if (!sfb__mask_grow(ctx, &mm[t], need)) r = sfb__oom(ctx, "shading limit tables");
+            }
+            if (r != SFB_SUCCESS) break;
+            if (nr == 1) sfb__limit_masks(top, v, B->opt->scheme, &mm[0], &mm[1], &mm[2]);
+            else sfb__shade_split_limit_masks(top, outreg, v, ov, B->loop, mm);
+            for (t = 0; t < 3; ++t)
+                if (!sfb__shade_rows_append(ctx, &lr[t], &mm[t], ov)) { r = sfb__oom(ctx, "shading limit tables"); break; }
+        }
+    }
+    for (t = 0; t < 3; ++t) {
+        if (r == SFB_SUCCESS) {
+            r = sfb__rows_to_stencils(ctx, &lr[t], top->nv, &sh->lim[t]);
+            if (r != SFB_SUCCESS) r = sfb__oom(ctx, "shading limit tables");
+        }
+        sfb__rows_free(ctx, &lr[t]);
+    }
+    return r;
+}
+
+sfb_result sfb__shading_build(sfb_context *ctx, const sfb__level *prep, const sfb__refine_options *opt, int L,
+                              const sfb_shading_options *o, sfb__shading **out) {
+    sfb__shade_build B;
+    sfb__shading *sh;
+    sfb_result r;
+    int k;
+    *out = NULL;
+    memset(&B, 0, sizeof B);
+    B.ctx = ctx; B.prep = prep; B.opt = opt; B.o = o; B.L = L;
+    B.loop = opt->scheme == SFB_SCHEME_LOOP;
+    if ((r = sfb__shade_check_options(ctx, o, L, &B.Ln, &B.Lw)) != SFB_SUCCESS) return r;
+    if ((r = sfb__shade_build_levels(&B)) != SFB_SUCCESS) goto done;
+    if ((r = sfb__shade_normals_level(&B)) != SFB_SUCCESS) goto done;
+    /* blend weights from the weights level to the last */
+    if ((r = sfb__shade_weights(&B)) != SFB_SUCCESS) goto done;
+    /* output vertices: one per region of the infinitely sharp partition */
+    if ((r = sfb__shade_outputs(&B)) != SFB_SUCCESS) goto done;
+    /* N_S rows up to the level below the last, then the output rows */
+    if ((r = sfb__shade_ns_steps(&B)) != SFB_SUCCESS) goto done;
+    if ((r = sfb__shade_ns_output(&B)) != SFB_SUCCESS) goto done;
+    /* limit position and tangents of every output vertex over the refined vertices */
+    if ((r = sfb__shade_limits(&B)) != SFB_SUCCESS) goto done;
+    sh = B.sh;
     sh->bytes = sizeof *sh + (sh->ns.entries + sh->npos.entries + sh->lim[0].entries + sh->lim[1].entries + sh->lim[2].entries) * 8 +
-                (size_t)sh->nout * 6 * sizeof(int) + (size_t)top->nfv * sizeof(int) + (size_t)sh->nlev.nfv * 3 * sizeof(int);
+                (size_t)sh->nout * 6 * sizeof(int) + (size_t)B.top->nfv * sizeof(int) + (size_t)sh->nlev.nfv * 3 * sizeof(int);
     for (k = 0; k < sh->nsteps; ++k) sh->bytes += sizeof *sh->steps + sh->steps[k].entries * 8 + (size_t)sh->steps[k].rows * 2 * sizeof(int);
 done:
-    if (lev) {
-        for (k = 1; k <= L; ++k) sfb__level_free(ctx, &lev[k]);
-        sfb__free(ctx, lev);
-    }
-    if (T) { for (k = 0; k <= L; ++k) sfb__stencils_free(ctx, &T[k]); sfb__free(ctx, T); }
-    if (reg) { for (k = 0; k <= L; ++k) sfb__regions_free(ctx, &reg[k]); sfb__free(ctx, reg); }
-    if (parent) { for (k = 0; k <= L; ++k) sfb__free(ctx, parent[k]); sfb__free(ctx, parent); }
-    sfb__regions_free(ctx, &outreg);
-    sfb__rows_free(ctx, &prow); sfb__rows_free(ctx, &crow);
-    sfb__free(ctx, A.acc); sfb__free(ctx, A.mark); sfb__free(ctx, A.touched);
-    sfb__free(ctx, m.idx); sfb__free(ctx, m.w);
-    for (t = 0; t < 3; ++t) { sfb__free(ctx, mm[t].idx); sfb__free(ctx, mm[t].w); }
-    sfb__free(ctx, sc.fset); sfb__free(ctx, sc.cnt);
-    sfb__free(ctx, bw); sfb__free(ctx, bn); sfb__free(ctx, order);
-    if (r != SFB_SUCCESS) { sfb__shading_free(ctx, sh); return r; }
-    *out = sh;
+    sfb__shade_build_free(&B);
+    if (r != SFB_SUCCESS) { sfb__shading_free(ctx, B.sh); return r; }
+    *out = B.sh;
     return SFB_SUCCESS;
 }
 
@@ -9011,18 +9317,270 @@ static int sfb__render_bounds(const sfb_mesh_data *m, const float *pos, double *
     return any;
 }
 
+/* The camera and the lights of one picture, the lights fixed to the camera. */
+typedef struct sfb__render_view {
+    sfb__camera cam;
+    double centre[3], radius;
+    double key[3], fill[3];  /* directions of the key and the fill light */
+    /* the light plane of the highlight lines: normal m, line direction e, across the lines d,
+     * a point a; line spacing and the plane's distance */
+    double light_m[3], light_e[3], light_d[3], light_a[3], spacing, lightdist;
+} sfb__render_view;
+
+/* The orbit camera around the bounding box of what the faces use and the lights (config c, a
+ * w x h picture). */
+static void sfb__render_view_setup(const sfb_mesh_data *m, const float *pos, const sfb_render_config *c, int w, int h,
+                                   sfb__render_view *V) {
+    double lo[3], hi[3], yaw, pitch;
+    sfb__camera *cam = &V->cam;
+    int i;
+    /* camera */
+    if (!sfb__render_bounds(m, pos, lo, hi)) { lo[0] = lo[1] = lo[2] = -1.0; hi[0] = hi[1] = hi[2] = 1.0; }
+    for (i = 0; i < 3; ++i) V->centre[i] = 0.5 * (lo[i] + hi[i]);
+    V->radius = 0.5 * sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) + (hi[2] - lo[2]) * (hi[2] - lo[2]));
+    if (!(V->radius > 0.0) || !isfinite(V->radius)) V->radius = 1.0;
+    yaw = (c->view_set ? c->yaw : SFB__RENDER_DEFAULT_YAW) * SFB__PI / 180.0;
+    pitch = (c->view_set ? c->pitch : SFB__RENDER_DEFAULT_PITCH) * SFB__PI / 180.0;
+    memset(cam, 0, sizeof *cam);
+    cam->ortho = c->orthographic != 0;
+    {
+        double dir[3], dist = V->radius / sin(SFB__RENDER_HALF_FOV * SFB__PI / 180.0);
+        double zoom = c->zoom > 0.0f ? c->zoom : 1.0, half = 0.5 * (w < h ? w : h) * SFB__RENDER_MARGIN;
+        dir[0] = cos(pitch) * sin(yaw); dir[1] = sin(pitch); dir[2] = cos(pitch) * cos(yaw);
+        for (i = 0; i < 3; ++i) { cam->eye[i] = V->centre[i] + dist * dir[i]; cam->fwd[i] = -dir[i]; }
+        cam->right[0] = cos(yaw); cam->right[1] = 0.0; cam->right[2] = -sin(yaw);
+        sfb__rcross(cam->right, cam->fwd, cam->up);
+        sfb__rnormalize(cam->up);
+        cam->focal = cam->ortho ? half * zoom / V->radius : half * zoom / tan(SFB__RENDER_HALF_FOV * SFB__PI / 180.0);
+        cam->cx = 0.5 * w;
+        cam->cy = 0.5 * h;
+    }
+    /* lights, fixed to the camera: a key light from the upper left behind the viewer, a fill */
+    for (i = 0; i < 3; ++i) {
+        V->key[i] = -cam->fwd[i] + 0.55 * cam->up[i] - 0.45 * cam->right[i];
+        V->fill[i] = -cam->fwd[i] - 0.3 * cam->up[i] + 0.8 * cam->right[i];
+    }
+    sfb__rnormalize(V->key);
+    sfb__rnormalize(V->fill);
+    /* the light plane of the highlight lines: facing the object from the camera's side, lines
+     * running at 30 degrees from the picture's vertical */
+    V->lightdist = (c->light_distance > 0.0f ? c->light_distance : SFB__RENDER_DEFAULT_LIGHT_DISTANCE) * V->radius;
+    V->spacing = 2.0 * V->radius / (c->stripes > 0.0f ? c->stripes : SFB__RENDER_DEFAULT_STRIPES);
+    for (i = 0; i < 3; ++i) {
+        V->light_m[i] = -cam->fwd[i];
+        V->light_e[i] = cos(SFB__PI / 6.0) * cam->up[i] + sin(SFB__PI / 6.0) * cam->right[i];
+        V->light_a[i] = V->centre[i] + V->lightdist * V->light_m[i];
+    }
+    sfb__rcross(V->light_m, V->light_e, V->light_d);
+    sfb__rnormalize(V->light_d);
+}
+
+/* Projects every vertex into pv (a non-finite one gets z = -1). */
+static void sfb__render_project(const sfb_mesh_data *m, const float *pos, const sfb__camera *cam, sfb__pv *pv) {
+    int i;
+    for (i = 0; i < m->vertex_count; ++i) {
+        const float *p = pos + 3 * (size_t)i;
+        double d[3], xc, yc, zc;
+        if (!(isfinite(p[0]) && isfinite(p[1]) && isfinite(p[2]))) { pv[i].z = -1.0; pv[i].x = pv[i].y = pv[i].q = 0.0; continue; }
+        d[0] = p[0] - cam->eye[0]; d[1] = p[1] - cam->eye[1]; d[2] = p[2] - cam->eye[2];
+        xc = sfb__rdot(d, cam->right); yc = sfb__rdot(d, cam->up); zc = sfb__rdot(d, cam->fwd);
+        pv[i].z = zc;
+        if (cam->ortho) {
+            pv[i].q = 1.0;
+            pv[i].x = cam->cx + cam->focal * xc;
+            pv[i].y = cam->cy - cam->focal * yc;
+        } else {
+            pv[i].q = zc > 0.0 ? 1.0 / zc : 0.0;
+            pv[i].x = cam->cx + cam->focal * xc * pv[i].q;
+            pv[i].y = cam->cy - cam->focal * yc * pv[i].q;
+        }
+    }
+}
+
+/* Pass 1: fan-triangulates and rasterizes every face that is not a hole; a face with a
+ * non-finite vertex or one behind the near plane is skipped (counted in *skipped). */
+static sfb_result sfb__render_rasterize(sfb_context *ctx, sfb__raster *R, const sfb_mesh_data *m, const sfb__pv *pv,
+                                        const unsigned char *hole, double radius, int *skipped) {
+    const sfb__camera *cam = R->cam;
+    const float *pos = R->pos;
+    double near_z = cam->ortho ? -HUGE_VAL : 1e-3 * radius;
+    size_t off;
+    sfb_result r;
+    int f, i;
+    for (f = 0, off = 0; f < m->face_count; off += (size_t)m->face_sizes[f], ++f) {
+        const int *fv = m->face_vertices + off;
+        int n = m->face_sizes[f], bad = 0, t;
+        double fn[3];
+        if ((f & 255) == 255 && (r = sfb__progress(ctx, 0.6f * (float)f / (float)m->face_count, "render")) != SFB_SUCCESS) return r;
+        if (hole && hole[f]) continue;
+        for (i = 0; i < n; ++i) {
+            const float *p = pos + 3 * (size_t)fv[i];
+            if (!(isfinite(p[0]) && isfinite(p[1]) && isfinite(p[2]))) bad = 1;
+            else if (!(pv[fv[i]].z > near_z)) bad = 1;
+        }
+        if (bad) { ++*skipped; continue; }
+        sfb__polygon_normal(pos, fv, n, fn);
+        if (!(sfb__rnormalize(fn) > 0.0)) { fn[0] = -cam->fwd[0]; fn[1] = -cam->fwd[1]; fn[2] = -cam->fwd[2]; }
+        for (t = 1; t + 1 < n; ++t) {
+            sfb__pv tri[3];
+            int vi[3], real[3];
+            vi[0] = fv[0]; vi[1] = fv[t]; vi[2] = fv[t + 1];
+            tri[0] = pv[vi[0]]; tri[1] = pv[vi[1]]; tri[2] = pv[vi[2]];
+            real[0] = 1;              /* (t, t+1) */
+            real[1] = t + 2 == n;     /* (t+1, 0): the polygon's last side */
+            real[2] = t == 1;         /* (0, 1): its first side */
+            sfb__raster_tri(R, tri, vi, real, fn);
+        }
+    }
+    return SFB_SUCCESS;
+}
+
+/* Pass 2a (highlight): the stripe coordinate of every covered pixel, kept in its scalar slot
+ * (+inf where the normal is parallel to the light plane or the value is out of range). */
+static void sfb__render_stripes(const sfb__raster *R, size_t npix, const sfb_render_config *c, const sfb__render_view *V) {
+    const sfb__camera *cam = &V->cam;
+    size_t k;
+    int i;
+    for (k = 0; k < npix; ++k) {
+        float *g = R->gb + k * SFB__RENDER_GB;
+        double n[3], p[3], v[3], nm, wv;
+        if (!(g[0] < (float)HUGE_VAL)) continue;
+        n[0] = g[1]; n[1] = g[2]; n[2] = g[3];
+        p[0] = g[4]; p[1] = g[5]; p[2] = g[6];
+        sfb__rnormalize(n);
+        if (cam->ortho) { v[0] = -cam->fwd[0]; v[1] = -cam->fwd[1]; v[2] = -cam->fwd[2]; }
+        else { v[0] = cam->eye[0] - p[0]; v[1] = cam->eye[1] - p[1]; v[2] = cam->eye[2] - p[2]; }
+        if (sfb__rdot(n, v) < 0.0) { n[0] = -n[0]; n[1] = -n[1]; n[2] = -n[2]; }
+        nm = sfb__rdot(n, V->light_m);
+        if (fabs(nm) < 1e-6) { g[7] = (float)HUGE_VAL; continue; }
+        if (c->light_at_infinity) {
+            wv = V->lightdist * sfb__rdot(n, V->light_d) / nm / V->spacing;
+        } else {
+            double ap[3], mu, X[3];
+            for (i = 0; i < 3; ++i) ap[i] = V->light_a[i] - p[i];
+            mu = sfb__rdot(ap, V->light_m) / nm;
+            for (i = 0; i < 3; ++i) X[i] = p[i] + mu * n[i] - V->light_a[i];
+            wv = sfb__rdot(X, V->light_d) / V->spacing;
+        }
+        g[7] = isfinite(wv) && fabs(wv) < 1e7 ? (float)wv : (float)HUGE_VAL;
+    }
+}
+
+/* The highlight colour of pixel (x, y) (index pix, stripe coordinate wv, diffuse term diff)
+ * over its lit grey base in rgb: a dark blue and a cyan band per period, filtered by the pixel's
+ * footprint in stripe periods. */
+static void sfb__render_highlight(const sfb__raster *R, int x, int y, size_t pix, double wv, double diff, double *rgb) {
+    int w = R->w, h = R->h, i;
+    double dx = HUGE_VAL, dy = HUGE_VAL, fw, cb, cc;
+    /* the pixel footprint in stripe periods: the smaller one-sided difference per
+     * axis (robust at silhouettes, where one neighbour is another surface) */
+    if (x > 0 && R->gb[(pix - 1) * SFB__RENDER_GB + 7] < 1e30f) dx = fabs(wv - R->gb[(pix - 1) * SFB__RENDER_GB + 7]);
+    if (x + 1 < w && R->gb[(pix + 1) * SFB__RENDER_GB + 7] < 1e30f) {
+        double d2 = fabs(wv - R->gb[(pix + 1) * SFB__RENDER_GB + 7]);
+        if (d2 < dx) dx = d2;
+    }
+    if (y > 0 && R->gb[(pix - (size_t)w) * SFB__RENDER_GB + 7] < 1e30f)
+        dy = fabs(wv - R->gb[(pix - (size_t)w) * SFB__RENDER_GB + 7]);
+    if (y + 1 < h && R->gb[(pix + (size_t)w) * SFB__RENDER_GB + 7] < 1e30f) {
+        double d2 = fabs(wv - R->gb[(pix + (size_t)w) * SFB__RENDER_GB + 7]);
+        if (d2 < dy) dy = d2;
+    }
+    if (dx == HUGE_VAL) dx = 0.0;
+    if (dy == HUGE_VAL) dy = 0.0;
+    fw = dx + dy;
+    cb = sfb__band_cover(wv, fw, 0.00, 0.22);
+    cc = sfb__band_cover(wv, fw, 0.50, 0.72);
+    {
+        double lum = 0.45 + 0.55 * diff;
+        double blue[3], cyan[3];
+        blue[0] = 0.05 * lum; blue[1] = 0.12 * lum; blue[2] = 0.75 * lum;
+        cyan[0] = 0.10 * lum; cyan[1] = 0.80 * lum; cyan[2] = 0.95 * lum;
+        for (i = 0; i < 3; ++i) rgb[i] = rgb[i] * (1.0 - cb - cc) + blue[i] * cb + cyan[i] * cc;
+    }
+}
+
+/* The colour of covered pixel (x, y) (index pix) in the config's mode, before gamma and the
+ * edge overlay: the normal as RGB, or lit (diffuse, specular, fill) grey, scalar map or
+ * highlight lines. */
+static void sfb__render_lit(const sfb__raster *R, const sfb_render_config *c, const sfb__render_view *V, int x, int y, size_t pix,
+                            double *rgb) {
+    const sfb__camera *cam = &V->cam;
+    const float *g = R->gb + pix * SFB__RENDER_GB;
+    double n[3], p[3], v[3], diff, spec, hv[3];
+    int i;
+    n[0] = g[1]; n[1] = g[2]; n[2] = g[3];
+    p[0] = g[4]; p[1] = g[5]; p[2] = g[6];
+    sfb__rnormalize(n);
+    if (c->mode == SFB_RENDER_NORMALS) {
+        for (i = 0; i < 3; ++i) rgb[i] = 0.5 + 0.5 * n[i];
+        return;
+    }
+    if (cam->ortho) { v[0] = -cam->fwd[0]; v[1] = -cam->fwd[1]; v[2] = -cam->fwd[2]; }
+    else { v[0] = cam->eye[0] - p[0]; v[1] = cam->eye[1] - p[1]; v[2] = cam->eye[2] - p[2]; }
+    sfb__rnormalize(v);
+    if (sfb__rdot(n, v) < 0.0) { n[0] = -n[0]; n[1] = -n[1]; n[2] = -n[2]; }
+    diff = sfb__rdot(n, V->key);
+    if (diff < 0.0) diff = 0.0;
+    for (i = 0; i < 3; ++i) hv[i] = V->key[i] + v[i];
+    sfb__rnormalize(hv);
+    spec = sfb__rdot(n, hv);
+    spec = spec > 0.0 ? pow(spec, 48.0) : 0.0;
+    if (c->mode == SFB_RENDER_SHADED) {
+        double fl = sfb__rdot(n, V->fill), lum;
+        if (fl < 0.0) fl = 0.0;
+        lum = 0.72 * (0.16 + 0.70 * diff + 0.18 * fl) + 0.30 * spec;
+        rgb[0] = rgb[1] = rgb[2] = lum;
+    } else if (c->mode == SFB_RENDER_WEIGHTS) {
+        double lum = 0.55 + 0.45 * diff;
+        sfb__colormap(g[7], rgb);
+        for (i = 0; i < 3; ++i) rgb[i] = rgb[i] * lum + 0.12 * spec;
+    } else {
+        /* highlight: a lit light-grey base with a dark blue and a cyan band per period */
+        double base = 0.42 + 0.55 * diff, wv = g[7];
+        rgb[0] = rgb[1] = rgb[2] = base;
+        if (wv < 1e30) sfb__render_highlight(R, x, y, pix, wv, diff, rgb);
+    }
+}
+
+/* Pass 2: shades every pixel into rgba (the background where nothing is drawn), counting the
+ * covered ones in *object_pixels. */
+static sfb_result sfb__render_shade(sfb_context *ctx, const sfb__raster *R, const sfb_render_config *c, const sfb__render_view *V,
+                                    const unsigned char *bg, unsigned char *rgba, long *object_pixels) {
+    int w = R->w, h = R->h, x, y, i;
+    sfb_result r;
+    for (y = 0; y < h; ++y) {
+        if ((y & 15) == 0 && (r = sfb__progress(ctx, 0.6f + 0.4f * (float)y / (float)h, "render")) != SFB_SUCCESS) return r;
+        for (x = 0; x < w; ++x) {
+            size_t pix = (size_t)y * (size_t)w + (size_t)x;
+            const float *g = R->gb + pix * SFB__RENDER_GB;
+            unsigned char *o = rgba + 4 * pix;
+            double rgb[3], e;
+            if (!(g[0] < (float)HUGE_VAL)) { memcpy(o, bg, 4); continue; }
+            ++*object_pixels;
+            sfb__render_lit(R, c, V, x, y, pix, rgb);
+            /* a little gamma on lit colours, so that the darker half keeps detail (normals are
+             * written as they are) */
+            if (c->mode != SFB_RENDER_NORMALS)
+                for (i = 0; i < 3; ++i) rgb[i] = pow(sfb__rclamp(rgb[i], 0.0, 1.0), 1.0 / 1.6);
+            if (R->edge && R->edge[pix]) {
+                e = R->edge[pix] / 255.0 * 0.85;
+                for (i = 0; i < 3; ++i) rgb[i] = rgb[i] * (1.0 - e) + 0.08 * e;
+            }
+            o[0] = sfb__to_byte(rgb[0]); o[1] = sfb__to_byte(rgb[1]); o[2] = sfb__to_byte(rgb[2]); o[3] = 255;
+        }
+    }
+    return SFB_SUCCESS;
+}
+
 SFB_API sfb_result sfb_render(sfb_context *ctx, const sfb_mesh_data *m, const sfb_render_config *cfg, sfb_image *out) {
     sfb_render_config c;
     const float *pos = NULL, *nrm = NULL, *scal = NULL;
-    int w = 0, h = 0, f, y, x, i;
-    size_t npix, bytes, gbytes, k, off;
-    sfb__camera cam;
+    int w = 0, h = 0, f;
+    size_t npix, bytes, gbytes, k;
+    sfb__render_view V;
     sfb__raster R;
     sfb__pv *pv = NULL;
     unsigned char *hole = NULL, *rgba = NULL;
-    double lo[3], hi[3], centre[3], radius, yaw, pitch;
-    double light_m[3], light_e[3], light_d[3], light_a[3], spacing, lightdist;
-    double key[3], fill[3];
     unsigned char bg[4];
     sfb_result r = SFB_SUCCESS;
     long object_pixels = 0;
@@ -9053,203 +9611,15 @@ SFB_API sfb_result sfb_render(sfb_context *ctx, const sfb_mesh_data *m, const sf
     for (f = 0; f < m->hole_count; ++f) hole[m->holes[f]] = 1;
     for (k = 0; k < npix; ++k) R.gb[k * SFB__RENDER_GB] = (float)HUGE_VAL;
 
-    /* camera */
-    if (!sfb__render_bounds(m, pos, lo, hi)) { lo[0] = lo[1] = lo[2] = -1.0; hi[0] = hi[1] = hi[2] = 1.0; }
-    for (i = 0; i < 3; ++i) centre[i] = 0.5 * (lo[i] + hi[i]);
-    radius = 0.5 * sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) + (hi[2] - lo[2]) * (hi[2] - lo[2]));
-    if (!(radius > 0.0) || !isfinite(radius)) radius = 1.0;
-    yaw = (c.view_set ? c.yaw : SFB__RENDER_DEFAULT_YAW) * SFB__PI / 180.0;
-    pitch = (c.view_set ? c.pitch : SFB__RENDER_DEFAULT_PITCH) * SFB__PI / 180.0;
-    memset(&cam, 0, sizeof cam);
-    cam.ortho = c.orthographic != 0;
-    {
-        double dir[3], dist = radius / sin(SFB__RENDER_HALF_FOV * SFB__PI / 180.0);
-        double zoom = c.zoom > 0.0f ? c.zoom : 1.0, half = 0.5 * (w < h ? w : h) * SFB__RENDER_MARGIN;
-        dir[0] = cos(pitch) * sin(yaw); dir[1] = sin(pitch); dir[2] = cos(pitch) * cos(yaw);
-        for (i = 0; i < 3; ++i) { cam.eye[i] = centre[i] + dist * dir[i]; cam.fwd[i] = -dir[i]; }
-        cam.right[0] = cos(yaw); cam.right[1] = 0.0; cam.right[2] = -sin(yaw);
-        sfb__rcross(cam.right, cam.fwd, cam.up);
-        sfb__rnormalize(cam.up);
-        cam.focal = cam.ortho ? half * zoom / radius : half * zoom / tan(SFB__RENDER_HALF_FOV * SFB__PI / 180.0);
-        cam.cx = 0.5 * w;
-        cam.cy = 0.5 * h;
-    }
-    /* lights, fixed to the camera: a key light from the upper left behind the viewer, a fill */
-    for (i = 0; i < 3; ++i) {
-        key[i] = -cam.fwd[i] + 0.55 * cam.up[i] - 0.45 * cam.right[i];
-        fill[i] = -cam.fwd[i] - 0.3 * cam.up[i] + 0.8 * cam.right[i];
-    }
-    sfb__rnormalize(key);
-    sfb__rnormalize(fill);
-    /* the light plane of the highlight lines: facing the object from the camera's side, lines
-     * running at 30 degrees from the picture's vertical */
-    lightdist = (c.light_distance > 0.0f ? c.light_distance : SFB__RENDER_DEFAULT_LIGHT_DISTANCE) * radius;
-    spacing = 2.0 * radius / (c.stripes > 0.0f ? c.stripes : SFB__RENDER_DEFAULT_STRIPES);
-    for (i = 0; i < 3; ++i) {
-        light_m[i] = -cam.fwd[i];
-        light_e[i] = cos(SFB__PI / 6.0) * cam.up[i] + sin(SFB__PI / 6.0) * cam.right[i];
-        light_a[i] = centre[i] + lightdist * light_m[i];
-    }
-    sfb__rcross(light_m, light_e, light_d);
-    sfb__rnormalize(light_d);
-
-    /* project the vertices */
-    for (i = 0; i < m->vertex_count; ++i) {
-        const float *p = pos + 3 * (size_t)i;
-        double d[3], xc, yc, zc;
-        if (!(isfinite(p[0]) && isfinite(p[1]) && isfinite(p[2]))) { pv[i].z = -1.0; pv[i].x = pv[i].y = pv[i].q = 0.0; continue; }
-        d[0] = p[0] - cam.eye[0]; d[1] = p[1] - cam.eye[1]; d[2] = p[2] - cam.eye[2];
-        xc = sfb__rdot(d, cam.right); yc = sfb__rdot(d, cam.up); zc = sfb__rdot(d, cam.fwd);
-        pv[i].z = zc;
-        if (cam.ortho) {
-            pv[i].q = 1.0;
-            pv[i].x = cam.cx + cam.focal * xc;
-            pv[i].y = cam.cy - cam.focal * yc;
-        } else {
-            pv[i].q = zc > 0.0 ? 1.0 / zc : 0.0;
-            pv[i].x = cam.cx + cam.focal * xc * pv[i].q;
-            pv[i].y = cam.cy - cam.focal * yc * pv[i].q;
-        }
-    }
-
+    sfb__render_view_setup(m, pos, &c, w, h, &V);
+    sfb__render_project(m, pos, &V.cam, pv);
     /* pass 1: rasterize */
-    R.w = w; R.h = h; R.pos = pos; R.nrm = nrm; R.scal = scal; R.cam = &cam; R.draw_edges = c.draw_edges != 0;
-    {
-        double near_z = cam.ortho ? -HUGE_VAL : 1e-3 * radius;
-        for (f = 0, off = 0; f < m->face_count; off += (size_t)m->face_sizes[f], ++f) {
-            const int *fv = m->face_vertices + off;
-            int n = m->face_sizes[f], bad = 0, t;
-            double fn[3];
-            if ((f & 255) == 255 && (r = sfb__progress(ctx, 0.6f * (float)f / (float)m->face_count, "render")) != SFB_SUCCESS) goto done;
-            if (hole && hole[f]) continue;
-            for (i = 0; i < n; ++i) {
-                const float *p = pos + 3 * (size_t)fv[i];
-                if (!(isfinite(p[0]) && isfinite(p[1]) && isfinite(p[2]))) bad = 1;
-                else if (!(pv[fv[i]].z > near_z)) bad = 1;
-            }
-            if (bad) { ++skipped; continue; }
-            sfb__polygon_normal(pos, fv, n, fn);
-            if (!(sfb__rnormalize(fn) > 0.0)) { fn[0] = -cam.fwd[0]; fn[1] = -cam.fwd[1]; fn[2] = -cam.fwd[2]; }
-            for (t = 1; t + 1 < n; ++t) {
-                sfb__pv tri[3];
-                int vi[3], real[3];
-                vi[0] = fv[0]; vi[1] = fv[t]; vi[2] = fv[t + 1];
-                tri[0] = pv[vi[0]]; tri[1] = pv[vi[1]]; tri[2] = pv[vi[2]];
-                real[0] = 1;              /* (t, t+1) */
-                real[1] = t + 2 == n;     /* (t+1, 0): the polygon's last side */
-                real[2] = t == 1;         /* (0, 1): its first side */
-                sfb__raster_tri(&R, tri, vi, real, fn);
-            }
-        }
-    }
-
+    R.w = w; R.h = h; R.pos = pos; R.nrm = nrm; R.scal = scal; R.cam = &V.cam; R.draw_edges = c.draw_edges != 0;
+    if ((r = sfb__render_rasterize(ctx, &R, m, pv, hole, V.radius, &skipped)) != SFB_SUCCESS) goto done;
     /* pass 2a (highlight): stripe coordinate per pixel, kept in the scalar slot */
-    if (c.mode == SFB_RENDER_HIGHLIGHT) {
-        for (k = 0; k < npix; ++k) {
-            float *g = R.gb + k * SFB__RENDER_GB;
-            double n[3], p[3], v[3], nm, wv;
-            if (!(g[0] < (float)HUGE_VAL)) continue;
-            n[0] = g[1]; n[1] = g[2]; n[2] = g[3];
-            p[0] = g[4]; p[1] = g[5]; p[2] = g[6];
-            sfb__rnormalize(n);
-            if (cam.ortho) { v[0] = -cam.fwd[0]; v[1] = -cam.fwd[1]; v[2] = -cam.fwd[2]; }
-            else { v[0] = cam.eye[0] - p[0]; v[1] = cam.eye[1] - p[1]; v[2] = cam.eye[2] - p[2]; }
-            if (sfb__rdot(n, v) < 0.0) { n[0] = -n[0]; n[1] = -n[1]; n[2] = -n[2]; }
-            nm = sfb__rdot(n, light_m);
-            if (fabs(nm) < 1e-6) { g[7] = (float)HUGE_VAL; continue; }
-            if (c.light_at_infinity) {
-                wv = lightdist * sfb__rdot(n, light_d) / nm / spacing;
-            } else {
-                double ap[3], mu, X[3];
-                for (i = 0; i < 3; ++i) ap[i] = light_a[i] - p[i];
-                mu = sfb__rdot(ap, light_m) / nm;
-                for (i = 0; i < 3; ++i) X[i] = p[i] + mu * n[i] - light_a[i];
-                wv = sfb__rdot(X, light_d) / spacing;
-            }
-            g[7] = isfinite(wv) && fabs(wv) < 1e7 ? (float)wv : (float)HUGE_VAL;
-        }
-    }
-
+    if (c.mode == SFB_RENDER_HIGHLIGHT) sfb__render_stripes(&R, npix, &c, &V);
     /* pass 2: shade */
-    for (y = 0; y < h; ++y) {
-        if ((y & 15) == 0 && (r = sfb__progress(ctx, 0.6f + 0.4f * (float)y / (float)h, "render")) != SFB_SUCCESS) goto done;
-        for (x = 0; x < w; ++x) {
-            size_t pix = (size_t)y * (size_t)w + (size_t)x;
-            const float *g = R.gb + pix * SFB__RENDER_GB;
-            unsigned char *o = rgba + 4 * pix;
-            double n[3], p[3], v[3], rgb[3], diff, spec, hv[3], e;
-            if (!(g[0] < (float)HUGE_VAL)) { memcpy(o, bg, 4); continue; }
-            ++object_pixels;
-            n[0] = g[1]; n[1] = g[2]; n[2] = g[3];
-            p[0] = g[4]; p[1] = g[5]; p[2] = g[6];
-            sfb__rnormalize(n);
-            if (c.mode == SFB_RENDER_NORMALS) {
-                for (i = 0; i < 3; ++i) rgb[i] = 0.5 + 0.5 * n[i];
-            } else {
-                if (cam.ortho) { v[0] = -cam.fwd[0]; v[1] = -cam.fwd[1]; v[2] = -cam.fwd[2]; }
-                else { v[0] = cam.eye[0] - p[0]; v[1] = cam.eye[1] - p[1]; v[2] = cam.eye[2] - p[2]; }
-                sfb__rnormalize(v);
-                if (sfb__rdot(n, v) < 0.0) { n[0] = -n[0]; n[1] = -n[1]; n[2] = -n[2]; }
-                diff = sfb__rdot(n, key);
-                if (diff < 0.0) diff = 0.0;
-                for (i = 0; i < 3; ++i) hv[i] = key[i] + v[i];
-                sfb__rnormalize(hv);
-                spec = sfb__rdot(n, hv);
-                spec = spec > 0.0 ? pow(spec, 48.0) : 0.0;
-                if (c.mode == SFB_RENDER_SHADED) {
-                    double fl = sfb__rdot(n, fill), lum;
-                    if (fl < 0.0) fl = 0.0;
-                    lum = 0.72 * (0.16 + 0.70 * diff + 0.18 * fl) + 0.30 * spec;
-                    rgb[0] = rgb[1] = rgb[2] = lum;
-                } else if (c.mode == SFB_RENDER_WEIGHTS) {
-                    double lum = 0.55 + 0.45 * diff;
-                    sfb__colormap(g[7], rgb);
-                    for (i = 0; i < 3; ++i) rgb[i] = rgb[i] * lum + 0.12 * spec;
-                } else {
-                    /* highlight: a lit light-grey base with a dark blue and a cyan band per period */
-                    double base = 0.42 + 0.55 * diff, wv = g[7];
-                    rgb[0] = rgb[1] = rgb[2] = base;
-                    if (wv < 1e30) {
-                        double dx = HUGE_VAL, dy = HUGE_VAL, fw, cb, cc;
-                        /* the pixel footprint in stripe periods: the smaller one-sided difference per
-                         * axis (robust at silhouettes, where one neighbour is another surface) */
-                        if (x > 0 && R.gb[(pix - 1) * SFB__RENDER_GB + 7] < 1e30f) dx = fabs(wv - R.gb[(pix - 1) * SFB__RENDER_GB + 7]);
-                        if (x + 1 < w && R.gb[(pix + 1) * SFB__RENDER_GB + 7] < 1e30f) {
-                            double d2 = fabs(wv - R.gb[(pix + 1) * SFB__RENDER_GB + 7]);
-                            if (d2 < dx) dx = d2;
-                        }
-                        if (y > 0 && R.gb[(pix - (size_t)w) * SFB__RENDER_GB + 7] < 1e30f)
-                            dy = fabs(wv - R.gb[(pix - (size_t)w) * SFB__RENDER_GB + 7]);
-                        if (y + 1 < h && R.gb[(pix + (size_t)w) * SFB__RENDER_GB + 7] < 1e30f) {
-                            double d2 = fabs(wv - R.gb[(pix + (size_t)w) * SFB__RENDER_GB + 7]);
-                            if (d2 < dy) dy = d2;
-                        }
-                        if (dx == HUGE_VAL) dx = 0.0;
-                        if (dy == HUGE_VAL) dy = 0.0;
-                        fw = dx + dy;
-                        cb = sfb__band_cover(wv, fw, 0.00, 0.22);
-                        cc = sfb__band_cover(wv, fw, 0.50, 0.72);
-                        {
-                            double lum = 0.45 + 0.55 * diff;
-                            double blue[3], cyan[3];
-                            blue[0] = 0.05 * lum; blue[1] = 0.12 * lum; blue[2] = 0.75 * lum;
-                            cyan[0] = 0.10 * lum; cyan[1] = 0.80 * lum; cyan[2] = 0.95 * lum;
-                            for (i = 0; i < 3; ++i) rgb[i] = rgb[i] * (1.0 - cb - cc) + blue[i] * cb + cyan[i] * cc;
-                        }
-                    }
-                }
-            }
-            /* a little gamma on lit colours, so that the darker half keeps detail (normals are
-             * written as they are) */
-            if (c.mode != SFB_RENDER_NORMALS)
-                for (i = 0; i < 3; ++i) rgb[i] = pow(sfb__rclamp(rgb[i], 0.0, 1.0), 1.0 / 1.6);
-            if (R.edge && R.edge[pix]) {
-                e = R.edge[pix] / 255.0 * 0.85;
-                for (i = 0; i < 3; ++i) rgb[i] = rgb[i] * (1.0 - e) + 0.08 * e;
-            }
-            o[0] = sfb__to_byte(rgb[0]); o[1] = sfb__to_byte(rgb[1]); o[2] = sfb__to_byte(rgb[2]); o[3] = 255;
-        }
-    }
+    if ((r = sfb__render_shade(ctx, &R, &c, &V, bg, rgba, &object_pixels)) != SFB_SUCCESS) goto done;
     if ((r = sfb__progress(ctx, 1.0f, "render")) != SFB_SUCCESS) goto done;
     out->width = w;
     out->height = h;

@@ -148,14 +148,10 @@ static sfb_result sfb__check_sharpness(sfb_context *ctx, float s, const sfb__src
 
 void sfb_mesh_destroy(sfb_mesh *mesh);
 
-sfb_result sfb__mesh_create(sfb_context *ctx, const sfb_mesh_desc *d, const sfb__src_lines *lines, sfb_mesh **out) {
-    sfb_mesh *m;
-    sfb_result r;
-    int i, v, e;
-    char msg[256];
-    if (!ctx) return SFB_INVALID_ARGS;
-    if (!d || !out) return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "sfb_mesh_create: NULL argument");
-    *out = NULL;
+/* Refuses a mesh description with bad counts, missing arrays, unknown options or non-finite
+ * positions, before any allocation. */
+static sfb_result sfb__mesh_check_desc(sfb_context *ctx, const sfb_mesh_desc *d) {
+    int v;
     if (d->vertex_count < 0 || d->face_count < 0 || d->crease_count < 0 || d->corner_count < 0 || d->hole_count < 0 ||
         d->uv_count < 0)
         return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "negative element count in the mesh description");
@@ -175,27 +171,27 @@ sfb_result sfb__mesh_create(sfb_context *ctx, const sfb_mesh_desc *d, const sfb_
     for (v = 0; v < d->vertex_count; ++v)
         if (!sfb__finite3(d->positions + 3 * (size_t)v))
             return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_VERTEX, v, "coordinate is not finite (NaN or inf)");
-    m = (sfb_mesh *)sfb__calloc(ctx, 1, sizeof(sfb_mesh));
-    if (!m) return sfb__oom(ctx, "mesh");
-    m->ctx = ctx;
-    m->boundary = d->boundary; m->crease_method = d->crease_method;
-    m->triangle_rule = d->triangle_rule; m->uv_interp = d->uv_interp;
-    r = sfb__level_from_faces(ctx, d->vertex_count, d->face_count, d->face_sizes, d->face_vertices, lines, SFB_ELEMENT_VERTEX, &m->base);
-    if (r != SFB_SUCCESS) { sfb_mesh_destroy(m); return r; }
-    for (v = 0; v < m->base.nv; ++v) {
-        int val = m->base.ve_off[v + 1] - m->base.ve_off[v];
-        int fal = m->base.vf_off[v + 1] - m->base.vf_off[v];
-        if (val > SFB_MAX_VALENCE || fal > SFB_MAX_VALENCE) {
-            sfb_mesh_destroy(m);
+    return SFB_SUCCESS;
+}
+
+/* Refuses a vertex of the base level with more edges or faces than SFB_MAX_VALENCE. */
+static sfb_result sfb__mesh_check_valence(sfb_context *ctx, const sfb__level *l) {
+    int v;
+    for (v = 0; v < l->nv; ++v) {
+        int val = l->ve_off[v + 1] - l->ve_off[v];
+        int fal = l->vf_off[v + 1] - l->vf_off[v];
+        if (val > SFB_MAX_VALENCE || fal > SFB_MAX_VALENCE)
             return sfb__error(ctx, SFB_LIMIT_EXCEEDED, SFB_ELEMENT_VERTEX, v, "valence %d is over the limit of %d (SFB_MAX_VALENCE)",
                               val > fal ? val : fal, SFB_MAX_VALENCE);
-        }
     }
-    m->positions = (float *)sfb__alloc(ctx, (size_t)d->vertex_count * 3 * sizeof(float) + 1);
-    m->face_sizes = (int *)sfb__alloc(ctx, (size_t)d->face_count * sizeof(int));
-    if (!m->positions || !m->face_sizes) { sfb_mesh_destroy(m); return sfb__oom(ctx, "mesh"); }
-    memcpy(m->positions, d->positions, (size_t)d->vertex_count * 3 * sizeof(float));
-    memcpy(m->face_sizes, d->face_sizes, (size_t)d->face_count * sizeof(int));
+    return SFB_SUCCESS;
+}
+
+/* Edge sharpness from the crease list and the per-face edge sharpness of the description. */
+static sfb_result sfb__mesh_apply_creases(sfb_context *ctx, sfb_mesh *m, const sfb_mesh_desc *d, const sfb__src_lines *lines) {
+    sfb_result r;
+    int i, e;
+    char msg[256];
     /* creases: later entries override earlier ones on the same edge (as OpenSubdiv) */
     for (i = 0; i < d->crease_count; ++i) {
         int a = d->crease_vertices[2 * i], b = d->crease_vertices[2 * i + 1];
@@ -204,15 +200,13 @@ sfb_result sfb__mesh_create(sfb_context *ctx, const sfb_mesh_desc *d, const sfb_
         if (a < 0 || a >= d->vertex_count || b < 0 || b >= d->vertex_count) {
             snprintf(msg, sizeof msg, "crease names vertex index %d out of range (%d vertices)",
                      (a < 0 || a >= d->vertex_count) ? a : b, d->vertex_count);
-            sfb_mesh_destroy(m);
             return sfb__elem_error(ctx, SFB_INVALID_TOPOLOGY, lines, lo, SFB_ELEMENT_EDGE, i, "crease", i, msg);
         }
         r = sfb__check_sharpness(ctx, s, lines, lo, "crease", i);
-        if (r != SFB_SUCCESS) { sfb_mesh_destroy(m); return r; }
+        if (r != SFB_SUCCESS) return r;
         e = sfb__find_edge(&m->base, a, b);
         if (e < 0) {
             snprintf(msg, sizeof msg, "crease between vertices %d and %d is not an edge of the mesh", a, b);
-            sfb_mesh_destroy(m);
             return sfb__elem_error(ctx, SFB_INVALID_TOPOLOGY, lines, lo, SFB_ELEMENT_EDGE, i, "crease", i, msg);
         }
         m->base.es[e] = s;
@@ -225,7 +219,6 @@ sfb_result sfb__mesh_create(sfb_context *ctx, const sfb_mesh_desc *d, const sfb_
                 float s = d->face_edge_sharpness[o + i];
                 if (isnan(s) || s < 0.0f) {
                     snprintf(msg, sizeof msg, "per-face edge sharpness %g is invalid: sharpness must be a number >= 0", (double)s);
-                    sfb_mesh_destroy(m);
                     return sfb__elem_error(ctx, SFB_INVALID_VALUE, lines, lines ? lines->face : NULL, SFB_ELEMENT_FACE, f, "face", f, msg);
                 }
                 /* seed 001: where two faces give an edge different values, the highest wins */
@@ -233,81 +226,125 @@ sfb_result sfb__mesh_create(sfb_context *ctx, const sfb_mesh_desc *d, const sfb_
             }
         }
     }
+    return SFB_SUCCESS;
+}
+
+/* Vertex sharpness from the corner list and face holes from the hole list of the description. */
+static sfb_result sfb__mesh_apply_corners_holes(sfb_context *ctx, sfb_mesh *m, const sfb_mesh_desc *d, const sfb__src_lines *lines) {
+    sfb_result r;
+    int i;
+    char msg[256];
     for (i = 0; i < d->corner_count; ++i) {
         int a = d->corner_vertices[i];
         const int *lo = lines ? lines->corner : NULL;
         if (a < 0 || a >= d->vertex_count) {
             snprintf(msg, sizeof msg, "corner names vertex index %d out of range (%d vertices)", a, d->vertex_count);
-            sfb_mesh_destroy(m);
             return sfb__elem_error(ctx, SFB_INVALID_TOPOLOGY, lines, lo, SFB_ELEMENT_VERTEX, a, "corner", i, msg);
         }
         r = sfb__check_sharpness(ctx, d->corner_sharpness[i], lines, lo, "corner", i);
-        if (r != SFB_SUCCESS) { sfb_mesh_destroy(m); return r; }
+        if (r != SFB_SUCCESS) return r;
         m->base.vs[a] = d->corner_sharpness[i];
     }
     for (i = 0; i < d->hole_count; ++i) {
         int f = d->holes[i];
         if (f < 0 || f >= d->face_count) {
             snprintf(msg, sizeof msg, "hole names face index %d out of range (%d faces)", f, d->face_count);
-            sfb_mesh_destroy(m);
             return sfb__elem_error(ctx, SFB_INVALID_TOPOLOGY, lines, lines ? lines->hole : NULL, SFB_ELEMENT_FACE, f, "hole", i, msg);
         }
         m->base.fhole[f] = 1;
     }
+    return SFB_SUCCESS;
+}
+
+/* Refuses non-finite UVs and face UV indices out of range (the UVs are copied by the caller). */
+static sfb_result sfb__mesh_check_uvs(sfb_context *ctx, const sfb_mesh *m, const sfb_mesh_desc *d, const sfb__src_lines *lines) {
+    size_t nfv = (size_t)m->base.nfv;
+    int i;
+    char msg[256];
+    for (i = 0; i < d->uv_count; ++i)
+        if (!isfinite(d->uvs[2 * i]) || !isfinite(d->uvs[2 * i + 1]))
+            return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_UV, i, "uv coordinate is not finite (NaN or inf)");
+    for (i = 0; (size_t)i < nfv; ++i)
+        if (d->face_uvs[i] < 0 || d->face_uvs[i] >= d->uv_count) {
+            int f = 0;
+            while (m->base.fv_off[f + 1] <= i) ++f;
+            snprintf(msg, sizeof msg, "uv index %d out of range (%d uvs)", d->face_uvs[i], d->uv_count);
+            return sfb__elem_error(ctx, SFB_INVALID_TOPOLOGY, lines, lines ? lines->face : NULL, SFB_ELEMENT_FACE, f, "face", f, msg);
+        }
+    return SFB_SUCCESS;
+}
+
+/* The description view (sfb_mesh_get_desc): per-edge creases, corners and holes as lists.
+ * Returns 0 when an allocation failed. */
+static int sfb__mesh_desc_view(sfb_context *ctx, sfb_mesh *m) {
+    int nc = 0, nk = 0, nh = 0, f, e, v;
+    for (e = 0; e < m->base.ne; ++e) nc += m->base.es[e] > 0.0f;
+    for (v = 0; v < m->base.nv; ++v) nk += m->base.vs[v] > 0.0f;
+    for (f = 0; f < m->base.nf; ++f) nh += m->base.fhole[f] != 0;
+    m->crease_vertices = (int *)sfb__alloc(ctx, (size_t)nc * 2 * sizeof(int) + 1);
+    m->crease_sharpness = (float *)sfb__alloc(ctx, (size_t)nc * sizeof(float) + 1);
+    m->corner_vertices = (int *)sfb__alloc(ctx, (size_t)nk * sizeof(int) + 1);
+    m->corner_sharpness = (float *)sfb__alloc(ctx, (size_t)nk * sizeof(float) + 1);
+    m->holes = (int *)sfb__alloc(ctx, (size_t)nh * sizeof(int) + 1);
+    if (!m->crease_vertices || !m->crease_sharpness || !m->corner_vertices || !m->corner_sharpness || !m->holes) return 0;
+    for (e = 0; e < m->base.ne; ++e)
+        if (m->base.es[e] > 0.0f) {
+            m->crease_vertices[2 * m->crease_count] = m->base.ev[2 * e];
+            m->crease_vertices[2 * m->crease_count + 1] = m->base.ev[2 * e + 1];
+            m->crease_sharpness[m->crease_count++] = m->base.es[e];
+        }
+    for (v = 0; v < m->base.nv; ++v)
+        if (m->base.vs[v] > 0.0f) {
+            m->corner_vertices[m->corner_count] = v;
+            m->corner_sharpness[m->corner_count++] = m->base.vs[v];
+        }
+    for (f = 0; f < m->base.nf; ++f)
+        if (m->base.fhole[f]) m->holes[m->hole_count++] = f;
+    return 1;
+}
+
+sfb_result sfb__mesh_create(sfb_context *ctx, const sfb_mesh_desc *d, const sfb__src_lines *lines, sfb_mesh **out) {
+    sfb_mesh *m;
+    sfb_result r;
+    const char *oom = NULL;
+    if (!ctx) return SFB_INVALID_ARGS;
+    if (!d || !out) return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "sfb_mesh_create: NULL argument");
+    *out = NULL;
+    if ((r = sfb__mesh_check_desc(ctx, d)) != SFB_SUCCESS) return r;
+    m = (sfb_mesh *)sfb__calloc(ctx, 1, sizeof(sfb_mesh));
+    if (!m) return sfb__oom(ctx, "mesh");
+    m->ctx = ctx;
+    m->boundary = d->boundary; m->crease_method = d->crease_method;
+    m->triangle_rule = d->triangle_rule; m->uv_interp = d->uv_interp;
+    r = sfb__level_from_faces(ctx, d->vertex_count, d->face_count, d->face_sizes, d->face_vertices, lines, SFB_ELEMENT_VERTEX, &m->base);
+    if (r != SFB_SUCCESS) goto fail;
+    if ((r = sfb__mesh_check_valence(ctx, &m->base)) != SFB_SUCCESS) goto fail;
+    m->positions = (float *)sfb__alloc(ctx, (size_t)d->vertex_count * 3 * sizeof(float) + 1);
+    m->face_sizes = (int *)sfb__alloc(ctx, (size_t)d->face_count * sizeof(int));
+    if (!m->positions || !m->face_sizes) { oom = "mesh"; goto fail; }
+    memcpy(m->positions, d->positions, (size_t)d->vertex_count * 3 * sizeof(float));
+    memcpy(m->face_sizes, d->face_sizes, (size_t)d->face_count * sizeof(int));
+    if ((r = sfb__mesh_apply_creases(ctx, m, d, lines)) != SFB_SUCCESS) goto fail;
+    if ((r = sfb__mesh_apply_corners_holes(ctx, m, d, lines)) != SFB_SUCCESS) goto fail;
     if (d->uv_count > 0) {
         size_t nfv = (size_t)m->base.nfv;
-        for (i = 0; i < d->uv_count; ++i)
-            if (!isfinite(d->uvs[2 * i]) || !isfinite(d->uvs[2 * i + 1])) {
-                sfb_mesh_destroy(m);
-                return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_UV, i, "uv coordinate is not finite (NaN or inf)");
-            }
-        for (i = 0; (size_t)i < nfv; ++i)
-            if (d->face_uvs[i] < 0 || d->face_uvs[i] >= d->uv_count) {
-                int f = 0;
-                while (m->base.fv_off[f + 1] <= i) ++f;
-                snprintf(msg, sizeof msg, "uv index %d out of range (%d uvs)", d->face_uvs[i], d->uv_count);
-                sfb_mesh_destroy(m);
-                return sfb__elem_error(ctx, SFB_INVALID_TOPOLOGY, lines, lines ? lines->face : NULL, SFB_ELEMENT_FACE, f, "face", f, msg);
-            }
+        if ((r = sfb__mesh_check_uvs(ctx, m, d, lines)) != SFB_SUCCESS) goto fail;
         m->uv_count = d->uv_count;
         m->uvs = (float *)sfb__alloc(ctx, (size_t)d->uv_count * 2 * sizeof(float));
         m->face_uvs = (int *)sfb__alloc(ctx, nfv * sizeof(int));
-        if (!m->uvs || !m->face_uvs) { sfb_mesh_destroy(m); return sfb__oom(ctx, "mesh uvs"); }
+        if (!m->uvs || !m->face_uvs) { oom = "mesh uvs"; goto fail; }
         memcpy(m->uvs, d->uvs, (size_t)d->uv_count * 2 * sizeof(float));
         memcpy(m->face_uvs, d->face_uvs, nfv * sizeof(int));
     }
-    /* desc view: per-edge creases, corners, holes */
-    {
-        int nc = 0, nk = 0, nh = 0, f;
-        for (e = 0; e < m->base.ne; ++e) nc += m->base.es[e] > 0.0f;
-        for (v = 0; v < m->base.nv; ++v) nk += m->base.vs[v] > 0.0f;
-        for (f = 0; f < m->base.nf; ++f) nh += m->base.fhole[f] != 0;
-        m->crease_vertices = (int *)sfb__alloc(ctx, (size_t)nc * 2 * sizeof(int) + 1);
-        m->crease_sharpness = (float *)sfb__alloc(ctx, (size_t)nc * sizeof(float) + 1);
-        m->corner_vertices = (int *)sfb__alloc(ctx, (size_t)nk * sizeof(int) + 1);
-        m->corner_sharpness = (float *)sfb__alloc(ctx, (size_t)nk * sizeof(float) + 1);
-        m->holes = (int *)sfb__alloc(ctx, (size_t)nh * sizeof(int) + 1);
-        if (!m->crease_vertices || !m->crease_sharpness || !m->corner_vertices || !m->corner_sharpness || !m->holes) {
-            sfb_mesh_destroy(m);
-            return sfb__oom(ctx, "mesh");
-        }
-        for (e = 0; e < m->base.ne; ++e)
-            if (m->base.es[e] > 0.0f) {
-                m->crease_vertices[2 * m->crease_count] = m->base.ev[2 * e];
-                m->crease_vertices[2 * m->crease_count + 1] = m->base.ev[2 * e + 1];
-                m->crease_sharpness[m->crease_count++] = m->base.es[e];
-            }
-        for (v = 0; v < m->base.nv; ++v)
-            if (m->base.vs[v] > 0.0f) {
-                m->corner_vertices[m->corner_count] = v;
-                m->corner_sharpness[m->corner_count++] = m->base.vs[v];
-            }
-        for (f = 0; f < m->base.nf; ++f)
-            if (m->base.fhole[f]) m->holes[m->hole_count++] = f;
-    }
+    if (!sfb__mesh_desc_view(ctx, m)) { oom = "mesh"; goto fail; }
     sfb__level_compute_rules(&m->base);
     *out = m;
     return SFB_SUCCESS;
+fail:
+    /* an allocation failure is reported after the mesh is gone (the message gives the bytes
+     * still in use) */
+    sfb_mesh_destroy(m);
+    return oom ? sfb__oom(ctx, oom) : r;
 }
 
 SFB_API sfb_result sfb_mesh_create(sfb_context *ctx, const sfb_mesh_desc *desc, sfb_mesh **out) {

@@ -269,18 +269,270 @@ static int sfb__render_bounds(const sfb_mesh_data *m, const float *pos, double *
     return any;
 }
 
+/* The camera and the lights of one picture, the lights fixed to the camera. */
+typedef struct sfb__render_view {
+    sfb__camera cam;
+    double centre[3], radius;
+    double key[3], fill[3];  /* directions of the key and the fill light */
+    /* the light plane of the highlight lines: normal m, line direction e, across the lines d,
+     * a point a; line spacing and the plane's distance */
+    double light_m[3], light_e[3], light_d[3], light_a[3], spacing, lightdist;
+} sfb__render_view;
+
+/* The orbit camera around the bounding box of what the faces use and the lights (config c, a
+ * w x h picture). */
+static void sfb__render_view_setup(const sfb_mesh_data *m, const float *pos, const sfb_render_config *c, int w, int h,
+                                   sfb__render_view *V) {
+    double lo[3], hi[3], yaw, pitch;
+    sfb__camera *cam = &V->cam;
+    int i;
+    /* camera */
+    if (!sfb__render_bounds(m, pos, lo, hi)) { lo[0] = lo[1] = lo[2] = -1.0; hi[0] = hi[1] = hi[2] = 1.0; }
+    for (i = 0; i < 3; ++i) V->centre[i] = 0.5 * (lo[i] + hi[i]);
+    V->radius = 0.5 * sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) + (hi[2] - lo[2]) * (hi[2] - lo[2]));
+    if (!(V->radius > 0.0) || !isfinite(V->radius)) V->radius = 1.0;
+    yaw = (c->view_set ? c->yaw : SFB__RENDER_DEFAULT_YAW) * SFB__PI / 180.0;
+    pitch = (c->view_set ? c->pitch : SFB__RENDER_DEFAULT_PITCH) * SFB__PI / 180.0;
+    memset(cam, 0, sizeof *cam);
+    cam->ortho = c->orthographic != 0;
+    {
+        double dir[3], dist = V->radius / sin(SFB__RENDER_HALF_FOV * SFB__PI / 180.0);
+        double zoom = c->zoom > 0.0f ? c->zoom : 1.0, half = 0.5 * (w < h ? w : h) * SFB__RENDER_MARGIN;
+        dir[0] = cos(pitch) * sin(yaw); dir[1] = sin(pitch); dir[2] = cos(pitch) * cos(yaw);
+        for (i = 0; i < 3; ++i) { cam->eye[i] = V->centre[i] + dist * dir[i]; cam->fwd[i] = -dir[i]; }
+        cam->right[0] = cos(yaw); cam->right[1] = 0.0; cam->right[2] = -sin(yaw);
+        sfb__rcross(cam->right, cam->fwd, cam->up);
+        sfb__rnormalize(cam->up);
+        cam->focal = cam->ortho ? half * zoom / V->radius : half * zoom / tan(SFB__RENDER_HALF_FOV * SFB__PI / 180.0);
+        cam->cx = 0.5 * w;
+        cam->cy = 0.5 * h;
+    }
+    /* lights, fixed to the camera: a key light from the upper left behind the viewer, a fill */
+    for (i = 0; i < 3; ++i) {
+        V->key[i] = -cam->fwd[i] + 0.55 * cam->up[i] - 0.45 * cam->right[i];
+        V->fill[i] = -cam->fwd[i] - 0.3 * cam->up[i] + 0.8 * cam->right[i];
+    }
+    sfb__rnormalize(V->key);
+    sfb__rnormalize(V->fill);
+    /* the light plane of the highlight lines: facing the object from the camera's side, lines
+     * running at 30 degrees from the picture's vertical */
+    V->lightdist = (c->light_distance > 0.0f ? c->light_distance : SFB__RENDER_DEFAULT_LIGHT_DISTANCE) * V->radius;
+    V->spacing = 2.0 * V->radius / (c->stripes > 0.0f ? c->stripes : SFB__RENDER_DEFAULT_STRIPES);
+    for (i = 0; i < 3; ++i) {
+        V->light_m[i] = -cam->fwd[i];
+        V->light_e[i] = cos(SFB__PI / 6.0) * cam->up[i] + sin(SFB__PI / 6.0) * cam->right[i];
+        V->light_a[i] = V->centre[i] + V->lightdist * V->light_m[i];
+    }
+    sfb__rcross(V->light_m, V->light_e, V->light_d);
+    sfb__rnormalize(V->light_d);
+}
+
+/* Projects every vertex into pv (a non-finite one gets z = -1). */
+static void sfb__render_project(const sfb_mesh_data *m, const float *pos, const sfb__camera *cam, sfb__pv *pv) {
+    int i;
+    for (i = 0; i < m->vertex_count; ++i) {
+        const float *p = pos + 3 * (size_t)i;
+        double d[3], xc, yc, zc;
+        if (!(isfinite(p[0]) && isfinite(p[1]) && isfinite(p[2]))) { pv[i].z = -1.0; pv[i].x = pv[i].y = pv[i].q = 0.0; continue; }
+        d[0] = p[0] - cam->eye[0]; d[1] = p[1] - cam->eye[1]; d[2] = p[2] - cam->eye[2];
+        xc = sfb__rdot(d, cam->right); yc = sfb__rdot(d, cam->up); zc = sfb__rdot(d, cam->fwd);
+        pv[i].z = zc;
+        if (cam->ortho) {
+            pv[i].q = 1.0;
+            pv[i].x = cam->cx + cam->focal * xc;
+            pv[i].y = cam->cy - cam->focal * yc;
+        } else {
+            pv[i].q = zc > 0.0 ? 1.0 / zc : 0.0;
+            pv[i].x = cam->cx + cam->focal * xc * pv[i].q;
+            pv[i].y = cam->cy - cam->focal * yc * pv[i].q;
+        }
+    }
+}
+
+/* Pass 1: fan-triangulates and rasterizes every face that is not a hole; a face with a
+ * non-finite vertex or one behind the near plane is skipped (counted in *skipped). */
+static sfb_result sfb__render_rasterize(sfb_context *ctx, sfb__raster *R, const sfb_mesh_data *m, const sfb__pv *pv,
+                                        const unsigned char *hole, double radius, int *skipped) {
+    const sfb__camera *cam = R->cam;
+    const float *pos = R->pos;
+    double near_z = cam->ortho ? -HUGE_VAL : 1e-3 * radius;
+    size_t off;
+    sfb_result r;
+    int f, i;
+    for (f = 0, off = 0; f < m->face_count; off += (size_t)m->face_sizes[f], ++f) {
+        const int *fv = m->face_vertices + off;
+        int n = m->face_sizes[f], bad = 0, t;
+        double fn[3];
+        if ((f & 255) == 255 && (r = sfb__progress(ctx, 0.6f * (float)f / (float)m->face_count, "render")) != SFB_SUCCESS) return r;
+        if (hole && hole[f]) continue;
+        for (i = 0; i < n; ++i) {
+            const float *p = pos + 3 * (size_t)fv[i];
+            if (!(isfinite(p[0]) && isfinite(p[1]) && isfinite(p[2]))) bad = 1;
+            else if (!(pv[fv[i]].z > near_z)) bad = 1;
+        }
+        if (bad) { ++*skipped; continue; }
+        sfb__polygon_normal(pos, fv, n, fn);
+        if (!(sfb__rnormalize(fn) > 0.0)) { fn[0] = -cam->fwd[0]; fn[1] = -cam->fwd[1]; fn[2] = -cam->fwd[2]; }
+        for (t = 1; t + 1 < n; ++t) {
+            sfb__pv tri[3];
+            int vi[3], real[3];
+            vi[0] = fv[0]; vi[1] = fv[t]; vi[2] = fv[t + 1];
+            tri[0] = pv[vi[0]]; tri[1] = pv[vi[1]]; tri[2] = pv[vi[2]];
+            real[0] = 1;              /* (t, t+1) */
+            real[1] = t + 2 == n;     /* (t+1, 0): the polygon's last side */
+            real[2] = t == 1;         /* (0, 1): its first side */
+            sfb__raster_tri(R, tri, vi, real, fn);
+        }
+    }
+    return SFB_SUCCESS;
+}
+
+/* Pass 2a (highlight): the stripe coordinate of every covered pixel, kept in its scalar slot
+ * (+inf where the normal is parallel to the light plane or the value is out of range). */
+static void sfb__render_stripes(const sfb__raster *R, size_t npix, const sfb_render_config *c, const sfb__render_view *V) {
+    const sfb__camera *cam = &V->cam;
+    size_t k;
+    int i;
+    for (k = 0; k < npix; ++k) {
+        float *g = R->gb + k * SFB__RENDER_GB;
+        double n[3], p[3], v[3], nm, wv;
+        if (!(g[0] < (float)HUGE_VAL)) continue;
+        n[0] = g[1]; n[1] = g[2]; n[2] = g[3];
+        p[0] = g[4]; p[1] = g[5]; p[2] = g[6];
+        sfb__rnormalize(n);
+        if (cam->ortho) { v[0] = -cam->fwd[0]; v[1] = -cam->fwd[1]; v[2] = -cam->fwd[2]; }
+        else { v[0] = cam->eye[0] - p[0]; v[1] = cam->eye[1] - p[1]; v[2] = cam->eye[2] - p[2]; }
+        if (sfb__rdot(n, v) < 0.0) { n[0] = -n[0]; n[1] = -n[1]; n[2] = -n[2]; }
+        nm = sfb__rdot(n, V->light_m);
+        if (fabs(nm) < 1e-6) { g[7] = (float)HUGE_VAL; continue; }
+        if (c->light_at_infinity) {
+            wv = V->lightdist * sfb__rdot(n, V->light_d) / nm / V->spacing;
+        } else {
+            double ap[3], mu, X[3];
+            for (i = 0; i < 3; ++i) ap[i] = V->light_a[i] - p[i];
+            mu = sfb__rdot(ap, V->light_m) / nm;
+            for (i = 0; i < 3; ++i) X[i] = p[i] + mu * n[i] - V->light_a[i];
+            wv = sfb__rdot(X, V->light_d) / V->spacing;
+        }
+        g[7] = isfinite(wv) && fabs(wv) < 1e7 ? (float)wv : (float)HUGE_VAL;
+    }
+}
+
+/* The highlight colour of pixel (x, y) (index pix, stripe coordinate wv, diffuse term diff)
+ * over its lit grey base in rgb: a dark blue and a cyan band per period, filtered by the pixel's
+ * footprint in stripe periods. */
+static void sfb__render_highlight(const sfb__raster *R, int x, int y, size_t pix, double wv, double diff, double *rgb) {
+    int w = R->w, h = R->h, i;
+    double dx = HUGE_VAL, dy = HUGE_VAL, fw, cb, cc;
+    /* the pixel footprint in stripe periods: the smaller one-sided difference per
+     * axis (robust at silhouettes, where one neighbour is another surface) */
+    if (x > 0 && R->gb[(pix - 1) * SFB__RENDER_GB + 7] < 1e30f) dx = fabs(wv - R->gb[(pix - 1) * SFB__RENDER_GB + 7]);
+    if (x + 1 < w && R->gb[(pix + 1) * SFB__RENDER_GB + 7] < 1e30f) {
+        double d2 = fabs(wv - R->gb[(pix + 1) * SFB__RENDER_GB + 7]);
+        if (d2 < dx) dx = d2;
+    }
+    if (y > 0 && R->gb[(pix - (size_t)w) * SFB__RENDER_GB + 7] < 1e30f)
+        dy = fabs(wv - R->gb[(pix - (size_t)w) * SFB__RENDER_GB + 7]);
+    if (y + 1 < h && R->gb[(pix + (size_t)w) * SFB__RENDER_GB + 7] < 1e30f) {
+        double d2 = fabs(wv - R->gb[(pix + (size_t)w) * SFB__RENDER_GB + 7]);
+        if (d2 < dy) dy = d2;
+    }
+    if (dx == HUGE_VAL) dx = 0.0;
+    if (dy == HUGE_VAL) dy = 0.0;
+    fw = dx + dy;
+    cb = sfb__band_cover(wv, fw, 0.00, 0.22);
+    cc = sfb__band_cover(wv, fw, 0.50, 0.72);
+    {
+        double lum = 0.45 + 0.55 * diff;
+        double blue[3], cyan[3];
+        blue[0] = 0.05 * lum; blue[1] = 0.12 * lum; blue[2] = 0.75 * lum;
+        cyan[0] = 0.10 * lum; cyan[1] = 0.80 * lum; cyan[2] = 0.95 * lum;
+        for (i = 0; i < 3; ++i) rgb[i] = rgb[i] * (1.0 - cb - cc) + blue[i] * cb + cyan[i] * cc;
+    }
+}
+
+/* The colour of covered pixel (x, y) (index pix) in the config's mode, before gamma and the
+ * edge overlay: the normal as RGB, or lit (diffuse, specular, fill) grey, scalar map or
+ * highlight lines. */
+static void sfb__render_lit(const sfb__raster *R, const sfb_render_config *c, const sfb__render_view *V, int x, int y, size_t pix,
+                            double *rgb) {
+    const sfb__camera *cam = &V->cam;
+    const float *g = R->gb + pix * SFB__RENDER_GB;
+    double n[3], p[3], v[3], diff, spec, hv[3];
+    int i;
+    n[0] = g[1]; n[1] = g[2]; n[2] = g[3];
+    p[0] = g[4]; p[1] = g[5]; p[2] = g[6];
+    sfb__rnormalize(n);
+    if (c->mode == SFB_RENDER_NORMALS) {
+        for (i = 0; i < 3; ++i) rgb[i] = 0.5 + 0.5 * n[i];
+        return;
+    }
+    if (cam->ortho) { v[0] = -cam->fwd[0]; v[1] = -cam->fwd[1]; v[2] = -cam->fwd[2]; }
+    else { v[0] = cam->eye[0] - p[0]; v[1] = cam->eye[1] - p[1]; v[2] = cam->eye[2] - p[2]; }
+    sfb__rnormalize(v);
+    if (sfb__rdot(n, v) < 0.0) { n[0] = -n[0]; n[1] = -n[1]; n[2] = -n[2]; }
+    diff = sfb__rdot(n, V->key);
+    if (diff < 0.0) diff = 0.0;
+    for (i = 0; i < 3; ++i) hv[i] = V->key[i] + v[i];
+    sfb__rnormalize(hv);
+    spec = sfb__rdot(n, hv);
+    spec = spec > 0.0 ? pow(spec, 48.0) : 0.0;
+    if (c->mode == SFB_RENDER_SHADED) {
+        double fl = sfb__rdot(n, V->fill), lum;
+        if (fl < 0.0) fl = 0.0;
+        lum = 0.72 * (0.16 + 0.70 * diff + 0.18 * fl) + 0.30 * spec;
+        rgb[0] = rgb[1] = rgb[2] = lum;
+    } else if (c->mode == SFB_RENDER_WEIGHTS) {
+        double lum = 0.55 + 0.45 * diff;
+        sfb__colormap(g[7], rgb);
+        for (i = 0; i < 3; ++i) rgb[i] = rgb[i] * lum + 0.12 * spec;
+    } else {
+        /* highlight: a lit light-grey base with a dark blue and a cyan band per period */
+        double base = 0.42 + 0.55 * diff, wv = g[7];
+        rgb[0] = rgb[1] = rgb[2] = base;
+        if (wv < 1e30) sfb__render_highlight(R, x, y, pix, wv, diff, rgb);
+    }
+}
+
+/* Pass 2: shades every pixel into rgba (the background where nothing is drawn), counting the
+ * covered ones in *object_pixels. */
+static sfb_result sfb__render_shade(sfb_context *ctx, const sfb__raster *R, const sfb_render_config *c, const sfb__render_view *V,
+                                    const unsigned char *bg, unsigned char *rgba, long *object_pixels) {
+    int w = R->w, h = R->h, x, y, i;
+    sfb_result r;
+    for (y = 0; y < h; ++y) {
+        if ((y & 15) == 0 && (r = sfb__progress(ctx, 0.6f + 0.4f * (float)y / (float)h, "render")) != SFB_SUCCESS) return r;
+        for (x = 0; x < w; ++x) {
+            size_t pix = (size_t)y * (size_t)w + (size_t)x;
+            const float *g = R->gb + pix * SFB__RENDER_GB;
+            unsigned char *o = rgba + 4 * pix;
+            double rgb[3], e;
+            if (!(g[0] < (float)HUGE_VAL)) { memcpy(o, bg, 4); continue; }
+            ++*object_pixels;
+            sfb__render_lit(R, c, V, x, y, pix, rgb);
+            /* a little gamma on lit colours, so that the darker half keeps detail (normals are
+             * written as they are) */
+            if (c->mode != SFB_RENDER_NORMALS)
+                for (i = 0; i < 3; ++i) rgb[i] = pow(sfb__rclamp(rgb[i], 0.0, 1.0), 1.0 / 1.6);
+            if (R->edge && R->edge[pix]) {
+                e = R->edge[pix] / 255.0 * 0.85;
+                for (i = 0; i < 3; ++i) rgb[i] = rgb[i] * (1.0 - e) + 0.08 * e;
+            }
+            o[0] = sfb__to_byte(rgb[0]); o[1] = sfb__to_byte(rgb[1]); o[2] = sfb__to_byte(rgb[2]); o[3] = 255;
+        }
+    }
+    return SFB_SUCCESS;
+}
+
 SFB_API sfb_result sfb_render(sfb_context *ctx, const sfb_mesh_data *m, const sfb_render_config *cfg, sfb_image *out) {
     sfb_render_config c;
     const float *pos = NULL, *nrm = NULL, *scal = NULL;
-    int w = 0, h = 0, f, y, x, i;
-    size_t npix, bytes, gbytes, k, off;
-    sfb__camera cam;
+    int w = 0, h = 0, f;
+    size_t npix, bytes, gbytes, k;
+    sfb__render_view V;
     sfb__raster R;
     sfb__pv *pv = NULL;
     unsigned char *hole = NULL, *rgba = NULL;
-    double lo[3], hi[3], centre[3], radius, yaw, pitch;
-    double light_m[3], light_e[3], light_d[3], light_a[3], spacing, lightdist;
-    double key[3], fill[3];
     unsigned char bg[4];
     sfb_result r = SFB_SUCCESS;
     long object_pixels = 0;
@@ -311,203 +563,15 @@ SFB_API sfb_result sfb_render(sfb_context *ctx, const sfb_mesh_data *m, const sf
     for (f = 0; f < m->hole_count; ++f) hole[m->holes[f]] = 1;
     for (k = 0; k < npix; ++k) R.gb[k * SFB__RENDER_GB] = (float)HUGE_VAL;
 
-    /* camera */
-    if (!sfb__render_bounds(m, pos, lo, hi)) { lo[0] = lo[1] = lo[2] = -1.0; hi[0] = hi[1] = hi[2] = 1.0; }
-    for (i = 0; i < 3; ++i) centre[i] = 0.5 * (lo[i] + hi[i]);
-    radius = 0.5 * sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) + (hi[2] - lo[2]) * (hi[2] - lo[2]));
-    if (!(radius > 0.0) || !isfinite(radius)) radius = 1.0;
-    yaw = (c.view_set ? c.yaw : SFB__RENDER_DEFAULT_YAW) * SFB__PI / 180.0;
-    pitch = (c.view_set ? c.pitch : SFB__RENDER_DEFAULT_PITCH) * SFB__PI / 180.0;
-    memset(&cam, 0, sizeof cam);
-    cam.ortho = c.orthographic != 0;
-    {
-        double dir[3], dist = radius / sin(SFB__RENDER_HALF_FOV * SFB__PI / 180.0);
-        double zoom = c.zoom > 0.0f ? c.zoom : 1.0, half = 0.5 * (w < h ? w : h) * SFB__RENDER_MARGIN;
-        dir[0] = cos(pitch) * sin(yaw); dir[1] = sin(pitch); dir[2] = cos(pitch) * cos(yaw);
-        for (i = 0; i < 3; ++i) { cam.eye[i] = centre[i] + dist * dir[i]; cam.fwd[i] = -dir[i]; }
-        cam.right[0] = cos(yaw); cam.right[1] = 0.0; cam.right[2] = -sin(yaw);
-        sfb__rcross(cam.right, cam.fwd, cam.up);
-        sfb__rnormalize(cam.up);
-        cam.focal = cam.ortho ? half * zoom / radius : half * zoom / tan(SFB__RENDER_HALF_FOV * SFB__PI / 180.0);
-        cam.cx = 0.5 * w;
-        cam.cy = 0.5 * h;
-    }
-    /* lights, fixed to the camera: a key light from the upper left behind the viewer, a fill */
-    for (i = 0; i < 3; ++i) {
-        key[i] = -cam.fwd[i] + 0.55 * cam.up[i] - 0.45 * cam.right[i];
-        fill[i] = -cam.fwd[i] - 0.3 * cam.up[i] + 0.8 * cam.right[i];
-    }
-    sfb__rnormalize(key);
-    sfb__rnormalize(fill);
-    /* the light plane of the highlight lines: facing the object from the camera's side, lines
-     * running at 30 degrees from the picture's vertical */
-    lightdist = (c.light_distance > 0.0f ? c.light_distance : SFB__RENDER_DEFAULT_LIGHT_DISTANCE) * radius;
-    spacing = 2.0 * radius / (c.stripes > 0.0f ? c.stripes : SFB__RENDER_DEFAULT_STRIPES);
-    for (i = 0; i < 3; ++i) {
-        light_m[i] = -cam.fwd[i];
-        light_e[i] = cos(SFB__PI / 6.0) * cam.up[i] + sin(SFB__PI / 6.0) * cam.right[i];
-        light_a[i] = centre[i] + lightdist * light_m[i];
-    }
-    sfb__rcross(light_m, light_e, light_d);
-    sfb__rnormalize(light_d);
-
-    /* project the vertices */
-    for (i = 0; i < m->vertex_count; ++i) {
-        const float *p = pos + 3 * (size_t)i;
-        double d[3], xc, yc, zc;
-        if (!(isfinite(p[0]) && isfinite(p[1]) && isfinite(p[2]))) { pv[i].z = -1.0; pv[i].x = pv[i].y = pv[i].q = 0.0; continue; }
-        d[0] = p[0] - cam.eye[0]; d[1] = p[1] - cam.eye[1]; d[2] = p[2] - cam.eye[2];
-        xc = sfb__rdot(d, cam.right); yc = sfb__rdot(d, cam.up); zc = sfb__rdot(d, cam.fwd);
-        pv[i].z = zc;
-        if (cam.ortho) {
-            pv[i].q = 1.0;
-            pv[i].x = cam.cx + cam.focal * xc;
-            pv[i].y = cam.cy - cam.focal * yc;
-        } else {
-            pv[i].q = zc > 0.0 ? 1.0 / zc : 0.0;
-            pv[i].x = cam.cx + cam.focal * xc * pv[i].q;
-            pv[i].y = cam.cy - cam.focal * yc * pv[i].q;
-        }
-    }
-
+    sfb__render_view_setup(m, pos, &c, w, h, &V);
+    sfb__render_project(m, pos, &V.cam, pv);
     /* pass 1: rasterize */
-    R.w = w; R.h = h; R.pos = pos; R.nrm = nrm; R.scal = scal; R.cam = &cam; R.draw_edges = c.draw_edges != 0;
-    {
-        double near_z = cam.ortho ? -HUGE_VAL : 1e-3 * radius;
-        for (f = 0, off = 0; f < m->face_count; off += (size_t)m->face_sizes[f], ++f) {
-            const int *fv = m->face_vertices + off;
-            int n = m->face_sizes[f], bad = 0, t;
-            double fn[3];
-            if ((f & 255) == 255 && (r = sfb__progress(ctx, 0.6f * (float)f / (float)m->face_count, "render")) != SFB_SUCCESS) goto done;
-            if (hole && hole[f]) continue;
-            for (i = 0; i < n; ++i) {
-                const float *p = pos + 3 * (size_t)fv[i];
-                if (!(isfinite(p[0]) && isfinite(p[1]) && isfinite(p[2]))) bad = 1;
-                else if (!(pv[fv[i]].z > near_z)) bad = 1;
-            }
-            if (bad) { ++skipped; continue; }
-            sfb__polygon_normal(pos, fv, n, fn);
-            if (!(sfb__rnormalize(fn) > 0.0)) { fn[0] = -cam.fwd[0]; fn[1] = -cam.fwd[1]; fn[2] = -cam.fwd[2]; }
-            for (t = 1; t + 1 < n; ++t) {
-                sfb__pv tri[3];
-                int vi[3], real[3];
-                vi[0] = fv[0]; vi[1] = fv[t]; vi[2] = fv[t + 1];
-                tri[0] = pv[vi[0]]; tri[1] = pv[vi[1]]; tri[2] = pv[vi[2]];
-                real[0] = 1;              /* (t, t+1) */
-                real[1] = t + 2 == n;     /* (t+1, 0): the polygon's last side */
-                real[2] = t == 1;         /* (0, 1): its first side */
-                sfb__raster_tri(&R, tri, vi, real, fn);
-            }
-        }
-    }
-
+    R.w = w; R.h = h; R.pos = pos; R.nrm = nrm; R.scal = scal; R.cam = &V.cam; R.draw_edges = c.draw_edges != 0;
+    if ((r = sfb__render_rasterize(ctx, &R, m, pv, hole, V.radius, &skipped)) != SFB_SUCCESS) goto done;
     /* pass 2a (highlight): stripe coordinate per pixel, kept in the scalar slot */
-    if (c.mode == SFB_RENDER_HIGHLIGHT) {
-        for (k = 0; k < npix; ++k) {
-            float *g = R.gb + k * SFB__RENDER_GB;
-            double n[3], p[3], v[3], nm, wv;
-            if (!(g[0] < (float)HUGE_VAL)) continue;
-            n[0] = g[1]; n[1] = g[2]; n[2] = g[3];
-            p[0] = g[4]; p[1] = g[5]; p[2] = g[6];
-            sfb__rnormalize(n);
-            if (cam.ortho) { v[0] = -cam.fwd[0]; v[1] = -cam.fwd[1]; v[2] = -cam.fwd[2]; }
-            else { v[0] = cam.eye[0] - p[0]; v[1] = cam.eye[1] - p[1]; v[2] = cam.eye[2] - p[2]; }
-            if (sfb__rdot(n, v) < 0.0) { n[0] = -n[0]; n[1] = -n[1]; n[2] = -n[2]; }
-            nm = sfb__rdot(n, light_m);
-            if (fabs(nm) < 1e-6) { g[7] = (float)HUGE_VAL; continue; }
-            if (c.light_at_infinity) {
-                wv = lightdist * sfb__rdot(n, light_d) / nm / spacing;
-            } else {
-                double ap[3], mu, X[3];
-                for (i = 0; i < 3; ++i) ap[i] = light_a[i] - p[i];
-                mu = sfb__rdot(ap, light_m) / nm;
-                for (i = 0; i < 3; ++i) X[i] = p[i] + mu * n[i] - light_a[i];
-                wv = sfb__rdot(X, light_d) / spacing;
-            }
-            g[7] = isfinite(wv) && fabs(wv) < 1e7 ? (float)wv : (float)HUGE_VAL;
-        }
-    }
-
+    if (c.mode == SFB_RENDER_HIGHLIGHT) sfb__render_stripes(&R, npix, &c, &V);
     /* pass 2: shade */
-    for (y = 0; y < h; ++y) {
-        if ((y & 15) == 0 && (r = sfb__progress(ctx, 0.6f + 0.4f * (float)y / (float)h, "render")) != SFB_SUCCESS) goto done;
-        for (x = 0; x < w; ++x) {
-            size_t pix = (size_t)y * (size_t)w + (size_t)x;
-            const float *g = R.gb + pix * SFB__RENDER_GB;
-            unsigned char *o = rgba + 4 * pix;
-            double n[3], p[3], v[3], rgb[3], diff, spec, hv[3], e;
-            if (!(g[0] < (float)HUGE_VAL)) { memcpy(o, bg, 4); continue; }
-            ++object_pixels;
-            n[0] = g[1]; n[1] = g[2]; n[2] = g[3];
-            p[0] = g[4]; p[1] = g[5]; p[2] = g[6];
-            sfb__rnormalize(n);
-            if (c.mode == SFB_RENDER_NORMALS) {
-                for (i = 0; i < 3; ++i) rgb[i] = 0.5 + 0.5 * n[i];
-            } else {
-                if (cam.ortho) { v[0] = -cam.fwd[0]; v[1] = -cam.fwd[1]; v[2] = -cam.fwd[2]; }
-                else { v[0] = cam.eye[0] - p[0]; v[1] = cam.eye[1] - p[1]; v[2] = cam.eye[2] - p[2]; }
-                sfb__rnormalize(v);
-                if (sfb__rdot(n, v) < 0.0) { n[0] = -n[0]; n[1] = -n[1]; n[2] = -n[2]; }
-                diff = sfb__rdot(n, key);
-                if (diff < 0.0) diff = 0.0;
-                for (i = 0; i < 3; ++i) hv[i] = key[i] + v[i];
-                sfb__rnormalize(hv);
-                spec = sfb__rdot(n, hv);
-                spec = spec > 0.0 ? pow(spec, 48.0) : 0.0;
-                if (c.mode == SFB_RENDER_SHADED) {
-                    double fl = sfb__rdot(n, fill), lum;
-                    if (fl < 0.0) fl = 0.0;
-                    lum = 0.72 * (0.16 + 0.70 * diff + 0.18 * fl) + 0.30 * spec;
-                    rgb[0] = rgb[1] = rgb[2] = lum;
-                } else if (c.mode == SFB_RENDER_WEIGHTS) {
-                    double lum = 0.55 + 0.45 * diff;
-                    sfb__colormap(g[7], rgb);
-                    for (i = 0; i < 3; ++i) rgb[i] = rgb[i] * lum + 0.12 * spec;
-                } else {
-                    /* highlight: a lit light-grey base with a dark blue and a cyan band per period */
-                    double base = 0.42 + 0.55 * diff, wv = g[7];
-                    rgb[0] = rgb[1] = rgb[2] = base;
-                    if (wv < 1e30) {
-                        double dx = HUGE_VAL, dy = HUGE_VAL, fw, cb, cc;
-                        /* the pixel footprint in stripe periods: the smaller one-sided difference per
-                         * axis (robust at silhouettes, where one neighbour is another surface) */
-                        if (x > 0 && R.gb[(pix - 1) * SFB__RENDER_GB + 7] < 1e30f) dx = fabs(wv - R.gb[(pix - 1) * SFB__RENDER_GB + 7]);
-                        if (x + 1 < w && R.gb[(pix + 1) * SFB__RENDER_GB + 7] < 1e30f) {
-                            double d2 = fabs(wv - R.gb[(pix + 1) * SFB__RENDER_GB + 7]);
-                            if (d2 < dx) dx = d2;
-                        }
-                        if (y > 0 && R.gb[(pix - (size_t)w) * SFB__RENDER_GB + 7] < 1e30f)
-                            dy = fabs(wv - R.gb[(pix - (size_t)w) * SFB__RENDER_GB + 7]);
-                        if (y + 1 < h && R.gb[(pix + (size_t)w) * SFB__RENDER_GB + 7] < 1e30f) {
-                            double d2 = fabs(wv - R.gb[(pix + (size_t)w) * SFB__RENDER_GB + 7]);
-                            if (d2 < dy) dy = d2;
-                        }
-                        if (dx == HUGE_VAL) dx = 0.0;
-                        if (dy == HUGE_VAL) dy = 0.0;
-                        fw = dx + dy;
-                        cb = sfb__band_cover(wv, fw, 0.00, 0.22);
-                        cc = sfb__band_cover(wv, fw, 0.50, 0.72);
-                        {
-                            double lum = 0.45 + 0.55 * diff;
-                            double blue[3], cyan[3];
-                            blue[0] = 0.05 * lum; blue[1] = 0.12 * lum; blue[2] = 0.75 * lum;
-                            cyan[0] = 0.10 * lum; cyan[1] = 0.80 * lum; cyan[2] = 0.95 * lum;
-                            for (i = 0; i < 3; ++i) rgb[i] = rgb[i] * (1.0 - cb - cc) + blue[i] * cb + cyan[i] * cc;
-                        }
-                    }
-                }
-            }
-            /* a little gamma on lit colours, so that the darker half keeps detail (normals are
-             * written as they are) */
-            if (c.mode != SFB_RENDER_NORMALS)
-                for (i = 0; i < 3; ++i) rgb[i] = pow(sfb__rclamp(rgb[i], 0.0, 1.0), 1.0 / 1.6);
-            if (R.edge && R.edge[pix]) {
-                e = R.edge[pix] / 255.0 * 0.85;
-                for (i = 0; i < 3; ++i) rgb[i] = rgb[i] * (1.0 - e) + 0.08 * e;
-            }
-            o[0] = sfb__to_byte(rgb[0]); o[1] = sfb__to_byte(rgb[1]); o[2] = sfb__to_byte(rgb[2]); o[3] = 255;
-        }
-    }
+    if ((r = sfb__render_shade(ctx, &R, &c, &V, bg, rgba, &object_pixels)) != SFB_SUCCESS) goto done;
     if ((r = sfb__progress(ctx, 1.0f, "render")) != SFB_SUCCESS) goto done;
     out->width = w;
     out->height = h;

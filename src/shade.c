@@ -286,28 +286,56 @@ static sfb_result sfb__shade_level_arg(sfb_context *ctx, int given, int level, c
     return SFB_SUCCESS;
 }
 
-sfb_result sfb__shading_build(sfb_context *ctx, const sfb__level *prep, const sfb__refine_options *opt, int L,
-                              const sfb_shading_options *o, sfb__shading **out) {
-    sfb__shading *sh = NULL;
-    sfb__level *lev = NULL;
-    sfb__stencils *T = NULL;
-    sfb__regions *reg = NULL, outreg;
-    int **parent = NULL;
+/* The working state of sfb__shading_build: the levels one step apart with their local
+ * stencils, regions and parent faces, the output regions, and the scratch of composing rows. */
+typedef struct sfb__shade_build {
+    sfb_context *ctx;
+    const sfb__level *prep;
+    const sfb__refine_options *opt;
+    const sfb_shading_options *o;
+    sfb__shading *sh;
+    int L, Ln, Lw;         /* last, normals and weights level */
+    int loop, per_level;   /* Loop scheme; N_S one level at a time (averaging not linear) */
+    sfb__level *lev;       /* L + 1 levels: lev[0] borrowed (prep), lev[Ln] moved to sh->nlev */
+    sfb__stencils *T;      /* L + 1: T[k] the step from level k to k + 1 */
+    sfb__regions *reg;     /* L + 1: regions (sharpness > 0) from the normals level up */
+    sfb__regions outreg;   /* regions of the last level split by infinitely sharp edges only */
+    int **parent;          /* L + 1: parent face of every face of level k (k >= 1) */
+    const sfb__level *top; /* the last level */
     sfb__rows prow, crow;
     sfb__accum A;
     sfb__mask m, mm[3];
     sfb__shade_scratch sc;
-    double *bw = NULL, *bn = NULL;
-    int *order = NULL;
-    sfb_result r = SFB_SUCCESS;
-    int loop = opt->scheme == SFB_SCHEME_LOOP;
-    int Ln = 0, Lw = 0, k, v, i, t, maxv = 1, per_level = 0, asz;
-    const sfb__level *top;
-    *out = NULL;
-    memset(&prow, 0, sizeof prow); memset(&crow, 0, sizeof crow); memset(&A, 0, sizeof A);
-    memset(&m, 0, sizeof m); memset(mm, 0, sizeof mm); memset(&sc, 0, sizeof sc); memset(&outreg, 0, sizeof outreg);
-    if ((r = sfb__shade_level_arg(ctx, o->normals_level, L, "normals", &Ln)) != SFB_SUCCESS) return r;
-    if ((r = sfb__shade_level_arg(ctx, o->weights_level, L, "weights", &Lw)) != SFB_SUCCESS) return r;
+    double *bw, *bn;       /* blend weights of the current and the next level */
+    int *order;            /* output vertices in N_S row order (b > 0 first) */
+} sfb__shade_build;
+
+/* Frees the working state of sfb__shading_build (not the shading it builds). */
+static void sfb__shade_build_free(sfb__shade_build *B) {
+    sfb_context *ctx = B->ctx;
+    int k, t, L = B->L;
+    if (B->lev) {
+        for (k = 1; k <= L; ++k) sfb__level_free(ctx, &B->lev[k]);
+        sfb__free(ctx, B->lev);
+    }
+    if (B->T) { for (k = 0; k <= L; ++k) sfb__stencils_free(ctx, &B->T[k]); sfb__free(ctx, B->T); }
+    if (B->reg) { for (k = 0; k <= L; ++k) sfb__regions_free(ctx, &B->reg[k]); sfb__free(ctx, B->reg); }
+    if (B->parent) { for (k = 0; k <= L; ++k) sfb__free(ctx, B->parent[k]); sfb__free(ctx, B->parent); }
+    sfb__regions_free(ctx, &B->outreg);
+    sfb__rows_free(ctx, &B->prow); sfb__rows_free(ctx, &B->crow);
+    sfb__free(ctx, B->A.acc); sfb__free(ctx, B->A.mark); sfb__free(ctx, B->A.touched);
+    sfb__free(ctx, B->m.idx); sfb__free(ctx, B->m.w);
+    for (t = 0; t < 3; ++t) { sfb__free(ctx, B->mm[t].idx); sfb__free(ctx, B->mm[t].w); }
+    sfb__free(ctx, B->sc.fset); sfb__free(ctx, B->sc.cnt);
+    sfb__free(ctx, B->bw); sfb__free(ctx, B->bn); sfb__free(ctx, B->order);
+}
+
+/* Checks the shading options against refinement level L; the normals and weights levels they
+ * give into *Ln and *Lw. */
+static sfb_result sfb__shade_check_options(sfb_context *ctx, const sfb_shading_options *o, int L, int *Ln, int *Lw) {
+    sfb_result r;
+    if ((r = sfb__shade_level_arg(ctx, o->normals_level, L, "normals", Ln)) != SFB_SUCCESS) return r;
+    if ((r = sfb__shade_level_arg(ctx, o->weights_level, L, "weights", Lw)) != SFB_SUCCESS) return r;
     if (o->variant != SFB_SHADE_VARIANT_A && o->variant != SFB_SHADE_VARIANT_B)
         return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, -1, "shading variant %d is not SFB_SHADE_VARIANT_A or _B", o->variant);
     if (o->darts != SFB_SHADE_DARTS_SMOOTH && o->darts != SFB_SHADE_DARTS_SHARP)
@@ -315,114 +343,156 @@ sfb_result sfb__shading_build(sfb_context *ctx, const sfb__level *prep, const sf
     if (o->averaging != SFB_SHADE_AVERAGE_LINEAR && o->averaging != SFB_SHADE_AVERAGE_RENORMALIZED && o->averaging != SFB_SHADE_AVERAGE_SPHERICAL)
         return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, -1,
                           "shading averaging %d is not SFB_SHADE_AVERAGE_LINEAR, _RENORMALIZED or _SPHERICAL", o->averaging);
-    sh = (sfb__shading *)sfb__calloc(ctx, 1, sizeof *sh);
-    lev = (sfb__level *)sfb__calloc(ctx, (size_t)L + 1, sizeof *lev);
-    T = (sfb__stencils *)sfb__calloc(ctx, (size_t)L + 1, sizeof *T);
-    reg = (sfb__regions *)sfb__calloc(ctx, (size_t)L + 1, sizeof *reg);
-    parent = (int **)sfb__calloc(ctx, (size_t)L + 1, sizeof *parent);
-    if (!sh || !lev || !T || !reg || !parent) { r = sfb__oom(ctx, "shading tables"); goto done; }
-    sh->normals_level = Ln; sh->weights_level = Lw; sh->level = L; sh->variant = o->variant; sh->darts = o->darts;
+    return SFB_SUCCESS;
+}
+
+/* Allocates the shading and the per-level arrays, then the levels one step at a time with each
+ * step's local stencils and parent faces, the region-mask scratch, the regions from the
+ * normals level up and the output regions of the last level. */
+static sfb_result sfb__shade_build_levels(sfb__shade_build *B) {
+    sfb_context *ctx = B->ctx;
+    const sfb_shading_options *o = B->o;
+    sfb__shading *sh;
+    sfb__level *lev;
+    sfb_result r;
+    int L = B->L, k, v, maxv = 1;
+    sh = B->sh = (sfb__shading *)sfb__calloc(ctx, 1, sizeof *sh);
+    lev = B->lev = (sfb__level *)sfb__calloc(ctx, (size_t)L + 1, sizeof *lev);
+    B->T = (sfb__stencils *)sfb__calloc(ctx, (size_t)L + 1, sizeof *B->T);
+    B->reg = (sfb__regions *)sfb__calloc(ctx, (size_t)L + 1, sizeof *B->reg);
+    B->parent = (int **)sfb__calloc(ctx, (size_t)L + 1, sizeof *B->parent);
+    if (!sh || !lev || !B->T || !B->reg || !B->parent) return sfb__oom(ctx, "shading tables");
+    sh->normals_level = B->Ln; sh->weights_level = B->Lw; sh->level = L; sh->variant = o->variant; sh->darts = o->darts;
     sh->averaging = o->averaging;
-    per_level = o->averaging != SFB_SHADE_AVERAGE_LINEAR && L > Ln;
+    B->per_level = o->averaging != SFB_SHADE_AVERAGE_LINEAR && L > B->Ln;
 
     /* the levels, one step at a time, with each step's local stencils */
-    lev[0] = *prep; /* borrowed */
+    lev[0] = *B->prep; /* borrowed */
     for (k = 0; k < L; ++k) {
-        r = sfb__refine(ctx, &lev[k], opt, 1, &lev[k + 1], &T[k], NULL, 0.8f, 0.8f);
-        if (r != SFB_SUCCESS) goto done;
-        parent[k + 1] = sfb__shade_parent_faces(ctx, &lev[k], &lev[k + 1], loop);
-        if (!parent[k + 1]) { r = sfb__oom(ctx, "shading tables"); goto done; }
+        r = sfb__refine(ctx, &lev[k], B->opt, 1, &lev[k + 1], &B->T[k], NULL, 0.8f, 0.8f);
+        if (r != SFB_SUCCESS) return r;
+        B->parent[k + 1] = sfb__shade_parent_faces(ctx, &lev[k], &lev[k + 1], B->loop);
+        if (!B->parent[k + 1]) return sfb__oom(ctx, "shading tables");
     }
-    top = &lev[L];
+    B->top = &lev[L];
     for (k = 0; k <= L; ++k)
         for (v = 0; v < lev[k].nv; ++v) {
             int n = lev[k].vf_off[v + 1] - lev[k].vf_off[v];
             if (n + 1 > maxv) maxv = n + 1;
         }
-    sc.fset = (int *)sfb__alloc(ctx, (size_t)maxv * sizeof(int));
-    sc.cnt = (double *)sfb__alloc(ctx, (size_t)maxv * sizeof(double));
-    if (!sc.fset || !sc.cnt) { r = sfb__oom(ctx, "shading tables"); goto done; }
+    B->sc.fset = (int *)sfb__alloc(ctx, (size_t)maxv * sizeof(int));
+    B->sc.cnt = (double *)sfb__alloc(ctx, (size_t)maxv * sizeof(double));
+    if (!B->sc.fset || !B->sc.cnt) return sfb__oom(ctx, "shading tables");
 
     /* regions (sharpness > 0) from the normals level up */
-    for (k = Ln; k <= L; ++k)
-        if ((r = sfb__regions_build(ctx, &lev[k], 0, &reg[k])) != SFB_SUCCESS) goto done;
-    if ((r = sfb__regions_build(ctx, top, 0, &outreg)) != SFB_SUCCESS) goto done;
+    for (k = B->Ln; k <= L; ++k)
+        if ((r = sfb__regions_build(ctx, &lev[k], 0, &B->reg[k])) != SFB_SUCCESS) return r;
+    return sfb__regions_build(ctx, B->top, 0, &B->outreg);
+}
 
-    /* the normals level: its topology, the source of every face at every vertex, positions */
+/* The normals level: its topology (sh->nlev: prepared from the base, or moved out of lev[Ln]),
+ * the source of every face at every vertex, the composing accumulator and, when it lies between
+ * the base and the last level, the table of its positions over the base vertices (sh->npos). */
+static sfb_result sfb__shade_normals_level(sfb__shade_build *B) {
+    sfb_context *ctx = B->ctx;
+    sfb__shading *sh = B->sh;
+    const sfb__level *prep = B->prep;
+    sfb_result r = SFB_SUCCESS;
+    int L = B->L, Ln = B->Ln, k, asz;
     if (Ln == 0) r = sfb__level_prepare(ctx, prep, 0, 0, &sh->nlev);
-    else { sh->nlev = lev[Ln]; memset(&lev[Ln], 0, sizeof lev[Ln]); }
-    if (r != SFB_SUCCESS) goto done;
-    if (Ln == L) top = &sh->nlev;
-    sh->nsrc = reg[Ln].total;
+    else { sh->nlev = B->lev[Ln]; memset(&B->lev[Ln], 0, sizeof B->lev[Ln]); }
+    if (r != SFB_SUCCESS) return r;
+    if (Ln == L) B->top = &sh->nlev;
+    sh->nsrc = B->reg[Ln].total;
     sh->nsrc_of_vf = (int *)sfb__alloc(ctx, ((size_t)sh->nlev.vf_off[sh->nlev.nv] + 1) * sizeof(int));
-    if (!sh->nsrc_of_vf) { r = sfb__oom(ctx, "shading tables"); goto done; }
-    memcpy(sh->nsrc_of_vf, reg[Ln].of_vf, (size_t)sh->nlev.vf_off[sh->nlev.nv] * sizeof(int));
+    if (!sh->nsrc_of_vf) return sfb__oom(ctx, "shading tables");
+    memcpy(sh->nsrc_of_vf, B->reg[Ln].of_vf, (size_t)sh->nlev.vf_off[sh->nlev.nv] * sizeof(int));
     asz = prep->nv > sh->nsrc ? prep->nv : sh->nsrc;
-    for (k = Ln; per_level && k < L; ++k)
-        if (reg[k].total > asz) asz = reg[k].total; /* per level: rows over each level's regions */
-    A.acc = (double *)sfb__alloc(ctx, ((size_t)asz + 1) * sizeof(double));
-    A.mark = (unsigned *)sfb__calloc(ctx, (size_t)asz + 1, sizeof(unsigned));
-    A.touched = (int *)sfb__alloc(ctx, ((size_t)asz + 1) * sizeof(int));
-    if (!A.acc || !A.mark || !A.touched) { r = sfb__oom(ctx, "shading tables"); goto done; }
+    for (k = Ln; B->per_level && k < L; ++k)
+        if (B->reg[k].total > asz) asz = B->reg[k].total; /* per level: rows over each level's regions */
+    B->A.acc = (double *)sfb__alloc(ctx, ((size_t)asz + 1) * sizeof(double));
+    B->A.mark = (unsigned *)sfb__calloc(ctx, (size_t)asz + 1, sizeof(unsigned));
+    B->A.touched = (int *)sfb__alloc(ctx, ((size_t)asz + 1) * sizeof(int));
+    if (!B->A.acc || !B->A.mark || !B->A.touched) return sfb__oom(ctx, "shading tables");
     sh->npos_mode = Ln == 0 ? 0 : Ln == L ? 2 : 1;
     if (sh->npos_mode == 1) {
-        if (!sfb__shade_identity(ctx, &prow, prep->nv)) { r = sfb__oom(ctx, "shading tables"); goto done; }
+        if (!sfb__shade_identity(ctx, &B->prow, prep->nv)) return sfb__oom(ctx, "shading tables");
         for (k = 0; k < Ln; ++k) {
-            if (!sfb__shade_compose_step(ctx, &A, &prow, &T[k], &m, &crow)) { r = sfb__oom(ctx, "shading tables"); goto done; }
-            sfb__rows_free(ctx, &prow);
-            prow = crow;
-            memset(&crow, 0, sizeof crow);
+            if (!sfb__shade_compose_step(ctx, &B->A, &B->prow, &B->T[k], &B->m, &B->crow)) return sfb__oom(ctx, "shading tables");
+            sfb__rows_free(ctx, &B->prow);
+            B->prow = B->crow;
+            memset(&B->crow, 0, sizeof B->crow);
         }
-        r = sfb__rows_to_stencils(ctx, &prow, prep->nv, &sh->npos);
-        if (r != SFB_SUCCESS) { r = sfb__oom(ctx, "shading tables"); goto done; }
-        sfb__rows_free(ctx, &prow);
+        r = sfb__rows_to_stencils(ctx, &B->prow, prep->nv, &sh->npos);
+        if (r != SFB_SUCCESS) return sfb__oom(ctx, "shading tables");
+        sfb__rows_free(ctx, &B->prow);
     }
+    return SFB_SUCCESS;
+}
 
-    /* blend weights from the weights level to the last */
-    bw = (double *)sfb__calloc(ctx, (size_t)(Lw == Ln ? &sh->nlev : &lev[Lw])->nv + 1, sizeof(double));
-    if (!bw) { r = sfb__oom(ctx, "shading weights"); goto done; }
-    sfb__shade_seed(Lw == Ln ? &sh->nlev : &lev[Lw], bw, loop, o->variant, o->darts, NULL);
+/* The blend weights from the weights level to the last (B->bw): seeded, then one subdivision
+ * step at a time, the held vertices and those released at the step seeded again. */
+static sfb_result sfb__shade_weights(sfb__shade_build *B) {
+    sfb_context *ctx = B->ctx;
+    const sfb_shading_options *o = B->o;
+    sfb__shading *sh = B->sh;
+    const sfb__level *lev = B->lev;
+    int L = B->L, Ln = B->Ln, Lw = B->Lw, loop = B->loop, k, v, i;
+    B->bw = (double *)sfb__calloc(ctx, (size_t)(Lw == Ln ? &sh->nlev : &lev[Lw])->nv + 1, sizeof(double));
+    if (!B->bw) return sfb__oom(ctx, "shading weights");
+    sfb__shade_seed(Lw == Ln ? &sh->nlev : &lev[Lw], B->bw, loop, o->variant, o->darts, NULL);
     for (k = Lw; k < L; ++k) {
-        const sfb__stencils *S = &T[k];
+        const sfb__stencils *S = &B->T[k];
         const sfb__level *pl = k == Ln ? &sh->nlev : &lev[k], *cl = k + 1 == Ln ? &sh->nlev : &lev[k + 1];
         unsigned char *released;
-        bn = (double *)sfb__calloc(ctx, (size_t)S->rows + 1, sizeof(double));
+        B->bn = (double *)sfb__calloc(ctx, (size_t)S->rows + 1, sizeof(double));
         released = (unsigned char *)sfb__calloc(ctx, (size_t)S->rows + 1, 1);
-        if (!bn || !released) { sfb__free(ctx, released); r = sfb__oom(ctx, "shading weights"); goto done; }
+        if (!B->bn || !released) { sfb__free(ctx, released); return sfb__oom(ctx, "shading weights"); }
         for (v = 0; v < S->rows; ++v) {
             double acc = 0.0;
-            for (i = 0; i < S->sizes[v]; ++i) acc += (double)S->weights[S->offsets[v] + i] * bw[S->indices[S->offsets[v] + i]];
-            bn[v] = acc < 0.0 ? 0.0 : acc > 1.0 ? 1.0 : acc;
+            for (i = 0; i < S->sizes[v]; ++i) acc += (double)S->weights[S->offsets[v] + i] * B->bw[S->indices[S->offsets[v] + i]];
+            B->bn[v] = acc < 0.0 ? 0.0 : acc > 1.0 ? 1.0 : acc;
         }
         /* vertex children whose parent was held and who are not: released at this level */
         for (v = 0; v < pl->nv; ++v)
             released[v] = sfb__shade_held(pl, v, loop, o->variant, o->darts) && !sfb__shade_held(cl, v, loop, o->variant, o->darts);
-        sfb__shade_seed(cl, bn, loop, o->variant, o->darts, released);
+        sfb__shade_seed(cl, B->bn, loop, o->variant, o->darts, released);
         sfb__free(ctx, released);
-        sfb__free(ctx, bw);
-        bw = bn;
-        bn = NULL;
+        sfb__free(ctx, B->bw);
+        B->bw = B->bn;
+        B->bn = NULL;
     }
+    return SFB_SUCCESS;
+}
 
-    /* output vertices: one per region of the infinitely sharp partition */
-    sh->nout = outreg.total;
+/* The output vertices, one per region of the infinitely sharp partition of the last level:
+ * their origin, face-vertex slots and blend weight, and the order of the N_S rows (those with
+ * b > 0 first, B->order). */
+static sfb_result sfb__shade_outputs(sfb__shade_build *B) {
+    sfb_context *ctx = B->ctx;
+    sfb__shading *sh = B->sh;
+    const sfb__level *top = B->top;
+    const sfb__regions *outreg = &B->outreg;
+    int *order;
+    int v, i;
+    sh->nout = outreg->total;
     sh->out_origin = (int *)sfb__alloc(ctx, ((size_t)sh->nout + 1) * sizeof(int));
     sh->out_fv = (int *)sfb__alloc(ctx, ((size_t)top->nfv + 1) * sizeof(int));
     sh->b = (float *)sfb__alloc(ctx, ((size_t)sh->nout + 1) * sizeof(float));
     sh->ns_idx_w = (int *)sfb__alloc(ctx, ((size_t)sh->nout + 1) * sizeof(int));
     sh->ns_idx_all = (int *)sfb__alloc(ctx, ((size_t)sh->nout + 1) * sizeof(int));
-    order = (int *)sfb__alloc(ctx, ((size_t)sh->nout + 1) * sizeof(int));
-    if (!sh->out_origin || !sh->out_fv || !sh->b || !sh->ns_idx_w || !sh->ns_idx_all || !order) { r = sfb__oom(ctx, "shading tables"); goto done; }
+    order = B->order = (int *)sfb__alloc(ctx, ((size_t)sh->nout + 1) * sizeof(int));
+    if (!sh->out_origin || !sh->out_fv || !sh->b || !sh->ns_idx_w || !sh->ns_idx_all || !order) return sfb__oom(ctx, "shading tables");
     for (v = 0; v < top->nv; ++v) {
-        int nr = outreg.first[v + 1] - outreg.first[v];
+        int nr = outreg->first[v + 1] - outreg->first[v];
         if (nr > 1) sh->nsplit++;
         for (i = 0; i < nr; ++i) {
-            sh->out_origin[outreg.first[v] + i] = v;
-            sh->b[outreg.first[v] + i] = (float)bw[v];
+            sh->out_origin[outreg->first[v] + i] = v;
+            sh->b[outreg->first[v] + i] = (float)B->bw[v];
         }
         for (i = top->vf_off[v]; i < top->vf_off[v + 1]; ++i) {
             int f = top->vf[i];
-            sh->out_fv[top->fv_off[f] + top->vf_slot[i]] = outreg.of_vf[i];
+            sh->out_fv[top->fv_off[f] + top->vf_slot[i]] = outreg->of_vf[i];
         }
     }
     /* N_S rows: those with b > 0 first */
@@ -433,54 +503,77 @@ sfb_result sfb__shading_build(sfb_context *ctx, const sfb__level *prep, const sf
         sh->ns_idx_all[order[i]] = i;
         sh->ns_idx_w[order[i]] = i < sh->nweighted ? i : -1;
     }
+    return SFB_SUCCESS;
+}
 
-    /* N_S: region rows composed from the normals level up to the level below the last. Per
-     * level (averaging not linear): each step's rows over the regions of the level below alone
-     * (composed with an identity, which merges repeated sources), kept as a table of its own. */
-    if (per_level) {
+/* N_S: region rows composed from the normals level up to the level below the last (B->prow).
+ * Per level (averaging not linear): each step's rows over the regions of the level below alone
+ * (composed with an identity, which merges repeated sources), kept as a table of its own. */
+static sfb_result sfb__shade_ns_steps(sfb__shade_build *B) {
+    sfb_context *ctx = B->ctx;
+    sfb__shading *sh = B->sh;
+    const sfb__level *lev = B->lev;
+    const sfb__regions *reg = B->reg;
+    sfb_result r;
+    int L = B->L, Ln = B->Ln, k;
+    if (B->per_level) {
         sh->steps = (sfb__stencils *)sfb__calloc(ctx, (size_t)(L - Ln), sizeof *sh->steps);
-        if (!sh->steps) { r = sfb__oom(ctx, "shading tables"); goto done; }
+        if (!sh->steps) return sfb__oom(ctx, "shading tables");
         sh->nsteps = L - Ln;
     }
-    if (!sfb__shade_identity(ctx, &prow, sh->nsrc)) { r = sfb__oom(ctx, "shading tables"); goto done; }
+    if (!sfb__shade_identity(ctx, &B->prow, sh->nsrc)) return sfb__oom(ctx, "shading tables");
     for (k = Ln; k < L - 1; ++k) {
         const sfb__level *pl = k == Ln ? &sh->nlev : &lev[k];
         int cv, rv;
-        memset(&crow, 0, sizeof crow);
-        crow.rows = reg[k + 1].total;
-        crow.off = (size_t *)sfb__alloc(ctx, ((size_t)crow.rows + 1) * sizeof(size_t));
-        if (!crow.off) { r = sfb__oom(ctx, "shading tables"); goto done; }
-        crow.off[0] = 0;
+        memset(&B->crow, 0, sizeof B->crow);
+        B->crow.rows = reg[k + 1].total;
+        B->crow.off = (size_t *)sfb__alloc(ctx, ((size_t)B->crow.rows + 1) * sizeof(size_t));
+        if (!B->crow.off) return sfb__oom(ctx, "shading tables");
+        B->crow.off[0] = 0;
         for (cv = 0; cv < lev[k + 1].nv; ++cv)
             for (rv = reg[k + 1].first[cv]; rv < reg[k + 1].first[cv + 1]; ++rv) {
                 int creg = reg[k + 1].first[cv + 1] - reg[k + 1].first[cv] > 1 ? rv : -1;
-                m.n = 0;
-                if (!sfb__shade_region_mask(ctx, pl, &reg[k], &lev[k + 1], &reg[k + 1], parent[k + 1], &T[k], cv, creg, 1.0, &m, &sc) ||
-                    !sfb__compose_row(ctx, &A, &prow, &m, &crow, rv)) { r = sfb__oom(ctx, "shading tables"); goto done; }
+                B->m.n = 0;
+                if (!sfb__shade_region_mask(ctx, pl, &reg[k], &lev[k + 1], &reg[k + 1], B->parent[k + 1], &B->T[k], cv, creg, 1.0, &B->m,
+                                            &B->sc) ||
+                    !sfb__compose_row(ctx, &B->A, &B->prow, &B->m, &B->crow, rv))
+                    return sfb__oom(ctx, "shading tables");
             }
-        sfb__rows_free(ctx, &prow);
-        if (per_level) {
-            r = sfb__rows_to_stencils(ctx, &crow, reg[k].total, &sh->steps[k - Ln]);
-            if (r != SFB_SUCCESS) { if (r == SFB_OUT_OF_MEMORY) r = sfb__oom(ctx, "shading tables"); goto done; }
-            sfb__rows_free(ctx, &crow);
-            if (!sfb__shade_identity(ctx, &prow, reg[k + 1].total)) { r = sfb__oom(ctx, "shading tables"); goto done; }
+        sfb__rows_free(ctx, &B->prow);
+        if (B->per_level) {
+            r = sfb__rows_to_stencils(ctx, &B->crow, reg[k].total, &sh->steps[k - Ln]);
+            if (r != SFB_SUCCESS) { if (r == SFB_OUT_OF_MEMORY) r = sfb__oom(ctx, "shading tables"); return r; }
+            sfb__rows_free(ctx, &B->crow);
+            if (!sfb__shade_identity(ctx, &B->prow, reg[k + 1].total)) return sfb__oom(ctx, "shading tables");
         } else {
-            prow = crow;
+            B->prow = B->crow;
         }
-        memset(&crow, 0, sizeof crow);
+        memset(&B->crow, 0, sizeof B->crow);
         r = sfb__progress(ctx, 0.8f, "shading");
-        if (r != SFB_SUCCESS) goto done;
+        if (r != SFB_SUCCESS) return r;
     }
-    /* the output rows, in `order`: each the face-weighted mean of the N_S regions it covers */
-    memset(&crow, 0, sizeof crow);
-    crow.rows = sh->nout;
-    crow.off = (size_t *)sfb__alloc(ctx, ((size_t)sh->nout + 1) * sizeof(size_t));
-    if (!crow.off) { r = sfb__oom(ctx, "shading tables"); goto done; }
-    crow.off[0] = 0;
+    return SFB_SUCCESS;
+}
+
+/* The output rows of N_S, in B->order: each the face-weighted mean of the N_S regions of the
+ * last level it covers; then the N_S table (sh->ns), or per level the last step's table and the
+ * sizes of the steps. */
+static sfb_result sfb__shade_ns_output(sfb__shade_build *B) {
+    sfb_context *ctx = B->ctx;
+    sfb__shading *sh = B->sh;
+    const sfb__level *top = B->top;
+    const sfb__regions *reg = B->reg, *outreg = &B->outreg;
+    sfb_result r;
+    int L = B->L, Ln = B->Ln, i, k;
+    memset(&B->crow, 0, sizeof B->crow);
+    B->crow.rows = sh->nout;
+    B->crow.off = (size_t *)sfb__alloc(ctx, ((size_t)sh->nout + 1) * sizeof(size_t));
+    if (!B->crow.off) return sfb__oom(ctx, "shading tables");
+    B->crow.off[0] = 0;
     for (i = 0; i < sh->nout; ++i) {
-        int ov = order[i], cv = sh->out_origin[ov], rv, j;
-        int faces = outreg.faces[ov];
-        m.n = 0;
+        int ov = B->order[i], cv = sh->out_origin[ov], rv, j;
+        int faces = outreg->faces[ov];
+        B->m.n = 0;
         for (rv = reg[L].first[cv]; rv < reg[L].first[cv + 1]; ++rv) {
             /* the output region of N_S region rv: that of any of its faces (a bare vertex has
              * one of each) */
@@ -488,22 +581,22 @@ sfb_result sfb__shading_build(sfb_context *ctx, const sfb__level *prep, const sf
             double frac;
             int creg = reg[L].first[cv + 1] - reg[L].first[cv] > 1 ? rv : -1;
             for (j = top->vf_off[cv]; j < top->vf_off[cv + 1]; ++j)
-                if (reg[L].of_vf[j] == rv) { in = outreg.of_vf[j] == ov; break; }
+                if (reg[L].of_vf[j] == rv) { in = outreg->of_vf[j] == ov; break; }
             if (!in) continue;
             frac = faces ? (double)reg[L].faces[rv] / faces : 1.0;
             if (L == Ln) {
-                if (!sfb__mask_grow(ctx, &m, 1)) { r = sfb__oom(ctx, "shading tables"); goto done; }
-                SFB__MASK_ADD(&m, rv, frac);
-            } else if (!sfb__shade_region_mask(ctx, L - 1 == Ln ? &sh->nlev : &lev[L - 1], &reg[L - 1], top, &reg[L],
-                                               parent[L], &T[L - 1], cv, creg, frac, &m, &sc)) {
-                r = sfb__oom(ctx, "shading tables"); goto done;
+                if (!sfb__mask_grow(ctx, &B->m, 1)) return sfb__oom(ctx, "shading tables");
+                SFB__MASK_ADD(&B->m, rv, frac);
+            } else if (!sfb__shade_region_mask(ctx, L - 1 == Ln ? &sh->nlev : &B->lev[L - 1], &reg[L - 1], top, &reg[L],
+                                               B->parent[L], &B->T[L - 1], cv, creg, frac, &B->m, &B->sc)) {
+                return sfb__oom(ctx, "shading tables");
             }
         }
-        if (!sfb__compose_row(ctx, &A, &prow, &m, &crow, i)) { r = sfb__oom(ctx, "shading tables"); goto done; }
+        if (!sfb__compose_row(ctx, &B->A, &B->prow, &B->m, &B->crow, i)) return sfb__oom(ctx, "shading tables");
     }
-    if (per_level) {
-        r = sfb__rows_to_stencils(ctx, &crow, reg[L - 1].total, &sh->steps[sh->nsteps - 1]);
-        if (r != SFB_SUCCESS) { if (r == SFB_OUT_OF_MEMORY) r = sfb__oom(ctx, "shading tables"); goto done; }
+    if (B->per_level) {
+        r = sfb__rows_to_stencils(ctx, &B->crow, reg[L - 1].total, &sh->steps[sh->nsteps - 1]);
+        if (r != SFB_SUCCESS) { if (r == SFB_OUT_OF_MEMORY) r = sfb__oom(ctx, "shading tables"); return r; }
         for (k = 0; k < sh->nsteps; ++k) {
             const sfb__stencils *S = &sh->steps[k];
             if (S->rows > sh->step_rows_max) sh->step_rows_max = S->rows;
@@ -512,104 +605,134 @@ sfb_result sfb__shading_build(sfb_context *ctx, const sfb__level *prep, const sf
                 if (S->sizes[i] > sh->step_size_max) sh->step_size_max = S->sizes[i];
         }
     } else {
-        r = sfb__rows_to_stencils(ctx, &crow, sh->nsrc, &sh->ns);
-        if (r != SFB_SUCCESS) { r = sfb__oom(ctx, "shading tables"); goto done; }
+        r = sfb__rows_to_stencils(ctx, &B->crow, sh->nsrc, &sh->ns);
+        if (r != SFB_SUCCESS) return sfb__oom(ctx, "shading tables");
     }
-    sfb__rows_free(ctx, &crow);
-    sfb__rows_free(ctx, &prow);
+    sfb__rows_free(ctx, &B->crow);
+    sfb__rows_free(ctx, &B->prow);
+    return SFB_SUCCESS;
+}
 
-    /* limit position and tangents of every output vertex over the refined vertices */
-    {
-        sfb__rows lr[3];
-        memset(lr, 0, sizeof lr);
-        for (t = 0; t < 3; ++t) {
-            lr[t].rows = sh->nout;
-            lr[t].off = (size_t *)sfb__alloc(ctx, ((size_t)sh->nout + 1) * sizeof(size_t));
-            if (!lr[t].off) r = sfb__oom(ctx, "shading limit tables");
-            else lr[t].off[0] = 0;
-        }
-        for (v = 0; v < top->nv && r == SFB_SUCCESS; ++v) {
-            int nr = outreg.first[v + 1] - outreg.first[v], e0 = top->ve_off[v], ne = top->ve_off[v + 1] - e0;
-            int f0 = top->vf_off[v], nf = top->vf_off[v + 1] - f0, rr;
-            int need = 3 * sfb__mask_need_vertex(top, v) + 8;
-            for (rr = 0; rr < nr && r == SFB_SUCCESS; ++rr) {
-                int ov = outreg.first[v] + rr;
-                for (t = 0; t < 3; ++t) {
-                    mm[t].n = 0;
-                    if (!sfb__mask_grow(ctx, &mm[t], need)) r = sfb__oom(ctx, "shading limit tables");
-                }
-                if (r != SFB_SUCCESS) break;
-                if (nr == 1) {
-                    sfb__limit_masks(top, v, opt->scheme, &mm[0], &mm[1], &mm[2]);
-                } else {
-                    /* the region's faces: a run first..first+len-1 around v (mod nf) */
-                    int first = -1, len = 0;
-                    for (i = 0; i < nf; ++i) {
-                        int prev = i > 0 ? outreg.of_vf[f0 + i - 1] : (nf == ne ? outreg.of_vf[f0 + nf - 1] : -1);
-                        if (outreg.of_vf[f0 + i] == ov) { len++; if (prev != ov) first = i; }
-                    }
-                    if (first < 0) first = 0;
-                    if (top->vrule[v] == SFB__RULE_CREASE) {
-                        float sharp[SFB_MAX_VALENCE + 1];
-                        int a, b;
-                        for (i = 0; i < ne && i <= SFB_MAX_VALENCE; ++i) sharp[i] = top->es[top->ve[e0 + i]];
-                        sfb__crease_pair(sharp, ne, &a, &b);
-                        SFB__MASK_ADD(&mm[0], v, 2.0 / 3.0);
-                        SFB__MASK_ADD(&mm[0], sfb__other_end(top, top->ve[e0 + a], v), 1.0 / 6.0);
-                        SFB__MASK_ADD(&mm[0], sfb__other_end(top, top->ve[e0 + b], v), 1.0 / 6.0);
-                        sfb__crease_tangent_masks(top, v, first, first + len, loop, &mm[1], &mm[2]);
-                    } else {
-                        SFB__MASK_ADD(&mm[0], v, 1.0);
-                        SFB__MASK_ADD(&mm[1], v, -1.0);
-                        SFB__MASK_ADD(&mm[1], sfb__other_end(top, top->ve[e0 + first % ne], v), 1.0);
-                        SFB__MASK_ADD(&mm[2], v, -1.0);
-                        SFB__MASK_ADD(&mm[2], sfb__other_end(top, top->ve[e0 + (first + 1) % ne], v), 1.0);
-                    }
-                }
-                for (t = 0; t < 3; ++t) {
-                    /* local rows: copy the mask (duplicates merged) */
-                    size_t at;
-                    int a2, b2;
-                    if (!sfb__rows_reserve(ctx, &lr[t], lr[t].n + (size_t)mm[t].n)) { r = sfb__oom(ctx, "shading limit tables"); break; }
-                    at = lr[t].n;
-                    for (a2 = 0; a2 < mm[t].n; ++a2) {
-                        for (b2 = (int)at; b2 < (int)lr[t].n && lr[t].idx[b2] != mm[t].idx[a2]; ++b2) {}
-                        if (b2 < (int)lr[t].n) lr[t].w[b2] += mm[t].w[a2];
-                        else { lr[t].idx[lr[t].n] = mm[t].idx[a2]; lr[t].w[lr[t].n] = mm[t].w[a2]; lr[t].n++; }
-                    }
-                    lr[t].off[ov + 1] = lr[t].n;
-                }
-            }
-        }
-        for (t = 0; t < 3; ++t) {
-            if (r == SFB_SUCCESS) {
-                r = sfb__rows_to_stencils(ctx, &lr[t], top->nv, &sh->lim[t]);
-                if (r != SFB_SUCCESS) r = sfb__oom(ctx, "shading limit tables");
-            }
-            sfb__rows_free(ctx, &lr[t]);
-        }
-        if (r != SFB_SUCCESS) goto done;
+/* The limit masks (position, two tangents) into mm of output vertex ov, one of the regions of
+ * split vertex v of the last level: at a crease vertex the crease tangent and that side's cross
+ * tangent, at a corner the two edges of the region's first face. */
+static void sfb__shade_split_limit_masks(const sfb__level *top, const sfb__regions *outreg, int v, int ov, int loop, sfb__mask *mm) {
+    int e0 = top->ve_off[v], ne = top->ve_off[v + 1] - e0;
+    int f0 = top->vf_off[v], nf = top->vf_off[v + 1] - f0, i;
+    /* the region's faces: a run first..first+len-1 around v (mod nf) */
+    int first = -1, len = 0;
+    for (i = 0; i < nf; ++i) {
+        int prev = i > 0 ? outreg->of_vf[f0 + i - 1] : (nf == ne ? outreg->of_vf[f0 + nf - 1] : -1);
+        if (outreg->of_vf[f0 + i] == ov) { len++; if (prev != ov) first = i; }
     }
+    if (first < 0) first = 0;
+    if (top->vrule[v] == SFB__RULE_CREASE) {
+        float sharp[SFB_MAX_VALENCE + 1];
+        int a, b;
+        for (i = 0; i < ne && i <= SFB_MAX_VALENCE; ++i) sharp[i] = top->es[top->ve[e0 + i]];
+        sfb__crease_pair(sharp, ne, &a, &b);
+        SFB__MASK_ADD(&mm[0], v, 2.0 / 3.0);
+        SFB__MASK_ADD(&mm[0], sfb__other_end(top, top->ve[e0 + a], v), 1.0 / 6.0);
+        SFB__MASK_ADD(&mm[0], sfb__other_end(top, top->ve[e0 + b], v), 1.0 / 6.0);
+        sfb__crease_tangent_masks(top, v, first, first + len, loop, &mm[1], &mm[2]);
+    } else {
+        SFB__MASK_ADD(&mm[0], v, 1.0);
+        SFB__MASK_ADD(&mm[1], v, -1.0);
+        SFB__MASK_ADD(&mm[1], sfb__other_end(top, top->ve[e0 + first % ne], v), 1.0);
+        SFB__MASK_ADD(&mm[2], v, -1.0);
+        SFB__MASK_ADD(&mm[2], sfb__other_end(top, top->ve[e0 + (first + 1) % ne], v), 1.0);
+    }
+}
+
+/* Appends mask mk to the local rows lr as row ov (duplicates merged); 0 when out of memory. */
+static int sfb__shade_rows_append(sfb_context *ctx, sfb__rows *lr, const sfb__mask *mk, int ov) {
+    size_t at;
+    int a2, b2;
+    if (!sfb__rows_reserve(ctx, lr, lr->n + (size_t)mk->n)) return 0;
+    at = lr->n;
+    for (a2 = 0; a2 < mk->n; ++a2) {
+        for (b2 = (int)at; b2 < (int)lr->n && lr->idx[b2] != mk->idx[a2]; ++b2) {}
+        if (b2 < (int)lr->n) lr->w[b2] += mk->w[a2];
+        else { lr->idx[lr->n] = mk->idx[a2]; lr->w[lr->n] = mk->w[a2]; lr->n++; }
+    }
+    lr->off[ov + 1] = lr->n;
+    return 1;
+}
+
+/* Limit position and tangents of every output vertex over the refined vertices of the last
+ * level (sh->lim[0..2]): local rows, one region of a split vertex at a time. */
+static sfb_result sfb__shade_limits(sfb__shade_build *B) {
+    sfb_context *ctx = B->ctx;
+    sfb__shading *sh = B->sh;
+    const sfb__level *top = B->top;
+    const sfb__regions *outreg = &B->outreg;
+    sfb__mask *mm = B->mm;
+    sfb__rows lr[3];
+    sfb_result r = SFB_SUCCESS;
+    int v, t;
+    memset(lr, 0, sizeof lr);
+    for (t = 0; t < 3; ++t) {
+        lr[t].rows = sh->nout;
+        lr[t].off = (size_t *)sfb__alloc(ctx, ((size_t)sh->nout + 1) * sizeof(size_t));
+        if (!lr[t].off) r = sfb__oom(ctx, "shading limit tables");
+        else lr[t].off[0] = 0;
+    }
+    for (v = 0; v < top->nv && r == SFB_SUCCESS; ++v) {
+        int nr = outreg->first[v + 1] - outreg->first[v], rr;
+        int need = 3 * sfb__mask_need_vertex(top, v) + 8;
+        for (rr = 0; rr < nr && r == SFB_SUCCESS; ++rr) {
+            int ov = outreg->first[v] + rr;
+            for (t = 0; t < 3; ++t) {
+                mm[t].n = 0;
+                if (!sfb__mask_grow(ctx, &mm[t], need)) r = sfb__oom(ctx, "shading limit tables");
+            }
+            if (r != SFB_SUCCESS) break;
+            if (nr == 1) sfb__limit_masks(top, v, B->opt->scheme, &mm[0], &mm[1], &mm[2]);
+            else sfb__shade_split_limit_masks(top, outreg, v, ov, B->loop, mm);
+            for (t = 0; t < 3; ++t)
+                if (!sfb__shade_rows_append(ctx, &lr[t], &mm[t], ov)) { r = sfb__oom(ctx, "shading limit tables"); break; }
+        }
+    }
+    for (t = 0; t < 3; ++t) {
+        if (r == SFB_SUCCESS) {
+            r = sfb__rows_to_stencils(ctx, &lr[t], top->nv, &sh->lim[t]);
+            if (r != SFB_SUCCESS) r = sfb__oom(ctx, "shading limit tables");
+        }
+        sfb__rows_free(ctx, &lr[t]);
+    }
+    return r;
+}
+
+sfb_result sfb__shading_build(sfb_context *ctx, const sfb__level *prep, const sfb__refine_options *opt, int L,
+                              const sfb_shading_options *o, sfb__shading **out) {
+    sfb__shade_build B;
+    sfb__shading *sh;
+    sfb_result r;
+    int k;
+    *out = NULL;
+    memset(&B, 0, sizeof B);
+    B.ctx = ctx; B.prep = prep; B.opt = opt; B.o = o; B.L = L;
+    B.loop = opt->scheme == SFB_SCHEME_LOOP;
+    if ((r = sfb__shade_check_options(ctx, o, L, &B.Ln, &B.Lw)) != SFB_SUCCESS) return r;
+    if ((r = sfb__shade_build_levels(&B)) != SFB_SUCCESS) goto done;
+    if ((r = sfb__shade_normals_level(&B)) != SFB_SUCCESS) goto done;
+    /* blend weights from the weights level to the last */
+    if ((r = sfb__shade_weights(&B)) != SFB_SUCCESS) goto done;
+    /* output vertices: one per region of the infinitely sharp partition */
+    if ((r = sfb__shade_outputs(&B)) != SFB_SUCCESS) goto done;
+    /* N_S rows up to the level below the last, then the output rows */
+    if ((r = sfb__shade_ns_steps(&B)) != SFB_SUCCESS) goto done;
+    if ((r = sfb__shade_ns_output(&B)) != SFB_SUCCESS) goto done;
+    /* limit position and tangents of every output vertex over the refined vertices */
+    if ((r = sfb__shade_limits(&B)) != SFB_SUCCESS) goto done;
+    sh = B.sh;
     sh->bytes = sizeof *sh + (sh->ns.entries + sh->npos.entries + sh->lim[0].entries + sh->lim[1].entries + sh->lim[2].entries) * 8 +
-                (size_t)sh->nout * 6 * sizeof(int) + (size_t)top->nfv * sizeof(int) + (size_t)sh->nlev.nfv * 3 * sizeof(int);
+                (size_t)sh->nout * 6 * sizeof(int) + (size_t)B.top->nfv * sizeof(int) + (size_t)sh->nlev.nfv * 3 * sizeof(int);
     for (k = 0; k < sh->nsteps; ++k) sh->bytes += sizeof *sh->steps + sh->steps[k].entries * 8 + (size_t)sh->steps[k].rows * 2 * sizeof(int);
 done:
-    if (lev) {
-        for (k = 1; k <= L; ++k) sfb__level_free(ctx, &lev[k]);
-        sfb__free(ctx, lev);
-    }
-    if (T) { for (k = 0; k <= L; ++k) sfb__stencils_free(ctx, &T[k]); sfb__free(ctx, T); }
-    if (reg) { for (k = 0; k <= L; ++k) sfb__regions_free(ctx, &reg[k]); sfb__free(ctx, reg); }
-    if (parent) { for (k = 0; k <= L; ++k) sfb__free(ctx, parent[k]); sfb__free(ctx, parent); }
-    sfb__regions_free(ctx, &outreg);
-    sfb__rows_free(ctx, &prow); sfb__rows_free(ctx, &crow);
-    sfb__free(ctx, A.acc); sfb__free(ctx, A.mark); sfb__free(ctx, A.touched);
-    sfb__free(ctx, m.idx); sfb__free(ctx, m.w);
-    for (t = 0; t < 3; ++t) { sfb__free(ctx, mm[t].idx); sfb__free(ctx, mm[t].w); }
-    sfb__free(ctx, sc.fset); sfb__free(ctx, sc.cnt);
-    sfb__free(ctx, bw); sfb__free(ctx, bn); sfb__free(ctx, order);
-    if (r != SFB_SUCCESS) { sfb__shading_free(ctx, sh); return r; }
-    *out = sh;
+    sfb__shade_build_free(&B);
+    if (r != SFB_SUCCESS) { sfb__shading_free(ctx, B.sh); return r; }
+    *out = B.sh;
     return SFB_SUCCESS;
 }
 

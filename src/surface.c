@@ -64,16 +64,11 @@ static double sfb__estimate_bytes(const sfb_mesh *m, sfb_scheme scheme, int leve
     return faces * 4.0 * 40.0 + verts * 16.0 * 12.0 * (limit ? 3.0 : 1.5);
 }
 
-SFB_API sfb_result sfb_surface_create(sfb_context *ctx, const sfb_mesh *mesh, const sfb_surface_config *cfg, sfb_surface **out) {
-    sfb_surface *s;
-    sfb__level prep;
-    sfb__refine_options opt;
-    sfb_result r;
+/* Refuses a scheme, level, flag set or mesh that sfb_surface_create cannot build, before any
+ * allocation (the size estimate against SFB_MAX_ELEMENTS and the memory budget included). */
+static sfb_result sfb__surface_check(sfb_context *ctx, const sfb_mesh *mesh, const sfb_surface_config *cfg) {
     double faces, bytes;
     int f;
-    if (!ctx) return SFB_INVALID_ARGS;
-    if (!mesh || !cfg || !out) return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "sfb_surface_create: NULL argument");
-    *out = NULL;
     if (cfg->scheme == SFB_SCHEME_MANIFOLD_BLEND) {
         /* a blending surface is evaluated (sfb_surface_eval / _tessellate), not refined */
         if (!(cfg->flags & SFB_REFINE_PATCHES) || cfg->refine_level != 0 || (cfg->flags & (SFB_REFINE_LIMIT | SFB_REFINE_SHADING)))
@@ -109,20 +104,19 @@ SFB_API sfb_result sfb_surface_create(sfb_context *ctx, const sfb_mesh *mesh, co
         return sfb__error(ctx, SFB_LIMIT_EXCEEDED, SFB_ELEMENT_NONE, -1,
                           "refining to level %d needs about %.0f MiB, over the memory budget of %.1f MiB",
                           cfg->refine_level, bytes / 1048576.0, (double)ctx->budget / 1048576.0);
-    s = (sfb_surface *)sfb__calloc(ctx, 1, sizeof *s);
-    if (!s) return sfb__oom(ctx, "surface");
-    s->ctx = ctx;
-    s->config = *cfg;
-    s->boundary = mesh->boundary; s->crease_method = mesh->crease_method;
-    s->triangle_rule = mesh->triangle_rule; s->uv_interp = mesh->uv_interp;
-    s->base_vertex_count = mesh->base.nv;
-    s->base_face_count = mesh->base.nf;
-    s->base_positions = (float *)sfb__alloc(ctx, (size_t)mesh->base.nv * 3 * sizeof(float) + 1);
-    if (!s->base_positions) { sfb_surface_destroy(s); return sfb__oom(ctx, "surface"); }
-    memcpy(s->base_positions, mesh->positions, (size_t)mesh->base.nv * 3 * sizeof(float));
+    return SFB_SUCCESS;
+}
+
+/* Refines the vertex mesh into s: the vertex (and limit) tables, the shading tables and the
+ * patch table the flags ask for (s keeps the prepared base level of a patch table). */
+static sfb_result sfb__surface_build_vertex(sfb_surface *s, const sfb_mesh *mesh, const sfb_surface_config *cfg) {
+    sfb_context *ctx = s->ctx;
+    sfb__level prep;
+    sfb__refine_options opt;
+    sfb_result r;
     r = sfb__level_prepare(ctx, &mesh->base, mesh->boundary == SFB_BOUNDARY_EDGE_AND_CORNER,
                            mesh->boundary == SFB_BOUNDARY_NONE && cfg->scheme != SFB_SCHEME_BILINEAR, &prep);
-    if (r != SFB_SUCCESS) { sfb_surface_destroy(s); return r; }
+    if (r != SFB_SUCCESS) return r;
     memset(&opt, 0, sizeof opt);
     opt.scheme = cfg->scheme == SFB_SCHEME_MANIFOLD_BLEND ? SFB_SCHEME_CATMARK : cfg->scheme; /* manifold: level 0, the identity */
     opt.crease_method = mesh->crease_method;
@@ -141,55 +135,62 @@ SFB_API sfb_result sfb_surface_create(sfb_context *ctx, const sfb_mesh *mesh, co
         if (r == SFB_SUCCESS) { s->has_patches = 1; s->pbase = prep; memset(&prep, 0, sizeof prep); }
     }
     sfb__level_free(ctx, &prep);
-    if (r != SFB_SUCCESS) { sfb_surface_destroy(s); return r; }
+    if (r != SFB_SUCCESS) return r;
     s->built[SFB_TABLE_VERTEX] = 1;
     if (opt.want_limit) s->built[SFB_TABLE_LIMIT] = s->built[SFB_TABLE_TANGENT_U] = s->built[SFB_TABLE_TANGENT_V] = 1;
-    if ((cfg->flags & SFB_REFINE_UVS) && mesh->uv_count > 0) {
-        /* The UV layout is refined as a mesh of its own: its vertices are the UV values, so a
-         * seam (an edge whose two faces disagree on a UV) is a boundary of the layout. It keeps
-         * the vertex mesh's creases and corners; its own corners (one face, two edges) are
-         * pinned, as OpenSubdiv's "linear corners only" face-varying mode. SFB_UV_LINEAR uses
-         * bilinear masks on the same face split. */
-        sfb__level uvl, uvp;
-        sfb__stencils dummy;
-        int o, i;
-        r = sfb__level_from_faces(ctx, mesh->uv_count, mesh->base.nf, mesh->face_sizes, mesh->face_uvs, NULL, SFB_ELEMENT_UV, &uvl);
-        if (r != SFB_SUCCESS) { sfb_surface_destroy(s); return r; }
-        for (f = 0; f < mesh->base.nf; ++f)
-            for (o = mesh->base.fv_off[f], i = 0; o + i < mesh->base.fv_off[f + 1]; ++i) {
-                int ue = uvl.fe[o + i], e = mesh->base.fe[o + i], uvv = mesh->face_uvs[o + i], vv = mesh->base.fv[o + i];
-                if (mesh->base.es[e] > uvl.es[ue]) uvl.es[ue] = mesh->base.es[e];
-                if (mesh->base.vs[vv] > uvl.vs[uvv]) uvl.vs[uvv] = mesh->base.vs[vv];
-            }
-        r = sfb__level_prepare(ctx, &uvl, 1, 0, &uvp);
-        sfb__level_free(ctx, &uvl);
-        if (r != SFB_SUCCESS) { sfb_surface_destroy(s); return r; }
-        memset(&opt, 0, sizeof opt);
-        opt.scheme = cfg->scheme;
-        opt.crease_method = mesh->crease_method;
-        opt.triangle_rule = mesh->triangle_rule;
-        opt.linear = mesh->uv_interp == SFB_UV_LINEAR;
-        memset(&dummy, 0, sizeof dummy);
-        r = sfb__refine(ctx, &uvp, &opt, cfg->refine_level, &s->uv_top, &s->tables[SFB_TABLE_UV], NULL, 0.8f, 1.0f);
-        sfb__level_free(ctx, &uvp);
-        if (r != SFB_SUCCESS) { sfb_surface_destroy(s); return r; }
-        s->built[SFB_TABLE_UV] = 1;
-        s->has_uvs = 1;
-        s->base_uv_count = mesh->uv_count;
-        s->base_uvs = (float *)sfb__alloc(ctx, (size_t)mesh->uv_count * 2 * sizeof(float));
-        if (!s->base_uvs) { sfb_surface_destroy(s); return sfb__oom(ctx, "surface"); }
-        memcpy(s->base_uvs, mesh->uvs, (size_t)mesh->uv_count * 2 * sizeof(float));
-    }
-    r = sfb__progress(ctx, 1.0f, "refine");
-    if (r != SFB_SUCCESS) { sfb_surface_destroy(s); return r; }
-    /* Hand the tables to the backend once (device upload); failures come back here. */
+    return SFB_SUCCESS;
+}
+
+/* The UV layout is refined as a mesh of its own: its vertices are the UV values, so a seam (an
+ * edge whose two faces disagree on a UV) is a boundary of the layout. It keeps the vertex
+ * mesh's creases and corners; its own corners (one face, two edges) are pinned, as
+ * OpenSubdiv's "linear corners only" face-varying mode. SFB_UV_LINEAR uses bilinear masks on
+ * the same face split. Builds the UV table into s (the base UVs are copied by the caller). */
+static sfb_result sfb__surface_build_uvs(sfb_surface *s, const sfb_mesh *mesh, const sfb_surface_config *cfg) {
+    sfb_context *ctx = s->ctx;
+    sfb__level uvl, uvp;
+    sfb__refine_options opt;
+    sfb__stencils dummy;
+    sfb_result r;
+    int f, o, i;
+    r = sfb__level_from_faces(ctx, mesh->uv_count, mesh->base.nf, mesh->face_sizes, mesh->face_uvs, NULL, SFB_ELEMENT_UV, &uvl);
+    if (r != SFB_SUCCESS) return r;
+    for (f = 0; f < mesh->base.nf; ++f)
+        for (o = mesh->base.fv_off[f], i = 0; o + i < mesh->base.fv_off[f + 1]; ++i) {
+            int ue = uvl.fe[o + i], e = mesh->base.fe[o + i], uvv = mesh->face_uvs[o + i], vv = mesh->base.fv[o + i];
+            if (mesh->base.es[e] > uvl.es[ue]) uvl.es[ue] = mesh->base.es[e];
+            if (mesh->base.vs[vv] > uvl.vs[uvv]) uvl.vs[uvv] = mesh->base.vs[vv];
+        }
+    r = sfb__level_prepare(ctx, &uvl, 1, 0, &uvp);
+    sfb__level_free(ctx, &uvl);
+    if (r != SFB_SUCCESS) return r;
+    memset(&opt, 0, sizeof opt);
+    opt.scheme = cfg->scheme;
+    opt.crease_method = mesh->crease_method;
+    opt.triangle_rule = mesh->triangle_rule;
+    opt.linear = mesh->uv_interp == SFB_UV_LINEAR;
+    memset(&dummy, 0, sizeof dummy);
+    r = sfb__refine(ctx, &uvp, &opt, cfg->refine_level, &s->uv_top, &s->tables[SFB_TABLE_UV], NULL, 0.8f, 1.0f);
+    sfb__level_free(ctx, &uvp);
+    if (r != SFB_SUCCESS) return r;
+    s->built[SFB_TABLE_UV] = 1;
+    s->has_uvs = 1;
+    s->base_uv_count = mesh->uv_count;
+    return SFB_SUCCESS;
+}
+
+/* Hands the built tables (stencils, shading, patches) to the context's backend once (device
+ * upload); failures come back here. */
+static sfb_result sfb__surface_upload(sfb_surface *s) {
+    sfb_context *ctx = s->ctx;
+    sfb_result r;
     if (ctx->backend && ctx->backend->upload_stencils) {
         int t;
         s->uploaded_by = ctx->backend;
         for (t = 0; t < SFB_TABLE_COUNT_; ++t) {
             if (!s->built[t] || s->tables[t].rows == 0) continue;
             r = ctx->backend->upload_stencils(ctx->backend_state, &s->tables[t], &s->backend_tables[t]);
-            if (r != SFB_SUCCESS) { sfb_surface_destroy(s); return r; }
+            if (r != SFB_SUCCESS) return r;
         }
         if (s->shading) {
             sfb__shading *sh = s->shading;
@@ -198,17 +199,53 @@ SFB_API sfb_result sfb_surface_create(sfb_context *ctx, const sfb_mesh *mesh, co
             for (t = 0; t < 5; ++t) {
                 if (st[t]->rows == 0) continue;
                 r = ctx->backend->upload_stencils(ctx->backend_state, st[t], &sh->handles[t]);
-                if (r != SFB_SUCCESS) { sfb_surface_destroy(s); return r; }
+                if (r != SFB_SUCCESS) return r;
             }
         }
     }
     if (s->has_patches && ctx->backend && ctx->backend->upload_patches) {
         s->uploaded_by = ctx->backend;
         r = ctx->backend->upload_patches(ctx->backend_state, &s->patches, &s->backend_patches);
-        if (r != SFB_SUCCESS) { sfb_surface_destroy(s); return r; }
+        if (r != SFB_SUCCESS) return r;
     }
+    return SFB_SUCCESS;
+}
+
+SFB_API sfb_result sfb_surface_create(sfb_context *ctx, const sfb_mesh *mesh, const sfb_surface_config *cfg, sfb_surface **out) {
+    sfb_surface *s;
+    sfb_result r;
+    int oom = 0;
+    if (!ctx) return SFB_INVALID_ARGS;
+    if (!mesh || !cfg || !out) return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "sfb_surface_create: NULL argument");
+    *out = NULL;
+    if ((r = sfb__surface_check(ctx, mesh, cfg)) != SFB_SUCCESS) return r;
+    s = (sfb_surface *)sfb__calloc(ctx, 1, sizeof *s);
+    if (!s) return sfb__oom(ctx, "surface");
+    s->ctx = ctx;
+    s->config = *cfg;
+    s->boundary = mesh->boundary; s->crease_method = mesh->crease_method;
+    s->triangle_rule = mesh->triangle_rule; s->uv_interp = mesh->uv_interp;
+    s->base_vertex_count = mesh->base.nv;
+    s->base_face_count = mesh->base.nf;
+    s->base_positions = (float *)sfb__alloc(ctx, (size_t)mesh->base.nv * 3 * sizeof(float) + 1);
+    if (!s->base_positions) { oom = 1; goto fail; }
+    memcpy(s->base_positions, mesh->positions, (size_t)mesh->base.nv * 3 * sizeof(float));
+    if ((r = sfb__surface_build_vertex(s, mesh, cfg)) != SFB_SUCCESS) goto fail;
+    if ((cfg->flags & SFB_REFINE_UVS) && mesh->uv_count > 0) {
+        if ((r = sfb__surface_build_uvs(s, mesh, cfg)) != SFB_SUCCESS) goto fail;
+        s->base_uvs = (float *)sfb__alloc(ctx, (size_t)mesh->uv_count * 2 * sizeof(float));
+        if (!s->base_uvs) { oom = 1; goto fail; }
+        memcpy(s->base_uvs, mesh->uvs, (size_t)mesh->uv_count * 2 * sizeof(float));
+    }
+    if ((r = sfb__progress(ctx, 1.0f, "refine")) != SFB_SUCCESS) goto fail;
+    if ((r = sfb__surface_upload(s)) != SFB_SUCCESS) goto fail;
     *out = s;
     return SFB_SUCCESS;
+fail:
+    /* the one cleanup path: everything s holds; an allocation failure is reported after it (the
+     * message gives the bytes still in use) */
+    sfb_surface_destroy(s);
+    return oom ? sfb__oom(ctx, "surface") : r;
 }
 
 SFB_API int sfb_surface_param_face_count(const sfb_surface *s) { return s && s->has_patches ? s->patches.nptex : 0; }

@@ -971,18 +971,9 @@ static sfb_result sfb__trim_emit(sfb__tess *T, sfb_tess_data *out, float p0, flo
     return SFB_SUCCESS;
 }
 
-SFB_API sfb_result sfb_surface_tessellate(const sfb_surface *s, const sfb_tess_config *cfg, sfb_tess_data *out) {
-    sfb_context *ctx;
-    sfb__tess T;
-    const sfb__level *l;
-    sfb_result r = SFB_SUCCESS;
-    int pf, f, e, i, k, nptex;
-    size_t v, done_v, nv;
-    float p_emit, p_eval;
-    if (out) memset(out, 0, sizeof *out);
-    if (!s) return SFB_INVALID_ARGS;
-    ctx = s->ctx;
-    if (!cfg || !out) return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "sfb_surface_tessellate: NULL argument");
+/* Refuses a surface without a patch table and a rate, tolerance, flag set or trimming mask
+ * out of range, before any allocation. */
+static sfb_result sfb__tess_check(sfb_context *ctx, const sfb_surface *s, const sfb_tess_config *cfg) {
     if (!s->has_patches || s->pbase.nf != s->base_face_count || !s->pbase.fe)
         return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1,
                           "sfb_surface_tessellate: the surface has no patch table (create it with SFB_REFINE_PATCHES)");
@@ -1011,44 +1002,188 @@ SFB_API sfb_result sfb_surface_tessellate(const sfb_surface *s, const sfb_tess_c
                               "trimming mask: %d x %d texels do not split into %d x %d equal tiles", m->width, m->height, m->tiles_u,
                               m->tiles_v);
     }
-    if ((r = sfb__progress(ctx, 0.0f, "tessellate")) != SFB_SUCCESS) return r;
+    return SFB_SUCCESS;
+}
 
-    memset(&T, 0, sizeof T);
-    T.ctx = ctx;
-    T.s = s;
-    T.l = l = &s->pbase;
-    T.pt = &s->patches;
-    T.rate = cfg->rate;
-    T.split = (cfg->flags & SFB_TESS_SPLIT_CREASES) != 0;
-    T.loop = T.pt->domain == SFB__DOMAIN_TRI;
-    nptex = T.pt->nptex;
-    T.prate = (int *)sfb__tess_array(ctx, (size_t)nptex, sizeof(int));
-    T.sseg = (int *)sfb__tess_array(ctx, (size_t)nptex, sizeof(int));
-    T.vspoke = (int *)sfb__tess_array(ctx, (size_t)nptex, sizeof(int));
-    T.ifirst = (int *)sfb__tess_array(ctx, (size_t)nptex, sizeof(int));
-    T.eseg = (int *)sfb__tess_array(ctx, (size_t)l->ne, sizeof(int));
-    T.engon = (unsigned char *)sfb__tess_array(ctx, (size_t)l->ne, 1);
-    T.vedge = (int *)sfb__tess_array(ctx, (size_t)l->nfv, sizeof(int));
-    T.vcenter = (int *)sfb__tess_array(ctx, (size_t)l->nf, sizeof(int));
-    T.vcorner = (int *)sfb__tess_array(ctx, (size_t)(T.split ? l->nfv : l->nv), sizeof(int));
-    T.bids = (int *)sfb__tess_array(ctx, (size_t)6 * (SFB__TESS_MAX_SEG + 1), sizeof(int));
-    if (T.split) {
-        T.uf = (int *)sfb__tess_array(ctx, (size_t)l->nfv, sizeof(int));
-        T.ecopy = (int *)sfb__tess_array(ctx, (size_t)l->nfv, sizeof(int));
+/* Zeroes T and sets it up for s and cfg: the work arrays, the uniform rate on every live param
+ * face, no vertex ids yet. On failure T holds what was allocated (sfb__tess_free_work). */
+static sfb_result sfb__tess_init(sfb__tess *T, const sfb_surface *s, const sfb_tess_config *cfg) {
+    sfb_context *ctx = s->ctx;
+    const sfb__level *l;
+    int pf, f, i, nptex;
+    memset(T, 0, sizeof *T);
+    T->ctx = ctx;
+    T->s = s;
+    T->l = l = &s->pbase;
+    T->pt = &s->patches;
+    T->rate = cfg->rate;
+    T->split = (cfg->flags & SFB_TESS_SPLIT_CREASES) != 0;
+    T->loop = T->pt->domain == SFB__DOMAIN_TRI;
+    nptex = T->pt->nptex;
+    T->prate = (int *)sfb__tess_array(ctx, (size_t)nptex, sizeof(int));
+    T->sseg = (int *)sfb__tess_array(ctx, (size_t)nptex, sizeof(int));
+    T->vspoke = (int *)sfb__tess_array(ctx, (size_t)nptex, sizeof(int));
+    T->ifirst = (int *)sfb__tess_array(ctx, (size_t)nptex, sizeof(int));
+    T->eseg = (int *)sfb__tess_array(ctx, (size_t)l->ne, sizeof(int));
+    T->engon = (unsigned char *)sfb__tess_array(ctx, (size_t)l->ne, 1);
+    T->vedge = (int *)sfb__tess_array(ctx, (size_t)l->nfv, sizeof(int));
+    T->vcenter = (int *)sfb__tess_array(ctx, (size_t)l->nf, sizeof(int));
+    T->vcorner = (int *)sfb__tess_array(ctx, (size_t)(T->split ? l->nfv : l->nv), sizeof(int));
+    T->bids = (int *)sfb__tess_array(ctx, (size_t)6 * (SFB__TESS_MAX_SEG + 1), sizeof(int));
+    if (T->split) {
+        T->uf = (int *)sfb__tess_array(ctx, (size_t)l->nfv, sizeof(int));
+        T->ecopy = (int *)sfb__tess_array(ctx, (size_t)l->nfv, sizeof(int));
     }
-    if (!T.prate || !T.sseg || !T.vspoke || !T.ifirst || !T.eseg || !T.engon || !T.vedge || !T.vcenter || !T.vcorner || !T.bids ||
-        (T.split && (!T.uf || !T.ecopy))) {
-        r = sfb__oom(ctx, "tessellation");
-        goto fail;
-    }
+    if (!T->prate || !T->sseg || !T->vspoke || !T->ifirst || !T->eseg || !T->engon || !T->vedge || !T->vcenter || !T->vcorner ||
+        !T->bids || (T->split && (!T->uf || !T->ecopy)))
+        return sfb__oom(ctx, "tessellation");
     for (pf = 0; pf < nptex; ++pf) {
-        T.prate[pf] = sfb__tess_live(&T, pf) ? T.rate : 0;
-        T.vspoke[pf] = -1;
-        T.sseg[pf] = 0;
+        T->prate[pf] = sfb__tess_live(T, pf) ? T->rate : 0;
+        T->vspoke[pf] = -1;
+        T->sseg[pf] = 0;
     }
-    for (i = 0; i < l->nfv; ++i) T.vedge[i] = -1;
-    for (f = 0; f < l->nf; ++f) T.vcenter[f] = -1;
-    for (i = 0; i < (T.split ? l->nfv : l->nv); ++i) T.vcorner[i] = -1;
+    for (i = 0; i < l->nfv; ++i) T->vedge[i] = -1;
+    for (f = 0; f < l->nf; ++f) T->vcenter[f] = -1;
+    for (i = 0; i < (T->split ? l->nfv : l->nv); ++i) T->vcorner[i] = -1;
+    return SFB_SUCCESS;
+}
+
+/* Segments of each base edge and spoke: the largest rate of the faces on it (an n-gon sub-face
+ * covers half an edge, so it asks for twice its rate, and the count stays even). */
+static void sfb__tess_edge_segments(sfb__tess *T) {
+    const sfb__level *l = T->l;
+    int pf, f, e, k, nptex = T->pt->nptex;
+    memset(T->eseg, 0, (size_t)l->ne * sizeof(int));
+    memset(T->engon, 0, (size_t)l->ne);
+    for (pf = 0; pf < nptex; ++pf) {
+        int rr = T->prate[pf], sub = T->pt->ptex_corner[pf], o, n;
+        if (rr <= 0) continue;
+        f = T->pt->ptex_face[pf];
+        o = l->fv_off[f];
+        n = sfb__tess_face_n(l, f);
+        if (sub < 0) { /* a quad, or a Loop triangle */
+            for (k = 0; k < n; ++k) {
+                e = l->fe[o + k];
+                if (T->eseg[e] < rr) T->eseg[e] = rr;
+            }
+        } else {
+            int ip = (sub + n - 1) % n, nx = T->pt->face_ptex[f] + (sub + 1) % n;
+            int e0 = l->fe[o + sub], e1 = l->fe[o + ip], other = T->prate[nx];
+            if (T->eseg[e0] < 2 * rr) T->eseg[e0] = 2 * rr;
+            if (T->eseg[e1] < 2 * rr) T->eseg[e1] = 2 * rr;
+            T->engon[e0] = T->engon[e1] = 1;
+            T->sseg[pf] = rr > other ? rr : other;
+        }
+    }
+    for (e = 0; e < l->ne; ++e)
+        if (T->engon[e] && (T->eseg[e] & 1)) T->eseg[e] += 1;
+}
+
+/* Sectors for split creases: corners of faces joined across every edge that is not split
+ * (holes join nothing), in the union-find T->uf. */
+static void sfb__tess_sectors(sfb__tess *T) {
+    const sfb__level *l = T->l;
+    int i, e;
+    for (i = 0; i < l->nfv; ++i) T->uf[i] = i;
+    for (e = 0; e < l->ne; ++e) {
+        int a = l->ef_off[e], z = l->ef_off[e + 1], first0 = -1, first1 = -1, q;
+        for (q = a; q < z; ++q) T->ecopy[l->fv_off[l->ef[q]] + l->ef_slot[q]] = q;
+        if (sfb__tess_split_edge(T, e)) continue;
+        for (q = a; q < z; ++q) {
+            int g = l->ef[q], o = l->fv_off[g], n = sfb__tess_face_n(l, g), sl = l->ef_slot[q];
+            int c0 = o + sl, c1 = o + (sl + 1) % n, t;
+            if (l->fhole[g]) continue;
+            if (l->fv[c0] != l->ev[2 * e]) { t = c0; c0 = c1; c1 = t; } /* c0 at ev[0], c1 at ev[1] */
+            if (first0 < 0) { first0 = c0; first1 = c1; }
+            else { sfb__tess_union(T->uf, first0, c0); sfb__tess_union(T->uf, first1, c1); }
+        }
+    }
+}
+
+/* The count pass: ids of every point, and the totals, checked against SFB_MAX_ELEMENTS before
+ * anything is allocated for them. */
+static sfb_result sfb__tess_count(sfb__tess *T) {
+    int pf, nptex = T->pt->nptex;
+    for (pf = 0; pf < nptex; ++pf) {
+        sfb__tess_face(T, pf, 0);
+        if (T->nvert > (size_t)SFB_MAX_ELEMENTS || T->ntri > (size_t)SFB_MAX_ELEMENTS)
+            return sfb__error(T->ctx, SFB_LIMIT_EXCEEDED, SFB_ELEMENT_NONE, -1,
+                              "tessellation at rate %d makes more than %d %s (SFB_MAX_ELEMENTS)", T->rate, SFB_MAX_ELEMENTS,
+                              T->nvert > (size_t)SFB_MAX_ELEMENTS ? "vertices" : "triangles");
+    }
+    return SFB_SUCCESS;
+}
+
+/* The emit pass without trimming: `out`'s arrays, then the locations and triangles of every
+ * param face written straight into them (progress from p0 to p1). */
+static sfb_result sfb__tess_emit(sfb__tess *T, sfb_tess_data *out, float p0, float p1) {
+    sfb_context *ctx = T->ctx;
+    int pf, nptex = T->pt->nptex;
+    size_t v;
+    sfb_result r;
+    out->vertex_count = (int)T->nvert;
+    out->triangle_count = (int)T->ntri;
+    out->positions = (float *)sfb__tess_array(ctx, T->nvert, 3 * sizeof(float));
+    out->normals = (float *)sfb__tess_array(ctx, T->nvert, 3 * sizeof(float));
+    out->locations = (sfb_location *)sfb__tess_array(ctx, T->nvert, sizeof(sfb_location));
+    out->triangles = (int *)sfb__tess_array(ctx, T->ntri, 3 * sizeof(int));
+    out->triangle_faces = (int *)sfb__tess_array(ctx, T->ntri, sizeof(int));
+    if (!out->positions || !out->normals || !out->locations || !out->triangles || !out->triangle_faces)
+        return sfb__oom(ctx, "tessellation");
+    for (v = 0; v < T->nvert; ++v) {
+        out->locations[v].face = -1;
+        out->locations[v].u = out->locations[v].v = 0.0f;
+    }
+    T->loc = out->locations;
+    T->tri = out->triangles;
+    T->tface = out->triangle_faces;
+    for (pf = 0; pf < nptex; ++pf) {
+        if (pf % SFB__TESS_FACE_CHUNK == 0 && pf > 0) {
+            r = sfb__progress(ctx, p0 + (p1 - p0) * (float)pf / (float)nptex, "tessellate");
+            if (r != SFB_SUCCESS) return r;
+        }
+        sfb__tess_face(T, pf, 1);
+    }
+    if (T->tri_at != T->ntri)
+        return sfb__error(ctx, SFB_BACKEND_ERROR, SFB_ELEMENT_NONE, -1, "tessellation wrote %zu triangles, counted %zu", T->tri_at, T->ntri);
+    for (v = 0; v < T->nvert; ++v)
+        if (out->locations[v].face < 0)
+            return sfb__error(ctx, SFB_BACKEND_ERROR, SFB_ELEMENT_NONE, -1, "tessellation vertex %zu has no location", v);
+    return SFB_SUCCESS;
+}
+
+/* Evaluates every vertex of `out` once, in chunks, on the context's backend (progress from p0
+ * to 1). */
+static sfb_result sfb__tess_evaluate(const sfb_surface *s, sfb_tess_data *out, float p0) {
+    sfb_context *ctx = s->ctx;
+    size_t done_v, nv = (size_t)out->vertex_count;
+    sfb_result r;
+    for (done_v = 0; done_v < nv; done_v += SFB__TESS_EVAL_CHUNK) {
+        size_t n = nv - done_v < SFB__TESS_EVAL_CHUNK ? nv - done_v : SFB__TESS_EVAL_CHUNK;
+        sfb_eval_output eo;
+        r = sfb__progress(ctx, p0 + (1.0f - p0) * (float)done_v / (float)nv, "tessellate");
+        if (r != SFB_SUCCESS) return r;
+        memset(&eo, 0, sizeof eo);
+        eo.position = out->positions + 3 * done_v;
+        eo.normal = out->normals + 3 * done_v;
+        r = sfb_surface_eval(s, out->locations + done_v, (int)n, &eo);
+        if (r != SFB_SUCCESS) return r;
+    }
+    return sfb__progress(ctx, 1.0f, "tessellate");
+}
+
+SFB_API sfb_result sfb_surface_tessellate(const sfb_surface *s, const sfb_tess_config *cfg, sfb_tess_data *out) {
+    sfb_context *ctx;
+    sfb__tess T;
+    sfb_result r = SFB_SUCCESS;
+    float p_emit, p_eval;
+    if (out) memset(out, 0, sizeof *out);
+    if (!s) return SFB_INVALID_ARGS;
+    ctx = s->ctx;
+    if (!cfg || !out) return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "sfb_surface_tessellate: NULL argument");
+    if ((r = sfb__tess_check(ctx, s, cfg)) != SFB_SUCCESS) return r;
+    if ((r = sfb__progress(ctx, 0.0f, "tessellate")) != SFB_SUCCESS) return r;
+    if ((r = sfb__tess_init(&T, s, cfg)) != SFB_SUCCESS) goto fail;
 
     /* 1. a rate per param face */
     p_emit = 0.0f;
@@ -1063,122 +1198,18 @@ SFB_API sfb_result sfb_surface_tessellate(const sfb_surface *s, const sfb_tess_c
         r = sfb__trim_rates(&T, p_emit);
         if (r != SFB_SUCCESS) goto fail;
     }
-
-    /* 2. segments of each base edge and spoke: the largest rate of the faces on it (an n-gon
-     * sub-face covers half an edge, so it asks for twice its rate, and the count stays even) */
-    memset(T.eseg, 0, (size_t)l->ne * sizeof(int));
-    memset(T.engon, 0, (size_t)l->ne);
-    for (pf = 0; pf < nptex; ++pf) {
-        int rr = T.prate[pf], sub = T.pt->ptex_corner[pf], o, n;
-        if (rr <= 0) continue;
-        f = T.pt->ptex_face[pf];
-        o = l->fv_off[f];
-        n = sfb__tess_face_n(l, f);
-        if (sub < 0) { /* a quad, or a Loop triangle */
-            for (k = 0; k < n; ++k) {
-                e = l->fe[o + k];
-                if (T.eseg[e] < rr) T.eseg[e] = rr;
-            }
-        } else {
-            int ip = (sub + n - 1) % n, nx = T.pt->face_ptex[f] + (sub + 1) % n;
-            int e0 = l->fe[o + sub], e1 = l->fe[o + ip], other = T.prate[nx];
-            if (T.eseg[e0] < 2 * rr) T.eseg[e0] = 2 * rr;
-            if (T.eseg[e1] < 2 * rr) T.eseg[e1] = 2 * rr;
-            T.engon[e0] = T.engon[e1] = 1;
-            T.sseg[pf] = rr > other ? rr : other;
-        }
-    }
-    for (e = 0; e < l->ne; ++e)
-        if (T.engon[e] && (T.eseg[e] & 1)) T.eseg[e] += 1;
-
-    /* 3. sectors for split creases: corners of faces joined across every edge that is not
-     * split (holes join nothing) */
-    if (T.split) {
-        for (i = 0; i < l->nfv; ++i) T.uf[i] = i;
-        for (e = 0; e < l->ne; ++e) {
-            int a = l->ef_off[e], z = l->ef_off[e + 1], first0 = -1, first1 = -1, q;
-            for (q = a; q < z; ++q) T.ecopy[l->fv_off[l->ef[q]] + l->ef_slot[q]] = q;
-            if (sfb__tess_split_edge(&T, e)) continue;
-            for (q = a; q < z; ++q) {
-                int g = l->ef[q], o = l->fv_off[g], n = sfb__tess_face_n(l, g), sl = l->ef_slot[q];
-                int c0 = o + sl, c1 = o + (sl + 1) % n, t;
-                if (l->fhole[g]) continue;
-                if (l->fv[c0] != l->ev[2 * e]) { t = c0; c0 = c1; c1 = t; } /* c0 at ev[0], c1 at ev[1] */
-                if (first0 < 0) { first0 = c0; first1 = c1; }
-                else { sfb__tess_union(T.uf, first0, c0); sfb__tess_union(T.uf, first1, c1); }
-            }
-        }
-    }
-
-    /* 4. count pass: ids of every point, and the totals, checked before allocating */
-    for (pf = 0; pf < nptex; ++pf) {
-        sfb__tess_face(&T, pf, 0);
-        if (T.nvert > (size_t)SFB_MAX_ELEMENTS || T.ntri > (size_t)SFB_MAX_ELEMENTS) {
-            r = sfb__error(ctx, SFB_LIMIT_EXCEEDED, SFB_ELEMENT_NONE, -1,
-                           "tessellation at rate %d makes more than %d %s (SFB_MAX_ELEMENTS)", T.rate, SFB_MAX_ELEMENTS,
-                           T.nvert > (size_t)SFB_MAX_ELEMENTS ? "vertices" : "triangles");
-            goto fail;
-        }
-    }
-    out->ctx_ = ctx;
-    if (T.trim) {
-        r = sfb__trim_emit(&T, out, p_emit, p_eval);
-        if (r != SFB_SUCCESS) goto fail;
-        goto evaluate;
-    }
-    out->vertex_count = (int)T.nvert;
-    out->triangle_count = (int)T.ntri;
-    out->positions = (float *)sfb__tess_array(ctx, T.nvert, 3 * sizeof(float));
-    out->normals = (float *)sfb__tess_array(ctx, T.nvert, 3 * sizeof(float));
-    out->locations = (sfb_location *)sfb__tess_array(ctx, T.nvert, sizeof(sfb_location));
-    out->triangles = (int *)sfb__tess_array(ctx, T.ntri, 3 * sizeof(int));
-    out->triangle_faces = (int *)sfb__tess_array(ctx, T.ntri, sizeof(int));
-    if (!out->positions || !out->normals || !out->locations || !out->triangles || !out->triangle_faces) {
-        r = sfb__oom(ctx, "tessellation");
-        goto fail;
-    }
-    for (v = 0; v < T.nvert; ++v) {
-        out->locations[v].face = -1;
-        out->locations[v].u = out->locations[v].v = 0.0f;
-    }
-
+    /* 2. segments of each base edge and spoke; 3. sectors for split creases */
+    sfb__tess_edge_segments(&T);
+    if (T.split) sfb__tess_sectors(&T);
+    /* 4. count pass */
+    if ((r = sfb__tess_count(&T)) != SFB_SUCCESS) goto fail;
     /* 5. emit pass: locations and triangles */
-    T.loc = out->locations;
-    T.tri = out->triangles;
-    T.tface = out->triangle_faces;
-    for (pf = 0; pf < nptex; ++pf) {
-        if (pf % SFB__TESS_FACE_CHUNK == 0 && pf > 0) {
-            r = sfb__progress(ctx, p_emit + (p_eval - p_emit) * (float)pf / (float)nptex, "tessellate");
-            if (r != SFB_SUCCESS) goto fail;
-        }
-        sfb__tess_face(&T, pf, 1);
-    }
-    if (T.tri_at != T.ntri) {
-        r = sfb__error(ctx, SFB_BACKEND_ERROR, SFB_ELEMENT_NONE, -1, "tessellation wrote %zu triangles, counted %zu", T.tri_at, T.ntri);
-        goto fail;
-    }
-    for (v = 0; v < T.nvert; ++v)
-        if (out->locations[v].face < 0) {
-            r = sfb__error(ctx, SFB_BACKEND_ERROR, SFB_ELEMENT_NONE, -1, "tessellation vertex %zu has no location", v);
-            goto fail;
-        }
-evaluate:
+    out->ctx_ = ctx;
+    r = T.trim ? sfb__trim_emit(&T, out, p_emit, p_eval) : sfb__tess_emit(&T, out, p_emit, p_eval);
+    if (r != SFB_SUCCESS) goto fail;
     sfb__tess_free_work(&T);
-
     /* 6. evaluate every vertex once, in chunks, on the context's backend */
-    nv = (size_t)out->vertex_count;
-    for (done_v = 0; done_v < nv; done_v += SFB__TESS_EVAL_CHUNK) {
-        size_t n = nv - done_v < SFB__TESS_EVAL_CHUNK ? nv - done_v : SFB__TESS_EVAL_CHUNK;
-        sfb_eval_output eo;
-        r = sfb__progress(ctx, p_eval + (1.0f - p_eval) * (float)done_v / (float)nv, "tessellate");
-        if (r != SFB_SUCCESS) goto fail;
-        memset(&eo, 0, sizeof eo);
-        eo.position = out->positions + 3 * done_v;
-        eo.normal = out->normals + 3 * done_v;
-        r = sfb_surface_eval(s, out->locations + done_v, (int)n, &eo);
-        if (r != SFB_SUCCESS) goto fail;
-    }
-    r = sfb__progress(ctx, 1.0f, "tessellate");
+    r = sfb__tess_evaluate(s, out, p_eval);
     if (r == SFB_SUCCESS) return SFB_SUCCESS;
 fail:
     sfb__tess_free_work(&T);

@@ -211,34 +211,36 @@ void sfb__eigen_cc_free(sfb_context *ctx, sfb__eigen_cc *e) {
     sfb__free(ctx, e);
 }
 
-/* Builds the eigen structure of valence N (3..SFB__STAM_MAX_VALENCE). keep: also keep V and A
- * (for tests). */
-sfb_result sfb__eigen_cc_build(sfb_context *ctx, int N, int keep, sfb__eigen_cc **out) {
-    sfb__eigen_cc *e;
-    int K = 2 * N + 8, col = 0, i, j, k, q;
-    double *A = NULL, *V = NULL, *W = NULL, *AV = NULL;
-    int *perm = NULL;
+/* V^-1 into vinv (V copied to the scratch W; perm holds K ints) and *err = max |A - V J V^-1|,
+ * J = diag(lambda) plus, where head (NULL: none) gives a Jordan head h for column k, a 1 at
+ * (h, k). Returns 0 when V is singular or the error is not at rounding level. */
+static int sfb__eigen_invert_check(int K, const double *A, const double *V, const double *lambda, const int *head, double *W,
+                                   int *perm, double *vinv, double *err_out) {
     size_t KK = (size_t)K * K;
-    *out = NULL;
-    if (N < 3 || N > SFB__STAM_MAX_VALENCE)
-        return sfb__error(ctx, SFB_LIMIT_EXCEEDED, SFB_ELEMENT_NONE, -1, "no Stam eigen structure for valence %d (3..%d)", N,
-                          SFB__STAM_MAX_VALENCE);
-    e = (sfb__eigen_cc *)sfb__calloc(ctx, 1, sizeof *e);
-    A = (double *)sfb__alloc(ctx, KK * sizeof(double));
-    V = (double *)sfb__calloc(ctx, KK, sizeof(double));
-    W = (double *)sfb__alloc(ctx, KK * sizeof(double));
-    AV = (double *)sfb__alloc(ctx, (size_t)9 * K * sizeof(double));
-    perm = (int *)sfb__alloc(ctx, (size_t)K * sizeof(int));
-    if (e) {
-        e->lambda = (double *)sfb__alloc(ctx, (size_t)K * sizeof(double));
-        e->vinv = (double *)sfb__alloc(ctx, KK * sizeof(double));
-        e->phi = (double *)sfb__alloc(ctx, (size_t)48 * K * sizeof(double));
-    }
-    if (!e || !A || !V || !W || !AV || !perm || !e->lambda || !e->vinv || !e->phi) goto oom;
-    e->N = N;
-    e->K = K;
-    sfb__stam_matrix(N, A);
-    /* right eigenvectors of S, column by column of V (row-major: V[r*K + col]) */
+    double err = 0.0;
+    int r, c, k;
+    memcpy(W, V, KK * sizeof(double));
+    if (!sfb__invert(K, W, vinv, perm)) return 0;
+    for (r = 0; r < K; ++r)
+        for (c = 0; c < K; ++c) {
+            double s = 0.0;
+            for (k = 0; k < K; ++k) {
+                double vj = V[(size_t)r * K + k] * lambda[k];
+                if (head && head[k] >= 0) vj += V[(size_t)r * K + head[k]];
+                s += vj * vinv[(size_t)k * K + c];
+            }
+            s -= A[(size_t)r * K + c];
+            if (fabs(s) > err) err = fabs(s);
+        }
+    *err_out = err;
+    return err < 1e-9;
+}
+
+/* The 2N+1 right eigenvectors of S (the ring points; frequency 0 as the 3x3 block on (V, e,
+ * f)) in the first rows of V's columns, their eigenvalues in lambda, the index of lambda = 1 in
+ * *dominant. Returns the number of columns made. */
+static int sfb__eigen_cc_ring(int N, const double *A, double *V, double *lambda, int *dominant) {
+    int K = 2 * N + 8, col = 0, i, j, q;
 #define SFB__SET(r, value) (V[(size_t)(r) * K + col] = (value))
     {
         /* j = 0: constant ring; 3x3 block on (V, e, f) */
@@ -276,8 +278,8 @@ sfb_result sfb__eigen_cc_build(sfb_context *ctx, int N, int keep, sfb__eigen_cc 
             }
             SFB__SET(0, x[0]);
             for (i = 1; i <= N; ++i) { SFB__SET(2 * i - 1, x[1]); SFB__SET(2 * i, x[2]); }
-            e->lambda[col] = lam[q];
-            if (q == 0) e->dominant = col;
+            lambda[col] = lam[q];
+            if (q == 0) *dominant = col;
             col++;
         }
     }
@@ -297,7 +299,7 @@ sfb_result sfb__eigen_cc_build(sfb_context *ctx, int N, int keep, sfb__eigen_cc 
                     SFB__SET(2 * i - 1, x0);
                     SFB__SET(2 * i, (x0 + x1) * d);
                 }
-                e->lambda[col++] = lams[q];
+                lambda[col++] = lams[q];
             }
         }
     }
@@ -309,11 +311,20 @@ sfb_result sfb__eigen_cc_build(sfb_context *ctx, int N, int keep, sfb__eigen_cc 
                 SFB__SET(2 * i - 1, q == 0 ? s : 0.0);
                 SFB__SET(2 * i, q == 1 ? s : 0.0);
             }
-            e->lambda[col++] = 0.25;
+            lambda[col++] = 0.25;
         }
     }
-    if (col != 2 * N + 1) goto defective;
-    /* extend each to A: (lambda I - S12) w = S11 u */
+#undef SFB__SET
+    return col;
+}
+
+/* Extends the `col` eigenvectors of S to A ((lambda I - S12) w = S11 u, in the outer rows of V)
+ * and appends [0; z] for the null vectors z of S12 - mu I. Returns the number of columns, -1
+ * when a system or a null space is not as expected. */
+static int sfb__eigen_cc_extend(int N, double *V, double *lambda, int col) {
+    static const double mus[4] = {0.125, 0.0625, 0.03125, 0.015625};
+    static const int mult[4] = {2, 2, 2, 1};
+    int K = 2 * N + 8, i, k, q;
     for (q = 0; q < col; ++q) {
         double M[49], M0[49], y[7], y0[7], w[7], res;
         for (i = 0; i < 7; ++i) {
@@ -323,47 +334,28 @@ sfb_result sfb__eigen_cc_build(sfb_context *ctx, int N, int keep, sfb__eigen_cc 
                 s += sfb__S11[i][k] / 64.0 * V[(size_t)src * K + q];
             }
             y[i] = y0[i] = s;
-            for (k = 0; k < 7; ++k) M[i * 7 + k] = M0[i * 7 + k] = (i == k ? e->lambda[q] : 0.0) - sfb__S12[i][k] / 64.0;
+            for (k = 0; k < 7; ++k) M[i * 7 + k] = M0[i * 7 + k] = (i == k ? lambda[q] : 0.0) - sfb__S12[i][k] / 64.0;
         }
         res = sfb__solve_full(7, M, y, w, M0, y0);
-        if (res > 1e-10) goto defective;
+        if (res > 1e-10) return -1;
         for (i = 0; i < 7; ++i) V[(size_t)(2 * N + 1 + i) * K + q] = w[i];
     }
-    {
-        static const double mus[4] = {0.125, 0.0625, 0.03125, 0.015625};
-        static const int mult[4] = {2, 2, 2, 1};
-        for (q = 0; q < 4; ++q) {
-            double z[2][7];
-            int got = sfb__s12_null(mus[q], z), f;
-            if (got != mult[q]) goto defective;
-            for (f = 0; f < got; ++f) {
-                for (i = 0; i < 7; ++i) V[(size_t)(2 * N + 1 + i) * K + col] = z[f][i];
-                e->lambda[col++] = mus[q];
-            }
+    for (q = 0; q < 4; ++q) {
+        double z[2][7];
+        int got = sfb__s12_null(mus[q], z), f;
+        if (got != mult[q]) return -1;
+        for (f = 0; f < got; ++f) {
+            for (i = 0; i < 7; ++i) V[(size_t)(2 * N + 1 + i) * K + col] = z[f][i];
+            lambda[col++] = mus[q];
         }
     }
-#undef SFB__SET
-    if (col != K) goto defective;
-    /* V^-1 */
-    memcpy(W, V, KK * sizeof(double));
-    if (!sfb__invert(K, W, e->vinv, perm)) goto defective;
-    /* check A = V L V^-1 */
-    {
-        double err = 0.0;
-        int r, c;
-        for (r = 0; r < K; ++r)
-            for (c = 0; c < K; ++c) {
-                double s = 0.0;
-                for (k = 0; k < K; ++k) s += V[(size_t)r * K + k] * e->lambda[k] * e->vinv[(size_t)k * K + c];
-                s -= A[(size_t)r * K + c];
-                if (fabs(s) > err) err = fabs(s);
-            }
-        e->error = err;
-        if (!(err < 1e-9)) goto defective;
-    }
-    e->sub = 0.0;
-    for (i = 0; i < K; ++i)
-        if (i != e->dominant && fabs(e->lambda[i]) > e->sub) e->sub = fabs(e->lambda[i]);
+    return col;
+}
+
+/* Phi_k = P_k Abar V (16 x K per sub-patch k = 1..3) into phi: the picked rows of Abar V, rows
+ * < K of it being rows of A V, rows K..K+8 [S21 0 S22] V (computed into the scratch AV, 9 x K). */
+static void sfb__eigen_cc_phi(int N, const double *A, const double *V, double *AV, double *phi) {
+    int K = 2 * N + 8, i, j, k, q;
     /* rows K..K+8 of Abar V: [S21 0 S22] V */
     for (i = 0; i < 9; ++i)
         for (q = 0; q < K; ++q) {
@@ -378,7 +370,7 @@ sfb_result sfb__eigen_cc_build(sfb_context *ctx, int N, int keep, sfb__eigen_cc 
     for (k = 1; k <= 3; ++k)
         for (j = 0; j < 16; ++j) {
             int p = sfb__stam_pick(N, k, j);
-            double *dst = e->phi + ((size_t)(k - 1) * 16 + j) * K;
+            double *dst = phi + ((size_t)(k - 1) * 16 + j) * K;
             for (q = 0; q < K; ++q) {
                 if (p < K) {
                     double s = 0.0;
@@ -390,6 +382,47 @@ sfb_result sfb__eigen_cc_build(sfb_context *ctx, int N, int keep, sfb__eigen_cc 
                 }
             }
         }
+}
+
+/* Builds the eigen structure of valence N (3..SFB__STAM_MAX_VALENCE). keep: also keep V and A
+ * (for tests). */
+sfb_result sfb__eigen_cc_build(sfb_context *ctx, int N, int keep, sfb__eigen_cc **out) {
+    sfb__eigen_cc *e;
+    int K = 2 * N + 8, col, i;
+    double *A = NULL, *V = NULL, *W = NULL, *AV = NULL;
+    int *perm = NULL;
+    size_t KK = (size_t)K * K;
+    *out = NULL;
+    if (N < 3 || N > SFB__STAM_MAX_VALENCE)
+        return sfb__error(ctx, SFB_LIMIT_EXCEEDED, SFB_ELEMENT_NONE, -1, "no Stam eigen structure for valence %d (3..%d)", N,
+                          SFB__STAM_MAX_VALENCE);
+    e = (sfb__eigen_cc *)sfb__calloc(ctx, 1, sizeof *e);
+    A = (double *)sfb__alloc(ctx, KK * sizeof(double));
+    V = (double *)sfb__calloc(ctx, KK, sizeof(double));
+    W = (double *)sfb__alloc(ctx, KK * sizeof(double));
+    AV = (double *)sfb__alloc(ctx, (size_t)9 * K * sizeof(double));
+    perm = (int *)sfb__alloc(ctx, (size_t)K * sizeof(int));
+    if (e) {
+        e->lambda = (double *)sfb__alloc(ctx, (size_t)K * sizeof(double));
+        e->vinv = (double *)sfb__alloc(ctx, KK * sizeof(double));
+        e->phi = (double *)sfb__alloc(ctx, (size_t)48 * K * sizeof(double));
+    }
+    if (!e || !A || !V || !W || !AV || !perm || !e->lambda || !e->vinv || !e->phi) goto oom;
+    e->N = N;
+    e->K = K;
+    sfb__stam_matrix(N, A);
+    /* right eigenvectors of S, column by column of V (row-major: V[r*K + col]) */
+    col = sfb__eigen_cc_ring(N, A, V, e->lambda, &e->dominant);
+    if (col != 2 * N + 1) goto defective;
+    /* extend each to A: (lambda I - S12) w = S11 u; then S12's own eigenvectors */
+    col = sfb__eigen_cc_extend(N, V, e->lambda, col);
+    if (col != K) goto defective;
+    /* V^-1, and the check A = V L V^-1 */
+    if (!sfb__eigen_invert_check(K, A, V, e->lambda, NULL, W, perm, e->vinv, &e->error)) goto defective;
+    e->sub = 0.0;
+    for (i = 0; i < K; ++i)
+        if (i != e->dominant && fabs(e->lambda[i]) > e->sub) e->sub = fabs(e->lambda[i]);
+    sfb__eigen_cc_phi(N, A, V, AV, e->phi);
     if (keep) { e->v = V; e->a = A; V = A = NULL; }
     sfb__free(ctx, A); sfb__free(ctx, V); sfb__free(ctx, W); sfb__free(ctx, AV); sfb__free(ctx, perm);
     *out = e;
@@ -527,12 +560,127 @@ static void sfb__loop_matrix(int N, double *A) {
 #undef SFB__A
 }
 
+/* S11's eigenvectors (outer order (1,1) (2,0) (2,-1) (0,2) (-1,2)) and eigenvalues */
+static const double sfb__loop_U[5][5] = {{1, 0, 0, 0, 0}, {1, 1, 0, 1, 0}, {0, 1, 0, 0, 0}, {1, 0, 1, 0, 1}, {0, 0, 1, 0, 0}};
+static const double sfb__loop_mu[5] = {0.125, 0.125, 0.125, 0.0625, 0.0625};
+
+/* S's eigenvectors in the first N+1 rows of V's columns, their eigenvalues in lambda, the
+ * index of lambda = 1 in *dominant and the eigenvalue of frequency 1 in *c1. Returns the
+ * number of columns made. */
+static int sfb__eigen_loop_ring(int N, double *V, double *lambda, int *dominant, double *c1) {
+    int K = N + 6, col = 0, i, j;
+#define SFB__SET(r, value) (V[(size_t)(r) * K + col] = (value))
+    {
+        double c = cos(2.0 * SFB__PI / N), alpha = 0.625 - (3.0 + 2.0 * c) * (3.0 + 2.0 * c) / 64.0;
+        for (i = 0; i <= N; ++i) SFB__SET(i, 1.0);
+        lambda[col] = 1.0;
+        *dominant = col++;
+        SFB__SET(0, -8.0 * alpha / 3.0);
+        for (i = 1; i <= N; ++i) SFB__SET(i, 1.0);
+        lambda[col++] = 0.625 - alpha;
+    }
+    for (j = 1; 2 * j < N; ++j) {
+        double t = 2.0 * SFB__PI * j / N;
+        int trig;
+        for (trig = 0; trig < 2; ++trig) {
+            SFB__SET(0, 0.0);
+            for (i = 0; i < N; ++i) SFB__SET(1 + i, trig ? sin(i * t) : cos(i * t));
+            lambda[col++] = 0.375 + 0.25 * cos(t);
+        }
+        if (j == 1) *c1 = 0.375 + 0.25 * cos(t);
+    }
+    if (N % 2 == 0) {
+        SFB__SET(0, 0.0);
+        for (i = 0; i < N; ++i) SFB__SET(1 + i, (i % 2) ? -1.0 : 1.0);
+        lambda[col++] = 0.125;
+    }
+#undef SFB__SET
+    return col;
+}
+
+/* Extends S's N+1 eigenvectors to A: (S11 - lambda) y = -S10 w, solved in S11's eigenbasis (Ui
+ * its inverse; outer_col the columns of S11's eigenvectors). Where A is defective the column
+ * becomes the partner of a Jordan head (head[q]). Returns 0 when it is defective more than
+ * once. */
+static int sfb__eigen_loop_extend(int N, const double *A, double *V, const double *Ui, const int *outer_col, double *lambda,
+                                  int *head) {
+    int K = N + 6, i, k, q, l, njordan = 0;
+    for (q = 0; q <= N; ++q) {
+        double rhs[5], d[5], yh[5], best = 0.0;
+        int lstar = -1;
+        for (i = 0; i < 5; ++i) {
+            double s = 0.0;
+            for (k = 0; k <= N; ++k) s += A[(size_t)(N + 1 + i) * K + k] * V[(size_t)k * K + q];
+            rhs[i] = s;
+        }
+        for (l = 0; l < 5; ++l) {
+            double s = 0.0;
+            for (i = 0; i < 5; ++i) s += Ui[l * 5 + i] * rhs[i];
+            d[l] = s;
+        }
+        for (l = 0; l < 5; ++l) {
+            if (fabs(lambda[q] - sfb__loop_mu[l]) > 1e-9) yh[l] = d[l] / (lambda[q] - sfb__loop_mu[l]);
+            else {
+                yh[l] = 0.0;
+                if (fabs(d[l]) > 1e-12 && fabs(d[l]) > best) { best = fabs(d[l]); lstar = l; }
+            }
+        }
+        for (i = 0; i < 5; ++i) {
+            double s = 0.0;
+            for (l = 0; l < 5; ++l) s += sfb__loop_U[i][l] * yh[l];
+            V[(size_t)(N + 1 + i) * K + q] = s;
+        }
+        if (lstar >= 0) {
+            /* defective: (A - lambda)[w; y] = sum over S11's lambda-eigenvectors of d_l [0; u_l].
+             * That sum replaces the column of u_lstar as the Jordan head; [w; y] is its partner. */
+            int h = outer_col[lstar];
+            if (++njordan > 1) return 0;
+            for (i = 0; i < 5; ++i) {
+                double s = 0.0;
+                for (l = 0; l < 5; ++l)
+                    if (fabs(lambda[q] - sfb__loop_mu[l]) <= 1e-9) s += d[l] * sfb__loop_U[i][l];
+                V[(size_t)(N + 1 + i) * K + h] = s;
+            }
+            lambda[q] = sfb__loop_mu[lstar];
+            head[q] = h;
+        }
+    }
+    return 1;
+}
+
+/* Phi_k into phi (15 x K per sub-patch k = 0..2): the Bezier points of the picked rows of
+ * Abar V. Returns 0 when a picked point is not in the enlarged set. */
+static int sfb__eigen_loop_phi(int N, const double *A, const double *V, double *phi) {
+    int K = N + 6, i, j, k, q;
+    for (k = 0; k < 3; ++k) {
+        static const int org[3][4] = {{1, 0, 1, 0}, {0, 1, 1, 0}, {1, 1, -1, 0}}; /* origin x, y; frame sign; unused */
+        int rows[12];
+        for (j = 0; j < 12; ++j) {
+            int x = org[k][0] + org[k][2] * sfb__box12[j][0], y = org[k][1] + org[k][2] * sfb__box12[j][1];
+            rows[j] = sfb__loop_index(N, x, y);
+            if (rows[j] < 0) return 0;
+        }
+        for (q = 0; q < K; ++q) {
+            double av[12];
+            for (j = 0; j < 12; ++j) {
+                double s = 0.0;
+                int c;
+                for (c = 0; c < K; ++c) s += A[(size_t)rows[j] * K + c] * V[(size_t)c * K + q];
+                av[j] = s;
+            }
+            for (j = 0; j < 15; ++j) {
+                double s = 0.0;
+                for (i = 0; i < 12; ++i) s += sfb__bez15_from_box[j][i] * av[i];
+                phi[((size_t)k * 15 + j) * K + q] = s / 24.0;
+            }
+        }
+    }
+    return 1;
+}
+
 sfb_result sfb__eigen_loop_build(sfb_context *ctx, int N, int keep, sfb__eigen_loop **out) {
-    /* S11's eigenvectors (outer order (1,1) (2,0) (2,-1) (0,2) (-1,2)) and eigenvalues */
-    static const double U[5][5] = {{1, 0, 0, 0, 0}, {1, 1, 0, 1, 0}, {0, 1, 0, 0, 0}, {1, 0, 1, 0, 1}, {0, 0, 1, 0, 0}};
-    static const double mu[5] = {0.125, 0.125, 0.125, 0.0625, 0.0625};
     sfb__eigen_loop *e;
-    int K = N + 6, col = 0, i, j, k, q, l, njordan = 0;
+    int K = N + 6, col, i, l;
     double *A = NULL, *V = NULL, *W = NULL;
     double Ui[25], Uw[25];
     int *perm = NULL, outer_col[5];
@@ -558,129 +706,24 @@ sfb_result sfb__eigen_loop_build(sfb_context *ctx, int N, int keep, sfb__eigen_l
     e->K = K;
     for (i = 0; i < K; ++i) e->head[i] = -1;
     sfb__loop_matrix(N, A);
-    for (i = 0; i < 25; ++i) Uw[i] = U[i / 5][i % 5];
+    for (i = 0; i < 25; ++i) Uw[i] = sfb__loop_U[i / 5][i % 5];
     if (!sfb__invert(5, Uw, Ui, perm)) goto defective;
     /* S's eigenvectors in the first N+1 rows of V */
-#define SFB__SET(r, value) (V[(size_t)(r) * K + col] = (value))
-    {
-        double c = cos(2.0 * SFB__PI / N), alpha = 0.625 - (3.0 + 2.0 * c) * (3.0 + 2.0 * c) / 64.0;
-        for (i = 0; i <= N; ++i) SFB__SET(i, 1.0);
-        e->lambda[col] = 1.0;
-        e->dominant = col++;
-        SFB__SET(0, -8.0 * alpha / 3.0);
-        for (i = 1; i <= N; ++i) SFB__SET(i, 1.0);
-        e->lambda[col++] = 0.625 - alpha;
-    }
-    for (j = 1; 2 * j < N; ++j) {
-        double t = 2.0 * SFB__PI * j / N;
-        int trig;
-        for (trig = 0; trig < 2; ++trig) {
-            SFB__SET(0, 0.0);
-            for (i = 0; i < N; ++i) SFB__SET(1 + i, trig ? sin(i * t) : cos(i * t));
-            e->lambda[col++] = 0.375 + 0.25 * cos(t);
-        }
-        if (j == 1) c1 = 0.375 + 0.25 * cos(t);
-    }
-    if (N % 2 == 0) {
-        SFB__SET(0, 0.0);
-        for (i = 0; i < N; ++i) SFB__SET(1 + i, (i % 2) ? -1.0 : 1.0);
-        e->lambda[col++] = 0.125;
-    }
-#undef SFB__SET
+    col = sfb__eigen_loop_ring(N, V, e->lambda, &e->dominant, &c1);
     if (col != N + 1) goto defective;
     /* S11's eigenvectors [0; u_l] */
     for (l = 0; l < 5; ++l) {
-        for (i = 0; i < 5; ++i) V[(size_t)(N + 1 + i) * K + col] = U[i][l];
-        e->lambda[col] = mu[l];
+        for (i = 0; i < 5; ++i) V[(size_t)(N + 1 + i) * K + col] = sfb__loop_U[i][l];
+        e->lambda[col] = sfb__loop_mu[l];
         outer_col[l] = col++;
     }
     /* extend S's eigenvectors: (S11 - lambda) y = -S10 w, in S11's eigenbasis */
-    for (q = 0; q <= N; ++q) {
-        double rhs[5], d[5], yh[5], best = 0.0;
-        int lstar = -1;
-        for (i = 0; i < 5; ++i) {
-            double s = 0.0;
-            for (k = 0; k <= N; ++k) s += A[(size_t)(N + 1 + i) * K + k] * V[(size_t)k * K + q];
-            rhs[i] = s;
-        }
-        for (l = 0; l < 5; ++l) {
-            double s = 0.0;
-            for (i = 0; i < 5; ++i) s += Ui[l * 5 + i] * rhs[i];
-            d[l] = s;
-        }
-        for (l = 0; l < 5; ++l) {
-            if (fabs(e->lambda[q] - mu[l]) > 1e-9) yh[l] = d[l] / (e->lambda[q] - mu[l]);
-            else {
-                yh[l] = 0.0;
-                if (fabs(d[l]) > 1e-12 && fabs(d[l]) > best) { best = fabs(d[l]); lstar = l; }
-            }
-        }
-        for (i = 0; i < 5; ++i) {
-            double s = 0.0;
-            for (l = 0; l < 5; ++l) s += U[i][l] * yh[l];
-            V[(size_t)(N + 1 + i) * K + q] = s;
-        }
-        if (lstar >= 0) {
-            /* defective: (A - lambda)[w; y] = sum over S11's lambda-eigenvectors of d_l [0; u_l].
-             * That sum replaces the column of u_lstar as the Jordan head; [w; y] is its partner. */
-            int h = outer_col[lstar];
-            if (++njordan > 1) goto defective;
-            for (i = 0; i < 5; ++i) {
-                double s = 0.0;
-                for (l = 0; l < 5; ++l)
-                    if (fabs(e->lambda[q] - mu[l]) <= 1e-9) s += d[l] * U[i][l];
-                V[(size_t)(N + 1 + i) * K + h] = s;
-            }
-            e->lambda[q] = mu[lstar];
-            e->head[q] = h;
-        }
-    }
-    /* V^-1 */
-    memcpy(W, V, KK * sizeof(double));
-    if (!sfb__invert(K, W, e->vinv, perm)) goto defective;
-    /* check A = V J V^-1 */
-    {
-        double err = 0.0;
-        int r, c;
-        for (r = 0; r < K; ++r)
-            for (c = 0; c < K; ++c) {
-                double s = 0.0;
-                for (k = 0; k < K; ++k) {
-                    double vj = V[(size_t)r * K + k] * e->lambda[k];
-                    if (e->head[k] >= 0) vj += V[(size_t)r * K + e->head[k]];
-                    s += vj * e->vinv[(size_t)k * K + c];
-                }
-                s -= A[(size_t)r * K + c];
-                if (fabs(s) > err) err = fabs(s);
-            }
-        e->error = err;
-        if (!(err < 1e-9)) goto defective;
-    }
+    if (!sfb__eigen_loop_extend(N, A, V, Ui, outer_col, e->lambda, e->head)) goto defective;
+    /* V^-1, and the check A = V J V^-1 */
+    if (!sfb__eigen_invert_check(K, A, V, e->lambda, e->head, W, perm, e->vinv, &e->error)) goto defective;
     e->sub = c1;
     /* Phi_k: Bezier points of the picked rows of Abar V */
-    for (k = 0; k < 3; ++k) {
-        static const int org[3][4] = {{1, 0, 1, 0}, {0, 1, 1, 0}, {1, 1, -1, 0}}; /* origin x, y; frame sign; unused */
-        int rows[12];
-        for (j = 0; j < 12; ++j) {
-            int x = org[k][0] + org[k][2] * sfb__box12[j][0], y = org[k][1] + org[k][2] * sfb__box12[j][1];
-            rows[j] = sfb__loop_index(N, x, y);
-            if (rows[j] < 0) goto defective;
-        }
-        for (q = 0; q < K; ++q) {
-            double av[12];
-            for (j = 0; j < 12; ++j) {
-                double s = 0.0;
-                int c;
-                for (c = 0; c < K; ++c) s += A[(size_t)rows[j] * K + c] * V[(size_t)c * K + q];
-                av[j] = s;
-            }
-            for (j = 0; j < 15; ++j) {
-                double s = 0.0;
-                for (i = 0; i < 12; ++i) s += sfb__bez15_from_box[j][i] * av[i];
-                e->phi[((size_t)k * 15 + j) * K + q] = s / 24.0;
-            }
-        }
-    }
+    if (!sfb__eigen_loop_phi(N, A, V, e->phi)) goto defective;
     if (keep) { e->v = V; e->a = A; V = A = NULL; }
     sfb__free(ctx, A); sfb__free(ctx, V); sfb__free(ctx, W); sfb__free(ctx, perm);
     *out = e;

@@ -320,56 +320,53 @@ static unsigned sfb__mf_corner_code(const sfb__level *l, const unsigned char *ki
     return SFB__MF_CODE(SFB__MF_PATCH, k, h, 0, 0);
 }
 
-sfb_result sfb__manifold_build(sfb_context *ctx, const sfb__level *base, int weights, const float *positions, sfb__patch_table *pt) {
-    sfb__level work, lev1, *L = NULL;
-    sfb__stencils T;
-    double *P = NULL, **pinv = NULL;
-    unsigned char *kind = NULL;
-    int *ev1 = NULL, *ev2 = NULL;
-    int quads = 1, f, v, i, j, c, refined = 0, nptex = 0, npatch = 0, nnodes = 0;
-    sfb_result r = SFB_SUCCESS;
-    memset(pt, 0, sizeof *pt);
-    memset(&work, 0, sizeof work); memset(&lev1, 0, sizeof lev1); memset(&T, 0, sizeof T);
-    if (weights != SFB_MANIFOLD_WEIGHTS_HERMITE && weights != SFB_MANIFOLD_WEIGHTS_CINF)
-        return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, -1, "manifold weights %d are not SFB_MANIFOLD_WEIGHTS_HERMITE or _CINF", weights);
-    pt->domain = SFB__DOMAIN_QUAD;
-    pt->mf_weights = weights;
+/* The manifold mesh L and its positions P (double, xyz): the base itself when every face is a
+ * quad, else one Catmull-Clark step of it into work/lev1/T with sharp edges and vertices
+ * carried as infinitely sharp (*refined = 1). */
+static sfb_result sfb__mf_manifold_mesh(sfb_context *ctx, const sfb__level *base, const float *positions, sfb__level *work,
+                                        sfb__level *lev1, sfb__stencils *T, const sfb__level **L_out, double **P_out, int *refined) {
+    const sfb__level *L;
+    double *P;
+    sfb_result r;
+    int quads = 1, f, v, i, c;
     for (f = 0; f < base->nf; ++f) if (base->fv_off[f + 1] - base->fv_off[f] != 4) quads = 0;
     if (quads) {
-        L = (sfb__level *)base;
-        P = (double *)sfb__alloc(ctx, ((size_t)base->nv + 1) * 3 * sizeof(double));
-        if (!P) goto oom;
+        *L_out = base;
+        P = *P_out = (double *)sfb__alloc(ctx, ((size_t)base->nv + 1) * 3 * sizeof(double));
+        if (!P) return sfb__oom(ctx, "manifold patch table");
         for (i = 0; i < 3 * base->nv; ++i) P[i] = positions[i];
     } else {
         /* one Catmull-Clark step, sharp edges and vertices carried as infinitely sharp */
         sfb__refine_options o;
         int e;
-        refined = 1;
-        if ((r = sfb__level_prepare(ctx, base, 0, 0, &work)) != SFB_SUCCESS) goto done;
-        for (e = 0; e < work.ne; ++e) if (work.es[e] > 0.0f) work.es[e] = SFB_SHARPNESS_INFINITE;
-        for (v = 0; v < work.nv; ++v) if (work.vs[v] > 0.0f) work.vs[v] = SFB_SHARPNESS_INFINITE;
-        sfb__level_compute_rules(&work);
+        *refined = 1;
+        if ((r = sfb__level_prepare(ctx, base, 0, 0, work)) != SFB_SUCCESS) return r;
+        for (e = 0; e < work->ne; ++e) if (work->es[e] > 0.0f) work->es[e] = SFB_SHARPNESS_INFINITE;
+        for (v = 0; v < work->nv; ++v) if (work->vs[v] > 0.0f) work->vs[v] = SFB_SHARPNESS_INFINITE;
+        sfb__level_compute_rules(work);
         memset(&o, 0, sizeof o);
         o.scheme = SFB_SCHEME_CATMARK;
-        if ((r = sfb__refine(ctx, &work, &o, 1, &lev1, &T, NULL, 0.0f, 0.5f)) != SFB_SUCCESS) goto done;
-        L = &lev1;
-        P = (double *)sfb__calloc(ctx, ((size_t)L->nv + 1) * 3, sizeof(double));
-        if (!P) goto oom;
-        for (v = 0; v < T.rows; ++v)
-            for (i = 0; i < T.sizes[v]; ++i) {
-                int src = T.indices[T.offsets[v] + i];
-                double w = T.weights[T.offsets[v] + i];
+        if ((r = sfb__refine(ctx, work, &o, 1, lev1, T, NULL, 0.0f, 0.5f)) != SFB_SUCCESS) return r;
+        L = *L_out = lev1;
+        P = *P_out = (double *)sfb__calloc(ctx, ((size_t)L->nv + 1) * 3, sizeof(double));
+        if (!P) return sfb__oom(ctx, "manifold patch table");
+        for (v = 0; v < T->rows; ++v)
+            for (i = 0; i < T->sizes[v]; ++i) {
+                int src = T->indices[T->offsets[v] + i];
+                double w = T->weights[T->offsets[v] + i];
                 for (c = 0; c < 3; ++c) P[3 * (size_t)v + c] += w * positions[3 * (size_t)src + c];
             }
     }
-    /* local geometries */
-    kind = (unsigned char *)sfb__alloc(ctx, (size_t)L->nv + 1);
-    ev1 = (int *)sfb__alloc(ctx, ((size_t)L->nv + 1) * sizeof(int));
-    ev2 = (int *)sfb__alloc(ctx, ((size_t)L->nv + 1) * sizeof(int));
-    pt->point_data = (float *)sfb__calloc(ctx, (size_t)L->nv * 27 + 1, sizeof(float));
-    pinv = (double **)sfb__calloc(ctx, SFB_MAX_VALENCE + 1, sizeof(double *));
-    if (!kind || !ev1 || !ev2 || !pt->point_data || !pinv) goto oom;
-    pt->npoints = 9 * L->nv;
+    return SFB_SUCCESS;
+}
+
+/* The local geometry of every vertex of L into pt->point_data (nine xyz rows each: a point, a
+ * crease curve or the fitted bi-quadratic patch), its kind and sharp edges into kind/ev1/ev2;
+ * pinv caches the pseudo-inverse of each valence. */
+static sfb_result sfb__mf_local_geometry(sfb_context *ctx, const sfb__level *L, const double *P, unsigned char *kind, int *ev1,
+                                         int *ev2, double **pinv, sfb__patch_table *pt) {
+    sfb_result r;
+    int v, i, c;
     for (v = 0; v < L->nv; ++v) {
         float *C = pt->point_data + 27 * (size_t)v;
         int k = L->vf_off[v + 1] - L->vf_off[v], e0 = L->ve_off[v];
@@ -386,7 +383,7 @@ sfb_result sfb__manifold_build(sfb_context *ctx, const sfb__level *base, int wei
             const double *M;
             int q;
             if (k > SFB_MAX_VALENCE) { kind[v] = SFB__MF_POINT; continue; }
-            if (!pinv[k] && (r = sfb__mf_pinv(ctx, k, &pinv[k])) != SFB_SUCCESS) goto done;
+            if (!pinv[k] && (r = sfb__mf_pinv(ctx, k, &pinv[k])) != SFB_SUCCESS) return r;
             M = pinv[k];
             for (q = 1; q < 9; ++q) {
                 double acc[3] = {0.0, 0.0, 0.0};
@@ -399,9 +396,15 @@ sfb_result sfb__manifold_build(sfb_context *ctx, const sfb__level *base, int wei
             }
         }
     }
-    /* param faces and patches */
+    return SFB_SUCCESS;
+}
+
+/* Counts the param faces, patches and quadtree nodes of the base faces and allocates the
+ * patch table's arrays for them. */
+static sfb_result sfb__mf_alloc_patches(sfb_context *ctx, const sfb__level *base, int refined, sfb__patch_table *pt) {
+    int f, nptex = 0, npatch = 0, nnodes = 0;
     pt->face_ptex = (int *)sfb__alloc(ctx, ((size_t)base->nf + 1) * sizeof(int));
-    if (!pt->face_ptex) goto oom;
+    if (!pt->face_ptex) return sfb__oom(ctx, "manifold patch table");
     for (f = 0; f < base->nf; ++f) {
         int n = base->fv_off[f + 1] - base->fv_off[f];
         pt->face_ptex[f] = nptex;
@@ -423,57 +426,89 @@ sfb_result sfb__manifold_build(sfb_context *ctx, const sfb__level *base, int wei
     pt->pcorner = (unsigned *)sfb__alloc(ctx, ((size_t)npatch + 1) * 4 * sizeof(unsigned));
     if (!pt->ptex_face || !pt->ptex_corner || !pt->ptex_root || !pt->nodes || !pt->ptype || !pt->pfirst || !pt->pparam || !pt->pvalence ||
         !pt->cv || !pt->pcorner)
-        goto oom;
-    {
-        int p = 0, node = 0;
-        for (f = 0; f < base->nf; ++f) {
-            int n = base->fv_off[f + 1] - base->fv_off[f], k0 = pt->face_ptex[f];
-            for (i = 0; i < (n == 4 ? 1 : n); ++i) {
-                pt->ptex_face[k0 + i] = f;
-                pt->ptex_corner[k0 + i] = n == 4 ? -1 : i;
-                pt->ptex_root[k0 + i] = -1;
-            }
-            if (base->fhole[f]) continue;
-            if (!refined) {
-                pt->ptex_root[k0] = -(p + 2);
-                pt->pparam[p] = SFB__PARAM(0, 0, 0, 0);
-                for (j = 0; j < 4; ++j) {
-                    pt->cv[4 * p + j] = L->fv[L->fv_off[f] + j];
-                    pt->pcorner[4 * p + j] = sfb__mf_corner_code(L, kind, ev1, ev2, f, j);
-                }
-                pt->ptype[p] = SFB__PATCH_MANIFOLD4; pt->pfirst[p] = 4 * p;
-                p++;
-                continue;
-            }
-            /* child quad i of base face f is refined face fv_off[f] + i, its slot 0 at the
-             * corner v_i (v_i, mid(v_i,v_i+1), centroid, mid(v_i-1,v_i)) */
-            if (n == 4) pt->ptex_root[k0] = node;
-            for (i = 0; i < n; ++i) {
-                int g = base->fv_off[f] + i, s0 = n == 4 ? (4 - i) % 4 : 0;
-                static const int qx[4] = {0, 1, 1, 0}, qy[4] = {0, 0, 1, 1};
-                if (n == 4) {
-                    pt->nodes[4 * node + qx[i] + 2 * qy[i]] = -(p + 2);
-                    pt->pparam[p] = SFB__PARAM(1, qx[i], qy[i], 0);
-                } else {
-                    pt->ptex_root[k0 + i] = -(p + 2);
-                    pt->pparam[p] = SFB__PARAM(0, 0, 0, 0);
-                }
-                for (j = 0; j < 4; ++j) {
-                    int slot = (s0 + j) % 4;
-                    pt->cv[4 * p + j] = L->fv[L->fv_off[g] + slot];
-                    pt->pcorner[4 * p + j] = sfb__mf_corner_code(L, kind, ev1, ev2, g, slot);
-                }
-                pt->ptype[p] = SFB__PATCH_MANIFOLD4; pt->pfirst[p] = 4 * p;
-                p++;
-            }
-            if (n == 4) node++;
+        return sfb__oom(ctx, "manifold patch table");
+    return SFB_SUCCESS;
+}
+
+/* Fills the param faces, quadtree nodes and MANIFOLD4 patches (control vertices and corner
+ * codes) of every base face: one patch per quad, or one per child quad when L is refined. */
+static void sfb__mf_fill_patches(const sfb__level *base, const sfb__level *L, int refined, const unsigned char *kind, const int *ev1,
+                                 const int *ev2, sfb__patch_table *pt) {
+    int p = 0, node = 0, f, i, j, npatch = pt->npatch;
+    for (f = 0; f < base->nf; ++f) {
+        int n = base->fv_off[f + 1] - base->fv_off[f], k0 = pt->face_ptex[f];
+        for (i = 0; i < (n == 4 ? 1 : n); ++i) {
+            pt->ptex_face[k0 + i] = f;
+            pt->ptex_corner[k0 + i] = n == 4 ? -1 : i;
+            pt->ptex_root[k0 + i] = -1;
         }
-        pt->pfirst[npatch] = 4 * npatch;
+        if (base->fhole[f]) continue;
+        if (!refined) {
+            pt->ptex_root[k0] = -(p + 2);
+            pt->pparam[p] = SFB__PARAM(0, 0, 0, 0);
+            for (j = 0; j < 4; ++j) {
+                pt->cv[4 * p + j] = L->fv[L->fv_off[f] + j];
+                pt->pcorner[4 * p + j] = sfb__mf_corner_code(L, kind, ev1, ev2, f, j);
+            }
+            pt->ptype[p] = SFB__PATCH_MANIFOLD4; pt->pfirst[p] = 4 * p;
+            p++;
+            continue;
+        }
+        /* child quad i of base face f is refined face fv_off[f] + i, its slot 0 at the
+         * corner v_i (v_i, mid(v_i,v_i+1), centroid, mid(v_i-1,v_i)) */
+        if (n == 4) pt->ptex_root[k0] = node;
+        for (i = 0; i < n; ++i) {
+            int g = base->fv_off[f] + i, s0 = n == 4 ? (4 - i) % 4 : 0;
+            static const int qx[4] = {0, 1, 1, 0}, qy[4] = {0, 0, 1, 1};
+            if (n == 4) {
+                pt->nodes[4 * node + qx[i] + 2 * qy[i]] = -(p + 2);
+                pt->pparam[p] = SFB__PARAM(1, qx[i], qy[i], 0);
+            } else {
+                pt->ptex_root[k0 + i] = -(p + 2);
+                pt->pparam[p] = SFB__PARAM(0, 0, 0, 0);
+            }
+            for (j = 0; j < 4; ++j) {
+                int slot = (s0 + j) % 4;
+                pt->cv[4 * p + j] = L->fv[L->fv_off[g] + slot];
+                pt->pcorner[4 * p + j] = sfb__mf_corner_code(L, kind, ev1, ev2, g, slot);
+            }
+            pt->ptype[p] = SFB__PATCH_MANIFOLD4; pt->pfirst[p] = 4 * p;
+            p++;
+        }
+        if (n == 4) node++;
     }
-    pt->counts[SFB__PATCH_MANIFOLD4] = npatch;
-    goto done;
-oom:
-    r = sfb__oom(ctx, "manifold patch table");
+    pt->pfirst[npatch] = 4 * npatch;
+}
+
+sfb_result sfb__manifold_build(sfb_context *ctx, const sfb__level *base, int weights, const float *positions, sfb__patch_table *pt) {
+    sfb__level work, lev1;
+    const sfb__level *L = NULL;
+    sfb__stencils T;
+    double *P = NULL, **pinv = NULL;
+    unsigned char *kind = NULL;
+    int *ev1 = NULL, *ev2 = NULL;
+    int i, refined = 0;
+    sfb_result r = SFB_SUCCESS;
+    memset(pt, 0, sizeof *pt);
+    memset(&work, 0, sizeof work); memset(&lev1, 0, sizeof lev1); memset(&T, 0, sizeof T);
+    if (weights != SFB_MANIFOLD_WEIGHTS_HERMITE && weights != SFB_MANIFOLD_WEIGHTS_CINF)
+        return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, -1, "manifold weights %d are not SFB_MANIFOLD_WEIGHTS_HERMITE or _CINF", weights);
+    pt->domain = SFB__DOMAIN_QUAD;
+    pt->mf_weights = weights;
+    if ((r = sfb__mf_manifold_mesh(ctx, base, positions, &work, &lev1, &T, &L, &P, &refined)) != SFB_SUCCESS) goto done;
+    /* local geometries */
+    kind = (unsigned char *)sfb__alloc(ctx, (size_t)L->nv + 1);
+    ev1 = (int *)sfb__alloc(ctx, ((size_t)L->nv + 1) * sizeof(int));
+    ev2 = (int *)sfb__alloc(ctx, ((size_t)L->nv + 1) * sizeof(int));
+    pt->point_data = (float *)sfb__calloc(ctx, (size_t)L->nv * 27 + 1, sizeof(float));
+    pinv = (double **)sfb__calloc(ctx, SFB_MAX_VALENCE + 1, sizeof(double *));
+    if (!kind || !ev1 || !ev2 || !pt->point_data || !pinv) { r = sfb__oom(ctx, "manifold patch table"); goto done; }
+    pt->npoints = 9 * L->nv;
+    if ((r = sfb__mf_local_geometry(ctx, L, P, kind, ev1, ev2, pinv, pt)) != SFB_SUCCESS) goto done;
+    /* param faces and patches */
+    if ((r = sfb__mf_alloc_patches(ctx, base, refined, pt)) != SFB_SUCCESS) goto done;
+    sfb__mf_fill_patches(base, L, refined, kind, ev1, ev2, pt);
+    pt->counts[SFB__PATCH_MANIFOLD4] = pt->npatch;
 done:
     if (pinv) { for (i = 0; i <= SFB_MAX_VALENCE; ++i) sfb__free(ctx, pinv[i]); sfb__free(ctx, pinv); }
     sfb__free(ctx, kind); sfb__free(ctx, ev1); sfb__free(ctx, ev2); sfb__free(ctx, P);
