@@ -222,6 +222,9 @@ typedef enum sfb_scheme {
     SFB_SCHEME_MANIFOLD_BLEND, SFB_SCHEME_TRIBEZIER
 } sfb_scheme;
 SFB_API const char *sfb_scheme_name(sfb_scheme s);
+/* The scheme named `name` ("catmark" or "catmull-clark", "loop", "bilinear", "manifold",
+ * "tribezier": sfb_scheme_name's names) into *out; returns 1, or 0 for an unknown name. */
+SFB_API int sfb_scheme_parse(const char *name, sfb_scheme *out);
 
 enum {
     SFB_REFINE_LIMIT = 1u << 0,  /* also build limit position + limit tangent tables */
@@ -958,6 +961,29 @@ typedef struct sfb__refine_options {
     int want_limit;
     int linear;          /* bilinear masks on the scheme's own face split (linear UVs) */
 } sfb__refine_options;
+
+/* ---- schemes at the API edge (scheme.c) ---- */
+enum { SFB__SCHEME_REFINES = 1u << 0,        /* uniform refinement (and limit stencils) by its rules */
+       SFB__SCHEME_SHADES = 1u << 1,         /* subdivision shading (seed 001) */
+       SFB__SCHEME_TRIANGLES = 1u << 2,      /* faces must be triangles */
+       SFB__SCHEME_BOUNDARY_HOLES = 1u << 3  /* boundary NONE makes boundary faces holes (OpenSubdiv) */ };
+typedef struct sfb__scheme_info {
+    sfb_scheme scheme;
+    const char *name;   /* sfb_scheme_name, sfb_scheme_parse */
+    const char *title;  /* for messages */
+    sfb_scheme rules;   /* the rules refine.c (and shade.c) apply for it */
+    unsigned caps;      /* SFB__SCHEME_* */
+    /* Its patch table for SFB_REFINE_PATCHES (NULL: not evaluated); prep is the prepared base
+     * level, opt has the rules. A scheme without REFINES but with a builder is evaluated only
+     * (level 0). */
+    sfb_result (*build_patches)(sfb_context *ctx, const sfb__level *prep, const sfb__refine_options *opt,
+                                const sfb_surface_config *cfg, const float *positions, sfb__patch_table *pt);
+} sfb__scheme_info;
+const sfb__scheme_info *sfb__scheme_info_of(sfb_scheme s);  /* NULL for a value that is no scheme */
+/* Refuses a scheme that cannot be built as configured (NULL si, not refinable, evaluated only). */
+sfb_result sfb__scheme_check_kind(sfb_context *ctx, const sfb__scheme_info *si, const sfb_surface_config *cfg);
+/* Refuses flags (SFB_REFINE_PATCHES, SFB_REFINE_SHADING) the scheme does not support. */
+sfb_result sfb__scheme_check_flags(sfb_context *ctx, const sfb__scheme_info *si, const sfb_surface_config *cfg);
 
 /* Refines `base` (already sharpened) `level` times; fills `top` and the stencil tables
  * (vertex, and limit/tangents when asked). */
@@ -7541,20 +7567,106 @@ SFB_API sfb_result sfb_mesh_write_obj(const sfb_mesh *mesh, sfb_write_fn write, 
     sfb_mesh_get_desc(mesh, &d);
     return sfb_write_obj(&d, write, user);
 }
+#line 1 "src/scheme.c"
+/* The schemes at the API edge: what each sfb_scheme is made of -- which rules refine it, which
+ * builder writes its patch table, what it supports -- in one table. sfb_surface_create reads
+ * the scheme's row here and calls its builders; nothing past the builders asks the scheme again
+ * (tables say what they are: docs/ARCHITECTURE.md). A new scheme is its builder's file plus one
+ * row below (and its enum value in sfb_api.h). */
+
+/* Patch-table builders of the schemes (the surface's prepared base level, refine options with
+ * the scheme's rules, its configuration and base positions). */
+static sfb_result sfb__scheme_build_isolated(sfb_context *ctx, const sfb__level *prep, const sfb__refine_options *opt,
+                                             const sfb_surface_config *cfg, const float *positions, sfb__patch_table *pt) {
+    return sfb__patches_build(ctx, prep, opt, cfg->isolation_level ? cfg->isolation_level : SFB_DEFAULT_ISOLATION, positions, pt);
+}
+
+static sfb_result sfb__scheme_build_manifold(sfb_context *ctx, const sfb__level *prep, const sfb__refine_options *opt,
+                                             const sfb_surface_config *cfg, const float *positions, sfb__patch_table *pt) {
+    (void)opt;
+    return sfb__manifold_build(ctx, prep, cfg->manifold.weights, positions, pt);
+}
+
+/* One row per scheme. */
+static const sfb__scheme_info sfb__schemes[] = {
+    {SFB_SCHEME_CATMARK, "catmark", "Catmull-Clark", SFB_SCHEME_CATMARK,
+     SFB__SCHEME_REFINES | SFB__SCHEME_SHADES | SFB__SCHEME_BOUNDARY_HOLES, sfb__scheme_build_isolated},
+    {SFB_SCHEME_LOOP, "loop", "Loop", SFB_SCHEME_LOOP,
+     SFB__SCHEME_REFINES | SFB__SCHEME_SHADES | SFB__SCHEME_BOUNDARY_HOLES | SFB__SCHEME_TRIANGLES, sfb__scheme_build_isolated},
+    {SFB_SCHEME_BILINEAR, "bilinear", "bilinear", SFB_SCHEME_BILINEAR, SFB__SCHEME_REFINES, NULL},
+    /* evaluated only: its tables are built at level 0, where Catmull-Clark's rules are the identity */
+    {SFB_SCHEME_MANIFOLD_BLEND, "manifold", "manifold blending", SFB_SCHEME_CATMARK, SFB__SCHEME_BOUNDARY_HOLES,
+     sfb__scheme_build_manifold},
+    /* declared in the API, not built yet (seed 004) */
+    {SFB_SCHEME_TRIBEZIER, "tribezier", "quartic triangular Bezier", SFB_SCHEME_CATMARK, 0, NULL}
+};
+
+const sfb__scheme_info *sfb__scheme_info_of(sfb_scheme s) {
+    size_t i;
+    for (i = 0; i < sizeof sfb__schemes / sizeof *sfb__schemes; ++i)
+        if (sfb__schemes[i].scheme == s) return &sfb__schemes[i];
+    return NULL;
+}
+
+SFB_API const char *sfb_scheme_name(sfb_scheme s) {
+    const sfb__scheme_info *si = sfb__scheme_info_of(s);
+    return si ? si->name : "unknown";
+}
+
+SFB_API int sfb_scheme_parse(const char *name, sfb_scheme *out) {
+    size_t i;
+    if (!name || !out) return 0;
+    if (strcmp(name, "catmull-clark") == 0) { *out = SFB_SCHEME_CATMARK; return 1; }
+    for (i = 0; i < sizeof sfb__schemes / sizeof *sfb__schemes; ++i)
+        if (strcmp(name, sfb__schemes[i].name) == 0) { *out = sfb__schemes[i].scheme; return 1; }
+    return 0;
+}
+
+/* The names of the schemes that have `cap` (or, cap 0, a patch builder), comma-separated. */
+static void sfb__scheme_list(unsigned cap, char *buf, size_t size) {
+    size_t i, used = 0;
+    buf[0] = 0;
+    for (i = 0; i < sizeof sfb__schemes / sizeof *sfb__schemes; ++i) {
+        const sfb__scheme_info *si = &sfb__schemes[i];
+        if (cap ? !(si->caps & cap) : !si->build_patches) continue;
+        used += (size_t)snprintf(buf + used, size - used, "%s%s", used ? ", " : "", si->name);
+        if (used >= size) return;
+    }
+}
+
+/* Refuses a scheme that cannot be built as configured (its kind of surface). */
+sfb_result sfb__scheme_check_kind(sfb_context *ctx, const sfb__scheme_info *si, const sfb_surface_config *cfg) {
+    if (!si) return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "scheme %d is not an sfb_scheme", (int)cfg->scheme);
+    if (!(si->caps & SFB__SCHEME_REFINES) && si->build_patches) {
+        /* evaluated, not refined (manifold blending) */
+        if (!(cfg->flags & SFB_REFINE_PATCHES) || cfg->refine_level != 0 || (cfg->flags & (SFB_REFINE_LIMIT | SFB_REFINE_SHADING)))
+            return sfb__error(ctx, SFB_UNSUPPORTED, SFB_ELEMENT_NONE, -1,
+                              "scheme '%s' is evaluated, not refined: use refine level 0 with SFB_REFINE_PATCHES (and neither "
+                              "SFB_REFINE_LIMIT nor SFB_REFINE_SHADING), then sfb_surface_eval or sfb_surface_tessellate", si->name);
+    } else if (!(si->caps & SFB__SCHEME_REFINES)) {
+        return sfb__error(ctx, SFB_UNSUPPORTED, SFB_ELEMENT_NONE, -1, "scheme '%s' cannot be refined uniformly yet", si->name);
+    }
+    return SFB_SUCCESS;
+}
+
+/* Refuses flags the scheme does not support (evaluation, shading). */
+sfb_result sfb__scheme_check_flags(sfb_context *ctx, const sfb__scheme_info *si, const sfb_surface_config *cfg) {
+    char list[256];
+    if ((cfg->flags & SFB_REFINE_PATCHES) && !si->build_patches) {
+        sfb__scheme_list(0, list, sizeof list);
+        return sfb__error(ctx, SFB_UNSUPPORTED, SFB_ELEMENT_NONE, -1, "evaluation (SFB_REFINE_PATCHES) is built for %s; scheme '%s' is not supported",
+                          list, si->name);
+    }
+    if ((cfg->flags & SFB_REFINE_SHADING) && !(si->caps & SFB__SCHEME_SHADES)) {
+        sfb__scheme_list(SFB__SCHEME_SHADES, list, sizeof list);
+        return sfb__error(ctx, SFB_UNSUPPORTED, SFB_ELEMENT_NONE, -1,
+                          "subdivision shading (SFB_REFINE_SHADING) is built for %s; scheme '%s' is not supported", list, si->name);
+    }
+    return SFB_SUCCESS;
+}
 #line 1 "src/surface.c"
 /* Surfaces: compile a mesh into tables once (sfb_surface_create), apply them on the
  * context's backend as often as needed (sfb_surface_eval_stencils / sfb_surface_refine). */
-
-SFB_API const char *sfb_scheme_name(sfb_scheme s) {
-    switch (s) {
-    case SFB_SCHEME_CATMARK: return "catmark";
-    case SFB_SCHEME_LOOP: return "loop";
-    case SFB_SCHEME_BILINEAR: return "bilinear";
-    case SFB_SCHEME_MANIFOLD_BLEND: return "manifold";
-    case SFB_SCHEME_TRIBEZIER: return "tribezier";
-    default: return "unknown";
-    }
-}
 
 SFB_API sfb_surface_config sfb_surface_config_init(sfb_scheme scheme, int level) {
     sfb_surface_config c;
@@ -7595,14 +7707,14 @@ SFB_API void sfb_surface_destroy(sfb_surface *s) {
 /* Rough peak bytes of refining `m` to `level`: topology of the last two levels plus composed
  * stencil rows in double during construction. Used to refuse early, before any allocation
  * sized by the level. */
-static double sfb__estimate_bytes(const sfb_mesh *m, sfb_scheme scheme, int level, int limit, double *faces_out) {
+static double sfb__estimate_bytes(const sfb_mesh *m, int triangles, int level, int limit, double *faces_out) {
     double faces = m->base.nf, verts = m->base.nv;
     int L;
     for (L = 0; L < level; ++L) {
-        if (scheme == SFB_SCHEME_LOOP) faces *= 4.0;
+        if (triangles) faces *= 4.0;
         else faces = (L == 0) ? (double)m->base.nfv : faces * 4.0;
     }
-    verts = scheme == SFB_SCHEME_LOOP ? faces / 2.0 + 2.0 : faces + 2.0;
+    verts = triangles ? faces / 2.0 + 2.0 : faces + 2.0;
     if (level == 0) verts = m->base.nv;
     *faces_out = faces;
     return faces * 4.0 * 40.0 + verts * 16.0 * 12.0 * (limit ? 3.0 : 1.5);
@@ -7611,36 +7723,25 @@ static double sfb__estimate_bytes(const sfb_mesh *m, sfb_scheme scheme, int leve
 /* Refuses a scheme, level, flag set or mesh that sfb_surface_create cannot build, before any
  * allocation (the size estimate against SFB_MAX_ELEMENTS and the memory budget included). */
 static sfb_result sfb__surface_check(sfb_context *ctx, const sfb_mesh *mesh, const sfb_surface_config *cfg) {
+    const sfb__scheme_info *si = sfb__scheme_info_of(cfg->scheme);
     double faces, bytes;
     int f;
-    if (cfg->scheme == SFB_SCHEME_MANIFOLD_BLEND) {
-        /* a blending surface is evaluated (sfb_surface_eval / _tessellate), not refined */
-        if (!(cfg->flags & SFB_REFINE_PATCHES) || cfg->refine_level != 0 || (cfg->flags & (SFB_REFINE_LIMIT | SFB_REFINE_SHADING)))
-            return sfb__error(ctx, SFB_UNSUPPORTED, SFB_ELEMENT_NONE, -1,
-                              "scheme 'manifold' is evaluated, not refined: use refine level 0 with SFB_REFINE_PATCHES (and neither "
-                              "SFB_REFINE_LIMIT nor SFB_REFINE_SHADING), then sfb_surface_eval or sfb_surface_tessellate");
-    } else if (cfg->scheme != SFB_SCHEME_CATMARK && cfg->scheme != SFB_SCHEME_LOOP && cfg->scheme != SFB_SCHEME_BILINEAR)
-        return sfb__error(ctx, SFB_UNSUPPORTED, SFB_ELEMENT_NONE, -1, "scheme '%s' cannot be refined uniformly yet", sfb_scheme_name(cfg->scheme));
+    sfb_result r;
+    if ((r = sfb__scheme_check_kind(ctx, si, cfg)) != SFB_SUCCESS) return r;
     if (cfg->refine_level < 0) return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "refinement level %d is negative", cfg->refine_level);
     if (cfg->refine_level > SFB_MAX_LEVEL)
         return sfb__error(ctx, SFB_LIMIT_EXCEEDED, SFB_ELEMENT_NONE, -1, "refinement level %d is over the limit of %d (SFB_MAX_LEVEL)",
                           cfg->refine_level, SFB_MAX_LEVEL);
-    if ((cfg->flags & SFB_REFINE_PATCHES) && cfg->scheme != SFB_SCHEME_CATMARK && cfg->scheme != SFB_SCHEME_LOOP &&
-        cfg->scheme != SFB_SCHEME_MANIFOLD_BLEND)
-        return sfb__error(ctx, SFB_UNSUPPORTED, SFB_ELEMENT_NONE, -1, "evaluation (SFB_REFINE_PATCHES) is built for Catmull-Clark, Loop and manifold; scheme '%s' is not supported",
-                          sfb_scheme_name(cfg->scheme));
-    if ((cfg->flags & SFB_REFINE_SHADING) && cfg->scheme != SFB_SCHEME_CATMARK && cfg->scheme != SFB_SCHEME_LOOP)
-        return sfb__error(ctx, SFB_UNSUPPORTED, SFB_ELEMENT_NONE, -1, "subdivision shading (SFB_REFINE_SHADING) is built for Catmull-Clark and Loop; scheme '%s' is not supported",
-                          sfb_scheme_name(cfg->scheme));
+    if ((r = sfb__scheme_check_flags(ctx, si, cfg)) != SFB_SUCCESS) return r;
     if ((cfg->flags & SFB_REFINE_PATCHES) && (cfg->isolation_level < 0 || cfg->isolation_level > SFB_MAX_LEVEL))
         return sfb__error(ctx, SFB_LIMIT_EXCEEDED, SFB_ELEMENT_NONE, -1, "isolation level %d is outside 0..%d (0 = default %d)",
                           cfg->isolation_level, SFB_MAX_LEVEL, SFB_DEFAULT_ISOLATION);
-    if (cfg->scheme == SFB_SCHEME_LOOP)
+    if (si->caps & SFB__SCHEME_TRIANGLES)
         for (f = 0; f < mesh->base.nf; ++f)
             if (mesh->base.fv_off[f + 1] - mesh->base.fv_off[f] != 3)
-                return sfb__error(ctx, SFB_INVALID_TOPOLOGY, SFB_ELEMENT_FACE, f, "Loop subdivision needs triangles; this face has %d vertices",
-                                  mesh->base.fv_off[f + 1] - mesh->base.fv_off[f]);
-    bytes = sfb__estimate_bytes(mesh, cfg->scheme, cfg->refine_level, (cfg->flags & SFB_REFINE_LIMIT) != 0, &faces);
+                return sfb__error(ctx, SFB_INVALID_TOPOLOGY, SFB_ELEMENT_FACE, f, "%s subdivision needs triangles; this face has %d vertices",
+                                  si->title, mesh->base.fv_off[f + 1] - mesh->base.fv_off[f]);
+    bytes = sfb__estimate_bytes(mesh, (si->caps & SFB__SCHEME_TRIANGLES) != 0, cfg->refine_level, (cfg->flags & SFB_REFINE_LIMIT) != 0, &faces);
     if (faces > (double)SFB_MAX_ELEMENTS)
         return sfb__error(ctx, SFB_LIMIT_EXCEEDED, SFB_ELEMENT_NONE, -1,
                           "refining to level %d would make %.0f faces, over the limit of %d", cfg->refine_level, faces, SFB_MAX_ELEMENTS);
@@ -7655,14 +7756,15 @@ static sfb_result sfb__surface_check(sfb_context *ctx, const sfb_mesh *mesh, con
  * patch table the flags ask for (s keeps the prepared base level of a patch table). */
 static sfb_result sfb__surface_build_vertex(sfb_surface *s, const sfb_mesh *mesh, const sfb_surface_config *cfg) {
     sfb_context *ctx = s->ctx;
+    const sfb__scheme_info *si = sfb__scheme_info_of(cfg->scheme);
     sfb__level prep;
     sfb__refine_options opt;
     sfb_result r;
     r = sfb__level_prepare(ctx, &mesh->base, mesh->boundary == SFB_BOUNDARY_EDGE_AND_CORNER,
-                           mesh->boundary == SFB_BOUNDARY_NONE && cfg->scheme != SFB_SCHEME_BILINEAR, &prep);
+                           mesh->boundary == SFB_BOUNDARY_NONE && (si->caps & SFB__SCHEME_BOUNDARY_HOLES), &prep);
     if (r != SFB_SUCCESS) return r;
     memset(&opt, 0, sizeof opt);
-    opt.scheme = cfg->scheme == SFB_SCHEME_MANIFOLD_BLEND ? SFB_SCHEME_CATMARK : cfg->scheme; /* manifold: level 0, the identity */
+    opt.scheme = si->rules;
     opt.crease_method = mesh->crease_method;
     opt.triangle_rule = mesh->triangle_rule;
     opt.want_limit = (cfg->flags & SFB_REFINE_LIMIT) != 0;
@@ -7670,12 +7772,8 @@ static sfb_result sfb__surface_build_vertex(sfb_surface *s, const sfb_mesh *mesh
                     opt.want_limit ? &s->tables[SFB_TABLE_LIMIT] : NULL, 0.0f, 0.8f);
     if (r == SFB_SUCCESS && (cfg->flags & SFB_REFINE_SHADING))
         r = sfb__shading_build(ctx, &prep, &opt, cfg->refine_level, &cfg->shading, &s->shading);
-    if (r == SFB_SUCCESS && (cfg->flags & SFB_REFINE_PATCHES) && cfg->scheme == SFB_SCHEME_MANIFOLD_BLEND) {
-        r = sfb__manifold_build(ctx, &prep, cfg->manifold.weights, s->base_positions, &s->patches);
-        if (r == SFB_SUCCESS) { s->has_patches = 1; s->pbase = prep; memset(&prep, 0, sizeof prep); }
-    } else if (r == SFB_SUCCESS && (cfg->flags & SFB_REFINE_PATCHES)) {
-        r = sfb__patches_build(ctx, &prep, &opt, cfg->isolation_level ? cfg->isolation_level : SFB_DEFAULT_ISOLATION,
-                                s->base_positions, &s->patches);
+    if (r == SFB_SUCCESS && (cfg->flags & SFB_REFINE_PATCHES)) {
+        r = si->build_patches(ctx, &prep, &opt, cfg, s->base_positions, &s->patches);
         if (r == SFB_SUCCESS) { s->has_patches = 1; s->pbase = prep; memset(&prep, 0, sizeof prep); }
     }
     sfb__level_free(ctx, &prep);
@@ -7709,7 +7807,7 @@ static sfb_result sfb__surface_build_uvs(sfb_surface *s, const sfb_mesh *mesh, c
     sfb__level_free(ctx, &uvl);
     if (r != SFB_SUCCESS) return r;
     memset(&opt, 0, sizeof opt);
-    opt.scheme = cfg->scheme;
+    opt.scheme = sfb__scheme_info_of(cfg->scheme)->rules;
     opt.crease_method = mesh->crease_method;
     opt.triangle_rule = mesh->triangle_rule;
     opt.linear = mesh->uv_interp == SFB_UV_LINEAR;

@@ -209,6 +209,9 @@ typedef enum sfb_scheme {
     SFB_SCHEME_MANIFOLD_BLEND, SFB_SCHEME_TRIBEZIER
 } sfb_scheme;
 SFB_API const char *sfb_scheme_name(sfb_scheme s);
+/* The scheme named `name` ("catmark" or "catmull-clark", "loop", "bilinear", "manifold",
+ * "tribezier": sfb_scheme_name's names) into *out; returns 1, or 0 for an unknown name. */
+SFB_API int sfb_scheme_parse(const char *name, sfb_scheme *out);
 
 enum {
     SFB_REFINE_LIMIT = 1u << 0,  /* also build limit position + limit tangent tables */

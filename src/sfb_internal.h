@@ -374,6 +374,29 @@ typedef struct sfb__refine_options {
     int linear;          /* bilinear masks on the scheme's own face split (linear UVs) */
 } sfb__refine_options;
 
+/* ---- schemes at the API edge (scheme.c) ---- */
+enum { SFB__SCHEME_REFINES = 1u << 0,        /* uniform refinement (and limit stencils) by its rules */
+       SFB__SCHEME_SHADES = 1u << 1,         /* subdivision shading (seed 001) */
+       SFB__SCHEME_TRIANGLES = 1u << 2,      /* faces must be triangles */
+       SFB__SCHEME_BOUNDARY_HOLES = 1u << 3  /* boundary NONE makes boundary faces holes (OpenSubdiv) */ };
+typedef struct sfb__scheme_info {
+    sfb_scheme scheme;
+    const char *name;   /* sfb_scheme_name, sfb_scheme_parse */
+    const char *title;  /* for messages */
+    sfb_scheme rules;   /* the rules refine.c (and shade.c) apply for it */
+    unsigned caps;      /* SFB__SCHEME_* */
+    /* Its patch table for SFB_REFINE_PATCHES (NULL: not evaluated); prep is the prepared base
+     * level, opt has the rules. A scheme without REFINES but with a builder is evaluated only
+     * (level 0). */
+    sfb_result (*build_patches)(sfb_context *ctx, const sfb__level *prep, const sfb__refine_options *opt,
+                                const sfb_surface_config *cfg, const float *positions, sfb__patch_table *pt);
+} sfb__scheme_info;
+const sfb__scheme_info *sfb__scheme_info_of(sfb_scheme s);  /* NULL for a value that is no scheme */
+/* Refuses a scheme that cannot be built as configured (NULL si, not refinable, evaluated only). */
+sfb_result sfb__scheme_check_kind(sfb_context *ctx, const sfb__scheme_info *si, const sfb_surface_config *cfg);
+/* Refuses flags (SFB_REFINE_PATCHES, SFB_REFINE_SHADING) the scheme does not support. */
+sfb_result sfb__scheme_check_flags(sfb_context *ctx, const sfb__scheme_info *si, const sfb_surface_config *cfg);
+
 /* Refines `base` (already sharpened) `level` times; fills `top` and the stencil tables
  * (vertex, and limit/tangents when asked). */
 sfb_result sfb__refine(sfb_context *ctx, const sfb__level *base, const sfb__refine_options *opt, int level,

@@ -1,17 +1,6 @@
 /* Surfaces: compile a mesh into tables once (sfb_surface_create), apply them on the
  * context's backend as often as needed (sfb_surface_eval_stencils / sfb_surface_refine). */
 
-SFB_API const char *sfb_scheme_name(sfb_scheme s) {
-    switch (s) {
-    case SFB_SCHEME_CATMARK: return "catmark";
-    case SFB_SCHEME_LOOP: return "loop";
-    case SFB_SCHEME_BILINEAR: return "bilinear";
-    case SFB_SCHEME_MANIFOLD_BLEND: return "manifold";
-    case SFB_SCHEME_TRIBEZIER: return "tribezier";
-    default: return "unknown";
-    }
-}
-
 SFB_API sfb_surface_config sfb_surface_config_init(sfb_scheme scheme, int level) {
     sfb_surface_config c;
     memset(&c, 0, sizeof c);
@@ -51,14 +40,14 @@ SFB_API void sfb_surface_destroy(sfb_surface *s) {
 /* Rough peak bytes of refining `m` to `level`: topology of the last two levels plus composed
  * stencil rows in double during construction. Used to refuse early, before any allocation
  * sized by the level. */
-static double sfb__estimate_bytes(const sfb_mesh *m, sfb_scheme scheme, int level, int limit, double *faces_out) {
+static double sfb__estimate_bytes(const sfb_mesh *m, int triangles, int level, int limit, double *faces_out) {
     double faces = m->base.nf, verts = m->base.nv;
     int L;
     for (L = 0; L < level; ++L) {
-        if (scheme == SFB_SCHEME_LOOP) faces *= 4.0;
+        if (triangles) faces *= 4.0;
         else faces = (L == 0) ? (double)m->base.nfv : faces * 4.0;
     }
-    verts = scheme == SFB_SCHEME_LOOP ? faces / 2.0 + 2.0 : faces + 2.0;
+    verts = triangles ? faces / 2.0 + 2.0 : faces + 2.0;
     if (level == 0) verts = m->base.nv;
     *faces_out = faces;
     return faces * 4.0 * 40.0 + verts * 16.0 * 12.0 * (limit ? 3.0 : 1.5);
@@ -67,36 +56,25 @@ static double sfb__estimate_bytes(const sfb_mesh *m, sfb_scheme scheme, int leve
 /* Refuses a scheme, level, flag set or mesh that sfb_surface_create cannot build, before any
  * allocation (the size estimate against SFB_MAX_ELEMENTS and the memory budget included). */
 static sfb_result sfb__surface_check(sfb_context *ctx, const sfb_mesh *mesh, const sfb_surface_config *cfg) {
+    const sfb__scheme_info *si = sfb__scheme_info_of(cfg->scheme);
     double faces, bytes;
     int f;
-    if (cfg->scheme == SFB_SCHEME_MANIFOLD_BLEND) {
-        /* a blending surface is evaluated (sfb_surface_eval / _tessellate), not refined */
-        if (!(cfg->flags & SFB_REFINE_PATCHES) || cfg->refine_level != 0 || (cfg->flags & (SFB_REFINE_LIMIT | SFB_REFINE_SHADING)))
-            return sfb__error(ctx, SFB_UNSUPPORTED, SFB_ELEMENT_NONE, -1,
-                              "scheme 'manifold' is evaluated, not refined: use refine level 0 with SFB_REFINE_PATCHES (and neither "
-                              "SFB_REFINE_LIMIT nor SFB_REFINE_SHADING), then sfb_surface_eval or sfb_surface_tessellate");
-    } else if (cfg->scheme != SFB_SCHEME_CATMARK && cfg->scheme != SFB_SCHEME_LOOP && cfg->scheme != SFB_SCHEME_BILINEAR)
-        return sfb__error(ctx, SFB_UNSUPPORTED, SFB_ELEMENT_NONE, -1, "scheme '%s' cannot be refined uniformly yet", sfb_scheme_name(cfg->scheme));
+    sfb_result r;
+    if ((r = sfb__scheme_check_kind(ctx, si, cfg)) != SFB_SUCCESS) return r;
     if (cfg->refine_level < 0) return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "refinement level %d is negative", cfg->refine_level);
     if (cfg->refine_level > SFB_MAX_LEVEL)
         return sfb__error(ctx, SFB_LIMIT_EXCEEDED, SFB_ELEMENT_NONE, -1, "refinement level %d is over the limit of %d (SFB_MAX_LEVEL)",
                           cfg->refine_level, SFB_MAX_LEVEL);
-    if ((cfg->flags & SFB_REFINE_PATCHES) && cfg->scheme != SFB_SCHEME_CATMARK && cfg->scheme != SFB_SCHEME_LOOP &&
-        cfg->scheme != SFB_SCHEME_MANIFOLD_BLEND)
-        return sfb__error(ctx, SFB_UNSUPPORTED, SFB_ELEMENT_NONE, -1, "evaluation (SFB_REFINE_PATCHES) is built for Catmull-Clark, Loop and manifold; scheme '%s' is not supported",
-                          sfb_scheme_name(cfg->scheme));
-    if ((cfg->flags & SFB_REFINE_SHADING) && cfg->scheme != SFB_SCHEME_CATMARK && cfg->scheme != SFB_SCHEME_LOOP)
-        return sfb__error(ctx, SFB_UNSUPPORTED, SFB_ELEMENT_NONE, -1, "subdivision shading (SFB_REFINE_SHADING) is built for Catmull-Clark and Loop; scheme '%s' is not supported",
-                          sfb_scheme_name(cfg->scheme));
+    if ((r = sfb__scheme_check_flags(ctx, si, cfg)) != SFB_SUCCESS) return r;
     if ((cfg->flags & SFB_REFINE_PATCHES) && (cfg->isolation_level < 0 || cfg->isolation_level > SFB_MAX_LEVEL))
         return sfb__error(ctx, SFB_LIMIT_EXCEEDED, SFB_ELEMENT_NONE, -1, "isolation level %d is outside 0..%d (0 = default %d)",
                           cfg->isolation_level, SFB_MAX_LEVEL, SFB_DEFAULT_ISOLATION);
-    if (cfg->scheme == SFB_SCHEME_LOOP)
+    if (si->caps & SFB__SCHEME_TRIANGLES)
         for (f = 0; f < mesh->base.nf; ++f)
             if (mesh->base.fv_off[f + 1] - mesh->base.fv_off[f] != 3)
-                return sfb__error(ctx, SFB_INVALID_TOPOLOGY, SFB_ELEMENT_FACE, f, "Loop subdivision needs triangles; this face has %d vertices",
-                                  mesh->base.fv_off[f + 1] - mesh->base.fv_off[f]);
-    bytes = sfb__estimate_bytes(mesh, cfg->scheme, cfg->refine_level, (cfg->flags & SFB_REFINE_LIMIT) != 0, &faces);
+                return sfb__error(ctx, SFB_INVALID_TOPOLOGY, SFB_ELEMENT_FACE, f, "%s subdivision needs triangles; this face has %d vertices",
+                                  si->title, mesh->base.fv_off[f + 1] - mesh->base.fv_off[f]);
+    bytes = sfb__estimate_bytes(mesh, (si->caps & SFB__SCHEME_TRIANGLES) != 0, cfg->refine_level, (cfg->flags & SFB_REFINE_LIMIT) != 0, &faces);
     if (faces > (double)SFB_MAX_ELEMENTS)
         return sfb__error(ctx, SFB_LIMIT_EXCEEDED, SFB_ELEMENT_NONE, -1,
                           "refining to level %d would make %.0f faces, over the limit of %d", cfg->refine_level, faces, SFB_MAX_ELEMENTS);
@@ -111,14 +89,15 @@ static sfb_result sfb__surface_check(sfb_context *ctx, const sfb_mesh *mesh, con
  * patch table the flags ask for (s keeps the prepared base level of a patch table). */
 static sfb_result sfb__surface_build_vertex(sfb_surface *s, const sfb_mesh *mesh, const sfb_surface_config *cfg) {
     sfb_context *ctx = s->ctx;
+    const sfb__scheme_info *si = sfb__scheme_info_of(cfg->scheme);
     sfb__level prep;
     sfb__refine_options opt;
     sfb_result r;
     r = sfb__level_prepare(ctx, &mesh->base, mesh->boundary == SFB_BOUNDARY_EDGE_AND_CORNER,
-                           mesh->boundary == SFB_BOUNDARY_NONE && cfg->scheme != SFB_SCHEME_BILINEAR, &prep);
+                           mesh->boundary == SFB_BOUNDARY_NONE && (si->caps & SFB__SCHEME_BOUNDARY_HOLES), &prep);
     if (r != SFB_SUCCESS) return r;
     memset(&opt, 0, sizeof opt);
-    opt.scheme = cfg->scheme == SFB_SCHEME_MANIFOLD_BLEND ? SFB_SCHEME_CATMARK : cfg->scheme; /* manifold: level 0, the identity */
+    opt.scheme = si->rules;
     opt.crease_method = mesh->crease_method;
     opt.triangle_rule = mesh->triangle_rule;
     opt.want_limit = (cfg->flags & SFB_REFINE_LIMIT) != 0;
@@ -126,12 +105,8 @@ static sfb_result sfb__surface_build_vertex(sfb_surface *s, const sfb_mesh *mesh
                     opt.want_limit ? &s->tables[SFB_TABLE_LIMIT] : NULL, 0.0f, 0.8f);
     if (r == SFB_SUCCESS && (cfg->flags & SFB_REFINE_SHADING))
         r = sfb__shading_build(ctx, &prep, &opt, cfg->refine_level, &cfg->shading, &s->shading);
-    if (r == SFB_SUCCESS && (cfg->flags & SFB_REFINE_PATCHES) && cfg->scheme == SFB_SCHEME_MANIFOLD_BLEND) {
-        r = sfb__manifold_build(ctx, &prep, cfg->manifold.weights, s->base_positions, &s->patches);
-        if (r == SFB_SUCCESS) { s->has_patches = 1; s->pbase = prep; memset(&prep, 0, sizeof prep); }
-    } else if (r == SFB_SUCCESS && (cfg->flags & SFB_REFINE_PATCHES)) {
-        r = sfb__patches_build(ctx, &prep, &opt, cfg->isolation_level ? cfg->isolation_level : SFB_DEFAULT_ISOLATION,
-                                s->base_positions, &s->patches);
+    if (r == SFB_SUCCESS && (cfg->flags & SFB_REFINE_PATCHES)) {
+        r = si->build_patches(ctx, &prep, &opt, cfg, s->base_positions, &s->patches);
         if (r == SFB_SUCCESS) { s->has_patches = 1; s->pbase = prep; memset(&prep, 0, sizeof prep); }
     }
     sfb__level_free(ctx, &prep);
@@ -165,7 +140,7 @@ static sfb_result sfb__surface_build_uvs(sfb_surface *s, const sfb_mesh *mesh, c
     sfb__level_free(ctx, &uvl);
     if (r != SFB_SUCCESS) return r;
     memset(&opt, 0, sizeof opt);
-    opt.scheme = cfg->scheme;
+    opt.scheme = sfb__scheme_info_of(cfg->scheme)->rules;
     opt.crease_method = mesh->crease_method;
     opt.triangle_rule = mesh->triangle_rule;
     opt.linear = mesh->uv_interp == SFB_UV_LINEAR;

@@ -100,14 +100,7 @@ sfb_mesh *cli_load_obj(sfb_context *ctx, const char *path) {
     return mesh;
 }
 
-int cli_scheme_from_name(const char *s, sfb_scheme *out) {
-    if (strcmp(s, "catmark") == 0 || strcmp(s, "catmull-clark") == 0) *out = SFB_SCHEME_CATMARK;
-    else if (strcmp(s, "loop") == 0) *out = SFB_SCHEME_LOOP;
-    else if (strcmp(s, "bilinear") == 0) *out = SFB_SCHEME_BILINEAR;
-    else if (strcmp(s, "manifold") == 0) *out = SFB_SCHEME_MANIFOLD_BLEND;
-    else return 0;
-    return 1;
-}
+int cli_scheme_from_name(const char *s, sfb_scheme *out) { return sfb_scheme_parse(s, out); }
 
 sfb_scheme cli_scheme_for(const char *path, int have_scheme, sfb_scheme scheme) {
     const char *base;
