@@ -137,11 +137,11 @@ $(BUILD)/gl_host: tests/gl_host.c $(BUILD)/libsfb.o
 	$(CC) $(CFLAGS) $(SAN) -I. tests/gl_host.c $(BUILD)/libsfb.o -o $@ $(GL_LIBS) $(LIBS)
 
 # Failure paths of gl/osmesa: compiles its own implementation with overrides (tests/gl_errors.c).
-$(BUILD)/gl_errors: tests/gl_errors.c surfblend.h $(BACKEND_HDRS)
+$(BUILD)/gl_errors: tests/gl_errors.c tests/harness.h surfblend.h $(BACKEND_HDRS)
 	$(CC) $(CFLAGS) $(SAN) -I. tests/gl_errors.c -o $@ $(LIBS)
 
 # Table pieces and split dispatches of gl/osmesa, under tiny limits (tests/gl_pieces.c).
-$(BUILD)/gl_pieces: tests/gl_pieces.c surfblend.h $(BACKEND_HDRS)
+$(BUILD)/gl_pieces: tests/gl_pieces.c tests/harness.h surfblend.h $(BACKEND_HDRS)
 	$(CC) $(CFLAGS) $(SAN) -I. tests/gl_pieces.c -o $@ $(LIBS)
 
 # Limit evaluation (sfb_surface_eval) on every backend: exactness, invariance, derivatives,
@@ -151,7 +151,7 @@ $(BUILD)/limit: tests/limit.c $(BUILD)/libsfb.o
 
 # The Stam eigen structures, checked against the subdivision matrices: compiles its own
 # implementation to reach the builders (tests/eigen.c).
-$(BUILD)/eigen: tests/eigen.c surfblend.h
+$(BUILD)/eigen: tests/eigen.c tests/harness.h surfblend.h
 	$(CC) $(CFLAGS) $(SAN) -I. tests/eigen.c -o $@ $(LIBS)
 
 # Subdivision shading (sfb_surface_shade) on every backend: weights, variants, darts, split
