@@ -6,6 +6,8 @@
  * not use a helper gets no warning for it; C99 and C++. */
 #ifndef SFB_TEST_HARNESS_H
 #define SFB_TEST_HARNESS_H
+#include <dirent.h>
+#include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -137,6 +139,70 @@ static inline char *slurp(const char *path, size_t *n) {
     return b;
 }
 
+static inline int harness_cmp_str(const void *a, const void *b) { return strcmp(*(const char *const *)a, *(const char *const *)b); }
+
+/* The names of the .obj files in `dir` (the peer shapes) that start with one of the
+ * comma-separated `prefixes` (NULL: any) and contain `match` (NULL: any), sorted; *n their
+ * count. NULL (*n = 0, and a SKIP of "shapes") when the directory cannot be opened. Free with
+ * free_names. */
+static inline char **list_shapes(const char *dir, const char *prefixes, const char *match, int *n) {
+    DIR *dp = dir ? opendir(dir) : NULL;
+    struct dirent *de;
+    char **names;
+    int cap = 64;
+    *n = 0;
+    if (!dp) {
+        char why[600];
+        snprintf(why, sizeof why, "peer shapes directory not found (%s): pass it as the first argument", dir ? dir : "none given");
+        skip("shapes", why);
+        return NULL;
+    }
+    names = (char **)xmalloc(sizeof(char *) * (size_t)cap);
+    while ((de = readdir(dp)) != NULL) {
+        size_t len = strlen(de->d_name);
+        int ok = !prefixes;
+        const char *p = prefixes;
+        if (len < 5 || strcmp(de->d_name + len - 4, ".obj") != 0) continue;
+        while (p && *p && !ok) {
+            const char *end = strchr(p, ',');
+            size_t pl = end ? (size_t)(end - p) : strlen(p);
+            ok = pl > 0 && strncmp(de->d_name, p, pl) == 0;
+            p = end ? end + 1 : NULL;
+        }
+        if (!ok || (match && !strstr(de->d_name, match))) continue;
+        if (*n == cap) {
+            char **nn = (char **)xmalloc(sizeof(char *) * (size_t)cap * 2);
+            memcpy(nn, names, sizeof(char *) * (size_t)cap);
+            free(names);
+            names = nn;
+            cap *= 2;
+        }
+        names[*n] = (char *)xmalloc(len + 1);
+        memcpy(names[(*n)++], de->d_name, len + 1);
+    }
+    closedir(dp);
+    if (*n) qsort(names, (size_t)*n, sizeof *names, harness_cmp_str);
+    return names;
+}
+static inline void free_names(char **names, int n) {
+    int i;
+    for (i = 0; i < n; ++i) free(names[i]);
+    free(names);
+}
+
+/* The diagonal of a mesh's bounding box. */
+static inline double mesh_diag(const sfb_mesh *m) {
+    sfb_mesh_info info;
+    double d = 0.0;
+    int k;
+    sfb_mesh_get_info(m, &info);
+    for (k = 0; k < 3; ++k) {
+        double e = info.bbox_max[k] - info.bbox_min[k];
+        d += e * e;
+    }
+    return sqrt(d);
+}
+
 /* ---- backends ---- */
 
 /* Is `name` an item of the comma-separated `list` (spaces around items ignored)? */
@@ -160,10 +226,16 @@ static inline int backend_required(const char *name) {
     return req && listed(req, name);
 }
 
-/* Records a check that cannot run for want of a backend: FAIL when required, else SKIP. */
+/* Records a check that cannot run for want of a backend: FAIL when required, else SKIP; why
+ * (a probe's report, say) loses its trailing newlines and spaces. */
 static inline void unavailable(const char *name, int required, const char *why) {
-    if (required) fail(name, "%s (required by SFB_REQUIRE_BACKENDS)", why);
-    else skip(name, why);
+    char line[700];
+    size_t n;
+    snprintf(line, sizeof line, "%s", why);
+    n = strlen(line);
+    while (n > 0 && (line[n - 1] == '\n' || line[n - 1] == ' ')) line[--n] = 0;
+    if (required) fail(name, "%s (required by SFB_REQUIRE_BACKENDS)", line);
+    else skip(name, line);
 }
 
 /* A context on exactly this backend, with the rest of cfg (threads, logger,
@@ -177,6 +249,11 @@ static inline sfb_context *make_context_with(sfb_context_config cfg, sfb_backend
     return ctx;
 }
 static inline sfb_context *make_context(sfb_backend_kind kind) { return make_context_with(sfb_context_config_init(), kind); }
+static inline sfb_context *make_context_threads(sfb_backend_kind kind, int threads) {
+    sfb_context_config cfg = sfb_context_config_init();
+    cfg.threads = threads;
+    return make_context_with(cfg, kind);
+}
 
 /* The backends under test, ref first: each with its own context when available. */
 typedef struct backend {
@@ -217,7 +294,15 @@ static inline int probe_backends_with(const sfb_context_config *cfg, const char 
 }
 static inline int probe_backends(void) { return probe_backends_with(NULL, NULL); }
 
-/* Records the check `name` of an unavailable backend: FAIL when required, else SKIP. */
+/* The check `name` needs the backend named `backend`, unavailable for `why`: FAIL when
+ * SFB_REQUIRE_BACKENDS names it, else SKIP ("BACKEND unavailable: why"). */
+static inline void backend_unavailable(const char *name, const char *backend, const char *why) {
+    char w[600];
+    snprintf(w, sizeof w, "%s unavailable: %s", backend, why);
+    unavailable(name, backend_required(backend), w);
+}
+
+/* Records the check `name` of an unavailable backend of g_be: FAIL when required, else SKIP. */
 static inline void backend_missing(const backend *b, const char *name) {
     char why[600];
     if (b->excluded) return;
