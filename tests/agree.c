@@ -335,7 +335,6 @@ static void run_mesh(const char *group, const char *label, const sfb_mesh *mesh,
 
 /* ---- (a) the peer corpus ---- */
 
-
 /* Level 3 as well for shapes this small (base faces): keeps the suite within its time budget.
  * --l3-faces N changes it (a large N: every shape at level 3). */
 static int g_l3_max_faces = 400;
@@ -346,9 +345,7 @@ static void run_shapes(const char *dir) {
     if (!names) return;
     if (n == 0) fail("shapes", "no .obj files in %s", dir);
     for (i = 0; i < n; ++i) {
-        char path[4096], label[300];
-        size_t size = 0;
-        char *text;
+        char label[300], why[1200];
         sfb_scheme scheme;
         sfb_mesh *mesh = NULL;
         sfb_mesh_info info;
@@ -362,16 +359,11 @@ static void run_shapes(const char *dir) {
         else if (strncmp(base, "loop_", 5) == 0) scheme = SFB_SCHEME_LOOP;
         else if (strncmp(base, "bilinear_", 9) == 0) scheme = SFB_SCHEME_BILINEAR;
         else { printf("# %s left out: no catmark_/loop_/bilinear_ prefix\n", base); continue; }
-        snprintf(path, sizeof path, "%s/%s", dir, names[i]);
-        text = slurp(path, &size);
-        if (!text) { snprintf(label, sizeof label, "shape/%s", base); fail(label, "cannot read %s", path); continue; }
-        if (sfb_mesh_read_obj(g_ref, text, size, &mesh) != SFB_SUCCESS) {
+        if (!(mesh = load_obj(g_ref, dir, names[i], why, sizeof why))) {
             snprintf(label, sizeof label, "shape/%s", base);
-            fail(label, "sfb_mesh_read_obj: %s", sfb_last_error(g_ref));
-            free(text);
+            fail(label, "%s", why);
             continue;
         }
-        free(text);
         sfb_mesh_get_info(mesh, &info);
         for (level = 2; level <= 3; ++level) {
             if (level == 3 && info.face_count > g_l3_max_faces) break;

@@ -190,6 +190,24 @@ static inline void free_names(char **names, int n) {
     free(names);
 }
 
+/* The mesh of the .obj file dir/name, read on ctx; NULL, with the reason in why ("cannot read
+ * PATH" or "sfb_mesh_read_obj: ERROR"), when it cannot be read. */
+static inline sfb_mesh *load_obj(sfb_context *ctx, const char *dir, const char *name, char *why, size_t wn) {
+    char path[4096];
+    size_t size = 0;
+    char *text;
+    sfb_mesh *m = NULL;
+    snprintf(path, sizeof path, "%s/%s", dir, name);
+    text = slurp(path, &size);
+    if (!text) snprintf(why, wn, "cannot read %s/%s", dir, name);
+    else if (sfb_mesh_read_obj(ctx, text, size, &m) != SFB_SUCCESS) {
+        snprintf(why, wn, "sfb_mesh_read_obj: %s", sfb_last_error(ctx));
+        m = NULL;
+    }
+    free(text);
+    return m;
+}
+
 /* The diagonal of a mesh's bounding box. */
 static inline double mesh_diag(const sfb_mesh *m) {
     sfb_mesh_info info;

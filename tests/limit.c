@@ -914,9 +914,7 @@ static int cmp_u64(const void *a, const void *b) {
 static int g_level = 2;
 
 static void run_shape(const char *dir, const char *file, sfb_context *ref) {
-    char path[4096], name[400];
-    size_t size;
-    char *text;
+    char name[400], why[1200];
     shape sh;
     sfb_surface *sref = NULL, *s0 = NULL;
     sfb_mesh_info mi;
@@ -934,15 +932,11 @@ static void run_shape(const char *dir, const char *file, sfb_context *ref) {
     sh.tri = strncmp(file, "loop_", 5) == 0;
     sh.ref = ref;
     g_cur_shape = sh.name;
-    snprintf(path, sizeof path, "%s/%s", dir, file);
     snprintf(name, sizeof name, "shape/%s", sh.name);
-    text = slurp(path, &size);
-    if (!text || sfb_mesh_read_obj(ref, text, size, &sh.mesh) != SFB_SUCCESS) {
-        fail(name, "cannot read: %s", text ? sfb_last_error(ref) : path);
-        free(text);
+    if (!(sh.mesh = load_obj(ref, dir, file, why, sizeof why))) {
+        fail(name, "%s", why);
         return;
     }
-    free(text);
     sfb_mesh_get_info(sh.mesh, &mi);
     for (k = 0; k < 3; ++k) sh.diag += ((double)mi.bbox_max[k] - mi.bbox_min[k]) * ((double)mi.bbox_max[k] - mi.bbox_min[k]);
     sh.diag = sqrt(sh.diag);
