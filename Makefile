@@ -140,29 +140,29 @@ $(BUILD)/osd_agree: tests/osd_agree.cpp $(BUILD)/libsfb.o
 	$(CXX) $(CXXFLAGS) $(SAN) -I. tests/osd_agree.cpp $(BUILD)/libsfb.o -o $@ -losdCPU $(LIBS)
 
 # Backend agreement (every optional backend against ref): links the library alone.
-$(BUILD)/agree: tests/agree.c $(BUILD)/libsfb.o
+$(BUILD)/agree: tests/agree.c tests/harness.h $(BUILD)/libsfb.o
 	$(CC) $(CFLAGS) $(SAN) -I. tests/agree.c $(BUILD)/libsfb.o -o $@ $(LIBS)
 
 # The engine case: the test is the GL host, so it links EGL and GL itself.
-$(BUILD)/gl_host: tests/gl_host.c $(BUILD)/libsfb.o
+$(BUILD)/gl_host: tests/gl_host.c tests/harness.h tests/egl_host.h $(BUILD)/libsfb.o
 	$(CC) $(CFLAGS) $(SAN) -I. tests/gl_host.c $(BUILD)/libsfb.o -o $@ $(GL_LIBS) $(LIBS)
 
 # Failure paths of gl/osmesa: compiles its own implementation with overrides (tests/gl_errors.c).
-$(BUILD)/gl_errors: tests/gl_errors.c surfblend.h $(BACKEND_HDRS)
+$(BUILD)/gl_errors: tests/gl_errors.c tests/harness.h surfblend.h $(BACKEND_HDRS)
 	$(CC) $(CFLAGS) $(SAN) -I. tests/gl_errors.c -o $@ $(LIBS)
 
 # Table pieces and split dispatches of gl/osmesa, under tiny limits (tests/gl_pieces.c).
-$(BUILD)/gl_pieces: tests/gl_pieces.c surfblend.h $(BACKEND_HDRS)
+$(BUILD)/gl_pieces: tests/gl_pieces.c tests/harness.h surfblend.h $(BACKEND_HDRS)
 	$(CC) $(CFLAGS) $(SAN) -I. tests/gl_pieces.c -o $@ $(LIBS)
 
 # Limit evaluation (sfb_surface_eval) on every backend: exactness, invariance, derivatives,
 # continuity, normals at extraordinary vertices (tests/limit.c).
-$(BUILD)/limit: tests/limit.c $(BUILD)/libsfb.o
+$(BUILD)/limit: tests/limit.c tests/harness.h $(BUILD)/libsfb.o
 	$(CC) $(CFLAGS) $(SAN) -I. tests/limit.c $(BUILD)/libsfb.o -o $@ $(LIBS)
 
 # The Stam eigen structures, checked against the subdivision matrices: compiles its own
 # implementation to reach the builders (tests/eigen.c).
-$(BUILD)/eigen: tests/eigen.c surfblend.h
+$(BUILD)/eigen: tests/eigen.c tests/harness.h surfblend.h
 	$(CC) $(CFLAGS) $(SAN) -I. tests/eigen.c -o $@ $(LIBS)
 
 # Subdivision shading (sfb_surface_shade) on every backend: weights, variants, darts, split
@@ -179,7 +179,7 @@ $(BUILD)/trim: tests/trim.c tests/harness.h surfblend.h $(BACKEND_HDRS)
 
 # The finish_normals kernel of every backend against ref, degenerate inputs included: compiles
 # its own implementation to reach the backend vtables (tests/finish_normals.c).
-$(BUILD)/finish_normals: tests/finish_normals.c surfblend.h $(BACKEND_HDRS)
+$(BUILD)/finish_normals: tests/finish_normals.c tests/harness.h surfblend.h $(BACKEND_HDRS)
 	$(CC) $(CFLAGS) $(SAN) -I. tests/finish_normals.c -o $@ $(LIBS)
 
 # Manifold-based blending (SFB_SCHEME_MANIFOLD_BLEND) on every backend: interpolation, continuity,
@@ -190,7 +190,7 @@ $(BUILD)/manifold: tests/manifold.c tests/harness.h surfblend.h $(BACKEND_HDRS)
 
 # Manifold blending on gl/osmesa and the vertex-shader draw path (with trimming) on a GL context
 # the test owns (links EGL/GL as gl_host) (tests/gl_manifold.c).
-$(BUILD)/gl_manifold: tests/gl_manifold.c $(BUILD)/libsfb.o
+$(BUILD)/gl_manifold: tests/gl_manifold.c tests/harness.h tests/egl_host.h $(BUILD)/libsfb.o
 	$(CC) $(CFLAGS) $(SAN) -I. tests/gl_manifold.c $(BUILD)/libsfb.o -o $@ $(GL_LIBS) $(LIBS)
 
 unit-build: $(BUILD)/surfblend $(BUILD)/unit $(BUILD)/osd_agree $(BUILD)/agree $(BUILD)/limit $(BUILD)/eigen $(BUILD)/gl_host \
@@ -232,7 +232,7 @@ test-neon: deps-neon amalgamate-check
 	BUILD=$(BUILD) SHAPES=$(SHAPES) ./tests/neon.sh
 
 # ---- benchmark ----
-$(BUILD)/bench: bench/bench.cpp $(BUILD)/libsfb.o
+$(BUILD)/bench: bench/bench.cpp tests/egl_host.h $(BUILD)/libsfb.o
 	$(CXX) $(CXXFLAGS) -I. bench/bench.cpp $(BUILD)/libsfb.o -o $@ $(BENCH_LIBS) $(LIBS)
 
 bench: deps-test

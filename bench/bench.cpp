@@ -51,9 +51,8 @@
 #include "surfblend.h"
 
 #define GL_GLEXT_PROTOTYPES 1
-#include <EGL/egl.h>
-#include <EGL/eglext.h>
 #include <GL/gl.h>
+#include "tests/egl_host.h"
 
 #include <opensubdiv/far/patchMap.h>
 #include <opensubdiv/far/patchTable.h>
@@ -372,59 +371,18 @@ struct EvalRow {
 };
 
 /* A headless desktop OpenGL 4.3 core context made current on this thread, as a host
- * application would have (EGL surfaceless platform, else the default display). */
+ * application would have (tests/egl_host.h: EGL surfaceless platform, else the default display). */
 struct HostGL {
-    EGLDisplay dpy;
-    EGLContext ctx;
+    egl_host h;
     std::string why, renderer;
-    HostGL() : dpy(EGL_NO_DISPLAY), ctx(EGL_NO_CONTEXT) {}
-    static bool has_word(const char *list, const char *w) {
-        if (!list) return false;
-        size_t n = strlen(w);
-        for (const char *p = list; (p = strstr(p, w)) != NULL; p += n)
-            if ((p == list || p[-1] == ' ') && (p[n] == ' ' || p[n] == 0)) return true;
-        return false;
-    }
+    HostGL() { h.dpy = EGL_NO_DISPLAY; h.ctx = EGL_NO_CONTEXT; h.renderer[0] = 0; }
     bool open() {
-        const char *client = eglQueryString(EGL_NO_DISPLAY, EGL_EXTENSIONS);
-        EGLint major = 0, minor = 0, n = 0;
-        if (has_word(client, "EGL_MESA_platform_surfaceless")) {
-            PFNEGLGETPLATFORMDISPLAYEXTPROC gpd = (PFNEGLGETPLATFORMDISPLAYEXTPROC)eglGetProcAddress("eglGetPlatformDisplayEXT");
-            if (gpd) dpy = gpd(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, NULL);
-            if (dpy != EGL_NO_DISPLAY && !eglInitialize(dpy, &major, &minor)) dpy = EGL_NO_DISPLAY;
-        }
-        if (dpy == EGL_NO_DISPLAY) {
-            dpy = eglGetDisplay(EGL_DEFAULT_DISPLAY);
-            if (dpy == EGL_NO_DISPLAY || !eglInitialize(dpy, &major, &minor)) {
-                dpy = EGL_NO_DISPLAY;
-                why = "no EGL display";
-                return false;
-            }
-        }
-        const char *ext = eglQueryString(dpy, EGL_EXTENSIONS);
-        if (!has_word(ext, "EGL_KHR_surfaceless_context")) { why = "EGL display lacks EGL_KHR_surfaceless_context"; return false; }
-        if (!eglBindAPI(EGL_OPENGL_API)) { why = "no desktop OpenGL through EGL"; return false; }
-        EGLConfig config = EGL_NO_CONFIG_KHR;
-        if (!has_word(ext, "EGL_KHR_no_config_context") && !has_word(ext, "EGL_MESA_configless_context")) {
-            const EGLint attrs[] = {EGL_RENDERABLE_TYPE, EGL_OPENGL_BIT, EGL_NONE};
-            if (!eglChooseConfig(dpy, attrs, &config, 1, &n) || n < 1) { why = "no EGL config for desktop OpenGL"; return false; }
-        }
-        const EGLint cattrs[] = {EGL_CONTEXT_MAJOR_VERSION, 4, EGL_CONTEXT_MINOR_VERSION, 3,
-                                 EGL_CONTEXT_OPENGL_PROFILE_MASK, EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT, EGL_NONE};
-        ctx = eglCreateContext(dpy, config, EGL_NO_CONTEXT, cattrs);
-        if (ctx == EGL_NO_CONTEXT) { why = "no OpenGL 4.3 core context through EGL"; return false; }
-        if (!eglMakeCurrent(dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, ctx)) { why = "eglMakeCurrent failed"; return false; }
-        const char *v = (const char *)glGetString(GL_VERSION), *r = (const char *)glGetString(GL_RENDERER);
-        renderer = std::string("OpenGL ") + (v ? v : "?") + "; " + (r ? r : "?");
+        char w[512];
+        if (!egl_host_open(&h, 4, 3, w, sizeof w)) { why = w; return false; }
+        renderer = h.renderer;
         return true;
     }
-    ~HostGL() {
-        if (ctx != EGL_NO_CONTEXT) {
-            eglMakeCurrent(dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
-            eglDestroyContext(dpy, ctx);
-        }
-        if (dpy != EGL_NO_DISPLAY) eglTerminate(dpy);
-    }
+    ~HostGL() { egl_host_close(&h); }
 };
 
 static sfb_context *eval_context(sfb_backend_kind kind, int threads, int use_current, std::string *why,

@@ -48,139 +48,32 @@
  */
 #define _POSIX_C_SOURCE 200809L
 #include "surfblend.h"
+#include "harness.h"
 
-#include <dirent.h>
 #include <math.h>
 #include <pthread.h>
-#include <stdarg.h>
 #include <stdint.h>
-#include <stdio.h>
-#include <stdlib.h>
-#include <string.h>
-#include <time.h>
 
 #define TOL_REL 1e-5
 
-/* ---- results ---- */
+/* ---- backends under test (tests/harness.h: backend) ---- */
 
-static int g_pass, g_fail, g_skip;
-static unsigned long long g_seed;
 static int g_verbose;
-
-static void check_pass(const char *name) {
-    printf("PASS %s\n", name);
-    fflush(stdout);
-    ++g_pass;
-}
-
-static void check_fail(const char *name, const char *fmt, ...)
-#if defined(__GNUC__)
-    __attribute__((format(printf, 2, 3)))
-#endif
-    ;
-static void check_fail(const char *name, const char *fmt, ...) {
-    va_list ap;
-    printf("FAIL %s: ", name);
-    va_start(ap, fmt);
-    vprintf(fmt, ap);
-    va_end(ap);
-    printf(" (seed %llu)\n", g_seed);
-    fflush(stdout);
-    ++g_fail;
-}
-
-static void check_skip(const char *name, const char *why) {
-    printf("SKIP %s: %s\n", name, why);
-    fflush(stdout);
-    ++g_skip;
-}
-
-static double now_s(void) {
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-/* ---- deterministic random numbers (splitmix64) ---- */
-
-typedef struct rng { unsigned long long s; } rng;
-
-static unsigned long long rng_next(rng *g) {
-    unsigned long long z = (g->s += 0x9E3779B97F4A7C15ull);
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    return z ^ (z >> 31);
-}
-static int rng_int(rng *g, int n) { return n <= 1 ? 0 : (int)(rng_next(g) % (unsigned long long)n); }
-static double rng_unit(rng *g) { return (double)(rng_next(g) >> 11) * (1.0 / 9007199254740992.0); }
-static double rng_range(rng *g, double lo, double hi) { return lo + (hi - lo) * rng_unit(g); }
-static rng rng_for(unsigned long long seed, unsigned long long stream) {
-    rng g;
-    g.s = seed ^ (stream * 0xD1B54A32D192ED03ull);
-    rng_next(&g);
-    return g;
-}
-
-/* ---- backends under test ---- */
-
-typedef struct backend {
-    sfb_backend_kind kind;
-    const char *name;
-    int available, required;
-    int excluded;       /* left out with --only: not tested, not reported */
-    char why[512];      /* probe: what runs, or why not */
-    sfb_context *ctx;   /* its own context (threads = 0) */
-} backend;
 
 static sfb_context *g_ref;      /* the oracle's context */
 static const char *g_only;      /* --only LIST: the backends to test (default all) */
 static backend g_backends[3];
 static const int g_backend_count = 3;
 
-static int name_listed(const char *list, const char *name) {
-    size_t n = strlen(name);
-    const char *p = list;
-    while (p && *p) {
-        const char *end = strchr(p, ',');
-        size_t len = end ? (size_t)(end - p) : strlen(p);
-        while (len > 0 && (*p == ' ')) { ++p; --len; }
-        while (len > 0 && p[len - 1] == ' ') --len;
-        if (len == n && strncmp(p, name, n) == 0) return 1;
-        p = end ? end + 1 : NULL;
-    }
-    return 0;
-}
-
-/* Says a check of backend b cannot run: SKIP, or FAIL when the backend is required. */
-static void check_unavailable(const backend *b, const char *name) {
-    char why[700];
-    if (b->excluded) return;
-    snprintf(why, sizeof why, "%s unavailable: %s", b->name, b->why);
-    if (b->required) check_fail(name, "%s (required by SFB_REQUIRE_BACKENDS)", why);
-    else check_skip(name, why);
-}
-
-static sfb_context *make_context(sfb_backend_kind kind, int threads) {
-    sfb_context_config cfg = sfb_context_config_init();
-    sfb_context *ctx = NULL;
-    cfg.backends = &kind;
-    cfg.backend_count = 1;
-    cfg.ignore_environment = 1;
-    cfg.threads = threads;
-    if (sfb_context_create(&cfg, &ctx) != SFB_SUCCESS) return NULL;
-    return ctx;
-}
-
 static void setup_backends(void) {
     static const sfb_backend_kind kinds[3] = {SFB_BACKEND_SIMD, SFB_BACKEND_GL, SFB_BACKEND_OSMESA};
-    const char *req = getenv("SFB_REQUIRE_BACKENDS");
     char ref_info[256];
     int i;
     if (sfb_backend_probe(SFB_BACKEND_REF, NULL, ref_info, sizeof ref_info) != SFB_SUCCESS)
-        check_fail("probe/ref", "ref must always be available: %s", ref_info);
+        fail("probe/ref", "ref must always be available: %s", ref_info);
     else
-        check_pass("probe/ref");
-    g_ref = make_context(SFB_BACKEND_REF, 1);
+        pass("probe/ref");
+    g_ref = make_context_threads(SFB_BACKEND_REF, 1);
     for (i = 0; i < g_backend_count; ++i) {
         backend *b = &g_backends[i];
         char name[64];
@@ -188,8 +81,8 @@ static void setup_backends(void) {
         memset(b, 0, sizeof *b);
         b->kind = kinds[i];
         b->name = sfb_backend_kind_name(kinds[i]);
-        b->required = req && name_listed(req, b->name);
-        if (g_only && !name_listed(g_only, b->name)) {
+        b->required = backend_required(b->name);
+        if (g_only && !listed(g_only, b->name)) {
             b->excluded = 1;
             snprintf(b->why, sizeof b->why, "left out by --only");
             continue;
@@ -199,20 +92,20 @@ static void setup_backends(void) {
         if (r != SFB_SUCCESS) {
             if (!b->why[0]) snprintf(b->why, sizeof b->why, "%s (no reason given)", sfb_result_string(r));
             printf("# %s: unavailable (%s): %s\n", b->name, sfb_result_string(r), b->why);
-            check_unavailable(b, name);
+            backend_missing(b, name);
             continue;
         }
         printf("# %s: available: %s\n", b->name, b->why[0] ? b->why : "(no description)");
-        b->ctx = make_context(b->kind, 0);
+        b->ctx = make_context_threads(b->kind, 0);
         if (!b->ctx) {
-            check_fail(name, "probe succeeded (%s) but sfb_context_create with backends = {%s} failed", b->why, b->name);
+            fail(name, "probe succeeded (%s) but sfb_context_create with backends = {%s} failed", b->why, b->name);
             snprintf(b->why, sizeof b->why, "context creation failed after a successful probe");
             continue;
         }
         if (strcmp(sfb_context_backend_name(b->ctx), b->name) != 0) {
             char rep[1024];
             sfb_context_backend_report(b->ctx, rep, sizeof rep);
-            check_fail(name, "context asked for %s alone runs %s; report: %s", b->name, sfb_context_backend_name(b->ctx), rep);
+            fail(name, "context asked for %s alone runs %s; report: %s", b->name, sfb_context_backend_name(b->ctx), rep);
             sfb_context_destroy(b->ctx);
             b->ctx = NULL;
             snprintf(b->why, sizeof b->why, "context selected another backend");
@@ -223,8 +116,8 @@ static void setup_backends(void) {
             char info[512];
             info[0] = 0;
             sfb_context_backend_info(b->ctx, info, sizeof info);
-            if (!info[0]) check_fail(name, "sfb_context_backend_info is empty for %s", b->name);
-            else check_pass(name);
+            if (!info[0]) fail(name, "sfb_context_backend_info is empty for %s", b->name);
+            else pass(name);
         }
     }
 }
@@ -300,15 +193,6 @@ static double bbox_diag(const float *p, int n, int dim) {
         }
     for (k = 0; k < dim; ++k) d += (hi[k] - lo[k]) * (hi[k] - lo[k]);
     return sqrt(d);
-}
-
-static void *xmalloc(size_t n) {
-    void *p = malloc(n ? n : 1);
-    if (!p) {
-        fprintf(stderr, "agree: out of memory (%zu bytes)\n", n);
-        exit(2);
-    }
-    return p;
 }
 
 /* ---- one mesh, all tables, every backend against ref ---- */
@@ -405,14 +289,14 @@ static void run_mesh(const char *group, const char *label, const sfb_mesh *mesh,
         table_out got[SFB_TABLE_COUNT_];
         size_t used = 0;
         snprintf(name, sizeof name, "%s/%s/%s", b->name, group, label);
-        if (!b->available) { check_unavailable(b, name); continue; }
-        if (r != SFB_SUCCESS) { check_fail(name, "ref failed on this mesh (%s)%s%s", err, extra ? "; " : "", extra ? extra : ""); continue; }
+        if (!b->available) { backend_missing(b, name); continue; }
+        if (r != SFB_SUCCESS) { fail(name, "ref failed on this mesh (%s)%s%s", err, extra ? "; " : "", extra ? extra : ""); continue; }
         if (sfb_surface_create(b->ctx, mesh, &cfg, &bs) != SFB_SUCCESS) {
-            check_fail(name, "sfb_surface_create on %s: %s%s%s", b->name, sfb_last_error(b->ctx), extra ? "; " : "", extra ? extra : "");
+            fail(name, "sfb_surface_create on %s: %s%s%s", b->name, sfb_last_error(b->ctx), extra ? "; " : "", extra ? extra : "");
             continue;
         }
         if (eval_all(bs, &d, got, err, sizeof err, b->ctx) != SFB_SUCCESS) {
-            check_fail(name, "%s%s%s", err, extra ? "; " : "", extra ? extra : "");
+            fail(name, "%s%s%s", err, extra ? "; " : "", extra ? extra : "");
             free_all(got);
             sfb_surface_destroy(bs);
             continue;
@@ -440,8 +324,8 @@ static void run_mesh(const char *group, const char *label, const sfb_mesh *mesh,
                 if (used >= sizeof fails) used = sizeof fails - 1;
             }
         }
-        if (fails[0]) check_fail(name, "%s%s%s", fails, extra ? "; mesh: " : "", extra ? extra : "");
-        else check_pass(name);
+        if (fails[0]) fail(name, "%s%s%s", fails, extra ? "; mesh: " : "", extra ? extra : "");
+        else pass(name);
         free_all(got);
         sfb_surface_destroy(bs);
     }
@@ -451,57 +335,17 @@ static void run_mesh(const char *group, const char *label, const sfb_mesh *mesh,
 
 /* ---- (a) the peer corpus ---- */
 
-static int cmp_str(const void *a, const void *b) { return strcmp(*(const char *const *)a, *(const char *const *)b); }
-
-static char *read_file(const char *path, size_t *size) {
-    FILE *f = fopen(path, "rb");
-    char *buf;
-    long n;
-    if (!f) return NULL;
-    if (fseek(f, 0, SEEK_END) != 0 || (n = ftell(f)) < 0 || fseek(f, 0, SEEK_SET) != 0) { fclose(f); return NULL; }
-    buf = (char *)xmalloc((size_t)n + 1);
-    if (fread(buf, 1, (size_t)n, f) != (size_t)n) { fclose(f); free(buf); return NULL; }
-    fclose(f);
-    buf[n] = 0;
-    *size = (size_t)n;
-    return buf;
-}
-
 /* Level 3 as well for shapes this small (base faces): keeps the suite within its time budget.
  * --l3-faces N changes it (a large N: every shape at level 3). */
 static int g_l3_max_faces = 400;
 
 static void run_shapes(const char *dir) {
-    DIR *dp = dir ? opendir(dir) : NULL;
-    struct dirent *e;
-    char **names = NULL;
-    int n = 0, cap = 0, i;
-    if (!dp) {
-        char why[600];
-        snprintf(why, sizeof why, "peer shapes directory not found (%s): pass it as the first argument", dir ? dir : "none given");
-        check_skip("shapes", why);
-        return;
-    }
-    while ((e = readdir(dp)) != NULL) {
-        size_t len = strlen(e->d_name);
-        if (len < 5 || strcmp(e->d_name + len - 4, ".obj") != 0) continue;
-        if (n == cap) {
-            char **nn;
-            cap = cap ? 2 * cap : 64;
-            nn = (char **)realloc(names, (size_t)cap * sizeof *names);
-            if (!nn) { fprintf(stderr, "agree: out of memory\n"); exit(2); }
-            names = nn;
-        }
-        names[n] = (char *)xmalloc(len + 1);
-        memcpy(names[n++], e->d_name, len + 1);
-    }
-    closedir(dp);
-    if (n == 0) check_fail("shapes", "no .obj files in %s", dir);
-    qsort(names, (size_t)n, sizeof *names, cmp_str);
+    int n = 0, i;
+    char **names = list_shapes(dir, NULL, NULL, &n);
+    if (!names) return;
+    if (n == 0) fail("shapes", "no .obj files in %s", dir);
     for (i = 0; i < n; ++i) {
-        char path[4096], label[300];
-        size_t size = 0;
-        char *text;
+        char label[300], why[1200];
         sfb_scheme scheme;
         sfb_mesh *mesh = NULL;
         sfb_mesh_info info;
@@ -515,16 +359,11 @@ static void run_shapes(const char *dir) {
         else if (strncmp(base, "loop_", 5) == 0) scheme = SFB_SCHEME_LOOP;
         else if (strncmp(base, "bilinear_", 9) == 0) scheme = SFB_SCHEME_BILINEAR;
         else { printf("# %s left out: no catmark_/loop_/bilinear_ prefix\n", base); continue; }
-        snprintf(path, sizeof path, "%s/%s", dir, names[i]);
-        text = read_file(path, &size);
-        if (!text) { snprintf(label, sizeof label, "shape/%s", base); check_fail(label, "cannot read %s", path); continue; }
-        if (sfb_mesh_read_obj(g_ref, text, size, &mesh) != SFB_SUCCESS) {
+        if (!(mesh = load_obj(g_ref, dir, names[i], why, sizeof why))) {
             snprintf(label, sizeof label, "shape/%s", base);
-            check_fail(label, "sfb_mesh_read_obj: %s", sfb_last_error(g_ref));
-            free(text);
+            fail(label, "%s", why);
             continue;
         }
-        free(text);
         sfb_mesh_get_info(mesh, &info);
         for (level = 2; level <= 3; ++level) {
             if (level == 3 && info.face_count > g_l3_max_faces) break;
@@ -533,8 +372,7 @@ static void run_shapes(const char *dir) {
         }
         sfb_mesh_destroy(mesh);
     }
-    for (i = 0; i < n; ++i) free(names[i]);
-    free(names);
+    free_names(names, n);
 }
 
 /* ---- (b) random meshes ---- */
@@ -731,7 +569,7 @@ static void run_random(int cases) {
         if (sfb_mesh_create(g_ref, &d, &mesh) != SFB_SUCCESS) {
             char name[100];
             snprintf(name, sizeof name, "random/%d", c);
-            check_fail(name, "sfb_mesh_create refused a generated mesh: %s; %s", sfb_last_error(g_ref), extra);
+            fail(name, "sfb_mesh_create refused a generated mesh: %s; %s", sfb_last_error(g_ref), extra);
             rmesh_free(&m);
             continue;
         }
@@ -890,7 +728,7 @@ static int layout_ref_make(layout_ref *L) {
     if (!L->mesh || sfb_surface_create(g_ref, L->mesh, &L->cfg, &rs) != SFB_SUCCESS ||
         sfb_surface_stencil_info(rs, SFB_TABLE_VERTEX, &L->info[0]) != SFB_SUCCESS ||
         sfb_surface_stencil_info(rs, SFB_TABLE_LIMIT, &L->info[1]) != SFB_SUCCESS) {
-        check_fail("layout", "ref could not build the layout mesh: %s", sfb_last_error(g_ref));
+        fail("layout", "ref could not build the layout mesh: %s", sfb_last_error(g_ref));
         sfb_surface_destroy(rs);
         return 0;
     }
@@ -904,7 +742,7 @@ static int layout_ref_make(layout_ref *L) {
         for (ti = 0; ti < 2; ++ti) {
             L->want[li][ti] = (float *)xmalloc((size_t)L->info[ti].rows * len * sizeof(float));
             if (sfb_surface_eval_stencils(rs, k_layout_tables[ti], L->psrc[li], pd, L->want[li][ti], pd) != SFB_SUCCESS) {
-                check_fail("layout", "ref eval failed (length %d): %s", len, sfb_last_error(g_ref));
+                fail("layout", "ref eval failed (length %d): %s", len, sfb_last_error(g_ref));
                 sfb_surface_destroy(rs);
                 return 0;
             }
@@ -932,13 +770,13 @@ static void layout_target(const layout_ref *L, const char *prefix, sfb_context *
         for (li = 0; li < 6; ++li)
             for (lk = 0; lk < 3; ++lk) {
                 snprintf(name, sizeof name, "%s/layout/len%d/%s", prefix, k_lengths[li], k_layouts[lk].name);
-                check_unavailable(b, name);
+                backend_missing(b, name);
             }
         return;
     }
     if (sfb_surface_create(ctx, L->mesh, &L->cfg, &s) != SFB_SUCCESS) {
         snprintf(name, sizeof name, "%s/layout", prefix);
-        check_fail(name, "sfb_surface_create: %s", sfb_last_error(ctx));
+        fail(name, "sfb_surface_create: %s", sfb_last_error(ctx));
         return;
     }
     for (li = 0; li < 6; ++li)
@@ -950,8 +788,8 @@ static void layout_target(const layout_ref *L, const char *prefix, sfb_context *
             for (ti = 0; ti < 2 && !msg[0]; ++ti)
                 layout_check(s, ctx, k_layout_tables[ti], L->info[0].sources, L->info[ti].rows, k_lengths[li], &k_layouts[lk],
                              L->psrc[li], L->want[li][ti], L->tol[li], msg, sizeof msg);
-            if (msg[0]) check_fail(name, "%s", msg);
-            else check_pass(name);
+            if (msg[0]) fail(name, "%s", msg);
+            else pass(name);
         }
     sfb_surface_destroy(s);
 }
@@ -971,7 +809,7 @@ static void run_layouts(void) {
         snprintf(prefix, sizeof prefix, "simd-%s", isas[k]);
         if (!g_backends[0].available) {
             snprintf(name, sizeof name, "%s/layout", prefix);
-            check_unavailable(&g_backends[0], name);
+            backend_missing(&g_backends[0], name);
             continue;
         }
         {
@@ -979,18 +817,18 @@ static void run_layouts(void) {
             char saved[64];
             snprintf(saved, sizeof saved, "%s", old ? old : "");
             setenv("SURFBLEND_SIMD_ISA", isas[k], 1);
-            ctx = make_context(SFB_BACKEND_SIMD, 2);
+            ctx = make_context_threads(SFB_BACKEND_SIMD, 2);
             if (old) setenv("SURFBLEND_SIMD_ISA", saved, 1);
             else unsetenv("SURFBLEND_SIMD_ISA");
         }
         snprintf(name, sizeof name, "%s/layout", prefix);
-        if (!ctx) { check_fail(name, "no simd context with SURFBLEND_SIMD_ISA=%s", isas[k]); continue; }
+        if (!ctx) { fail(name, "no simd context with SURFBLEND_SIMD_ISA=%s", isas[k]); continue; }
         info[0] = 0;
         sfb_context_backend_info(ctx, info, sizeof info);
         if (strncmp(info, isas[k], strlen(isas[k])) != 0 || info[strlen(isas[k])] != ' ') {
             char why[400];
             snprintf(why, sizeof why, "this CPU or build has no %s kernel (the backend runs: %s)", isas[k], info);
-            check_skip(name, why);
+            skip(name, why);
         } else {
             layout_target(&L, prefix, ctx, NULL, 0);
         }
@@ -1035,32 +873,32 @@ static void run_threads(void) {
         for (ti = 0; ti < 3; ++ti) {
             char name[64];
             snprintf(name, sizeof name, "simd/threads/%d", thread_counts[ti]);
-            check_unavailable(simd, name);
+            backend_missing(simd, name);
         }
-        check_unavailable(simd, "simd/threads/concurrent-calls");
+        backend_missing(simd, "simd/threads/concurrent-calls");
         return;
     }
     mesh = layout_mesh(g_ref, 48, 32, &keep); /* 1536 quads -> 98304 at level 3 */
     cfg.flags = SFB_REFINE_LIMIT;
     if (!mesh || sfb_surface_create(g_ref, mesh, &cfg, &rs) != SFB_SUCCESS) {
-        check_fail("simd/threads", "ref could not build the thread-test mesh: %s", sfb_last_error(g_ref));
+        fail("simd/threads", "ref could not build the thread-test mesh: %s", sfb_last_error(g_ref));
         if (mesh) sfb_mesh_destroy(mesh);
         rmesh_free(&keep);
         return;
     }
     sfb_mesh_get_desc(mesh, &d);
     diag = bbox_diag(d.positions, d.vertex_count, 3);
-    if (eval_all(rs, &d, want, err, sizeof err, g_ref) != SFB_SUCCESS) check_fail("simd/threads", "ref: %s", err);
+    if (eval_all(rs, &d, want, err, sizeof err, g_ref) != SFB_SUCCESS) fail("simd/threads", "ref: %s", err);
     for (t = 0; t < SFB_TABLE_COUNT_; ++t) tol[t] = want[t].built ? table_tol((sfb_table)t, diag, 0.0, &want[t]) : 0.0;
     for (ti = 0; ti < 3; ++ti) {
         char name[64], fails[1500];
         size_t used = 0;
-        sfb_context *ctx = make_context(SFB_BACKEND_SIMD, thread_counts[ti]);
+        sfb_context *ctx = make_context_threads(SFB_BACKEND_SIMD, thread_counts[ti]);
         sfb_surface *s = NULL;
         table_out got[SFB_TABLE_COUNT_];
         snprintf(name, sizeof name, "simd/threads/%d", thread_counts[ti]);
         if (!ctx || strcmp(sfb_context_backend_name(ctx), "simd") != 0) {
-            check_fail(name, "no simd context with threads = %d", thread_counts[ti]);
+            fail(name, "no simd context with threads = %d", thread_counts[ti]);
             if (ctx) sfb_context_destroy(ctx);
             continue;
         }
@@ -1070,7 +908,7 @@ static void run_threads(void) {
             printf("# simd threads=%d: %s\n", thread_counts[ti], info);
         }
         if (sfb_surface_create(ctx, mesh, &cfg, &s) != SFB_SUCCESS) {
-            check_fail(name, "sfb_surface_create: %s", sfb_last_error(ctx));
+            fail(name, "sfb_surface_create: %s", sfb_last_error(ctx));
             sfb_context_destroy(ctx);
             continue;
         }
@@ -1091,8 +929,8 @@ static void run_threads(void) {
                 }
             }
         }
-        if (fails[0]) check_fail(name, "%s", fails);
-        else check_pass(name);
+        if (fails[0]) fail(name, "%s", fails);
+        else pass(name);
         free_all(got);
         /* several application threads on the one surface (documented as safe for simd) */
         if (thread_counts[ti] == 2) {
@@ -1125,8 +963,8 @@ static void run_threads(void) {
                 if (c.bad) snprintf(fails, sizeof fails, "caller %d: max |diff| %.3g > tol %.3g at row %d", k, c.err, c.tol, c.row);
             }
             for (k = 0; k < NCALLERS; ++k) free(jobs[k].dst);
-            if (fails[0]) check_fail("simd/threads/concurrent-calls", "%s", fails);
-            else check_pass("simd/threads/concurrent-calls");
+            if (fails[0]) fail("simd/threads/concurrent-calls", "%s", fails);
+            else pass("simd/threads/concurrent-calls");
         }
         sfb_surface_destroy(s);
         sfb_context_destroy(ctx);
@@ -1149,7 +987,7 @@ static void run_eval_gl_unsupported(void) {
     int i;
     memset(&d, 0, sizeof d);
     d.vertex_count = 4; d.positions = pos; d.face_count = 1; d.face_sizes = fs; d.face_vertices = fv;
-    if (sfb_mesh_create(g_ref, &d, &mesh) != SFB_SUCCESS) { check_fail("eval_gl", "mesh: %s", sfb_last_error(g_ref)); return; }
+    if (sfb_mesh_create(g_ref, &d, &mesh) != SFB_SUCCESS) { fail("eval_gl", "mesh: %s", sfb_last_error(g_ref)); return; }
     for (i = -1; i < g_backend_count; ++i) {
         const char *bname = i < 0 ? "ref" : g_backends[i].name;
         sfb_context *ctx = i < 0 ? g_ref : g_backends[i].ctx;
@@ -1157,15 +995,15 @@ static void run_eval_gl_unsupported(void) {
         char name[64];
         sfb_result r;
         snprintf(name, sizeof name, "%s/eval_gl-unsupported", bname);
-        if (i >= 0 && !g_backends[i].available) { check_unavailable(&g_backends[i], name); continue; }
-        if (sfb_surface_create(ctx, mesh, &cfg, &s) != SFB_SUCCESS) { check_fail(name, "surface: %s", sfb_last_error(ctx)); continue; }
+        if (i >= 0 && !g_backends[i].available) { backend_missing(&g_backends[i], name); continue; }
+        if (sfb_surface_create(ctx, mesh, &cfg, &s) != SFB_SUCCESS) { fail(name, "surface: %s", sfb_last_error(ctx)); continue; }
         /* buffer names 1 and 2 mean nothing here: the call must refuse before touching GL */
         r = sfb_surface_eval_stencils_gl(s, SFB_TABLE_VERTEX, 1u, bd, 2u, bd);
         if (r != SFB_UNSUPPORTED)
-            check_fail(name, "sfb_surface_eval_stencils_gl on a %s context without gl_use_current_context returned %s, want SFB_UNSUPPORTED",
+            fail(name, "sfb_surface_eval_stencils_gl on a %s context without gl_use_current_context returned %s, want SFB_UNSUPPORTED",
                        bname, sfb_result_string(r));
         else
-            check_pass(name);
+            pass(name);
         sfb_surface_destroy(s);
     }
     sfb_mesh_destroy(mesh);
@@ -1184,16 +1022,16 @@ static void run_environment(void) {
     r = sfb_context_create(&cfg, &ctx);
     unsetenv("SURFBLEND_BACKEND");
     if (r != SFB_SUCCESS) {
-        check_fail("env/bogus", "sfb_context_create with SURFBLEND_BACKEND=bogus: %s", sfb_result_string(r));
+        fail("env/bogus", "sfb_context_create with SURFBLEND_BACKEND=bogus: %s", sfb_result_string(r));
     } else {
         rep[0] = 0;
         sfb_context_backend_report(ctx, rep, sizeof rep);
         if (!strstr(rep, "unknown") || !strstr(rep, "bogus"))
-            check_fail("env/bogus", "report does not name the unknown backend 'bogus': %s", rep);
+            fail("env/bogus", "report does not name the unknown backend 'bogus': %s", rep);
         else if (strcmp(sfb_context_backend_name(ctx), "none") == 0)
-            check_fail("env/bogus", "no backend selected: %s", rep);
+            fail("env/bogus", "no backend selected: %s", rep);
         else
-            check_pass("env/bogus");
+            pass("env/bogus");
         sfb_context_destroy(ctx);
         ctx = NULL;
     }
@@ -1205,12 +1043,12 @@ static void run_environment(void) {
     r = sfb_context_create(&cfg, &ctx);
     unsetenv("SURFBLEND_BACKEND");
     if (r != SFB_SUCCESS) {
-        check_fail("env/ignored", "sfb_context_create: %s", sfb_result_string(r));
+        fail("env/ignored", "sfb_context_create: %s", sfb_result_string(r));
     } else {
         rep[0] = 0;
         sfb_context_backend_report(ctx, rep, sizeof rep);
-        if (strstr(rep, "bogus")) check_fail("env/ignored", "ignore_environment = 1 but the report mentions SURFBLEND_BACKEND: %s", rep);
-        else check_pass("env/ignored");
+        if (strstr(rep, "bogus")) fail("env/ignored", "ignore_environment = 1 but the report mentions SURFBLEND_BACKEND: %s", rep);
+        else pass("env/ignored");
         sfb_context_destroy(ctx);
         ctx = NULL;
     }
@@ -1246,7 +1084,7 @@ static void run_environment(void) {
             r = sfb_context_create(&cfg, &ctx);
             if (via_env) unsetenv("SURFBLEND_BACKEND");
             if (r != SFB_SUCCESS) {
-                check_fail(name, "sfb_context_create returned %s (want a fallback to ref)", sfb_result_string(r));
+                fail(name, "sfb_context_create returned %s (want a fallback to ref)", sfb_result_string(r));
                 continue;
             }
             rep[0] = 0;
@@ -1255,11 +1093,11 @@ static void run_environment(void) {
             line = strstr(rep, line_start);
             reason = line ? line + strlen(line_start) : NULL;
             if (strcmp(sfb_context_backend_name(ctx), "ref") != 0)
-                check_fail(name, "selected %s, want ref; report: %s", sfb_context_backend_name(ctx), rep);
+                fail(name, "selected %s, want ref; report: %s", sfb_context_backend_name(ctx), rep);
             else if (!reason || *reason == ')' || *reason == '\n' || *reason == 0)
-                check_fail(name, "report lacks \"%s<reason>)\": %s", line_start, rep);
+                fail(name, "report lacks \"%s<reason>)\": %s", line_start, rep);
             else
-                check_pass(name);
+                pass(name);
             if (g_verbose) printf("# %s report: %s", name, rep);
             sfb_context_destroy(ctx);
         }
@@ -1269,12 +1107,11 @@ static void run_environment(void) {
 /* ---- main ---- */
 
 int main(int argc, char **argv) {
-    const char *shapes = NULL;
-    const char *env_seed = getenv("SFB_SEED");
-    int cases = 36, i, seeded = 0;
+    const char *shapes = NULL, *seed = NULL;
+    int cases = 36, i;
     double t0 = now_s(), t;
     for (i = 1; i < argc; ++i) {
-        if (strcmp(argv[i], "--seed") == 0 && i + 1 < argc) { g_seed = strtoull(argv[++i], NULL, 10); seeded = 1; }
+        if (strcmp(argv[i], "--seed") == 0 && i + 1 < argc) seed = argv[++i];
         else if (strcmp(argv[i], "--cases") == 0 && i + 1 < argc) cases = atoi(argv[++i]);
         else if (strcmp(argv[i], "--l3-faces") == 0 && i + 1 < argc) g_l3_max_faces = atoi(argv[++i]);
         else if (strcmp(argv[i], "--verbose") == 0) g_verbose = 1;
@@ -1284,16 +1121,14 @@ int main(int argc, char **argv) {
             return 2;
         } else shapes = argv[i];
     }
-    if (!seeded && env_seed && *env_seed) { g_seed = strtoull(env_seed, NULL, 10); seeded = 1; }
-    if (!seeded) g_seed = (unsigned long long)time(NULL);
+    harness_seed(seed);
     printf("# seed %llu (rerun with --seed %llu or SFB_SEED=%llu)\n", g_seed, g_seed, g_seed);
     if (getenv("SFB_REQUIRE_BACKENDS")) printf("# SFB_REQUIRE_BACKENDS=%s\n", getenv("SFB_REQUIRE_BACKENDS"));
 
     setup_backends();
     if (!g_ref) {
-        check_fail("ref", "cannot create a ref context");
-        printf("%d passed, %d failed, %d skipped\n", g_pass, g_fail, g_skip);
-        return 1;
+        fail("ref", "cannot create a ref context");
+        return close_tests();
     }
     t = now_s();
     run_environment();
@@ -1314,6 +1149,5 @@ int main(int argc, char **argv) {
         if (g_backends[i].ctx) sfb_context_destroy(g_backends[i].ctx);
     sfb_context_destroy(g_ref);
     printf("# total %.1f s\n", now_s() - t0);
-    printf("%d passed, %d failed, %d skipped\n", g_pass, g_fail, g_skip);
-    return g_fail ? 1 : 0;
+    return close_tests();
 }

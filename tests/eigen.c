@@ -13,25 +13,11 @@
  * the quartic Bezier triangle of the 12-point box spline on the same points, at random (u,v)
  * (position and first and second derivatives): a test of the layout, the subdivision and
  * enlarged matrices, the picking of the three sub-patches (the middle one turned), the level
- * search and the derivative scales. Prints PASS/FAIL lines and "N passed, N failed". */
+ * search and the derivative scales. Prints PASS/FAIL lines and "N passed, N failed, N skipped" (tests/harness.h). */
 #define SURFBLEND_IMPLEMENTATION
 #include "surfblend.h"
+#include "harness.h"
 #include <math.h>
-#include <stdio.h>
-#include <stdlib.h>
-#include <string.h>
-
-static int g_pass, g_fail;
-
-static void result(int ok, const char *name, const char *fmt, double a, double b) {
-    if (ok) { g_pass++; printf("PASS %s\n", name); }
-    else {
-        g_fail++;
-        printf("FAIL %s: ", name);
-        printf(fmt, a, b);
-        printf("\n");
-    }
-}
 
 /* max |A V - V J| and max |V V^-1 - I|, J = diag(lambda) + the Jordan heads' ones */
 static void check_decomposition(int K, const double *A, const double *V, const double *vinv, const double *lambda, const int *head,
@@ -72,8 +58,7 @@ static void check_cc(sfb_context *ctx, int N, double *worst) {
     double eav, einv, rs, ev_err = 0.0, sub, t = 2.0 * 3.14159265358979323846 / N;
     if (sfb__eigen_cc_build(ctx, N, 1, &e) != SFB_SUCCESS) {
         snprintf(name, sizeof name, "catmark/%d/build", N);
-        result(0, name, "%s%.0g", 0.0, 0.0);
-        printf("  (%s)\n", sfb_last_error(ctx));
+        fail(name, "%s", sfb_last_error(ctx));
         return;
     }
     check_decomposition(K, e->a, e->v, e->vinv, e->lambda, NULL, &eav, &einv);
@@ -86,14 +71,14 @@ static void check_cc(sfb_context *ctx, int N, double *worst) {
     }
     sub = (5.0 + cos(t) + cos(t / 2.0) * sqrt(2.0 * (9.0 + cos(t)))) / 16.0;
     snprintf(name, sizeof name, "catmark/%d/A_rules", N);
-    result(rs < 1e-13 && ev_err < 1e-15, name, "row sums off by %.3g, EV row off by %.3g", rs, ev_err);
+    check(rs < 1e-13 && ev_err < 1e-15, name, "row sums off by %.3g, EV row off by %.3g", rs, ev_err);
     snprintf(name, sizeof name, "catmark/%d/AV=VL", N);
-    result(eav < 1e-9 && einv < 1e-9, name, "|AV - VL| = %.3g, |V V^-1 - I| = %.3g", eav, einv);
+    check(eav < 1e-9 && einv < 1e-9, name, "|AV - VL| = %.3g, |V V^-1 - I| = %.3g", eav, einv);
     snprintf(name, sizeof name, "catmark/%d/eigenvalues", N);
     {
         double onesdev = 0.0;
         for (i = 0; i < K; ++i) onesdev = fmax(onesdev, fabs(e->v[(size_t)i * K + e->dominant] / e->v[e->dominant] - 1.0));
-        result(fabs(e->lambda[e->dominant] - 1.0) < 1e-15 && fabs(e->sub - sub) < 1e-12 && onesdev < 1e-12, name,
+        check(fabs(e->lambda[e->dominant] - 1.0) < 1e-15 && fabs(e->sub - sub) < 1e-12 && onesdev < 1e-12, name,
                "dominant/ones off by %.3g, subdominant off by %.3g", fmax(fabs(e->lambda[e->dominant] - 1.0), onesdev), fabs(e->sub - sub));
     }
     if (eav > *worst) *worst = eav;
@@ -107,8 +92,7 @@ static void check_loop(sfb_context *ctx, int N, double *worst) {
     double eav, einv, rs, ev_err, c = cos(2.0 * 3.14159265358979323846 / N), alpha = 0.625 - (3.0 + 2.0 * c) * (3.0 + 2.0 * c) / 64.0;
     if (sfb__eigen_loop_build(ctx, N, 1, &e) != SFB_SUCCESS) {
         snprintf(name, sizeof name, "loop/%d/build", N);
-        result(0, name, "%s%.0g", 0.0, 0.0);
-        printf("  (%s)\n", sfb_last_error(ctx));
+        fail(name, "%s", sfb_last_error(ctx));
         return;
     }
     check_decomposition(K, e->a, e->v, e->vinv, e->lambda, e->head, &eav, &einv);
@@ -118,28 +102,26 @@ static void check_loop(sfb_context *ctx, int N, double *worst) {
     for (i = 1; i <= N; ++i) ev_err = fmax(ev_err, fabs(e->a[i] - alpha / N));
     for (i = N + 1; i < K; ++i) ev_err = fmax(ev_err, fabs(e->a[i]));
     snprintf(name, sizeof name, "loop/%d/A_rules", N);
-    result(rs < 1e-13 && ev_err < 1e-15, name, "row sums off by %.3g, EV row off by %.3g", rs, ev_err);
+    check(rs < 1e-13 && ev_err < 1e-15, name, "row sums off by %.3g, EV row off by %.3g", rs, ev_err);
     snprintf(name, sizeof name, "loop/%d/AV=VJ", N);
-    result(eav < 1e-9 && einv < 1e-9, name, "|AV - VJ| = %.3g, |V V^-1 - I| = %.3g", eav, einv);
+    check(eav < 1e-9 && einv < 1e-9, name, "|AV - VJ| = %.3g, |V V^-1 - I| = %.3g", eav, einv);
     for (i = 0; i < K; ++i) nj += e->head[i] >= 0;
     snprintf(name, sizeof name, "loop/%d/jordan_blocks", N);
-    result(nj == (N == 3 ? 1 : 0), name, "%.0f Jordan blocks, expected %.0f", (double)nj, N == 3 ? 1.0 : 0.0);
+    check(nj == (N == 3 ? 1 : 0), name, "%.0f Jordan blocks, expected %.0f", (double)nj, N == 3 ? 1.0 : 0.0);
     snprintf(name, sizeof name, "loop/%d/eigenvalues", N);
     {
         double onesdev = 0.0;
         for (i = 0; i < K; ++i) onesdev = fmax(onesdev, fabs(e->v[(size_t)i * K + e->dominant] / e->v[e->dominant] - 1.0));
-        result(fabs(e->lambda[e->dominant] - 1.0) < 1e-15 && fabs(e->sub - (0.375 + 0.25 * c)) < 1e-15 && onesdev < 1e-12, name,
+        check(fabs(e->lambda[e->dominant] - 1.0) < 1e-15 && fabs(e->sub - (0.375 + 0.25 * c)) < 1e-15 && onesdev < 1e-12, name,
                "dominant/ones off by %.3g, subdominant off by %.3g", onesdev, fabs(e->sub - (0.375 + 0.25 * c)));
     }
     if (eav > *worst) *worst = eav;
     sfb__eigen_loop_free(ctx, e);
 }
 
-static unsigned long long g_seed = 12345;
-static double rnd(void) {
-    g_seed = g_seed * 6364136223846793005ULL + 1442695040888963407ULL;
-    return (double)(g_seed >> 11) * (1.0 / 9007199254740992.0);
-}
+/* the random control points and parameters: a fixed stream */
+static rng g_rng = {12345};
+static double rnd(void) { return rng_unit(&g_rng); }
 
 /* Loop, valence 6: the eigen form against the box spline of the same 12 points. */
 static void check_loop_regular(sfb_context *ctx) {
@@ -147,7 +129,7 @@ static void check_loop_regular(sfb_context *ctx) {
     float pts[12 * 3], coef[12 * 3], bez[15 * 3];
     int cv[15], i, j, c, q, k, box[12];
     double worst[3] = {0.0, 0.0, 0.0}, scale = 0.0;
-    if (!e) { result(0, "loop/6/stam_equals_box_spline", "no eigen structure%.0g%.0g", 0.0, 0.0); return; }
+    if (!e) { fail("loop/6/stam_equals_box_spline", "no eigen structure"); return; }
     /* random control points on the lattice, a little perturbed */
     for (i = 0; i < 12; ++i)
         for (c = 0; c < 3; ++c) pts[3 * i + c] = (float)(rnd() * 2.0 - 1.0);
@@ -204,23 +186,18 @@ static void check_loop_regular(sfb_context *ctx) {
         }
     }
     printf("# loop valence 6, eigen form vs box spline: position %.3g, first derivatives %.3g, second %.3g\n", worst[0], worst[1], worst[2]);
-    result(worst[0] < 1e-6 && worst[1] < 1e-5 * fmax(1.0, scale), "loop/6/stam_equals_box_spline", "position off by %.3g, derivatives by %.3g",
+    check(worst[0] < 1e-6 && worst[1] < 1e-5 * fmax(1.0, scale), "loop/6/stam_equals_box_spline", "position off by %.3g, derivatives by %.3g",
            worst[0], worst[1]);
-    result(worst[2] < 1e-4, "loop/6/stam_second_derivatives", "second derivatives off by %.3g%.0g", worst[2], 0.0);
+    check(worst[2] < 1e-4, "loop/6/stam_second_derivatives", "second derivatives off by %.3g", worst[2]);
 }
 
 int main(void) {
-    sfb_context *ctx = NULL;
-    sfb_context_config cfg = sfb_context_config_init();
-    sfb_backend_kind k = SFB_BACKEND_REF;
+    sfb_context *ctx = make_context(SFB_BACKEND_REF);
     double wcc = 0.0, wloop = 0.0;
     int N;
-    cfg.backends = &k;
-    cfg.backend_count = 1;
-    cfg.ignore_environment = 1;
-    if (sfb_context_create(&cfg, &ctx) != SFB_SUCCESS) {
-        printf("FAIL context\n0 passed, 1 failed\n");
-        return 1;
+    if (!ctx) {
+        fail("context", "no ref context");
+        return close_tests();
     }
     /* every valence up to 64, then a sample up to the largest */
     for (N = 3; N <= SFB__STAM_MAX_VALENCE; N += N < 64 ? 1 : N < 128 ? 16 : 32) {
@@ -231,6 +208,5 @@ int main(void) {
     printf("# worst |AV - VJ| / max|A|: Catmull-Clark %.3g, Loop %.3g\n", wcc, wloop);
     check_loop_regular(ctx);
     sfb_context_destroy(ctx);
-    printf("%d passed, %d failed\n", g_pass, g_fail);
-    return g_fail ? 1 : 0;
+    return close_tests();
 }

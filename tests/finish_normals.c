@@ -48,66 +48,9 @@
 #define SURFBLEND_ALL_BACKENDS
 #include "surfblend.h"
 
+#include "harness.h"
+
 #include <math.h>
-#include <stdarg.h>
-#include <stdio.h>
-#include <stdlib.h>
-#include <string.h>
-#include <time.h>
-
-static int g_pass, g_fail, g_skip;
-static unsigned long long g_seed;
-
-static void pass(const char *name) {
-    printf("PASS %s\n", name);
-    fflush(stdout);
-    ++g_pass;
-}
-
-static void fail(const char *name, const char *fmt, ...)
-#if defined(__GNUC__)
-    __attribute__((format(printf, 2, 3)))
-#endif
-    ;
-static void fail(const char *name, const char *fmt, ...) {
-    va_list ap;
-    printf("FAIL %s: ", name);
-    va_start(ap, fmt);
-    vprintf(fmt, ap);
-    va_end(ap);
-    printf(" (seed %llu)\n", g_seed);
-    fflush(stdout);
-    ++g_fail;
-}
-
-static void skip(const char *name, const char *why) {
-    printf("SKIP %s: %s\n", name, why);
-    fflush(stdout);
-    ++g_skip;
-}
-
-static double now_s(void) {
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-/* ---- random numbers (splitmix64) ---- */
-typedef struct rng { unsigned long long s; } rng;
-static unsigned long long rng_next(rng *g) {
-    unsigned long long z = (g->s += 0x9E3779B97F4A7C15ull);
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    return z ^ (z >> 31);
-}
-static double rng_unit(rng *g) { return (double)(rng_next(g) >> 11) * (1.0 / 9007199254740992.0); }
-static int rng_int(rng *g, int n) { return n <= 1 ? 0 : (int)(rng_next(g) % (unsigned long long)n); }
-static rng rng_for(unsigned long long stream) {
-    rng g;
-    g.s = g_seed ^ (stream * 0xD1B54A32D192ED03ull);
-    rng_next(&g);
-    return g;
-}
 
 /* ---- test data ---- */
 typedef struct data {
@@ -115,15 +58,6 @@ typedef struct data {
     float *tu, *tv, *ns, *b;
     int *idx;
 } data;
-
-static void *xmalloc(size_t bytes) {
-    void *p = malloc(bytes ? bytes : 1);
-    if (!p) {
-        printf("FAIL setup: out of memory\n");
-        exit(1);
-    }
-    return p;
-}
 
 static void data_alloc(data *d, int n, int nns) {
     d->n = n;
@@ -170,7 +104,7 @@ static void unit_of(const float *f, double *u) {
 
 /* Random, non-degenerate elements (see the header) for exponent p. */
 static void data_random(data *d, int n, int nns, float p, unsigned long long stream) {
-    rng g = rng_for(stream);
+    rng g = rng_for(g_seed, stream);
     int i, k;
     data_alloc(d, n, nns);
     for (k = 0; k < nns; ++k) random_vec(&g, d->ns + 3 * (size_t)k);
@@ -711,47 +645,15 @@ static void run_target(const target *t, const suite *S) {
 }
 
 /* ---- backends ---- */
-static int name_listed(const char *list, const char *name) {
-    size_t n = strlen(name);
-    const char *p = list;
-    while (p && *p) {
-        const char *end = strchr(p, ',');
-        size_t len = end ? (size_t)(end - p) : strlen(p);
-        while (len > 0 && *p == ' ') { ++p; --len; }
-        while (len > 0 && p[len - 1] == ' ') --len;
-        if (len == n && strncmp(p, name, n) == 0) return 1;
-        p = end ? end + 1 : NULL;
-    }
-    return 0;
-}
-
 /* A context on `kind` alone (NULL with `why` filled when it cannot initialise). */
-static sfb_context *make_context(sfb_backend_kind kind, int threads, char *why, size_t why_size) {
-    sfb_context_config cfg = sfb_context_config_init();
-    sfb_context *ctx = NULL;
-    sfb_result r;
-    cfg.backends = &kind;
-    cfg.backend_count = 1;
-    cfg.ignore_environment = 1;
-    cfg.threads = threads;
-    r = sfb_context_create(&cfg, &ctx);
-    if (r == SFB_SUCCESS && ctx->backend && ctx->backend->kind == kind) return ctx;
+static sfb_context *target_context(sfb_backend_kind kind, int threads, char *why, size_t why_size) {
+    sfb_context *ctx = make_context_threads(kind, threads);
+    if (ctx && ctx->backend && ctx->backend->kind == kind) return ctx;
     if (ctx) sfb_context_destroy(ctx);
     why[0] = 0;
     if (sfb_backend_probe(kind, NULL, why, why_size) == SFB_SUCCESS || !why[0])
-        snprintf(why, why_size, "sfb_context_create: %s", sfb_result_string(r));
+        snprintf(why, why_size, "sfb_context_create failed (or chose another backend) after a successful probe");
     return NULL;
-}
-
-/* why: the probe's report line ("NAME: unavailable (reason)"). */
-static void unavailable(const char *name, int required, const char *why) {
-    char line[700];
-    size_t n;
-    snprintf(line, sizeof line, "%s", why);
-    n = strlen(line);
-    while (n > 0 && (line[n - 1] == '\n' || line[n - 1] == ' ')) line[--n] = 0;
-    if (required) fail(name, "%s (required by SFB_REQUIRE_BACKENDS)", line);
-    else skip(name, line);
 }
 
 /* simd: each instruction set (or the one SURFBLEND_SIMD_ISA pins) with threads 1 and 2; one
@@ -780,7 +682,7 @@ static void run_simd(const suite *S, int required) {
             memset(&t, 0, sizeof t);
             snprintf(t.name, sizeof t.name, "simd-%s/t%d", isa, threads);
             setenv("SURFBLEND_SIMD_ISA", isa, 1);
-            ctx = make_context(SFB_BACKEND_SIMD, threads, why, sizeof why);
+            ctx = target_context(SFB_BACKEND_SIMD, threads, why, sizeof why);
             if (saved[0]) setenv("SURFBLEND_SIMD_ISA", saved, 1);
             else unsetenv("SURFBLEND_SIMD_ISA");
             if (!ctx) {
@@ -811,7 +713,7 @@ static void run_gl(const suite *S, sfb_backend_kind kind, int required) {
     sfb_context *ctx;
     memset(&t, 0, sizeof t);
     snprintf(t.name, sizeof t.name, "%s", sfb_backend_kind_name(kind));
-    ctx = make_context(kind, 1, why, sizeof why);
+    ctx = target_context(kind, 1, why, sizeof why);
     if (!ctx) {
         unavailable(t.name, required, why);
         return;
@@ -858,7 +760,7 @@ static void bench(int n) {
         const sfb_backend_kind kind = k == 4 ? SFB_BACKEND_OSMESA : kinds[k];
         target t;
         char why[512], info[400] = "";
-        sfb_context *ctx = make_context(kind, k == 2 ? 2 : 1, why, sizeof why);
+        sfb_context *ctx = target_context(kind, k == 2 ? 2 : 1, why, sizeof why);
         if (!ctx) {
             printf("# bench %s: unavailable: %s\n", sfb_backend_kind_name(kind), why);
             continue;
@@ -879,21 +781,20 @@ static void bench(int n) {
 }
 
 int main(int argc, char **argv) {
-    const char *req = getenv("SFB_REQUIRE_BACKENDS");
+    const char *req = getenv("SFB_REQUIRE_BACKENDS"), *seed = NULL;
     suite S;
     target ref;
     sfb__backend_vtable ref_vt;
     int i, bench_n = 0;
-    g_seed = (unsigned long long)time(NULL);
-    if (getenv("SFB_SEED")) g_seed = strtoull(getenv("SFB_SEED"), NULL, 10);
     for (i = 1; i < argc; ++i) {
-        if (strcmp(argv[i], "--seed") == 0 && i + 1 < argc) g_seed = strtoull(argv[++i], NULL, 10);
+        if (strcmp(argv[i], "--seed") == 0 && i + 1 < argc) seed = argv[++i];
         else if (strcmp(argv[i], "--bench") == 0 && i + 1 < argc) bench_n = atoi(argv[++i]);
         else {
             fprintf(stderr, "usage: %s [--seed S] [--bench N]\n", argv[0]);
             return 2;
         }
     }
+    harness_seed(seed);
     printf("# seed %llu\n", g_seed);
     if (req) printf("# SFB_REQUIRE_BACKENDS=%s\n", req);
     if (bench_n > 0) {
@@ -909,13 +810,12 @@ int main(int argc, char **argv) {
     sfb__backend_bind(SFB_BACKEND_REF, &ref_vt);
     ref.vt = &ref_vt;
     run_target(&ref, &S);
-    run_simd(&S, req && name_listed(req, "simd"));
-    run_gl(&S, SFB_BACKEND_GL, req && name_listed(req, "gl"));
-    run_gl(&S, SFB_BACKEND_OSMESA, req && name_listed(req, "osmesa"));
+    run_simd(&S, backend_required("simd"));
+    run_gl(&S, SFB_BACKEND_GL, backend_required("gl"));
+    run_gl(&S, SFB_BACKEND_OSMESA, backend_required("osmesa"));
 
     for (i = 0; i < 4; ++i) data_free(&S.random[i]);
     data_free(&S.small);
     data_free(&S.large);
-    printf("%d passed, %d failed, %d skipped\n", g_pass, g_fail, g_skip);
-    return g_fail ? 1 : 0;
+    return close_tests();
 }

@@ -46,131 +46,25 @@
  */
 #define _POSIX_C_SOURCE 200809L
 #define GL_GLEXT_PROTOTYPES 1
-#include <EGL/egl.h>
-#include <EGL/eglext.h>
 #include <GL/glcorearb.h>
 
 #include "surfblend.h"
+#include "egl_host.h"
+#include "harness.h"
 
 #include <math.h>
-#include <stdarg.h>
 #include <stdint.h>
-#include <stdio.h>
-#include <stdlib.h>
-#include <string.h>
 #include <sys/types.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
-#ifndef EGL_PLATFORM_SURFACELESS_MESA
-#define EGL_PLATFORM_SURFACELESS_MESA 0x31DD
-#endif
-
 #define TOL_REL 1e-5
 
-static int g_pass, g_fail, g_skip, g_verbose, g_required;
+static int g_verbose, g_required;
 
-static void check_pass(const char *name) { printf("PASS %s\n", name); fflush(stdout); ++g_pass; }
-static void check_fail(const char *name, const char *fmt, ...)
-#if defined(__GNUC__)
-    __attribute__((format(printf, 2, 3)))
-#endif
-    ;
-static void check_fail(const char *name, const char *fmt, ...) {
-    va_list ap;
-    printf("FAIL %s: ", name);
-    va_start(ap, fmt);
-    vprintf(fmt, ap);
-    va_end(ap);
-    printf("\n");
-    fflush(stdout);
-    ++g_fail;
-}
-static void check_skip(const char *name, const char *why) { printf("SKIP %s: %s\n", name, why); fflush(stdout); ++g_skip; }
+/* ---- the host's context: a desktop OpenGL 4.3 core context, current, no surface (tests/egl_host.h) ---- */
 
-static void *xmalloc(size_t n) {
-    void *p = malloc(n ? n : 1);
-    if (!p) { fprintf(stderr, "gl_host: out of memory\n"); exit(2); }
-    return p;
-}
-
-/* ---- the host's context ---- */
-
-typedef struct host {
-    EGLDisplay dpy;
-    EGLContext ctx;
-    char renderer[256];
-} host;
-
-static int has_word(const char *list, const char *word) {
-    size_t n = strlen(word);
-    const char *p = list;
-    if (!list) return 0;
-    while ((p = strstr(p, word)) != NULL) {
-        if ((p == list || p[-1] == ' ') && (p[n] == ' ' || p[n] == 0)) return 1;
-        p += n;
-    }
-    return 0;
-}
-
-/* Makes a desktop OpenGL 4.3 core context current with no surface. 0 + why on failure. */
-static int host_create(host *h, char *why, size_t wn) {
-    const char *client = eglQueryString(EGL_NO_DISPLAY, EGL_EXTENSIONS);
-    EGLint major = 0, minor = 0, n = 0;
-    EGLConfig config = EGL_NO_CONFIG_KHR;
-    const char *ext, *version;
-    static const EGLint ctx_attrs[] = {EGL_CONTEXT_MAJOR_VERSION, 4, EGL_CONTEXT_MINOR_VERSION, 3,
-                                       EGL_CONTEXT_OPENGL_PROFILE_MASK, EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT, EGL_NONE};
-    int gmaj = 0, gmin = 0;
-    memset(h, 0, sizeof *h);
-    h->dpy = EGL_NO_DISPLAY;
-    if (has_word(client, "EGL_MESA_platform_surfaceless")) {
-        PFNEGLGETPLATFORMDISPLAYEXTPROC gpd = (PFNEGLGETPLATFORMDISPLAYEXTPROC)eglGetProcAddress("eglGetPlatformDisplayEXT");
-        if (gpd) h->dpy = gpd(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, NULL);
-        if (h->dpy != EGL_NO_DISPLAY && !eglInitialize(h->dpy, &major, &minor)) h->dpy = EGL_NO_DISPLAY;
-    }
-    if (h->dpy == EGL_NO_DISPLAY) {
-        h->dpy = eglGetDisplay(EGL_DEFAULT_DISPLAY);
-        if (h->dpy == EGL_NO_DISPLAY || !eglInitialize(h->dpy, &major, &minor)) {
-            snprintf(why, wn, "no EGL display (surfaceless platform or default display; EGL error 0x%x)", (unsigned)eglGetError());
-            h->dpy = EGL_NO_DISPLAY;
-            return 0;
-        }
-    }
-    ext = eglQueryString(h->dpy, EGL_EXTENSIONS);
-    if (!has_word(ext, "EGL_KHR_surfaceless_context")) {
-        snprintf(why, wn, "EGL %d.%d display lacks EGL_KHR_surfaceless_context", major, minor);
-        return 0;
-    }
-    if (!eglBindAPI(EGL_OPENGL_API)) {
-        snprintf(why, wn, "eglBindAPI(EGL_OPENGL_API) failed: no desktop OpenGL through EGL here");
-        return 0;
-    }
-    if (!has_word(ext, "EGL_KHR_no_config_context") && !has_word(ext, "EGL_MESA_configless_context")) {
-        static const EGLint cfg_attrs[] = {EGL_RENDERABLE_TYPE, EGL_OPENGL_BIT, EGL_NONE};
-        if (!eglChooseConfig(h->dpy, cfg_attrs, &config, 1, &n) || n < 1) {
-            snprintf(why, wn, "no EGL config with EGL_OPENGL_BIT");
-            return 0;
-        }
-    }
-    h->ctx = eglCreateContext(h->dpy, config, EGL_NO_CONTEXT, ctx_attrs);
-    if (h->ctx == EGL_NO_CONTEXT) {
-        snprintf(why, wn, "no OpenGL 4.3 core context (eglCreateContext: EGL error 0x%x; %s)", (unsigned)eglGetError(),
-                 eglQueryString(h->dpy, EGL_VENDOR));
-        return 0;
-    }
-    if (!eglMakeCurrent(h->dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, h->ctx)) {
-        snprintf(why, wn, "eglMakeCurrent failed (EGL error 0x%x)", (unsigned)eglGetError());
-        return 0;
-    }
-    version = (const char *)glGetString(GL_VERSION);
-    if (!version || sscanf(version, "%d.%d", &gmaj, &gmin) != 2 || gmaj * 10 + gmin < 43) {
-        snprintf(why, wn, "OpenGL version %s is below 4.3", version ? version : "(none)");
-        return 0;
-    }
-    snprintf(h->renderer, sizeof h->renderer, "OpenGL %s; %s", version, (const char *)glGetString(GL_RENDERER));
-    return 1;
-}
+typedef egl_host host;
 
 /* ---- the host's own GL state ---- */
 
@@ -474,15 +368,11 @@ static void cpu_eval_check(const sfb_surface *s, sfb_context *ctx, const referen
     free(out);
 }
 
-static sfb_context *make_context(sfb_backend_kind kind, int use_current) {
+/* A context on `kind` alone; use_current: the gl backend on the current (host's) context. */
+static sfb_context *gl_context(sfb_backend_kind kind, int use_current) {
     sfb_context_config cfg = sfb_context_config_init();
-    sfb_context *ctx = NULL;
-    cfg.backends = &kind;
-    cfg.backend_count = 1;
-    cfg.ignore_environment = 1;
     cfg.gl_use_current_context = use_current;
-    if (sfb_context_create(&cfg, &ctx) != SFB_SUCCESS) return NULL;
-    return ctx;
+    return make_context_with(cfg, kind);
 }
 
 /* ---- a second backend context (own EGL context, or OSMesa) used while the host's is current ---- */
@@ -503,7 +393,7 @@ static void beside_host(const host *h, sfb_backend_kind kind, const gl_state *se
     if (!mesh || !reference_make(ref, mesh, &cfg, &m, &R)) { snprintf(msg, n, "ref failed: %s", sfb_last_error(ref)); return; }
     if (sfb_backend_probe(kind, NULL, probe, sizeof probe) != SFB_SUCCESS) {
         snprintf(msg, n, "SKIP:%s unavailable: %s", sfb_backend_kind_name(kind), probe);
-    } else if (!(ctx = make_context(kind, 0))) {
+    } else if (!(ctx = gl_context(kind, 0))) {
         snprintf(msg, n, "sfb_context_create(%s) failed after a successful probe", sfb_backend_kind_name(kind));
     } else {
         if (eglGetCurrentContext() != h->ctx) snprintf(msg, n, "creating the %s context left another EGL context current", sfb_backend_kind_name(kind));
@@ -556,9 +446,9 @@ static int child_beside(sfb_backend_kind kind) {
     gl_state set;
     char why[700], msg[900];
     sfb_context *ref;
-    if (!host_create(&h, why, sizeof why)) { printf("SKIP:%s\n", why); return 77; }
+    if (!egl_host_open(&h, 4, 3, why, sizeof why)) { printf("SKIP:%s\n", why); return 77; }
     host_set_state(&o, &set);
-    ref = make_context(SFB_BACKEND_REF, 0);
+    ref = gl_context(SFB_BACKEND_REF, 0);
     if (!ref) { printf("no ref context\n"); return 1; }
     beside_host(&h, kind, &set, ref, msg, sizeof msg);
     sfb_context_destroy(ref);
@@ -567,20 +457,17 @@ static int child_beside(sfb_backend_kind kind) {
     return 0;
 }
 
-static int name_listed(const char *list, const char *name);
-
 static void run_child_check(const char *self, const char *name, const char *arg) {
-    const char *req = getenv("SFB_REQUIRE_BACKENDS");
     int fds[2];
     pid_t pid;
     char out[1200];
     size_t used = 0;
     ssize_t k;
     int status = 0;
-    if (pipe(fds) != 0) { check_fail(name, "pipe failed"); return; }
+    if (pipe(fds) != 0) { fail(name, "pipe failed"); return; }
     fflush(stdout);
     pid = fork();
-    if (pid < 0) { check_fail(name, "fork failed"); return; }
+    if (pid < 0) { fail(name, "fork failed"); return; }
     if (pid == 0) {
         char *const args[] = {(char *)self, (char *)"--child", (char *)arg, NULL};
         dup2(fds[1], 1);
@@ -596,13 +483,13 @@ static void run_child_check(const char *self, const char *name, const char *arg)
     close(fds[0]);
     waitpid(pid, &status, 0);
     while (used > 0 && (out[used - 1] == '\n' || out[used - 1] == '\r')) out[--used] = 0;
-    if (WIFSIGNALED(status)) check_fail(name, "the child process died of signal %d%s%s", WTERMSIG(status), used ? "; output: " : "", out);
-    else if (WEXITSTATUS(status) == 0) check_pass(name);
+    if (WIFSIGNALED(status)) fail(name, "the child process died of signal %d%s%s", WTERMSIG(status), used ? "; output: " : "", out);
+    else if (WEXITSTATUS(status) == 0) pass(name);
     else if (WEXITSTATUS(status) == 77) {
-        if (req && name_listed(req, arg)) check_fail(name, "%s (required by SFB_REQUIRE_BACKENDS)", strncmp(out, "SKIP:", 5) == 0 ? out + 5 : out);
-        else check_skip(name, strncmp(out, "SKIP:", 5) == 0 ? out + 5 : out);
+        if (backend_required(arg)) fail(name, "%s (required by SFB_REQUIRE_BACKENDS)", strncmp(out, "SKIP:", 5) == 0 ? out + 5 : out);
+        else skip(name, strncmp(out, "SKIP:", 5) == 0 ? out + 5 : out);
     }
-    else check_fail(name, "%s", used ? out : "child failed without a message");
+    else fail(name, "%s", used ? out : "child failed without a message");
 }
 
 /* ---- a GLES 3.1 host ---- */
@@ -610,33 +497,16 @@ static void run_child_check(const char *self, const char *name, const char *arg)
 /* Makes an OpenGL ES 3.1 context current on the host's display, runs the gl backend on it
  * (buffer to buffer, every table), then makes the host's desktop context current again. */
 static void gles_check(const host *h, const sfb_mesh *mesh, const sfb_surface_config *cfg, const reference *R) {
-    static const EGLint attrs[] = {EGL_CONTEXT_MAJOR_VERSION, 3, EGL_CONTEXT_MINOR_VERSION, 1, EGL_NONE};
-    const char *ext = eglQueryString(h->dpy, EGL_EXTENSIONS);
-    EGLConfig config = EGL_NO_CONFIG_KHR;
     EGLContext es;
-    EGLint n = 0;
     sfb_context *ctx;
     sfb_surface *s = NULL;
     char msg[700] = "", info[512] = "";
     int t;
-    if (!eglBindAPI(EGL_OPENGL_ES_API)) {
-        eglBindAPI(EGL_OPENGL_API);
-        check_skip("host/gles31", "this EGL has no OpenGL ES API");
+    if ((es = egl_host_gles_begin(h, 3, 1, msg, sizeof msg)) == EGL_NO_CONTEXT) {
+        skip("host/gles31", msg);
         return;
     }
-    if (!has_word(ext, "EGL_KHR_no_config_context") && !has_word(ext, "EGL_MESA_configless_context")) {
-        static const EGLint ca[] = {EGL_RENDERABLE_TYPE, EGL_OPENGL_ES3_BIT, EGL_NONE};
-        if (!eglChooseConfig(h->dpy, ca, &config, 1, &n) || n < 1) config = NULL;
-    }
-    es = config || n == 0 ? eglCreateContext(h->dpy, config, EGL_NO_CONTEXT, attrs) : EGL_NO_CONTEXT;
-    if (es == EGL_NO_CONTEXT || !eglMakeCurrent(h->dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, es)) {
-        if (es != EGL_NO_CONTEXT) eglDestroyContext(h->dpy, es);
-        eglBindAPI(EGL_OPENGL_API);
-        eglMakeCurrent(h->dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, h->ctx);
-        check_skip("host/gles31", "no OpenGL ES 3.1 context through EGL here");
-        return;
-    }
-    ctx = make_context(SFB_BACKEND_GL, 1);
+    ctx = gl_context(SFB_BACKEND_GL, 1);
     if (!ctx) snprintf(msg, sizeof msg, "no gl backend on a GLES 3.1 host context");
     else sfb_context_backend_info(ctx, info, sizeof info);
     if (!msg[0] && sfb_surface_create(ctx, mesh, cfg, &s) != SFB_SUCCESS) snprintf(msg, sizeof msg, "sfb_surface_create: %s", sfb_last_error(ctx));
@@ -677,33 +547,15 @@ static void gles_check(const host *h, const sfb_mesh *mesh, const sfb_surface_co
     }
     sfb_surface_destroy(s);
     if (ctx) sfb_context_destroy(ctx);
-    eglMakeCurrent(h->dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
-    eglDestroyContext(h->dpy, es);
-    eglBindAPI(EGL_OPENGL_API);
-    eglMakeCurrent(h->dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, h->ctx);
-    if (msg[0]) check_fail("host/gles31", "%s", msg);
+    egl_host_gles_end(h, es);
+    if (msg[0]) fail("host/gles31", "%s", msg);
     else {
         if (g_verbose) printf("# gles host: %s\n", info);
-        check_pass("host/gles31");
+        pass("host/gles31");
     }
 }
 
 /* ---- main ---- */
-
-/* Is `name` one of the comma-separated names in `list`? */
-static int name_listed(const char *list, const char *name) {
-    size_t n = strlen(name);
-    const char *p = list;
-    while (p && *p) {
-        const char *end = strchr(p, ',');
-        size_t len = end ? (size_t)(end - p) : strlen(p);
-        while (len > 0 && *p == ' ') { ++p; --len; }
-        while (len > 0 && p[len - 1] == ' ') --len;
-        if (len == n && strncmp(p, name, n) == 0) return 1;
-        p = end ? end + 1 : NULL;
-    }
-    return 0;
-}
 
 static const char *const k_checks[] = {
     "host/probe", "host/sfb-context", "host/surface", "host/eval_gl/VERTEX", "host/eval_gl/LIMIT", "host/eval_gl/TANGENT_U",
@@ -724,38 +576,35 @@ int main(int argc, char **argv) {
     sfb_surface_config cfg = sfb_surface_config_init(SFB_SCHEME_CATMARK, 2);
     reference R;
     tmesh m;
-    const char *req = getenv("SFB_REQUIRE_BACKENDS");
     int i, t;
 
     if (argc == 3 && strcmp(argv[1], "--child") == 0)
         return child_beside(strcmp(argv[2], "osmesa") == 0 ? SFB_BACKEND_OSMESA : SFB_BACKEND_GL);
     for (i = 1; i < argc; ++i)
         if (strcmp(argv[i], "--verbose") == 0) g_verbose = 1;
-    g_required = req && name_listed(req, "gl");
+    g_required = backend_required("gl");
 
-    if (!host_create(&h, why, sizeof why)) {
+    if (!egl_host_open(&h, 4, 3, why, sizeof why)) {
         int k;
-        if (g_required) check_fail("host/context", "%s (gl required by SFB_REQUIRE_BACKENDS)", why);
-        else check_skip("host/context", why);
+        if (g_required) fail("host/context", "%s (gl required by SFB_REQUIRE_BACKENDS)", why);
+        else skip("host/context", why);
         for (k = 0; k_checks[k]; ++k) {
-            if (g_required) check_fail(k_checks[k], "no host context: %s", why);
-            else check_skip(k_checks[k], "no EGL / OpenGL 4.3 core context here");
+            if (g_required) fail(k_checks[k], "no host context: %s", why);
+            else skip(k_checks[k], "no EGL / OpenGL 4.3 core context here");
         }
-        printf("%d passed, %d failed, %d skipped\n", g_pass, g_fail, g_skip);
-        return g_fail ? 1 : 0;
+        return close_tests();
     }
     printf("# host context: %s\n", h.renderer);
-    check_pass("host/context");
+    pass("host/context");
     host_set_state(&o, &set);
-    if (!o.prog) check_fail("host/context", "the host's own compute program did not link");
+    if (!o.prog) fail("host/context", "the host's own compute program did not link");
 
-    ref = make_context(SFB_BACKEND_REF, 0);
+    ref = gl_context(SFB_BACKEND_REF, 0);
     cfg.flags = SFB_REFINE_LIMIT | SFB_REFINE_UVS;
     mesh = ref ? make_mesh(ref, &m) : NULL;
     if (!mesh || !reference_make(ref, mesh, &cfg, &m, &R)) {
-        check_fail("host/reference", "ref could not refine the test mesh: %s", ref ? sfb_last_error(ref) : "no context");
-        printf("%d passed, %d failed, %d skipped\n", g_pass, g_fail, g_skip);
-        return 1;
+        fail("host/reference", "ref could not refine the test mesh: %s", ref ? sfb_last_error(ref) : "no context");
+        return close_tests();
     }
 
     /* the gl backend must be able to run on this context at all (built in, GL 4.3) */
@@ -766,26 +615,25 @@ int main(int argc, char **argv) {
         if (sfb_backend_probe(SFB_BACKEND_GL, &pc, probe, sizeof probe) != SFB_SUCCESS) {
             int k;
             for (k = 0; k_checks[k]; ++k) {
-                if (g_required) check_fail(k_checks[k], "gl backend unavailable on the host's context: %s (required by SFB_REQUIRE_BACKENDS)", probe);
+                if (g_required) fail(k_checks[k], "gl backend unavailable on the host's context: %s (required by SFB_REQUIRE_BACKENDS)", probe);
                 else {
                     char w[600];
                     snprintf(w, sizeof w, "gl backend unavailable on the host's context: %s", probe);
-                    check_skip(k_checks[k], w);
+                    skip(k_checks[k], w);
                 }
             }
             reference_free(&R);
             sfb_mesh_destroy(mesh);
             sfb_context_destroy(ref);
-            printf("%d passed, %d failed, %d skipped\n", g_pass, g_fail, g_skip);
-            return g_fail ? 1 : 0;
+            return close_tests();
         }
         state_diff(&set, msg, sizeof msg);
-        if (msg[0]) check_fail("host/probe", "host state changed by sfb_backend_probe(gl, gl_use_current_context): %s", msg);
-        else check_pass("host/probe");
+        if (msg[0]) fail("host/probe", "host state changed by sfb_backend_probe(gl, gl_use_current_context): %s", msg);
+        else pass("host/probe");
     }
 
     /* the sfb context on the host's context */
-    ctx = make_context(SFB_BACKEND_GL, 1);
+    ctx = gl_context(SFB_BACKEND_GL, 1);
     info[0] = 0;
     if (ctx) sfb_context_backend_info(ctx, info, sizeof info);
     state_diff(&set, msg, sizeof msg);
@@ -794,35 +642,35 @@ int main(int argc, char **argv) {
         sfb_context_config pc = sfb_context_config_init();
         pc.gl_use_current_context = 1;
         sfb_backend_probe(SFB_BACKEND_GL, &pc, probe, sizeof probe);
-        check_fail("host/sfb-context", "no gl context on the host's context: %s", probe);
+        fail("host/sfb-context", "no gl context on the host's context: %s", probe);
     } else if (strcmp(sfb_context_backend_name(ctx), "gl") != 0) {
-        check_fail("host/sfb-context", "selected %s", sfb_context_backend_name(ctx));
+        fail("host/sfb-context", "selected %s", sfb_context_backend_name(ctx));
     } else if (!strstr(info, "host")) {
-        check_fail("host/sfb-context", "backend info does not say it runs on the host's context: %s", info);
+        fail("host/sfb-context", "backend info does not say it runs on the host's context: %s", info);
     } else if (msg[0]) {
-        check_fail("host/sfb-context", "host state changed by sfb_context_create: %s", msg);
+        fail("host/sfb-context", "host state changed by sfb_context_create: %s", msg);
     } else {
         printf("# sfb gl backend: %s\n", info);
-        check_pass("host/sfb-context");
+        pass("host/sfb-context");
     }
     if (ctx && strcmp(sfb_context_backend_name(ctx), "gl") == 0) {
         if (sfb_surface_create(ctx, mesh, &cfg, &s) != SFB_SUCCESS) {
-            check_fail("host/surface", "sfb_surface_create: %s", sfb_last_error(ctx));
+            fail("host/surface", "sfb_surface_create: %s", sfb_last_error(ctx));
         } else {
             state_diff(&set, msg, sizeof msg);
-            if (msg[0]) check_fail("host/surface", "host state changed by sfb_surface_create (table upload): %s", msg);
-            else check_pass("host/surface");
+            if (msg[0]) fail("host/surface", "host state changed by sfb_surface_create (table upload): %s", msg);
+            else pass("host/surface");
         }
     } else {
-        check_fail("host/surface", "no gl context on the host's context");
+        fail("host/surface", "no gl context on the host's context");
     }
 
     /* host buffer -> host buffer, each table; the host's vertex layout: xyz at +1 of 5 floats */
     for (t = 0; t < 5; ++t) {
         char name[64];
         snprintf(name, sizeof name, "host/eval_gl/%s", table_name(t));
-        if (!s) { check_fail(name, "no surface"); continue; }
-        if (!R.built[t]) { check_skip(name, "table not built for this mesh"); continue; }
+        if (!s) { fail(name, "no surface"); continue; }
+        if (!R.built[t]) { skip(name, "table not built for this mesh"); continue; }
         {
             int len = R.len[t];
             sfb_buffer_desc sd, dd;
@@ -837,14 +685,14 @@ int main(int argc, char **argv) {
             r = sfb_surface_eval_stencils_gl(s, (sfb_table)t, sb, sd, db, dd);
             state_diff(&set, msg, sizeof msg);
             if (r != SFB_SUCCESS) {
-                check_fail(name, "sfb_surface_eval_stencils_gl: %s: %s", sfb_result_string(r), sfb_last_error(ctx));
+                fail(name, "sfb_surface_eval_stencils_gl: %s: %s", sfb_result_string(r), sfb_last_error(ctx));
             } else if (msg[0]) {
-                check_fail(name, "host state changed: %s", msg);
+                fail(name, "host state changed: %s", msg);
             } else {
                 got = host_read(db, df);
                 compare_view(R.want[t], R.rows[t], len, got, dd, df, R.tol[t], msg, sizeof msg);
-                if (msg[0]) check_fail(name, "%s (src {%d,%d,%d}, dst {%d,%d,%d})", msg, sd.offset, sd.length, sd.stride, dd.offset, dd.length, dd.stride);
-                else check_pass(name);
+                if (msg[0]) fail(name, "%s (src {%d,%d,%d}, dst {%d,%d,%d})", msg, sd.offset, sd.length, sd.stride, dd.offset, dd.length, dd.stride);
+                else pass(name);
                 free(got);
             }
             glDeleteBuffers(1, &sb);
@@ -864,7 +712,7 @@ int main(int argc, char **argv) {
             sfb_buffer_desc pd, sd, dd;
             sfb_result r;
             snprintf(name, sizeof name, "host/eval_gl/len%d", len);
-            if (!s) { check_fail(name, "no surface"); continue; }
+            if (!s) { fail(name, "no surface"); continue; }
             psrc = (float *)xmalloc((size_t)sources * len * sizeof(float));
             want = (float *)xmalloc((size_t)rows * len * sizeof(float));
             for (k = 0; k < sources * len; ++k) {
@@ -877,7 +725,7 @@ int main(int argc, char **argv) {
                 sfb_surface *rs = NULL;
                 if (sfb_surface_create(ref, mesh, &cfg, &rs) != SFB_SUCCESS ||
                     sfb_surface_eval_stencils(rs, SFB_TABLE_VERTEX, psrc, pd, want, pd) != SFB_SUCCESS)
-                    check_fail(name, "ref: %s", sfb_last_error(ref));
+                    fail(name, "ref: %s", sfb_last_error(ref));
                 sfb_surface_destroy(rs);
             }
             sd.offset = len; sd.length = len; sd.stride = 2 * len + 1;
@@ -887,13 +735,13 @@ int main(int argc, char **argv) {
                 GLuint sb = host_buffer(psrc, sources, len, sd, -1e30f, 3, &sf), db = host_buffer(NULL, rows, len, dd, sentinel(), 7, &df);
                 r = sfb_surface_eval_stencils_gl(s, SFB_TABLE_VERTEX, sb, sd, db, dd);
                 state_diff(&set, msg, sizeof msg);
-                if (r != SFB_SUCCESS) check_fail(name, "sfb_surface_eval_stencils_gl: %s: %s", sfb_result_string(r), sfb_last_error(ctx));
-                else if (msg[0]) check_fail(name, "host state changed: %s", msg);
+                if (r != SFB_SUCCESS) fail(name, "sfb_surface_eval_stencils_gl: %s: %s", sfb_result_string(r), sfb_last_error(ctx));
+                else if (msg[0]) fail(name, "host state changed: %s", msg);
                 else {
                     float *got = host_read(db, df);
                     compare_view(want, rows, len, got, dd, df, TOL_REL * mx, msg, sizeof msg);
-                    if (msg[0]) check_fail(name, "%s (src {%d,%d,%d}, dst {%d,%d,%d})", msg, sd.offset, sd.length, sd.stride, dd.offset, dd.length, dd.stride);
-                    else check_pass(name);
+                    if (msg[0]) fail(name, "%s (src {%d,%d,%d}, dst {%d,%d,%d})", msg, sd.offset, sd.length, sd.stride, dd.offset, dd.length, dd.stride);
+                    else pass(name);
                     free(got);
                 }
                 glDeleteBuffers(1, &sb);
@@ -908,13 +756,13 @@ int main(int argc, char **argv) {
     for (t = 0; t < 5; ++t) {
         char name[64];
         snprintf(name, sizeof name, "host/eval_cpu/%s", table_name(t));
-        if (!s) { check_fail(name, "no surface"); continue; }
-        if (!R.built[t]) { check_skip(name, "table not built for this mesh"); continue; }
+        if (!s) { fail(name, "no surface"); continue; }
+        if (!R.built[t]) { skip(name, "table not built for this mesh"); continue; }
         cpu_eval_check(s, ctx, &R, t, msg, sizeof msg);
-        if (msg[0]) { check_fail(name, "%s", msg); continue; }
+        if (msg[0]) { fail(name, "%s", msg); continue; }
         state_diff(&set, msg, sizeof msg);
-        if (msg[0]) check_fail(name, "host state changed: %s", msg);
-        else check_pass(name);
+        if (msg[0]) fail(name, "host state changed: %s", msg);
+        else pass(name);
     }
 
     /* refusals: a destination too small, a name that is not a buffer */
@@ -943,23 +791,23 @@ int main(int argc, char **argv) {
         state_diff(&set, msg, sizeof msg);
         got = host_read(db, df);
         for (k = 0; k < df && is_sentinel(got[k]); ++k) {}
-        if (r == SFB_SUCCESS) check_fail("host/eval_gl-too-small", "a destination of %d rows for %d rows was accepted", rows - 1, rows);
-        else if (msg[0]) check_fail("host/eval_gl-too-small", "host state after the refusal: %s", msg);
-        else if (k < df) check_fail("host/eval_gl-too-small", "refused (%s) but float %zu of the buffer was written", sfb_result_string(r), k);
-        else check_pass("host/eval_gl-too-small");
+        if (r == SFB_SUCCESS) fail("host/eval_gl-too-small", "a destination of %d rows for %d rows was accepted", rows - 1, rows);
+        else if (msg[0]) fail("host/eval_gl-too-small", "host state after the refusal: %s", msg);
+        else if (k < df) fail("host/eval_gl-too-small", "refused (%s) but float %zu of the buffer was written", sfb_result_string(r), k);
+        else pass("host/eval_gl-too-small");
         if (g_verbose) printf("# too small: %s: %s\n", sfb_result_string(r), sfb_last_error(ctx));
         free(got);
         glDeleteBuffers(1, &db);
         r = sfb_surface_eval_stencils_gl(s, SFB_TABLE_VERTEX, sb, d3, 987654u, d3);
         state_diff(&set, msg, sizeof msg);
-        if (r == SFB_SUCCESS) check_fail("host/eval_gl-not-a-buffer", "buffer name 987654 (never generated) was accepted");
-        else if (msg[0]) check_fail("host/eval_gl-not-a-buffer", "host state after the refusal: %s", msg);
-        else check_pass("host/eval_gl-not-a-buffer");
+        if (r == SFB_SUCCESS) fail("host/eval_gl-not-a-buffer", "buffer name 987654 (never generated) was accepted");
+        else if (msg[0]) fail("host/eval_gl-not-a-buffer", "host state after the refusal: %s", msg);
+        else pass("host/eval_gl-not-a-buffer");
         if (g_verbose) printf("# not a buffer: %s: %s\n", sfb_result_string(r), sfb_last_error(ctx));
         glDeleteBuffers(1, &sb);
     } else {
-        check_fail("host/eval_gl-too-small", "no surface");
-        check_fail("host/eval_gl-not-a-buffer", "no surface");
+        fail("host/eval_gl-too-small", "no surface");
+        fail("host/eval_gl-not-a-buffer", "no surface");
     }
 
     /* the GL-buffer entry on a ref context */
@@ -968,13 +816,13 @@ int main(int argc, char **argv) {
         sfb_buffer_desc d3 = {0, 3, 3};
         sfb_result r;
         if (sfb_surface_create(ref, mesh, &cfg, &rs) != SFB_SUCCESS) {
-            check_fail("host/ref-unsupported", "ref surface: %s", sfb_last_error(ref));
+            fail("host/ref-unsupported", "ref surface: %s", sfb_last_error(ref));
         } else {
             r = sfb_surface_eval_stencils_gl(rs, SFB_TABLE_VERTEX, o.buf[0], d3, o.buf[1], d3);
             state_diff(&set, msg, sizeof msg);
-            if (r != SFB_UNSUPPORTED) check_fail("host/ref-unsupported", "returned %s, want SFB_UNSUPPORTED", sfb_result_string(r));
-            else if (msg[0]) check_fail("host/ref-unsupported", "host state changed: %s", msg);
-            else check_pass("host/ref-unsupported");
+            if (r != SFB_UNSUPPORTED) fail("host/ref-unsupported", "returned %s, want SFB_UNSUPPORTED", sfb_result_string(r));
+            else if (msg[0]) fail("host/ref-unsupported", "host state changed: %s", msg);
+            else pass("host/ref-unsupported");
             sfb_surface_destroy(rs);
         }
     }
@@ -982,10 +830,10 @@ int main(int argc, char **argv) {
     /* another backend context beside the host's */
     beside_host(&h, SFB_BACKEND_GL, &set, ref, msg, sizeof msg);
     if (strncmp(msg, "SKIP:", 5) == 0) {
-        if (g_required) check_fail("host/own-gl-beside-host", "%s", msg + 5);
-        else check_skip("host/own-gl-beside-host", msg + 5);
-    } else if (msg[0]) check_fail("host/own-gl-beside-host", "%s", msg);
-    else check_pass("host/own-gl-beside-host");
+        if (g_required) fail("host/own-gl-beside-host", "%s", msg + 5);
+        else skip("host/own-gl-beside-host", msg + 5);
+    } else if (msg[0]) fail("host/own-gl-beside-host", "%s", msg);
+    else pass("host/own-gl-beside-host");
     run_child_check(argv[0], "host/osmesa-beside-host", "osmesa");
 
     /* one host buffer for both views: control points at the start, refined points after them */
@@ -1002,33 +850,33 @@ int main(int argc, char **argv) {
         dd.offset = 3 * m.nv; dd.length = 3; dd.stride = 3;
         r = sfb_surface_eval_stencils_gl(s, SFB_TABLE_VERTEX, b, sd, b, dd);
         state_diff(&set, msg, sizeof msg);
-        if (r != SFB_SUCCESS) check_fail("host/eval_gl/one-buffer", "sfb_surface_eval_stencils_gl: %s: %s", sfb_result_string(r), sfb_last_error(ctx));
-        else if (msg[0]) check_fail("host/eval_gl/one-buffer", "host state changed: %s", msg);
+        if (r != SFB_SUCCESS) fail("host/eval_gl/one-buffer", "sfb_surface_eval_stencils_gl: %s: %s", sfb_result_string(r), sfb_last_error(ctx));
+        else if (msg[0]) fail("host/eval_gl/one-buffer", "host state changed: %s", msg);
         else {
             float *got = host_read(b, floats);
             for (k = 0; k < 3 * m.nv && got[k] == m.pos[k]; ++k) {}
-            if (k < 3 * m.nv) check_fail("host/eval_gl/one-buffer", "the control points in the source view changed (float %d)", k);
+            if (k < 3 * m.nv) fail("host/eval_gl/one-buffer", "the control points in the source view changed (float %d)", k);
             else {
                 sfb_buffer_desc view = {0, 3, 3};
                 compare_view(R.want[SFB_TABLE_VERTEX], rows, 3, got + 3 * m.nv, view, (size_t)rows * 3, R.tol[SFB_TABLE_VERTEX], msg, sizeof msg);
-                if (msg[0]) check_fail("host/eval_gl/one-buffer", "%s", msg);
-                else check_pass("host/eval_gl/one-buffer");
+                if (msg[0]) fail("host/eval_gl/one-buffer", "%s", msg);
+                else pass("host/eval_gl/one-buffer");
             }
             free(got);
         }
         glDeleteBuffers(1, &b);
         free(packed);
     } else {
-        check_fail("host/eval_gl/one-buffer", "no surface");
+        fail("host/eval_gl/one-buffer", "no surface");
     }
 
     /* teardown with the host's context current */
     sfb_surface_destroy(s);
     if (ctx) sfb_context_destroy(ctx);
     state_diff(&set, msg, sizeof msg);
-    if (eglGetCurrentContext() != h.ctx) check_fail("host/destroy", "the host's context is no longer current");
-    else if (msg[0]) check_fail("host/destroy", "host state changed by sfb_surface_destroy / sfb_context_destroy: %s", msg);
-    else check_pass("host/destroy");
+    if (eglGetCurrentContext() != h.ctx) fail("host/destroy", "the host's context is no longer current");
+    else if (msg[0]) fail("host/destroy", "host state changed by sfb_surface_destroy / sfb_context_destroy: %s", msg);
+    else pass("host/destroy");
 
     /* the engine case on a GLES 3.1 host context */
     gles_check(&h, mesh, &cfg, &R);
@@ -1041,9 +889,6 @@ int main(int argc, char **argv) {
     glDeleteProgram(o.prog);
     glDeleteVertexArrays(1, &o.vao);
     glDeleteBuffers(8, o.buf);
-    eglMakeCurrent(h.dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
-    eglDestroyContext(h.dpy, h.ctx);
-    eglTerminate(h.dpy);
-    printf("%d passed, %d failed, %d skipped\n", g_pass, g_fail, g_skip);
-    return g_fail ? 1 : 0;
+    egl_host_close(&h);
+    return close_tests();
 }

@@ -62,99 +62,25 @@
  */
 #define _POSIX_C_SOURCE 200809L
 #define GL_GLEXT_PROTOTYPES 1
-#include <EGL/egl.h>
-#include <EGL/eglext.h>
 #include <GL/glcorearb.h>
 
 #include "surfblend.h"
+#include "egl_host.h"
+#include "harness.h"
 
 #include <math.h>
-#include <stdarg.h>
-#include <stdio.h>
-#include <stdlib.h>
-#include <string.h>
-#include <time.h>
 
-#ifndef EGL_PLATFORM_SURFACELESS_MESA
-#define EGL_PLATFORM_SURFACELESS_MESA 0x31DD
-#endif
-
-static int g_pass, g_fail, g_skip, g_verbose;
+static int g_verbose;
 /* Normals: tolerance max(1e-3, (K_NORMAL + K_STEP / h) / sin(theta)) (see the file comment). */
 #define K_NORMAL 1e-5
 #define K_STEP 4e-7
 static const char *g_shapes = "../shared/peers/opensubdiv-shapes";
 
-static void check_pass(const char *name) { printf("PASS %s\n", name); fflush(stdout); ++g_pass; }
-static void check_fail(const char *name, const char *fmt, ...)
-#if defined(__GNUC__)
-    __attribute__((format(printf, 2, 3)))
-#endif
-    ;
-static void check_fail(const char *name, const char *fmt, ...) {
-    va_list ap;
-    printf("FAIL %s: ", name);
-    va_start(ap, fmt);
-    vprintf(fmt, ap);
-    va_end(ap);
-    printf("\n");
-    fflush(stdout);
-    ++g_fail;
-}
-static void check_skip(const char *name, const char *why) { printf("SKIP %s: %s\n", name, why); fflush(stdout); ++g_skip; }
-
-/* An unavailable backend: FAIL when SFB_REQUIRE_BACKENDS lists it, else SKIP. */
-static int name_listed(const char *list, const char *name) {
-    size_t n = strlen(name);
-    const char *p = list;
-    while (p && *p) {
-        const char *end = strchr(p, ',');
-        size_t len = end ? (size_t)(end - p) : strlen(p);
-        while (len > 0 && *p == ' ') { ++p; --len; }
-        while (len > 0 && p[len - 1] == ' ') --len;
-        if (len == n && strncmp(p, name, n) == 0) return 1;
-        p = end ? end + 1 : NULL;
-    }
-    return 0;
-}
-static void check_unavailable(const char *name, const char *backend, const char *why) {
-    const char *req = getenv("SFB_REQUIRE_BACKENDS");
-    if (req && name_listed(req, backend)) check_fail(name, "%s unavailable: %s (required by SFB_REQUIRE_BACKENDS)", backend, why);
-    else {
-        char w[700];
-        snprintf(w, sizeof w, "%s unavailable: %s", backend, why);
-        check_skip(name, w);
-    }
-}
-
-static void *xmalloc(size_t n) {
-    void *p = malloc(n ? n : 1);
-    if (!p) { fprintf(stderr, "gl_manifold: out of memory\n"); exit(2); }
-    return p;
-}
-
-static char *read_file(const char *path, size_t *size) {
-    FILE *f = fopen(path, "rb");
-    char *buf;
-    long n;
-    if (!f) return NULL;
-    if (fseek(f, 0, SEEK_END) != 0 || (n = ftell(f)) < 0 || fseek(f, 0, SEEK_SET) != 0) { fclose(f); return NULL; }
-    buf = (char *)xmalloc((size_t)n + 1);
-    if (fread(buf, 1, (size_t)n, f) != (size_t)n) { fclose(f); free(buf); return NULL; }
-    fclose(f);
-    *size = (size_t)n;
-    return buf;
-}
-
-static sfb_context *make_context(sfb_backend_kind kind, int use_current) {
+/* A context on `kind` alone; use_current: the gl backend on the current (host's) context. */
+static sfb_context *gl_context(sfb_backend_kind kind, int use_current) {
     sfb_context_config cfg = sfb_context_config_init();
-    sfb_context *ctx = NULL;
-    cfg.backends = &kind;
-    cfg.backend_count = 1;
-    cfg.ignore_environment = 1;
     cfg.gl_use_current_context = use_current;
-    if (sfb_context_create(&cfg, &ctx) != SFB_SUCCESS) return NULL;
-    return ctx;
+    return make_context_with(cfg, kind);
 }
 
 /* ---- shapes ---- */
@@ -172,7 +98,7 @@ static int shape_load(shape *s, const char *name) {
     memset(s, 0, sizeof *s);
     s->name = name;
     snprintf(path, sizeof path, "%s/%s.obj", g_shapes, name);
-    s->text = read_file(path, &s->size);
+    s->text = slurp(path, &s->size);
     return s->text != NULL;
 }
 
@@ -417,7 +343,7 @@ static void compute_checks(sfb_context *ref) {
         const char *bname = sfb_backend_kind_name(kinds[b]);
         char probe[512];
         sfb_context *ctx = NULL;
-        if (sfb_backend_probe(kinds[b], NULL, probe, sizeof probe) == SFB_SUCCESS) ctx = make_context(kinds[b], 0);
+        if (sfb_backend_probe(kinds[b], NULL, probe, sizeof probe) == SFB_SUCCESS) ctx = gl_context(kinds[b], 0);
         for (k = 0; k_compute_shapes[k]; ++k)
             for (w = 0; w < 2; ++w) {
                 char name[160], msg[1200];
@@ -429,8 +355,8 @@ static void compute_checks(sfb_context *ref) {
                 double worst[6], move[3];
                 int n, second, i, skipped = 0;
                 snprintf(name, sizeof name, "compute/%s/%s/%s", bname, k_compute_shapes[k], w ? "cinf" : "hermite");
-                if (!ctx) { check_unavailable(name, bname, probe); continue; }
-                if (!shape_load(&sh, k_compute_shapes[k])) { check_skip(name, "peer shape not found (pass SHAPES_DIR)"); continue; }
+                if (!ctx) { backend_unavailable(name, bname, probe); continue; }
+                if (!shape_load(&sh, k_compute_shapes[k])) { skip(name, "peer shape not found (pass SHAPES_DIR)"); continue; }
                 mr = shape_mesh(ref, &sh);
                 mg = shape_mesh(ctx, &sh);
                 move[0] = 0.78 * sh.diag; move[1] = -0.624 * sh.diag; move[2] = 0.832 * sh.diag;
@@ -441,7 +367,7 @@ static void compute_checks(sfb_context *ref) {
                 srt = mrt ? manifold_surface(ref, mrt, w) : NULL;
                 sgt = mgt ? manifold_surface(ctx, mgt, w) : NULL;
                 if (!sr || !sg || !srt || !sgt) {
-                    check_fail(name, "building the surfaces: ref: %s; %s: %s", sr && srt ? "ok" : sfb_last_error(ref), bname,
+                    fail(name, "building the surfaces: ref: %s; %s: %s", sr && srt ? "ok" : sfb_last_error(ref), bname,
                                sg && sgt ? "ok" : sfb_last_error(ctx));
                 } else {
                     loc = sample_locations(sr, &sh, &n, 1234u + (unsigned)k);
@@ -452,9 +378,9 @@ static void compute_checks(sfb_context *ref) {
                     evals_alloc(&RT, n, 0);
                     evals_alloc(&GT, n, 0);
                     if (evals_run(sr, loc, n, &R) != SFB_SUCCESS || evals_run(srt, loc, n, &RT) != SFB_SUCCESS)
-                        check_fail(name, "ref eval: %s", sfb_last_error(ref));
+                        fail(name, "ref eval: %s", sfb_last_error(ref));
                     else if (evals_run(sg, loc, n, &G) != SFB_SUCCESS || evals_run(sgt, loc, n, &GT) != SFB_SUCCESS)
-                        check_fail(name, "%s eval: %s", bname, sfb_last_error(ctx));
+                        fail(name, "%s eval: %s", bname, sfb_last_error(ctx));
                     else {
                         ncond *nc = normal_conditions(sr, &sh, loc, &R, n, w);
                         msg[0] = 0;
@@ -469,13 +395,13 @@ static void compute_checks(sfb_context *ref) {
                                          GT.n[3 * i + 1], GT.n[3 * i + 2]);
                         }
                         if (!msg[0]) compare_evals(&sh, loc, &R, &G, nc, n, second, msg, sizeof msg, worst);
-                        if (msg[0]) check_fail(name, "%s", msg);
+                        if (msg[0]) fail(name, "%s", msg);
                         else {
                             printf("# %s: %d samples, worst position %.2g x diag, derivative %.2g x tol, normal %.2g rad (x sin(theta): %.2g, "
                                    "at ref's steps %.2g, %.2g)%s",
                                    name, n, worst[0], worst[1], worst[2], worst[3], worst[4], worst[5], skipped ? "" : "\n");
                             if (skipped) printf("; %d normals at ref's C-infinity 1e-2 step not compared\n", skipped);
-                            check_pass(name);
+                            pass(name);
                         }
                         free(nc);
                     }
@@ -493,81 +419,17 @@ static void compute_checks(sfb_context *ref) {
 /* ---- the host ---- */
 
 typedef struct host {
-    EGLDisplay dpy;
-    EGLContext ctx;
-    char renderer[256];
+    egl_host e; /* tests/egl_host.h */
     GLuint fbo, color, depth;
 } host;
-
-static int has_word(const char *list, const char *word) {
-    size_t n = strlen(word);
-    const char *p = list;
-    if (!list) return 0;
-    while ((p = strstr(p, word)) != NULL) {
-        if ((p == list || p[-1] == ' ') && (p[n] == ' ' || p[n] == 0)) return 1;
-        p += n;
-    }
-    return 0;
-}
 
 enum { FB_SIZE = 512 };
 
 /* Makes a desktop OpenGL 4.3 core context current with no surface, and a 512 x 512 RGBA8 +
  * depth framebuffer object bound for drawing. 0 + why on failure. */
 static int host_create(host *h, char *why, size_t wn) {
-    const char *client = eglQueryString(EGL_NO_DISPLAY, EGL_EXTENSIONS);
-    EGLint major = 0, minor = 0, n = 0;
-    EGLConfig config = EGL_NO_CONFIG_KHR;
-    const char *ext, *version;
-    static const EGLint ctx_attrs[] = {EGL_CONTEXT_MAJOR_VERSION, 4, EGL_CONTEXT_MINOR_VERSION, 3,
-                                       EGL_CONTEXT_OPENGL_PROFILE_MASK, EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT, EGL_NONE};
-    int gmaj = 0, gmin = 0;
     memset(h, 0, sizeof *h);
-    h->dpy = EGL_NO_DISPLAY;
-    if (has_word(client, "EGL_MESA_platform_surfaceless")) {
-        PFNEGLGETPLATFORMDISPLAYEXTPROC gpd = (PFNEGLGETPLATFORMDISPLAYEXTPROC)eglGetProcAddress("eglGetPlatformDisplayEXT");
-        if (gpd) h->dpy = gpd(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, NULL);
-        if (h->dpy != EGL_NO_DISPLAY && !eglInitialize(h->dpy, &major, &minor)) h->dpy = EGL_NO_DISPLAY;
-    }
-    if (h->dpy == EGL_NO_DISPLAY) {
-        h->dpy = eglGetDisplay(EGL_DEFAULT_DISPLAY);
-        if (h->dpy == EGL_NO_DISPLAY || !eglInitialize(h->dpy, &major, &minor)) {
-            snprintf(why, wn, "no EGL display (surfaceless platform or default display; EGL error 0x%x)", (unsigned)eglGetError());
-            h->dpy = EGL_NO_DISPLAY;
-            return 0;
-        }
-    }
-    ext = eglQueryString(h->dpy, EGL_EXTENSIONS);
-    if (!has_word(ext, "EGL_KHR_surfaceless_context")) {
-        snprintf(why, wn, "EGL %d.%d display lacks EGL_KHR_surfaceless_context", major, minor);
-        return 0;
-    }
-    if (!eglBindAPI(EGL_OPENGL_API)) {
-        snprintf(why, wn, "eglBindAPI(EGL_OPENGL_API) failed: no desktop OpenGL through EGL here");
-        return 0;
-    }
-    if (!has_word(ext, "EGL_KHR_no_config_context") && !has_word(ext, "EGL_MESA_configless_context")) {
-        static const EGLint cfg_attrs[] = {EGL_RENDERABLE_TYPE, EGL_OPENGL_BIT, EGL_NONE};
-        if (!eglChooseConfig(h->dpy, cfg_attrs, &config, 1, &n) || n < 1) {
-            snprintf(why, wn, "no EGL config with EGL_OPENGL_BIT");
-            return 0;
-        }
-    }
-    h->ctx = eglCreateContext(h->dpy, config, EGL_NO_CONTEXT, ctx_attrs);
-    if (h->ctx == EGL_NO_CONTEXT) {
-        snprintf(why, wn, "no OpenGL 4.3 core context (eglCreateContext: EGL error 0x%x)", (unsigned)eglGetError());
-        return 0;
-    }
-    if (!eglMakeCurrent(h->dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, h->ctx)) {
-        snprintf(why, wn, "eglMakeCurrent failed (EGL error 0x%x)", (unsigned)eglGetError());
-        return 0;
-    }
-    version = (const char *)glGetString(GL_VERSION);
-    if (!version || sscanf(version, "%d.%d", &gmaj, &gmin) != 2 || gmaj * 10 + gmin < 43) {
-        snprintf(why, wn, "OpenGL version %s is below 4.3", version ? version : "(none)");
-        return 0;
-    }
-    snprintf(h->renderer, sizeof h->renderer, "OpenGL %s; %s", version, (const char *)glGetString(GL_RENDERER));
+    if (!egl_host_open(&h->e, 4, 3, why, wn)) return 0;
     glGenFramebuffers(1, &h->fbo);
     glGenRenderbuffers(1, &h->color);
     glGenRenderbuffers(1, &h->depth);
@@ -817,7 +679,7 @@ static void capture_check(const char *name, sfb_context *ctx, sfb_context *ref, 
     sfb_result r;
     shape sh;
     if (!sg || !sr) {
-        check_fail(name, "building the surfaces: %s / %s", sg ? "ok" : sfb_last_error(ctx), sr ? "ok" : sfb_last_error(ref));
+        fail(name, "building the surfaces: %s / %s", sg ? "ok" : sfb_last_error(ctx), sr ? "ok" : sfb_last_error(ref));
         sfb_surface_destroy(sg); sfb_surface_destroy(sr);
         return;
     }
@@ -833,7 +695,7 @@ static void capture_check(const char *name, sfb_context *ctx, sfb_context *ref, 
     clear_fb();
     r = sfb_surface_draw_gl(sg, &p);
     if (r != SFB_SUCCESS) {
-        check_fail(name, "sfb_surface_draw_gl: %s: %s", sfb_result_string(r), sfb_last_error(ctx));
+        fail(name, "sfb_surface_draw_gl: %s: %s", sfb_result_string(r), sfb_last_error(ctx));
         glDeleteBuffers(1, &buf);
         sfb_surface_destroy(sg); sfb_surface_destroy(sr);
         return;
@@ -890,8 +752,8 @@ static void capture_check(const char *name, sfb_context *ctx, sfb_context *ref, 
         free(nc);
         if (!msg[0]) printf("# %s: %d samples (%d hole faces), worst position %.2g x diag, normal %.2g rad\n", name, q, holes, wp, wn);
     }
-    if (msg[0]) check_fail(name, "%s", msg);
-    else check_pass(name);
+    if (msg[0]) fail(name, "%s", msg);
+    else pass(name);
     evals_free(&R);
     free(loc);
     free(cap);
@@ -900,14 +762,8 @@ static void capture_check(const char *name, sfb_context *ctx, sfb_context *ref, 
 }
 
 static void expect(const char *name, sfb_result got, sfb_result want, sfb_context *ctx) {
-    if (got == want) check_pass(name);
-    else check_fail(name, "returned %s (%s), documented: %s", sfb_result_string(got), sfb_last_error(ctx), sfb_result_string(want));
-}
-
-static double now_s(void) {
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+    if (got == want) pass(name);
+    else fail(name, "returned %s (%s), documented: %s", sfb_result_string(got), sfb_last_error(ctx), sfb_result_string(want));
 }
 
 /* Frames per second of one surface at rate 29 (30 x 30 samples per face). */
@@ -942,32 +798,15 @@ static void bench_one(const char *label, sfb_context *ctx, const sfb_mesh *m) {
  * "#version 310 es" variants, compiled by the driver at run time): sfb_surface_eval and the
  * captured samples of a C-infinity torus against ref, and a render that covers pixels. */
 static void gles_check(const host *h, sfb_context *ref) {
-    static const EGLint attrs[] = {EGL_CONTEXT_MAJOR_VERSION, 3, EGL_CONTEXT_MINOR_VERSION, 1, EGL_NONE};
-    const char *ext = eglQueryString(h->dpy, EGL_EXTENSIONS);
-    EGLConfig config = EGL_NO_CONFIG_KHR;
     EGLContext es;
-    EGLint n = 0;
     sfb_context *ctx = NULL;
     sfb_mesh *mg = NULL, *mr = NULL;
     sfb_surface *sg = NULL, *sr = NULL;
     char msg[1200] = "";
     GLuint fbo = 0, rb[2] = {0, 0}, cap = 0;
     const int rate = 6, per = (rate + 1) * (rate + 1);
-    if (!eglBindAPI(EGL_OPENGL_ES_API)) {
-        eglBindAPI(EGL_OPENGL_API);
-        check_skip("draw/gles31", "this EGL has no OpenGL ES API");
-        return;
-    }
-    if (!has_word(ext, "EGL_KHR_no_config_context") && !has_word(ext, "EGL_MESA_configless_context")) {
-        static const EGLint ca[] = {EGL_RENDERABLE_TYPE, EGL_OPENGL_ES3_BIT, EGL_NONE};
-        if (!eglChooseConfig(h->dpy, ca, &config, 1, &n) || n < 1) config = NULL;
-    }
-    es = config || n == 0 ? eglCreateContext(h->dpy, config, EGL_NO_CONTEXT, attrs) : EGL_NO_CONTEXT;
-    if (es == EGL_NO_CONTEXT || !eglMakeCurrent(h->dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, es)) {
-        if (es != EGL_NO_CONTEXT) eglDestroyContext(h->dpy, es);
-        eglBindAPI(EGL_OPENGL_API);
-        eglMakeCurrent(h->dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, h->ctx);
-        check_skip("draw/gles31", "no OpenGL ES 3.1 context through EGL here");
+    if ((es = egl_host_gles_begin(&h->e, 3, 1, msg, sizeof msg)) == EGL_NO_CONTEXT) {
+        skip("draw/gles31", msg);
         return;
     }
     glGenFramebuffers(1, &fbo);
@@ -980,7 +819,7 @@ static void gles_check(const host *h, sfb_context *ref) {
     glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, rb[0]);
     glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, rb[1]);
     glViewport(0, 0, FB_SIZE, FB_SIZE);
-    ctx = make_context(SFB_BACKEND_GL, 1);
+    ctx = gl_context(SFB_BACKEND_GL, 1);
     if (!ctx) snprintf(msg, sizeof msg, "no gl backend on a GLES 3.1 host context");
     if (!msg[0]) {
         char info[512];
@@ -1062,12 +901,9 @@ static void gles_check(const host *h, sfb_context *ref) {
     if (ctx) sfb_context_destroy(ctx);
     glDeleteFramebuffers(1, &fbo);
     glDeleteRenderbuffers(2, rb);
-    eglMakeCurrent(h->dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
-    eglDestroyContext(h->dpy, es);
-    eglBindAPI(EGL_OPENGL_API);
-    eglMakeCurrent(h->dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, h->ctx);
-    if (msg[0]) check_fail("draw/gles31", "%s", msg);
-    else check_pass("draw/gles31");
+    egl_host_gles_end(&h->e, es);
+    if (msg[0]) fail("draw/gles31", "%s", msg);
+    else pass("draw/gles31");
 }
 
 static const char *const k_draw_checks[] = {"draw/capture/catmark_torus", "draw/capture/catmark_pyramid", "draw/capture/catmark_cube_creases1",
@@ -1089,13 +925,13 @@ static void draw_checks(sfb_context *ref, int bench) {
     sfb_context_config pc = sfb_context_config_init();
     int k, full = 0;
     if (!host_create(&h, why, sizeof why)) {
-        for (k = 0; k_draw_checks[k]; ++k) check_unavailable(k_draw_checks[k], "gl", why);
+        for (k = 0; k_draw_checks[k]; ++k) backend_unavailable(k_draw_checks[k], "gl", why);
         return;
     }
-    printf("# host context: %s\n", h.renderer);
+    printf("# host context: %s\n", h.e.renderer);
     pc.gl_use_current_context = 1;
-    if (sfb_backend_probe(SFB_BACKEND_GL, &pc, probe, sizeof probe) != SFB_SUCCESS || !(ctx = make_context(SFB_BACKEND_GL, 1))) {
-        for (k = 0; k_draw_checks[k]; ++k) check_unavailable(k_draw_checks[k], "gl", probe);
+    if (sfb_backend_probe(SFB_BACKEND_GL, &pc, probe, sizeof probe) != SFB_SUCCESS || !(ctx = gl_context(SFB_BACKEND_GL, 1))) {
+        for (k = 0; k_draw_checks[k]; ++k) backend_unavailable(k_draw_checks[k], "gl", probe);
         return;
     }
     host_set_state(&o, &set);
@@ -1109,24 +945,24 @@ static void draw_checks(sfb_context *ref, int bench) {
             shape sh;
             sfb_mesh *mg, *mr;
             snprintf(name, sizeof name, "draw/capture/%s", names[k]);
-            if (!shape_load(&sh, names[k])) { check_skip(name, "peer shape not found (pass SHAPES_DIR)"); continue; }
+            if (!shape_load(&sh, names[k])) { skip(name, "peer shape not found (pass SHAPES_DIR)"); continue; }
             mg = shape_mesh(ctx, &sh);
             mr = shape_mesh(ref, &sh);
-            if (!mg || !mr) check_fail(name, "reading the shape: %s", sfb_last_error(mg ? ref : ctx));
+            if (!mg || !mr) fail(name, "reading the shape: %s", sfb_last_error(mg ? ref : ctx));
             else capture_check(name, ctx, ref, mg, mr, sh.diag, sh.nonquads, k & 1, 7 + k);
             sfb_mesh_destroy(mg); sfb_mesh_destroy(mr);
             free(sh.text);
         }
         grid = grid_mesh(ctx, 5, 5);
         gridr = grid_mesh(ref, 5, 5);
-        if (!grid || !gridr) check_fail("draw/capture/grid-cinf", "grid mesh: %s", sfb_last_error(ctx));
+        if (!grid || !gridr) fail("draw/capture/grid-cinf", "grid mesh: %s", sfb_last_error(ctx));
         else capture_check("draw/capture/grid-cinf", ctx, ref, grid, gridr, 2.0 * sqrt(2.0), 0, 1, 12);
     }
 
     /* pixels and trimming on the bumped grid, seen from the front */
     gs = grid ? manifold_surface(ctx, grid, SFB_MANIFOLD_WEIGHTS_HERMITE) : NULL;
     if (!gs) {
-        for (k = 5; k < 10; ++k) check_fail(k_draw_checks[k], "no grid surface: %s", sfb_last_error(ctx));
+        for (k = 5; k < 10; ++k) fail(k_draw_checks[k], "no grid surface: %s", sfb_last_error(ctx));
     } else {
         static const float lo[3] = {-1.0f, -1.0f, -0.2f}, hi[3] = {1.0f, 1.0f, 0.2f};
         sfb_gl_draw_params p = sfb_gl_draw_params_init();
@@ -1150,35 +986,35 @@ static void draw_checks(sfb_context *ref, int bench) {
         full = covered_pixels();
         state_diff(&set, msg, sizeof msg);
         if (r1 != SFB_SUCCESS || r2 != SFB_SUCCESS || r3 != SFB_SUCCESS || r != SFB_SUCCESS)
-            check_fail("draw/state", "sfb_gl_trim_texture %s %s %s, sfb_surface_draw_gl %s: %s", sfb_result_string(r1), sfb_result_string(r2),
+            fail("draw/state", "sfb_gl_trim_texture %s %s %s, sfb_surface_draw_gl %s: %s", sfb_result_string(r1), sfb_result_string(r2),
                        sfb_result_string(r3), sfb_result_string(r), sfb_last_error(ctx));
-        else if (msg[0]) check_fail("draw/state", "host state changed: %s", msg);
-        else check_pass("draw/state");
+        else if (msg[0]) fail("draw/state", "host state changed: %s", msg);
+        else pass("draw/state");
         if (r == SFB_SUCCESS && full > FB_SIZE * FB_SIZE / 4) {
             printf("# draw/pixels: the untrimmed grid covers %d of %d pixels\n", full, FB_SIZE * FB_SIZE);
-            check_pass("draw/pixels");
+            pass("draw/pixels");
         } else {
-            check_fail("draw/pixels", "the untrimmed grid covers %d of %d pixels (%s)", full, FB_SIZE * FB_SIZE, sfb_last_error(ctx));
+            fail("draw/pixels", "the untrimmed grid covers %d of %d pixels (%s)", full, FB_SIZE * FB_SIZE, sfb_last_error(ctx));
         }
         p.trim_texture = th;
         clear_fb();
         r = sfb_surface_draw_gl(gs, &p);
         half_px = covered_pixels();
-        if (r != SFB_SUCCESS) check_fail("draw/trim-half", "%s: %s", sfb_result_string(r), sfb_last_error(ctx));
+        if (r != SFB_SUCCESS) fail("draw/trim-half", "%s: %s", sfb_result_string(r), sfb_last_error(ctx));
         else if (!(full > 0 && fabs((double)half_px / full - 0.5) <= 0.05))
-            check_fail("draw/trim-half", "%d pixels trimmed against %d untrimmed (ratio %.3f, wanted 0.5 within 10%%)", half_px, full,
+            fail("draw/trim-half", "%d pixels trimmed against %d untrimmed (ratio %.3f, wanted 0.5 within 10%%)", half_px, full,
                        full ? (double)half_px / full : 0.0);
         else {
             printf("# draw/trim-half: %d of %d pixels (ratio %.4f)\n", half_px, full, (double)half_px / full);
-            check_pass("draw/trim-half");
+            pass("draw/trim-half");
         }
         p.trim_texture = tb;
         clear_fb();
         r = sfb_surface_draw_gl(gs, &p);
         black_px = covered_pixels();
-        if (r != SFB_SUCCESS) check_fail("draw/trim-black", "%s: %s", sfb_result_string(r), sfb_last_error(ctx));
-        else if (black_px != 0) check_fail("draw/trim-black", "an all-black mask left %d pixels", black_px);
-        else check_pass("draw/trim-black");
+        if (r != SFB_SUCCESS) fail("draw/trim-black", "%s: %s", sfb_result_string(r), sfb_last_error(ctx));
+        else if (black_px != 0) fail("draw/trim-black", "an all-black mask left %d pixels", black_px);
+        else pass("draw/trim-black");
         /* atlas: face 0 trimmed, face 1 kept, faces 2.. untrimmed = all minus face 0 */
         p.trim_texture = 0;
         p.first_face = 0;
@@ -1194,15 +1030,15 @@ static void draw_checks(sfb_context *ref, int bench) {
         clear_fb();
         if (r == SFB_SUCCESS) r = sfb_surface_draw_gl(gs, &p);
         atlas_px = covered_pixels();
-        if (r != SFB_SUCCESS) check_fail("draw/trim-atlas", "%s: %s", sfb_result_string(r), sfb_last_error(ctx));
+        if (r != SFB_SUCCESS) fail("draw/trim-atlas", "%s: %s", sfb_result_string(r), sfb_last_error(ctx));
         else if (!(face0_px > 0 && abs(atlas_px - (full - face0_px)) <= full / 100))
-            check_fail("draw/trim-atlas", "%d pixels with the atlas; untrimmed %d, face 0 alone %d: wanted %d", atlas_px, full, face0_px,
+            fail("draw/trim-atlas", "%d pixels with the atlas; untrimmed %d, face 0 alone %d: wanted %d", atlas_px, full, face0_px,
                        full - face0_px);
-        else check_pass("draw/trim-atlas");
+        else pass("draw/trim-atlas");
 
         /* errors */
         {
-            sfb_context *rc = make_context(SFB_BACKEND_REF, 0), *oc = NULL, *mc = NULL;
+            sfb_context *rc = gl_context(SFB_BACKEND_REF, 0), *oc = NULL, *mc = NULL;
             sfb_surface *cs = NULL, *rs = NULL, *os = NULL, *ms = NULL;
             sfb_surface_config cc = sfb_surface_config_init(SFB_SCHEME_CATMARK, 0);
             sfb_gl_draw_params e = sfb_gl_draw_params_init();
@@ -1218,24 +1054,24 @@ static void draw_checks(sfb_context *ref, int bench) {
             rs = m2 ? manifold_surface(rc, m2, 0) : NULL;
             expect("errors/ref-context", rs ? sfb_surface_draw_gl(rs, &e) : SFB_INVALID_ARGS, SFB_UNSUPPORTED, rc);
             sfb_surface_destroy(rs); sfb_mesh_destroy(m2); m2 = NULL;
-            if (sfb_backend_probe(SFB_BACKEND_GL, NULL, probe, sizeof probe) == SFB_SUCCESS && (oc = make_context(SFB_BACKEND_GL, 0)) != NULL) {
+            if (sfb_backend_probe(SFB_BACKEND_GL, NULL, probe, sizeof probe) == SFB_SUCCESS && (oc = gl_context(SFB_BACKEND_GL, 0)) != NULL) {
                 m2 = grid_mesh(oc, 2, 2);
                 os = m2 ? manifold_surface(oc, m2, 0) : NULL;
                 expect("errors/own-gl-context", os ? sfb_surface_draw_gl(os, &e) : SFB_INVALID_ARGS, SFB_UNSUPPORTED, oc);
                 sfb_surface_destroy(os); sfb_mesh_destroy(m2); m2 = NULL;
             } else {
-                check_unavailable("errors/own-gl-context", "gl", probe);
+                backend_unavailable("errors/own-gl-context", "gl", probe);
             }
-            if (sfb_backend_probe(SFB_BACKEND_OSMESA, NULL, probe, sizeof probe) == SFB_SUCCESS && (mc = make_context(SFB_BACKEND_OSMESA, 0)) != NULL) {
+            if (sfb_backend_probe(SFB_BACKEND_OSMESA, NULL, probe, sizeof probe) == SFB_SUCCESS && (mc = gl_context(SFB_BACKEND_OSMESA, 0)) != NULL) {
                 m2 = grid_mesh(mc, 2, 2);
                 ms = m2 ? manifold_surface(mc, m2, 0) : NULL;
                 expect("errors/osmesa-context", ms ? sfb_surface_draw_gl(ms, &e) : SFB_INVALID_ARGS, SFB_UNSUPPORTED, mc);
                 sfb_surface_destroy(ms); sfb_mesh_destroy(m2); m2 = NULL;
             } else {
-                check_unavailable("errors/osmesa-context", "osmesa", probe);
+                backend_unavailable("errors/osmesa-context", "osmesa", probe);
             }
             /* the own-context contexts above made their contexts current in between: ours again */
-            eglMakeCurrent(h.dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, h.ctx);
+            eglMakeCurrent(h.e.dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, h.e.ctx);
             e.rate = -1;
             expect("errors/rate-negative", sfb_surface_draw_gl(gs, &e), SFB_INVALID_ARGS, ctx);
             e.rate = 1025;
@@ -1281,13 +1117,13 @@ static void draw_checks(sfb_context *ref, int bench) {
             if (r == SFB_INVALID_VALUE && rc) r = sfb_gl_trim_texture(rc, &mh, &junk) == SFB_UNSUPPORTED ? SFB_INVALID_VALUE : SFB_SUCCESS;
             expect("errors/trim-texture-mask", junk == 0 ? r : SFB_SUCCESS, SFB_INVALID_VALUE, ctx);
             state_diff(&set, msg, sizeof msg);
-            if (msg[0]) check_fail("errors/state", "host state changed by the failing calls: %s", msg);
-            else check_pass("errors/state");
+            if (msg[0]) fail("errors/state", "host state changed by the failing calls: %s", msg);
+            else pass("errors/state");
             sfb_surface_destroy(cs);
             sfb_context_destroy(oc);
             sfb_context_destroy(mc);
             sfb_context_destroy(rc);
-            eglMakeCurrent(h.dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, h.ctx);
+            eglMakeCurrent(h.e.dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, h.e.ctx);
         }
         glDeleteTextures(1, &th);
         glDeleteTextures(1, &tb);
@@ -1321,8 +1157,8 @@ static void draw_checks(sfb_context *ref, int bench) {
     sfb_mesh_destroy(gridr);
     sfb_context_destroy(ctx);
     state_diff(&set, msg, sizeof msg);
-    if (msg[0]) check_fail("draw/destroy", "host state changed by sfb_context_destroy: %s", msg);
-    else check_pass("draw/destroy");
+    if (msg[0]) fail("draw/destroy", "host state changed by sfb_context_destroy: %s", msg);
+    else pass("draw/destroy");
 }
 
 int main(int argc, char **argv) {
@@ -1335,15 +1171,13 @@ int main(int argc, char **argv) {
         else if (strcmp(argv[i], "--bench") == 0) bench = 1;
         else g_shapes = argv[i];
     }
-    ref = make_context(SFB_BACKEND_REF, 0);
+    ref = gl_context(SFB_BACKEND_REF, 0);
     if (!ref) {
-        check_fail("setup", "no ref context");
-        printf("%d passed, %d failed, %d skipped\n", g_pass, g_fail, g_skip);
-        return 1;
+        fail("setup", "no ref context");
+        return close_tests();
     }
     compute_checks(ref);
     draw_checks(ref, bench);
     sfb_context_destroy(ref);
-    printf("%d passed, %d failed, %d skipped\n", g_pass, g_fail, g_skip);
-    return g_fail ? 1 : 0;
+    return close_tests();
 }

@@ -2,19 +2,16 @@
  * shader-storage block limit (8 KiB) and 2 work groups per dispatch, so a level-3 table is cut
  * into several pieces and each piece into several dispatches. gl and osmesa must still agree with
  * ref, and a buffer over the limit must come back as SFB_LIMIT_EXCEEDED with the sizes named.
- * Prints PASS/FAIL/SKIP lines and "N passed, N failed, N skipped". */
+ * Prints PASS/FAIL/SKIP lines and "N passed, N failed, N skipped" (tests/harness.h). */
 #define SURFBLEND_IMPLEMENTATION
 #define SURFBLEND_GL
 #define SURFBLEND_OSMESA
 #define SFB__GL_TEST_MAX_BLOCK 8192
 #define SFB__GL_TEST_MAX_GROUPS 2
 #include "surfblend.h"
-#include <stdio.h>
-#include <stdlib.h>
-#include <string.h>
+#include "harness.h"
 #include <math.h>
 
-static int passed, failed, skipped;
 static int last_entries; /* entries of the last VERTEX table built */
 
 /* a cube with semi-sharp top edges and a corner */
@@ -64,50 +61,46 @@ static sfb_result run(sfb_backend_kind kind, int level, float **out, int *rows, 
 
 int main(void) {
     static const sfb_backend_kind kinds[2] = {SFB_BACKEND_GL, SFB_BACKEND_OSMESA};
-    const char *req = getenv("SFB_REQUIRE_BACKENDS");
     float *ref = NULL, *got = NULL;
     int ref_rows = 0, rows = 0, k, i;
-    char err[1024], info[512];
+    char err[1024], info[512], name3[96], name4[96];
     if (run(SFB_BACKEND_REF, 3, &ref, &ref_rows, err, sizeof err) != SFB_SUCCESS) {
-        printf("FAIL ref refinement: %s\n0 passed, 1 failed, 0 skipped\n", err);
-        return 1;
+        fail("ref refinement", "%s", err);
+        return close_tests();
     }
     /* the point of the test: the table must need more than one piece of 2048 entries */
-    if (last_entries > 2048) { printf("PASS level-3 table has %d entries: at least 2 pieces\n", last_entries); ++passed; }
-    else { printf("FAIL level-3 table has only %d entries: no split to test\n", last_entries); ++failed; }
+    snprintf(name3, sizeof name3, "level-3 table has %d entries", last_entries);
+    check(last_entries > 2048, name3, "no split to test (at most 2048: one piece)");
     for (k = 0; k < 2; ++k) {
         const char *name = sfb_backend_kind_name(kinds[k]);
         sfb_result r;
         double worst = 0;
+        snprintf(name3, sizeof name3, "%s level 3 in pieces", name);
+        snprintf(name4, sizeof name4, "%s buffer over the block limit", name);
         if (sfb_backend_probe(kinds[k], NULL, info, sizeof info) != SFB_SUCCESS) {
-            if (req && strstr(req, name)) { printf("FAIL %s required but unavailable: %s\n", name, info); ++failed; }
-            else { printf("SKIP %s: %s\n", name, info); skipped += 2; }
+            char why[600];
+            snprintf(why, sizeof why, "%s unavailable: %s", name, info);
+            unavailable(name3, backend_required(name), why);
+            unavailable(name4, backend_required(name), why);
             continue;
         }
         /* level 3: 386 rows in several pieces of at most 2048 entries, 128 rows per dispatch */
         r = run(kinds[k], 3, &got, &rows, err, sizeof err);
         if (r != SFB_SUCCESS || rows != ref_rows) {
-            printf("FAIL %s level 3 in pieces: %s (%s)\n", name, sfb_result_string(r), err);
-            ++failed;
+            fail(name3, "%s (%s)", sfb_result_string(r), err);
         } else {
             for (i = 0; i < rows * 6; ++i) if (fabs((double)got[i] - ref[i]) > worst) worst = fabs((double)got[i] - ref[i]);
             /* tolerance: 1e-5 x the cube's diagonal (2 sqrt 3) */
-            if (worst <= 1e-5 * 3.4641) { printf("PASS %s level 3 in pieces agrees with ref (max %.3g)\n", name, worst); ++passed; }
-            else { printf("FAIL %s level 3 in pieces differs from ref by %.3g\n", name, worst); ++failed; }
+            printf("# %s agrees with ref to %.3g\n", name3, worst);
+            check(worst <= 1e-5 * 3.4641, name3, "differs from ref by %.3g", worst);
         }
         free(got);
         /* level 4: 1538 rows x 12 bytes of results is over the 8 KiB block */
         r = run(kinds[k], 4, &got, &rows, err, sizeof err);
-        if (r == SFB_LIMIT_EXCEEDED && strstr(err, "GL_MAX_SHADER_STORAGE_BLOCK_SIZE")) {
-            printf("PASS %s buffer over the block limit is refused: %s\n", name, err);
-            ++passed;
-        } else {
-            printf("FAIL %s buffer over the block limit: %s (%s)\n", name, sfb_result_string(r), err);
-            ++failed;
-        }
+        if (r == SFB_LIMIT_EXCEEDED && strstr(err, "GL_MAX_SHADER_STORAGE_BLOCK_SIZE")) printf("# %s is refused: %s\n", name4, err);
+        check(r == SFB_LIMIT_EXCEEDED && strstr(err, "GL_MAX_SHADER_STORAGE_BLOCK_SIZE") != NULL, name4, "%s (%s)", sfb_result_string(r), err);
         free(got);
     }
     free(ref);
-    printf("%d passed, %d failed, %d skipped\n", passed, failed, skipped);
-    return failed ? 1 : 0;
+    return close_tests();
 }

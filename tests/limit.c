@@ -68,33 +68,11 @@
 #define _POSIX_C_SOURCE 200809L
 #include "surfblend.h"
 
-#include <dirent.h>
+#include "harness.h"
+
 #include <math.h>
-#include <stdarg.h>
-#include <stdio.h>
-#include <stdlib.h>
-#include <string.h>
-#include <time.h>
 
-static int g_pass, g_fail, g_skip, g_verbose;
-static unsigned long long g_seed;
-
-static void pass(const char *name) { g_pass++; printf("PASS %s\n", name); }
-static void fail(const char *name, const char *fmt, ...)
-#if defined(__GNUC__)
-    __attribute__((format(printf, 2, 3)))
-#endif
-    ;
-static void fail(const char *name, const char *fmt, ...) {
-    va_list ap;
-    g_fail++;
-    printf("FAIL %s: ", name);
-    va_start(ap, fmt);
-    vprintf(fmt, ap);
-    va_end(ap);
-    printf(" (seed %llu)\n", g_seed);
-}
-static void skip(const char *name, const char *why) { g_skip++; printf("SKIP %s: %s\n", name, why); }
+static int g_verbose;
 
 /* Worst measured values over the Loop shapes, per backend (printed at the end): the current
  * backend is g_cur_be. */
@@ -116,22 +94,9 @@ static void stat_max(int k, double v) {
     }
 }
 
-static unsigned long long rnd(unsigned long long *s) {
-    unsigned long long z = (*s += 0x9e3779b97f4a7c15ull);
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-    return z ^ (z >> 31);
-}
-static double rnd_unit(unsigned long long *s) { return (double)(rnd(s) >> 11) * (1.0 / 9007199254740992.0); }
 /* k / 2^20: exact in float, and so are its images on the refined faces (scaled by 2^L, shifted,
  * mirrored), so that both surfaces of the invariance check are evaluated at the same point */
-static double rnd_dyadic(unsigned long long *s) { return ldexp((double)(rnd(s) >> 44), -20); }
-
-static void *xmalloc(size_t n) {
-    void *p = malloc(n ? n : 1);
-    if (!p) { fprintf(stderr, "limit: out of memory\n"); exit(2); }
-    return p;
-}
+static double rng_dyadic(rng *g) { return ldexp((double)(rng_next(g) >> 44), -20); }
 
 static double dist3(const float *a, const float *b) {
     double d0 = (double)a[0] - b[0], d1 = (double)a[1] - b[1], d2 = (double)a[2] - b[2];
@@ -146,40 +111,13 @@ static double angle3(const float *a, const float *b) {
 }
 static int finite3(const float *a) { return isfinite(a[0]) && isfinite(a[1]) && isfinite(a[2]); }
 
-/* ---- backends ---- */
-typedef struct backend { sfb_backend_kind kind; const char *name; int available, required; char why[512]; sfb_context *ctx; } backend;
-static backend g_be[4];
-static int g_nbe;
-
-static int listed(const char *list, const char *name) {
-    size_t n = strlen(name);
-    const char *p = list;
-    while (p && *p) {
-        const char *e = strchr(p, ',');
-        size_t len = e ? (size_t)(e - p) : strlen(p);
-        if (len == n && strncmp(p, name, n) == 0) return 1;
-        p = e ? e + 1 : NULL;
-    }
-    return 0;
-}
-
+/* ---- backends (tests/harness.h: g_be, ref first) ---- */
 /* A backend without its own eval_patches would be served by ref (with a log line): that must
  * not count as the backend passing. */
 static int g_fallbacks;
 static void on_log(int level, const char *msg, void *user) {
     (void)level; (void)user;
     if (strstr(msg, "lacks eval_patches")) g_fallbacks++;
-}
-
-static sfb_context *make_context(sfb_backend_kind kind) {
-    sfb_context_config cfg = sfb_context_config_init();
-    sfb_context *ctx = NULL;
-    cfg.logger.func = on_log;
-    cfg.backends = &kind;
-    cfg.backend_count = 1;
-    cfg.ignore_environment = 1;
-    if (sfb_context_create(&cfg, &ctx) != SFB_SUCCESS) return NULL;
-    return ctx;
 }
 
 /* ---- param-face bookkeeping of a uniform refinement (refine.c's child order) ---- */
@@ -558,18 +496,18 @@ static void check_derivatives(const backend *b, const shape *sh, const sfb_surfa
     float *N = (float *)xmalloc(sizeof(float) * 15 * (size_t)n);
     const double h = 1e-3;
     double worst1 = 0.0, worst2 = 0.0;
-    unsigned long long st = g_seed ^ 0x51ed;
+    rng st = {g_seed ^ 0x51ed};
     int np = sfb_surface_param_face_count(s);
     snprintf(name, sizeof name, "%s/derivatives/%s", b->name, sh->name);
     for (k = 0, q = 0; k < n * 40 && q < n; ++k) {
         sfb_location c;
         int t;
-        c.face = (int)(rnd(&st) % (unsigned long long)np);
-        c.u = (float)(0.05 + 0.9 * rnd_unit(&st));
-        c.v = (float)(0.05 + 0.9 * rnd_unit(&st));
+        c.face = (int)(rng_next(&st) % (unsigned long long)np);
+        c.u = (float)(0.05 + 0.9 * rng_unit(&st));
+        c.v = (float)(0.05 + 0.9 * rng_unit(&st));
         if (sh->tri) {
             /* inside the triangle, the differences' steps included: u, v >= 0.05, u + v <= 0.95 */
-            double x = rnd_unit(&st), y = rnd_unit(&st);
+            double x = rng_unit(&st), y = rng_unit(&st);
             if (x + y > 1.0) { x = 1.0 - x; y = 1.0 - y; }
             c.u = (float)(0.05 + 0.85 * x);
             c.v = (float)(0.05 + 0.85 * y);
@@ -968,20 +906,6 @@ static void check_agree(const backend *b, const shape *sh, const sfb_surface *s,
         for (c = 0; c < 7; ++c) free(o[k][c]);
 }
 
-static char *read_file(const char *path, size_t *size) {
-    FILE *f = fopen(path, "rb");
-    char *buf;
-    long n;
-    if (!f) return NULL;
-    if (fseek(f, 0, SEEK_END) != 0 || (n = ftell(f)) < 0 || fseek(f, 0, SEEK_SET) != 0) { fclose(f); return NULL; }
-    buf = (char *)xmalloc((size_t)n + 1);
-    if (fread(buf, 1, (size_t)n, f) != (size_t)n) { fclose(f); free(buf); return NULL; }
-    fclose(f);
-    *size = (size_t)n;
-    return buf;
-}
-
-static int cmp_str(const void *a, const void *b) { return strcmp(*(const char *const *)a, *(const char *const *)b); }
 static int cmp_u64(const void *a, const void *b) {
     unsigned long long x = *(const unsigned long long *)a, y = *(const unsigned long long *)b;
     return x < y ? -1 : x > y;
@@ -990,9 +914,7 @@ static int cmp_u64(const void *a, const void *b) {
 static int g_level = 2;
 
 static void run_shape(const char *dir, const char *file, sfb_context *ref) {
-    char path[4096], name[400];
-    size_t size;
-    char *text;
+    char name[400], why[1200];
     shape sh;
     sfb_surface *sref = NULL, *s0 = NULL;
     sfb_mesh_info mi;
@@ -1010,15 +932,11 @@ static void run_shape(const char *dir, const char *file, sfb_context *ref) {
     sh.tri = strncmp(file, "loop_", 5) == 0;
     sh.ref = ref;
     g_cur_shape = sh.name;
-    snprintf(path, sizeof path, "%s/%s", dir, file);
     snprintf(name, sizeof name, "shape/%s", sh.name);
-    text = read_file(path, &size);
-    if (!text || sfb_mesh_read_obj(ref, text, size, &sh.mesh) != SFB_SUCCESS) {
-        fail(name, "cannot read: %s", text ? sfb_last_error(ref) : path);
-        free(text);
+    if (!(sh.mesh = load_obj(ref, dir, file, why, sizeof why))) {
+        fail(name, "%s", why);
         return;
     }
-    free(text);
     sfb_mesh_get_info(sh.mesh, &mi);
     for (k = 0; k < 3; ++k) sh.diag += ((double)mi.bbox_max[k] - mi.bbox_min[k]) * ((double)mi.bbox_max[k] - mi.bbox_min[k]);
     sh.diag = sqrt(sh.diag);
@@ -1145,7 +1063,7 @@ static void run_shape(const char *dir, const char *file, sfb_context *ref) {
         /* random locations, and (with the rebuilt mesh) the same points on the refined mesh */
         {
             int np = sfb_surface_param_face_count(sref), want = 200, tries;
-            unsigned long long st = g_seed ^ (unsigned long long)strlen(sh.name) * 7919u;
+            rng st = {g_seed ^ (unsigned long long)strlen(sh.name) * 7919u};
             sfb_surface *sr = rm ? make_surface(ref, rm, 0, SFB_REFINE_PATCHES, SFB_DEFAULT_ISOLATION - L, sh.tri) : NULL;
             if (rm && !sr) snprintf(inv_why, sizeof inv_why, "the rebuilt level-%d mesh has no surface: %s", L, sfb_last_error(ref));
             sh.loc = (sfb_location *)xmalloc(sizeof(sfb_location) * (size_t)want);
@@ -1155,9 +1073,9 @@ static void run_shape(const char *dir, const char *file, sfb_context *ref) {
                 float P[3];
                 int f, found = -1, first, count;
                 double a, bb;
-                l.face = (int)(rnd(&st) % (unsigned long long)np);
-                l.u = (float)rnd_dyadic(&st);
-                l.v = (float)rnd_dyadic(&st);
+                l.face = (int)(rng_next(&st) % (unsigned long long)np);
+                l.u = (float)rng_dyadic(&st);
+                l.v = (float)rng_dyadic(&st);
                 if (sh.tri) {
                     /* uniform in the triangle */
                     double x = l.u, y = l.v;
@@ -1202,8 +1120,7 @@ static void run_shape(const char *dir, const char *file, sfb_context *ref) {
             g_cur_be = e;
             if (!b->available) {
                 snprintf(nm, sizeof nm, "%s/%s", b->name, sh.name);
-                if (b->required) fail(nm, "%s unavailable: %s (required by SFB_REQUIRE_BACKENDS)", b->name, b->why);
-                else skip(nm, b->why);
+                backend_missing(b, nm);
                 continue;
             }
             s = make_surface(b->ctx, sh.mesh, 0, SFB_REFINE_PATCHES, 0, sh.tri);
@@ -1252,57 +1169,28 @@ out:
 }
 
 int main(int argc, char **argv) {
-    const char *dir = NULL, *only = NULL, *match = NULL, *req = getenv("SFB_REQUIRE_BACKENDS");
-    static const sfb_backend_kind kinds[4] = {SFB_BACKEND_REF, SFB_BACKEND_SIMD, SFB_BACKEND_GL, SFB_BACKEND_OSMESA};
-    DIR *dp;
-    struct dirent *de;
-    char **names = NULL;
-    int n = 0, i, have_seed = 0;
+    const char *dir = NULL, *only = NULL, *match = NULL, *seed = NULL;
+    sfb_context_config cfg = sfb_context_config_init();
+    char **names;
+    int n = 0, i;
     for (i = 1; i < argc; ++i) {
-        if (!strcmp(argv[i], "--seed") && i + 1 < argc) { g_seed = strtoull(argv[++i], NULL, 10); have_seed = 1; }
+        if (!strcmp(argv[i], "--seed") && i + 1 < argc) seed = argv[++i];
         else if (!strcmp(argv[i], "--only") && i + 1 < argc) only = argv[++i];
         else if (!strcmp(argv[i], "--level") && i + 1 < argc) g_level = atoi(argv[++i]);
         else if (!strcmp(argv[i], "--verbose")) g_verbose = 1;
         else if (!strcmp(argv[i], "--match") && i + 1 < argc) match = argv[++i];
         else dir = argv[i];
     }
-    if (!have_seed) g_seed = getenv("SFB_SEED") ? strtoull(getenv("SFB_SEED"), NULL, 10) : (unsigned long long)time(NULL);
+    harness_seed(seed);
     printf("# seed %llu\n", g_seed);
-    for (i = 0; i < 4; ++i) {
-        backend *b = &g_be[g_nbe];
-        memset(b, 0, sizeof *b);
-        b->kind = kinds[i];
-        b->name = sfb_backend_kind_name(kinds[i]);
-        if (i > 0 && only && !listed(only, b->name)) continue;
-        b->required = req && listed(req, b->name);
-        if (sfb_backend_probe(b->kind, NULL, b->why, sizeof b->why) == SFB_SUCCESS && (b->ctx = make_context(b->kind)) != NULL &&
-            !strcmp(sfb_context_backend_name(b->ctx), b->name))
-            b->available = 1;
-        printf("# %s: %s\n", b->name, b->available ? "available" : b->why);
-        g_nbe++;
-    }
-    if (!g_be[0].available) { printf("FAIL probe/ref: %s\n0 passed, 1 failed, 0 skipped\n", g_be[0].why); return 1; }
-    dp = dir ? opendir(dir) : NULL;
-    if (!dp) { printf("SKIP shapes: directory not found (%s)\n", dir ? dir : "none given"); g_skip++; }
-    while (dp && (de = readdir(dp)) != NULL) {
-        size_t len = strlen(de->d_name);
-        if (len < 5 || strcmp(de->d_name + len - 4, ".obj") || (strncmp(de->d_name, "catmark_", 8) && strncmp(de->d_name, "loop_", 5)))
-            continue;
-        if (match && !strstr(de->d_name, match)) continue;
-        names = (char **)realloc(names, sizeof(char *) * (size_t)(n + 1));
-        names[n] = (char *)xmalloc(len + 1);
-        memcpy(names[n++], de->d_name, len + 1);
-    }
-    if (dp) closedir(dp);
-    qsort(names, (size_t)n, sizeof *names, cmp_str);
+    cfg.logger.func = on_log;
+    if (!probe_backends_with(&cfg, only)) return 1;
+    names = list_shapes(dir, "catmark_,loop_", match, &n);
     for (i = 0; i < n; ++i) {
         run_shape(dir, names[i], g_be[0].ctx);
-        free(names[i]);
         fflush(stdout);
     }
-    free(names);
-    for (i = 0; i < g_nbe; ++i)
-        if (g_be[i].ctx) sfb_context_destroy(g_be[i].ctx);
+    free_names(names, n);
     {
         /* Loop: the worst measured values per check kind and backend */
         int k;
@@ -1312,6 +1200,5 @@ int main(int argc, char **argv) {
                     if (g_stat_where[i][k][0])
                         printf("# loop worst %s %s: %.3g (%s)\n", g_be[i].name, k_stat_names[k], g_stat[i][k], g_stat_where[i][k]);
     }
-    printf("%d passed, %d failed, %d skipped\n", g_pass, g_fail, g_skip);
-    return g_fail ? 1 : 0;
+    return finish_tests();
 }

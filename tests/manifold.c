@@ -20,7 +20,6 @@
 #define SURFBLEND_IMPLEMENTATION
 #define SURFBLEND_ALL_BACKENDS
 #include "surfblend.h"
-#include <dirent.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -51,14 +50,6 @@ static sfb_surface *make_surface(sfb_context *ctx, const sfb_mesh *m, int weight
     c.manifold.weights = weights;
     if (sfb_surface_create(ctx, m, &c, &s) != SFB_SUCCESS) return NULL;
     return s;
-}
-
-static double diag_of(const sfb_mesh *m) {
-    sfb_mesh_info info;
-    double dx, dy, dz;
-    sfb_mesh_get_info(m, &info);
-    dx = info.bbox_max[0] - info.bbox_min[0]; dy = info.bbox_max[1] - info.bbox_min[1]; dz = info.bbox_max[2] - info.bbox_min[2];
-    return sqrt(dx * dx + dy * dy + dz * dz);
 }
 
 /* ---- built-in meshes: a cube of n x n quads per side, optionally pushed onto the unit sphere ---- */
@@ -649,8 +640,6 @@ static void bad_configs(sfb_context *ctx, const sfb_mesh *m) {
     } else fail("bad/valid manifold surface", "%s", sfb_last_error(ctx));
 }
 
-static int cmp_str(const void *a, const void *b) { return strcmp(*(const char *const *)a, *(const char *const *)b); }
-
 static int has_sharp(const sfb_surface *s) {
     int e;
     int v;
@@ -669,7 +658,7 @@ static int all_quads(const sfb_mesh *m) {
  * and corners must show. */
 static void run_mesh(const char *name, const sfb_mesh *m, int features) {
     int w;
-    double diag = diag_of(m);
+    double diag = mesh_diag(m);
     for (w = 0; w < 2; ++w) {
         char nm[700];
         sfb_surface *s = make_surface(g_be[0].ctx, m, w);
@@ -691,9 +680,7 @@ static void run_mesh(const char *name, const sfb_mesh *m, int features) {
 
 int main(int argc, char **argv) {
     const char *dir = argc > 1 ? argv[1] : NULL, *match = argc > 2 ? argv[2] : NULL;
-    DIR *dp;
-    struct dirent *de;
-    char **names = NULL;
+    char **names;
     int n = 0, i;
     if (!probe_backends()) return 1;
     weights_unit();
@@ -707,40 +694,23 @@ int main(int argc, char **argv) {
         if ((m = cube(g_be[0].ctx, 4, 1, CUBE_DART)) != NULL) { run_mesh("sphere4_dart", m, 1); sfb_mesh_destroy(m); } else fail("cube", "mesh");
         if ((m = cube(g_be[0].ctx, 2, 1, CUBE_ALL_SHARP)) != NULL) {
             sfb_surface *s = make_surface(g_be[0].ctx, m, 0);
-            if (s) { only_points("sphere2_all_sharp", s, diag_of(m)); sfb_surface_destroy(s); } else fail("sphere2_all_sharp", "create");
+            if (s) { only_points("sphere2_all_sharp", s, mesh_diag(m)); sfb_surface_destroy(s); } else fail("sphere2_all_sharp", "create");
             run_mesh("sphere2_all_sharp", m, 1);
             sfb_mesh_destroy(m);
         } else fail("cube", "mesh");
     }
-    dp = dir ? opendir(dir) : NULL;
-    if (!dp) { printf("SKIP shapes: directory not found (%s)\n", dir ? dir : "none given"); g_skip++; }
-    while (dp && (de = readdir(dp)) != NULL) {
-        size_t len = strlen(de->d_name);
-        if (len < 5 || strcmp(de->d_name + len - 4, ".obj") || strncmp(de->d_name, "catmark_", 8)) continue;
-        if (match && !strstr(de->d_name, match)) continue;
-        names = (char **)realloc(names, sizeof(char *) * (size_t)(n + 1));
-        names[n] = (char *)malloc(len + 1);
-        memcpy(names[n++], de->d_name, len + 1);
-    }
-    if (dp) closedir(dp);
-    if (n) qsort(names, (size_t)n, sizeof *names, cmp_str);
+    names = list_shapes(dir, "catmark_", match, &n);
     for (i = 0; i < n; ++i) {
-        char path[4096];
-        size_t sz;
-        char *text;
-        sfb_mesh *m = NULL;
-        snprintf(path, sizeof path, "%s/%s", dir, names[i]);
-        text = slurp(path, &sz);
-        if (!text || sfb_mesh_read_obj(g_be[0].ctx, text, sz, &m) != SFB_SUCCESS) {
+        char why[1200];
+        sfb_mesh *m = load_obj(g_be[0].ctx, dir, names[i], why, sizeof why);
+        if (!m) {
             char nm[1024];
             snprintf(nm, sizeof nm, "shape/%s", names[i]);
             skip(nm, "not readable as a mesh");
         } else run_mesh(names[i], m, 0);
         if (m) sfb_mesh_destroy(m);
-        free(text);
-        free(names[i]);
         fflush(stdout);
     }
-    free(names);
+    free_names(names, n);
     return finish_tests();
 }

@@ -39,7 +39,6 @@
 #define SURFBLEND_IMPLEMENTATION
 #define SURFBLEND_ALL_BACKENDS
 #include "surfblend.h"
-#include <dirent.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -130,14 +129,6 @@ static double smoothness(const sfb_surface *s, const sfb_mesh_data *d, const flo
     return worst;
 }
 
-static double diag_of(const sfb_mesh *m) {
-    sfb_mesh_info info;
-    double dx, dy, dz;
-    sfb_mesh_get_info(m, &info);
-    dx = info.bbox_max[0] - info.bbox_min[0]; dy = info.bbox_max[1] - info.bbox_min[1]; dz = info.bbox_max[2] - info.bbox_min[2];
-    return sqrt(dx * dx + dy * dy + dz * dz);
-}
-
 /* Largest errors of a backend's shade output d against ref's r of the same surface options
  * (tolerances at the top of this file): position / diagonal (wp), and N_B, N_L, N_S as multiples
  * of their tolerances (wn, wl, ws); nill counts the vertices left out. */
@@ -206,7 +197,7 @@ static void run_mesh(const char *name, const sfb_mesh *m, int loop, int smooth_l
     sfb_mesh_info info;
     sfb_mesh_data ref[2];
     sfb_surface *sref;
-    double diag = diag_of(m);
+    double diag = mesh_diag(m);
     char nm[512];
     int e, i, L, held_any = 0, rdart = 0;
     sfb_mesh_get_info(m, &info);
@@ -680,8 +671,6 @@ static void sphere_log(const double q[3], const double n[3], double t[3]) {
     for (c = 0; c < 3; ++c) t[c] = sv > 0.0 ? u[c] * th / sv : 0.0;
 }
 
-static double rnd(unsigned *state) { *state = *state * 1664525u + 1013904223u; return (double)(*state >> 8) / 16777216.0; }
-
 static void normalize3(double *v) {
     double l = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
     v[0] /= l; v[1] /= l; v[2] /= l;
@@ -692,7 +681,7 @@ static void spherical_mean_tests(void) {
     static const double as[4] = {0.05, 0.3, 1.0, 1.5}, ws[3] = {0.2, 0.5, 0.8};
     double worst = 0.0, lin, resid = 0.0, unit = 0.0, equi = 0.0, q[3], n[3 * 8], w[8];
     int i, j, c, trial, fallbacks = 0, maxit = 0;
-    unsigned seed = 12345u;
+    rng seed = {12345u}; /* tests/harness.h */
     /* two unit vectors at angle 2a, weights w and 1 - w: the mean lies on their arc at (1 - w) 2a */
     for (i = 0; i < 4; ++i)
         for (j = 0; j < 3; ++j) {
@@ -721,12 +710,12 @@ static void spherical_mean_tests(void) {
         int cnt = 3 + trial % 6, it;
         double ctr[3], spread = trial % 3 == 0 ? 0.1 : trial % 3 == 1 ? 0.3 : 0.5, g[3] = {0.0, 0.0, 0.0}, W = 0.0, l;
         double axis[3], ang, R[9], rn[3 * 8], rq[3], Rq[3];
-        for (c = 0; c < 3; ++c) ctr[c] = rnd(&seed) * 2.0 - 1.0;
+        for (c = 0; c < 3; ++c) ctr[c] = rng_unit(&seed) * 2.0 - 1.0;
         normalize3(ctr);
         for (i = 0; i < cnt; ++i) {
-            for (c = 0; c < 3; ++c) n[3 * i + c] = ctr[c] + spread * (rnd(&seed) * 2.0 - 1.0);
+            for (c = 0; c < 3; ++c) n[3 * i + c] = ctr[c] + spread * (rng_unit(&seed) * 2.0 - 1.0);
             normalize3(n + 3 * i);
-            w[i] = 0.05 + rnd(&seed);
+            w[i] = 0.05 + rng_unit(&seed);
             W += w[i];
         }
         it = sfb__shade_spherical_mean(cnt, n, w, q);
@@ -742,9 +731,9 @@ static void spherical_mean_tests(void) {
         l = fabs(sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2]) - 1.0);
         if (l > unit) unit = l;
         /* a rotation R (axis, angle; Rodrigues): mean(R n_i) = R mean(n_i) */
-        for (c = 0; c < 3; ++c) axis[c] = rnd(&seed) * 2.0 - 1.0;
+        for (c = 0; c < 3; ++c) axis[c] = rng_unit(&seed) * 2.0 - 1.0;
         normalize3(axis);
-        ang = 6.0 * rnd(&seed);
+        ang = 6.0 * rng_unit(&seed);
         {
             double cs = cos(ang), sn = sin(ang), x = axis[0], y = axis[1], z = axis[2];
             R[0] = cs + x * x * (1 - cs); R[1] = x * y * (1 - cs) - z * sn; R[2] = x * z * (1 - cs) + y * sn;
@@ -777,7 +766,7 @@ static void spherical_mean_tests(void) {
  * (the tolerances of run_mesh), same topology and weights as linear. */
 static void averaging_check(const char *name, const sfb_mesh *m, int loop) {
     sfb_mesh_info info;
-    double diag = diag_of(m);
+    double diag = mesh_diag(m);
     int avg, e, a, i;
     char nm[512];
     sfb_mesh_get_info(m, &info);
@@ -886,13 +875,9 @@ static const char *const g_avg_shapes[] = {"catmark_cube.obj",   "catmark_cube_c
                                            "catmark_xord_boundary.obj", "catmark_cubes_infsharp.obj", "loop_cube.obj",
                                            "loop_cubes_semisharp.obj", "loop_icos_infsharp.obj", "loop_xord_interior.obj"};
 
-static int cmp_str(const void *a, const void *b) { return strcmp(*(const char *const *)a, *(const char *const *)b); }
-
 int main(int argc, char **argv) {
     const char *dir = argc > 1 ? argv[1] : NULL, *match = argc > 2 ? argv[2] : NULL;
-    DIR *dp;
-    struct dirent *de;
-    char **names = NULL;
+    char **names;
     int n = 0, i, k;
     if (!probe_backends()) return 1;
     /* built-in meshes */
@@ -916,28 +901,12 @@ int main(int argc, char **argv) {
     failing_allocations(SFB_SHADE_AVERAGE_RENORMALIZED);
     failing_allocations(SFB_SHADE_AVERAGE_SPHERICAL);
     spherical_mean_tests();
-    dp = dir ? opendir(dir) : NULL;
-    if (!dp) { printf("SKIP shapes: directory not found (%s)\n", dir ? dir : "none given"); g_skip++; }
-    while (dp && (de = readdir(dp)) != NULL) {
-        size_t len = strlen(de->d_name);
-        if (len < 5 || strcmp(de->d_name + len - 4, ".obj") || (strncmp(de->d_name, "catmark_", 8) && strncmp(de->d_name, "loop_", 5)))
-            continue;
-        if (match && !strstr(de->d_name, match)) continue;
-        names = (char **)realloc(names, sizeof(char *) * (size_t)(n + 1));
-        names[n] = (char *)malloc(len + 1);
-        memcpy(names[n++], de->d_name, len + 1);
-    }
-    if (dp) closedir(dp);
-    if (n) qsort(names, (size_t)n, sizeof *names, cmp_str);
+    names = list_shapes(dir, "catmark_,loop_", match, &n);
     for (i = 0; i < n; ++i) {
-        char path[4096];
-        size_t sz;
-        char *text;
-        sfb_mesh *m = NULL;
+        char why[1200];
         int loop = !strncmp(names[i], "loop_", 5);
-        snprintf(path, sizeof path, "%s/%s", dir, names[i]);
-        text = slurp(path, &sz);
-        if (!text || sfb_mesh_read_obj(g_be[0].ctx, text, sz, &m) != SFB_SUCCESS) {
+        sfb_mesh *m = load_obj(g_be[0].ctx, dir, names[i], why, sizeof why);
+        if (!m) {
             char nm[600];
             snprintf(nm, sizeof nm, "shape/%s", names[i]);
             skip(nm, "not readable as a mesh");
@@ -966,10 +935,8 @@ int main(int argc, char **argv) {
             }
         }
         if (m) sfb_mesh_destroy(m);
-        free(text);
-        free(names[i]);
         fflush(stdout);
     }
-    free(names);
+    free_names(names, n);
     return finish_tests();
 }

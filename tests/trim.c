@@ -193,14 +193,6 @@ static sfb_surface *surface_of(sfb_context *ctx, const sfb_mesh *m, int loop) {
     return s;
 }
 
-static double diag_of(const sfb_mesh *m) {
-    sfb_mesh_info info;
-    double dx, dy, dz;
-    sfb_mesh_get_info(m, &info);
-    dx = info.bbox_max[0] - info.bbox_min[0]; dy = info.bbox_max[1] - info.bbox_min[1]; dz = info.bbox_max[2] - info.bbox_min[2];
-    return sqrt(dx * dx + dy * dy + dz * dz);
-}
-
 /* ---- (u,v) of a tessellation vertex in any param face it lies on ----
  * Each param face's sides are named by what they lie on in the base mesh: a base edge a -> b
  * over the part [s0, s1] of it (from a), or a spoke of an n-gon (from the midpoint of its
@@ -569,7 +561,7 @@ static double angle3(const float *a, const float *b) {
 static void run_case(const expect *E, const sfb_mesh *m, const mask *M) {
     sfb_tess_data ref;
     int e, have_ref = 0;
-    double diag = diag_of(m);
+    double diag = mesh_diag(m);
     char nm[512];
     sfb_trim_mask tm = mask_api(M);
     memset(&ref, 0, sizeof ref);
@@ -998,18 +990,12 @@ int main(int argc, char **argv) {
     octa = mesh_of(g_be[0].ctx, octahedron_obj);
     creased = mesh_of(g_be[0].ctx, creased_cube_obj);
     if (!grid6 || !grid3 || !cube || !prism || !octa || !creased) {
-        printf("FAIL meshes: %s\n", sfb_last_error(g_be[0].ctx));
-        g_fail++;
+        fail("meshes", "%s", sfb_last_error(g_be[0].ctx));
         goto out;
     }
     if (dir) {
-        char path[4096];
-        size_t n;
-        char *text;
-        snprintf(path, sizeof path, "%s/loop_cube.obj", dir);
-        text = slurp(path, &n);
-        if (!text || sfb_mesh_read_obj(g_be[0].ctx, text, n, &lcube) != SFB_SUCCESS) lcube = NULL;
-        free(text);
+        char why[1200];
+        lcube = load_obj(g_be[0].ctx, dir, "loop_cube.obj", why, sizeof why);
     }
 
     /* half masks: a planar grid (rate 3 asked, raised to the mask), the n-gon prism, Loop */
