@@ -160,33 +160,33 @@ $(BUILD)/gl_pieces: tests/gl_pieces.c tests/harness.h surfblend.h $(BACKEND_HDRS
 $(BUILD)/limit: tests/limit.c tests/harness.h $(BUILD)/libsfb.o
 	$(CC) $(CFLAGS) $(SAN) -I. tests/limit.c $(BUILD)/libsfb.o -o $@ $(LIBS)
 
-# The Stam eigen structures, checked against the subdivision matrices: compiles its own
-# implementation to reach the builders (tests/eigen.c).
-$(BUILD)/eigen: tests/eigen.c tests/harness.h surfblend.h
-	$(CC) $(CFLAGS) $(SAN) -I. tests/eigen.c -o $@ $(LIBS)
+# The Stam eigen structures, checked against the subdivision matrices: reaches the builders
+# through src/sfb_internal.h, linked from libsfb.o as the suites below (tests/eigen.c).
+$(BUILD)/eigen: tests/eigen.c tests/harness.h src/sfb_internal.h $(BUILD)/libsfb.o
+	$(CC) $(CFLAGS) $(SAN) -I. tests/eigen.c $(BUILD)/libsfb.o -o $@ $(LIBS)
 
 # Subdivision shading (sfb_surface_shade) on every backend: weights, variants, darts, split
-# normals, smoothness at extraordinary vertices; compiles its own implementation to read the
-# refined level's vertex rules (tests/shade.c).
-$(BUILD)/shade: tests/shade.c tests/harness.h surfblend.h $(BACKEND_HDRS)
-	$(CC) $(CFLAGS) $(SAN) -I. tests/shade.c -o $@ $(LIBS)
+# normals, smoothness at extraordinary vertices; reads the refined level's vertex rules through
+# src/sfb_internal.h (tests/shade.c).
+$(BUILD)/shade: tests/shade.c tests/harness.h src/sfb_internal.h $(BUILD)/libsfb.o
+	$(CC) $(CFLAGS) $(SAN) -I. tests/shade.c $(BUILD)/libsfb.o -o $@ $(LIBS)
 
 # Trimming of tessellations with a mask (sfb_surface_tessellate) on every backend: kept areas,
 # the cut on the contour, watertightness, atlases, agreement, bad masks, failing allocations
-# (tests/trim.c, its own implementation like tests/shade.c).
-$(BUILD)/trim: tests/trim.c tests/harness.h surfblend.h $(BACKEND_HDRS)
-	$(CC) $(CFLAGS) $(SAN) -I. tests/trim.c -o $@ $(LIBS)
+# (tests/trim.c).
+$(BUILD)/trim: tests/trim.c tests/harness.h src/sfb_internal.h $(BUILD)/libsfb.o
+	$(CC) $(CFLAGS) $(SAN) -I. tests/trim.c $(BUILD)/libsfb.o -o $@ $(LIBS)
 
-# The finish_normals kernel of every backend against ref, degenerate inputs included: compiles
-# its own implementation to reach the backend vtables (tests/finish_normals.c).
-$(BUILD)/finish_normals: tests/finish_normals.c tests/harness.h surfblend.h $(BACKEND_HDRS)
-	$(CC) $(CFLAGS) $(SAN) -I. tests/finish_normals.c -o $@ $(LIBS)
+# The finish_normals kernel of every backend against ref, degenerate inputs included: reaches the
+# backend vtables through src/sfb_internal.h (tests/finish_normals.c).
+$(BUILD)/finish_normals: tests/finish_normals.c tests/harness.h src/sfb_internal.h $(BUILD)/libsfb.o
+	$(CC) $(CFLAGS) $(SAN) -I. tests/finish_normals.c $(BUILD)/libsfb.o -o $@ $(LIBS)
 
 # Manifold-based blending (SFB_SCHEME_MANIFOLD_BLEND) on every backend: interpolation, continuity,
-# creases/darts/corners, derivatives, agreement; compiles its own implementation to reach the
-# patch table (tests/manifold.c).
-$(BUILD)/manifold: tests/manifold.c tests/harness.h surfblend.h $(BACKEND_HDRS)
-	$(CC) $(CFLAGS) $(SAN) -I. tests/manifold.c -o $@ $(LIBS)
+# creases/darts/corners, derivatives, agreement; reaches the patch table through
+# src/sfb_internal.h (tests/manifold.c).
+$(BUILD)/manifold: tests/manifold.c tests/harness.h src/sfb_internal.h $(BUILD)/libsfb.o
+	$(CC) $(CFLAGS) $(SAN) -I. tests/manifold.c $(BUILD)/libsfb.o -o $@ $(LIBS)
 
 # Manifold blending on gl/osmesa and the vertex-shader draw path (with trimming) on a GL context
 # the test owns (links EGL/GL as gl_host) (tests/gl_manifold.c).

@@ -822,6 +822,9 @@ const sfb__eigen_cc *sfb__eigen_cc_get(sfb_context *ctx, int N);
 void sfb__eigen_loop_free(sfb_context *ctx, sfb__eigen_loop *e);
 sfb_result sfb__eigen_loop_build(sfb_context *ctx, int N, int keep, sfb__eigen_loop **out);
 const sfb__eigen_loop *sfb__eigen_loop_get(sfb_context *ctx, int N);
+/* Index of the lattice point (x, y) in the enlarged set of the Loop eigen structure of valence
+ * N, -1 if not in it (patch/eigen.c). */
+int sfb__loop_index(int N, int x, int y);
 
 /* ---- topology of one level ---- */
 enum { SFB__TAG_BOUNDARY = 1, SFB__TAG_NONMANIFOLD = 2 };
@@ -1013,6 +1016,13 @@ sfb_result sfb__surface_apply(const sfb_surface *s, const sfb__stencils *t, void
 sfb_result sfb__refine_output(const sfb_surface *s, const float *base, int base_count, int want_limit, sfb_mesh_data *o);
 
 void sfb__shading_free(sfb_context *ctx, sfb__shading *sh);
+/* shade.c's vertex classes and spherical mean (also read by tests/shade.c): is v a smooth
+ * extraordinary vertex; is v's blend weight held (by the variant and the darts option); the
+ * weighted spherical mean of count vectors (returns the iterations taken, 0 for the zero result,
+ * -1 where the linear average was returned; see shade.c). */
+int sfb__shade_extraordinary(const sfb__level *l, int v, int loop);
+int sfb__shade_held(const sfb__level *l, int v, int loop, int variant, int darts);
+int sfb__shade_spherical_mean(int count, const double *n, const double *w, double out[3]);
 sfb_result sfb__shading_build(sfb_context *ctx, const sfb__level *prep, const sfb__refine_options *opt, int level,
                               const sfb_shading_options *o, sfb__shading **out);
 
@@ -1043,6 +1053,8 @@ void sfb__mf_eval(const float *pts, const int *cv, const unsigned *codes, int ki
 void sfb__mf_eval_patch(const sfb__patch_table *pt, const float *pts, int patch, double s, double t, int want2, double res[6][3],
                         double nrm[3]);
 sfb_result sfb__mf_pinv(sfb_context *ctx, int k, double **out);
+/* The blend weight eta of SFB_MANIFOLD_WEIGHTS_* `kind` at t, and its derivative in *dt. */
+double sfb__mf_eta(int kind, double t, double *dt);
 sfb_result sfb__patches_build(sfb_context *ctx, const sfb__level *base, const sfb__refine_options *opt, int limit,
                               const float *positions, sfb__patch_table *pt);
 /* Patch index (or -1: a hole) and local (s,t) of a valid location; *scale = 2^depth, negative
@@ -3095,7 +3107,7 @@ const sfb__eigen_cc *sfb__eigen_cc_get(sfb_context *ctx, int N) {
  * gets lambda^m Phi_l + m lambda^(m-1) Phi_h. */
 
 /* Index of lattice point (x,y) in the enlarged set, -1 if not in it. */
-static int sfb__loop_index(int N, int x, int y) {
+int sfb__loop_index(int N, int x, int y) {
     static const signed char pts[17][3] = {{0, 0, 0}, {1, 0, 1}, {0, 1, 2}, {-1, 1, 3}, {1, -1, -1},
                                            {1, 1, 7},  {2, 0, 8}, {2, -1, 9}, {0, 2, 10}, {-1, 2, 11},
                                            {3, 0, 12}, {2, 1, 13}, {3, -1, 14}, {1, 2, 15}, {0, 3, 16}, {-1, 3, 17}, {99, 99, 0}};
@@ -4120,7 +4132,7 @@ sfb_result sfb__patches_build(sfb_context *ctx, const sfb__level *base, const sf
  * ENDCAP (the bilinear cap at the isolation limit) -- how a candidate quad becomes one
  * (sfb__pb_face_quad, called by the isolation driver in patch/build.c) and their ref evaluation
  * (the sfb__kind_* evaluators that patch/table.c dispatches to). The GLSL kernel
- * (backends/glsl/patches.comp.glsl) and the simd kernels evaluate the same records in float. */
+ * (backends/gl/glsl/patches.comp.glsl) and the simd kernels evaluate the same records in float. */
 
 /* Class of vertex v as a corner of quad g; *pos = g's fan position. */
 static int sfb__corner_class(const sfb__level *l, int v, int g, int slot, int *pos) {
@@ -4861,7 +4873,7 @@ void sfb__kind_stam_loop(const sfb__patch_table *pt, const float *pts, int patch
 static double sfb__mf_g(double x) { return x > 0.0 ? exp(-1.0 / x) : 0.0; }
 
 /* eta and its derivative (kind: SFB_MANIFOLD_WEIGHTS_*). */
-static double sfb__mf_eta(int kind, double t, double *dt) {
+double sfb__mf_eta(int kind, double t, double *dt) {
     if (kind == SFB_MANIFOLD_WEIGHTS_CINF) {
         double a, b, da, db, s;
         if (t <= 0.0) { *dt = 0.0; return 1.0; }
@@ -8309,7 +8321,7 @@ void sfb__shading_free(sfb_context *ctx, sfb__shading *sh) {
     sfb__free(ctx, sh);
 }
 
-static int sfb__shade_extraordinary(const sfb__level *l, int v, int loop) {
+int sfb__shade_extraordinary(const sfb__level *l, int v, int loop) {
     int f0 = l->vf_off[v], nf = l->vf_off[v + 1] - f0, i, reg;
     if (l->ve_off[v + 1] == l->ve_off[v]) return 0; /* bare vertex */
     if (l->vtag[v] & SFB__TAG_NONMANIFOLD) return 1;
@@ -8322,7 +8334,7 @@ static int sfb__shade_extraordinary(const sfb__level *l, int v, int loop) {
     return 0;
 }
 
-static int sfb__shade_held(const sfb__level *l, int v, int loop, int variant, int darts) {
+int sfb__shade_held(const sfb__level *l, int v, int loop, int variant, int darts) {
     int rule = l->vrule[v];
     if (variant != SFB_SHADE_VARIANT_B) return 0;
     if (rule == SFB__RULE_CREASE || rule == SFB__RULE_CORNER) return 1;
@@ -8914,7 +8926,7 @@ static sfb_result sfb__shade_apply(const sfb_surface *s, const sfb__stencils *t,
  * non-finite iterate give the normalised linear average instead. Returns the iterations taken
  * (>= 1), 0 for the zero result, -1 where the linear average was returned. Pure: safe from any
  * thread. */
-static int sfb__shade_spherical_mean(int count, const double *n, const double *w, double out[3]) {
+int sfb__shade_spherical_mean(int count, const double *n, const double *w, double out[3]) {
     double s[3] = {0.0, 0.0, 0.0}, q[3], W = 0.0, len;
     int i, c, it, degenerate = 0;
     for (i = 0; i < count; ++i) {

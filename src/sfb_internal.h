@@ -234,6 +234,9 @@ const sfb__eigen_cc *sfb__eigen_cc_get(sfb_context *ctx, int N);
 void sfb__eigen_loop_free(sfb_context *ctx, sfb__eigen_loop *e);
 sfb_result sfb__eigen_loop_build(sfb_context *ctx, int N, int keep, sfb__eigen_loop **out);
 const sfb__eigen_loop *sfb__eigen_loop_get(sfb_context *ctx, int N);
+/* Index of the lattice point (x, y) in the enlarged set of the Loop eigen structure of valence
+ * N, -1 if not in it (patch/eigen.c). */
+int sfb__loop_index(int N, int x, int y);
 
 /* ---- topology of one level ---- */
 enum { SFB__TAG_BOUNDARY = 1, SFB__TAG_NONMANIFOLD = 2 };
@@ -425,6 +428,13 @@ sfb_result sfb__surface_apply(const sfb_surface *s, const sfb__stencils *t, void
 sfb_result sfb__refine_output(const sfb_surface *s, const float *base, int base_count, int want_limit, sfb_mesh_data *o);
 
 void sfb__shading_free(sfb_context *ctx, sfb__shading *sh);
+/* shade.c's vertex classes and spherical mean (also read by tests/shade.c): is v a smooth
+ * extraordinary vertex; is v's blend weight held (by the variant and the darts option); the
+ * weighted spherical mean of count vectors (returns the iterations taken, 0 for the zero result,
+ * -1 where the linear average was returned; see shade.c). */
+int sfb__shade_extraordinary(const sfb__level *l, int v, int loop);
+int sfb__shade_held(const sfb__level *l, int v, int loop, int variant, int darts);
+int sfb__shade_spherical_mean(int count, const double *n, const double *w, double out[3]);
 sfb_result sfb__shading_build(sfb_context *ctx, const sfb__level *prep, const sfb__refine_options *opt, int level,
                               const sfb_shading_options *o, sfb__shading **out);
 
@@ -455,6 +465,8 @@ void sfb__mf_eval(const float *pts, const int *cv, const unsigned *codes, int ki
 void sfb__mf_eval_patch(const sfb__patch_table *pt, const float *pts, int patch, double s, double t, int want2, double res[6][3],
                         double nrm[3]);
 sfb_result sfb__mf_pinv(sfb_context *ctx, int k, double **out);
+/* The blend weight eta of SFB_MANIFOLD_WEIGHTS_* `kind` at t, and its derivative in *dt. */
+double sfb__mf_eta(int kind, double t, double *dt);
 sfb_result sfb__patches_build(sfb_context *ctx, const sfb__level *base, const sfb__refine_options *opt, int limit,
                               const float *positions, sfb__patch_table *pt);
 /* Patch index (or -1: a hole) and local (s,t) of a valid location; *scale = 2^depth, negative

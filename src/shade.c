@@ -156,7 +156,7 @@ void sfb__shading_free(sfb_context *ctx, sfb__shading *sh) {
     sfb__free(ctx, sh);
 }
 
-static int sfb__shade_extraordinary(const sfb__level *l, int v, int loop) {
+int sfb__shade_extraordinary(const sfb__level *l, int v, int loop) {
     int f0 = l->vf_off[v], nf = l->vf_off[v + 1] - f0, i, reg;
     if (l->ve_off[v + 1] == l->ve_off[v]) return 0; /* bare vertex */
     if (l->vtag[v] & SFB__TAG_NONMANIFOLD) return 1;
@@ -169,7 +169,7 @@ static int sfb__shade_extraordinary(const sfb__level *l, int v, int loop) {
     return 0;
 }
 
-static int sfb__shade_held(const sfb__level *l, int v, int loop, int variant, int darts) {
+int sfb__shade_held(const sfb__level *l, int v, int loop, int variant, int darts) {
     int rule = l->vrule[v];
     if (variant != SFB_SHADE_VARIANT_B) return 0;
     if (rule == SFB__RULE_CREASE || rule == SFB__RULE_CORNER) return 1;
@@ -761,7 +761,7 @@ static sfb_result sfb__shade_apply(const sfb_surface *s, const sfb__stencils *t,
  * non-finite iterate give the normalised linear average instead. Returns the iterations taken
  * (>= 1), 0 for the zero result, -1 where the linear average was returned. Pure: safe from any
  * thread. */
-static int sfb__shade_spherical_mean(int count, const double *n, const double *w, double out[3]) {
+int sfb__shade_spherical_mean(int count, const double *n, const double *w, double out[3]) {
     double s[3] = {0.0, 0.0, 0.0}, q[3], W = 0.0, len;
     int i, c, it, degenerate = 0;
     for (i = 0; i < count; ++i) {

@@ -48,7 +48,7 @@
  * theta: a normal is the cross product of the tangents, and the float kernel's tangents carry
  * relative errors of about 1e-7..1e-5 (K_NORMAL = 1e-5), which turn into about that over
  * sin(theta) in direction. Where ref's tangents vanish (a point or curve corner, an edge between
- * two points) ref takes the normal h = 1e-4 (else 1e-2) inside the face (src/manifold.c): theta
+ * two points) ref takes the normal h = 1e-4 (else 1e-2) inside the face (src/patch/manifold.c): theta
  * is measured there, and the tangents there are h-sized differences of patch-sized values, so
  * float keeps about 6e-8 / h of them (K_STEP = 4e-7: at most 4e-3 / sin(theta) at h = 1e-4; on
  * the peer shapes those tangents can be nearly parallel, sin(theta) down to 1e-4). Where ref is
@@ -324,7 +324,7 @@ static sfb_location *sample_locations(const sfb_surface *ref, const shape *sh, i
 static const char *const k_compute_shapes[] = {"catmark_cube", "catmark_torus", "catmark_car", "catmark_cube_creases1", "catmark_hole_test2",
                                                "catmark_pyramid", "catmark_nonquads", "catmark_helmet", NULL};
 
-/* Where ref is not the oracle, with C-infinity weights: ref's eta' (src/manifold.c,
+/* Where ref is not the oracle, with C-infinity weights: ref's eta' (src/patch/manifold.c,
  * sfb__mf_eta) forms (da s - a (da + db)) / s^2, in which the terms of size exp(-1/t) are lost
  * to rounding near t = 0 (b and db against a and da in a + b and da + db; the same value written
  * (da b - a db) / s^2 keeps them): its eta'(t) is off by 1e-3 relative at t = 0.025 and is all

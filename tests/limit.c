@@ -52,7 +52,7 @@
  * Loop runs through the same checks on triangles: a param face is a base triangle with
  * barycentric (u,v) (the point (1-u-v) P0 + u P1 + v P2, u + v <= 1), and one Loop step splits
  * it into the corner children at P0, P1, P2 and the middle child, turned by 180 degrees
- * (src/patches.c). So: exact at the three corners of every refined triangle; invariance at
+ * (src/patch/). So: exact at the three corners of every refined triangle; invariance at
  * random barycentric locations mapped to the refined triangle holding them; derivatives at
  * random (u,v) with u, v >= 0.05, u + v <= 0.95 (the differences stay inside); continuity along
  * shared edges (edge k of a triangle runs from corner k to corner k + 1: (0,0)->(1,0),

@@ -30,9 +30,8 @@
  *     leaving `out` zeroed and nothing leaked, progress in order.
  * A backend that is unavailable SKIPs (FAILs when listed in SFB_REQUIRE_BACKENDS). Usage:
  * trim [SHAPES_DIR] (OpenSubdiv's loop_cube.obj is read from there when present). */
-#define SURFBLEND_IMPLEMENTATION
-#define SURFBLEND_ALL_BACKENDS
 #include "surfblend.h"
+#include "src/sfb_internal.h" /* the library's internal interfaces (linked from libsfb.o) */
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>

@@ -10,7 +10,7 @@
 /* backends/gl/glsl/manifold.comp.glsl */
 static const char sfb__glsl_manifold_comp_glsl[] =
     "// Manifold-based blending surfaces (seed 000 sections V.1-V.4; the MANIFOLD4 patch family): the\n"
-    "// blend of four chart local geometries, in float. It is the ref kernel of src/manifold.c\n"
+    "// blend of four chart local geometries, in float. It is the ref kernel of src/patch/manifold.c\n"
     "// (sfb__mf_eta, sfb__mf_local, sfb__mf_eval, sfb__mf_eval_patch), whose top comment is the spec.\n"
     "//\n"
     "// One source, two stages:\n"
@@ -478,7 +478,7 @@ static const char sfb__glsl_patches_comp_glsl[] =
     "// Patch evaluation (exact limit surface of Catmull-Clark and Loop): one invocation per location.\n"
     "// The CPU has already found each location's patch and its (s,t) in it (sfb__patch_locate, a\n"
     "// quadtree walk; for Loop the triangle descent), so this kernel only evaluates. It is the ref\n"
-    "// kernel (src/patches.c: sfb__eval_bspline16, sfb__eval_stam, sfb__eval_endcap,\n"
+    "// kernel (src/patch/quad.c, tri.c, table.c: sfb__eval_bspline16, sfb__eval_stam, sfb__eval_endcap,\n"
     "// sfb__eval_beztri, sfb__eval_stam_loop, sfb__eval_endcap_tri, sfb__ref_eval_one) in float.\n"
     "//\n"
     "// Buffers (one piece of the uploaded table; indices are piece-local):\n"

@@ -1,7 +1,7 @@
 /* backends/simd/manifold.h -- the simd backend's manifold family: eval_patches on MANIFOLD4
- * tables (manifold blending, seed 000, src/manifold.c). Part of backends/simd/sfb_simd.h.
+ * tables (manifold blending, seed 000, src/patch/manifold.c). Part of backends/simd/sfb_simd.h.
  *
- * The function is ref's sfb__mf_eval (src/manifold.c holds the spec), evaluated in float on W
+ * The function is ref's sfb__mf_eval (src/patch/manifold.c holds the spec), evaluated in float on W
  * locations at once, one location per vector lane (structure of arrays): W = 16 avx512, 8 avx2,
  * 4 sse2 and neon on AArch64, 1 portable and 32-bit neon.
  *

@@ -481,7 +481,7 @@ const sfb__eigen_cc *sfb__eigen_cc_get(sfb_context *ctx, int N) {
  * gets lambda^m Phi_l + m lambda^(m-1) Phi_h. */
 
 /* Index of lattice point (x,y) in the enlarged set, -1 if not in it. */
-static int sfb__loop_index(int N, int x, int y) {
+int sfb__loop_index(int N, int x, int y) {
     static const signed char pts[17][3] = {{0, 0, 0}, {1, 0, 1}, {0, 1, 2}, {-1, 1, 3}, {1, -1, -1},
                                            {1, 1, 7},  {2, 0, 8}, {2, -1, 9}, {0, 2, 10}, {-1, 2, 11},
                                            {3, 0, 12}, {2, 1, 13}, {3, -1, 14}, {1, 2, 15}, {0, 3, 16}, {-1, 3, 17}, {99, 99, 0}};

@@ -67,7 +67,7 @@
 static double sfb__mf_g(double x) { return x > 0.0 ? exp(-1.0 / x) : 0.0; }
 
 /* eta and its derivative (kind: SFB_MANIFOLD_WEIGHTS_*). */
-static double sfb__mf_eta(int kind, double t, double *dt) {
+double sfb__mf_eta(int kind, double t, double *dt) {
     if (kind == SFB_MANIFOLD_WEIGHTS_CINF) {
         double a, b, da, db, s;
         if (t <= 0.0) { *dt = 0.0; return 1.0; }

@@ -3,7 +3,7 @@
  * ENDCAP (the bilinear cap at the isolation limit) -- how a candidate quad becomes one
  * (sfb__pb_face_quad, called by the isolation driver in patch/build.c) and their ref evaluation
  * (the sfb__kind_* evaluators that patch/table.c dispatches to). The GLSL kernel
- * (backends/glsl/patches.comp.glsl) and the simd kernels evaluate the same records in float. */
+ * (backends/gl/glsl/patches.comp.glsl) and the simd kernels evaluate the same records in float. */
 
 /* Class of vertex v as a corner of quad g; *pos = g's fan position. */
 static int sfb__corner_class(const sfb__level *l, int v, int g, int slot, int *pos) {

@@ -1,5 +1,5 @@
 // Manifold-based blending surfaces (seed 000 sections V.1-V.4; the MANIFOLD4 patch family): the
-// blend of four chart local geometries, in float. It is the ref kernel of src/manifold.c
+// blend of four chart local geometries, in float. It is the ref kernel of src/patch/manifold.c
 // (sfb__mf_eta, sfb__mf_local, sfb__mf_eval, sfb__mf_eval_patch), whose top comment is the spec.
 //
 // One source, two stages:

@@ -1,7 +1,7 @@
 // Patch evaluation (exact limit surface of Catmull-Clark and Loop): one invocation per location.
 // The CPU has already found each location's patch and its (s,t) in it (sfb__patch_locate, a
 // quadtree walk; for Loop the triangle descent), so this kernel only evaluates. It is the ref
-// kernel (src/patches.c: sfb__eval_bspline16, sfb__eval_stam, sfb__eval_endcap,
+// kernel (src/patch/quad.c, tri.c, table.c: sfb__eval_bspline16, sfb__eval_stam, sfb__eval_endcap,
 // sfb__eval_beztri, sfb__eval_stam_loop, sfb__eval_endcap_tri, sfb__ref_eval_one) in float.
 //
 // Buffers (one piece of the uploaded table; indices are piece-local):
