@@ -252,8 +252,13 @@ fuzz: deps-fuzz $(FUZZ_TARGETS)
 	@for t in $(FUZZ_TARGETS); do \
 	  name=$$(basename $$t); work=$(BUILD)/fuzz/corpus-$$name; mkdir -p $$work; \
 	  echo "== $$name for $(FUZZ_TIME) s"; \
-	  ./$$t -max_total_time=$(FUZZ_TIME) -dict=fuzz/obj.dict -print_final_stats=1 $$work fuzz/corpus > $$work.log 2>&1; rc=$$?; \
-	  tail -n 12 $$work.log; [ $$rc -eq 0 ] || { echo "$$name FAILED (exit $$rc; log: $$work.log)"; exit 1; }; \
+	  ./$$t -max_total_time=$(FUZZ_TIME) -dict=fuzz/obj.dict -print_final_stats=1 -artifact_prefix=$$work- $$work fuzz/corpus > $$work.log 2>&1; rc=$$?; \
+	  tail -n 12 $$work.log; [ $$rc -eq 0 ] || { \
+	    echo "$$name FAILED (exit $$rc; log: $$work.log); the report:"; grep -m1 'Seed:' $$work.log; \
+	    sed -n '/invariant violated\|==ERROR\|ERROR: libFuzzer\|runtime error\|deadly signal/,$$p' $$work.log | head -n 80; \
+	    for c in $$work-crash-* $$work-leak-* $$work-timeout-* $$work-oom-*; do [ -f "$$c" ] || continue; \
+	      echo "input $$c (base64; reproduce: base64 -d > in && $$t in):"; base64 -w 100 "$$c" | head -n 40; done; \
+	    exit 1; }; \
 	done
 
 clean:

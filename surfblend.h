@@ -225,6 +225,15 @@ SFB_API const char *sfb_scheme_name(sfb_scheme s);
 /* The scheme named `name` ("catmark" or "catmull-clark", "loop", "bilinear", "manifold",
  * "tribezier": sfb_scheme_name's names) into *out; returns 1, or 0 for an unknown name. */
 SFB_API int sfb_scheme_parse(const char *name, sfb_scheme *out);
+/* What a scheme supports (the SFB_SCHEME_CAN_* bits), so that callers ask a capability instead of
+ * comparing schemes; 0 for a value that is not an sfb_scheme. */
+enum {
+    SFB_SCHEME_CAN_REFINE = 1u << 0,   /* uniform refinement by its rules (sfb_surface_refine) */
+    SFB_SCHEME_CAN_SHADE = 1u << 1,    /* subdivision shading (SFB_REFINE_SHADING, sfb_surface_shade) */
+    SFB_SCHEME_TRIANGLES = 1u << 2,    /* faces must be triangles; its parametric faces are triangles */
+    SFB_SCHEME_CAN_EVAL = 1u << 4      /* a patch table (SFB_REFINE_PATCHES: sfb_surface_eval, tessellate) */
+};
+SFB_API unsigned sfb_scheme_caps(sfb_scheme s);
 
 enum {
     SFB_REFINE_LIMIT = 1u << 0,  /* also build limit position + limit tangent tables */
@@ -477,6 +486,7 @@ typedef struct sfb_patch_info {
     int stam, end_caps, max_depth, points;
     int manifold;          /* MANIFOLD4 blends (one per quad of the manifold mesh) */
     size_t bytes;  /* memory of the patch table and its points */
+    int domain_sides;      /* 4: a parametric face's (u,v) is the unit square; 3: the triangle u + v <= 1 */
 } sfb_patch_info;
 SFB_API sfb_result sfb_surface_patch_info(const sfb_surface *surface, sfb_patch_info *out);
 
@@ -966,9 +976,10 @@ typedef struct sfb__refine_options {
 } sfb__refine_options;
 
 /* ---- schemes at the API edge (scheme.c) ---- */
-enum { SFB__SCHEME_REFINES = 1u << 0,        /* uniform refinement (and limit stencils) by its rules */
-       SFB__SCHEME_SHADES = 1u << 1,         /* subdivision shading (seed 001) */
-       SFB__SCHEME_TRIANGLES = 1u << 2,      /* faces must be triangles */
+/* The public SFB_SCHEME_CAN_* bits, plus the ones only the library reads. */
+enum { SFB__SCHEME_REFINES = SFB_SCHEME_CAN_REFINE,    /* uniform refinement (and limit stencils) by its rules */
+       SFB__SCHEME_SHADES = SFB_SCHEME_CAN_SHADE,      /* subdivision shading (seed 001) */
+       SFB__SCHEME_TRIANGLES = SFB_SCHEME_TRIANGLES,   /* faces must be triangles */
        SFB__SCHEME_BOUNDARY_HOLES = 1u << 3  /* boundary NONE makes boundary faces holes (OpenSubdiv) */ };
 typedef struct sfb__scheme_info {
     sfb_scheme scheme;
@@ -1083,15 +1094,17 @@ void sfb__kind_stam_loop(const sfb__patch_table *pt, const float *pts, int patch
 /* The record evaluations themselves (res as above; the Stam kinds' nres: the first derivatives
  * divided by their scale, a finite tangent frame down to the extraordinary vertex). */
 void sfb__bspline_basis(double t, double *b, double *d, double *dd);   /* uniform cubic B-spline: value, d, d2 */
-void sfb__bez15_basis(double s, double t, double B[6][15]);           /* quartic Bernstein on a triangle */
+void sfb__bez15_basis(double s, double t, int nw, double B[6][15]);   /* quartic Bernstein on a triangle (nw 3 or 6) */
+double sfb__ipow(double x, int m);                                    /* x^m, m >= 0, by repeated squaring */
 void sfb__eval_bspline16(const float *pts, const int *cv, double s, double t, double res[6][3]);
 void sfb__eval_endcap(const float *pts, const int *cv, double s, double t, double res[6][3]);
-void sfb__eval_stam(const sfb__eigen_cc *e, const float *pts, const int *cv, int corner, double s, double t, double res[6][3],
-                    double nres[2][3]);
+/* The Stam kinds take nw: 3 for P and its first derivatives (res[3..5] = 0), 6 for all. */
+void sfb__eval_stam(const sfb__eigen_cc *e, const float *pts, const int *cv, int corner, double s, double t, int nw,
+                    double res[6][3], double nres[2][3]);
 void sfb__eval_beztri(const float *pts, const int *cv, double s, double t, double res[6][3]);
 void sfb__eval_endcap_tri(const float *pts, const int *cv, double s, double t, double res[6][3]);
-void sfb__eval_stam_loop(const sfb__eigen_loop *e, const float *pts, const int *cv, int corner, double s, double t, double res[6][3],
-                         double nres[2][3]);
+void sfb__eval_stam_loop(const sfb__eigen_loop *e, const float *pts, const int *cv, int corner, double s, double t, int nw,
+                         double res[6][3], double nres[2][3]);
 /* Shared by the kinds (patch/table.c): c = a x b; an end cap's normal (nc = 3 or 4 corners); the
  * end of both Stam kernels (the EV frame's derivatives mapped to (s,t) through J, scaled). */
 void sfb__cross3(const double *a, const double *b, double *c);
@@ -3471,6 +3484,13 @@ void sfb__endcap_normal(const float *pts, const int *cv, int nc, double s, doubl
  * (row 0) and the second derivatives (rows 3..5) in the EV frame's (u,v); J = d(u,v)/d(s,t).
  * Writes res (P, Ps, Pt, Pss, Pst, Ptt; first derivatives times sc1, second times sc2) and nres
  * (the normalised first derivatives in (s,t)). */
+double sfb__ipow(double x, int m) {
+    double r = 1.0;
+    for (; m > 0; m >>= 1, x *= x)
+        if (m & 1) r *= x;
+    return r;
+}
+
 void sfb__stam_finish(double J[2][2], double sc1, double sc2, double sr[6][3], double nr[2][3], double res[6][3],
                              double nres[2][3]) {
     int c;
@@ -4409,12 +4429,15 @@ void sfb__eval_endcap(const float *pts, const int *cv, double s, double t, doubl
 }
 
 /* Stam: (s,t) in the patch, the EV at frame corner `corner`. nres[2] gets the derivatives
- * divided by sub^(n-1) 2^n (a finite tangent frame down to the EV). */
-void sfb__eval_stam(const sfb__eigen_cc *e, const float *pts, const int *cv, int corner, double s, double t, double res[6][3],
-                           double nres[2][3]) {
-    int K = e->K, i, j, c, k, n = 1, at_ev;
-    double u, v, J[2][2], bu[4], du[4], ddu[4], bv[4], dv[4], ddv[4], uu, vv;
-    double sr[6][3], nr[2][3];
+ * divided by sub^(n-1) 2^n (a finite tangent frame down to the EV). nw = 3 computes P and the
+ * first derivatives only (res[3..5] = 0), nw = 6 the second derivatives too. Powers are
+ * integer powers (repeated squaring), so every backend that calls this gets ref's very sums
+ * (the simd backend does, for the locations nearer the EV than its packed levels). */
+void sfb__eval_stam(const sfb__eigen_cc *e, const float *pts, const int *cv, int corner, double s, double t, int nw,
+                    double res[6][3], double nres[2][3]) {
+    int K = e->K, i, j, c, k, n = 1, at_ev, m;
+    double u, v, J[2][2], bu[4], du[4], ddu[4], bv[4], dv[4], ddv[4], uu, vv, w[6][16];
+    double sr[6][3], nr[2][3], sc1, sc2;
     const double *phi;
     switch (corner) {
     default: u = s; v = t; J[0][0] = 1; J[0][1] = 0; J[1][0] = 0; J[1][1] = 1; break;
@@ -4437,22 +4460,38 @@ void sfb__eval_stam(const sfb__eigen_cc *e, const float *pts, const int *cv, int
     }
     sfb__bspline_basis(uu, bu, du, ddu);
     sfb__bspline_basis(vv, bv, dv, ddv);
+    for (j = 0; j < 16; ++j) {
+        const int a = j % 4, b = j / 4;
+        w[0][j] = bu[a] * bv[b]; w[1][j] = du[a] * bv[b]; w[2][j] = bu[a] * dv[b];
+        w[3][j] = ddu[a] * bv[b]; w[4][j] = du[a] * dv[b]; w[5][j] = bu[a] * ddv[b];
+    }
     phi = e->phi + (size_t)(k - 1) * 16 * K;
+    m = n - 1;
     for (i = 0; i < K; ++i) {
         double f[6] = {0, 0, 0, 0, 0, 0}, lp, ln;
         const float *p = pts + 3 * (size_t)cv[i];
-        for (j = 0; j < 16; ++j) {
-            double ph = phi[(size_t)j * K + i];
-            int a = j % 4, b = j / 4;
-            f[0] += bu[a] * bv[b] * ph; f[1] += du[a] * bv[b] * ph; f[2] += bu[a] * dv[b] * ph;
-            f[3] += ddu[a] * bv[b] * ph; f[4] += du[a] * dv[b] * ph; f[5] += bu[a] * ddv[b] * ph;
+        const double *ph = phi + i;
+        /* the eigenbasis function i and its derivatives at (uu, vv); named accumulators keep
+         * the sums in registers */
+        if (nw <= 3) {
+            double f0 = 0.0, f1 = 0.0, f2 = 0.0;
+            for (j = 0; j < 16; ++j, ph += K) { f0 += w[0][j] * *ph; f1 += w[1][j] * *ph; f2 += w[2][j] * *ph; }
+            f[0] = f0; f[1] = f1; f[2] = f2;
+        } else {
+            double f0 = 0.0, f1 = 0.0, f2 = 0.0, f3 = 0.0, f4 = 0.0, f5 = 0.0;
+            for (j = 0; j < 16; ++j, ph += K) {
+                f0 += w[0][j] * *ph; f1 += w[1][j] * *ph; f2 += w[2][j] * *ph;
+                f3 += w[3][j] * *ph; f4 += w[4][j] * *ph; f5 += w[5][j] * *ph;
+            }
+            f[0] = f0; f[1] = f1; f[2] = f2; f[3] = f3; f[4] = f4; f[5] = f5;
         }
         if (at_ev) {
             lp = i == e->dominant ? 1.0 : 0.0;
             ln = (i != e->dominant && fabs(fabs(e->lambda[i]) - e->sub) <= 1e-12) ? 1.0 : 0.0;
         } else {
-            lp = pow(e->lambda[i], n - 1);
-            ln = i == e->dominant ? 0.0 : pow(e->lambda[i] / e->sub, n - 1);
+            /* position: lambda^(n-1); derivatives normalised by sub^(n-1) (finite down to the EV) */
+            lp = sfb__ipow(e->lambda[i], m);
+            ln = i == e->dominant ? 0.0 : sfb__ipow(e->lambda[i] / e->sub, m);
         }
         for (c = 0; c < 3; ++c) {
             sr[0][c] += lp * f[0] * p[c];
@@ -4463,14 +4502,15 @@ void sfb__eval_stam(const sfb__eigen_cc *e, const float *pts, const int *cv, int
             sr[5][c] += ln * f[5] * p[c];
         }
     }
-    sfb__stam_finish(J, at_ev ? 1.0 : pow(e->sub, n - 1) * ldexp(1.0, n), at_ev ? 0.0 : pow(e->sub, n - 1) * ldexp(1.0, 2 * n), sr, nr,
-                     res, nres);
+    sc1 = at_ev ? 1.0 : sfb__ipow(e->sub, m) * ldexp(1.0, n);
+    sc2 = at_ev || nw <= 3 ? 0.0 : sfb__ipow(e->sub, m) * ldexp(1.0, 2 * n);
+    sfb__stam_finish(J, sc1, sc2, sr, nr, res, nres);
 }
 
 /* The Stam kind's evaluator (sfb__patch_kind, patch/table.c): res and the normalised tangent frame. */
 void sfb__kind_stam(const sfb__patch_table *pt, const float *pts, int patch, const int *cv, double s, double t, double res[6][3],
                     double dir[2][3]) {
-    sfb__eval_stam(pt->eig[pt->pvalence[patch]], pts, cv, SFB__PARAM_CORNER(pt->pparam[patch]), s, t, res, dir);
+    sfb__eval_stam(pt->eig[pt->pvalence[patch]], pts, cv, SFB__PARAM_CORNER(pt->pparam[patch]), s, t, 6, res, dir);
 }
 #line 1 "src/patch/tri.c"
 /* The triangle family's records (SFB__FAMILY_TRI): BEZTRI15 (a regular triangle: its box
@@ -4674,30 +4714,31 @@ sfb_result sfb__pb_face_tri(sfb__pbuild *b, sfb__wlevel *w, int g, int level, in
 /* ---- ref evaluation ---- */
 
 /* Quartic Bernstein basis on a triangle, our point order (row by row in t, s rising in a
- * row): B[0..5][15] = value, d/ds, d/dt, d2/ds2, d2/dsdt, d2/dt2. */
-static double sfb__tpow(double x, int e) {
-    double r = 1.0;
-    if (e < 0) return 0.0;
-    while (e-- > 0) r *= x;
-    return r;
-}
-
-void sfb__bez15_basis(double s, double t, double B[6][15]) {
-    static const double fact[5] = {1, 1, 2, 6, 24};
-    double w = 1.0 - s - t;
+ * row): B[0..5][15] = value, d/ds, d/dt, d2/ds2, d2/dsdt, d2/dt2 (the last three only when
+ * nw = 6; nw = 3 leaves them unset). Powers up to 4 of s, t and w = 1 - s - t from tables, and
+ * the binomial weights 4! / (i! j! k!). */
+void sfb__bez15_basis(double s, double t, int nw, double B[6][15]) {
+    static const double mult[15] = {1, 4, 6, 4, 1, 4, 12, 12, 4, 6, 12, 6, 4, 4, 1};
+    double ps[5], pt[5], pw[5];
     int i, j, q = 0;
+    const double w = 1.0 - s - t;
+    ps[0] = pt[0] = pw[0] = 1.0;
+    for (i = 1; i < 5; ++i) { ps[i] = ps[i - 1] * s; pt[i] = pt[i - 1] * t; pw[i] = pw[i - 1] * w; }
     for (j = 0; j <= 4; ++j)
         for (i = 0; i + j <= 4; ++i, ++q) {
-            int k = 4 - i - j;
-            double c = 24.0 / (fact[i] * fact[j] * fact[k]);
-#define SFB__M(a, b, cc) (sfb__tpow(s, a) * sfb__tpow(t, b) * sfb__tpow(w, cc))
+            const int k = 4 - i - j;
+            const double c = mult[q];
+            /* s^a t^b w^e, 0 for a negative exponent */
+#define SFB__M(a, b, e) ((a) < 0 || (b) < 0 || (e) < 0 ? 0.0 : ps[(a) < 0 ? 0 : (a)] * pt[(b) < 0 ? 0 : (b)] * pw[(e) < 0 ? 0 : (e)])
             B[0][q] = c * SFB__M(i, j, k);
             B[1][q] = c * (i * SFB__M(i - 1, j, k) - k * SFB__M(i, j, k - 1));
             B[2][q] = c * (j * SFB__M(i, j - 1, k) - k * SFB__M(i, j, k - 1));
-            B[3][q] = c * (i * (i - 1) * SFB__M(i - 2, j, k) - 2.0 * i * k * SFB__M(i - 1, j, k - 1) + k * (k - 1) * SFB__M(i, j, k - 2));
-            B[4][q] = c * (i * j * SFB__M(i - 1, j - 1, k) - i * k * SFB__M(i - 1, j, k - 1) - j * k * SFB__M(i, j - 1, k - 1) +
-                           k * (k - 1) * SFB__M(i, j, k - 2));
-            B[5][q] = c * (j * (j - 1) * SFB__M(i, j - 2, k) - 2.0 * j * k * SFB__M(i, j - 1, k - 1) + k * (k - 1) * SFB__M(i, j, k - 2));
+            if (nw > 3) {
+                B[3][q] = c * (i * (i - 1) * SFB__M(i - 2, j, k) - 2 * i * k * SFB__M(i - 1, j, k - 1) + k * (k - 1) * SFB__M(i, j, k - 2));
+                B[4][q] = c * (i * j * SFB__M(i - 1, j - 1, k) - i * k * SFB__M(i - 1, j, k - 1) - j * k * SFB__M(i, j - 1, k - 1) +
+                               k * (k - 1) * SFB__M(i, j, k - 2));
+                B[5][q] = c * (j * (j - 1) * SFB__M(i, j - 2, k) - 2 * j * k * SFB__M(i, j - 1, k - 1) + k * (k - 1) * SFB__M(i, j, k - 2));
+            }
 #undef SFB__M
         }
 }
@@ -4705,7 +4746,7 @@ void sfb__bez15_basis(double s, double t, double B[6][15]) {
 void sfb__eval_beztri(const float *pts, const int *cv, double s, double t, double res[6][3]) {
     double B[6][15];
     int j, q, c;
-    sfb__bez15_basis(s, t, B);
+    sfb__bez15_basis(s, t, 6, B);
     memset(res, 0, sizeof(double) * 18);
     for (j = 0; j < 15; ++j) {
         const float *p = pts + 3 * (size_t)cv[j];
@@ -4725,14 +4766,16 @@ void sfb__eval_endcap_tri(const float *pts, const int *cv, double s, double t, d
     }
 }
 
-/* Stam-Loop: (s,t) in the patch, the EV at frame corner `corner`; nres as sfb__eval_stam. */
-void sfb__eval_stam_loop(const sfb__eigen_loop *e, const float *pts, const int *cv, int corner, double s, double t,
-                                double res[6][3], double nres[2][3]) {
-    int K = e->K, i, j, c, k, n = 1, at_ev, m;
-    double u, v, J[2][2], B[6][15], ss, tt, sign = 1.0;
+/* Stam-Loop: (s,t) in the patch, the EV at frame corner `corner`; nw, nres and the powers as
+ * sfb__eval_stam (the Jordan term of valence 3 included). */
+void sfb__eval_stam_loop(const sfb__eigen_loop *e, const float *pts, const int *cv, int corner, double s, double t, int nw,
+                         double res[6][3], double nres[2][3]) {
+    int K = e->K, i, j, c, k, n = 1, at_ev, m, q;
+    double u, v, J[2][2], B[6][15], ss, tt, sign = 1.0, subm, sc1, sc2;
     double sr[6][3], nr[2][3];
     double f[SFB__STAM_MAX_VALENCE + 6][6];
     const double *phi;
+    if (nw > 3) nw = 6; else nw = 3;
     switch (corner) {
     default: u = s; v = t; J[0][0] = 1; J[0][1] = 0; J[1][0] = 0; J[1][1] = 1; break;
     case 1: u = t; v = 1.0 - s - t; J[0][0] = 0; J[0][1] = 1; J[1][0] = -1; J[1][1] = -1; break;
@@ -4754,35 +4797,43 @@ void sfb__eval_stam_loop(const sfb__eigen_loop *e, const float *pts, const int *
         else { k = 2; ss = 1.0 - 2.0 * u; tt = 1.0 - 2.0 * v; sign = -1.0; }
     }
     m = n - 1;
-    sfb__bez15_basis(ss, tt, B);
+    sfb__bez15_basis(ss, tt, nw, B);
     phi = e->phi + (size_t)k * 15 * K;
     for (i = 0; i < K; ++i) {
-        int q;
-        for (q = 0; q < 6; ++q) f[i][q] = 0.0;
-        for (j = 0; j < 15; ++j) {
-            double ph = phi[(size_t)j * K + i];
-            for (q = 0; q < 6; ++q) f[i][q] += B[q][j] * ph;
+        /* eigenbasis function i and its derivatives at (ss, tt); named accumulators keep the
+         * sums in registers */
+        const double *ph = phi + i;
+        double f0 = 0.0, f1 = 0.0, f2 = 0.0, f3 = 0.0, f4 = 0.0, f5 = 0.0;
+        if (nw == 3) {
+            for (j = 0; j < 15; ++j, ph += K) { f0 += B[0][j] * *ph; f1 += B[1][j] * *ph; f2 += B[2][j] * *ph; }
+        } else {
+            for (j = 0; j < 15; ++j, ph += K) {
+                f0 += B[0][j] * *ph; f1 += B[1][j] * *ph; f2 += B[2][j] * *ph;
+                f3 += B[3][j] * *ph; f4 += B[4][j] * *ph; f5 += B[5][j] * *ph;
+            }
         }
+        f[i][0] = f0; f[i][1] = f1; f[i][2] = f2; f[i][3] = f3; f[i][4] = f4; f[i][5] = f5;
     }
+    subm = sfb__ipow(e->sub, m);
     for (i = 0; i < K; ++i) {
         const float *p = pts + 3 * (size_t)cv[i];
         double g[6];
-        int q;
         for (q = 0; q < 6; ++q) g[q] = 0.0;
         if (at_ev) {
             g[0] = i == e->dominant ? f[i][0] : 0.0;
             if (i != e->dominant && fabs(e->lambda[i] - e->sub) <= 1e-12)
                 for (q = 1; q < 3; ++q) g[q] = f[i][q];
         } else {
-            double lp = pow(e->lambda[i], m), ln = i == e->dominant ? 0.0 : pow(e->lambda[i] / e->sub, m);
+            /* position: lambda^m; derivatives normalised by sub^m (finite down to the EV) */
+            const double lp = sfb__ipow(e->lambda[i], m), ln = i == e->dominant ? 0.0 : sfb__ipow(e->lambda[i] / e->sub, m);
             g[0] = lp * f[i][0];
-            for (q = 1; q < 6; ++q) g[q] = ln * f[i][q];
+            for (q = 1; q < nw; ++q) g[q] = ln * f[i][q];
             if (e->head[i] >= 0 && m > 0) {
                 /* the second vector of a Jordan block: m lambda^(m-1) of its head's function */
-                int h = e->head[i];
-                double jl = m * pow(e->lambda[i], m - 1), jn = jl / pow(e->sub, m);
+                const int h = e->head[i];
+                const double jl = m * sfb__ipow(e->lambda[i], m - 1), jn = jl / subm;
                 g[0] += jl * f[h][0];
-                for (q = 1; q < 6; ++q) g[q] += jn * f[h][q];
+                for (q = 1; q < nw; ++q) g[q] += jn * f[h][q];
             }
         }
         for (c = 0; c < 3; ++c) {
@@ -4795,13 +4846,15 @@ void sfb__eval_stam_loop(const sfb__eigen_loop *e, const float *pts, const int *
         }
     }
     for (c = 0; c < 3; ++c) { nr[0][c] *= sign; nr[1][c] *= sign; } /* the middle sub-patch is turned */
-    sfb__stam_finish(J, at_ev ? 1.0 : pow(e->sub, m) * ldexp(1.0, n), at_ev ? 0.0 : pow(e->sub, m) * ldexp(1.0, 2 * n), sr, nr, res, nres);
+    sc1 = at_ev ? 1.0 : subm * ldexp(1.0, n);
+    sc2 = at_ev || nw == 3 ? 0.0 : subm * ldexp(1.0, 2 * n);
+    sfb__stam_finish(J, sc1, sc2, sr, nr, res, nres);
 }
 
 /* The Stam kind's evaluator (sfb__patch_kind, patch/table.c): res and the normalised tangent frame. */
 void sfb__kind_stam_loop(const sfb__patch_table *pt, const float *pts, int patch, const int *cv, double s, double t, double res[6][3],
                          double dir[2][3]) {
-    sfb__eval_stam_loop(pt->eigl[pt->pvalence[patch]], pts, cv, SFB__PARAM_CORNER(pt->pparam[patch]), s, t, res, dir);
+    sfb__eval_stam_loop(pt->eigl[pt->pvalence[patch]], pts, cv, SFB__PARAM_CORNER(pt->pparam[patch]), s, t, 6, res, dir);
 }
 #line 1 "src/patch/manifold.c"
 /* Manifold-based blending surfaces with darts, creases and corners (seed 000, after Ying and
@@ -7079,7 +7132,10 @@ static int sfb__parse_double(const char *t, size_t n, double *out) {
     x = strtod(buf, &endp);
     if (*endp != 0 || endp == buf) return 1;
     *out = x;
-    if (!isfinite(x) || fabs(x) > 3.4028234663852886e38) return 2;
+    /* not finite as a float: the doubles that round to infinity, |x| >= FLT_MAX + half an ulp
+     * (2^128 - 2^103; FLT_MAX itself, written with 9 digits as 3.40282347e+38, is above
+     * FLT_MAX as a double and rounds back to it) */
+    if (!isfinite(x) || fabs(x) >= 3.4028235677973366e38) return 2;
     return 0;
 }
 
@@ -7634,6 +7690,13 @@ SFB_API int sfb_scheme_parse(const char *name, sfb_scheme *out) {
     return 0;
 }
 
+SFB_API unsigned sfb_scheme_caps(sfb_scheme s) {
+    const sfb__scheme_info *si = sfb__scheme_info_of(s);
+    if (!si) return 0;
+    return (si->caps & (SFB_SCHEME_CAN_REFINE | SFB_SCHEME_CAN_SHADE | SFB_SCHEME_TRIANGLES)) |
+           (si->build_patches ? (unsigned)SFB_SCHEME_CAN_EVAL : 0u);
+}
+
 /* The names of the schemes that have `cap` (or, cap 0, a patch builder), comma-separated. */
 static void sfb__scheme_list(unsigned cap, char *buf, size_t size) {
     size_t i, used = 0;
@@ -7939,6 +8002,7 @@ SFB_API sfb_result sfb_surface_patch_info(const sfb_surface *s, sfb_patch_info *
     o->manifold = pt->counts[SFB__PATCH_MANIFOLD4];
     o->max_depth = pt->max_depth;
     o->points = pt->npoints;
+    o->domain_sides = pt->domain == SFB__DOMAIN_TRI ? 3 : 4;
     o->bytes = (size_t)pt->npatch * (4 * sizeof(int)) + (size_t)pt->ncv * sizeof(int) + (size_t)pt->nptex * 3 * sizeof(int) +
                (size_t)pt->nnodes * 4 * sizeof(int) + (size_t)pt->npoints * 3 * sizeof(float) + (pt->pcorner ? (size_t)pt->npatch * 4 * sizeof(unsigned) : 0);
     return SFB_SUCCESS;

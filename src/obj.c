@@ -88,7 +88,10 @@ static int sfb__parse_double(const char *t, size_t n, double *out) {
     x = strtod(buf, &endp);
     if (*endp != 0 || endp == buf) return 1;
     *out = x;
-    if (!isfinite(x) || fabs(x) > 3.4028234663852886e38) return 2;
+    /* not finite as a float: the doubles that round to infinity, |x| >= FLT_MAX + half an ulp
+     * (2^128 - 2^103; FLT_MAX itself, written with 9 digits as 3.40282347e+38, is above
+     * FLT_MAX as a double and rounds back to it) */
+    if (!isfinite(x) || fabs(x) >= 3.4028235677973366e38) return 2;
     return 0;
 }
 

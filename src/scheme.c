@@ -52,6 +52,13 @@ SFB_API int sfb_scheme_parse(const char *name, sfb_scheme *out) {
     return 0;
 }
 
+SFB_API unsigned sfb_scheme_caps(sfb_scheme s) {
+    const sfb__scheme_info *si = sfb__scheme_info_of(s);
+    if (!si) return 0;
+    return (si->caps & (SFB_SCHEME_CAN_REFINE | SFB_SCHEME_CAN_SHADE | SFB_SCHEME_TRIANGLES)) |
+           (si->build_patches ? (unsigned)SFB_SCHEME_CAN_EVAL : 0u);
+}
+
 /* The names of the schemes that have `cap` (or, cap 0, a patch builder), comma-separated. */
 static void sfb__scheme_list(unsigned cap, char *buf, size_t size) {
     size_t i, used = 0;

@@ -212,6 +212,15 @@ SFB_API const char *sfb_scheme_name(sfb_scheme s);
 /* The scheme named `name` ("catmark" or "catmull-clark", "loop", "bilinear", "manifold",
  * "tribezier": sfb_scheme_name's names) into *out; returns 1, or 0 for an unknown name. */
 SFB_API int sfb_scheme_parse(const char *name, sfb_scheme *out);
+/* What a scheme supports (the SFB_SCHEME_CAN_* bits), so that callers ask a capability instead of
+ * comparing schemes; 0 for a value that is not an sfb_scheme. */
+enum {
+    SFB_SCHEME_CAN_REFINE = 1u << 0,   /* uniform refinement by its rules (sfb_surface_refine) */
+    SFB_SCHEME_CAN_SHADE = 1u << 1,    /* subdivision shading (SFB_REFINE_SHADING, sfb_surface_shade) */
+    SFB_SCHEME_TRIANGLES = 1u << 2,    /* faces must be triangles; its parametric faces are triangles */
+    SFB_SCHEME_CAN_EVAL = 1u << 4      /* a patch table (SFB_REFINE_PATCHES: sfb_surface_eval, tessellate) */
+};
+SFB_API unsigned sfb_scheme_caps(sfb_scheme s);
 
 enum {
     SFB_REFINE_LIMIT = 1u << 0,  /* also build limit position + limit tangent tables */
@@ -464,6 +473,7 @@ typedef struct sfb_patch_info {
     int stam, end_caps, max_depth, points;
     int manifold;          /* MANIFOLD4 blends (one per quad of the manifold mesh) */
     size_t bytes;  /* memory of the patch table and its points */
+    int domain_sides;      /* 4: a parametric face's (u,v) is the unit square; 3: the triangle u + v <= 1 */
 } sfb_patch_info;
 SFB_API sfb_result sfb_surface_patch_info(const sfb_surface *surface, sfb_patch_info *out);
 

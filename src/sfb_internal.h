@@ -378,9 +378,10 @@ typedef struct sfb__refine_options {
 } sfb__refine_options;
 
 /* ---- schemes at the API edge (scheme.c) ---- */
-enum { SFB__SCHEME_REFINES = 1u << 0,        /* uniform refinement (and limit stencils) by its rules */
-       SFB__SCHEME_SHADES = 1u << 1,         /* subdivision shading (seed 001) */
-       SFB__SCHEME_TRIANGLES = 1u << 2,      /* faces must be triangles */
+/* The public SFB_SCHEME_CAN_* bits, plus the ones only the library reads. */
+enum { SFB__SCHEME_REFINES = SFB_SCHEME_CAN_REFINE,    /* uniform refinement (and limit stencils) by its rules */
+       SFB__SCHEME_SHADES = SFB_SCHEME_CAN_SHADE,      /* subdivision shading (seed 001) */
+       SFB__SCHEME_TRIANGLES = SFB_SCHEME_TRIANGLES,   /* faces must be triangles */
        SFB__SCHEME_BOUNDARY_HOLES = 1u << 3  /* boundary NONE makes boundary faces holes (OpenSubdiv) */ };
 typedef struct sfb__scheme_info {
     sfb_scheme scheme;
@@ -495,15 +496,17 @@ void sfb__kind_stam_loop(const sfb__patch_table *pt, const float *pts, int patch
 /* The record evaluations themselves (res as above; the Stam kinds' nres: the first derivatives
  * divided by their scale, a finite tangent frame down to the extraordinary vertex). */
 void sfb__bspline_basis(double t, double *b, double *d, double *dd);   /* uniform cubic B-spline: value, d, d2 */
-void sfb__bez15_basis(double s, double t, double B[6][15]);           /* quartic Bernstein on a triangle */
+void sfb__bez15_basis(double s, double t, int nw, double B[6][15]);   /* quartic Bernstein on a triangle (nw 3 or 6) */
+double sfb__ipow(double x, int m);                                    /* x^m, m >= 0, by repeated squaring */
 void sfb__eval_bspline16(const float *pts, const int *cv, double s, double t, double res[6][3]);
 void sfb__eval_endcap(const float *pts, const int *cv, double s, double t, double res[6][3]);
-void sfb__eval_stam(const sfb__eigen_cc *e, const float *pts, const int *cv, int corner, double s, double t, double res[6][3],
-                    double nres[2][3]);
+/* The Stam kinds take nw: 3 for P and its first derivatives (res[3..5] = 0), 6 for all. */
+void sfb__eval_stam(const sfb__eigen_cc *e, const float *pts, const int *cv, int corner, double s, double t, int nw,
+                    double res[6][3], double nres[2][3]);
 void sfb__eval_beztri(const float *pts, const int *cv, double s, double t, double res[6][3]);
 void sfb__eval_endcap_tri(const float *pts, const int *cv, double s, double t, double res[6][3]);
-void sfb__eval_stam_loop(const sfb__eigen_loop *e, const float *pts, const int *cv, int corner, double s, double t, double res[6][3],
-                         double nres[2][3]);
+void sfb__eval_stam_loop(const sfb__eigen_loop *e, const float *pts, const int *cv, int corner, double s, double t, int nw,
+                         double res[6][3], double nres[2][3]);
 /* Shared by the kinds (patch/table.c): c = a x b; an end cap's normal (nc = 3 or 4 corners); the
  * end of both Stam kernels (the EV frame's derivatives mapped to (s,t) through J, scaled). */
 void sfb__cross3(const double *a, const double *b, double *c);

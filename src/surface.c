@@ -260,6 +260,7 @@ SFB_API sfb_result sfb_surface_patch_info(const sfb_surface *s, sfb_patch_info *
     o->manifold = pt->counts[SFB__PATCH_MANIFOLD4];
     o->max_depth = pt->max_depth;
     o->points = pt->npoints;
+    o->domain_sides = pt->domain == SFB__DOMAIN_TRI ? 3 : 4;
     o->bytes = (size_t)pt->npatch * (4 * sizeof(int)) + (size_t)pt->ncv * sizeof(int) + (size_t)pt->nptex * 3 * sizeof(int) +
                (size_t)pt->nnodes * 4 * sizeof(int) + (size_t)pt->npoints * 3 * sizeof(float) + (pt->pcorner ? (size_t)pt->npatch * 4 * sizeof(unsigned) : 0);
     return SFB_SUCCESS;

@@ -163,7 +163,7 @@ static void check_loop_regular(sfb_context *ctx) {
         if (u + v > 1.0) { u = 1.0 - u; v = 1.0 - v; }
         /* the EV may sit at any corner of the leaf: rotate the Bezier triangle's parameters */
         sfb__eval_stam_loop(e, coef, cv, corner, corner == 0 ? u : corner == 1 ? 1.0 - u - v : v,
-                            corner == 0 ? v : corner == 1 ? u : 1.0 - u - v, rs, nres);
+                            corner == 0 ? v : corner == 1 ? u : 1.0 - u - v, 6, rs, nres);
         sfb__eval_beztri(bez, cv, u, v, rb);
         /* map the Stam results (in the rotated frame) back: compare position, and the
          * derivatives along the Bezier frame's directions through the chain rule */

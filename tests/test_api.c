@@ -471,6 +471,45 @@ Test(obj, write_read_round_trip)
     grid_free(&g);
 }
 
+/* Extreme floats survive the round trip exactly: FLT_MAX (written as 3.40282347e+38, a double
+ * above FLT_MAX that rounds back to it), the smallest normal and denormal; a number that rounds
+ * to infinity as a float is refused. (Found by fuzz_mesh: -FLT_MAX was refused on re-reading.) */
+Test(obj, float_extremes_round_trip)
+{
+    sfb_context *ctx = make_ctx();
+    const float big = 3.40282347e+38f, tiny = 1.17549435e-38f, denorm = 1.4e-45f;
+    const float pos[12] = { -big, 0, big, big, tiny, 0, 0, -denorm, denorm, 1, 1, -tiny };
+    const int sizes[1] = { 4 }, fv[4] = { 0, 1, 2, 3 };
+    sfb_mesh_desc d;
+    memset(&d, 0, sizeof d);
+    d.vertex_count = 4;
+    d.positions = pos;
+    d.face_count = 1;
+    d.face_sizes = sizes;
+    d.face_vertices = fv;
+    sfb_mesh *m1 = NULL, *m2 = NULL;
+    cr_assert_eq(sfb_mesh_create(ctx, &d, &m1), SFB_SUCCESS, "%s", sfb_last_error(ctx));
+    membuf out = { NULL, 0, 0, 0 };
+    cr_assert_eq(sfb_mesh_write_obj(m1, mem_write, &out), SFB_SUCCESS, "%s", sfb_last_error(ctx));
+    sfb_result r = sfb_mesh_read_obj(ctx, out.buf, out.len, &m2);
+    cr_assert_eq(r, SFB_SUCCESS, "re-reading: %s\n%s", sfb_last_error(ctx), out.buf);
+    sfb_mesh_desc b;
+    sfb_mesh_get_desc(m2, &b);
+    cr_assert_eq(b.vertex_count, 4);
+    for (int i = 0; i < 12; ++i) cr_expect(b.positions[i] == pos[i], "component %d: %.9g became %.9g", i, pos[i], b.positions[i]);
+    sfb_mesh_destroy(m2);
+    m2 = NULL;
+    static const char over[] = "v 3.4028236e38 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+    cr_expect_eq(sfb_mesh_read_obj(ctx, over, sizeof over - 1, &m2), SFB_INVALID_VALUE);
+    cr_expect_null(m2);
+    static const char at[] = "v -3.40282347e+38 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+    cr_expect_eq(sfb_mesh_read_obj(ctx, at, sizeof at - 1, &m2), SFB_SUCCESS, "%s", sfb_last_error(ctx));
+    sfb_mesh_destroy(m2);
+    free(out.buf);
+    sfb_mesh_destroy(m1);
+    sfb_context_destroy(ctx);
+}
+
 Test(obj, round_trip_uvs)
 {
     sfb_context *ctx = make_ctx();
@@ -712,6 +751,44 @@ Test(api, null_arguments)
 
     sfb_surface_destroy(s);
     sfb_mesh_destroy(m);
+    sfb_context_destroy(ctx);
+}
+
+/* sfb_scheme_caps says what each scheme supports; patch info says the parametric domain. */
+Test(api, scheme_caps_and_domain)
+{
+    cr_expect_eq(sfb_scheme_caps(SFB_SCHEME_CATMARK), SFB_SCHEME_CAN_REFINE | SFB_SCHEME_CAN_SHADE | SFB_SCHEME_CAN_EVAL);
+    cr_expect_eq(sfb_scheme_caps(SFB_SCHEME_LOOP),
+                 SFB_SCHEME_CAN_REFINE | SFB_SCHEME_CAN_SHADE | SFB_SCHEME_CAN_EVAL | SFB_SCHEME_TRIANGLES);
+    cr_expect_eq(sfb_scheme_caps(SFB_SCHEME_BILINEAR), SFB_SCHEME_CAN_REFINE);
+    cr_expect_eq(sfb_scheme_caps(SFB_SCHEME_MANIFOLD_BLEND), SFB_SCHEME_CAN_EVAL);
+    cr_expect_eq(sfb_scheme_caps((sfb_scheme)99), 0u);
+    cr_expect_eq(sfb_scheme_caps((sfb_scheme)-1), 0u);
+
+    sfb_context *ctx = make_ctx();
+    static const float pos[12] = { 0, 0, 0, 1, 0, 0, 1, 1, 0.2f, 0, 1, 0 };
+    static const int quad[4] = { 0, 1, 2, 3 }, tris[6] = { 0, 1, 2, 0, 2, 3 };
+    static const int qsizes[1] = { 4 }, tsizes[2] = { 3, 3 };
+    for (int t = 0; t < 2; ++t) {
+        sfb_mesh_desc d;
+        memset(&d, 0, sizeof d);
+        d.vertex_count = 4;
+        d.positions = pos;
+        d.face_count = t ? 2 : 1;
+        d.face_sizes = t ? tsizes : qsizes;
+        d.face_vertices = t ? tris : quad;
+        sfb_mesh *m = NULL;
+        cr_assert_eq(sfb_mesh_create(ctx, &d, &m), SFB_SUCCESS);
+        sfb_surface_config sc = sfb_surface_config_init(t ? SFB_SCHEME_LOOP : SFB_SCHEME_CATMARK, 0);
+        sc.flags = SFB_REFINE_PATCHES;
+        sfb_surface *s = NULL;
+        cr_assert_eq(sfb_surface_create(ctx, m, &sc, &s), SFB_SUCCESS);
+        sfb_patch_info pi;
+        cr_assert_eq(sfb_surface_patch_info(s, &pi), SFB_SUCCESS);
+        cr_expect_eq(pi.domain_sides, t ? 3 : 4, "scheme %s", sfb_scheme_name(sc.scheme));
+        sfb_surface_destroy(s);
+        sfb_mesh_destroy(m);
+    }
     sfb_context_destroy(ctx);
 }
 

@@ -556,13 +556,19 @@ static unsigned long long next_random(unsigned long long *state) {
 /* N random locations on parametric faces that are not holes. Holes are found by asking the
  * library (a face whose centre it rejects), which also covers faces that boundary mode
  * 'none' turns into holes. */
-static int random_locations(sfb_context *ctx, const sfb_surface *surf, int triangles, long count, unsigned long long seed, loc_list *L) {
-    int np = sfb_surface_param_face_count(surf), nlive = 0, i;
+static int random_locations(sfb_context *ctx, const sfb_surface *surf, long count, unsigned long long seed, loc_list *L) {
+    int np = sfb_surface_param_face_count(surf), nlive = 0, i, triangles;
+    sfb_patch_info pi;
     int *live = (int *)malloc(((size_t)np + 1) * sizeof(int));
     sfb_location *probe = (sfb_location *)malloc(((size_t)np + 1) * sizeof(sfb_location));
     float *pos = (float *)malloc(((size_t)np + 1) * 3 * sizeof(float));
     int ok = 0;
     if (!live || !probe || !pos) goto done;
+    if (sfb_surface_patch_info(surf, &pi) != SFB_SUCCESS) {
+        cli_error("%s", sfb_last_error(ctx));
+        goto done;
+    }
+    triangles = pi.domain_sides == 3; /* sample u + v <= 1 */
     for (i = 0; i < np; ++i) live[nlive++] = i;
     for (;;) {
         sfb_eval_output eo;
@@ -768,9 +774,9 @@ done:
 }
 
 /* eval's locations: from --locations, or --random on the faces that are not holes. */
-static int eval_locations(sfb_context *ctx, const sfb_surface *surf, const cli_opts *o, sfb_scheme scheme, loc_list *L) {
+static int eval_locations(sfb_context *ctx, const sfb_surface *surf, const cli_opts *o, loc_list *L) {
     if (o->locfile) return read_locations(o->locfile, L);
-    return random_locations(ctx, surf, scheme == SFB_SCHEME_LOOP, o->nrandom, (unsigned long long)o->seed, L);
+    return random_locations(ctx, surf, o->nrandom, (unsigned long long)o->seed, L);
 }
 
 /* One line per location: face u v, position, normal[, du, dv]. */
@@ -809,7 +815,7 @@ static int cmd_eval(cli_opts *o) {
     mesh = cli_load_obj(ctx, o->in);
     if (!mesh) goto done;
     surf = make_patch_surface(ctx, mesh, o->in, scheme, o->weights);
-    if (!surf || !eval_locations(ctx, surf, o, scheme, &L)) goto done;
+    if (!surf || !eval_locations(ctx, surf, o, &L)) goto done;
     n = (size_t)L.count;
     buf = (float *)malloc((n + 1) * 12 * sizeof(float));
     if (!buf) { cli_error("out of memory"); goto done; }
@@ -1023,9 +1029,13 @@ typedef struct render_state {
     sfb_image img;
 } render_state;
 
+/* Whether render draws the scheme's tessellated patches (a scheme without subdivision shading:
+ * the manifold blend) rather than its shaded refinement. */
+static int render_tessellates(const cli_opts *o) { return !(sfb_scheme_caps((sfb_scheme)o->scheme) & SFB_SCHEME_CAN_SHADE); }
+
 /* The option combinations render refuses: 0, or usage_error()'s status. */
 static int render_check(cli_opts *o) {
-    int manifold = o->scheme == SFB_SCHEME_MANIFOLD_BLEND;
+    int manifold = render_tessellates(o);
     if (o->seen[O_MODE] > 1) return usage_error(o->cmd, "render takes one of --highlight, --blend-weights, --normal-colors");
     if (!manifold && (o->seen[O_RATE] || o->trim))
         return usage_error(o->cmd, "--rate and --trim belong to --scheme manifold (the subdivision schemes render their shaded refinement)");
@@ -1101,7 +1111,7 @@ static void png_to_file(void *user, void *data, int size) {
 static void render_summary(const cli_opts *o, const render_state *s) {
     static const char *mode_names[4] = { "shading", "highlight lines", "blend weights", "normal colours" };
     char what[256], field[64] = "";
-    int manifold = o->scheme == SFB_SCHEME_MANIFOLD_BLEND;
+    int manifold = render_tessellates(o);
     if (o->mode != SFB_RENDER_WEIGHTS && !manifold) snprintf(field, sizeof field, " of the %s normals", normal_names[o->normals]);
     snprintf(what, sizeof what, "render %s%s, %dx%d (%d object pixels%s):", mode_names[o->mode], field, s->img.width, s->img.height,
              s->img.object_pixels, s->img.skipped_faces ? ", faces with non-finite positions skipped" : "");
@@ -1123,7 +1133,7 @@ static int cmd_render(cli_opts *o) {
     if (!load_trim(o, &s.mask, &s.texels)) return 1;
     s.ctx = cli_make_context(o->backend);
     if (!s.ctx) goto done;
-    if (o->scheme == SFB_SCHEME_MANIFOLD_BLEND ? !render_manifold_mesh(o, &s) : !shade_mesh(s.ctx, o, &s.mesh, &s.surf, &s.data)) goto done;
+    if (render_tessellates(o) ? !render_manifold_mesh(o, &s) : !shade_mesh(s.ctx, o, &s.mesh, &s.surf, &s.data)) goto done;
     if (!render_draw(o, &s) || !cli_output_open(&out, o->outp)) goto done;
     if (!stbi_write_png_to_func(png_to_file, out.f, s.img.width, s.img.height, 4, s.img.rgba, s.img.width * 4)) {
         cli_error("encoding the PNG failed (out of memory)");

@@ -109,11 +109,23 @@ static void sfb__simd_write(const sfb__simd_pjob *j, int q, double res[6][3], co
             for (c = 0; c < 3; ++c) dst[k][3 * (size_t)q + c] = (float)src[k][c];
 }
 
-static double sfb__simd_ipow(double x, int m) {
-    double r = 1.0;
-    for (; m > 0; m >>= 1, x *= x)
-        if (m & 1) r *= x;
-    return r;
+/* The end of the Stam locations beyond the packed levels: res (in the patch's (s, t)) scaled
+ * to the location's parametric face by the locate scale sc, the normal from the finite frame
+ * nres; a frame whose normal under- or overflows goes to the ref kernel. */
+static void sfb__simd_far_finish(const sfb__simd_pjob *j, int q, double sc, double res[6][3], double nres[2][3]) {
+    double nrm[3], len;
+    int c;
+    nrm[0] = nres[0][1] * nres[1][2] - nres[0][2] * nres[1][1];
+    nrm[1] = nres[0][2] * nres[1][0] - nres[0][0] * nres[1][2];
+    nrm[2] = nres[0][0] * nres[1][1] - nres[0][1] * nres[1][0];
+    len = sqrt(nrm[0] * nrm[0] + nrm[1] * nrm[1] + nrm[2] * nrm[2]);
+    if (j->out->normal && !(len > 0.0 && len <= 1e300)) { sfb__simd_ref_one(j, q); return; }
+    for (c = 0; c < 3; ++c) {
+        if (j->out->normal) nrm[c] /= len;
+        res[1][c] *= sc; res[2][c] *= sc;
+        res[3][c] *= sc * sc; res[4][c] *= sc * sc; res[5][c] *= sc * sc;
+    }
+    sfb__simd_write(j, q, res, nrm);
 }
 
 /* Unit normal from window tangents du, dv (lanes 0..2), or 0 where float cannot be trusted to

@@ -25,98 +25,18 @@ static void sfb__simd_basis(float t, float b[4], float d[4], float dd[4]) {
     }
 }
 
-/* A Stam location nearer the EV than the stored levels: the eigen-structure sums of ref's
- * kernel in double (integer powers instead of pow, only the outputs asked for). The EV
- * itself and degenerate tangents go to ref. */
+/* A Stam location nearer the EV than the stored levels: ref's own evaluation
+ * (sfb__eval_stam, only the outputs asked for) and a normal from its finite tangent frame;
+ * a degenerate frame goes to the ref kernel (its normal fallbacks). */
 static void sfb__simd_stam_far(const sfb__simd_pjob *j, int q) {
     const sfb__patch_table *pt = j->pt;
     const sfb_location *l = &j->locs[q];
-    double s, t, sc, u, v, uu, vv, J[2][2], bu[4], du[4], ddu[4], bv[4], dv[4], ddv[4], w[6][16];
-    double acc[6][3], res[6][3], nres[2][3], nrm[3], len, sub, sc1, sc2;
+    double s, t, sc, res[6][3], nres[2][3];
     const sfb__eigen_cc *e;
-    const double *phi;
-    const int *cv;
-    const int p = sfb__patch_locate(pt, l->face, l->u, l->v, &s, &t, &sc), nw = j->second ? 6 : 3;
-    int n = 1, k, i, jj, c, m;
+    const int p = sfb__patch_locate(pt, l->face, l->u, l->v, &s, &t, &sc);
     if (p < 0 || pt->ptype[p] != SFB__PATCH_STAM || !(e = pt->eig[pt->pvalence[p]])) { sfb__simd_ref_one(j, q); return; }
-    switch (SFB__PARAM_CORNER(pt->pparam[p])) {
-    default: u = s; v = t; J[0][0] = 1; J[0][1] = 0; J[1][0] = 0; J[1][1] = 1; break;
-    case 1: u = t; v = 1.0 - s; J[0][0] = 0; J[0][1] = 1; J[1][0] = -1; J[1][1] = 0; break;
-    case 2: u = 1.0 - s; v = 1.0 - t; J[0][0] = -1; J[0][1] = 0; J[1][0] = 0; J[1][1] = -1; break;
-    case 3: u = 1.0 - t; v = s; J[0][0] = 0; J[0][1] = -1; J[1][0] = 1; J[1][1] = 0; break;
-    }
-    if (u == 0.0 && v == 0.0) { sfb__simd_ref_one(j, q); return; }
-    while (u < 0.5 && v < 0.5) { u *= 2.0; v *= 2.0; ++n; }
-    if (v < 0.5) { k = 1; uu = 2.0 * u - 1.0; vv = 2.0 * v; }
-    else if (u < 0.5) { k = 3; uu = 2.0 * u; vv = 2.0 * v - 1.0; }
-    else { k = 2; uu = 2.0 * u - 1.0; vv = 2.0 * v - 1.0; }
-    for (i = 0; i < 2; ++i) {
-        const double x = i ? vv : uu, x2 = x * x, x3 = x2 * x, y = 1.0 - x;
-        double *b = i ? bv : bu, *d = i ? dv : du, *dd = i ? ddv : ddu;
-        b[0] = y * y * y / 6.0; b[1] = (3.0 * x3 - 6.0 * x2 + 4.0) / 6.0; b[2] = (-3.0 * x3 + 3.0 * x2 + 3.0 * x + 1.0) / 6.0; b[3] = x3 / 6.0;
-        d[0] = -0.5 * y * y; d[1] = 1.5 * x2 - 2.0 * x; d[2] = -1.5 * x2 + x + 0.5; d[3] = 0.5 * x2;
-        dd[0] = y; dd[1] = 3.0 * x - 2.0; dd[2] = -3.0 * x + 1.0; dd[3] = x;
-    }
-    for (jj = 0; jj < 16; ++jj) {
-        const int a = jj % 4, b = jj / 4;
-        w[0][jj] = bu[a] * bv[b]; w[1][jj] = du[a] * bv[b]; w[2][jj] = bu[a] * dv[b];
-        w[3][jj] = ddu[a] * bv[b]; w[4][jj] = du[a] * dv[b]; w[5][jj] = bu[a] * ddv[b];
-    }
-    memset(acc, 0, sizeof acc);
-    sub = e->sub;
-    phi = e->phi + (size_t)(k - 1) * 16 * (size_t)e->K;
-    cv = pt->cv + pt->pfirst[p];
-    for (i = 0; i < e->K; ++i) {
-        /* position: lambda^(n-1); derivatives normalised by sub^(n-1) (finite down to the EV) */
-        const double lp = sfb__simd_ipow(e->lambda[i], n - 1), ln = i == e->dominant ? 0.0 : sfb__simd_ipow(e->lambda[i] / sub, n - 1);
-        const float *pnt = pt->point_data + 3 * (size_t)cv[i];
-        const double *ph = phi + i;
-        double f[6] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
-        /* the eigenbasis function i and its derivatives at (uu, vv); named accumulators keep
-         * the sums in registers */
-        if (nw == 3) {
-            double f0 = 0.0, f1 = 0.0, f2 = 0.0;
-            for (jj = 0; jj < 16; ++jj, ph += e->K) { f0 += w[0][jj] * *ph; f1 += w[1][jj] * *ph; f2 += w[2][jj] * *ph; }
-            f[0] = f0; f[1] = f1; f[2] = f2;
-        } else {
-            double f0 = 0.0, f1 = 0.0, f2 = 0.0, f3 = 0.0, f4 = 0.0, f5 = 0.0;
-            for (jj = 0; jj < 16; ++jj, ph += e->K) {
-                f0 += w[0][jj] * *ph; f1 += w[1][jj] * *ph; f2 += w[2][jj] * *ph;
-                f3 += w[3][jj] * *ph; f4 += w[4][jj] * *ph; f5 += w[5][jj] * *ph;
-            }
-            f[0] = f0; f[1] = f1; f[2] = f2; f[3] = f3; f[4] = f4; f[5] = f5;
-        }
-        f[0] *= lp;
-        for (m = 1; m < nw; ++m) f[m] *= ln;
-        for (m = 0; m < nw; ++m)
-            for (c = 0; c < 3; ++c) acc[m][c] += f[m] * pnt[c];
-    }
-    sc1 = sfb__simd_ipow(sub, n - 1) * ldexp(1.0, n) * sc;
-    sc2 = sfb__simd_ipow(sub, n - 1) * ldexp(1.0, 2 * n) * sc * sc;
-    for (c = 0; c < 3; ++c) {
-        nres[0][c] = acc[1][c] * J[0][0] + acc[2][c] * J[1][0];
-        nres[1][c] = acc[1][c] * J[0][1] + acc[2][c] * J[1][1];
-    }
-    nrm[0] = nres[0][1] * nres[1][2] - nres[0][2] * nres[1][1];
-    nrm[1] = nres[0][2] * nres[1][0] - nres[0][0] * nres[1][2];
-    nrm[2] = nres[0][0] * nres[1][1] - nres[0][1] * nres[1][0];
-    len = sqrt(nrm[0] * nrm[0] + nrm[1] * nrm[1] + nrm[2] * nrm[2]);
-    if (j->out->normal && !(len > 0.0 && len <= 1e300)) { sfb__simd_ref_one(j, q); return; }
-    for (c = 0; c < 3; ++c) {
-        const double Puu = acc[3][c], Puv = acc[4][c], Pvv = acc[5][c];
-        if (j->out->normal) nrm[c] /= len;
-        res[0][c] = acc[0][c];
-        res[1][c] = nres[0][c] * sc1;
-        res[2][c] = nres[1][c] * sc1;
-        if (j->second) {
-            res[3][c] = sc2 * (Puu * J[0][0] * J[0][0] + 2.0 * Puv * J[0][0] * J[1][0] + Pvv * J[1][0] * J[1][0]);
-            res[4][c] = sc2 * (Puu * J[0][0] * J[0][1] + Puv * (J[0][0] * J[1][1] + J[0][1] * J[1][0]) + Pvv * J[1][0] * J[1][1]);
-            res[5][c] = sc2 * (Puu * J[0][1] * J[0][1] + 2.0 * Puv * J[0][1] * J[1][1] + Pvv * J[1][1] * J[1][1]);
-        } else {
-            res[3][c] = res[4][c] = res[5][c] = 0.0;
-        }
-    }
-    sfb__simd_write(j, q, res, nrm);
+    sfb__eval_stam(e, pt->point_data, pt->cv + pt->pfirst[p], SFB__PARAM_CORNER(pt->pparam[p]), s, t, j->second ? 6 : 3, res, nres);
+    sfb__simd_far_finish(j, q, sc, res, nres);
 }
 
 /* Locates location q (in float: exact, as above) and prepares its slot; prefetches the window. */

@@ -3,130 +3,20 @@
  * packed levels, the quartic Bezier triangle kernels per instruction set (in double), and
  * packing the triangles. Layout and numerics: patches.h. */
 
-/* Quartic Bernstein basis on a triangle in double, the table's point order (row j by row in
- * t, s rising in a row): B[0..5][15] = value, d/ds, d/dt, d2/ds2, d2/dsdt, d2/dt2 (the last three
- * only when nw = 6). Powers up to 4 of s, t and w = 1 - s - t, and the binomial weights. */
-static void sfb__simd_bez15(double s, double t, int nw, double B[6][15]) {
-    static const double mult[15] = {1, 4, 6, 4, 1, 4, 12, 12, 4, 6, 12, 6, 4, 4, 1};
-    double ps[5], pt[5], pw[5];
-    int i, j, q = 0;
-    const double w = 1.0 - s - t;
-    ps[0] = pt[0] = pw[0] = 1.0;
-    for (i = 1; i < 5; ++i) { ps[i] = ps[i - 1] * s; pt[i] = pt[i - 1] * t; pw[i] = pw[i - 1] * w; }
-    for (j = 0; j <= 4; ++j)
-        for (i = 0; i + j <= 4; ++i, ++q) {
-            const int k = 4 - i - j;
-            const double c = mult[q];
-            /* s^a t^b w^c with negative exponents as 0 */
-#define SFB__SIMD_M(a, b, e) ((a) < 0 || (b) < 0 || (e) < 0 ? 0.0 : ps[(a) < 0 ? 0 : (a)] * pt[(b) < 0 ? 0 : (b)] * pw[(e) < 0 ? 0 : (e)])
-            B[0][q] = c * SFB__SIMD_M(i, j, k);
-            B[1][q] = c * (i * SFB__SIMD_M(i - 1, j, k) - k * SFB__SIMD_M(i, j, k - 1));
-            B[2][q] = c * (j * SFB__SIMD_M(i, j - 1, k) - k * SFB__SIMD_M(i, j, k - 1));
-            if (nw > 3) {
-                B[3][q] = c * (i * (i - 1) * SFB__SIMD_M(i - 2, j, k) - 2 * i * k * SFB__SIMD_M(i - 1, j, k - 1) + k * (k - 1) * SFB__SIMD_M(i, j, k - 2));
-                B[4][q] = c * (i * j * SFB__SIMD_M(i - 1, j - 1, k) - i * k * SFB__SIMD_M(i - 1, j, k - 1) - j * k * SFB__SIMD_M(i, j - 1, k - 1) +
-                               k * (k - 1) * SFB__SIMD_M(i, j, k - 2));
-                B[5][q] = c * (j * (j - 1) * SFB__SIMD_M(i, j - 2, k) - 2 * j * k * SFB__SIMD_M(i, j - 1, k - 1) + k * (k - 1) * SFB__SIMD_M(i, j, k - 2));
-            }
-#undef SFB__SIMD_M
-        }
-}
-
-/* A Stam-Loop location nearer the EV than the packed levels: ref's eigen-structure sums in
- * double (integer powers, the Jordan term of valence 3, only the outputs asked for). The EV
- * itself and degenerate tangents go to ref. */
+/* A Stam-Loop location nearer the EV than the packed levels: ref's own evaluation
+ * (sfb__eval_stam_loop, only the outputs asked for), finished as sfb__simd_stam_far. */
 static void sfb__simd_loop_far(const sfb__simd_pjob *j, int q) {
     const sfb__patch_table *pt = j->pt;
     const sfb_location *l = &j->locs[q];
-    double s, t, sc, u, v, ss, tt, J[2][2], B[6][15], f[SFB__STAM_MAX_VALENCE + 6][6];
-    double acc[6][3], res[6][3], nres[2][3], nrm[3], len, sub, subm, sign = 1.0, sc1, sc2;
+    double s, t, sc, res[6][3], nres[2][3];
     const sfb__eigen_loop *e;
-    const double *phi;
-    const int *cv;
-    const int p = sfb__patch_locate(pt, l->face, l->u, l->v, &s, &t, &sc), nw = j->second ? 6 : 3;
-    int n = 1, k, i, jj, c, m, w;
+    const int p = sfb__patch_locate(pt, l->face, l->u, l->v, &s, &t, &sc);
     if (p < 0 || pt->ptype[p] != SFB__PATCH_STAM_LOOP || !(e = pt->eigl[pt->pvalence[p]]) || e->K > SFB__STAM_MAX_VALENCE + 6) {
         sfb__simd_ref_one(j, q);
         return;
     }
-    switch (SFB__PARAM_CORNER(pt->pparam[p])) {
-    default: u = s; v = t; J[0][0] = 1; J[0][1] = 0; J[1][0] = 0; J[1][1] = 1; break;
-    case 1: u = t; v = 1.0 - s - t; J[0][0] = 0; J[0][1] = 1; J[1][0] = -1; J[1][1] = -1; break;
-    case 2: u = 1.0 - s - t; v = s; J[0][0] = -1; J[0][1] = -1; J[1][0] = 1; J[1][1] = 0; break;
-    }
-    if (u < 0.0) u = 0.0;
-    if (v < 0.0) v = 0.0;
-    if (u + v == 0.0) { sfb__simd_ref_one(j, q); return; }
-    while (u + v < 0.5) { u *= 2.0; v *= 2.0; ++n; }
-    if (u >= 0.5) { k = 0; ss = 2.0 * u - 1.0; tt = 2.0 * v; }
-    else if (v >= 0.5) { k = 1; ss = 2.0 * u; tt = 2.0 * v - 1.0; }
-    else { k = 2; ss = 1.0 - 2.0 * u; tt = 1.0 - 2.0 * v; sign = -1.0; }
-    m = n - 1;
-    sfb__simd_bez15(ss, tt, nw, B);
-    phi = e->phi + (size_t)k * 15 * (size_t)e->K;
-    for (i = 0; i < e->K; ++i) {
-        /* eigenbasis function i and its derivatives at (ss, tt); named accumulators keep the
-         * sums in registers */
-        const double *ph = phi + i;
-        double f0 = 0.0, f1 = 0.0, f2 = 0.0, f3 = 0.0, f4 = 0.0, f5 = 0.0;
-        if (nw == 3) {
-            for (jj = 0; jj < 15; ++jj, ph += e->K) { f0 += B[0][jj] * *ph; f1 += B[1][jj] * *ph; f2 += B[2][jj] * *ph; }
-        } else {
-            for (jj = 0; jj < 15; ++jj, ph += e->K) {
-                f0 += B[0][jj] * *ph; f1 += B[1][jj] * *ph; f2 += B[2][jj] * *ph;
-                f3 += B[3][jj] * *ph; f4 += B[4][jj] * *ph; f5 += B[5][jj] * *ph;
-            }
-        }
-        f[i][0] = f0; f[i][1] = f1; f[i][2] = f2; f[i][3] = f3; f[i][4] = f4; f[i][5] = f5;
-    }
-    memset(acc, 0, sizeof acc);
-    sub = e->sub;
-    subm = sfb__simd_ipow(sub, m);
-    cv = pt->cv + pt->pfirst[p];
-    for (i = 0; i < e->K; ++i) {
-        /* position: lambda^m; derivatives normalised by sub^m (finite down to the EV) */
-        const float *pnt = pt->point_data + 3 * (size_t)cv[i];
-        const double lp = sfb__simd_ipow(e->lambda[i], m), ln = i == e->dominant ? 0.0 : sfb__simd_ipow(e->lambda[i] / sub, m);
-        double g[6];
-        for (w = 0; w < nw; ++w) g[w] = (w ? ln : lp) * f[i][w];
-        if (e->head[i] >= 0 && m > 0) {
-            /* the second vector of a Jordan block: m lambda^(m-1) of its head's function */
-            const int hd = e->head[i];
-            const double jl = m * sfb__simd_ipow(e->lambda[i], m - 1), jn = jl / subm;
-            for (w = 0; w < nw; ++w) g[w] += (w ? jn : jl) * f[hd][w];
-        }
-        {
-            const double x = pnt[0], y = pnt[1], z = pnt[2];
-            for (w = 0; w < nw; ++w) { acc[w][0] += g[w] * x; acc[w][1] += g[w] * y; acc[w][2] += g[w] * z; }
-        }
-    }
-    sc1 = subm * ldexp(1.0, n) * sc;
-    sc2 = subm * ldexp(1.0, 2 * n) * sc * sc;
-    for (c = 0; c < 3; ++c) {
-        const double Pu = sign * acc[1][c], Pv = sign * acc[2][c];
-        nres[0][c] = Pu * J[0][0] + Pv * J[1][0];
-        nres[1][c] = Pu * J[0][1] + Pv * J[1][1];
-    }
-    nrm[0] = nres[0][1] * nres[1][2] - nres[0][2] * nres[1][1];
-    nrm[1] = nres[0][2] * nres[1][0] - nres[0][0] * nres[1][2];
-    nrm[2] = nres[0][0] * nres[1][1] - nres[0][1] * nres[1][0];
-    len = sqrt(nrm[0] * nrm[0] + nrm[1] * nrm[1] + nrm[2] * nrm[2]);
-    if (j->out->normal && !(len > 0.0 && len <= 1e300)) { sfb__simd_ref_one(j, q); return; }
-    for (c = 0; c < 3; ++c) {
-        const double Puu = acc[3][c], Puv = acc[4][c], Pvv = acc[5][c];
-        if (j->out->normal) nrm[c] /= len;
-        res[0][c] = acc[0][c];
-        res[1][c] = nres[0][c] * sc1;
-        res[2][c] = nres[1][c] * sc1;
-        if (j->second) {
-            res[3][c] = sc2 * (Puu * J[0][0] * J[0][0] + 2.0 * Puv * J[0][0] * J[1][0] + Pvv * J[1][0] * J[1][0]);
-            res[4][c] = sc2 * (Puu * J[0][0] * J[0][1] + Puv * (J[0][0] * J[1][1] + J[0][1] * J[1][0]) + Pvv * J[1][0] * J[1][1]);
-            res[5][c] = sc2 * (Puu * J[0][1] * J[0][1] + 2.0 * Puv * J[0][1] * J[1][1] + Pvv * J[1][1] * J[1][1]);
-        } else {
-            res[3][c] = res[4][c] = res[5][c] = 0.0;
-        }
-    }
-    sfb__simd_write(j, q, res, nrm);
+    sfb__eval_stam_loop(e, pt->point_data, pt->cv + pt->pfirst[p], SFB__PARAM_CORNER(pt->pparam[p]), s, t, j->second ? 6 : 3, res, nres);
+    sfb__simd_far_finish(j, q, sc, res, nres);
 }
 
 /* prep for a Loop table: the triangle descent of sfb__patch_locate, in double with ref's very
@@ -395,8 +285,8 @@ static int sfb__simd_pack_stam_loop(float *g, const sfb__patch_table *pt, int p)
                 for (c = 0; c < 3; ++c) q[k][jj][c] = 0.0;
                 for (i = 0; i < K; ++i) {
                     const float *c_i = pt->point_data + 3 * (size_t)cv[i];
-                    double w = sfb__simd_ipow(e->lambda[i], m) * phi[i];
-                    if (e->head[i] >= 0 && e->head[i] < K && m > 0) w += m * sfb__simd_ipow(e->lambda[i], m - 1) * phi[e->head[i]];
+                    double w = sfb__ipow(e->lambda[i], m) * phi[i];
+                    if (e->head[i] >= 0 && e->head[i] < K && m > 0) w += m * sfb__ipow(e->lambda[i], m - 1) * phi[e->head[i]];
                     for (c = 0; c < 3; ++c) q[k][jj][c] += w * c_i[c];
                 }
             }

@@ -280,12 +280,15 @@ void sfb__eval_endcap(const float *pts, const int *cv, double s, double t, doubl
 }
 
 /* Stam: (s,t) in the patch, the EV at frame corner `corner`. nres[2] gets the derivatives
- * divided by sub^(n-1) 2^n (a finite tangent frame down to the EV). */
-void sfb__eval_stam(const sfb__eigen_cc *e, const float *pts, const int *cv, int corner, double s, double t, double res[6][3],
-                           double nres[2][3]) {
-    int K = e->K, i, j, c, k, n = 1, at_ev;
-    double u, v, J[2][2], bu[4], du[4], ddu[4], bv[4], dv[4], ddv[4], uu, vv;
-    double sr[6][3], nr[2][3];
+ * divided by sub^(n-1) 2^n (a finite tangent frame down to the EV). nw = 3 computes P and the
+ * first derivatives only (res[3..5] = 0), nw = 6 the second derivatives too. Powers are
+ * integer powers (repeated squaring), so every backend that calls this gets ref's very sums
+ * (the simd backend does, for the locations nearer the EV than its packed levels). */
+void sfb__eval_stam(const sfb__eigen_cc *e, const float *pts, const int *cv, int corner, double s, double t, int nw,
+                    double res[6][3], double nres[2][3]) {
+    int K = e->K, i, j, c, k, n = 1, at_ev, m;
+    double u, v, J[2][2], bu[4], du[4], ddu[4], bv[4], dv[4], ddv[4], uu, vv, w[6][16];
+    double sr[6][3], nr[2][3], sc1, sc2;
     const double *phi;
     switch (corner) {
     default: u = s; v = t; J[0][0] = 1; J[0][1] = 0; J[1][0] = 0; J[1][1] = 1; break;
@@ -308,22 +311,38 @@ void sfb__eval_stam(const sfb__eigen_cc *e, const float *pts, const int *cv, int
     }
     sfb__bspline_basis(uu, bu, du, ddu);
     sfb__bspline_basis(vv, bv, dv, ddv);
+    for (j = 0; j < 16; ++j) {
+        const int a = j % 4, b = j / 4;
+        w[0][j] = bu[a] * bv[b]; w[1][j] = du[a] * bv[b]; w[2][j] = bu[a] * dv[b];
+        w[3][j] = ddu[a] * bv[b]; w[4][j] = du[a] * dv[b]; w[5][j] = bu[a] * ddv[b];
+    }
     phi = e->phi + (size_t)(k - 1) * 16 * K;
+    m = n - 1;
     for (i = 0; i < K; ++i) {
         double f[6] = {0, 0, 0, 0, 0, 0}, lp, ln;
         const float *p = pts + 3 * (size_t)cv[i];
-        for (j = 0; j < 16; ++j) {
-            double ph = phi[(size_t)j * K + i];
-            int a = j % 4, b = j / 4;
-            f[0] += bu[a] * bv[b] * ph; f[1] += du[a] * bv[b] * ph; f[2] += bu[a] * dv[b] * ph;
-            f[3] += ddu[a] * bv[b] * ph; f[4] += du[a] * dv[b] * ph; f[5] += bu[a] * ddv[b] * ph;
+        const double *ph = phi + i;
+        /* the eigenbasis function i and its derivatives at (uu, vv); named accumulators keep
+         * the sums in registers */
+        if (nw <= 3) {
+            double f0 = 0.0, f1 = 0.0, f2 = 0.0;
+            for (j = 0; j < 16; ++j, ph += K) { f0 += w[0][j] * *ph; f1 += w[1][j] * *ph; f2 += w[2][j] * *ph; }
+            f[0] = f0; f[1] = f1; f[2] = f2;
+        } else {
+            double f0 = 0.0, f1 = 0.0, f2 = 0.0, f3 = 0.0, f4 = 0.0, f5 = 0.0;
+            for (j = 0; j < 16; ++j, ph += K) {
+                f0 += w[0][j] * *ph; f1 += w[1][j] * *ph; f2 += w[2][j] * *ph;
+                f3 += w[3][j] * *ph; f4 += w[4][j] * *ph; f5 += w[5][j] * *ph;
+            }
+            f[0] = f0; f[1] = f1; f[2] = f2; f[3] = f3; f[4] = f4; f[5] = f5;
         }
         if (at_ev) {
             lp = i == e->dominant ? 1.0 : 0.0;
             ln = (i != e->dominant && fabs(fabs(e->lambda[i]) - e->sub) <= 1e-12) ? 1.0 : 0.0;
         } else {
-            lp = pow(e->lambda[i], n - 1);
-            ln = i == e->dominant ? 0.0 : pow(e->lambda[i] / e->sub, n - 1);
+            /* position: lambda^(n-1); derivatives normalised by sub^(n-1) (finite down to the EV) */
+            lp = sfb__ipow(e->lambda[i], m);
+            ln = i == e->dominant ? 0.0 : sfb__ipow(e->lambda[i] / e->sub, m);
         }
         for (c = 0; c < 3; ++c) {
             sr[0][c] += lp * f[0] * p[c];
@@ -334,12 +353,13 @@ void sfb__eval_stam(const sfb__eigen_cc *e, const float *pts, const int *cv, int
             sr[5][c] += ln * f[5] * p[c];
         }
     }
-    sfb__stam_finish(J, at_ev ? 1.0 : pow(e->sub, n - 1) * ldexp(1.0, n), at_ev ? 0.0 : pow(e->sub, n - 1) * ldexp(1.0, 2 * n), sr, nr,
-                     res, nres);
+    sc1 = at_ev ? 1.0 : sfb__ipow(e->sub, m) * ldexp(1.0, n);
+    sc2 = at_ev || nw <= 3 ? 0.0 : sfb__ipow(e->sub, m) * ldexp(1.0, 2 * n);
+    sfb__stam_finish(J, sc1, sc2, sr, nr, res, nres);
 }
 
 /* The Stam kind's evaluator (sfb__patch_kind, patch/table.c): res and the normalised tangent frame. */
 void sfb__kind_stam(const sfb__patch_table *pt, const float *pts, int patch, const int *cv, double s, double t, double res[6][3],
                     double dir[2][3]) {
-    sfb__eval_stam(pt->eig[pt->pvalence[patch]], pts, cv, SFB__PARAM_CORNER(pt->pparam[patch]), s, t, res, dir);
+    sfb__eval_stam(pt->eig[pt->pvalence[patch]], pts, cv, SFB__PARAM_CORNER(pt->pparam[patch]), s, t, 6, res, dir);
 }

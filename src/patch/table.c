@@ -90,6 +90,13 @@ void sfb__endcap_normal(const float *pts, const int *cv, int nc, double s, doubl
  * (row 0) and the second derivatives (rows 3..5) in the EV frame's (u,v); J = d(u,v)/d(s,t).
  * Writes res (P, Ps, Pt, Pss, Pst, Ptt; first derivatives times sc1, second times sc2) and nres
  * (the normalised first derivatives in (s,t)). */
+double sfb__ipow(double x, int m) {
+    double r = 1.0;
+    for (; m > 0; m >>= 1, x *= x)
+        if (m & 1) r *= x;
+    return r;
+}
+
 void sfb__stam_finish(double J[2][2], double sc1, double sc2, double sr[6][3], double nr[2][3], double res[6][3],
                              double nres[2][3]) {
     int c;

@@ -199,30 +199,31 @@ sfb_result sfb__pb_face_tri(sfb__pbuild *b, sfb__wlevel *w, int g, int level, in
 /* ---- ref evaluation ---- */
 
 /* Quartic Bernstein basis on a triangle, our point order (row by row in t, s rising in a
- * row): B[0..5][15] = value, d/ds, d/dt, d2/ds2, d2/dsdt, d2/dt2. */
-static double sfb__tpow(double x, int e) {
-    double r = 1.0;
-    if (e < 0) return 0.0;
-    while (e-- > 0) r *= x;
-    return r;
-}
-
-void sfb__bez15_basis(double s, double t, double B[6][15]) {
-    static const double fact[5] = {1, 1, 2, 6, 24};
-    double w = 1.0 - s - t;
+ * row): B[0..5][15] = value, d/ds, d/dt, d2/ds2, d2/dsdt, d2/dt2 (the last three only when
+ * nw = 6; nw = 3 leaves them unset). Powers up to 4 of s, t and w = 1 - s - t from tables, and
+ * the binomial weights 4! / (i! j! k!). */
+void sfb__bez15_basis(double s, double t, int nw, double B[6][15]) {
+    static const double mult[15] = {1, 4, 6, 4, 1, 4, 12, 12, 4, 6, 12, 6, 4, 4, 1};
+    double ps[5], pt[5], pw[5];
     int i, j, q = 0;
+    const double w = 1.0 - s - t;
+    ps[0] = pt[0] = pw[0] = 1.0;
+    for (i = 1; i < 5; ++i) { ps[i] = ps[i - 1] * s; pt[i] = pt[i - 1] * t; pw[i] = pw[i - 1] * w; }
     for (j = 0; j <= 4; ++j)
         for (i = 0; i + j <= 4; ++i, ++q) {
-            int k = 4 - i - j;
-            double c = 24.0 / (fact[i] * fact[j] * fact[k]);
-#define SFB__M(a, b, cc) (sfb__tpow(s, a) * sfb__tpow(t, b) * sfb__tpow(w, cc))
+            const int k = 4 - i - j;
+            const double c = mult[q];
+            /* s^a t^b w^e, 0 for a negative exponent */
+#define SFB__M(a, b, e) ((a) < 0 || (b) < 0 || (e) < 0 ? 0.0 : ps[(a) < 0 ? 0 : (a)] * pt[(b) < 0 ? 0 : (b)] * pw[(e) < 0 ? 0 : (e)])
             B[0][q] = c * SFB__M(i, j, k);
             B[1][q] = c * (i * SFB__M(i - 1, j, k) - k * SFB__M(i, j, k - 1));
             B[2][q] = c * (j * SFB__M(i, j - 1, k) - k * SFB__M(i, j, k - 1));
-            B[3][q] = c * (i * (i - 1) * SFB__M(i - 2, j, k) - 2.0 * i * k * SFB__M(i - 1, j, k - 1) + k * (k - 1) * SFB__M(i, j, k - 2));
-            B[4][q] = c * (i * j * SFB__M(i - 1, j - 1, k) - i * k * SFB__M(i - 1, j, k - 1) - j * k * SFB__M(i, j - 1, k - 1) +
-                           k * (k - 1) * SFB__M(i, j, k - 2));
-            B[5][q] = c * (j * (j - 1) * SFB__M(i, j - 2, k) - 2.0 * j * k * SFB__M(i, j - 1, k - 1) + k * (k - 1) * SFB__M(i, j, k - 2));
+            if (nw > 3) {
+                B[3][q] = c * (i * (i - 1) * SFB__M(i - 2, j, k) - 2 * i * k * SFB__M(i - 1, j, k - 1) + k * (k - 1) * SFB__M(i, j, k - 2));
+                B[4][q] = c * (i * j * SFB__M(i - 1, j - 1, k) - i * k * SFB__M(i - 1, j, k - 1) - j * k * SFB__M(i, j - 1, k - 1) +
+                               k * (k - 1) * SFB__M(i, j, k - 2));
+                B[5][q] = c * (j * (j - 1) * SFB__M(i, j - 2, k) - 2 * j * k * SFB__M(i, j - 1, k - 1) + k * (k - 1) * SFB__M(i, j, k - 2));
+            }
 #undef SFB__M
         }
 }
@@ -230,7 +231,7 @@ void sfb__bez15_basis(double s, double t, double B[6][15]) {
 void sfb__eval_beztri(const float *pts, const int *cv, double s, double t, double res[6][3]) {
     double B[6][15];
     int j, q, c;
-    sfb__bez15_basis(s, t, B);
+    sfb__bez15_basis(s, t, 6, B);
     memset(res, 0, sizeof(double) * 18);
     for (j = 0; j < 15; ++j) {
         const float *p = pts + 3 * (size_t)cv[j];
@@ -250,14 +251,16 @@ void sfb__eval_endcap_tri(const float *pts, const int *cv, double s, double t, d
     }
 }
 
-/* Stam-Loop: (s,t) in the patch, the EV at frame corner `corner`; nres as sfb__eval_stam. */
-void sfb__eval_stam_loop(const sfb__eigen_loop *e, const float *pts, const int *cv, int corner, double s, double t,
-                                double res[6][3], double nres[2][3]) {
-    int K = e->K, i, j, c, k, n = 1, at_ev, m;
-    double u, v, J[2][2], B[6][15], ss, tt, sign = 1.0;
+/* Stam-Loop: (s,t) in the patch, the EV at frame corner `corner`; nw, nres and the powers as
+ * sfb__eval_stam (the Jordan term of valence 3 included). */
+void sfb__eval_stam_loop(const sfb__eigen_loop *e, const float *pts, const int *cv, int corner, double s, double t, int nw,
+                         double res[6][3], double nres[2][3]) {
+    int K = e->K, i, j, c, k, n = 1, at_ev, m, q;
+    double u, v, J[2][2], B[6][15], ss, tt, sign = 1.0, subm, sc1, sc2;
     double sr[6][3], nr[2][3];
     double f[SFB__STAM_MAX_VALENCE + 6][6];
     const double *phi;
+    if (nw > 3) nw = 6; else nw = 3;
     switch (corner) {
     default: u = s; v = t; J[0][0] = 1; J[0][1] = 0; J[1][0] = 0; J[1][1] = 1; break;
     case 1: u = t; v = 1.0 - s - t; J[0][0] = 0; J[0][1] = 1; J[1][0] = -1; J[1][1] = -1; break;
@@ -279,35 +282,43 @@ void sfb__eval_stam_loop(const sfb__eigen_loop *e, const float *pts, const int *
         else { k = 2; ss = 1.0 - 2.0 * u; tt = 1.0 - 2.0 * v; sign = -1.0; }
     }
     m = n - 1;
-    sfb__bez15_basis(ss, tt, B);
+    sfb__bez15_basis(ss, tt, nw, B);
     phi = e->phi + (size_t)k * 15 * K;
     for (i = 0; i < K; ++i) {
-        int q;
-        for (q = 0; q < 6; ++q) f[i][q] = 0.0;
-        for (j = 0; j < 15; ++j) {
-            double ph = phi[(size_t)j * K + i];
-            for (q = 0; q < 6; ++q) f[i][q] += B[q][j] * ph;
+        /* eigenbasis function i and its derivatives at (ss, tt); named accumulators keep the
+         * sums in registers */
+        const double *ph = phi + i;
+        double f0 = 0.0, f1 = 0.0, f2 = 0.0, f3 = 0.0, f4 = 0.0, f5 = 0.0;
+        if (nw == 3) {
+            for (j = 0; j < 15; ++j, ph += K) { f0 += B[0][j] * *ph; f1 += B[1][j] * *ph; f2 += B[2][j] * *ph; }
+        } else {
+            for (j = 0; j < 15; ++j, ph += K) {
+                f0 += B[0][j] * *ph; f1 += B[1][j] * *ph; f2 += B[2][j] * *ph;
+                f3 += B[3][j] * *ph; f4 += B[4][j] * *ph; f5 += B[5][j] * *ph;
+            }
         }
+        f[i][0] = f0; f[i][1] = f1; f[i][2] = f2; f[i][3] = f3; f[i][4] = f4; f[i][5] = f5;
     }
+    subm = sfb__ipow(e->sub, m);
     for (i = 0; i < K; ++i) {
         const float *p = pts + 3 * (size_t)cv[i];
         double g[6];
-        int q;
         for (q = 0; q < 6; ++q) g[q] = 0.0;
         if (at_ev) {
             g[0] = i == e->dominant ? f[i][0] : 0.0;
             if (i != e->dominant && fabs(e->lambda[i] - e->sub) <= 1e-12)
                 for (q = 1; q < 3; ++q) g[q] = f[i][q];
         } else {
-            double lp = pow(e->lambda[i], m), ln = i == e->dominant ? 0.0 : pow(e->lambda[i] / e->sub, m);
+            /* position: lambda^m; derivatives normalised by sub^m (finite down to the EV) */
+            const double lp = sfb__ipow(e->lambda[i], m), ln = i == e->dominant ? 0.0 : sfb__ipow(e->lambda[i] / e->sub, m);
             g[0] = lp * f[i][0];
-            for (q = 1; q < 6; ++q) g[q] = ln * f[i][q];
+            for (q = 1; q < nw; ++q) g[q] = ln * f[i][q];
             if (e->head[i] >= 0 && m > 0) {
                 /* the second vector of a Jordan block: m lambda^(m-1) of its head's function */
-                int h = e->head[i];
-                double jl = m * pow(e->lambda[i], m - 1), jn = jl / pow(e->sub, m);
+                const int h = e->head[i];
+                const double jl = m * sfb__ipow(e->lambda[i], m - 1), jn = jl / subm;
                 g[0] += jl * f[h][0];
-                for (q = 1; q < 6; ++q) g[q] += jn * f[h][q];
+                for (q = 1; q < nw; ++q) g[q] += jn * f[h][q];
             }
         }
         for (c = 0; c < 3; ++c) {
@@ -320,11 +331,13 @@ void sfb__eval_stam_loop(const sfb__eigen_loop *e, const float *pts, const int *
         }
     }
     for (c = 0; c < 3; ++c) { nr[0][c] *= sign; nr[1][c] *= sign; } /* the middle sub-patch is turned */
-    sfb__stam_finish(J, at_ev ? 1.0 : pow(e->sub, m) * ldexp(1.0, n), at_ev ? 0.0 : pow(e->sub, m) * ldexp(1.0, 2 * n), sr, nr, res, nres);
+    sc1 = at_ev ? 1.0 : subm * ldexp(1.0, n);
+    sc2 = at_ev || nw == 3 ? 0.0 : subm * ldexp(1.0, 2 * n);
+    sfb__stam_finish(J, sc1, sc2, sr, nr, res, nres);
 }
 
 /* The Stam kind's evaluator (sfb__patch_kind, patch/table.c): res and the normalised tangent frame. */
 void sfb__kind_stam_loop(const sfb__patch_table *pt, const float *pts, int patch, const int *cv, double s, double t, double res[6][3],
                          double dir[2][3]) {
-    sfb__eval_stam_loop(pt->eigl[pt->pvalence[patch]], pts, cv, SFB__PARAM_CORNER(pt->pparam[patch]), s, t, res, dir);
+    sfb__eval_stam_loop(pt->eigl[pt->pvalence[patch]], pts, cv, SFB__PARAM_CORNER(pt->pparam[patch]), s, t, 6, res, dir);
 }
