@@ -32,13 +32,17 @@ PKGS_TEST := g++ libosd-dev libcriterion-dev pkg-config \
              libegl1 libegl-mesa0 libgl1-mesa-dri libosmesa6 libegl-dev libgl-dev glslang-tools
 # The CLI writes PNG pictures (surfblend render) with stb_image_write (libstb-dev, headers only).
 PKGS_CLI  := libstb-dev
+# The glTF export tool (tools/sfb2gltf.cpp, C++17): tinygltf (Debian ships it as a library, with
+# nlohmann-json for its JSON) and meshoptimizer.
+PKGS_GLTF := g++ libtinygltf-dev nlohmann-json3-dev libmeshoptimizer-dev
+GLTF_LIBS := -ltinygltf -lmeshoptimizer
 PKGS_FUZZ := clang libclang-rt-14-dev
 # The NEON kernels, cross-compiled for AArch64 and run under qemu user emulation (make test-neon).
 PKGS_NEON := gcc-aarch64-linux-gnu libc6-dev-arm64-cross qemu-user-static
 
 .PHONY: all run test check-modules test-neon deps-neon bench fuzz asan amalgamate amalgamate-check embed-glsl deps deps-test deps-fuzz clean unit-build
 
-all: $(BUILD)/surfblend
+all: $(BUILD)/surfblend $(BUILD)/sfb2gltf
 
 define need_pkgs
 	@missing=""; for p in $(1); do dpkg -s $$p >/dev/null 2>&1 || missing="$$missing $$p"; done; \
@@ -53,9 +57,9 @@ define need_pkgs
 endef
 
 deps:
-	$(call need_pkgs,$(PKGS_BASE) $(PKGS_CLI))
+	$(call need_pkgs,$(PKGS_BASE) $(PKGS_CLI) $(PKGS_GLTF))
 deps-test:
-	$(call need_pkgs,$(PKGS_BASE) $(PKGS_CLI) $(PKGS_TEST))
+	$(call need_pkgs,$(PKGS_BASE) $(PKGS_CLI) $(PKGS_GLTF) $(PKGS_TEST))
 deps-fuzz:
 	$(call need_pkgs,$(PKGS_FUZZ))
 deps-neon:
@@ -94,11 +98,18 @@ $(BUILD)/cli_common.o: tools/cli_common.c tools/cli_common.h surfblend.h
 $(BUILD)/surfblend: tools/surfblend.c tools/cli_common.h $(BUILD)/cli_common.o $(BUILD)/libsfb.o | deps
 	$(CC) $(CFLAGS) $(SAN) -I. tools/surfblend.c $(BUILD)/cli_common.o $(BUILD)/libsfb.o -o $@ $(LIBS)
 
+$(BUILD)/sfb2gltf: tools/sfb2gltf.cpp tools/cli_common.h $(BUILD)/cli_common.o $(BUILD)/libsfb.o | deps
+	$(CXX) $(subst -std=c++14,-std=c++17,$(CXXFLAGS)) $(SAN) -I. -Itools tools/sfb2gltf.cpp $(BUILD)/cli_common.o $(BUILD)/libsfb.o -o $@ $(GLTF_LIBS) $(LIBS)
+
+# reads sfb2gltf's files back (tinygltf) and compares them with the library (tests/gltf_test.sh)
+$(BUILD)/gltf_check: tests/gltf_check.cpp tests/harness.h $(BUILD)/libsfb.o | deps
+	$(CXX) $(subst -std=c++14,-std=c++17,$(CXXFLAGS)) $(SAN) -I. tests/gltf_check.cpp $(BUILD)/libsfb.o -o $@ -ltinygltf $(LIBS)
+
 $(BUILD)/examples/%: examples/%.c $(BUILD)/libsfb.o
 	@mkdir -p $(BUILD)/examples
 	$(CC) $(CFLAGS) $(SAN) -I. $< $(BUILD)/libsfb.o -o $@ $(LIBS)
 
-run: deps $(BUILD)/surfblend
+run: deps $(BUILD)/surfblend $(BUILD)/sfb2gltf
 	@mkdir -p out
 	./$(BUILD)/surfblend info examples/data/creased_box.obj
 	./$(BUILD)/surfblend refine --scheme catmark --level 3 --limit examples/data/creased_box.obj -o out/creased_box_level3.obj
@@ -131,6 +142,11 @@ run: deps $(BUILD)/surfblend
 	./$(BUILD)/surfblend render --scheme manifold --rate 8 --trim examples/data/trim_disc.png --view 35,30 --size 800x600 \
 	  examples/data/torus.obj -o out/manifold_trimmed.png
 	@echo "wrote out/manifold_features.obj out/manifold_features.png out/manifold_trimmed.png"
+	@# the main job's end: glTF 2.0 for engines and viewers -- the creased box with subdivision-shading
+	@# normals (hard edges split), and the manifold blend tessellated
+	./$(BUILD)/sfb2gltf --level 3 examples/data/creased_box.obj -o out/creased_box.glb
+	./$(BUILD)/sfb2gltf --scheme manifold --tess 16 examples/data/manifold_features.obj -o out/manifold_features.glb
+	@for f in out/creased_box.glb out/manifold_features.glb; do echo "wrote $$f ($$(wc -c < $$f) bytes)"; done
 
 # ---- tests ----
 $(BUILD)/unit: $(TEST_SRCS) $(BUILD)/libsfb.o
@@ -194,7 +210,8 @@ $(BUILD)/gl_manifold: tests/gl_manifold.c tests/harness.h tests/egl_host.h $(BUI
 	$(CC) $(CFLAGS) $(SAN) -I. tests/gl_manifold.c $(BUILD)/libsfb.o -o $@ $(GL_LIBS) $(LIBS)
 
 unit-build: $(BUILD)/surfblend $(BUILD)/unit $(BUILD)/osd_agree $(BUILD)/agree $(BUILD)/limit $(BUILD)/eigen $(BUILD)/gl_host \
-            $(BUILD)/gl_errors $(BUILD)/gl_pieces $(BUILD)/shade $(BUILD)/trim $(BUILD)/finish_normals $(BUILD)/manifold $(BUILD)/gl_manifold $(EXAMPLES)
+            $(BUILD)/gl_errors $(BUILD)/gl_pieces $(BUILD)/shade $(BUILD)/trim $(BUILD)/finish_normals $(BUILD)/manifold $(BUILD)/gl_manifold $(EXAMPLES) \
+            $(BUILD)/sfb2gltf $(BUILD)/gltf_check
 
 # On CI (CI set and not false/0) the optional backends must run, not be skipped: the suites
 # fail for a backend in SFB_REQUIRE_BACKENDS that is unavailable. CI has Mesa llvmpipe and

@@ -376,6 +376,73 @@ SFB_API void sfb_mesh_get_desc(const sfb_mesh *m, sfb_mesh_desc *d) {
     d->triangle_rule = m->triangle_rule; d->uv_interp = m->uv_interp;
 }
 
+/* Face f's Newell normal (unnormalised; twice the vector area of a planar polygon). */
+static void sfb__face_newell(const sfb_mesh *m, int f, double n[3]) {
+    const int a = m->base.fv_off[f], k = m->base.fv_off[f + 1] - a;
+    int i;
+    n[0] = n[1] = n[2] = 0.0;
+    for (i = 0; i < k; ++i) {
+        const float *p = m->positions + 3 * (size_t)m->base.fv[a + i], *q = m->positions + 3 * (size_t)m->base.fv[a + (i + 1) % k];
+        n[0] += ((double)p[1] - q[1]) * ((double)p[2] + q[2]);
+        n[1] += ((double)p[2] - q[2]) * ((double)p[0] + q[0]);
+        n[2] += ((double)p[0] - q[0]) * ((double)p[1] + q[1]);
+    }
+}
+
+SFB_API sfb_result sfb_mesh_crease_by_angle(sfb_context *ctx, const sfb_mesh *m, float degrees, sfb_mesh **out, int *added) {
+    const sfb__level *l;
+    sfb_mesh_desc d;
+    double *fn = NULL, cos_limit;
+    int *cv = NULL, e, nc = 0, nadd = 0;
+    float *cs = NULL;
+    sfb_result r;
+    if (added) *added = 0;
+    if (!ctx || !m || !out) return SFB_INVALID_ARGS;
+    *out = NULL;
+    if (!(degrees >= 0.0f && degrees <= 180.0f))
+        return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "crease angle %g is not a number of degrees in 0..180", (double)degrees);
+    l = &m->base;
+    fn = (double *)sfb__alloc(ctx, ((size_t)l->nf + 1) * 3 * sizeof(double));
+    cv = (int *)sfb__alloc(ctx, ((size_t)l->ne + 1) * 2 * sizeof(int));
+    cs = (float *)sfb__alloc(ctx, ((size_t)l->ne + 1) * sizeof(float));
+    if (!fn || !cv || !cs) {
+        sfb__free(ctx, fn); sfb__free(ctx, cv); sfb__free(ctx, cs);
+        return sfb__oom(ctx, "the crease-angle edge lists");
+    }
+    for (e = 0; e < l->nf; ++e) sfb__face_newell(m, e, fn + 3 * (size_t)e);
+    cos_limit = cos((double)degrees * 3.14159265358979323846 / 180.0);
+    for (e = 0; e < l->ne; ++e) {
+        float sharp = l->es[e];
+        if (l->ef_off[e + 1] - l->ef_off[e] == 2 && sharp < SFB_SHARPNESS_INFINITE) {
+            const int f0 = l->ef[l->ef_off[e]], f1 = l->ef[l->ef_off[e] + 1];
+            const double *a = fn + 3 * (size_t)f0, *b = fn + 3 * (size_t)f1;
+            const double la = sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]), lb = sqrt(b[0] * b[0] + b[1] * b[1] + b[2] * b[2]);
+            const int holes = (l->fhole && (l->fhole[f0] || l->fhole[f1]));
+            /* the angle is over the limit when cos(angle) < cos(limit) (180: never) */
+            if (!holes && la > 0.0 && lb > 0.0 && isfinite(la) && isfinite(lb) && degrees < 180.0f &&
+                (a[0] * b[0] + a[1] * b[1] + a[2] * b[2]) / (la * lb) < cos_limit) {
+                sharp = SFB_SHARPNESS_INFINITE;
+                ++nadd;
+            }
+        }
+        if (sharp > 0.0f) {
+            cv[2 * nc] = l->ev[2 * e];
+            cv[2 * nc + 1] = l->ev[2 * e + 1];
+            cs[nc++] = sharp;
+        }
+    }
+    sfb_mesh_get_desc(m, &d);
+    d.crease_count = nc;
+    d.crease_vertices = cv;
+    d.crease_sharpness = cs;
+    r = sfb_mesh_create(ctx, &d, out);
+    if (r == SFB_SUCCESS && added) *added = nadd;
+    sfb__free(ctx, fn);
+    sfb__free(ctx, cv);
+    sfb__free(ctx, cs);
+    return r;
+}
+
 SFB_API void sfb_mesh_get_info(const sfb_mesh *m, sfb_mesh_info *o) {
     const sfb__level *l;
     sfb__level prep;

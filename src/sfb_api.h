@@ -183,6 +183,15 @@ SFB_API void sfb_mesh_destroy(sfb_mesh *mesh);
  * (fs/as input is folded into them). */
 SFB_API void sfb_mesh_get_desc(const sfb_mesh *mesh, sfb_mesh_desc *out);
 
+/* A copy of `mesh` whose edges with a dihedral angle over `degrees` (0..180) are infinitely sharp
+ * creases: what a faceted (CAD-like) mesh with no crease tags needs for its hard edges to stay
+ * hard. The angle of an edge is the angle between the (Newell) normals of its two faces, so 0
+ * for a flat edge; edges with one face (boundaries), more than two (non-manifold), a hole face
+ * or a degenerate face keep their sharpness, as do edges that are sharper already. Everything
+ * else (UVs, corners, holes, rules) is copied. *added (may be NULL) gets the number of edges
+ * made sharp. */
+SFB_API sfb_result sfb_mesh_crease_by_angle(sfb_context *ctx, const sfb_mesh *mesh, float degrees, sfb_mesh **out, int *added);
+
 typedef int (*sfb_write_fn)(const void *data, size_t size, void *user); /* returns non-zero on failure */
 /* Writes OBJ (v, vt, f, t crease/corner/hole/interpolateboundary/creasemethod/smoothtriangles). */
 SFB_API sfb_result sfb_write_obj(const sfb_mesh_desc *desc, sfb_write_fn write, void *user);

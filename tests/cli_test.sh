@@ -109,6 +109,16 @@ edge_stats() { awk '/^f /{ for (i = 2; i <= 4; ++i) { split($i, a, "/"); v[i - 1
   END { b = 0; m = 0; for (k in u) { if (u[k] == 1) b++; else if (u[k] > 2) m++ } printf "%d %d %d\n", b, m, dup + 0 }' "$1"; }
 printf 'v -1 -1 1\nv 1 -1 1\nv -1 1 1\nv 1 1 1\nv -1 1 -1\nv 1 1 -1\nv -1 -1 -1\nv 1 -1 -1\nf 1 2 4 3\nf 3 4 6 5\nf 5 6 8 7\nf 7 8 2 1\nf 2 8 6 4\nf 7 1 3 5\n' > "$TMP/cube.obj"
 printf 'v 1 0 -1\nv 0.309017 0.951057 -1\nv -0.809017 0.587785 -1\nv -0.809017 -0.587785 -1\nv 0.309017 -0.951057 -1\nv 1 0 1\nv 0.309017 0.951057 1\nv -0.809017 0.587785 1\nv -0.809017 -0.587785 1\nv 0.309017 -0.951057 1\nf 6 7 8 9 10\nf 5 4 3 2 1\nf 1 2 7 6\nf 2 3 8 7\nf 3 4 9 8\nf 4 5 10 9\nf 5 1 6 10\n' > "$TMP/prism.obj"
+# --crease-angle (shared with sfb2gltf): the cube's 12 edges are at 90 degrees
+check "info --crease-angle 30 succeeds" 0 "$CLI" info --crease-angle 30 "$TMP/cube.obj"
+contains "--crease-angle 30 makes the cube's edges sharp" "$TMP/out" "12 infinitely sharp"
+check "info --crease-angle 120 succeeds" 0 "$CLI" info --crease-angle 120 "$TMP/cube.obj"
+contains "--crease-angle 120 leaves them smooth" "$TMP/out" "0 infinitely sharp"
+check "--crease-angle 0 is a usage error" 2 "$CLI" info --crease-angle 0 "$TMP/cube.obj"
+check "--crease-angle 181 is a usage error" 2 "$CLI" refine --crease-angle 181 "$TMP/cube.obj" -o "$TMP/o.obj"
+check "refine --crease-angle 30 succeeds" 0 "$CLI" refine --level 1 --crease-angle 30 "$TMP/cube.obj" -o "$TMP/o.obj"
+check "its output reads back" 0 "$CLI" info "$TMP/o.obj"
+contains "the refined cube keeps the sharp edges" "$TMP/out" "24 infinitely sharp"
 for r in 1 2 5; do
   check "tess cube rate $r succeeds" 0 "$CLI" tess --rate $r "$TMP/cube.obj" -o "$TMP/t.obj"
   st=$(edge_stats "$TMP/t.obj")

@@ -102,6 +102,8 @@ suite counted trim "$BUILD/trim" $(with_shapes)
 suite counted agree "$BUILD/agree" $(with_shapes)
 suite counted gl_manifold "$BUILD/gl_manifold" "$SHAPES"
 suite counted cli env BUILD="$BUILD" SHAPES="$SHAPES" ./tests/cli_test.sh
+# the glTF export tool: usage, bad input, the Khronos validator, read back against the library
+suite counted gltf env BUILD="$BUILD" SHAPES="$SHAPES" ./tests/gltf_test.sh
 suite criterion unit "$BUILD/unit" --jobs 1
 suite counted finish_normals "$BUILD/finish_normals"
 suite counted eigen "$BUILD/eigen"

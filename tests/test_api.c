@@ -792,6 +792,73 @@ Test(api, scheme_caps_and_domain)
     sfb_context_destroy(ctx);
 }
 
+/* --crease-angle's library half: the cube's 12 edges (90 degrees) become infinitely sharp for a
+ * limit under 90 and none for one over it; sharper edges keep their sharpness (not counted),
+ * semi-sharp ones under the limit stay semi-sharp, the rest of the mesh is copied. */
+Test(api, crease_by_angle)
+{
+    static const float pos[24] = { -1, -1, 1, 1, -1, 1, -1, 1, 1, 1, 1, 1, -1, 1, -1, 1, 1, -1, -1, -1, -1, 1, -1, -1 };
+    static const int sizes[6] = { 4, 4, 4, 4, 4, 4 };
+    static const int fv[24] = { 0, 1, 3, 2, 2, 3, 5, 4, 4, 5, 7, 6, 6, 7, 1, 0, 1, 7, 5, 3, 6, 0, 2, 4 };
+    static const int cv[4] = { 0, 1, 1, 3 };
+    static const float cs[2] = { 10.0f, 2.0f };
+    sfb_context *ctx = make_ctx();
+    sfb_mesh_desc d;
+    memset(&d, 0, sizeof d);
+    d.vertex_count = 8;
+    d.positions = pos;
+    d.face_count = 6;
+    d.face_sizes = sizes;
+    d.face_vertices = fv;
+    d.boundary = SFB_BOUNDARY_EDGE_AND_CORNER;
+    sfb_mesh *m = NULL, *c = NULL;
+    cr_assert_eq(sfb_mesh_create(ctx, &d, &m), SFB_SUCCESS, "%s", sfb_last_error(ctx));
+    int added = -1;
+    sfb_mesh_info in;
+    cr_assert_eq(sfb_mesh_crease_by_angle(ctx, m, 30.0f, &c, &added), SFB_SUCCESS, "%s", sfb_last_error(ctx));
+    cr_expect_eq(added, 12);
+    sfb_mesh_get_info(c, &in);
+    cr_expect_eq(in.infsharp_edges, 12);
+    sfb_mesh_desc got;
+    sfb_mesh_get_desc(c, &got);
+    cr_expect_eq(got.boundary, SFB_BOUNDARY_EDGE_AND_CORNER, "the rest is copied");
+    sfb_mesh_destroy(c);
+    c = NULL;
+    cr_assert_eq(sfb_mesh_crease_by_angle(ctx, m, 100.0f, &c, &added), SFB_SUCCESS);
+    cr_expect_eq(added, 0);
+    sfb_mesh_get_info(c, &in);
+    cr_expect_eq(in.sharp_edges, 0);
+    sfb_mesh_destroy(c);
+    c = NULL;
+    sfb_mesh_destroy(m);
+    /* one edge infinitely sharp already, one semi-sharp */
+    d.crease_count = 2;
+    d.crease_vertices = cv;
+    d.crease_sharpness = cs;
+    cr_assert_eq(sfb_mesh_create(ctx, &d, &m), SFB_SUCCESS);
+    cr_assert_eq(sfb_mesh_crease_by_angle(ctx, m, 100.0f, &c, &added), SFB_SUCCESS);
+    sfb_mesh_get_info(c, &in);
+    cr_expect_eq(added, 0);
+    cr_expect_eq(in.infsharp_edges, 1);
+    cr_expect_eq(in.semisharp_edges, 1, "the semi-sharp edge keeps its sharpness");
+    sfb_mesh_destroy(c);
+    c = NULL;
+    cr_assert_eq(sfb_mesh_crease_by_angle(ctx, m, 45.0f, &c, &added), SFB_SUCCESS);
+    sfb_mesh_get_info(c, &in);
+    cr_expect_eq(added, 11, "the infinitely sharp edge is not counted again");
+    cr_expect_eq(in.infsharp_edges, 12);
+    sfb_mesh_destroy(c);
+    c = NULL;
+    /* bad angles */
+    cr_expect_eq(sfb_mesh_crease_by_angle(ctx, m, -1.0f, &c, &added), SFB_INVALID_ARGS);
+    cr_expect_eq(sfb_mesh_crease_by_angle(ctx, m, 181.0f, &c, &added), SFB_INVALID_ARGS);
+    cr_expect_eq(sfb_mesh_crease_by_angle(ctx, m, NAN, &c, &added), SFB_INVALID_ARGS);
+    cr_expect_null(c);
+    cr_expect_eq(sfb_mesh_crease_by_angle(ctx, NULL, 30.0f, &c, &added), SFB_INVALID_ARGS);
+    sfb_mesh_destroy(m);
+    sfb_context_destroy(ctx);
+}
+
 /* the stencil tables and sfb_surface_refine agree, and refine_positions follows new positions */
 Test(api, stencils_match_refine)
 {

@@ -3,6 +3,16 @@
 #define _POSIX_C_SOURCE 200809L /* mkstemp, fdopen, fchmod, umask, stat */
 #endif
 #include "cli_common.h"
+/* trimming masks (Debian libstb-dev), private to this file: the glTF tool links tinygltf, which
+ * carries its own copy */
+#define STB_IMAGE_IMPLEMENTATION
+#define STB_IMAGE_STATIC
+#define STBI_ONLY_PNG
+#if defined(__GNUC__)
+/* the static copy leaves some of stb's API unused (reported at the end of the file) */
+#pragma GCC diagnostic ignored "-Wunused-function"
+#endif
+#include <stb/stb_image.h>
 
 #include <errno.h>
 #include <stdarg.h>
@@ -50,6 +60,13 @@ char *cli_read_file(const char *path, size_t *size) {
 }
 
 sfb_context *cli_make_context(const char *backend) {
+    sfb_progress none;
+    none.func = NULL;
+    none.user = NULL;
+    return cli_make_context_progress(backend, none);
+}
+
+sfb_context *cli_make_context_progress(const char *backend, sfb_progress progress) {
     sfb_context_config cfg = sfb_context_config_init();
     sfb_backend_kind kinds[3];
     sfb_context *ctx = NULL;
@@ -68,6 +85,7 @@ sfb_context *cli_make_context(const char *backend) {
         cfg.backend_count = 3;
         cfg.ignore_environment = 1;
     }
+    cfg.progress = progress;
     r = sfb_context_create(&cfg, &ctx);
     if (r != SFB_SUCCESS) {
         cli_error("no backend could be initialised (%s)", sfb_result_string(r));
@@ -98,6 +116,20 @@ sfb_mesh *cli_load_obj(sfb_context *ctx, const char *path) {
         return NULL;
     }
     return mesh;
+}
+
+sfb_mesh *cli_load_mesh(sfb_context *ctx, const char *path, double crease_angle) {
+    sfb_mesh *mesh = cli_load_obj(ctx, path), *creased = NULL;
+    sfb_result r;
+    int added = 0;
+    if (!mesh || crease_angle < 0.0) return mesh;
+    r = sfb_mesh_crease_by_angle(ctx, mesh, (float)crease_angle, &creased, &added);
+    sfb_mesh_destroy(mesh);
+    if (r != SFB_SUCCESS) {
+        cli_error("%s: --crease-angle: %s: %s", path, sfb_result_string(r), sfb_last_error(ctx));
+        return NULL;
+    }
+    return creased;
 }
 
 int cli_scheme_from_name(const char *s, sfb_scheme *out) { return sfb_scheme_parse(s, out); }
@@ -204,4 +236,37 @@ int cli_write_file(const char *path, const void *data, size_t size) {
 
 int cli_file_write(const void *data, size_t size, void *user) {
     return fwrite(data, 1, size, (FILE *)user) != size;
+}
+
+int cli_load_mask(const char *path, unsigned char **texels, int *w, int *h) {
+    int n = 0, j;
+    size_t row;
+    unsigned char *px, *tmp, *copy;
+    *texels = NULL;
+    px = stbi_load(path, w, h, &n, 1);
+    if (!px) {
+        cli_error("cannot read the trimming mask '%s': %s", path, stbi_failure_reason());
+        return 0;
+    }
+    row = (size_t)*w;
+    tmp = (unsigned char *)malloc(row ? row : 1);
+    copy = (unsigned char *)malloc(row * (size_t)*h > 0 ? row * (size_t)*h : 1);
+    if (!tmp || !copy) {
+        cli_error("out of memory reading '%s'", path);
+        free(tmp);
+        free(copy);
+        stbi_image_free(px);
+        return 0;
+    }
+    for (j = 0; j < *h / 2; ++j) {
+        unsigned char *a = px + (size_t)j * row, *b = px + (size_t)(*h - 1 - j) * row;
+        memcpy(tmp, a, row);
+        memcpy(a, b, row);
+        memcpy(b, tmp, row);
+    }
+    memcpy(copy, px, row * (size_t)*h);
+    free(tmp);
+    stbi_image_free(px);
+    *texels = copy;
+    return 1;
 }

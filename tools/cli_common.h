@@ -37,8 +37,20 @@ char *cli_read_file(const char *path, size_t *size);
  * no backend starts. */
 sfb_context *cli_make_context(const char *backend);
 
+/* cli_make_context with the library's progress reports (and cancellation) going to `progress`. */
+sfb_context *cli_make_context_progress(const char *backend, sfb_progress progress);
+
+/* A trimming mask (sfb_trim_mask) from the PNG at `path`: one grey byte per texel, rows
+ * flipped so that the picture's top row is v = 1 (the mask's row 0 is v = 0). 1 with *texels
+ * (free it) and the size set, or 0 with a message printed. */
+int cli_load_mask(const char *path, unsigned char **texels, int *w, int *h);
+
 /* The OBJ file at `path` ("-": standard input) as a mesh; NULL with the reason printed. */
 sfb_mesh *cli_load_obj(sfb_context *ctx, const char *path);
+
+/* cli_load_obj, then (crease_angle >= 0, degrees) the edges whose dihedral angle is over it made
+ * infinitely sharp creases (sfb_mesh_crease_by_angle): --crease-angle of every tool. */
+sfb_mesh *cli_load_mesh(sfb_context *ctx, const char *path, double crease_angle);
 
 /* catmark (or catmull-clark), loop, bilinear, manifold: 1 and *out set; 0 for another name. */
 int cli_scheme_from_name(const char *name, sfb_scheme *out);

@@ -5,14 +5,11 @@
  * Exit codes: 0 success, 1 bad input (message on stderr), 2 usage error. */
 #include "surfblend.h"
 #include "tools/cli_common.h"
-/* PNG output and trimming-mask input (Debian libstb-dev); the library itself only takes and
- * returns raw pixel buffers */
+/* PNG output (Debian libstb-dev; the trimming masks are read by cli_common.c); the library
+ * itself only takes and returns raw pixel buffers */
 #define STB_IMAGE_WRITE_IMPLEMENTATION
 #define STB_IMAGE_WRITE_STATIC
 #include <stb/stb_image_write.h>
-#define STB_IMAGE_IMPLEMENTATION
-#define STBI_ONLY_PNG
-#include <stb/stb_image.h>
 #include <math.h>
 #include <stddef.h>
 #include <stdio.h>
@@ -26,7 +23,7 @@
 enum {
     O_HELP, O_BACKEND, O_OUTPUT, O_SCHEME, O_LEVEL, O_LIMIT, O_WEIGHTS, O_LOCATIONS, O_RANDOM, O_SEED, O_DERIVATIVES,
     O_RATE, O_TOLERANCE, O_SPLIT, O_TRIM, O_TILES, O_VARIANT, O_DARTS, O_NORMALS_LEVEL, O_WEIGHTS_LEVEL, O_P,
-    O_AVERAGING, O_ALL_SUBDIVIDED, O_NORMALS, O_POSITIONS, O_MODE, O_EDGES, O_SIZE, O_VIEW, O_ZOOM, O_STRIPES,
+    O_AVERAGING, O_ALL_SUBDIVIDED, O_NORMALS, O_POSITIONS, O_MODE, O_EDGES, O_SIZE, O_VIEW, O_ZOOM, O_STRIPES, O_CREASE_ANGLE,
     O_COUNT_
 };
 
@@ -49,6 +46,7 @@ typedef struct cli_opts {
     int normals, limit_pos, mode, edges;                    /* render */
     long size[2];
     double view[2], zoom, stripes;
+    double crease_angle;                                    /* --crease-angle (seen[O_CREASE_ANGLE]) */
     int seen[O_COUNT_];
 } cli_opts;
 
@@ -187,6 +185,9 @@ static const opt_spec options[] = {
     { "--trim-tiles", NULL, K_LONG2, C_TESS | C_RENDER, O_TILES, AT(tiles), "U V", NULL, ANY_INT, 0, "two numbers U V",
       "the mask is an atlas of U x V tiles, tile t (row-major from v = 0) for\n"
       "parametric face t; later faces untrimmed (default: one mask for all)" },
+    { "--crease-angle", NULL, K_POSITIVE, C_INFO | C_SURFACE, O_CREASE_ANGLE, AT(crease_angle), "DEG", NULL, 0, 180, 0,
+      "degrees in (0, 180]", "edges whose dihedral angle is over DEG become infinitely sharp creases (a faceted\n"
+      "mesh with no crease tags; sfb_mesh_crease_by_angle)" },
     { "--backend", NULL, K_STRING, C_SURFACE, O_BACKEND, AT(backend), "NAME", NULL, 0, 0, 0, "a name",
       "ref|simd|gl|osmesa, tried first (else SURFBLEND_BACKEND, else the default order)" },
     { "-o", "--output", K_STRING, C_SURFACE, O_OUTPUT, AT(outp), "FILE", NULL, 0, 0, 0, "a file name",
@@ -642,42 +643,13 @@ static int edge_counts(const sfb_tess_data *t, long *total, long *closed, long *
     return 1;
 }
 
-/* A trimming mask from a PNG: 8-bit grey (luminance of colour pictures; alpha ignored), rows
- * flipped so that the picture's top row is v = 1 (the mask's row 0 is v = 0). Returns the
- * texels (free them), or NULL with a message printed. */
-static unsigned char *load_mask(const char *path, int *w, int *h) {
-    int n = 0, j;
-    size_t row;
-    unsigned char *px = stbi_load(path, w, h, &n, 1), *tmp;
-    if (!px) {
-        cli_error("cannot read the trimming mask '%s': %s", path, stbi_failure_reason());
-        return NULL;
-    }
-    row = (size_t)*w;
-    tmp = (unsigned char *)malloc(row ? row : 1);
-    if (!tmp) {
-        cli_error("out of memory reading '%s'", path);
-        stbi_image_free(px);
-        return NULL;
-    }
-    for (j = 0; j < *h / 2; ++j) {
-        unsigned char *a = px + (size_t)j * row, *b = px + (size_t)(*h - 1 - j) * row;
-        memcpy(tmp, a, row);
-        memcpy(a, b, row);
-        memcpy(b, tmp, row);
-    }
-    free(tmp);
-    return px;
-}
-
 /* The trimming mask of --trim (with --trim-tiles) into *mask; 1, or 0 with a message printed.
- * *texels is what to free (stbi_image_free). */
+ * *texels is what to free (free). */
 static int load_trim(const cli_opts *o, sfb_trim_mask *mask, unsigned char **texels) {
     memset(mask, 0, sizeof *mask);
     *texels = NULL;
     if (!o->trim) return 1;
-    *texels = load_mask(o->trim, &mask->width, &mask->height);
-    if (!*texels) return 0;
+    if (!cli_load_mask(o->trim, texels, &mask->width, &mask->height)) return 0;
     mask->texels = *texels;
     mask->tiles_u = (int)o->tiles[0];
     mask->tiles_v = (int)o->tiles[1];
@@ -693,7 +665,7 @@ static int cmd_info(cli_opts *o) {
     int hist[33], over, i, problems = 0;
     ctx = cli_make_context(NULL);
     if (!ctx) return 1;
-    mesh = cli_load_obj(ctx, o->in);
+    mesh = cli_load_mesh(ctx, o->in, o->seen[O_CREASE_ANGLE] ? o->crease_angle : -1.0);
     if (!mesh) { sfb_context_destroy(ctx); return 1; }
     sfb_mesh_get_info(mesh, &in);
     printf("file:        %s\n", o->in);
@@ -739,7 +711,7 @@ static int cmd_refine(cli_opts *o) {
     memset(&out, 0, sizeof out);
     ctx = cli_make_context(o->backend);
     if (!ctx) return 1;
-    mesh = cli_load_obj(ctx, o->in);
+    mesh = cli_load_mesh(ctx, o->in, o->seen[O_CREASE_ANGLE] ? o->crease_angle : -1.0);
     if (!mesh) goto done;
     cfg = sfb_surface_config_init(scheme, o->level);
     cfg.flags = SFB_REFINE_UVS | (o->limit ? SFB_REFINE_LIMIT : 0u);
@@ -812,7 +784,7 @@ static int cmd_eval(cli_opts *o) {
     if ((o->nrandom >= 0) == (o->locfile != NULL)) return usage_error(o->cmd, "eval needs either --random N or --locations FILE");
     ctx = cli_make_context(o->backend);
     if (!ctx) return 1;
-    mesh = cli_load_obj(ctx, o->in);
+    mesh = cli_load_mesh(ctx, o->in, o->seen[O_CREASE_ANGLE] ? o->crease_angle : -1.0);
     if (!mesh) goto done;
     surf = make_patch_surface(ctx, mesh, o->in, scheme, o->weights);
     if (!surf || !eval_locations(ctx, surf, o, &L)) goto done;
@@ -889,8 +861,8 @@ static int cmd_tess(cli_opts *o) {
     if (o->seen[O_TILES] && !o->trim) return usage_error(o->cmd, "--trim-tiles needs --trim MASK.png");
     if (!load_trim(o, &mask, &texels)) return 1;
     ctx = cli_make_context(o->backend);
-    if (!ctx) { stbi_image_free(texels); return 1; }
-    mesh = cli_load_obj(ctx, o->in);
+    if (!ctx) { free(texels); return 1; }
+    mesh = cli_load_mesh(ctx, o->in, o->seen[O_CREASE_ANGLE] ? o->crease_angle : -1.0);
     if (!mesh) goto done;
     surf = make_patch_surface(ctx, mesh, o->in, cli_scheme_for(o->in, o->seen[O_SCHEME], (sfb_scheme)o->scheme), o->weights);
     if (!surf) goto done;
@@ -913,7 +885,7 @@ done:
     sfb_surface_destroy(surf);
     sfb_mesh_destroy(mesh);
     sfb_context_destroy(ctx);
-    stbi_image_free(texels);
+    free(texels);
     return rc;
 }
 
@@ -925,7 +897,7 @@ static int shade_mesh(sfb_context *ctx, const cli_opts *o, sfb_mesh **mesh, sfb_
     sfb_surface_config cfg;
     sfb_shade_params sp;
     sfb_result r;
-    *mesh = cli_load_obj(ctx, o->in);
+    *mesh = cli_load_mesh(ctx, o->in, o->seen[O_CREASE_ANGLE] ? o->crease_angle : -1.0);
     if (!*mesh) return 0;
     cfg = sfb_surface_config_init(cli_scheme_for(o->in, o->seen[O_SCHEME], (sfb_scheme)o->scheme), o->level);
     cfg.flags = SFB_REFINE_LIMIT | SFB_REFINE_SHADING;
@@ -1052,7 +1024,7 @@ static int render_manifold_mesh(const cli_opts *o, render_state *s) {
     sfb_tess_config tc = sfb_tess_config_init((int)(o->rate > 2147483647L ? 2147483647L : o->rate < -2147483647L ? -2147483647L : o->rate));
     sfb_result r;
     int i;
-    s->mesh = cli_load_obj(s->ctx, o->in);
+    s->mesh = cli_load_mesh(s->ctx, o->in, o->seen[O_CREASE_ANGLE] ? o->crease_angle : -1.0);
     if (!s->mesh) return 0;
     s->surf = make_patch_surface(s->ctx, s->mesh, o->in, (sfb_scheme)o->scheme, o->weights);
     if (!s->surf) return 0;
@@ -1146,7 +1118,7 @@ done:
     sfb_image_free(&s.img);
     if (s.face_sizes) { free(s.face_sizes); memset(&s.data, 0, sizeof s.data); }
     sfb_tess_data_free(&s.td);
-    stbi_image_free(s.texels);
+    free(s.texels);
     sfb_mesh_data_free(&s.data);
     sfb_surface_destroy(s.surf);
     sfb_mesh_destroy(s.mesh);

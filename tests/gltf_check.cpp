@@ -1,0 +1,363 @@
+// gltf_check: reads a .glb/.gltf that sfb2gltf wrote (tinygltf) and compares it with what the
+// library gives for the same input and options, computed here directly:
+//
+//   gltf_check FILE.glb IN.obj [--scheme S] [--level L] [--normals shading|limit|flat]
+//              [--crease-angle DEG] [--tess RATE] [--min-splits N] [--uvs yes|no]
+//
+// Checks (PASS/FAIL lines, tests/harness.h):
+//  - the file loads; one mesh, one TRIANGLES primitive with indices, POSITION, NORMAL;
+//  - the triangle count equals the library's (refined faces fan-triangulated, holes left out;
+//    or the tessellation's);
+//  - every glTF vertex (position, normal, uv) is one of the library's output vertices (refined:
+//    the shaded mesh's (vertex, uv) corners with N_B, N_L or the face normal; tessellated: the
+//    tessellation's vertices), within 1e-6 relative (positions), 1e-5 (normals), 1e-6 (uvs,
+//    with glTF's v = 1 - v), and the number of distinct vertices is the library's;
+//  - normals are unit; POSITION's min/max are the data's;
+//  - with --min-splits N: at least N positions carry more than one normal (hard edges split);
+//  - --uvs yes|no: TEXCOORD_0 is there or not.
+#include <tiny_gltf.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "surfblend.h"
+#include "tests/harness.h"
+
+namespace {
+
+struct Vertex {
+    float p[3], n[3], t[2];
+};
+
+// Reads accessor `index` as floats (FLOAT, or normalised integers: dequantised).
+bool read_floats(const tinygltf::Model &m, int index, int comps, std::vector<float> *out) {
+    if (index < 0 || index >= (int)m.accessors.size()) return false;
+    const tinygltf::Accessor &a = m.accessors[(size_t)index];
+    if (tinygltf::GetNumComponentsInType((uint32_t)a.type) != comps || a.bufferView < 0) return false;
+    const tinygltf::BufferView &v = m.bufferViews[(size_t)a.bufferView];
+    const std::vector<unsigned char> &b = m.buffers[(size_t)v.buffer].data;
+    const int csize = tinygltf::GetComponentSizeInBytes((uint32_t)a.componentType);
+    const size_t stride = v.byteStride ? v.byteStride : (size_t)(csize * comps);
+    out->resize(a.count * (size_t)comps);
+    for (size_t i = 0; i < a.count; ++i)
+        for (int c = 0; c < comps; ++c) {
+            const size_t at = v.byteOffset + a.byteOffset + i * stride + (size_t)c * (size_t)csize;
+            if (at + (size_t)csize > b.size()) return false;
+            double x;
+            switch (a.componentType) {
+            case TINYGLTF_COMPONENT_TYPE_FLOAT: { float f; memcpy(&f, &b[at], 4); x = f; break; }
+            case TINYGLTF_COMPONENT_TYPE_SHORT: { short s; memcpy(&s, &b[at], 2); x = a.normalized ? std::max(s / 32767.0, -1.0) : s; break; }
+            case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: { unsigned short s; memcpy(&s, &b[at], 2); x = a.normalized ? s / 65535.0 : s; break; }
+            case TINYGLTF_COMPONENT_TYPE_BYTE: { signed char s = (signed char)b[at]; x = a.normalized ? std::max(s / 127.0, -1.0) : s; break; }
+            case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: { x = a.normalized ? b[at] / 255.0 : b[at]; break; }
+            default: return false;
+            }
+            (*out)[i * (size_t)comps + (size_t)c] = (float)x;
+        }
+    return true;
+}
+
+bool read_indices(const tinygltf::Model &m, int index, std::vector<unsigned> *out) {
+    if (index < 0 || index >= (int)m.accessors.size()) return false;
+    const tinygltf::Accessor &a = m.accessors[(size_t)index];
+    if (a.type != TINYGLTF_TYPE_SCALAR || a.bufferView < 0) return false;
+    const tinygltf::BufferView &v = m.bufferViews[(size_t)a.bufferView];
+    const std::vector<unsigned char> &b = m.buffers[(size_t)v.buffer].data;
+    const int csize = tinygltf::GetComponentSizeInBytes((uint32_t)a.componentType);
+    out->resize(a.count);
+    for (size_t i = 0; i < a.count; ++i) {
+        const size_t at = v.byteOffset + a.byteOffset + i * (size_t)csize;
+        if (at + (size_t)csize > b.size()) return false;
+        unsigned x = 0;
+        if (csize == 1) x = b[at];
+        else if (csize == 2) { unsigned short s; memcpy(&s, &b[at], 2); x = s; }
+        else memcpy(&x, &b[at], 4);
+        (*out)[i] = x;
+    }
+    return true;
+}
+
+void unit(float *n) {
+    double l = std::sqrt((double)n[0] * n[0] + (double)n[1] * n[1] + (double)n[2] * n[2]);
+    if (l > 0.0) for (int c = 0; c < 3; ++c) n[c] = (float)(n[c] / l);
+}
+
+// The library's vertices and triangle count for the same options.
+struct Reference {
+    std::vector<Vertex> verts;
+    long triangles = 0;
+    size_t distinct = 0; // distinct (output vertex, uv) corners: a split vertex whose copies have equal normals stays two
+    bool uvs = false;
+};
+
+bool reference(const char *in, sfb_scheme scheme, int level, const std::string &normals, double angle, int rate, Reference *R) {
+    sfb_context *ctx = nullptr;
+    sfb_context_config cc = sfb_context_config_init();
+    static const sfb_backend_kind ref[1] = {SFB_BACKEND_REF};
+    cc.backends = ref;
+    cc.backend_count = 1;
+    cc.ignore_environment = 1;
+    if (sfb_context_create(&cc, &ctx) != SFB_SUCCESS) return false;
+    size_t size = 0;
+    char *text = slurp(in, &size);
+    sfb_mesh *mesh = nullptr, *creased = nullptr;
+    sfb_surface *surf = nullptr;
+    sfb_mesh_data d;
+    sfb_tess_data t;
+    memset(&d, 0, sizeof d);
+    memset(&t, 0, sizeof t);
+    bool ok = text && sfb_mesh_read_obj(ctx, text, size, &mesh) == SFB_SUCCESS;
+    free(text);
+    if (ok && angle >= 0.0) {
+        ok = sfb_mesh_crease_by_angle(ctx, mesh, (float)angle, &creased, nullptr) == SFB_SUCCESS;
+        if (ok) { sfb_mesh_destroy(mesh); mesh = creased; }
+    }
+    sfb_mesh_desc md;
+    sfb_mesh_get_desc(mesh, &md);
+    if (ok) {
+        sfb_surface_config cfg = sfb_surface_config_init(scheme, rate > 0 ? 0 : level);
+        cfg.flags = rate > 0 ? (unsigned)SFB_REFINE_PATCHES
+                             : ((normals == "flat" ? 0u : (unsigned)SFB_REFINE_SHADING) | (md.uv_count > 0 ? (unsigned)SFB_REFINE_UVS : 0u));
+        ok = sfb_surface_create(ctx, mesh, &cfg, &surf) == SFB_SUCCESS;
+    }
+    if (ok && rate > 0) {
+        sfb_tess_config tc = sfb_tess_config_init(rate);
+        tc.flags = SFB_TESS_SPLIT_CREASES;
+        ok = sfb_surface_tessellate(surf, &tc, &t) == SFB_SUCCESS;
+        for (int i = 0; ok && i < t.vertex_count; ++i) {
+            Vertex v{};
+            memcpy(v.p, t.positions + 3 * (size_t)i, sizeof v.p);
+            memcpy(v.n, t.normals + 3 * (size_t)i, sizeof v.n);
+            unit(v.n);
+            R->verts.push_back(v);
+        }
+        R->triangles = t.triangle_count;
+        R->distinct = (size_t)t.vertex_count;
+    } else if (ok) {
+        ok = (normals == "flat" ? sfb_surface_refine(surf, &d) : sfb_surface_shade(surf, nullptr, &d)) == SFB_SUCCESS;
+        const float *nrm = normals == "limit" ? d.limit_normals : d.normals;
+        R->uvs = d.uvs && d.face_uvs && d.uv_count > 0;
+        std::vector<char> hole((size_t)d.face_count + 1, 0);
+        for (int h = 0; ok && h < d.hole_count; ++h) hole[(size_t)d.holes[h]] = 1;
+        int at = 0;
+        std::vector<unsigned long long> corners;
+        for (int f = 0; ok && f < d.face_count; at += d.face_sizes[f], ++f) {
+            if (hole[(size_t)f]) continue;
+            const int k = d.face_sizes[f];
+            R->triangles += k - 2;
+            for (int i = 0; i < k; ++i) {
+                Vertex v{};
+                const int vi = d.face_vertices[at + i];
+                corners.push_back((unsigned long long)(unsigned)vi << 32 | (unsigned)(R->uvs ? d.face_uvs[at + i] : 0));
+                memcpy(v.p, d.positions + 3 * (size_t)vi, sizeof v.p);
+                if (normals == "flat") {
+                    v.n[0] = v.n[1] = v.n[2] = NAN; // compared separately: per triangle
+                } else {
+                    memcpy(v.n, nrm + 3 * (size_t)vi, sizeof v.n);
+                    unit(v.n);
+                }
+                if (R->uvs) {
+                    v.t[0] = d.uvs[2 * (size_t)d.face_uvs[at + i]];
+                    v.t[1] = 1.0f - d.uvs[2 * (size_t)d.face_uvs[at + i] + 1];
+                }
+                R->verts.push_back(v);
+            }
+        }
+        std::sort(corners.begin(), corners.end());
+        R->distinct = (size_t)(std::unique(corners.begin(), corners.end()) - corners.begin());
+    }
+    if (!ok) fprintf(stderr, "gltf_check: the reference failed: %s\n", sfb_last_error(ctx));
+    sfb_mesh_data_free(&d);
+    sfb_tess_data_free(&t);
+    sfb_surface_destroy(surf);
+    sfb_mesh_destroy(mesh);
+    sfb_context_destroy(ctx);
+    return ok;
+}
+
+// Position key on a grid of `cell` (neighbouring cells searched too).
+typedef std::array<long long, 3> Key;
+Key key_of(const float *p, double cell) {
+    return Key{(long long)std::floor(p[0] / cell), (long long)std::floor(p[1] / cell), (long long)std::floor(p[2] / cell)};
+}
+
+} // namespace
+
+int main(int argc, char **argv) {
+    if (argc < 3) {
+        fprintf(stderr, "usage: gltf_check FILE.glb IN.obj [--scheme S] [--level L] [--normals N] [--crease-angle DEG] [--tess RATE] "
+                        "[--min-splits N] [--uvs yes|no]\n");
+        return 2;
+    }
+    const char *file = argv[1], *in = argv[2];
+    sfb_scheme scheme = SFB_SCHEME_CATMARK;
+    bool have_scheme = false;
+    int level = 3, rate = 0, min_splits = -1;
+    double angle = -1.0;
+    std::string normals, uvs_want;
+    // sfb2gltf's options are accepted as they are: the flags (--no-optimize, --gltf, -q) change
+    // nothing the checks compare
+    for (int i = 3; i < argc; ++i) {
+        const std::string a = argv[i];
+        const char *v = i + 1 < argc ? argv[i + 1] : "";
+        if (a == "--no-optimize" || a == "--gltf" || a == "-q" || a == "--quiet") continue;
+        if (a == "--scheme") have_scheme = sfb_scheme_parse(v, &scheme);
+        else if (a == "--level") level = atoi(v);
+        else if (a == "--normals") normals = v;
+        else if (a == "--crease-angle") angle = atof(v);
+        else if (a == "--tess") rate = atoi(v);
+        else if (a == "--min-splits") min_splits = atoi(v);
+        else if (a == "--uvs") uvs_want = v;
+        else if (a == "--backend") {}
+        else { fprintf(stderr, "gltf_check: unknown option '%s'\n", a.c_str()); return 2; }
+        ++i;
+    }
+    if (!have_scheme) {
+        const char *b = strrchr(in, '/');
+        b = b ? b + 1 : in;
+        scheme = !strncmp(b, "loop_", 5) ? SFB_SCHEME_LOOP : !strncmp(b, "bilinear_", 9) ? SFB_SCHEME_BILINEAR : SFB_SCHEME_CATMARK;
+    }
+    if (normals.empty()) normals = rate > 0 ? "limit" : (sfb_scheme_caps(scheme) & SFB_SCHEME_CAN_SHADE) ? "shading" : "flat";
+    const std::string name = std::string(strrchr(file, '/') ? strrchr(file, '/') + 1 : file);
+
+    tinygltf::TinyGLTF loader;
+    tinygltf::Model model;
+    std::string err, warn;
+    const bool binary = name.size() > 4 && name.substr(name.size() - 4) == ".glb";
+    const bool loaded = binary ? loader.LoadBinaryFromFile(&model, &err, &warn, file) : loader.LoadASCIIFromFile(&model, &err, &warn, file);
+    check(loaded, (name + ": loads").c_str(), "%s", err.c_str());
+    if (!loaded) return close_tests();
+    const bool shape = model.meshes.size() == 1 && model.meshes[0].primitives.size() == 1;
+    check(shape, (name + ": one mesh with one primitive").c_str(), "%zu meshes", model.meshes.size());
+    if (!shape) return close_tests();
+    const tinygltf::Primitive &prim = model.meshes[0].primitives[0];
+    std::vector<float> P, N, T;
+    std::vector<unsigned> I;
+    const bool attrs = prim.mode == TINYGLTF_MODE_TRIANGLES && prim.attributes.count("POSITION") && prim.attributes.count("NORMAL") &&
+                       read_floats(model, prim.attributes.at("POSITION"), 3, &P) && read_floats(model, prim.attributes.at("NORMAL"), 3, &N) &&
+                       read_indices(model, prim.indices, &I) && N.size() == P.size() && I.size() % 3 == 0;
+    check(attrs, (name + ": indexed triangles with POSITION and NORMAL").c_str(), "mode %d", prim.mode);
+    if (!attrs) return close_tests();
+    const bool has_uv = prim.attributes.count("TEXCOORD_0") && read_floats(model, prim.attributes.at("TEXCOORD_0"), 2, &T) &&
+                        T.size() / 2 == P.size() / 3;
+    if (!uvs_want.empty())
+        check(has_uv == (uvs_want == "yes"), (name + ": TEXCOORD_0 " + (uvs_want == "yes" ? "present" : "absent")).c_str(), "it is %s",
+              has_uv ? "present" : "absent");
+    const size_t nv = P.size() / 3;
+    {
+        bool in_range = true;
+        for (unsigned i : I) in_range = in_range && i < nv;
+        check(in_range, (name + ": indices in range").c_str(), "an index >= %zu", nv);
+        if (!in_range) return close_tests();
+    }
+    // min/max of POSITION
+    {
+        const tinygltf::Accessor &a = model.accessors[(size_t)prim.attributes.at("POSITION")];
+        bool ok = a.minValues.size() == 3 && a.maxValues.size() == 3;
+        for (int c = 0; ok && c < 3; ++c) {
+            float lo = P[(size_t)c], hi = P[(size_t)c];
+            for (size_t v = 0; v < nv; ++v) { lo = std::min(lo, P[3 * v + (size_t)c]); hi = std::max(hi, P[3 * v + (size_t)c]); }
+            ok = (float)a.minValues[(size_t)c] == lo && (float)a.maxValues[(size_t)c] == hi;
+        }
+        check(ok, (name + ": POSITION min/max are the data's").c_str(), "they differ");
+    }
+    double worst_len = 0.0;
+    for (size_t v = 0; v < nv; ++v)
+        worst_len = std::max(worst_len, std::fabs(std::sqrt((double)N[3 * v] * N[3 * v] + (double)N[3 * v + 1] * N[3 * v + 1] +
+                                                            (double)N[3 * v + 2] * N[3 * v + 2]) - 1.0));
+    check(worst_len < 1e-5, (name + ": normals are unit").c_str(), "| |n| - 1 | up to %g", worst_len);
+
+    Reference R;
+    if (!reference(in, scheme, level, normals, angle, rate, &R)) {
+        fail((name + ": the library's reference").c_str(), "could not be computed");
+        return close_tests();
+    }
+    check((long)(I.size() / 3) == R.triangles, (name + ": triangle count is the library's").c_str(), "%zu, the library %ld", I.size() / 3,
+          R.triangles);
+    if (uvs_want.empty()) check(has_uv == R.uvs, (name + ": TEXCOORD_0 exactly when the library has UVs").c_str(), "glTF %d, library %d", has_uv, R.uvs);
+
+    // every glTF vertex is a library vertex; distinct library vertices as many as glTF's
+    float lo[3] = {P[0], P[1], P[2]}, hi[3] = {P[0], P[1], P[2]};
+    for (size_t v = 0; v < nv; ++v)
+        for (int c = 0; c < 3; ++c) { lo[c] = std::min(lo[c], P[3 * v + (size_t)c]); hi[c] = std::max(hi[c], P[3 * v + (size_t)c]); }
+    const double diag = std::sqrt((double)(hi[0] - lo[0]) * (hi[0] - lo[0]) + (double)(hi[1] - lo[1]) * (hi[1] - lo[1]) +
+                                  (double)(hi[2] - lo[2]) * (hi[2] - lo[2]));
+    const double ptol = 1e-6 * (diag > 0 ? diag : 1.0), cell = std::max(ptol * 4.0, 1e-30);
+    const bool flat = normals == "flat";
+    std::map<Key, std::vector<size_t>> grid;
+    for (size_t r = 0; r < R.verts.size(); ++r) grid[key_of(R.verts[r].p, cell)].push_back(r);
+    auto same = [&](const Vertex &a, const float *p, const float *n, const float *t) {
+        for (int c = 0; c < 3; ++c)
+            if (std::fabs(a.p[c] - p[c]) > ptol) return false;
+        // a zero library normal (the shading's at non-manifold vertices, where no limit normal
+        // exists) becomes a face normal in sfb2gltf: any unit normal matches it
+        const bool zero = a.n[0] == 0.0f && a.n[1] == 0.0f && a.n[2] == 0.0f;
+        if (!flat && !zero)
+            for (int c = 0; c < 3; ++c)
+                if (std::fabs(a.n[c] - n[c]) > 1e-5) return false;
+        if (t && R.uvs)
+            for (int c = 0; c < 2; ++c)
+                if (std::fabs(a.t[c] - t[c]) > 1e-6) return false;
+        return true;
+    };
+    size_t unmatched = 0, first_bad = 0;
+    for (size_t v = 0; v < nv; ++v) {
+        const float *p = &P[3 * v], *n = &N[3 * v], *t = has_uv ? &T[2 * v] : nullptr;
+        const Key k = key_of(p, cell);
+        bool found = false;
+        for (int dx = -1; dx <= 1 && !found; ++dx)
+            for (int dy = -1; dy <= 1 && !found; ++dy)
+                for (int dz = -1; dz <= 1 && !found; ++dz) {
+                    auto it = grid.find(Key{k[0] + dx, k[1] + dy, k[2] + dz});
+                    if (it == grid.end()) continue;
+                    for (size_t r : it->second)
+                        if (same(R.verts[r], p, n, t)) { found = true; break; }
+                }
+        if (!found && unmatched++ == 0) first_bad = v;
+    }
+    check(unmatched == 0, (name + ": every vertex is the library's (position, normal, uv)").c_str(),
+          "%zu of %zu are not; the first, %zu: (%g %g %g) n (%g %g %g)", unmatched, nv, first_bad, P[3 * first_bad], P[3 * first_bad + 1],
+          P[3 * first_bad + 2], N[3 * first_bad], N[3 * first_bad + 1], N[3 * first_bad + 2]);
+    if (flat) {
+        // flat: each triangle's vertices carry its own face normal
+        size_t bad = 0;
+        for (size_t i = 0; i < I.size(); i += 3) {
+            const float *a = &P[3 * (size_t)I[i]], *b = &P[3 * (size_t)I[i + 1]], *c = &P[3 * (size_t)I[i + 2]];
+            double u[3], w[3], f[3];
+            for (int q = 0; q < 3; ++q) { u[q] = (double)b[q] - a[q]; w[q] = (double)c[q] - a[q]; }
+            f[0] = u[1] * w[2] - u[2] * w[1]; f[1] = u[2] * w[0] - u[0] * w[2]; f[2] = u[0] * w[1] - u[1] * w[0];
+            const double l = std::sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]);
+            if (!(l > 0)) continue;
+            for (int j = 0; j < 3; ++j) {
+                const float *n = &N[3 * (size_t)I[i + (size_t)j]];
+                if (std::fabs(n[0] - f[0] / l) + std::fabs(n[1] - f[1] / l) + std::fabs(n[2] - f[2] / l) > 1e-4) { ++bad; break; }
+            }
+        }
+        check(bad == 0, (name + ": flat normals are the triangles' own").c_str(), "%zu triangles differ", bad);
+    } else {
+        check(R.distinct == nv, (name + ": as many vertices as the library's distinct corners").c_str(), "%zu, the library %zu", nv,
+              R.distinct);
+    }
+    if (min_splits >= 0) {
+        // positions with more than one normal: hard edges kept split
+        std::map<std::array<float, 3>, std::vector<std::array<float, 3>>> normals_at;
+        for (size_t v = 0; v < nv; ++v) {
+            auto &list = normals_at[{P[3 * v], P[3 * v + 1], P[3 * v + 2]}];
+            std::array<float, 3> n = {N[3 * v], N[3 * v + 1], N[3 * v + 2]};
+            bool seen = false;
+            for (auto &m : list) seen = seen || (std::fabs(m[0] - n[0]) + std::fabs(m[1] - n[1]) + std::fabs(m[2] - n[2]) < 1e-3f);
+            if (!seen) list.push_back(n);
+        }
+        int splits = 0;
+        for (auto &kv : normals_at) splits += kv.second.size() > 1;
+        check(splits >= min_splits, (name + ": hard edges stay split").c_str(), "%d positions with several normals, wanted >= %d", splits,
+              min_splits);
+    }
+    return close_tests();
+}

@@ -1,0 +1,203 @@
+#!/bin/bash
+# Tests of the glTF export tool sfb2gltf: usage and bad input (exit codes, messages, no partial
+# output), every export checked by the Khronos glTF-Validator (0 errors, 0 warnings: every peer
+# shape, the examples, the real meshes, every scheme and option), and read back with tinygltf
+# against the library's own output (build/gltf_check: positions, normals, UVs, counts, split
+# hard edges).
+set -u
+BUILD=${BUILD:-build}
+SHAPES=${SHAPES:-../shared/peers/opensubdiv-shapes}
+REAL=${REAL:-$(dirname "$SHAPES")/real-meshes}
+TOOL=$BUILD/sfb2gltf
+CHECK=$BUILD/gltf_check
+# the validator wrapper (tests/web/validate.mjs, npm gltf-validator installed by make deps-web)
+VALIDATE=${VALIDATE:-node tests/web/validate.mjs}
+TMP=$(mktemp -d)
+trap 'rm -rf "$TMP"' EXIT
+P=0; F=0; S=0
+ok() { P=$((P + 1)); echo "ok $1"; }
+bad() { F=$((F + 1)); echo "FAIL $1"; }
+check() { # description, expected exit code, command...
+  local desc=$1 want=$2; shift 2
+  "$@" > "$TMP/out" 2> "$TMP/err"; local got=$?
+  if [ "$got" = "$want" ]; then ok "$desc"; else bad "$desc: exit $got, wanted $want"; head -n 5 "$TMP/err"; fi
+}
+contains() { # description, file, pattern
+  if grep -qi -- "$3" "$2"; then ok "$1"; else bad "$1: '$3' not in output"; head -n 5 "$2"; fi
+}
+absent() { # description, file
+  if [ ! -e "$2" ]; then ok "$1"; else bad "$1: $2 exists"; fi
+}
+# gltf_check's PASS/FAIL lines into the counts
+count_check() {
+  local out; out=$("$CHECK" "$@" 2>&1)
+  P=$((P + $(grep -c '^PASS' <<< "$out"))); local f; f=$(grep -c '^FAIL' <<< "$out"); F=$((F + f))
+  [ "$f" -gt 0 ] && grep '^FAIL' <<< "$out"
+  grep -q 'passed,' <<< "$out" || { bad "gltf_check $1 did not finish"; echo "$out" | tail -3; }
+}
+
+BOX=examples/data/creased_box.obj
+# ---- usage ----
+check "--help succeeds" 0 "$TOOL" --help
+contains "--help lists --crease-angle" "$TMP/out" "--crease-angle"
+contains "--help lists --tess" "$TMP/out" "--tess RATE"
+check "--version succeeds" 0 "$TOOL" --version
+contains "--version names surfblend" "$TMP/out" "surfblend"
+check "no arguments is a usage error" 2 "$TOOL"
+check "no output is a usage error" 2 "$TOOL" "$BOX"
+check "an unknown option is a usage error" 2 "$TOOL" --frobnicate "$BOX" -o "$TMP/x.glb"
+check "a bad --level is a usage error" 2 "$TOOL" --level x "$BOX" -o "$TMP/x.glb"
+check "--level with --tess is a usage error" 2 "$TOOL" --level 2 --tess 4 "$BOX" -o "$TMP/x.glb"
+check "--tess 0 is a usage error" 2 "$TOOL" --tess 0 "$BOX" -o "$TMP/x.glb"
+check "--tess 1025 is a usage error" 2 "$TOOL" --tess 1025 "$BOX" -o "$TMP/x.glb"
+check "--trim without --tess is a usage error" 2 "$TOOL" --trim examples/data/trim_disc.png "$BOX" -o "$TMP/x.glb"
+check "--normals shading on bilinear is a usage error" 2 "$TOOL" --scheme bilinear --normals shading "$BOX" -o "$TMP/x.glb"
+check "--normals shading with --tess is a usage error" 2 "$TOOL" --tess 4 --normals shading "$BOX" -o "$TMP/x.glb"
+check "--crease-angle 200 is a usage error" 2 "$TOOL" --crease-angle 200 "$BOX" -o "$TMP/x.glb"
+check "an unknown scheme is a usage error" 2 "$TOOL" --scheme tribezier "$BOX" -o "$TMP/x.glb"
+absent "usage errors leave no output" "$TMP/x.glb"
+
+# ---- bad input: exit 1, one line naming the file, no output file ----
+badcase() { # description, pattern the message must contain, input, options...
+  local desc=$1 pat=$2 in=$3; shift 3
+  rm -f "$TMP/o.glb"
+  check "$desc is bad input" 1 "$TOOL" "$@" "$in" -o "$TMP/o.glb"
+  contains "$desc: the message names the problem" "$TMP/err" "$pat"
+  absent "$desc: no output file" "$TMP/o.glb"
+  if [ "$(wc -l < "$TMP/err")" -le 2 ]; then ok "$desc: the message is short"; else bad "$desc: $(wc -l < "$TMP/err") lines of messages"; fi
+}
+badcase "a missing file" "does-not-exist" "$TMP/does-not-exist.obj"
+printf '\x00\x01\x02binary junk\xff' > "$TMP/junk.obj"
+badcase "a binary file" "junk.obj" "$TMP/junk.obj"
+printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n' > "$TMP/range.obj"
+badcase "an out-of-range index" "line 4" "$TMP/range.obj"
+printf 'v 0 0 0\nv 1 nan 0\nv 0 1 0\nf 1 2 3\n' > "$TMP/nan.obj"
+badcase "a NaN coordinate" "finite" "$TMP/nan.obj"
+printf '# nothing\n' > "$TMP/empty.obj"
+badcase "a file with no faces" "empty.obj" "$TMP/empty.obj"
+printf 'v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\nt hole 1/0/0 0\n' > "$TMP/allhole.obj"
+badcase "a mesh whose every face is a hole" "no triangles" "$TMP/allhole.obj"
+badcase "a level over the limit" "limit" "$BOX" --level 11
+badcase "Loop on quads" "triangles" "$BOX" --scheme loop
+badcase "a missing trimming mask" "mask" "$BOX" --tess 4 --trim "$TMP/none.png"
+check "an unwritable output is bad input" 1 "$TOOL" "$BOX" -o "$TMP/no/such/dir/x.glb"
+contains "the unwritable output is named" "$TMP/err" "no/such/dir"
+echo keep > "$TMP/keep.glb"
+check "a failed export" 1 "$TOOL" --level 11 "$BOX" -o "$TMP/keep.glb"
+if [ "$(cat "$TMP/keep.glb")" = keep ]; then ok "a failed export leaves an existing file untouched"; else bad "a failed export changed the existing file"; fi
+check "a failed .gltf export" 1 "$TOOL" --level 11 "$BOX" -o "$TMP/f.gltf"
+absent "a failed .gltf export leaves no .gltf" "$TMP/f.gltf"
+absent "a failed .gltf export leaves no .bin" "$TMP/f.bin"
+if ls "$TMP" | grep -q '\.tmp\|^\.'; then bad "temporary files left behind: $(ls -a "$TMP" | tr '\n' ' ')"; else ok "no temporary files left behind"; fi
+
+# ---- exports ----
+mkdir -p "$TMP/v"
+export_ok() { # name, input, options...: writes $TMP/v/NAME
+  local name=$1 in=$2; shift 2
+  check "export $name" 0 "$TOOL" -q "$@" "$in" -o "$TMP/v/$name"
+}
+export_ok box.glb "$BOX"
+export_ok box.gltf "$BOX"
+export_ok box_flat.glb "$BOX" --normals flat
+export_ok box_limit.glb "$BOX" --normals limit
+export_ok box_tess.glb "$BOX" --tess 8
+export_ok box_adaptive.glb "$BOX" --tess 32 --tolerance 0.002
+export_ok box_noopt.glb "$BOX" --no-optimize
+export_ok box_bilinear.glb "$BOX" --scheme bilinear --level 2
+export_ok box_gltf_flag.glb "$BOX" --gltf
+export_ok manifold.glb examples/data/manifold_features.obj --scheme manifold
+export_ok manifold_trim.glb examples/data/manifold_features.obj --scheme manifold --tess 24 --trim examples/data/trim_disc.png
+export_ok torus.glb examples/data/torus.obj
+export_ok torus_tess_flat.glb examples/data/torus.obj --tess 6 --normals flat
+check "export with --progress" 0 "$TOOL" --progress "$BOX" -o "$TMP/v/box_progress.glb"
+contains "--progress draws the stages" "$TMP/err" "\[5/5\] write"
+check "a summary line by default" 0 "$TOOL" "$BOX" -o "$TMP/v/box_summary.glb"
+contains "the summary gives the triangles" "$TMP/err" "triangles"
+if [ -f "$TMP/v/box.bin" ] && grep -q '"uri": "box.bin"' "$TMP/v/box.gltf"; then ok ".gltf refers to its .bin"; else bad ".gltf without its .bin"; fi
+if [ -f "$TMP/v/box_gltf_flag.bin" ] && head -c 1 "$TMP/v/box_gltf_flag.glb" | grep -q '{'; then ok "--gltf writes JSON and a .bin"; else bad "--gltf did not write JSON + .bin"; fi
+if [ "$(head -c 4 "$TMP/v/box.glb")" = glTF ]; then ok ".glb is binary glTF"; else bad ".glb does not start with glTF"; fi
+# the peer shapes (Catmull-Clark, Loop, bilinear; UVs, holes, non-manifold) at level 2
+n=0
+if [ -d "$SHAPES" ]; then
+  for f in "$SHAPES"/*.obj; do
+    b=$(basename "$f" .obj)
+    if "$TOOL" -q --level 2 "$f" -o "$TMP/v/peer_$b.glb" 2> "$TMP/err"; then n=$((n + 1)); else bad "export peer $b: $(head -n 1 "$TMP/err")"; fi
+  done
+  if [ "$n" -ge 20 ]; then ok "$n peer shapes exported"; else bad "only $n peer shapes exported"; fi
+  export_ok peer_loop_tess.glb "$SHAPES/loop_cube_creases0.obj" --tess 8
+  export_ok peer_car_flat.glb "$SHAPES/catmark_car.obj" --level 1 --normals flat
+  export_ok peer_pole_limit.glb "$SHAPES/catmark_pole8.obj" --normals limit
+else
+  S=$((S + 1)); echo "SKIP peer shapes: not found at $SHAPES"
+fi
+# the real meshes (made by other people), as they are and with --crease-angle 30
+if [ -d "$REAL" ] && ls "$REAL"/*.obj > /dev/null 2>&1; then
+  for f in "$REAL"/*.obj; do
+    b=$(basename "$f" .obj)
+    export_ok "real_$b.glb" "$f" --level 1
+    export_ok "real_${b}_angle.glb" "$f" --level 1 --crease-angle 30
+    export_ok "real_${b}_tess.glb" "$f" --tess 3 --crease-angle 30
+  done
+else
+  S=$((S + 1)); echo "SKIP real meshes: not found at $REAL"
+fi
+
+# ---- the Khronos validator on every export ----
+if $VALIDATE --help > /dev/null 2>&1 || [ $? = 2 ]; then
+  if $VALIDATE "$TMP"/v/*.glb "$TMP"/v/*.gltf > "$TMP/val" 2>&1; then
+    ok "glTF-Validator: $(grep -c '^ok' "$TMP/val") files, 0 errors, 0 warnings"
+  else
+    bad "glTF-Validator found errors or warnings:"; grep -v '^ok' "$TMP/val" | head -n 20
+  fi
+else
+  S=$((S + 1)); echo "SKIP glTF-Validator: '$VALIDATE' does not run (make deps-web installs it)"
+fi
+
+# ---- read back against the library (ref backend on both sides: the same numbers) ----
+mkdir -p "$TMP/r"
+readback() { # name, input, options for both..., -- checker-only options
+  local name=$1 in=$2; shift 2
+  local opts=() extra=()
+  while [ $# -gt 0 ] && [ "$1" != -- ]; do opts+=("$1"); shift; done
+  [ $# -gt 0 ] && shift
+  extra=("$@")
+  if "$TOOL" -q --backend ref "${opts[@]}" "$in" -o "$TMP/r/$name" 2> "$TMP/err"; then
+    count_check "$TMP/r/$name" "$in" "${opts[@]}" "${extra[@]}"
+  else
+    bad "export $name for reading back: $(head -n 1 "$TMP/err")"
+  fi
+}
+readback box.glb "$BOX" --level 3
+readback box_limit.glb "$BOX" --level 2 --normals limit
+readback box_flat.gltf "$BOX" --level 2 --normals flat
+readback box_tess.glb "$BOX" --tess 6
+# hard edges: a cube whose 12 edges are infinitely sharp (t crease), and the same by --crease-angle
+printf 'v -1 -1 1\nv 1 -1 1\nv -1 1 1\nv 1 1 1\nv -1 1 -1\nv 1 1 -1\nv -1 -1 -1\nv 1 -1 -1\nf 1 2 4 3\nf 3 4 6 5\nf 5 6 8 7\nf 7 8 2 1\nf 2 8 6 4\nf 7 1 3 5\n' > "$TMP/cube.obj"
+cp "$TMP/cube.obj" "$TMP/hard.obj"
+for e in "1 2" "2 4" "4 3" "3 1" "3 5" "4 6" "5 6" "5 7" "6 8" "7 8" "8 2" "7 1"; do
+  set -- $e; echo "t crease 2/1/0 $(($1 - 1)) $(($2 - 1)) 10" >> "$TMP/hard.obj"
+done
+readback hard.glb "$TMP/hard.obj" --level 2 -- --min-splits 20
+readback hard_angle.glb "$TMP/cube.obj" --level 2 --crease-angle 30 -- --min-splits 20
+readback hard_tess.glb "$TMP/hard.obj" --tess 4 -- --min-splits 20
+if [ -d "$SHAPES" ]; then
+  readback car.glb "$SHAPES/catmark_car.obj" --level 2 -- --uvs yes
+  readback fvar.glb "$SHAPES/catmark_fvar_bound1.obj" --level 2 -- --uvs yes
+  readback loop.glb "$SHAPES/loop_cube_creases1.obj" --level 2
+  readback loop_tess.glb "$SHAPES/loop_cube_creases1.obj" --tess 5
+  readback holes.glb "$SHAPES/catmark_hole_test2.obj" --level 2
+  readback nonman.glb "$SHAPES/catmark_nonman_edges.obj" --level 2
+  readback bilinear.glb "$SHAPES/bilinear_nonquads0.obj" --level 1 -- --uvs yes
+  readback manifold.glb "$SHAPES/catmark_cube_creases1.obj" --scheme manifold --tess 8
+  readback noopt.glb "$SHAPES/catmark_chaikin1.obj" --level 2 --no-optimize
+fi
+# the default backend gives the same counts (the numbers within the backends' agreement)
+if "$TOOL" -q "$BOX" -o "$TMP/r/default.glb" && "$TOOL" -q --backend ref "$BOX" -o "$TMP/r/ref.glb"; then
+  a=$(stat -c %s "$TMP/r/default.glb"); b=$(stat -c %s "$TMP/r/ref.glb")
+  if [ "$a" = "$b" ]; then ok "the default backend's export has the ref export's size ($a bytes)"; else bad "export sizes differ: default $a, ref $b"; fi
+else
+  bad "exports on the default and ref backends"
+fi
+
+echo "$P passed, $F failed, $S skipped"
+[ "$F" = 0 ]
