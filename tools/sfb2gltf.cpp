@@ -26,6 +26,8 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <array>
+#include <map>
 #include <chrono>
 #include <cmath>
 #include <cstdarg>
@@ -44,7 +46,7 @@
 namespace {
 
 const char *const kUsage =
-    "usage: sfb2gltf [options] IN.obj -o OUT.glb|OUT.gltf\n"
+    "usage: sfb2gltf [options] IN.obj|IN.glb|IN.gltf -o OUT.glb|OUT.gltf\n"
     "\n"
     "Subdivides (or evaluates) a control mesh with creases and writes it as glTF 2.0: .glb by\n"
     "default, .gltf with a .bin beside it when OUT ends in .gltf or with --gltf.\n"
@@ -456,12 +458,8 @@ bool ends_with(const std::string &s, const char *suffix) {
     return true;
 }
 
-void build_model(const OutMesh &m, const std::string &name, const Options &o, tinygltf::Model *model) {
-    model->asset.version = "2.0";
-    char gen[64];
-    snprintf(gen, sizeof gen, "surfblend sfb2gltf %d.%d.%d", SFB_VERSION_MAJOR, SFB_VERSION_MINOR, SFB_VERSION_PATCH);
-    model->asset.generator = gen;
-    model->buffers.resize(1);
+// One output primitive: the mesh's accessors appended to the model's buffer.
+tinygltf::Primitive add_primitive(tinygltf::Model *model, const OutMesh &m, int material) {
     const size_t nv = m.positions.size() / 3;
     // indices: uint16 where every index fits (65535 is primitive restart in some APIs: kept out)
     int index_view;
@@ -480,7 +478,7 @@ void build_model(const OutMesh &m, const std::string &name, const Options &o, ti
     std::vector<double> mn(3, 0.0), mx(3, 0.0);
     for (size_t v = 0; v < nv; ++v)
         for (int c = 0; c < 3; ++c) {
-            const double x = m.positions[3 * v + c];
+            const double x = m.positions[3 * v + (size_t)c];
             if (v == 0 || x < mn[(size_t)c]) mn[(size_t)c] = x;
             if (v == 0 || x > mx[(size_t)c]) mx[(size_t)c] = x;
         }
@@ -492,29 +490,8 @@ void build_model(const OutMesh &m, const std::string &name, const Options &o, ti
         view = add_view(*model, m.uvs.data(), m.uvs.size() * sizeof(float), TINYGLTF_TARGET_ARRAY_BUFFER, 8);
         prim.attributes["TEXCOORD_0"] = add_accessor(*model, view, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC2, nv);
     }
-    // the input (OBJ) carries no material: a neutral PBR default
-    tinygltf::Material mat;
-    mat.name = "surfblend default";
-    mat.pbrMetallicRoughness.baseColorFactor = {0.8, 0.8, 0.8, 1.0};
-    mat.pbrMetallicRoughness.metallicFactor = 0.0;
-    mat.pbrMetallicRoughness.roughnessFactor = 0.5;
-    mat.doubleSided = false;
-    model->materials.push_back(mat);
-    prim.material = 0;
-    tinygltf::Mesh mesh;
-    mesh.name = name;
-    mesh.primitives.push_back(prim);
-    model->meshes.push_back(mesh);
-    tinygltf::Node node;
-    node.name = name;
-    node.mesh = 0;
-    model->nodes.push_back(node);
-    tinygltf::Scene scene;
-    scene.name = "surfblend";
-    scene.nodes.push_back(0);
-    model->scenes.push_back(scene);
-    model->defaultScene = 0;
-    (void)o;
+    prim.material = material;
+    return prim;
 }
 
 // Serialises the model to OUT (.glb, or .gltf with its buffer in BIN beside it), each file
@@ -562,80 +539,407 @@ int write_model(tinygltf::Model &model, const Options &o, size_t *bytes) {
 
 // ------------------------------------------------------------------ the pipeline
 
+// One control mesh: an OBJ file, or one TRIANGLES primitive of a glTF mesh.
+struct Part {
+    sfb_mesh *mesh = nullptr;
+    int gltf_mesh = 0;     // the output mesh it belongs to
+    int material = -1;     // the input's material (-1: the default one)
+    std::string name;      // for messages: FILE, or FILE mesh M primitive P
+    OutMesh out;
+};
+
 struct Run {
     Options o;
     Progress bar;
     sfb_context *ctx = nullptr;
-    sfb_mesh *mesh = nullptr;
-    sfb_surface *surf = nullptr;
-    sfb_mesh_data data{};
-    sfb_tess_data tess{};
-    unsigned char *trim_texels = nullptr;
+    std::vector<Part> parts;
+    // the output's skeleton: the glTF input's nodes, scenes, materials (and their textures) and
+    // mesh names, or for an OBJ one node and mesh named after the file, the default material
+    tinygltf::Model skeleton;
     ~Run() {
-        sfb_mesh_data_free(&data);
-        sfb_tess_data_free(&tess);
-        sfb_surface_destroy(surf);
-        sfb_mesh_destroy(mesh);
+        for (Part &p : parts) sfb_mesh_destroy(p.mesh);
         sfb_context_destroy(ctx);
-        free(trim_texels);
     }
-    int fail_lib(const char *what, sfb_result r) {
+    int fail_lib(const std::string &where, const char *what, sfb_result r) {
         bar.end();
-        cli_error("%s: %s: %s: %s", o.in, what, sfb_result_string(r), sfb_last_error(ctx));
+        cli_error("%s: %s: %s: %s", where.c_str(), what, sfb_result_string(r), sfb_last_error(ctx));
         return 1;
     }
 };
 
-int read_stage(Run &R) {
-    R.bar.begin("read", 1);
-    R.mesh = cli_load_mesh(R.ctx, R.o.in, R.o.have_angle ? R.o.angle : -1.0);
-    return R.mesh ? 0 : 1;
+// ---- glTF input
+
+// Reads accessor `index` (FLOAT, or normalised integers) as `comps` floats per element; an
+// empty string, or why it cannot be read.
+std::string accessor_floats(const tinygltf::Model &m, int index, int comps, std::vector<float> *out) {
+    if (index < 0 || index >= (int)m.accessors.size()) return "an accessor index out of range";
+    const tinygltf::Accessor &a = m.accessors[(size_t)index];
+    if (a.sparse.isSparse) return "a sparse accessor (not read: densify the file first)";
+    if (tinygltf::GetNumComponentsInType((uint32_t)a.type) != comps) return "an accessor of the wrong type";
+    if (a.bufferView < 0 || a.bufferView >= (int)m.bufferViews.size()) return "an accessor without data";
+    const tinygltf::BufferView &v = m.bufferViews[(size_t)a.bufferView];
+    if (v.buffer < 0 || v.buffer >= (int)m.buffers.size()) return "a bufferView without a buffer";
+    const std::vector<unsigned char> &b = m.buffers[(size_t)v.buffer].data;
+    const int csize = tinygltf::GetComponentSizeInBytes((uint32_t)a.componentType);
+    if (csize <= 0) return "an accessor of an unknown component type";
+    const size_t stride = v.byteStride ? v.byteStride : (size_t)csize * (size_t)comps;
+    if (a.count > (size_t)SFB_MAX_ELEMENTS) return "an accessor over the element limit";
+    out->resize(a.count * (size_t)comps);
+    for (size_t i = 0; i < a.count; ++i)
+        for (int c = 0; c < comps; ++c) {
+            const size_t at = v.byteOffset + a.byteOffset + i * stride + (size_t)c * (size_t)csize;
+            if (at + (size_t)csize > b.size() || at + (size_t)csize > v.byteOffset + v.byteLength) return "an accessor past the end of its buffer";
+            double x;
+            switch (a.componentType) {
+            case TINYGLTF_COMPONENT_TYPE_FLOAT: { float f; memcpy(&f, &b[at], 4); x = f; break; }
+            case TINYGLTF_COMPONENT_TYPE_SHORT: { short q; memcpy(&q, &b[at], 2); x = a.normalized ? std::max(q / 32767.0, -1.0) : q; break; }
+            case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: { unsigned short q; memcpy(&q, &b[at], 2); x = a.normalized ? q / 65535.0 : q; break; }
+            case TINYGLTF_COMPONENT_TYPE_BYTE: { signed char q = (signed char)b[at]; x = a.normalized ? std::max(q / 127.0, -1.0) : q; break; }
+            case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: x = a.normalized ? b[at] / 255.0 : b[at]; break;
+            default: return "an accessor of an unsupported component type";
+            }
+            if (!std::isfinite(x)) return "a NaN or infinite value";
+            (*out)[i * (size_t)comps + (size_t)c] = (float)x;
+        }
+    return "";
 }
 
-int build_stage(Run &R) {
-    R.bar.begin("build", 2);
+std::string accessor_indices(const tinygltf::Model &m, int index, size_t vertices, std::vector<unsigned> *out) {
+    if (index < 0 || index >= (int)m.accessors.size()) return "an index accessor out of range";
+    const tinygltf::Accessor &a = m.accessors[(size_t)index];
+    if (a.sparse.isSparse) return "a sparse index accessor (not read)";
+    if (a.type != TINYGLTF_TYPE_SCALAR || a.bufferView < 0 || a.bufferView >= (int)m.bufferViews.size()) return "an index accessor that is not scalar";
+    const tinygltf::BufferView &v = m.bufferViews[(size_t)a.bufferView];
+    if (v.buffer < 0 || v.buffer >= (int)m.buffers.size()) return "a bufferView without a buffer";
+    const std::vector<unsigned char> &b = m.buffers[(size_t)v.buffer].data;
+    const int csize = tinygltf::GetComponentSizeInBytes((uint32_t)a.componentType);
+    if (csize != 1 && csize != 2 && csize != 4) return "indices of an unsupported type";
+    if (a.count > (size_t)SFB_MAX_ELEMENTS) return "an index accessor over the element limit";
+    out->resize(a.count);
+    for (size_t i = 0; i < a.count; ++i) {
+        const size_t at = v.byteOffset + a.byteOffset + i * (v.byteStride ? v.byteStride : (size_t)csize);
+        if (at + (size_t)csize > b.size()) return "indices past the end of their buffer";
+        unsigned x = 0;
+        if (csize == 1) x = b[at];
+        else if (csize == 2) { unsigned short q; memcpy(&q, &b[at], 2); x = q; }
+        else memcpy(&x, &b[at], 4);
+        if (x >= vertices) return "an index out of range (" + std::to_string(x) + " of " + std::to_string(vertices) + " vertices)";
+        (*out)[i] = x;
+    }
+    return "";
+}
+
+// Position key: exact float bits, -0 as 0.
+std::array<unsigned, 3> pos_key(const float *p) {
+    std::array<unsigned, 3> k;
+    for (int c = 0; c < 3; ++c) {
+        float x = p[c] == 0.0f ? 0.0f : p[c];
+        memcpy(&k[(size_t)c], &x, 4);
+    }
+    return k;
+}
+
+struct KeyHash {
+    size_t operator()(const std::array<unsigned, 3> &k) const { return ((size_t)k[0] * 73856093u) ^ ((size_t)k[1] * 19349663u) ^ ((size_t)k[2] * 83492791u); }
+};
+
+// A TRIANGLES primitive as a control mesh. glTF carries hard edges by splitting vertices: the
+// vertices are welded by exact position, and an edge whose two triangles see different normals
+// (over 1e-4 apart) at either end becomes infinitely sharp. UVs become face-varying (a UV seam:
+// a boundary of the UV layout), v turned back (v_obj = 1 - v). Creases may also come from the
+// primitive's extras: "sfb_creases": [a0, b0, s0, a1, b1, s1, ...], a/b vertex indices of the
+// primitive, s the sharpness (>= 10: infinitely sharp); the sharper of the two wins.
+std::string primitive_to_mesh(sfb_context *ctx, const tinygltf::Model &m, const tinygltf::Primitive &prim, sfb_mesh **out) {
+    if (prim.mode != TINYGLTF_MODE_TRIANGLES && prim.mode != -1)
+        return "a primitive of mode " + std::to_string(prim.mode) + " (only TRIANGLES, mode 4, makes a surface)";
+    auto pit = prim.attributes.find("POSITION");
+    if (pit == prim.attributes.end()) return "a primitive without POSITION";
+    std::vector<float> P, N, T;
+    std::string e = accessor_floats(m, pit->second, 3, &P);
+    if (!e.empty()) return "POSITION: " + e;
+    const size_t nv = P.size() / 3;
+    auto nit = prim.attributes.find("NORMAL"), tit = prim.attributes.find("TEXCOORD_0");
+    if (nit != prim.attributes.end() && !(e = accessor_floats(m, nit->second, 3, &N)).empty()) return "NORMAL: " + e;
+    if (tit != prim.attributes.end() && !(e = accessor_floats(m, tit->second, 2, &T)).empty()) return "TEXCOORD_0: " + e;
+    if ((!N.empty() && N.size() / 3 != nv) || (!T.empty() && T.size() / 2 != nv)) return "attributes of different lengths";
+    std::vector<unsigned> I;
+    if (prim.indices >= 0) {
+        if (!(e = accessor_indices(m, prim.indices, nv, &I)).empty()) return e;
+    } else {
+        I.resize(nv);
+        for (size_t i = 0; i < nv; ++i) I[i] = (unsigned)i;
+    }
+    if (I.size() < 3 || I.size() % 3) return "no triangles";
+    // weld
+    std::unordered_map<std::array<unsigned, 3>, int, KeyHash> weld;
+    std::vector<int> welded(nv);
+    std::vector<float> positions;
+    for (size_t v = 0; v < nv; ++v) {
+        auto r = weld.emplace(pos_key(&P[3 * v]), (int)(positions.size() / 3));
+        if (r.second) positions.insert(positions.end(), &P[3 * v], &P[3 * v] + 3);
+        welded[v] = r.first->second;
+    }
+    // UVs by value
+    std::map<std::pair<float, float>, int> uv_id;
+    std::vector<float> uvs;
+    std::vector<int> sizes, fv, fuv, tri_of; // tri_of: the kept triangles' first index in I
+    for (size_t t = 0; t < I.size(); t += 3) {
+        const int a = welded[I[t]], b = welded[I[t + 1]], c = welded[I[t + 2]];
+        if (a == b || b == c || a == c) continue; // degenerate after welding: not a face
+        sizes.push_back(3);
+        tri_of.push_back((int)t);
+        for (int k = 0; k < 3; ++k) {
+            fv.push_back(welded[I[t + (size_t)k]]);
+            if (!T.empty()) {
+                const unsigned o = I[t + (size_t)k];
+                auto r = uv_id.emplace(std::make_pair(T[2 * o], 1.0f - T[2 * o + 1]), (int)(uvs.size() / 2));
+                if (r.second) { uvs.push_back(T[2 * o]); uvs.push_back(1.0f - T[2 * o + 1]); }
+                fuv.push_back(r.first->second);
+            }
+        }
+    }
+    if (sizes.empty()) return "no triangles (every one degenerate)";
+    // hard edges: the normals the two triangles of an edge see at its ends
+    std::map<std::pair<int, int>, float> sharp;
+    if (!N.empty()) {
+        std::map<std::pair<int, int>, std::vector<std::pair<unsigned, unsigned>>> sides; // welded edge -> (orig at lo, orig at hi)
+        for (size_t f = 0; f < tri_of.size(); ++f)
+            for (int k = 0; k < 3; ++k) {
+                const unsigned oa = I[(size_t)tri_of[f] + (size_t)k], ob = I[(size_t)tri_of[f] + (size_t)(k + 1) % 3];
+                const int wa = welded[oa], wb = welded[ob];
+                sides[{std::min(wa, wb), std::max(wa, wb)}].push_back(wa < wb ? std::make_pair(oa, ob) : std::make_pair(ob, oa));
+            }
+        auto differ = [&](unsigned x, unsigned y) {
+            return std::fabs(N[3 * x] - N[3 * y]) + std::fabs(N[3 * x + 1] - N[3 * y + 1]) + std::fabs(N[3 * x + 2] - N[3 * y + 2]) > 1e-4f;
+        };
+        for (auto &kv : sides)
+            if (kv.second.size() == 2 && (differ(kv.second[0].first, kv.second[1].first) || differ(kv.second[0].second, kv.second[1].second)))
+                sharp[kv.first] = SFB_SHARPNESS_INFINITE;
+    }
+    auto xit = prim.extras.IsObject() && prim.extras.Has("sfb_creases") ? &prim.extras.Get("sfb_creases") : nullptr;
+    if (xit) {
+        if (!xit->IsArray() || xit->ArrayLen() % 3) return "extras.sfb_creases is not an array of (a, b, sharpness) triples";
+        for (size_t i = 0; i + 2 < xit->ArrayLen(); i += 3) {
+            const tinygltf::Value &va = xit->Get((int)i), &vb = xit->Get((int)i + 1), &vs = xit->Get((int)i + 2);
+            if (!va.IsNumber() || !vb.IsNumber() || !vs.IsNumber()) return "extras.sfb_creases holds a value that is not a number";
+            const double da = va.GetNumberAsDouble(), db = vb.GetNumberAsDouble(), ds = vs.GetNumberAsDouble();
+            if (!(da >= 0 && da < (double)nv && db >= 0 && db < (double)nv) || !(ds >= 0))
+                return "extras.sfb_creases triple " + std::to_string(i / 3) + " names a vertex out of range or a negative sharpness";
+            const int wa = welded[(size_t)da], wb = welded[(size_t)db];
+            float &s = sharp[{std::min(wa, wb), std::max(wa, wb)}];
+            s = std::max(s, (float)std::min(ds, (double)SFB_SHARPNESS_INFINITE));
+        }
+    }
+    std::vector<int> cv;
+    std::vector<float> cs;
+    for (auto &kv : sharp) { cv.push_back(kv.first.first); cv.push_back(kv.first.second); cs.push_back(kv.second); }
     sfb_mesh_desc d;
-    sfb_mesh_get_desc(R.mesh, &d);
+    memset(&d, 0, sizeof d);
+    d.vertex_count = (int)(positions.size() / 3);
+    d.positions = positions.data();
+    d.face_count = (int)sizes.size();
+    d.face_sizes = sizes.data();
+    d.face_vertices = fv.data();
+    d.crease_count = (int)cs.size();
+    d.crease_vertices = cv.data();
+    d.crease_sharpness = cs.data();
+    if (!T.empty()) {
+        d.uv_count = (int)(uvs.size() / 2);
+        d.uvs = uvs.data();
+        d.face_uvs = fuv.data();
+    }
+    sfb_result r = sfb_mesh_create(ctx, &d, out);
+    if (r != SFB_SUCCESS) return std::string(sfb_result_string(r)) + ": " + sfb_last_error(ctx);
+    return "";
+}
+
+int read_gltf(Run &R) {
+    tinygltf::TinyGLTF loader;
+    tinygltf::Model &m = R.skeleton;
+    std::string err, warn;
+    FILE *probe = fopen(R.o.in, "rb");
+    if (!probe) {
+        cli_error("cannot read '%s'", R.o.in);
+        return 1;
+    }
+    char magic[4] = {0, 0, 0, 0};
+    const size_t got = fread(magic, 1, 4, probe);
+    fclose(probe);
+    const bool binary = got == 4 && !memcmp(magic, "glTF", 4);
+    const bool ok = binary ? loader.LoadBinaryFromFile(&m, &err, &warn, R.o.in) : loader.LoadASCIIFromFile(&m, &err, &warn, R.o.in);
+    if (!ok) {
+        std::string first = err.substr(0, err.find('\n'));
+        cli_error("%s: not a readable glTF file: %s", R.o.in, first.empty() ? "tinygltf gave no reason" : first.c_str());
+        return 1;
+    }
+    for (size_t mi = 0; mi < m.meshes.size(); ++mi)
+        for (size_t pi = 0; pi < m.meshes[mi].primitives.size(); ++pi) {
+            const tinygltf::Primitive &prim = m.meshes[mi].primitives[pi];
+            Part part;
+            part.gltf_mesh = (int)mi;
+            part.material = prim.material >= 0 && prim.material < (int)m.materials.size() ? prim.material : -1;
+            part.name = std::string(R.o.in) + " mesh " + std::to_string(mi) + " primitive " + std::to_string(pi);
+            std::string e = primitive_to_mesh(R.ctx, m, prim, &part.mesh);
+            if (!e.empty()) {
+                R.bar.end();
+                cli_error("%s: %s", part.name.c_str(), e.c_str());
+                return 1;
+            }
+            if (R.o.have_angle) {
+                sfb_mesh *creased = nullptr;
+                sfb_result r = sfb_mesh_crease_by_angle(R.ctx, part.mesh, (float)R.o.angle, &creased, nullptr);
+                sfb_mesh_destroy(part.mesh);
+                part.mesh = creased;
+                if (r != SFB_SUCCESS) return R.fail_lib(part.name, "--crease-angle", r);
+            }
+            R.parts.push_back(std::move(part));
+        }
+    if (R.parts.empty()) {
+        cli_error("%s: no triangles (the file has no mesh primitives)", R.o.in);
+        return 1;
+    }
+    return 0;
+}
+
+bool is_gltf_name(const char *path) {
+    const std::string p = path;
+    return ends_with(p, ".glb") || ends_with(p, ".gltf");
+}
+
+// ---- the stages
+
+int read_stage(Run &R) {
+    R.bar.begin("read", 1);
+    if (is_gltf_name(R.o.in)) return read_gltf(R);
+    Part part;
+    part.name = R.o.in;
+    part.mesh = cli_load_mesh(R.ctx, R.o.in, R.o.have_angle ? R.o.angle : -1.0);
+    if (!part.mesh) return 1;
+    R.parts.push_back(std::move(part));
+    // an OBJ: one node and mesh named after the file
+    tinygltf::Mesh mesh;
+    mesh.name = base_name(R.o.in);
+    R.skeleton.meshes.push_back(mesh);
+    tinygltf::Node node;
+    node.name = mesh.name;
+    node.mesh = 0;
+    R.skeleton.nodes.push_back(node);
+    tinygltf::Scene scene;
+    scene.name = "surfblend";
+    scene.nodes.push_back(0);
+    R.skeleton.scenes.push_back(scene);
+    R.skeleton.defaultScene = 0;
+    return 0;
+}
+
+// Builds and evaluates each part into its OutMesh (the surface and its data freed as it goes).
+int evaluate_part(Run &R, Part &part) {
+    sfb_mesh_desc d;
+    sfb_mesh_get_desc(part.mesh, &d);
     sfb_surface_config cfg = sfb_surface_config_init(R.o.scheme, R.o.have_tess ? 0 : R.o.level);
     if (R.o.have_tess) cfg.flags = SFB_REFINE_PATCHES;
     else cfg.flags = (R.o.normals == NORMALS_FLAT ? 0u : (unsigned)SFB_REFINE_SHADING) | (d.uv_count > 0 ? (unsigned)SFB_REFINE_UVS : 0u);
-    sfb_result r = sfb_surface_create(R.ctx, R.mesh, &cfg, &R.surf);
-    return r == SFB_SUCCESS ? 0 : R.fail_lib("building the surface", r);
-}
-
-int evaluate_stage(Run &R, OutMesh *m) {
+    sfb_surface *surf = nullptr;
+    sfb_result r = sfb_surface_create(R.ctx, part.mesh, &cfg, &surf);
+    if (r != SFB_SUCCESS) return R.fail_lib(part.name, "building the surface", r);
     R.bar.begin("evaluate", 3);
-    sfb_result r;
+    int rc = 0;
     if (R.o.have_tess) {
         sfb_tess_config tc = sfb_tess_config_init(R.o.rate);
         tc.tolerance = (float)R.o.tolerance;
         tc.flags = SFB_TESS_SPLIT_CREASES;
         sfb_trim_mask mask;
+        unsigned char *texels = nullptr;
         if (R.o.trim) {
             memset(&mask, 0, sizeof mask);
             int w = 0, h = 0;
-            if (!cli_load_mask(R.o.trim, &R.trim_texels, &w, &h)) return 1;
+            if (!cli_load_mask(R.o.trim, &texels, &w, &h)) {
+                sfb_surface_destroy(surf);
+                return 1;
+            }
             mask.width = w;
             mask.height = h;
-            mask.texels = R.trim_texels;
+            mask.texels = texels;
             tc.trim = &mask;
         }
-        r = sfb_surface_tessellate(R.surf, &tc, &R.tess);
-        if (r != SFB_SUCCESS) return R.fail_lib("tessellating", r);
-        mesh_from_tess(R.tess, R.o.normals == NORMALS_FLAT, m);
-        return 0;
+        sfb_tess_data t;
+        memset(&t, 0, sizeof t);
+        r = sfb_surface_tessellate(surf, &tc, &t);
+        if (r == SFB_SUCCESS) mesh_from_tess(t, R.o.normals == NORMALS_FLAT, &part.out);
+        else rc = R.fail_lib(part.name, "tessellating", r);
+        sfb_tess_data_free(&t);
+        free(texels);
+    } else {
+        sfb_mesh_data data;
+        memset(&data, 0, sizeof data);
+        if (R.o.normals == NORMALS_FLAT) {
+            r = sfb_surface_refine(surf, &data);
+            if (r == SFB_SUCCESS) mesh_from_faces(data, nullptr, true, &part.out);
+            else rc = R.fail_lib(part.name, "refining", r);
+        } else {
+            sfb_shade_params sp = sfb_shade_params_init();
+            r = sfb_surface_shade(surf, &sp, &data);
+            if (r == SFB_SUCCESS) mesh_from_faces(data, R.o.normals == NORMALS_LIMIT ? data.limit_normals : data.normals, false, &part.out);
+            else rc = R.fail_lib(part.name, "shading", r);
+        }
+        sfb_mesh_data_free(&data);
     }
-    if (R.o.normals == NORMALS_FLAT) {
-        r = sfb_surface_refine(R.surf, &R.data);
-        if (r != SFB_SUCCESS) return R.fail_lib("refining", r);
-        mesh_from_faces(R.data, nullptr, true, m);
-        return 0;
+    sfb_surface_destroy(surf);
+    return rc;
+}
+
+// The output model: the skeleton's nodes, scenes, materials (textures, images, samplers) and
+// mesh names, each mesh's primitives replaced by the evaluated parts. Animations, skins and
+// morph targets are not kept (the surface is evaluated at rest).
+void assemble(Run &R, tinygltf::Model *model) {
+    tinygltf::Model &k = R.skeleton;
+    model->asset.version = "2.0";
+    char gen[64];
+    snprintf(gen, sizeof gen, "surfblend sfb2gltf %d.%d.%d", SFB_VERSION_MAJOR, SFB_VERSION_MINOR, SFB_VERSION_PATCH);
+    model->asset.generator = gen;
+    model->buffers.resize(1);
+    model->nodes = k.nodes;
+    for (tinygltf::Node &n : model->nodes) {
+        n.skin = -1;
+        n.weights.clear();
+        n.camera = n.camera >= 0 && n.camera < (int)k.cameras.size() ? n.camera : -1;
     }
-    sfb_shade_params sp = sfb_shade_params_init();
-    r = sfb_surface_shade(R.surf, &sp, &R.data);
-    if (r != SFB_SUCCESS) return R.fail_lib("shading", r);
-    mesh_from_faces(R.data, R.o.normals == NORMALS_LIMIT ? R.data.limit_normals : R.data.normals, false, m);
-    return 0;
+    model->cameras = k.cameras;
+    model->scenes = k.scenes;
+    model->defaultScene = k.defaultScene;
+    model->materials = k.materials;
+    model->textures = k.textures;
+    model->images = k.images;
+    model->samplers = k.samplers;
+    model->extensionsUsed.clear();
+    int default_material = -1;
+    model->meshes.resize(k.meshes.size());
+    for (size_t i = 0; i < k.meshes.size(); ++i) model->meshes[i].name = k.meshes[i].name;
+    for (const Part &p : R.parts) {
+        int mat = p.material;
+        if (mat < 0) {
+            if (default_material < 0) {
+                // the input carries no material here: a neutral PBR default
+                tinygltf::Material dm;
+                dm.name = "surfblend default";
+                dm.pbrMetallicRoughness.baseColorFactor = {0.8, 0.8, 0.8, 1.0};
+                dm.pbrMetallicRoughness.metallicFactor = 0.0;
+                dm.pbrMetallicRoughness.roughnessFactor = 0.5;
+                model->materials.push_back(dm);
+                default_material = (int)model->materials.size() - 1;
+            }
+            mat = default_material;
+        }
+        if (p.out.indices.empty()) continue;
+        model->meshes[(size_t)p.gltf_mesh].primitives.push_back(add_primitive(model, p.out, mat));
+    }
+    // a mesh left without primitives (all its parts empty) cannot be written: its nodes lose it
+    std::vector<int> remap(model->meshes.size(), -1);
+    std::vector<tinygltf::Mesh> kept;
+    for (size_t i = 0; i < model->meshes.size(); ++i)
+        if (!model->meshes[i].primitives.empty()) { remap[i] = (int)kept.size(); kept.push_back(model->meshes[i]); }
+    model->meshes.swap(kept);
+    for (tinygltf::Node &n : model->nodes) n.mesh = n.mesh >= 0 && n.mesh < (int)remap.size() ? remap[(size_t)n.mesh] : -1;
 }
 
 } // namespace
@@ -649,30 +953,45 @@ int main(int argc, char **argv) {
     sfb_progress progress = {progress_cb, &R.bar};
     R.ctx = cli_make_context_progress(R.o.backend, progress);
     if (!R.ctx) return 1;
-    OutMesh m;
-    if (read_stage(R) || build_stage(R) || evaluate_stage(R, &m)) {
+    if (read_stage(R)) {
         R.bar.end();
         return 1;
     }
-    drop_degenerate(&m);
-    if (m.indices.empty()) {
+    R.bar.begin("build", 2);
+    size_t vertices = 0, triangles = 0;
+    bool uvs = false;
+    for (Part &p : R.parts) {
+        if (evaluate_part(R, p)) {
+            R.bar.end();
+            return 1;
+        }
+        sfb_mesh_destroy(p.mesh);
+        p.mesh = nullptr;
+        drop_degenerate(&p.out);
+    }
+    R.bar.begin("optimise", 4);
+    for (Part &p : R.parts) {
+        if (R.o.optimize) optimize_mesh(&p.out);
+        else compact_mesh(&p.out);
+        vertices += p.out.positions.size() / 3;
+        triangles += p.out.indices.size() / 3;
+        uvs = uvs || !p.out.uvs.empty();
+    }
+    if (triangles == 0) {
         R.bar.end();
         cli_error("%s: the surface has no triangles to write (every face a hole, or degenerate)", R.o.in);
         return 1;
     }
-    R.bar.begin("optimise", 4);
-    if (R.o.optimize) optimize_mesh(&m);
-    else compact_mesh(&m);
     R.bar.begin("write", 5);
     tinygltf::Model model;
-    build_model(m, base_name(R.o.in), R.o, &model);
+    assemble(R, &model);
     size_t bytes = 0;
     rc = write_model(model, R.o, &bytes);
     R.bar.end();
     if (rc) return 1;
     if (!R.o.quiet)
-        fprintf(stderr, "sfb2gltf: %s: %s %s: %zu vertices, %zu triangles%s -> %s (%zu bytes, backend %s)\n", R.o.in,
-                sfb_scheme_name(R.o.scheme), R.o.have_tess ? "tessellated" : "refined", m.positions.size() / 3, m.indices.size() / 3,
-                m.uvs.empty() ? "" : ", UVs", R.o.out, bytes, sfb_context_backend_name(R.ctx));
+        fprintf(stderr, "sfb2gltf: %s: %s %s: %zu mesh%s, %zu vertices, %zu triangles%s -> %s (%zu bytes, backend %s)\n", R.o.in,
+                sfb_scheme_name(R.o.scheme), R.o.have_tess ? "tessellated" : "refined", R.parts.size(), R.parts.size() == 1 ? "" : "es",
+                vertices, triangles, uvs ? ", UVs" : "", R.o.out, bytes, sfb_context_backend_name(R.ctx));
     return 0;
 }
