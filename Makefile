@@ -35,7 +35,15 @@ PKGS_CLI  := libstb-dev
 PKGS_FUZZ := clang libclang-rt-14-dev
 # The NEON kernels, cross-compiled for AArch64 and run under qemu user emulation (make test-neon).
 PKGS_NEON := gcc-aarch64-linux-gnu libc6-dev-arm64-cross qemu-user-static
+# The web checks (tests/web/): Chromium for three.js in a real headless browser, Node and npm for
+# the Khronos glTF validator, three.js and the browser driver (playwright-core). Node and npm
+# are only asked for when their commands are missing (a Node from elsewhere is fine: >= 18).
+PKGS_WEB  := chromium $(if $(shell command -v node 2>/dev/null),,nodejs) $(if $(shell command -v npm 2>/dev/null),,npm)
+# npm packages of the web checks, installed by `npm ci` from the committed package.json and
+# package-lock.json (tests/web/) into NODE_DIR; the scripts find them there (SFB_NODE_DIR).
+NODE_DIR  ?= $(BUILD)/node
 
+.PHONY: deps-web test-web install uninstall
 .PHONY: all run test check-modules test-neon deps-neon bench fuzz asan amalgamate amalgamate-check embed-glsl deps deps-test deps-fuzz clean unit-build
 
 all: $(BUILD)/surfblend
@@ -60,6 +68,16 @@ deps-fuzz:
 	$(call need_pkgs,$(PKGS_FUZZ))
 deps-neon:
 	$(call need_pkgs,$(PKGS_NEON))
+deps-web:
+	$(call need_pkgs,$(PKGS_WEB))
+	@$(MAKE) --no-print-directory $(NODE_DIR)/.installed
+
+# (re-run when the lock file changes; npm ci installs exactly what it lists)
+$(NODE_DIR)/.installed: tests/web/package.json tests/web/package-lock.json
+	@mkdir -p $(NODE_DIR)
+	cp tests/web/package.json tests/web/package-lock.json $(NODE_DIR)/
+	cd $(NODE_DIR) && npm ci --no-audit --no-fund --loglevel=error
+	@touch $@
 
 # ---- the single header ----
 amalgamate:
