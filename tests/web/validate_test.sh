@@ -1,7 +1,8 @@
 #!/bin/bash
 # The glTF validation wrapper (tests/web/validate.mjs) on files written here from scratch
 # (tests/web/gltf_fixtures.mjs): valid ones pass, broken ones fail with the validator's codes.
-# Closes with "N passed, N failed, N skipped"; without node or gltf-validator: one skip, reason given.
+# Closes with "N passed, N failed, N skipped"; without node or gltf-validator: one skip, reason given
+# (a failure instead when SFB_REQUIRE_WEB is set, as on CI).
 set -u
 cd "$(dirname "$0")/../.."
 BUILD=${BUILD:-build}
@@ -10,10 +11,13 @@ W=$BUILD/web/validate; rm -rf "$W"; mkdir -p "$W"
 P=0; F=0
 pass() { P=$((P + 1)); echo "ok $1"; }
 fail() { F=$((F + 1)); echo "FAIL $1"; }
-if ! command -v node >/dev/null; then echo "SKIP validate: node not found"; echo "0 passed, 0 failed, 1 skipped"; exit 0; fi
-if [ ! -f "$SFB_NODE_DIR/node_modules/gltf-validator/package.json" ]; then
-  echo "SKIP validate: gltf-validator not installed under $SFB_NODE_DIR (make deps-web)"; echo "0 passed, 0 failed, 1 skipped"; exit 0
-fi
+unavailable() { # skipped with the reason; failed when SFB_REQUIRE_WEB is set (CI)
+  if [ -n "${SFB_REQUIRE_WEB:-}" ]; then echo "FAIL validate: $1 (SFB_REQUIRE_WEB is set)"; echo "0 passed, 1 failed, 0 skipped"; exit 1; fi
+  echo "SKIP validate: $1"; echo "0 passed, 0 failed, 1 skipped"; exit 0
+}
+command -v node >/dev/null || unavailable "node not found"
+[ -f "$SFB_NODE_DIR/node_modules/gltf-validator/package.json" ] || unavailable "gltf-validator not installed under $SFB_NODE_DIR (make deps-web)"
+
 node tests/web/gltf_fixtures.mjs "$W" || { fail "fixtures written"; echo "$P passed, $F failed, 0 skipped"; exit 1; }
 
 # expect NAME RC [CODE...]: validate.mjs on $W/NAME exits RC and prints each CODE
