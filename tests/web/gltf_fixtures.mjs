@@ -2,7 +2,7 @@
 // Small glTF 2.0 files for the web checks, written from scratch (no exporter involved):
 //
 //   node tests/web/gltf_fixtures.mjs OUTDIR            the validator's fixtures (below)
-//   node tests/web/gltf_fixtures.mjs --obj IN.obj OUT.glb|OUT.gltf [--quantize]
+//   node tests/web/gltf_fixtures.mjs --obj IN.obj OUT.glb|OUT.gltf [--quantize] [--meshopt]
 //                                                      a triangulated OBJ as indexed glTF
 //
 // Fixtures: tri.glb and tri.gltf + tri.bin (one triangle, valid), tri_unused.gltf (valid, with
@@ -11,7 +11,9 @@
 // primitive without POSITION). --obj keeps every OBJ vertex (v) as one glTF vertex with its
 // normal (the vn of its first corner) and fans each face into triangles, as three.js's
 // OBJLoader does; --quantize stores positions as normalized SHORT with a node transform and
-// normals as normalized BYTE (KHR_mesh_quantization).
+// normals as normalized BYTE (KHR_mesh_quantization); --meshopt stores the vertex attributes
+// compressed (EXT_meshopt_compression, ATTRIBUTES mode; the validator does not check that
+// extension's data: it reports it as an unsupported extension, an info).
 import { mkdirSync, readFileSync, writeFileSync } from 'node:fs';
 import { basename, join } from 'node:path';
 
@@ -79,6 +81,71 @@ function buildAsset({ attrs, indices, node = {}, extensions = [] }) {
   };
   if (extensions.length) { json.extensionsUsed = extensions; json.extensionsRequired = extensions; }
   return { json, bin };
+}
+
+// EXT_meshopt_compression's ATTRIBUTES stream (version 0) of count elements of stride bytes:
+// per block of elements, per byte position, the bytes' deltas from the previous element,
+// zigzag-coded, every 16-byte group stored at 8 bits (the codec's plainest form; a real
+// encoder picks 0, 2 or 4 bits where they suffice); then the tail, the first element.
+function meshoptEncodeAttributes(bytes, count, stride) {
+  const out = [0xa0];
+  const blockMax = Math.min((8192 / stride) & ~15, 256);
+  const last = Array.from(bytes.subarray(0, stride));
+  for (let base = 0; base < count; base += blockMax) {
+    const n = Math.min(blockMax, count - base), aligned = (n + 15) & ~15;
+    for (let k = 0; k < stride; ++k) {
+      const deltas = new Uint8Array(aligned);
+      let p = last[k];
+      for (let i = 0; i < n; ++i) {
+        const v = bytes[(base + i) * stride + k], d = (v - p) & 0xff;
+        deltas[i] = ((d << 1) ^ ((d & 0x80) ? 0xff : 0)) & 0xff; // zigzag
+        p = v;
+      }
+      const groups = aligned / 16, headerSize = (groups + 3) >> 2;
+      const header = new Array(headerSize).fill(0);
+      for (let g = 0; g < groups; ++g) header[g >> 2] |= 3 << ((g & 3) * 2); // 3: 8 bits per byte
+      out.push(...header);
+      for (let i = 0; i < aligned; ++i) out.push(deltas[i]);
+    }
+    for (let k = 0; k < stride; ++k) last[k] = bytes[(base + n - 1) * stride + k];
+  }
+  for (let i = stride; i < 32; ++i) out.push(0);
+  for (let k = 0; k < stride; ++k) out.push(bytes[k]);
+  return new Uint8Array(out);
+}
+
+// The asset with its vertex attribute views stored EXT_meshopt_compression-compressed in
+// buffer 0, decompressing into buffer 1 (a fallback buffer without data); index views stay
+// as they were, in buffer 0.
+function meshoptCompress({ json, bin }) {
+  const chunks = [];
+  let length = 0, fallback = 0;
+  const push = (bytes) => {
+    const off = length;
+    chunks.push(bytes); length += bytes.length;
+    const pad = (4 - (length % 4)) % 4;
+    if (pad) { chunks.push(new Uint8Array(pad)); length += pad; }
+    return off;
+  };
+  json.bufferViews.forEach((view, k) => {
+    const data = bin.subarray(view.byteOffset, view.byteOffset + view.byteLength);
+    if (view.target !== ARRAY_BUFFER) { view.byteOffset = push(data); return; }
+    const acc = json.accessors.find((a) => a.bufferView === k);
+    const stride = view.byteStride || (acc.type === 'VEC3' ? 3 : acc.type === 'VEC2' ? 2 : 1) * 4;
+    const count = view.byteLength / stride;
+    const encoded = meshoptEncodeAttributes(data, count, stride);
+    const off = push(encoded);
+    json.bufferViews[k] = { buffer: 1, byteOffset: fallback, byteLength: view.byteLength, byteStride: stride, target: view.target,
+      extensions: { EXT_meshopt_compression: { buffer: 0, byteOffset: off, byteLength: encoded.length, byteStride: stride, mode: 'ATTRIBUTES', count } } };
+    fallback += (view.byteLength + 3) & ~3;
+  });
+  const out = new Uint8Array(length);
+  let o = 0;
+  for (const c of chunks) { out.set(c, o); o += c.length; }
+  json.buffers = [{ byteLength: length }, { byteLength: fallback, extensions: { EXT_meshopt_compression: { fallback: true } } }];
+  json.extensionsUsed = [...(json.extensionsUsed || []), 'EXT_meshopt_compression'];
+  json.extensionsRequired = [...(json.extensionsRequired || []), 'EXT_meshopt_compression'];
+  return { json, bin: out };
 }
 
 function glbBytes(json, bin) {
@@ -196,10 +263,11 @@ function objToAsset(text, quantize) {
 
 const args = process.argv.slice(2);
 if (args[0] === '--obj' && args.length >= 3) {
-  writeAsset(args[2], objToAsset(readFileSync(args[1], 'utf8'), args.includes('--quantize')));
+  const asset = objToAsset(readFileSync(args[1], 'utf8'), args.includes('--quantize'));
+  writeAsset(args[2], args.includes('--meshopt') ? meshoptCompress(asset) : asset);
 } else if (args.length === 1 && !args[0].startsWith('-')) {
   fixtures(args[0]);
 } else {
-  console.error('usage: node tests/web/gltf_fixtures.mjs OUTDIR | --obj IN.obj OUT.glb|OUT.gltf [--quantize]');
+  console.error('usage: node tests/web/gltf_fixtures.mjs OUTDIR | --obj IN.obj OUT.glb|OUT.gltf [--quantize] [--meshopt]');
   process.exit(2);
 }

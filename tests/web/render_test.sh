@@ -3,7 +3,7 @@
 # tests/web/png_iou.c), without any glTF exporter: a shaded OBJ from `surfblend shade` is drawn
 # by `surfblend render` (the same refined mesh: --positions refined, same size and view) and by
 # render.mjs through OBJLoader, and through GLTFLoader after tests/web/gltf_fixtures.mjs wrote it
-# as .glb / .gltf (float, and KHR_mesh_quantization); the silhouettes' IoU must be >= MIN_IOU,
+# as .glb / .gltf (float, KHR_mesh_quantization, EXT_meshopt_compression); the silhouettes' IoU must be >= MIN_IOU,
 # the counts three.js reports must be the OBJ's, the glTF files must validate, and a
 # deliberately different view must fall well below (< BAD_IOU), so that the check can fail.
 # Closes with "N passed, N failed, N skipped". Without node, the npm packages, Chromium or
@@ -63,7 +63,8 @@ node tests/web/gltf_fixtures.mjs "$W/fx" || { fail "fixtures"; finish; }
 job probe "$W/fx/tri.glb" 0 0 1 64x64
 
 # prepare NAME SRC.obj LEVEL YAW PITCH ZOOM SIZE [FORMAT...]: one mesh's models and pictures.
-# FORMAT: glb, gltf (with its .bin), glb:quantized (KHR_mesh_quantization)
+# FORMAT: glb, gltf (with its .bin), glb:quantized (KHR_mesh_quantization), glb:meshopt (the
+# same, its vertex attributes EXT_meshopt_compression-compressed: needs the MeshoptDecoder)
 prepare() {
   local name=$1 src=$2 level=$3 yaw=$4 pitch=$5 zoom=$6 size=$7 obj v t g file opt; shift 7
   obj=$W/$name.obj
@@ -80,12 +81,13 @@ prepare() {
   for g in "$@"; do
     file=$W/$name.${g%%:*}; opt=
     [ "${g#*:}" = quantized ] && { opt=--quantize; file=$W/$name.q.${g%%:*}; }
+    [ "${g#*:}" = meshopt ] && { opt="--quantize --meshopt"; file=$W/$name.mq.${g%%:*}; }
     node tests/web/gltf_fixtures.mjs --obj "$obj" "$file" $opt || { fail "$name $g: written"; continue; }
     if node tests/web/validate.mjs "$file"; then pass "$name $g: validates"; else fail "$name $g: validates"; continue; fi
-    job "$name.$g" "$file" "$yaw" "$pitch" "$zoom" "$size"; CHECKS+=("iou $name $g $v $t")
+    job "$name.${g/:/_}" "$file" "$yaw" "$pitch" "$zoom" "$size"; CHECKS+=("iou $name ${g/:/_} $v $t")
   done
 }
-prepare creased_box examples/data/creased_box.obj 3 30 25 1 320x240 glb gltf glb:quantized
+prepare creased_box examples/data/creased_box.obj 3 30 25 1 320x240 glb gltf glb:quantized glb:meshopt
 if [ -d "$SHAPES" ]; then
   prepare catmark_car "$SHAPES/catmark_car.obj" 2 -60 20 1.1 240x320 glb
   prepare loop_toroidal_tet "$SHAPES/loop_toroidal_tet.obj" 3 15 40 1 300x300
