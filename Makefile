@@ -236,9 +236,8 @@ test: deps-test amalgamate-check
 	fi; \
 	BUILD=$(BUILD) SHAPES=$(SHAPES) CC="$(CC)" CXX="$(CXX)" JOBS=$(JOBS) ./tests/run_all.sh
 
-# The web checks alone (tests/web/: validator wrapper, three.js in headless Chromium against the
-# software renderer) and the install check: what make test runs as the suites validate, web and
-# install.
+# The web checks alone (tests/web/: the validator wrapper, three.js in headless Chromium against
+# the software renderer): what make test runs as the suites web_validate and web_render.
 test-web: deps-web $(BUILD)/surfblend $(BUILD)/web/png_iou
 	BUILD=$(BUILD) ./tests/web/validate_test.sh
 	BUILD=$(BUILD) SHAPES=$(SHAPES) ./tests/web/render_test.sh
