@@ -39,7 +39,15 @@ GLTF_LIBS := -ltinygltf -lmeshoptimizer
 PKGS_FUZZ := clang libclang-rt-14-dev
 # The NEON kernels, cross-compiled for AArch64 and run under qemu user emulation (make test-neon).
 PKGS_NEON := gcc-aarch64-linux-gnu libc6-dev-arm64-cross qemu-user-static
+# The web checks (tests/web/): Chromium for three.js in a real headless browser, Node and npm for
+# the Khronos glTF validator, three.js and the browser driver (playwright-core). Node and npm
+# are only asked for when their commands are missing (a Node from elsewhere is fine: >= 18).
+PKGS_WEB  := chromium $(if $(shell command -v node 2>/dev/null),,nodejs) $(if $(shell command -v npm 2>/dev/null),,npm)
+# npm packages of the web checks, installed by `npm ci` from the committed package.json and
+# package-lock.json (tests/web/) into NODE_DIR; the scripts find them there (SFB_NODE_DIR).
+NODE_DIR  ?= $(BUILD)/node
 
+.PHONY: deps-web test-web install uninstall
 .PHONY: all run test check-modules test-neon deps-neon bench fuzz asan amalgamate amalgamate-check embed-glsl deps deps-test deps-fuzz clean unit-build
 
 all: $(BUILD)/surfblend $(BUILD)/sfb2gltf
@@ -64,6 +72,16 @@ deps-fuzz:
 	$(call need_pkgs,$(PKGS_FUZZ))
 deps-neon:
 	$(call need_pkgs,$(PKGS_NEON))
+deps-web:
+	$(call need_pkgs,$(PKGS_WEB))
+	@$(MAKE) --no-print-directory $(NODE_DIR)/.installed
+
+# (re-run when the lock file changes; npm ci installs exactly what it lists)
+$(NODE_DIR)/.installed: tests/web/package.json tests/web/package-lock.json
+	@mkdir -p $(NODE_DIR)
+	cp tests/web/package.json tests/web/package-lock.json $(NODE_DIR)/
+	cd $(NODE_DIR) && npm ci --no-audit --no-fund --loglevel=error
+	@touch $@
 
 # ---- the single header ----
 amalgamate:
@@ -209,7 +227,12 @@ $(BUILD)/manifold: tests/manifold.c tests/harness.h src/sfb_internal.h $(BUILD)/
 $(BUILD)/gl_manifold: tests/gl_manifold.c tests/harness.h tests/egl_host.h $(BUILD)/libsfb.o
 	$(CC) $(CFLAGS) $(SAN) -I. tests/gl_manifold.c $(BUILD)/libsfb.o -o $@ $(GL_LIBS) $(LIBS)
 
-unit-build: $(BUILD)/surfblend $(BUILD)/unit $(BUILD)/osd_agree $(BUILD)/agree $(BUILD)/limit $(BUILD)/eigen $(BUILD)/gl_host \
+# The web checks' silhouette comparer (stb_image from PKGS_CLI) (tests/web/png_iou.c).
+$(BUILD)/web/png_iou: tests/web/png_iou.c | deps
+	@mkdir -p $(BUILD)/web
+	$(CC) -std=c99 $(OPT) -g -Wall -Wextra $(SAN) $< -o $@ -lm
+
+unit-build: $(BUILD)/web/png_iou $(BUILD)/surfblend $(BUILD)/unit $(BUILD)/osd_agree $(BUILD)/agree $(BUILD)/limit $(BUILD)/eigen $(BUILD)/gl_host \
             $(BUILD)/gl_errors $(BUILD)/gl_pieces $(BUILD)/shade $(BUILD)/trim $(BUILD)/finish_normals $(BUILD)/manifold $(BUILD)/gl_manifold $(EXAMPLES) \
             $(BUILD)/sfb2gltf $(BUILD)/gltf_check
 
@@ -218,13 +241,71 @@ unit-build: $(BUILD)/surfblend $(BUILD)/unit $(BUILD)/osd_agree $(BUILD)/agree $
 # OSMesa but no GPU. A value already in the environment wins. The programs build JOBS at a time
 # and the suites run JOBS side by side (tests/run_all.sh prints each one's wall time).
 JOBS ?= $(shell nproc 2>/dev/null || echo 2)
+# The web checks' packages (deps-web) are installed too, but a failure there (not root, offline)
+# only makes the web suites skip, with the reason; on CI they must run (SFB_REQUIRE_WEB).
 test: deps-test amalgamate-check
+	@$(MAKE) --no-print-directory deps-web || echo "make deps-web failed: the web suites will be skipped (on CI: failed)"
 	$(MAKE) --no-print-directory -j$(JOBS) unit-build
 	@if [ -n "$${CI:-}" ] && [ "$${CI}" != false ] && [ "$${CI}" != 0 ]; then \
 	  export SFB_REQUIRE_BACKENDS="$${SFB_REQUIRE_BACKENDS:-simd,gl,osmesa}"; \
-	  echo "CI=$${CI}: SFB_REQUIRE_BACKENDS=$${SFB_REQUIRE_BACKENDS}"; \
+	  export SFB_REQUIRE_WEB="$${SFB_REQUIRE_WEB:-1}"; \
+	  echo "CI=$${CI}: SFB_REQUIRE_BACKENDS=$${SFB_REQUIRE_BACKENDS} SFB_REQUIRE_WEB=$${SFB_REQUIRE_WEB}"; \
 	fi; \
 	BUILD=$(BUILD) SHAPES=$(SHAPES) CC="$(CC)" CXX="$(CXX)" JOBS=$(JOBS) ./tests/run_all.sh
+
+# The web checks alone (tests/web/: the validator wrapper, three.js in headless Chromium against
+# the software renderer): what make test runs as the suites web_validate and web_render.
+test-web: deps-web $(BUILD)/surfblend $(BUILD)/web/png_iou
+	BUILD=$(BUILD) ./tests/web/validate_test.sh
+	BUILD=$(BUILD) SHAPES=$(SHAPES) ./tests/web/render_test.sh
+
+# ---- install ----
+# make install [PREFIX=/usr/local] [DESTDIR=]: the header and the backends/ headers it includes
+# from beside itself in $(INCLUDEDIR)/surfblend/, the programs in $(BINDIR), surfblend.pc in
+# $(PKGCONFIGDIR) (Cflags -I$(INCLUDEDIR)/surfblend, so that #include "surfblend.h" works as in
+# examples/; Libs what the implementation needs). INSTALL_PROGRAMS are built and installed;
+# INSTALL_PROGRAMS_IF_BUILT are installed when $(BUILD)/NAME exists (a program whose build rule
+# is elsewhere: move it to INSTALL_PROGRAMS once this Makefile builds it).
+PREFIX      ?= /usr/local
+DESTDIR     ?=
+BINDIR      ?= $(PREFIX)/bin
+INCLUDEDIR  ?= $(PREFIX)/include
+LIBDIR      ?= $(PREFIX)/lib
+PKGCONFIGDIR?= $(LIBDIR)/pkgconfig
+INSTALL     ?= install
+INSTALL_PROGRAMS         ?= surfblend sfb2gltf
+INSTALL_PROGRAMS_IF_BUILT ?=
+SFB_VERSION := $(shell sed -nE 's/^\#define SFB_VERSION_(MAJOR|MINOR|PATCH) ([0-9]+).*/\2/p' src/sfb_api.h | paste -sd. -)
+INSTALL_HEADERS := $(shell find backends -name '*.h' | LC_ALL=C sort)
+
+$(BUILD)/surfblend.pc: src/sfb_api.h Makefile
+	@mkdir -p $(BUILD)
+	@printf '%s\n' 'prefix=$(PREFIX)' 'includedir=$(INCLUDEDIR)' '' 'Name: surfblend' \
+	  'Description: single-header subdivision surfaces (C99); define SURFBLEND_IMPLEMENTATION (and SURFBLEND_ALL_BACKENDS) in one file' \
+	  'Version: $(SFB_VERSION)' 'Cflags: -I$${includedir}/surfblend' 'Libs: -lm -lpthread -ldl' \
+	  | sed 's|=$(PREFIX)/|=$${prefix}/|' > $@
+	@echo "wrote $@ (prefix $(PREFIX))"
+
+# (surfblend.pc depends on PREFIX: it is written again on every install)
+install: $(addprefix $(BUILD)/,$(INSTALL_PROGRAMS))
+	@rm -f $(BUILD)/surfblend.pc && $(MAKE) --no-print-directory $(BUILD)/surfblend.pc
+	$(INSTALL) -d $(DESTDIR)$(BINDIR) $(DESTDIR)$(INCLUDEDIR)/surfblend $(DESTDIR)$(PKGCONFIGDIR)
+	$(INSTALL) -m 644 surfblend.h $(DESTDIR)$(INCLUDEDIR)/surfblend/surfblend.h
+	@for h in $(INSTALL_HEADERS); do \
+	  $(INSTALL) -d $(DESTDIR)$(INCLUDEDIR)/surfblend/$$(dirname $$h) && \
+	  $(INSTALL) -m 644 $$h $(DESTDIR)$(INCLUDEDIR)/surfblend/$$h || exit 1; \
+	done; echo "installed surfblend.h and $(words $(INSTALL_HEADERS)) backend headers in $(DESTDIR)$(INCLUDEDIR)/surfblend"
+	@for p in $(INSTALL_PROGRAMS); do echo "$(INSTALL) -m 755 $(BUILD)/$$p $(DESTDIR)$(BINDIR)/$$p"; \
+	  $(INSTALL) -m 755 $(BUILD)/$$p $(DESTDIR)$(BINDIR)/$$p || exit 1; done
+	@for p in $(INSTALL_PROGRAMS_IF_BUILT); do \
+	  if [ -x $(BUILD)/$$p ]; then echo "$(INSTALL) -m 755 $(BUILD)/$$p $(DESTDIR)$(BINDIR)/$$p"; \
+	    $(INSTALL) -m 755 $(BUILD)/$$p $(DESTDIR)$(BINDIR)/$$p || exit 1; \
+	  else echo "$$p: not built ($(BUILD)/$$p), not installed"; fi; done
+	$(INSTALL) -m 644 $(BUILD)/surfblend.pc $(DESTDIR)$(PKGCONFIGDIR)/surfblend.pc
+
+uninstall:
+	rm -f $(addprefix $(DESTDIR)$(BINDIR)/,$(INSTALL_PROGRAMS) $(INSTALL_PROGRAMS_IF_BUILT)) $(DESTDIR)$(PKGCONFIGDIR)/surfblend.pc
+	rm -rf $(DESTDIR)$(INCLUDEDIR)/surfblend
 
 # The suites again under AddressSanitizer + UndefinedBehaviorSanitizer, on the reduced but
 # complete profile: every suite and code path, on the peer shapes of tests/sanitize_shapes.txt

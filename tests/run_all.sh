@@ -7,7 +7,8 @@
 #
 # SFB_TEST_PROFILE=sanitize (make asan): the suites that run library code only, on the shapes
 # the caller passes (make asan passes a smaller set, tests/sanitize_shapes.txt); the checks that
-# only compile (C99/C++ header, separate modules) or validate GLSL are not run again there.
+# only compile (C99/C++ header, separate modules, install) or validate GLSL, and the web checks,
+# are not run again there.
 set -u
 BUILD=${BUILD:-build}
 SHAPES=${SHAPES:-../shared/peers/opensubdiv-shapes}
@@ -120,6 +121,13 @@ if [ "$PROFILE" != sanitize ]; then
   suite single check-modules env CC="$CC" CXX="$CXX" ./tools/check_modules.sh "$BUILD"
   # the GLSL kernels validated with glslangValidator, embedded copies up to date
   suite counted glsl bash tools/check_glsl.sh
+  # the web checks (tests/web/): three.js in headless Chromium against the software renderer, the
+  # glTF validator wrapper; skipped with the reason where Chromium, WebGL or the npm packages
+  # are missing (make deps-web), failed instead with SFB_REQUIRE_WEB (CI)
+  suite counted web_render env BUILD="$BUILD" SHAPES="$SHAPES" ./tests/web/render_test.sh
+  suite counted web_validate env BUILD="$BUILD" ./tests/web/validate_test.sh
+  # make install into temporary prefixes, a program built against it with pkg-config
+  suite counted install env BUILD="$BUILD" CC="$CC" ./tests/install_test.sh
 fi
 # the examples build and run
 for ex in "$BUILD"/examples/*; do
