@@ -53,7 +53,7 @@ const char *const kUsage =
     "\n"
     "options:\n"
     "  -o, --output FILE      the output file (required)\n"
-    "  --gltf                 write .gltf + .bin (OUT's extension is kept; the .bin takes OUT's base name)\n"
+    "  --gltf                 write .gltf + .bin whatever OUT's extension (but .glb); the .bin takes OUT's base name\n"
     "  --scheme S             catmark, loop, bilinear or manifold (default: from the file name prefix\n"
     "                         loop_ or bilinear_, else catmark)\n"
     "  --level L              uniform refinement level 0..10 (default 3; not with --tess)\n"
@@ -112,6 +112,14 @@ bool parse_double(const char *s, double *out) {
     double v = strtod(s, &end);
     if (*end || !std::isfinite(v)) return false;
     *out = v;
+    return true;
+}
+
+bool ends_with(const std::string &s, const char *suffix) {
+    size_t n = strlen(suffix);
+    if (s.size() < n) return false;
+    for (size_t i = 0; i < n; ++i)
+        if (tolower((unsigned char)s[s.size() - n + i]) != suffix[i]) return false;
     return true;
 }
 
@@ -183,6 +191,7 @@ int parse_args(int argc, char **argv, Options *o) {
     }
     if (!o->in) return usage_error("no input file");
     if (!o->out) return usage_error("no output file (-o OUT.glb)");
+    if (o->gltf && ends_with(o->out, ".glb")) return usage_error("--gltf writes JSON text: name the output .gltf, not .glb");
     if (!o->have_scheme) o->scheme = cli_scheme_for(o->in, 0, o->scheme);
     const unsigned caps = sfb_scheme_caps(o->scheme);
     const bool tess_only = !(caps & SFB_SCHEME_CAN_REFINE); // the manifold blend: evaluated, not refined
@@ -450,13 +459,6 @@ std::string base_name(const std::string &path) {
     return d == std::string::npos || d == 0 ? b : b.substr(0, d);
 }
 
-bool ends_with(const std::string &s, const char *suffix) {
-    size_t n = strlen(suffix);
-    if (s.size() < n) return false;
-    for (size_t i = 0; i < n; ++i)
-        if (tolower((unsigned char)s[s.size() - n + i]) != suffix[i]) return false;
-    return true;
-}
 
 // One output primitive: the mesh's accessors appended to the model's buffer.
 tinygltf::Primitive add_primitive(tinygltf::Model *model, const OutMesh &m, int material) {
