@@ -119,8 +119,12 @@ if [ "$PROFILE" != sanitize ]; then
   # the GLSL kernels validated with glslangValidator, embedded copies up to date
   suite counted glsl bash tools/check_glsl.sh
 fi
-# the examples build and run
+# the engine example (examples/03_engine.cpp) on llvmpipe: its GL state checks, glGetError, and
+# its last frame's silhouette against sfb_render's (IoU >= 0.98) (tests/engine_test.sh)
+suite counted engine env BUILD="$BUILD" ./tests/engine_test.sh
+# the examples build and run (those with a suite of their own above are run there)
 for ex in "$BUILD"/examples/*; do
+  case $(basename "$ex") in 03_engine) continue ;; esac
   [ -x "$ex" ] && suite single "example-$(basename "$ex")" "$ex"
 done
 wait
