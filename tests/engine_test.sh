@@ -17,6 +17,13 @@ OUT=$BUILD/test-logs/engine
 MIN_IOU=0.98
 # the software rasteriser even where a GPU driver is installed (CI has none)
 export LIBGL_ALWAYS_SOFTWARE=${LIBGL_ALWAYS_SOFTWARE-1}
+# make asan (SFB_TEST_PROFILE=sanitize): AddressSanitizer and UBSan stay on, leak checking is off
+# for the example. Mesa 22.3's llvmpipe (swrast_dri.so) keeps a few allocations of the vertex
+# pipeline reachable only from its own globals; eglTerminate unloads the driver, so at exit
+# LeakSanitizer reports them with frames in an unloaded module, which tests/lsan.supp cannot name
+# (keeping the driver loaded makes the reports vanish). surfblend's own teardown on a host context
+# is leak-checked by tests/gl_host.c and tests/gl_manifold.c.
+if [ "${SFB_TEST_PROFILE:-full}" = sanitize ]; then export ASAN_OPTIONS="detect_leaks=0${ASAN_OPTIONS:+:$ASAN_OPTIONS}"; fi
 rm -rf "$OUT"; mkdir -p "$OUT"
 P=0; F=0; S=0
 pass() { P=$((P + 1)); echo "PASS $1"; }
@@ -38,7 +45,8 @@ else fail "engine/help" "exit $rc, or --size/--output missing from stdout"; fi
 if [ $rc -eq 2 ] && grep -q "unknown option '--frobnicate'" "$OUT/bad.err"; then pass "engine/usage-error"
 else fail "engine/usage-error" "exit $rc (want 2) or no message naming the option"; fi
 
-# run NAME ARGS...: the example with its own checks; 0 ran and passed, 1 failed, 77 cannot run here
+# run NAME ARGS...: the example with its own checks (a failure is FAIL engine/NAME); 0 ran and
+# passed, 1 failed, 77 cannot run here
 SKIP_WHY=""
 run() {
   local name=$1 rc; shift
@@ -85,17 +93,19 @@ else
 fi
 
 # 2. a portrait picture (the smaller side is the width), another view, zoomed out, 5 frames
-if run portrait --size 240x360 --view 120,-30 --zoom 0.8 --frames 5 -o "$OUT/portrait.png" --reference "$OUT/portrait-ref.png"; then
+run portrait --size 240x360 --view 120,-30 --zoom 0.8 --frames 5 -o "$OUT/portrait.png" --reference "$OUT/portrait-ref.png"; rc=$?
+if [ $rc -eq 0 ]; then
   v=$(iou portrait "$OUT/portrait.png" "$OUT/portrait-ref.png")
   echo "# portrait IoU: ${v:-none}"
   if [ -n "$v" ] && at_least "$v" "$MIN_IOU"; then pass "engine/portrait"; else fail "engine/portrait" "IoU ${v:-not measured} < $MIN_IOU"; fi
-fi
+elif [ $rc -eq 77 ]; then not_run "engine/portrait"; fi
 
 # 3. the comparison can fail: the reference drawn 10 degrees off must not match
-if run offset --frames 2 -o "$OUT/offset.png" --reference "$OUT/offset-ref.png" --reference-view 40,25; then
+run iou-discriminates --frames 2 -o "$OUT/offset.png" --reference "$OUT/offset-ref.png" --reference-view 40,25; rc=$?
+if [ $rc -eq 0 ]; then
   v=$(iou offset "$OUT/offset.png" "$OUT/offset-ref.png")
   echo "# IoU with the reference 10 degrees off: ${v:-none}"
   if [ -n "$v" ] && ! at_least "$v" "$MIN_IOU"; then pass "engine/iou-discriminates"
   else fail "engine/iou-discriminates" "IoU ${v:-not measured} with a wrong camera is not below $MIN_IOU"; fi
-fi
+elif [ $rc -eq 77 ]; then not_run "engine/iou-discriminates"; fi
 close
