@@ -71,6 +71,8 @@
 #pragma GCC diagnostic pop
 #endif
 
+#include <sys/stat.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -91,7 +93,7 @@ const int kExitCheck = 1, kExitUsage = 2, kExitSkip = 77;
 
 struct Options {
     std::string mesh = "examples/data/creased_box.obj";
-    std::string out = "03_engine.png";
+    std::string out = "out/03_engine.png"; /* out/ is made when missing */
     std::string reference;          /* empty: no software picture */
     int level = 3, frames = 30, width = 640, height = 480;
     float yaw = 30.0f, pitch = 25.0f, zoom = 1.0f; /* sfb_render's default view */
@@ -110,7 +112,7 @@ void usage(FILE *f) {
                  "      --size WxH             picture size in pixels, 1..8192 a side (default 640x480)\n"
                  "      --view YAW,PITCH       camera orbit in degrees, as sfb_render (default 30,25)\n"
                  "      --zoom Z               magnification, > 0 (default 1)\n"
-                 "  -o, --output OUT.png       the last frame (default 03_engine.png)\n"
+                 "  -o, --output OUT.png       the last frame (default out/03_engine.png)\n"
                  "      --reference REF.png    also write sfb_render's software picture of the last frame's\n"
                  "                             surface (ref backend) with the same camera\n"
                  "      --reference-view Y,P   the software picture's view instead (for testing the comparison)\n"
@@ -286,9 +288,10 @@ void main() {
     vec3 to_eye = normalize(-v_position_view);
     if (dot(n, to_eye) < 0.0) n = -n;                      // two-sided, as sfb_render
     vec3 key = normalize(vec3(-0.45, 0.55, 1.0));          // a light over the viewer's left shoulder
-    float diffuse = max(dot(n, key), 0.0);
+    vec3 fill = normalize(vec3(0.8, -0.3, 1.0));           // a weaker one from the lower right
+    float diffuse = max(dot(n, key), 0.0) + 0.35 * max(dot(n, fill), 0.0);
     float specular = pow(max(dot(reflect(-key, n), to_eye), 0.0), 40.0);
-    frag_color = vec4(u_color * (0.22 + 0.78 * diffuse) + vec3(0.25 * specular), 1.0);
+    frag_color = vec4(u_color * (0.2 + 0.65 * diffuse) + vec3(0.25 * specular), 1.0);
 }
 )";
 
@@ -503,6 +506,7 @@ int main(int argc, char **argv) {
     int parsed = parse_args(argc, argv, &opt);
     if (parsed != 0) return parsed > 0 ? 0 : kExitUsage;
 
+    if (opt.out == Options().out) mkdir("out", 0777); /* the default's folder; an error shows when writing */
     std::string obj;
     if (!read_file(opt.mesh, obj)) { std::fprintf(stderr, "03_engine: cannot read %s\n", opt.mesh.c_str()); return kExitCheck; }
 
