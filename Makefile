@@ -15,6 +15,8 @@ SRC_MODULES := src/sfb_api.h src/sfb_internal.h $(wildcard src/*.c src/patch/*.c
 TEST_SRCS   := $(wildcard tests/test_*.c)
 BACKEND_HDRS:= $(wildcard backends/*.h backends/*/*.h backends/*/glsl/*.glsl)
 EXAMPLES    := $(patsubst examples/%.c,$(BUILD)/examples/%,$(wildcard examples/*.c))
+# C++ examples (examples/03_engine.cpp: an engine that owns its EGL context, links EGL and GL itself)
+EXAMPLES_CXX:= $(patsubst examples/%.cpp,$(BUILD)/examples/%,$(wildcard examples/*.cpp))
 # Test programs that play a GL host link EGL and GL themselves (the library never does).
 GL_LIBS     := -lEGL -lGL
 # The benchmark: OpenSubdiv's CPU evaluators (its OmpEvaluator is in Debian's libosdCPU, built
@@ -36,6 +38,9 @@ PKGS_CLI  := libstb-dev
 # nlohmann-json for its JSON) and meshoptimizer.
 PKGS_GLTF := g++ libtinygltf-dev nlohmann-json3-dev libmeshoptimizer-dev
 GLTF_LIBS := -ltinygltf -lmeshoptimizer
+# The C++ examples: GLM (headers only), the EGL/GL headers and link libraries (the engine example
+# is a GL host), g++; they write PNG with stb_image_write (PKGS_CLI).
+PKGS_EXAMPLES := g++ libglm-dev libegl-dev libgl-dev
 PKGS_FUZZ := clang libclang-rt-14-dev
 # The NEON kernels, cross-compiled for AArch64 and run under qemu user emulation (make test-neon).
 PKGS_NEON := gcc-aarch64-linux-gnu libc6-dev-arm64-cross qemu-user-static
@@ -48,9 +53,9 @@ PKGS_WEB  := chromium $(if $(shell command -v node 2>/dev/null),,nodejs) $(if $(
 NODE_DIR  ?= $(BUILD)/node
 
 .PHONY: deps-web test-web install uninstall
-.PHONY: all run test check-modules test-neon deps-neon bench fuzz asan amalgamate amalgamate-check embed-glsl deps deps-test deps-fuzz clean unit-build
+.PHONY: all run test check-modules test-neon deps-neon bench fuzz asan amalgamate amalgamate-check embed-glsl deps deps-test deps-examples deps-fuzz clean unit-build
 
-all: $(BUILD)/surfblend $(BUILD)/sfb2gltf
+all: $(BUILD)/surfblend $(BUILD)/sfb2gltf $(EXAMPLES) $(EXAMPLES_CXX)
 
 define need_pkgs
 	@missing=""; for p in $(1); do dpkg -s $$p >/dev/null 2>&1 || missing="$$missing $$p"; done; \
@@ -67,7 +72,9 @@ endef
 deps:
 	$(call need_pkgs,$(PKGS_BASE) $(PKGS_CLI) $(PKGS_GLTF))
 deps-test:
-	$(call need_pkgs,$(PKGS_BASE) $(PKGS_CLI) $(PKGS_GLTF) $(PKGS_TEST))
+	$(call need_pkgs,$(PKGS_BASE) $(PKGS_CLI) $(PKGS_GLTF) $(PKGS_TEST) $(PKGS_EXAMPLES))
+deps-examples:
+	$(call need_pkgs,$(PKGS_BASE) $(PKGS_CLI) $(PKGS_EXAMPLES))
 deps-fuzz:
 	$(call need_pkgs,$(PKGS_FUZZ))
 deps-neon:
@@ -127,6 +134,12 @@ $(BUILD)/examples/%: examples/%.c $(BUILD)/libsfb.o
 	@mkdir -p $(BUILD)/examples
 	$(CC) $(CFLAGS) $(SAN) -I. $< $(BUILD)/libsfb.o -o $@ $(LIBS)
 
+# C++ examples (GLM, stb_image_write); the engine example is a GL host and links EGL and GL itself
+# (order-only: the packages of PKGS_EXAMPLES)
+$(BUILD)/examples/%: examples/%.cpp tests/egl_host.h $(BUILD)/libsfb.o | deps-examples
+	@mkdir -p $(BUILD)/examples
+	$(CXX) $(CXXFLAGS) $(SAN) -I. $< $(BUILD)/libsfb.o -o $@ $(GL_LIBS) $(LIBS)
+
 run: deps $(BUILD)/surfblend $(BUILD)/sfb2gltf
 	@mkdir -p out
 	./$(BUILD)/surfblend info examples/data/creased_box.obj
@@ -172,6 +185,11 @@ $(BUILD)/unit: $(TEST_SRCS) $(BUILD)/libsfb.o
 
 $(BUILD)/osd_agree: tests/osd_agree.cpp $(BUILD)/libsfb.o
 	$(CXX) $(CXXFLAGS) $(SAN) -I. tests/osd_agree.cpp $(BUILD)/libsfb.o -o $@ -losdCPU $(LIBS)
+
+# Silhouette IoU of two PNGs, for the engine example's test (tests/engine_test.sh; stb_image).
+$(BUILD)/png_iou: tests/png_iou.c | deps
+	@mkdir -p $(BUILD)
+	$(CC) $(CFLAGS) $(SAN) tests/png_iou.c -o $@ -lm
 
 # Backend agreement (every optional backend against ref): links the library alone.
 $(BUILD)/agree: tests/agree.c tests/harness.h $(BUILD)/libsfb.o
@@ -234,7 +252,7 @@ $(BUILD)/web/png_iou: tests/web/png_iou.c | deps
 
 unit-build: $(BUILD)/web/png_iou $(BUILD)/surfblend $(BUILD)/unit $(BUILD)/osd_agree $(BUILD)/agree $(BUILD)/limit $(BUILD)/eigen $(BUILD)/gl_host \
             $(BUILD)/gl_errors $(BUILD)/gl_pieces $(BUILD)/shade $(BUILD)/trim $(BUILD)/finish_normals $(BUILD)/manifold $(BUILD)/gl_manifold $(EXAMPLES) \
-            $(BUILD)/sfb2gltf $(BUILD)/gltf_check
+            $(EXAMPLES_CXX) $(BUILD)/png_iou $(BUILD)/sfb2gltf $(BUILD)/gltf_check
 
 # On CI (CI set and not false/0) the optional backends must run, not be skipped: the suites
 # fail for a backend in SFB_REQUIRE_BACKENDS that is unavailable. CI has Mesa llvmpipe and

@@ -1,8 +1,8 @@
 /* A headless EGL context of the kind a host application has, for the programs that play the host
- * of the gl backend (tests/gl_host.c, tests/gl_manifold.c, bench/bench.cpp): the display (Mesa's
- * surfaceless platform when the client extensions offer it, else the default display), a desktop
- * OpenGL core context made current with no surface, an OpenGL ES context beside it on the same
- * display, and the teardown. Include after a GL header that declares glGetString (GL/gl.h, or
+ * of the gl backend (tests/gl_host.c, tests/gl_manifold.c, bench/bench.cpp,
+ * examples/03_engine.cpp): the display (Mesa's surfaceless platform when the client extensions
+ * offer it, else the default display), a desktop OpenGL core context made current with no
+ * surface, an OpenGL ES context beside it on the same display, and the teardown. Include after a GL header that declares glGetString (GL/gl.h, or
  * GL/glcorearb.h with GL_GLEXT_PROTOTYPES).
  * Everything is static inline; C99 and C++. Links -lEGL and -lGL. */
 #ifndef SFB_TEST_EGL_HOST_H

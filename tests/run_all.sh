@@ -129,8 +129,12 @@ if [ "$PROFILE" != sanitize ]; then
   # make install into temporary prefixes, a program built against it with pkg-config
   suite counted install env BUILD="$BUILD" CC="$CC" ./tests/install_test.sh
 fi
-# the examples build and run
+# the engine example (examples/03_engine.cpp) on llvmpipe: its GL state checks, glGetError, and
+# its last frame's silhouette against sfb_render's (IoU >= 0.98) (tests/engine_test.sh)
+suite counted engine env BUILD="$BUILD" ./tests/engine_test.sh
+# the examples build and run (those with a suite of their own above are run there)
 for ex in "$BUILD"/examples/*; do
+  case $(basename "$ex") in 03_engine) continue ;; esac
   [ -x "$ex" ] && suite single "example-$(basename "$ex")" "$ex"
 done
 wait
