@@ -14,7 +14,9 @@
 //    with glTF's v = 1 - v), and the number of distinct vertices is the library's;
 //  - normals are unit; POSITION's min/max are the data's;
 //  - with --min-splits N: at least N positions carry more than one normal (hard edges split);
-//  - --uvs yes|no: TEXCOORD_0 is there or not.
+//  - --uvs yes|no: TEXCOORD_0 is there or not;
+//  - --quantize (with sfb2gltf's --position-bits, --normal-bits, --uv-bits): the data is read
+//    dequantised and through the node transforms, and must agree within half a grid step.
 #include <tiny_gltf.h>
 
 #include <algorithm>
@@ -201,12 +203,15 @@ int main(int argc, char **argv) {
     int level = 3, rate = 0, min_splits = -1;
     double angle = -1.0;
     std::string normals, uvs_want;
+    bool quantized = false;
+    int position_bits = 14, normal_bits = 8, uv_bits = 12;
     // sfb2gltf's options are accepted as they are: the flags (--no-optimize, --gltf, -q) change
     // nothing the checks compare
     for (int i = 3; i < argc; ++i) {
         const std::string a = argv[i];
         const char *v = i + 1 < argc ? argv[i + 1] : "";
         if (a == "--no-optimize" || a == "--gltf" || a == "-q" || a == "--quiet") continue;
+        if (a == "--quantize") { quantized = true; continue; }
         if (a == "--scheme") have_scheme = sfb_scheme_parse(v, &scheme);
         else if (a == "--level") level = atoi(v);
         else if (a == "--normals") normals = v;
@@ -215,6 +220,9 @@ int main(int argc, char **argv) {
         else if (a == "--min-splits") min_splits = atoi(v);
         else if (a == "--uvs") uvs_want = v;
         else if (a == "--backend") {}
+        else if (a == "--position-bits") position_bits = atoi(v);
+        else if (a == "--normal-bits") normal_bits = atoi(v);
+        else if (a == "--uv-bits") uv_bits = atoi(v);
         else { fprintf(stderr, "gltf_check: unknown option '%s'\n", a.c_str()); return 2; }
         ++i;
     }
@@ -267,11 +275,39 @@ int main(int argc, char **argv) {
         }
         check(ok, (name + ": POSITION min/max are the data's").c_str(), "they differ");
     }
+    // positions into the scene: the transforms of the nodes down to the (first) node of mesh 0
+    // (translation and uniform-or-not scale; --quantize's dequantisation is such a node)
+    {
+        std::vector<int> parent(model.nodes.size(), -1);
+        for (size_t i = 0; i < model.nodes.size(); ++i)
+            for (int c : model.nodes[i].children)
+                if (c >= 0 && c < (int)parent.size()) parent[(size_t)c] = (int)i;
+        int at = -1;
+        for (size_t i = 0; i < model.nodes.size() && at < 0; ++i)
+            if (model.nodes[i].mesh == 0) at = (int)i;
+        bool rotated = false;
+        for (; at >= 0; at = parent[(size_t)at]) {
+            const tinygltf::Node &n = model.nodes[(size_t)at];
+            rotated = rotated || !n.rotation.empty() || !n.matrix.empty();
+            for (size_t v = 0; v < nv; ++v)
+                for (int c = 0; c < 3; ++c) {
+                    double x = P[3 * v + (size_t)c];
+                    if (n.scale.size() == 3) x *= n.scale[(size_t)c];
+                    if (n.translation.size() == 3) x += n.translation[(size_t)c];
+                    P[3 * v + (size_t)c] = (float)x;
+                }
+        }
+        check(!rotated, (name + ": node transforms are translations and scales").c_str(), "a rotation or matrix (not compared)");
+    }
+    // tolerances: float data agrees to rounding; quantized data within half a grid step
+    const double qpos = quantized ? 1.0 / (double)((1L << (position_bits - 1)) - 1) : 0.0;
+    const double ntol = quantized ? 1.0 / (double)((1L << (normal_bits - 1)) - 1) + (normal_bits <= 8 ? 1.0 / 127 : 1.0 / 32767) : 1e-5;
+    const double ttol = quantized ? 1.0 / (double)((1L << uv_bits) - 1) + 1.0 / 65535 : 1e-6;
     double worst_len = 0.0;
     for (size_t v = 0; v < nv; ++v)
         worst_len = std::max(worst_len, std::fabs(std::sqrt((double)N[3 * v] * N[3 * v] + (double)N[3 * v + 1] * N[3 * v + 1] +
                                                             (double)N[3 * v + 2] * N[3 * v + 2]) - 1.0));
-    check(worst_len < 1e-5, (name + ": normals are unit").c_str(), "| |n| - 1 | up to %g", worst_len);
+    check(worst_len < 2.0 * ntol, (name + ": normals are unit").c_str(), "| |n| - 1 | up to %g", worst_len);
 
     Reference R;
     if (!reference(in, scheme, level, normals, angle, rate, &R)) {
@@ -288,7 +324,7 @@ int main(int argc, char **argv) {
         for (int c = 0; c < 3; ++c) { lo[c] = std::min(lo[c], P[3 * v + (size_t)c]); hi[c] = std::max(hi[c], P[3 * v + (size_t)c]); }
     const double diag = std::sqrt((double)(hi[0] - lo[0]) * (hi[0] - lo[0]) + (double)(hi[1] - lo[1]) * (hi[1] - lo[1]) +
                                   (double)(hi[2] - lo[2]) * (hi[2] - lo[2]));
-    const double ptol = 1e-6 * (diag > 0 ? diag : 1.0), cell = std::max(ptol * 4.0, 1e-30);
+    const double ptol = (1e-6 + 0.51 * qpos) * (diag > 0 ? diag : 1.0), cell = std::max(ptol * 4.0, 1e-30);
     const bool flat = normals == "flat";
     std::map<Key, std::vector<size_t>> grid;
     for (size_t r = 0; r < R.verts.size(); ++r) grid[key_of(R.verts[r].p, cell)].push_back(r);
@@ -300,10 +336,10 @@ int main(int argc, char **argv) {
         const bool zero = a.n[0] == 0.0f && a.n[1] == 0.0f && a.n[2] == 0.0f;
         if (!flat && !zero)
             for (int c = 0; c < 3; ++c)
-                if (std::fabs(a.n[c] - n[c]) > 1e-5) return false;
+                if (std::fabs(a.n[c] - n[c]) > ntol) return false;
         if (t && R.uvs)
             for (int c = 0; c < 2; ++c)
-                if (std::fabs(a.t[c] - t[c]) > 1e-6) return false;
+                if (std::fabs(a.t[c] - t[c]) > ttol) return false;
         return true;
     };
     size_t unmatched = 0, first_bad = 0;

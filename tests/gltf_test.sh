@@ -103,6 +103,11 @@ export_ok box_limit.glb "$BOX" --normals limit
 export_ok box_tess.glb "$BOX" --tess 8
 export_ok box_adaptive.glb "$BOX" --tess 32 --tolerance 0.002
 export_ok box_noopt.glb "$BOX" --no-optimize
+export_ok box_quant.glb "$BOX" --quantize
+export_ok box_quant16.gltf "$BOX" --quantize --position-bits 16 --normal-bits 16 --uv-bits 16
+export_ok torus_quant_tess.glb examples/data/torus.obj --tess 6 --quantize --normal-bits 10
+check "--normal-bits without --quantize is a usage error" 2 "$TOOL" --normal-bits 10 "$BOX" -o "$TMP/x.glb"
+check "--position-bits 17 is a usage error" 2 "$TOOL" --quantize --position-bits 17 "$BOX" -o "$TMP/x.glb"
 export_ok box_bilinear.glb "$BOX" --scheme bilinear --level 2
 export_ok box_gltf_flag.json "$BOX" --gltf
 check "--gltf with a .glb name is a usage error" 2 "$TOOL" --gltf "$BOX" -o "$TMP/v/x.glb"
@@ -244,6 +249,9 @@ readback box.glb "$BOX" --level 3
 readback box_limit.glb "$BOX" --level 2 --normals limit
 readback box_flat.gltf "$BOX" --level 2 --normals flat
 readback box_tess.glb "$BOX" --tess 6
+readback box_quant.glb "$BOX" --level 3 --quantize
+readback box_quant_bits.glb "$BOX" --level 2 --quantize --position-bits 10 --normal-bits 12
+readback box_quant_tess.glb "$BOX" --tess 5 --quantize --position-bits 16 --normal-bits 16
 # hard edges: a cube whose 12 edges are infinitely sharp (t crease), and the same by --crease-angle
 printf 'v -1 -1 1\nv 1 -1 1\nv -1 1 1\nv 1 1 1\nv -1 1 -1\nv 1 1 -1\nv -1 -1 -1\nv 1 -1 -1\nf 1 2 4 3\nf 3 4 6 5\nf 5 6 8 7\nf 7 8 2 1\nf 2 8 6 4\nf 7 1 3 5\n' > "$TMP/cube.obj"
 cp "$TMP/cube.obj" "$TMP/hard.obj"
@@ -255,6 +263,7 @@ readback hard_angle.glb "$TMP/cube.obj" --level 2 --crease-angle 30 -- --min-spl
 readback hard_tess.glb "$TMP/hard.obj" --tess 4 -- --min-splits 20
 if [ -d "$SHAPES" ]; then
   readback car.glb "$SHAPES/catmark_car.obj" --level 2 -- --uvs yes
+  readback car_quant.glb "$SHAPES/catmark_car.obj" --level 2 --quantize --uv-bits 10 -- --uvs yes
   readback fvar.glb "$SHAPES/catmark_fvar_bound1.obj" --level 2 -- --uvs yes
   readback loop.glb "$SHAPES/loop_cube_creases1.obj" --level 2
   readback loop_tess.glb "$SHAPES/loop_cube_creases1.obj" --tess 5

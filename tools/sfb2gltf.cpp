@@ -67,6 +67,11 @@ const char *const kUsage =
     "  --crease-angle DEG     edges whose dihedral angle is over DEG (0..180) become infinitely sharp creases\n"
     "  --trim MASK.png        with --tess: trim the surface by a mask over each parametric face (seed 000)\n"
     "  --backend NAME         ref, simd, gl or osmesa (default: the library's order)\n"
+    "  --quantize             KHR_mesh_quantization: positions as 16-bit integers on a grid of\n"
+    "                         --position-bits B (default 14) bits over the mesh's extent, undone by a node\n"
+    "                         transform; normals as normalised 8- or 16-bit integers rounded to\n"
+    "                         --normal-bits (default 8); UVs in [0,1] as normalised 16-bit integers rounded\n"
+    "                         to --uv-bits (default 12; UVs outside [0,1] stay float)\n"
     "  --no-optimize          keep the evaluation's vertex and triangle order (no meshoptimizer passes)\n"
     "  --progress             a progress bar on stderr even when stderr is not a terminal\n"
     "  -q, --quiet            no summary line and no progress bar\n"
@@ -84,6 +89,8 @@ struct Options {
     sfb_scheme scheme = SFB_SCHEME_CATMARK;
     int level = 3, rate = 0;
     double tolerance = 0.0, angle = 0.0;
+    bool quantize = false, have_bits = false;
+    int position_bits = 14, normal_bits = 8, uv_bits = 12; // --quantize
     NormalsMode normals = NORMALS_DEFAULT;
 };
 
@@ -175,6 +182,14 @@ int parse_args(int argc, char **argv, Options *o) {
             if (!(o->trim = value(a))) return usage_error("--trim needs a PNG file");
         } else if (!strcmp(a, "--backend")) {
             if (!(o->backend = value(a))) return usage_error("--backend needs a name (ref, simd, gl, osmesa)");
+        } else if (!strcmp(a, "--quantize")) {
+            o->quantize = true;
+        } else if (!strcmp(a, "--position-bits") || !strcmp(a, "--normal-bits") || !strcmp(a, "--uv-bits")) {
+            long v;
+            const long lo = a[2] == 'n' ? 2 : 2, hi = 16;
+            if (!parse_long(value(a), lo, hi, &v)) return usage_error("%s needs a number of bits 2..16", a);
+            (a[2] == 'p' ? o->position_bits : a[2] == 'n' ? o->normal_bits : o->uv_bits) = (int)v;
+            o->have_bits = true;
         } else if (!strcmp(a, "--no-optimize")) {
             o->optimize = false;
         } else if (!strcmp(a, "--progress")) {
@@ -191,6 +206,7 @@ int parse_args(int argc, char **argv, Options *o) {
     }
     if (!o->in) return usage_error("no input file");
     if (!o->out) return usage_error("no output file (-o OUT.glb)");
+    if (o->have_bits && !o->quantize) return usage_error("--position-bits, --normal-bits and --uv-bits belong to --quantize");
     if (o->gltf && ends_with(o->out, ".glb")) return usage_error("--gltf writes JSON text: name the output .gltf, not .glb");
     if (!o->have_scheme) o->scheme = cli_scheme_for(o->in, 0, o->scheme);
     const unsigned caps = sfb_scheme_caps(o->scheme);
@@ -459,6 +475,81 @@ std::string base_name(const std::string &path) {
     return d == std::string::npos || d == 0 ? b : b.substr(0, d);
 }
 
+
+// The quantization of one output mesh (all its primitives): positions p = t + s q with q the
+// stored integers, |q| <= 2^(bits-1) - 1 (a uniform scale, so that normals need nothing).
+struct Quant {
+    double t[3] = {0, 0, 0}, s = 1.0;
+};
+
+// v in [-1, 1] (normals) or [0, 1] (uvs) rounded to `bits` bits, as the normalised integer of
+// `full` (127, 32767 or 65535) that dequantises to it most nearly.
+long snap(double v, int bits, long full, bool is_signed) {
+    const double steps = is_signed ? (double)((1L << (bits - 1)) - 1) : (double)((1L << bits) - 1);
+    const double r = std::round(v * steps) / steps;
+    return std::lround(std::min(std::max(r, is_signed ? -1.0 : 0.0), 1.0) * (double)full);
+}
+
+tinygltf::Primitive add_primitive_quantized(tinygltf::Model *model, const OutMesh &m, int material, const Quant &q, const Options &o) {
+    tinygltf::Primitive prim;
+    const size_t nv = m.positions.size() / 3;
+    int index_view, index_type;
+    if (nv < 65535) {
+        std::vector<unsigned short> s(m.indices.begin(), m.indices.end());
+        index_view = add_view(*model, s.data(), s.size() * sizeof(unsigned short), TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER, 0);
+        index_type = TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT;
+    } else {
+        index_view = add_view(*model, m.indices.data(), m.indices.size() * sizeof(unsigned), TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER, 0);
+        index_type = TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT;
+    }
+    prim.mode = TINYGLTF_MODE_TRIANGLES;
+    prim.indices = add_accessor(*model, index_view, index_type, TINYGLTF_TYPE_SCALAR, m.indices.size());
+    // positions: SHORT x 3, padded to 8 bytes (vertex attributes are 4-byte aligned)
+    const long qmax = (1L << (o.position_bits - 1)) - 1;
+    std::vector<short> P(nv * 4, 0);
+    std::vector<double> mn(3, 0.0), mx(3, 0.0);
+    for (size_t v = 0; v < nv; ++v)
+        for (int c = 0; c < 3; ++c) {
+            const long x = std::lround((m.positions[3 * v + (size_t)c] - q.t[c]) / q.s);
+            const short sx = (short)std::min(std::max(x, -qmax), qmax);
+            P[4 * v + (size_t)c] = sx;
+            if (v == 0 || sx < mn[(size_t)c]) mn[(size_t)c] = sx;
+            if (v == 0 || sx > mx[(size_t)c]) mx[(size_t)c] = sx;
+        }
+    int view = add_view(*model, P.data(), P.size() * sizeof(short), TINYGLTF_TARGET_ARRAY_BUFFER, 8);
+    prim.attributes["POSITION"] = add_accessor(*model, view, TINYGLTF_COMPONENT_TYPE_SHORT, TINYGLTF_TYPE_VEC3, nv, mn, mx);
+    // normals: normalised BYTE x 3 (padded to 4) up to 8 bits, SHORT x 3 (padded to 8) above
+    if (o.normal_bits <= 8) {
+        std::vector<signed char> N(nv * 4, 0);
+        for (size_t v = 0; v < nv; ++v)
+            for (int c = 0; c < 3; ++c) N[4 * v + (size_t)c] = (signed char)snap(m.normals[3 * v + (size_t)c], o.normal_bits, 127, true);
+        view = add_view(*model, N.data(), N.size(), TINYGLTF_TARGET_ARRAY_BUFFER, 4);
+        prim.attributes["NORMAL"] = add_accessor(*model, view, TINYGLTF_COMPONENT_TYPE_BYTE, TINYGLTF_TYPE_VEC3, nv);
+    } else {
+        std::vector<short> N(nv * 4, 0);
+        for (size_t v = 0; v < nv; ++v)
+            for (int c = 0; c < 3; ++c) N[4 * v + (size_t)c] = (short)snap(m.normals[3 * v + (size_t)c], o.normal_bits, 32767, true);
+        view = add_view(*model, N.data(), N.size() * sizeof(short), TINYGLTF_TARGET_ARRAY_BUFFER, 8);
+        prim.attributes["NORMAL"] = add_accessor(*model, view, TINYGLTF_COMPONENT_TYPE_SHORT, TINYGLTF_TYPE_VEC3, nv);
+    }
+    model->accessors[(size_t)prim.attributes["NORMAL"]].normalized = true;
+    if (!m.uvs.empty()) {
+        bool unit = true;
+        for (float x : m.uvs) unit = unit && x >= 0.0f && x <= 1.0f;
+        if (unit) {
+            std::vector<unsigned short> T(nv * 2);
+            for (size_t i = 0; i < T.size(); ++i) T[i] = (unsigned short)snap(m.uvs[i], o.uv_bits, 65535, false);
+            view = add_view(*model, T.data(), T.size() * sizeof(unsigned short), TINYGLTF_TARGET_ARRAY_BUFFER, 4);
+            prim.attributes["TEXCOORD_0"] = add_accessor(*model, view, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT, TINYGLTF_TYPE_VEC2, nv);
+            model->accessors[(size_t)prim.attributes["TEXCOORD_0"]].normalized = true;
+        } else {
+            view = add_view(*model, m.uvs.data(), m.uvs.size() * sizeof(float), TINYGLTF_TARGET_ARRAY_BUFFER, 8);
+            prim.attributes["TEXCOORD_0"] = add_accessor(*model, view, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC2, nv);
+        }
+    }
+    prim.material = material;
+    return prim;
+}
 
 // One output primitive: the mesh's accessors appended to the model's buffer.
 tinygltf::Primitive add_primitive(tinygltf::Model *model, const OutMesh &m, int material) {
@@ -915,6 +1006,30 @@ void assemble(Run &R, tinygltf::Model *model) {
     model->samplers = k.samplers;
     model->extensionsUsed.clear();
     int default_material = -1;
+    // --quantize: one grid per output mesh, over the extent of all its parts
+    std::vector<Quant> quant(k.meshes.size());
+    if (R.o.quantize) {
+        std::vector<double> lo(3 * k.meshes.size(), HUGE_VAL), hi(3 * k.meshes.size(), -HUGE_VAL);
+        for (const Part &p : R.parts)
+            for (size_t v = 0; v < p.out.positions.size(); v += 3)
+                for (int c = 0; c < 3; ++c) {
+                    double &l = lo[3 * (size_t)p.gltf_mesh + (size_t)c], &h = hi[3 * (size_t)p.gltf_mesh + (size_t)c];
+                    l = std::min(l, (double)p.out.positions[v + (size_t)c]);
+                    h = std::max(h, (double)p.out.positions[v + (size_t)c]);
+                }
+        const double qmax = (double)((1L << (R.o.position_bits - 1)) - 1);
+        for (size_t i = 0; i < quant.size(); ++i) {
+            double half = 0.0;
+            for (int c = 0; c < 3; ++c) {
+                if (!(lo[3 * i + (size_t)c] <= hi[3 * i + (size_t)c])) continue;
+                quant[i].t[c] = 0.5 * (lo[3 * i + (size_t)c] + hi[3 * i + (size_t)c]);
+                half = std::max(half, 0.5 * (hi[3 * i + (size_t)c] - lo[3 * i + (size_t)c]));
+            }
+            quant[i].s = half > 0.0 ? half / qmax : 1.0;
+        }
+        model->extensionsUsed.push_back("KHR_mesh_quantization");
+        model->extensionsRequired.push_back("KHR_mesh_quantization");
+    }
     model->meshes.resize(k.meshes.size());
     for (size_t i = 0; i < k.meshes.size(); ++i) model->meshes[i].name = k.meshes[i].name;
     for (const Part &p : R.parts) {
@@ -933,7 +1048,8 @@ void assemble(Run &R, tinygltf::Model *model) {
             mat = default_material;
         }
         if (p.out.indices.empty()) continue;
-        model->meshes[(size_t)p.gltf_mesh].primitives.push_back(add_primitive(model, p.out, mat));
+        model->meshes[(size_t)p.gltf_mesh].primitives.push_back(R.o.quantize ? add_primitive_quantized(model, p.out, mat, quant[(size_t)p.gltf_mesh], R.o)
+                                                                              : add_primitive(model, p.out, mat));
     }
     // a mesh left without primitives (all its parts empty) cannot be written: its nodes lose it
     std::vector<int> remap(model->meshes.size(), -1);
@@ -941,7 +1057,22 @@ void assemble(Run &R, tinygltf::Model *model) {
     for (size_t i = 0; i < model->meshes.size(); ++i)
         if (!model->meshes[i].primitives.empty()) { remap[i] = (int)kept.size(); kept.push_back(model->meshes[i]); }
     model->meshes.swap(kept);
-    for (tinygltf::Node &n : model->nodes) n.mesh = n.mesh >= 0 && n.mesh < (int)remap.size() ? remap[(size_t)n.mesh] : -1;
+    const size_t nodes = model->nodes.size();
+    for (size_t i = 0; i < nodes; ++i) {
+        tinygltf::Node &n = model->nodes[i];
+        const int old = n.mesh;
+        n.mesh = old >= 0 && old < (int)remap.size() ? remap[(size_t)old] : -1;
+        if (!R.o.quantize || n.mesh < 0) continue;
+        // the dequantisation: the mesh moves to a child node whose transform undoes the grid
+        tinygltf::Node child;
+        child.name = n.name + " (dequantize)";
+        child.mesh = n.mesh;
+        child.translation = {quant[(size_t)old].t[0], quant[(size_t)old].t[1], quant[(size_t)old].t[2]};
+        child.scale = {quant[(size_t)old].s, quant[(size_t)old].s, quant[(size_t)old].s};
+        model->nodes[i].mesh = -1;
+        model->nodes[i].children.push_back((int)model->nodes.size());
+        model->nodes.push_back(child);
+    }
 }
 
 } // namespace

@@ -86,6 +86,23 @@ prepare() {
     if node tests/web/validate.mjs "$file"; then pass "$name $g: validates"; else fail "$name $g: validates"; continue; fi
     job "$name.${g/:/_}" "$file" "$yaw" "$pitch" "$zoom" "$size"; CHECKS+=("iou $name ${g/:/_} $v $t")
   done
+  # the same surface exported by sfb2gltf (shading normals, hard edges split, optimised): the
+  # page must draw it as the software renderer does, with the counts sfb2gltf reports
+  if [ -x "$BUILD/sfb2gltf" ]; then
+    if "$BUILD/sfb2gltf" --level "$level" "$src" -o "$W/$name.sfb2gltf.glb" 2> "$W/$name.sfb2gltf.log"; then
+      read -r gv gt <<< "$(sed -nE 's/.* ([0-9]+) vertices, ([0-9]+) triangles.*/\1 \2/p' "$W/$name.sfb2gltf.log")"
+      if [ "$gt" = "$t" ]; then pass "$name sfb2gltf: $gt triangles, as the shaded mesh"; else fail "$name sfb2gltf: $gt triangles, the shaded mesh $t"; fi
+      job "$name.sfb2gltf" "$W/$name.sfb2gltf.glb" "$yaw" "$pitch" "$zoom" "$size"; CHECKS+=("iou $name sfb2gltf $gv $gt")
+      # quantized (KHR_mesh_quantization: integer positions under a dequantising node)
+      if "$BUILD/sfb2gltf" -q --quantize --level "$level" "$src" -o "$W/$name.sfb2gltfq.glb" 2> "$W/$name.sfb2gltfq.log"; then
+        job "$name.sfb2gltfq" "$W/$name.sfb2gltfq.glb" "$yaw" "$pitch" "$zoom" "$size"; CHECKS+=("iou $name sfb2gltfq $gv $gt")
+      else
+        fail "$name: sfb2gltf --quantize"; cat "$W/$name.sfb2gltfq.log"
+      fi
+    else
+      fail "$name: sfb2gltf"; cat "$W/$name.sfb2gltf.log"
+    fi
+  fi
 }
 prepare creased_box examples/data/creased_box.obj 3 30 25 1 320x240 glb gltf glb:quantized glb:meshopt
 if [ -d "$SHAPES" ]; then
