@@ -128,7 +128,7 @@ $(BUILD)/sfb2gltf: tools/sfb2gltf.cpp tools/cli_common.h $(BUILD)/cli_common.o $
 
 # reads sfb2gltf's files back (tinygltf) and compares them with the library (tests/gltf_test.sh)
 $(BUILD)/gltf_check: tests/gltf_check.cpp tests/harness.h $(BUILD)/libsfb.o | deps
-	$(CXX) $(subst -std=c++14,-std=c++17,$(CXXFLAGS)) $(SAN) -I. tests/gltf_check.cpp $(BUILD)/libsfb.o -o $@ -ltinygltf $(LIBS)
+	$(CXX) $(subst -std=c++14,-std=c++17,$(CXXFLAGS)) $(SAN) -I. tests/gltf_check.cpp $(BUILD)/libsfb.o -o $@ $(GLTF_LIBS) $(LIBS)
 
 $(BUILD)/examples/%: examples/%.c $(BUILD)/libsfb.o
 	@mkdir -p $(BUILD)/examples

@@ -15,9 +15,13 @@
 //  - normals are unit; POSITION's min/max are the data's;
 //  - with --min-splits N: at least N positions carry more than one normal (hard edges split);
 //  - --uvs yes|no: TEXCOORD_0 is there or not;
+//  - EXT_meshopt_compression files are decoded first (meshoptimizer's decoders) into a plain
+//    glTF in memory, which tinygltf then reads;
 //  - --quantize (with sfb2gltf's --position-bits, --normal-bits, --uv-bits): the data is read
 //    dequantised and through the node transforms, and must agree within half a grid step.
 #include <tiny_gltf.h>
+#include <meshoptimizer.h>
+#include <nlohmann/json.hpp>
 
 #include <algorithm>
 #include <array>
@@ -183,6 +187,84 @@ bool reference(const char *in, sfb_scheme scheme, int level, const std::string &
     return ok;
 }
 
+std::string read_all(const std::string &path) {
+    size_t n = 0;
+    char *b = slurp(path.c_str(), &n);
+    std::string s = b ? std::string(b, n) : std::string();
+    free(b);
+    return s;
+}
+
+uint32_t le32(const std::string &s, size_t at) {
+    uint32_t x = 0;
+    for (int k = 0; k < 4; ++k) x |= (uint32_t)(unsigned char)s[at + (size_t)k] << (8 * k);
+    return x;
+}
+
+// A .glb or .gltf that uses EXT_meshopt_compression, decoded into a plain GLB in memory (the
+// fallback buffer filled, the extension removed); empty when the file does not use it, or on a
+// decoding failure (*err says which).
+std::string meshopt_decode_file(const std::string &path, std::string *err) {
+    const std::string file = read_all(path);
+    std::string json;
+    std::vector<std::string> buffers; // the data of each buffer (external or BIN)
+    nlohmann::json doc;
+    if (file.size() >= 20 && file.compare(0, 4, "glTF") == 0) {
+        const uint32_t jl = le32(file, 12);
+        json = file.substr(20, jl);
+        const size_t bin_at = 20 + jl;
+        doc = nlohmann::json::parse(json, nullptr, false);
+        if (doc.is_discarded()) { *err = "bad JSON chunk"; return ""; }
+        if (bin_at + 8 <= file.size()) buffers.push_back(file.substr(bin_at + 8, le32(file, bin_at)));
+    } else {
+        doc = nlohmann::json::parse(file, nullptr, false);
+        if (doc.is_discarded()) { *err = "bad JSON"; return ""; }
+        const std::string dir = path.substr(0, path.find_last_of('/') == std::string::npos ? 0 : path.find_last_of('/') + 1);
+        for (auto &b : doc["buffers"]) buffers.push_back(b.contains("uri") ? read_all(dir + b["uri"].get<std::string>()) : std::string());
+    }
+    bool uses = false;
+    for (auto &e : doc.value("extensionsUsed", nlohmann::json::array())) uses = uses || e == "EXT_meshopt_compression";
+    if (!uses) return "";
+    int fallback = -1;
+    for (size_t i = 0; i < doc["buffers"].size(); ++i)
+        if (doc["buffers"][i].contains("extensions")) fallback = (int)i;
+    if (fallback < 0) { *err = "no fallback buffer"; return ""; }
+    std::string plain((size_t)doc["buffers"][(size_t)fallback]["byteLength"].get<size_t>(), '\0');
+    for (auto &v : doc["bufferViews"]) {
+        if (!v.contains("extensions") || !v["extensions"].contains("EXT_meshopt_compression")) { *err = "a view not compressed"; return ""; }
+        const auto &x = v["extensions"]["EXT_meshopt_compression"];
+        const std::string &src = buffers.at(x["buffer"].get<size_t>());
+        const size_t off = x.value("byteOffset", (size_t)0), len = x["byteLength"], count = x["count"], stride = x["byteStride"];
+        unsigned char *dst = reinterpret_cast<unsigned char *>(&plain[v.value("byteOffset", (size_t)0)]);
+        const unsigned char *in = reinterpret_cast<const unsigned char *>(src.data()) + off;
+        int rc = x["mode"] == "ATTRIBUTES" ? meshopt_decodeVertexBuffer(dst, count, stride, in, len)
+                                           : meshopt_decodeIndexBuffer(dst, count, stride, in, len);
+        if (rc != 0) { *err = "a view does not decode (" + std::to_string(rc) + ")"; return ""; }
+        v.erase("extensions");
+        v["buffer"] = 0;
+    }
+    doc["buffers"] = nlohmann::json::array({{{"byteLength", plain.size()}}});
+    for (const char *key : {"extensionsUsed", "extensionsRequired"}) {
+        nlohmann::json kept = nlohmann::json::array();
+        for (auto &e : doc.value(key, nlohmann::json::array()))
+            if (e != "EXT_meshopt_compression") kept.push_back(e);
+        doc[key] = kept;
+        if (kept.empty()) doc.erase(key);
+    }
+    std::string j = doc.dump();
+    while (j.size() % 4) j.push_back(' ');
+    while (plain.size() % 4) plain.push_back('\0');
+    std::string glb = "glTF";
+    auto u32 = [&](uint32_t x) { for (int k = 0; k < 4; ++k) glb.push_back((char)(x >> (8 * k) & 0xff)); };
+    u32(2);
+    u32((uint32_t)(28 + j.size() + plain.size()));
+    u32((uint32_t)j.size());
+    glb += "JSON" + j;
+    u32((uint32_t)plain.size());
+    glb += std::string("BIN\0", 4) + plain;
+    return glb;
+}
+
 // Position key on a grid of `cell` (neighbouring cells searched too).
 typedef std::array<long long, 3> Key;
 Key key_of(const float *p, double cell) {
@@ -212,6 +294,7 @@ int main(int argc, char **argv) {
         const char *v = i + 1 < argc ? argv[i + 1] : "";
         if (a == "--no-optimize" || a == "--gltf" || a == "-q" || a == "--quiet") continue;
         if (a == "--quantize") { quantized = true; continue; }
+        if (a == "--compress") continue; // decoded whenever the file uses it
         if (a == "--scheme") have_scheme = sfb_scheme_parse(v, &scheme);
         else if (a == "--level") level = atoi(v);
         else if (a == "--normals") normals = v;
@@ -238,7 +321,14 @@ int main(int argc, char **argv) {
     tinygltf::Model model;
     std::string err, warn;
     const bool binary = name.size() > 4 && name.substr(name.size() - 4) == ".glb";
-    const bool loaded = binary ? loader.LoadBinaryFromFile(&model, &err, &warn, file) : loader.LoadASCIIFromFile(&model, &err, &warn, file);
+    std::string derr;
+    const std::string decoded = meshopt_decode_file(file, &derr);
+    if (!derr.empty()) fail((name + ": EXT_meshopt_compression decodes").c_str(), "%s", derr.c_str());
+    if (!decoded.empty()) pass((name + ": EXT_meshopt_compression decodes").c_str());
+    const bool loaded = !decoded.empty() ? loader.LoadBinaryFromMemory(&model, &err, &warn, reinterpret_cast<const unsigned char *>(decoded.data()),
+                                                                        (unsigned)decoded.size())
+                        : binary ? loader.LoadBinaryFromFile(&model, &err, &warn, file)
+                                 : loader.LoadASCIIFromFile(&model, &err, &warn, file);
     check(loaded, (name + ": loads").c_str(), "%s", err.c_str());
     if (!loaded) return close_tests();
     const bool shape = model.meshes.size() == 1 && model.meshes[0].primitives.size() == 1;

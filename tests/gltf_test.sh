@@ -106,6 +106,11 @@ export_ok box_noopt.glb "$BOX" --no-optimize
 export_ok box_quant.glb "$BOX" --quantize
 export_ok box_quant16.gltf "$BOX" --quantize --position-bits 16 --normal-bits 16 --uv-bits 16
 export_ok torus_quant_tess.glb examples/data/torus.obj --tess 6 --quantize --normal-bits 10
+export_ok box_compress.glb "$BOX" --compress
+export_ok box_compress_quant.glb "$BOX" --compress --quantize
+export_ok box_compress_quant.gltf "$BOX" --compress --quantize
+a=$(stat -c %s "$TMP/v/box.glb"); b=$(stat -c %s "$TMP/v/box_compress_quant.glb")
+if [ "$b" -lt "$a" ]; then ok "--compress --quantize is smaller ($b bytes, plain $a)"; else bad "--compress --quantize: $b bytes, plain $a"; fi
 check "--normal-bits without --quantize is a usage error" 2 "$TOOL" --normal-bits 10 "$BOX" -o "$TMP/x.glb"
 check "--position-bits 17 is a usage error" 2 "$TOOL" --quantize --position-bits 17 "$BOX" -o "$TMP/x.glb"
 export_ok box_bilinear.glb "$BOX" --scheme bilinear --level 2
@@ -252,6 +257,8 @@ readback box_tess.glb "$BOX" --tess 6
 readback box_quant.glb "$BOX" --level 3 --quantize
 readback box_quant_bits.glb "$BOX" --level 2 --quantize --position-bits 10 --normal-bits 12
 readback box_quant_tess.glb "$BOX" --tess 5 --quantize --position-bits 16 --normal-bits 16
+readback box_compress.glb "$BOX" --level 3 --compress
+readback box_compress_quant.gltf "$BOX" --level 2 --compress --quantize
 # hard edges: a cube whose 12 edges are infinitely sharp (t crease), and the same by --crease-angle
 printf 'v -1 -1 1\nv 1 -1 1\nv -1 1 1\nv 1 1 1\nv -1 1 -1\nv 1 1 -1\nv -1 -1 -1\nv 1 -1 -1\nf 1 2 4 3\nf 3 4 6 5\nf 5 6 8 7\nf 7 8 2 1\nf 2 8 6 4\nf 7 1 3 5\n' > "$TMP/cube.obj"
 cp "$TMP/cube.obj" "$TMP/hard.obj"
@@ -264,6 +271,7 @@ readback hard_tess.glb "$TMP/hard.obj" --tess 4 -- --min-splits 20
 if [ -d "$SHAPES" ]; then
   readback car.glb "$SHAPES/catmark_car.obj" --level 2 -- --uvs yes
   readback car_quant.glb "$SHAPES/catmark_car.obj" --level 2 --quantize --uv-bits 10 -- --uvs yes
+  readback car_compress.glb "$SHAPES/catmark_car.obj" --level 2 --quantize --compress -- --uvs yes
   readback fvar.glb "$SHAPES/catmark_fvar_bound1.obj" --level 2 -- --uvs yes
   readback loop.glb "$SHAPES/loop_cube_creases1.obj" --level 2
   readback loop_tess.glb "$SHAPES/loop_cube_creases1.obj" --tess 5

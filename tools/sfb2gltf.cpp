@@ -31,6 +31,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdarg>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -72,6 +73,9 @@ const char *const kUsage =
     "                         transform; normals as normalised 8- or 16-bit integers rounded to\n"
     "                         --normal-bits (default 8); UVs in [0,1] as normalised 16-bit integers rounded\n"
     "                         to --uv-bits (default 12; UVs outside [0,1] stay float)\n"
+    "  --compress             EXT_meshopt_compression: indices and vertex attributes encoded with\n"
+    "                         meshoptimizer's codecs (a loader must decode it: three.js with its\n"
+    "                         MeshoptDecoder, gltfpack); best with --quantize\n"
     "  --no-optimize          keep the evaluation's vertex and triangle order (no meshoptimizer passes)\n"
     "  --progress             a progress bar on stderr even when stderr is not a terminal\n"
     "  -q, --quiet            no summary line and no progress bar\n"
@@ -89,7 +93,7 @@ struct Options {
     sfb_scheme scheme = SFB_SCHEME_CATMARK;
     int level = 3, rate = 0;
     double tolerance = 0.0, angle = 0.0;
-    bool quantize = false, have_bits = false;
+    bool quantize = false, have_bits = false, compress = false;
     int position_bits = 14, normal_bits = 8, uv_bits = 12; // --quantize
     NormalsMode normals = NORMALS_DEFAULT;
 };
@@ -182,6 +186,8 @@ int parse_args(int argc, char **argv, Options *o) {
             if (!(o->trim = value(a))) return usage_error("--trim needs a PNG file");
         } else if (!strcmp(a, "--backend")) {
             if (!(o->backend = value(a))) return usage_error("--backend needs a name (ref, simd, gl, osmesa)");
+        } else if (!strcmp(a, "--compress")) {
+            o->compress = true;
         } else if (!strcmp(a, "--quantize")) {
             o->quantize = true;
         } else if (!strcmp(a, "--position-bits") || !strcmp(a, "--normal-bits") || !strcmp(a, "--uv-bits")) {
@@ -587,28 +593,88 @@ tinygltf::Primitive add_primitive(tinygltf::Model *model, const OutMesh &m, int 
     return prim;
 }
 
-// Serialises the model to OUT (.glb, or .gltf with its buffer in BIN beside it), each file
-// written atomically. Returns 0, or 1 with the reason printed.
+// EXT_meshopt_compression: every bufferView of buffer 0 encoded with meshoptimizer's codecs
+// (index views as TRIANGLES, attribute views as ATTRIBUTES) into a new buffer; the views then
+// point into a fallback buffer that has a length and no data (extensionsRequired: a loader
+// must decode). Edits the JSON `doc` and returns the compressed bytes.
+std::vector<unsigned char> meshopt_compress(const tinygltf::Model &model, const std::vector<unsigned char> &bin, nlohmann::json &doc) {
+    std::vector<unsigned char> out;
+    for (size_t i = 0; i < model.bufferViews.size(); ++i) {
+        const tinygltf::BufferView &v = model.bufferViews[i];
+        const unsigned char *data = bin.data() + v.byteOffset;
+        std::vector<unsigned char> enc;
+        nlohmann::json ext;
+        while (out.size() % 4) out.push_back(0);
+        if (v.target == TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER) {
+            // the index view's component size, from its accessor
+            size_t isize = 4;
+            for (const tinygltf::Accessor &a : model.accessors)
+                if (a.bufferView == (int)i) isize = (size_t)tinygltf::GetComponentSizeInBytes((uint32_t)a.componentType);
+            const size_t count = v.byteLength / isize;
+            std::vector<unsigned> idx(count);
+            unsigned top = 0;
+            for (size_t k = 0; k < count; ++k) {
+                if (isize == 2) { unsigned short q; memcpy(&q, data + 2 * k, 2); idx[k] = q; }
+                else memcpy(&idx[k], data + 4 * k, 4);
+                top = std::max(top, idx[k]);
+            }
+            enc.resize(meshopt_encodeIndexBufferBound(count, (size_t)top + 1));
+            enc.resize(meshopt_encodeIndexBuffer(enc.data(), enc.size(), idx.data(), count));
+            ext = {{"buffer", 0}, {"byteOffset", out.size()}, {"byteLength", enc.size()}, {"byteStride", isize}, {"count", count}, {"mode", "TRIANGLES"}};
+        } else {
+            const size_t stride = v.byteStride, count = v.byteLength / stride;
+            enc.resize(meshopt_encodeVertexBufferBound(count, stride));
+            enc.resize(meshopt_encodeVertexBuffer(enc.data(), enc.size(), data, count, stride));
+            ext = {{"buffer", 0}, {"byteOffset", out.size()}, {"byteLength", enc.size()}, {"byteStride", stride}, {"count", count}, {"mode", "ATTRIBUTES"}};
+        }
+        out.insert(out.end(), enc.begin(), enc.end());
+        nlohmann::json &jv = doc["bufferViews"][i];
+        jv["buffer"] = 1;
+        jv["extensions"]["EXT_meshopt_compression"] = ext;
+    }
+    while (out.size() % 4) out.push_back(0);
+    for (const char *key : {"extensionsUsed", "extensionsRequired"}) {
+        if (!doc.contains(key)) doc[key] = nlohmann::json::array();
+        doc[key].push_back("EXT_meshopt_compression");
+    }
+    return out;
+}
+
+// A GLB container: the 12-byte header, the JSON chunk (padded with spaces), the BIN chunk
+// (padded with zeros).
+std::string glb_container(const std::string &json, const std::vector<unsigned char> &bin) {
+    std::string j = json;
+    while (j.size() % 4) j.push_back(' ');
+    const uint32_t total = (uint32_t)(12 + 8 + j.size() + (bin.empty() ? 0 : 8 + bin.size()));
+    std::string out;
+    auto u32 = [&](uint32_t x) { for (int k = 0; k < 4; ++k) out.push_back((char)(x >> (8 * k) & 0xff)); };
+    out += "glTF";
+    u32(2);
+    u32(total);
+    u32((uint32_t)j.size());
+    out += "JSON";
+    out += j;
+    if (!bin.empty()) {
+        u32((uint32_t)bin.size());
+        out += std::string("BIN\0", 4);
+        out.append(reinterpret_cast<const char *>(bin.data()), bin.size());
+    }
+    return out;
+}
+
+// Serialises the model to OUT (.glb, or .gltf with its buffer in a .bin beside it), each file
+// written atomically. tinygltf writes the JSON of everything but the buffers; the buffers (and
+// --compress's bufferView extensions) are ours. Returns 0, or 1 with the reason printed.
 int write_model(tinygltf::Model &model, const Options &o, size_t *bytes) {
     const std::string out = o.out;
     const bool text = o.gltf || ends_with(out, ".gltf");
-    tinygltf::TinyGLTF writer;
-    std::ostringstream stream;
-    if (!text) {
-        if (!writer.WriteGltfSceneToStream(&model, stream, false, true)) {
-            cli_error("%s: tinygltf could not serialise the model", o.out);
-            return 1;
-        }
-        const std::string s = stream.str();
-        *bytes = s.size();
-        return cli_write_file(o.out, s.data(), s.size());
-    }
-    // .gltf: tinygltf would embed the buffer as base64 in a stream; write the JSON with the
-    // buffer's uri pointing at our own .bin instead
     std::vector<unsigned char> bin;
     bin.swap(model.buffers[0].data);
-    const size_t bin_size = bin.size();
-    if (!writer.WriteGltfSceneToStream(&model, stream, true, false)) {
+    const size_t raw_size = bin.size();
+    model.buffers.clear();
+    tinygltf::TinyGLTF writer;
+    std::ostringstream stream;
+    if (!writer.WriteGltfSceneToStream(&model, stream, false, false)) {
         cli_error("%s: tinygltf could not serialise the model", o.out);
         return 1;
     }
@@ -617,9 +683,19 @@ int write_model(tinygltf::Model &model, const Options &o, size_t *bytes) {
         cli_error("%s: tinygltf wrote JSON that does not parse", o.out);
         return 1;
     }
-    std::string dir = out.substr(0, out.find_last_of('/') == std::string::npos ? 0 : out.find_last_of('/') + 1);
+    const std::string dir = out.substr(0, out.find_last_of('/') == std::string::npos ? 0 : out.find_last_of('/') + 1);
     const std::string bin_name = base_name(out) + ".bin";
-    doc["buffers"] = nlohmann::json::array({{{"byteLength", bin_size}, {"uri", bin_name}}});
+    if (o.compress) bin = meshopt_compress(model, bin, doc);
+    nlohmann::json buffer = {{"byteLength", bin.size()}};
+    if (text) buffer["uri"] = bin_name;
+    doc["buffers"] = nlohmann::json::array({buffer});
+    if (o.compress)
+        doc["buffers"].push_back({{"byteLength", raw_size}, {"extensions", {{"EXT_meshopt_compression", {{"fallback", true}}}}}});
+    if (!text) {
+        const std::string glb = glb_container(doc.dump(), bin);
+        *bytes = glb.size();
+        return cli_write_file(o.out, glb.data(), glb.size());
+    }
     const std::string json = doc.dump(2) + "\n";
     if (cli_write_file((dir + bin_name).c_str(), bin.data(), bin.size())) return 1;
     if (cli_write_file(o.out, json.data(), json.size())) {

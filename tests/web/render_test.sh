@@ -99,6 +99,12 @@ prepare() {
       else
         fail "$name: sfb2gltf --quantize"; cat "$W/$name.sfb2gltfq.log"
       fi
+      # quantized and compressed (EXT_meshopt_compression: three's MeshoptDecoder)
+      if "$BUILD/sfb2gltf" -q --quantize --compress --level "$level" "$src" -o "$W/$name.sfb2gltfc.glb" 2> "$W/$name.sfb2gltfc.log"; then
+        job "$name.sfb2gltfc" "$W/$name.sfb2gltfc.glb" "$yaw" "$pitch" "$zoom" "$size"; CHECKS+=("iou $name sfb2gltfc $gv $gt")
+      else
+        fail "$name: sfb2gltf --quantize --compress"; cat "$W/$name.sfb2gltfc.log"
+      fi
     else
       fail "$name: sfb2gltf"; cat "$W/$name.sfb2gltf.log"
     fi
