@@ -128,6 +128,24 @@ if [ -f "$TMP/v/box.bin" ] && grep -q '"uri": "box.bin"' "$TMP/v/box.gltf"; then
 mv "$TMP/v/box_gltf_flag.json" "$TMP/v/box_gltf_flag.gltf"
 if [ -f "$TMP/v/box_gltf_flag.bin" ] && head -c 1 "$TMP/v/box_gltf_flag.gltf" | grep -q '{'; then ok "--gltf writes JSON and a .bin"; else bad "--gltf did not write JSON + .bin"; fi
 if [ "$(head -c 4 "$TMP/v/box.glb")" = glTF ]; then ok ".glb is binary glTF"; else bad ".glb does not start with glTF"; fi
+# --report: the deviation from the exact limit surface (the summary line gives the maxima)
+report() { # description, max position error wanted (awk condition on p), on the normal error (n), options...
+  local desc=$1 pc=$2 nc=$3; shift 3
+  check "$desc: export with --report" 0 "$TOOL" "$@" --report "$TMP/v/report.json" "$BOX" -o "$TMP/v/report.glb"
+  local line p n
+  line=$(grep "deviation from the limit surface" "$TMP/err")
+  p=$(sed -nE 's/.*positions up to ([^ ]+) .*/\1/p' <<< "$line"); n=$(sed -nE 's/.*normals up to ([^ ]+) degrees.*/\1/p' <<< "$line")
+  if [ -n "$p" ] && awk -v p="$p" -v n="$n" "BEGIN { exit !(($pc) && ($nc)) }"; then ok "$desc: positions $p, normals $n degrees"
+  else bad "$desc: positions '$p', normals '$n' degrees (wanted $pc, $nc)"; fi
+  contains "$desc: the report has the normal error" "$TMP/v/report.json" '"normal_error_degrees"'
+}
+report "tessellated, float" "p == 0" "n < 1e-3" --tess 6
+report "tessellated, quantized" "p > 0 && p < 3e-4" "n > 0.01 && n < 1" --tess 6 --quantize
+report "tessellated, 16-bit quantized" "p > 0 && p < 5e-5" "n < 0.01" --tess 6 --quantize --position-bits 16 --normal-bits 16
+report "refined (against the limit points)" "p > 1e-3" "n >= 0" --level 2
+check "--report into a missing folder fails" 1 "$TOOL" --report "$TMP/no/dir/r.json" "$BOX" -o "$TMP/v/r2.glb"
+rm -f "$TMP/v/report.glb" "$TMP/v/r2.glb"
+
 # the peer shapes (Catmull-Clark, Loop, bilinear; UVs, holes, non-manifold) at level 2
 n=0
 if [ -d "$SHAPES" ]; then

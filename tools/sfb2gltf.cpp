@@ -76,6 +76,9 @@ const char *const kUsage =
     "  --compress             EXT_meshopt_compression: indices and vertex attributes encoded with\n"
     "                         meshoptimizer's codecs (a loader must decode it: three.js with its\n"
     "                         MeshoptDecoder, gltfpack); best with --quantize\n"
+    "  --report FILE.json     per mesh: counts, bytes, and the deviation of what is written (after\n"
+    "                         --quantize) from the exact limit surface: positions (model units and share\n"
+    "                         of the diagonal) and normals (degrees); a summary line on stderr\n"
     "  --no-optimize          keep the evaluation's vertex and triangle order (no meshoptimizer passes)\n"
     "  --progress             a progress bar on stderr even when stderr is not a terminal\n"
     "  -q, --quiet            no summary line and no progress bar\n"
@@ -87,7 +90,7 @@ const char *const kUsage =
 enum NormalsMode { NORMALS_DEFAULT, NORMALS_SHADING, NORMALS_LIMIT, NORMALS_FLAT };
 
 struct Options {
-    const char *in = nullptr, *out = nullptr, *trim = nullptr, *backend = nullptr;
+    const char *in = nullptr, *out = nullptr, *trim = nullptr, *backend = nullptr, *report = nullptr;
     bool gltf = false, optimize = true, quiet = false, progress = false;
     bool have_scheme = false, have_level = false, have_tess = false, have_tolerance = false, have_angle = false;
     sfb_scheme scheme = SFB_SCHEME_CATMARK;
@@ -186,6 +189,8 @@ int parse_args(int argc, char **argv, Options *o) {
             if (!(o->trim = value(a))) return usage_error("--trim needs a PNG file");
         } else if (!strcmp(a, "--backend")) {
             if (!(o->backend = value(a))) return usage_error("--backend needs a name (ref, simd, gl, osmesa)");
+        } else if (!strcmp(a, "--report")) {
+            if (!(o->report = value(a))) return usage_error("--report needs a file name (FILE.json)");
         } else if (!strcmp(a, "--compress")) {
             o->compress = true;
         } else if (!strcmp(a, "--quantize")) {
@@ -281,6 +286,9 @@ int progress_cb(float done, const char *, void *user) {
 struct OutMesh {
     std::vector<float> positions, normals, uvs; // xyz, xyz, uv per vertex (uvs empty: none)
     std::vector<unsigned> indices;              // 3 per triangle
+    // per vertex: the exact limit surface's point and unit normal there (--report measures the
+    // written data against them)
+    std::vector<float> exact_p, exact_n;
 };
 
 void normalize3(float *n, const float *fallback) {
@@ -313,7 +321,7 @@ void tri_normal(const float *a, const float *b, const float *c, float *n) {
 // that a UV seam splits a vertex and nothing else does; polygons fan-triangulated from their
 // first corner; holes skipped. normals: per vertex (NULL with flat: one per triangle, vertices
 // then split per triangle).
-void mesh_from_faces(const sfb_mesh_data &d, const float *normals, bool flat, OutMesh *m) {
+void mesh_from_faces(const sfb_mesh_data &d, const float *normals, bool flat, const float *limit_p, const float *limit_n, OutMesh *m) {
     std::vector<char> hole((size_t)d.face_count + 1, 0);
     for (int h = 0; h < d.hole_count; ++h)
         if (d.holes[h] >= 0 && d.holes[h] < d.face_count) hole[(size_t)d.holes[h]] = 1;
@@ -328,6 +336,12 @@ void mesh_from_faces(const sfb_mesh_data &d, const float *normals, bool flat, Ou
         }
         const unsigned id = (unsigned)(m->positions.size() / 3);
         for (int c = 0; c < 3; ++c) m->positions.push_back(d.positions[3 * (size_t)v + c]);
+        if (limit_p && limit_n) {
+            float ln[3] = {limit_n[3 * (size_t)v], limit_n[3 * (size_t)v + 1], limit_n[3 * (size_t)v + 2]};
+            normalize3(ln, flat_n);
+            m->exact_p.insert(m->exact_p.end(), limit_p + 3 * (size_t)v, limit_p + 3 * (size_t)v + 3);
+            m->exact_n.insert(m->exact_n.end(), ln, ln + 3);
+        }
         float n[3];
         const float *src = flat ? flat_n : normals + 3 * (size_t)v;
         for (int c = 0; c < 3; ++c) n[c] = src[c];
@@ -360,6 +374,8 @@ void mesh_from_tess(const sfb_tess_data &t, bool flat, OutMesh *m) {
         m->positions.assign(t.positions, t.positions + 3 * (size_t)t.vertex_count);
         m->normals.assign(t.normals, t.normals + 3 * (size_t)t.vertex_count);
         m->indices.assign(t.triangles, t.triangles + 3 * (size_t)t.triangle_count);
+        m->exact_p = m->positions;
+        m->exact_n.assign(t.normals, t.normals + 3 * (size_t)t.vertex_count);
         for (int i = 0; i < t.triangle_count; ++i) {
             float fn[3];
             const int *c = t.triangles + 3 * (size_t)i;
@@ -377,6 +393,8 @@ void mesh_from_tess(const sfb_tess_data &t, bool flat, OutMesh *m) {
             m->indices.push_back((unsigned)(m->positions.size() / 3));
             for (int q = 0; q < 3; ++q) m->positions.push_back(t.positions[3 * (size_t)c[j] + q]);
             m->normals.insert(m->normals.end(), fn, fn + 3);
+            for (int q = 0; q < 3; ++q) m->exact_p.push_back(t.positions[3 * (size_t)c[j] + q]);
+            for (int q = 0; q < 3; ++q) m->exact_n.push_back(t.normals[3 * (size_t)c[j] + q]);
         }
     }
 }
@@ -418,6 +436,8 @@ void optimize_mesh(OutMesh *m) {
     remap_stream(m->positions, 3);
     remap_stream(m->normals, 3);
     remap_stream(m->uvs, 2);
+    remap_stream(m->exact_p, 3);
+    remap_stream(m->exact_n, 3);
 }
 
 // Without the optimiser: unused vertices still go (the validator warns on unused data), order kept.
@@ -440,6 +460,8 @@ void compact_mesh(OutMesh *m) {
     squeeze(m->positions, 3);
     squeeze(m->normals, 3);
     squeeze(m->uvs, 2);
+    squeeze(m->exact_p, 3);
+    squeeze(m->exact_n, 3);
 }
 
 // ------------------------------------------------------------------ glTF
@@ -722,6 +744,7 @@ struct Run {
     Progress bar;
     sfb_context *ctx = nullptr;
     std::vector<Part> parts;
+    std::vector<Quant> quant; // --quantize: per output mesh (set by assemble)
     // the output's skeleton: the glTF input's nodes, scenes, materials (and their textures) and
     // mesh names, or for an OBJ one node and mesh named after the file, the default material
     tinygltf::Model skeleton;
@@ -1007,7 +1030,8 @@ int evaluate_part(Run &R, Part &part) {
     sfb_mesh_get_desc(part.mesh, &d);
     sfb_surface_config cfg = sfb_surface_config_init(R.o.scheme, R.o.have_tess ? 0 : R.o.level);
     if (R.o.have_tess) cfg.flags = SFB_REFINE_PATCHES;
-    else cfg.flags = (R.o.normals == NORMALS_FLAT ? 0u : (unsigned)SFB_REFINE_SHADING) | (d.uv_count > 0 ? (unsigned)SFB_REFINE_UVS : 0u);
+    else cfg.flags = (R.o.normals == NORMALS_FLAT ? (R.o.report ? (unsigned)SFB_REFINE_LIMIT : 0u) : (unsigned)SFB_REFINE_SHADING) |
+                     (d.uv_count > 0 ? (unsigned)SFB_REFINE_UVS : 0u);
     sfb_surface *surf = nullptr;
     sfb_result r = sfb_surface_create(R.ctx, part.mesh, &cfg, &surf);
     if (r != SFB_SUCCESS) return R.fail_lib(part.name, "building the surface", r);
@@ -1043,12 +1067,14 @@ int evaluate_part(Run &R, Part &part) {
         memset(&data, 0, sizeof data);
         if (R.o.normals == NORMALS_FLAT) {
             r = sfb_surface_refine(surf, &data);
-            if (r == SFB_SUCCESS) mesh_from_faces(data, nullptr, true, &part.out);
+            if (r == SFB_SUCCESS) mesh_from_faces(data, nullptr, true, data.limit_positions, data.normals, &part.out);
             else rc = R.fail_lib(part.name, "refining", r);
         } else {
             sfb_shade_params sp = sfb_shade_params_init();
             r = sfb_surface_shade(surf, &sp, &data);
-            if (r == SFB_SUCCESS) mesh_from_faces(data, R.o.normals == NORMALS_LIMIT ? data.limit_normals : data.normals, false, &part.out);
+            if (r == SFB_SUCCESS)
+                mesh_from_faces(data, R.o.normals == NORMALS_LIMIT ? data.limit_normals : data.normals, false, data.limit_positions,
+                                data.limit_normals, &part.out);
             else rc = R.fail_lib(part.name, "shading", r);
         }
         sfb_mesh_data_free(&data);
@@ -1083,7 +1109,8 @@ void assemble(Run &R, tinygltf::Model *model) {
     model->extensionsUsed.clear();
     int default_material = -1;
     // --quantize: one grid per output mesh, over the extent of all its parts
-    std::vector<Quant> quant(k.meshes.size());
+    std::vector<Quant> &quant = R.quant;
+    quant.assign(k.meshes.size(), Quant());
     if (R.o.quantize) {
         std::vector<double> lo(3 * k.meshes.size(), HUGE_VAL), hi(3 * k.meshes.size(), -HUGE_VAL);
         for (const Part &p : R.parts)
@@ -1151,6 +1178,95 @@ void assemble(Run &R, tinygltf::Model *model) {
     }
 }
 
+// --report: what is written against the exact limit surface, per part.
+struct Deviation {
+    double pos_max = 0.0, pos_sq = 0.0, nrm_max = 0.0, nrm_sq = 0.0, diag = 0.0;
+    size_t n = 0;
+};
+
+Deviation measure(const Part &p, const Run &R) {
+    Deviation d;
+    const OutMesh &m = p.out;
+    const size_t nv = m.positions.size() / 3;
+    if (m.exact_p.size() != m.positions.size() || m.exact_n.size() != m.normals.size()) return d;
+    const Quant *q = R.o.quantize && p.gltf_mesh < (int)R.quant.size() ? &R.quant[(size_t)p.gltf_mesh] : nullptr;
+    const long qmax = (1L << (R.o.position_bits - 1)) - 1;
+    const long full = R.o.normal_bits <= 8 ? 127 : 32767;
+    double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+    for (size_t v = 0; v < nv; ++v) {
+        double w[3], n[3], e2 = 0.0, nl = 0.0, dot = 0.0;
+        for (int c = 0; c < 3; ++c) {
+            const double x = m.positions[3 * v + (size_t)c];
+            if (q) {
+                const long k = std::min(std::max(std::lround((x - q->t[c]) / q->s), -qmax), qmax);
+                w[c] = (float)(q->t[c] + q->s * (double)k); // as a loader computes it, in float
+                n[c] = (double)snap(m.normals[3 * v + (size_t)c], R.o.normal_bits, full, true) / (double)full;
+            } else {
+                w[c] = x;
+                n[c] = m.normals[3 * v + (size_t)c];
+            }
+            e2 += (w[c] - m.exact_p[3 * v + (size_t)c]) * (w[c] - m.exact_p[3 * v + (size_t)c]);
+            nl += n[c] * n[c];
+            lo[c] = std::min(lo[c], (double)m.exact_p[3 * v + (size_t)c]);
+            hi[c] = std::max(hi[c], (double)m.exact_p[3 * v + (size_t)c]);
+        }
+        (void)nl;
+        // the angle as atan2(|a x b|, a . b): exact for small angles, where acos is not
+        const double *a = n;
+        const double b[3] = {m.exact_n[3 * v], m.exact_n[3 * v + 1], m.exact_n[3 * v + 2]};
+        const double x[3] = {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+        for (int c = 0; c < 3; ++c) dot += a[c] * b[c];
+        const double deg = std::atan2(std::sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]), dot) * 180.0 / 3.14159265358979323846;
+        d.pos_max = std::max(d.pos_max, std::sqrt(e2));
+        d.pos_sq += e2;
+        d.nrm_max = std::max(d.nrm_max, deg);
+        d.nrm_sq += deg * deg;
+        ++d.n;
+    }
+    for (int c = 0; c < 3; ++c)
+        if (hi[c] >= lo[c]) d.diag += (hi[c] - lo[c]) * (hi[c] - lo[c]);
+    d.diag = std::sqrt(d.diag);
+    return d;
+}
+
+// Writes the --report JSON (atomically) and the summary line; 0, or 1 (printed).
+int write_report(const Run &R, size_t bytes) {
+    nlohmann::json meshes = nlohmann::json::array();
+    Deviation all;
+    for (const Part &p : R.parts) {
+        const Deviation d = measure(p, R);
+        const size_t nv = p.out.positions.size() / 3;
+        const size_t raw = nv * (R.o.quantize ? 12 : 24) + p.out.uvs.size() * (R.o.quantize ? 2 : 4) +
+                           p.out.indices.size() * (nv < 65535 ? 2 : 4);
+        nlohmann::json j = {{"name", p.name}, {"mesh", p.gltf_mesh}, {"vertices", nv}, {"triangles", p.out.indices.size() / 3},
+                            {"uvs", !p.out.uvs.empty()}, {"bytes_uncompressed", raw}};
+        if (d.n) {
+            j["position_error"] = {{"max", d.pos_max}, {"rms", std::sqrt(d.pos_sq / (double)d.n)}, {"max_of_diagonal", d.diag > 0 ? d.pos_max / d.diag : 0.0}};
+            j["normal_error_degrees"] = {{"max", d.nrm_max}, {"rms", std::sqrt(d.nrm_sq / (double)d.n)}};
+            all.pos_max = std::max(all.pos_max, d.pos_max);
+            all.nrm_max = std::max(all.nrm_max, d.nrm_max);
+            all.diag = std::max(all.diag, d.diag);
+            all.n += d.n;
+        }
+        meshes.push_back(j);
+    }
+    nlohmann::json doc = {{"input", R.o.in}, {"output", R.o.out}, {"bytes", bytes}, {"scheme", sfb_scheme_name(R.o.scheme)},
+                          {"evaluation", R.o.have_tess ? "tessellated" : "refined"}, {"level", R.o.have_tess ? 0 : R.o.level},
+                          {"rate", R.o.have_tess ? R.o.rate : 0},
+                          {"normals", R.o.normals == NORMALS_SHADING ? "shading" : R.o.normals == NORMALS_LIMIT ? "limit" : "flat"},
+                          {"quantize", R.o.quantize ? nlohmann::json({{"position_bits", R.o.position_bits}, {"normal_bits", R.o.normal_bits},
+                                                                      {"uv_bits", R.o.uv_bits}}) : nlohmann::json(false)},
+                          {"compress", R.o.compress}, {"meshes", meshes},
+                          {"measured", "each written vertex (after quantization) against the exact limit surface's point and normal "
+                                       "of the same vertex: refined vertices against their limit points"}};
+    const std::string text = doc.dump(2) + "\n";
+    if (cli_write_file(R.o.report, text.data(), text.size())) return 1;
+    if (!R.o.quiet && all.n)
+        fprintf(stderr, "sfb2gltf: deviation from the limit surface: positions up to %.3g (%.2g of the diagonal), normals up to %.3g degrees -> %s\n",
+                all.pos_max, all.diag > 0 ? all.pos_max / all.diag : 0.0, all.nrm_max, R.o.report);
+    return 0;
+}
+
 } // namespace
 
 int main(int argc, char **argv) {
@@ -1198,6 +1314,7 @@ int main(int argc, char **argv) {
     rc = write_model(model, R.o, &bytes);
     R.bar.end();
     if (rc) return 1;
+    if (R.o.report && write_report(R, bytes)) return 1;
     if (!R.o.quiet)
         fprintf(stderr, "sfb2gltf: %s: %s %s: %zu mesh%s, %zu vertices, %zu triangles%s -> %s (%zu bytes, backend %s)\n", R.o.in,
                 sfb_scheme_name(R.o.scheme), R.o.have_tess ? "tessellated" : "refined", R.parts.size(), R.parts.size() == 1 ? "" : "es",
