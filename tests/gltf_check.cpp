@@ -240,6 +240,9 @@ std::string meshopt_decode_file(const std::string &path, std::string *err) {
         int rc = x["mode"] == "ATTRIBUTES" ? meshopt_decodeVertexBuffer(dst, count, stride, in, len)
                                            : meshopt_decodeIndexBuffer(dst, count, stride, in, len);
         if (rc != 0) { *err = "a view does not decode (" + std::to_string(rc) + ")"; return ""; }
+        const std::string filter = x.value("filter", std::string("NONE"));
+        if (filter == "OCTAHEDRAL") meshopt_decodeFilterOct(dst, count, stride);
+        else if (filter != "NONE") { *err = "filter " + filter + " not read"; return ""; }
         v.erase("extensions");
         v["buffer"] = 0;
     }
@@ -391,7 +394,9 @@ int main(int argc, char **argv) {
     }
     // tolerances: float data agrees to rounding; quantized data within half a grid step
     const double qpos = quantized ? 1.0 / (double)((1L << (position_bits - 1)) - 1) : 0.0;
-    const double ntol = quantized ? 1.0 / (double)((1L << (normal_bits - 1)) - 1) + (normal_bits <= 8 ? 1.0 / 127 : 1.0 / 32767) : 1e-5;
+    // (twice the rounding step: --compress stores normals with the octahedral filter, whose
+    // K-bit grid is coarser per component than K-bit components)
+    const double ntol = quantized ? 2.0 / (double)((1L << (normal_bits - 1)) - 1) + (normal_bits <= 8 ? 1.0 / 127 : 1.0 / 32767) : 1e-5;
     const double ttol = quantized ? 1.0 / (double)((1L << uv_bits) - 1) + 1.0 / 65535 : 1e-6;
     double worst_len = 0.0;
     for (size_t v = 0; v < nv; ++v)

@@ -518,7 +518,8 @@ long snap(double v, int bits, long full, bool is_signed) {
     return std::lround(std::min(std::max(r, is_signed ? -1.0 : 0.0), 1.0) * (double)full);
 }
 
-tinygltf::Primitive add_primitive_quantized(tinygltf::Model *model, const OutMesh &m, int material, const Quant &q, const Options &o) {
+tinygltf::Primitive add_primitive_quantized(tinygltf::Model *model, const OutMesh &m, int material, const Quant &q, const Options &o,
+                                            std::vector<int> *oct_views) {
     tinygltf::Primitive prim;
     const size_t nv = m.positions.size() / 3;
     int index_view, index_type;
@@ -547,7 +548,20 @@ tinygltf::Primitive add_primitive_quantized(tinygltf::Model *model, const OutMes
     int view = add_view(*model, P.data(), P.size() * sizeof(short), TINYGLTF_TARGET_ARRAY_BUFFER, 8);
     prim.attributes["POSITION"] = add_accessor(*model, view, TINYGLTF_COMPONENT_TYPE_SHORT, TINYGLTF_TYPE_VEC3, nv, mn, mx);
     // normals: normalised BYTE x 3 (padded to 4) up to 8 bits, SHORT x 3 (padded to 8) above
-    if (o.normal_bits <= 8) {
+    if (o.compress) {
+        // with --compress: the octahedral filter of EXT_meshopt_compression (two K-bit components
+        // per unit vector, decoded to a normalised x, y, z), which compresses far better
+        std::vector<float> F(nv * 4, 0.0f);
+        for (size_t v = 0; v < nv; ++v)
+            for (int c = 0; c < 3; ++c) F[4 * v + (size_t)c] = m.normals[3 * v + (size_t)c];
+        const size_t stride = o.normal_bits <= 8 ? 4 : 8;
+        std::vector<unsigned char> N(nv * stride);
+        meshopt_encodeFilterOct(N.data(), nv, stride, o.normal_bits, F.data());
+        view = add_view(*model, N.data(), N.size(), TINYGLTF_TARGET_ARRAY_BUFFER, (int)stride);
+        oct_views->push_back(view);
+        prim.attributes["NORMAL"] = add_accessor(*model, view, stride == 4 ? TINYGLTF_COMPONENT_TYPE_BYTE : TINYGLTF_COMPONENT_TYPE_SHORT,
+                                                 TINYGLTF_TYPE_VEC3, nv);
+    } else if (o.normal_bits <= 8) {
         std::vector<signed char> N(nv * 4, 0);
         for (size_t v = 0; v < nv; ++v)
             for (int c = 0; c < 3; ++c) N[4 * v + (size_t)c] = (signed char)snap(m.normals[3 * v + (size_t)c], o.normal_bits, 127, true);
@@ -619,7 +633,8 @@ tinygltf::Primitive add_primitive(tinygltf::Model *model, const OutMesh &m, int 
 // (index views as TRIANGLES, attribute views as ATTRIBUTES) into a new buffer; the views then
 // point into a fallback buffer that has a length and no data (extensionsRequired: a loader
 // must decode). Edits the JSON `doc` and returns the compressed bytes.
-std::vector<unsigned char> meshopt_compress(const tinygltf::Model &model, const std::vector<unsigned char> &bin, nlohmann::json &doc) {
+std::vector<unsigned char> meshopt_compress(const tinygltf::Model &model, const std::vector<unsigned char> &bin, const std::vector<int> &oct_views,
+                                            nlohmann::json &doc) {
     std::vector<unsigned char> out;
     for (size_t i = 0; i < model.bufferViews.size(); ++i) {
         const tinygltf::BufferView &v = model.bufferViews[i];
@@ -648,6 +663,7 @@ std::vector<unsigned char> meshopt_compress(const tinygltf::Model &model, const 
             enc.resize(meshopt_encodeVertexBufferBound(count, stride));
             enc.resize(meshopt_encodeVertexBuffer(enc.data(), enc.size(), data, count, stride));
             ext = {{"buffer", 0}, {"byteOffset", out.size()}, {"byteLength", enc.size()}, {"byteStride", stride}, {"count", count}, {"mode", "ATTRIBUTES"}};
+            if (std::find(oct_views.begin(), oct_views.end(), (int)i) != oct_views.end()) ext["filter"] = "OCTAHEDRAL";
         }
         out.insert(out.end(), enc.begin(), enc.end());
         nlohmann::json &jv = doc["bufferViews"][i];
@@ -687,7 +703,7 @@ std::string glb_container(const std::string &json, const std::vector<unsigned ch
 // Serialises the model to OUT (.glb, or .gltf with its buffer in a .bin beside it), each file
 // written atomically. tinygltf writes the JSON of everything but the buffers; the buffers (and
 // --compress's bufferView extensions) are ours. Returns 0, or 1 with the reason printed.
-int write_model(tinygltf::Model &model, const Options &o, size_t *bytes) {
+int write_model(tinygltf::Model &model, const Options &o, const std::vector<int> &oct_views, size_t *bytes) {
     const std::string out = o.out;
     const bool text = o.gltf || ends_with(out, ".gltf");
     std::vector<unsigned char> bin;
@@ -707,7 +723,7 @@ int write_model(tinygltf::Model &model, const Options &o, size_t *bytes) {
     }
     const std::string dir = out.substr(0, out.find_last_of('/') == std::string::npos ? 0 : out.find_last_of('/') + 1);
     const std::string bin_name = base_name(out) + ".bin";
-    if (o.compress) bin = meshopt_compress(model, bin, doc);
+    if (o.compress) bin = meshopt_compress(model, bin, oct_views, doc);
     nlohmann::json buffer = {{"byteLength", bin.size()}};
     if (text) buffer["uri"] = bin_name;
     doc["buffers"] = nlohmann::json::array({buffer});
@@ -745,6 +761,7 @@ struct Run {
     sfb_context *ctx = nullptr;
     std::vector<Part> parts;
     std::vector<Quant> quant; // --quantize: per output mesh (set by assemble)
+    std::vector<int> oct_views; // --quantize --compress: the normal views stored with the octahedral filter
     // the output's skeleton: the glTF input's nodes, scenes, materials (and their textures) and
     // mesh names, or for an OBJ one node and mesh named after the file, the default material
     tinygltf::Model skeleton;
@@ -1151,7 +1168,7 @@ void assemble(Run &R, tinygltf::Model *model) {
             mat = default_material;
         }
         if (p.out.indices.empty()) continue;
-        model->meshes[(size_t)p.gltf_mesh].primitives.push_back(R.o.quantize ? add_primitive_quantized(model, p.out, mat, quant[(size_t)p.gltf_mesh], R.o)
+        model->meshes[(size_t)p.gltf_mesh].primitives.push_back(R.o.quantize ? add_primitive_quantized(model, p.out, mat, quant[(size_t)p.gltf_mesh], R.o, &R.oct_views)
                                                                               : add_primitive(model, p.out, mat));
     }
     // a mesh left without primitives (all its parts empty) cannot be written: its nodes lose it
@@ -1201,6 +1218,21 @@ Deviation measure(const Part &p, const Run &R) {
                 const long k = std::min(std::max(std::lround((x - q->t[c]) / q->s), -qmax), qmax);
                 w[c] = (float)(q->t[c] + q->s * (double)k); // as a loader computes it, in float
                 n[c] = (double)snap(m.normals[3 * v + (size_t)c], R.o.normal_bits, full, true) / (double)full;
+                if (R.o.compress && c == 2) {
+                    // the octahedral filter's round trip, as the file stores it
+                    const float f[4] = {m.normals[3 * v], m.normals[3 * v + 1], m.normals[3 * v + 2], 0.0f};
+                    if (full == 127) {
+                        signed char b[4];
+                        meshopt_encodeFilterOct(b, 1, 4, R.o.normal_bits, f);
+                        meshopt_decodeFilterOct(b, 1, 4);
+                        for (int e = 0; e < 3; ++e) n[e] = b[e] / 127.0;
+                    } else {
+                        short b[4];
+                        meshopt_encodeFilterOct(b, 1, 8, R.o.normal_bits, f);
+                        meshopt_decodeFilterOct(b, 1, 8);
+                        for (int e = 0; e < 3; ++e) n[e] = b[e] / 32767.0;
+                    }
+                }
             } else {
                 w[c] = x;
                 n[c] = m.normals[3 * v + (size_t)c];
@@ -1311,7 +1343,7 @@ int main(int argc, char **argv) {
     tinygltf::Model model;
     assemble(R, &model);
     size_t bytes = 0;
-    rc = write_model(model, R.o, &bytes);
+    rc = write_model(model, R.o, R.oct_views, &bytes);
     R.bar.end();
     if (rc) return 1;
     if (R.o.report && write_report(R, bytes)) return 1;
