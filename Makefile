@@ -354,6 +354,9 @@ $(BUILD)/bench: bench/bench.cpp tests/egl_host.h $(BUILD)/libsfb.o
 bench: deps-test
 	$(MAKE) --no-print-directory $(BUILD)/bench OPT=-O3
 	$(abspath $(BUILD))/bench
+	@$(MAKE) --no-print-directory deps-web || echo "make deps-web failed: no gltfpack column"
+	$(MAKE) --no-print-directory $(BUILD)/sfb2gltf
+	BUILD=$(BUILD) SHAPES=$(SHAPES) ./bench/gltf.sh
 
 # ---- fuzzing (libFuzzer, clang) ----
 FUZZ_TIME ?= 60

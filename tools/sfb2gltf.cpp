@@ -68,7 +68,7 @@ const char *const kUsage =
     "  --crease-angle DEG     edges whose dihedral angle is over DEG (0..180) become infinitely sharp creases\n"
     "  --trim MASK.png        with --tess: trim the surface by a mask over each parametric face (seed 000)\n"
     "  --backend NAME         ref, simd, gl or osmesa (default: the library's order)\n"
-    "  --quantize             KHR_mesh_quantization: positions as 16-bit integers on a grid of\n"
+    "  --quantize             KHR_mesh_quantization: positions as unsigned 16-bit integers on a grid of\n"
     "                         --position-bits B (default 14) bits over the mesh's extent, undone by a node\n"
     "                         transform; normals as normalised 8- or 16-bit integers rounded to\n"
     "                         --normal-bits (default 8); UVs in [0,1] as normalised 16-bit integers rounded\n"
@@ -505,7 +505,7 @@ std::string base_name(const std::string &path) {
 
 
 // The quantization of one output mesh (all its primitives): positions p = t + s q with q the
-// stored integers, |q| <= 2^(bits-1) - 1 (a uniform scale, so that normals need nothing).
+// stored integers, 0 <= q <= 2^bits - 1 (a uniform scale, so that normals need nothing).
 struct Quant {
     double t[3] = {0, 0, 0}, s = 1.0;
 };
@@ -533,20 +533,22 @@ tinygltf::Primitive add_primitive_quantized(tinygltf::Model *model, const OutMes
     }
     prim.mode = TINYGLTF_MODE_TRIANGLES;
     prim.indices = add_accessor(*model, index_view, index_type, TINYGLTF_TYPE_SCALAR, m.indices.size());
-    // positions: SHORT x 3, padded to 8 bytes (vertex attributes are 4-byte aligned)
-    const long qmax = (1L << (o.position_bits - 1)) - 1;
-    std::vector<short> P(nv * 4, 0);
+    // positions: UNSIGNED_SHORT x 3 from the mesh's minimum corner, padded to 8 bytes (vertex
+    // attributes are 4-byte aligned); unsigned rather than centred signed values: no sign flips
+    // between neighbours, which meshoptimizer's byte-wise delta codec compresses better
+    const long qmax = (1L << o.position_bits) - 1;
+    std::vector<unsigned short> P(nv * 4, 0);
     std::vector<double> mn(3, 0.0), mx(3, 0.0);
     for (size_t v = 0; v < nv; ++v)
         for (int c = 0; c < 3; ++c) {
             const long x = std::lround((m.positions[3 * v + (size_t)c] - q.t[c]) / q.s);
-            const short sx = (short)std::min(std::max(x, -qmax), qmax);
+            const unsigned short sx = (unsigned short)std::min(std::max(x, 0L), qmax);
             P[4 * v + (size_t)c] = sx;
             if (v == 0 || sx < mn[(size_t)c]) mn[(size_t)c] = sx;
             if (v == 0 || sx > mx[(size_t)c]) mx[(size_t)c] = sx;
         }
-    int view = add_view(*model, P.data(), P.size() * sizeof(short), TINYGLTF_TARGET_ARRAY_BUFFER, 8);
-    prim.attributes["POSITION"] = add_accessor(*model, view, TINYGLTF_COMPONENT_TYPE_SHORT, TINYGLTF_TYPE_VEC3, nv, mn, mx);
+    int view = add_view(*model, P.data(), P.size() * sizeof(unsigned short), TINYGLTF_TARGET_ARRAY_BUFFER, 8);
+    prim.attributes["POSITION"] = add_accessor(*model, view, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT, TINYGLTF_TYPE_VEC3, nv, mn, mx);
     // normals: normalised BYTE x 3 (padded to 4) up to 8 bits, SHORT x 3 (padded to 8) above
     if (o.compress) {
         // with --compress: the octahedral filter of EXT_meshopt_compression (two K-bit components
@@ -1137,15 +1139,15 @@ void assemble(Run &R, tinygltf::Model *model) {
                     l = std::min(l, (double)p.out.positions[v + (size_t)c]);
                     h = std::max(h, (double)p.out.positions[v + (size_t)c]);
                 }
-        const double qmax = (double)((1L << (R.o.position_bits - 1)) - 1);
+        const double qmax = (double)((1L << R.o.position_bits) - 1);
         for (size_t i = 0; i < quant.size(); ++i) {
-            double half = 0.0;
+            double extent = 0.0;
             for (int c = 0; c < 3; ++c) {
                 if (!(lo[3 * i + (size_t)c] <= hi[3 * i + (size_t)c])) continue;
-                quant[i].t[c] = 0.5 * (lo[3 * i + (size_t)c] + hi[3 * i + (size_t)c]);
-                half = std::max(half, 0.5 * (hi[3 * i + (size_t)c] - lo[3 * i + (size_t)c]));
+                quant[i].t[c] = lo[3 * i + (size_t)c];
+                extent = std::max(extent, hi[3 * i + (size_t)c] - lo[3 * i + (size_t)c]);
             }
-            quant[i].s = half > 0.0 ? half / qmax : 1.0;
+            quant[i].s = extent > 0.0 ? extent / qmax : 1.0;
         }
         model->extensionsUsed.push_back("KHR_mesh_quantization");
         model->extensionsRequired.push_back("KHR_mesh_quantization");
@@ -1207,7 +1209,7 @@ Deviation measure(const Part &p, const Run &R) {
     const size_t nv = m.positions.size() / 3;
     if (m.exact_p.size() != m.positions.size() || m.exact_n.size() != m.normals.size()) return d;
     const Quant *q = R.o.quantize && p.gltf_mesh < (int)R.quant.size() ? &R.quant[(size_t)p.gltf_mesh] : nullptr;
-    const long qmax = (1L << (R.o.position_bits - 1)) - 1;
+    const long qmax = (1L << R.o.position_bits) - 1;
     const long full = R.o.normal_bits <= 8 ? 127 : 32767;
     double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
     for (size_t v = 0; v < nv; ++v) {
@@ -1215,7 +1217,7 @@ Deviation measure(const Part &p, const Run &R) {
         for (int c = 0; c < 3; ++c) {
             const double x = m.positions[3 * v + (size_t)c];
             if (q) {
-                const long k = std::min(std::max(std::lround((x - q->t[c]) / q->s), -qmax), qmax);
+                const long k = std::min(std::max(std::lround((x - q->t[c]) / q->s), 0L), qmax);
                 w[c] = (float)(q->t[c] + q->s * (double)k); // as a loader computes it, in float
                 n[c] = (double)snap(m.normals[3 * v + (size_t)c], R.o.normal_bits, full, true) / (double)full;
                 if (R.o.compress && c == 2) {
