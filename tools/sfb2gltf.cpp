@@ -399,6 +399,15 @@ void mesh_from_tess(const sfb_tess_data &t, bool flat, OutMesh *m) {
     }
 }
 
+// f(stream, components) on every per-vertex stream of m (a reorder must move them all).
+template <class F> void each_stream(OutMesh *m, F f) {
+    f(m->positions, 3);
+    f(m->normals, 3);
+    f(m->uvs, 2);
+    f(m->exact_p, 3);
+    f(m->exact_n, 3);
+}
+
 // Drops triangles with a repeated index (meshoptimizer and the validator dislike them; a
 // subdivided pole can make them) and vertices with a non-finite position.
 void drop_degenerate(OutMesh *m) {
@@ -433,11 +442,7 @@ void optimize_mesh(OutMesh *m) {
         meshopt_remapVertexBuffer(o.data(), s.data(), nv, comps * sizeof(float), remap.data());
         s.swap(o);
     };
-    remap_stream(m->positions, 3);
-    remap_stream(m->normals, 3);
-    remap_stream(m->uvs, 2);
-    remap_stream(m->exact_p, 3);
-    remap_stream(m->exact_n, 3);
+    each_stream(m, remap_stream);
 }
 
 // Without the optimiser: unused vertices still go (the validator warns on unused data), order kept.
@@ -457,11 +462,7 @@ void compact_mesh(OutMesh *m) {
             if (remap[v] != ~0u) std::copy(&s[v * comps], &s[v * comps] + comps, &o[(size_t)remap[v] * comps]);
         s.swap(o);
     };
-    squeeze(m->positions, 3);
-    squeeze(m->normals, 3);
-    squeeze(m->uvs, 2);
-    squeeze(m->exact_p, 3);
-    squeeze(m->exact_n, 3);
+    each_stream(m, squeeze);
 }
 
 // ------------------------------------------------------------------ glTF
@@ -504,6 +505,25 @@ std::string base_name(const std::string &path) {
 }
 
 
+// A TRIANGLES primitive with m's indices: uint16 where every index fits (65535 is primitive
+// restart in some APIs: kept out), else uint32.
+tinygltf::Primitive add_triangles(tinygltf::Model *model, const OutMesh &m) {
+    const size_t nv = m.positions.size() / 3;
+    int view, type;
+    if (nv < 65535) {
+        std::vector<unsigned short> s(m.indices.begin(), m.indices.end());
+        view = add_view(*model, s.data(), s.size() * sizeof(unsigned short), TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER, 0);
+        type = TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT;
+    } else {
+        view = add_view(*model, m.indices.data(), m.indices.size() * sizeof(unsigned), TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER, 0);
+        type = TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT;
+    }
+    tinygltf::Primitive prim;
+    prim.mode = TINYGLTF_MODE_TRIANGLES;
+    prim.indices = add_accessor(*model, view, type, TINYGLTF_TYPE_SCALAR, m.indices.size());
+    return prim;
+}
+
 // The quantization of one output mesh (all its primitives): positions p = t + s q with q the
 // stored integers, 0 <= q <= 2^bits - 1 (a uniform scale, so that normals need nothing).
 struct Quant {
@@ -520,19 +540,8 @@ long snap(double v, int bits, long full, bool is_signed) {
 
 tinygltf::Primitive add_primitive_quantized(tinygltf::Model *model, const OutMesh &m, int material, const Quant &q, const Options &o,
                                             std::vector<int> *oct_views) {
-    tinygltf::Primitive prim;
     const size_t nv = m.positions.size() / 3;
-    int index_view, index_type;
-    if (nv < 65535) {
-        std::vector<unsigned short> s(m.indices.begin(), m.indices.end());
-        index_view = add_view(*model, s.data(), s.size() * sizeof(unsigned short), TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER, 0);
-        index_type = TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT;
-    } else {
-        index_view = add_view(*model, m.indices.data(), m.indices.size() * sizeof(unsigned), TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER, 0);
-        index_type = TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT;
-    }
-    prim.mode = TINYGLTF_MODE_TRIANGLES;
-    prim.indices = add_accessor(*model, index_view, index_type, TINYGLTF_TYPE_SCALAR, m.indices.size());
+    tinygltf::Primitive prim = add_triangles(model, m);
     // positions: UNSIGNED_SHORT x 3 from the mesh's minimum corner, padded to 8 bytes (vertex
     // attributes are 4-byte aligned); unsigned rather than centred signed values: no sign flips
     // between neighbours, which meshoptimizer's byte-wise delta codec compresses better
@@ -598,20 +607,7 @@ tinygltf::Primitive add_primitive_quantized(tinygltf::Model *model, const OutMes
 // One output primitive: the mesh's accessors appended to the model's buffer.
 tinygltf::Primitive add_primitive(tinygltf::Model *model, const OutMesh &m, int material) {
     const size_t nv = m.positions.size() / 3;
-    // indices: uint16 where every index fits (65535 is primitive restart in some APIs: kept out)
-    int index_view;
-    int index_type;
-    if (nv < 65535) {
-        std::vector<unsigned short> s(m.indices.begin(), m.indices.end());
-        index_view = add_view(*model, s.data(), s.size() * sizeof(unsigned short), TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER, 0);
-        index_type = TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT;
-    } else {
-        index_view = add_view(*model, m.indices.data(), m.indices.size() * sizeof(unsigned), TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER, 0);
-        index_type = TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT;
-    }
-    tinygltf::Primitive prim;
-    prim.mode = TINYGLTF_MODE_TRIANGLES;
-    prim.indices = add_accessor(*model, index_view, index_type, TINYGLTF_TYPE_SCALAR, m.indices.size());
+    tinygltf::Primitive prim = add_triangles(model, m);
     std::vector<double> mn(3, 0.0), mx(3, 0.0);
     for (size_t v = 0; v < nv; ++v)
         for (int c = 0; c < 3; ++c) {
