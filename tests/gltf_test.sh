@@ -128,6 +128,17 @@ if [ -f "$TMP/v/box.bin" ] && grep -q '"uri": "box.bin"' "$TMP/v/box.gltf"; then
 mv "$TMP/v/box_gltf_flag.json" "$TMP/v/box_gltf_flag.gltf"
 if [ -f "$TMP/v/box_gltf_flag.bin" ] && head -c 1 "$TMP/v/box_gltf_flag.gltf" | grep -q '{'; then ok "--gltf writes JSON and a .bin"; else bad "--gltf did not write JSON + .bin"; fi
 if [ "$(head -c 4 "$TMP/v/box.glb")" = glTF ]; then ok ".glb is binary glTF"; else bad ".glb does not start with glTF"; fi
+# --lods: one mesh and node per level (or rate)
+check "--lods 1,2,3" 0 "$TOOL" --lods 1,2,3 --gltf "$BOX" -o "$TMP/v/lods.gltf"
+contains "--lods writes three meshes" "$TMP/err" "3 meshes"
+for l in 1 2 3; do contains "--lods: a node for level $l" "$TMP/v/lods.gltf" "\"creased_box level $l\""; done
+check "--lods with --tess gives rates" 0 "$TOOL" --tess 1 --lods 2,6 --gltf "$BOX" -o "$TMP/v/lods_tess.gltf"
+contains "--lods --tess: a node for rate 6" "$TMP/v/lods_tess.gltf" "rate 6"
+export_ok lods_quant.glb "$BOX" --lods 0,2 --quantize --compress
+check "--lods with --level is a usage error" 2 "$TOOL" --lods 1,2 --level 2 "$BOX" -o "$TMP/x.glb"
+check "--lods 1,x is a usage error" 2 "$TOOL" --lods 1,x "$BOX" -o "$TMP/x.glb"
+badcase "--lods over the level limit" "limit" "$BOX" --lods 1,11
+
 # --report: the deviation from the exact limit surface (the summary line gives the maxima)
 report() { # description, max position error wanted (awk condition on p), on the normal error (n), options...
   local desc=$1 pc=$2 nc=$3; shift 3
@@ -226,6 +237,9 @@ contains "the node names are kept" "$TMP/v/in_two.gltf" '"right"'
 contains "the mesh names are kept" "$TMP/v/in_two.gltf" '"tetra B"'
 contains "the material is passed through" "$TMP/v/in_two.gltf" '"red paint"'
 contains "the mesh without a material gets the default" "$TMP/v/in_two.gltf" '"surfblend default"'
+check "glTF input with two meshes, two LODs" 0 "$TOOL" --lods 1,2 --gltf "$TMP/two.gltf" -o "$TMP/v/in_two_lods.gltf"
+contains "two meshes at two LODs are four" "$TMP/err" "4 meshes"
+contains "a LOD node under a named node" "$TMP/v/in_two_lods.gltf" '"right level 2"'
 gltf_doc '{"attributes": {"POSITION": 0}, "indices": 1, "extras": {"sfb_creases": [0, 1, 10, 1, 2, 2.5]}}' > "$TMP/extras.gltf"
 check "creases from extras.sfb_creases" 0 "$TOOL" -q --level 1 "$TMP/extras.gltf" -o "$TMP/v/in_extras.glb"
 # bad glTF input: the message names the file and the problem, no output

@@ -76,6 +76,9 @@ const char *const kUsage =
     "  --compress             EXT_meshopt_compression: indices and vertex attributes encoded with\n"
     "                         meshoptimizer's codecs (a loader must decode it: three.js with its\n"
     "                         MeshoptDecoder, gltfpack); best with --quantize\n"
+    "  --lods L0,L1,...       one mesh per level (or per rate with --tess, whose RATE it replaces; up to\n"
+    "                         16), each shown by its own node named \"NAME level L\" (\"NAME rate R\");\n"
+    "                         every LOD evaluates the same surface\n"
     "  --report FILE.json     per mesh: counts, bytes, and the deviation of what is written (after\n"
     "                         --quantize) from the exact limit surface: positions (model units and share\n"
     "                         of the diagonal) and normals (degrees); a summary line on stderr\n"
@@ -99,6 +102,7 @@ struct Options {
     bool quantize = false, have_bits = false, compress = false;
     int position_bits = 14, normal_bits = 8, uv_bits = 12; // --quantize
     NormalsMode normals = NORMALS_DEFAULT;
+    std::vector<int> lods; // --lods: levels (or, with --tess, rates)
 };
 
 int usage_error(const char *fmt, ...) {
@@ -189,6 +193,20 @@ int parse_args(int argc, char **argv, Options *o) {
             if (!(o->trim = value(a))) return usage_error("--trim needs a PNG file");
         } else if (!strcmp(a, "--backend")) {
             if (!(o->backend = value(a))) return usage_error("--backend needs a name (ref, simd, gl, osmesa)");
+        } else if (!strcmp(a, "--lods")) {
+            const char *v = value(a);
+            if (!v || !*v) return usage_error("--lods needs a list L0,L1,... (levels, or rates with --tess)");
+            std::string list = v;
+            size_t at = 0;
+            while (at <= list.size()) {
+                size_t end = list.find(',', at);
+                if (end == std::string::npos) end = list.size();
+                long x;
+                if (!parse_long(list.substr(at, end - at).c_str(), 0, 1024, &x) || o->lods.size() >= 16)
+                    return usage_error("--lods takes up to 16 numbers separated by commas (got '%s')", v);
+                o->lods.push_back((int)x);
+                at = end + 1;
+            }
         } else if (!strcmp(a, "--report")) {
             if (!(o->report = value(a))) return usage_error("--report needs a file name (FILE.json)");
         } else if (!strcmp(a, "--compress")) {
@@ -226,6 +244,8 @@ int parse_args(int argc, char **argv, Options *o) {
         o->have_tess = true;
         o->rate = 16;
     }
+    if (!o->lods.empty() && o->have_level)
+        return usage_error("--lods gives the levels (or the rates with --tess): not with --level");
     if (o->have_tess && o->have_level) return usage_error("--level and --tess exclude each other (refine, or tessellate the limit)");
     if (o->have_tess && !(caps & SFB_SCHEME_CAN_EVAL))
         return usage_error("--tess needs a scheme with a limit surface (%s has none)", sfb_scheme_name(o->scheme));
@@ -747,6 +767,8 @@ int write_model(tinygltf::Model &model, const Options &o, const std::vector<int>
 // One control mesh: an OBJ file, or one TRIANGLES primitive of a glTF mesh.
 struct Part {
     sfb_mesh *mesh = nullptr;
+    bool owns = true;      // the LOD copies of a part share its mesh; the first owns it
+    int level = 0, rate = 0; // what it is evaluated at (--level / --tess, or its --lods entry)
     int gltf_mesh = 0;     // the output mesh it belongs to
     int material = -1;     // the input's material (-1: the default one)
     std::string name;      // for messages: FILE, or FILE mesh M primitive P
@@ -764,7 +786,8 @@ struct Run {
     // mesh names, or for an OBJ one node and mesh named after the file, the default material
     tinygltf::Model skeleton;
     ~Run() {
-        for (Part &p : parts) sfb_mesh_destroy(p.mesh);
+        for (Part &p : parts)
+            if (p.owns) sfb_mesh_destroy(p.mesh);
         sfb_context_destroy(ctx);
     }
     int fail_lib(const std::string &where, const char *what, sfb_result r) {
@@ -1043,7 +1066,7 @@ int read_stage(Run &R) {
 int evaluate_part(Run &R, Part &part) {
     sfb_mesh_desc d;
     sfb_mesh_get_desc(part.mesh, &d);
-    sfb_surface_config cfg = sfb_surface_config_init(R.o.scheme, R.o.have_tess ? 0 : R.o.level);
+    sfb_surface_config cfg = sfb_surface_config_init(R.o.scheme, R.o.have_tess ? 0 : part.level);
     if (R.o.have_tess) cfg.flags = SFB_REFINE_PATCHES;
     else cfg.flags = (R.o.normals == NORMALS_FLAT ? (R.o.report ? (unsigned)SFB_REFINE_LIMIT : 0u) : (unsigned)SFB_REFINE_SHADING) |
                      (d.uv_count > 0 ? (unsigned)SFB_REFINE_UVS : 0u);
@@ -1053,7 +1076,7 @@ int evaluate_part(Run &R, Part &part) {
     R.bar.begin("evaluate", 3);
     int rc = 0;
     if (R.o.have_tess) {
-        sfb_tess_config tc = sfb_tess_config_init(R.o.rate);
+        sfb_tess_config tc = sfb_tess_config_init(part.rate);
         tc.tolerance = (float)R.o.tolerance;
         tc.flags = SFB_TESS_SPLIT_CREASES;
         sfb_trim_mask mask;
@@ -1193,6 +1216,54 @@ void assemble(Run &R, tinygltf::Model *model) {
     }
 }
 
+// Every part at its level or rate; with --lods, one copy of each part per entry, each in a mesh
+// of its own ("NAME level L" / "NAME rate R"), and each node that showed a mesh now shows its
+// LODs as child nodes named the same way (glTF has no standard LOD switch: a viewer shows them
+// all; an engine picks one by name). Every LOD evaluates the same limit surface.
+void expand_lods(Run &R) {
+    for (Part &p : R.parts) {
+        p.level = R.o.level;
+        p.rate = R.o.rate;
+    }
+    if (R.o.lods.empty()) return;
+    tinygltf::Model &k = R.skeleton;
+    const size_t nm = k.meshes.size(), nl = R.o.lods.size();
+    auto what = [&](size_t i) { return std::string(R.o.have_tess ? " rate " : " level ") + std::to_string(R.o.lods[i]); };
+    std::vector<tinygltf::Mesh> meshes;
+    for (size_t i = 0; i < nl; ++i)
+        for (size_t m = 0; m < nm; ++m) {
+            tinygltf::Mesh mesh;
+            mesh.name = (k.meshes[m].name.empty() ? "mesh " + std::to_string(m) : k.meshes[m].name) + what(i);
+            meshes.push_back(mesh);
+        }
+    k.meshes.swap(meshes);
+    std::vector<Part> parts;
+    for (size_t i = 0; i < nl; ++i)
+        for (const Part &p : R.parts) {
+            Part q = p;
+            q.owns = i == 0;
+            q.gltf_mesh = (int)(i * nm) + p.gltf_mesh;
+            (R.o.have_tess ? q.rate : q.level) = R.o.lods[i];
+            q.name = p.name + what(i);
+            parts.push_back(q);
+        }
+    R.parts.swap(parts);
+    const size_t nodes = k.nodes.size();
+    for (size_t n = 0; n < nodes; ++n) {
+        const int m = k.nodes[n].mesh;
+        if (m < 0 || m >= (int)nm) continue;
+        k.nodes[n].mesh = -1;
+        const std::string base = k.nodes[n].name.empty() ? "node " + std::to_string(n) : k.nodes[n].name;
+        for (size_t i = 0; i < nl; ++i) {
+            tinygltf::Node child;
+            child.name = base + what(i);
+            child.mesh = (int)(i * nm) + m;
+            k.nodes[n].children.push_back((int)k.nodes.size());
+            k.nodes.push_back(child);
+        }
+    }
+}
+
 // --report: what is written against the exact limit surface, per part.
 struct Deviation {
     double pos_max = 0.0, pos_sq = 0.0, nrm_max = 0.0, nrm_sq = 0.0, diag = 0.0;
@@ -1312,6 +1383,7 @@ int main(int argc, char **argv) {
         R.bar.end();
         return 1;
     }
+    expand_lods(R);
     R.bar.begin("build", 2);
     size_t vertices = 0, triangles = 0;
     bool uvs = false;
@@ -1320,8 +1392,6 @@ int main(int argc, char **argv) {
             R.bar.end();
             return 1;
         }
-        sfb_mesh_destroy(p.mesh);
-        p.mesh = nullptr;
         drop_degenerate(&p.out);
     }
     R.bar.begin("optimise", 4);
