@@ -23,7 +23,7 @@ export LIBGL_ALWAYS_SOFTWARE=${LIBGL_ALWAYS_SOFTWARE-1}
 # LeakSanitizer reports them with frames in an unloaded module, which tests/lsan.supp cannot name
 # (keeping the driver loaded makes the reports vanish). surfblend's own teardown on a host context
 # is leak-checked by tests/gl_host.c and tests/gl_manifold.c.
-if [ "${SFB_TEST_PROFILE:-full}" = sanitize ]; then export ASAN_OPTIONS="detect_leaks=0${ASAN_OPTIONS:+:$ASAN_OPTIONS}"; fi
+if [ "${SFB_TEST_PROFILE:-full}" = sanitize ]; then export ASAN_OPTIONS="${ASAN_OPTIONS:+$ASAN_OPTIONS:}detect_leaks=0"; fi
 rm -rf "$OUT"; mkdir -p "$OUT"
 P=0; F=0; S=0
 pass() { P=$((P + 1)); echo "PASS $1"; }
