@@ -488,8 +488,15 @@ SFB_API sfb_result sfb_surface_patch_info(const sfb_surface *surface, sfb_patch_
 
 /* ---- tessellation (needs SFB_REFINE_PATCHES) ---- */
 enum {
-    SFB_TESS_SPLIT_CREASES = 1u << 0  /* duplicate the vertices along infinitely sharp interior creases, one
+    SFB_TESS_SPLIT_CREASES = 1u << 0, /* duplicate the vertices along infinitely sharp interior creases, one
                                          copy per side, each with that side's normal (split normals) */
+    SFB_TESS_UVS = 1u << 1            /* also the face-varying UVs at each vertex (sfb_tess_data.uvs): the limit of
+                                         sfb_surface_refine's UVs at the same point (the mesh's uv_interp), so a
+                                         tessellation and a refinement of one surface agree; vertices on a UV seam
+                                         (an edge whose faces disagree on a UV) are split, one copy per side. Needs a
+                                         surface created with SFB_REFINE_UVS from a mesh with UVs. A UV layout that is
+                                         not a manifold (placeholder UVs shared by unrelated faces) is isolated one
+                                         level only, so near its irregular features the UVs are approximated */
 };
 /* Trimming (seed 000 section V.5), for every scheme: a mask over each parametric face's (u,v)
  * square [0,1]^2 (a Loop triangle uses the half u + v <= 1 of it). Texel (i, j) =
@@ -517,13 +524,15 @@ typedef struct sfb_tess_config {
 SFB_API sfb_tess_config sfb_tess_config_init(int rate);
 
 /* Indexed triangles. Watertight: a vertex on an edge shared by two parametric faces is computed
- * once and shared (except along infinitely sharp creases with SFB_TESS_SPLIT_CREASES). */
+ * once and shared (except along infinitely sharp creases with SFB_TESS_SPLIT_CREASES, and UV
+ * seams with SFB_TESS_UVS: there each side has its copy, at the same position). */
 typedef struct sfb_tess_data {
     int vertex_count, triangle_count;
     float *positions, *normals;   /* xyz per vertex (unit normals) */
     sfb_location *locations;      /* per vertex: the parametric face and (u,v) it was evaluated at */
     int *triangles;               /* 3 vertex indices per triangle, counter-clockwise seen from the normal side */
     int *triangle_faces;          /* parametric face of each triangle */
+    float *uvs;                   /* uv per vertex with SFB_TESS_UVS, else NULL */
     sfb_context *ctx_;            /* allocator owner */
 } sfb_tess_data;
 SFB_API sfb_result sfb_surface_tessellate(const sfb_surface *surface, const sfb_tess_config *config, sfb_tess_data *out);

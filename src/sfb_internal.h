@@ -10,6 +10,22 @@
 #define SFB__PI 3.14159265358979323846
 #endif
 
+/* Linkage of the module interfaces declared below (SFB__IF). In the amalgamation, surfblend.h,
+ * the whole library is one translation unit and they are static: the compiler inlines across
+ * modules as freely as within one, and a program that includes the implementation exports no
+ * sfb__ names. A later definition without `static` keeps that internal linkage (C99 6.2.2p4,
+ * and C++ likewise), so the modules' definitions are written plain. Modules compiled as their
+ * own translation units (`make check-modules`, src/sfb_module.h) and the white-box suites, which
+ * call internals from a library object built with SURFBLEND_EXPOSE_INTERNALS, get external
+ * linkage. */
+#if defined(SFB__SEPARATE_MODULES) || defined(SURFBLEND_EXPOSE_INTERNALS)
+#  define SFB__IF
+#elif defined(__GNUC__)
+#  define SFB__IF static __attribute__((unused))
+#else
+#  define SFB__IF static
+#endif
+
 /* ---- backend vtable ---- */
 struct sfb__patch_table;
 /* A stencil table: row r reads sizes[r] entries starting at offsets[r] from indices/weights. */
@@ -82,25 +98,25 @@ typedef struct sfb__backend_vtable {
 #endif
 /* Each fills the slots its backend implements (see sfb__backend_vtable). */
 typedef void (*sfb__backend_bind_fn)(sfb__backend_vtable *vt);
-void sfb__ref_bind(sfb__backend_vtable *vt);
+SFB__IF void sfb__ref_bind(sfb__backend_vtable *vt);
 /* Zeroes *vt and binds the backend `kind` into it; 0 when that backend is not built in. */
-int sfb__backend_bind(sfb_backend_kind kind, sfb__backend_vtable *vt);
+SFB__IF int sfb__backend_bind(sfb_backend_kind kind, sfb__backend_vtable *vt);
 #ifdef SURFBLEND_SIMD
-void sfb__simd_bind(sfb__backend_vtable *vt);
+SFB__IF void sfb__simd_bind(sfb__backend_vtable *vt);
 #endif
 #ifdef SURFBLEND_GL
-void sfb__gl_bind(sfb__backend_vtable *vt);
+SFB__IF void sfb__gl_bind(sfb__backend_vtable *vt);
 #endif
 #ifdef SURFBLEND_OSMESA
-void sfb__osmesa_bind(sfb__backend_vtable *vt);
+SFB__IF void sfb__osmesa_bind(sfb__backend_vtable *vt);
 #endif
 /* The ref kernels, callable directly (the oracle; other backends hand it what they cannot do). */
-sfb_result sfb__ref_eval_stencils(void *state, const sfb__stencils *t, void *handle, int first, int last, const float *src,
+SFB__IF sfb_result sfb__ref_eval_stencils(void *state, const sfb__stencils *t, void *handle, int first, int last, const float *src,
                                   sfb_buffer_desc sd, float *dst, sfb_buffer_desc dd);
 struct sfb__patch_table;
-sfb_result sfb__ref_eval_patches(void *state, const struct sfb__patch_table *pt, void *handle, const sfb_location *locs, int first,
+SFB__IF sfb_result sfb__ref_eval_patches(void *state, const struct sfb__patch_table *pt, void *handle, const sfb_location *locs, int first,
                                  int last, const sfb_eval_output *out);
-sfb_result sfb__ref_finish_normals(void *state, int first, int last, const float *tu, const float *tv, const float *ns,
+SFB__IF sfb_result sfb__ref_finish_normals(void *state, int first, int last, const float *tu, const float *tv, const float *ns,
                                    const int *ns_index, const float *b, float p, float *out_blend, float *out_limit, float *out_sub);
 
 /* ---- Stam eigen structures (patch/eigen.c) ---- */
@@ -205,38 +221,38 @@ struct sfb_context {
     sfb_error_info error_info;
 };
 
-void *sfb__alloc(sfb_context *ctx, size_t size);
-void *sfb__calloc(sfb_context *ctx, size_t count, size_t size);
-void *sfb__realloc(sfb_context *ctx, void *ptr, size_t size);
-void sfb__free(sfb_context *ctx, void *ptr);
+SFB__IF void *sfb__alloc(sfb_context *ctx, size_t size);
+SFB__IF void *sfb__calloc(sfb_context *ctx, size_t count, size_t size);
+SFB__IF void *sfb__realloc(sfb_context *ctx, void *ptr, size_t size);
+SFB__IF void sfb__free(sfb_context *ctx, void *ptr);
 /* count*size with overflow check; returns 0 on overflow. */
-int sfb__mul_size(size_t a, size_t b, size_t *out);
-sfb_result sfb__error(sfb_context *ctx, sfb_result r, sfb_element_kind kind, long index, const char *fmt, ...)
+SFB__IF int sfb__mul_size(size_t a, size_t b, size_t *out);
+SFB__IF sfb_result sfb__error(sfb_context *ctx, sfb_result r, sfb_element_kind kind, long index, const char *fmt, ...)
 #if defined(__GNUC__)
     __attribute__((format(printf, 5, 6)))
 #endif
     ;
-void sfb__log(sfb_context *ctx, int level, const char *fmt, ...)
+SFB__IF void sfb__log(sfb_context *ctx, int level, const char *fmt, ...)
 #if defined(__GNUC__)
     __attribute__((format(printf, 3, 4)))
 #endif
     ;
 /* Reports a failed allocation: SFB_LIMIT_EXCEEDED when the memory budget refused it,
  * SFB_OUT_OF_MEMORY when the allocator itself failed. */
-sfb_result sfb__oom(sfb_context *ctx, const char *what);
+SFB__IF sfb_result sfb__oom(sfb_context *ctx, const char *what);
 /* Returns SFB_CANCELLED (with the error set) when the callback asks to stop. */
-sfb_result sfb__progress(sfb_context *ctx, float done, const char *stage);
-sfb_result sfb__select_backend(sfb_context *ctx, const char *env_override);
-sfb_result sfb__context_create_reporting(const sfb_context_config *config, sfb_context **out, char *report, size_t size);
-void sfb__eigen_cc_free(sfb_context *ctx, sfb__eigen_cc *e);
-sfb_result sfb__eigen_cc_build(sfb_context *ctx, int N, int keep, sfb__eigen_cc **out);
-const sfb__eigen_cc *sfb__eigen_cc_get(sfb_context *ctx, int N);
-void sfb__eigen_loop_free(sfb_context *ctx, sfb__eigen_loop *e);
-sfb_result sfb__eigen_loop_build(sfb_context *ctx, int N, int keep, sfb__eigen_loop **out);
-const sfb__eigen_loop *sfb__eigen_loop_get(sfb_context *ctx, int N);
+SFB__IF sfb_result sfb__progress(sfb_context *ctx, float done, const char *stage);
+SFB__IF sfb_result sfb__select_backend(sfb_context *ctx, const char *env_override);
+SFB__IF sfb_result sfb__context_create_reporting(const sfb_context_config *config, sfb_context **out, char *report, size_t size);
+SFB__IF void sfb__eigen_cc_free(sfb_context *ctx, sfb__eigen_cc *e);
+SFB__IF sfb_result sfb__eigen_cc_build(sfb_context *ctx, int N, int keep, sfb__eigen_cc **out);
+SFB__IF const sfb__eigen_cc *sfb__eigen_cc_get(sfb_context *ctx, int N);
+SFB__IF void sfb__eigen_loop_free(sfb_context *ctx, sfb__eigen_loop *e);
+SFB__IF sfb_result sfb__eigen_loop_build(sfb_context *ctx, int N, int keep, sfb__eigen_loop **out);
+SFB__IF const sfb__eigen_loop *sfb__eigen_loop_get(sfb_context *ctx, int N);
 /* Index of the lattice point (x, y) in the enlarged set of the Loop eigen structure of valence
  * N, -1 if not in it (patch/eigen.c). */
-int sfb__loop_index(int N, int x, int y);
+SFB__IF int sfb__loop_index(int N, int x, int y);
 
 /* ---- topology of one level ---- */
 enum { SFB__TAG_BOUNDARY = 1, SFB__TAG_NONMANIFOLD = 2 };
@@ -253,14 +269,14 @@ typedef struct sfb__level {
     unsigned char *etag, *vtag, *vrule, *fhole;
 } sfb__level;
 
-void sfb__level_free(sfb_context *ctx, sfb__level *l);
+SFB__IF void sfb__level_free(sfb_context *ctx, sfb__level *l);
 /* From nv, nf, fv_off, fv, fe, ne, ev: builds every adjacency array and the tags. */
-sfb_result sfb__level_complete(sfb_context *ctx, sfb__level *l);
+SFB__IF sfb_result sfb__level_complete(sfb_context *ctx, sfb__level *l);
 /* Sharpness/rule helpers shared by refinement and info. */
-int sfb__rule_from(float vertex_sharpness, int sharp_edge_count);
-void sfb__level_compute_rules(sfb__level *l);
+SFB__IF int sfb__rule_from(float vertex_sharpness, int sharp_edge_count);
+SFB__IF void sfb__level_compute_rules(sfb__level *l);
 /* The end of edge e that is not v (topology.c). */
-int sfb__other_end(const sfb__level *l, int e, int v);
+SFB__IF int sfb__other_end(const sfb__level *l, int e, int v);
 
 /* ---- the stencil algebra (stencil.c) ---- */
 /* Composed rows (double weights): row r holds entries [off[r], off[r+1]) of idx/w. */
@@ -285,20 +301,20 @@ typedef struct sfb__accum {
     int *touched;
     unsigned stamp;
 } sfb__accum;
-void sfb__rows_free(sfb_context *ctx, sfb__rows *r);
+SFB__IF void sfb__rows_free(sfb_context *ctx, sfb__rows *r);
 /* Room for `need` entries in all; 0 on allocation failure. */
-int sfb__rows_reserve(sfb_context *ctx, sfb__rows *r, size_t need);
+SFB__IF int sfb__rows_reserve(sfb_context *ctx, sfb__rows *r, size_t need);
 /* Room for `need` more pairs; 0 on allocation failure. */
-int sfb__mask_grow(sfb_context *ctx, sfb__mask *m, int need);
+SFB__IF int sfb__mask_grow(sfb_context *ctx, sfb__mask *m, int need);
 /* Adds w * (face centroid of f). */
-void sfb__mask_face(sfb__mask *m, const sfb__level *l, int f, double w);
+SFB__IF void sfb__mask_face(sfb__mask *m, const sfb__level *l, int f, double w);
 /* An upper bound of the pairs a vertex rule of v adds. */
-int sfb__mask_need_vertex(const sfb__level *l, int v);
+SFB__IF int sfb__mask_need_vertex(const sfb__level *l, int v);
 /* Row `row` of `out` = mask m composed with the parent rows prow; 0 on allocation failure or when
  * the accumulator's stamp wrapped (the caller resets it). */
-int sfb__compose_row(sfb_context *ctx, sfb__accum *A, const sfb__rows *prow, const sfb__mask *m, sfb__rows *out, int row);
+SFB__IF int sfb__compose_row(sfb_context *ctx, sfb__accum *A, const sfb__rows *prow, const sfb__mask *m, sfb__rows *out, int row);
 /* The float stencil table of r (over `sources` source elements). */
-sfb_result sfb__rows_to_stencils(sfb_context *ctx, const sfb__rows *r, int sources, sfb__stencils *s);
+SFB__IF sfb_result sfb__rows_to_stencils(sfb_context *ctx, const sfb__rows *r, int sources, sfb__stencils *s);
 
 /* ---- mesh (mesh.c) ---- */
 /* Line numbers of OBJ statements, so that errors found while building the mesh can name the
@@ -307,10 +323,10 @@ typedef struct sfb__src_lines {
     const int *face, *crease, *corner, *hole;
 } sfb__src_lines;
 /* Builds a level (topology only, zero sharpness) from faces; validates indices. */
-sfb_result sfb__level_from_faces(sfb_context *ctx, int nv, int nf, const int *sizes, const int *fvin, const sfb__src_lines *lines,
+SFB__IF sfb_result sfb__level_from_faces(sfb_context *ctx, int nv, int nf, const int *sizes, const int *fvin, const sfb__src_lines *lines,
                                  sfb_element_kind vkind, sfb__level *l);
 /* sfb_mesh_create with OBJ line numbers for the errors (lines may be NULL). */
-sfb_result sfb__mesh_create(sfb_context *ctx, const sfb_mesh_desc *d, const sfb__src_lines *lines, sfb_mesh **out);
+SFB__IF sfb_result sfb__mesh_create(sfb_context *ctx, const sfb_mesh_desc *d, const sfb__src_lines *lines, sfb_mesh **out);
 struct sfb_mesh {
     sfb_context *ctx;
     sfb__level base;            /* topology, with user sharpness (not yet boundary-sharpened) */
@@ -356,6 +372,7 @@ struct sfb_surface {
     float *base_positions, *base_uvs;
     sfb__level top;              /* topology of the refined level */
     sfb__level uv_top;           /* topology of the refined UV layout (when built) */
+    sfb__level uv_base;          /* the prepared base UV layout (UVs and patches): tessellated UVs (tess.c) */
     int has_uvs;
     sfb__stencils tables[SFB_TABLE_COUNT_];
     int built[SFB_TABLE_COUNT_];
@@ -395,52 +412,52 @@ typedef struct sfb__scheme_info {
     sfb_result (*build_patches)(sfb_context *ctx, const sfb__level *prep, const sfb__refine_options *opt,
                                 const sfb_surface_config *cfg, const float *positions, sfb__patch_table *pt);
 } sfb__scheme_info;
-const sfb__scheme_info *sfb__scheme_info_of(sfb_scheme s);  /* NULL for a value that is no scheme */
+SFB__IF const sfb__scheme_info *sfb__scheme_info_of(sfb_scheme s);  /* NULL for a value that is no scheme */
 /* Refuses a scheme that cannot be built as configured (NULL si, not refinable, evaluated only). */
-sfb_result sfb__scheme_check_kind(sfb_context *ctx, const sfb__scheme_info *si, const sfb_surface_config *cfg);
+SFB__IF sfb_result sfb__scheme_check_kind(sfb_context *ctx, const sfb__scheme_info *si, const sfb_surface_config *cfg);
 /* Refuses flags (SFB_REFINE_PATCHES, SFB_REFINE_SHADING) the scheme does not support. */
-sfb_result sfb__scheme_check_flags(sfb_context *ctx, const sfb__scheme_info *si, const sfb_surface_config *cfg);
+SFB__IF sfb_result sfb__scheme_check_flags(sfb_context *ctx, const sfb__scheme_info *si, const sfb_surface_config *cfg);
 
 /* Refines `base` (already sharpened) `level` times; fills `top` and the stencil tables
  * (vertex, and limit/tangents when asked). */
-sfb_result sfb__refine(sfb_context *ctx, const sfb__level *base, const sfb__refine_options *opt, int level,
+SFB__IF sfb_result sfb__refine(sfb_context *ctx, const sfb__level *base, const sfb__refine_options *opt, int level,
                        sfb__level *top, sfb__stencils *vertex_table, sfb__stencils *limit_tables /* [3] or NULL */,
                        float progress_from, float progress_to);
-void sfb__stencils_free(sfb_context *ctx, sfb__stencils *s);
+SFB__IF void sfb__stencils_free(sfb_context *ctx, sfb__stencils *s);
 /* One refinement step of `p` (composed rows prow) into `c` (composed rows crow); A, m, ps, cs are
  * the caller's scratch; progress from p0 over dp. */
-sfb_result sfb__refine_step(sfb_context *ctx, const sfb__refine_options *opt, const sfb__level *p, const sfb__rows *prow,
+SFB__IF sfb_result sfb__refine_step(sfb_context *ctx, const sfb__refine_options *opt, const sfb__level *p, const sfb__rows *prow,
                             sfb__level *c, sfb__rows *crow, sfb__accum *A, sfb__mask *m, float *ps, float *cs, float p0, float dp);
 /* The crease pair of a vertex: first and last incident edge with sharpness > 0 in ve order. */
-void sfb__crease_pair(const float *sharp, int n, int *a, int *b);
+SFB__IF void sfb__crease_pair(const float *sharp, int n, int *a, int *b);
 /* Crease limit tangent masks at v between its crease edges a and b (either order; loop: Loop's scale). */
-void sfb__crease_tangent_masks(const sfb__level *l, int v, int a, int b, int loop, sfb__mask *m1, sfb__mask *m2);
+SFB__IF void sfb__crease_tangent_masks(const sfb__level *l, int v, int a, int b, int loop, sfb__mask *m1, sfb__mask *m2);
 /* Limit position and tangent masks of vertex v by its rule. */
-void sfb__limit_masks(const sfb__level *l, int v, sfb_scheme scheme, sfb__mask *mp, sfb__mask *m1, sfb__mask *m2);
+SFB__IF void sfb__limit_masks(const sfb__level *l, int v, sfb_scheme scheme, sfb__mask *mp, sfb__mask *m1, sfb__mask *m2);
 /* Copy of the base level with OpenSubdiv's boundary/non-manifold sharpening and holes applied. */
-sfb_result sfb__level_prepare(sfb_context *ctx, const sfb__level *src, int sharpen_corners, int make_boundary_holes,
+SFB__IF sfb_result sfb__level_prepare(sfb_context *ctx, const sfb__level *src, int sharpen_corners, int make_boundary_holes,
                               sfb__level *dst);
 
 /* Rows [0, rows) of table t on the context's backend (handle: its upload of t), or on ref when
  * the backend lacks eval_stencils (surface.c). */
-sfb_result sfb__surface_apply(const sfb_surface *s, const sfb__stencils *t, void *handle, int rows, const float *src,
+SFB__IF sfb_result sfb__surface_apply(const sfb_surface *s, const sfb__stencils *t, void *handle, int rows, const float *src,
                               sfb_buffer_desc sd, float *dst, sfb_buffer_desc dd);
 /* The refined (or limit) mesh of a surface into o (surface.c). */
-sfb_result sfb__refine_output(const sfb_surface *s, const float *base, int base_count, int want_limit, sfb_mesh_data *o);
+SFB__IF sfb_result sfb__refine_output(const sfb_surface *s, const float *base, int base_count, int want_limit, sfb_mesh_data *o);
 
-void sfb__shading_free(sfb_context *ctx, sfb__shading *sh);
+SFB__IF void sfb__shading_free(sfb_context *ctx, sfb__shading *sh);
 /* shade.c's vertex classes and spherical mean (also read by tests/shade.c): is v a smooth
  * extraordinary vertex; is v's blend weight held (by the variant and the darts option); the
  * weighted spherical mean of count vectors (returns the iterations taken, 0 for the zero result,
  * -1 where the linear average was returned; see shade.c). */
-int sfb__shade_extraordinary(const sfb__level *l, int v, int loop);
-int sfb__shade_held(const sfb__level *l, int v, int loop, int variant, int darts);
-int sfb__shade_spherical_mean(int count, const double *n, const double *w, double out[3]);
-sfb_result sfb__shading_build(sfb_context *ctx, const sfb__level *prep, const sfb__refine_options *opt, int level,
+SFB__IF int sfb__shade_extraordinary(const sfb__level *l, int v, int loop);
+SFB__IF int sfb__shade_held(const sfb__level *l, int v, int loop, int variant, int darts);
+SFB__IF int sfb__shade_spherical_mean(int count, const double *n, const double *w, double out[3]);
+SFB__IF sfb_result sfb__shading_build(sfb_context *ctx, const sfb__level *prep, const sfb__refine_options *opt, int level,
                               const sfb_shading_options *o, sfb__shading **out);
 
 /* ---- patch tables (patch/) ---- */
-void sfb__patch_table_free(sfb_context *ctx, sfb__patch_table *pt);
+SFB__IF void sfb__patch_table_free(sfb_context *ctx, sfb__patch_table *pt);
 /* The families present in a table, as bits 1 << SFB__FAMILY_*. */
 static inline unsigned sfb__patch_families(const sfb__patch_table *pt) {
     unsigned m = 0;
@@ -460,19 +477,19 @@ enum { SFB__MF_PATCH = 0, SFB__MF_POINT = 1, SFB__MF_CURVE = 2 };
 #define SFB__MF_H(c) ((int)(((c) >> 15) & 8191u))
 #define SFB__MF_A1(c) ((int)(((c) >> 28) & 3u))
 #define SFB__MF_A2(c) ((int)(((c) >> 30) & 3u))
-sfb_result sfb__manifold_build(sfb_context *ctx, const sfb__level *base, int weights, const float *positions, sfb__patch_table *pt);
-void sfb__mf_eval(const float *pts, const int *cv, const unsigned *codes, int kind, double c, double d, double S[3], double Sc[3],
+SFB__IF sfb_result sfb__manifold_build(sfb_context *ctx, const sfb__level *base, int weights, const float *positions, sfb__patch_table *pt);
+SFB__IF void sfb__mf_eval(const float *pts, const int *cv, const unsigned *codes, int kind, double c, double d, double S[3], double Sc[3],
                   double Sd[3]);
-void sfb__mf_eval_patch(const sfb__patch_table *pt, const float *pts, int patch, double s, double t, int want2, double res[6][3],
+SFB__IF void sfb__mf_eval_patch(const sfb__patch_table *pt, const float *pts, int patch, double s, double t, int want2, double res[6][3],
                         double nrm[3]);
-sfb_result sfb__mf_pinv(sfb_context *ctx, int k, double **out);
+SFB__IF sfb_result sfb__mf_pinv(sfb_context *ctx, int k, double **out);
 /* The blend weight eta of SFB_MANIFOLD_WEIGHTS_* `kind` at t, and its derivative in *dt. */
-double sfb__mf_eta(int kind, double t, double *dt);
-sfb_result sfb__patches_build(sfb_context *ctx, const sfb__level *base, const sfb__refine_options *opt, int limit,
+SFB__IF double sfb__mf_eta(int kind, double t, double *dt);
+SFB__IF sfb_result sfb__patches_build(sfb_context *ctx, const sfb__level *base, const sfb__refine_options *opt, int limit,
                               const float *positions, sfb__patch_table *pt);
 /* Patch index (or -1: a hole) and local (s,t) of a valid location; *scale = 2^depth, negative
  * after an odd number of middle triangle children (patch/table.c). */
-int sfb__patch_locate(const sfb__patch_table *pt, int ptex, double u, double v, double *s, double *t, double *scale);
+SFB__IF int sfb__patch_locate(const sfb__patch_table *pt, int ptex, double u, double v, double *s, double *t, double *scale);
 
 /* ---- reading records (patch/table.c) and the record kinds (patch/quad.c, patch/tri.c) ---- */
 /* A record type's ref evaluation. res = P, Ps, Pt, Pss, Pst, Ptt in the record's (s,t) (before
@@ -488,30 +505,30 @@ typedef struct sfb__patch_kind {
     int cap_corners;
 } sfb__patch_kind;
 /* The ref evaluator of a (non-MANIFOLD4) record type. */
-sfb__patch_kind sfb__patch_kind_of(int type);
-void sfb__kind_stam(const sfb__patch_table *pt, const float *pts, int patch, const int *cv, double s, double t, double res[6][3],
+SFB__IF sfb__patch_kind sfb__patch_kind_of(int type);
+SFB__IF void sfb__kind_stam(const sfb__patch_table *pt, const float *pts, int patch, const int *cv, double s, double t, double res[6][3],
                     double dir[2][3]);
-void sfb__kind_stam_loop(const sfb__patch_table *pt, const float *pts, int patch, const int *cv, double s, double t, double res[6][3],
+SFB__IF void sfb__kind_stam_loop(const sfb__patch_table *pt, const float *pts, int patch, const int *cv, double s, double t, double res[6][3],
                          double dir[2][3]);
 /* The record evaluations themselves (res as above; the Stam kinds' nres: the first derivatives
  * divided by their scale, a finite tangent frame down to the extraordinary vertex). */
-void sfb__bspline_basis(double t, double *b, double *d, double *dd);   /* uniform cubic B-spline: value, d, d2 */
-void sfb__bez15_basis(double s, double t, int nw, double B[6][15]);   /* quartic Bernstein on a triangle (nw 3 or 6) */
-double sfb__ipow(double x, int m);                                    /* x^m, m >= 0, by repeated squaring */
-void sfb__eval_bspline16(const float *pts, const int *cv, double s, double t, double res[6][3]);
-void sfb__eval_endcap(const float *pts, const int *cv, double s, double t, double res[6][3]);
+SFB__IF void sfb__bspline_basis(double t, double *b, double *d, double *dd);   /* uniform cubic B-spline: value, d, d2 */
+SFB__IF void sfb__bez15_basis(double s, double t, int nw, double B[6][15]);   /* quartic Bernstein on a triangle (nw 3 or 6) */
+SFB__IF double sfb__ipow(double x, int m);                                    /* x^m, m >= 0, by repeated squaring */
+SFB__IF void sfb__eval_bspline16(const float *pts, const int *cv, double s, double t, double res[6][3]);
+SFB__IF void sfb__eval_endcap(const float *pts, const int *cv, double s, double t, double res[6][3]);
 /* The Stam kinds take nw: 3 for P and its first derivatives (res[3..5] = 0), 6 for all. */
-void sfb__eval_stam(const sfb__eigen_cc *e, const float *pts, const int *cv, int corner, double s, double t, int nw,
+SFB__IF void sfb__eval_stam(const sfb__eigen_cc *e, const float *pts, const int *cv, int corner, double s, double t, int nw,
                     double res[6][3], double nres[2][3]);
-void sfb__eval_beztri(const float *pts, const int *cv, double s, double t, double res[6][3]);
-void sfb__eval_endcap_tri(const float *pts, const int *cv, double s, double t, double res[6][3]);
-void sfb__eval_stam_loop(const sfb__eigen_loop *e, const float *pts, const int *cv, int corner, double s, double t, int nw,
+SFB__IF void sfb__eval_beztri(const float *pts, const int *cv, double s, double t, double res[6][3]);
+SFB__IF void sfb__eval_endcap_tri(const float *pts, const int *cv, double s, double t, double res[6][3]);
+SFB__IF void sfb__eval_stam_loop(const sfb__eigen_loop *e, const float *pts, const int *cv, int corner, double s, double t, int nw,
                          double res[6][3], double nres[2][3]);
 /* Shared by the kinds (patch/table.c): c = a x b; an end cap's normal (nc = 3 or 4 corners); the
  * end of both Stam kernels (the EV frame's derivatives mapped to (s,t) through J, scaled). */
-void sfb__cross3(const double *a, const double *b, double *c);
-void sfb__endcap_normal(const float *pts, const int *cv, int nc, double s, double t, double nrm[3]);
-void sfb__stam_finish(double J[2][2], double sc1, double sc2, double sr[6][3], double nr[2][3], double res[6][3], double nres[2][3]);
+SFB__IF void sfb__cross3(const double *a, const double *b, double *c);
+SFB__IF void sfb__endcap_normal(const float *pts, const int *cv, int nc, double s, double t, double nrm[3]);
+SFB__IF void sfb__stam_finish(double J[2][2], double sc1, double sc2, double sr[6][3], double nr[2][3], double res[6][3], double nres[2][3]);
 
 /* ---- building records (patch/build.c), for the scheme builders ---- */
 /* Classes of a face's corner for the regular records. */
@@ -540,23 +557,23 @@ typedef struct sfb__wlevel {
 } sfb__wlevel;
 /* A grid cell's mask: up to 4 (vertex, weight) terms. */
 typedef struct sfb__cell { int n, real; int v[4]; double w[4]; } sfb__cell;
-int sfb__is_inf(float s);                                          /* s is SFB_SHARPNESS_INFINITE */
-int sfb__face_n(const sfb__level *l, int f);                       /* corners of face f */
-int sfb__fan_pos(const sfb__level *l, int v, int g, int slot);     /* g's position around v, or -1 */
-int sfb__face_semisharp(const sfb__level *l, int g);               /* something at g's corners still decays */
+SFB__IF int sfb__is_inf(float s);                                          /* s is SFB_SHARPNESS_INFINITE */
+SFB__IF int sfb__face_n(const sfb__level *l, int f);                       /* corners of face f */
+SFB__IF int sfb__fan_pos(const sfb__level *l, int v, int g, int slot);     /* g's position around v, or -1 */
+SFB__IF int sfb__face_semisharp(const sfb__level *l, int g);               /* something at g's corners still decays */
 /* A point row = mask m over working-level vertices composed with their rows (a single vertex
  * with weight 1 is shared); -1 on allocation failure. */
-int sfb__pb_point(sfb__pbuild *b, const sfb__rows *wrows, const sfb__mask *m);
+SFB__IF int sfb__pb_point(sfb__pbuild *b, const sfb__rows *wrows, const sfb__mask *m);
 /* A new record of `type` with ncv points; its index, or -1 on allocation failure. */
-int sfb__pb_patch(sfb__pbuild *b, int type, unsigned param, int valence, int ncv);
+SFB__IF int sfb__pb_patch(sfb__pbuild *b, int type, unsigned param, int valence, int ncv);
 /* Inserts record `patch` (-1: a hole) at (ptex, depth, i, j of param) in the tree; 0 on failure. */
-int sfb__pb_insert(sfb__pbuild *b, int ptex, unsigned param, int patch);
-void sfb__wlevel_free(sfb_context *ctx, sfb__wlevel *w);
+SFB__IF int sfb__pb_insert(sfb__pbuild *b, int ptex, unsigned param, int patch);
+SFB__IF void sfb__wlevel_free(sfb_context *ctx, sfb__wlevel *w);
 /* The end cap of face g (n = 3 or 4 corners, frame corner 0 at slot rot). */
-sfb_result sfb__pb_endcap(sfb__pbuild *b, sfb__wlevel *w, int g, int rot, int n, unsigned param);
+SFB__IF sfb_result sfb__pb_endcap(sfb__pbuild *b, sfb__wlevel *w, int g, int rot, int n, unsigned param);
 /* A Stam-kind record of K eigen-coefficient points over the vertices C (freed). */
-sfb_result sfb__pb_eigen_patch(sfb__pbuild *b, sfb__wlevel *w, int type, int ptex, unsigned param, int N, int K, const double *vinv,
+SFB__IF sfb_result sfb__pb_eigen_patch(sfb__pbuild *b, sfb__wlevel *w, int type, int ptex, unsigned param, int N, int K, const double *vinv,
                                int *C);
 /* Classifies candidate g of the working level: adds its record, or sets *refine. */
-sfb_result sfb__pb_face_quad(sfb__pbuild *b, sfb__wlevel *w, int g, int level, int limit, int *refine);
-sfb_result sfb__pb_face_tri(sfb__pbuild *b, sfb__wlevel *w, int g, int level, int limit, int *refine);
+SFB__IF sfb_result sfb__pb_face_quad(sfb__pbuild *b, sfb__wlevel *w, int g, int level, int limit, int *refine);
+SFB__IF sfb_result sfb__pb_face_tri(sfb__pbuild *b, sfb__wlevel *w, int g, int level, int limit, int *refine);

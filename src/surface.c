@@ -32,6 +32,7 @@ SFB_API void sfb_surface_destroy(sfb_surface *s) {
     sfb__level_free(ctx, &s->pbase);
     sfb__level_free(ctx, &s->top);
     sfb__level_free(ctx, &s->uv_top);
+    sfb__level_free(ctx, &s->uv_base);
     sfb__free(ctx, s->base_positions);
     sfb__free(ctx, s->base_uvs);
     sfb__free(ctx, s);
@@ -146,6 +147,8 @@ static sfb_result sfb__surface_build_uvs(sfb_surface *s, const sfb_mesh *mesh, c
     opt.linear = mesh->uv_interp == SFB_UV_LINEAR;
     memset(&dummy, 0, sizeof dummy);
     r = sfb__refine(ctx, &uvp, &opt, cfg->refine_level, &s->uv_top, &s->tables[SFB_TABLE_UV], NULL, 0.8f, 1.0f);
+    /* kept for tessellated UVs (SFB_TESS_UVS builds their patch table from it when asked) */
+    if (r == SFB_SUCCESS && (cfg->flags & SFB_REFINE_PATCHES)) { s->uv_base = uvp; memset(&uvp, 0, sizeof uvp); }
     sfb__level_free(ctx, &uvp);
     if (r != SFB_SUCCESS) return r;
     s->built[SFB_TABLE_UV] = 1;

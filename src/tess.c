@@ -94,7 +94,7 @@ SFB_API void sfb_tess_data_free(sfb_tess_data *d) {
     ctx = d->ctx_;
     if (ctx) {
         sfb__free(ctx, d->positions); sfb__free(ctx, d->normals); sfb__free(ctx, d->locations);
-        sfb__free(ctx, d->triangles); sfb__free(ctx, d->triangle_faces);
+        sfb__free(ctx, d->triangles); sfb__free(ctx, d->triangle_faces); sfb__free(ctx, d->uvs);
     }
     memset(d, 0, sizeof *d);
 }
@@ -112,7 +112,8 @@ typedef struct sfb__tess {
     const sfb_surface *s;
     const sfb__level *l;          /* the prepared base level the patches were built from */
     const sfb__patch_table *pt;
-    int rate, split;
+    int rate, split;              /* split: some edges have a copy per face (esplit) */
+    unsigned char *esplit;        /* split: per base edge, its faces get their own copies of its points */
     int loop;                     /* Loop: every param face is a base triangle */
     int *prate;                   /* per param face: interior rate, 0 = nothing (hole) */
     int *eseg;                    /* per base edge: segments over the whole edge */
@@ -160,7 +161,8 @@ static void sfb__tess_free_work(sfb__tess *T) {
     sfb__free(ctx, T->uf); sfb__free(ctx, T->ecopy); sfb__free(ctx, T->vcorner); sfb__free(ctx, T->vedge);
     sfb__free(ctx, T->vspoke); sfb__free(ctx, T->vcenter); sfb__free(ctx, T->ifirst); sfb__free(ctx, T->bids);
     T->prate = T->eseg = T->sseg = T->uf = T->ecopy = T->vcorner = T->vedge = T->vspoke = T->vcenter = T->ifirst = T->bids = NULL;
-    T->engon = NULL;
+    sfb__free(ctx, T->esplit);
+    T->engon = T->esplit = NULL;
     sfb__free(ctx, T->fstate); sfb__free(ctx, T->cuv); sfb__free(ctx, T->ckept); sfb__free(ctx, T->otri);
     sfb__free(ctx, T->oface); sfb__free(ctx, T->nloc); sfb__free(ctx, T->cuts);
     T->fstate = T->ckept = NULL;
@@ -174,10 +176,27 @@ static void sfb__tess_free_work(sfb__tess *T) {
 
 static int sfb__tess_face_n(const sfb__level *l, int f) { return l->fv_off[f + 1] - l->fv_off[f]; }
 
-/* Edges whose two sides get their own vertices under SFB_TESS_SPLIT_CREASES: infinitely sharp
- * and not on the boundary (a boundary edge has one side only). */
-static int sfb__tess_split_edge(const sfb__tess *T, int e) {
-    return T->split && T->l->es[e] >= SFB_SHARPNESS_INFINITE && !(T->l->etag[e] & SFB__TAG_BOUNDARY);
+/* Edges whose sides get their own vertices (sfb__tess_mark_splits): under SFB_TESS_SPLIT_CREASES
+ * the infinitely sharp interior ones, under SFB_TESS_UVS the UV seams. */
+static int sfb__tess_split_edge(const sfb__tess *T, int e) { return T->split && T->esplit[e]; }
+
+/* Whether the faces of base edge e disagree on the UV at either of its ends (uvl: the base UV
+ * layout, whose faces are the base level's). */
+static int sfb__tess_uv_seam(const sfb__level *l, const sfb__level *uvl, int e) {
+    int a = l->ef_off[e], z = l->ef_off[e + 1], q, u0 = -1, u1 = -1;
+    for (q = a; q < z; ++q) {
+        int g = l->ef[q], o = l->fv_off[g], n = l->fv_off[g + 1] - o, sl = l->ef_slot[q];
+        int c0 = o + sl, c1 = o + (sl + 1) % n, t;
+        if (l->fv[c0] != l->ev[2 * e]) { t = c0; c0 = c1; c1 = t; } /* c0 at ev[0], c1 at ev[1] */
+        if (q == a) { u0 = uvl->fv[c0]; u1 = uvl->fv[c1]; }
+        else if (uvl->fv[c0] != u0 || uvl->fv[c1] != u1) return 1;
+    }
+    return 0;
+}
+
+/* An infinitely sharp edge not on the boundary (a boundary edge has one side only). */
+static int sfb__tess_crease_edge(const sfb__level *l, int e) {
+    return l->es[e] >= SFB_SHARPNESS_INFINITE && !(l->etag[e] & SFB__TAG_BOUNDARY);
 }
 
 static int sfb__tess_find(int *uf, int x) {
@@ -983,8 +1002,14 @@ static sfb_result sfb__tess_check(sfb_context *ctx, const sfb_surface *s, const 
     if (!(cfg->tolerance >= 0.0f))
         return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "tessellation tolerance %g must be >= 0 (0: uniform)",
                           (double)cfg->tolerance);
-    if (cfg->flags & ~(unsigned)SFB_TESS_SPLIT_CREASES)
+    if (cfg->flags & ~(unsigned)(SFB_TESS_SPLIT_CREASES | SFB_TESS_UVS))
         return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "unknown tessellation flags 0x%x", cfg->flags);
+    if ((cfg->flags & SFB_TESS_UVS) && (!s->has_uvs || !s->base_uvs || !s->uv_base.fv))
+        return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1,
+                          "sfb_surface_tessellate: SFB_TESS_UVS, but the surface has no UVs (create it with SFB_REFINE_UVS | "
+                          "SFB_REFINE_PATCHES from a mesh with UVs)");
+    if ((cfg->flags & SFB_TESS_UVS) && (s->uv_base.nf != s->pbase.nf || s->uv_base.nfv != s->pbase.nfv))
+        return sfb__error(ctx, SFB_BACKEND_ERROR, SFB_ELEMENT_NONE, -1, "sfb_surface_tessellate: the UV layout's faces are not the surface's");
     if (cfg->trim) {
         const sfb_trim_mask *m = cfg->trim;
         if (!m->texels) return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, -1, "trimming mask: texels is NULL");
@@ -1017,7 +1042,7 @@ static sfb_result sfb__tess_init(sfb__tess *T, const sfb_surface *s, const sfb_t
     T->l = l = &s->pbase;
     T->pt = &s->patches;
     T->rate = cfg->rate;
-    T->split = (cfg->flags & SFB_TESS_SPLIT_CREASES) != 0;
+    T->split = (cfg->flags & (SFB_TESS_SPLIT_CREASES | SFB_TESS_UVS)) != 0;
     T->loop = T->pt->domain == SFB__DOMAIN_TRI;
     nptex = T->pt->nptex;
     T->prate = (int *)sfb__tess_array(ctx, (size_t)nptex, sizeof(int));
@@ -1033,10 +1058,17 @@ static sfb_result sfb__tess_init(sfb__tess *T, const sfb_surface *s, const sfb_t
     if (T->split) {
         T->uf = (int *)sfb__tess_array(ctx, (size_t)l->nfv, sizeof(int));
         T->ecopy = (int *)sfb__tess_array(ctx, (size_t)l->nfv, sizeof(int));
+        T->esplit = (unsigned char *)sfb__tess_array(ctx, (size_t)l->ne, 1);
     }
     if (!T->prate || !T->sseg || !T->vspoke || !T->ifirst || !T->eseg || !T->engon || !T->vedge || !T->vcenter || !T->vcorner ||
-        !T->bids || (T->split && (!T->uf || !T->ecopy)))
+        !T->bids || (T->split && (!T->uf || !T->ecopy || !T->esplit)))
         return sfb__oom(ctx, "tessellation");
+    if (T->split) {
+        int e;
+        for (e = 0; e < l->ne; ++e)
+            T->esplit[e] = (unsigned char)(((cfg->flags & SFB_TESS_SPLIT_CREASES) && sfb__tess_crease_edge(l, e)) ||
+                                           ((cfg->flags & SFB_TESS_UVS) && sfb__tess_uv_seam(l, &s->uv_base, e)));
+    }
     for (pf = 0; pf < nptex; ++pf) {
         T->prate[pf] = sfb__tess_live(T, pf) ? T->rate : 0;
         T->vspoke[pf] = -1;
@@ -1153,15 +1185,15 @@ static sfb_result sfb__tess_emit(sfb__tess *T, sfb_tess_data *out, float p0, flo
 }
 
 /* Evaluates every vertex of `out` once, in chunks, on the context's backend (progress from p0
- * to 1). */
-static sfb_result sfb__tess_evaluate(const sfb_surface *s, sfb_tess_data *out, float p0) {
+ * to p1). */
+static sfb_result sfb__tess_evaluate(const sfb_surface *s, sfb_tess_data *out, float p0, float p1) {
     sfb_context *ctx = s->ctx;
     size_t done_v, nv = (size_t)out->vertex_count;
     sfb_result r;
     for (done_v = 0; done_v < nv; done_v += SFB__TESS_EVAL_CHUNK) {
         size_t n = nv - done_v < SFB__TESS_EVAL_CHUNK ? nv - done_v : SFB__TESS_EVAL_CHUNK;
         sfb_eval_output eo;
-        r = sfb__progress(ctx, p0 + (1.0f - p0) * (float)done_v / (float)nv, "tessellate");
+        r = sfb__progress(ctx, p0 + (p1 - p0) * (float)done_v / (float)nv, "tessellate");
         if (r != SFB_SUCCESS) return r;
         memset(&eo, 0, sizeof eo);
         eo.position = out->positions + 3 * done_v;
@@ -1169,7 +1201,109 @@ static sfb_result sfb__tess_evaluate(const sfb_surface *s, sfb_tess_data *out, f
         r = sfb_surface_eval(s, out->locations + done_v, (int)n, &eo);
         if (r != SFB_SUCCESS) return r;
     }
-    return sfb__progress(ctx, 1.0f, "tessellate");
+    return sfb__progress(ctx, p1, "tessellate");
+}
+
+/* SFB_UV_LINEAR: the UVs follow each face linearly, as the bilinear masks refine them on the
+ * scheme's own face split -- a quad bilinearly, an n-gon's sub-face i bilinearly between its
+ * corner's UV, the two edge midpoints and the centroid, a Loop triangle barycentrically. */
+static void sfb__tess_uv_linear(const sfb_surface *s, const sfb_location *L, float uv[2]) {
+    const sfb__level *ul = &s->uv_base;
+    const sfb__patch_table *pt = &s->patches;
+    int f = pt->ptex_face[L->face], sub = pt->ptex_corner[L->face], o = ul->fv_off[f], n = ul->fv_off[f + 1] - o, c, k;
+    double u = L->u, v = L->v;
+    for (c = 0; c < 2; ++c) {
+        double q[4];
+        if (pt->domain == SFB__DOMAIN_TRI) {
+            uv[c] = (float)((1.0 - u - v) * s->base_uvs[2 * ul->fv[o] + c] + u * s->base_uvs[2 * ul->fv[o + 1] + c] +
+                            v * s->base_uvs[2 * ul->fv[o + 2] + c]);
+            continue;
+        }
+        if (sub < 0) {
+            for (k = 0; k < 4; ++k) q[k] = s->base_uvs[2 * ul->fv[o + k] + c];
+        } else {
+            double mean = 0.0, a = s->base_uvs[2 * ul->fv[o + sub] + c];
+            for (k = 0; k < n; ++k) mean += s->base_uvs[2 * ul->fv[o + k] + c];
+            q[0] = a;
+            q[1] = 0.5 * (a + s->base_uvs[2 * ul->fv[o + (sub + 1) % n] + c]);
+            q[2] = mean / n;
+            q[3] = 0.5 * (a + s->base_uvs[2 * ul->fv[o + (sub + n - 1) % n] + c]);
+        }
+        uv[c] = (float)((1.0 - u) * (1.0 - v) * q[0] + u * (1.0 - v) * q[1] + u * v * q[2] + (1.0 - u) * v * q[3]);
+    }
+}
+
+/* SFB_TESS_UVS: out->uvs at out->locations (progress from p0 to 1). Smooth UVs are the limit
+ * of the refined UV layout: the scheme's own patch builder run on the base UV layout (its
+ * vertices the UV values, z = 0), evaluated by ref (2-D data, cheap beside the positions); the
+ * layout has the surface's faces, hence its parametric faces. The manifold blend blends the UV
+ * layout as it blends positions (the blend is linear in the data). The table is built per call:
+ * a surface that never tessellates UVs does not pay for it. */
+static sfb_result sfb__tess_eval_uvs(const sfb_surface *s, sfb_tess_data *out, float p0) {
+    sfb_context *ctx = s->ctx;
+    size_t v, nv = (size_t)out->vertex_count, done_v;
+    sfb__patch_table upt;
+    sfb__refine_options opt;
+    sfb_surface_config ucfg;
+    const sfb__scheme_info *si = sfb__scheme_info_of(s->config.scheme);
+    float *P = NULL, *tmp = NULL;
+    sfb_result r = SFB_SUCCESS;
+    int i;
+    out->uvs = (float *)sfb__tess_array(ctx, nv, 2 * sizeof(float));
+    if (!out->uvs) return sfb__oom(ctx, "tessellated UVs");
+    if (s->uv_interp == SFB_UV_LINEAR || !si || !si->build_patches) {
+        for (v = 0; v < nv; ++v) sfb__tess_uv_linear(s, &out->locations[v], out->uvs + 2 * v);
+        return sfb__progress(ctx, 1.0f, "tessellate");
+    }
+    memset(&upt, 0, sizeof upt);
+    memset(&opt, 0, sizeof opt);
+    opt.scheme = si->rules;
+    opt.crease_method = s->crease_method;
+    opt.triangle_rule = s->triangle_rule;
+    P = (float *)sfb__tess_array(ctx, (size_t)s->uv_base.nv, 3 * sizeof(float));
+    tmp = (float *)sfb__tess_array(ctx, SFB__TESS_EVAL_CHUNK, 3 * sizeof(float));
+    if (!P || !tmp) { r = sfb__oom(ctx, "tessellated UVs"); goto done; }
+    for (i = 0; i < s->uv_base.nv; ++i) {
+        P[3 * i] = s->base_uvs[2 * i];
+        P[3 * i + 1] = s->base_uvs[2 * i + 1];
+        P[3 * i + 2] = 0.0f;
+    }
+    /* A layout that is not a manifold (a UV value shared by faces that do not form one fan, as
+     * placeholder UVs are: OpenSubdiv's car has 4 UV values for 1575 faces) is sharpened there
+     * like any non-manifold vertex, and every face beside such a vertex is irregular: isolating
+     * them to the surface's level costs seconds and gigabytes for a label, not a layout. Such a
+     * layout is isolated one level only; end caps approximate it near its irregular features. */
+    ucfg = s->config;
+    for (i = 0; i < s->uv_base.nv; ++i)
+        if (s->uv_base.vtag[i] & SFB__TAG_NONMANIFOLD) break;
+    if (i < s->uv_base.nv) {
+        ucfg.isolation_level = 1;
+        sfb__log(ctx, SFB_LOG_INFO, "tessellated UVs: the UV layout is not a manifold (UV %d): isolated one level", i);
+    }
+    if ((r = si->build_patches(ctx, &s->uv_base, &opt, &ucfg, P, &upt)) != SFB_SUCCESS) goto done;
+    if (upt.nptex != s->patches.nptex) {
+        r = sfb__error(ctx, SFB_BACKEND_ERROR, SFB_ELEMENT_NONE, -1, "tessellated UVs: the UV layout has %d parametric faces, the surface %d",
+                       upt.nptex, s->patches.nptex);
+        goto done;
+    }
+    for (done_v = 0; done_v < nv; done_v += SFB__TESS_EVAL_CHUNK) {
+        size_t n = nv - done_v < SFB__TESS_EVAL_CHUNK ? nv - done_v : SFB__TESS_EVAL_CHUNK;
+        sfb_eval_output eo;
+        if ((r = sfb__progress(ctx, p0 + (1.0f - p0) * (float)done_v / (float)nv, "tessellate")) != SFB_SUCCESS) goto done;
+        memset(&eo, 0, sizeof eo);
+        eo.position = tmp;
+        if ((r = sfb__ref_eval_patches(NULL, &upt, NULL, out->locations + done_v, 0, (int)n, &eo)) != SFB_SUCCESS) goto done;
+        for (v = 0; v < n; ++v) {
+            out->uvs[2 * (done_v + v)] = tmp[3 * v];
+            out->uvs[2 * (done_v + v) + 1] = tmp[3 * v + 1];
+        }
+    }
+    r = sfb__progress(ctx, 1.0f, "tessellate");
+done:
+    sfb__patch_table_free(ctx, &upt);
+    sfb__free(ctx, P);
+    sfb__free(ctx, tmp);
+    return r;
 }
 
 SFB_API sfb_result sfb_surface_tessellate(const sfb_surface *s, const sfb_tess_config *cfg, sfb_tess_data *out) {
@@ -1208,8 +1342,9 @@ SFB_API sfb_result sfb_surface_tessellate(const sfb_surface *s, const sfb_tess_c
     r = T.trim ? sfb__trim_emit(&T, out, p_emit, p_eval) : sfb__tess_emit(&T, out, p_emit, p_eval);
     if (r != SFB_SUCCESS) goto fail;
     sfb__tess_free_work(&T);
-    /* 6. evaluate every vertex once, in chunks, on the context's backend */
-    r = sfb__tess_evaluate(s, out, p_eval);
+    /* 6. evaluate every vertex once, in chunks, on the context's backend; 7. the UVs */
+    r = sfb__tess_evaluate(s, out, p_eval, (cfg->flags & SFB_TESS_UVS) ? 0.9f : 1.0f);
+    if (r == SFB_SUCCESS && (cfg->flags & SFB_TESS_UVS)) r = sfb__tess_eval_uvs(s, out, 0.9f);
     if (r == SFB_SUCCESS) return SFB_SUCCESS;
 fail:
     sfb__tess_free_work(&T);

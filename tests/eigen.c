@@ -1,6 +1,6 @@
 /* The Stam eigen structures (src/patch/eigen.c), checked independently of the checks the builds do
  * themselves. This program reaches the internal builders through src/sfb_internal.h (linked
- * from libsfb.o). For every valence 3..64 and a sample up to SFB__STAM_MAX_VALENCE, Catmull-Clark and Loop:
+ * from libsfb_internal.o). For every valence 3..64 and a sample up to SFB__STAM_MAX_VALENCE, Catmull-Clark and Loop:
  *   - the subdivision matrix A is affine (rows sum to 1) and its EV row is the scheme's
  *     vertex rule (weights written here from the textbook formulas);
  *   - A V = V J and V V^-1 = I, recomputed here from the kept V, the eigenvalues and the
@@ -14,8 +14,9 @@
  * (position and first and second derivatives): a test of the layout, the subdivision and
  * enlarged matrices, the picking of the three sub-patches (the middle one turned), the level
  * search and the derivative scales. Prints PASS/FAIL lines and "N passed, N failed, N skipped" (tests/harness.h). */
+#define SURFBLEND_EXPOSE_INTERNALS /* the internals below have external linkage in libsfb_internal.o */
 #include "surfblend.h"
-#include "src/sfb_internal.h" /* the library's internal interfaces (linked from libsfb.o) */
+#include "src/sfb_internal.h" /* the library's internal interfaces (linked from libsfb_internal.o) */
 #include "harness.h"
 #include <math.h>
 

@@ -128,19 +128,24 @@ bool reference(const char *in, sfb_scheme scheme, int level, const std::string &
     sfb_mesh_get_desc(mesh, &md);
     if (ok) {
         sfb_surface_config cfg = sfb_surface_config_init(scheme, rate > 0 ? 0 : level);
-        cfg.flags = rate > 0 ? (unsigned)SFB_REFINE_PATCHES
+        cfg.flags = rate > 0 ? (unsigned)SFB_REFINE_PATCHES | (md.uv_count > 0 ? (unsigned)SFB_REFINE_UVS : 0u)
                              : ((normals == "flat" ? 0u : (unsigned)SFB_REFINE_SHADING) | (md.uv_count > 0 ? (unsigned)SFB_REFINE_UVS : 0u));
         ok = sfb_surface_create(ctx, mesh, &cfg, &surf) == SFB_SUCCESS;
     }
     if (ok && rate > 0) {
         sfb_tess_config tc = sfb_tess_config_init(rate);
-        tc.flags = SFB_TESS_SPLIT_CREASES;
+        tc.flags = SFB_TESS_SPLIT_CREASES | (md.uv_count > 0 ? (unsigned)SFB_TESS_UVS : 0u);
         ok = sfb_surface_tessellate(surf, &tc, &t) == SFB_SUCCESS;
+        R->uvs = ok && t.uvs;
         for (int i = 0; ok && i < t.vertex_count; ++i) {
             Vertex v{};
             memcpy(v.p, t.positions + 3 * (size_t)i, sizeof v.p);
             memcpy(v.n, t.normals + 3 * (size_t)i, sizeof v.n);
             unit(v.n);
+            if (R->uvs) {
+                v.t[0] = t.uvs[2 * (size_t)i];
+                v.t[1] = 1.0f - t.uvs[2 * (size_t)i + 1];
+            }
             R->verts.push_back(v);
         }
         R->triangles = t.triangle_count;

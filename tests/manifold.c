@@ -1,5 +1,5 @@
 /* Manifold-based blending surfaces (SFB_SCHEME_MANIFOLD_BLEND, src/patch/manifold.c, seed 000) on every
- * backend, ref first. It reaches the patch table through src/sfb_internal.h (linked from libsfb.o).
+ * backend, ref first. It reaches the patch table through src/sfb_internal.h (linked from libsfb_internal.o).
  * Checks (both weight kinds, Hermite and C-infinity, where it matters):
  *   - weights: the four blend weights sum to 1 and eta' matches differences of eta; a face whose
  *     four local geometries are one point is that point with zero derivatives;
@@ -17,8 +17,9 @@
  *     within 1e-5 of the diagonal, normals within 1e-3 rad, derivatives within 1e-4 relative;
  *   - bad configurations give the documented errors.
  * A backend that is unavailable SKIPs (FAILs when listed in SFB_REQUIRE_BACKENDS). */
+#define SURFBLEND_EXPOSE_INTERNALS /* the internals below have external linkage in libsfb_internal.o */
 #include "surfblend.h"
-#include "src/sfb_internal.h" /* the library's internal interfaces (linked from libsfb.o) */
+#include "src/sfb_internal.h" /* the library's internal interfaces (linked from libsfb_internal.o) */
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>

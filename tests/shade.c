@@ -1,5 +1,5 @@
 /* Subdivision shading (sfb_surface_shade, src/shade.c) on every backend, ref first. This program
- * reads the refined level's vertex rules through src/sfb_internal.h (linked from libsfb.o). Checks:
+ * reads the refined level's vertex rules through src/sfb_internal.h (linked from libsfb_internal.o). Checks:
  *   - agreement: N_B, N_L, N_S and limit positions of every backend against ref, identical blend
  *     weights and output topology. Positions within 1e-5 x bounding-box diagonal; N_S within
  *     1e-3 rad (its sources are face normals of the backend's float positions at the normals
@@ -36,8 +36,9 @@
  *     it is not lowered, which modes and normals levels 1..3 lower it;
  *   - bad options and failing allocations (each averaging mode).
  * A backend that is unavailable SKIPs (FAILs when listed in SFB_REQUIRE_BACKENDS). */
+#define SURFBLEND_EXPOSE_INTERNALS /* the internals below have external linkage in libsfb_internal.o */
 #include "surfblend.h"
-#include "src/sfb_internal.h" /* the library's internal interfaces (linked from libsfb.o) */
+#include "src/sfb_internal.h" /* the library's internal interfaces (linked from libsfb_internal.o) */
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>

@@ -69,7 +69,7 @@ static sfb_mesh *tx_mesh(sfb_context *ctx, const char *obj)
 static sfb_surface *tx_surface(sfb_context *ctx, const sfb_mesh *m)
 {
     sfb_surface_config sc = sfb_surface_config_init(SFB_SCHEME_CATMARK, 0);
-    sc.flags = SFB_REFINE_PATCHES;
+    sc.flags = SFB_REFINE_PATCHES | SFB_REFINE_UVS; /* UVs: only where the mesh has them */
     sfb_surface *s = NULL;
     sfb_result r = sfb_surface_create(ctx, m, &sc, &s);
     cr_assert_eq(r, SFB_SUCCESS, "surface: %s", sfb_last_error(ctx));
@@ -783,7 +783,7 @@ static void failure_sweep_mesh(int cancel, float tol, unsigned flags, const char
         pr.cancel_at = 0;
         if (r == SFB_SUCCESS) {
             cr_expect_gt(failures, 1, "only %d failure points", failures);
-            if (flags & SFB_TESS_SPLIT_CREASES) {
+            if (flags & (SFB_TESS_SPLIT_CREASES | SFB_TESS_UVS)) {
                 edge_stats st = stats_of(&t, NULL);
                 if (tol == 0.0f) cr_expect_eq(st.once, split_once);
                 else cr_expect_gt(st.once, 0);
@@ -1491,4 +1491,297 @@ Test(tess_loop, split_creases_semisharp_only_stays_closed)
     sfb_surface_destroy(s);
     sfb_mesh_destroy(m);
     sfb_context_destroy(ctx);
+}
+
+/* ------------------------------------------------------------------------- */
+/* tessellated UVs (SFB_TESS_UVS)                                             */
+
+/* A flat disk around a pentagon (loop: around a vertex of valence 5), every vertex given the
+ * UV 0.25 * (x, y) + 0.5: the UV layout is the position mesh under an affine map, so the limit
+ * UVs must be that map of the limit positions exactly -- creases included, which the layout
+ * keeps (an infinitely sharp spoke ending in a dart, a semi-sharp ring edge). Catmull-Clark:
+ * a pentagon and a ring of 5 quads (n-gon sub-faces, interior valence-3 vertices, a
+ * boundary); Loop: 5 triangles around the centre, 10 around them. */
+static char *flat_uv_disk(int loop)
+{
+    double P[40][2];
+    int np = 0, F[40][4], nf = 0, fs = loop ? 3 : 4;
+    const double pi = 3.14159265358979323846;
+    if (!loop) {
+        for (int i = 0; i < 5; ++i) { P[np][0] = cos(2 * pi * i / 5); P[np][1] = sin(2 * pi * i / 5); np++; }
+        for (int i = 0; i < 5; ++i) { P[np][0] = 2 * cos(2 * pi * i / 5); P[np][1] = 2 * sin(2 * pi * i / 5); np++; }
+        for (int i = 0; i < 5; ++i) { /* the quad beside pentagon edge (i, i+1), out to the outer ring */
+            int a = i, b = (i + 1) % 5;
+            F[nf][0] = b; F[nf][1] = a; F[nf][2] = 5 + a; F[nf][3] = 5 + b; nf++;
+        }
+    } else {
+        P[np][0] = 0; P[np][1] = 0; np++;
+        for (int i = 0; i < 5; ++i) { P[np][0] = cos(2 * pi * i / 5); P[np][1] = sin(2 * pi * i / 5); np++; }
+        for (int i = 0; i < 5; ++i) { P[np][0] = 2 * cos(2 * pi * (i + 0.5) / 5); P[np][1] = 2 * sin(2 * pi * (i + 0.5) / 5); np++; }
+        for (int i = 0; i < 5; ++i) {
+            int a = 1 + i, b = 1 + (i + 1) % 5, o = 6 + i, on = 6 + (i + 1) % 5;
+            F[nf][0] = 0; F[nf][1] = a; F[nf][2] = b; nf++;
+            F[nf][0] = b; F[nf][1] = a; F[nf][2] = o; nf++;
+            F[nf][0] = b; F[nf][1] = o; F[nf][2] = on; nf++;
+        }
+    }
+    size_t cap = 8192;
+    char *s = malloc(cap);
+    size_t at = 0;
+    for (int i = 0; i < np; ++i) at += (size_t)snprintf(s + at, cap - at, "v %.9g %.9g 0\n", P[i][0], P[i][1]);
+    for (int i = 0; i < np; ++i) at += (size_t)snprintf(s + at, cap - at, "vt %.9g %.9g\n", 0.25 * P[i][0] + 0.5, 0.25 * P[i][1] + 0.5);
+    if (!loop) at += (size_t)snprintf(s + at, cap - at, "f 1/1 2/2 3/3 4/4 5/5\n");
+    for (int f = 0; f < nf; ++f) {
+        at += (size_t)snprintf(s + at, cap - at, "f");
+        for (int k = 0; k < fs; ++k) at += (size_t)snprintf(s + at, cap - at, " %d/%d", F[f][k] + 1, F[f][k] + 1);
+        at += (size_t)snprintf(s + at, cap - at, "\n");
+    }
+    /* an infinitely sharp spoke (a dart inside) and a semi-sharp edge */
+    at += (size_t)snprintf(s + at, cap - at, loop ? "t crease 2/1/0 0 1 10\nt crease 2/1/0 2 3 1.5\n"
+                                                  : "t crease 2/1/0 0 5 10\nt crease 2/1/0 1 2 1.5\n");
+    cr_assert_lt(at, cap);
+    return s;
+}
+
+static sfb_surface *uv_surface(sfb_context *ctx, const sfb_mesh *m, sfb_scheme scheme)
+{
+    sfb_surface_config sc = sfb_surface_config_init(scheme, 0);
+    sc.flags = SFB_REFINE_PATCHES | SFB_REFINE_UVS;
+    sfb_surface *s = NULL;
+    sfb_result r = sfb_surface_create(ctx, m, &sc, &s);
+    cr_assert_eq(r, SFB_SUCCESS, "surface (%s): %s", sfb_scheme_name(scheme), sfb_last_error(ctx));
+    return s;
+}
+
+static void expect_affine_uvs(const sfb_tess_data *t, const char *what)
+{
+    double worst = 0.0;
+    cr_assert_not_null(t->uvs, "%s: no UVs", what);
+    for (int v = 0; v < t->vertex_count; ++v)
+        for (int c = 0; c < 2; ++c) {
+            double d = fabs((double)t->uvs[2 * v + c] - (0.25 * t->positions[3 * v + c] + 0.5));
+            if (d > worst) worst = d;
+        }
+    cr_expect_lt(worst, 2e-6, "%s: UVs are %g from the affine map of the positions", what, worst);
+}
+
+Test(tess_uv, limit_uvs_are_the_layout_map_of_the_limit_positions)
+{
+    static const struct { sfb_scheme scheme; int loop; const char *name; } cases[] = {
+        { SFB_SCHEME_CATMARK, 0, "Catmull-Clark" }, { SFB_SCHEME_LOOP, 1, "Loop" }, { SFB_SCHEME_MANIFOLD_BLEND, 0, "manifold" } };
+    for (size_t k = 0; k < sizeof cases / sizeof *cases; ++k) {
+        sfb_context *ctx = tx_ctx();
+        char *obj = flat_uv_disk(cases[k].loop);
+        sfb_mesh *m = tx_mesh(ctx, obj);
+        sfb_surface *s = uv_surface(ctx, m, cases[k].scheme);
+        const float tols[2] = { 0.0f, 1e-3f };
+        for (int j = 0; j < 2; ++j) {
+            sfb_tess_data t = tess_ok(s, ctx, 9, tols[j], SFB_TESS_UVS | SFB_TESS_SPLIT_CREASES);
+            expect_affine_uvs(&t, cases[k].name);
+            sfb_tess_data_free(&t);
+        }
+        sfb_surface_destroy(s);
+        sfb_mesh_destroy(m);
+        sfb_context_destroy(ctx);
+        free(obj);
+    }
+}
+
+/* Seams the flat disk has none of: with SFB_TESS_UVS alone nothing is split, and the
+ * triangles are those of the plain tessellation. */
+Test(tess_uv, no_seams_no_split)
+{
+    sfb_context *ctx = tx_ctx();
+    char *obj = flat_uv_disk(0);
+    sfb_mesh *m = tx_mesh(ctx, obj);
+    sfb_surface *s = uv_surface(ctx, m, SFB_SCHEME_CATMARK);
+    sfb_tess_data a = tess_ok(s, ctx, 6, 0.0f, 0), b = tess_ok(s, ctx, 6, 0.0f, SFB_TESS_UVS);
+    cr_expect_null(a.uvs);
+    cr_expect_eq(a.vertex_count, b.vertex_count);
+    cr_expect_eq(a.triangle_count, b.triangle_count);
+    cr_expect_eq(memcmp(a.triangles, b.triangles, sizeof(int) * 3 * (size_t)a.triangle_count), 0);
+    cr_expect_eq(memcmp(a.positions, b.positions, sizeof(float) * 3 * (size_t)a.vertex_count), 0);
+    sfb_tess_data_free(&a);
+    sfb_tess_data_free(&b);
+    sfb_surface_destroy(s);
+    sfb_mesh_destroy(m);
+    sfb_context_destroy(ctx);
+    free(obj);
+}
+
+/* The cube with every face its own UV island (four UVs of its own), the unit square in the
+ * face's vertex order:
+ * every edge is a seam, so each face has its own (R+1)^2 vertices; the island is one quad with
+ * pinned corners, whose limit is exactly its bilinear map, so a vertex's UV is its (u,v) in
+ * its face. Welding by position gives the plain tessellation back. Trimmed too (the cut
+ * points carry their face's UVs). */
+static const char *cube_islands_obj =
+    "v -1 -1 1\nv 1 -1 1\nv -1 1 1\nv 1 1 1\nv -1 1 -1\nv 1 1 -1\nv -1 -1 -1\nv 1 -1 -1\n"
+    "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n"
+    "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n"
+    "f 1/1 2/2 4/3 3/4\nf 3/5 4/6 6/7 5/8\nf 5/9 6/10 8/11 7/12\nf 7/13 8/14 2/15 1/16\nf 2/17 8/18 6/19 4/20\n"
+    "f 7/21 1/22 3/23 5/24\n";
+
+/* vertices with no earlier vertex within 1e-5 (copies are evaluated once per side) */
+static long distinct_positions(const sfb_tess_data *t)
+{
+    long d = 0;
+    for (int i = 0; i < t->vertex_count; ++i) {
+        int dup = 0;
+        for (int j = 0; j < i && !dup; ++j)
+            dup = fabs(t->positions[3 * i] - t->positions[3 * j]) < 1e-5 && fabs(t->positions[3 * i + 1] - t->positions[3 * j + 1]) < 1e-5 &&
+                  fabs(t->positions[3 * i + 2] - t->positions[3 * j + 2]) < 1e-5;
+        d += !dup;
+    }
+    return d;
+}
+
+Test(tess_uv, every_edge_a_seam)
+{
+    sfb_context *ctx = tx_ctx();
+    sfb_mesh *m = tx_mesh(ctx, cube_islands_obj);
+    sfb_surface *s = uv_surface(ctx, m, SFB_SCHEME_CATMARK);
+    for (int R = 1; R <= 8; R += 7) {
+        sfb_tess_data t = tess_ok(s, ctx, R, 0.0f, SFB_TESS_UVS);
+        cr_expect_eq(t.vertex_count, 6 * (R + 1) * (R + 1), "rate %d: %d vertices", R, t.vertex_count);
+        cr_expect_eq(distinct_positions(&t), 6L * R * R + 2, "rate %d: welded", R);
+        double worst = 0.0;
+        for (int v = 0; v < t.vertex_count; ++v) {
+            double du = fabs(t.uvs[2 * v] - t.locations[v].u), dv = fabs(t.uvs[2 * v + 1] - t.locations[v].v);
+            if (du > worst) worst = du;
+            if (dv > worst) worst = dv;
+        }
+        cr_expect_lt(worst, 1e-6, "rate %d: UV is %g from the location", R, worst);
+        /* every triangle's vertices are located in the triangle's own face */
+        for (int i = 0; i < 3 * t.triangle_count; ++i)
+            cr_expect_eq(t.locations[t.triangles[i]].face, t.triangle_faces[i / 3]);
+        sfb_tess_data_free(&t);
+    }
+    /* trimmed: keep u < 0.5 of every face */
+    unsigned char tex[16 * 16];
+    for (int y = 0; y < 16; ++y)
+        for (int x = 0; x < 16; ++x) tex[16 * y + x] = x < 8 ? 255 : 0;
+    sfb_trim_mask mask;
+    memset(&mask, 0, sizeof mask);
+    mask.texels = tex;
+    mask.width = mask.height = 16;
+    sfb_tess_config c = sfb_tess_config_init(4);
+    c.flags = SFB_TESS_UVS;
+    c.trim = &mask;
+    sfb_tess_data t;
+    cr_assert_eq(sfb_surface_tessellate(s, &c, &t), SFB_SUCCESS, "%s", sfb_last_error(ctx));
+    cr_assert_not_null(t.uvs);
+    for (int v = 0; v < t.vertex_count; ++v) {
+        cr_expect_lt(fabs(t.uvs[2 * v] - t.locations[v].u), 1e-6);
+        cr_expect_lt(fabs(t.uvs[2 * v + 1] - t.locations[v].v), 1e-6);
+    }
+    sfb_tess_data_free(&t);
+    sfb_surface_destroy(s);
+    sfb_mesh_destroy(m);
+    sfb_context_destroy(ctx);
+}
+
+/* SFB_UV_LINEAR: a pentagon's sub-face i between its corner, the edge midpoints and the
+ * centroid, bilinearly; checked at the corners of the sub-faces against the refined UVs of
+ * level 1 (which the linear masks make exact), and inside against the bilinear map. */
+Test(tess_uv, linear_uvs)
+{
+    sfb_context *ctx = tx_ctx();
+    sfb_mesh *m0 = tx_mesh(ctx, prism_obj);
+    sfb_mesh_desc d;
+    sfb_mesh_get_desc(m0, &d);
+    /* UVs: each vertex's (x, z) squashed into [0,1], one per vertex */
+    float uv[20];
+    int fuv[64];
+    for (int i = 0; i < 10; ++i) { uv[2 * i] = 0.5f + 0.4f * d.positions[3 * i]; uv[2 * i + 1] = 0.5f + 0.25f * d.positions[3 * i + 2] + 0.1f * d.positions[3 * i + 1]; }
+    int nfv = 0;
+    for (int f = 0; f < d.face_count; ++f) nfv += d.face_sizes[f];
+    cr_assert_leq(nfv, 64);
+    for (int i = 0; i < nfv; ++i) fuv[i] = d.face_vertices[i];
+    d.uv_count = 10; d.uvs = uv; d.face_uvs = fuv;
+    d.uv_interp = SFB_UV_LINEAR;
+    sfb_mesh *m = NULL;
+    cr_assert_eq(sfb_mesh_create(ctx, &d, &m), SFB_SUCCESS, "%s", sfb_last_error(ctx));
+    sfb_surface *s = uv_surface(ctx, m, SFB_SCHEME_CATMARK);
+    sfb_tess_data t = tess_ok(s, ctx, 4, 0.0f, SFB_TESS_UVS);
+    int checked = 0;
+    for (int v = 0; v < t.vertex_count; ++v) {
+        int base, sub;
+        cr_assert_eq(sfb_surface_param_face_base(s, t.locations[v].face, &base, &sub), SFB_SUCCESS);
+        int o = 0;
+        for (int f = 0; f < base; ++f) o += d.face_sizes[f];
+        int n = d.face_sizes[base];
+        double q[4][2], u = t.locations[v].u, w = t.locations[v].v;
+        for (int c = 0; c < 2; ++c) {
+            if (sub < 0) {
+                for (int k = 0; k < 4; ++k) q[k][c] = uv[2 * fuv[o + k] + c];
+            } else {
+                double mean = 0;
+                for (int k = 0; k < n; ++k) mean += uv[2 * fuv[o + k] + c];
+                q[0][c] = uv[2 * fuv[o + sub] + c];
+                q[1][c] = 0.5 * (q[0][c] + uv[2 * fuv[o + (sub + 1) % n] + c]);
+                q[2][c] = mean / n;
+                q[3][c] = 0.5 * (q[0][c] + uv[2 * fuv[o + (sub + n - 1) % n] + c]);
+            }
+            double want = (1 - u) * (1 - w) * q[0][c] + u * (1 - w) * q[1][c] + u * w * q[2][c] + (1 - u) * w * q[3][c];
+            cr_expect_lt(fabs(t.uvs[2 * v + c] - want), 1e-6, "vertex %d uv %d: %g, want %g", v, c, t.uvs[2 * v + c], want);
+        }
+        checked += sub >= 0;
+    }
+    cr_expect_gt(checked, 0, "no vertex on a pentagon's sub-face");
+    /* the refinement agrees at level 1: the centroid of the top pentagon is refined UV ... */
+    sfb_surface_config sc = sfb_surface_config_init(SFB_SCHEME_CATMARK, 1);
+    sc.flags = SFB_REFINE_UVS;
+    sfb_surface *s1 = NULL;
+    cr_assert_eq(sfb_surface_create(ctx, m, &sc, &s1), SFB_SUCCESS);
+    sfb_mesh_data md;
+    cr_assert_eq(sfb_surface_refine(s1, &md), SFB_SUCCESS, "%s", sfb_last_error(ctx));
+    /* ... every refined UV value is some tessellated vertex's UV (rate 4 holds level 1's points) */
+    for (int i = 0; i < md.uv_count; ++i) {
+        double best = 1e9;
+        for (int v = 0; v < t.vertex_count; ++v) {
+            double e = fabs(md.uvs[2 * i] - t.uvs[2 * v]) + fabs(md.uvs[2 * i + 1] - t.uvs[2 * v + 1]);
+            if (e < best) best = e;
+        }
+        cr_expect_lt(best, 1e-6, "refined UV %d (%g, %g) is no tessellated UV", i, md.uvs[2 * i], md.uvs[2 * i + 1]);
+    }
+    sfb_mesh_data_free(&md);
+    sfb_surface_destroy(s1);
+    sfb_tess_data_free(&t);
+    sfb_surface_destroy(s);
+    sfb_mesh_destroy(m);
+    sfb_mesh_destroy(m0);
+    sfb_context_destroy(ctx);
+}
+
+Test(tess_uv, refused_without_uvs)
+{
+    sfb_context *ctx = tx_ctx();
+    sfb_mesh *m = tx_mesh(ctx, cube_obj);
+    sfb_surface *s = uv_surface(ctx, m, SFB_SCHEME_CATMARK);
+    sfb_tess_config c = sfb_tess_config_init(3);
+    c.flags = SFB_TESS_UVS;
+    sfb_tess_data t;
+    cr_expect_eq(sfb_surface_tessellate(s, &c, &t), SFB_INVALID_ARGS);
+    cr_expect(strstr(sfb_last_error(ctx), "no UVs") != NULL, "message: %s", sfb_last_error(ctx));
+    cr_expect_null(t.positions);
+    sfb_surface_destroy(s);
+    sfb_mesh_destroy(m);
+    /* a mesh with UVs, but a surface built without SFB_REFINE_UVS */
+    m = tx_mesh(ctx, cube_islands_obj);
+    sfb_surface_config sc = sfb_surface_config_init(SFB_SCHEME_CATMARK, 0);
+    sc.flags = SFB_REFINE_PATCHES;
+    s = NULL;
+    cr_assert_eq(sfb_surface_create(ctx, m, &sc, &s), SFB_SUCCESS);
+    cr_expect_eq(sfb_surface_tessellate(s, &c, &t), SFB_INVALID_ARGS);
+    sfb_surface_destroy(s);
+    sfb_mesh_destroy(m);
+    sfb_context_destroy(ctx);
+}
+
+Test(tess_uv, failures_and_cancellation)
+{
+    /* the cube of islands: every face open along its 4 x 70 boundary edges */
+    failure_sweep_mesh(0, 0.0f, SFB_TESS_UVS, cube_islands_obj, SFB_SCHEME_CATMARK, 70, 6L * 4 * 70);
+    failure_sweep_mesh(1, 0.0f, SFB_TESS_UVS, cube_islands_obj, SFB_SCHEME_CATMARK, 70, 6L * 4 * 70);
 }

@@ -30,8 +30,9 @@
  *     leaving `out` zeroed and nothing leaked, progress in order.
  * A backend that is unavailable SKIPs (FAILs when listed in SFB_REQUIRE_BACKENDS). Usage:
  * trim [SHAPES_DIR] (OpenSubdiv's loop_cube.obj is read from there when present). */
+#define SURFBLEND_EXPOSE_INTERNALS /* the internals below have external linkage in libsfb_internal.o */
 #include "surfblend.h"
-#include "src/sfb_internal.h" /* the library's internal interfaces (linked from libsfb.o) */
+#include "src/sfb_internal.h" /* the library's internal interfaces (linked from libsfb_internal.o) */
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>

@@ -396,6 +396,11 @@ void mesh_from_tess(const sfb_tess_data &t, bool flat, OutMesh *m) {
         m->indices.assign(t.triangles, t.triangles + 3 * (size_t)t.triangle_count);
         m->exact_p = m->positions;
         m->exact_n.assign(t.normals, t.normals + 3 * (size_t)t.vertex_count);
+        if (t.uvs) // glTF's v runs down the image
+            for (int v = 0; v < t.vertex_count; ++v) {
+                m->uvs.push_back(t.uvs[2 * (size_t)v]);
+                m->uvs.push_back(1.0f - t.uvs[2 * (size_t)v + 1]);
+            }
         for (int i = 0; i < t.triangle_count; ++i) {
             float fn[3];
             const int *c = t.triangles + 3 * (size_t)i;
@@ -415,6 +420,10 @@ void mesh_from_tess(const sfb_tess_data &t, bool flat, OutMesh *m) {
             m->normals.insert(m->normals.end(), fn, fn + 3);
             for (int q = 0; q < 3; ++q) m->exact_p.push_back(t.positions[3 * (size_t)c[j] + q]);
             for (int q = 0; q < 3; ++q) m->exact_n.push_back(t.normals[3 * (size_t)c[j] + q]);
+            if (t.uvs) {
+                m->uvs.push_back(t.uvs[2 * (size_t)c[j]]);
+                m->uvs.push_back(1.0f - t.uvs[2 * (size_t)c[j] + 1]);
+            }
         }
     }
 }
@@ -1067,7 +1076,7 @@ int evaluate_part(Run &R, Part &part) {
     sfb_mesh_desc d;
     sfb_mesh_get_desc(part.mesh, &d);
     sfb_surface_config cfg = sfb_surface_config_init(R.o.scheme, R.o.have_tess ? 0 : part.level);
-    if (R.o.have_tess) cfg.flags = SFB_REFINE_PATCHES;
+    if (R.o.have_tess) cfg.flags = SFB_REFINE_PATCHES | (d.uv_count > 0 ? (unsigned)SFB_REFINE_UVS : 0u);
     else cfg.flags = (R.o.normals == NORMALS_FLAT ? (R.o.report ? (unsigned)SFB_REFINE_LIMIT : 0u) : (unsigned)SFB_REFINE_SHADING) |
                      (d.uv_count > 0 ? (unsigned)SFB_REFINE_UVS : 0u);
     sfb_surface *surf = nullptr;
@@ -1078,7 +1087,7 @@ int evaluate_part(Run &R, Part &part) {
     if (R.o.have_tess) {
         sfb_tess_config tc = sfb_tess_config_init(part.rate);
         tc.tolerance = (float)R.o.tolerance;
-        tc.flags = SFB_TESS_SPLIT_CREASES;
+        tc.flags = SFB_TESS_SPLIT_CREASES | (d.uv_count > 0 ? (unsigned)SFB_TESS_UVS : 0u); // UV seams split too
         sfb_trim_mask mask;
         unsigned char *texels = nullptr;
         if (R.o.trim) {
