@@ -228,11 +228,12 @@ SFB_API int sfb_mesh_valence_histogram(const sfb_mesh *mesh, int *counts, int ma
 /* ---- surfaces ---- */
 typedef enum sfb_scheme {
     SFB_SCHEME_CATMARK = 0, SFB_SCHEME_LOOP, SFB_SCHEME_BILINEAR,
-    SFB_SCHEME_MANIFOLD_BLEND, SFB_SCHEME_TRIBEZIER
+    SFB_SCHEME_MANIFOLD_BLEND, SFB_SCHEME_TRIBEZIER,
+    SFB_SCHEME_PN  /* curved PN triangles (evaluated only: SFB_REFINE_PATCHES), on triangle meshes */
 } sfb_scheme;
 SFB_API const char *sfb_scheme_name(sfb_scheme s);
 /* The scheme named `name` ("catmark" or "catmull-clark", "loop", "bilinear", "manifold",
- * "tribezier": sfb_scheme_name's names) into *out; returns 1, or 0 for an unknown name. */
+ * "tribezier", "pn": sfb_scheme_name's names) into *out; returns 1, or 0 for an unknown name. */
 SFB_API int sfb_scheme_parse(const char *name, sfb_scheme *out);
 /* What a scheme supports (the SFB_SCHEME_CAN_* bits), so that callers ask a capability instead of
  * comparing schemes; 0 for a value that is not an sfb_scheme. */
@@ -1015,7 +1016,9 @@ typedef struct sfb__refine_options {
 enum { SFB__SCHEME_REFINES = SFB_SCHEME_CAN_REFINE,    /* uniform refinement (and limit stencils) by its rules */
        SFB__SCHEME_SHADES = SFB_SCHEME_CAN_SHADE,      /* subdivision shading (seed 001) */
        SFB__SCHEME_TRIANGLES = SFB_SCHEME_TRIANGLES,   /* faces must be triangles */
-       SFB__SCHEME_BOUNDARY_HOLES = 1u << 3  /* boundary NONE makes boundary faces holes (OpenSubdiv) */ };
+       SFB__SCHEME_BOUNDARY_HOLES = 1u << 3, /* boundary NONE makes boundary faces holes (OpenSubdiv) */
+       SFB__SCHEME_LINEAR_UVS = 1u << 4      /* tessellated UVs follow each face linearly (PN: the scheme on a
+                                                planar layout is the linear map, and a UV triangle may be flat) */ };
 typedef struct sfb__scheme_info {
     sfb_scheme scheme;
     const char *name;   /* sfb_scheme_name, sfb_scheme_parse */
@@ -1093,6 +1096,8 @@ enum { SFB__MF_PATCH = 0, SFB__MF_POINT = 1, SFB__MF_CURVE = 2 };
 #define SFB__MF_H(c) ((int)(((c) >> 15) & 8191u))
 #define SFB__MF_A1(c) ((int)(((c) >> 28) & 3u))
 #define SFB__MF_A2(c) ((int)(((c) >> 30) & 3u))
+/* Curved PN triangles (patch/pn.c): one BEZIER_TRI15 patch per triangle of base. */
+SFB__IF sfb_result sfb__pn_build(sfb_context *ctx, const sfb__level *base, const float *positions, sfb__patch_table *pt);
 SFB__IF sfb_result sfb__manifold_build(sfb_context *ctx, const sfb__level *base, int weights, const float *positions, sfb__patch_table *pt);
 SFB__IF void sfb__mf_eval(const float *pts, const int *cv, const unsigned *codes, int kind, double c, double d, double S[3], double Sc[3],
                   double Sd[3]);
@@ -5410,6 +5415,187 @@ done:
     if (r != SFB_SUCCESS) sfb__patch_table_free(ctx, pt);
     return r;
 }
+#line 1 "src/patch/pn.c"
+/* Curved PN triangles (SFB_SCHEME_PN; ALGORITHMS.md section 5.3): what engines tessellate
+ * today, beside seed 004's triangular splines for comparison. One cubic Bezier triangle per
+ * mesh triangle from its corners and their vertex normals, degree-raised to the quartic
+ * BEZIER_TRI15 patches the Loop work evaluates, so eval, tessellation, trimming, rendering and
+ * the glTF export run on every backend unchanged.
+ *
+ * Choices the method leaves open, made here:
+ *   - vertex normals: the angle-weighted mean of the incident triangles' normals (each
+ *     triangle's normal weighted by its angle at the vertex), computed from the base positions
+ *     when the surface is built; a mean that cancels (opposite triangles) falls back to the
+ *     first incident triangle's normal. PN triangles know no creases: sharpness tags are
+ *     ignored, every vertex has one normal.
+ *   - the patch's own normals (du x dv) are the surface's normals; at a corner they equal the
+ *     vertex normal, since both edge points next to a corner lie in the plane through it normal
+ *     to that vertex normal. The quadratic normal field of the method (for shading) is not
+ *     evaluated.
+ *   - refused: faces that are not triangles, non-manifold edges (more than two triangles),
+ *     degenerate triangles (an area below 1e-12 of the squared bounding-box diagonal, or
+ *     non-finite positions), since their normals, and so the patch, are undefined.
+ * Param faces are the triangles, (u,v) barycentric as Loop's: (1-u-v) P0 + u P1 + v P2. */
+
+/* Cubic point (a = exponent of s, b = exponent of t) of triangle (P[0], P[1], P[2]) with
+ * vertex normals N: corners P0 (0,0), P1 (3,0), P2 (0,3). */
+static void sfb__pn_cubic(double P[3][3], double N[3][3], double C[4][4][3]) {
+    /* the corner of each (a, b) on the boundary and the corner it points to */
+    static const int edge[6][4] = {{1, 0, 0, 1}, {2, 0, 1, 0}, {0, 1, 0, 2}, {0, 2, 2, 0}, {2, 1, 1, 2}, {1, 2, 2, 1}};
+    double E[3] = {0, 0, 0}, V[3];
+    int k, c;
+    for (c = 0; c < 3; ++c) {
+        C[0][0][c] = P[0][c];
+        C[3][0][c] = P[1][c];
+        C[0][3][c] = P[2][c];
+        V[c] = (P[0][c] + P[1][c] + P[2][c]) / 3.0;
+    }
+    for (k = 0; k < 6; ++k) {
+        const int a = edge[k][0], b = edge[k][1], i = edge[k][2], j = edge[k][3];
+        double w = 0.0;
+        for (c = 0; c < 3; ++c) w += (P[j][c] - P[i][c]) * N[i][c];
+        for (c = 0; c < 3; ++c) {
+            C[a][b][c] = (2.0 * P[i][c] + P[j][c] - w * N[i][c]) / 3.0;
+            E[c] += C[a][b][c] / 6.0;
+        }
+    }
+    for (c = 0; c < 3; ++c) C[1][1][c] = E[c] + 0.5 * (E[c] - V[c]);
+}
+
+/* Degree raising to our quartic order (row by row in t, s rising in a row):
+ * q(i,j,k) = (i c(i-1,j) + j c(i,j-1) + k c(i,j)) / 4 with k = 4 - i - j the exponent of w. */
+static void sfb__pn_raise(double C[4][4][3], float *out) {
+    int i, j, c, q = 0;
+    for (j = 0; j <= 4; ++j)
+        for (i = 0; i + j <= 4; ++i, ++q) {
+            const int k = 4 - i - j;
+            for (c = 0; c < 3; ++c) {
+                double v = 0.0;
+                if (i > 0) v += i * C[i - 1][j][c];
+                if (j > 0) v += j * C[i][j - 1][c];
+                if (k > 0) v += k * C[i][j][c];
+                out[3 * q + c] = (float)(v / 4.0);
+            }
+        }
+}
+
+static void sfb__pn_face_normal(const float *a, const float *b, const float *c, double n[3]) {
+    double u[3], v[3];
+    int k;
+    for (k = 0; k < 3; ++k) { u[k] = (double)b[k] - a[k]; v[k] = (double)c[k] - a[k]; }
+    sfb__cross3(u, v, n);
+}
+
+/* The angle at corner a of triangle (a, b, c). */
+static double sfb__pn_angle(const float *a, const float *b, const float *c) {
+    double u[3], v[3], x[3], d = 0.0;
+    int k;
+    for (k = 0; k < 3; ++k) { u[k] = (double)b[k] - a[k]; v[k] = (double)c[k] - a[k]; d += u[k] * v[k]; }
+    sfb__cross3(u, v, x);
+    return atan2(sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]), d);
+}
+
+sfb_result sfb__pn_build(sfb_context *ctx, const sfb__level *l, const float *positions, sfb__patch_table *pt) {
+    double *vn = NULL, lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0}, diag2 = 0.0;
+    int f, v, e, k, c, p = 0, npatch = 0;
+    sfb_result r = SFB_SUCCESS;
+    memset(pt, 0, sizeof *pt);
+    for (f = 0; f < l->nf; ++f)
+        if (sfb__face_n(l, f) != 3)
+            return sfb__error(ctx, SFB_INVALID_TOPOLOGY, SFB_ELEMENT_FACE, f, "PN triangles: face %d has %d vertices (triangles only)", f,
+                              sfb__face_n(l, f));
+    for (e = 0; e < l->ne; ++e)
+        if (l->ef_off[e + 1] - l->ef_off[e] > 2)
+            return sfb__error(ctx, SFB_INVALID_TOPOLOGY, SFB_ELEMENT_EDGE, e, "PN triangles: edge %d (%d-%d) is non-manifold (%d triangles)",
+                              e, l->ev[2 * e], l->ev[2 * e + 1], l->ef_off[e + 1] - l->ef_off[e]);
+    for (v = 0; v < l->nv; ++v)
+        for (c = 0; c < 3; ++c) {
+            const double x = positions[3 * (size_t)v + c];
+            if (!(x == x) || x > 3.4e38 || x < -3.4e38)
+                return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_VERTEX, v, "PN triangles: vertex %d is not finite", v);
+            if (v == 0 || x < lo[c]) lo[c] = x;
+            if (v == 0 || x > hi[c]) hi[c] = x;
+        }
+    for (c = 0; c < 3; ++c) diag2 += (hi[c] - lo[c]) * (hi[c] - lo[c]);
+    vn = (double *)sfb__calloc(ctx, (size_t)l->nv * 3 + 1, sizeof(double));
+    if (!vn) return sfb__oom(ctx, "PN triangles");
+    for (f = 0; f < l->nf; ++f) {
+        const int *fv = l->fv + l->fv_off[f];
+        double n[3], len;
+        sfb__pn_face_normal(positions + 3 * (size_t)fv[0], positions + 3 * (size_t)fv[1], positions + 3 * (size_t)fv[2], n);
+        len = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+        if (!(0.5 * len > 1e-12 * diag2)) {
+            r = sfb__error(ctx, SFB_INVALID_TOPOLOGY, SFB_ELEMENT_FACE, f, "PN triangles: triangle %d (%d %d %d) is degenerate (area %g)", f,
+                           fv[0], fv[1], fv[2], 0.5 * len);
+            goto done;
+        }
+        if (!l->fhole[f]) npatch++;
+        for (k = 0; k < 3; ++k) {
+            const double a = sfb__pn_angle(positions + 3 * (size_t)fv[k], positions + 3 * (size_t)fv[(k + 1) % 3],
+                                           positions + 3 * (size_t)fv[(k + 2) % 3]);
+            for (c = 0; c < 3; ++c) vn[3 * (size_t)fv[k] + c] += a * n[c] / len;
+        }
+    }
+    for (v = 0; v < l->nv; ++v) {
+        double *n = vn + 3 * (size_t)v, len = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+        if (!(len > 1e-9) && l->vf_off[v + 1] > l->vf_off[v]) { /* cancelled: the first triangle's normal */
+            const int g = l->vf[l->vf_off[v]], *fv = l->fv + l->fv_off[g];
+            sfb__pn_face_normal(positions + 3 * (size_t)fv[0], positions + 3 * (size_t)fv[1], positions + 3 * (size_t)fv[2], n);
+            len = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+        }
+        if (len > 0.0)
+            for (c = 0; c < 3; ++c) n[c] /= len;
+    }
+    /* the table: one param face and one BEZIER_TRI15 patch (15 points of its own) per triangle */
+    pt->domain = SFB__DOMAIN_TRI;
+    pt->nptex = l->nf;
+    pt->npatch = npatch;
+    pt->ncv = 15 * npatch;
+    pt->npoints = 15 * npatch;
+    pt->face_ptex = (int *)sfb__alloc(ctx, ((size_t)l->nf + 1) * sizeof(int));
+    pt->ptex_face = (int *)sfb__alloc(ctx, ((size_t)l->nf + 1) * sizeof(int));
+    pt->ptex_corner = (int *)sfb__alloc(ctx, ((size_t)l->nf + 1) * sizeof(int));
+    pt->ptex_root = (int *)sfb__alloc(ctx, ((size_t)l->nf + 1) * sizeof(int));
+    pt->nodes = (int *)sfb__alloc(ctx, 4 * sizeof(int));
+    pt->ptype = (int *)sfb__alloc(ctx, ((size_t)npatch + 1) * sizeof(int));
+    pt->pfirst = (int *)sfb__alloc(ctx, ((size_t)npatch + 1) * sizeof(int));
+    pt->pparam = (unsigned *)sfb__alloc(ctx, ((size_t)npatch + 1) * sizeof(unsigned));
+    pt->pvalence = (int *)sfb__calloc(ctx, (size_t)npatch + 1, sizeof(int));
+    pt->cv = (int *)sfb__alloc(ctx, ((size_t)npatch + 1) * 15 * sizeof(int));
+    pt->point_data = (float *)sfb__alloc(ctx, ((size_t)npatch + 1) * 45 * sizeof(float));
+    if (!pt->face_ptex || !pt->ptex_face || !pt->ptex_corner || !pt->ptex_root || !pt->nodes || !pt->ptype || !pt->pfirst ||
+        !pt->pparam || !pt->pvalence || !pt->cv || !pt->point_data) {
+        r = sfb__oom(ctx, "PN triangles");
+        goto done;
+    }
+    for (f = 0; f < l->nf; ++f) {
+        const int *fv = l->fv + l->fv_off[f];
+        double P[3][3], N[3][3], C[4][4][3];
+        pt->face_ptex[f] = pt->ptex_face[f] = f;
+        pt->ptex_corner[f] = -1;
+        if (l->fhole[f]) { pt->ptex_root[f] = -1; continue; }
+        for (k = 0; k < 3; ++k)
+            for (c = 0; c < 3; ++c) {
+                P[k][c] = positions[3 * (size_t)fv[k] + c];
+                N[k][c] = vn[3 * (size_t)fv[k] + c];
+            }
+        sfb__pn_cubic(P, N, C);
+        sfb__pn_raise(C, pt->point_data + 45 * (size_t)p);
+        pt->ptype[p] = SFB__PATCH_BEZTRI;
+        pt->pfirst[p] = 15 * p;
+        pt->pparam[p] = SFB__PARAM(0, 0, 0, 0);
+        for (k = 0; k < 15; ++k) pt->cv[15 * p + k] = 15 * p + k;
+        pt->ptex_root[f] = -(p + 2);
+        p++;
+    }
+    pt->face_ptex[l->nf] = l->nf;
+    pt->pfirst[npatch] = 15 * npatch;
+    pt->counts[SFB__PATCH_BEZTRI] = npatch;
+done:
+    sfb__free(ctx, vn);
+    if (r != SFB_SUCCESS) sfb__patch_table_free(ctx, pt);
+    return r;
+}
 #line 1 "src/tess.c"
 /* Watertight tessellation of the limit surface (sfb_surface_tessellate).
  *
@@ -6650,7 +6836,9 @@ static void sfb__tess_uv_linear(const sfb_surface *s, const sfb_location *L, flo
  * of the refined UV layout: the scheme's own patch builder run on the base UV layout (its
  * vertices the UV values, z = 0), evaluated by ref (2-D data, cheap beside the positions); the
  * layout has the surface's faces, hence its parametric faces. The manifold blend blends the UV
- * layout as it blends positions (the blend is linear in the data). The table is built per call:
+ * layout as it blends positions (the blend is linear in the data); PN triangles
+ * (SFB__SCHEME_LINEAR_UVS) take the linear UVs, which is what they make of a planar layout. The
+ * table is built per call:
  * a surface that never tessellates UVs does not pay for it. */
 static sfb_result sfb__tess_eval_uvs(const sfb_surface *s, sfb_tess_data *out, float p0) {
     sfb_context *ctx = s->ctx;
@@ -6664,7 +6852,7 @@ static sfb_result sfb__tess_eval_uvs(const sfb_surface *s, sfb_tess_data *out, f
     int i;
     out->uvs = (float *)sfb__tess_array(ctx, nv, 2 * sizeof(float));
     if (!out->uvs) return sfb__oom(ctx, "tessellated UVs");
-    if (s->uv_interp == SFB_UV_LINEAR || !si || !si->build_patches) {
+    if (s->uv_interp == SFB_UV_LINEAR || !si || !si->build_patches || (si->caps & SFB__SCHEME_LINEAR_UVS)) {
         for (v = 0; v < nv; ++v) sfb__tess_uv_linear(s, &out->locations[v], out->uvs + 2 * v);
         return sfb__progress(ctx, 1.0f, "tessellate");
     }
@@ -7892,6 +8080,12 @@ static sfb_result sfb__scheme_build_manifold(sfb_context *ctx, const sfb__level 
     return sfb__manifold_build(ctx, prep, cfg->manifold.weights, positions, pt);
 }
 
+static sfb_result sfb__scheme_build_pn(sfb_context *ctx, const sfb__level *prep, const sfb__refine_options *opt,
+                                       const sfb_surface_config *cfg, const float *positions, sfb__patch_table *pt) {
+    (void)opt; (void)cfg;
+    return sfb__pn_build(ctx, prep, positions, pt);
+}
+
 /* One row per scheme. */
 static const sfb__scheme_info sfb__schemes[] = {
     {SFB_SCHEME_CATMARK, "catmark", "Catmull-Clark", SFB_SCHEME_CATMARK,
@@ -7903,7 +8097,9 @@ static const sfb__scheme_info sfb__schemes[] = {
     {SFB_SCHEME_MANIFOLD_BLEND, "manifold", "manifold blending", SFB_SCHEME_CATMARK, SFB__SCHEME_BOUNDARY_HOLES,
      sfb__scheme_build_manifold},
     /* declared in the API, not built yet (seed 004) */
-    {SFB_SCHEME_TRIBEZIER, "tribezier", "quartic triangular Bezier", SFB_SCHEME_CATMARK, 0, NULL}
+    {SFB_SCHEME_TRIBEZIER, "tribezier", "quartic triangular Bezier", SFB_SCHEME_CATMARK, 0, NULL},
+    /* evaluated only: its tables are built at level 0, where Loop's rules are the identity */
+    {SFB_SCHEME_PN, "pn", "PN triangles", SFB_SCHEME_LOOP, SFB__SCHEME_TRIANGLES | SFB__SCHEME_LINEAR_UVS, sfb__scheme_build_pn}
 };
 
 const sfb__scheme_info *sfb__scheme_info_of(sfb_scheme s) {

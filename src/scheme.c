@@ -17,6 +17,12 @@ static sfb_result sfb__scheme_build_manifold(sfb_context *ctx, const sfb__level 
     return sfb__manifold_build(ctx, prep, cfg->manifold.weights, positions, pt);
 }
 
+static sfb_result sfb__scheme_build_pn(sfb_context *ctx, const sfb__level *prep, const sfb__refine_options *opt,
+                                       const sfb_surface_config *cfg, const float *positions, sfb__patch_table *pt) {
+    (void)opt; (void)cfg;
+    return sfb__pn_build(ctx, prep, positions, pt);
+}
+
 /* One row per scheme. */
 static const sfb__scheme_info sfb__schemes[] = {
     {SFB_SCHEME_CATMARK, "catmark", "Catmull-Clark", SFB_SCHEME_CATMARK,
@@ -28,7 +34,9 @@ static const sfb__scheme_info sfb__schemes[] = {
     {SFB_SCHEME_MANIFOLD_BLEND, "manifold", "manifold blending", SFB_SCHEME_CATMARK, SFB__SCHEME_BOUNDARY_HOLES,
      sfb__scheme_build_manifold},
     /* declared in the API, not built yet (seed 004) */
-    {SFB_SCHEME_TRIBEZIER, "tribezier", "quartic triangular Bezier", SFB_SCHEME_CATMARK, 0, NULL}
+    {SFB_SCHEME_TRIBEZIER, "tribezier", "quartic triangular Bezier", SFB_SCHEME_CATMARK, 0, NULL},
+    /* evaluated only: its tables are built at level 0, where Loop's rules are the identity */
+    {SFB_SCHEME_PN, "pn", "PN triangles", SFB_SCHEME_LOOP, SFB__SCHEME_TRIANGLES | SFB__SCHEME_LINEAR_UVS, sfb__scheme_build_pn}
 };
 
 const sfb__scheme_info *sfb__scheme_info_of(sfb_scheme s) {

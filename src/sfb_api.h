@@ -215,11 +215,12 @@ SFB_API int sfb_mesh_valence_histogram(const sfb_mesh *mesh, int *counts, int ma
 /* ---- surfaces ---- */
 typedef enum sfb_scheme {
     SFB_SCHEME_CATMARK = 0, SFB_SCHEME_LOOP, SFB_SCHEME_BILINEAR,
-    SFB_SCHEME_MANIFOLD_BLEND, SFB_SCHEME_TRIBEZIER
+    SFB_SCHEME_MANIFOLD_BLEND, SFB_SCHEME_TRIBEZIER,
+    SFB_SCHEME_PN  /* curved PN triangles (evaluated only: SFB_REFINE_PATCHES), on triangle meshes */
 } sfb_scheme;
 SFB_API const char *sfb_scheme_name(sfb_scheme s);
 /* The scheme named `name` ("catmark" or "catmull-clark", "loop", "bilinear", "manifold",
- * "tribezier": sfb_scheme_name's names) into *out; returns 1, or 0 for an unknown name. */
+ * "tribezier", "pn": sfb_scheme_name's names) into *out; returns 1, or 0 for an unknown name. */
 SFB_API int sfb_scheme_parse(const char *name, sfb_scheme *out);
 /* What a scheme supports (the SFB_SCHEME_CAN_* bits), so that callers ask a capability instead of
  * comparing schemes; 0 for a value that is not an sfb_scheme. */

@@ -399,7 +399,9 @@ typedef struct sfb__refine_options {
 enum { SFB__SCHEME_REFINES = SFB_SCHEME_CAN_REFINE,    /* uniform refinement (and limit stencils) by its rules */
        SFB__SCHEME_SHADES = SFB_SCHEME_CAN_SHADE,      /* subdivision shading (seed 001) */
        SFB__SCHEME_TRIANGLES = SFB_SCHEME_TRIANGLES,   /* faces must be triangles */
-       SFB__SCHEME_BOUNDARY_HOLES = 1u << 3  /* boundary NONE makes boundary faces holes (OpenSubdiv) */ };
+       SFB__SCHEME_BOUNDARY_HOLES = 1u << 3, /* boundary NONE makes boundary faces holes (OpenSubdiv) */
+       SFB__SCHEME_LINEAR_UVS = 1u << 4      /* tessellated UVs follow each face linearly (PN: the scheme on a
+                                                planar layout is the linear map, and a UV triangle may be flat) */ };
 typedef struct sfb__scheme_info {
     sfb_scheme scheme;
     const char *name;   /* sfb_scheme_name, sfb_scheme_parse */
@@ -477,6 +479,8 @@ enum { SFB__MF_PATCH = 0, SFB__MF_POINT = 1, SFB__MF_CURVE = 2 };
 #define SFB__MF_H(c) ((int)(((c) >> 15) & 8191u))
 #define SFB__MF_A1(c) ((int)(((c) >> 28) & 3u))
 #define SFB__MF_A2(c) ((int)(((c) >> 30) & 3u))
+/* Curved PN triangles (patch/pn.c): one BEZIER_TRI15 patch per triangle of base. */
+SFB__IF sfb_result sfb__pn_build(sfb_context *ctx, const sfb__level *base, const float *positions, sfb__patch_table *pt);
 SFB__IF sfb_result sfb__manifold_build(sfb_context *ctx, const sfb__level *base, int weights, const float *positions, sfb__patch_table *pt);
 SFB__IF void sfb__mf_eval(const float *pts, const int *cv, const unsigned *codes, int kind, double c, double d, double S[3], double Sc[3],
                   double Sd[3]);

@@ -1237,7 +1237,9 @@ static void sfb__tess_uv_linear(const sfb_surface *s, const sfb_location *L, flo
  * of the refined UV layout: the scheme's own patch builder run on the base UV layout (its
  * vertices the UV values, z = 0), evaluated by ref (2-D data, cheap beside the positions); the
  * layout has the surface's faces, hence its parametric faces. The manifold blend blends the UV
- * layout as it blends positions (the blend is linear in the data). The table is built per call:
+ * layout as it blends positions (the blend is linear in the data); PN triangles
+ * (SFB__SCHEME_LINEAR_UVS) take the linear UVs, which is what they make of a planar layout. The
+ * table is built per call:
  * a surface that never tessellates UVs does not pay for it. */
 static sfb_result sfb__tess_eval_uvs(const sfb_surface *s, sfb_tess_data *out, float p0) {
     sfb_context *ctx = s->ctx;
@@ -1251,7 +1253,7 @@ static sfb_result sfb__tess_eval_uvs(const sfb_surface *s, sfb_tess_data *out, f
     int i;
     out->uvs = (float *)sfb__tess_array(ctx, nv, 2 * sizeof(float));
     if (!out->uvs) return sfb__oom(ctx, "tessellated UVs");
-    if (s->uv_interp == SFB_UV_LINEAR || !si || !si->build_patches) {
+    if (s->uv_interp == SFB_UV_LINEAR || !si || !si->build_patches || (si->caps & SFB__SCHEME_LINEAR_UVS)) {
         for (v = 0; v < nv; ++v) sfb__tess_uv_linear(s, &out->locations[v], out->uvs + 2 * v);
         return sfb__progress(ctx, 1.0f, "tessellate");
     }

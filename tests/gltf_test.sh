@@ -168,6 +168,7 @@ if [ -d "$SHAPES" ]; then
   if [ "$n" -ge 20 ]; then ok "$n peer shapes exported"; else bad "only $n peer shapes exported"; fi
   export_ok peer_loop_tess.glb "$SHAPES/loop_cube_creases0.obj" --tess 8
   export_ok peer_car_tess_uv.glb "$SHAPES/catmark_car.obj" --tess 2
+  export_ok peer_pn.glb "$SHAPES/loop_icosahedron.obj" --scheme pn
   export_ok peer_car_flat.glb "$SHAPES/catmark_car.obj" --level 1 --normals flat
   export_ok peer_pole_limit.glb "$SHAPES/catmark_pole8.obj" --normals limit
 else
@@ -320,6 +321,9 @@ if [ -d "$SHAPES" ]; then
   readback fvar_tess_quant.glb "$SHAPES/catmark_fvar_bound1.obj" --tess 4 --quantize --compress -- --uvs yes
   readback loop_tess_uv.glb "$SHAPES/loop_chaikin1.obj" --tess 4 -- --uvs yes
   readback manifold_uv.glb "$SHAPES/catmark_fvar_bound1.obj" --scheme manifold --tess 6 -- --uvs yes
+  # PN triangles (evaluated only: tessellated like the manifold blend)
+  readback pn.glb "$SHAPES/loop_icosahedron.obj" --scheme pn --tess 6
+  readback pn_uv.glb "$SHAPES/loop_chaikin1.obj" --scheme pn --tess 4 -- --uvs yes
   readback noopt.glb "$SHAPES/catmark_chaikin1.obj" --level 2 --no-optimize
 fi
 # the default backend gives the same counts (the numbers within the backends' agreement)

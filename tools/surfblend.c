@@ -110,14 +110,14 @@ static const opt_choice positions_choices[] = { { "refined", 0, 0 }, { "limit", 
 static const opt_spec options[] = {
     { "--scheme", NULL, K_SCHEME, C_REFINE, O_SCHEME, AT(scheme), "catmark|loop|bilinear", NULL, 0, 0, 0,
       "catmark, loop or bilinear", "subdivision scheme (default: from the file name prefix loop_ or bilinear_, else catmark)" },
-    { "--scheme", NULL, K_SCHEME, C_EVAL | C_TESS, O_SCHEME, AT(scheme), "catmark|loop|manifold", NULL, 0, 0, 0,
-      "catmark, loop or manifold", "a subdivision limit surface or the manifold blending surface (seed 000)\n"
+    { "--scheme", NULL, K_SCHEME, C_EVAL | C_TESS, O_SCHEME, AT(scheme), "catmark|loop|manifold|pn", NULL, 0, 0, 0,
+      "catmark, loop, manifold or pn", "a subdivision limit surface, the manifold blending surface (seed 000) or PN triangles\n"
       "(default: from the file name prefix loop_ or bilinear_, else catmark)" },
     { "--scheme", NULL, K_SCHEME, C_SHADE, O_SCHEME, AT(scheme), "catmark|loop", NULL, 0, 0, NO_BILINEAR,
       "catmark or loop", "subdivision scheme (default: from the file name prefix loop_, else catmark)" },
-    { "--scheme", NULL, K_SCHEME, C_RENDER, O_SCHEME, AT(scheme), "catmark|loop|manifold", NULL, 0, 0, NO_BILINEAR,
-      "catmark, loop or manifold", "subdivision scheme (default: from the file name prefix loop_, else catmark);\n"
-      "manifold: draw the manifold blending surface (seed 000) tessellated instead" },
+    { "--scheme", NULL, K_SCHEME, C_RENDER, O_SCHEME, AT(scheme), "catmark|loop|manifold|pn", NULL, 0, 0, NO_BILINEAR,
+      "catmark, loop, manifold or pn", "subdivision scheme (default: from the file name prefix loop_, else catmark);\n"
+      "manifold, pn: draw the manifold blending surface (seed 000) or PN triangles tessellated instead" },
     { "--level", NULL, K_INT, C_REFINE, O_LEVEL, AT(level), "L", NULL, 0, 1000, 0, "a number >= 0",
       "uniform refinement level 0..10 (default 2)" },
     { "--level", NULL, K_INT, C_SHADING, O_LEVEL, AT(level), "L", NULL, 0, 1000, 0, "a number >= 0",
@@ -1087,10 +1087,13 @@ static void render_summary(const cli_opts *o, const render_state *s) {
     if (o->mode != SFB_RENDER_WEIGHTS && !manifold) snprintf(field, sizeof field, " of the %s normals", normal_names[o->normals]);
     snprintf(what, sizeof what, "render %s%s, %dx%d (%d object pixels%s):", mode_names[o->mode], field, s->img.width, s->img.height,
              s->img.object_pixels, s->img.skipped_faces ? ", faces with non-finite positions skipped" : "");
-    if (manifold)
+    if (manifold && o->scheme == SFB_SCHEME_MANIFOLD_BLEND)
         cli_error("%s manifold blend (%s weights) tessellated at rate %ld%s: %d triangles -> %s (backend %s)", what,
                   o->weights ? "C-infinity" : "Hermite", o->rate, o->trim ? ", trimmed" : "", s->td.triangle_count, o->outp,
                   sfb_context_backend_name(s->ctx));
+    else if (manifold)
+        cli_error("%s %s surface tessellated at rate %ld%s: %d triangles -> %s (backend %s)", what, sfb_scheme_name((sfb_scheme)o->scheme),
+                  o->rate, o->trim ? ", trimmed" : "", s->td.triangle_count, o->outp, sfb_context_backend_name(s->ctx));
     else shade_summary(what, o, &s->data, s->ctx);
 }
 
