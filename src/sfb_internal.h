@@ -445,6 +445,10 @@ SFB__IF sfb_result sfb__level_prepare(sfb_context *ctx, const sfb__level *src, i
 SFB__IF sfb_result sfb__surface_apply(const sfb_surface *s, const sfb__stencils *t, void *handle, int rows, const float *src,
                               sfb_buffer_desc sd, float *dst, sfb_buffer_desc dd);
 /* The refined (or limit) mesh of a surface into o (surface.c). */
+/* Tessellated UVs (surface.c, where the scheme is read): smooth (the layout's limit) or linear,
+ * and the patch table of the base UV layout. */
+SFB__IF int sfb__surface_smooth_uvs(const sfb_surface *s);
+SFB__IF sfb_result sfb__surface_uv_patches(const sfb_surface *s, struct sfb__patch_table *upt);
 SFB__IF sfb_result sfb__refine_output(const sfb_surface *s, const float *base, int base_count, int want_limit, sfb_mesh_data *o);
 
 SFB__IF void sfb__shading_free(sfb_context *ctx, sfb__shading *sh);

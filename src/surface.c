@@ -157,6 +157,60 @@ static sfb_result sfb__surface_build_uvs(sfb_surface *s, const sfb_mesh *mesh, c
     return SFB_SUCCESS;
 }
 
+/* Whether tessellated UVs are the limit of the UV layout (its own patch table,
+ * sfb__surface_uv_patches), or follow each face linearly: SFB_UV_LINEAR, and the schemes marked
+ * SFB__SCHEME_LINEAR_UVS or without a patch builder. */
+int sfb__surface_smooth_uvs(const sfb_surface *s) {
+    const sfb__scheme_info *si = sfb__scheme_info_of(s->config.scheme);
+    return s->uv_interp != SFB_UV_LINEAR && si && si->build_patches && !(si->caps & SFB__SCHEME_LINEAR_UVS);
+}
+
+/* The patch table of the base UV layout (its vertices the UV values, z = 0) by the scheme's own
+ * builder, for tessellated UVs (tess.c); its parametric faces are the surface's.
+ * A layout that is not a manifold (a UV value shared by faces that do not form one fan, as
+ * placeholder UVs are: OpenSubdiv's car has 4 UV values for 1575 faces) is sharpened there like
+ * any non-manifold vertex, and every face beside such a vertex is irregular: isolating them to
+ * the surface's level costs seconds and gigabytes for a label, not a layout. Such a layout is
+ * isolated one level only; end caps approximate it near its irregular features. */
+sfb_result sfb__surface_uv_patches(const sfb_surface *s, sfb__patch_table *upt) {
+    sfb_context *ctx = s->ctx;
+    const sfb__scheme_info *si = sfb__scheme_info_of(s->config.scheme);
+    sfb__refine_options opt;
+    sfb_surface_config ucfg;
+    float *P;
+    sfb_result r;
+    int i;
+    memset(upt, 0, sizeof *upt);
+    if (!si || !si->build_patches || !s->uv_base.fv)
+        return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "tessellated UVs: the surface has no UV layout to evaluate");
+    memset(&opt, 0, sizeof opt);
+    opt.scheme = si->rules;
+    opt.crease_method = s->crease_method;
+    opt.triangle_rule = s->triangle_rule;
+    P = (float *)sfb__alloc(ctx, ((size_t)s->uv_base.nv + 1) * 3 * sizeof(float));
+    if (!P) return sfb__oom(ctx, "tessellated UVs");
+    for (i = 0; i < s->uv_base.nv; ++i) {
+        P[3 * i] = s->base_uvs[2 * i];
+        P[3 * i + 1] = s->base_uvs[2 * i + 1];
+        P[3 * i + 2] = 0.0f;
+    }
+    ucfg = s->config;
+    for (i = 0; i < s->uv_base.nv; ++i)
+        if (s->uv_base.vtag[i] & SFB__TAG_NONMANIFOLD) break;
+    if (i < s->uv_base.nv) {
+        ucfg.isolation_level = 1;
+        sfb__log(ctx, SFB_LOG_INFO, "tessellated UVs: the UV layout is not a manifold (UV %d): isolated one level", i);
+    }
+    r = si->build_patches(ctx, &s->uv_base, &opt, &ucfg, P, upt);
+    sfb__free(ctx, P);
+    if (r == SFB_SUCCESS && upt->nptex != s->patches.nptex) {
+        r = sfb__error(ctx, SFB_BACKEND_ERROR, SFB_ELEMENT_NONE, -1, "tessellated UVs: the UV layout has %d parametric faces, the surface %d",
+                       upt->nptex, s->patches.nptex);
+        sfb__patch_table_free(ctx, upt);
+    }
+    return r;
+}
+
 /* Hands the built tables (stencils, shading, patches) to the context's backend once (device
  * upload); failures come back here. */
 static sfb_result sfb__surface_upload(sfb_surface *s) {

@@ -1234,60 +1234,27 @@ static void sfb__tess_uv_linear(const sfb_surface *s, const sfb_location *L, flo
 }
 
 /* SFB_TESS_UVS: out->uvs at out->locations (progress from p0 to 1). Smooth UVs are the limit
- * of the refined UV layout: the scheme's own patch builder run on the base UV layout (its
- * vertices the UV values, z = 0), evaluated by ref (2-D data, cheap beside the positions); the
- * layout has the surface's faces, hence its parametric faces. The manifold blend blends the UV
- * layout as it blends positions (the blend is linear in the data); PN triangles
- * (SFB__SCHEME_LINEAR_UVS) take the linear UVs, which is what they make of a planar layout. The
- * table is built per call:
- * a surface that never tessellates UVs does not pay for it. */
+ * of the refined UV layout: the layout's own patch table (sfb__surface_uv_patches, built per
+ * call, so a surface that never tessellates UVs does not pay for it), evaluated by ref (2-D
+ * data, cheap beside the positions). The manifold blend blends the UV layout as it blends
+ * positions (the blend is linear in the data); PN triangles take the linear UVs, which is what
+ * they make of a planar layout. */
 static sfb_result sfb__tess_eval_uvs(const sfb_surface *s, sfb_tess_data *out, float p0) {
     sfb_context *ctx = s->ctx;
     size_t v, nv = (size_t)out->vertex_count, done_v;
     sfb__patch_table upt;
-    sfb__refine_options opt;
-    sfb_surface_config ucfg;
-    const sfb__scheme_info *si = sfb__scheme_info_of(s->config.scheme);
-    float *P = NULL, *tmp = NULL;
+    float *tmp = NULL;
     sfb_result r = SFB_SUCCESS;
-    int i;
     out->uvs = (float *)sfb__tess_array(ctx, nv, 2 * sizeof(float));
     if (!out->uvs) return sfb__oom(ctx, "tessellated UVs");
-    if (s->uv_interp == SFB_UV_LINEAR || !si || !si->build_patches || (si->caps & SFB__SCHEME_LINEAR_UVS)) {
+    memset(&upt, 0, sizeof upt);
+    if (!sfb__surface_smooth_uvs(s)) {
         for (v = 0; v < nv; ++v) sfb__tess_uv_linear(s, &out->locations[v], out->uvs + 2 * v);
         return sfb__progress(ctx, 1.0f, "tessellate");
     }
-    memset(&upt, 0, sizeof upt);
-    memset(&opt, 0, sizeof opt);
-    opt.scheme = si->rules;
-    opt.crease_method = s->crease_method;
-    opt.triangle_rule = s->triangle_rule;
-    P = (float *)sfb__tess_array(ctx, (size_t)s->uv_base.nv, 3 * sizeof(float));
     tmp = (float *)sfb__tess_array(ctx, SFB__TESS_EVAL_CHUNK, 3 * sizeof(float));
-    if (!P || !tmp) { r = sfb__oom(ctx, "tessellated UVs"); goto done; }
-    for (i = 0; i < s->uv_base.nv; ++i) {
-        P[3 * i] = s->base_uvs[2 * i];
-        P[3 * i + 1] = s->base_uvs[2 * i + 1];
-        P[3 * i + 2] = 0.0f;
-    }
-    /* A layout that is not a manifold (a UV value shared by faces that do not form one fan, as
-     * placeholder UVs are: OpenSubdiv's car has 4 UV values for 1575 faces) is sharpened there
-     * like any non-manifold vertex, and every face beside such a vertex is irregular: isolating
-     * them to the surface's level costs seconds and gigabytes for a label, not a layout. Such a
-     * layout is isolated one level only; end caps approximate it near its irregular features. */
-    ucfg = s->config;
-    for (i = 0; i < s->uv_base.nv; ++i)
-        if (s->uv_base.vtag[i] & SFB__TAG_NONMANIFOLD) break;
-    if (i < s->uv_base.nv) {
-        ucfg.isolation_level = 1;
-        sfb__log(ctx, SFB_LOG_INFO, "tessellated UVs: the UV layout is not a manifold (UV %d): isolated one level", i);
-    }
-    if ((r = si->build_patches(ctx, &s->uv_base, &opt, &ucfg, P, &upt)) != SFB_SUCCESS) goto done;
-    if (upt.nptex != s->patches.nptex) {
-        r = sfb__error(ctx, SFB_BACKEND_ERROR, SFB_ELEMENT_NONE, -1, "tessellated UVs: the UV layout has %d parametric faces, the surface %d",
-                       upt.nptex, s->patches.nptex);
-        goto done;
-    }
+    if (!tmp) return sfb__oom(ctx, "tessellated UVs");
+    if ((r = sfb__surface_uv_patches(s, &upt)) != SFB_SUCCESS) goto done;
     for (done_v = 0; done_v < nv; done_v += SFB__TESS_EVAL_CHUNK) {
         size_t n = nv - done_v < SFB__TESS_EVAL_CHUNK ? nv - done_v : SFB__TESS_EVAL_CHUNK;
         sfb_eval_output eo;
@@ -1303,7 +1270,6 @@ static sfb_result sfb__tess_eval_uvs(const sfb_surface *s, sfb_tess_data *out, f
     r = sfb__progress(ctx, 1.0f, "tessellate");
 done:
     sfb__patch_table_free(ctx, &upt);
-    sfb__free(ctx, P);
     sfb__free(ctx, tmp);
     return r;
 }
