@@ -1235,14 +1235,17 @@ static void sfb__tess_uv_linear(const sfb_surface *s, const sfb_location *L, flo
 
 /* SFB_TESS_UVS: out->uvs at out->locations (progress from p0 to 1). Smooth UVs are the limit
  * of the refined UV layout: the layout's own patch table (sfb__surface_uv_patches, built per
- * call, so a surface that never tessellates UVs does not pay for it), evaluated by ref (2-D
- * data, cheap beside the positions). The manifold blend blends the UV layout as it blends
+ * call, so a surface that never tessellates UVs does not pay for it), uploaded to and
+ * evaluated on the context's backend as the positions are. The manifold blend blends the UV layout as it blends
  * positions (the blend is linear in the data); PN triangles take the linear UVs, which is what
  * they make of a planar layout. */
 static sfb_result sfb__tess_eval_uvs(const sfb_surface *s, sfb_tess_data *out, float p0) {
     sfb_context *ctx = s->ctx;
     size_t v, nv = (size_t)out->vertex_count, done_v;
     sfb__patch_table upt;
+    const sfb__backend_vtable *be = ctx->backend;
+    void *handle = NULL;
+    int uploaded = 0;
     float *tmp = NULL;
     sfb_result r = SFB_SUCCESS;
     out->uvs = (float *)sfb__tess_array(ctx, nv, 2 * sizeof(float));
@@ -1255,13 +1258,20 @@ static sfb_result sfb__tess_eval_uvs(const sfb_surface *s, sfb_tess_data *out, f
     tmp = (float *)sfb__tess_array(ctx, SFB__TESS_EVAL_CHUNK, 3 * sizeof(float));
     if (!tmp) return sfb__oom(ctx, "tessellated UVs");
     if ((r = sfb__surface_uv_patches(s, &upt)) != SFB_SUCCESS) goto done;
+    /* on the context's backend, like the positions (ref when it has no patch kernels) */
+    if (be && be->upload_patches && be->eval_patches) {
+        if ((r = be->upload_patches(ctx->backend_state, &upt, &handle)) != SFB_SUCCESS) goto done;
+        uploaded = 1;
+    }
     for (done_v = 0; done_v < nv; done_v += SFB__TESS_EVAL_CHUNK) {
         size_t n = nv - done_v < SFB__TESS_EVAL_CHUNK ? nv - done_v : SFB__TESS_EVAL_CHUNK;
         sfb_eval_output eo;
         if ((r = sfb__progress(ctx, p0 + (1.0f - p0) * (float)done_v / (float)nv, "tessellate")) != SFB_SUCCESS) goto done;
         memset(&eo, 0, sizeof eo);
         eo.position = tmp;
-        if ((r = sfb__ref_eval_patches(NULL, &upt, NULL, out->locations + done_v, 0, (int)n, &eo)) != SFB_SUCCESS) goto done;
+        r = be && be->eval_patches ? be->eval_patches(ctx->backend_state, &upt, handle, out->locations + done_v, 0, (int)n, &eo)
+                                   : sfb__ref_eval_patches(NULL, &upt, NULL, out->locations + done_v, 0, (int)n, &eo);
+        if (r != SFB_SUCCESS) goto done;
         for (v = 0; v < n; ++v) {
             out->uvs[2 * (done_v + v)] = tmp[3 * v];
             out->uvs[2 * (done_v + v) + 1] = tmp[3 * v + 1];
@@ -1269,6 +1279,7 @@ static sfb_result sfb__tess_eval_uvs(const sfb_surface *s, sfb_tess_data *out, f
     }
     r = sfb__progress(ctx, 1.0f, "tessellate");
 done:
+    if (uploaded && be->release_patches) be->release_patches(ctx->backend_state, handle);
     sfb__patch_table_free(ctx, &upt);
     sfb__free(ctx, tmp);
     return r;
