@@ -2,7 +2,7 @@
  *
  * Input: OBJ text. If sfb_mesh_read_obj accepts it, build the PN surface (an error is fine, with
  * a message: faces that are not triangles, non-manifold edges, degenerate triangles), then:
- *   - evaluate every parametric face at its three corners, edge midpoints and centre: a normal
+ *   - evaluate every parametric face (holes excepted) at its corners, edge midpoints and centre: a normal
  *     is unit length or zero; when every input position is finite and small (|x| < 1e6), the
  *     positions are finite, a corner is its mesh vertex (within 1e-5 of the bounding-box
  *     diagonal), and every point lies within the bounding box grown by 10 times its diagonal;
@@ -57,13 +57,17 @@ static void run(sfb_context *ctx, const sfb_mesh *mesh)
         float *P = (float *)malloc(sizeof(float) * 6 * (size_t)(7 * nf + 1)), *N = P + 3 * (size_t)(7 * nf + 1);
         sfb_eval_output o;
         if (!L || !P) fail("test allocation", NULL);
-        for (f = 0; f < nf; ++f)
+        for (f = 0; f < nf; ++f) {
+            int h, hole = 0;
+            for (h = 0; h < d.hole_count; ++h) hole |= d.holes[h] == f; /* one param face per triangle */
+            if (hole) continue;
             for (q = 0; q < 7; ++q) {
                 L[n].face = f;
                 L[n].u = uv[q][0];
                 L[n].v = uv[q][1];
                 n++;
             }
+        }
         memset(&o, 0, sizeof o);
         o.position = P;
         o.normal = N;
