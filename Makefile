@@ -179,6 +179,12 @@ run: deps $(BUILD)/surfblend $(BUILD)/sfb2gltf
 	./$(BUILD)/surfblend render --scheme manifold --rate 8 --trim examples/data/trim_disc.png --view 35,30 --size 800x600 \
 	  examples/data/torus.obj -o out/manifold_trimmed.png
 	@echo "wrote out/manifold_features.obj out/manifold_features.png out/manifold_trimmed.png"
+	@# quartic triangular Bezier surfaces (seed 004): a straight crease through a vertex of valence 5
+	@# at s = 0 (smooth, G1), 0.5 and 1 (the crease), with highlight lines (as the seed's Fig. 9)
+	@for s in 0 0.5 1; do \
+	  ./$(BUILD)/surfblend render --scheme tribezier --sharpness $$s --rate 12 --highlight --view 30,50 --size 600x450 \
+	    examples/data/tribezier_crease_v5.obj -o out/tribezier_crease_v5_s$$s.png || exit 1; done
+	@echo "wrote out/tribezier_crease_v5_s0.png out/tribezier_crease_v5_s0.5.png out/tribezier_crease_v5_s1.png"
 	@# the main job's end: glTF 2.0 for engines and viewers -- the creased box with subdivision-shading
 	@# normals (hard edges split), and the manifold blend tessellated
 	./$(BUILD)/sfb2gltf --level 3 examples/data/creased_box.obj -o out/creased_box.glb
@@ -247,6 +253,12 @@ $(BUILD)/finish_normals: tests/finish_normals.c tests/harness.h surfblend.h $(BA
 $(BUILD)/manifold: tests/manifold.c tests/harness.h src/sfb_internal.h $(BUILD)/libsfb_internal.o
 	$(CC) $(CFLAGS) $(SAN) -I. tests/manifold.c $(BUILD)/libsfb_internal.o -o $@ $(LIBS)
 
+# Quartic triangular Bezier surfaces (SFB_SCHEME_TRIBEZIER, seed 004): G1, Loop where regular,
+# creases and the s-blend, the undulation measurement, every backend's eval; reaches the builder's
+# double points through src/sfb_internal.h (tests/tribezier.c).
+$(BUILD)/tribezier: tests/tribezier.c tests/tribezier_mesh.h tests/harness.h src/sfb_internal.h $(BUILD)/libsfb_internal.o
+	$(CC) $(CFLAGS) $(SAN) -I. tests/tribezier.c $(BUILD)/libsfb_internal.o -o $@ $(LIBS)
+
 # Manifold blending on gl/osmesa and the vertex-shader draw path (with trimming) on a GL context
 # the test owns (links EGL/GL as gl_host) (tests/gl_manifold.c).
 $(BUILD)/gl_manifold: tests/gl_manifold.c tests/harness.h tests/egl_host.h $(BUILD)/libsfb.o
@@ -258,7 +270,7 @@ $(BUILD)/web/png_iou: tests/web/png_iou.c | deps
 	$(CC) -std=c99 $(OPT) -g -Wall -Wextra $(SAN) $< -o $@ -lm
 
 unit-build: $(BUILD)/web/png_iou $(BUILD)/surfblend $(BUILD)/unit $(BUILD)/osd_agree $(BUILD)/agree $(BUILD)/limit $(BUILD)/eigen $(BUILD)/gl_host \
-            $(BUILD)/gl_errors $(BUILD)/gl_pieces $(BUILD)/shade $(BUILD)/trim $(BUILD)/finish_normals $(BUILD)/manifold $(BUILD)/gl_manifold $(EXAMPLES) \
+            $(BUILD)/gl_errors $(BUILD)/gl_pieces $(BUILD)/shade $(BUILD)/trim $(BUILD)/finish_normals $(BUILD)/manifold $(BUILD)/tribezier $(BUILD)/gl_manifold $(EXAMPLES) \
             $(EXAMPLES_CXX) $(BUILD)/png_iou $(BUILD)/sfb2gltf $(BUILD)/gltf_check
 
 # On CI (CI set and not false/0) the optional backends must run, not be skipped: the suites

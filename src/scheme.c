@@ -23,6 +23,12 @@ static sfb_result sfb__scheme_build_pn(sfb_context *ctx, const sfb__level *prep,
     return sfb__pn_build(ctx, prep, positions, pt);
 }
 
+static sfb_result sfb__scheme_build_tribezier(sfb_context *ctx, const sfb__level *prep, const sfb__refine_options *opt,
+                                              const sfb_surface_config *cfg, const float *positions, sfb__patch_table *pt) {
+    (void)opt;
+    return sfb__tribezier_build(ctx, prep, positions, &cfg->tribezier, pt);
+}
+
 /* One row per scheme. */
 static const sfb__scheme_info sfb__schemes[] = {
     {SFB_SCHEME_CATMARK, "catmark", "Catmull-Clark", SFB_SCHEME_CATMARK,
@@ -33,8 +39,9 @@ static const sfb__scheme_info sfb__schemes[] = {
     /* evaluated only: its tables are built at level 0, where Catmull-Clark's rules are the identity */
     {SFB_SCHEME_MANIFOLD_BLEND, "manifold", "manifold blending", SFB_SCHEME_CATMARK, SFB__SCHEME_BOUNDARY_HOLES,
      sfb__scheme_build_manifold},
-    /* declared in the API, not built yet (seed 004) */
-    {SFB_SCHEME_TRIBEZIER, "tribezier", "quartic triangular Bezier", SFB_SCHEME_CATMARK, 0, NULL},
+    /* evaluated only (seed 004): its tables are built at level 0, where Loop's rules are the identity */
+    {SFB_SCHEME_TRIBEZIER, "tribezier", "quartic triangular Bezier", SFB_SCHEME_LOOP, SFB__SCHEME_TRIANGLES | SFB__SCHEME_LINEAR_UVS,
+     sfb__scheme_build_tribezier},
     /* evaluated only: its tables are built at level 0, where Loop's rules are the identity */
     {SFB_SCHEME_PN, "pn", "PN triangles", SFB_SCHEME_LOOP, SFB__SCHEME_TRIANGLES | SFB__SCHEME_LINEAR_UVS, sfb__scheme_build_pn}
 };

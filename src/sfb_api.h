@@ -273,6 +273,15 @@ typedef struct sfb_manifold_options {
     int weights;        /* sfb_manifold_weights */
 } sfb_manifold_options;
 
+/* Quartic triangular Bezier surfaces (seed 004), SFB_SCHEME_TRIBEZIER; zero = defaults: every
+ * crease's s from its sharpness tag clamped to [0, 1] (infinite: 1), every corner's from its
+ * corner tag. s = 0 is the smooth (G1) spline surface, s = 1 the crease, between them the point-wise
+ * blend. */
+typedef struct sfb_tribezier_options {
+    int sharpness_set;  /* nonzero: `sharpness` replaces every tagged crease's and corner's s */
+    float sharpness;    /* in [0, 1] */
+} sfb_tribezier_options;
+
 typedef struct sfb_surface_config {
     sfb_scheme scheme;
     int refine_level;   /* uniform refinement level compiled into the tables (0..SFB_MAX_LEVEL) */
@@ -281,6 +290,7 @@ typedef struct sfb_surface_config {
                            (0: SFB_DEFAULT_ISOLATION); below it faces get an end cap */
     sfb_shading_options shading; /* SFB_REFINE_SHADING */
     sfb_manifold_options manifold; /* SFB_SCHEME_MANIFOLD_BLEND */
+    sfb_tribezier_options tribezier; /* SFB_SCHEME_TRIBEZIER */
 } sfb_surface_config;
 #define SFB_DEFAULT_ISOLATION 8
 SFB_API sfb_surface_config sfb_surface_config_init(sfb_scheme scheme, int level);

@@ -464,6 +464,9 @@ SFB__IF sfb_result sfb__shading_build(sfb_context *ctx, const sfb__level *prep, 
 
 /* ---- patch tables (patch/) ---- */
 SFB__IF void sfb__patch_table_free(sfb_context *ctx, sfb__patch_table *pt);
+/* One BEZIER_TRI15 patch of its own 15 points (net: 45 doubles per triangle) per triangle of l that
+ * is not a hole (patch/table.c; PN triangles, tribezier). */
+SFB__IF sfb_result sfb__patch_table_beztri_own(sfb_context *ctx, const sfb__level *l, const double *net, sfb__patch_table *pt);
 /* The families present in a table, as bits 1 << SFB__FAMILY_*. */
 static inline unsigned sfb__patch_families(const sfb__patch_table *pt) {
     unsigned m = 0;
@@ -485,6 +488,23 @@ enum { SFB__MF_PATCH = 0, SFB__MF_POINT = 1, SFB__MF_CURVE = 2 };
 #define SFB__MF_A2(c) ((int)(((c) >> 30) & 3u))
 /* Curved PN triangles (patch/pn.c): one BEZIER_TRI15 patch per triangle of base. */
 SFB__IF sfb_result sfb__pn_build(sfb_context *ctx, const sfb__level *base, const float *positions, sfb__patch_table *pt);
+/* Quartic triangular Bezier surfaces with sharpness (patch/tribezier.c, seed 004): the 15 points
+ * of every triangle of base (patch order, double, 45 per triangle, freed by the caller) and what
+ * the G1 solve did; flags SFB__TBZ_SEED_PLANE builds the seed's smooth net at crease vertices (a
+ * tangent plane that ignores the crease, for the undulation measurement). */
+enum { SFB__TBZ_SEED_PLANE = 1 };
+typedef struct sfb__tbz_stats {
+    long iterations;   /* CGLS iterations, all coordinates and nets */
+    long unknowns;     /* points moved by the G1 solve, per coordinate and net */
+    long constraints;  /* G1 rows */
+    double residual;   /* largest G1 row left, relative to the net's largest coordinate */
+    int fallbacks;     /* smooth nets rebuilt with the seed's tangent plane (ours unsolvable) */
+} sfb__tbz_stats;
+SFB__IF sfb_result sfb__tribezier_points(sfb_context *ctx, const sfb__level *base, const float *positions,
+                                         const sfb_tribezier_options *opt, unsigned flags, double **out, sfb__tbz_stats *stats);
+/* The same as one BEZIER_TRI15 patch per triangle. */
+SFB__IF sfb_result sfb__tribezier_build(sfb_context *ctx, const sfb__level *base, const float *positions,
+                                        const sfb_tribezier_options *opt, sfb__patch_table *pt);
 SFB__IF sfb_result sfb__manifold_build(sfb_context *ctx, const sfb__level *base, int weights, const float *positions, sfb__patch_table *pt);
 SFB__IF void sfb__mf_eval(const float *pts, const int *cv, const unsigned *codes, int kind, double c, double d, double S[3], double Sc[3],
                   double Sd[3]);

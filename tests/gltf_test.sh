@@ -54,8 +54,11 @@ check "--trim without --tess is a usage error" 2 "$TOOL" --trim examples/data/tr
 check "--normals shading on bilinear is a usage error" 2 "$TOOL" --scheme bilinear --normals shading "$BOX" -o "$TMP/x.glb"
 check "--normals shading with --tess is a usage error" 2 "$TOOL" --tess 4 --normals shading "$BOX" -o "$TMP/x.glb"
 check "--crease-angle 200 is a usage error" 2 "$TOOL" --crease-angle 200 "$BOX" -o "$TMP/x.glb"
-check "an unknown scheme is a usage error" 2 "$TOOL" --scheme tribezier "$BOX" -o "$TMP/x.glb"
+check "an unknown scheme is a usage error" 2 "$TOOL" --scheme nosuch "$BOX" -o "$TMP/x.glb"
 absent "usage errors leave no output" "$TMP/x.glb"
+check "tribezier (seed 004) is exported tessellated" 0 "$TOOL" --scheme tribezier --tess 4 examples/data/tribezier_crease_v5.obj -o "$TMP/tbz.glb"
+check "tribezier refuses quads (exit 1)" 1 "$TOOL" --scheme tribezier --tess 4 "$BOX" -o "$TMP/tbzq.glb"
+absent "a refused tribezier export leaves no output" "$TMP/tbzq.glb"
 
 # ---- bad input: exit 1, one line naming the file, no output file ----
 badcase() { # description, pattern the message must contain, input, options...

@@ -99,6 +99,7 @@ suite counted shade "$BUILD/shade" $(with_shapes)
 [ "$HAVE_SHAPES" = 1 ] && suite counted limit "$BUILD/limit" "$SHAPES" || skipped limit "peer shapes not found at $SHAPES"
 [ "$HAVE_SHAPES" = 1 ] && suite counted osd_agree "$BUILD/osd_agree" "$SHAPES" || skipped osd_agree "peer shapes not found at $SHAPES"
 suite counted manifold "$BUILD/manifold" $(with_shapes)
+suite counted tribezier "$BUILD/tribezier" "$(dirname "$SHAPES")/real-meshes"
 suite counted trim "$BUILD/trim" $(with_shapes)
 suite counted agree "$BUILD/agree" $(with_shapes)
 suite counted gl_manifold "$BUILD/gl_manifold" "$SHAPES"

@@ -55,7 +55,7 @@ const char *const kUsage =
     "options:\n"
     "  -o, --output FILE      the output file (required)\n"
     "  --gltf                 write .gltf + .bin whatever OUT's extension (but .glb); the .bin takes OUT's base name\n"
-    "  --scheme S             catmark, loop, bilinear, manifold or pn (default: from the file name prefix\n"
+    "  --scheme S             catmark, loop, bilinear, manifold, tribezier or pn (default: from the file name prefix\n"
     "                         loop_ or bilinear_, else catmark)\n"
     "  --level L              uniform refinement level 0..10 (default 3; not with --tess)\n"
     "  --tess RATE            the exact limit surface tessellated at RATE segments per parametric-face\n"

@@ -23,7 +23,7 @@
 enum {
     O_HELP, O_BACKEND, O_OUTPUT, O_SCHEME, O_LEVEL, O_LIMIT, O_WEIGHTS, O_LOCATIONS, O_RANDOM, O_SEED, O_DERIVATIVES,
     O_RATE, O_TOLERANCE, O_SPLIT, O_TRIM, O_TILES, O_VARIANT, O_DARTS, O_NORMALS_LEVEL, O_WEIGHTS_LEVEL, O_P,
-    O_AVERAGING, O_ALL_SUBDIVIDED, O_NORMALS, O_POSITIONS, O_MODE, O_EDGES, O_SIZE, O_VIEW, O_ZOOM, O_STRIPES, O_CREASE_ANGLE,
+    O_AVERAGING, O_ALL_SUBDIVIDED, O_NORMALS, O_POSITIONS, O_MODE, O_EDGES, O_SIZE, O_VIEW, O_ZOOM, O_STRIPES, O_CREASE_ANGLE, O_SHARPNESS,
     O_COUNT_
 };
 
@@ -47,6 +47,7 @@ typedef struct cli_opts {
     long size[2];
     double view[2], zoom, stripes;
     double crease_angle;                                    /* --crease-angle (seen[O_CREASE_ANGLE]) */
+    double sharpness;                                       /* --sharpness (seen[O_SHARPNESS]): tribezier */
     int seen[O_COUNT_];
 } cli_opts;
 
@@ -110,14 +111,18 @@ static const opt_choice positions_choices[] = { { "refined", 0, 0 }, { "limit", 
 static const opt_spec options[] = {
     { "--scheme", NULL, K_SCHEME, C_REFINE, O_SCHEME, AT(scheme), "catmark|loop|bilinear", NULL, 0, 0, 0,
       "catmark, loop or bilinear", "subdivision scheme (default: from the file name prefix loop_ or bilinear_, else catmark)" },
-    { "--scheme", NULL, K_SCHEME, C_EVAL | C_TESS, O_SCHEME, AT(scheme), "catmark|loop|manifold|pn", NULL, 0, 0, 0,
-      "catmark, loop, manifold or pn", "a subdivision limit surface, the manifold blending surface (seed 000) or PN triangles\n"
+    { "--scheme", NULL, K_SCHEME, C_EVAL | C_TESS, O_SCHEME, AT(scheme), "catmark|loop|manifold|tribezier|pn", NULL, 0, 0, 0,
+      "catmark, loop, manifold, tribezier or pn", "a subdivision limit surface, the manifold blending surface (seed 000), quartic\n"
+      "triangular Bezier surfaces with sharpness (seed 004) or PN triangles\n"
       "(default: from the file name prefix loop_ or bilinear_, else catmark)" },
     { "--scheme", NULL, K_SCHEME, C_SHADE, O_SCHEME, AT(scheme), "catmark|loop", NULL, 0, 0, NO_BILINEAR,
       "catmark or loop", "subdivision scheme (default: from the file name prefix loop_, else catmark)" },
-    { "--scheme", NULL, K_SCHEME, C_RENDER, O_SCHEME, AT(scheme), "catmark|loop|manifold|pn", NULL, 0, 0, NO_BILINEAR,
-      "catmark, loop, manifold or pn", "subdivision scheme (default: from the file name prefix loop_, else catmark);\n"
-      "manifold, pn: draw the manifold blending surface (seed 000) or PN triangles tessellated instead" },
+    { "--scheme", NULL, K_SCHEME, C_RENDER, O_SCHEME, AT(scheme), "catmark|loop|manifold|tribezier|pn", NULL, 0, 0, NO_BILINEAR,
+      "catmark, loop, manifold, tribezier or pn", "subdivision scheme (default: from the file name prefix loop_, else catmark);\n"
+      "manifold, tribezier, pn: draw the manifold blending surface (seed 000), the quartic triangular\n"
+      "Bezier surface (seed 004) or PN triangles tessellated instead" },
+    { "--sharpness", NULL, K_DOUBLE, C_EVAL | C_TESS | C_RENDER, O_SHARPNESS, AT(sharpness), "S", NULL, 0, 0, 0, "a number in [0, 1]",
+      "tribezier: one s in [0, 1] for every tagged crease and corner (default: each tag's\nsharpness clamped to [0, 1])" },
     { "--level", NULL, K_INT, C_REFINE, O_LEVEL, AT(level), "L", NULL, 0, 1000, 0, "a number >= 0",
       "uniform refinement level 0..10 (default 2)" },
     { "--level", NULL, K_INT, C_SHADING, O_LEVEL, AT(level), "L", NULL, 0, 1000, 0, "a number >= 0",
@@ -447,12 +452,17 @@ static int parse_args(const cli_command *c, int argc, char **argv, cli_opts *o) 
 /* ---- eval and tess: the limit surface through the patch table ---- */
 
 /* A surface with its patch table (limit evaluation, tessellation). */
-static sfb_surface *make_patch_surface(sfb_context *ctx, const sfb_mesh *mesh, const char *path, sfb_scheme scheme, int weights) {
+/* (o: the manifold weights and the tribezier sharpness) */
+static sfb_surface *make_patch_surface(sfb_context *ctx, const sfb_mesh *mesh, const char *path, sfb_scheme scheme, const cli_opts *o) {
     sfb_surface_config cfg = sfb_surface_config_init(scheme, 0);
     sfb_surface *surf = NULL;
     sfb_result r;
     cfg.flags = SFB_REFINE_PATCHES;
-    cfg.manifold.weights = weights;
+    cfg.manifold.weights = o->weights;
+    if (o->seen[O_SHARPNESS]) {
+        cfg.tribezier.sharpness_set = 1;
+        cfg.tribezier.sharpness = (float)o->sharpness;
+    }
     r = sfb_surface_create(ctx, mesh, &cfg, &surf);
     if (r != SFB_SUCCESS) {
         cli_error("%s: %s: %s", path, sfb_result_string(r), sfb_last_error(ctx));
@@ -786,7 +796,7 @@ static int cmd_eval(cli_opts *o) {
     if (!ctx) return 1;
     mesh = cli_load_mesh(ctx, o->in, o->seen[O_CREASE_ANGLE] ? o->crease_angle : -1.0);
     if (!mesh) goto done;
-    surf = make_patch_surface(ctx, mesh, o->in, scheme, o->weights);
+    surf = make_patch_surface(ctx, mesh, o->in, scheme, o);
     if (!surf || !eval_locations(ctx, surf, o, &L)) goto done;
     n = (size_t)L.count;
     buf = (float *)malloc((n + 1) * 12 * sizeof(float));
@@ -864,7 +874,7 @@ static int cmd_tess(cli_opts *o) {
     if (!ctx) { free(texels); return 1; }
     mesh = cli_load_mesh(ctx, o->in, o->seen[O_CREASE_ANGLE] ? o->crease_angle : -1.0);
     if (!mesh) goto done;
-    surf = make_patch_surface(ctx, mesh, o->in, cli_scheme_for(o->in, o->seen[O_SCHEME], (sfb_scheme)o->scheme), o->weights);
+    surf = make_patch_surface(ctx, mesh, o->in, cli_scheme_for(o->in, o->seen[O_SCHEME], (sfb_scheme)o->scheme), o);
     if (!surf) goto done;
     tc = sfb_tess_config_init((int)o->rate);
     tc.tolerance = (float)o->tolerance;
@@ -1026,7 +1036,7 @@ static int render_manifold_mesh(const cli_opts *o, render_state *s) {
     int i;
     s->mesh = cli_load_mesh(s->ctx, o->in, o->seen[O_CREASE_ANGLE] ? o->crease_angle : -1.0);
     if (!s->mesh) return 0;
-    s->surf = make_patch_surface(s->ctx, s->mesh, o->in, (sfb_scheme)o->scheme, o->weights);
+    s->surf = make_patch_surface(s->ctx, s->mesh, o->in, (sfb_scheme)o->scheme, o);
     if (!s->surf) return 0;
     tc.trim = o->trim ? &s->mask : NULL;
     r = sfb_surface_tessellate(s->surf, &tc, &s->td);

@@ -46,7 +46,7 @@ static void sfb__pn_cubic(double P[3][3], double N[3][3], double C[4][4][3]) {
 
 /* Degree raising to our quartic order (row by row in t, s rising in a row):
  * q(i,j,k) = (i c(i-1,j) + j c(i,j-1) + k c(i,j)) / 4 with k = 4 - i - j the exponent of w. */
-static void sfb__pn_raise(double C[4][4][3], float *out) {
+static void sfb__pn_raise(double C[4][4][3], double *out) {
     int i, j, c, q = 0;
     for (j = 0; j <= 4; ++j)
         for (i = 0; i + j <= 4; ++i, ++q) {
@@ -56,7 +56,7 @@ static void sfb__pn_raise(double C[4][4][3], float *out) {
                 if (i > 0) v += i * C[i - 1][j][c];
                 if (j > 0) v += j * C[i][j - 1][c];
                 if (k > 0) v += k * C[i][j][c];
-                out[3 * q + c] = (float)(v / 4.0);
+                out[3 * q + c] = v / 4.0;
             }
         }
 }
@@ -78,8 +78,8 @@ static double sfb__pn_angle(const float *a, const float *b, const float *c) {
 }
 
 sfb_result sfb__pn_build(sfb_context *ctx, const sfb__level *l, const float *positions, sfb__patch_table *pt) {
-    double *vn = NULL, lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0}, diag2 = 0.0;
-    int f, v, e, k, c, p = 0, npatch = 0;
+    double *vn = NULL, *net = NULL, lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0}, diag2 = 0.0;
+    int f, v, e, k, c;
     sfb_result r = SFB_SUCCESS;
     memset(pt, 0, sizeof *pt);
     for (f = 0; f < l->nf; ++f)
@@ -111,7 +111,6 @@ sfb_result sfb__pn_build(sfb_context *ctx, const sfb__level *l, const float *pos
                            fv[0], fv[1], fv[2], 0.5 * len);
             goto done;
         }
-        if (!l->fhole[f]) npatch++;
         for (k = 0; k < 3; ++k) {
             const double a = sfb__pn_angle(positions + 3 * (size_t)fv[k], positions + 3 * (size_t)fv[(k + 1) % 3],
                                            positions + 3 * (size_t)fv[(k + 2) % 3]);
@@ -129,52 +128,23 @@ sfb_result sfb__pn_build(sfb_context *ctx, const sfb__level *l, const float *pos
             for (c = 0; c < 3; ++c) n[c] /= len;
     }
     /* the table: one param face and one BEZIER_TRI15 patch (15 points of its own) per triangle */
-    pt->domain = SFB__DOMAIN_TRI;
-    pt->nptex = l->nf;
-    pt->npatch = npatch;
-    pt->ncv = 15 * npatch;
-    pt->npoints = 15 * npatch;
-    pt->face_ptex = (int *)sfb__alloc(ctx, ((size_t)l->nf + 1) * sizeof(int));
-    pt->ptex_face = (int *)sfb__alloc(ctx, ((size_t)l->nf + 1) * sizeof(int));
-    pt->ptex_corner = (int *)sfb__alloc(ctx, ((size_t)l->nf + 1) * sizeof(int));
-    pt->ptex_root = (int *)sfb__alloc(ctx, ((size_t)l->nf + 1) * sizeof(int));
-    pt->nodes = (int *)sfb__alloc(ctx, 4 * sizeof(int));
-    pt->ptype = (int *)sfb__alloc(ctx, ((size_t)npatch + 1) * sizeof(int));
-    pt->pfirst = (int *)sfb__alloc(ctx, ((size_t)npatch + 1) * sizeof(int));
-    pt->pparam = (unsigned *)sfb__alloc(ctx, ((size_t)npatch + 1) * sizeof(unsigned));
-    pt->pvalence = (int *)sfb__calloc(ctx, (size_t)npatch + 1, sizeof(int));
-    pt->cv = (int *)sfb__alloc(ctx, ((size_t)npatch + 1) * 15 * sizeof(int));
-    pt->point_data = (float *)sfb__alloc(ctx, ((size_t)npatch + 1) * 45 * sizeof(float));
-    if (!pt->face_ptex || !pt->ptex_face || !pt->ptex_corner || !pt->ptex_root || !pt->nodes || !pt->ptype || !pt->pfirst ||
-        !pt->pparam || !pt->pvalence || !pt->cv || !pt->point_data) {
-        r = sfb__oom(ctx, "PN triangles");
-        goto done;
-    }
+    net = (double *)sfb__alloc(ctx, 45 * (size_t)l->nf * sizeof(double) + 1);
+    if (!net) { r = sfb__oom(ctx, "PN triangles"); goto done; }
     for (f = 0; f < l->nf; ++f) {
         const int *fv = l->fv + l->fv_off[f];
         double P[3][3], N[3][3], C[4][4][3];
-        pt->face_ptex[f] = pt->ptex_face[f] = f;
-        pt->ptex_corner[f] = -1;
-        if (l->fhole[f]) { pt->ptex_root[f] = -1; continue; }
         for (k = 0; k < 3; ++k)
             for (c = 0; c < 3; ++c) {
                 P[k][c] = positions[3 * (size_t)fv[k] + c];
                 N[k][c] = vn[3 * (size_t)fv[k] + c];
             }
         sfb__pn_cubic(P, N, C);
-        sfb__pn_raise(C, pt->point_data + 45 * (size_t)p);
-        pt->ptype[p] = SFB__PATCH_BEZTRI;
-        pt->pfirst[p] = 15 * p;
-        pt->pparam[p] = SFB__PARAM(0, 0, 0, 0);
-        for (k = 0; k < 15; ++k) pt->cv[15 * p + k] = 15 * p + k;
-        pt->ptex_root[f] = -(p + 2);
-        p++;
+        sfb__pn_raise(C, net + 45 * (size_t)f);
     }
-    pt->face_ptex[l->nf] = l->nf;
-    pt->pfirst[npatch] = 15 * npatch;
-    pt->counts[SFB__PATCH_BEZTRI] = npatch;
+    r = sfb__patch_table_beztri_own(ctx, l, net, pt);
 done:
     sfb__free(ctx, vn);
+    sfb__free(ctx, net);
     if (r != SFB_SUCCESS) sfb__patch_table_free(ctx, pt);
     return r;
 }

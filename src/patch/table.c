@@ -19,6 +19,52 @@ void sfb__patch_table_free(sfb_context *ctx, sfb__patch_table *pt) {
  * sign. The corner bits of the code give the face slot of the child's param corner 0. */
 
 /* Patch index (or -1: hole) and local (s,t) of a valid location; *scale = 2^depth. */
+/* A table of one BEZIER_TRI15 patch with 15 points of its own per triangle of l that is not a
+ * hole (one param face per triangle, depth 0), the points from net (45 doubles per triangle, our
+ * patch order) -- the shape of schemes whose points are not masks (PN triangles, tribezier). */
+sfb_result sfb__patch_table_beztri_own(sfb_context *ctx, const sfb__level *l, const double *net, sfb__patch_table *pt) {
+    int f, k, p = 0, npatch = 0;
+    memset(pt, 0, sizeof *pt);
+    for (f = 0; f < l->nf; ++f) npatch += !l->fhole[f];
+    pt->domain = SFB__DOMAIN_TRI;
+    pt->nptex = l->nf;
+    pt->npatch = npatch;
+    pt->ncv = 15 * npatch;
+    pt->npoints = 15 * npatch;
+    pt->face_ptex = (int *)sfb__alloc(ctx, ((size_t)l->nf + 1) * sizeof(int));
+    pt->ptex_face = (int *)sfb__alloc(ctx, ((size_t)l->nf + 1) * sizeof(int));
+    pt->ptex_corner = (int *)sfb__alloc(ctx, ((size_t)l->nf + 1) * sizeof(int));
+    pt->ptex_root = (int *)sfb__alloc(ctx, ((size_t)l->nf + 1) * sizeof(int));
+    pt->nodes = (int *)sfb__alloc(ctx, 4 * sizeof(int));
+    pt->ptype = (int *)sfb__alloc(ctx, ((size_t)npatch + 1) * sizeof(int));
+    pt->pfirst = (int *)sfb__alloc(ctx, ((size_t)npatch + 1) * sizeof(int));
+    pt->pparam = (unsigned *)sfb__alloc(ctx, ((size_t)npatch + 1) * sizeof(unsigned));
+    pt->pvalence = (int *)sfb__calloc(ctx, (size_t)npatch + 1, sizeof(int));
+    pt->cv = (int *)sfb__alloc(ctx, ((size_t)npatch + 1) * 15 * sizeof(int));
+    pt->point_data = (float *)sfb__alloc(ctx, ((size_t)npatch + 1) * 45 * sizeof(float));
+    if (!pt->face_ptex || !pt->ptex_face || !pt->ptex_corner || !pt->ptex_root || !pt->nodes || !pt->ptype || !pt->pfirst ||
+        !pt->pparam || !pt->pvalence || !pt->cv || !pt->point_data) {
+        sfb__patch_table_free(ctx, pt);
+        return sfb__oom(ctx, "patch table");
+    }
+    for (f = 0; f < l->nf; ++f) {
+        pt->face_ptex[f] = pt->ptex_face[f] = f;
+        pt->ptex_corner[f] = -1;
+        if (l->fhole[f]) { pt->ptex_root[f] = -1; continue; }
+        for (k = 0; k < 45; ++k) pt->point_data[45 * (size_t)p + k] = (float)net[45 * (size_t)f + k];
+        pt->ptype[p] = SFB__PATCH_BEZTRI;
+        pt->pfirst[p] = 15 * p;
+        pt->pparam[p] = SFB__PARAM(0, 0, 0, 0);
+        for (k = 0; k < 15; ++k) pt->cv[15 * p + k] = 15 * p + k;
+        pt->ptex_root[f] = -(p + 2);
+        p++;
+    }
+    pt->face_ptex[l->nf] = l->nf;
+    pt->pfirst[npatch] = 15 * npatch;
+    pt->counts[SFB__PATCH_BEZTRI] = npatch;
+    return SFB_SUCCESS;
+}
+
 int sfb__patch_locate(const sfb__patch_table *pt, int ptex, double u, double v, double *s, double *t, double *scale) {
     int node = pt->ptex_root[ptex];
     double sc = 1.0;

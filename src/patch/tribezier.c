@@ -1,0 +1,873 @@
+/* Quartic triangular Bezier surfaces with a sharpness slider (SFB_SCHEME_TRIBEZIER, seed 004;
+ * ALGORITHMS.md sections 5 and 8). One quartic Bezier triangle (15 points) per mesh triangle,
+ * emitted as the BEZIER_TRI15 patches the Loop work evaluates, so eval, tessellation, trimming,
+ * rendering and the glTF export run on every backend unchanged.
+ *
+ * The construction, and the choices the seed leaves open:
+ *   - the control net is global: one point per vertex (b400), three per edge (b310, b220, b130),
+ *     three per triangle (b211, b121, b112), so neighbouring patches share their boundary points
+ *     and the surface is closed (C0) by construction, for every s.
+ *   - two nets are built from the mesh: the smooth one (s = 0) and the sharp one (s = 1, every
+ *     tagged feature sharp); the surface at s is (1 - s) smooth + s sharp point by point (seed
+ *     section 4, ALGORITHMS.md 8.5: every Bezier point of the mesh extension is linear in s).
+ *     Where creases carry different s, a point takes the s of the nearest feature (graph distance
+ *     over mesh edges; at a feature vertex the mean of its features' s, averaged over the point's
+ *     home vertices: its corner, its edge's ends, its triangle's corners); for one s everywhere
+ *     the blend is exact.
+ *   - regular vertices (valence 6, or a crease/boundary vertex with three triangles on each
+ *     side) take Sabin's rules (seed eq. 4-7, ALGORITHMS.md 8.1) on the mesh extended across
+ *     sharp edges by parallelograms (seed eq. 8 at s = 1: the phantom across wall edge (a, b) is
+ *     a + b - the near-side opposite vertex). There the surface is the Loop limit surface, and
+ *     a regular sharp crease is Loop's crease: the degree-raised cubic B-spline of its vertices.
+ *   - sharp edges (in the sharp net every tagged edge with s > 0, in both nets every boundary
+ *     edge) whose ends are crease or corner vertices are fixed to that cubic B-spline (a corner
+ *     is interpolated, its phantom 2V - N), in both neighbours' patches.
+ *   - G1 at extraordinary vertices: ALGORITHMS.md 8.4's polynomial construction (S2), generalised.
+ *     Chosen over 8.3's Gregory triangle because it stays a polynomial BEZIER_TRI15 patch (no new
+ *     kernel family on every backend) and because its constraints are linear, so creases,
+ *     corners and boundaries enter it as more constraints rather than as separate cases. Every
+ *     Bezier point within net distance TBZ_REACH of an irregular vertex is an unknown; per
+ *     interior edge that is not sharp in the net being built, the five quartic Bernstein
+ *     coefficients of mu(t) X(t) + nu(t) Y(t) - lambda(t) T(t) vanish (X, Y: derivatives of the
+ *     two patches towards their opposite vertices, T along the edge), mu, nu, lambda linear in t
+ *     with their end values from the characteristic angles of the two end vertices (below); the
+ *     smallest change of the unknowns (least squares, CGLS from zero: the minimum-norm solution)
+ *     that satisfies them is applied. Regular regions are untouched, so they stay Loop's.
+ *   - characteristic angles phi (the angle each triangle takes at a vertex): 2 pi / n at a
+ *     smooth vertex (and at a dart, and at a vertex with only a corner tag); a sector between two
+ *     sharp edges with k triangles spans pi at a crease or boundary vertex (its two crease
+ *     tangents opposite, as the B-spline's are), and at a corner the angle between its two sharp
+ *     edges (clamped to [pi/8, 7 pi/8]).
+ *   - the seed's open problem (section 5, undulation at s = 0.5 near an extraordinary crease
+ *     vertex): in the smooth net an irregular crease vertex keeps the sector angles (pi each
+ *     side) and is given the sharp net's corner point and crease tangents (the B-spline's), so
+ *     its tangent plane contains the crease tangents and the crease curve starts on the crease
+ *     polygon's B-spline for every s. (TBZ_SEED_PLANE builds the seed's kind instead, the smooth
+ *     net ignoring the crease, for the measurement in bench/tests.)
+ *   - darts: in the sharp net the dart vertex stays smooth (uniform angles, a Loop-limit corner);
+ *     the dart edge is C0 only (no G1 constraint) and is not fixed to a B-spline, so the crease
+ *     fades out at the dart.
+ *   - corners (a `t corner` tag, or three or more sharp edges; a boundary vertex with one
+ *     triangle): the sharp net interpolates the vertex (b400 = V), each sector G1 in itself
+ *     (the seed's eq. 9 blend is replaced by the constraint solve, which covers every valence).
+ *   - refused: faces that are not triangles (split them first: the choice of diagonal is the
+ *     modeller's), non-manifold edges and vertices, degenerate triangles (area below 1e-12 of the
+ *     squared bounding-box diagonal), non-finite positions, an override s outside [0, 1] or NaN.
+ * Param faces are the triangles, (u,v) barycentric as Loop's: (1-u-v) P0 + u P1 + v P2. */
+
+#define TBZ_REACH 6   /* net distance of the unknowns from an irregular vertex (ALGORITHMS.md 8.4) */
+#define TBZ_PI 3.14159265358979323846
+
+enum { TBZ_SMOOTH = 0, TBZ_DART, TBZ_CREASE, TBZ_CORNER };
+
+typedef struct sfb__tbz {
+    sfb_context *ctx;
+    const sfb__level *l;
+    const float *pos;
+    int nv, ne, nf, np;
+    int seed_plane;
+    /* per state */
+    int sharp;                 /* building the sharp net */
+    unsigned char *efeat;      /* per edge: sharp in this net */
+    unsigned char *vtype;      /* per vertex */
+    unsigned char *virr;       /* per vertex: irregular in this net */
+    double *phi;               /* per vertex-face (vf order): characteristic angle */
+    double *x;                 /* np * 3: the net */
+    unsigned char *fixed;      /* per point */
+    int *dist;                 /* per point: net distance to an irregular vertex */
+    float *tag_s;              /* per edge: s of a tagged edge (0: none) */
+    float *corner_s;           /* per vertex: s of a corner tag (0: none) */
+    sfb__tbz_stats st;
+} sfb__tbz;
+
+static int tbz_vp(const sfb__tbz *T, int v) { (void)T; return v; }
+static int tbz_ep(const sfb__tbz *T, int e, int q) { return T->nv + 3 * e + q; }
+static int tbz_fp(const sfb__tbz *T, int f, int k) { return T->nv + 3 * T->ne + 3 * f + k; }
+
+/* Global index of the point of triangle f with weights w[k] on its corner k (sum 4). */
+static int tbz_pt(const sfb__tbz *T, int f, const int w[3]) {
+    const sfb__level *l = T->l;
+    const int *fv = l->fv + l->fv_off[f];
+    int k;
+    for (k = 0; k < 3; ++k)
+        if (w[k] == 4) return tbz_vp(T, fv[k]);
+    for (k = 0; k < 3; ++k)
+        if (w[(k + 2) % 3] == 0) { /* on edge k: fv[k] -> fv[k+1] */
+            const int e = l->fe[l->fv_off[f] + k], near = w[k]; /* weight of fv[k] */
+            return l->ev[2 * e] == fv[k] ? tbz_ep(T, e, 4 - near - 1) : tbz_ep(T, e, near - 1);
+        }
+    for (k = 0; k < 3; ++k)
+        if (w[k] == 2) return tbz_fp(T, f, k);
+    return -1;
+}
+
+/* The 15 global indices of triangle f in our patch order (row by row in v, u rising). */
+static void tbz_patch(const sfb__tbz *T, int f, int g[15]) {
+    int i, j, q = 0;
+    for (j = 0; j <= 4; ++j)
+        for (i = 0; i + j <= 4; ++i, ++q) {
+            int w[3];
+            w[0] = 4 - i - j; w[1] = i; w[2] = j;
+            g[q] = tbz_pt(T, f, w);
+        }
+}
+
+static int tbz_qij(int i, int j) { return 5 * j - j * (j - 1) / 2 + i; }
+
+static int tbz_ring(const sfb__level *l, int v, int j) { return sfb__other_end(l, l->ve[l->ve_off[v] + j], v); }
+static int tbz_nf(const sfb__level *l, int v) { return l->vf_off[v + 1] - l->vf_off[v]; }
+static int tbz_boundary(const sfb__level *l, int v) { return l->ve_off[v + 1] - l->ve_off[v] > tbz_nf(l, v); }
+
+static void tbz_get(const sfb__tbz *T, int v, double out[3]) {
+    out[0] = T->pos[3 * (size_t)v]; out[1] = T->pos[3 * (size_t)v + 1]; out[2] = T->pos[3 * (size_t)v + 2];
+}
+static void tbz_axpy(double *y, double a, const double *x) { y[0] += a * x[0]; y[1] += a * x[1]; y[2] += a * x[2]; }
+
+/* The spoke slot of edge e in v's ring. */
+static int tbz_spoke(const sfb__level *l, int v, int e) {
+    int i;
+    for (i = l->ve_off[v]; i < l->ve_off[v + 1]; ++i)
+        if (l->ve[i] == e) return i - l->ve_off[v];
+    return -1;
+}
+
+/* The two sharp neighbours of a crease vertex (first and last sharp spoke). */
+static void tbz_crease_pair(const sfb__tbz *T, int v, int *a, int *b) {
+    const sfb__level *l = T->l;
+    int i, m = l->ve_off[v + 1] - l->ve_off[v];
+    *a = *b = -1;
+    for (i = 0; i < m; ++i)
+        if (T->efeat[l->ve[l->ve_off[v] + i]] || ((T->vtype[v] & 16) && T->tag_s[l->ve[l->ve_off[v] + i]] > 0.0f)) {
+            if (*a < 0) *a = tbz_ring(l, v, i);
+            else *b = tbz_ring(l, v, i);
+        }
+}
+
+/* Corner point of the sharp crease curve at v: (A + 4V + B)/6 at a crease vertex, V at a corner. */
+static void tbz_crease_point(const sfb__tbz *T, int v, int type, double P[3]) {
+    double V[3], A[3], B[3];
+    int a, b, c;
+    tbz_get(T, v, V);
+    if (type != TBZ_CREASE) { memcpy(P, V, sizeof V); return; }
+    tbz_crease_pair(T, v, &a, &b);
+    tbz_get(T, a, A); tbz_get(T, b, B);
+    for (c = 0; c < 3; ++c) P[c] = (A[c] + 4.0 * V[c] + B[c]) / 6.0;
+}
+
+/* Classifies the vertices of the net being built and sets their characteristic angles. */
+static void tbz_classify(sfb__tbz *T) {
+    const sfb__level *l = T->l;
+    int v, e, j;
+    for (e = 0; e < T->ne; ++e) {
+        const int bnd = l->ef_off[e + 1] - l->ef_off[e] == 1;
+        T->efeat[e] = (unsigned char)(bnd || (T->sharp && T->tag_s[e] > 0.0f));
+    }
+    for (v = 0; v < T->nv; ++v) {
+        const int n = tbz_nf(l, v), m = l->ve_off[v + 1] - l->ve_off[v], bnd = tbz_boundary(l, v);
+        int nfeat = 0, ntag = 0, type, irr = 0;
+        double *phi = T->phi + l->vf_off[v];
+        for (j = 0; j < m; ++j) {
+            const int ej = l->ve[l->ve_off[v] + j];
+            nfeat += T->efeat[ej];
+            ntag += T->tag_s[ej] > 0.0f && l->ef_off[ej + 1] - l->ef_off[ej] == 2;
+        }
+        if (n == 0) { T->vtype[v] = TBZ_SMOOTH; T->virr[v] = 0; continue; }
+        if (bnd && n == 1) type = TBZ_CORNER;
+        else if (nfeat >= 3 || (T->sharp && T->corner_s[v] > 0.0f && nfeat >= 2)) type = TBZ_CORNER;
+        else if (nfeat == 2) type = TBZ_CREASE;
+        else if (nfeat == 1) type = TBZ_DART;
+        else type = TBZ_SMOOTH;
+        /* the smooth net at a tagged crease vertex: our tangent plane through the crease tangents */
+        if (!T->sharp && !T->seed_plane && type == TBZ_SMOOTH && ntag == 2 && !(T->corner_s[v] > 0.0f)) type = TBZ_CREASE + 16;
+        T->vtype[v] = (unsigned char)type;
+        if (type == TBZ_SMOOTH || type == TBZ_DART) {
+            for (j = 0; j < n; ++j) phi[j] = 2.0 * TBZ_PI / n;
+            irr = n != 6 || type == TBZ_DART || (T->sharp && T->corner_s[v] > 0.0f);
+        } else {
+            /* sectors between sharp (or, type CREASE + 16, tagged) spokes */
+            int first = -1, k, start, cnt;
+            for (j = 0; j < m; ++j) {
+                const int ej = l->ve[l->ve_off[v] + j];
+                if (type == TBZ_CREASE + 16 ? T->tag_s[ej] > 0.0f : T->efeat[ej]) { first = j; break; }
+            }
+            start = first;
+            irr = (type == TBZ_CORNER);
+            for (cnt = 0; cnt < n;) {
+                /* the sector from spoke `start`: faces start, start+1, ... until the next sharp spoke */
+                double span, V[3], A[3], B[3], la = 0, lb = 0, d = 0;
+                int end = start, c;
+                k = 0;
+                do {
+                    int ej;
+                    ++k;
+                    end = (end + 1) % m;
+                    ej = l->ve[l->ve_off[v] + end];
+                    if (type == TBZ_CREASE + 16 ? T->tag_s[ej] > 0.0f : T->efeat[ej]) break;
+                } while (cnt + k < n);
+                if (type == TBZ_CORNER) {
+                    tbz_get(T, v, V); tbz_get(T, tbz_ring(l, v, start), A); tbz_get(T, tbz_ring(l, v, end), B);
+                    for (c = 0; c < 3; ++c) {
+                        A[c] -= V[c]; B[c] -= V[c];
+                        la += A[c] * A[c]; lb += B[c] * B[c]; d += A[c] * B[c];
+                    }
+                    span = acos(fmax(-1.0, fmin(1.0, d / sqrt(la * lb + 1e-300))));
+                    span = fmin(fmax(span, TBZ_PI / 8), 7 * TBZ_PI / 8);
+                } else {
+                    span = TBZ_PI;
+                }
+                for (j = 0; j < k; ++j) phi[(start + j) % n] = span / k;
+                if (k != 3) irr = 1;
+                cnt += k;
+                start = end;
+            }
+            /* ours, regular (three triangles a side): the plain smooth vertex */
+            if (type == TBZ_CREASE + 16) T->vtype[v] = (unsigned char)(irr ? (TBZ_CREASE | 16) : TBZ_SMOOTH);
+        }
+        T->virr[v] = (unsigned char)irr;
+    }
+}
+
+/* The ring of regular vertex v in the extended mesh seen from its triangle slot j: R[0] = r_j,
+ * R[1] = r_{j+1}, ... (six points; across sharp spokes the parallelogram phantoms). */
+static void tbz_ring6(const sfb__tbz *T, int v, int j, double R[6][3]) {
+    const sfb__level *l = T->l;
+    const int n = tbz_nf(l, v), m = l->ve_off[v + 1] - l->ve_off[v];
+    double V[3];
+    int i, c;
+    tbz_get(T, v, V);
+    if (T->vtype[v] == TBZ_SMOOTH) {
+        for (i = 0; i < 6; ++i) tbz_get(T, tbz_ring(l, v, (j + i) % n), R[i]);
+        return;
+    }
+    {
+        /* crease / boundary with three triangles a side: the sector holding slot j */
+        int s0 = j, k;
+        double S[4][3];
+        while (!T->efeat[l->ve[l->ve_off[v] + s0]]) s0 = (s0 + m - 1) % m;
+        for (k = 0; k < 4; ++k) tbz_get(T, tbz_ring(l, v, (s0 + k) % m), S[k]);
+        /* ccw: C1 = S0, n1, n2, C2 = S3, V + C2 - n2, V + C1 - n1 */
+        {
+            double E[6][3];
+            for (k = 0; k < 4; ++k) memcpy(E[k], S[k], sizeof S[k]);
+            for (c = 0; c < 3; ++c) {
+                E[4][c] = V[c] + S[3][c] - S[2][c];
+                E[5][c] = V[c] + S[0][c] - S[1][c];
+            }
+            k = (j - s0 + m) % m; /* slot j's position in the sector */
+            for (i = 0; i < 6; ++i) memcpy(R[i], E[(k + i) % 6], sizeof E[0]);
+        }
+    }
+}
+
+/* Loop limit corner of a smooth vertex (ALGORITHMS.md 8.2; 8.1 at n = 6). */
+static void tbz_loop_corner(const sfb__tbz *T, int v, double P[3]) {
+    const sfb__level *l = T->l;
+    const int n = tbz_nf(l, v);
+    const double cn = cos(2.0 * TBZ_PI / n), a = 0.625 - (0.375 + 0.25 * cn) * (0.375 + 0.25 * cn), w = 3.0 * n / (8.0 * a);
+    double V[3], R[3];
+    int j;
+    tbz_get(T, v, V);
+    P[0] = w * V[0]; P[1] = w * V[1]; P[2] = w * V[2];
+    for (j = 0; j < n; ++j) { tbz_get(T, tbz_ring(l, v, j), R); tbz_axpy(P, 1.0, R); }
+    for (j = 0; j < 3; ++j) P[j] /= (w + n);
+}
+
+/* The initial net (and its fixed points) for the current state. */
+static void tbz_initial(sfb__tbz *T) {
+    const sfb__level *l = T->l;
+    int v, e, f, j, c, k;
+    memset(T->fixed, 0, (size_t)T->np);
+    /* corners */
+    for (v = 0; v < T->nv; ++v) {
+        double *P = T->x + 3 * (size_t)tbz_vp(T, v);
+        const int type = T->vtype[v] & 15, n = tbz_nf(l, v);
+        if (n == 0) { tbz_get(T, v, P); continue; }
+        if (!T->virr[v]) {
+            double R[6][3], V[3];
+            tbz_ring6(T, v, 0, R);
+            tbz_get(T, v, V);
+            for (c = 0; c < 3; ++c) P[c] = (6.0 * V[c] + R[0][c] + R[1][c] + R[2][c] + R[3][c] + R[4][c] + R[5][c]) / 12.0;
+        } else if (type == TBZ_CREASE || type == TBZ_CORNER) {
+            tbz_crease_point(T, v, type, P);
+        } else if (T->sharp && T->corner_s[v] > 0.0f) {
+            tbz_get(T, v, P);
+        } else {
+            tbz_loop_corner(T, v, P);
+        }
+        if (type == TBZ_CORNER || (type == TBZ_CREASE && T->virr[v]) || (T->sharp && T->corner_s[v] > 0.0f)) T->fixed[v] = 1;
+        if (type == TBZ_CREASE && !T->virr[v] && (T->vtype[v] & 16) == 0) T->fixed[v] = 1; /* = the regular value */
+    }
+    /* edge points: near each end from that end's rules, the middle from the two opposite vertices */
+    for (e = 0; e < T->ne; ++e) {
+        const int a = l->ev[2 * e], b = l->ev[2 * e + 1];
+        int end;
+        for (end = 0; end < 2; ++end) {
+            const int v = end ? b : a, w = end ? a : b, q = end ? 2 : 0;
+            double *E = T->x + 3 * (size_t)tbz_ep(T, e, q), V[3], W[3];
+            const int m = tbz_spoke(l, v, e), n = tbz_nf(l, v);
+            const double *P = T->x + 3 * (size_t)v;
+            tbz_get(T, v, V); tbz_get(T, w, W);
+            if (!T->virr[v]) {
+                double R[6][3];
+                /* a slot whose triangle has the spoke as R[0] or R[1] */
+                if (m < n) {
+                    tbz_ring6(T, v, m, R);
+                    for (c = 0; c < 3; ++c)
+                        E[c] = (12.0 * V[c] + 4.0 * R[0][c] + 3.0 * (R[1][c] + R[5][c]) + R[2][c] + R[4][c]) / 24.0;
+                } else {
+                    tbz_ring6(T, v, m - 1, R);
+                    for (c = 0; c < 3; ++c)
+                        E[c] = (12.0 * V[c] + 4.0 * R[1][c] + 3.0 * (R[2][c] + R[0][c]) + R[3][c] + R[5][c]) / 24.0;
+                }
+            } else if (((T->vtype[v] & 15) == TBZ_SMOOTH || (T->vtype[v] & 15) == TBZ_DART) && !(T->sharp && T->corner_s[v] > 0.0f)) {
+                /* 8.2: P + 3/4 (3 + 2c)/(6n) T_m */
+                const double cn = cos(2.0 * TBZ_PI / n), g = 0.75 * (3.0 + 2.0 * cn) / (6.0 * n);
+                double R[3];
+                memcpy(E, P, 3 * sizeof(double));
+                for (k = 0; k < n; ++k) {
+                    tbz_get(T, tbz_ring(l, v, (m + k) % n), R);
+                    tbz_axpy(E, g * cos(2.0 * TBZ_PI * k / n), R);
+                }
+            } else {
+                /* the B-spline's: 3/4 P + 1/4 (2V + W)/3 */
+                for (c = 0; c < 3; ++c) E[c] = 0.75 * P[c] + (2.0 * V[c] + W[c]) / 12.0;
+            }
+        }
+        {
+            /* b220 = (2a + 2b + X + Y)/6; across a sharp edge Y = a + b - X, so (a + b)/2 */
+            double *M = T->x + 3 * (size_t)tbz_ep(T, e, 1), A[3], B[3], X[3];
+            tbz_get(T, a, A); tbz_get(T, b, B);
+            if (T->efeat[e] || l->ef_off[e + 1] - l->ef_off[e] < 2) {
+                for (c = 0; c < 3; ++c) M[c] = 0.5 * (A[c] + B[c]);
+            } else {
+                for (c = 0; c < 3; ++c) M[c] = (2.0 * A[c] + 2.0 * B[c]) / 6.0;
+                for (k = 0; k < 2; ++k) {
+                    const int g = l->ef[l->ef_off[e] + k], s = l->ef_slot[l->ef_off[e] + k];
+                    tbz_get(T, l->fv[l->fv_off[g] + (s + 2) % 3], X);
+                    tbz_axpy(M, 1.0 / 6.0, X);
+                }
+            }
+        }
+        /* a sharp edge between crease/corner ends: the degree-raised cubic B-spline */
+        if (T->efeat[e] && (T->vtype[a] & 15) >= TBZ_CREASE && (T->vtype[b] & 15) >= TBZ_CREASE && !(T->vtype[a] & 16) &&
+            !(T->vtype[b] & 16)) {
+            double P0[3], P3[3], A[3], B[3];
+            tbz_crease_point(T, a, T->vtype[a] & 15, P0);
+            tbz_crease_point(T, b, T->vtype[b] & 15, P3);
+            tbz_get(T, a, A); tbz_get(T, b, B);
+            for (c = 0; c < 3; ++c) {
+                const double P1 = (2.0 * A[c] + B[c]) / 3.0, P2 = (A[c] + 2.0 * B[c]) / 3.0;
+                T->x[3 * (size_t)tbz_ep(T, e, 0) + c] = (P0[c] + 3.0 * P1) / 4.0;
+                T->x[3 * (size_t)tbz_ep(T, e, 1) + c] = (P1 + P2) / 2.0;
+                T->x[3 * (size_t)tbz_ep(T, e, 2) + c] = (3.0 * P2 + P3[c]) / 4.0;
+            }
+            T->fixed[tbz_ep(T, e, 0)] = T->fixed[tbz_ep(T, e, 1)] = T->fixed[tbz_ep(T, e, 2)] = 1;
+        }
+        /* the smooth net at our crease vertex: the crease tangent is the B-spline's */
+        for (k = 0; k < 2; ++k) {
+            const int v = k ? b : a, w = k ? a : b;
+            if ((T->vtype[v] & 16) && T->virr[v] && T->tag_s[e] > 0.0f) {
+                double V[3], W[3], *E = T->x + 3 * (size_t)tbz_ep(T, e, k ? 2 : 0);
+                const double *P = T->x + 3 * (size_t)v;
+                tbz_get(T, v, V); tbz_get(T, w, W);
+                for (c = 0; c < 3; ++c) E[c] = 0.25 * P[c] + 0.75 * (2.0 * V[c] + W[c]) / 3.0;
+                T->fixed[tbz_ep(T, e, k ? 2 : 0)] = 1;
+            }
+        }
+    }
+    /* an irregular smooth vertex keeps its Loop limit point and tangent plane (ALGORITHMS.md 8.2:
+     * corner and edge points already satisfy the t = 0 relations): left free, the minimum-norm
+     * solve collapses tangents to zero where extraordinary vertices touch (valence 4: the
+     * relation X + Y = 0 T holds for X = Y = 0), and with them fixed the constraints stay
+     * solvable there (checked on closed meshes of valence 4 and 5 everywhere) */
+    {
+        for (v = 0; v < T->nv; ++v)
+            if (T->virr[v] && (T->vtype[v] & 15) == TBZ_SMOOTH) {
+                T->fixed[v] = 1;
+                for (j = l->ve_off[v]; j < l->ve_off[v + 1]; ++j) {
+                    e = l->ve[j];
+                    T->fixed[tbz_ep(T, e, l->ev[2 * e] == v ? 0 : 2)] = 1;
+                }
+            }
+    }
+    /* our irregular crease vertex in the smooth net: every spoke's tangent from the sector
+     * angles, T(theta) = cos(theta) a + sin(theta) b, a the B-spline's crease tangent (so both
+     * crease tangents lie in the plane), b = 2/(3n) sum sin(theta_j) (r_j - V); fixed, so the
+     * t = 0 relations hold and no tangent can collapse */
+    for (v = 0; v < T->nv; ++v)
+        if (T->vtype[v] == (TBZ_CREASE | 16) && T->virr[v]) {
+            const int n = tbz_nf(l, v);
+            const double *P = T->x + 3 * (size_t)v, *phi = T->phi + l->vf_off[v];
+            double th[64], a[3], bv[3] = {0, 0, 0}, V[3], R[3], A[3], B[3];
+            int first = -1, other = -1;
+            if (n > 64) continue;
+            for (j = 0; j < n; ++j)
+                if (T->tag_s[l->ve[l->ve_off[v] + j]] > 0.0f) { if (first < 0) first = j; else other = j; }
+            if (first < 0 || other < 0) continue;
+            tbz_get(T, v, V);
+            th[first] = 0.0;
+            for (k = 1; k < n; ++k) th[(first + k) % n] = th[(first + k - 1) % n] + phi[(first + k - 1) % n];
+            tbz_get(T, tbz_ring(l, v, first), A); tbz_get(T, tbz_ring(l, v, other), B);
+            for (c = 0; c < 3; ++c) a[c] = (A[c] - B[c]) / 6.0;
+            for (j = 0; j < n; ++j) {
+                tbz_get(T, tbz_ring(l, v, j), R);
+                for (c = 0; c < 3; ++c) bv[c] += 2.0 / (3.0 * n) * sin(th[j]) * (R[c] - V[c]);
+            }
+            for (j = 0; j < n; ++j) {
+                const int ej = l->ve[l->ve_off[v] + j], q = tbz_ep(T, ej, l->ev[2 * ej] == v ? 0 : 2);
+                for (c = 0; c < 3; ++c) T->x[3 * (size_t)q + c] = P[c] + 0.75 * (cos(th[j]) * a[c] + sin(th[j]) * bv[c]);
+                T->fixed[q] = 1;
+            }
+        }
+    /* interior points: b211 near corner v of triangle (v, r_m, r_{m+1}) */
+    for (f = 0; f < T->nf; ++f) {
+        const int *fv = l->fv + l->fv_off[f];
+        for (k = 0; k < 3; ++k) {
+            const int v = fv[k], n = tbz_nf(l, v), bnd = tbz_boundary(l, v);
+            double *F = T->x + 3 * (size_t)tbz_fp(T, f, k), V[3];
+            int m = -1;
+            for (j = l->vf_off[v]; j < l->vf_off[v + 1]; ++j)
+                if (l->vf[j] == f) { m = j - l->vf_off[v]; break; }
+            tbz_get(T, v, V);
+            if (!T->virr[v]) {
+                double R[6][3];
+                tbz_ring6(T, v, m, R);
+                for (c = 0; c < 3; ++c) F[c] = (10.0 * V[c] + 6.0 * R[0][c] + 6.0 * R[1][c] + R[5][c] + R[2][c]) / 24.0;
+            } else {
+                double A[3], B[3], Cm[3], D[3];
+                tbz_get(T, tbz_ring(l, v, m), A);
+                tbz_get(T, tbz_ring(l, v, m + 1 <= (bnd ? n : n - 1) ? m + 1 : 0), B);
+                if (!bnd || m > 0) tbz_get(T, tbz_ring(l, v, (m + n - 1) % n), Cm);
+                else for (c = 0; c < 3; ++c) Cm[c] = V[c] + A[c] - B[c];
+                if (!bnd) tbz_get(T, tbz_ring(l, v, (m + 2) % n), D);
+                else if (m + 2 <= n) tbz_get(T, tbz_ring(l, v, m + 2), D);
+                else for (c = 0; c < 3; ++c) D[c] = V[c] + B[c] - A[c];
+                for (c = 0; c < 3; ++c) F[c] = (10.0 * V[c] + 6.0 * A[c] + 6.0 * B[c] + Cm[c] + D[c]) / 24.0;
+            }
+        }
+    }
+}
+
+/* ---- the G1 constraints and their least-squares solve ---- */
+
+typedef struct tbz_sys {
+    int rows, cap_rows;
+    size_t n, cap;
+    size_t *off;
+    int *col;       /* global point index */
+    double *w;
+} tbz_sys;
+
+static int tbz_sys_push(sfb__tbz *T, tbz_sys *S, int col, double w) {
+    if (S->n == S->cap) {
+        size_t nc = S->cap ? 2 * S->cap : 4096;
+        int *c2 = (int *)sfb__realloc(T->ctx, S->col, nc * sizeof(int));
+        double *w2;
+        if (!c2) return 0;
+        S->col = c2;
+        w2 = (double *)sfb__realloc(T->ctx, S->w, nc * sizeof(double));
+        if (!w2) return 0;
+        S->w = w2;
+        S->cap = nc;
+    }
+    S->col[S->n] = col;
+    S->w[S->n++] = w;
+    return 1;
+}
+static int tbz_sys_row(sfb__tbz *T, tbz_sys *S) {
+    if (S->rows + 1 >= S->cap_rows) {
+        int nc = S->cap_rows ? 2 * S->cap_rows : 1024;
+        size_t *o2 = (size_t *)sfb__realloc(T->ctx, S->off, ((size_t)nc + 1) * sizeof(size_t));
+        if (!o2) return 0;
+        S->off = o2;
+        S->cap_rows = nc;
+    }
+    if (S->rows == 0) S->off[0] = 0;
+    S->off[++S->rows] = S->n;
+    return 1;
+}
+
+/* End coefficients (mu, nu, lambda) of the G1 relation along spoke to `w` at vertex v, where X
+ * is the derivative towards the triangle after the spoke (ccw) and Y towards the one before;
+ * `at_end` for the edge's far end (t = 1). Normalised to mu + nu = 2. */
+static void tbz_coef(const sfb__tbz *T, int v, int e, int at_end, double out[3]) {
+    const sfb__level *l = T->l;
+    const int n = tbz_nf(l, v), m = tbz_spoke(l, v, e);
+    const double *phi = T->phi + l->vf_off[v];
+    const double after = phi[m % n], before = phi[(m + n - 1) % n];
+    double mu, nu, la, s;
+    if (!at_end) {
+        /* at t = 0: sin(before) T_{m+1} + sin(after) T_{m-1} = sin(after + before) T_m */
+        mu = sin(before); nu = sin(after); la = sin(after + before);
+    } else {
+        /* at t = 1 (seen from the far end, X towards its ring's previous, Y towards its next) */
+        mu = sin(after); nu = sin(before); la = mu + nu - sin(after + before);
+    }
+    s = 2.0 / (mu + nu);
+    out[0] = mu * s; out[1] = nu * s; out[2] = la * s;
+}
+
+/* Five rows for interior edge e. */
+static int tbz_edge_rows(sfb__tbz *T, tbz_sys *S, int e) {
+    const sfb__level *l = T->l;
+    const int a = l->ev[2 * e], b = l->ev[2 * e + 1];
+    int fL = -1, fR = -1, sL = 0, sR = 0, k, j, m;
+    int Ei[5], Li[4], Ri[4];
+    double c0[3], c1[3];
+    for (k = 0; k < 2; ++k) {
+        const int g = l->ef[l->ef_off[e] + k], s = l->ef_slot[l->ef_off[e] + k];
+        if (l->fv[l->fv_off[g] + s] == a) { fL = g; sL = s; }
+        else { fR = g; sR = s; }
+    }
+    if (fL < 0 || fR < 0) return 1;
+    /* left triangle (a, b, C): a at slot sL, b at sL+1, C at sL+2; right (b, a, D): b at sR */
+    for (j = 0; j <= 4; ++j) {
+        int w[3];
+        w[sL] = 4 - j; w[(sL + 1) % 3] = j; w[(sL + 2) % 3] = 0;
+        Ei[j] = tbz_pt(T, fL, w);
+    }
+    for (j = 0; j <= 3; ++j) {
+        int w[3];
+        w[sL] = 3 - j; w[(sL + 1) % 3] = j; w[(sL + 2) % 3] = 1;
+        Li[j] = tbz_pt(T, fL, w);
+        w[(sR + 1) % 3] = 3 - j; w[sR] = j; w[(sR + 2) % 3] = 1;
+        Ri[j] = tbz_pt(T, fR, w);
+    }
+    {
+        int any = 0;
+        for (j = 0; j < 5; ++j) any |= !T->fixed[Ei[j]] && T->dist[Ei[j]] <= TBZ_REACH;
+        for (j = 0; j < 4; ++j) any |= (!T->fixed[Li[j]] && T->dist[Li[j]] <= TBZ_REACH) || (!T->fixed[Ri[j]] && T->dist[Ri[j]] <= TBZ_REACH);
+        if (!any) return 1;
+    }
+    /* at a: X towards C (after the spoke in a's ring), Y towards D */
+    tbz_coef(T, a, e, 0, c0);
+    /* at b: X towards C is b's ring previous, Y towards D its next */
+    tbz_coef(T, b, e, 1, c1);
+    for (m = 0; m <= 4; ++m) {
+        for (j = m - 1; j <= m; ++j) {
+            const double *cc = j == m ? c0 : c1;
+            const double f = j == m ? (4.0 - m) / 4.0 : m / 4.0;
+            if (j < 0 || j > 3) continue;
+            /* mu (L_j - E_j) + nu (R_j - E_j) - la (E_{j+1} - E_j) */
+            if (!tbz_sys_push(T, S, Li[j], f * cc[0]) || !tbz_sys_push(T, S, Ri[j], f * cc[1]) ||
+                !tbz_sys_push(T, S, Ei[j], f * (cc[2] - cc[0] - cc[1])) || !tbz_sys_push(T, S, Ei[j + 1], -f * cc[2]))
+                return 0;
+        }
+        if (!tbz_sys_row(T, S)) return 0;
+    }
+    return 1;
+}
+
+/* Net distances (in steps of the Bezier net) from the irregular vertices' corner points. */
+static void tbz_distances(sfb__tbz *T) {
+    int i, f, it, q;
+    static const int nb[3][2] = {{1, 0}, {0, 1}, {-1, 1}};
+    for (i = 0; i < T->np; ++i) T->dist[i] = i < T->nv && T->virr[i] ? 0 : 1000;
+    for (it = 0; it < TBZ_REACH + 2; ++it) {
+        int changed = 0;
+        for (f = 0; f < T->nf; ++f) {
+            int g[15], a, jj;
+            tbz_patch(T, f, g);
+            for (jj = 0; jj <= 4; ++jj)
+                for (a = 0; a + jj <= 4; ++a)
+                    for (q = 0; q < 3; ++q) {
+                        const int i2 = a + nb[q][0], j2 = jj + nb[q][1];
+                        int p0, p1;
+                        if (i2 < 0 || i2 + j2 > 4) continue;
+                        p0 = g[tbz_qij(a, jj)]; p1 = g[tbz_qij(i2, j2)];
+                        if (T->dist[p0] + 1 < T->dist[p1]) { T->dist[p1] = T->dist[p0] + 1; changed = 1; }
+                        if (T->dist[p1] + 1 < T->dist[p0]) { T->dist[p0] = T->dist[p1] + 1; changed = 1; }
+                    }
+        }
+        if (!changed) break;
+    }
+}
+
+/* Applies the smallest change of the unknowns that satisfies the constraints (CGLS from zero,
+ * per coordinate: the minimum-norm least-squares solution). */
+static sfb_result tbz_solve(sfb__tbz *T) {
+    const sfb__level *l = T->l;
+    tbz_sys S;
+    int *ucol = NULL, nu = 0, e, i, c, r;
+    double *buf = NULL, scale = 0.0;
+    sfb_result res = SFB_SUCCESS;
+    memset(&S, 0, sizeof S);
+    for (e = 0; e < T->ne; ++e)
+        if (l->ef_off[e + 1] - l->ef_off[e] == 2 && !T->efeat[e])
+            if (!tbz_edge_rows(T, &S, e)) { res = sfb__oom(T->ctx, "tribezier constraints"); goto done; }
+    if (S.rows == 0) goto done;
+    ucol = (int *)sfb__alloc(T->ctx, (size_t)T->np * sizeof(int));
+    if (!ucol) { res = sfb__oom(T->ctx, "tribezier constraints"); goto done; }
+    for (i = 0; i < T->np; ++i) ucol[i] = (!T->fixed[i] && T->dist[i] <= TBZ_REACH) ? nu++ : -1;
+    for (i = 0; i < T->np; ++i)
+        for (c = 0; c < 3; ++c) scale = fmax(scale, fabs(T->x[3 * (size_t)i + c]));
+    if (scale == 0.0) scale = 1.0;
+    buf = (double *)sfb__alloc(T->ctx, ((size_t)2 * S.rows + 3 * (size_t)nu + 1) * sizeof(double));
+    if (!buf) { res = sfb__oom(T->ctx, "tribezier constraints"); goto done; }
+    for (c = 0; c < 3; ++c) {
+        double *rr = buf, *q = buf + S.rows, *xs = buf + 2 * (size_t)S.rows, *sv = xs + nu, *p = sv + nu;
+        double gamma = 0.0, rn = 0.0;
+        double gamma0;
+        /* consistent systems converge to rn below 1e-15 of the scale; where they are not (touching
+         * extraordinary vertices of different valences) the least-squares point is reached when
+         * A^T r stops falling */
+        int it, maxit = 20 * nu + 200 < 5000 ? 20 * nu + 200 : 5000;
+        /* residual of the initial net: b = -A x0 */
+        for (r = 0; r < S.rows; ++r) {
+            double v = 0.0;
+            size_t k;
+            for (k = S.off[r]; k < S.off[r + 1]; ++k) v += S.w[k] * T->x[3 * (size_t)S.col[k] + c];
+            rr[r] = -v;
+        }
+        for (i = 0; i < nu; ++i) xs[i] = sv[i] = 0.0;
+        for (r = 0; r < S.rows; ++r) {
+            size_t k;
+            for (k = S.off[r]; k < S.off[r + 1]; ++k)
+                if (ucol[S.col[k]] >= 0) sv[ucol[S.col[k]]] += S.w[k] * rr[r];
+        }
+        for (i = 0; i < nu; ++i) { p[i] = sv[i]; gamma += sv[i] * sv[i]; }
+        gamma0 = gamma;
+        for (it = 0; it < maxit && gamma > 0.0; ++it) {
+            double qq = 0.0, alpha, g2 = 0.0;
+            rn = 0.0;
+            for (r = 0; r < S.rows; ++r) {
+                double v = 0.0;
+                size_t k;
+                for (k = S.off[r]; k < S.off[r + 1]; ++k)
+                    if (ucol[S.col[k]] >= 0) v += S.w[k] * p[ucol[S.col[k]]];
+                q[r] = v;
+                qq += v * v;
+            }
+            if (!(qq > 0.0)) break;
+            alpha = gamma / qq;
+            for (i = 0; i < nu; ++i) xs[i] += alpha * p[i];
+            for (r = 0; r < S.rows; ++r) { rr[r] -= alpha * q[r]; rn = fmax(rn, fabs(rr[r])); }
+            if (rn <= 1e-15 * scale) break;
+            for (i = 0; i < nu; ++i) sv[i] = 0.0;
+            for (r = 0; r < S.rows; ++r) {
+                size_t k;
+                for (k = S.off[r]; k < S.off[r + 1]; ++k)
+                    if (ucol[S.col[k]] >= 0) sv[ucol[S.col[k]]] += S.w[k] * rr[r];
+            }
+            for (i = 0; i < nu; ++i) g2 += sv[i] * sv[i];
+            if (g2 <= 1e-26 * gamma0) break;
+            for (i = 0; i < nu; ++i) p[i] = sv[i] + (g2 / gamma) * p[i];
+            gamma = g2;
+        }
+        T->st.iterations += it;
+        for (i = 0; i < T->np; ++i)
+            if (ucol[i] >= 0) T->x[3 * (size_t)i + c] += xs[ucol[i]];
+        /* the residual left, relative to the net's scale */
+        for (r = 0; r < S.rows; ++r) {
+            double v = 0.0;
+            size_t k;
+            for (k = S.off[r]; k < S.off[r + 1]; ++k) v += S.w[k] * T->x[3 * (size_t)S.col[k] + c];
+            T->st.residual = fmax(T->st.residual, fabs(v) / scale);
+        }
+    }
+    T->st.unknowns += nu;
+    T->st.constraints += S.rows;
+done:
+    sfb__free(T->ctx, S.off); sfb__free(T->ctx, S.col); sfb__free(T->ctx, S.w);
+    sfb__free(T->ctx, ucol); sfb__free(T->ctx, buf);
+    return res;
+}
+
+/* Builds the net of the current state into T->x. */
+static sfb_result tbz_state(sfb__tbz *T, int sharp) {
+    T->sharp = sharp;
+    tbz_classify(T);
+    tbz_initial(T);
+    tbz_distances(T);
+    return tbz_solve(T);
+}
+
+/* Does a patch corner of the net have (nearly) parallel edge tangents? */
+static int tbz_degenerate(const sfb__tbz *T) {
+    int f, k, c;
+    for (f = 0; f < T->nf; ++f)
+        for (k = 0; k < 3; ++k) {
+            int w[3], p0, p1, p2;
+            double a[3], b[3], x[3], la = 0, lb = 0;
+            w[k] = 4; w[(k + 1) % 3] = 0; w[(k + 2) % 3] = 0;
+            p0 = tbz_pt(T, f, w);
+            w[k] = 3; w[(k + 1) % 3] = 1;
+            p1 = tbz_pt(T, f, w);
+            w[(k + 1) % 3] = 0; w[(k + 2) % 3] = 1;
+            p2 = tbz_pt(T, f, w);
+            for (c = 0; c < 3; ++c) {
+                a[c] = T->x[3 * (size_t)p1 + c] - T->x[3 * (size_t)p0 + c];
+                b[c] = T->x[3 * (size_t)p2 + c] - T->x[3 * (size_t)p0 + c];
+                la += a[c] * a[c]; lb += b[c] * b[c];
+            }
+            sfb__cross3(a, b, x);
+            if (!(sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]) > 1e-6 * sqrt(la * lb))) return 1;
+        }
+    return 0;
+}
+
+/* Per vertex the s of the nearest tagged feature (breadth first over mesh edges). */
+static sfb_result tbz_vertex_s(sfb__tbz *T, double *vs) {
+    const sfb__level *l = T->l;
+    int *queue = (int *)sfb__alloc(T->ctx, ((size_t)T->nv + 1) * sizeof(int)), head = 0, tail = 0, v, i;
+    unsigned char *seen;
+    if (!queue) return sfb__oom(T->ctx, "tribezier");
+    seen = (unsigned char *)sfb__calloc(T->ctx, (size_t)T->nv + 1, 1);
+    if (!seen) { sfb__free(T->ctx, queue); return sfb__oom(T->ctx, "tribezier"); }
+    for (v = 0; v < T->nv; ++v) {
+        double sum = 0.0;
+        int cnt = 0;
+        for (i = l->ve_off[v]; i < l->ve_off[v + 1]; ++i)
+            if (T->tag_s[l->ve[i]] > 0.0f && l->ef_off[l->ve[i] + 1] - l->ef_off[l->ve[i]] == 2) { sum += T->tag_s[l->ve[i]]; cnt++; }
+        vs[v] = cnt ? sum / cnt : 0.0;
+        if (T->corner_s[v] > 0.0f) { vs[v] = cnt ? fmax(vs[v], T->corner_s[v]) : T->corner_s[v]; cnt = 1; }
+        if (cnt) { seen[v] = 1; queue[tail++] = v; }
+    }
+    while (head < tail) {
+        const int u = queue[head++];
+        for (i = l->ve_off[u]; i < l->ve_off[u + 1]; ++i) {
+            const int w = sfb__other_end(l, l->ve[i], u);
+            if (!seen[w]) { seen[w] = 1; vs[w] = vs[u]; queue[tail++] = w; }
+        }
+    }
+    sfb__free(T->ctx, queue); sfb__free(T->ctx, seen);
+    return SFB_SUCCESS;
+}
+
+sfb_result sfb__tribezier_points(sfb_context *ctx, const sfb__level *l, const float *positions, const sfb_tribezier_options *opt,
+                                 unsigned flags, double **out, sfb__tbz_stats *stats) {
+    sfb__tbz T;
+    double *x0 = NULL, *vs = NULL, *res = NULL, lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0}, diag2 = 0.0;
+    int v, e, f, c, k, any_tag = 0;
+    sfb_result r = SFB_SUCCESS;
+    *out = NULL;
+    memset(&T, 0, sizeof T);
+    if (opt && opt->sharpness_set && !(opt->sharpness >= 0.0f && opt->sharpness <= 1.0f))
+        return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "tribezier: sharpness %g is not in [0, 1]", (double)opt->sharpness);
+    for (f = 0; f < l->nf; ++f)
+        if (sfb__face_n(l, f) != 3)
+            return sfb__error(ctx, SFB_INVALID_TOPOLOGY, SFB_ELEMENT_FACE, f,
+                              "tribezier: face %d has %d vertices (triangles only: split it first)", f, sfb__face_n(l, f));
+    for (e = 0; e < l->ne; ++e)
+        if (l->ef_off[e + 1] - l->ef_off[e] > 2)
+            return sfb__error(ctx, SFB_INVALID_TOPOLOGY, SFB_ELEMENT_EDGE, e, "tribezier: edge %d (%d-%d) is non-manifold (%d triangles)", e,
+                              l->ev[2 * e], l->ev[2 * e + 1], l->ef_off[e + 1] - l->ef_off[e]);
+    for (v = 0; v < l->nv; ++v) {
+        if (l->vtag[v] & SFB__TAG_NONMANIFOLD)
+            return sfb__error(ctx, SFB_INVALID_TOPOLOGY, SFB_ELEMENT_VERTEX, v, "tribezier: vertex %d is non-manifold (its triangles are not one fan)", v);
+        for (c = 0; c < 3; ++c) {
+            const double x = positions[3 * (size_t)v + c];
+            if (!(x == x) || x > 3.4e38 || x < -3.4e38)
+                return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_VERTEX, v, "tribezier: vertex %d is not finite", v);
+            if (v == 0 || x < lo[c]) lo[c] = x;
+            if (v == 0 || x > hi[c]) hi[c] = x;
+        }
+    }
+    for (c = 0; c < 3; ++c) diag2 += (hi[c] - lo[c]) * (hi[c] - lo[c]);
+    for (f = 0; f < l->nf; ++f) {
+        const int *fv = l->fv + l->fv_off[f];
+        double u[3], w[3], n[3];
+        for (c = 0; c < 3; ++c) {
+            u[c] = (double)positions[3 * (size_t)fv[1] + c] - positions[3 * (size_t)fv[0] + c];
+            w[c] = (double)positions[3 * (size_t)fv[2] + c] - positions[3 * (size_t)fv[0] + c];
+        }
+        sfb__cross3(u, w, n);
+        if (!(0.5 * sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]) > 1e-12 * diag2))
+            return sfb__error(ctx, SFB_INVALID_TOPOLOGY, SFB_ELEMENT_FACE, f, "tribezier: triangle %d (%d %d %d) is degenerate", f, fv[0],
+                              fv[1], fv[2]);
+    }
+    T.ctx = ctx; T.l = l; T.pos = positions;
+    T.nv = l->nv; T.ne = l->ne; T.nf = l->nf;
+    T.np = l->nv + 3 * l->ne + 3 * l->nf;
+    T.seed_plane = (flags & SFB__TBZ_SEED_PLANE) != 0;
+    T.efeat = (unsigned char *)sfb__calloc(ctx, (size_t)T.ne + 1, 1);
+    T.vtype = (unsigned char *)sfb__calloc(ctx, (size_t)T.nv + 1, 1);
+    T.virr = (unsigned char *)sfb__calloc(ctx, (size_t)T.nv + 1, 1);
+    T.phi = (double *)sfb__calloc(ctx, (size_t)l->vf_off[l->nv] + 1, sizeof(double));
+    T.x = (double *)sfb__calloc(ctx, 3 * (size_t)T.np + 1, sizeof(double));
+    T.fixed = (unsigned char *)sfb__calloc(ctx, (size_t)T.np + 1, 1);
+    T.dist = (int *)sfb__calloc(ctx, (size_t)T.np + 1, sizeof(int));
+    T.tag_s = (float *)sfb__calloc(ctx, (size_t)T.ne + 1, sizeof(float));
+    T.corner_s = (float *)sfb__calloc(ctx, (size_t)T.nv + 1, sizeof(float));
+    res = (double *)sfb__alloc(ctx, 45 * (size_t)T.nf * sizeof(double) + 1);
+    if (!T.efeat || !T.vtype || !T.virr || !T.phi || !T.x || !T.fixed || !T.dist || !T.tag_s || !T.corner_s || !res) {
+        r = sfb__oom(ctx, "tribezier");
+        goto done;
+    }
+    /* s per feature: the tag clamped to [0, 1] (infinite: 1), or the override */
+    for (e = 0; e < T.ne; ++e)
+        if (l->ef_off[e + 1] - l->ef_off[e] == 2 && l->es[e] > 0.0f) {
+            T.tag_s[e] = opt && opt->sharpness_set ? opt->sharpness : (l->es[e] < 1.0f ? l->es[e] : 1.0f);
+            if (T.tag_s[e] <= 0.0f) T.tag_s[e] = 1e-30f; /* a feature at s = 0: the smooth net's treatment */
+            any_tag = 1;
+        }
+    for (v = 0; v < T.nv; ++v)
+        if (l->vs[v] > 0.0f && !(tbz_boundary(l, v) && tbz_nf(l, v) == 1)) {
+            T.corner_s[v] = opt && opt->sharpness_set ? opt->sharpness : (l->vs[v] < 1.0f ? l->vs[v] : 1.0f);
+            if (T.corner_s[v] <= 0.0f) T.corner_s[v] = 1e-30f;
+            any_tag = 1;
+        }
+    r = tbz_state(&T, 0);
+    if (r == SFB_SUCCESS && !T.seed_plane && any_tag && (T.st.residual > 1e-10 || tbz_degenerate(&T))) {
+        /* our crease tangent plane left the constraints unsolvable or a patch corner degenerate
+         * (seen at valence 8 and up with a crease through the vertex): the smooth net falls back
+         * to the seed's kind (measured in tests/tribezier.c) */
+        memset(&T.st, 0, sizeof T.st);
+        T.seed_plane = 1;
+        r = tbz_state(&T, 0);
+        T.seed_plane = (flags & SFB__TBZ_SEED_PLANE) != 0;
+        T.st.fallbacks++;
+    }
+    if (r != SFB_SUCCESS) goto done;
+    if (any_tag) {
+        x0 = T.x;
+        T.x = (double *)sfb__calloc(ctx, 3 * (size_t)T.np + 1, sizeof(double));
+        vs = (double *)sfb__calloc(ctx, (size_t)T.nv + 1, sizeof(double));
+        if (!T.x || !vs) { r = sfb__oom(ctx, "tribezier"); goto done; }
+        r = tbz_state(&T, 1);
+        if (r != SFB_SUCCESS) goto done;
+        r = tbz_vertex_s(&T, vs);
+        if (r != SFB_SUCCESS) goto done;
+    }
+    for (f = 0; f < T.nf; ++f) {
+        const int *fv = l->fv + l->fv_off[f];
+        int g[15], i, j, q = 0;
+        tbz_patch(&T, f, g);
+        for (j = 0; j <= 4; ++j)
+            for (i = 0; i + j <= 4; ++i, ++q) {
+                double s = 0.0, wsum = 0.0;
+                if (any_tag) {
+                    /* the point's home vertices: weights > 0 */
+                    const int w[3] = {4 - i - j, i, j};
+                    for (k = 0; k < 3; ++k)
+                        if (w[k] > 0 && (w[0] == 4 || w[1] == 4 || w[2] == 4 ? w[k] == 4 : 1)) { s += vs[fv[k]]; wsum += 1.0; }
+                    s = wsum > 0.0 ? s / wsum : 0.0;
+                    if (s < 1e-20) s = 0.0;
+                }
+                for (c = 0; c < 3; ++c) {
+                    const double sh = T.x[3 * (size_t)g[q] + c];
+                    res[45 * (size_t)f + 3 * q + c] = any_tag ? (1.0 - s) * x0[3 * (size_t)g[q] + c] + s * sh : sh;
+                }
+            }
+    }
+    *out = res;
+    res = NULL;
+    if (stats) *stats = T.st;
+done:
+    sfb__free(ctx, T.efeat); sfb__free(ctx, T.vtype); sfb__free(ctx, T.virr); sfb__free(ctx, T.phi);
+    sfb__free(ctx, T.x); sfb__free(ctx, T.fixed); sfb__free(ctx, T.dist); sfb__free(ctx, T.tag_s); sfb__free(ctx, T.corner_s);
+    sfb__free(ctx, x0); sfb__free(ctx, vs); sfb__free(ctx, res);
+    return r;
+}
+
+sfb_result sfb__tribezier_build(sfb_context *ctx, const sfb__level *l, const float *positions, const sfb_tribezier_options *opt,
+                                sfb__patch_table *pt) {
+    double *net = NULL;
+    sfb_result r;
+    memset(pt, 0, sizeof *pt);
+    r = sfb__tribezier_points(ctx, l, positions, opt, 0, &net, NULL);
+    if (r != SFB_SUCCESS) return r;
+    r = sfb__patch_table_beztri_own(ctx, l, net, pt);
+    sfb__free(ctx, net);
+    return r;
+}

@@ -1,0 +1,684 @@
+/* Quartic triangular Bezier surfaces with sharpness (SFB_SCHEME_TRIBEZIER, src/patch/tribezier.c,
+ * seed 004), in double from the builder's own points (src/sfb_internal.h, linked from
+ * libsfb_internal.o) and through sfb_surface_eval on every backend:
+ *   - s = 0: the normal jump across every interior edge (atan2 form, ALGORITHMS.md 8.6, 11 points
+ *     per edge) <= 1e-9 rad and the position gap <= 1e-7 x diagonal, on disks around one vertex of
+ *     valence 3..12, jittered, and on closed meshes whose extraordinary vertices touch;
+ *   - regular regions (every corner of the triangle regular, two rings from any irregular vertex)
+ *     equal SFB_SCHEME_LOOP's limit surface within 1e-7 x diagonal;
+ *   - s = 1 on a regular crease: the crease curve is the degree-raised cubic B-spline of its
+ *     vertices; corners at s = 1 pass through the corner vertex;
+ *   - 0 < s < 1: positions are (1 - s) P(0) + s P(1) within 1e-9 x diagonal, the normal jump
+ *     across the crease grows with s, and is continuous in s;
+ *   - the undulation of the crease curve at s = 0.25, 0.5, 0.75 near extraordinary crease
+ *     vertices of valence 4, 5, 7 (ours against the seed's tangent plane, printed);
+ *   - every backend's sfb_surface_eval agrees with the builder's points (positions 1e-6 x
+ *     diagonal, normal jumps across edges <= 1e-5 rad);
+ *   - bad input: s outside [0, 1] or NaN, quads, non-manifold edges, degenerate triangles.
+ * A backend that is unavailable SKIPs (FAILs when listed in SFB_REQUIRE_BACKENDS). */
+#define SURFBLEND_EXPOSE_INTERNALS /* the internals below have external linkage in libsfb_internal.o */
+#include "surfblend.h"
+#include "src/sfb_internal.h" /* the library's internal interfaces (linked from libsfb_internal.o) */
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "harness.h"
+#include "tribezier_mesh.h"
+
+/* ---- quartic Bezier triangles in double (our point order: row by row in v, u rising) ---- */
+
+static int qij(int i, int j) { return 5 * j - j * (j - 1) / 2 + i; }
+
+/* Position and the derivatives along u and v at (u, v). */
+static void bez_eval(const double *b, double u, double v, double P[3], double Du[3], double Dv[3]) {
+    const double w = 1.0 - u - v;
+    double pw[3][5];
+    int i, j, k, c;
+    static const double f[5] = {1, 1, 2, 6, 24};
+    for (k = 0; k < 5; ++k) {
+        pw[0][k] = pow(w, k); pw[1][k] = pow(u, k); pw[2][k] = pow(v, k);
+    }
+    for (c = 0; c < 3; ++c) P[c] = Du[c] = Dv[c] = 0.0;
+    for (j = 0; j <= 4; ++j)
+        for (i = 0; i + j <= 4; ++i) {
+            k = 4 - i - j;
+            for (c = 0; c < 3; ++c) P[c] += 24.0 / (f[i] * f[j] * f[k]) * pw[0][k] * pw[1][i] * pw[2][j] * b[3 * qij(i, j) + c];
+        }
+    /* derivatives: 4 sum over degree 3 (exponents i, j, k of u, v, w) */
+    for (j = 0; j <= 3; ++j)
+        for (i = 0; i + j <= 3; ++i) {
+            const double B = 6.0 / (f[i] * f[j] * f[3 - i - j]) * pw[0][3 - i - j] * pw[1][i] * pw[2][j];
+            for (c = 0; c < 3; ++c) {
+                Du[c] += 4.0 * B * (b[3 * qij(i + 1, j) + c] - b[3 * qij(i, j) + c]);
+                Dv[c] += 4.0 * B * (b[3 * qij(i, j + 1) + c] - b[3 * qij(i, j) + c]);
+            }
+        }
+}
+
+static void cross(const double *a, const double *b, double *c) {
+    c[0] = a[1] * b[2] - a[2] * b[1]; c[1] = a[2] * b[0] - a[0] * b[2]; c[2] = a[0] * b[1] - a[1] * b[0];
+}
+static double norm3(const double *a) { return sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]); }
+static double angle_between(const double *a, const double *b) {
+    double x[3];
+    cross(a, b, x);
+    return atan2(norm3(x), a[0] * b[0] + a[1] * b[1] + a[2] * b[2]);
+}
+
+/* (u, v) of barycentric weights (1 - t) on slot k and t on slot k+1 of a triangle. */
+static void edge_uv(int k, double t, double *u, double *v) {
+    double w[3] = {0, 0, 0};
+    w[k] = 1.0 - t; w[(k + 1) % 3] = t;
+    *u = w[1]; *v = w[2];
+}
+
+typedef struct g1_result {
+    double jump, gap;      /* largest normal jump (rad) and position gap */
+    double flat;           /* smallest |du x dv| / (|du| |dv|) on the edges (0: a degenerate patch) */
+    int edges;
+} g1_result;
+
+/* Normal jumps across the interior edges of l (those with skip_sharp set and sharpness > 0 left
+ * out), 11 points per edge. */
+static g1_result g1_measure(const sfb__level *l, const double *net, int skip_sharp) {
+    g1_result g = {0, 0, 1, 0};
+    int e, q, c;
+    for (e = 0; e < l->ne; ++e) {
+        int f0, f1, s0, s1;
+        if (l->ef_off[e + 1] - l->ef_off[e] != 2) continue;
+        if (skip_sharp && l->es[e] > 0.0f) continue;
+        f0 = l->ef[l->ef_off[e]]; s0 = l->ef_slot[l->ef_off[e]];
+        f1 = l->ef[l->ef_off[e] + 1]; s1 = l->ef_slot[l->ef_off[e] + 1];
+        g.edges++;
+        for (q = 0; q <= 10; ++q) {
+            const double t = q / 10.0;
+            double u0, v0, u1, v1, P0[3], P1[3], a0[3], b0[3], a1[3], b1[3], n0[3], n1[3], d[3];
+            edge_uv(s0, t, &u0, &v0);
+            edge_uv(s1, 1.0 - t, &u1, &v1); /* the other face runs the edge the other way */
+            bez_eval(net + 45 * (size_t)f0, u0, v0, P0, a0, b0);
+            bez_eval(net + 45 * (size_t)f1, u1, v1, P1, a1, b1);
+            cross(a0, b0, n0); cross(a1, b1, n1);
+            g.flat = fmin(g.flat, fmin(norm3(n0) / (norm3(a0) * norm3(b0) + 1e-300), norm3(n1) / (norm3(a1) * norm3(b1) + 1e-300)));
+            for (c = 0; c < 3; ++c) d[c] = P0[c] - P1[c];
+            if (norm3(d) > g.gap) g.gap = norm3(d);
+            {
+                const double j = angle_between(n0, n1);
+                if (j > g.jump) {
+                    g.jump = j;
+                    if (getenv("TBZ_DEBUG") && j > 1e-6)
+                        printf("  worst so far: edge %d (%d-%d) valences %d %d t %.1f jump %.3g\n", e, l->ev[2 * e], l->ev[2 * e + 1],
+                               l->vf_off[l->ev[2 * e] + 1] - l->vf_off[l->ev[2 * e]],
+                               l->vf_off[l->ev[2 * e + 1] + 1] - l->vf_off[l->ev[2 * e + 1]], t, j);
+                }
+            }
+        }
+    }
+    return g;
+}
+
+static double diag_of(const float *p, int nv) {
+    double lo[3], hi[3], d = 0;
+    int v, c;
+    for (c = 0; c < 3; ++c) { lo[c] = 1e300; hi[c] = -1e300; }
+    for (v = 0; v < nv; ++v)
+        for (c = 0; c < 3; ++c) { lo[c] = fmin(lo[c], p[3 * v + c]); hi[c] = fmax(hi[c], p[3 * v + c]); }
+    for (c = 0; c < 3; ++c) d += (hi[c] - lo[c]) * (hi[c] - lo[c]);
+    return sqrt(d);
+}
+
+/* A mesh from OBJ text and its prepared level. */
+typedef struct tmesh {
+    sfb_mesh *m;
+    sfb__level prep;
+    double diag;
+} tmesh;
+
+static int tmesh_load(sfb_context *ctx, const char *obj, tmesh *t) {
+    memset(t, 0, sizeof *t);
+    if (sfb_mesh_read_obj(ctx, obj, strlen(obj), &t->m) != SFB_SUCCESS) return 0;
+    if (sfb__level_prepare(ctx, &t->m->base, 1, 0, &t->prep) != SFB_SUCCESS) return 0;
+    t->diag = diag_of(t->m->positions, t->m->base.nv);
+    return 1;
+}
+static void tmesh_free(sfb_context *ctx, tmesh *t) {
+    sfb__level_free(ctx, &t->prep);
+    sfb_mesh_destroy(t->m);
+}
+
+static double *net_of(sfb_context *ctx, tmesh *t, const sfb_tribezier_options *o, unsigned flags, sfb__tbz_stats *st) {
+    double *net = NULL;
+    if (sfb__tribezier_points(ctx, &t->prep, t->m->positions, o, flags, &net, st) != SFB_SUCCESS) {
+        printf("  build: %s\n", sfb_last_error(ctx));
+        return NULL;
+    }
+    return net;
+}
+
+static void test_g1_disks(sfb_context *ctx) {
+    int n, jit;
+    for (jit = 0; jit < 2; ++jit)
+        for (n = 3; n <= 12; ++n) {
+            tbm_opts o;
+            tmesh t;
+            char name[96], *obj;
+            double *net;
+            sfb__tbz_stats st;
+            memset(&o, 0, sizeof o);
+            o.n = n; o.R = 5; o.bump = 1.0; o.jitter = jit ? 0.3 : 0.0; o.seed = 7u + (unsigned)n;
+            snprintf(name, sizeof name, "g1_disk_valence_%d%s", n, jit ? "_jittered" : "");
+            obj = tbm_obj(&o);
+            if (!tmesh_load(ctx, obj, &t)) { fail(name, "load: %s", sfb_last_error(ctx)); free(obj); continue; }
+            net = net_of(ctx, &t, NULL, 0, &st);
+            if (!net) fail(name, "not built");
+            else {
+                g1_result g = g1_measure(&t.prep, net, 0);
+                check(g.jump <= 1e-9 && g.gap <= 1e-7 * t.diag && g.flat > 1e-3, name, "flatness %.3g, normal jump %.3g rad, gap %.3g (diag %.3g), %d edges, residual %.3g, %ld it",
+                      g.flat, g.jump, g.gap, t.diag, g.edges, st.residual, st.iterations);
+                printf("  %s: jump %.3g rad gap %.3g, %ld unknowns %ld rows %ld iterations residual %.3g\n", name, g.jump, g.gap,
+                       st.unknowns, st.constraints, st.iterations, st.residual);
+            }
+            sfb__free(ctx, net);
+            tmesh_free(ctx, &t);
+            free(obj);
+        }
+}
+
+static const char *octahedron =
+    "v 1 0 0\nv -1 0 0\nv 0 1 0\nv 0 -1 0\nv 0 0 1\nv 0 0 -1\n"
+    "f 1 3 5\nf 3 2 5\nf 2 4 5\nf 4 1 5\nf 3 1 6\nf 2 3 6\nf 4 2 6\nf 1 4 6\n";
+
+/* An icosahedron (valence 5 everywhere: every edge joins two extraordinary vertices). */
+static char *icosahedron(void) {
+    const double p = (1.0 + sqrt(5.0)) / 2.0;
+    static const int F[20][3] = {{0, 11, 5}, {0, 5, 1}, {0, 1, 7}, {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4}, {11, 10, 2}, {10, 7, 6},
+                                 {7, 1, 8}, {3, 9, 4}, {3, 4, 2}, {3, 2, 6}, {3, 6, 8}, {3, 8, 9}, {4, 9, 5}, {2, 4, 11}, {6, 2, 10},
+                                 {8, 6, 7}, {9, 8, 1}};
+    const double V[12][3] = {{-1, p, 0}, {1, p, 0}, {-1, -p, 0}, {1, -p, 0}, {0, -1, p}, {0, 1, p},
+                             {0, -1, -p}, {0, 1, -p}, {p, 0, -1}, {p, 0, 1}, {-p, 0, -1}, {-p, 0, 1}};
+    char *s = (char *)malloc(4096);
+    size_t len = 0;
+    int i;
+    for (i = 0; i < 12; ++i) len += (size_t)snprintf(s + len, 4096 - len, "v %.17g %.17g %.17g\n", V[i][0], V[i][1], V[i][2]);
+    for (i = 0; i < 20; ++i) len += (size_t)snprintf(s + len, 4096 - len, "f %d %d %d\n", F[i][0] + 1, F[i][1] + 1, F[i][2] + 1);
+    return s;
+}
+
+/* G1 on one mesh given as OBJ text. */
+static void g1_one(sfb_context *ctx, const char *name, const char *obj, double tol) {
+    tmesh t;
+    double *net;
+    sfb__tbz_stats st;
+    if (!tmesh_load(ctx, obj, &t)) { fail(name, "load: %s", sfb_last_error(ctx)); return; }
+    net = net_of(ctx, &t, NULL, 0, &st);
+    if (!net) fail(name, "not built");
+    else {
+        g1_result g = g1_measure(&t.prep, net, 0);
+        check(g.jump <= tol && g.gap <= 1e-7 * t.diag && g.flat > 1e-3, name, "flatness %.3g, normal jump %.3g rad, gap %.3g (diag %.3g), %d edges, residual %.3g",
+              g.flat, g.jump, g.gap, t.diag, g.edges, st.residual);
+        printf("  %s: jump %.3g rad gap %.3g, %ld unknowns %ld rows %ld iterations residual %.3g\n", name, g.jump, g.gap, st.unknowns,
+               st.constraints, st.iterations, st.residual);
+    }
+    sfb__free(ctx, net);
+    tmesh_free(ctx, &t);
+}
+
+static void test_g1_closed(sfb_context *ctx) {
+    char *ico = icosahedron();
+    g1_one(ctx, "g1_octahedron_adjacent_valence_4", octahedron, 1e-9);
+    g1_one(ctx, "g1_icosahedron_adjacent_valence_5", ico, 1e-9);
+    free(ico);
+}
+
+/* Triangles of the disk whose corners all lie in rings lo..hi. */
+static int in_rings(const tbm_opts *o, const sfb__level *l, int f, int lo, int hi) {
+    int k;
+    for (k = 0; k < 3; ++k) {
+        const int v = l->fv[l->fv_off[f] + k];
+        int r = 0;
+        while (v > 0 && !(v >= 1 + o->n * r * (r + 1) / 2 && v < 1 + o->n * (r + 1) * (r + 2) / 2)) ++r;
+        if (v == 0) r = -1;
+        if (r + 1 < lo || r + 1 > hi) return 0;
+    }
+    return 1;
+}
+
+/* Regular regions equal the Loop limit surface (SFB_SCHEME_LOOP's sfb_surface_eval). */
+static void test_regular_is_loop(sfb_context *ctx) {
+    int n;
+    for (n = 4; n <= 7; n += 3) {
+        tbm_opts o;
+        tmesh t;
+        char name[96], *obj;
+        double *net, worst = 0.0;
+        sfb_surface *loop = NULL;
+        sfb_surface_config sc = sfb_surface_config_init(SFB_SCHEME_LOOP, 0);
+        int f, q, count = 0;
+        memset(&o, 0, sizeof o);
+        o.n = n; o.R = 8; o.bump = 2.0; o.jitter = 0.2; o.seed = 3u;
+        snprintf(name, sizeof name, "regular_region_is_loop_valence_%d", n);
+        obj = tbm_obj(&o);
+        if (!tmesh_load(ctx, obj, &t)) { fail(name, "load"); free(obj); continue; }
+        net = net_of(ctx, &t, NULL, 0, NULL);
+        sc.flags = SFB_REFINE_PATCHES;
+        if (!net || sfb_surface_create(ctx, t.m, &sc, &loop) != SFB_SUCCESS) { fail(name, "%s", sfb_last_error(ctx)); }
+        else {
+            for (f = 0; f < t.prep.nf; ++f) {
+                if (!in_rings(&o, &t.prep, f, 3, 5)) continue;
+                for (q = 0; q < 6; ++q) {
+                    sfb_location loc;
+                    float P[3];
+                    sfb_eval_output eo;
+                    double B[3], du[3], dv[3], d;
+                    memset(&eo, 0, sizeof eo);
+                    eo.position = P;
+                    loc.face = f; loc.u = (float)((q % 3) / 4.0 + 0.1); loc.v = (float)((q / 3) / 3.0 + 0.1);
+                    if (sfb_surface_eval(loop, &loc, 1, &eo) != SFB_SUCCESS) continue;
+                    bez_eval(net + 45 * (size_t)f, loc.u, loc.v, B, du, dv);
+                    d = sqrt((B[0] - P[0]) * (B[0] - P[0]) + (B[1] - P[1]) * (B[1] - P[1]) + (B[2] - P[2]) * (B[2] - P[2]));
+                    worst = fmax(worst, d);
+                    count++;
+                }
+            }
+            /* Loop's own points are floats: 1e-7 x diagonal is a few float ulps of the coordinates */
+            check(count > 100 && worst <= 1e-7 * t.diag * 4, name, "%d points, worst %.3g (diag %.3g)", count, worst, t.diag);
+        }
+        if (loop) sfb_surface_destroy(loop);
+        sfb__free(ctx, net);
+        tmesh_free(ctx, &t);
+        free(obj);
+    }
+}
+
+/* The crease curve (edge points of the crease edges) of the disk's ray 0, ring r to r+1. */
+static void crease_edge_points(const tbm_opts *o, const sfb__level *l, const double *net, int r, double out[5][3]) {
+    const int a = tbm_index(o, 0, r, 0), b = tbm_index(o, 0, r + 1, 0);
+    int f, k, j, c;
+    for (f = 0; f < l->nf; ++f)
+        for (k = 0; k < 3; ++k)
+            if (l->fv[l->fv_off[f] + k] == a && l->fv[l->fv_off[f] + (k + 1) % 3] == b) {
+                for (j = 0; j <= 4; ++j) {
+                    int w[3] = {0, 0, 0}, i2, j2;
+                    w[k] = 4 - j; w[(k + 1) % 3] = j;
+                    i2 = w[1]; j2 = w[2];
+                    for (c = 0; c < 3; ++c) out[j][c] = net[45 * (size_t)f + 3 * qij(i2, j2) + c];
+                }
+                return;
+            }
+}
+
+static void bspline_edge(const double *A0, const double *A, const double *B, const double *B1, double out[5][3]) {
+    int c;
+    for (c = 0; c < 3; ++c) {
+        const double P0 = (A0[c] + 4 * A[c] + B[c]) / 6, P1 = (2 * A[c] + B[c]) / 3, P2 = (A[c] + 2 * B[c]) / 3, P3 = (A[c] + 4 * B[c] + B1[c]) / 6;
+        out[0][c] = P0; out[1][c] = (P0 + 3 * P1) / 4; out[2][c] = (P1 + P2) / 2; out[3][c] = (3 * P2 + P3) / 4; out[4][c] = P3;
+    }
+}
+
+/* Creases: s = 1 on a regular crease is the B-spline; the blend; the jump grows with s; corners. */
+static void test_creases(sfb_context *ctx) {
+    tbm_opts o;
+    tmesh t;
+    char *obj;
+    double *net[5] = {NULL, NULL, NULL, NULL, NULL};
+    const double S[5] = {0.0, 0.25, 0.5, 0.75, 1.0};
+    int i, k, c, r;
+    memset(&o, 0, sizeof o);
+    o.n = 6; o.R = 7; o.crease_k = 3; o.sharp = 1.0; o.ridge = 0.6; o.bump = 1.0; o.jitter = 0.2; o.seed = 11u;
+    obj = tbm_obj(&o);
+    if (!tmesh_load(ctx, obj, &t)) { fail("crease/load", "%s", sfb_last_error(ctx)); free(obj); return; }
+    for (i = 0; i < 5; ++i) {
+        sfb_tribezier_options to;
+        to.sharpness_set = 1; to.sharpness = (float)S[i];
+        net[i] = net_of(ctx, &t, &to, 0, NULL);
+        if (!net[i]) { fail("crease/build", "s %g", S[i]); goto done; }
+    }
+    {
+        /* s = 1: the crease ring 1..2 .. 4..5 (regular crease vertices) is the cubic B-spline */
+        double worst = 0.0;
+        for (r = 1; r <= 4; ++r) {
+            double got[5][3], want[5][3], V[4][3];
+            for (k = 0; k < 4; ++k)
+                for (c = 0; c < 3; ++c) V[k][c] = t.m->positions[3 * tbm_index(&o, 0, r - 1 + k, 0) + c];
+            crease_edge_points(&o, &t.prep, net[4], r, got);
+            bspline_edge(V[0], V[1], V[2], V[3], want);
+            for (k = 0; k < 5; ++k)
+                for (c = 0; c < 3; ++c) worst = fmax(worst, fabs(got[k][c] - want[k][c]));
+        }
+        check(worst <= 1e-7 * t.diag, "crease/s1_regular_crease_is_loop_bspline", "worst %.3g (diag %.3g)", worst, t.diag);
+    }
+    {
+        /* the blend, point by point */
+        double worst = 0.0;
+        size_t q;
+        for (i = 1; i < 4; ++i)
+            for (q = 0; q < 45 * (size_t)t.prep.nf; ++q) worst = fmax(worst, fabs(net[i][q] - ((1 - S[i]) * net[0][q] + S[i] * net[4][q])));
+        check(worst <= 1e-9 * t.diag, "crease/blend_is_exact", "worst %.3g", worst);
+    }
+    {
+        /* G1 at s = 0 (the crease smooth), the jump across the crease grows with s */
+        g1_result g0 = g1_measure(&t.prep, net[0], 0), gs[5];
+        int mono = 1;
+        check(g0.jump <= 1e-9 && g0.flat > 1e-3, "crease/s0_is_g1_across_the_crease", "jump %.3g flat %.3g", g0.jump, g0.flat);
+        for (i = 0; i < 5; ++i) {
+            /* jumps across the tagged edges only: measure all, subtract nothing (the others are G1) */
+            gs[i] = g1_measure(&t.prep, net[i], 0);
+            if (i > 0 && !(gs[i].jump > gs[i - 1].jump)) mono = 0;
+        }
+        check(mono && gs[4].jump > 0.1, "crease/jump_grows_with_s", "jumps %.3g %.3g %.3g %.3g %.3g", gs[0].jump, gs[1].jump, gs[2].jump,
+              gs[3].jump, gs[4].jump);
+        {
+            /* G1 across the edges that are not tagged, at s = 1 */
+            g1_result g1 = g1_measure(&t.prep, net[4], 1);
+            check(g1.jump <= 1e-9, "crease/s1_g1_off_the_crease", "jump %.3g", g1.jump);
+        }
+    }
+    {
+        /* continuity in s */
+        sfb_tribezier_options to;
+        double *a, *b, worst = 0.0;
+        size_t q;
+        to.sharpness_set = 1; to.sharpness = 0.5f;
+        a = net_of(ctx, &t, &to, 0, NULL);
+        to.sharpness = 0.5f + 1e-6f;
+        b = net_of(ctx, &t, &to, 0, NULL);
+        for (q = 0; a && b && q < 45 * (size_t)t.prep.nf; ++q) worst = fmax(worst, fabs(a[q] - b[q]));
+        check(a && b && worst <= 1e-4 * t.diag, "crease/continuous_in_s", "a change of 1e-6 in s moves points by %.3g", worst);
+        sfb__free(ctx, a); sfb__free(ctx, b);
+    }
+done:
+    for (i = 0; i < 5; ++i) sfb__free(ctx, net[i]);
+    tmesh_free(ctx, &t);
+    free(obj);
+}
+
+/* Creases at extraordinary vertices of valence 3..12 and a corner: G1 off the crease at s = 1,
+ * G1 everywhere at s = 0, corners interpolated at s = 1. */
+static void test_crease_evs(sfb_context *ctx) {
+    int n, corner;
+    for (corner = 0; corner < 2; ++corner)
+        for (n = corner ? 3 : 4; n <= 12; ++n) {
+            tbm_opts o;
+            tmesh t;
+            char name[128], *obj;
+            double *n0, *n1;
+            sfb_tribezier_options to;
+            sfb__tbz_stats st;
+            memset(&o, 0, sizeof o);
+            o.n = n; o.R = 5; o.crease_k = corner ? 0 : n / 2; o.corner3 = corner; o.sharp = 1.0; o.ridge = 0.5; o.bump = 1.0;
+            o.jitter = 0.15; o.seed = 5u + (unsigned)n;
+            obj = tbm_obj(&o);
+            snprintf(name, sizeof name, "%s_valence_%d", corner ? "corner" : "crease", n);
+            if (!tmesh_load(ctx, obj, &t)) { fail(name, "load"); free(obj); continue; }
+            to.sharpness_set = 1; to.sharpness = 0.0f;
+            n0 = net_of(ctx, &t, &to, 0, &st);
+            if (st.fallbacks) printf("  %s: the smooth net fell back to the seed's tangent plane\n", name);
+            to.sharpness = 1.0f;
+            n1 = net_of(ctx, &t, &to, 0, NULL);
+            if (!n0 || !n1) fail(name, "not built");
+            else {
+                g1_result g0 = g1_measure(&t.prep, n0, 0), g1 = g1_measure(&t.prep, n1, 1);
+                char nm[160];
+                snprintf(nm, sizeof nm, "%s/s0_g1", name);
+                check(g0.jump <= 1e-9 && g0.flat > 1e-3, nm, "jump %.3g flat %.3g", g0.jump, g0.flat);
+                snprintf(nm, sizeof nm, "%s/s1_g1_off_the_creases", name);
+                check(g1.jump <= 1e-9 && g1.flat > 1e-3, nm, "jump %.3g flat %.3g", g1.jump, g1.flat);
+                if (corner) {
+                    double d = 0;
+                    int c;
+                    for (c = 0; c < 3; ++c) d += fabs(n1[c] - t.m->positions[c]); /* the centre is corner 0 of triangle 0 */
+                    snprintf(nm, sizeof nm, "%s/s1_through_the_corner_vertex", name);
+                    check(d <= 1e-12, nm, "distance %.3g", d);
+                }
+            }
+            sfb__free(ctx, n0); sfb__free(ctx, n1);
+            tmesh_free(ctx, &t);
+            free(obj);
+        }
+}
+
+/* The seed's open problem: the crease curve near an extraordinary crease vertex at s = 0.25,
+ * 0.5, 0.75: (a) its largest distance from the vertical plane through the (straight) crease
+ * line y = 0, (b) the curvature sign changes of its projection into that plane (x, z) within two
+ * edges of the vertex, ours against the seed's tangent plane. */
+static void test_undulation(sfb_context *ctx) {
+    static const int vals[3] = {4, 5, 7};
+    double ours_dev[4] = {0, 0, 0, 0};
+    int vi, mode, si, ours_changes[4] = {0, 0, 0, 0};
+    for (vi = 0; vi < 3; ++vi)
+        for (mode = 0; mode < 2; ++mode) {
+            tbm_opts o;
+            tmesh t;
+            char *obj;
+            double *n0, *n1, mean_edge = 0.0;
+            sfb_tribezier_options to;
+            int e;
+            memset(&o, 0, sizeof o);
+            o.n = vals[vi]; o.R = 5; o.crease_k = vals[vi] / 2; o.sharp = 1.0; o.ridge = 0.5; o.bump = 0.0;
+            obj = tbm_obj(&o);
+            if (!tmesh_load(ctx, obj, &t)) { fail("undulation/load", "load"); free(obj); continue; }
+            for (e = 0; e < t.prep.ne; ++e) {
+                const float *a = t.m->positions + 3 * t.prep.ev[2 * e], *b = t.m->positions + 3 * t.prep.ev[2 * e + 1];
+                mean_edge += sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2])) / t.prep.ne;
+            }
+            to.sharpness_set = 1; to.sharpness = 0.0f;
+            n0 = net_of(ctx, &t, &to, mode ? SFB__TBZ_SEED_PLANE : 0, NULL);
+            to.sharpness = 1.0f;
+            n1 = net_of(ctx, &t, &to, mode ? SFB__TBZ_SEED_PLANE : 0, NULL);
+            for (si = 1; n0 && n1 && si <= 3; ++si) {
+                const double s = 0.25 * si;
+                double dev = 0.0, prev_k = 0.0;
+                int changes = 0, side, r, q, c;
+                char nm[160];
+                /* both rays of the crease: ray 0 and ray k, rings 0..2 */
+                for (side = 0; side < 2; ++side) {
+                    prev_k = 0.0;
+                    for (r = 0; r < 2; ++r) {
+                        double B0[5][3], B1[5][3];
+                        tbm_opts oo = o;
+                        if (side) {
+                            /* ray k: rotate the wedge numbering so that ray k is ray 0 */
+                            oo.crease_k = 0;
+                        }
+                        {
+                            const int a = side ? tbm_index(&o, o.crease_k, r, 0) : tbm_index(&o, 0, r, 0);
+                            const int b = side ? tbm_index(&o, o.crease_k, r + 1, 0) : tbm_index(&o, 0, r + 1, 0);
+                            int f, k, j;
+                            for (f = 0; f < t.prep.nf; ++f)
+                                for (k = 0; k < 3; ++k)
+                                    if (t.prep.fv[t.prep.fv_off[f] + k] == a && t.prep.fv[t.prep.fv_off[f] + (k + 1) % 3] == b)
+                                        for (j = 0; j <= 4; ++j) {
+                                            int w[3] = {0, 0, 0};
+                                            w[k] = 4 - j; w[(k + 1) % 3] = j;
+                                            for (c = 0; c < 3; ++c) {
+                                                B0[j][c] = n0[45 * (size_t)f + 3 * qij(w[1], w[2]) + c];
+                                                B1[j][c] = n1[45 * (size_t)f + 3 * qij(w[1], w[2]) + c];
+                                            }
+                                        }
+                        }
+                        (void)oo;
+                        for (q = 0; q <= 50; ++q) {
+                            const double u = q / 50.0, bb[5] = {pow(1 - u, 4), 4 * u * pow(1 - u, 3), 6 * u * u * (1 - u) * (1 - u), 4 * u * u * u * (1 - u), pow(u, 4)};
+                            const double d1[4] = {pow(1 - u, 3), 3 * u * (1 - u) * (1 - u), 3 * u * u * (1 - u), u * u * u};
+                            const double d2[3] = {(1 - u) * (1 - u), 2 * u * (1 - u), u * u};
+                            double X[3] = {0, 0, 0}, D1[3] = {0, 0, 0}, D2[3] = {0, 0, 0}, k2;
+                            int j;
+                            for (j = 0; j < 5; ++j)
+                                for (c = 0; c < 3; ++c) X[c] += bb[j] * ((1 - s) * B0[j][c] + s * B1[j][c]);
+                            for (j = 0; j < 4; ++j)
+                                for (c = 0; c < 3; ++c) D1[c] += 4 * d1[j] * ((1 - s) * (B0[j + 1][c] - B0[j][c]) + s * (B1[j + 1][c] - B1[j][c]));
+                            for (j = 0; j < 3; ++j)
+                                for (c = 0; c < 3; ++c)
+                                    D2[c] += 12 * d2[j] * ((1 - s) * (B0[j + 2][c] - 2 * B0[j + 1][c] + B0[j][c]) + s * (B1[j + 2][c] - 2 * B1[j + 1][c] + B1[j][c]));
+                            dev = fmax(dev, fabs(X[1]));
+                            /* signed curvature of the (x, z) projection */
+                            /* the curvature, counted where it exceeds 1e-3 / mean edge (a straight
+                             * stretch is not a sign change) */
+                            k2 = (D1[0] * D2[2] - D1[2] * D2[0]) / pow(D1[0] * D1[0] + D1[2] * D1[2] + 1e-300, 1.5);
+                            if (fabs(k2) * mean_edge > 1e-3) {
+                                if (prev_k != 0.0 && (k2 > 0) != (prev_k > 0)) changes++;
+                                prev_k = k2;
+                            }
+                        }
+                    }
+                }
+                snprintf(nm, sizeof nm, "undulation/valence_%d/s_%.2f/%s", o.n, s, mode ? "ours_no_worse_than_the_seed_plane" : "ours");
+                printf("  %s: deviation from the crease plane %.3g (%.3g mean edges), curvature sign changes %d\n", nm, dev, dev / mean_edge, changes);
+                if (!mode) { ours_dev[si] = dev; ours_changes[si] = changes; }
+                else {
+                    /* asserted: ours deviates from the crease plane no more than the seed's kind;
+                     * printed, not met: the issue's bound of 1e-3 mean edges at valence 5 and 7 and
+                     * no curvature sign change (ours has as many or more) */
+                    check(ours_dev[si] <= dev + 1e-12, nm, "ours %.3g against the seed's %.3g (sign changes %d against %d)",
+                          ours_dev[si], dev, ours_changes[si], changes);
+                    printf("  %s: ours within 1e-3 mean edges: %s\n", nm, ours_dev[si] <= 1e-3 * mean_edge ? "yes" : "no");
+                }
+            }
+            sfb__free(ctx, n0); sfb__free(ctx, n1);
+            tmesh_free(ctx, &t);
+            free(obj);
+        }
+}
+
+/* Bad input: clear errors, nothing left allocated (the counting allocator). */
+static long g_live;
+static void *cnt_alloc(size_t n, void *u) { void *p = malloc(n); (void)u; if (p) g_live++; return p; }
+static void *cnt_realloc(void *p, size_t n, void *u) { (void)u; if (!p) return cnt_alloc(n, u); return realloc(p, n); }
+static void cnt_free(void *p, void *u) { (void)u; if (p) { g_live--; free(p); } }
+
+static void bad_one(const char *name, const char *obj, float s, int set, sfb_result want) {
+    sfb_context_config cc = sfb_context_config_init();
+    sfb_context *ctx = NULL;
+    sfb_mesh *m = NULL;
+    sfb_surface *sf = NULL;
+    sfb_surface_config sc = sfb_surface_config_init(SFB_SCHEME_TRIBEZIER, 0);
+    sfb_result r;
+    long before;
+    cc.ignore_environment = 1;
+    cc.allocator.alloc = cnt_alloc; cc.allocator.realloc = cnt_realloc; cc.allocator.free = cnt_free;
+    if (sfb_context_create(&cc, &ctx) != SFB_SUCCESS) { fail(name, "context"); return; }
+    if (sfb_mesh_read_obj(ctx, obj, strlen(obj), &m) != SFB_SUCCESS) { fail(name, "read: %s", sfb_last_error(ctx)); sfb_context_destroy(ctx); return; }
+    before = g_live;
+    sc.flags = SFB_REFINE_PATCHES;
+    sc.tribezier.sharpness_set = set; sc.tribezier.sharpness = s;
+    r = sfb_surface_create(ctx, m, &sc, &sf);
+    check(r == want && !sf && g_live == before && (strstr(sfb_last_error(ctx), "tribezier") != NULL || strstr(sfb_last_error(ctx), "triangles") != NULL), name, "result %d (want %d), %ld blocks left, '%s'", (int)r,
+          (int)want, g_live - before, sfb_last_error(ctx));
+    printf("  %s: %s\n", name, sfb_last_error(ctx));
+    if (sf) sfb_surface_destroy(sf);
+    sfb_mesh_destroy(m);
+    sfb_context_destroy(ctx);
+}
+
+static void test_bad_input(void) {
+    const char *tri = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3\nf 2 4 3\n";
+    bad_one("bad/sharpness_above_1", tri, 1.5f, 1, SFB_INVALID_ARGS);
+    bad_one("bad/sharpness_negative", tri, -0.1f, 1, SFB_INVALID_ARGS);
+    bad_one("bad/sharpness_nan", tri, (float)NAN, 1, SFB_INVALID_ARGS);
+    bad_one("bad/quad", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n", 0, 0, SFB_INVALID_TOPOLOGY);
+    bad_one("bad/non_manifold_edge", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 -1 0\nv 0 0 1\nf 1 2 3\nf 2 1 4\nf 1 2 5\n", 0, 0, SFB_INVALID_TOPOLOGY);
+    bad_one("bad/degenerate_triangle", "v 0 0 0\nv 1 0 0\nv 2 0 0\nv 0 1 0\nf 1 2 3\nf 1 4 2\n", 0, 0, SFB_INVALID_TOPOLOGY);
+}
+
+/* Every backend's sfb_surface_eval against the builder's points, and its normals across edges. */
+static void test_backends(void) {
+    tbm_opts o;
+    char *obj;
+    int b;
+    memset(&o, 0, sizeof o);
+    o.n = 5; o.R = 4; o.crease_k = 2; o.sharp = 0.5; o.ridge = 0.4; o.bump = 1.0; o.jitter = 0.2; o.seed = 9u;
+    obj = tbm_obj(&o);
+    for (b = 0; b < g_nbe; ++b) {
+        char nm[160];
+        sfb_context *ctx = g_be[b].ctx;
+        tmesh t;
+        double *net = NULL, worst = 0.0, jump = 0.0;
+        sfb_surface *sf = NULL;
+        sfb_surface_config sc = sfb_surface_config_init(SFB_SCHEME_TRIBEZIER, 0);
+        int f, q, e;
+        snprintf(nm, sizeof nm, "%s/eval_matches_the_builder_and_is_g1", g_be[b].name);
+        if (!g_be[b].available) { backend_missing(&g_be[b], nm); continue; }
+        if (!tmesh_load(ctx, obj, &t)) { fail(nm, "load"); continue; }
+        net = net_of(ctx, &t, NULL, 0, NULL);
+        sc.flags = SFB_REFINE_PATCHES;
+        if (!net || sfb_surface_create(ctx, t.m, &sc, &sf) != SFB_SUCCESS) { fail(nm, "%s", sfb_last_error(ctx)); }
+        else {
+            for (f = 0; f < t.prep.nf; ++f)
+                for (q = 0; q < 10; ++q) {
+                    sfb_location loc;
+                    float P[3];
+                    sfb_eval_output eo;
+                    double B[3], du[3], dv[3];
+                    int c;
+                    memset(&eo, 0, sizeof eo);
+                    eo.position = P;
+                    loc.face = f; loc.u = (float)(0.05 + 0.09 * q); loc.v = (float)(0.9 - loc.u) * 0.5f;
+                    if (sfb_surface_eval(sf, &loc, 1, &eo) != SFB_SUCCESS) { worst = 1e30; continue; }
+                    bez_eval(net + 45 * (size_t)f, loc.u, loc.v, B, du, dv);
+                    for (c = 0; c < 3; ++c) worst = fmax(worst, fabs(B[c] - P[c]));
+                }
+            /* normals across the untagged interior edges at 11 points, both faces */
+            for (e = 0; e < t.prep.ne; ++e) {
+                int k2, s0, s1, f0, f1;
+                if (t.prep.ef_off[e + 1] - t.prep.ef_off[e] != 2 || t.prep.es[e] > 0.0f) continue;
+                f0 = t.prep.ef[t.prep.ef_off[e]]; s0 = t.prep.ef_slot[t.prep.ef_off[e]];
+                f1 = t.prep.ef[t.prep.ef_off[e] + 1]; s1 = t.prep.ef_slot[t.prep.ef_off[e] + 1];
+                for (k2 = 1; k2 < 10; ++k2) {
+                    sfb_location loc[2];
+                    float N[6];
+                    double u, v, a[3], bb[3];
+                    sfb_eval_output eo;
+                    memset(&eo, 0, sizeof eo);
+                    eo.normal = N;
+                    edge_uv(s0, k2 / 10.0, &u, &v); loc[0].face = f0; loc[0].u = (float)u; loc[0].v = (float)v;
+                    edge_uv(s1, 1.0 - k2 / 10.0, &u, &v); loc[1].face = f1; loc[1].u = (float)u; loc[1].v = (float)v;
+                    /* on the edge u + v = 1 in double after rounding to float */
+                    while ((double)loc[0].u + loc[0].v > 1.0) loc[0].v = nextafterf(loc[0].v, 0.0f);
+                    while ((double)loc[1].u + loc[1].v > 1.0) loc[1].v = nextafterf(loc[1].v, 0.0f);
+                    if (sfb_surface_eval(sf, loc, 2, &eo) != SFB_SUCCESS) { if (jump < 1e30) printf("  eval: %s\n", sfb_last_error(ctx)); jump = 1e30; continue; }
+                    a[0] = N[0]; a[1] = N[1]; a[2] = N[2]; bb[0] = N[3]; bb[1] = N[4]; bb[2] = N[5];
+                    jump = fmax(jump, angle_between(a, bb));
+                }
+            }
+            check(worst <= 1e-6 * t.diag && jump <= 1e-5, nm, "position %.3g (diag %.3g), normal jump %.3g rad", worst, t.diag, jump);
+        }
+        if (sf) sfb_surface_destroy(sf);
+        sfb__free(ctx, net);
+        tmesh_free(ctx, &t);
+    }
+    free(obj);
+}
+
+int main(int argc, char **argv) {
+    sfb_context *ctx = NULL;
+    sfb_context_config cc = sfb_context_config_init();
+    (void)argc; (void)argv;
+    cc.ignore_environment = 1;
+    if (sfb_context_create(&cc, &ctx) != SFB_SUCCESS) { printf("no context\n"); return 1; }
+    test_g1_disks(ctx);
+    test_g1_closed(ctx);
+    test_regular_is_loop(ctx);
+    test_creases(ctx);
+    test_crease_evs(ctx);
+    test_undulation(ctx);
+    test_bad_input();
+    {
+        /* a real mesh whose extraordinary vertices of different valences touch: there the
+         * constraints have no exact solution and the least-squares point is near-G1 (asserted
+         * 1e-2 rad, printed) */
+        const char *dir = argc > 1 ? argv[1] : "../shared/peers/real-meshes";
+        char path[1024];
+        size_t n;
+        char *obj;
+        snprintf(path, sizeof path, "%s/spot.obj", dir);
+        obj = slurp(path, &n);
+        if (!obj) skip("g1_real_mesh_spot_near_g1", "spot.obj not found (pass the real-meshes folder)");
+        else { g1_one(ctx, "g1_real_mesh_spot_near_g1", obj, 1e-2); free(obj); }
+    }
+    sfb_context_destroy(ctx);
+    if (!probe_backends()) return 1;
+    test_backends();
+    return close_tests();
+}
