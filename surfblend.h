@@ -1091,6 +1091,9 @@ SFB__IF sfb_result sfb__shading_build(sfb_context *ctx, const sfb__level *prep, 
 
 /* ---- patch tables (patch/) ---- */
 SFB__IF void sfb__patch_table_free(sfb_context *ctx, sfb__patch_table *pt);
+/* Refuses non-triangles, non-manifold edges (vertices: manifold_vertices), non-finite positions and
+ * degenerate triangles for a one-patch-per-triangle scheme named who (patch/table.c). */
+SFB__IF sfb_result sfb__tri_mesh_check(sfb_context *ctx, const sfb__level *l, const float *positions, const char *who, int manifold_vertices);
 /* One BEZIER_TRI15 patch of its own 15 points (net: 45 doubles per triangle) per triangle of l that
  * is not a hole (patch/table.c; PN triangles, tribezier). */
 SFB__IF sfb_result sfb__patch_table_beztri_own(sfb_context *ctx, const sfb__level *l, const double *net, sfb__patch_table *pt);
@@ -3487,6 +3490,50 @@ void sfb__patch_table_free(sfb_context *ctx, sfb__patch_table *pt) {
  * sign. The corner bits of the code give the face slot of the child's param corner 0. */
 
 /* Patch index (or -1: hole) and local (s,t) of a valid location; *scale = 2^depth. */
+/* Refuses what a scheme of one patch per triangle cannot build (who names it in the message):
+ * faces that are not triangles, non-manifold edges (and, with manifold_vertices, vertices whose
+ * triangles are not one fan), non-finite positions, triangles with an area below 1e-12 of the
+ * squared bounding-box diagonal. */
+sfb_result sfb__tri_mesh_check(sfb_context *ctx, const sfb__level *l, const float *positions, const char *who, int manifold_vertices) {
+    double lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0}, diag2 = 0.0;
+    int f, e, v, c;
+    for (f = 0; f < l->nf; ++f)
+        if (sfb__face_n(l, f) != 3)
+            return sfb__error(ctx, SFB_INVALID_TOPOLOGY, SFB_ELEMENT_FACE, f, "%s: face %d has %d vertices (triangles only)", who, f,
+                              sfb__face_n(l, f));
+    for (e = 0; e < l->ne; ++e)
+        if (l->ef_off[e + 1] - l->ef_off[e] > 2)
+            return sfb__error(ctx, SFB_INVALID_TOPOLOGY, SFB_ELEMENT_EDGE, e, "%s: edge %d (%d-%d) is non-manifold (%d triangles)", who, e,
+                              l->ev[2 * e], l->ev[2 * e + 1], l->ef_off[e + 1] - l->ef_off[e]);
+    for (v = 0; v < l->nv; ++v) {
+        if (manifold_vertices && (l->vtag[v] & SFB__TAG_NONMANIFOLD))
+            return sfb__error(ctx, SFB_INVALID_TOPOLOGY, SFB_ELEMENT_VERTEX, v, "%s: vertex %d is non-manifold (its triangles are not one fan)",
+                              who, v);
+        for (c = 0; c < 3; ++c) {
+            const double x = positions[3 * (size_t)v + c];
+            if (!(x == x) || x > 3.4e38 || x < -3.4e38)
+                return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_VERTEX, v, "%s: vertex %d is not finite", who, v);
+            if (v == 0 || x < lo[c]) lo[c] = x;
+            if (v == 0 || x > hi[c]) hi[c] = x;
+        }
+    }
+    for (c = 0; c < 3; ++c) diag2 += (hi[c] - lo[c]) * (hi[c] - lo[c]);
+    for (f = 0; f < l->nf; ++f) {
+        const int *fv = l->fv + l->fv_off[f];
+        double u[3], w[3], n[3], area;
+        for (c = 0; c < 3; ++c) {
+            u[c] = (double)positions[3 * (size_t)fv[1] + c] - positions[3 * (size_t)fv[0] + c];
+            w[c] = (double)positions[3 * (size_t)fv[2] + c] - positions[3 * (size_t)fv[0] + c];
+        }
+        sfb__cross3(u, w, n);
+        area = 0.5 * sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+        if (!(area > 1e-12 * diag2))
+            return sfb__error(ctx, SFB_INVALID_TOPOLOGY, SFB_ELEMENT_FACE, f, "%s: triangle %d (%d %d %d) is degenerate (area %g)", who, f,
+                              fv[0], fv[1], fv[2], area);
+    }
+    return SFB_SUCCESS;
+}
+
 /* A table of one BEZIER_TRI15 patch with 15 points of its own per triangle of l that is not a
  * hole (one param face per triangle, depth 0), the points from net (45 doubles per triangle, our
  * patch order) -- the shape of schemes whose points are not masks (PN triangles, tribezier). */
@@ -5576,39 +5623,19 @@ static double sfb__pn_angle(const float *a, const float *b, const float *c) {
 }
 
 sfb_result sfb__pn_build(sfb_context *ctx, const sfb__level *l, const float *positions, sfb__patch_table *pt) {
-    double *vn = NULL, *net = NULL, lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0}, diag2 = 0.0;
-    int f, v, e, k, c;
+    double *vn = NULL, *net = NULL;
+    int f, v, k, c;
     sfb_result r = SFB_SUCCESS;
     memset(pt, 0, sizeof *pt);
-    for (f = 0; f < l->nf; ++f)
-        if (sfb__face_n(l, f) != 3)
-            return sfb__error(ctx, SFB_INVALID_TOPOLOGY, SFB_ELEMENT_FACE, f, "PN triangles: face %d has %d vertices (triangles only)", f,
-                              sfb__face_n(l, f));
-    for (e = 0; e < l->ne; ++e)
-        if (l->ef_off[e + 1] - l->ef_off[e] > 2)
-            return sfb__error(ctx, SFB_INVALID_TOPOLOGY, SFB_ELEMENT_EDGE, e, "PN triangles: edge %d (%d-%d) is non-manifold (%d triangles)",
-                              e, l->ev[2 * e], l->ev[2 * e + 1], l->ef_off[e + 1] - l->ef_off[e]);
-    for (v = 0; v < l->nv; ++v)
-        for (c = 0; c < 3; ++c) {
-            const double x = positions[3 * (size_t)v + c];
-            if (!(x == x) || x > 3.4e38 || x < -3.4e38)
-                return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_VERTEX, v, "PN triangles: vertex %d is not finite", v);
-            if (v == 0 || x < lo[c]) lo[c] = x;
-            if (v == 0 || x > hi[c]) hi[c] = x;
-        }
-    for (c = 0; c < 3; ++c) diag2 += (hi[c] - lo[c]) * (hi[c] - lo[c]);
+    r = sfb__tri_mesh_check(ctx, l, positions, "PN triangles", 0);
+    if (r != SFB_SUCCESS) return r;
     vn = (double *)sfb__calloc(ctx, (size_t)l->nv * 3 + 1, sizeof(double));
     if (!vn) return sfb__oom(ctx, "PN triangles");
     for (f = 0; f < l->nf; ++f) {
         const int *fv = l->fv + l->fv_off[f];
         double n[3], len;
         sfb__pn_face_normal(positions + 3 * (size_t)fv[0], positions + 3 * (size_t)fv[1], positions + 3 * (size_t)fv[2], n);
-        len = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-        if (!(0.5 * len > 1e-12 * diag2)) {
-            r = sfb__error(ctx, SFB_INVALID_TOPOLOGY, SFB_ELEMENT_FACE, f, "PN triangles: triangle %d (%d %d %d) is degenerate (area %g)", f,
-                           fv[0], fv[1], fv[2], 0.5 * len);
-            goto done;
-        }
+        len = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]); /* > 0: sfb__tri_mesh_check refused degenerate triangles */
         for (k = 0; k < 3; ++k) {
             const double a = sfb__pn_angle(positions + 3 * (size_t)fv[k], positions + 3 * (size_t)fv[(k + 1) % 3],
                                            positions + 3 * (size_t)fv[(k + 2) % 3]);
@@ -6386,45 +6413,15 @@ static sfb_result tbz_vertex_s(sfb__tbz *T, double *vs) {
 sfb_result sfb__tribezier_points(sfb_context *ctx, const sfb__level *l, const float *positions, const sfb_tribezier_options *opt,
                                  unsigned flags, double **out, sfb__tbz_stats *stats) {
     sfb__tbz T;
-    double *x0 = NULL, *vs = NULL, *res = NULL, lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0}, diag2 = 0.0;
+    double *x0 = NULL, *vs = NULL, *res = NULL;
     int v, e, f, c, k, any_tag = 0;
     sfb_result r = SFB_SUCCESS;
     *out = NULL;
     memset(&T, 0, sizeof T);
     if (opt && opt->sharpness_set && !(opt->sharpness >= 0.0f && opt->sharpness <= 1.0f))
         return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "tribezier: sharpness %g is not in [0, 1]", (double)opt->sharpness);
-    for (f = 0; f < l->nf; ++f)
-        if (sfb__face_n(l, f) != 3)
-            return sfb__error(ctx, SFB_INVALID_TOPOLOGY, SFB_ELEMENT_FACE, f,
-                              "tribezier: face %d has %d vertices (triangles only: split it first)", f, sfb__face_n(l, f));
-    for (e = 0; e < l->ne; ++e)
-        if (l->ef_off[e + 1] - l->ef_off[e] > 2)
-            return sfb__error(ctx, SFB_INVALID_TOPOLOGY, SFB_ELEMENT_EDGE, e, "tribezier: edge %d (%d-%d) is non-manifold (%d triangles)", e,
-                              l->ev[2 * e], l->ev[2 * e + 1], l->ef_off[e + 1] - l->ef_off[e]);
-    for (v = 0; v < l->nv; ++v) {
-        if (l->vtag[v] & SFB__TAG_NONMANIFOLD)
-            return sfb__error(ctx, SFB_INVALID_TOPOLOGY, SFB_ELEMENT_VERTEX, v, "tribezier: vertex %d is non-manifold (its triangles are not one fan)", v);
-        for (c = 0; c < 3; ++c) {
-            const double x = positions[3 * (size_t)v + c];
-            if (!(x == x) || x > 3.4e38 || x < -3.4e38)
-                return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_VERTEX, v, "tribezier: vertex %d is not finite", v);
-            if (v == 0 || x < lo[c]) lo[c] = x;
-            if (v == 0 || x > hi[c]) hi[c] = x;
-        }
-    }
-    for (c = 0; c < 3; ++c) diag2 += (hi[c] - lo[c]) * (hi[c] - lo[c]);
-    for (f = 0; f < l->nf; ++f) {
-        const int *fv = l->fv + l->fv_off[f];
-        double u[3], w[3], n[3];
-        for (c = 0; c < 3; ++c) {
-            u[c] = (double)positions[3 * (size_t)fv[1] + c] - positions[3 * (size_t)fv[0] + c];
-            w[c] = (double)positions[3 * (size_t)fv[2] + c] - positions[3 * (size_t)fv[0] + c];
-        }
-        sfb__cross3(u, w, n);
-        if (!(0.5 * sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]) > 1e-12 * diag2))
-            return sfb__error(ctx, SFB_INVALID_TOPOLOGY, SFB_ELEMENT_FACE, f, "tribezier: triangle %d (%d %d %d) is degenerate", f, fv[0],
-                              fv[1], fv[2]);
-    }
+    r = sfb__tri_mesh_check(ctx, l, positions, "tribezier", 1);
+    if (r != SFB_SUCCESS) return r;
     T.ctx = ctx; T.l = l; T.pos = positions;
     T.nv = l->nv; T.ne = l->ne; T.nf = l->nf;
     T.np = l->nv + 3 * l->ne + 3 * l->nf;

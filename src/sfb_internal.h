@@ -464,6 +464,9 @@ SFB__IF sfb_result sfb__shading_build(sfb_context *ctx, const sfb__level *prep, 
 
 /* ---- patch tables (patch/) ---- */
 SFB__IF void sfb__patch_table_free(sfb_context *ctx, sfb__patch_table *pt);
+/* Refuses non-triangles, non-manifold edges (vertices: manifold_vertices), non-finite positions and
+ * degenerate triangles for a one-patch-per-triangle scheme named who (patch/table.c). */
+SFB__IF sfb_result sfb__tri_mesh_check(sfb_context *ctx, const sfb__level *l, const float *positions, const char *who, int manifold_vertices);
 /* One BEZIER_TRI15 patch of its own 15 points (net: 45 doubles per triangle) per triangle of l that
  * is not a hole (patch/table.c; PN triangles, tribezier). */
 SFB__IF sfb_result sfb__patch_table_beztri_own(sfb_context *ctx, const sfb__level *l, const double *net, sfb__patch_table *pt);

@@ -477,11 +477,6 @@ static void test_undulation(sfb_context *ctx) {
                     prev_k = 0.0;
                     for (r = 0; r < 2; ++r) {
                         double B0[5][3], B1[5][3];
-                        tbm_opts oo = o;
-                        if (side) {
-                            /* ray k: rotate the wedge numbering so that ray k is ray 0 */
-                            oo.crease_k = 0;
-                        }
                         {
                             const int a = side ? tbm_index(&o, o.crease_k, r, 0) : tbm_index(&o, 0, r, 0);
                             const int b = side ? tbm_index(&o, o.crease_k, r + 1, 0) : tbm_index(&o, 0, r + 1, 0);
@@ -498,7 +493,6 @@ static void test_undulation(sfb_context *ctx) {
                                             }
                                         }
                         }
-                        (void)oo;
                         for (q = 0; q <= 50; ++q) {
                             const double u = q / 50.0, bb[5] = {pow(1 - u, 4), 4 * u * pow(1 - u, 3), 6 * u * u * (1 - u) * (1 - u), 4 * u * u * u * (1 - u), pow(u, 4)};
                             const double d1[4] = {pow(1 - u, 3), 3 * u * (1 - u) * (1 - u), 3 * u * u * (1 - u), u * u * u};

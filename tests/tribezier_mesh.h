@@ -52,11 +52,10 @@ static char *tbm_obj(const tbm_opts *o) {
         for (w = 0; w < n; ++w)
             for (b = 0; b < r; ++b) {
                 /* point b of ring r in wedge w: between ray w and ray w+1 */
-                const double t = (double)b / r, th = ang[w] + t * (ang[w + 1] - ang[w]);
+                const double t = (double)b / r;
                 /* straight lattice rows: interpolate the two ray points linearly */
                 const double x0 = r * cos(ang[w]), y0 = r * sin(ang[w]), x1 = r * cos(ang[w + 1]), y1 = r * sin(ang[w + 1]);
                 double x = x0 + t * (x1 - x0), y = y0 + t * (y1 - y0), z;
-                (void)th;
                 if (o->jitter > 0) { x += o->jitter * (tbm_unit(&seed) - 0.5); y += o->jitter * (tbm_unit(&seed) - 0.5); }
                 z = o->ridge * fabs(y) + o->bump * (x * x - 0.5 * y * y) / (R * R);
                 if (o->jitter > 0) z += o->jitter * (tbm_unit(&seed) - 0.5);

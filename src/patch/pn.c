@@ -78,39 +78,19 @@ static double sfb__pn_angle(const float *a, const float *b, const float *c) {
 }
 
 sfb_result sfb__pn_build(sfb_context *ctx, const sfb__level *l, const float *positions, sfb__patch_table *pt) {
-    double *vn = NULL, *net = NULL, lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0}, diag2 = 0.0;
-    int f, v, e, k, c;
+    double *vn = NULL, *net = NULL;
+    int f, v, k, c;
     sfb_result r = SFB_SUCCESS;
     memset(pt, 0, sizeof *pt);
-    for (f = 0; f < l->nf; ++f)
-        if (sfb__face_n(l, f) != 3)
-            return sfb__error(ctx, SFB_INVALID_TOPOLOGY, SFB_ELEMENT_FACE, f, "PN triangles: face %d has %d vertices (triangles only)", f,
-                              sfb__face_n(l, f));
-    for (e = 0; e < l->ne; ++e)
-        if (l->ef_off[e + 1] - l->ef_off[e] > 2)
-            return sfb__error(ctx, SFB_INVALID_TOPOLOGY, SFB_ELEMENT_EDGE, e, "PN triangles: edge %d (%d-%d) is non-manifold (%d triangles)",
-                              e, l->ev[2 * e], l->ev[2 * e + 1], l->ef_off[e + 1] - l->ef_off[e]);
-    for (v = 0; v < l->nv; ++v)
-        for (c = 0; c < 3; ++c) {
-            const double x = positions[3 * (size_t)v + c];
-            if (!(x == x) || x > 3.4e38 || x < -3.4e38)
-                return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_VERTEX, v, "PN triangles: vertex %d is not finite", v);
-            if (v == 0 || x < lo[c]) lo[c] = x;
-            if (v == 0 || x > hi[c]) hi[c] = x;
-        }
-    for (c = 0; c < 3; ++c) diag2 += (hi[c] - lo[c]) * (hi[c] - lo[c]);
+    r = sfb__tri_mesh_check(ctx, l, positions, "PN triangles", 0);
+    if (r != SFB_SUCCESS) return r;
     vn = (double *)sfb__calloc(ctx, (size_t)l->nv * 3 + 1, sizeof(double));
     if (!vn) return sfb__oom(ctx, "PN triangles");
     for (f = 0; f < l->nf; ++f) {
         const int *fv = l->fv + l->fv_off[f];
         double n[3], len;
         sfb__pn_face_normal(positions + 3 * (size_t)fv[0], positions + 3 * (size_t)fv[1], positions + 3 * (size_t)fv[2], n);
-        len = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-        if (!(0.5 * len > 1e-12 * diag2)) {
-            r = sfb__error(ctx, SFB_INVALID_TOPOLOGY, SFB_ELEMENT_FACE, f, "PN triangles: triangle %d (%d %d %d) is degenerate (area %g)", f,
-                           fv[0], fv[1], fv[2], 0.5 * len);
-            goto done;
-        }
+        len = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]); /* > 0: sfb__tri_mesh_check refused degenerate triangles */
         for (k = 0; k < 3; ++k) {
             const double a = sfb__pn_angle(positions + 3 * (size_t)fv[k], positions + 3 * (size_t)fv[(k + 1) % 3],
                                            positions + 3 * (size_t)fv[(k + 2) % 3]);

@@ -19,6 +19,50 @@ void sfb__patch_table_free(sfb_context *ctx, sfb__patch_table *pt) {
  * sign. The corner bits of the code give the face slot of the child's param corner 0. */
 
 /* Patch index (or -1: hole) and local (s,t) of a valid location; *scale = 2^depth. */
+/* Refuses what a scheme of one patch per triangle cannot build (who names it in the message):
+ * faces that are not triangles, non-manifold edges (and, with manifold_vertices, vertices whose
+ * triangles are not one fan), non-finite positions, triangles with an area below 1e-12 of the
+ * squared bounding-box diagonal. */
+sfb_result sfb__tri_mesh_check(sfb_context *ctx, const sfb__level *l, const float *positions, const char *who, int manifold_vertices) {
+    double lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0}, diag2 = 0.0;
+    int f, e, v, c;
+    for (f = 0; f < l->nf; ++f)
+        if (sfb__face_n(l, f) != 3)
+            return sfb__error(ctx, SFB_INVALID_TOPOLOGY, SFB_ELEMENT_FACE, f, "%s: face %d has %d vertices (triangles only)", who, f,
+                              sfb__face_n(l, f));
+    for (e = 0; e < l->ne; ++e)
+        if (l->ef_off[e + 1] - l->ef_off[e] > 2)
+            return sfb__error(ctx, SFB_INVALID_TOPOLOGY, SFB_ELEMENT_EDGE, e, "%s: edge %d (%d-%d) is non-manifold (%d triangles)", who, e,
+                              l->ev[2 * e], l->ev[2 * e + 1], l->ef_off[e + 1] - l->ef_off[e]);
+    for (v = 0; v < l->nv; ++v) {
+        if (manifold_vertices && (l->vtag[v] & SFB__TAG_NONMANIFOLD))
+            return sfb__error(ctx, SFB_INVALID_TOPOLOGY, SFB_ELEMENT_VERTEX, v, "%s: vertex %d is non-manifold (its triangles are not one fan)",
+                              who, v);
+        for (c = 0; c < 3; ++c) {
+            const double x = positions[3 * (size_t)v + c];
+            if (!(x == x) || x > 3.4e38 || x < -3.4e38)
+                return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_VERTEX, v, "%s: vertex %d is not finite", who, v);
+            if (v == 0 || x < lo[c]) lo[c] = x;
+            if (v == 0 || x > hi[c]) hi[c] = x;
+        }
+    }
+    for (c = 0; c < 3; ++c) diag2 += (hi[c] - lo[c]) * (hi[c] - lo[c]);
+    for (f = 0; f < l->nf; ++f) {
+        const int *fv = l->fv + l->fv_off[f];
+        double u[3], w[3], n[3], area;
+        for (c = 0; c < 3; ++c) {
+            u[c] = (double)positions[3 * (size_t)fv[1] + c] - positions[3 * (size_t)fv[0] + c];
+            w[c] = (double)positions[3 * (size_t)fv[2] + c] - positions[3 * (size_t)fv[0] + c];
+        }
+        sfb__cross3(u, w, n);
+        area = 0.5 * sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+        if (!(area > 1e-12 * diag2))
+            return sfb__error(ctx, SFB_INVALID_TOPOLOGY, SFB_ELEMENT_FACE, f, "%s: triangle %d (%d %d %d) is degenerate (area %g)", who, f,
+                              fv[0], fv[1], fv[2], area);
+    }
+    return SFB_SUCCESS;
+}
+
 /* A table of one BEZIER_TRI15 patch with 15 points of its own per triangle of l that is not a
  * hole (one param face per triangle, depth 0), the points from net (45 doubles per triangle, our
  * patch order) -- the shape of schemes whose points are not masks (PN triangles, tribezier). */

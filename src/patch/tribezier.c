@@ -737,45 +737,15 @@ static sfb_result tbz_vertex_s(sfb__tbz *T, double *vs) {
 sfb_result sfb__tribezier_points(sfb_context *ctx, const sfb__level *l, const float *positions, const sfb_tribezier_options *opt,
                                  unsigned flags, double **out, sfb__tbz_stats *stats) {
     sfb__tbz T;
-    double *x0 = NULL, *vs = NULL, *res = NULL, lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0}, diag2 = 0.0;
+    double *x0 = NULL, *vs = NULL, *res = NULL;
     int v, e, f, c, k, any_tag = 0;
     sfb_result r = SFB_SUCCESS;
     *out = NULL;
     memset(&T, 0, sizeof T);
     if (opt && opt->sharpness_set && !(opt->sharpness >= 0.0f && opt->sharpness <= 1.0f))
         return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "tribezier: sharpness %g is not in [0, 1]", (double)opt->sharpness);
-    for (f = 0; f < l->nf; ++f)
-        if (sfb__face_n(l, f) != 3)
-            return sfb__error(ctx, SFB_INVALID_TOPOLOGY, SFB_ELEMENT_FACE, f,
-                              "tribezier: face %d has %d vertices (triangles only: split it first)", f, sfb__face_n(l, f));
-    for (e = 0; e < l->ne; ++e)
-        if (l->ef_off[e + 1] - l->ef_off[e] > 2)
-            return sfb__error(ctx, SFB_INVALID_TOPOLOGY, SFB_ELEMENT_EDGE, e, "tribezier: edge %d (%d-%d) is non-manifold (%d triangles)", e,
-                              l->ev[2 * e], l->ev[2 * e + 1], l->ef_off[e + 1] - l->ef_off[e]);
-    for (v = 0; v < l->nv; ++v) {
-        if (l->vtag[v] & SFB__TAG_NONMANIFOLD)
-            return sfb__error(ctx, SFB_INVALID_TOPOLOGY, SFB_ELEMENT_VERTEX, v, "tribezier: vertex %d is non-manifold (its triangles are not one fan)", v);
-        for (c = 0; c < 3; ++c) {
-            const double x = positions[3 * (size_t)v + c];
-            if (!(x == x) || x > 3.4e38 || x < -3.4e38)
-                return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_VERTEX, v, "tribezier: vertex %d is not finite", v);
-            if (v == 0 || x < lo[c]) lo[c] = x;
-            if (v == 0 || x > hi[c]) hi[c] = x;
-        }
-    }
-    for (c = 0; c < 3; ++c) diag2 += (hi[c] - lo[c]) * (hi[c] - lo[c]);
-    for (f = 0; f < l->nf; ++f) {
-        const int *fv = l->fv + l->fv_off[f];
-        double u[3], w[3], n[3];
-        for (c = 0; c < 3; ++c) {
-            u[c] = (double)positions[3 * (size_t)fv[1] + c] - positions[3 * (size_t)fv[0] + c];
-            w[c] = (double)positions[3 * (size_t)fv[2] + c] - positions[3 * (size_t)fv[0] + c];
-        }
-        sfb__cross3(u, w, n);
-        if (!(0.5 * sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]) > 1e-12 * diag2))
-            return sfb__error(ctx, SFB_INVALID_TOPOLOGY, SFB_ELEMENT_FACE, f, "tribezier: triangle %d (%d %d %d) is degenerate", f, fv[0],
-                              fv[1], fv[2]);
-    }
+    r = sfb__tri_mesh_check(ctx, l, positions, "tribezier", 1);
+    if (r != SFB_SUCCESS) return r;
     T.ctx = ctx; T.l = l; T.pos = positions;
     T.nv = l->nv; T.ne = l->ne; T.nf = l->nf;
     T.np = l->nv + 3 * l->ne + 3 * l->nf;
