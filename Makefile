@@ -136,7 +136,8 @@ $(BUILD)/sfb2gltf: tools/sfb2gltf.cpp tools/cli_common.h $(BUILD)/cli_common.o $
 $(BUILD)/gltf_check: tests/gltf_check.cpp tests/harness.h $(BUILD)/libsfb.o | deps
 	$(CXX) $(subst -std=c++14,-std=c++17,$(CXXFLAGS)) $(SAN) -I. tests/gltf_check.cpp $(BUILD)/libsfb.o -o $@ $(GLTF_LIBS) $(LIBS)
 
-$(BUILD)/examples/%: examples/%.c $(BUILD)/libsfb.o
+# (order-only: examples/04_tribezier_panel.c writes PNG with stb_image_write, PKGS_CLI)
+$(BUILD)/examples/%: examples/%.c $(BUILD)/libsfb.o | deps
 	@mkdir -p $(BUILD)/examples
 	$(CC) $(CFLAGS) $(SAN) -I. $< $(BUILD)/libsfb.o -o $@ $(LIBS)
 
@@ -146,7 +147,7 @@ $(BUILD)/examples/%: examples/%.cpp tests/egl_host.h $(BUILD)/libsfb.o | deps-ex
 	@mkdir -p $(BUILD)/examples
 	$(CXX) $(CXXFLAGS) $(SAN) -I. $< $(BUILD)/libsfb.o -o $@ $(GL_LIBS) $(LIBS)
 
-run: deps $(BUILD)/surfblend $(BUILD)/sfb2gltf
+run: deps $(BUILD)/surfblend $(BUILD)/sfb2gltf $(BUILD)/examples/04_tribezier_panel
 	@mkdir -p out
 	./$(BUILD)/surfblend info examples/data/creased_box.obj
 	./$(BUILD)/surfblend refine --scheme catmark --level 3 --limit examples/data/creased_box.obj -o out/creased_box_level3.obj
@@ -185,6 +186,9 @@ run: deps $(BUILD)/surfblend $(BUILD)/sfb2gltf
 	  ./$(BUILD)/surfblend render --scheme tribezier --sharpness $$s --rate 12 --highlight --view 30,50 --size 600x450 \
 	    examples/data/tribezier_crease_v5.obj -o out/tribezier_crease_v5_s$$s.png || exit 1; done
 	@echo "wrote out/tribezier_crease_v5_s0.png out/tribezier_crease_v5_s0.5.png out/tribezier_crease_v5_s1.png"
+	@# the seed's Figs. 8-11 as one panel: a crease at valence 4, 5 and 7 and a corner at valence 3
+	@# (meshes built in the program), each at s = 0, 0.5 and 1, with highlight lines
+	./$(BUILD)/examples/04_tribezier_panel out/tribezier_panel.png
 	@# the main job's end: glTF 2.0 for engines and viewers -- the creased box with subdivision-shading
 	@# normals (hard edges split), and the manifold blend tessellated
 	./$(BUILD)/sfb2gltf --level 3 examples/data/creased_box.obj -o out/creased_box.glb
