@@ -791,7 +791,12 @@ static void max_mean_diff(const std::vector<float> &a, const std::vector<float> 
     *mean = n ? s / (double)n : 0.0;
 }
 
-static int limit_section(double diag, bool loop) {
+/* kind: LIMIT_CATMARK, LIMIT_LOOP, or LIMIT_TRIBEZIER (seed 004's quartic triangular Bezier
+ * surface on Loop's triangulated torus, beside surfblend's Loop patches and OpenSubdiv's Loop
+ * patch table: issue 16's construction and evaluation rows). */
+enum { LIMIT_CATMARK = 0, LIMIT_LOOP = 1, LIMIT_TRIBEZIER = 2 };
+static int limit_section(double diag, int kind) {
+    const bool loop = kind != LIMIT_CATMARK, tbz = kind == LIMIT_TRIBEZIER;
     const int npoints = 1000000, warm = 1, reps = 3, tess_rate = 8;
     const double budget_ms = 1e300; /* always the 3 runs */
     const double tol = 1e-5 * diag;  /* surfblend backends against ref */
@@ -803,10 +808,12 @@ static int limit_section(double diag, bool loop) {
     TorusMesh mesh(100, 60, true);
     if (loop) mesh.triangulate();
     const Sdc::SchemeType osd_type = loop ? Sdc::SCHEME_LOOP : Sdc::SCHEME_CATMARK;
-    const char *scheme_name = loop ? "Loop" : "Catmull-Clark";
+    const char *scheme_name = tbz ? "tribezier" : loop ? "Loop" : "Catmull-Clark";
     sfb_mesh_desc desc = mesh.sfb_desc();
-    sfb_surface_config pcfg = sfb_surface_config_init(loop ? SFB_SCHEME_LOOP : SFB_SCHEME_CATMARK, 0);
+    sfb_surface_config pcfg = sfb_surface_config_init(tbz ? SFB_SCHEME_TRIBEZIER : loop ? SFB_SCHEME_LOOP : SFB_SCHEME_CATMARK, 0);
     pcfg.flags = SFB_REFINE_PATCHES;
+    sfb_surface_config loopcfg = sfb_surface_config_init(SFB_SCHEME_LOOP, 0); /* tribezier: Loop's build beside it */
+    loopcfg.flags = SFB_REFINE_PATCHES;
 
     /* the reference surface (ref backend): mesh statistics, parametric faces */
     std::string why;
@@ -827,10 +834,15 @@ static int limit_section(double diag, bool loop) {
     sfb_surface_patch_info(rsurf, &pi);
     int nparam = sfb_surface_param_face_count(rsurf);
 
-    printf("\n==== %s ====\nlimit evaluation (SFB_REFINE_PATCHES, %s) on the torus with extraordinary vertices%s:\n"
-           "%d faces (%d quads, %d triangles, %d hexagons) = %d parametric faces, %d vertices, %d extraordinary\n"
+    if (tbz)
+        printf("\n==== tribezier (seed 004) ====\nquartic triangular Bezier surfaces (SFB_SCHEME_TRIBEZIER; s from the crease tags clamped to\n"
+               "[0, 1], so the semi-sharp rings are s = 1 creases) beside Loop (surfblend's and OpenSubdiv's patches) on the\n"
+               "torus with extraordinary vertices, cut into triangles:\n");
+    else printf("\n==== %s ====\nlimit evaluation (SFB_REFINE_PATCHES, %s) on the torus with extraordinary vertices%s:\n", scheme_name,
+                scheme_name, loop ? ", cut into triangles" : "");
+    printf("%d faces (%d quads, %d triangles, %d hexagons) = %d parametric faces, %d vertices, %d extraordinary\n"
            "(%s, some on the semi-sharp and the infinitely sharp ring), the same %d creases and corner\n",
-           scheme_name, scheme_name, loop ? ", cut into triangles" : "", mi.face_count, mi.quads, mi.triangles, mi.ngons, nparam,
+           mi.face_count, mi.quads, mi.triangles, mi.ngons, nparam,
            mi.vertex_count, loop ? mi.extraordinary_loop : mi.extraordinary_catmark, loop ? "valence 3 to 9" : "valence 3 and 5",
            mi.sharp_edges);
     fflush(stdout);
@@ -850,6 +862,16 @@ static int limit_section(double diag, bool loop) {
         if (r != SFB_SUCCESS) { printf("  sfb_surface_create failed: %s\n", sfb_last_error(rctx)); status = 1; break; }
         t_sfb_build.push_back(tb);
         t_sfb_surf.push_back(ts);
+    }
+    std::vector<double> t_sfb_loop; /* tribezier: surfblend's Loop patches of the same mesh */
+    for (int rep = 0; tbz && rep < 3; ++rep) {
+        sfb_surface *s = NULL;
+        Clock::time_point t0 = Clock::now();
+        sfb_result r = sfb_surface_create(rctx, rmesh, &loopcfg, &s);
+        double ts = ms_since(t0);
+        sfb_surface_destroy(s);
+        if (r != SFB_SUCCESS) { printf("  sfb_surface_create (Loop) failed: %s\n", sfb_last_error(rctx)); status = 1; break; }
+        t_sfb_loop.push_back(ts);
     }
     OsdPatches osd;
     bool osd_ok = true;
@@ -895,8 +917,16 @@ static int limit_section(double diag, bool loop) {
         snprintf(what, sizeof what, "%d patches: %d %s, %d Stam, %d end caps; max depth %d; %d points (patch table + points)",
                  pi.patches, loop ? pi.bezier : pi.bspline, loop ? "Bezier triangles" : "B-spline", pi.stam, pi.end_caps,
                  pi.max_depth, pi.points);
-        printf("%-38s | %9.2f | %7.2f | %9.2f | %s\n", "surfblend sfb_surface_create", ss, ss > 0 ? op / ss : 0.0,
-               (double)pi.bytes / (1 << 20), what);
+        printf("%-38s | %9.2f | %7.2f | %9.2f | %s\n", tbz ? "surfblend sfb_surface_create, tribezier" : "surfblend sfb_surface_create",
+               ss, ss > 0 ? op / ss : 0.0, (double)pi.bytes / (1 << 20), what);
+        if (tbz && !t_sfb_loop.empty()) {
+            double sl = median(t_sfb_loop);
+            printf("%-38s | %9.2f | %7.2f | %9s | %s\n", "surfblend sfb_surface_create, Loop", sl, sl > 0 ? op / sl : 0.0, "",
+                   "SFB_SCHEME_LOOP on the same mesh: Bezier triangles where regular, Stam / end caps at extraordinary vertices");
+            printf("per 1,000 triangles: tribezier %.2f ms, surfblend Loop %.2f ms, OpenSubdiv Loop refine + patch table %.2f ms\n"
+                   "(target: tribezier <= OpenSubdiv's)\n", ss * 1000.0 / mi.triangles, sl * 1000.0 / mi.triangles,
+                   op * 1000.0 / mi.triangles);
+        }
         if (osd_ok) {
             snprintf(what, sizeof what, "TopologyRefinerFactory + RefineAdaptive(isolation %d) + PatchTableFactory (Gregory basis end "
                      "caps): %d patches, %d regular, %d Gregory basis, %d other", osd.isolation,
@@ -1092,8 +1122,9 @@ static int limit_section(double diag, bool loop) {
            "'x OSD' and 'x ref' are how many times faster than OpenSubdiv's FindPatch + CpuEvaluator and than\n"
            "surfblend's ref in this run. surfblend's time includes locating the patch (sfb_surface_eval takes\n"
            "(face, u, v)). 'diff vs ref' is the largest position difference from ref (OpenSubdiv: its Gregory\n"
-           "end caps approximate the surface near extraordinary vertices).\n",
-           scheme_name, npoints, loop ? " folded into u + v <= 1" : "", reps, warm);
+           "end caps approximate the surface near extraordinary vertices%s).\n",
+           scheme_name, npoints, loop ? " folded into u + v <= 1" : "", reps, warm,
+           tbz ? "; here it evaluates Loop's limit surface, another surface than tribezier's, so its diff is no error" : "");
     printf("%-38s | %9s | %8s | %7s | %6s | %11s | %s\n", "limit eval", "best ms", "M pts/s", "x OSD", "x ref", "diff vs ref",
            "what runs");
     for (size_t i = 0; i < rows.size(); ++i) {
@@ -1441,16 +1472,32 @@ static int manifold_section() {
     return status;
 }
 
+static double bbox_diagonal(const TorusMesh &t) {
+    float lo[3] = {1e30f, 1e30f, 1e30f}, hi[3] = {-1e30f, -1e30f, -1e30f};
+    double d = 0.0;
+    for (int i = 0; i < t.vertex_count(); ++i)
+        for (int c = 0; c < 3; ++c) {
+            lo[c] = std::min(lo[c], t.positions[3 * (size_t)i + c]);
+            hi[c] = std::max(hi[c], t.positions[3 * (size_t)i + c]);
+        }
+    for (int c = 0; c < 3; ++c) d += (double)(hi[c] - lo[c]) * (hi[c] - lo[c]);
+    return std::sqrt(d);
+}
+
 int main(int argc, char **argv) {
     int max_level = 4;
     bool limit_only = false;
     if (argc > 1 && strcmp(argv[1], "--shade") == 0) return shade_section();
     if (argc > 1 && strcmp(argv[1], "--manifold") == 0) return manifold_section();
+    if (argc > 1 && strcmp(argv[1], "--tribezier") == 0) {
+        TorusMesh t(100, 60);
+        return limit_section(bbox_diagonal(t), LIMIT_TRIBEZIER);
+    }
     if (argc > 1) {
         limit_only = strcmp(argv[1], "--limit") == 0;
         max_level = limit_only ? 0 : atoi(argv[1]);
         if (argc > 2 || (!limit_only && (max_level < 1 || max_level > 6))) {
-            fprintf(stderr, "usage: bench [MAX_LEVEL 1..6, default 4 | --limit (the limit evaluation section alone) | --shade (the shading section alone) | --manifold (the manifold blending section alone)]\n");
+            fprintf(stderr, "usage: bench [MAX_LEVEL 1..6, default 4 | --limit (the limit evaluation section alone) | --shade (the shading section alone) | --manifold (the manifold blending section alone) | --tribezier (the tribezier section alone)]\n");
             return 2;
         }
     }
@@ -1465,22 +1512,13 @@ int main(int argc, char **argv) {
 
     TorusMesh torus(100, 60);
     sfb_mesh_desc desc = torus.sfb_desc();
-    double diag = 0.0;
-    {
-        float lo[3] = {1e30f, 1e30f, 1e30f}, hi[3] = {-1e30f, -1e30f, -1e30f};
-        for (int i = 0; i < torus.vertex_count(); ++i)
-            for (int c = 0; c < 3; ++c) {
-                lo[c] = std::min(lo[c], torus.positions[3 * (size_t)i + c]);
-                hi[c] = std::max(hi[c], torus.positions[3 * (size_t)i + c]);
-            }
-        for (int c = 0; c < 3; ++c) diag += (double)(hi[c] - lo[c]) * (hi[c] - lo[c]);
-        diag = std::sqrt(diag);
-    }
+    const double diag = bbox_diagonal(torus);
     const double tol = 1e-6 * diag; /* as in tests/osd_agree.cpp */
     if (limit_only) {
         sfb_context_destroy(ctx);
-        int st = limit_section(diag, false);
-        if (limit_section(diag, true) != 0) st = 1;
+        int st = limit_section(diag, LIMIT_CATMARK);
+        if (limit_section(diag, LIMIT_LOOP) != 0) st = 1;
+        if (limit_section(diag, LIMIT_TRIBEZIER) != 0) st = 1;
         printf("total time %.1f s\n", ms_since(t_start) / 1000.0);
         return st;
     }
@@ -1625,8 +1663,9 @@ int main(int argc, char **argv) {
     }
     sfb_context_destroy(ctx);
     if (eval_section(torus, diag) != 0) status = 1;
-    if (limit_section(diag, false) != 0) status = 1;
-    if (limit_section(diag, true) != 0) status = 1;
+    if (limit_section(diag, LIMIT_CATMARK) != 0) status = 1;
+    if (limit_section(diag, LIMIT_LOOP) != 0) status = 1;
+    if (limit_section(diag, LIMIT_TRIBEZIER) != 0) status = 1;
     if (shade_section() != 0) status = 1;
     if (manifold_section() != 0) status = 1;
     printf("total time %.1f s\n", ms_since(t_start) / 1000.0);

@@ -501,6 +501,8 @@ typedef struct sfb__tbz_stats {
     long unknowns;     /* points moved by the G1 solve, per coordinate and net */
     long constraints;  /* G1 rows */
     double residual;   /* largest G1 row left, relative to the net's largest coordinate */
+    double ours_residual; /* the same within the constraint components around extraordinary crease vertices with
+                             our tangent plane */
     int fallbacks;     /* smooth nets rebuilt with the seed's tangent plane (ours unsolvable) */
 } sfb__tbz_stats;
 SFB__IF sfb_result sfb__tribezier_points(sfb_context *ctx, const sfb__level *base, const float *positions,

@@ -32,7 +32,9 @@
  *     two patches towards their opposite vertices, T along the edge), mu, nu, lambda linear in t
  *     with their end values from the characteristic angles of the two end vertices (below); the
  *     smallest change of the unknowns (least squares, CGLS from zero: the minimum-norm solution)
- *     that satisfies them is applied. Regular regions are untouched, so they stay Loop's.
+ *     that satisfies them is applied, per connected component of the constraints (each solved on
+ *     a compact copy of its rows, three coordinates at once; see tbz_cgls for when it stops).
+ *     Regular regions are untouched, so they stay Loop's.
  *   - characteristic angles phi (the angle each triangle takes at a vertex): 2 pi / n at a
  *     smooth vertex (and at a dart, and at a vertex with only a corner tag); a sector between two
  *     sharp edges with k triangles spans pi at a crease or boundary vertex (its two crease
@@ -77,6 +79,11 @@ typedef struct sfb__tbz {
     int *dist;                 /* per point: net distance to an irregular vertex */
     float *tag_s;              /* per edge: s of a tagged edge (0: none) */
     float *corner_s;           /* per vertex: s of a corner tag (0: none) */
+    /* the seed-plane fallback of the smooth net: the first (our-plane) solution and its vertices
+     * of type CREASE | 16; components of the constraints away from those are the same systems in
+     * both nets, so their solution is copied rather than solved again */
+    const double *reuse_x;
+    const unsigned char *reuse_ours;
     sfb__tbz_stats st;
 } sfb__tbz;
 
@@ -454,6 +461,7 @@ typedef struct tbz_sys {
     int rows, cap_rows;
     size_t n, cap;
     size_t *off;
+    int *edge, cur_edge; /* per row: its mesh edge */
     int *col;       /* global point index */
     double *w;
 } tbz_sys;
@@ -478,11 +486,16 @@ static int tbz_sys_row(sfb__tbz *T, tbz_sys *S) {
     if (S->rows + 1 >= S->cap_rows) {
         int nc = S->cap_rows ? 2 * S->cap_rows : 1024;
         size_t *o2 = (size_t *)sfb__realloc(T->ctx, S->off, ((size_t)nc + 1) * sizeof(size_t));
+        int *e2;
         if (!o2) return 0;
         S->off = o2;
+        e2 = (int *)sfb__realloc(T->ctx, S->edge, ((size_t)nc + 1) * sizeof(int));
+        if (!e2) return 0;
+        S->edge = e2;
         S->cap_rows = nc;
     }
     if (S->rows == 0) S->off[0] = 0;
+    S->edge[S->rows] = S->cur_edge;
     S->off[++S->rows] = S->n;
     return 1;
 }
@@ -583,93 +596,255 @@ static void tbz_distances(sfb__tbz *T) {
     }
 }
 
-/* Applies the smallest change of the unknowns that satisfies the constraints (CGLS from zero,
- * per coordinate: the minimum-norm least-squares solution). */
+/* Union-find root of unknown i (path halving). */
+static int tbz_root(int *parent, int i) {
+    while (parent[i] != i) { parent[i] = parent[parent[i]]; i = parent[i]; }
+    return i;
+}
+
+/* CGLS from zero on one connected component of the constraints (rows `rows[0..nr)`, unknowns
+ * `unk[0..nu)` with local[] mapping a point to its column or -1), the three coordinates at once
+ * (one matrix, three right-hand sides, each with its own recurrence); adds the change to T->x.
+ * The component's matrix is first copied into a compact local CSR (lo/lc/lw: S->n + nr + 1
+ * entries each; duplicate columns of a row merged, fixed points left out). w: 6 * nr + 12 * nu +
+ * 3 * TBZ_STALL doubles. Stops a coordinate when its residual is below 1e-15 of the scale
+ * (consistent: exactly G1), when A^T r has fallen by 1e-13, or when |r|^2 has fallen by less
+ * than 1e-5 of itself over the last TBZ_STALL iterations (inconsistent -- touching extraordinary
+ * vertices of different valences --: the least-squares residual is reached; what CGLS would
+ * still move are the near-null directions, which only make the net wilder). */
+#define TBZ_STALL 40
+#define TBZ_MAX(a, b) ((a) > (b) ? (a) : (b))
+static void tbz_cgls(sfb__tbz *T, const tbz_sys *S, const int *rows, int nr, const int *unk, int nu, const int *local, double scale,
+                     double *w, size_t *lo, int *lc, double *lw) {
+    double *rr = w, *q = w + 3 * (size_t)nr, *xs = q + 3 * (size_t)nr, *sv = xs + 3 * (size_t)nu, *p = sv + 3 * (size_t)nu;
+    double *hist = p + 3 * (size_t)nu;
+    double gamma[3], gamma0[3];
+    int active[3], it, i, r, c, left = 3;
+    const int maxit = 20 * nu + 200 < 5000 ? 20 * nu + 200 : 5000;
+    size_t n = 0, k, k2;
+    /* the local matrix, and the residual of the initial net b = -A x0 (fixed points included) */
+    for (r = 0; r < nr; ++r) {
+        double v[3] = {0.0, 0.0, 0.0};
+        lo[r] = n;
+        for (k = S->off[rows[r]]; k < S->off[rows[r] + 1]; ++k) {
+            const int u = local[S->col[k]];
+            for (c = 0; c < 3; ++c) v[c] += S->w[k] * T->x[3 * (size_t)S->col[k] + c];
+            if (u < 0) continue;
+            for (k2 = lo[r]; k2 < n && lc[k2] != u; ++k2) {}
+            if (k2 < n) lw[k2] += S->w[k];
+            else { lc[n] = u; lw[n++] = S->w[k]; }
+        }
+        for (c = 0; c < 3; ++c) rr[3 * r + c] = -v[c];
+    }
+    lo[nr] = n;
+    for (i = 0; i < 3 * nu; ++i) xs[i] = sv[i] = 0.0;
+    for (r = 0; r < nr; ++r)
+        for (k = lo[r]; k < lo[r + 1]; ++k)
+            for (c = 0; c < 3; ++c) sv[3 * lc[k] + c] += lw[k] * rr[3 * r + c];
+    for (c = 0; c < 3; ++c) { gamma[c] = 0.0; active[c] = 1; }
+    for (i = 0; i < nu; ++i)
+        for (c = 0; c < 3; ++c) { p[3 * i + c] = sv[3 * i + c]; gamma[c] += sv[3 * i + c] * sv[3 * i + c]; }
+    for (c = 0; c < 3; ++c) {
+        gamma0[c] = gamma[c];
+        if (!(gamma[c] > 0.0)) { active[c] = 0; --left; }
+    }
+    for (it = 0; it < maxit && left > 0; ++it) {
+        double qq[3] = {0.0, 0.0, 0.0}, rn[3] = {0.0, 0.0, 0.0}, r2[3] = {0.0, 0.0, 0.0}, g2[3] = {0.0, 0.0, 0.0}, alpha[3];
+        for (r = 0; r < nr; ++r) {
+            double v0 = 0.0, v1 = 0.0, v2 = 0.0;
+            for (k = lo[r]; k < lo[r + 1]; ++k) {
+                const double *pp = p + 3 * lc[k];
+                v0 += lw[k] * pp[0]; v1 += lw[k] * pp[1]; v2 += lw[k] * pp[2];
+            }
+            q[3 * r] = v0; q[3 * r + 1] = v1; q[3 * r + 2] = v2;
+            qq[0] += v0 * v0; qq[1] += v1 * v1; qq[2] += v2 * v2;
+        }
+        for (c = 0; c < 3; ++c) {
+            if (active[c] && !(qq[c] > 0.0)) { active[c] = 0; --left; }
+            alpha[c] = active[c] ? gamma[c] / qq[c] : 0.0;
+        }
+        for (i = 0; i < nu; ++i)
+            for (c = 0; c < 3; ++c) xs[3 * i + c] += alpha[c] * p[3 * i + c];
+        for (r = 0; r < nr; ++r)
+            for (c = 0; c < 3; ++c) {
+                const double v = rr[3 * r + c] - alpha[c] * q[3 * r + c];
+                rr[3 * r + c] = v;
+                rn[c] = TBZ_MAX(rn[c], fabs(v));
+                r2[c] += v * v;
+            }
+        for (c = 0; c < 3; ++c) {
+            double *h = hist + (size_t)c * TBZ_STALL;
+            if (!active[c]) continue;
+            if (rn[c] <= 1e-15 * scale || (it >= TBZ_STALL && h[it % TBZ_STALL] - r2[c] <= 1e-5 * r2[c])) { active[c] = 0; --left; }
+            h[it % TBZ_STALL] = r2[c];
+        }
+        if (left == 0) { ++it; break; }
+        for (i = 0; i < 3 * nu; ++i) sv[i] = 0.0;
+        for (r = 0; r < nr; ++r) {
+            const double r0 = rr[3 * r], r1 = rr[3 * r + 1], r2b = rr[3 * r + 2];
+            for (k = lo[r]; k < lo[r + 1]; ++k) {
+                double *ss = sv + 3 * lc[k];
+                ss[0] += lw[k] * r0; ss[1] += lw[k] * r1; ss[2] += lw[k] * r2b;
+            }
+        }
+        for (i = 0; i < nu; ++i)
+            for (c = 0; c < 3; ++c) g2[c] += sv[3 * i + c] * sv[3 * i + c];
+        for (c = 0; c < 3; ++c) {
+            if (active[c] && g2[c] <= 1e-26 * gamma0[c]) { active[c] = 0; --left; }
+            if (!active[c]) continue;
+            for (i = 0; i < nu; ++i) p[3 * i + c] = sv[3 * i + c] + (g2[c] / gamma[c]) * p[3 * i + c];
+            gamma[c] = g2[c];
+        }
+    }
+    T->st.iterations += it;
+    for (i = 0; i < nu; ++i)
+        for (c = 0; c < 3; ++c) T->x[3 * (size_t)unk[i] + c] += xs[3 * i + c];
+}
+
+/* The connected components of the constraints: rows sharing an unknown are in one. rows[] and
+ * unk[] list the rows and the unknowns' points component by component, [rstart[i], rstart[i+1])
+ * and [ustart[i], ustart[i+1]); maxr, maxu the largest component's counts. */
+typedef struct tbz_comps {
+    int nc, maxr, maxu;
+    int *rstart, *ustart, *rows, *unk;
+} tbz_comps;
+
+static sfb_result tbz_components(sfb__tbz *T, const tbz_sys *S, const int *ucol, int nu, tbz_comps *C) {
+    int *parent = (int *)sfb__alloc(T->ctx, ((size_t)nu + 1) * sizeof(int));
+    int *comp = (int *)sfb__alloc(T->ctx, ((size_t)nu + (size_t)S->rows + 1) * sizeof(int)); /* per unknown, then per row */
+    int i, r, nc = 0;
+    sfb_result res = SFB_SUCCESS;
+    C->rows = (int *)sfb__alloc(T->ctx, ((size_t)S->rows + 1) * sizeof(int));
+    C->unk = (int *)sfb__alloc(T->ctx, ((size_t)nu + 1) * sizeof(int));
+    if (!parent || !comp || !C->rows || !C->unk) { res = sfb__oom(T->ctx, "tribezier constraints"); goto done; }
+    for (i = 0; i < nu; ++i) parent[i] = i;
+    for (r = 0; r < S->rows; ++r) {
+        int first = -1;
+        size_t k;
+        for (k = S->off[r]; k < S->off[r + 1]; ++k) {
+            const int u = ucol[S->col[k]];
+            if (u < 0) continue;
+            if (first < 0) first = tbz_root(parent, u);
+            else { const int b2 = tbz_root(parent, u); if (b2 != first) parent[b2] = first; }
+        }
+        comp[nu + r] = first; /* an unknown for now; -1: the row has none (tbz_edge_rows skips those) */
+    }
+    for (i = 0; i < nu; ++i) comp[i] = -1;
+    for (i = 0; i < nu; ++i) { const int root = tbz_root(parent, i); if (comp[root] < 0) comp[root] = nc++; }
+    for (i = 0; i < nu; ++i) parent[i] = tbz_root(parent, i);  /* every unknown points at its root... */
+    for (i = 0; i < nu; ++i) parent[i] = comp[parent[i]];       /* ...then holds its component */
+    C->nc = nc;
+    C->rstart = (int *)sfb__calloc(T->ctx, (size_t)nc + 2, sizeof(int));
+    C->ustart = (int *)sfb__calloc(T->ctx, (size_t)nc + 2, sizeof(int));
+    if (!C->rstart || !C->ustart) { res = sfb__oom(T->ctx, "tribezier constraints"); goto done; }
+    for (r = 0; r < S->rows; ++r) {
+        const int u0 = comp[nu + r];
+        comp[nu + r] = u0 >= 0 ? parent[u0] : -1;
+        if (u0 >= 0) ++C->rstart[comp[nu + r] + 1];
+    }
+    for (i = 0; i < nu; ++i) ++C->ustart[parent[i] + 1];
+    for (i = 0; i < nc; ++i) {
+        C->maxr = C->rstart[i + 1] > C->maxr ? C->rstart[i + 1] : C->maxr;
+        C->maxu = C->ustart[i + 1] > C->maxu ? C->ustart[i + 1] : C->maxu;
+        C->rstart[i + 1] += C->rstart[i];
+        C->ustart[i + 1] += C->ustart[i];
+    }
+    /* fill, reusing comp[0..nc) (the per-unknown part is no longer needed) as the cursors */
+    for (i = 0; i < nc; ++i) comp[i] = C->rstart[i];
+    for (r = 0; r < S->rows; ++r)
+        if (comp[nu + r] >= 0) C->rows[comp[comp[nu + r]]++] = r;
+    for (i = 0; i < nc; ++i) comp[i] = C->ustart[i];
+    for (i = 0; i < T->np; ++i)
+        if (ucol[i] >= 0) C->unk[comp[parent[ucol[i]]]++] = i;
+done:
+    sfb__free(T->ctx, parent);
+    sfb__free(T->ctx, comp);
+    return res;
+}
+
+/* Applies the smallest change of the unknowns that satisfies the constraints: the minimum-norm
+ * least-squares solution, per connected component of the constraint graph (the solution of a
+ * block-diagonal system is the blocks' solutions; each block converges at its own pace, so a
+ * slow block near touching extraordinary vertices does not hold the others up). */
 static sfb_result tbz_solve(sfb__tbz *T) {
     const sfb__level *l = T->l;
     tbz_sys S;
-    int *ucol = NULL, nu = 0, e, i, c, r;
+    unsigned char *ours = NULL;
+    size_t *lo = NULL;
+    int *lc = NULL;
+    double *lw = NULL;
+    tbz_comps C;
+    int *ucol = NULL, *rstart, *ustart, *rows, *unk, *local = NULL;
+    int nu = 0, e, i, r, nc;
     double *buf = NULL, scale = 0.0;
     sfb_result res = SFB_SUCCESS;
     memset(&S, 0, sizeof S);
+    memset(&C, 0, sizeof C);
     for (e = 0; e < T->ne; ++e)
-        if (l->ef_off[e + 1] - l->ef_off[e] == 2 && !T->efeat[e])
+        if (l->ef_off[e + 1] - l->ef_off[e] == 2 && !T->efeat[e]) {
+            S.cur_edge = e;
             if (!tbz_edge_rows(T, &S, e)) { res = sfb__oom(T->ctx, "tribezier constraints"); goto done; }
+        }
     if (S.rows == 0) goto done;
     ucol = (int *)sfb__alloc(T->ctx, (size_t)T->np * sizeof(int));
-    if (!ucol) { res = sfb__oom(T->ctx, "tribezier constraints"); goto done; }
-    for (i = 0; i < T->np; ++i) ucol[i] = (!T->fixed[i] && T->dist[i] <= TBZ_REACH) ? nu++ : -1;
-    for (i = 0; i < T->np; ++i)
-        for (c = 0; c < 3; ++c) scale = fmax(scale, fabs(T->x[3 * (size_t)i + c]));
+    local = (int *)sfb__alloc(T->ctx, (size_t)T->np * sizeof(int));
+    if (!ucol || !local) { res = sfb__oom(T->ctx, "tribezier constraints"); goto done; }
+    for (i = 0; i < T->np; ++i) { ucol[i] = (!T->fixed[i] && T->dist[i] <= TBZ_REACH) ? nu++ : -1; local[i] = -1; }
+    for (i = 0; i < 3 * T->np; ++i) scale = fmax(scale, fabs(T->x[i]));
     if (scale == 0.0) scale = 1.0;
-    buf = (double *)sfb__alloc(T->ctx, ((size_t)2 * S.rows + 3 * (size_t)nu + 1) * sizeof(double));
+    if ((res = tbz_components(T, &S, ucol, nu, &C)) != SFB_SUCCESS) goto done;
+    nc = C.nc; rstart = C.rstart; ustart = C.ustart; rows = C.rows; unk = C.unk;
+    lo = (size_t *)sfb__alloc(T->ctx, ((size_t)S.rows + 1) * sizeof(size_t));
+    lc = (int *)sfb__alloc(T->ctx, (S.n + 1) * sizeof(int));
+    lw = (double *)sfb__alloc(T->ctx, (S.n + 1) * sizeof(double));
+    if (!lo || !lc || !lw) { res = sfb__oom(T->ctx, "tribezier constraints"); goto done; }
+    buf = (double *)sfb__alloc(T->ctx, ((size_t)6 * C.maxr + 12 * (size_t)C.maxu + 3 * TBZ_STALL + 1) * sizeof(double));
     if (!buf) { res = sfb__oom(T->ctx, "tribezier constraints"); goto done; }
-    for (c = 0; c < 3; ++c) {
-        double *rr = buf, *q = buf + S.rows, *xs = buf + 2 * (size_t)S.rows, *sv = xs + nu, *p = sv + nu;
-        double gamma = 0.0, rn = 0.0;
-        double gamma0;
-        /* consistent systems converge to rn below 1e-15 of the scale; where they are not (touching
-         * extraordinary vertices of different valences) the least-squares point is reached when
-         * A^T r stops falling */
-        int it, maxit = 20 * nu + 200 < 5000 ? 20 * nu + 200 : 5000;
-        /* residual of the initial net: b = -A x0 */
-        for (r = 0; r < S.rows; ++r) {
-            double v = 0.0;
-            size_t k;
-            for (k = S.off[r]; k < S.off[r + 1]; ++k) v += S.w[k] * T->x[3 * (size_t)S.col[k] + c];
-            rr[r] = -v;
+    /* components at an extraordinary crease vertex with our plane (this net's, or in the
+     * fallback the first net's) */
+    ours = (unsigned char *)sfb__calloc(T->ctx, (size_t)nc + 1, 1);
+    if (!ours) { res = sfb__oom(T->ctx, "tribezier constraints"); goto done; }
+    for (i = 0; i < nc; ++i)
+        for (r = rstart[i]; r < rstart[i + 1] && !ours[i]; ++r) {
+            const int e2 = S.edge[rows[r]], a = l->ev[2 * e2], b = l->ev[2 * e2 + 1];
+            ours[i] = (unsigned char)(((T->vtype[a] & 16) && T->virr[a]) || ((T->vtype[b] & 16) && T->virr[b]) ||
+                                      (T->reuse_ours && (T->reuse_ours[a] || T->reuse_ours[b])));
         }
-        for (i = 0; i < nu; ++i) xs[i] = sv[i] = 0.0;
-        for (r = 0; r < S.rows; ++r) {
-            size_t k;
-            for (k = S.off[r]; k < S.off[r + 1]; ++k)
-                if (ucol[S.col[k]] >= 0) sv[ucol[S.col[k]]] += S.w[k] * rr[r];
+    for (i = 0; i < nc; ++i) {
+        const int u0 = ustart[i], cu = ustart[i + 1] - u0;
+        int j;
+        if (T->reuse_x && !ours[i]) {
+            for (j = 0; j < cu; ++j)
+                for (r = 0; r < 3; ++r) T->x[3 * (size_t)unk[u0 + j] + r] = T->reuse_x[3 * (size_t)unk[u0 + j] + r];
+            continue;
         }
-        for (i = 0; i < nu; ++i) { p[i] = sv[i]; gamma += sv[i] * sv[i]; }
-        gamma0 = gamma;
-        for (it = 0; it < maxit && gamma > 0.0; ++it) {
-            double qq = 0.0, alpha, g2 = 0.0;
-            rn = 0.0;
-            for (r = 0; r < S.rows; ++r) {
-                double v = 0.0;
-                size_t k;
-                for (k = S.off[r]; k < S.off[r + 1]; ++k)
-                    if (ucol[S.col[k]] >= 0) v += S.w[k] * p[ucol[S.col[k]]];
-                q[r] = v;
-                qq += v * v;
+        for (j = 0; j < cu; ++j) local[unk[u0 + j]] = j;
+        tbz_cgls(T, &S, rows + rstart[i], rstart[i + 1] - rstart[i], unk + u0, cu, local, scale, buf, lo, lc, lw);
+        for (j = 0; j < cu; ++j) local[unk[u0 + j]] = -1;
+    }
+    /* the residual left, relative to the net's scale; and that of the components around an
+     * extraordinary crease vertex with our tangent plane (vtype CREASE | 16), which decides the
+     * fallback to the seed's plane (sfb__tribezier_points) */
+    {
+        for (i = 0; i < nc; ++i)
+            for (r = rstart[i]; r < rstart[i + 1]; ++r) {
+                int c;
+                for (c = 0; c < 3; ++c) {
+                    double v = 0.0;
+                    size_t k;
+                    for (k = S.off[rows[r]]; k < S.off[rows[r] + 1]; ++k) v += S.w[k] * T->x[3 * (size_t)S.col[k] + c];
+                    T->st.residual = TBZ_MAX(T->st.residual, fabs(v) / scale);
+                    if (ours[i]) T->st.ours_residual = TBZ_MAX(T->st.ours_residual, fabs(v) / scale);
+                }
             }
-            if (!(qq > 0.0)) break;
-            alpha = gamma / qq;
-            for (i = 0; i < nu; ++i) xs[i] += alpha * p[i];
-            for (r = 0; r < S.rows; ++r) { rr[r] -= alpha * q[r]; rn = fmax(rn, fabs(rr[r])); }
-            if (rn <= 1e-15 * scale) break;
-            for (i = 0; i < nu; ++i) sv[i] = 0.0;
-            for (r = 0; r < S.rows; ++r) {
-                size_t k;
-                for (k = S.off[r]; k < S.off[r + 1]; ++k)
-                    if (ucol[S.col[k]] >= 0) sv[ucol[S.col[k]]] += S.w[k] * rr[r];
-            }
-            for (i = 0; i < nu; ++i) g2 += sv[i] * sv[i];
-            if (g2 <= 1e-26 * gamma0) break;
-            for (i = 0; i < nu; ++i) p[i] = sv[i] + (g2 / gamma) * p[i];
-            gamma = g2;
-        }
-        T->st.iterations += it;
-        for (i = 0; i < T->np; ++i)
-            if (ucol[i] >= 0) T->x[3 * (size_t)i + c] += xs[ucol[i]];
-        /* the residual left, relative to the net's scale */
-        for (r = 0; r < S.rows; ++r) {
-            double v = 0.0;
-            size_t k;
-            for (k = S.off[r]; k < S.off[r + 1]; ++k) v += S.w[k] * T->x[3 * (size_t)S.col[k] + c];
-            T->st.residual = fmax(T->st.residual, fabs(v) / scale);
-        }
     }
     T->st.unknowns += nu;
     T->st.constraints += S.rows;
 done:
-    sfb__free(T->ctx, S.off); sfb__free(T->ctx, S.col); sfb__free(T->ctx, S.w);
-    sfb__free(T->ctx, ucol); sfb__free(T->ctx, buf);
+    sfb__free(T->ctx, S.off); sfb__free(T->ctx, S.edge); sfb__free(T->ctx, S.col); sfb__free(T->ctx, S.w);
+    sfb__free(T->ctx, ucol); sfb__free(T->ctx, local);
+    sfb__free(T->ctx, C.rows); sfb__free(T->ctx, C.unk); sfb__free(T->ctx, C.rstart); sfb__free(T->ctx, C.ustart); sfb__free(T->ctx, buf);
+    sfb__free(T->ctx, ours); sfb__free(T->ctx, lo); sfb__free(T->ctx, lc); sfb__free(T->ctx, lw);
     return res;
 }
 
@@ -778,13 +953,25 @@ sfb_result sfb__tribezier_points(sfb_context *ctx, const sfb__level *l, const fl
             any_tag = 1;
         }
     r = tbz_state(&T, 0);
-    if (r == SFB_SUCCESS && !T.seed_plane && any_tag && (T.st.residual > 1e-10 || tbz_degenerate(&T))) {
-        /* our crease tangent plane left the constraints unsolvable or a patch corner degenerate
-         * (seen at valence 8 and up with a crease through the vertex): the smooth net falls back
-         * to the seed's kind (measured in tests/tribezier.c) */
+    if (r == SFB_SUCCESS && !T.seed_plane && any_tag && (T.st.ours_residual > 1e-10 || tbz_degenerate(&T))) {
+        /* our crease tangent plane left the constraints around it unsolvable or a patch corner
+         * degenerate (seen at valence 8 and up with a crease through the vertex): the smooth net
+         * falls back to the seed's kind (measured in tests/tribezier.c). Residuals elsewhere
+         * (touching extraordinary vertices of different valences) are no reason to. */
+        double *first = T.x;
+        unsigned char *was = (unsigned char *)sfb__calloc(ctx, (size_t)T.nv + 1, 1);
+        T.x = (double *)sfb__calloc(ctx, 3 * (size_t)T.np + 1, sizeof(double));
+        if (!T.x || !was) { sfb__free(ctx, first); sfb__free(ctx, was); r = sfb__oom(ctx, "tribezier"); goto done; }
+        for (v = 0; v < T.nv; ++v) was[v] = (unsigned char)((T.vtype[v] & 16) && T.virr[v]);
         memset(&T.st, 0, sizeof T.st);
         T.seed_plane = 1;
+        T.reuse_x = first;
+        T.reuse_ours = was;
         r = tbz_state(&T, 0);
+        T.reuse_x = NULL;
+        T.reuse_ours = NULL;
+        sfb__free(ctx, first);
+        sfb__free(ctx, was);
         T.seed_plane = (flags & SFB__TBZ_SEED_PLANE) != 0;
         T.st.fallbacks++;
     }
