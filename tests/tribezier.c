@@ -445,14 +445,14 @@ static void test_crease_evs(sfb_context *ctx) {
  * edges of the vertex, ours against the seed's tangent plane. */
 static void test_undulation(sfb_context *ctx) {
     static const int vals[3] = {4, 5, 7};
-    double ours_dev[4] = {0, 0, 0, 0};
+    double ours_dev[4] = {0, 0, 0, 0}, ours_range[4] = {0, 0, 0, 0};
     int vi, mode, si, ours_changes[4] = {0, 0, 0, 0};
     for (vi = 0; vi < 3; ++vi)
         for (mode = 0; mode < 2; ++mode) {
             tbm_opts o;
             tmesh t;
             char *obj;
-            double *n0, *n1, mean_edge = 0.0;
+            double *n0, *n1, mean_edge = 0.0, loop_off = 0.0;
             sfb_tribezier_options to;
             int e;
             memset(&o, 0, sizeof o);
@@ -463,13 +463,42 @@ static void test_undulation(sfb_context *ctx) {
                 const float *a = t.m->positions + 3 * t.prep.ev[2 * e], *b = t.m->positions + 3 * t.prep.ev[2 * e + 1];
                 mean_edge += sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2])) / t.prep.ne;
             }
+            {
+                /* Loop's own limit surface of the same mesh (untagged) at the crease vertices of
+                 * rings 1 and 2: it lies loop_off off the crease plane where the mesh is not
+                 * symmetric about it (valence 5, 7), and s = 0 equals it at regular vertices, so
+                 * at s the crease curve is at least (1 - s) loop_off off the plane: the issue's
+                 * 1e-3 mean edges cannot be met there by any construction that keeps Loop's
+                 * surface where the mesh is regular */
+                sfb_mesh *lm = NULL;
+                sfb_surface *ls = NULL;
+                sfb_mesh_data ld;
+                sfb_surface_config lc = sfb_surface_config_init(SFB_SCHEME_LOOP, 0);
+                tbm_opts lo = o;
+                char *lobj;
+                lo.sharp = 0.0;
+                lobj = tbm_obj(&lo);
+                memset(&ld, 0, sizeof ld);
+                lc.flags = SFB_REFINE_LIMIT;
+                if (sfb_mesh_read_obj(ctx, lobj, strlen(lobj), &lm) == SFB_SUCCESS && sfb_surface_create(ctx, lm, &lc, &ls) == SFB_SUCCESS &&
+                    sfb_surface_refine(ls, &ld) == SFB_SUCCESS) {
+                    int r2, sd;
+                    for (sd = 0; sd < 2; ++sd)
+                        for (r2 = 1; r2 <= 2; ++r2)
+                            loop_off = fmax(loop_off, fabs(ld.limit_positions[3 * tbm_index(&o, sd ? o.crease_k : 0, r2, 0) + 1]));
+                } else fail("undulation/loop", "Loop limit: %s", sfb_last_error(ctx));
+                sfb_mesh_data_free(&ld);
+                sfb_surface_destroy(ls);
+                sfb_mesh_destroy(lm);
+                free(lobj);
+            }
             to.sharpness_set = 1; to.sharpness = 0.0f;
             n0 = net_of(ctx, &t, &to, mode ? SFB__TBZ_SEED_PLANE : 0, NULL);
             to.sharpness = 1.0f;
             n1 = net_of(ctx, &t, &to, mode ? SFB__TBZ_SEED_PLANE : 0, NULL);
             for (si = 1; n0 && n1 && si <= 3; ++si) {
                 const double s = 0.25 * si;
-                double dev = 0.0, prev_k = 0.0;
+                double dev = 0.0, prev_k = 0.0, zlo = 1e300, zhi = -1e300;
                 int changes = 0, side, r, q, c;
                 char nm[160];
                 /* both rays of the crease: ray 0 and ray k, rings 0..2 */
@@ -507,6 +536,7 @@ static void test_undulation(sfb_context *ctx) {
                                 for (c = 0; c < 3; ++c)
                                     D2[c] += 12 * d2[j] * ((1 - s) * (B0[j + 2][c] - 2 * B0[j + 1][c] + B0[j][c]) + s * (B1[j + 2][c] - 2 * B1[j + 1][c] + B1[j][c]));
                             dev = fmax(dev, fabs(X[1]));
+                            zlo = fmin(zlo, X[2]); zhi = fmax(zhi, X[2]);
                             /* signed curvature of the (x, z) projection */
                             /* the curvature, counted where it exceeds 1e-3 / mean edge (a straight
                              * stretch is not a sign change) */
@@ -519,14 +549,25 @@ static void test_undulation(sfb_context *ctx) {
                     }
                 }
                 snprintf(nm, sizeof nm, "undulation/valence_%d/s_%.2f/%s", o.n, s, mode ? "ours_no_worse_than_the_seed_plane" : "ours");
-                printf("  %s: deviation from the crease plane %.3g (%.3g mean edges), curvature sign changes %d\n", nm, dev, dev / mean_edge, changes);
-                if (!mode) { ours_dev[si] = dev; ours_changes[si] = changes; }
-                else {
-                    /* asserted: ours deviates from the crease plane no more than the seed's kind;
-                     * printed, not met: the issue's bound of 1e-3 mean edges at valence 5 and 7 and
-                     * no curvature sign change (ours has as many or more) */
-                    check(ours_dev[si] <= dev + 1e-12, nm, "ours %.3g against the seed's %.3g (sign changes %d against %d)",
-                          ours_dev[si], dev, ours_changes[si], changes);
+                /* (a) the deviation from the vertical plane; (b) the curvature sign changes of the
+                 * projection into it; and the undulation within the plane, the height range of
+                 * the projection (the crease line is straight and level: 0 at s = 1) */
+                printf("  %s: deviation from the crease plane %.3g (%.3g mean edges; Loop's limit forces >= %.3g), curvature sign "
+                       "changes %d, height range in the plane %.3g mean edges\n",
+                       nm, dev, dev / mean_edge, (1.0 - s) * loop_off / mean_edge, changes, (zhi - zlo) / mean_edge);
+                if (!mode) {
+                    char nb[200];
+                    ours_dev[si] = dev; ours_changes[si] = changes; ours_range[si] = zhi - zlo;
+                    /* asserted: ours is within 10% of the deviation Loop's limit forces */
+                    snprintf(nb, sizeof nb, "%s_near_the_loop_bound", nm);
+                    check(dev <= 1.1 * (1.0 - s) * loop_off + 1e-12 * mean_edge, nb, "deviation %.3g, Loop's bound %.3g", dev, (1.0 - s) * loop_off);
+                } else {
+                    /* asserted: ours deviates from the crease plane, and undulates within it, no
+                     * more than the seed's kind; printed, not met: the issue's bound of 1e-3 mean
+                     * edges at valence 5 and 7 (below Loop's own offset) and no curvature sign change */
+                    check(ours_dev[si] <= dev + 1e-12 && ours_range[si] <= zhi - zlo + 1e-12, nm,
+                          "ours %.3g against the seed's %.3g, height range %.3g against %.3g (sign changes %d against %d)", ours_dev[si], dev,
+                          ours_range[si] / mean_edge, (zhi - zlo) / mean_edge, ours_changes[si], changes);
                     printf("  %s: ours within 1e-3 mean edges: %s\n", nm, ours_dev[si] <= 1e-3 * mean_edge ? "yes" : "no");
                 }
             }

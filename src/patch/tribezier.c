@@ -42,10 +42,14 @@
  *     edges (clamped to [pi/8, 7 pi/8]).
  *   - the seed's open problem (section 5, undulation at s = 0.5 near an extraordinary crease
  *     vertex): in the smooth net an irregular crease vertex keeps the sector angles (pi each
- *     side) and is given the sharp net's corner point and crease tangents (the B-spline's), so
- *     its tangent plane contains the crease tangents and the crease curve starts on the crease
- *     polygon's B-spline for every s. (TBZ_SEED_PLANE builds the seed's kind instead, the smooth
- *     net ignoring the crease, for the measurement in bench/tests.)
+ *     side) and is given the crease B-spline's tangents, so its tangent plane contains the
+ *     crease tangents; its corner point is the B-spline's point moved by the mean offset of its
+ *     crease neighbours' smooth points from their B-spline points, so the smooth crease curve
+ *     runs on at the height and side the smooth surface has along the crease (pinned to the
+ *     B-spline point it dipped there: the in-plane undulation was 0.11 mean edges at s = 0.25,
+ *     now 0.0014-0.0023, the seed's kind 0.008-0.016; tests/tribezier.c). (TBZ_SEED_PLANE builds
+ *     the seed's kind instead, the smooth net ignoring the crease, for the measurement in
+ *     bench/tests.)
  *   - darts: in the sharp net the dart vertex stays smooth (uniform angles, a Loop-limit corner);
  *     the dart edge is C0 only (no G1 constraint) and is not fixed to a B-spline, so the crease
  *     fades out at the dart.
@@ -304,6 +308,33 @@ static void tbz_initial(sfb__tbz *T) {
         if (type == TBZ_CORNER || (type == TBZ_CREASE && T->virr[v]) || (T->sharp && T->corner_s[v] > 0.0f)) T->fixed[v] = 1;
         if (type == TBZ_CREASE && !T->virr[v] && (T->vtype[v] & 16) == 0) T->fixed[v] = 1; /* = the regular value */
     }
+    /* our irregular crease vertex in the smooth net: its corner point is the crease B-spline's
+     * point moved by the mean offset of its two crease neighbours' smooth corner points from
+     * their own B-spline points. The smooth surface lies off the crease polygon by that offset
+     * along the whole crease (Loop's limit: above a valley, beside the crease where the mesh is
+     * not symmetric); pinning the extraordinary vertex to the B-spline made the crease curve dip
+     * there, an undulation of its own at every s < 1 (tests/tribezier.c, undulation). A
+     * neighbour that is not an ordinary crease vertex (two tagged edges) adds no offset. */
+    if (!T->sharp && !T->seed_plane)
+        for (v = 0; v < T->nv; ++v)
+            if (T->vtype[v] == (TBZ_CREASE | 16) && T->virr[v]) {
+                double off[3] = {0.0, 0.0, 0.0};
+                int m = l->ve_off[v + 1] - l->ve_off[v], cnt = 0;
+                for (j = 0; j < m; ++j) {
+                    const int w = tbz_ring(l, v, j);
+                    int nb[2], nn = 0, i2, m2 = l->ve_off[w + 1] - l->ve_off[w];
+                    double W[3], A[3], B[3];
+                    if (!(T->tag_s[l->ve[l->ve_off[v] + j]] > 0.0f) || (T->vtype[w] == (TBZ_CREASE | 16) && T->virr[w])) continue;
+                    for (i2 = 0; i2 < m2; ++i2)
+                        if (T->tag_s[l->ve[l->ve_off[w] + i2]] > 0.0f) { if (nn < 2) nb[nn] = tbz_ring(l, w, i2); ++nn; }
+                    if (nn != 2 || tbz_boundary(l, w) || T->corner_s[w] > 0.0f) continue;
+                    tbz_get(T, w, W); tbz_get(T, nb[0], A); tbz_get(T, nb[1], B);
+                    for (c = 0; c < 3; ++c) off[c] += T->x[3 * (size_t)tbz_vp(T, w) + c] - (A[c] + 4.0 * W[c] + B[c]) / 6.0;
+                    ++cnt;
+                }
+                if (cnt)
+                    for (c = 0; c < 3; ++c) T->x[3 * (size_t)tbz_vp(T, v) + c] += off[c] / cnt;
+            }
     /* edge points: near each end from that end's rules, the middle from the two opposite vertices */
     for (e = 0; e < T->ne; ++e) {
         const int a = l->ev[2 * e], b = l->ev[2 * e + 1];
