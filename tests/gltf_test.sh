@@ -57,6 +57,12 @@ check "--crease-angle 200 is a usage error" 2 "$TOOL" --crease-angle 200 "$BOX" 
 check "an unknown scheme is a usage error" 2 "$TOOL" --scheme nosuch "$BOX" -o "$TMP/x.glb"
 absent "usage errors leave no output" "$TMP/x.glb"
 check "tribezier (seed 004) is exported tessellated" 0 "$TOOL" --scheme tribezier --tess 4 examples/data/tribezier_crease_v5.obj -o "$TMP/tbz.glb"
+check "tribezier --sharpness 0.5 is exported" 0 "$TOOL" --scheme tribezier --sharpness 0.5 --tess 4 examples/data/tribezier_crease_v5.obj -o "$TMP/tbz5.glb"
+if [ -f "$TMP/tbz.glb" ] && [ -f "$TMP/tbz5.glb" ] && ! cmp -s "$TMP/tbz.glb" "$TMP/tbz5.glb"; then ok "--sharpness changes the tribezier surface"
+else bad "--sharpness 0.5 wrote the same file as the tags' s = 1"; fi
+check "--sharpness outside [0, 1] is a usage error (exit 2)" 2 "$TOOL" --scheme tribezier --sharpness 1.5 --tess 4 examples/data/tribezier_crease_v5.obj -o "$TMP/tbzbad.glb"
+check "--sharpness on another scheme is a usage error (exit 2)" 2 "$TOOL" --scheme loop --sharpness 0.5 examples/data/tribezier_crease_v5.obj -o "$TMP/tbzbad.glb"
+absent "a refused --sharpness leaves no output" "$TMP/tbzbad.glb"
 check "tribezier refuses quads (exit 1)" 1 "$TOOL" --scheme tribezier --tess 4 "$BOX" -o "$TMP/tbzq.glb"
 absent "a refused tribezier export leaves no output" "$TMP/tbzq.glb"
 

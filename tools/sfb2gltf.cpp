@@ -66,6 +66,8 @@ const char *const kUsage =
     "                         limit (exact limit normals; the default with --tess and for manifold) or\n"
     "                         flat (one normal per triangle; the default for bilinear)\n"
     "  --crease-angle DEG     edges whose dihedral angle is over DEG (0..180) become infinitely sharp creases\n"
+    "  --sharpness S          --scheme tribezier: s in [0, 1] for every tagged crease and corner (0: the smooth\n"
+    "                         G1 surface, 1: the crease; default: each tag's value clamped to [0, 1])\n"
     "  --trim MASK.png        with --tess: trim the surface by a mask over each parametric face (seed 000)\n"
     "  --backend NAME         ref, simd, gl or osmesa (default: the library's order)\n"
     "  --quantize             KHR_mesh_quantization: positions as unsigned 16-bit integers on a grid of\n"
@@ -99,6 +101,8 @@ struct Options {
     sfb_scheme scheme = SFB_SCHEME_CATMARK;
     int level = 3, rate = 0;
     double tolerance = 0.0, angle = 0.0;
+    bool have_sharpness = false;
+    double sharpness = 0.0; // --sharpness (tribezier: every tagged crease's and corner's s)
     bool quantize = false, have_bits = false, compress = false;
     int position_bits = 14, normal_bits = 8, uv_bits = 12; // --quantize
     NormalsMode normals = NORMALS_DEFAULT;
@@ -189,6 +193,10 @@ int parse_args(int argc, char **argv, Options *o) {
             if (!parse_double(value(a), &o->angle) || o->angle < 0.0 || o->angle > 180.0)
                 return usage_error("--crease-angle needs degrees in 0..180");
             o->have_angle = true;
+        } else if (!strcmp(a, "--sharpness")) {
+            if (!parse_double(value(a), &o->sharpness) || !(o->sharpness >= 0.0 && o->sharpness <= 1.0))
+                return usage_error("--sharpness needs a number in [0, 1]");
+            o->have_sharpness = true;
         } else if (!strcmp(a, "--trim")) {
             if (!(o->trim = value(a))) return usage_error("--trim needs a PNG file");
         } else if (!strcmp(a, "--backend")) {
@@ -250,6 +258,7 @@ int parse_args(int argc, char **argv, Options *o) {
     if (o->have_tess && !(caps & SFB_SCHEME_CAN_EVAL))
         return usage_error("--tess needs a scheme with a limit surface (%s has none)", sfb_scheme_name(o->scheme));
     if (o->have_tolerance && !o->have_tess) return usage_error("--tolerance belongs to --tess");
+    if (o->have_sharpness && o->scheme != SFB_SCHEME_TRIBEZIER) return usage_error("--sharpness belongs to --scheme tribezier");
     if (o->trim && !o->have_tess) return usage_error("--trim belongs to --tess (trimming cuts the tessellation)");
     if (o->normals == NORMALS_DEFAULT)
         o->normals = o->have_tess ? NORMALS_LIMIT : (caps & SFB_SCHEME_CAN_SHADE) ? NORMALS_SHADING : NORMALS_FLAT;
@@ -1076,6 +1085,10 @@ int evaluate_part(Run &R, Part &part) {
     sfb_mesh_desc d;
     sfb_mesh_get_desc(part.mesh, &d);
     sfb_surface_config cfg = sfb_surface_config_init(R.o.scheme, R.o.have_tess ? 0 : part.level);
+    if (R.o.have_sharpness) {
+        cfg.tribezier.sharpness_set = 1;
+        cfg.tribezier.sharpness = (float)R.o.sharpness;
+    }
     if (R.o.have_tess) cfg.flags = SFB_REFINE_PATCHES | (d.uv_count > 0 ? (unsigned)SFB_REFINE_UVS : 0u);
     else cfg.flags = (R.o.normals == NORMALS_FLAT ? (R.o.report ? (unsigned)SFB_REFINE_LIMIT : 0u) : (unsigned)SFB_REFINE_SHADING) |
                      (d.uv_count > 0 ? (unsigned)SFB_REFINE_UVS : 0u);
