@@ -1097,6 +1097,9 @@ SFB__IF sfb_result sfb__tri_mesh_check(sfb_context *ctx, const sfb__level *l, co
 /* One BEZIER_TRI15 patch of its own 15 points (net: 45 doubles per triangle) per triangle of l that
  * is not a hole (patch/table.c; PN triangles, tribezier). */
 SFB__IF sfb_result sfb__patch_table_beztri_own(sfb_context *ctx, const sfb__level *l, const double *net, sfb__patch_table *pt);
+/* The same with four child patches per triangle f (45 doubles each at net + 180 f + 45 i, child i
+ * of the parametric triangle's quadtree: corners 0, 1, 2, the middle 3). */
+SFB__IF sfb_result sfb__patch_table_beztri_children(sfb_context *ctx, const sfb__level *l, const double *net, sfb__patch_table *pt);
 /* The families present in a table, as bits 1 << SFB__FAMILY_*. */
 static inline unsigned sfb__patch_families(const sfb__patch_table *pt) {
     unsigned m = 0;
@@ -1134,7 +1137,13 @@ typedef struct sfb__tbz_stats {
 } sfb__tbz_stats;
 SFB__IF sfb_result sfb__tribezier_points(sfb_context *ctx, const sfb__level *base, const float *positions,
                                          const sfb_tribezier_options *opt, unsigned flags, double **out, sfb__tbz_stats *stats);
-/* The same as one BEZIER_TRI15 patch per triangle. */
+/* The same on the mesh after one Loop step (*rl, free with sfb__level_free): 45 doubles per child
+ * face 4 f + i (child i of triangle f in its parametric triangle's quadtree frame). */
+SFB__IF sfb_result sfb__tribezier_refined_points(sfb_context *ctx, const sfb__level *base, const float *positions,
+                                                 const sfb_tribezier_options *opt, unsigned flags, sfb__level *rl, double **out,
+                                                 sfb__tbz_stats *stats);
+/* The same as one BEZIER_TRI15 patch per triangle, or four (one Loop step) where the mesh's own
+ * G1 constraints have no exact solution. */
 SFB__IF sfb_result sfb__tribezier_build(sfb_context *ctx, const sfb__level *base, const float *positions,
                                         const sfb_tribezier_options *opt, sfb__patch_table *pt);
 SFB__IF sfb_result sfb__manifold_build(sfb_context *ctx, const sfb__level *base, int weights, const float *positions, sfb__patch_table *pt);
@@ -3539,20 +3548,20 @@ sfb_result sfb__tri_mesh_check(sfb_context *ctx, const sfb__level *l, const floa
 /* A table of one BEZIER_TRI15 patch with 15 points of its own per triangle of l that is not a
  * hole (one param face per triangle, depth 0), the points from net (45 doubles per triangle, our
  * patch order) -- the shape of schemes whose points are not masks (PN triangles, tribezier). */
-sfb_result sfb__patch_table_beztri_own(sfb_context *ctx, const sfb__level *l, const double *net, sfb__patch_table *pt) {
-    int f, k, p = 0, npatch = 0;
-    memset(pt, 0, sizeof *pt);
-    for (f = 0; f < l->nf; ++f) npatch += !l->fhole[f];
+/* The arrays of a table of npatch BEZIER_TRI15 patches (15 own points each) over nf triangles
+ * with nnodes quadtree nodes; 0 (and the table freed) when out of memory. */
+static int sfb__beztri_alloc(sfb_context *ctx, int nf, int npatch, int nnodes, sfb__patch_table *pt) {
     pt->domain = SFB__DOMAIN_TRI;
-    pt->nptex = l->nf;
+    pt->nptex = nf;
     pt->npatch = npatch;
     pt->ncv = 15 * npatch;
     pt->npoints = 15 * npatch;
-    pt->face_ptex = (int *)sfb__alloc(ctx, ((size_t)l->nf + 1) * sizeof(int));
-    pt->ptex_face = (int *)sfb__alloc(ctx, ((size_t)l->nf + 1) * sizeof(int));
-    pt->ptex_corner = (int *)sfb__alloc(ctx, ((size_t)l->nf + 1) * sizeof(int));
-    pt->ptex_root = (int *)sfb__alloc(ctx, ((size_t)l->nf + 1) * sizeof(int));
-    pt->nodes = (int *)sfb__alloc(ctx, 4 * sizeof(int));
+    pt->nnodes = nnodes;
+    pt->face_ptex = (int *)sfb__alloc(ctx, ((size_t)nf + 1) * sizeof(int));
+    pt->ptex_face = (int *)sfb__alloc(ctx, ((size_t)nf + 1) * sizeof(int));
+    pt->ptex_corner = (int *)sfb__alloc(ctx, ((size_t)nf + 1) * sizeof(int));
+    pt->ptex_root = (int *)sfb__alloc(ctx, ((size_t)nf + 1) * sizeof(int));
+    pt->nodes = (int *)sfb__alloc(ctx, ((size_t)nnodes + 1) * 4 * sizeof(int));
     pt->ptype = (int *)sfb__alloc(ctx, ((size_t)npatch + 1) * sizeof(int));
     pt->pfirst = (int *)sfb__alloc(ctx, ((size_t)npatch + 1) * sizeof(int));
     pt->pparam = (unsigned *)sfb__alloc(ctx, ((size_t)npatch + 1) * sizeof(unsigned));
@@ -3562,8 +3571,16 @@ sfb_result sfb__patch_table_beztri_own(sfb_context *ctx, const sfb__level *l, co
     if (!pt->face_ptex || !pt->ptex_face || !pt->ptex_corner || !pt->ptex_root || !pt->nodes || !pt->ptype || !pt->pfirst ||
         !pt->pparam || !pt->pvalence || !pt->cv || !pt->point_data) {
         sfb__patch_table_free(ctx, pt);
-        return sfb__oom(ctx, "patch table");
+        return 0;
     }
+    return 1;
+}
+
+sfb_result sfb__patch_table_beztri_own(sfb_context *ctx, const sfb__level *l, const double *net, sfb__patch_table *pt) {
+    int f, k, p = 0, npatch = 0;
+    memset(pt, 0, sizeof *pt);
+    for (f = 0; f < l->nf; ++f) npatch += !l->fhole[f];
+    if (!sfb__beztri_alloc(ctx, l->nf, npatch, 0, pt)) return sfb__oom(ctx, "patch table");
     for (f = 0; f < l->nf; ++f) {
         pt->face_ptex[f] = pt->ptex_face[f] = f;
         pt->ptex_corner[f] = -1;
@@ -3575,6 +3592,33 @@ sfb_result sfb__patch_table_beztri_own(sfb_context *ctx, const sfb__level *l, co
         for (k = 0; k < 15; ++k) pt->cv[15 * p + k] = 15 * p + k;
         pt->ptex_root[f] = -(p + 2);
         p++;
+    }
+    pt->face_ptex[l->nf] = l->nf;
+    pt->pfirst[npatch] = 15 * npatch;
+    pt->counts[SFB__PATCH_BEZTRI] = npatch;
+    return SFB_SUCCESS;
+}
+
+sfb_result sfb__patch_table_beztri_children(sfb_context *ctx, const sfb__level *l, const double *net, sfb__patch_table *pt) {
+    int f, k, i, p = 0, nn = 0, npatch = 0;
+    memset(pt, 0, sizeof *pt);
+    for (f = 0; f < l->nf; ++f) npatch += l->fhole[f] ? 0 : 4;
+    if (!sfb__beztri_alloc(ctx, l->nf, npatch, npatch / 4, pt)) return sfb__oom(ctx, "patch table");
+    pt->max_depth = 1;
+    for (f = 0; f < l->nf; ++f) {
+        pt->face_ptex[f] = pt->ptex_face[f] = f;
+        pt->ptex_corner[f] = -1;
+        if (l->fhole[f]) { pt->ptex_root[f] = -1; continue; }
+        pt->ptex_root[f] = nn;
+        for (i = 0; i < 4; ++i, ++p) {
+            for (k = 0; k < 45; ++k) pt->point_data[45 * (size_t)p + k] = (float)net[180 * (size_t)f + 45 * (size_t)i + k];
+            pt->ptype[p] = SFB__PATCH_BEZTRI;
+            pt->pfirst[p] = 15 * p;
+            pt->pparam[p] = SFB__PARAM(1, i & 1, i >> 1, 0); /* quadrant x + 2y = i: sfb__pb_insert's encoding */
+            for (k = 0; k < 15; ++k) pt->cv[15 * p + k] = 15 * p + k;
+            pt->nodes[4 * nn + i] = -(p + 2);
+        }
+        ++nn;
     }
     pt->face_ptex[l->nf] = l->nf;
     pt->pfirst[npatch] = 15 * npatch;
@@ -5712,7 +5756,11 @@ done:
  *     smallest change of the unknowns (least squares, CGLS from zero: the minimum-norm solution)
  *     that satisfies them is applied, per connected component of the constraints (each solved on
  *     a compact copy of its rows, three coordinates at once; see tbz_cgls for when it stops).
- *     Regular regions are untouched, so they stay Loop's.
+ *     Regular regions are untouched, so they stay Loop's. Where extraordinary vertices of
+ *     different valences touch, the constraints have no exact solution on the mesh itself; the
+ *     net is then built on the mesh after one Loop step (tbz_refine: the smooth net's positions
+ *     by Loop's smooth rules, the sharp net's with its features sharp), four child patches per
+ *     triangle (sfb__tribezier_build), and is exactly G1 again (tests/tribezier.c, touching_evs).
  *   - characteristic angles phi (the angle each triangle takes at a vertex): 2 pi / n at a
  *     smooth vertex (and at a dart, and at a vertex with only a corner tag); a sector between two
  *     sharp edges with k triangles spans pi at a crease or boundary vertex (its two crease
@@ -6618,8 +6666,8 @@ static sfb_result tbz_vertex_s(sfb__tbz *T, double *vs) {
     return SFB_SUCCESS;
 }
 
-sfb_result sfb__tribezier_points(sfb_context *ctx, const sfb__level *l, const float *positions, const sfb_tribezier_options *opt,
-                                 unsigned flags, double **out, sfb__tbz_stats *stats) {
+static sfb_result tbz_points(sfb_context *ctx, const sfb__level *l, const float *positions, const float *sharp_positions,
+                             const sfb_tribezier_options *opt, unsigned flags, double **out, sfb__tbz_stats *stats) {
     sfb__tbz T;
     double *x0 = NULL, *vs = NULL, *res = NULL;
     int v, e, f, c, k, any_tag = 0;
@@ -6628,8 +6676,6 @@ sfb_result sfb__tribezier_points(sfb_context *ctx, const sfb__level *l, const fl
     memset(&T, 0, sizeof T);
     if (opt && opt->sharpness_set && !(opt->sharpness >= 0.0f && opt->sharpness <= 1.0f))
         return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "tribezier: sharpness %g is not in [0, 1]", (double)opt->sharpness);
-    r = sfb__tri_mesh_check(ctx, l, positions, "tribezier", 1);
-    if (r != SFB_SUCCESS) return r;
     T.ctx = ctx; T.l = l; T.pos = positions;
     T.nv = l->nv; T.ne = l->ne; T.nf = l->nf;
     T.np = l->nv + 3 * l->ne + 3 * l->nf;
@@ -6690,6 +6736,7 @@ sfb_result sfb__tribezier_points(sfb_context *ctx, const sfb__level *l, const fl
         T.x = (double *)sfb__calloc(ctx, 3 * (size_t)T.np + 1, sizeof(double));
         vs = (double *)sfb__calloc(ctx, (size_t)T.nv + 1, sizeof(double));
         if (!T.x || !vs) { r = sfb__oom(ctx, "tribezier"); goto done; }
+        T.pos = sharp_positions;
         r = tbz_state(&T, 1);
         if (r != SFB_SUCCESS) goto done;
         r = tbz_vertex_s(&T, vs);
@@ -6726,13 +6773,174 @@ done:
     return r;
 }
 
+sfb_result sfb__tribezier_points(sfb_context *ctx, const sfb__level *l, const float *positions, const sfb_tribezier_options *opt,
+                                 unsigned flags, double **out, sfb__tbz_stats *stats) {
+    sfb_result r;
+    *out = NULL;
+    if (opt && opt->sharpness_set && !(opt->sharpness >= 0.0f && opt->sharpness <= 1.0f))
+        return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "tribezier: sharpness %g is not in [0, 1]", (double)opt->sharpness);
+    r = sfb__tri_mesh_check(ctx, l, positions, "tribezier", 1);
+    if (r != SFB_SUCCESS) return r;
+    return tbz_points(ctx, l, positions, positions, opt, flags, out, stats);
+}
+
+/* One Loop step of the triangle mesh `b` into *rl, with the positions of the smooth net's rules
+ * (only boundaries sharp) into *ps and of the sharp net's (boundaries, every tagged edge and
+ * corner tag) into *pp. Child face 4f + i of triangle f = (V0, V1, V2), edge points E01, E12,
+ * E20: i = 0 (V0, E01, E20), 1 (E01, V1, E12), 2 (E20, E12, V2), 3 (E12, E20, E01) -- each in
+ * the frame of quadtree child i of the parametric triangle (sfb__patch_locate), so its 15
+ * points are that child patch's. Child edges keep their parent edge's tag, the old vertices
+ * their corner tags. */
+static sfb_result tbz_refine(sfb_context *ctx, const sfb__level *b, const float *pos, const sfb_tribezier_options *opt, sfb__level *rl,
+                             float **ps, float **pp) {
+    const int nv = b->nv, nf = b->nf, ne = b->ne, nv2 = nv + ne;
+    int *sizes = (int *)sfb__alloc(ctx, (size_t)4 * nf * sizeof(int) + 1);
+    int *fv = (int *)sfb__alloc(ctx, (size_t)12 * nf * sizeof(int) + 1);
+    int f, e, v, k, c, net;
+    sfb_result r;
+    memset(rl, 0, sizeof *rl);
+    *ps = (float *)sfb__alloc(ctx, (size_t)3 * nv2 * sizeof(float) + 1);
+    *pp = (float *)sfb__alloc(ctx, (size_t)3 * nv2 * sizeof(float) + 1);
+    if (!sizes || !fv || !*ps || !*pp) { r = sfb__oom(ctx, "tribezier refinement"); goto done; }
+    for (f = 0; f < nf; ++f) {
+        const int *V = b->fv + b->fv_off[f], *E = b->fe + b->fv_off[f]; /* E[k]: edge V[k] -> V[k+1] */
+        const int ch[4][3] = {{V[0], nv + E[0], nv + E[2]}, {nv + E[0], V[1], nv + E[1]}, {nv + E[2], nv + E[1], V[2]},
+                              {nv + E[1], nv + E[2], nv + E[0]}};
+        for (k = 0; k < 4; ++k) {
+            sizes[4 * f + k] = 3;
+            for (c = 0; c < 3; ++c) fv[12 * f + 3 * k + c] = ch[k][c];
+        }
+    }
+    r = sfb__level_from_faces(ctx, nv2, 4 * nf, sizes, fv, NULL, SFB_ELEMENT_VERTEX, rl);
+    if (r != SFB_SUCCESS) goto done;
+    for (e = 0; e < rl->ne; ++e) {
+        const int a = rl->ev[2 * e], d = rl->ev[2 * e + 1], old = a < nv ? a : d, mid = a < nv ? d : a;
+        rl->es[e] = (old < nv && mid >= nv) ? b->es[mid - nv] : 0.0f;
+    }
+    for (v = 0; v < nv2; ++v) rl->vs[v] = v < nv ? b->vs[v] : 0.0f;
+    for (f = 0; f < 4 * nf; ++f) rl->fhole[f] = b->fhole[f / 4];
+    for (net = 0; net < 2; ++net) {
+        float *out = net ? *pp : *ps;
+        /* the sharp edges of this net's rules */
+        for (e = 0; e < ne; ++e) {
+            const int n2 = b->ef_off[e + 1] - b->ef_off[e], a = b->ev[2 * e], d = b->ev[2 * e + 1];
+            const int sharp = n2 < 2 || (net && b->es[e] > 0.0f);
+            double P[3];
+            for (c = 0; c < 3; ++c) P[c] = sharp ? 0.5 * ((double)pos[3 * a + c] + pos[3 * d + c]) : 0.375 * ((double)pos[3 * a + c] + pos[3 * d + c]);
+            if (!sharp)
+                for (k = 0; k < 2; ++k) {
+                    const int g = b->ef[b->ef_off[e] + k], sl = b->ef_slot[b->ef_off[e] + k];
+                    const int o = b->fv[b->fv_off[g] + (sl + 2) % 3];
+                    for (c = 0; c < 3; ++c) P[c] += 0.125 * pos[3 * o + c];
+                }
+            for (c = 0; c < 3; ++c) out[3 * (size_t)(nv + e) + c] = (float)P[c];
+        }
+        for (v = 0; v < nv; ++v) {
+            const int m = b->ve_off[v + 1] - b->ve_off[v], nfv = b->vf_off[v + 1] - b->vf_off[v];
+            int ns = 0, sa = -1, sb = -1, j;
+            double P[3];
+            for (j = 0; j < m; ++j) {
+                const int ej = b->ve[b->ve_off[v] + j];
+                if (b->ef_off[ej + 1] - b->ef_off[ej] < 2 || (net && b->es[ej] > 0.0f)) {
+                    const int w = sfb__other_end(b, ej, v);
+                    if (ns == 0) sa = w; else sb = w;
+                    ++ns;
+                }
+            }
+            if (nfv == 0 || ns >= 3 || (m > nfv && nfv == 1) || (net && b->vs[v] > 0.0f)) {
+                for (c = 0; c < 3; ++c) P[c] = pos[3 * v + c]; /* corner */
+            } else if (ns == 2) {
+                for (c = 0; c < 3; ++c) P[c] = 0.75 * pos[3 * v + c] + 0.125 * ((double)pos[3 * sa + c] + pos[3 * sb + c]);
+            } else {
+                /* Loop's rule (the library's, refine.c): (5/8 - (3/8 + cos(2 pi / n) / 4)^2) / n per neighbour */
+                const double beta = 0.25 * cos(2.0 * TBZ_PI / m) + 0.375, w = (0.625 - beta * beta) / m;
+                for (c = 0; c < 3; ++c) P[c] = (1.0 - m * w) * pos[3 * v + c];
+                for (j = 0; j < m; ++j) {
+                    const int o = sfb__other_end(b, b->ve[b->ve_off[v] + j], v);
+                    for (c = 0; c < 3; ++c) P[c] += w * pos[3 * o + c];
+                }
+            }
+            for (c = 0; c < 3; ++c) out[3 * (size_t)v + c] = (float)P[c];
+        }
+    }
+    (void)opt;
+done:
+    sfb__free(ctx, sizes);
+    sfb__free(ctx, fv);
+    if (r != SFB_SUCCESS) {
+        sfb__level_free(ctx, rl);
+        sfb__free(ctx, *ps); sfb__free(ctx, *pp);
+        *ps = *pp = NULL;
+    }
+    return r;
+}
+
+sfb_result sfb__tribezier_refined_points(sfb_context *ctx, const sfb__level *l, const float *positions, const sfb_tribezier_options *opt,
+                                         unsigned flags, sfb__level *rl, double **out, sfb__tbz_stats *stats) {
+    float *ps = NULL, *pp = NULL;
+    sfb_result r;
+    *out = NULL;
+    memset(rl, 0, sizeof *rl);
+    if (opt && opt->sharpness_set && !(opt->sharpness >= 0.0f && opt->sharpness <= 1.0f))
+        return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "tribezier: sharpness %g is not in [0, 1]", (double)opt->sharpness);
+    r = sfb__tri_mesh_check(ctx, l, positions, "tribezier", 1);
+    if (r == SFB_SUCCESS) r = tbz_refine(ctx, l, positions, opt, rl, &ps, &pp);
+    if (r == SFB_SUCCESS) r = tbz_points(ctx, rl, ps, pp, opt, flags, out, stats);
+    if (r != SFB_SUCCESS) sfb__level_free(ctx, rl);
+    sfb__free(ctx, ps);
+    sfb__free(ctx, pp);
+    return r;
+}
+
+/* One patch per triangle where the G1 constraints are solvable on the mesh itself; where they
+ * are not (extraordinary vertices of different valences that touch, found up front, or a
+ * residual above 1e-10 left), the net is built on the mesh after one Loop step instead (Peters' remedy: afterwards every
+ * extraordinary vertex is surrounded by ordinary ones) and each triangle gets its four child
+ * patches (depth 1 of its parametric triangle); the refined net is kept if it is closer to G1. */
+/* Do two interior extraordinary vertices of different valences share an edge? (Then the
+ * constraints on the mesh itself have no exact solution: the refined net is built directly.) */
+static int tbz_touching(const sfb__level *l) {
+    int e;
+    for (e = 0; e < l->ne; ++e) {
+        const int a = l->ev[2 * e], b = l->ev[2 * e + 1], na = tbz_nf(l, a), nb = tbz_nf(l, b);
+        if (l->ef_off[e + 1] - l->ef_off[e] != 2 || tbz_boundary(l, a) || tbz_boundary(l, b)) continue;
+        if (na != 6 && nb != 6 && na != nb) return 1;
+    }
+    return 0;
+}
+
 sfb_result sfb__tribezier_build(sfb_context *ctx, const sfb__level *l, const float *positions, const sfb_tribezier_options *opt,
                                 sfb__patch_table *pt) {
-    double *net = NULL;
+    double *net = NULL, *net4 = NULL;
+    sfb__tbz_stats st, st4;
+    sfb__level rl;
     sfb_result r;
     memset(pt, 0, sizeof *pt);
-    r = sfb__tribezier_points(ctx, l, positions, opt, 0, &net, NULL);
+    memset(&st, 0, sizeof st);
+    if (tbz_touching(l)) {
+        r = sfb__tribezier_refined_points(ctx, l, positions, opt, 0, &rl, &net4, NULL);
+        if (r != SFB_SUCCESS) return r;
+        r = sfb__patch_table_beztri_children(ctx, l, net4, pt);
+        sfb__free(ctx, net4);
+        sfb__level_free(ctx, &rl);
+        return r;
+    }
+    r = sfb__tribezier_points(ctx, l, positions, opt, 0, &net, &st);
     if (r != SFB_SUCCESS) return r;
+    if (st.residual > 1e-10) {
+        memset(&st4, 0, sizeof st4);
+        r = sfb__tribezier_refined_points(ctx, l, positions, opt, 0, &rl, &net4, &st4);
+        if (r != SFB_SUCCESS) { sfb__free(ctx, net); return r; }
+        if (st4.residual < st.residual) {
+            sfb__free(ctx, net);
+            r = sfb__patch_table_beztri_children(ctx, l, net4, pt);
+            sfb__free(ctx, net4);
+            sfb__level_free(ctx, &rl);
+            return r;
+        }
+        sfb__free(ctx, net4);
+        sfb__level_free(ctx, &rl);
+    }
     r = sfb__patch_table_beztri_own(ctx, l, net, pt);
     sfb__free(ctx, net);
     return r;

@@ -470,6 +470,9 @@ SFB__IF sfb_result sfb__tri_mesh_check(sfb_context *ctx, const sfb__level *l, co
 /* One BEZIER_TRI15 patch of its own 15 points (net: 45 doubles per triangle) per triangle of l that
  * is not a hole (patch/table.c; PN triangles, tribezier). */
 SFB__IF sfb_result sfb__patch_table_beztri_own(sfb_context *ctx, const sfb__level *l, const double *net, sfb__patch_table *pt);
+/* The same with four child patches per triangle f (45 doubles each at net + 180 f + 45 i, child i
+ * of the parametric triangle's quadtree: corners 0, 1, 2, the middle 3). */
+SFB__IF sfb_result sfb__patch_table_beztri_children(sfb_context *ctx, const sfb__level *l, const double *net, sfb__patch_table *pt);
 /* The families present in a table, as bits 1 << SFB__FAMILY_*. */
 static inline unsigned sfb__patch_families(const sfb__patch_table *pt) {
     unsigned m = 0;
@@ -507,7 +510,13 @@ typedef struct sfb__tbz_stats {
 } sfb__tbz_stats;
 SFB__IF sfb_result sfb__tribezier_points(sfb_context *ctx, const sfb__level *base, const float *positions,
                                          const sfb_tribezier_options *opt, unsigned flags, double **out, sfb__tbz_stats *stats);
-/* The same as one BEZIER_TRI15 patch per triangle. */
+/* The same on the mesh after one Loop step (*rl, free with sfb__level_free): 45 doubles per child
+ * face 4 f + i (child i of triangle f in its parametric triangle's quadtree frame). */
+SFB__IF sfb_result sfb__tribezier_refined_points(sfb_context *ctx, const sfb__level *base, const float *positions,
+                                                 const sfb_tribezier_options *opt, unsigned flags, sfb__level *rl, double **out,
+                                                 sfb__tbz_stats *stats);
+/* The same as one BEZIER_TRI15 patch per triangle, or four (one Loop step) where the mesh's own
+ * G1 constraints have no exact solution. */
 SFB__IF sfb_result sfb__tribezier_build(sfb_context *ctx, const sfb__level *base, const float *positions,
                                         const sfb_tribezier_options *opt, sfb__patch_table *pt);
 SFB__IF sfb_result sfb__manifold_build(sfb_context *ctx, const sfb__level *base, int weights, const float *positions, sfb__patch_table *pt);

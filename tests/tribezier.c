@@ -577,6 +577,138 @@ static void test_undulation(sfb_context *ctx) {
         }
 }
 
+/* The largest angle between the normals sfb_surface_eval gives on the two faces of every interior
+ * edge of l (skip_tagged: untagged edges only), 9 points per edge; 1e30 when eval fails. */
+static double eval_edge_jump(sfb_context *ctx, const sfb_surface *sf, const sfb__level *l, int skip_tagged) {
+    double jump = 0.0;
+    int e, k2;
+    for (e = 0; e < l->ne; ++e) {
+        int s0, s1, f0, f1;
+        if (l->ef_off[e + 1] - l->ef_off[e] != 2 || (skip_tagged && l->es[e] > 0.0f)) continue;
+        f0 = l->ef[l->ef_off[e]]; s0 = l->ef_slot[l->ef_off[e]];
+        f1 = l->ef[l->ef_off[e] + 1]; s1 = l->ef_slot[l->ef_off[e] + 1];
+        for (k2 = 1; k2 < 10; ++k2) {
+            sfb_location loc[2];
+            float N[6];
+            double u, v, a[3], bb[3];
+            sfb_eval_output eo;
+            memset(&eo, 0, sizeof eo);
+            eo.normal = N;
+            edge_uv(s0, k2 / 10.0, &u, &v); loc[0].face = f0; loc[0].u = (float)u; loc[0].v = (float)v;
+            edge_uv(s1, 1.0 - k2 / 10.0, &u, &v); loc[1].face = f1; loc[1].u = (float)u; loc[1].v = (float)v;
+            /* on the edge u + v = 1 in double after rounding to float */
+            while ((double)loc[0].u + loc[0].v > 1.0) loc[0].v = nextafterf(loc[0].v, 0.0f);
+            while ((double)loc[1].u + loc[1].v > 1.0) loc[1].v = nextafterf(loc[1].v, 0.0f);
+            if (sfb_surface_eval(sf, loc, 2, &eo) != SFB_SUCCESS) { printf("  eval: %s\n", sfb_last_error(ctx)); return 1e30; }
+            a[0] = N[0]; a[1] = N[1]; a[2] = N[2]; bb[0] = N[3]; bb[1] = N[4]; bb[2] = N[5];
+            jump = fmax(jump, angle_between(a, bb));
+        }
+    }
+    return jump;
+}
+
+/* Extraordinary vertices of different valences that touch: the mesh's own G1 constraints have
+ * no exact solution (near-G1 only); after one Loop step they do (sfb__tribezier_refined_points,
+ * which sfb__tribezier_build switches to there: four patches per triangle). A cube cut into
+ * triangles (valences 3 to 6, all touching) and spot.obj. */
+static const char *tri_cube =
+    "v -1 -1 -1\nv 1 -1 -1\nv 1 1 -1\nv -1 1 -1\nv -1 -1 1\nv 1 -1 1\nv 1 1 1\nv -1 1 1\n"
+    "f 1 4 3\nf 1 3 2\nf 5 6 7\nf 5 7 8\nf 1 2 6\nf 1 6 5\nf 2 3 7\nf 2 7 6\nf 3 4 8\nf 3 8 7\nf 4 1 5\nf 4 5 8\n";
+
+static void refined_one(sfb_context *ctx, const char *name, const char *obj) {
+    tmesh t;
+    double *net = NULL, *net4 = NULL;
+    sfb__tbz_stats st, st4;
+    sfb__level rl;
+    char nm[160];
+    memset(&rl, 0, sizeof rl);
+    if (!tmesh_load(ctx, obj, &t)) { fail(name, "load: %s", sfb_last_error(ctx)); return; }
+    net = net_of(ctx, &t, NULL, 0, &st);
+    if (sfb__tribezier_refined_points(ctx, &t.prep, t.m->positions, NULL, 0, &rl, &net4, &st4) != SFB_SUCCESS || !net) {
+        fail(name, "not built: %s", sfb_last_error(ctx));
+    } else {
+        g1_result g0 = g1_measure(&t.prep, net, 0), g = g1_measure(&rl, net4, 0);
+        snprintf(nm, sizeof nm, "%s_unrefined_is_not_g1", name);
+        check(st.residual > 1e-10 && g0.jump > 1e-6, nm, "residual %.3g, normal jump %.3g rad", st.residual, g0.jump);
+        snprintf(nm, sizeof nm, "%s_after_one_loop_step_is_g1", name);
+        check(g.jump <= 1e-9 && g.gap <= 1e-7 * t.diag && g.flat > 1e-3 && st4.residual <= 1e-12, nm,
+              "normal jump %.3g rad (unrefined %.3g), gap %.3g, flatness %.3g, residual %.3g", g.jump, g0.jump, g.gap, g.flat, st4.residual);
+        printf("  %s: unrefined jump %.3g rad residual %.3g; one Loop step: jump %.3g rad, gap %.3g, %ld unknowns, residual %.3g\n", name,
+               g0.jump, st.residual, g.jump, g.gap, st4.unknowns, st4.residual);
+    }
+    sfb__free(ctx, net);
+    sfb__free(ctx, net4);
+    sfb__level_free(ctx, &rl);
+    tmesh_free(ctx, &t);
+}
+
+static void test_refined(sfb_context *ctx, const char *dir) {
+    char path[4096], *obj;
+    size_t n;
+    refined_one(ctx, "touching_evs/triangulated_cube", tri_cube);
+    snprintf(path, sizeof path, "%s/spot.obj", dir);
+    obj = slurp(path, &n);
+    if (!obj) { skip("touching_evs/spot", "spot.obj not found (pass the real-meshes folder)"); return; }
+    refined_one(ctx, "touching_evs/spot", obj);
+    free(obj);
+}
+
+/* Through sfb_surface_eval on every backend: the triangulated cube's surface (built with one
+ * Loop step, four child patches per triangle) is G1 across every triangle's edges and matches
+ * the refined net at the child's (s, t) (sfb__patch_locate's frames). */
+static void test_backends_refined(void) {
+    int b;
+    for (b = 0; b < g_nbe; ++b) {
+        char nm[160];
+        sfb_context *ctx = g_be[b].ctx;
+        tmesh t;
+        sfb__level rl;
+        double *net4 = NULL, worst = 0.0, jump = 0.0;
+        sfb_surface *sf = NULL;
+        sfb_surface_config sc = sfb_surface_config_init(SFB_SCHEME_TRIBEZIER, 0);
+        sfb_patch_info pi;
+        int f, q;
+        memset(&rl, 0, sizeof rl);
+        snprintf(nm, sizeof nm, "%s/touching_evs_eval_is_g1_on_four_children", g_be[b].name);
+        if (!g_be[b].available) { backend_missing(&g_be[b], nm); continue; }
+        if (!tmesh_load(ctx, tri_cube, &t)) { fail(nm, "load"); continue; }
+        sc.flags = SFB_REFINE_PATCHES;
+        if (sfb__tribezier_refined_points(ctx, &t.prep, t.m->positions, NULL, 0, &rl, &net4, NULL) != SFB_SUCCESS ||
+            sfb_surface_create(ctx, t.m, &sc, &sf) != SFB_SUCCESS) {
+            fail(nm, "%s", sfb_last_error(ctx));
+        } else {
+            memset(&pi, 0, sizeof pi);
+            sfb_surface_patch_info(sf, &pi);
+            for (f = 0; f < t.prep.nf; ++f)
+                for (q = 0; q < 12; ++q) {
+                    sfb_location loc;
+                    float P[3];
+                    sfb_eval_output eo;
+                    double B[3], du[3], dv[3], u, v, su, sv;
+                    int c, child;
+                    memset(&eo, 0, sizeof eo);
+                    eo.position = P;
+                    loc.face = f; loc.u = (float)(0.03 + 0.08 * q); loc.v = (float)(0.95 - loc.u) * (q % 3) / 2.0f;
+                    if (sfb_surface_eval(sf, &loc, 1, &eo) != SFB_SUCCESS) { worst = 1e30; continue; }
+                    u = loc.u; v = loc.v;
+                    if (u >= 0.5) { child = 1; su = 2 * u - 1; sv = 2 * v; }
+                    else if (v >= 0.5) { child = 2; su = 2 * u; sv = 2 * v - 1; }
+                    else if (u + v < 0.5) { child = 0; su = 2 * u; sv = 2 * v; }
+                    else { child = 3; su = 1 - 2 * u; sv = 1 - 2 * v; }
+                    bez_eval(net4 + 45 * (size_t)(4 * f + child), su, sv, B, du, dv);
+                    for (c = 0; c < 3; ++c) worst = fmax(worst, fabs(B[c] - P[c]));
+                }
+            jump = eval_edge_jump(ctx, sf, &t.prep, 0);
+            check(pi.patches == 4 * t.prep.nf && worst <= 1e-6 * t.diag && jump <= 1e-5, nm,
+                  "%d patches for %d triangles, position %.3g (diag %.3g), normal jump %.3g rad", pi.patches, t.prep.nf, worst, t.diag, jump);
+        }
+        if (sf) sfb_surface_destroy(sf);
+        sfb__free(ctx, net4);
+        sfb__level_free(ctx, &rl);
+        tmesh_free(ctx, &t);
+    }
+}
+
 /* Bad input: clear errors, nothing left allocated (the counting allocator). */
 static long g_live;
 static void *cnt_alloc(size_t n, void *u) { void *p = malloc(n); (void)u; if (p) g_live++; return p; }
@@ -632,7 +764,7 @@ static void test_backends(void) {
         double *net = NULL, worst = 0.0, jump = 0.0;
         sfb_surface *sf = NULL;
         sfb_surface_config sc = sfb_surface_config_init(SFB_SCHEME_TRIBEZIER, 0);
-        int f, q, e;
+        int f, q;
         snprintf(nm, sizeof nm, "%s/eval_matches_the_builder_and_is_g1", g_be[b].name);
         if (!g_be[b].available) { backend_missing(&g_be[b], nm); continue; }
         if (!tmesh_load(ctx, obj, &t)) { fail(nm, "load"); continue; }
@@ -654,29 +786,8 @@ static void test_backends(void) {
                     bez_eval(net + 45 * (size_t)f, loc.u, loc.v, B, du, dv);
                     for (c = 0; c < 3; ++c) worst = fmax(worst, fabs(B[c] - P[c]));
                 }
-            /* normals across the untagged interior edges at 11 points, both faces */
-            for (e = 0; e < t.prep.ne; ++e) {
-                int k2, s0, s1, f0, f1;
-                if (t.prep.ef_off[e + 1] - t.prep.ef_off[e] != 2 || t.prep.es[e] > 0.0f) continue;
-                f0 = t.prep.ef[t.prep.ef_off[e]]; s0 = t.prep.ef_slot[t.prep.ef_off[e]];
-                f1 = t.prep.ef[t.prep.ef_off[e] + 1]; s1 = t.prep.ef_slot[t.prep.ef_off[e] + 1];
-                for (k2 = 1; k2 < 10; ++k2) {
-                    sfb_location loc[2];
-                    float N[6];
-                    double u, v, a[3], bb[3];
-                    sfb_eval_output eo;
-                    memset(&eo, 0, sizeof eo);
-                    eo.normal = N;
-                    edge_uv(s0, k2 / 10.0, &u, &v); loc[0].face = f0; loc[0].u = (float)u; loc[0].v = (float)v;
-                    edge_uv(s1, 1.0 - k2 / 10.0, &u, &v); loc[1].face = f1; loc[1].u = (float)u; loc[1].v = (float)v;
-                    /* on the edge u + v = 1 in double after rounding to float */
-                    while ((double)loc[0].u + loc[0].v > 1.0) loc[0].v = nextafterf(loc[0].v, 0.0f);
-                    while ((double)loc[1].u + loc[1].v > 1.0) loc[1].v = nextafterf(loc[1].v, 0.0f);
-                    if (sfb_surface_eval(sf, loc, 2, &eo) != SFB_SUCCESS) { if (jump < 1e30) printf("  eval: %s\n", sfb_last_error(ctx)); jump = 1e30; continue; }
-                    a[0] = N[0]; a[1] = N[1]; a[2] = N[2]; bb[0] = N[3]; bb[1] = N[4]; bb[2] = N[5];
-                    jump = fmax(jump, angle_between(a, bb));
-                }
-            }
+            /* normals across the untagged interior edges, both faces */
+            jump = eval_edge_jump(ctx, sf, &t.prep, 1);
             check(worst <= 1e-6 * t.diag && jump <= 1e-5, nm, "position %.3g (diag %.3g), normal jump %.3g rad", worst, t.diag, jump);
         }
         if (sf) sfb_surface_destroy(sf);
@@ -711,9 +822,11 @@ int main(int argc, char **argv) {
         obj = slurp(path, &n);
         if (!obj) skip("g1_real_mesh_spot_near_g1", "spot.obj not found (pass the real-meshes folder)");
         else { g1_one(ctx, "g1_real_mesh_spot_near_g1", obj, 1e-2); free(obj); }
+        test_refined(ctx, dir);
     }
     sfb_context_destroy(ctx);
     if (!probe_backends()) return 1;
     test_backends();
+    test_backends_refined();
     return close_tests();
 }

@@ -66,20 +66,20 @@ sfb_result sfb__tri_mesh_check(sfb_context *ctx, const sfb__level *l, const floa
 /* A table of one BEZIER_TRI15 patch with 15 points of its own per triangle of l that is not a
  * hole (one param face per triangle, depth 0), the points from net (45 doubles per triangle, our
  * patch order) -- the shape of schemes whose points are not masks (PN triangles, tribezier). */
-sfb_result sfb__patch_table_beztri_own(sfb_context *ctx, const sfb__level *l, const double *net, sfb__patch_table *pt) {
-    int f, k, p = 0, npatch = 0;
-    memset(pt, 0, sizeof *pt);
-    for (f = 0; f < l->nf; ++f) npatch += !l->fhole[f];
+/* The arrays of a table of npatch BEZIER_TRI15 patches (15 own points each) over nf triangles
+ * with nnodes quadtree nodes; 0 (and the table freed) when out of memory. */
+static int sfb__beztri_alloc(sfb_context *ctx, int nf, int npatch, int nnodes, sfb__patch_table *pt) {
     pt->domain = SFB__DOMAIN_TRI;
-    pt->nptex = l->nf;
+    pt->nptex = nf;
     pt->npatch = npatch;
     pt->ncv = 15 * npatch;
     pt->npoints = 15 * npatch;
-    pt->face_ptex = (int *)sfb__alloc(ctx, ((size_t)l->nf + 1) * sizeof(int));
-    pt->ptex_face = (int *)sfb__alloc(ctx, ((size_t)l->nf + 1) * sizeof(int));
-    pt->ptex_corner = (int *)sfb__alloc(ctx, ((size_t)l->nf + 1) * sizeof(int));
-    pt->ptex_root = (int *)sfb__alloc(ctx, ((size_t)l->nf + 1) * sizeof(int));
-    pt->nodes = (int *)sfb__alloc(ctx, 4 * sizeof(int));
+    pt->nnodes = nnodes;
+    pt->face_ptex = (int *)sfb__alloc(ctx, ((size_t)nf + 1) * sizeof(int));
+    pt->ptex_face = (int *)sfb__alloc(ctx, ((size_t)nf + 1) * sizeof(int));
+    pt->ptex_corner = (int *)sfb__alloc(ctx, ((size_t)nf + 1) * sizeof(int));
+    pt->ptex_root = (int *)sfb__alloc(ctx, ((size_t)nf + 1) * sizeof(int));
+    pt->nodes = (int *)sfb__alloc(ctx, ((size_t)nnodes + 1) * 4 * sizeof(int));
     pt->ptype = (int *)sfb__alloc(ctx, ((size_t)npatch + 1) * sizeof(int));
     pt->pfirst = (int *)sfb__alloc(ctx, ((size_t)npatch + 1) * sizeof(int));
     pt->pparam = (unsigned *)sfb__alloc(ctx, ((size_t)npatch + 1) * sizeof(unsigned));
@@ -89,8 +89,16 @@ sfb_result sfb__patch_table_beztri_own(sfb_context *ctx, const sfb__level *l, co
     if (!pt->face_ptex || !pt->ptex_face || !pt->ptex_corner || !pt->ptex_root || !pt->nodes || !pt->ptype || !pt->pfirst ||
         !pt->pparam || !pt->pvalence || !pt->cv || !pt->point_data) {
         sfb__patch_table_free(ctx, pt);
-        return sfb__oom(ctx, "patch table");
+        return 0;
     }
+    return 1;
+}
+
+sfb_result sfb__patch_table_beztri_own(sfb_context *ctx, const sfb__level *l, const double *net, sfb__patch_table *pt) {
+    int f, k, p = 0, npatch = 0;
+    memset(pt, 0, sizeof *pt);
+    for (f = 0; f < l->nf; ++f) npatch += !l->fhole[f];
+    if (!sfb__beztri_alloc(ctx, l->nf, npatch, 0, pt)) return sfb__oom(ctx, "patch table");
     for (f = 0; f < l->nf; ++f) {
         pt->face_ptex[f] = pt->ptex_face[f] = f;
         pt->ptex_corner[f] = -1;
@@ -102,6 +110,33 @@ sfb_result sfb__patch_table_beztri_own(sfb_context *ctx, const sfb__level *l, co
         for (k = 0; k < 15; ++k) pt->cv[15 * p + k] = 15 * p + k;
         pt->ptex_root[f] = -(p + 2);
         p++;
+    }
+    pt->face_ptex[l->nf] = l->nf;
+    pt->pfirst[npatch] = 15 * npatch;
+    pt->counts[SFB__PATCH_BEZTRI] = npatch;
+    return SFB_SUCCESS;
+}
+
+sfb_result sfb__patch_table_beztri_children(sfb_context *ctx, const sfb__level *l, const double *net, sfb__patch_table *pt) {
+    int f, k, i, p = 0, nn = 0, npatch = 0;
+    memset(pt, 0, sizeof *pt);
+    for (f = 0; f < l->nf; ++f) npatch += l->fhole[f] ? 0 : 4;
+    if (!sfb__beztri_alloc(ctx, l->nf, npatch, npatch / 4, pt)) return sfb__oom(ctx, "patch table");
+    pt->max_depth = 1;
+    for (f = 0; f < l->nf; ++f) {
+        pt->face_ptex[f] = pt->ptex_face[f] = f;
+        pt->ptex_corner[f] = -1;
+        if (l->fhole[f]) { pt->ptex_root[f] = -1; continue; }
+        pt->ptex_root[f] = nn;
+        for (i = 0; i < 4; ++i, ++p) {
+            for (k = 0; k < 45; ++k) pt->point_data[45 * (size_t)p + k] = (float)net[180 * (size_t)f + 45 * (size_t)i + k];
+            pt->ptype[p] = SFB__PATCH_BEZTRI;
+            pt->pfirst[p] = 15 * p;
+            pt->pparam[p] = SFB__PARAM(1, i & 1, i >> 1, 0); /* quadrant x + 2y = i: sfb__pb_insert's encoding */
+            for (k = 0; k < 15; ++k) pt->cv[15 * p + k] = 15 * p + k;
+            pt->nodes[4 * nn + i] = -(p + 2);
+        }
+        ++nn;
     }
     pt->face_ptex[l->nf] = l->nf;
     pt->pfirst[npatch] = 15 * npatch;

@@ -34,7 +34,11 @@
  *     smallest change of the unknowns (least squares, CGLS from zero: the minimum-norm solution)
  *     that satisfies them is applied, per connected component of the constraints (each solved on
  *     a compact copy of its rows, three coordinates at once; see tbz_cgls for when it stops).
- *     Regular regions are untouched, so they stay Loop's.
+ *     Regular regions are untouched, so they stay Loop's. Where extraordinary vertices of
+ *     different valences touch, the constraints have no exact solution on the mesh itself; the
+ *     net is then built on the mesh after one Loop step (tbz_refine: the smooth net's positions
+ *     by Loop's smooth rules, the sharp net's with its features sharp), four child patches per
+ *     triangle (sfb__tribezier_build), and is exactly G1 again (tests/tribezier.c, touching_evs).
  *   - characteristic angles phi (the angle each triangle takes at a vertex): 2 pi / n at a
  *     smooth vertex (and at a dart, and at a vertex with only a corner tag); a sector between two
  *     sharp edges with k triangles spans pi at a crease or boundary vertex (its two crease
@@ -940,8 +944,8 @@ static sfb_result tbz_vertex_s(sfb__tbz *T, double *vs) {
     return SFB_SUCCESS;
 }
 
-sfb_result sfb__tribezier_points(sfb_context *ctx, const sfb__level *l, const float *positions, const sfb_tribezier_options *opt,
-                                 unsigned flags, double **out, sfb__tbz_stats *stats) {
+static sfb_result tbz_points(sfb_context *ctx, const sfb__level *l, const float *positions, const float *sharp_positions,
+                             const sfb_tribezier_options *opt, unsigned flags, double **out, sfb__tbz_stats *stats) {
     sfb__tbz T;
     double *x0 = NULL, *vs = NULL, *res = NULL;
     int v, e, f, c, k, any_tag = 0;
@@ -950,8 +954,6 @@ sfb_result sfb__tribezier_points(sfb_context *ctx, const sfb__level *l, const fl
     memset(&T, 0, sizeof T);
     if (opt && opt->sharpness_set && !(opt->sharpness >= 0.0f && opt->sharpness <= 1.0f))
         return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "tribezier: sharpness %g is not in [0, 1]", (double)opt->sharpness);
-    r = sfb__tri_mesh_check(ctx, l, positions, "tribezier", 1);
-    if (r != SFB_SUCCESS) return r;
     T.ctx = ctx; T.l = l; T.pos = positions;
     T.nv = l->nv; T.ne = l->ne; T.nf = l->nf;
     T.np = l->nv + 3 * l->ne + 3 * l->nf;
@@ -1012,6 +1014,7 @@ sfb_result sfb__tribezier_points(sfb_context *ctx, const sfb__level *l, const fl
         T.x = (double *)sfb__calloc(ctx, 3 * (size_t)T.np + 1, sizeof(double));
         vs = (double *)sfb__calloc(ctx, (size_t)T.nv + 1, sizeof(double));
         if (!T.x || !vs) { r = sfb__oom(ctx, "tribezier"); goto done; }
+        T.pos = sharp_positions;
         r = tbz_state(&T, 1);
         if (r != SFB_SUCCESS) goto done;
         r = tbz_vertex_s(&T, vs);
@@ -1048,13 +1051,174 @@ done:
     return r;
 }
 
+sfb_result sfb__tribezier_points(sfb_context *ctx, const sfb__level *l, const float *positions, const sfb_tribezier_options *opt,
+                                 unsigned flags, double **out, sfb__tbz_stats *stats) {
+    sfb_result r;
+    *out = NULL;
+    if (opt && opt->sharpness_set && !(opt->sharpness >= 0.0f && opt->sharpness <= 1.0f))
+        return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "tribezier: sharpness %g is not in [0, 1]", (double)opt->sharpness);
+    r = sfb__tri_mesh_check(ctx, l, positions, "tribezier", 1);
+    if (r != SFB_SUCCESS) return r;
+    return tbz_points(ctx, l, positions, positions, opt, flags, out, stats);
+}
+
+/* One Loop step of the triangle mesh `b` into *rl, with the positions of the smooth net's rules
+ * (only boundaries sharp) into *ps and of the sharp net's (boundaries, every tagged edge and
+ * corner tag) into *pp. Child face 4f + i of triangle f = (V0, V1, V2), edge points E01, E12,
+ * E20: i = 0 (V0, E01, E20), 1 (E01, V1, E12), 2 (E20, E12, V2), 3 (E12, E20, E01) -- each in
+ * the frame of quadtree child i of the parametric triangle (sfb__patch_locate), so its 15
+ * points are that child patch's. Child edges keep their parent edge's tag, the old vertices
+ * their corner tags. */
+static sfb_result tbz_refine(sfb_context *ctx, const sfb__level *b, const float *pos, const sfb_tribezier_options *opt, sfb__level *rl,
+                             float **ps, float **pp) {
+    const int nv = b->nv, nf = b->nf, ne = b->ne, nv2 = nv + ne;
+    int *sizes = (int *)sfb__alloc(ctx, (size_t)4 * nf * sizeof(int) + 1);
+    int *fv = (int *)sfb__alloc(ctx, (size_t)12 * nf * sizeof(int) + 1);
+    int f, e, v, k, c, net;
+    sfb_result r;
+    memset(rl, 0, sizeof *rl);
+    *ps = (float *)sfb__alloc(ctx, (size_t)3 * nv2 * sizeof(float) + 1);
+    *pp = (float *)sfb__alloc(ctx, (size_t)3 * nv2 * sizeof(float) + 1);
+    if (!sizes || !fv || !*ps || !*pp) { r = sfb__oom(ctx, "tribezier refinement"); goto done; }
+    for (f = 0; f < nf; ++f) {
+        const int *V = b->fv + b->fv_off[f], *E = b->fe + b->fv_off[f]; /* E[k]: edge V[k] -> V[k+1] */
+        const int ch[4][3] = {{V[0], nv + E[0], nv + E[2]}, {nv + E[0], V[1], nv + E[1]}, {nv + E[2], nv + E[1], V[2]},
+                              {nv + E[1], nv + E[2], nv + E[0]}};
+        for (k = 0; k < 4; ++k) {
+            sizes[4 * f + k] = 3;
+            for (c = 0; c < 3; ++c) fv[12 * f + 3 * k + c] = ch[k][c];
+        }
+    }
+    r = sfb__level_from_faces(ctx, nv2, 4 * nf, sizes, fv, NULL, SFB_ELEMENT_VERTEX, rl);
+    if (r != SFB_SUCCESS) goto done;
+    for (e = 0; e < rl->ne; ++e) {
+        const int a = rl->ev[2 * e], d = rl->ev[2 * e + 1], old = a < nv ? a : d, mid = a < nv ? d : a;
+        rl->es[e] = (old < nv && mid >= nv) ? b->es[mid - nv] : 0.0f;
+    }
+    for (v = 0; v < nv2; ++v) rl->vs[v] = v < nv ? b->vs[v] : 0.0f;
+    for (f = 0; f < 4 * nf; ++f) rl->fhole[f] = b->fhole[f / 4];
+    for (net = 0; net < 2; ++net) {
+        float *out = net ? *pp : *ps;
+        /* the sharp edges of this net's rules */
+        for (e = 0; e < ne; ++e) {
+            const int n2 = b->ef_off[e + 1] - b->ef_off[e], a = b->ev[2 * e], d = b->ev[2 * e + 1];
+            const int sharp = n2 < 2 || (net && b->es[e] > 0.0f);
+            double P[3];
+            for (c = 0; c < 3; ++c) P[c] = sharp ? 0.5 * ((double)pos[3 * a + c] + pos[3 * d + c]) : 0.375 * ((double)pos[3 * a + c] + pos[3 * d + c]);
+            if (!sharp)
+                for (k = 0; k < 2; ++k) {
+                    const int g = b->ef[b->ef_off[e] + k], sl = b->ef_slot[b->ef_off[e] + k];
+                    const int o = b->fv[b->fv_off[g] + (sl + 2) % 3];
+                    for (c = 0; c < 3; ++c) P[c] += 0.125 * pos[3 * o + c];
+                }
+            for (c = 0; c < 3; ++c) out[3 * (size_t)(nv + e) + c] = (float)P[c];
+        }
+        for (v = 0; v < nv; ++v) {
+            const int m = b->ve_off[v + 1] - b->ve_off[v], nfv = b->vf_off[v + 1] - b->vf_off[v];
+            int ns = 0, sa = -1, sb = -1, j;
+            double P[3];
+            for (j = 0; j < m; ++j) {
+                const int ej = b->ve[b->ve_off[v] + j];
+                if (b->ef_off[ej + 1] - b->ef_off[ej] < 2 || (net && b->es[ej] > 0.0f)) {
+                    const int w = sfb__other_end(b, ej, v);
+                    if (ns == 0) sa = w; else sb = w;
+                    ++ns;
+                }
+            }
+            if (nfv == 0 || ns >= 3 || (m > nfv && nfv == 1) || (net && b->vs[v] > 0.0f)) {
+                for (c = 0; c < 3; ++c) P[c] = pos[3 * v + c]; /* corner */
+            } else if (ns == 2) {
+                for (c = 0; c < 3; ++c) P[c] = 0.75 * pos[3 * v + c] + 0.125 * ((double)pos[3 * sa + c] + pos[3 * sb + c]);
+            } else {
+                /* Loop's rule (the library's, refine.c): (5/8 - (3/8 + cos(2 pi / n) / 4)^2) / n per neighbour */
+                const double beta = 0.25 * cos(2.0 * TBZ_PI / m) + 0.375, w = (0.625 - beta * beta) / m;
+                for (c = 0; c < 3; ++c) P[c] = (1.0 - m * w) * pos[3 * v + c];
+                for (j = 0; j < m; ++j) {
+                    const int o = sfb__other_end(b, b->ve[b->ve_off[v] + j], v);
+                    for (c = 0; c < 3; ++c) P[c] += w * pos[3 * o + c];
+                }
+            }
+            for (c = 0; c < 3; ++c) out[3 * (size_t)v + c] = (float)P[c];
+        }
+    }
+    (void)opt;
+done:
+    sfb__free(ctx, sizes);
+    sfb__free(ctx, fv);
+    if (r != SFB_SUCCESS) {
+        sfb__level_free(ctx, rl);
+        sfb__free(ctx, *ps); sfb__free(ctx, *pp);
+        *ps = *pp = NULL;
+    }
+    return r;
+}
+
+sfb_result sfb__tribezier_refined_points(sfb_context *ctx, const sfb__level *l, const float *positions, const sfb_tribezier_options *opt,
+                                         unsigned flags, sfb__level *rl, double **out, sfb__tbz_stats *stats) {
+    float *ps = NULL, *pp = NULL;
+    sfb_result r;
+    *out = NULL;
+    memset(rl, 0, sizeof *rl);
+    if (opt && opt->sharpness_set && !(opt->sharpness >= 0.0f && opt->sharpness <= 1.0f))
+        return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "tribezier: sharpness %g is not in [0, 1]", (double)opt->sharpness);
+    r = sfb__tri_mesh_check(ctx, l, positions, "tribezier", 1);
+    if (r == SFB_SUCCESS) r = tbz_refine(ctx, l, positions, opt, rl, &ps, &pp);
+    if (r == SFB_SUCCESS) r = tbz_points(ctx, rl, ps, pp, opt, flags, out, stats);
+    if (r != SFB_SUCCESS) sfb__level_free(ctx, rl);
+    sfb__free(ctx, ps);
+    sfb__free(ctx, pp);
+    return r;
+}
+
+/* One patch per triangle where the G1 constraints are solvable on the mesh itself; where they
+ * are not (extraordinary vertices of different valences that touch, found up front, or a
+ * residual above 1e-10 left), the net is built on the mesh after one Loop step instead (Peters' remedy: afterwards every
+ * extraordinary vertex is surrounded by ordinary ones) and each triangle gets its four child
+ * patches (depth 1 of its parametric triangle); the refined net is kept if it is closer to G1. */
+/* Do two interior extraordinary vertices of different valences share an edge? (Then the
+ * constraints on the mesh itself have no exact solution: the refined net is built directly.) */
+static int tbz_touching(const sfb__level *l) {
+    int e;
+    for (e = 0; e < l->ne; ++e) {
+        const int a = l->ev[2 * e], b = l->ev[2 * e + 1], na = tbz_nf(l, a), nb = tbz_nf(l, b);
+        if (l->ef_off[e + 1] - l->ef_off[e] != 2 || tbz_boundary(l, a) || tbz_boundary(l, b)) continue;
+        if (na != 6 && nb != 6 && na != nb) return 1;
+    }
+    return 0;
+}
+
 sfb_result sfb__tribezier_build(sfb_context *ctx, const sfb__level *l, const float *positions, const sfb_tribezier_options *opt,
                                 sfb__patch_table *pt) {
-    double *net = NULL;
+    double *net = NULL, *net4 = NULL;
+    sfb__tbz_stats st, st4;
+    sfb__level rl;
     sfb_result r;
     memset(pt, 0, sizeof *pt);
-    r = sfb__tribezier_points(ctx, l, positions, opt, 0, &net, NULL);
+    memset(&st, 0, sizeof st);
+    if (tbz_touching(l)) {
+        r = sfb__tribezier_refined_points(ctx, l, positions, opt, 0, &rl, &net4, NULL);
+        if (r != SFB_SUCCESS) return r;
+        r = sfb__patch_table_beztri_children(ctx, l, net4, pt);
+        sfb__free(ctx, net4);
+        sfb__level_free(ctx, &rl);
+        return r;
+    }
+    r = sfb__tribezier_points(ctx, l, positions, opt, 0, &net, &st);
     if (r != SFB_SUCCESS) return r;
+    if (st.residual > 1e-10) {
+        memset(&st4, 0, sizeof st4);
+        r = sfb__tribezier_refined_points(ctx, l, positions, opt, 0, &rl, &net4, &st4);
+        if (r != SFB_SUCCESS) { sfb__free(ctx, net); return r; }
+        if (st4.residual < st.residual) {
+            sfb__free(ctx, net);
+            r = sfb__patch_table_beztri_children(ctx, l, net4, pt);
+            sfb__free(ctx, net4);
+            sfb__level_free(ctx, &rl);
+            return r;
+        }
+        sfb__free(ctx, net4);
+        sfb__level_free(ctx, &rl);
+    }
     r = sfb__patch_table_beztri_own(ctx, l, net, pt);
     sfb__free(ctx, net);
     return r;
