@@ -6009,6 +6009,38 @@ static void tbz_loop_corner(const sfb__tbz *T, int v, double P[3]) {
     for (j = 0; j < 3; ++j) P[j] /= (w + n);
 }
 
+/* Our irregular crease vertex in the smooth net: its corner point is the crease B-spline's
+ * point moved by the mean offset of its two crease neighbours' smooth corner points from
+ * their own B-spline points. The smooth surface lies off the crease polygon by that offset
+ * along the whole crease (Loop's limit: above a valley, beside the crease where the mesh is
+ * not symmetric); pinning the extraordinary vertex to the B-spline made the crease curve dip
+ * there, an undulation of its own at every s < 1 (tests/tribezier.c, undulation). A
+ * neighbour that is not an ordinary crease vertex (two tagged edges) adds no offset. */
+static void tbz_ours_offset(sfb__tbz *T) {
+    const sfb__level *l = T->l;
+    int v, j, c;
+    if (T->sharp || T->seed_plane) return;
+    for (v = 0; v < T->nv; ++v) {
+        double off[3] = {0.0, 0.0, 0.0};
+        int m = l->ve_off[v + 1] - l->ve_off[v], cnt = 0;
+        if (T->vtype[v] != (TBZ_CREASE | 16) || !T->virr[v]) continue;
+        for (j = 0; j < m; ++j) {
+            const int w = tbz_ring(l, v, j);
+            int nb[2], nn = 0, i2, m2 = l->ve_off[w + 1] - l->ve_off[w];
+            double W[3], A[3], B[3];
+            if (!(T->tag_s[l->ve[l->ve_off[v] + j]] > 0.0f) || (T->vtype[w] == (TBZ_CREASE | 16) && T->virr[w])) continue;
+            for (i2 = 0; i2 < m2; ++i2)
+                if (T->tag_s[l->ve[l->ve_off[w] + i2]] > 0.0f) { if (nn < 2) nb[nn] = tbz_ring(l, w, i2); ++nn; }
+            if (nn != 2 || tbz_boundary(l, w) || T->corner_s[w] > 0.0f) continue;
+            tbz_get(T, w, W); tbz_get(T, nb[0], A); tbz_get(T, nb[1], B);
+            for (c = 0; c < 3; ++c) off[c] += T->x[3 * (size_t)tbz_vp(T, w) + c] - (A[c] + 4.0 * W[c] + B[c]) / 6.0;
+            ++cnt;
+        }
+        if (cnt)
+            for (c = 0; c < 3; ++c) T->x[3 * (size_t)tbz_vp(T, v) + c] += off[c] / cnt;
+    }
+}
+
 /* The initial net (and its fixed points) for the current state. */
 static void tbz_initial(sfb__tbz *T) {
     const sfb__level *l = T->l;
@@ -6034,33 +6066,7 @@ static void tbz_initial(sfb__tbz *T) {
         if (type == TBZ_CORNER || (type == TBZ_CREASE && T->virr[v]) || (T->sharp && T->corner_s[v] > 0.0f)) T->fixed[v] = 1;
         if (type == TBZ_CREASE && !T->virr[v] && (T->vtype[v] & 16) == 0) T->fixed[v] = 1; /* = the regular value */
     }
-    /* our irregular crease vertex in the smooth net: its corner point is the crease B-spline's
-     * point moved by the mean offset of its two crease neighbours' smooth corner points from
-     * their own B-spline points. The smooth surface lies off the crease polygon by that offset
-     * along the whole crease (Loop's limit: above a valley, beside the crease where the mesh is
-     * not symmetric); pinning the extraordinary vertex to the B-spline made the crease curve dip
-     * there, an undulation of its own at every s < 1 (tests/tribezier.c, undulation). A
-     * neighbour that is not an ordinary crease vertex (two tagged edges) adds no offset. */
-    if (!T->sharp && !T->seed_plane)
-        for (v = 0; v < T->nv; ++v)
-            if (T->vtype[v] == (TBZ_CREASE | 16) && T->virr[v]) {
-                double off[3] = {0.0, 0.0, 0.0};
-                int m = l->ve_off[v + 1] - l->ve_off[v], cnt = 0;
-                for (j = 0; j < m; ++j) {
-                    const int w = tbz_ring(l, v, j);
-                    int nb[2], nn = 0, i2, m2 = l->ve_off[w + 1] - l->ve_off[w];
-                    double W[3], A[3], B[3];
-                    if (!(T->tag_s[l->ve[l->ve_off[v] + j]] > 0.0f) || (T->vtype[w] == (TBZ_CREASE | 16) && T->virr[w])) continue;
-                    for (i2 = 0; i2 < m2; ++i2)
-                        if (T->tag_s[l->ve[l->ve_off[w] + i2]] > 0.0f) { if (nn < 2) nb[nn] = tbz_ring(l, w, i2); ++nn; }
-                    if (nn != 2 || tbz_boundary(l, w) || T->corner_s[w] > 0.0f) continue;
-                    tbz_get(T, w, W); tbz_get(T, nb[0], A); tbz_get(T, nb[1], B);
-                    for (c = 0; c < 3; ++c) off[c] += T->x[3 * (size_t)tbz_vp(T, w) + c] - (A[c] + 4.0 * W[c] + B[c]) / 6.0;
-                    ++cnt;
-                }
-                if (cnt)
-                    for (c = 0; c < 3; ++c) T->x[3 * (size_t)tbz_vp(T, v) + c] += off[c] / cnt;
-            }
+    tbz_ours_offset(T);
     /* edge points: near each end from that end's rules, the middle from the two opposite vertices */
     for (e = 0; e < T->ne; ++e) {
         const int a = l->ev[2 * e], b = l->ev[2 * e + 1];
