@@ -6680,8 +6680,6 @@ static sfb_result tbz_points(sfb_context *ctx, const sfb__level *l, const float 
     sfb_result r = SFB_SUCCESS;
     *out = NULL;
     memset(&T, 0, sizeof T);
-    if (opt && opt->sharpness_set && !(opt->sharpness >= 0.0f && opt->sharpness <= 1.0f))
-        return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "tribezier: sharpness %g is not in [0, 1]", (double)opt->sharpness);
     T.ctx = ctx; T.l = l; T.pos = positions;
     T.nv = l->nv; T.ne = l->ne; T.nf = l->nf;
     T.np = l->nv + 3 * l->ne + 3 * l->nf;
@@ -6779,13 +6777,19 @@ done:
     return r;
 }
 
+/* The refusals of both entry points: an override s outside [0, 1] or NaN, and
+ * sfb__tri_mesh_check's. */
+static sfb_result tbz_check(sfb_context *ctx, const sfb__level *l, const float *positions, const sfb_tribezier_options *opt) {
+    if (opt && opt->sharpness_set && !(opt->sharpness >= 0.0f && opt->sharpness <= 1.0f))
+        return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "tribezier: sharpness %g is not in [0, 1]", (double)opt->sharpness);
+    return sfb__tri_mesh_check(ctx, l, positions, "tribezier", 1);
+}
+
 sfb_result sfb__tribezier_points(sfb_context *ctx, const sfb__level *l, const float *positions, const sfb_tribezier_options *opt,
                                  unsigned flags, double **out, sfb__tbz_stats *stats) {
     sfb_result r;
     *out = NULL;
-    if (opt && opt->sharpness_set && !(opt->sharpness >= 0.0f && opt->sharpness <= 1.0f))
-        return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "tribezier: sharpness %g is not in [0, 1]", (double)opt->sharpness);
-    r = sfb__tri_mesh_check(ctx, l, positions, "tribezier", 1);
+    r = tbz_check(ctx, l, positions, opt);
     if (r != SFB_SUCCESS) return r;
     return tbz_points(ctx, l, positions, positions, opt, flags, out, stats);
 }
@@ -6797,8 +6801,7 @@ sfb_result sfb__tribezier_points(sfb_context *ctx, const sfb__level *l, const fl
  * the frame of quadtree child i of the parametric triangle (sfb__patch_locate), so its 15
  * points are that child patch's. Child edges keep their parent edge's tag, the old vertices
  * their corner tags. */
-static sfb_result tbz_refine(sfb_context *ctx, const sfb__level *b, const float *pos, const sfb_tribezier_options *opt, sfb__level *rl,
-                             float **ps, float **pp) {
+static sfb_result tbz_refine(sfb_context *ctx, const sfb__level *b, const float *pos, sfb__level *rl, float **ps, float **pp) {
     const int nv = b->nv, nf = b->nf, ne = b->ne, nv2 = nv + ne;
     int *sizes = (int *)sfb__alloc(ctx, (size_t)4 * nf * sizeof(int) + 1);
     int *fv = (int *)sfb__alloc(ctx, (size_t)12 * nf * sizeof(int) + 1);
@@ -6869,7 +6872,6 @@ static sfb_result tbz_refine(sfb_context *ctx, const sfb__level *b, const float 
             for (c = 0; c < 3; ++c) out[3 * (size_t)v + c] = (float)P[c];
         }
     }
-    (void)opt;
 done:
     sfb__free(ctx, sizes);
     sfb__free(ctx, fv);
@@ -6887,10 +6889,8 @@ sfb_result sfb__tribezier_refined_points(sfb_context *ctx, const sfb__level *l, 
     sfb_result r;
     *out = NULL;
     memset(rl, 0, sizeof *rl);
-    if (opt && opt->sharpness_set && !(opt->sharpness >= 0.0f && opt->sharpness <= 1.0f))
-        return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "tribezier: sharpness %g is not in [0, 1]", (double)opt->sharpness);
-    r = sfb__tri_mesh_check(ctx, l, positions, "tribezier", 1);
-    if (r == SFB_SUCCESS) r = tbz_refine(ctx, l, positions, opt, rl, &ps, &pp);
+    r = tbz_check(ctx, l, positions, opt);
+    if (r == SFB_SUCCESS) r = tbz_refine(ctx, l, positions, rl, &ps, &pp);
     if (r == SFB_SUCCESS) r = tbz_points(ctx, rl, ps, pp, opt, flags, out, stats);
     if (r != SFB_SUCCESS) sfb__level_free(ctx, rl);
     sfb__free(ctx, ps);
