@@ -263,6 +263,11 @@ $(BUILD)/manifold: tests/manifold.c tests/harness.h src/sfb_internal.h $(BUILD)/
 $(BUILD)/tribezier: tests/tribezier.c tests/tribezier_mesh.h tests/harness.h src/sfb_internal.h $(BUILD)/libsfb_internal.o
 	$(CC) $(CFLAGS) $(SAN) -I. tests/tribezier.c $(BUILD)/libsfb_internal.o -o $@ $(LIBS)
 
+# Surface quality analysis (sfb_surface_analyze, seed 003) on every backend: analytic paraboloid
+# and saddle, level independence, no gaps, agreement with ref, bad configurations (tests/analyze.c).
+$(BUILD)/analyze: tests/analyze.c tests/harness.h $(BUILD)/libsfb.o
+	$(CC) $(CFLAGS) $(SAN) -I. tests/analyze.c $(BUILD)/libsfb.o -o $@ $(LIBS)
+
 # Manifold blending on gl/osmesa and the vertex-shader draw path (with trimming) on a GL context
 # the test owns (links EGL/GL as gl_host) (tests/gl_manifold.c).
 $(BUILD)/gl_manifold: tests/gl_manifold.c tests/harness.h tests/egl_host.h $(BUILD)/libsfb.o
@@ -274,7 +279,7 @@ $(BUILD)/web/png_iou: tests/web/png_iou.c | deps
 	$(CC) -std=c99 $(OPT) -g -Wall -Wextra $(SAN) $< -o $@ -lm
 
 unit-build: $(BUILD)/web/png_iou $(BUILD)/surfblend $(BUILD)/unit $(BUILD)/osd_agree $(BUILD)/agree $(BUILD)/limit $(BUILD)/eigen $(BUILD)/gl_host \
-            $(BUILD)/gl_errors $(BUILD)/gl_pieces $(BUILD)/shade $(BUILD)/trim $(BUILD)/finish_normals $(BUILD)/manifold $(BUILD)/tribezier $(BUILD)/gl_manifold $(EXAMPLES) \
+            $(BUILD)/gl_errors $(BUILD)/gl_pieces $(BUILD)/shade $(BUILD)/trim $(BUILD)/finish_normals $(BUILD)/manifold $(BUILD)/tribezier $(BUILD)/analyze $(BUILD)/gl_manifold $(EXAMPLES) \
             $(EXAMPLES_CXX) $(BUILD)/png_iou $(BUILD)/sfb2gltf $(BUILD)/gltf_check
 
 # On CI (CI set and not false/0) the optional backends must run, not be skipped: the suites

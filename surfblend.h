@@ -617,6 +617,111 @@ typedef struct sfb_image {
 SFB_API sfb_result sfb_render(sfb_context *ctx, const sfb_mesh_data *mesh, const sfb_render_config *config, sfb_image *out);
 SFB_API void sfb_image_free(sfb_image *img);
 
+/* ---- surface quality analysis (seed 003), exact per pixel ----
+ * sfb_surface_analyze draws a picture of a surface with patch tables (SFB_REFINE_PATCHES; every
+ * scheme that evaluates) whose colours come from the exact limit position, normal and second
+ * derivatives at every pixel, never from a mesh's interpolated normals. Steps: a proxy (each
+ * parametric face sampled on a 2^level grid through the backend's eval_patches) is rasterised
+ * into a buffer of (parametric face, u, v, depth) per pixel; each covered pixel is then projected
+ * onto the exact surface along its own view ray (Newton steps on (u,v) in the picture's plane,
+ * seeded by the proxy and, where that leaves its parametric face or the proxy's silhouette, by
+ * the neighbouring pixels' solutions, so coverage and silhouettes are the limit surface's); the
+ * limit surface is evaluated there (the backend's eval_patches) and the backend's `shade` kernel
+ * turns position and derivatives into the mode's value; colours are filtered by each pixel's
+ * footprint (band filtering, no moire). With `polygon_based` the same picture comes from the
+ * proxy's interpolated limit positions and normals instead (the seed's Fig. 7b, for comparison).
+ * Long analyses report progress (stage "analyze": 0.3 once the proxy is evaluated and
+ * rasterised, 0.75 once every pixel is projected and evaluated, 0.9 after the shade kernel) and
+ * can be cancelled (SFB_CANCELLED, nothing kept). The camera is sfb_render's (an orbit around the
+ * centre of the control mesh's bounding box, y up) unless eye, target and up are given. */
+typedef enum sfb_analyze_mode {
+    SFB_ANALYZE_REFLECTION = 0, /* seed 003: the view ray's reflection r = v - 2(v.n)n meets a finite light plane carrying a
+                                   texture (stripes, lattice, circles or an RGBA image); rays that miss show the miss colour */
+    SFB_ANALYZE_HIGHLIGHT,      /* Beier-Chen highlight lines: the normal line P + mu n meets the light plane (ALGORITHMS.md 7),
+                                   stripes across the plane (view-independent) */
+    SFB_ANALYZE_ZEBRA,          /* zebra: stripes of an environment at infinity, by the angle between the reflected view ray
+                                   and the stripe axis (bands of constant acos(r.axis)) */
+    SFB_ANALYZE_ISOPHOTE,       /* isophotes: bands of n.l (l the light direction), coloured blue (n.l = -1) to red (1) */
+    SFB_ANALYZE_CURVATURE,      /* Gaussian, mean or largest absolute principal curvature from the exact second
+                                   derivatives, in a diverging map (blue < 0 < red; max: white 0 .. red), range returned */
+    SFB_ANALYZE_NORMALS,        /* the unit normal as RGB = 0.5 + 0.5 n */
+    SFB_ANALYZE_SHADED,         /* diffuse + specular grey */
+    SFB_ANALYZE_MODE_COUNT_
+} sfb_analyze_mode;
+typedef enum sfb_light_pattern {
+    SFB_LIGHT_STRIPES = 0, /* parallel light lines across the plane's u axis */
+    SFB_LIGHT_LATTICE,     /* lines along both axes (seed Fig. 6a) */
+    SFB_LIGHT_CIRCLES,     /* regularly arranged round lights (seed Fig. 6b) */
+    SFB_LIGHT_IMAGE        /* the caller's RGBA texture over the whole plane */
+} sfb_light_pattern;
+typedef enum sfb_curvature_kind { SFB_CURVATURE_GAUSSIAN = 0, SFB_CURVATURE_MEAN, SFB_CURVATURE_MAX_ABS } sfb_curvature_kind;
+#define SFB_ANALYZE_MAX_SIZE 8192 /* largest width or height in pixels */
+#define SFB_ANALYZE_MAX_LEVEL 8   /* proxy level: 2^level segments per parametric-face edge */
+typedef struct sfb_analyze_config {
+    int width, height;        /* pixels; both 0: 640 x 480; one of them 0 or either negative: SFB_INVALID_ARGS */
+    int mode;                 /* sfb_analyze_mode */
+    int level;                /* proxy: each parametric face sampled on 2^level segments per edge; 0: 2 (1 is the
+                                 coarsest, "subdivided once") */
+    int polygon_based;        /* 1: shade from the proxy's interpolated limit positions and normals (the polygon-based
+                                 method the seed shows to be wrong), for comparison */
+    int newton_steps;         /* Newton steps per seed; 0: 8 */
+    /* camera: the orbit of sfb_render (view_set, yaw, pitch, zoom) or, with camera_set, eye/target/up */
+    int view_set;
+    float yaw, pitch, zoom;
+    int camera_set;
+    float eye[3], target[3], up[3];
+    float fov;                /* degrees, full vertical angle, 0: 30; orthographic: the picture's height in model units
+                                 (0: the bounding sphere fits) */
+    int orthographic;
+    float near_plane;         /* distance below which proxy triangles are not drawn; 0: 1e-3 bounding radii; < 0: error */
+    /* light */
+    int light_pattern;        /* sfb_light_pattern (REFLECTION, HIGHLIGHT) */
+    int light_set;            /* 1: the plane below; 0: derived from the bounding box and the view */
+    float light_center[3], light_normal[3], light_axis[3]; /* the plane: centre, normal (toward the surface), its u axis
+                                 (the direction across the stripes; projected into the plane) */
+    float light_size[2];      /* extent along u and v in model units (0: 16 bounding radii) */
+    float stripes;            /* stripes (or lattice cells, circle rows) across the light's u extent; REFLECTION 0: 24;
+                                 HIGHLIGHT: per bounding-sphere diameter, 0: 8; ZEBRA: per 180 degrees, 0: 16;
+                                 ISOPHOTE: bands over n.l in [-1,1], 0: 10 */
+    float stripe_width;       /* lit share of each period (0..1), 0: 0.5 (circles: diameter share of the cell) */
+    float light_dir[3];       /* ZEBRA axis, ISOPHOTE light, SHADED key; all 0: from the camera (upper left) */
+    const unsigned char *light_rgba; /* SFB_LIGHT_IMAGE: light_width x light_height RGBA, row 0 at the plane's v = 0 */
+    int light_width, light_height;
+    int curvature;            /* sfb_curvature_kind */
+    float curvature_range;    /* > 0: the colour map spans [-range, range] ([0, range] for MAX_ABS); 0: the 90th
+                                 percentile of |value| over the picture */
+    unsigned char background[4]; /* RGBA of uncovered pixels; all 0: opaque dark grey */
+    unsigned char miss[4];       /* REFLECTION: colour of rays that miss the light plane; all 0: near black */
+} sfb_analyze_config;
+SFB_API sfb_analyze_config sfb_analyze_config_init(int mode);
+typedef struct sfb_analysis {
+    int width, height;
+    unsigned char *rgba;      /* width * height * 4, rows top to bottom, alpha 255 on the surface */
+    float *values;            /* per pixel the mode's value at the pixel centre: stripe coordinate (REFLECTION: u
+                                 periods, HIGHLIGHT/ZEBRA/ISOPHOTE: periods), curvature; NaN where uncovered or missed */
+    unsigned char *classes;   /* per pixel: 0 uncovered, 1 missed the light, 2 dark band / outside a light, 3 lit band /
+                                 inside a light; ISOPHOTE: 2 + band; CURVATURE: 2 + round(8 value / range) + 8 (17 bands, the
+                                 middle one centred on 0), max |k|: 2 + floor(16 value / range); NORMALS, SHADED: 2 */
+    sfb_location *hits;       /* per pixel: the parametric face and (u,v) the colour was evaluated at (face -1: none) */
+    int covered_pixels;       /* pixels on the surface */
+    int proxy_pixels;         /* pixels the proxy covered */
+    int grown_pixels;         /* covered by the exact surface beyond the proxy's silhouette */
+    int dropped_pixels;       /* covered by the proxy, but no view ray through them meets the exact surface */
+    int fallback_pixels;      /* Newton did not converge: the proxy's point was used */
+    int light_hits;           /* REFLECTION/HIGHLIGHT: pixels whose ray met the light plane */
+    float value_min, value_max; /* over covered pixels */
+    float range;              /* CURVATURE: the colour map's range used */
+    sfb_context *ctx_;
+} sfb_analysis;
+/* Checks everything first (sizes and level: SFB_INVALID_ARGS / SFB_LIMIT_EXCEEDED; the memory
+ * budget; NaN or infinite camera, light or range values, a camera whose eye equals its target,
+ * a negative near plane, a zero light normal, an axis parallel to it, an image light without
+ * texels or with a zero size: SFB_INVALID_VALUE). A REFLECTION or HIGHLIGHT picture whose rays
+ * all miss the light plane (parallel to every ray, or behind the surface) is SFB_INVALID_VALUE
+ * too. On failure `out` is zeroed and nothing is kept. */
+SFB_API sfb_result sfb_surface_analyze(const sfb_surface *surface, const sfb_analyze_config *config, sfb_analysis *out);
+SFB_API void sfb_analysis_free(sfb_analysis *a);
+
 #ifdef __cplusplus
 }
 #endif
@@ -668,6 +773,7 @@ typedef struct sfb__stencils {
  * that lacks a kernel writes nothing for it, and a NULL kernel slot makes the core run `ref`'s
  * (with a log line). Every slot but name/kind/init/shutdown may be NULL. A context keeps its
  * own copy of the bound table (no global state). */
+struct sfb__shade_job;
 typedef struct sfb__backend_vtable {
     const char *name;
     sfb_backend_kind kind;
@@ -705,7 +811,32 @@ typedef struct sfb__backend_vtable {
     sfb_result (*finish_normals)(void *state, int first, int last, const float *tu, const float *tv,
                                  const float *ns, const int *ns_index, const float *b, float p,
                                  float *out_blend, float *out_limit, float *out_sub);
+    /* Seed 003's per-pixel analysis (analyze.c): items [first,last) of `job` (exact limit
+     * position, derivatives and normal per pixel) -> the mode's values (sfb__shade_job). */
+    sfb_result (*shade)(void *state, const struct sfb__shade_job *job, int first, int last);
 } sfb__backend_vtable;
+
+/* One analysis's shading (the `shade` slot). Per item i: P = position[3i..], N = normal (unit),
+ * turned toward the viewer (V = eye - P, or -fwd when orthographic); R = -V/|V| reflected
+ * about N. The mode's values (value2 may be NULL for modes without a second one):
+ *   REFLECTION: mu = ((lc - P).lm) / (R.lm); mu <= 0 or |R.lm| < 1e-9: NaN (missed); X = P + mu R,
+ *     value = ((X - lc).lu / lsize[0] + 0.5) * periods[0], value2 = ((X - lc).lv / lsize[1] + 0.5) * periods[1];
+ *     X outside the plane's extent (either coordinate outside [0, periods]): NaN;
+ *   HIGHLIGHT: the same with Dir = N and mu of any sign (only |N.lm| < 1e-9 misses), no extent;
+ *   ZEBRA: value = periods[0] * acos(R.dir) / pi;  ISOPHOTE: value = N.dir;
+ *   CURVATURE: Gaussian K = (LN - M^2) / (EG - F^2), mean H = -(EN - 2FM + GL) / (2 (EG - F^2)) (convex
+ *     toward the viewer > 0), or
+ *     max |k| = |H| + sqrt(max(H^2 - K, 0)), from du, dv (E, F, G) and duu, duv, dvv along N (L, M, N);
+ *     a degenerate first fundamental form gives NaN;
+ *   NORMALS, SHADED: value = N.dir (the diffuse term). */
+typedef struct sfb__shade_job {
+    int mode, curvature, ortho;
+    double eye[3], fwd[3];
+    double lc[3], lm[3], lu[3], lv[3], lsize[2], periods[2], dir[3];
+    const float *position, *du, *dv, *normal, *duu, *duv, *dvv;
+    float *value, *value2;
+} sfb__shade_job;
+SFB__IF sfb_result sfb__ref_shade(void *state, const sfb__shade_job *job, int first, int last);
 
 /* Optional backends (backends/sfb_*.h), compiled in by SURFBLEND_SIMD / _GL / _OSMESA or
  * SURFBLEND_ALL_BACKENDS; the headers are included at the end of the implementation. */
@@ -1071,6 +1202,9 @@ SFB__IF sfb_result sfb__level_prepare(sfb_context *ctx, const sfb__level *src, i
  * the backend lacks eval_stencils (surface.c). */
 SFB__IF sfb_result sfb__surface_apply(const sfb_surface *s, const sfb__stencils *t, void *handle, int rows, const float *src,
                               sfb_buffer_desc sd, float *dst, sfb_buffer_desc dd);
+/* sfb_surface_eval without the per-location checks, for locations the library made itself
+ * (analyze.c): the context's backend or ref (surface.c). */
+SFB__IF sfb_result sfb__surface_eval_unchecked(const sfb_surface *s, const sfb_location *loc, int count, const sfb_eval_output *out);
 /* The refined (or limit) mesh of a surface into o (surface.c). */
 /* Tessellated UVs (surface.c, where the scheme is read): smooth (the layout's limit) or linear,
  * and the patch table of the base UV layout. */
@@ -1737,6 +1871,72 @@ sfb_result sfb__ref_finish_normals(void *state, int first, int last, const float
     return SFB_SUCCESS;
 }
 
+/* Seed 003's shade kernel, item by item in double (the contract is sfb__shade_job's comment). */
+static double sfb__sh_dot(const double *a, const double *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+static double sfb__sh_curvature(const sfb__shade_job *j, size_t i, const double *n) {
+    double pu[3], pv[3], puu[3], puv[3], pvv[3], E, F, G, L, M, N, det, K, H;
+    int c;
+    for (c = 0; c < 3; ++c) {
+        pu[c] = j->du[3 * i + c]; pv[c] = j->dv[3 * i + c];
+        puu[c] = j->duu[3 * i + c]; puv[c] = j->duv[3 * i + c]; pvv[c] = j->dvv[3 * i + c];
+    }
+    E = sfb__sh_dot(pu, pu); F = sfb__sh_dot(pu, pv); G = sfb__sh_dot(pv, pv);
+    L = sfb__sh_dot(puu, n); M = sfb__sh_dot(puv, n); N = sfb__sh_dot(pvv, n);
+    det = E * G - F * F;
+    if (!(det > 1e-30 * (E * G + 1e-300)) || !isfinite(det)) return NAN;
+    K = (L * N - M * M) / det;
+    H = -(E * N - 2.0 * F * M + G * L) / (2.0 * det); /* the sign: convex toward the viewer is > 0 */
+    if (j->curvature == SFB_CURVATURE_GAUSSIAN) return K;
+    if (j->curvature == SFB_CURVATURE_MEAN) return H;
+    return fabs(H) + sqrt(H * H - K > 0.0 ? H * H - K : 0.0);
+}
+sfb_result sfb__ref_shade(void *state, const sfb__shade_job *j, int first, int last) {
+    int q, c;
+    (void)state;
+    for (q = first; q < last; ++q) {
+        size_t i = (size_t)q;
+        double p[3], n[3], v[3], r[3], vl, vn, val = NAN, val2 = NAN;
+        for (c = 0; c < 3; ++c) { p[c] = j->position[3 * i + c]; n[c] = j->normal[3 * i + c]; }
+        if (j->ortho) for (c = 0; c < 3; ++c) v[c] = -j->fwd[c];
+        else for (c = 0; c < 3; ++c) v[c] = j->eye[c] - p[c];
+        vl = sqrt(sfb__sh_dot(v, v));
+        if (vl > 0.0) for (c = 0; c < 3; ++c) v[c] /= vl;
+        vn = sfb__sh_dot(v, n);
+        /* the normal toward the viewer; the curvature's sign follows it (convex toward the eye: > 0) */
+        if (vn < 0.0) { for (c = 0; c < 3; ++c) n[c] = -n[c]; vn = -vn; }
+        for (c = 0; c < 3; ++c) r[c] = 2.0 * vn * n[c] - v[c];
+        switch (j->mode) {
+        case SFB_ANALYZE_REFLECTION:
+        case SFB_ANALYZE_HIGHLIGHT: {
+            const double *dir = j->mode == SFB_ANALYZE_REFLECTION ? r : n;
+            double dm = sfb__sh_dot(dir, j->lm), ap[3], mu, x[3], a, b;
+            if (!(fabs(dm) > 1e-9)) break;
+            for (c = 0; c < 3; ++c) ap[c] = j->lc[c] - p[c];
+            mu = sfb__sh_dot(ap, j->lm) / dm;
+            if (j->mode == SFB_ANALYZE_REFLECTION && !(mu > 0.0)) break;
+            for (c = 0; c < 3; ++c) x[c] = p[c] + mu * dir[c] - j->lc[c];
+            a = (sfb__sh_dot(x, j->lu) / j->lsize[0] + 0.5) * j->periods[0];
+            b = (sfb__sh_dot(x, j->lv) / j->lsize[1] + 0.5) * j->periods[1];
+            if (j->mode == SFB_ANALYZE_REFLECTION && !(a >= 0.0 && a <= j->periods[0] && b >= 0.0 && b <= j->periods[1])) break;
+            if (!(isfinite(a) && isfinite(b) && fabs(a) < 1e7 && fabs(b) < 1e7)) break;
+            val = a; val2 = b;
+            break;
+        }
+        case SFB_ANALYZE_ZEBRA: {
+            double t = sfb__sh_dot(r, j->dir);
+            t = t < -1.0 ? -1.0 : t > 1.0 ? 1.0 : t;
+            val = j->periods[0] * acos(t) / SFB__PI;
+            break;
+        }
+        case SFB_ANALYZE_CURVATURE: val = sfb__sh_curvature(j, i, n); break;
+        default: val = sfb__sh_dot(n, j->dir); break; /* ISOPHOTE, NORMALS, SHADED */
+        }
+        j->value[i] = (float)val;
+        if (j->value2) j->value2[i] = (float)val2;
+    }
+    return SFB_SUCCESS;
+}
+
 /* Every kernel (sfb__ref_eval_patches is in patches.c). */
 void sfb__ref_bind(sfb__backend_vtable *vt) {
     vt->name = "ref";
@@ -1746,6 +1946,7 @@ void sfb__ref_bind(sfb__backend_vtable *vt) {
     vt->eval_stencils = sfb__ref_eval_stencils;
     vt->eval_patches = sfb__ref_eval_patches;
     vt->finish_normals = sfb__ref_finish_normals;
+    vt->shade = sfb__ref_shade;
 }
 #line 1 "src/topology.c"
 /* Topology of one level: adjacency, counter-clockwise ordering around manifold vertices,
@@ -9839,7 +10040,6 @@ SFB_API sfb_result sfb_surface_patch_info(const sfb_surface *s, sfb_patch_info *
 
 SFB_API sfb_result sfb_surface_eval(const sfb_surface *s, const sfb_location *loc, int count, const sfb_eval_output *out) {
     sfb_context *ctx;
-    const sfb__backend_vtable *be;
     int q;
     if (!s) return SFB_INVALID_ARGS;
     ctx = s->ctx;
@@ -9861,6 +10061,12 @@ SFB_API sfb_result sfb_surface_eval(const sfb_surface *s, const sfb_location *lo
         if (s->patches.ptex_root[l->face] == -1)
             return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, q, "location %d: parametric face %d is a hole", q, l->face);
     }
+    return sfb__surface_eval_unchecked(s, loc, count, out);
+}
+
+sfb_result sfb__surface_eval_unchecked(const sfb_surface *s, const sfb_location *loc, int count, const sfb_eval_output *out) {
+    sfb_context *ctx = s->ctx;
+    const sfb__backend_vtable *be;
     if (count == 0) return SFB_SUCCESS;
     be = ctx->backend;
     if (!be || !be->eval_patches) {
@@ -11637,6 +11843,1147 @@ done:
     sfb__free(ctx, pv);
     sfb__free(ctx, hole);
     sfb__free(ctx, rgba);
+    return r;
+}
+#line 1 "src/analyze.c"
+/* Seed 003: surface quality analysis evaluated exactly per pixel (sfb_surface_analyze).
+ *
+ * 1. Proxy: every parametric face that is not a hole is sampled on a uniform grid of 2^level
+ *    segments per edge (a quad: (n+1)^2 points, a triangle: (n+1)(n+2)/2), evaluated through
+ *    the backend's eval_patches; each grid triangle knows its face and its corners' (u,v) in
+ *    that face, so rasterising it gives per pixel (face, u, v, depth) with perspective-correct
+ *    (u,v). No tessellation index buffers are shared: a pixel's (u,v) is always in its own
+ *    face's frame.
+ * 2. Projection (beyond the seed, which shades the proxy's (u,v) and leaves gaps, §5): each
+ *    pixel is moved onto the exact surface along its own view ray. We solve in the picture
+ *    plane: find (u,v) with proj(S(u,v)) = pixel centre, Newton on the 2x2 Jacobian
+ *    d proj / d(u,v) = d proj / dP [S_u S_v], steps clamped to a third of the domain and the
+ *    iterate clamped into it. Outcomes per attempt: HIT (residual below SFB__AN_TOL pixels),
+ *    NEAR (still within half a pixel after the steps: Newton did not converge), MISS (further,
+ *    or pushed against the domain's border twice: the point lies in another face).
+ *    Round 0 seeds every proxy pixel with its own (face, u, v). Every later round seeds the
+ *    pixels that are not hit yet from the hits of their 8 neighbours made in the round
+ *    before (up to three distinct faces each): that crosses into neighbouring parametric faces
+ *    without any face adjacency, and grows coverage past the proxy's silhouette up to the
+ *    exact one (pixels outside it MISS and stop the growth). The rounds end when a round hits
+ *    nothing new (at most SFB__AN_ROUNDS).
+ *    Then a proxy pixel without a hit is kept on the proxy's point when one attempt was NEAR
+ *    (counted: fallback_pixels), and dropped when all MISSed (the exact surface is not there:
+ *    counted: dropped_pixels); hits outside the proxy are counted as grown_pixels.
+ * 3. Shade: the hits' exact positions, derivatives and normals (second derivatives for
+ *    CURVATURE, evaluated once more there) go to the backend's `shade` kernel (ref's when it
+ *    lacks one), which returns the mode's values.
+ * 4. Colour: per pixel from its values, the band or pattern filtered by its footprint (the
+ *    smaller one-sided difference of the value to its neighbours, per axis), so bands finer than
+ *    a pixel fade to their average colour.
+ * polygon_based: step 2 is skipped; position and normal are the proxy's interpolated limit
+ * positions and limit normals (the polygon-based method of the seed's Fig. 7b).
+ * Choice (the seed is silent): the mean curvature's sign follows the normal turned toward the
+ * viewer, so a surface bulging toward the eye has H > 0. */
+
+#define SFB__AN_DEFAULT_W 640
+#define SFB__AN_DEFAULT_H 480
+#define SFB__AN_DEFAULT_LEVEL 2
+#define SFB__AN_DEFAULT_STEPS 8
+#define SFB__AN_TOL 2e-3      /* pixels: a hit */
+#define SFB__AN_NEAR 0.5      /* pixels: within this, a non-converged attempt may fall back to the proxy */
+#define SFB__AN_ROUNDS 64
+#define SFB__AN_DILATE 2.0    /* pixels: uncovered pixels this close to a proxy triangle are seeded from it too */
+#define SFB__AN_MARGIN 0.92   /* the bounding sphere's share of the smaller side (as sfb_render) */
+
+SFB_API sfb_analyze_config sfb_analyze_config_init(int mode) {
+    sfb_analyze_config c;
+    memset(&c, 0, sizeof c);
+    c.mode = mode;
+    return c;
+}
+
+SFB_API void sfb_analysis_free(sfb_analysis *a) {
+    if (!a) return;
+    if (a->ctx_) {
+        sfb__free(a->ctx_, a->rgba);
+        sfb__free(a->ctx_, a->values);
+        sfb__free(a->ctx_, a->classes);
+        sfb__free(a->ctx_, a->hits);
+    }
+    memset(a, 0, sizeof *a);
+}
+
+static double sfb__an_dot(const double *a, const double *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+static void sfb__an_cross(const double *a, const double *b, double *o) {
+    o[0] = a[1] * b[2] - a[2] * b[1];
+    o[1] = a[2] * b[0] - a[0] * b[2];
+    o[2] = a[0] * b[1] - a[1] * b[0];
+}
+static double sfb__an_unit(double *a) {
+    double l = sqrt(sfb__an_dot(a, a));
+    if (l > 0.0 && isfinite(l)) { a[0] /= l; a[1] /= l; a[2] /= l; }
+    return l;
+}
+static void sfb__an_unit3f(float *a) {
+    double l = sqrt((double)a[0] * a[0] + (double)a[1] * a[1] + (double)a[2] * a[2]);
+    if (l > 0.0 && isfinite(l)) { a[0] = (float)(a[0] / l); a[1] = (float)(a[1] / l); a[2] = (float)(a[2] / l); }
+}
+static double sfb__an_clamp(double x, double lo, double hi) { return x < lo ? lo : x > hi ? hi : x; }
+static int sfb__an_finite3(const float *p) { return isfinite(p[0]) && isfinite(p[1]) && isfinite(p[2]); }
+/* The camera: right/up/forward unit vectors, pixels per unit (focal), the picture centre. */
+typedef struct sfb__an_cam {
+    double eye[3], right[3], up[3], fwd[3], focal, cx, cy, near_z;
+    int ortho;
+} sfb__an_cam;
+
+/* Projects p: screen x, y (pixels, y down) and view depth z; returns 0 behind the near plane. */
+static int sfb__an_project(const sfb__an_cam *c, const double *p, double *sx, double *sy, double *z) {
+    double d[3], xc, yc, zc;
+    d[0] = p[0] - c->eye[0]; d[1] = p[1] - c->eye[1]; d[2] = p[2] - c->eye[2];
+    xc = sfb__an_dot(d, c->right); yc = sfb__an_dot(d, c->up); zc = sfb__an_dot(d, c->fwd);
+    *z = zc;
+    if (c->ortho) { *sx = c->cx + c->focal * xc; *sy = c->cy - c->focal * yc; return 1; }
+    if (!(zc > c->near_z)) return 0;
+    *sx = c->cx + c->focal * xc / zc;
+    *sy = c->cy - c->focal * yc / zc;
+    return 1;
+}
+
+/* The Jacobian of the projection at p times t: d(sx, sy) along t. */
+static void sfb__an_project_dir(const sfb__an_cam *c, const double *p, const double *t, double *dx, double *dy) {
+    double d[3], xc, yc, zc, tx, ty, tz;
+    d[0] = p[0] - c->eye[0]; d[1] = p[1] - c->eye[1]; d[2] = p[2] - c->eye[2];
+    tx = sfb__an_dot(t, c->right); ty = sfb__an_dot(t, c->up);
+    if (c->ortho) { *dx = c->focal * tx; *dy = -c->focal * ty; return; }
+    xc = sfb__an_dot(d, c->right); yc = sfb__an_dot(d, c->up); zc = sfb__an_dot(d, c->fwd);
+    tz = sfb__an_dot(t, c->fwd);
+    *dx = c->focal * (tx * zc - xc * tz) / (zc * zc);
+    *dy = -c->focal * (ty * zc - yc * tz) / (zc * zc);
+}
+
+/* ---- configuration checks ---- */
+static int sfb__an_finite_n(const float *v, int n) {
+    int i;
+    for (i = 0; i < n; ++i) if (!isfinite(v[i])) return 0;
+    return 1;
+}
+static sfb_result sfb__an_check(sfb_context *ctx, const sfb_analyze_config *c, int *w, int *h, int *level) {
+    if (c->width == 0 && c->height == 0) { *w = SFB__AN_DEFAULT_W; *h = SFB__AN_DEFAULT_H; }
+    else { *w = c->width; *h = c->height; }
+    if (*w <= 0 || *h <= 0)
+        return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "analysis image size %d x %d: both must be >= 1 (both 0: the default 640 x 480)",
+                          c->width, c->height);
+    if (*w > SFB_ANALYZE_MAX_SIZE || *h > SFB_ANALYZE_MAX_SIZE)
+        return sfb__error(ctx, SFB_LIMIT_EXCEEDED, SFB_ELEMENT_NONE, -1, "analysis image size %d x %d is over the limit of %d (SFB_ANALYZE_MAX_SIZE)",
+                          *w, *h, SFB_ANALYZE_MAX_SIZE);
+    if (c->mode < 0 || c->mode >= SFB_ANALYZE_MODE_COUNT_)
+        return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "unknown analysis mode %d", c->mode);
+    *level = c->level ? c->level : SFB__AN_DEFAULT_LEVEL;
+    if (*level < 0 || *level > SFB_ANALYZE_MAX_LEVEL)
+        return sfb__error(ctx, c->level < 0 ? SFB_INVALID_ARGS : SFB_LIMIT_EXCEEDED, SFB_ELEMENT_NONE, -1, "proxy level %d is outside 1..%d",
+                          c->level, SFB_ANALYZE_MAX_LEVEL);
+    if (c->newton_steps < 0 || c->newton_steps > 64)
+        return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "newton_steps %d is outside 0..64", c->newton_steps);
+    if (c->light_pattern < SFB_LIGHT_STRIPES || c->light_pattern > SFB_LIGHT_IMAGE)
+        return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "unknown light pattern %d", c->light_pattern);
+    if (c->curvature < SFB_CURVATURE_GAUSSIAN || c->curvature > SFB_CURVATURE_MAX_ABS)
+        return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "unknown curvature kind %d", c->curvature);
+    if (c->polygon_based && c->mode == SFB_ANALYZE_CURVATURE)
+        return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "the polygon-based method has no second derivatives: no CURVATURE picture");
+    if (!isfinite(c->yaw) || !isfinite(c->pitch) || !isfinite(c->zoom) || c->zoom < 0.0f || !isfinite(c->fov) || c->fov < 0.0f ||
+        (!c->orthographic && !(c->fov < 179.0f)))
+        return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, -1, "view (yaw %g, pitch %g, zoom %g, fov %g): angles must be finite, zoom and fov >= 0, fov < 179 degrees",
+                          (double)c->yaw, (double)c->pitch, (double)c->zoom, (double)c->fov);
+    if (!isfinite(c->near_plane) || c->near_plane < 0.0f)
+        return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, -1, "near plane %g must be finite and >= 0 (0: automatic)", (double)c->near_plane);
+    if (c->camera_set) {
+        double d[3], up[3], x[3];
+        int i;
+        if (!sfb__an_finite_n(c->eye, 3) || !sfb__an_finite_n(c->target, 3) || !sfb__an_finite_n(c->up, 3))
+            return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, -1, "camera eye, target or up is not finite");
+        for (i = 0; i < 3; ++i) { d[i] = (double)c->target[i] - c->eye[i]; up[i] = c->up[i]; }
+        if (!(sfb__an_unit(d) > 0.0))
+            return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, -1, "camera eye equals its target");
+        if (!(sfb__an_dot(up, up) > 0.0)) up[1] = 1.0;
+        sfb__an_unit(up);
+        sfb__an_cross(d, up, x);
+        if (!(sqrt(sfb__an_dot(x, x)) > 1e-6))
+            return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, -1, "camera up (%g, %g, %g) is parallel to the view direction",
+                              (double)c->up[0], (double)c->up[1], (double)c->up[2]);
+    }
+    if (!isfinite(c->stripes) || c->stripes < 0.0f || c->stripes > 1e5f || !isfinite(c->stripe_width) || c->stripe_width < 0.0f ||
+        c->stripe_width >= 1.0f)
+        return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, -1, "stripes %g (0..1e5) and stripe width %g ([0, 1)) out of range",
+                          (double)c->stripes, (double)c->stripe_width);
+    if (!sfb__an_finite_n(c->light_dir, 3) || !isfinite(c->curvature_range) || c->curvature_range < 0.0f)
+        return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, -1, "light direction or curvature range is not finite (range must be >= 0)");
+    if (c->light_set) {
+        double m[3], a[3], x[3];
+        int i;
+        if (!sfb__an_finite_n(c->light_center, 3) || !sfb__an_finite_n(c->light_normal, 3) || !sfb__an_finite_n(c->light_axis, 3) ||
+            !sfb__an_finite_n(c->light_size, 2) || c->light_size[0] < 0.0f || c->light_size[1] < 0.0f)
+            return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, -1, "light plane centre, normal, axis or size is not finite (sizes >= 0)");
+        for (i = 0; i < 3; ++i) { m[i] = c->light_normal[i]; a[i] = c->light_axis[i]; }
+        if (!(sfb__an_unit(m) > 0.0))
+            return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, -1, "light plane normal is zero");
+        sfb__an_unit(a);
+        sfb__an_cross(m, a, x);
+        if (!(sqrt(sfb__an_dot(x, x)) > 1e-6))
+            return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, -1, "light plane axis (%g, %g, %g) is zero or parallel to its normal",
+                              (double)c->light_axis[0], (double)c->light_axis[1], (double)c->light_axis[2]);
+    }
+    if (c->light_pattern == SFB_LIGHT_IMAGE && (c->mode == SFB_ANALYZE_REFLECTION || c->mode == SFB_ANALYZE_HIGHLIGHT)) {
+        if (c->light_width <= 0 || c->light_height <= 0 || !c->light_rgba)
+            return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, -1, "image light of %d x %d texels%s: it needs texels and a size >= 1",
+                              c->light_width, c->light_height, c->light_rgba ? "" : " without data");
+        if (c->light_width > 16384 || c->light_height > 16384)
+            return sfb__error(ctx, SFB_LIMIT_EXCEEDED, SFB_ELEMENT_NONE, -1, "image light of %d x %d texels is over 16384", c->light_width,
+                              c->light_height);
+    }
+    return SFB_SUCCESS;
+}
+
+/* ---- state of one analysis ---- */
+typedef struct sfb__an {
+    sfb_context *ctx;
+    const sfb_surface *s;
+    const sfb_analyze_config *c;
+    int w, h, tri, nf, R, per;   /* picture, triangle domain, parametric faces, grid segments, grid points per face */
+    sfb__an_cam cam;
+    double centre[3], radius;
+    /* the proxy: grid points of every face (NaN for holes) */
+    float *gpos, *gnrm;
+    /* per pixel */
+    float *depth;                /* +inf: empty */
+    int *face;                   /* proxy face, -1: none */
+    float *uv;                   /* proxy (u,v) */
+    float *ppos, *pnrm;          /* polygon_based: interpolated proxy position and normal */
+    int *cface;                  /* uncovered pixels within SFB__AN_DILATE pixels of a proxy triangle: its face, */
+    float *cuv, *cdist;          /* the (u,v) of its nearest point, the distance in pixels */
+    int *hit;                    /* index into the hit arrays, -1: none */
+    unsigned char *state;        /* SFB__AN_* per pixel */
+    /* hits (compact) */
+    int nhit, cap;
+    int *hpix;
+    sfb_location *hloc;
+    float *hpos, *hdu, *hdv, *hnrm, *hdepth;
+} sfb__an;
+
+enum { SFB__AN_NONE = 0, SFB__AN_TRIED_NEAR = 1, SFB__AN_HIT = 2 };
+
+static void sfb__an_grid_uv(const sfb__an *A, int k, double *u, double *v) {
+    int R = A->R;
+    if (!A->tri) { *u = (double)(k % (R + 1)) / R; *v = (double)(k / (R + 1)) / R; return; }
+    {
+        int j = 0, row = R + 1;
+        while (k >= row) { k -= row; --row; ++j; }
+        *u = (double)k / R;
+        *v = (double)j / R;
+    }
+}
+static int sfb__an_grid_index(const sfb__an *A, int i, int j) {
+    int R = A->R;
+    return A->tri ? j * (R + 1) - j * (j - 1) / 2 + i : j * (R + 1) + i;
+}
+
+/* Step 1a: the proxy's grid points, evaluated on the backend. */
+static sfb_result sfb__an_proxy(sfb__an *A) {
+    const sfb__patch_table *pt = &A->s->patches;
+    size_t n = (size_t)A->nf * (size_t)A->per, k, chunk = 1u << 16;
+    sfb_location *loc = (sfb_location *)sfb__alloc(A->ctx, chunk * sizeof(sfb_location));
+    sfb_result r = SFB_SUCCESS;
+    if (!loc) return sfb__oom(A->ctx, "the analysis proxy");
+    for (k = 0; k < n && r == SFB_SUCCESS; k += chunk) {
+        size_t m = n - k < chunk ? n - k : chunk, q, cnt = 0;
+        sfb_eval_output out;
+        size_t first_eval = k;
+        /* holes: skip (their points stay NaN) -- evaluate runs of non-hole locations */
+        for (q = 0; q < m; ++q) {
+            size_t g = k + q;
+            int f = (int)(g / (size_t)A->per);
+            double u, v;
+            if (pt->ptex_root[f] == -1) {
+                int c;
+                for (c = 0; c < 3; ++c) A->gpos[3 * g + c] = A->gnrm[3 * g + c] = NAN;
+                continue;
+            }
+            sfb__an_grid_uv(A, (int)(g % (size_t)A->per), &u, &v);
+            loc[cnt].face = f;
+            loc[cnt].u = (float)u;
+            loc[cnt].v = (float)v;
+            if (A->tri && (double)loc[cnt].u + (double)loc[cnt].v > 1.0) loc[cnt].v = nextafterf(loc[cnt].v, 0.0f);
+            /* evaluate into place: the run must be contiguous in g */
+            if (cnt == 0) first_eval = g;
+            if (g != first_eval + cnt) {
+                /* flush the run before this location */
+                sfb_location keep = loc[cnt];
+                memset(&out, 0, sizeof out);
+                out.position = A->gpos + 3 * first_eval;
+                out.normal = A->gnrm + 3 * first_eval;
+                if ((r = sfb__surface_eval_unchecked(A->s, loc, (int)cnt, &out)) != SFB_SUCCESS) break;
+                loc[0] = keep;
+                cnt = 0;
+                first_eval = g;
+            }
+            ++cnt;
+        }
+        if (r == SFB_SUCCESS && cnt > 0) {
+            memset(&out, 0, sizeof out);
+            out.position = A->gpos + 3 * first_eval;
+            out.normal = A->gnrm + 3 * first_eval;
+            r = sfb__surface_eval_unchecked(A->s, loc, (int)cnt, &out);
+        }
+        if (r == SFB_SUCCESS) r = sfb__progress(A->ctx, 0.2f * (float)(k + m) / (float)n, "analyze");
+    }
+    sfb__free(A->ctx, loc);
+    return r;
+}
+
+/* The camera (the config's or sfb_render's orbit) from the control mesh's bounding box (not the
+ * proxy's: the picture must not depend on the proxy's level). */
+static void sfb__an_camera(sfb__an *A) {
+    const sfb_analyze_config *c = A->c;
+    double lo[3] = { HUGE_VAL, HUGE_VAL, HUGE_VAL }, hi[3] = { -HUGE_VAL, -HUGE_VAL, -HUGE_VAL };
+    size_t n = (size_t)A->s->base_vertex_count, k;
+    sfb__an_cam *cam = &A->cam;
+    int i, any = 0, w = A->w, h = A->h;
+    double half = 0.5 * (w < h ? w : h) * SFB__AN_MARGIN, zoom = c->zoom > 0.0f ? c->zoom : 1.0;
+    double hfov = (c->fov > 0.0f && !c->orthographic ? c->fov : 30.0) * 0.5 * SFB__PI / 180.0;
+    for (k = 0; k < n; ++k) {
+        const float *p = A->s->base_positions + 3 * k;
+        if (!sfb__an_finite3(p)) continue;
+        for (i = 0; i < 3; ++i) { if (p[i] < lo[i]) lo[i] = p[i]; if (p[i] > hi[i]) hi[i] = p[i]; }
+        any = 1;
+    }
+    if (!any) { lo[0] = lo[1] = lo[2] = -1.0; hi[0] = hi[1] = hi[2] = 1.0; }
+    for (i = 0; i < 3; ++i) A->centre[i] = 0.5 * (lo[i] + hi[i]);
+    A->radius = 0.5 * sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) + (hi[2] - lo[2]) * (hi[2] - lo[2]));
+    if (!(A->radius > 0.0) || !isfinite(A->radius)) A->radius = 1.0;
+    memset(cam, 0, sizeof *cam);
+    cam->ortho = c->orthographic != 0;
+    cam->cx = 0.5 * w;
+    cam->cy = 0.5 * h;
+    if (c->camera_set) {
+        double up[3];
+        for (i = 0; i < 3; ++i) { cam->eye[i] = c->eye[i]; cam->fwd[i] = (double)c->target[i] - c->eye[i]; up[i] = c->up[i]; }
+        sfb__an_unit(cam->fwd);
+        if (!(sfb__an_dot(up, up) > 0.0)) up[1] = 1.0;
+        sfb__an_cross(cam->fwd, up, cam->right);
+        sfb__an_unit(cam->right);
+        sfb__an_cross(cam->right, cam->fwd, cam->up);
+        sfb__an_unit(cam->up);
+        if (cam->ortho) cam->focal = c->fov > 0.0f ? h / (double)c->fov : half / A->radius;
+        else cam->focal = 0.5 * h / tan(hfov);
+    } else {
+        double yaw = (c->view_set ? c->yaw : 30.0f) * SFB__PI / 180.0, pitch = (c->view_set ? c->pitch : 25.0f) * SFB__PI / 180.0;
+        double dir[3], dist = A->radius / sin(hfov);
+        dir[0] = cos(pitch) * sin(yaw); dir[1] = sin(pitch); dir[2] = cos(pitch) * cos(yaw);
+        for (i = 0; i < 3; ++i) { cam->eye[i] = A->centre[i] + dist * dir[i]; cam->fwd[i] = -dir[i]; }
+        cam->right[0] = cos(yaw); cam->right[1] = 0.0; cam->right[2] = -sin(yaw);
+        sfb__an_cross(cam->right, cam->fwd, cam->up);
+        sfb__an_unit(cam->up);
+        cam->focal = cam->ortho ? half * zoom / A->radius : half * zoom / tan(hfov);
+    }
+    cam->near_z = c->near_plane > 0.0f ? c->near_plane : 1e-3 * A->radius;
+}
+
+/* Step 1b: rasterises one proxy triangle (grid points g[3] of face f). */
+static void sfb__an_raster_tri(sfb__an *A, int f, const int *g) {
+    double sx[3], sy[3], sz[3], q[3], uu[3], vv[3], area, inv, minx, maxx, miny, maxy, elen[3];
+    int k, x, y, ix0, ix1, iy0, iy1;
+    const float *P[3];
+    for (k = 0; k < 3; ++k) {
+        double p[3];
+        size_t gi = (size_t)f * (size_t)A->per + (size_t)g[k];
+        P[k] = A->gpos + 3 * gi;
+        if (!sfb__an_finite3(P[k])) return;
+        p[0] = P[k][0]; p[1] = P[k][1]; p[2] = P[k][2];
+        if (!sfb__an_project(&A->cam, p, &sx[k], &sy[k], &sz[k])) return;
+        q[k] = A->cam.ortho ? 1.0 : 1.0 / sz[k];
+        sfb__an_grid_uv(A, g[k], &uu[k], &vv[k]);
+    }
+    area = (sx[1] - sx[0]) * (sy[2] - sy[0]) - (sx[2] - sx[0]) * (sy[1] - sy[0]);
+    if (!(fabs(area) > 1e-12) || !isfinite(area)) return;
+    minx = sx[0] < sx[1] ? (sx[0] < sx[2] ? sx[0] : sx[2]) : (sx[1] < sx[2] ? sx[1] : sx[2]);
+    maxx = sx[0] > sx[1] ? (sx[0] > sx[2] ? sx[0] : sx[2]) : (sx[1] > sx[2] ? sx[1] : sx[2]);
+    miny = sy[0] < sy[1] ? (sy[0] < sy[2] ? sy[0] : sy[2]) : (sy[1] < sy[2] ? sy[1] : sy[2]);
+    maxy = sy[0] > sy[1] ? (sy[0] > sy[2] ? sy[0] : sy[2]) : (sy[1] > sy[2] ? sy[1] : sy[2]);
+    minx = sfb__an_clamp(ceil(minx - 0.5 - SFB__AN_DILATE), 0.0, (double)A->w);
+    maxx = sfb__an_clamp(floor(maxx - 0.5 + SFB__AN_DILATE), -1.0, (double)A->w - 1.0);
+    miny = sfb__an_clamp(ceil(miny - 0.5 - SFB__AN_DILATE), 0.0, (double)A->h);
+    maxy = sfb__an_clamp(floor(maxy - 0.5 + SFB__AN_DILATE), -1.0, (double)A->h - 1.0);
+    ix0 = (int)minx; ix1 = (int)maxx; iy0 = (int)miny; iy1 = (int)maxy;
+    inv = 1.0 / area;
+    elen[0] = sqrt((sx[2] - sx[1]) * (sx[2] - sx[1]) + (sy[2] - sy[1]) * (sy[2] - sy[1]));
+    elen[1] = sqrt((sx[0] - sx[2]) * (sx[0] - sx[2]) + (sy[0] - sy[2]) * (sy[0] - sy[2]));
+    elen[2] = sqrt((sx[1] - sx[0]) * (sx[1] - sx[0]) + (sy[1] - sy[0]) * (sy[1] - sy[0]));
+    for (y = iy0; y <= iy1; ++y) {
+        double py = y + 0.5;
+        for (x = ix0; x <= ix1; ++x) {
+            double px = x + 0.5, b[3], den, z;
+            size_t pix = (size_t)y * (size_t)A->w + (size_t)x;
+            b[0] = ((sx[2] - sx[1]) * (py - sy[1]) - (sy[2] - sy[1]) * (px - sx[1])) * inv;
+            b[1] = ((sx[0] - sx[2]) * (py - sy[2]) - (sy[0] - sy[2]) * (px - sx[2])) * inv;
+            b[2] = ((sx[1] - sx[0]) * (py - sy[0]) - (sy[1] - sy[0]) * (px - sx[0])) * inv;
+            if (b[0] < 0.0 || b[1] < 0.0 || b[2] < 0.0) {
+                /* outside: a candidate seed for an uncovered pixel within SFB__AN_DILATE pixels
+                 * (the proxy's silhouette lies inside the exact one on convex parts, and edge-on
+                 * faces may cover no pixel centre at all) */
+                double d = 0.0, sum;
+                if (A->face[pix] >= 0) continue;
+                for (k = 0; k < 3; ++k)
+                    if (b[k] < 0.0 && elen[k] > 0.0) { double e = -b[k] * fabs(area) / elen[k]; if (e > d) d = e; }
+                if (!(d <= SFB__AN_DILATE) || !(d < A->cdist[pix])) continue;
+                for (k = 0; k < 3; ++k) if (b[k] < 0.0) b[k] = 0.0;
+                for (k = 0; k < 3; ++k) b[k] *= q[k];
+                sum = b[0] + b[1] + b[2];
+                if (!(sum > 0.0)) continue;
+                A->cdist[pix] = (float)d;
+                A->cface[pix] = f;
+                A->cuv[2 * pix] = (float)sfb__an_clamp((b[0] * uu[0] + b[1] * uu[1] + b[2] * uu[2]) / sum, 0.0, 1.0);
+                A->cuv[2 * pix + 1] = (float)sfb__an_clamp((b[0] * vv[0] + b[1] * vv[1] + b[2] * vv[2]) / sum, 0.0, 1.0);
+                continue;
+            }
+            den = b[0] * q[0] + b[1] * q[1] + b[2] * q[2];
+            if (!(den > 0.0)) continue;
+            z = A->cam.ortho ? b[0] * sz[0] + b[1] * sz[1] + b[2] * sz[2] : 1.0 / den;
+            if (!(z < (double)A->depth[pix])) continue;
+            for (k = 0; k < 3; ++k) b[k] = b[k] * q[k] / den;
+            A->depth[pix] = (float)z;
+            A->face[pix] = f;
+            A->uv[2 * pix] = (float)sfb__an_clamp(b[0] * uu[0] + b[1] * uu[1] + b[2] * uu[2], 0.0, 1.0);
+            A->uv[2 * pix + 1] = (float)sfb__an_clamp(b[0] * vv[0] + b[1] * vv[1] + b[2] * vv[2], 0.0, 1.0);
+            if (A->ppos) {
+                int c;
+                size_t base = (size_t)f * (size_t)A->per;
+                for (c = 0; c < 3; ++c) {
+                    A->ppos[3 * pix + c] = (float)(b[0] * P[0][c] + b[1] * P[1][c] + b[2] * P[2][c]);
+                    A->pnrm[3 * pix + c] = (float)(b[0] * A->gnrm[3 * (base + g[0]) + c] + b[1] * A->gnrm[3 * (base + g[1]) + c] +
+                                                   b[2] * A->gnrm[3 * (base + g[2]) + c]);
+                }
+            }
+        }
+    }
+}
+
+static sfb_result sfb__an_raster(sfb__an *A) {
+    int f, i, j, R = A->R;
+    sfb_result r;
+    for (f = 0; f < A->nf; ++f) {
+        if ((f & 63) == 63 && (r = sfb__progress(A->ctx, 0.2f + 0.1f * (float)f / (float)A->nf, "analyze")) != SFB_SUCCESS) return r;
+        if (A->s->patches.ptex_root[f] == -1) continue;
+        for (j = 0; j < R; ++j)
+            for (i = 0; i < (A->tri ? R - j : R); ++i) {
+                int g[3];
+                if (A->tri) {
+                    g[0] = sfb__an_grid_index(A, i, j); g[1] = sfb__an_grid_index(A, i + 1, j); g[2] = sfb__an_grid_index(A, i, j + 1);
+                    sfb__an_raster_tri(A, f, g);
+                    if (i + j + 1 < R) {
+                        g[0] = sfb__an_grid_index(A, i + 1, j); g[1] = sfb__an_grid_index(A, i + 1, j + 1); g[2] = sfb__an_grid_index(A, i, j + 1);
+                        sfb__an_raster_tri(A, f, g);
+                    }
+                } else {
+                    g[0] = sfb__an_grid_index(A, i, j); g[1] = sfb__an_grid_index(A, i + 1, j); g[2] = sfb__an_grid_index(A, i + 1, j + 1);
+                    sfb__an_raster_tri(A, f, g);
+                    g[1] = g[2]; g[2] = sfb__an_grid_index(A, i, j + 1);
+                    sfb__an_raster_tri(A, f, g);
+                }
+            }
+    }
+    return SFB_SUCCESS;
+}
+
+/* ---- step 2: Newton projection, in batches ---- */
+typedef struct sfb__an_try {
+    int pix, steps, pinned, outcome;   /* outcome: 0 running, 1 hit, 2 near, 3 miss */
+    double res;
+} sfb__an_try;
+
+/* Records the evaluation at loc as pixel pix's hit at depth z (a pixel already hit keeps the
+ * nearer one). */
+static void sfb__an_add_hit(sfb__an *A, int pix, const sfb_location *loc, double z, const float *p, const float *du, const float *dv,
+                            const float *n) {
+    int k = A->hit[pix], c;
+    if (k >= 0) {
+        if (!(z < A->hdepth[k] - 1e-6 * A->radius)) return;
+    } else {
+        k = A->nhit++;
+        A->hpix[k] = pix;
+        A->hit[pix] = k;
+        A->state[pix] = SFB__AN_HIT;
+    }
+    A->hloc[k] = *loc;
+    A->hdepth[k] = (float)z;
+    for (c = 0; c < 3; ++c) {
+        A->hpos[3 * k + c] = p[c]; A->hdu[3 * k + c] = du[c]; A->hdv[3 * k + c] = dv[c]; A->hnrm[3 * k + c] = n[c];
+    }
+}
+
+/* Clamps (u,v) into the domain; returns 1 when it had to. */
+static int sfb__an_clamp_domain(const sfb__an *A, double *u, double *v) {
+    int moved = 0;
+    if (*u < 0.0) { *u = 0.0; moved = 1; }
+    if (*v < 0.0) { *v = 0.0; moved = 1; }
+    if (*u > 1.0) { *u = 1.0; moved = 1; }
+    if (*v > 1.0) { *v = 1.0; moved = 1; }
+    if (A->tri && *u + *v > 1.0) {
+        double e = 0.5 * (*u + *v - 1.0);
+        *u -= e; *v -= e;
+        if (*u < 0.0) { *v += *u; *u = 0.0; }
+        if (*v < 0.0) { *u += *v; *v = 0.0; }
+        moved = 1;
+    }
+    return moved;
+}
+
+/* Runs the attempts (tries[i] for pixel tries[i].pix from locs[i]) to their outcomes; records
+ * hits (a pixel hit by an earlier attempt of the same batch keeps the nearer one). */
+static sfb_result sfb__an_newton(sfb__an *A, sfb__an_try *tries, sfb_location *locs, int count, float *buf, int steps) {
+    int active = count, it, i;
+    float *pos = buf, *du = buf + 3 * (size_t)count, *dv = buf + 6 * (size_t)count, *nrm = buf + 9 * (size_t)count;
+    sfb_eval_output out;
+    sfb_result r;
+    /* the active attempts are kept first: order[] maps them */
+    for (it = 0; it <= steps && active > 0; ++it) {
+        int keep = 0;
+        memset(&out, 0, sizeof out);
+        out.position = pos; out.du = du; out.dv = dv; out.normal = nrm;
+        if ((r = sfb__surface_eval_unchecked(A->s, locs, active, &out)) != SFB_SUCCESS) return r;
+        for (i = 0; i < active; ++i) {
+            sfb__an_try *t = &tries[i];
+            int pix = t->pix, x = pix % A->w, y = pix / A->w;
+            double p[3], tu[3], tv[3], sx, sy, z, rx, ry, j00, j01, j10, j11, det, du_, dv_, m, u, v, res;
+            int c, ok;
+            for (c = 0; c < 3; ++c) { p[c] = pos[3 * i + c]; tu[c] = du[3 * i + c]; tv[c] = dv[3 * i + c]; }
+            ok = sfb__an_finite3(pos + 3 * i) && sfb__an_project(&A->cam, p, &sx, &sy, &z);
+            res = HUGE_VAL;
+            if (ok) {
+                rx = (x + 0.5) - sx; ry = (y + 0.5) - sy;
+                res = sqrt(rx * rx + ry * ry);
+            }
+            t->res = res;
+            if (ok && res < SFB__AN_TOL) {
+                sfb__an_add_hit(A, pix, &locs[i], z, pos + 3 * i, du + 3 * i, dv + 3 * i, nrm + 3 * i);
+                t->outcome = 1;
+                continue;
+            }
+            if (!ok || it == steps) { t->outcome = ok && res < SFB__AN_NEAR ? 2 : 3; continue; }
+            sfb__an_project_dir(&A->cam, p, tu, &j00, &j10);
+            sfb__an_project_dir(&A->cam, p, tv, &j01, &j11);
+            det = j00 * j11 - j01 * j10;
+            if (!(fabs(det) > 1e-18) || !isfinite(det)) { t->outcome = res < SFB__AN_NEAR ? 2 : 3; continue; }
+            du_ = (j11 * rx - j01 * ry) / det;
+            dv_ = (-j10 * rx + j00 * ry) / det;
+            m = fabs(du_) > fabs(dv_) ? fabs(du_) : fabs(dv_);
+            if (m > 0.34) { du_ *= 0.34 / m; dv_ *= 0.34 / m; }
+            u = locs[i].u + du_;
+            v = locs[i].v + dv_;
+            if (sfb__an_clamp_domain(A, &u, &v)) {
+                if (++t->pinned >= 2) { t->outcome = res < SFB__AN_NEAR ? 2 : 3; continue; }
+            } else t->pinned = 0;
+            locs[i].u = (float)u;
+            locs[i].v = (float)v;
+            if (A->tri && (double)locs[i].u + (double)locs[i].v > 1.0) locs[i].v = nextafterf(locs[i].v, 0.0f);
+            ++t->steps;
+        }
+        /* compact the running attempts to the front (finished ones are done with) */
+        for (i = 0; i < active; ++i)
+            if (tries[i].outcome == 0) {
+                if (keep != i) { sfb__an_try t = tries[keep]; sfb_location l = locs[keep]; tries[keep] = tries[i]; locs[keep] = locs[i]; tries[i] = t; locs[i] = l; }
+                ++keep;
+            }
+        /* finished attempts moved behind the active ones keep their outcome for the caller */
+        active = keep;
+    }
+    for (i = 0; i < count; ++i)
+        if (tries[i].outcome == 2 && A->state[tries[i].pix] == SFB__AN_NONE) A->state[tries[i].pix] = SFB__AN_TRIED_NEAR;
+    return SFB_SUCCESS;
+}
+
+/* Step 2 over every round (see the file's comment). */
+static sfb_result sfb__an_project_all(sfb__an *A, int steps) {
+    size_t npix = (size_t)A->w * (size_t)A->h, p;
+    int cap = 0, count = 0, round, first_new;
+    sfb__an_try *tries = NULL;
+    sfb_location *locs = NULL;
+    float *buf = NULL;
+    int *mark = NULL;  /* per pixel: the last round that seeded it, and 3 faces it was seeded from */
+    sfb_result r = SFB_SUCCESS;
+    for (p = 0; p < npix; ++p) if (A->face[p] >= 0 || A->cface[p] >= 0) ++cap;
+    cap = cap > 4096 ? cap : 4096;
+    tries = (sfb__an_try *)sfb__alloc(A->ctx, (size_t)cap * sizeof *tries);
+    locs = (sfb_location *)sfb__alloc(A->ctx, (size_t)cap * sizeof *locs);
+    buf = (float *)sfb__alloc(A->ctx, (size_t)cap * 12 * sizeof(float));
+    mark = (int *)sfb__calloc(A->ctx, npix, 4 * sizeof(int));
+    if (!tries || !locs || !buf || !mark) { r = sfb__oom(A->ctx, "the analysis projection"); goto done; }
+    /* round 0: every proxy pixel from its own (face, u, v) */
+    for (p = 0; p < npix; ++p)
+        if (A->face[p] >= 0) {
+            memset(&tries[count], 0, sizeof tries[count]);
+            tries[count].pix = (int)p;
+            locs[count].face = A->face[p];
+            locs[count].u = A->uv[2 * p];
+            locs[count].v = A->uv[2 * p + 1];
+            if (A->tri && (double)locs[count].u + (double)locs[count].v > 1.0) locs[count].v = nextafterf(locs[count].v, 0.0f);
+            ++count;
+        } else if (A->cface[p] >= 0) {
+            memset(&tries[count], 0, sizeof tries[count]);
+            tries[count].pix = (int)p;
+            locs[count].face = A->cface[p];
+            locs[count].u = A->cuv[2 * p];
+            locs[count].v = A->cuv[2 * p + 1];
+            if (A->tri && (double)locs[count].u + (double)locs[count].v > 1.0) locs[count].v = nextafterf(locs[count].v, 0.0f);
+            ++count;
+        }
+    first_new = 0;
+    if ((r = sfb__an_newton(A, tries, locs, count, buf, steps)) != SFB_SUCCESS) goto done;
+    if ((r = sfb__progress(A->ctx, 0.6f, "analyze")) != SFB_SUCCESS) goto done;
+    /* later rounds: the pixels next to the last round's hits, seeded by them */
+    for (round = 1; round <= SFB__AN_ROUNDS; ++round) {
+        int last_new = A->nhit, h;
+        count = 0;
+        for (h = first_new; h < last_new; ++h) {
+            int pix = A->hpix[h], x = pix % A->w, y = pix / A->w, dx, dy;
+            for (dy = -1; dy <= 1; ++dy)
+                for (dx = -1; dx <= 1; ++dx) {
+                    int nx = x + dx, ny = y + dy, q, k, *mq, f = A->hloc[h].face;
+                    if ((dx | dy) == 0 || nx < 0 || ny < 0 || nx >= A->w || ny >= A->h) continue;
+                    q = ny * A->w + nx;
+                    if (A->hit[q] >= 0) continue;
+                    mq = mark + 4 * (size_t)q;
+                    if (mq[0] != round) { mq[0] = round; mq[1] = mq[2] = mq[3] = -1; }
+                    for (k = 1; k <= 3 && mq[k] >= 0 && mq[k] != f; ++k) {}
+                    if (k > 3 || mq[k] == f) continue; /* three faces tried this round, or this one */
+                    mq[k] = f;
+                    if (count == cap) {
+                        int nc = cap * 2;
+                        void *a = sfb__realloc(A->ctx, tries, (size_t)nc * sizeof *tries);
+                        if (!a) { r = sfb__oom(A->ctx, "the analysis projection"); goto done; }
+                        tries = (sfb__an_try *)a;
+                        a = sfb__realloc(A->ctx, locs, (size_t)nc * sizeof *locs);
+                        if (!a) { r = sfb__oom(A->ctx, "the analysis projection"); goto done; }
+                        locs = (sfb_location *)a;
+                        a = sfb__realloc(A->ctx, buf, (size_t)nc * 12 * sizeof(float));
+                        if (!a) { r = sfb__oom(A->ctx, "the analysis projection"); goto done; }
+                        buf = (float *)a;
+                        cap = nc;
+                    }
+                    memset(&tries[count], 0, sizeof tries[count]);
+                    tries[count].pix = q;
+                    locs[count] = A->hloc[h];
+                    ++count;
+                }
+        }
+        if (count == 0) break;
+        first_new = A->nhit;
+        if ((r = sfb__an_newton(A, tries, locs, count, buf, steps)) != SFB_SUCCESS) goto done;
+        if (A->nhit == first_new) break;
+        if ((r = sfb__progress(A->ctx, 0.6f + 0.1f * (float)round / SFB__AN_ROUNDS, "analyze")) != SFB_SUCCESS) goto done;
+    }
+done:
+    sfb__free(A->ctx, tries);
+    sfb__free(A->ctx, locs);
+    sfb__free(A->ctx, buf);
+    sfb__free(A->ctx, mark);
+    return r;
+}
+
+/* Proxy pixels left without a hit: NEAR ones fall back to the proxy's point (evaluated there),
+ * the others are dropped. polygon_based: every proxy pixel is a "hit" on its interpolated data. */
+static sfb_result sfb__an_leftovers(sfb__an *A, int *fallback, int *dropped) {
+    size_t npix = (size_t)A->w * (size_t)A->h, p;
+    int n = 0, i;
+    sfb_location *loc;
+    float *buf;
+    int *pix;
+    sfb_eval_output out;
+    sfb_result r;
+    *fallback = *dropped = 0;
+    for (p = 0; p < npix; ++p)
+        if (A->face[p] >= 0 && A->hit[p] < 0) {
+            if (A->state[p] == SFB__AN_TRIED_NEAR) ++n;
+            else ++*dropped;
+        }
+    if (n == 0) return SFB_SUCCESS;
+    loc = (sfb_location *)sfb__alloc(A->ctx, (size_t)n * sizeof *loc);
+    buf = (float *)sfb__alloc(A->ctx, (size_t)n * 12 * sizeof(float));
+    pix = (int *)sfb__alloc(A->ctx, (size_t)n * sizeof(int));
+    if (!loc || !buf || !pix) { sfb__free(A->ctx, loc); sfb__free(A->ctx, buf); sfb__free(A->ctx, pix); return sfb__oom(A->ctx, "the analysis fallback"); }
+    for (p = 0, i = 0; p < npix; ++p)
+        if (A->face[p] >= 0 && A->hit[p] < 0 && A->state[p] == SFB__AN_TRIED_NEAR) {
+            pix[i] = (int)p;
+            loc[i].face = A->face[p]; loc[i].u = A->uv[2 * p]; loc[i].v = A->uv[2 * p + 1];
+            if (A->tri && (double)loc[i].u + (double)loc[i].v > 1.0) loc[i].v = nextafterf(loc[i].v, 0.0f);
+            ++i;
+        }
+    memset(&out, 0, sizeof out);
+    out.position = buf; out.du = buf + 3 * (size_t)n; out.dv = buf + 6 * (size_t)n; out.normal = buf + 9 * (size_t)n;
+    r = sfb__surface_eval_unchecked(A->s, loc, n, &out);
+    if (r == SFB_SUCCESS)
+        for (i = 0; i < n; ++i)
+            sfb__an_add_hit(A, pix[i], &loc[i], A->depth[pix[i]], out.position + 3 * (size_t)i, out.du + 3 * (size_t)i, out.dv + 3 * (size_t)i,
+                            out.normal + 3 * (size_t)i);
+    *fallback = n;
+    sfb__free(A->ctx, loc); sfb__free(A->ctx, buf); sfb__free(A->ctx, pix);
+    return r;
+}
+
+/* ---- step 4: colours ---- */
+/* Integral over [0, x] of the unit-periodic indicator of [a, b] (0 <= a <= b <= 1), and the
+ * share of the footprint [w - fw/2, w + fw/2] it covers. */
+static double sfb__an_band_integral(double x, double a, double b) {
+    double fl = floor(x), fr = x - fl;
+    return fl * (b - a) + (sfb__an_clamp(fr, a, b) - a);
+}
+static double sfb__an_band(double w, double fw, double a, double b) {
+    if (fw > 64.0) return b - a;
+    if (fw < 1e-4) { double fr = w - floor(w); return fr >= a && fr < b; }
+    return (sfb__an_band_integral(w + 0.5 * fw, a, b) - sfb__an_band_integral(w - 0.5 * fw, a, b)) / fw;
+}
+/* The footprint of pixel pix in units of the value in v: per axis the smaller one-sided
+ * difference (robust at silhouettes and band ends), summed. */
+static double sfb__an_footprint(const float *v, int w, int h, int pix) {
+    int x = pix % w, y = pix / w;
+    double c = v[pix], dx = HUGE_VAL, dy = HUGE_VAL, d;
+    if (x > 0 && isfinite(v[pix - 1])) { d = fabs(c - v[pix - 1]); if (d < dx) dx = d; }
+    if (x + 1 < w && isfinite(v[pix + 1])) { d = fabs(c - v[pix + 1]); if (d < dx) dx = d; }
+    if (y > 0 && isfinite(v[pix - w])) { d = fabs(c - v[pix - w]); if (d < dy) dy = d; }
+    if (y + 1 < h && isfinite(v[pix + w])) { d = fabs(c - v[pix + w]); if (d < dy) dy = d; }
+    if (dx == HUGE_VAL) dx = 0.0;
+    if (dy == HUGE_VAL) dy = 0.0;
+    return dx + dy;
+}
+/* Blue, cyan, green, yellow, red for t in [0,1]. */
+static void sfb__an_colormap(double t, double *rgb) {
+    static const double stops[5][3] = { {0.10, 0.20, 1.00}, {0.00, 0.85, 1.00}, {0.10, 0.90, 0.15}, {1.00, 0.92, 0.00}, {1.00, 0.10, 0.05} };
+    double x = sfb__an_clamp(t, 0.0, 1.0) * 4.0, f;
+    int i = (int)x, c;
+    if (i > 3) i = 3;
+    f = x - i;
+    for (c = 0; c < 3; ++c) rgb[c] = stops[i][c] * (1.0 - f) + stops[i + 1][c] * f;
+}
+static unsigned char sfb__an_byte(double v) { return (unsigned char)(sfb__an_clamp(v, 0.0, 1.0) * 255.0 + 0.5); }
+
+/* The looks of one analysis: resolved light and colours. */
+typedef struct sfb__an_look {
+    sfb__shade_job job;
+    double key[3], width, range;
+    int pattern;
+    unsigned char bg[4], miss[4];
+} sfb__an_look;
+
+static void sfb__an_lights(const sfb__an *A, sfb__an_look *L) {
+    const sfb_analyze_config *c = A->c;
+    const sfb__an_cam *cam = &A->cam;
+    sfb__shade_job *j = &L->job;
+    double R = A->radius, d[3];
+    int i, mode = c->mode;
+    memset(L, 0, sizeof *L);
+    j->mode = mode; j->curvature = c->curvature; j->ortho = cam->ortho;
+    for (i = 0; i < 3; ++i) { j->eye[i] = cam->eye[i]; j->fwd[i] = cam->fwd[i]; }
+    for (i = 0; i < 3; ++i) L->key[i] = -cam->fwd[i] + 0.55 * cam->up[i] - 0.45 * cam->right[i];
+    sfb__an_unit(L->key);
+    L->pattern = c->light_pattern;
+    L->width = c->stripe_width > 0.0f ? c->stripe_width
+               : L->pattern == SFB_LIGHT_LATTICE ? 0.2 : L->pattern == SFB_LIGHT_CIRCLES ? 0.6 : 0.5;
+    for (i = 0; i < 3; ++i) d[i] = c->light_dir[i];
+    if (!(sfb__an_unit(d) > 0.0)) {
+        /* zebra: bands about the camera's up; isophotes and shading: the key light */
+        for (i = 0; i < 3; ++i) d[i] = mode == SFB_ANALYZE_ZEBRA ? cam->up[i] : L->key[i];
+    }
+    for (i = 0; i < 3; ++i) j->dir[i] = d[i];
+    if (mode == SFB_ANALYZE_REFLECTION || mode == SFB_ANALYZE_HIGHLIGHT) {
+        double ell[3], per = c->stripes > 0.0f ? c->stripes : mode == SFB_ANALYZE_REFLECTION ? 24.0 : 8.0, t;
+        if (c->light_set) {
+            for (i = 0; i < 3; ++i) { j->lc[i] = c->light_center[i]; j->lm[i] = c->light_normal[i]; j->lu[i] = c->light_axis[i]; }
+            sfb__an_unit(j->lm);
+            j->lsize[0] = c->light_size[0] > 0.0f ? c->light_size[0] : 16.0 * R;
+            j->lsize[1] = c->light_size[1] > 0.0f ? c->light_size[1] : j->lsize[0];
+        } else if (mode == SFB_ANALYZE_REFLECTION) {
+            /* behind the viewer and above (the seed's Fig. 2 lights the surface from above; a plane
+             * the viewer's side of the surface lights what the viewer sees), lines running up it */
+            for (i = 0; i < 3; ++i) ell[i] = 0.6 * cam->up[i] - cam->fwd[i];
+            sfb__an_unit(ell);
+            for (i = 0; i < 3; ++i) { j->lc[i] = A->centre[i] + 3.0 * R * ell[i]; j->lm[i] = -ell[i]; j->lu[i] = cam->right[i]; }
+            j->lsize[0] = j->lsize[1] = 16.0 * R;
+        } else {
+            /* sfb_render's highlight plane: toward the camera, lines at 30 degrees from vertical */
+            double e[3];
+            for (i = 0; i < 3; ++i) {
+                j->lm[i] = -cam->fwd[i];
+                j->lc[i] = A->centre[i] + 3.0 * R * j->lm[i];
+                e[i] = cos(SFB__PI / 6.0) * cam->up[i] + sin(SFB__PI / 6.0) * cam->right[i];
+            }
+            sfb__an_cross(e, j->lm, j->lu);
+            j->lsize[0] = j->lsize[1] = 2.0 * R;
+        }
+        t = sfb__an_dot(j->lu, j->lm);
+        for (i = 0; i < 3; ++i) j->lu[i] -= t * j->lm[i];
+        sfb__an_unit(j->lu);
+        sfb__an_cross(j->lm, j->lu, j->lv);
+        j->periods[0] = per;
+        j->periods[1] = per * j->lsize[1] / j->lsize[0];
+    } else if (mode == SFB_ANALYZE_ZEBRA) j->periods[0] = c->stripes > 0.0f ? c->stripes : 16.0;
+    else if (mode == SFB_ANALYZE_ISOPHOTE) j->periods[0] = c->stripes > 0.0f ? c->stripes : 10.0;
+    if (c->background[0] | c->background[1] | c->background[2] | c->background[3]) memcpy(L->bg, c->background, 4);
+    else { L->bg[0] = 44; L->bg[1] = 48; L->bg[2] = 56; L->bg[3] = 255; }
+    if (c->miss[0] | c->miss[1] | c->miss[2] | c->miss[3]) memcpy(L->miss, c->miss, 4);
+    else { L->miss[0] = 14; L->miss[1] = 14; L->miss[2] = 18; L->miss[3] = 255; }
+}
+
+/* The k-th smallest of v[0..n) (reorders v; quickselect, median-of-three pivots). */
+static float sfb__an_select(float *v, int n, int k) {
+    int lo = 0, hi = n - 1;
+    while (lo < hi) {
+        int i = lo, j = hi, mid = lo + (hi - lo) / 2;
+        float a = v[lo], b = v[mid], c = v[hi], piv = a < b ? (b < c ? b : (a < c ? c : a)) : (a < c ? a : (b < c ? c : b));
+        while (i <= j) {
+            while (v[i] < piv) ++i;
+            while (v[j] > piv) --j;
+            if (i <= j) { float t = v[i]; v[i] = v[j]; v[j] = t; ++i; --j; }
+        }
+        if (k <= j) hi = j;
+        else if (k >= i) lo = i;
+        else break;
+    }
+    return v[k];
+}
+
+/* The curvature map's range: the config's, or the 90th percentile of |value| (exact, so that
+ * a few pixels more or less move it by a rank, not by a histogram bin). */
+static sfb_result sfb__an_range(const sfb__an *A, const float *val, int n, double *range) {
+    float *a;
+    int i, m = 0;
+    *range = 1.0;
+    if (A->c->curvature_range > 0.0f) { *range = A->c->curvature_range; return SFB_SUCCESS; }
+    a = (float *)sfb__alloc(A->ctx, ((size_t)n + 1) * sizeof(float));
+    if (!a) return sfb__oom(A->ctx, "the curvature range");
+    for (i = 0; i < n; ++i) if (isfinite(val[i])) a[m++] = fabsf(val[i]);
+    if (m > 0) {
+        double r = sfb__an_select(a, m, (int)(0.9 * (m - 1)));
+        if (r > 0.0) *range = r;
+    }
+    sfb__free(A->ctx, a);
+    return SFB_SUCCESS;
+}
+
+/* Samples the image light at plane coordinates (s, t) in [0,1] (bilinear, clamped). */
+static void sfb__an_texel(const sfb_analyze_config *c, double s, double t, double *rgba) {
+    double x = sfb__an_clamp(s, 0.0, 1.0) * c->light_width - 0.5, y = sfb__an_clamp(t, 0.0, 1.0) * c->light_height - 0.5, fx, fy;
+    int x0, y0, x1, y1, k;
+    x = sfb__an_clamp(x, 0.0, c->light_width - 1.0);
+    y = sfb__an_clamp(y, 0.0, c->light_height - 1.0);
+    x0 = (int)x; y0 = (int)y; fx = x - x0; fy = y - y0;
+    x1 = x0 + 1 < c->light_width ? x0 + 1 : x0;
+    y1 = y0 + 1 < c->light_height ? y0 + 1 : y0;
+    for (k = 0; k < 4; ++k) {
+        const unsigned char *T = c->light_rgba;
+        double a = T[4 * ((size_t)y0 * c->light_width + x0) + k], b = T[4 * ((size_t)y0 * c->light_width + x1) + k];
+        double d = T[4 * ((size_t)y1 * c->light_width + x0) + k], e = T[4 * ((size_t)y1 * c->light_width + x1) + k];
+        rgba[k] = ((a * (1 - fx) + b * fx) * (1 - fy) + (d * (1 - fx) + e * fx) * fy) / 255.0;
+    }
+}
+
+/* Lit share of a light-pattern pixel (values a, b with footprints fa, fb) and its class (2/3). */
+static double sfb__an_pattern(const sfb__an_look *L, double a, double b, double fa, double fb, int *cls) {
+    double w = L->width, cover;
+    if (L->pattern == SFB_LIGHT_LATTICE) {
+        double ca = sfb__an_band(a, fa, 0.0, w), cb = sfb__an_band(b, fb, 0.0, w);
+        double ra = a - floor(a), rb = b - floor(b);
+        *cls = (ra < w || rb < w) ? 3 : 2;
+        return ca + cb - ca * cb;
+    }
+    if (L->pattern == SFB_LIGHT_CIRCLES) {
+        double ua = a - floor(a) - 0.5, ub = b - floor(b) - 0.5, d = sqrt(ua * ua + ub * ub), rad = 0.5 * w;
+        double f = fa > fb ? fa : fb, edge, avg = SFB__PI * rad * rad, t;
+        *cls = d < rad ? 3 : 2;
+        edge = f > 1e-6 ? sfb__an_clamp((rad - d) / f + 0.5, 0.0, 1.0) : (d < rad);
+        t = sfb__an_clamp((f - 0.25) / 0.25, 0.0, 1.0);
+        cover = (1.0 - t) * edge + t * avg;
+        return cover;
+    }
+    *cls = (a - floor(a)) < w ? 3 : 2;
+    return sfb__an_band(a, fa, 0.0, w);
+}
+
+/* Colours every pixel from the values (full-picture arrays v1, v2) and the hits' normals. */
+static void sfb__an_colour(const sfb__an *A, const sfb__an_look *L, const float *v1, const float *v2, unsigned char *rgba,
+                           unsigned char *cls, int *light_hits) {
+    const sfb_analyze_config *c = A->c;
+    size_t npix = (size_t)A->w * (size_t)A->h, p;
+    int mode = c->mode;
+    for (p = 0; p < npix; ++p) {
+        int k = A->hit[p], i, cl = 2;
+        double rgb[3] = { 0.0, 0.0, 0.0 }, n[3], diff, a = v1[p];
+        unsigned char *o = rgba + 4 * p;
+        if (k < 0) { memcpy(o, L->bg, 4); cls[p] = 0; continue; }
+        for (i = 0; i < 3; ++i) n[i] = A->hnrm[3 * (size_t)k + i];
+        {
+            double vv[3];
+            if (A->cam.ortho) for (i = 0; i < 3; ++i) vv[i] = -A->cam.fwd[i];
+            else for (i = 0; i < 3; ++i) vv[i] = A->cam.eye[i] - A->hpos[3 * (size_t)k + i];
+            if (sfb__an_dot(vv, n) < 0.0) for (i = 0; i < 3; ++i) n[i] = -n[i];
+        }
+        diff = sfb__an_dot(n, L->key);
+        if (diff < 0.0) diff = 0.0;
+        switch (mode) {
+        case SFB_ANALYZE_REFLECTION:
+        case SFB_ANALYZE_HIGHLIGHT:
+            if (!isfinite(a)) {
+                cl = 1;
+                for (i = 0; i < 3; ++i) rgb[i] = L->miss[i] / 255.0;
+                break;
+            }
+            ++*light_hits;
+            if (L->pattern == SFB_LIGHT_IMAGE) {
+                double t[4], base = mode == SFB_ANALYZE_REFLECTION ? 0.08 : 0.3 + 0.4 * diff;
+                sfb__an_texel(c, a / L->job.periods[0], v2[p] / L->job.periods[1], t);
+                for (i = 0; i < 3; ++i) rgb[i] = base * (1.0 - t[3]) + t[i] * t[3];
+                cl = 2 + (0.299 * t[0] + 0.587 * t[1] + 0.114 * t[2] >= 0.5);
+            } else {
+                double fa = sfb__an_footprint(v1, A->w, A->h, (int)p), fb = sfb__an_footprint(v2, A->w, A->h, (int)p);
+                double cover = sfb__an_pattern(L, a, v2[p], fa, fb, &cl);
+                if (mode == SFB_ANALYZE_REFLECTION) {
+                    double dark = 0.07 + 0.16 * diff;
+                    for (i = 0; i < 3; ++i) rgb[i] = dark * (1.0 - cover) + 0.97 * cover;
+                } else {
+                    double base = 0.45 + 0.5 * diff, blue[3];
+                    blue[0] = 0.05 * base; blue[1] = 0.12 * base; blue[2] = 0.70 * base;
+                    for (i = 0; i < 3; ++i) rgb[i] = base * cover + blue[i] * (1.0 - cover);
+                }
+            }
+            break;
+        case SFB_ANALYZE_ZEBRA: {
+            double fa = sfb__an_footprint(v1, A->w, A->h, (int)p), cover = sfb__an_band(a, fa, 0.0, L->width);
+            cl = (a - floor(a)) < L->width ? 3 : 2;
+            for (i = 0; i < 3; ++i) rgb[i] = 0.04 + 0.92 * cover;
+            break;
+        }
+        case SFB_ANALYZE_ISOPHOTE: {
+            double N = L->job.periods[0], x = (sfb__an_clamp(a, -1.0, 1.0) + 1.0) * 0.5 * N, fx = sfb__an_footprint(v1, A->w, A->h, (int)p) * 0.5 * N;
+            double kb = floor(x), f = x - kb, c0[3], c1[3], m = 0.0;
+            int kk = (int)kb, nb = kk;
+            if (kk >= (int)N) kk = (int)N - 1;
+            cl = 2 + (kk < 0 ? 0 : kk > 200 ? 200 : kk);
+            sfb__an_colormap((kk + 0.5) / N, c0);
+            if (fx > 1e-6 && f < 0.5 * fx) { nb = kk - 1; m = (0.5 * fx - f) / fx; }
+            else if (fx > 1e-6 && 1.0 - f < 0.5 * fx) { nb = kk + 1; m = (0.5 * fx - (1.0 - f)) / fx; }
+            if (nb < 0) nb = 0;
+            if (nb >= (int)N) nb = (int)N - 1;
+            sfb__an_colormap((nb + 0.5) / N, c1);
+            for (i = 0; i < 3; ++i) rgb[i] = c0[i] * (1.0 - m) + c1[i] * m;
+            break;
+        }
+        case SFB_ANALYZE_CURVATURE: {
+            double t, lum = 0.72 + 0.28 * diff;
+            if (!isfinite(a)) { cl = 1; rgb[0] = rgb[1] = rgb[2] = 0.5; break; }
+            if (c->curvature == SFB_CURVATURE_MAX_ABS) {
+                t = sfb__an_clamp(a / L->range, 0.0, 1.0);
+                cl = 2 + (int)sfb__an_clamp(floor(t * 16.0), 0.0, 15.0);
+                sfb__an_colormap(t, rgb);
+            } else {
+                static const double neg[3] = { 0.12, 0.30, 1.00 }, pos[3] = { 1.00, 0.16, 0.08 };
+                t = sfb__an_clamp(a / L->range, -1.0, 1.0);
+                cl = 2 + 8 + (int)floor(t * 8.0 + 0.5); /* 17 bins, the middle one centred on 0 */
+                for (i = 0; i < 3; ++i) rgb[i] = (1.0 - fabs(t)) * 0.96 + fabs(t) * (t < 0.0 ? neg[i] : pos[i]);
+            }
+            for (i = 0; i < 3; ++i) rgb[i] *= lum;
+            break;
+        }
+        case SFB_ANALYZE_NORMALS:
+            for (i = 0; i < 3; ++i) rgb[i] = 0.5 + 0.5 * A->hnrm[3 * (size_t)k + i];
+            break;
+        default: {
+            double hv[3], vv[3], spec;
+            if (A->cam.ortho) for (i = 0; i < 3; ++i) vv[i] = -A->cam.fwd[i];
+            else for (i = 0; i < 3; ++i) vv[i] = A->cam.eye[i] - A->hpos[3 * (size_t)k + i];
+            sfb__an_unit(vv);
+            for (i = 0; i < 3; ++i) hv[i] = L->key[i] + vv[i];
+            sfb__an_unit(hv);
+            spec = sfb__an_dot(n, hv);
+            spec = spec > 0.0 ? pow(spec, 48.0) : 0.0;
+            rgb[0] = rgb[1] = rgb[2] = pow(sfb__an_clamp(0.72 * (0.16 + 0.78 * diff) + 0.3 * spec, 0.0, 1.0), 1.0 / 1.6);
+            break;
+        }
+        }
+        cls[p] = (unsigned char)cl;
+        o[0] = sfb__an_byte(rgb[0]); o[1] = sfb__an_byte(rgb[1]); o[2] = sfb__an_byte(rgb[2]); o[3] = 255;
+    }
+}
+
+/* The shade kernel of the context's backend, or ref's. */
+static sfb_result sfb__an_shade(const sfb__an *A, const sfb__shade_job *job, int n) {
+    sfb_context *ctx = A->ctx;
+    const sfb__backend_vtable *be = ctx->backend;
+    if (n == 0) return SFB_SUCCESS;
+    if (!be || !be->shade) {
+        sfb__log(ctx, SFB_LOG_INFO, "backend %s lacks shade; using ref", be ? be->name : "none");
+        return sfb__ref_shade(NULL, job, 0, n);
+    }
+    return be->shade(ctx->backend_state, job, 0, n);
+}
+
+static void sfb__an_free(sfb__an *A) {
+    sfb_context *ctx = A->ctx;
+    sfb__free(ctx, A->gpos); sfb__free(ctx, A->gnrm);
+    sfb__free(ctx, A->cface); sfb__free(ctx, A->cuv); sfb__free(ctx, A->cdist);
+    sfb__free(ctx, A->depth); sfb__free(ctx, A->face); sfb__free(ctx, A->uv); sfb__free(ctx, A->ppos); sfb__free(ctx, A->pnrm);
+    sfb__free(ctx, A->hit); sfb__free(ctx, A->state);
+    sfb__free(ctx, A->hpix); sfb__free(ctx, A->hloc); sfb__free(ctx, A->hpos); sfb__free(ctx, A->hdu); sfb__free(ctx, A->hdv);
+    sfb__free(ctx, A->hnrm); sfb__free(ctx, A->hdepth);
+}
+
+/* Bytes the analysis will hold at its peak (checked against the budget before allocating). */
+static double sfb__an_bytes(const sfb__an *A) {
+    double npix = (double)A->w * A->h, grid = (double)A->nf * A->per;
+    double per_pixel = 16 + 4 + 4 + 8 + 4 + 1 + 4 + 4 + 1 + 4 + 12 /* buffers, outputs */ + 4 + 12 + 48 + 4 /* hits */ +
+                       (A->c->polygon_based ? 24 : 84 + 16) /* proxy data or the projection's attempts and marks */;
+    return npix * per_pixel + grid * 24.0 + 65536.0 * sizeof(sfb_location);
+}
+
+SFB_API sfb_result sfb_surface_analyze(const sfb_surface *s, const sfb_analyze_config *cfg, sfb_analysis *out) {
+    sfb_analyze_config c;
+    sfb__an A;
+    sfb__an_look L;
+    sfb_context *ctx;
+    size_t npix, p;
+    float *v1 = NULL, *v2 = NULL, *hv1 = NULL, *hv2 = NULL, *sec = NULL;
+    unsigned char *rgba = NULL, *cls = NULL;
+    sfb_location *hits = NULL;
+    sfb_result r;
+    int level = 0, steps, k, fallback = 0, dropped = 0, proxy_pixels = 0, grown = 0, light_hits = 0;
+    double need;
+    if (out) memset(out, 0, sizeof *out);
+    if (!s) return SFB_INVALID_ARGS;
+    ctx = s->ctx;
+    if (!out) return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "sfb_surface_analyze: NULL output");
+    if (!s->has_patches)
+        return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "sfb_surface_analyze: the surface has no patch table (create it with SFB_REFINE_PATCHES)");
+    c = cfg ? *cfg : sfb_analyze_config_init(SFB_ANALYZE_REFLECTION);
+    memset(&A, 0, sizeof A);
+    if ((r = sfb__an_check(ctx, &c, &A.w, &A.h, &level)) != SFB_SUCCESS) return r;
+    A.ctx = ctx; A.s = s; A.c = &c;
+    A.tri = s->patches.domain == SFB__DOMAIN_TRI;
+    A.nf = s->patches.nptex;
+    A.R = 1 << level;
+    A.per = A.tri ? (A.R + 1) * (A.R + 2) / 2 : (A.R + 1) * (A.R + 1);
+    steps = c.newton_steps ? c.newton_steps : SFB__AN_DEFAULT_STEPS;
+    npix = (size_t)A.w * (size_t)A.h;
+    if ((double)A.nf * A.per > 2147483647.0)
+        return sfb__error(ctx, SFB_LIMIT_EXCEEDED, SFB_ELEMENT_NONE, -1, "proxy of %d parametric faces at level %d is too large", A.nf, level);
+    need = sfb__an_bytes(&A);
+    if (need > (double)ctx->budget - (double)ctx->live_bytes)
+        return sfb__error(ctx, SFB_LIMIT_EXCEEDED, SFB_ELEMENT_NONE, -1,
+                          "a %d x %d analysis with a level-%d proxy needs about %.0f MB, over the memory budget (%zu bytes, %zu in use)", A.w,
+                          A.h, level, need / 1048576.0, ctx->budget, ctx->live_bytes);
+    if ((r = sfb__progress(ctx, 0.0f, "analyze")) != SFB_SUCCESS) return r;
+    A.gpos = (float *)sfb__alloc(ctx, (size_t)A.nf * A.per * 3 * sizeof(float));
+    A.gnrm = (float *)sfb__alloc(ctx, (size_t)A.nf * A.per * 3 * sizeof(float));
+    A.depth = (float *)sfb__alloc(ctx, npix * sizeof(float));
+    A.face = (int *)sfb__alloc(ctx, npix * sizeof(int));
+    A.uv = (float *)sfb__alloc(ctx, npix * 2 * sizeof(float));
+    A.hit = (int *)sfb__alloc(ctx, npix * sizeof(int));
+    A.cface = (int *)sfb__alloc(ctx, npix * sizeof(int));
+    A.cuv = (float *)sfb__alloc(ctx, npix * 2 * sizeof(float));
+    A.cdist = (float *)sfb__alloc(ctx, npix * sizeof(float));
+    A.state = (unsigned char *)sfb__calloc(ctx, npix, 1);
+    if (c.polygon_based) {
+        A.ppos = (float *)sfb__alloc(ctx, npix * 3 * sizeof(float));
+        A.pnrm = (float *)sfb__alloc(ctx, npix * 3 * sizeof(float));
+    }
+    A.hpix = (int *)sfb__alloc(ctx, npix * sizeof(int));
+    A.hloc = (sfb_location *)sfb__alloc(ctx, npix * sizeof(sfb_location));
+    A.hpos = (float *)sfb__alloc(ctx, npix * 3 * sizeof(float));
+    A.hdu = (float *)sfb__alloc(ctx, npix * 3 * sizeof(float));
+    A.hdv = (float *)sfb__alloc(ctx, npix * 3 * sizeof(float));
+    A.hnrm = (float *)sfb__alloc(ctx, npix * 3 * sizeof(float));
+    A.hdepth = (float *)sfb__alloc(ctx, npix * sizeof(float));
+    if (!A.gpos || !A.gnrm || !A.depth || !A.face || !A.uv || !A.hit || !A.cface || !A.cuv || !A.cdist || !A.state || (c.polygon_based && (!A.ppos || !A.pnrm)) || !A.hpix ||
+        !A.hloc || !A.hpos || !A.hdu || !A.hdv || !A.hnrm || !A.hdepth) {
+        r = sfb__oom(ctx, "the analysis buffers");
+        goto done;
+    }
+    for (p = 0; p < npix; ++p) { A.depth[p] = A.cdist[p] = (float)HUGE_VAL; A.face[p] = A.cface[p] = -1; A.hit[p] = -1; }
+    /* 1: the proxy and its raster */
+    if ((r = sfb__an_proxy(&A)) != SFB_SUCCESS) goto done;
+    sfb__an_camera(&A);
+    if ((r = sfb__an_raster(&A)) != SFB_SUCCESS) goto done;
+    for (p = 0; p < npix; ++p) proxy_pixels += A.face[p] >= 0;
+    if ((r = sfb__progress(ctx, 0.3f, "analyze")) != SFB_SUCCESS) goto done;
+    /* 2: onto the exact surface (or the polygon-based data) */
+    if (c.polygon_based) {
+        static const float zero[3] = { 0.0f, 0.0f, 0.0f };
+        for (p = 0; p < npix; ++p)
+            if (A.face[p] >= 0) {
+                sfb_location l;
+                l.face = A.face[p]; l.u = A.uv[2 * p]; l.v = A.uv[2 * p + 1];
+                sfb__an_add_hit(&A, (int)p, &l, A.depth[p], A.ppos + 3 * p, zero, zero, A.pnrm + 3 * p);
+                sfb__an_unit3f(A.hnrm + 3 * (size_t)A.hit[p]);
+            }
+    } else {
+        if ((r = sfb__an_project_all(&A, steps)) != SFB_SUCCESS) goto done;
+        if ((r = sfb__an_leftovers(&A, &fallback, &dropped)) != SFB_SUCCESS) goto done;
+        for (k = 0; k < A.nhit; ++k) grown += A.face[A.hpix[k]] < 0;
+    }
+    if ((r = sfb__progress(ctx, 0.75f, "analyze")) != SFB_SUCCESS) goto done;
+    /* 3: second derivatives (curvature) and the shade kernel */
+    sfb__an_lights(&A, &L);
+    hv1 = (float *)sfb__alloc(ctx, ((size_t)A.nhit + 1) * sizeof(float));
+    hv2 = (float *)sfb__alloc(ctx, ((size_t)A.nhit + 1) * sizeof(float));
+    if (!hv1 || !hv2) { r = sfb__oom(ctx, "the analysis values"); goto done; }
+    L.job.position = A.hpos; L.job.du = A.hdu; L.job.dv = A.hdv; L.job.normal = A.hnrm;
+    L.job.value = hv1; L.job.value2 = hv2;
+    if (c.mode == SFB_ANALYZE_CURVATURE && A.nhit > 0) {
+        sfb_eval_output o;
+        sec = (float *)sfb__alloc(ctx, (size_t)A.nhit * 9 * sizeof(float));
+        if (!sec) { r = sfb__oom(ctx, "the analysis second derivatives"); goto done; }
+        memset(&o, 0, sizeof o);
+        o.duu = sec; o.duv = sec + 3 * (size_t)A.nhit; o.dvv = sec + 6 * (size_t)A.nhit;
+        if ((r = sfb__surface_eval_unchecked(s, A.hloc, A.nhit, &o)) != SFB_SUCCESS) goto done;
+        L.job.duu = o.duu; L.job.duv = o.duv; L.job.dvv = o.dvv;
+    }
+    if ((r = sfb__an_shade(&A, &L.job, A.nhit)) != SFB_SUCCESS) goto done;
+    if ((r = sfb__progress(ctx, 0.9f, "analyze")) != SFB_SUCCESS) goto done;
+    /* 4: colours */
+    v1 = (float *)sfb__alloc(ctx, npix * sizeof(float));
+    v2 = (float *)sfb__alloc(ctx, npix * sizeof(float));
+    rgba = (unsigned char *)sfb__alloc(ctx, npix * 4);
+    cls = (unsigned char *)sfb__alloc(ctx, npix);
+    hits = (sfb_location *)sfb__alloc(ctx, npix * sizeof(sfb_location));
+    if (!v1 || !v2 || !rgba || !cls || !hits) { r = sfb__oom(ctx, "the analysis picture"); goto done; }
+    for (p = 0; p < npix; ++p) { v1[p] = v2[p] = NAN; hits[p].face = -1; hits[p].u = hits[p].v = 0.0f; }
+    out->value_min = (float)HUGE_VAL; out->value_max = (float)-HUGE_VAL;
+    for (k = 0; k < A.nhit; ++k) {
+        int q = A.hpix[k];
+        v1[q] = hv1[k]; v2[q] = hv2[k]; hits[q] = A.hloc[k];
+        if (isfinite(hv1[k])) {
+            if (hv1[k] < out->value_min) out->value_min = hv1[k];
+            if (hv1[k] > out->value_max) out->value_max = hv1[k];
+        }
+    }
+    if (!(out->value_min <= out->value_max)) out->value_min = out->value_max = 0.0f;
+    L.range = 0.0;
+    if (c.mode == SFB_ANALYZE_CURVATURE && (r = sfb__an_range(&A, hv1, A.nhit, &L.range)) != SFB_SUCCESS) goto done;
+    sfb__an_colour(&A, &L, v1, v2, rgba, cls, &light_hits);
+    if ((c.mode == SFB_ANALYZE_REFLECTION || c.mode == SFB_ANALYZE_HIGHLIGHT) && A.nhit > 0 && light_hits == 0) {
+        r = sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, -1,
+                       "the light plane meets none of the %d rays from the surface: it is parallel to them, behind the surface or too small",
+                       A.nhit);
+        goto done;
+    }
+    if ((r = sfb__progress(ctx, 1.0f, "analyze")) != SFB_SUCCESS) goto done;
+    out->width = A.w; out->height = A.h;
+    out->rgba = rgba; out->values = v1; out->classes = cls; out->hits = hits;
+    out->covered_pixels = A.nhit;
+    out->proxy_pixels = proxy_pixels;
+    out->grown_pixels = grown;
+    out->dropped_pixels = dropped;
+    out->fallback_pixels = fallback;
+    out->light_hits = light_hits;
+    out->range = (float)L.range;
+    out->ctx_ = ctx;
+    rgba = NULL; v1 = NULL; cls = NULL; hits = NULL;
+done:
+    if (r != SFB_SUCCESS) memset(out, 0, sizeof *out);
+    sfb__an_free(&A);
+    sfb__free(ctx, v1); sfb__free(ctx, v2); sfb__free(ctx, hv1); sfb__free(ctx, hv2); sfb__free(ctx, sec);
+    sfb__free(ctx, rgba); sfb__free(ctx, cls); sfb__free(ctx, hits);
     return r;
 }
 #line 1 "src/backends_include.c"

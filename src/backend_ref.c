@@ -71,6 +71,72 @@ sfb_result sfb__ref_finish_normals(void *state, int first, int last, const float
     return SFB_SUCCESS;
 }
 
+/* Seed 003's shade kernel, item by item in double (the contract is sfb__shade_job's comment). */
+static double sfb__sh_dot(const double *a, const double *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+static double sfb__sh_curvature(const sfb__shade_job *j, size_t i, const double *n) {
+    double pu[3], pv[3], puu[3], puv[3], pvv[3], E, F, G, L, M, N, det, K, H;
+    int c;
+    for (c = 0; c < 3; ++c) {
+        pu[c] = j->du[3 * i + c]; pv[c] = j->dv[3 * i + c];
+        puu[c] = j->duu[3 * i + c]; puv[c] = j->duv[3 * i + c]; pvv[c] = j->dvv[3 * i + c];
+    }
+    E = sfb__sh_dot(pu, pu); F = sfb__sh_dot(pu, pv); G = sfb__sh_dot(pv, pv);
+    L = sfb__sh_dot(puu, n); M = sfb__sh_dot(puv, n); N = sfb__sh_dot(pvv, n);
+    det = E * G - F * F;
+    if (!(det > 1e-30 * (E * G + 1e-300)) || !isfinite(det)) return NAN;
+    K = (L * N - M * M) / det;
+    H = -(E * N - 2.0 * F * M + G * L) / (2.0 * det); /* the sign: convex toward the viewer is > 0 */
+    if (j->curvature == SFB_CURVATURE_GAUSSIAN) return K;
+    if (j->curvature == SFB_CURVATURE_MEAN) return H;
+    return fabs(H) + sqrt(H * H - K > 0.0 ? H * H - K : 0.0);
+}
+sfb_result sfb__ref_shade(void *state, const sfb__shade_job *j, int first, int last) {
+    int q, c;
+    (void)state;
+    for (q = first; q < last; ++q) {
+        size_t i = (size_t)q;
+        double p[3], n[3], v[3], r[3], vl, vn, val = NAN, val2 = NAN;
+        for (c = 0; c < 3; ++c) { p[c] = j->position[3 * i + c]; n[c] = j->normal[3 * i + c]; }
+        if (j->ortho) for (c = 0; c < 3; ++c) v[c] = -j->fwd[c];
+        else for (c = 0; c < 3; ++c) v[c] = j->eye[c] - p[c];
+        vl = sqrt(sfb__sh_dot(v, v));
+        if (vl > 0.0) for (c = 0; c < 3; ++c) v[c] /= vl;
+        vn = sfb__sh_dot(v, n);
+        /* the normal toward the viewer; the curvature's sign follows it (convex toward the eye: > 0) */
+        if (vn < 0.0) { for (c = 0; c < 3; ++c) n[c] = -n[c]; vn = -vn; }
+        for (c = 0; c < 3; ++c) r[c] = 2.0 * vn * n[c] - v[c];
+        switch (j->mode) {
+        case SFB_ANALYZE_REFLECTION:
+        case SFB_ANALYZE_HIGHLIGHT: {
+            const double *dir = j->mode == SFB_ANALYZE_REFLECTION ? r : n;
+            double dm = sfb__sh_dot(dir, j->lm), ap[3], mu, x[3], a, b;
+            if (!(fabs(dm) > 1e-9)) break;
+            for (c = 0; c < 3; ++c) ap[c] = j->lc[c] - p[c];
+            mu = sfb__sh_dot(ap, j->lm) / dm;
+            if (j->mode == SFB_ANALYZE_REFLECTION && !(mu > 0.0)) break;
+            for (c = 0; c < 3; ++c) x[c] = p[c] + mu * dir[c] - j->lc[c];
+            a = (sfb__sh_dot(x, j->lu) / j->lsize[0] + 0.5) * j->periods[0];
+            b = (sfb__sh_dot(x, j->lv) / j->lsize[1] + 0.5) * j->periods[1];
+            if (j->mode == SFB_ANALYZE_REFLECTION && !(a >= 0.0 && a <= j->periods[0] && b >= 0.0 && b <= j->periods[1])) break;
+            if (!(isfinite(a) && isfinite(b) && fabs(a) < 1e7 && fabs(b) < 1e7)) break;
+            val = a; val2 = b;
+            break;
+        }
+        case SFB_ANALYZE_ZEBRA: {
+            double t = sfb__sh_dot(r, j->dir);
+            t = t < -1.0 ? -1.0 : t > 1.0 ? 1.0 : t;
+            val = j->periods[0] * acos(t) / SFB__PI;
+            break;
+        }
+        case SFB_ANALYZE_CURVATURE: val = sfb__sh_curvature(j, i, n); break;
+        default: val = sfb__sh_dot(n, j->dir); break; /* ISOPHOTE, NORMALS, SHADED */
+        }
+        j->value[i] = (float)val;
+        if (j->value2) j->value2[i] = (float)val2;
+    }
+    return SFB_SUCCESS;
+}
+
 /* Every kernel (sfb__ref_eval_patches is in patches.c). */
 void sfb__ref_bind(sfb__backend_vtable *vt) {
     vt->name = "ref";
@@ -80,4 +146,5 @@ void sfb__ref_bind(sfb__backend_vtable *vt) {
     vt->eval_stencils = sfb__ref_eval_stencils;
     vt->eval_patches = sfb__ref_eval_patches;
     vt->finish_normals = sfb__ref_finish_normals;
+    vt->shade = sfb__ref_shade;
 }

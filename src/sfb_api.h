@@ -604,6 +604,111 @@ typedef struct sfb_image {
 SFB_API sfb_result sfb_render(sfb_context *ctx, const sfb_mesh_data *mesh, const sfb_render_config *config, sfb_image *out);
 SFB_API void sfb_image_free(sfb_image *img);
 
+/* ---- surface quality analysis (seed 003), exact per pixel ----
+ * sfb_surface_analyze draws a picture of a surface with patch tables (SFB_REFINE_PATCHES; every
+ * scheme that evaluates) whose colours come from the exact limit position, normal and second
+ * derivatives at every pixel, never from a mesh's interpolated normals. Steps: a proxy (each
+ * parametric face sampled on a 2^level grid through the backend's eval_patches) is rasterised
+ * into a buffer of (parametric face, u, v, depth) per pixel; each covered pixel is then projected
+ * onto the exact surface along its own view ray (Newton steps on (u,v) in the picture's plane,
+ * seeded by the proxy and, where that leaves its parametric face or the proxy's silhouette, by
+ * the neighbouring pixels' solutions, so coverage and silhouettes are the limit surface's); the
+ * limit surface is evaluated there (the backend's eval_patches) and the backend's `shade` kernel
+ * turns position and derivatives into the mode's value; colours are filtered by each pixel's
+ * footprint (band filtering, no moire). With `polygon_based` the same picture comes from the
+ * proxy's interpolated limit positions and normals instead (the seed's Fig. 7b, for comparison).
+ * Long analyses report progress (stage "analyze": 0.3 once the proxy is evaluated and
+ * rasterised, 0.75 once every pixel is projected and evaluated, 0.9 after the shade kernel) and
+ * can be cancelled (SFB_CANCELLED, nothing kept). The camera is sfb_render's (an orbit around the
+ * centre of the control mesh's bounding box, y up) unless eye, target and up are given. */
+typedef enum sfb_analyze_mode {
+    SFB_ANALYZE_REFLECTION = 0, /* seed 003: the view ray's reflection r = v - 2(v.n)n meets a finite light plane carrying a
+                                   texture (stripes, lattice, circles or an RGBA image); rays that miss show the miss colour */
+    SFB_ANALYZE_HIGHLIGHT,      /* Beier-Chen highlight lines: the normal line P + mu n meets the light plane (ALGORITHMS.md 7),
+                                   stripes across the plane (view-independent) */
+    SFB_ANALYZE_ZEBRA,          /* zebra: stripes of an environment at infinity, by the angle between the reflected view ray
+                                   and the stripe axis (bands of constant acos(r.axis)) */
+    SFB_ANALYZE_ISOPHOTE,       /* isophotes: bands of n.l (l the light direction), coloured blue (n.l = -1) to red (1) */
+    SFB_ANALYZE_CURVATURE,      /* Gaussian, mean or largest absolute principal curvature from the exact second
+                                   derivatives, in a diverging map (blue < 0 < red; max: white 0 .. red), range returned */
+    SFB_ANALYZE_NORMALS,        /* the unit normal as RGB = 0.5 + 0.5 n */
+    SFB_ANALYZE_SHADED,         /* diffuse + specular grey */
+    SFB_ANALYZE_MODE_COUNT_
+} sfb_analyze_mode;
+typedef enum sfb_light_pattern {
+    SFB_LIGHT_STRIPES = 0, /* parallel light lines across the plane's u axis */
+    SFB_LIGHT_LATTICE,     /* lines along both axes (seed Fig. 6a) */
+    SFB_LIGHT_CIRCLES,     /* regularly arranged round lights (seed Fig. 6b) */
+    SFB_LIGHT_IMAGE        /* the caller's RGBA texture over the whole plane */
+} sfb_light_pattern;
+typedef enum sfb_curvature_kind { SFB_CURVATURE_GAUSSIAN = 0, SFB_CURVATURE_MEAN, SFB_CURVATURE_MAX_ABS } sfb_curvature_kind;
+#define SFB_ANALYZE_MAX_SIZE 8192 /* largest width or height in pixels */
+#define SFB_ANALYZE_MAX_LEVEL 8   /* proxy level: 2^level segments per parametric-face edge */
+typedef struct sfb_analyze_config {
+    int width, height;        /* pixels; both 0: 640 x 480; one of them 0 or either negative: SFB_INVALID_ARGS */
+    int mode;                 /* sfb_analyze_mode */
+    int level;                /* proxy: each parametric face sampled on 2^level segments per edge; 0: 2 (1 is the
+                                 coarsest, "subdivided once") */
+    int polygon_based;        /* 1: shade from the proxy's interpolated limit positions and normals (the polygon-based
+                                 method the seed shows to be wrong), for comparison */
+    int newton_steps;         /* Newton steps per seed; 0: 8 */
+    /* camera: the orbit of sfb_render (view_set, yaw, pitch, zoom) or, with camera_set, eye/target/up */
+    int view_set;
+    float yaw, pitch, zoom;
+    int camera_set;
+    float eye[3], target[3], up[3];
+    float fov;                /* degrees, full vertical angle, 0: 30; orthographic: the picture's height in model units
+                                 (0: the bounding sphere fits) */
+    int orthographic;
+    float near_plane;         /* distance below which proxy triangles are not drawn; 0: 1e-3 bounding radii; < 0: error */
+    /* light */
+    int light_pattern;        /* sfb_light_pattern (REFLECTION, HIGHLIGHT) */
+    int light_set;            /* 1: the plane below; 0: derived from the bounding box and the view */
+    float light_center[3], light_normal[3], light_axis[3]; /* the plane: centre, normal (toward the surface), its u axis
+                                 (the direction across the stripes; projected into the plane) */
+    float light_size[2];      /* extent along u and v in model units (0: 16 bounding radii) */
+    float stripes;            /* stripes (or lattice cells, circle rows) across the light's u extent; REFLECTION 0: 24;
+                                 HIGHLIGHT: per bounding-sphere diameter, 0: 8; ZEBRA: per 180 degrees, 0: 16;
+                                 ISOPHOTE: bands over n.l in [-1,1], 0: 10 */
+    float stripe_width;       /* lit share of each period (0..1), 0: 0.5 (circles: diameter share of the cell) */
+    float light_dir[3];       /* ZEBRA axis, ISOPHOTE light, SHADED key; all 0: from the camera (upper left) */
+    const unsigned char *light_rgba; /* SFB_LIGHT_IMAGE: light_width x light_height RGBA, row 0 at the plane's v = 0 */
+    int light_width, light_height;
+    int curvature;            /* sfb_curvature_kind */
+    float curvature_range;    /* > 0: the colour map spans [-range, range] ([0, range] for MAX_ABS); 0: the 90th
+                                 percentile of |value| over the picture */
+    unsigned char background[4]; /* RGBA of uncovered pixels; all 0: opaque dark grey */
+    unsigned char miss[4];       /* REFLECTION: colour of rays that miss the light plane; all 0: near black */
+} sfb_analyze_config;
+SFB_API sfb_analyze_config sfb_analyze_config_init(int mode);
+typedef struct sfb_analysis {
+    int width, height;
+    unsigned char *rgba;      /* width * height * 4, rows top to bottom, alpha 255 on the surface */
+    float *values;            /* per pixel the mode's value at the pixel centre: stripe coordinate (REFLECTION: u
+                                 periods, HIGHLIGHT/ZEBRA/ISOPHOTE: periods), curvature; NaN where uncovered or missed */
+    unsigned char *classes;   /* per pixel: 0 uncovered, 1 missed the light, 2 dark band / outside a light, 3 lit band /
+                                 inside a light; ISOPHOTE: 2 + band; CURVATURE: 2 + round(8 value / range) + 8 (17 bands, the
+                                 middle one centred on 0), max |k|: 2 + floor(16 value / range); NORMALS, SHADED: 2 */
+    sfb_location *hits;       /* per pixel: the parametric face and (u,v) the colour was evaluated at (face -1: none) */
+    int covered_pixels;       /* pixels on the surface */
+    int proxy_pixels;         /* pixels the proxy covered */
+    int grown_pixels;         /* covered by the exact surface beyond the proxy's silhouette */
+    int dropped_pixels;       /* covered by the proxy, but no view ray through them meets the exact surface */
+    int fallback_pixels;      /* Newton did not converge: the proxy's point was used */
+    int light_hits;           /* REFLECTION/HIGHLIGHT: pixels whose ray met the light plane */
+    float value_min, value_max; /* over covered pixels */
+    float range;              /* CURVATURE: the colour map's range used */
+    sfb_context *ctx_;
+} sfb_analysis;
+/* Checks everything first (sizes and level: SFB_INVALID_ARGS / SFB_LIMIT_EXCEEDED; the memory
+ * budget; NaN or infinite camera, light or range values, a camera whose eye equals its target,
+ * a negative near plane, a zero light normal, an axis parallel to it, an image light without
+ * texels or with a zero size: SFB_INVALID_VALUE). A REFLECTION or HIGHLIGHT picture whose rays
+ * all miss the light plane (parallel to every ray, or behind the surface) is SFB_INVALID_VALUE
+ * too. On failure `out` is zeroed and nothing is kept. */
+SFB_API sfb_result sfb_surface_analyze(const sfb_surface *surface, const sfb_analyze_config *config, sfb_analysis *out);
+SFB_API void sfb_analysis_free(sfb_analysis *a);
+
 #ifdef __cplusplus
 }
 #endif

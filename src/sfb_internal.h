@@ -41,6 +41,7 @@ typedef struct sfb__stencils {
  * that lacks a kernel writes nothing for it, and a NULL kernel slot makes the core run `ref`'s
  * (with a log line). Every slot but name/kind/init/shutdown may be NULL. A context keeps its
  * own copy of the bound table (no global state). */
+struct sfb__shade_job;
 typedef struct sfb__backend_vtable {
     const char *name;
     sfb_backend_kind kind;
@@ -78,7 +79,32 @@ typedef struct sfb__backend_vtable {
     sfb_result (*finish_normals)(void *state, int first, int last, const float *tu, const float *tv,
                                  const float *ns, const int *ns_index, const float *b, float p,
                                  float *out_blend, float *out_limit, float *out_sub);
+    /* Seed 003's per-pixel analysis (analyze.c): items [first,last) of `job` (exact limit
+     * position, derivatives and normal per pixel) -> the mode's values (sfb__shade_job). */
+    sfb_result (*shade)(void *state, const struct sfb__shade_job *job, int first, int last);
 } sfb__backend_vtable;
+
+/* One analysis's shading (the `shade` slot). Per item i: P = position[3i..], N = normal (unit),
+ * turned toward the viewer (V = eye - P, or -fwd when orthographic); R = -V/|V| reflected
+ * about N. The mode's values (value2 may be NULL for modes without a second one):
+ *   REFLECTION: mu = ((lc - P).lm) / (R.lm); mu <= 0 or |R.lm| < 1e-9: NaN (missed); X = P + mu R,
+ *     value = ((X - lc).lu / lsize[0] + 0.5) * periods[0], value2 = ((X - lc).lv / lsize[1] + 0.5) * periods[1];
+ *     X outside the plane's extent (either coordinate outside [0, periods]): NaN;
+ *   HIGHLIGHT: the same with Dir = N and mu of any sign (only |N.lm| < 1e-9 misses), no extent;
+ *   ZEBRA: value = periods[0] * acos(R.dir) / pi;  ISOPHOTE: value = N.dir;
+ *   CURVATURE: Gaussian K = (LN - M^2) / (EG - F^2), mean H = -(EN - 2FM + GL) / (2 (EG - F^2)) (convex
+ *     toward the viewer > 0), or
+ *     max |k| = |H| + sqrt(max(H^2 - K, 0)), from du, dv (E, F, G) and duu, duv, dvv along N (L, M, N);
+ *     a degenerate first fundamental form gives NaN;
+ *   NORMALS, SHADED: value = N.dir (the diffuse term). */
+typedef struct sfb__shade_job {
+    int mode, curvature, ortho;
+    double eye[3], fwd[3];
+    double lc[3], lm[3], lu[3], lv[3], lsize[2], periods[2], dir[3];
+    const float *position, *du, *dv, *normal, *duu, *duv, *dvv;
+    float *value, *value2;
+} sfb__shade_job;
+SFB__IF sfb_result sfb__ref_shade(void *state, const sfb__shade_job *job, int first, int last);
 
 /* Optional backends (backends/sfb_*.h), compiled in by SURFBLEND_SIMD / _GL / _OSMESA or
  * SURFBLEND_ALL_BACKENDS; the headers are included at the end of the implementation. */
@@ -444,6 +470,9 @@ SFB__IF sfb_result sfb__level_prepare(sfb_context *ctx, const sfb__level *src, i
  * the backend lacks eval_stencils (surface.c). */
 SFB__IF sfb_result sfb__surface_apply(const sfb_surface *s, const sfb__stencils *t, void *handle, int rows, const float *src,
                               sfb_buffer_desc sd, float *dst, sfb_buffer_desc dd);
+/* sfb_surface_eval without the per-location checks, for locations the library made itself
+ * (analyze.c): the context's backend or ref (surface.c). */
+SFB__IF sfb_result sfb__surface_eval_unchecked(const sfb_surface *s, const sfb_location *loc, int count, const sfb_eval_output *out);
 /* The refined (or limit) mesh of a surface into o (surface.c). */
 /* Tessellated UVs (surface.c, where the scheme is read): smooth (the layout's limit) or linear,
  * and the patch table of the base UV layout. */

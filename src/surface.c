@@ -325,7 +325,6 @@ SFB_API sfb_result sfb_surface_patch_info(const sfb_surface *s, sfb_patch_info *
 
 SFB_API sfb_result sfb_surface_eval(const sfb_surface *s, const sfb_location *loc, int count, const sfb_eval_output *out) {
     sfb_context *ctx;
-    const sfb__backend_vtable *be;
     int q;
     if (!s) return SFB_INVALID_ARGS;
     ctx = s->ctx;
@@ -347,6 +346,12 @@ SFB_API sfb_result sfb_surface_eval(const sfb_surface *s, const sfb_location *lo
         if (s->patches.ptex_root[l->face] == -1)
             return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, q, "location %d: parametric face %d is a hole", q, l->face);
     }
+    return sfb__surface_eval_unchecked(s, loc, count, out);
+}
+
+sfb_result sfb__surface_eval_unchecked(const sfb_surface *s, const sfb_location *loc, int count, const sfb_eval_output *out) {
+    sfb_context *ctx = s->ctx;
+    const sfb__backend_vtable *be;
     if (count == 0) return SFB_SUCCESS;
     be = ctx->backend;
     if (!be || !be->eval_patches) {

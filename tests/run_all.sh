@@ -101,6 +101,7 @@ suite counted shade "$BUILD/shade" $(with_shapes)
 suite counted manifold "$BUILD/manifold" $(with_shapes)
 suite counted tribezier "$BUILD/tribezier" "$(dirname "$SHAPES")/real-meshes"
 suite counted trim "$BUILD/trim" $(with_shapes)
+suite counted analyze "$BUILD/analyze" "$SHAPES"
 suite counted agree "$BUILD/agree" $(with_shapes)
 suite counted gl_manifold "$BUILD/gl_manifold" "$SHAPES"
 suite counted cli env BUILD="$BUILD" SHAPES="$SHAPES" ./tests/cli_test.sh

@@ -238,17 +238,18 @@ int cli_file_write(const void *data, size_t size, void *user) {
     return fwrite(data, 1, size, (FILE *)user) != size;
 }
 
-int cli_load_mask(const char *path, unsigned char **texels, int *w, int *h) {
+/* A PNG with `channels` bytes per texel, rows flipped (the picture's top row last). */
+static int load_png_flipped(const char *path, int channels, const char *what, unsigned char **texels, int *w, int *h) {
     int n = 0, j;
     size_t row;
     unsigned char *px, *tmp, *copy;
     *texels = NULL;
-    px = stbi_load(path, w, h, &n, 1);
+    px = stbi_load(path, w, h, &n, channels);
     if (!px) {
-        cli_error("cannot read the trimming mask '%s': %s", path, stbi_failure_reason());
+        cli_error("cannot read the %s '%s': %s", what, path, stbi_failure_reason());
         return 0;
     }
-    row = (size_t)*w;
+    row = (size_t)*w * (size_t)channels;
     tmp = (unsigned char *)malloc(row ? row : 1);
     copy = (unsigned char *)malloc(row * (size_t)*h > 0 ? row * (size_t)*h : 1);
     if (!tmp || !copy) {
@@ -269,4 +270,12 @@ int cli_load_mask(const char *path, unsigned char **texels, int *w, int *h) {
     stbi_image_free(px);
     *texels = copy;
     return 1;
+}
+
+int cli_load_mask(const char *path, unsigned char **texels, int *w, int *h) {
+    return load_png_flipped(path, 1, "trimming mask", texels, w, h);
+}
+
+int cli_load_rgba(const char *path, unsigned char **texels, int *w, int *h) {
+    return load_png_flipped(path, 4, "light image", texels, w, h);
 }

@@ -44,6 +44,8 @@ sfb_context *cli_make_context_progress(const char *backend, sfb_progress progres
  * flipped so that the picture's top row is v = 1 (the mask's row 0 is v = 0). 1 with *texels
  * (free it) and the size set, or 0 with a message printed. */
 int cli_load_mask(const char *path, unsigned char **texels, int *w, int *h);
+/* An RGBA light image the same way (4 bytes per texel, row 0 the picture's bottom row). */
+int cli_load_rgba(const char *path, unsigned char **texels, int *w, int *h);
 
 /* The OBJ file at `path` ("-": standard input) as a mesh; NULL with the reason printed. */
 sfb_mesh *cli_load_obj(sfb_context *ctx, const char *path);

@@ -24,6 +24,7 @@ enum {
     O_HELP, O_BACKEND, O_OUTPUT, O_SCHEME, O_LEVEL, O_LIMIT, O_WEIGHTS, O_LOCATIONS, O_RANDOM, O_SEED, O_DERIVATIVES,
     O_RATE, O_TOLERANCE, O_SPLIT, O_TRIM, O_TILES, O_VARIANT, O_DARTS, O_NORMALS_LEVEL, O_WEIGHTS_LEVEL, O_P,
     O_AVERAGING, O_ALL_SUBDIVIDED, O_NORMALS, O_POSITIONS, O_MODE, O_EDGES, O_SIZE, O_VIEW, O_ZOOM, O_STRIPES, O_CREASE_ANGLE, O_SHARPNESS,
+    O_AMODE, O_LIGHT, O_CURVATURE, O_EYE, O_TARGET, O_UP, O_FOV, O_ORTHO, O_POLYGON, O_BAND,
     O_COUNT_
 };
 
@@ -48,13 +49,16 @@ typedef struct cli_opts {
     double view[2], zoom, stripes;
     double crease_angle;                                    /* --crease-angle (seen[O_CREASE_ANGLE]) */
     double sharpness;                                       /* --sharpness (seen[O_SHARPNESS]): tribezier */
+    int amode, curvature, ortho, polygon;                   /* analyze */
+    const char *light;
+    double eye[3], target[3], up[3], fov, band;
     int seen[O_COUNT_];
 } cli_opts;
 
 /* Command bits: which commands take an option. */
 enum {
-    C_INFO = 1, C_REFINE = 2, C_EVAL = 4, C_TESS = 8, C_SHADE = 16, C_RENDER = 32, C_BACKENDS = 64,
-    C_ALL = 127, C_SURFACE = C_REFINE | C_EVAL | C_TESS | C_SHADE | C_RENDER, C_SHADING = C_SHADE | C_RENDER
+    C_INFO = 1, C_REFINE = 2, C_EVAL = 4, C_TESS = 8, C_SHADE = 16, C_RENDER = 32, C_BACKENDS = 64, C_ANALYZE = 128,
+    C_ALL = 255, C_SURFACE = C_REFINE | C_EVAL | C_TESS | C_SHADE | C_RENDER | C_ANALYZE, C_SHADING = C_SHADE | C_RENDER
 };
 
 typedef enum opt_kind {
@@ -70,7 +74,8 @@ typedef enum opt_kind {
     K_SCHEME,   /* a scheme name (cli_scheme_from_name) not in the mask .value: int */
     K_LEVEL,    /* a shading level >= 0 (int; 0: SFB_SHADE_LEVEL_CONTROL) */
     K_SIZE,     /* WxH, long[2] each 1..1000000 */
-    K_VIEW      /* YAW,PITCH in degrees, double[2] */
+    K_VIEW,     /* YAW,PITCH in degrees, double[2] */
+    K_VEC3      /* X,Y,Z, double[3], finite */
 } opt_kind;
 
 typedef struct opt_choice { const char *name; int value, hidden; } opt_choice;
@@ -102,6 +107,14 @@ static const opt_choice averaging_choices[] = {
 static const opt_choice normals_choices[] = { { "limit", 0, 0 }, { "subdivided", 1, 0 }, { "blended", 2, 0 }, { NULL, 0, 0 } };
 static const char *const normal_names[3] = { "limit", "subdivided", "blended" };
 static const opt_choice positions_choices[] = { { "refined", 0, 0 }, { "limit", 1, 0 }, { NULL, 0, 0 } };
+static const opt_choice amode_choices[] = {
+    { "reflection", SFB_ANALYZE_REFLECTION, 0 }, { "highlight", SFB_ANALYZE_HIGHLIGHT, 0 }, { "zebra", SFB_ANALYZE_ZEBRA, 0 },
+    { "isophote", SFB_ANALYZE_ISOPHOTE, 0 }, { "curvature", SFB_ANALYZE_CURVATURE, 0 }, { "normals", SFB_ANALYZE_NORMALS, 0 },
+    { "shaded", SFB_ANALYZE_SHADED, 0 }, { NULL, 0, 0 }
+};
+static const opt_choice curvature_choices[] = {
+    { "gaussian", SFB_CURVATURE_GAUSSIAN, 0 }, { "mean", SFB_CURVATURE_MEAN, 0 }, { "max", SFB_CURVATURE_MAX_ABS, 0 }, { NULL, 0, 0 }
+};
 
 #define AT(field) offsetof(cli_opts, field)
 #define ANY_INT -2147483647.0, 2147483647.0
@@ -111,7 +124,7 @@ static const opt_choice positions_choices[] = { { "refined", 0, 0 }, { "limit", 
 static const opt_spec options[] = {
     { "--scheme", NULL, K_SCHEME, C_REFINE, O_SCHEME, AT(scheme), "catmark|loop|bilinear", NULL, 0, 0, 0,
       "catmark, loop or bilinear", "subdivision scheme (default: from the file name prefix loop_ or bilinear_, else catmark)" },
-    { "--scheme", NULL, K_SCHEME, C_EVAL | C_TESS, O_SCHEME, AT(scheme), "catmark|loop|manifold|tribezier|pn", NULL, 0, 0, 0,
+    { "--scheme", NULL, K_SCHEME, C_EVAL | C_TESS | C_ANALYZE, O_SCHEME, AT(scheme), "catmark|loop|manifold|tribezier|pn", NULL, 0, 0, 0,
       "catmark, loop, manifold, tribezier or pn", "a subdivision limit surface, the manifold blending surface (seed 000), quartic\n"
       "triangular Bezier surfaces with sharpness (seed 004) or PN triangles\n"
       "(default: from the file name prefix loop_ or bilinear_, else catmark)" },
@@ -121,7 +134,7 @@ static const opt_spec options[] = {
       "catmark, loop, manifold, tribezier or pn", "subdivision scheme (default: from the file name prefix loop_, else catmark);\n"
       "manifold, tribezier, pn: draw the manifold blending surface (seed 000), the quartic triangular\n"
       "Bezier surface (seed 004) or PN triangles tessellated instead" },
-    { "--sharpness", NULL, K_DOUBLE, C_EVAL | C_TESS | C_RENDER, O_SHARPNESS, AT(sharpness), "S", NULL, 0, 0, 0, "a number in [0, 1]",
+    { "--sharpness", NULL, K_DOUBLE, C_EVAL | C_TESS | C_RENDER | C_ANALYZE, O_SHARPNESS, AT(sharpness), "S", NULL, 0, 0, 0, "a number in [0, 1]",
       "tribezier: one s in [0, 1] for every tagged crease and corner (default: each tag's\nsharpness clamped to [0, 1])" },
     { "--level", NULL, K_INT, C_REFINE, O_LEVEL, AT(level), "L", NULL, 0, 1000, 0, "a number >= 0",
       "uniform refinement level 0..10 (default 2)" },
@@ -129,7 +142,7 @@ static const opt_spec options[] = {
       "uniform refinement level 0..10 (default 3)" },
     { "--limit", NULL, K_SET, C_REFINE, O_LIMIT, AT(limit), NULL, NULL, 0, 0, 1, NULL,
       "write limit positions (and limit normals as vn) instead of refined points" },
-    { "--manifold-weights", "--weights", K_CHOICE, C_EVAL | C_TESS, O_WEIGHTS, AT(weights), NULL, weight_choices, 0, 0, 0, NULL,
+    { "--manifold-weights", "--weights", K_CHOICE, C_EVAL | C_TESS | C_ANALYZE, O_WEIGHTS, AT(weights), NULL, weight_choices, 0, 0, 0, NULL,
       "manifold blend weights: Hermite (default) or C-infinity (--weights: the old spelling)" },
     { "--locations", NULL, K_STRING, C_EVAL, O_LOCATIONS, AT(locfile), "FILE", NULL, 0, 0, 0, "a file name",
       "lines 'face u v' (parametric face; u, v in [0,1], and u + v <= 1 on Loop's\ntriangles; '#' starts a comment)" },
@@ -170,14 +183,37 @@ static const opt_spec options[] = {
     { "--positions", NULL, K_CHOICE, C_RENDER, O_POSITIONS, AT(limit_pos), NULL, positions_choices, 0, 0, 0, NULL,
       "refined points or limit positions (default limit)" },
     /* the range (1..8192) is the library's to check and report */
-    { "--size", NULL, K_SIZE, C_RENDER, O_SIZE, AT(size), "WxH", NULL, 0, 0, 0, "positive WxH, e.g. 800x600",
+    { "--size", NULL, K_SIZE, C_RENDER | C_ANALYZE, O_SIZE, AT(size), "WxH", NULL, 0, 0, 0, "positive WxH, e.g. 800x600",
       "picture size, 1..8192 each (default 640x480)" },
-    { "--view", NULL, K_VIEW, C_RENDER, O_VIEW, AT(view), "YAW,PITCH", NULL, 0, 0, 0, "YAW,PITCH in degrees, e.g. 30,20",
+    { "--view", NULL, K_VIEW, C_RENDER | C_ANALYZE, O_VIEW, AT(view), "YAW,PITCH", NULL, 0, 0, 0, "YAW,PITCH in degrees, e.g. 30,20",
       "camera angles in degrees around the y axis and above the xz plane (default 30,25)" },
-    { "--zoom", NULL, K_POSITIVE, C_RENDER, O_ZOOM, AT(zoom), "Z", NULL, 0, 1e6, 0, "a number > 0",
+    { "--zoom", NULL, K_POSITIVE, C_RENDER | C_ANALYZE, O_ZOOM, AT(zoom), "Z", NULL, 0, 1e6, 0, "a number > 0",
       "magnification (default 1: the bounding sphere fits)" },
     { "--stripes", NULL, K_POSITIVE, C_RENDER, O_STRIPES, AT(stripes), "N", NULL, 0, 1e5, 0, "a number in (0, 100000]",
       "highlight lines per object diameter (default 8)" },
+    { "--stripes", NULL, K_POSITIVE, C_ANALYZE, O_STRIPES, AT(stripes), "N", NULL, 0, 1e5, 0, "a number in (0, 100000]",
+      "stripes across the light (reflection: 24 over the plane; highlight: 8 per\n"
+      "object diameter; zebra: 16 per 180 degrees; isophote: 10 bands)" },
+    { "--mode", NULL, K_CHOICE, C_ANALYZE, O_AMODE, AT(amode), NULL, amode_choices, 0, 0, 0, NULL,
+      "what to draw from the exact surface (default reflection: seed 003's area light)" },
+    { "--light", NULL, K_STRING, C_ANALYZE, O_LIGHT, AT(light), "stripes|lattice|circles|FILE.png", NULL, 0, 0, 0,
+      "stripes, lattice, circles or a PNG file", "the light plane's texture (reflection, highlight; default stripes)" },
+    { "--band", NULL, K_POSITIVE, C_ANALYZE, O_BAND, AT(band), "W", NULL, 0, 0.999, 0, "a number in (0, 1)",
+      "lit share of each stripe period (circles: diameter per cell; default 0.5)" },
+    { "--curvature", NULL, K_CHOICE, C_ANALYZE, O_CURVATURE, AT(curvature), NULL, curvature_choices, 0, 0, 0, NULL,
+      "--mode curvature: Gaussian (default), mean or largest absolute principal" },
+    { "--level", NULL, K_INT, C_ANALYZE, O_LEVEL, AT(level), "L", NULL, 1, SFB_ANALYZE_MAX_LEVEL, 0, "a number in 1..8",
+      "proxy: 2^L segments per parametric-face edge (default 2); the picture\n"
+      "does not depend on it (every pixel is projected onto the exact surface)" },
+    { "--polygon-based", NULL, K_SET, C_ANALYZE, O_POLYGON, AT(polygon), NULL, NULL, 0, 0, 1, NULL,
+      "shade the proxy's interpolated limit normals instead (the method seed 003\n"
+      "shows to be wrong; for comparison)" },
+    { "--eye", NULL, K_VEC3, C_ANALYZE, O_EYE, AT(eye), "X,Y,Z", NULL, 0, 0, 0, "X,Y,Z, e.g. 0,2,5", "camera position (with --target)" },
+    { "--target", NULL, K_VEC3, C_ANALYZE, O_TARGET, AT(target), "X,Y,Z", NULL, 0, 0, 0, "X,Y,Z, e.g. 0,0,0", "point the camera looks at" },
+    { "--up", NULL, K_VEC3, C_ANALYZE, O_UP, AT(up), "X,Y,Z", NULL, 0, 0, 0, "X,Y,Z, e.g. 0,1,0", "camera up direction (default 0,1,0)" },
+    { "--fov", NULL, K_POSITIVE, C_ANALYZE, O_FOV, AT(fov), "DEG", NULL, 0, 178, 0, "degrees in (0, 178]",
+      "vertical field of view (default 30; --orthographic: the picture's height in model units)" },
+    { "--orthographic", NULL, K_SET, C_ANALYZE, O_ORTHO, AT(ortho), NULL, NULL, 0, 0, 1, NULL, "orthographic camera (default perspective)" },
     { "--edges", NULL, K_SET, C_RENDER, O_EDGES, AT(edges), NULL, NULL, 0, 0, 1, NULL, "draw the refined mesh's edges" },
     { "--rate", NULL, K_LONG, C_RENDER, O_RATE, AT(rate), "N", NULL, ANY_INT, 0, "a number",
       "--scheme manifold: segments per parametric-face edge, 1..1024 (default 16)" },
@@ -320,6 +356,18 @@ static int parse_view(const char *s, double *yp) {
     return end != ps && !*end && isfinite(yp[0]) && isfinite(yp[1]);
 }
 
+/* X,Y,Z, finite */
+static int parse_vec3(const char *s, double *xyz) {
+    char *end;
+    int i;
+    for (i = 0; i < 3; ++i) {
+        xyz[i] = strtod(s, &end);
+        if (end == s || !isfinite(xyz[i]) || *end != (i < 2 ? ',' : 0)) return 0;
+        s = end + 1;
+    }
+    return 1;
+}
+
 static int value_count(opt_kind k) { return k == K_HELP || k == K_SET ? 0 : k == K_LONG2 ? 2 : 1; }
 
 /* Stores the value(s) v of option s into *o; 0 when they are not what s needs. */
@@ -358,6 +406,7 @@ static int store_value(const opt_spec *s, char **v, cli_opts *o) {
         return 1;
     case K_SIZE: return parse_size(v[0], (long *)p);
     case K_VIEW: return parse_view(v[0], (double *)p);
+    case K_VEC3: return parse_vec3(v[0], (double *)p);
     }
     return 0;
 }
@@ -400,6 +449,7 @@ static void opts_init(cli_opts *o, const cli_command *c) {
     o->mode = SFB_RENDER_SHADED;
     o->size[0] = 640;
     o->size[1] = 480;
+    if (c->bit & C_ANALYZE) o->level = 2;
 }
 
 /* Reads command c's arguments into *o. Returns 0; 2 after a usage error (printed); -1 after
@@ -1139,6 +1189,99 @@ done:
     return rc;
 }
 
+/* ---- analyze: seed 003's exact per-pixel surface analysis ---- */
+static int analyze_light(const cli_opts *o, sfb_analyze_config *ac, unsigned char **texels) {
+    static const char *const names[3] = { "stripes", "lattice", "circles" };
+    int i, w = 0, h = 0;
+    if (!o->light) return 1;
+    for (i = 0; i < 3; ++i)
+        if (strcmp(o->light, names[i]) == 0) { ac->light_pattern = i; return 1; }
+    if (!cli_load_rgba(o->light, texels, &w, &h)) return 0;
+    ac->light_pattern = SFB_LIGHT_IMAGE;
+    ac->light_rgba = *texels;
+    ac->light_width = w;
+    ac->light_height = h;
+    return 1;
+}
+
+static int cmd_analyze(cli_opts *o) {
+    static const char *const mode_names[] = { "reflection lines", "highlight lines", "zebra", "isophotes", "curvature", "normals", "shading" };
+    static const char *const curv_names[] = { "Gaussian", "mean", "max |k|" };
+    int rc = 1, i;
+    sfb_scheme scheme = cli_scheme_for(o->in, o->seen[O_SCHEME], (sfb_scheme)o->scheme);
+    sfb_context *ctx = NULL;
+    sfb_mesh *mesh = NULL;
+    sfb_surface *surf = NULL;
+    sfb_analyze_config ac = sfb_analyze_config_init(o->amode);
+    sfb_analysis an;
+    unsigned char *texels = NULL;
+    sfb_result r;
+    cli_output out;
+    memset(&an, 0, sizeof an);
+    memset(&out, 0, sizeof out);
+    if (o->seen[O_EYE] != o->seen[O_TARGET]) return usage_error(o->cmd, "--eye and --target go together");
+    if (o->seen[O_UP] && !o->seen[O_EYE]) return usage_error(o->cmd, "--up needs --eye and --target");
+    if (o->seen[O_EYE] && (o->seen[O_VIEW] || o->seen[O_ZOOM])) return usage_error(o->cmd, "--eye/--target replace --view and --zoom");
+    if (o->seen[O_CURVATURE] && o->amode != SFB_ANALYZE_CURVATURE) return usage_error(o->cmd, "--curvature belongs to --mode curvature");
+    if (o->seen[O_LIGHT] && o->amode != SFB_ANALYZE_REFLECTION && o->amode != SFB_ANALYZE_HIGHLIGHT)
+        return usage_error(o->cmd, "--light belongs to --mode reflection and highlight");
+    if (!analyze_light(o, &ac, &texels)) return 1;
+    ac.width = (int)o->size[0];
+    ac.height = (int)o->size[1];
+    ac.level = o->level;
+    ac.polygon_based = o->polygon;
+    ac.curvature = o->curvature;
+    ac.stripes = (float)o->stripes;
+    ac.stripe_width = (float)o->band;
+    ac.orthographic = o->ortho;
+    ac.fov = (float)o->fov;
+    if (o->seen[O_VIEW]) { ac.view_set = 1; ac.yaw = (float)o->view[0]; ac.pitch = (float)o->view[1]; }
+    ac.zoom = (float)o->zoom;
+    if (o->seen[O_EYE]) {
+        ac.camera_set = 1;
+        for (i = 0; i < 3; ++i) {
+            ac.eye[i] = (float)o->eye[i];
+            ac.target[i] = (float)o->target[i];
+            ac.up[i] = o->seen[O_UP] ? (float)o->up[i] : (i == 1 ? 1.0f : 0.0f);
+        }
+    }
+    ctx = cli_make_context(o->backend);
+    if (!ctx) goto done;
+    mesh = cli_load_mesh(ctx, o->in, o->seen[O_CREASE_ANGLE] ? o->crease_angle : -1.0);
+    if (!mesh) goto done;
+    surf = make_patch_surface(ctx, mesh, o->in, scheme, o);
+    if (!surf) goto done;
+    r = sfb_surface_analyze(surf, &ac, &an);
+    if (r != SFB_SUCCESS) {
+        cli_error("%s: %s: %s", o->in, sfb_result_string(r), sfb_last_error(ctx));
+        goto done;
+    }
+    if (!cli_output_open(&out, o->outp)) goto done;
+    if (!stbi_write_png_to_func(png_to_file, out.f, an.width, an.height, 4, an.rgba, an.width * 4)) {
+        cli_error("encoding the PNG failed (out of memory)");
+        goto done;
+    }
+    cli_error("analyze %s%s%s of the %s surface (%s, level-%d proxy), %dx%d: %d surface pixels (proxy %d, %d grown to the exact "
+              "silhouette, %d dropped, %d on the proxy's point)%s -> %s (backend %s)",
+              o->amode == SFB_ANALYZE_CURVATURE ? curv_names[o->curvature] : "", o->amode == SFB_ANALYZE_CURVATURE ? " " : "",
+              mode_names[o->amode], sfb_scheme_name(scheme), o->polygon ? "polygon-based" : "exact per pixel", o->level, an.width, an.height,
+              an.covered_pixels, an.proxy_pixels, an.grown_pixels, an.dropped_pixels, an.fallback_pixels, "", o->outp,
+              sfb_context_backend_name(ctx));
+    if (o->amode == SFB_ANALYZE_CURVATURE)
+        cli_error("  curvature %g .. %g, colour map range +-%g", (double)an.value_min, (double)an.value_max, (double)an.range);
+    if (o->amode == SFB_ANALYZE_REFLECTION || o->amode == SFB_ANALYZE_HIGHLIGHT)
+        cli_error("  %d of %d rays meet the light plane", an.light_hits, an.covered_pixels);
+    rc = 0;
+done:
+    rc = cli_output_finish(&out, rc);
+    sfb_analysis_free(&an);
+    free(texels);
+    sfb_surface_destroy(surf);
+    sfb_mesh_destroy(mesh);
+    sfb_context_destroy(ctx);
+    return rc;
+}
+
 /* Probes every backend on its own: available with what it runs on, or why not. */
 static int cmd_backends(cli_opts *o) {
     int k;
@@ -1174,6 +1317,9 @@ static const cli_command commands[] = {
       "one of --highlight, --blend-weights, --normal-colors (default grey shading); --rate, --manifold-weights\n"
       "    and --trim belong to --scheme manifold, the shading options and --blend-weights to the other schemes",
       1, "OUT.png", cmd_render },
+    { "analyze", C_ANALYZE, "[options] IN.obj -o OUT.png", "surface quality (seed 003) from the exact limit surface per pixel (PNG)",
+      "every pixel is projected onto the exact surface along its view ray and shaded from its exact normal\n"
+      "    (and second derivatives): the picture does not depend on --level", 1, "OUT.png", cmd_analyze },
     { "backends", C_BACKENDS, "", "list the backends and whether each is available", NULL, 0, NULL, cmd_backends },
 };
 #define COMMAND_COUNT (sizeof commands / sizeof commands[0])

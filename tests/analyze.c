@@ -1,0 +1,464 @@
+/* Surface quality analysis (sfb_surface_analyze, src/analyze.c, seed 003) on every backend:
+ *   - analytic truth: regular Catmull-Clark grids whose control points sample the paraboloid
+ *     z = a (x^2 + y^2) (limit: the same paraboloid raised by 2a/3, since the uniform cubic
+ *     B-spline of the samples of x^2 is x^2 + 1/3) and the saddle z = a x y (reproduced exactly),
+ *     seen from straight above (orthographic) inside their regular region: the reflection
+ *     classes agree with the analytic ones on >= 99.5 % of the pixels, Gaussian and mean curvature
+ *     within 1e-4 relative;
+ *   - level independence: the classes of level-1 and level-4 proxies agree on >= 99.5 % of the
+ *     pixels both cover, on shapes with extraordinary vertices and creases (Catmull-Clark, Loop,
+ *     manifold blending), while the polygon-based method disagrees far more (both printed);
+ *   - no gaps: at level 1 no uncovered pixel is enclosed by the surface, and the coverage equals
+ *     a level-6 proxy's except within a one-pixel band of its silhouette;
+ *   - every backend against ref: >= 99.5 % identical classes, curvature within 1e-3 relative;
+ *   - bad configurations are refused with the output zeroed; cancellation; the memory budget.
+ * A backend that is unavailable SKIPs (FAILs when listed in SFB_REQUIRE_BACKENDS). */
+#include "surfblend.h"
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "harness.h"
+
+static const char *g_shapes = "../shared/peers/opensubdiv-shapes";
+
+/* A regular grid of n x n vertices, spacing 1, centred at 0, z = f(x, y). */
+static sfb_mesh *grid_mesh(sfb_context *ctx, int n, double a, int saddle) {
+    float *p = (float *)xmalloc((size_t)n * n * 3 * sizeof(float));
+    int *fs = (int *)xmalloc((size_t)(n - 1) * (n - 1) * sizeof(int)), *fv = (int *)xmalloc((size_t)(n - 1) * (n - 1) * 4 * sizeof(int));
+    int i, j, f = 0;
+    sfb_mesh_desc d;
+    sfb_mesh *m = NULL;
+    double c = 0.5 * (n - 1);
+    for (j = 0; j < n; ++j)
+        for (i = 0; i < n; ++i) {
+            double x = i - c, y = j - c;
+            p[3 * (j * n + i)] = (float)x;
+            p[3 * (j * n + i) + 1] = (float)y;
+            p[3 * (j * n + i) + 2] = (float)(saddle ? a * x * y : a * (x * x + y * y));
+        }
+    for (j = 0; j + 1 < n; ++j)
+        for (i = 0; i + 1 < n; ++i) {
+            fs[f] = 4;
+            fv[4 * f] = j * n + i; fv[4 * f + 1] = j * n + i + 1; fv[4 * f + 2] = (j + 1) * n + i + 1; fv[4 * f + 3] = (j + 1) * n + i;
+            ++f;
+        }
+    memset(&d, 0, sizeof d);
+    d.vertex_count = n * n; d.positions = p; d.face_count = f; d.face_sizes = fs; d.face_vertices = fv;
+    if (sfb_mesh_create(ctx, &d, &m) != SFB_SUCCESS) m = NULL;
+    free(p); free(fs); free(fv);
+    return m;
+}
+
+static sfb_surface *patch_surface(sfb_context *ctx, const sfb_mesh *m, sfb_scheme scheme) {
+    sfb_surface_config sc = sfb_surface_config_init(scheme, 0);
+    sfb_surface *s = NULL;
+    sc.flags = SFB_REFINE_PATCHES;
+    if (sfb_surface_create(ctx, m, &sc, &s) != SFB_SUCCESS) return NULL;
+    return s;
+}
+
+static sfb_mesh *load_shape(sfb_context *ctx, const char *path) {
+    size_t n;
+    char *t = slurp(path, &n);
+    sfb_mesh *m = NULL;
+    if (!t) return NULL;
+    if (sfb_mesh_read_obj(ctx, t, n, &m) != SFB_SUCCESS) m = NULL;
+    free(t);
+    return m;
+}
+
+/* The view from straight above onto the square [-h, h]^2 (orthographic). */
+static void top_view(sfb_analyze_config *c, double h, int size) {
+    c->width = c->height = size;
+    c->camera_set = 1;
+    c->orthographic = 1;
+    c->eye[0] = 0.0f; c->eye[1] = 0.0f; c->eye[2] = 30.0f;
+    c->target[0] = c->target[1] = c->target[2] = 0.0f;
+    c->up[0] = 0.0f; c->up[1] = 1.0f; c->up[2] = 0.0f;
+    c->fov = (float)(2.0 * h);
+}
+/* A light plane above: centre (0, 0, 12), facing down, axis x, 40 x 40, 20 stripes. */
+static void top_light(sfb_analyze_config *c) {
+    c->light_set = 1;
+    c->light_center[0] = 0.0f; c->light_center[1] = 0.0f; c->light_center[2] = 12.0f;
+    c->light_normal[0] = 0.0f; c->light_normal[1] = 0.0f; c->light_normal[2] = -1.0f;
+    c->light_axis[0] = 1.0f; c->light_axis[1] = 0.0f; c->light_axis[2] = 0.0f;
+    c->light_size[0] = c->light_size[1] = 40.0f;
+    c->stripes = 20.0f;
+}
+
+/* ---- analytic truth ---- */
+typedef struct surf_pt { double z, fx, fy, fxx, fxy, fyy; } surf_pt;
+static surf_pt analytic(double a, int saddle, double x, double y) {
+    surf_pt s;
+    if (saddle) { s.z = a * x * y; s.fx = a * y; s.fy = a * x; s.fxx = 0.0; s.fxy = a; s.fyy = 0.0; }
+    else { s.z = a * (x * x + y * y) + 2.0 * a / 3.0; s.fx = 2.0 * a * x; s.fy = 2.0 * a * y; s.fxx = 2.0 * a; s.fxy = 0.0; s.fyy = 2.0 * a; }
+    return s;
+}
+
+static void test_analytic(sfb_context *ctx, int saddle) {
+    const double a = saddle ? 0.06 : 0.05, h = 3.5;
+    const int size = 160;
+    char name[128];
+    sfb_mesh *m = grid_mesh(ctx, 16, a, saddle);
+    sfb_surface *s = m ? patch_surface(ctx, m, SFB_SCHEME_CATMARK) : NULL;
+    sfb_analyze_config c = sfb_analyze_config_init(SFB_ANALYZE_REFLECTION);
+    sfb_analysis an;
+    int kind, x, y;
+    snprintf(name, sizeof name, "analytic_%s_reflection", saddle ? "saddle" : "paraboloid");
+    if (!s) { fail(name, "no surface: %s", sfb_last_error(ctx)); sfb_mesh_destroy(m); return; }
+    top_view(&c, h, size);
+    top_light(&c);
+    c.level = 1;
+    if (sfb_surface_analyze(s, &c, &an) != SFB_SUCCESS) fail(name, "%s", sfb_last_error(ctx));
+    else {
+        long same = 0, total = 0;
+        double worst = 0.0;
+        for (y = 0; y < size; ++y)
+            for (x = 0; x < size; ++x) {
+                /* the pixel centre's ray: (px, py) in the model, straight down */
+                double px = -h + 2.0 * h * (x + 0.5) / size, py = h - 2.0 * h * (y + 0.5) / size, n[3], r[3], l, mu, X[3], w;
+                surf_pt t = analytic(a, saddle, px, py);
+                int cls, k = y * size + x;
+                n[0] = -t.fx; n[1] = -t.fy; n[2] = 1.0;
+                l = sqrt(n[0] * n[0] + n[1] * n[1] + 1.0);
+                n[0] /= l; n[1] /= l; n[2] /= l;
+                /* v = (0, 0, 1) toward the viewer; r = 2 (v.n) n - v */
+                r[0] = 2.0 * n[2] * n[0]; r[1] = 2.0 * n[2] * n[1]; r[2] = 2.0 * n[2] * n[2] - 1.0;
+                mu = (12.0 - t.z) / r[2];
+                X[0] = px + mu * r[0]; X[1] = py + mu * r[1]; X[2] = t.z + mu * r[2];
+                w = (X[0] / 40.0 + 0.5) * 20.0;
+                cls = (w - floor(w)) < 0.5 ? 3 : 2;
+                ++total;
+                same += an.classes[k] == cls;
+                if (isfinite(an.values[k]) && fabs(an.values[k] - w) > worst) worst = fabs(an.values[k] - w);
+            }
+        check(same >= 0.995 * total, name, "classes agree on %.3f %% of %ld pixels (worst stripe coordinate error %.2e)",
+              100.0 * same / total, total, worst);
+        printf("# %s: %.3f %% of %ld pixels agree, stripe coordinate within %.2e\n", name, 100.0 * same / total, total, worst);
+        sfb_analysis_free(&an);
+    }
+    for (kind = 0; kind < 2; ++kind) {
+        snprintf(name, sizeof name, "analytic_%s_%s_curvature", saddle ? "saddle" : "paraboloid", kind ? "mean" : "gaussian");
+        c = sfb_analyze_config_init(SFB_ANALYZE_CURVATURE);
+        top_view(&c, h, size);
+        c.curvature = kind ? SFB_CURVATURE_MEAN : SFB_CURVATURE_GAUSSIAN;
+        c.level = 1;
+        if (sfb_surface_analyze(s, &c, &an) != SFB_SUCCESS) { fail(name, "%s", sfb_last_error(ctx)); continue; }
+        {
+            double worst = 0.0, scale = 0.0;
+            long bad = 0, total = 0;
+            for (y = 0; y < size; ++y)
+                for (x = 0; x < size; ++x) {
+                    double px = -h + 2.0 * h * (x + 0.5) / size, py = h - 2.0 * h * (y + 0.5) / size, W2, K, H, want, got, e;
+                    surf_pt t = analytic(a, saddle, px, py);
+                    W2 = 1.0 + t.fx * t.fx + t.fy * t.fy;
+                    K = (t.fxx * t.fyy - t.fxy * t.fxy) / (W2 * W2);
+                    /* the library's sign: convex toward the viewer (above) positive */
+                    H = -((1.0 + t.fx * t.fx) * t.fyy - 2.0 * t.fx * t.fy * t.fxy + (1.0 + t.fy * t.fy) * t.fxx) / (2.0 * pow(W2, 1.5));
+                    want = kind ? H : K;
+                    got = an.values[y * size + x];
+                    scale = fabs(want) > scale ? fabs(want) : scale;
+                    /* relative to the value, or where it passes through 0 (the saddle's mean
+                     * curvature on the axes) to a hundredth of the shape's scale a */
+                    e = fabs(got - want) / (fabs(want) > 1e-2 * a ? fabs(want) : 1e-2 * a);
+                    if (!(e <= 1e-4)) ++bad;
+                    if (e > worst || !isfinite(e)) worst = isfinite(e) ? e : HUGE_VAL;
+                    ++total;
+                }
+            check(bad == 0, name, "%ld of %ld pixels off by more than 1e-4 relative (worst %.2e)", bad, total, worst);
+            printf("# %s: worst relative error %.2e over %ld pixels\n", name, worst, total);
+        }
+        sfb_analysis_free(&an);
+    }
+    sfb_surface_destroy(s);
+    sfb_mesh_destroy(m);
+}
+
+/* ---- level independence, no gaps ---- */
+typedef struct shape { const char *label, *path; sfb_scheme scheme; } shape;
+
+/* Share of pixels covered in both with the same class, over those covered in both. */
+static double agreement(const sfb_analysis *a, const sfb_analysis *b, long *both) {
+    long n = 0, same = 0, k, np = (long)a->width * a->height;
+    for (k = 0; k < np; ++k)
+        if (a->classes[k] && b->classes[k]) { ++n; same += a->classes[k] == b->classes[k]; }
+    *both = n;
+    return n ? (double)same / n : 0.0;
+}
+
+static int analyze_at(sfb_surface *s, int level, int polygon, sfb_analysis *an) {
+    sfb_analyze_config c = sfb_analyze_config_init(SFB_ANALYZE_REFLECTION);
+    c.width = 240; c.height = 180;
+    c.level = level;
+    c.polygon_based = polygon;
+    return sfb_surface_analyze(s, &c, an) == SFB_SUCCESS;
+}
+
+/* Uncovered pixels that the background, flooded from the border, does not reach. */
+static long enclosed_holes(const sfb_analysis *a) {
+    int w = a->width, h = a->height;
+    long n = (long)w * h, k, holes = 0, top = 0;
+    unsigned char *seen = (unsigned char *)calloc((size_t)n, 1);
+    long *stack = (long *)xmalloc((size_t)n * sizeof(long));
+    for (k = 0; k < n; ++k) {
+        int x = (int)(k % w), y = (int)(k / w);
+        if ((x == 0 || y == 0 || x == w - 1 || y == h - 1) && a->classes[k] == 0) { seen[k] = 1; stack[top++] = k; }
+    }
+    while (top > 0) {
+        long q = stack[--top];
+        int x = (int)(q % w), y = (int)(q / w), d;
+        static const int dx[4] = { 1, -1, 0, 0 }, dy[4] = { 0, 0, 1, -1 };
+        for (d = 0; d < 4; ++d) {
+            int nx = x + dx[d], ny = y + dy[d];
+            long r;
+            if (nx < 0 || ny < 0 || nx >= w || ny >= h) continue;
+            r = (long)ny * w + nx;
+            if (!seen[r] && a->classes[r] == 0) { seen[r] = 1; stack[top++] = r; }
+        }
+    }
+    for (k = 0; k < n; ++k) holes += a->classes[k] == 0 && !seen[k];
+    free(seen);
+    free(stack);
+    return holes;
+}
+
+/* Pixels whose coverage differs from ref's that are not next to ref's silhouette. */
+static long coverage_off_band(const sfb_analysis *a, const sfb_analysis *ref) {
+    int w = a->width, h = a->height, x, y, dx, dy;
+    long off = 0;
+    for (y = 0; y < h; ++y)
+        for (x = 0; x < w; ++x) {
+            long k = (long)y * w + x;
+            int ca = a->classes[k] != 0, cr = ref->classes[k] != 0, band = 0;
+            if (ca == cr) continue;
+            for (dy = -1; dy <= 1 && !band; ++dy)
+                for (dx = -1; dx <= 1; ++dx) {
+                    int nx = x + dx, ny = y + dy;
+                    if (nx < 0 || ny < 0 || nx >= w || ny >= h) continue;
+                    if ((ref->classes[(long)ny * w + nx] != 0) != cr) { band = 1; break; }
+                }
+            off += !band;
+        }
+    return off;
+}
+
+static void test_levels(sfb_context *ctx, const shape *shapes, int count) {
+    int i;
+    for (i = 0; i < count; ++i) {
+        char name[160];
+        sfb_mesh *m = load_shape(ctx, shapes[i].path);
+        sfb_surface *s = m ? patch_surface(ctx, m, shapes[i].scheme) : NULL;
+        sfb_analysis e1, e4, p1, p4, e6;
+        long both_e, both_p;
+        double ae, ap;
+        snprintf(name, sizeof name, "level_independence_%s", shapes[i].label);
+        if (!m) { skip(name, "shape not found"); continue; }
+        if (!s) { fail(name, "no surface: %s", sfb_last_error(ctx)); sfb_mesh_destroy(m); continue; }
+        memset(&e1, 0, sizeof e1); memset(&e4, 0, sizeof e4); memset(&p1, 0, sizeof p1); memset(&p4, 0, sizeof p4); memset(&e6, 0, sizeof e6);
+        if (!analyze_at(s, 1, 0, &e1) || !analyze_at(s, 4, 0, &e4) || !analyze_at(s, 1, 1, &p1) || !analyze_at(s, 4, 1, &p4) ||
+            !analyze_at(s, 6, 0, &e6)) {
+            fail(name, "%s", sfb_last_error(ctx));
+        } else {
+            ae = agreement(&e1, &e4, &both_e);
+            ap = agreement(&p1, &p4, &both_p);
+            printf("# %s: exact per pixel level 1 vs 4 agree on %.3f %% of %ld pixels; polygon-based on %.3f %% of %ld "
+                   "(level 1: %d fallback, %d grown, %d dropped)\n",
+                   shapes[i].label, 100.0 * ae, both_e, 100.0 * ap, both_p, e1.fallback_pixels, e1.grown_pixels, e1.dropped_pixels);
+            check(ae >= 0.995 && both_e > 1000, name, "level 1 vs 4 agree on %.3f %% of %ld pixels (>= 99.5 %% wanted)", 100.0 * ae, both_e);
+            snprintf(name, sizeof name, "polygon_based_depends_on_level_%s", shapes[i].label);
+            check(1.0 - ap >= 3.0 * (1.0 - ae) && 1.0 - ap > 0.01, name, "polygon-based disagreement %.3f %% vs exact %.3f %%",
+                  100.0 * (1.0 - ap), 100.0 * (1.0 - ae));
+            snprintf(name, sizeof name, "no_gaps_%s", shapes[i].label);
+            {
+                long holes = enclosed_holes(&e1), off = coverage_off_band(&e1, &e6);
+                check(holes == 0 && off == 0, name, "level 1: %ld enclosed uncovered pixels, %ld coverage differences from level 6 outside the one-pixel band",
+                      holes, off);
+                printf("# %s: level-1 proxy covers %d pixels, the exact surface %d (level 6: %d)\n", shapes[i].label, e1.proxy_pixels,
+                       e1.covered_pixels, e6.covered_pixels);
+            }
+        }
+        sfb_analysis_free(&e1); sfb_analysis_free(&e4); sfb_analysis_free(&p1); sfb_analysis_free(&p4); sfb_analysis_free(&e6);
+        sfb_surface_destroy(s);
+        sfb_mesh_destroy(m);
+    }
+}
+
+/* ---- backends against ref ---- */
+static void test_backends(const shape *shapes, int count) {
+    int b, i, mode;
+    for (b = 1; b < g_nbe; ++b) {
+        const backend *be = &g_be[b];
+        for (i = 0; i < count; ++i)
+            for (mode = 0; mode < 2; ++mode) {
+                char name[160];
+                sfb_mesh *mr, *mb;
+                sfb_surface *sr, *sb;
+                sfb_analyze_config c = sfb_analyze_config_init(mode ? SFB_ANALYZE_CURVATURE : SFB_ANALYZE_REFLECTION);
+                sfb_analysis ar, ab;
+                snprintf(name, sizeof name, "backend_%s_%s_%s", be->name, shapes[i].label, mode ? "curvature" : "reflection");
+                if (!be->available) { backend_missing(be, name); continue; }
+                mr = load_shape(g_be[0].ctx, shapes[i].path);
+                mb = load_shape(be->ctx, shapes[i].path);
+                if (!mr || !mb) { skip(name, "shape not found"); sfb_mesh_destroy(mr); sfb_mesh_destroy(mb); continue; }
+                sr = patch_surface(g_be[0].ctx, mr, shapes[i].scheme);
+                sb = patch_surface(be->ctx, mb, shapes[i].scheme);
+                c.width = 200; c.height = 150; c.level = 2;
+                c.curvature = SFB_CURVATURE_MEAN;
+                memset(&ar, 0, sizeof ar); memset(&ab, 0, sizeof ab);
+                /* the backend runs with ref's colour range (the automatic one is a percentile over the
+                 * covered pixels, which may differ by a grazing pixel or two at the silhouette) */
+                if (!sr || !sb || sfb_surface_analyze(sr, &c, &ar) != SFB_SUCCESS ||
+                    (c.curvature_range = mode ? ar.range : 0.0f, sfb_surface_analyze(sb, &c, &ab)) != SFB_SUCCESS) {
+                    fail(name, "%s / %s", sfb_last_error(g_be[0].ctx), sfb_last_error(be->ctx));
+                } else {
+                    long k, np = (long)ar.width * ar.height, same = 0, cov = 0, bad = 0, both = 0;
+                    for (k = 0; k < np; ++k) {
+                        if (ar.classes[k] || ab.classes[k]) { ++cov; same += ar.classes[k] == ab.classes[k]; }
+                        if (mode && ar.classes[k] && ab.classes[k] && isfinite(ar.values[k])) {
+                            double x = ar.values[k], y = ab.values[k], sc = fabs(x) > fabs(ar.range) * 1e-3 ? fabs(x) : fabs(ar.range) * 1e-3;
+                            ++both;
+                            if (!(fabs(x - y) <= 1e-3 * sc)) ++bad;
+                        }
+                    }
+                    if (mode)
+                        check(same >= 0.995 * cov && bad <= 0.005 * both, name, "%.3f %% identical classes, %ld of %ld curvatures off by > 1e-3 relative",
+                              100.0 * same / (cov ? cov : 1), bad, both);
+                    else
+                        check(same >= 0.995 * cov, name, "%.3f %% identical classes of %ld pixels", 100.0 * same / (cov ? cov : 1), cov);
+                }
+                sfb_analysis_free(&ar); sfb_analysis_free(&ab);
+                sfb_surface_destroy(sr); sfb_surface_destroy(sb);
+                sfb_mesh_destroy(mr); sfb_mesh_destroy(mb);
+            }
+    }
+}
+
+/* ---- bad configurations, cancellation, budget ---- */
+static int zeroed(const sfb_analysis *a) {
+    sfb_analysis z;
+    memset(&z, 0, sizeof z);
+    return memcmp(a, &z, sizeof z) == 0;
+}
+static void refused(sfb_surface *s, sfb_context *ctx, const sfb_analyze_config *c, sfb_result want, const char *name) {
+    sfb_analysis a;
+    sfb_result r;
+    memset(&a, 0x5a, sizeof a);
+    r = sfb_surface_analyze(s, c, &a);
+    check(r == want && zeroed(&a) && strlen(sfb_last_error(ctx)) > 10, name, "got %s (%s), output %s", sfb_result_string(r), sfb_last_error(ctx),
+          zeroed(&a) ? "zeroed" : "not zeroed");
+    if (r == SFB_SUCCESS) sfb_analysis_free(&a);
+}
+
+static int cancel_at_half(float done, const char *stage, void *user) {
+    if (strcmp(stage, "analyze") != 0) return 0;
+    ++*(int *)user;
+    return done > 0.5f;
+}
+
+static void test_bad(sfb_context *ctx) {
+    sfb_mesh *m = grid_mesh(ctx, 10, 0.0, 0);
+    sfb_surface *s = m ? patch_surface(ctx, m, SFB_SCHEME_CATMARK) : NULL;
+    sfb_analyze_config c, base = sfb_analyze_config_init(SFB_ANALYZE_REFLECTION);
+    static const unsigned char texel[4] = { 255, 255, 255, 255 };
+    if (!s) { fail("bad_config", "no surface"); sfb_mesh_destroy(m); return; }
+    top_view(&base, 3.0, 64);
+    c = base; c.width = 0; refused(s, ctx, &c, SFB_INVALID_ARGS, "bad_zero_size_image");
+    c = base; c.height = -3; refused(s, ctx, &c, SFB_INVALID_ARGS, "bad_negative_size");
+    c = base; c.width = SFB_ANALYZE_MAX_SIZE + 1; refused(s, ctx, &c, SFB_LIMIT_EXCEEDED, "bad_size_over_limit");
+    c = base; c.level = SFB_ANALYZE_MAX_LEVEL + 1; refused(s, ctx, &c, SFB_LIMIT_EXCEEDED, "bad_level_over_limit");
+    c = base; c.mode = 99; refused(s, ctx, &c, SFB_INVALID_ARGS, "bad_mode");
+    c = base; c.eye[1] = NAN; refused(s, ctx, &c, SFB_INVALID_VALUE, "bad_nan_eye");
+    c = base; c.target[2] = c.eye[2]; c.target[0] = c.eye[0]; c.target[1] = c.eye[1]; refused(s, ctx, &c, SFB_INVALID_VALUE, "bad_eye_equals_target");
+    c = base; c.near_plane = -1.0f; c.eye[2] = 0.0f; c.target[2] = -1.0f; refused(s, ctx, &c, SFB_INVALID_VALUE, "bad_negative_near_plane_inside_bbox");
+    c = base; c.fov = NAN; refused(s, ctx, &c, SFB_INVALID_VALUE, "bad_nan_fov");
+    c = base; top_light(&c); c.light_normal[0] = c.light_normal[1] = c.light_normal[2] = 0.0f; refused(s, ctx, &c, SFB_INVALID_VALUE, "bad_zero_light_normal");
+    c = base; top_light(&c); c.light_axis[0] = 0.0f; c.light_axis[2] = 1.0f; refused(s, ctx, &c, SFB_INVALID_VALUE, "bad_light_axis_along_normal");
+    /* a flat sheet seen from above reflects every ray straight up: a light plane standing
+     * upright is parallel to all of them */
+    c = base; top_light(&c);
+    c.light_normal[0] = 1.0f; c.light_normal[2] = 0.0f; c.light_axis[0] = 0.0f; c.light_axis[1] = 1.0f;
+    refused(s, ctx, &c, SFB_INVALID_VALUE, "bad_light_plane_parallel_to_every_ray");
+    c = base; c.light_pattern = SFB_LIGHT_IMAGE; c.light_rgba = texel; c.light_width = 0; c.light_height = 1;
+    refused(s, ctx, &c, SFB_INVALID_VALUE, "bad_zero_size_light_texture");
+    c = base; c.light_pattern = SFB_LIGHT_IMAGE; c.light_rgba = NULL; c.light_width = 1; c.light_height = 1;
+    refused(s, ctx, &c, SFB_INVALID_VALUE, "bad_light_texture_without_texels");
+    c = base; c.stripes = NAN; refused(s, ctx, &c, SFB_INVALID_VALUE, "bad_nan_stripes");
+    c = base; c.polygon_based = 1; c.mode = SFB_ANALYZE_CURVATURE; refused(s, ctx, &c, SFB_INVALID_ARGS, "bad_polygon_based_curvature");
+    {
+        sfb_analysis a;
+        sfb_result r = sfb_surface_analyze(s, &base, NULL);
+        check(r == SFB_INVALID_ARGS, "bad_null_output", "got %s", sfb_result_string(r));
+        memset(&a, 0, sizeof a);
+        r = sfb_surface_analyze(s, &base, &a);
+        check(r == SFB_SUCCESS && a.covered_pixels == 64 * 64, "flat_sheet_covers_the_picture", "%s: %d of %d pixels", sfb_result_string(r),
+              a.covered_pixels, 64 * 64);
+        sfb_analysis_free(&a);
+    }
+    sfb_surface_destroy(s);
+    sfb_mesh_destroy(m);
+    {
+        /* cancellation from the progress callback, and the memory budget checked first */
+        sfb_context_config cc = sfb_context_config_init();
+        sfb_context *c2 = NULL;
+        int calls = 0;
+        cc.progress.func = cancel_at_half;
+        cc.progress.user = &calls;
+        cc.ignore_environment = 1;
+        if (sfb_context_create(&cc, &c2) == SFB_SUCCESS) {
+            sfb_mesh *m2 = grid_mesh(c2, 10, 0.05, 0);
+            sfb_surface *s2 = m2 ? patch_surface(c2, m2, SFB_SCHEME_CATMARK) : NULL;
+            sfb_analysis a;
+            sfb_result r;
+            memset(&a, 0x5a, sizeof a);
+            calls = 0;
+            r = s2 ? sfb_surface_analyze(s2, &base, &a) : SFB_OUT_OF_MEMORY;
+            check(r == SFB_CANCELLED && zeroed(&a) && calls > 1, "cancelled_by_progress", "got %s after %d reports", sfb_result_string(r), calls);
+            sfb_surface_destroy(s2);
+            sfb_mesh_destroy(m2);
+            sfb_context_destroy(c2);
+        } else fail("cancelled_by_progress", "no context");
+        cc = sfb_context_config_init();
+        cc.ignore_environment = 1;
+        cc.memory_budget = 8u << 20;
+        if (sfb_context_create(&cc, &c2) == SFB_SUCCESS) {
+            sfb_mesh *m2 = grid_mesh(c2, 10, 0.05, 0);
+            sfb_surface *s2 = m2 ? patch_surface(c2, m2, SFB_SCHEME_CATMARK) : NULL;
+            sfb_analyze_config big = base;
+            big.width = big.height = 4096;
+            if (s2) refused(s2, c2, &big, SFB_LIMIT_EXCEEDED, "memory_budget_checked_first");
+            else fail("memory_budget_checked_first", "no surface");
+            sfb_surface_destroy(s2);
+            sfb_mesh_destroy(m2);
+            sfb_context_destroy(c2);
+        } else fail("memory_budget_checked_first", "no context");
+    }
+}
+
+int main(int argc, char **argv) {
+    sfb_context *ctx = NULL;
+    sfb_context_config cc = sfb_context_config_init();
+    char p[4][1024];
+    shape shapes[4];
+    if (argc > 1) g_shapes = argv[1];
+    snprintf(p[0], sizeof p[0], "examples/data/creased_box.obj");
+    snprintf(p[1], sizeof p[1], "%s/catmark_cube_creases1.obj", g_shapes);
+    snprintf(p[2], sizeof p[2], "%s/loop_cube_creases1.obj", g_shapes);
+    snprintf(p[3], sizeof p[3], "examples/data/manifold_features.obj");
+    shapes[0].label = "creased_box"; shapes[0].path = p[0]; shapes[0].scheme = SFB_SCHEME_CATMARK;
+    shapes[1].label = "catmark_cube_creases1"; shapes[1].path = p[1]; shapes[1].scheme = SFB_SCHEME_CATMARK;
+    shapes[2].label = "loop_cube_creases1"; shapes[2].path = p[2]; shapes[2].scheme = SFB_SCHEME_LOOP;
+    shapes[3].label = "manifold_features"; shapes[3].path = p[3]; shapes[3].scheme = SFB_SCHEME_MANIFOLD_BLEND;
+    cc.ignore_environment = 1;
+    if (sfb_context_create(&cc, &ctx) != SFB_SUCCESS) { printf("no context\n"); return 1; }
+    test_analytic(ctx, 0);
+    test_analytic(ctx, 1);
+    test_levels(ctx, shapes, 4);
+    test_bad(ctx);
+    sfb_context_destroy(ctx);
+    if (!probe_backends()) return 1;
+    test_backends(shapes, 3);
+    return finish_tests();
+}
