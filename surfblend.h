@@ -11888,7 +11888,7 @@ done:
 #define SFB__AN_TOL 2e-3      /* pixels: a hit */
 #define SFB__AN_NEAR 0.5      /* pixels: within this, a non-converged attempt may fall back to the proxy */
 #define SFB__AN_ROUNDS 64
-#define SFB__AN_DILATE 2.0    /* pixels: uncovered pixels this close to a proxy triangle are seeded from it too */
+#define SFB__AN_DILATE 2.0    /* pixels: uncovered pixels this close to a thin proxy triangle are seeded from it too */
 #define SFB__AN_MARGIN 0.92   /* the bounding sphere's share of the smaller side (as sfb_render) */
 
 SFB_API sfb_analyze_config sfb_analyze_config_init(int mode) {
@@ -12057,6 +12057,7 @@ typedef struct sfb__an {
     int *cface;                  /* uncovered pixels within SFB__AN_DILATE pixels of a proxy triangle: its face, */
     float *cuv, *cdist;          /* the (u,v) of its nearest point, the distance in pixels */
     int *hit;                    /* index into the hit arrays, -1: none */
+    int *adj;                    /* per face and side: (4 * neighbour face + its side) * 2 + reversed, -1: none */
     unsigned char *state;        /* SFB__AN_* per pixel */
     /* hits (compact) */
     int nhit, cap;
@@ -12135,6 +12136,73 @@ static sfb_result sfb__an_proxy(sfb__an *A) {
     return r;
 }
 
+/* ---- parametric-face adjacency, from the proxy (for Newton steps that leave a face) ----
+ * Sides: quad 0 (v = 0, u = t), 1 (u = 1, v = t), 2 (v = 1, u = 1 - t), 3 (u = 0, v = 1 - t);
+ * triangle 0 (v = 0, u = t), 1 (u + v = 1, v = t), 2 (u = 0, v = 1 - t); t runs from the side's
+ * first corner to its next. Two sides are neighbours when their ends and middles (proxy points,
+ * evaluated from each face's own patch) coincide within 1e-5 bounding radii: a crease edge, a
+ * Catmull-Clark n-gon's inner sides and a Loop edge alike. */
+static void sfb__an_side_point(int tri, int side, double t, double *u, double *v) {
+    if (tri) {
+        if (side == 0) { *u = t; *v = 0.0; }
+        else if (side == 1) { *u = 1.0 - t; *v = t; }
+        else { *u = 0.0; *v = 1.0 - t; }
+        return;
+    }
+    if (side == 0) { *u = t; *v = 0.0; }
+    else if (side == 1) { *u = 1.0; *v = t; }
+    else if (side == 2) { *u = 1.0 - t; *v = 1.0; }
+    else { *u = 0.0; *v = 1.0 - t; }
+}
+/* The grid index of the point at t = k / R on a side. */
+static int sfb__an_side_grid(const sfb__an *A, int side, int k) {
+    int R = A->R;
+    double u, v;
+    sfb__an_side_point(A->tri, side, (double)k / R, &u, &v);
+    return sfb__an_grid_index(A, (int)floor(u * R + 0.5), (int)floor(v * R + 0.5));
+}
+typedef struct sfb__an_side { long long key; int face, side; } sfb__an_side;
+static int sfb__an_side_cmp(const void *a, const void *b) {
+    const sfb__an_side *x = (const sfb__an_side *)a, *y = (const sfb__an_side *)b;
+    return x->key < y->key ? -1 : x->key > y->key ? 1 : 0;
+}
+static int sfb__an_close(const float *a, const float *b, double tol) {
+    return fabs((double)a[0] - b[0]) <= tol && fabs((double)a[1] - b[1]) <= tol && fabs((double)a[2] - b[2]) <= tol;
+}
+static sfb_result sfb__an_adjacency(sfb__an *A) {
+    int ns = A->tri ? 3 : 4, f, k, n = 0, i, j;
+    double q = 1e-4 * A->radius, tol = 1e-5 * A->radius;
+    sfb__an_side *sd = (sfb__an_side *)sfb__alloc(A->ctx, ((size_t)A->nf * ns + 1) * sizeof *sd);
+    if (!sd) return sfb__oom(A->ctx, "the analysis face adjacency");
+    for (i = 0; i < A->nf * 4; ++i) A->adj[i] = -1;
+    for (f = 0; f < A->nf; ++f)
+        for (k = 0; k < ns; ++k) {
+            const float *m = A->gpos + 3 * ((size_t)f * A->per + sfb__an_side_grid(A, k, A->R / 2));
+            unsigned long long h = 1469598103934665603ull;
+            int c;
+            if (!sfb__an_finite3(m)) continue;
+            for (c = 0; c < 3; ++c) { h ^= (unsigned long long)(long long)floor(m[c] / q); h *= 1099511628211ull; }
+            sd[n].key = (long long)(h >> 1); sd[n].face = f; sd[n].side = k; ++n;
+        }
+    qsort(sd, (size_t)n, sizeof *sd, sfb__an_side_cmp);
+    for (i = 0; i < n; i = j) {
+        for (j = i + 1; j < n && sd[j].key == sd[i].key; ++j) {}
+        if (j - i == 2) {
+            const sfb__an_side *a = &sd[i], *b = &sd[i + 1];
+            const float *a0 = A->gpos + 3 * ((size_t)a->face * A->per + sfb__an_side_grid(A, a->side, 0));
+            const float *a1 = A->gpos + 3 * ((size_t)a->face * A->per + sfb__an_side_grid(A, a->side, A->R));
+            const float *b0 = A->gpos + 3 * ((size_t)b->face * A->per + sfb__an_side_grid(A, b->side, 0));
+            const float *b1 = A->gpos + 3 * ((size_t)b->face * A->per + sfb__an_side_grid(A, b->side, A->R));
+            int rev = sfb__an_close(a0, b1, tol) && sfb__an_close(a1, b0, tol), same = sfb__an_close(a0, b0, tol) && sfb__an_close(a1, b1, tol);
+            if (a->face == b->face || (!rev && !same)) continue;
+            A->adj[4 * a->face + a->side] = (4 * b->face + b->side) * 2 + rev;
+            A->adj[4 * b->face + b->side] = (4 * a->face + a->side) * 2 + rev;
+        }
+    }
+    sfb__free(A->ctx, sd);
+    return SFB_SUCCESS;
+}
+
 /* The camera (the config's or sfb_render's orbit) from the control mesh's bounding box (not the
  * proxy's: the picture must not depend on the proxy's level). */
 static void sfb__an_camera(sfb__an *A) {
@@ -12185,7 +12253,7 @@ static void sfb__an_camera(sfb__an *A) {
 
 /* Step 1b: rasterises one proxy triangle (grid points g[3] of face f). */
 static void sfb__an_raster_tri(sfb__an *A, int f, const int *g) {
-    double sx[3], sy[3], sz[3], q[3], uu[3], vv[3], area, inv, minx, maxx, miny, maxy, elen[3];
+    double sx[3], sy[3], sz[3], q[3], uu[3], vv[3], area, inv, minx, maxx, miny, maxy, elen[3], dilate;
     int k, x, y, ix0, ix1, iy0, iy1;
     const float *P[3];
     for (k = 0; k < 3; ++k) {
@@ -12204,15 +12272,28 @@ static void sfb__an_raster_tri(sfb__an *A, int f, const int *g) {
     maxx = sx[0] > sx[1] ? (sx[0] > sx[2] ? sx[0] : sx[2]) : (sx[1] > sx[2] ? sx[1] : sx[2]);
     miny = sy[0] < sy[1] ? (sy[0] < sy[2] ? sy[0] : sy[2]) : (sy[1] < sy[2] ? sy[1] : sy[2]);
     maxy = sy[0] > sy[1] ? (sy[0] > sy[2] ? sy[0] : sy[2]) : (sy[1] > sy[2] ? sy[1] : sy[2]);
-    minx = sfb__an_clamp(ceil(minx - 0.5 - SFB__AN_DILATE), 0.0, (double)A->w);
-    maxx = sfb__an_clamp(floor(maxx - 0.5 + SFB__AN_DILATE), -1.0, (double)A->w - 1.0);
-    miny = sfb__an_clamp(ceil(miny - 0.5 - SFB__AN_DILATE), 0.0, (double)A->h);
-    maxy = sfb__an_clamp(floor(maxy - 0.5 + SFB__AN_DILATE), -1.0, (double)A->h - 1.0);
-    ix0 = (int)minx; ix1 = (int)maxx; iy0 = (int)miny; iy1 = (int)maxy;
-    inv = 1.0 / area;
     elen[0] = sqrt((sx[2] - sx[1]) * (sx[2] - sx[1]) + (sy[2] - sy[1]) * (sy[2] - sy[1]));
     elen[1] = sqrt((sx[0] - sx[2]) * (sx[0] - sx[2]) + (sy[0] - sy[2]) * (sy[0] - sy[2]));
     elen[2] = sqrt((sx[1] - sx[0]) * (sx[1] - sx[0]) + (sy[1] - sy[0]) * (sy[1] - sy[0]));
+    /* thin or grazing triangles (near the silhouette, where the exact surface may stick out past
+     * them, or where they cover no pixel centre at all) also seed the uncovered pixels around
+     * them; the others' neighbours are reached by the rounds */
+    {
+        double longest = elen[0] > elen[1] ? (elen[0] > elen[2] ? elen[0] : elen[2]) : (elen[1] > elen[2] ? elen[1] : elen[2]);
+        double e1[3], e2[3], cr[3], a3, sc;
+        for (k = 0; k < 3; ++k) { e1[k] = (double)P[1][k] - P[0][k]; e2[k] = (double)P[2][k] - P[0][k]; }
+        sfb__an_cross(e1, e2, cr);
+        sc = A->cam.ortho ? A->cam.focal : A->cam.focal * 3.0 / (sz[0] + sz[1] + sz[2]);
+        a3 = sqrt(sfb__an_dot(cr, cr)) * sc * sc; /* twice the area, in pixels, seen face-on */
+        /* thin (under 2 pixels high) or grazing (seen at under 20 degrees): near the silhouette */
+        dilate = fabs(area) < 2.0 * longest || fabs(area) < 0.35 * a3 ? SFB__AN_DILATE : 0.0;
+    }
+    minx = sfb__an_clamp(ceil(minx - 0.5 - dilate), 0.0, (double)A->w);
+    maxx = sfb__an_clamp(floor(maxx - 0.5 + dilate), -1.0, (double)A->w - 1.0);
+    miny = sfb__an_clamp(ceil(miny - 0.5 - dilate), 0.0, (double)A->h);
+    maxy = sfb__an_clamp(floor(maxy - 0.5 + dilate), -1.0, (double)A->h - 1.0);
+    ix0 = (int)minx; ix1 = (int)maxx; iy0 = (int)miny; iy1 = (int)maxy;
+    inv = 1.0 / area;
     for (y = iy0; y <= iy1; ++y) {
         double py = y + 0.5;
         for (x = ix0; x <= ix1; ++x) {
@@ -12226,10 +12307,10 @@ static void sfb__an_raster_tri(sfb__an *A, int f, const int *g) {
                  * (the proxy's silhouette lies inside the exact one on convex parts, and edge-on
                  * faces may cover no pixel centre at all) */
                 double d = 0.0, sum;
-                if (A->face[pix] >= 0) continue;
+                if (dilate == 0.0 || A->face[pix] >= 0) continue;
                 for (k = 0; k < 3; ++k)
                     if (b[k] < 0.0 && elen[k] > 0.0) { double e = -b[k] * fabs(area) / elen[k]; if (e > d) d = e; }
-                if (!(d <= SFB__AN_DILATE) || !(d < A->cdist[pix])) continue;
+                if (!(d <= dilate) || !(d < A->cdist[pix])) continue;
                 for (k = 0; k < 3; ++k) if (b[k] < 0.0) b[k] = 0.0;
                 for (k = 0; k < 3; ++k) b[k] *= q[k];
                 sum = b[0] + b[1] + b[2];
@@ -12291,7 +12372,7 @@ static sfb_result sfb__an_raster(sfb__an *A) {
 
 /* ---- step 2: Newton projection, in batches ---- */
 typedef struct sfb__an_try {
-    int pix, steps, pinned, outcome;   /* outcome: 0 running, 1 hit, 2 near, 3 miss */
+    int pix, steps, pinned, crossed, outcome;   /* outcome: 0 running, 1 hit, 2 near, 3 miss */
     double res;
 } sfb__an_try;
 
@@ -12330,6 +12411,24 @@ static int sfb__an_clamp_domain(const sfb__an *A, double *u, double *v) {
         moved = 1;
     }
     return moved;
+}
+
+/* The side a step to (uo, vo) left the domain by (clamped to (u, v)), and t on it; -1: none. */
+static int sfb__an_exit_side(const sfb__an *A, double uo, double vo, double u, double v, double *t) {
+    double over[4] = { 0.0, 0.0, 0.0, 0.0 };
+    int k, best = -1;
+    if (A->tri) {
+        over[0] = -vo; over[2] = -uo; over[1] = uo + vo - 1.0;
+    } else {
+        over[0] = -vo; over[1] = uo - 1.0; over[2] = vo - 1.0; over[3] = -uo;
+    }
+    for (k = 0; k < (A->tri ? 3 : 4); ++k)
+        if (over[k] > 0.0 && (best < 0 || over[k] > over[best])) best = k;
+    if (best < 0) return -1;
+    if (A->tri) *t = best == 0 ? u : best == 1 ? v : 1.0 - v;
+    else *t = best == 0 ? u : best == 1 ? v : best == 2 ? 1.0 - u : 1.0 - v;
+    *t = sfb__an_clamp(*t, 0.0, 1.0);
+    return best;
 }
 
 /* Runs the attempts (tries[i] for pixel tries[i].pix from locs[i]) to their outcomes; records
@@ -12375,7 +12474,17 @@ static sfb_result sfb__an_newton(sfb__an *A, sfb__an_try *tries, sfb_location *l
             u = locs[i].u + du_;
             v = locs[i].v + dv_;
             if (sfb__an_clamp_domain(A, &u, &v)) {
-                if (++t->pinned >= 2) { t->outcome = res < SFB__AN_NEAR ? 2 : 3; continue; }
+                /* left the face: carry on in the neighbour across the side it left by (at most
+                 * 4 crossings), else give up after two steps against the border */
+                double uo = locs[i].u + du_, vo = locs[i].v + dv_, ts = 0.0;
+                int side = sfb__an_exit_side(A, uo, vo, u, v, &ts), nb = side >= 0 ? A->adj[4 * locs[i].face + side] : -1;
+                if (nb >= 0 && t->crossed < 4) {
+                    int nside = (nb >> 1) & 3, nf = nb >> 3;
+                    sfb__an_side_point(A->tri, nside, (nb & 1) ? 1.0 - ts : ts, &u, &v);
+                    locs[i].face = nf;
+                    ++t->crossed;
+                    t->pinned = 0;
+                } else if (++t->pinned >= 2) { t->outcome = res < SFB__AN_NEAR ? 2 : 3; continue; }
             } else t->pinned = 0;
             locs[i].u = (float)u;
             locs[i].v = (float)v;
@@ -12824,7 +12933,7 @@ static void sfb__an_free(sfb__an *A) {
     sfb__free(ctx, A->gpos); sfb__free(ctx, A->gnrm);
     sfb__free(ctx, A->cface); sfb__free(ctx, A->cuv); sfb__free(ctx, A->cdist);
     sfb__free(ctx, A->depth); sfb__free(ctx, A->face); sfb__free(ctx, A->uv); sfb__free(ctx, A->ppos); sfb__free(ctx, A->pnrm);
-    sfb__free(ctx, A->hit); sfb__free(ctx, A->state);
+    sfb__free(ctx, A->hit); sfb__free(ctx, A->state); sfb__free(ctx, A->adj);
     sfb__free(ctx, A->hpix); sfb__free(ctx, A->hloc); sfb__free(ctx, A->hpos); sfb__free(ctx, A->hdu); sfb__free(ctx, A->hdv);
     sfb__free(ctx, A->hnrm); sfb__free(ctx, A->hdepth);
 }
@@ -12834,7 +12943,7 @@ static double sfb__an_bytes(const sfb__an *A) {
     double npix = (double)A->w * A->h, grid = (double)A->nf * A->per;
     double per_pixel = 16 + 4 + 4 + 8 + 4 + 1 + 4 + 4 + 1 + 4 + 12 /* buffers, outputs */ + 4 + 12 + 48 + 4 /* hits */ +
                        (A->c->polygon_based ? 24 : 84 + 16) /* proxy data or the projection's attempts and marks */;
-    return npix * per_pixel + grid * 24.0 + 65536.0 * sizeof(sfb_location);
+    return npix * per_pixel + grid * 24.0 + 65536.0 * sizeof(sfb_location) + (double)A->nf * 4 * (sizeof(int) + sizeof(sfb__an_side));
 }
 
 SFB_API sfb_result sfb_surface_analyze(const sfb_surface *s, const sfb_analyze_config *cfg, sfb_analysis *out) {
@@ -12879,6 +12988,7 @@ SFB_API sfb_result sfb_surface_analyze(const sfb_surface *s, const sfb_analyze_c
     A.face = (int *)sfb__alloc(ctx, npix * sizeof(int));
     A.uv = (float *)sfb__alloc(ctx, npix * 2 * sizeof(float));
     A.hit = (int *)sfb__alloc(ctx, npix * sizeof(int));
+    A.adj = (int *)sfb__alloc(ctx, ((size_t)A.nf + 1) * 4 * sizeof(int));
     A.cface = (int *)sfb__alloc(ctx, npix * sizeof(int));
     A.cuv = (float *)sfb__alloc(ctx, npix * 2 * sizeof(float));
     A.cdist = (float *)sfb__alloc(ctx, npix * sizeof(float));
@@ -12894,7 +13004,7 @@ SFB_API sfb_result sfb_surface_analyze(const sfb_surface *s, const sfb_analyze_c
     A.hdv = (float *)sfb__alloc(ctx, npix * 3 * sizeof(float));
     A.hnrm = (float *)sfb__alloc(ctx, npix * 3 * sizeof(float));
     A.hdepth = (float *)sfb__alloc(ctx, npix * sizeof(float));
-    if (!A.gpos || !A.gnrm || !A.depth || !A.face || !A.uv || !A.hit || !A.cface || !A.cuv || !A.cdist || !A.state || (c.polygon_based && (!A.ppos || !A.pnrm)) || !A.hpix ||
+    if (!A.gpos || !A.gnrm || !A.depth || !A.face || !A.uv || !A.hit || !A.adj || !A.cface || !A.cuv || !A.cdist || !A.state || (c.polygon_based && (!A.ppos || !A.pnrm)) || !A.hpix ||
         !A.hloc || !A.hpos || !A.hdu || !A.hdv || !A.hnrm || !A.hdepth) {
         r = sfb__oom(ctx, "the analysis buffers");
         goto done;
@@ -12903,6 +13013,7 @@ SFB_API sfb_result sfb_surface_analyze(const sfb_surface *s, const sfb_analyze_c
     /* 1: the proxy and its raster */
     if ((r = sfb__an_proxy(&A)) != SFB_SUCCESS) goto done;
     sfb__an_camera(&A);
+    if (!c.polygon_based && (r = sfb__an_adjacency(&A)) != SFB_SUCCESS) goto done;
     if ((r = sfb__an_raster(&A)) != SFB_SUCCESS) goto done;
     for (p = 0; p < npix; ++p) proxy_pixels += A.face[p] >= 0;
     if ((r = sfb__progress(ctx, 0.3f, "analyze")) != SFB_SUCCESS) goto done;
