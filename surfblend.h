@@ -11885,7 +11885,7 @@ done:
 #define SFB__AN_DEFAULT_H 480
 #define SFB__AN_DEFAULT_LEVEL 2
 #define SFB__AN_DEFAULT_STEPS 8
-#define SFB__AN_TOL 2e-3      /* pixels: a hit */
+#define SFB__AN_TOL 2e-3      /* pixels: a hit (looser ones let stripe classes flip where stripes are dense) */
 #define SFB__AN_NEAR 0.5      /* pixels: within this, a non-converged attempt may fall back to the proxy */
 #define SFB__AN_ROUNDS 64
 #define SFB__AN_DILATE 2.0    /* pixels: uncovered pixels this close to a thin proxy triangle are seeded from it too */
@@ -12251,30 +12251,29 @@ static void sfb__an_camera(sfb__an *A) {
     cam->near_z = c->near_plane > 0.0f ? c->near_plane : 1e-3 * A->radius;
 }
 
-/* Step 1b: rasterises one proxy triangle (grid points g[3] of face f). */
-static void sfb__an_raster_tri(sfb__an *A, int f, const int *g) {
-    double sx[3], sy[3], sz[3], q[3], uu[3], vv[3], area, inv, minx, maxx, miny, maxy, elen[3], dilate;
+/* A proxy point in the picture: screen x, y, view depth z, the weight q (1/z or 1), its (u,v). */
+typedef struct sfb__an_sv { double x, y, z, q, u, v; int ok; } sfb__an_sv;
+
+/* Step 1b: rasterises one proxy triangle (grid points g[3] of face f, projected in V); pass 1
+ * only seeds the uncovered pixels around thin or grazing ones. */
+static void sfb__an_raster_tri(sfb__an *A, int f, const int *g, const sfb__an_sv *V, int pass) {
+    const sfb__an_sv *a = &V[g[0]], *b1 = &V[g[1]], *c2 = &V[g[2]];
+    double area, inv, minx, maxx, miny, maxy, elen[3], dilate, ea[3], eb[3], ec[3];
     int k, x, y, ix0, ix1, iy0, iy1;
     const float *P[3];
-    for (k = 0; k < 3; ++k) {
-        double p[3];
-        size_t gi = (size_t)f * (size_t)A->per + (size_t)g[k];
-        P[k] = A->gpos + 3 * gi;
-        if (!sfb__an_finite3(P[k])) return;
-        p[0] = P[k][0]; p[1] = P[k][1]; p[2] = P[k][2];
-        if (!sfb__an_project(&A->cam, p, &sx[k], &sy[k], &sz[k])) return;
-        q[k] = A->cam.ortho ? 1.0 : 1.0 / sz[k];
-        sfb__an_grid_uv(A, g[k], &uu[k], &vv[k]);
-    }
-    area = (sx[1] - sx[0]) * (sy[2] - sy[0]) - (sx[2] - sx[0]) * (sy[1] - sy[0]);
+    const sfb__an_sv *S[3];
+    S[0] = a; S[1] = b1; S[2] = c2;
+    if (!a->ok || !b1->ok || !c2->ok) return;
+    for (k = 0; k < 3; ++k) P[k] = A->gpos + 3 * ((size_t)f * (size_t)A->per + (size_t)g[k]);
+    area = (b1->x - a->x) * (c2->y - a->y) - (c2->x - a->x) * (b1->y - a->y);
     if (!(fabs(area) > 1e-12) || !isfinite(area)) return;
-    minx = sx[0] < sx[1] ? (sx[0] < sx[2] ? sx[0] : sx[2]) : (sx[1] < sx[2] ? sx[1] : sx[2]);
-    maxx = sx[0] > sx[1] ? (sx[0] > sx[2] ? sx[0] : sx[2]) : (sx[1] > sx[2] ? sx[1] : sx[2]);
-    miny = sy[0] < sy[1] ? (sy[0] < sy[2] ? sy[0] : sy[2]) : (sy[1] < sy[2] ? sy[1] : sy[2]);
-    maxy = sy[0] > sy[1] ? (sy[0] > sy[2] ? sy[0] : sy[2]) : (sy[1] > sy[2] ? sy[1] : sy[2]);
-    elen[0] = sqrt((sx[2] - sx[1]) * (sx[2] - sx[1]) + (sy[2] - sy[1]) * (sy[2] - sy[1]));
-    elen[1] = sqrt((sx[0] - sx[2]) * (sx[0] - sx[2]) + (sy[0] - sy[2]) * (sy[0] - sy[2]));
-    elen[2] = sqrt((sx[1] - sx[0]) * (sx[1] - sx[0]) + (sy[1] - sy[0]) * (sy[1] - sy[0]));
+    minx = a->x < b1->x ? (a->x < c2->x ? a->x : c2->x) : (b1->x < c2->x ? b1->x : c2->x);
+    maxx = a->x > b1->x ? (a->x > c2->x ? a->x : c2->x) : (b1->x > c2->x ? b1->x : c2->x);
+    miny = a->y < b1->y ? (a->y < c2->y ? a->y : c2->y) : (b1->y < c2->y ? b1->y : c2->y);
+    maxy = a->y > b1->y ? (a->y > c2->y ? a->y : c2->y) : (b1->y > c2->y ? b1->y : c2->y);
+    elen[0] = sqrt((c2->x - b1->x) * (c2->x - b1->x) + (c2->y - b1->y) * (c2->y - b1->y));
+    elen[1] = sqrt((a->x - c2->x) * (a->x - c2->x) + (a->y - c2->y) * (a->y - c2->y));
+    elen[2] = sqrt((b1->x - a->x) * (b1->x - a->x) + (b1->y - a->y) * (b1->y - a->y));
     /* thin or grazing triangles (near the silhouette, where the exact surface may stick out past
      * them, or where they cover no pixel centre at all) also seed the uncovered pixels around
      * them; the others' neighbours are reached by the rounds */
@@ -12283,53 +12282,61 @@ static void sfb__an_raster_tri(sfb__an *A, int f, const int *g) {
         double e1[3], e2[3], cr[3], a3, sc;
         for (k = 0; k < 3; ++k) { e1[k] = (double)P[1][k] - P[0][k]; e2[k] = (double)P[2][k] - P[0][k]; }
         sfb__an_cross(e1, e2, cr);
-        sc = A->cam.ortho ? A->cam.focal : A->cam.focal * 3.0 / (sz[0] + sz[1] + sz[2]);
+        sc = A->cam.ortho ? A->cam.focal : A->cam.focal * 3.0 / (a->z + b1->z + c2->z);
         a3 = sqrt(sfb__an_dot(cr, cr)) * sc * sc; /* twice the area, in pixels, seen face-on */
         /* thin (under 2 pixels high) or grazing (seen at under 20 degrees): near the silhouette */
         dilate = fabs(area) < 2.0 * longest || fabs(area) < 0.35 * a3 ? SFB__AN_DILATE : 0.0;
     }
+    if (pass == 0) dilate = 0.0;
+    else if (dilate == 0.0) return;
     minx = sfb__an_clamp(ceil(minx - 0.5 - dilate), 0.0, (double)A->w);
     maxx = sfb__an_clamp(floor(maxx - 0.5 + dilate), -1.0, (double)A->w - 1.0);
     miny = sfb__an_clamp(ceil(miny - 0.5 - dilate), 0.0, (double)A->h);
     maxy = sfb__an_clamp(floor(maxy - 0.5 + dilate), -1.0, (double)A->h - 1.0);
     ix0 = (int)minx; ix1 = (int)maxx; iy0 = (int)miny; iy1 = (int)maxy;
     inv = 1.0 / area;
+    /* barycentric k = ea[k] * px + eb[k] * py + ec[k] (edge k opposite corner k) */
+    for (k = 0; k < 3; ++k) {
+        const sfb__an_sv *p0 = S[(k + 1) % 3], *p1 = S[(k + 2) % 3];
+        ea[k] = -(p1->y - p0->y) * inv;
+        eb[k] = (p1->x - p0->x) * inv;
+        ec[k] = ((p1->y - p0->y) * p0->x - (p1->x - p0->x) * p0->y) * inv;
+    }
     for (y = iy0; y <= iy1; ++y) {
-        double py = y + 0.5;
+        double py = y + 0.5, px0 = ix0 + 0.5, b[3], row[3];
+        for (k = 0; k < 3; ++k) row[k] = ea[k] * px0 + eb[k] * py + ec[k];
         for (x = ix0; x <= ix1; ++x) {
-            double px = x + 0.5, b[3], den, z;
+            double den, z;
             size_t pix = (size_t)y * (size_t)A->w + (size_t)x;
-            b[0] = ((sx[2] - sx[1]) * (py - sy[1]) - (sy[2] - sy[1]) * (px - sx[1])) * inv;
-            b[1] = ((sx[0] - sx[2]) * (py - sy[2]) - (sy[0] - sy[2]) * (px - sx[2])) * inv;
-            b[2] = ((sx[1] - sx[0]) * (py - sy[0]) - (sy[1] - sy[0]) * (px - sx[0])) * inv;
+            b[0] = row[0]; b[1] = row[1]; b[2] = row[2];
+            row[0] += ea[0]; row[1] += ea[1]; row[2] += ea[2];
+            if (pass && A->face[pix] >= 0) continue;
             if (b[0] < 0.0 || b[1] < 0.0 || b[2] < 0.0) {
-                /* outside: a candidate seed for an uncovered pixel within SFB__AN_DILATE pixels
-                 * (the proxy's silhouette lies inside the exact one on convex parts, and edge-on
-                 * faces may cover no pixel centre at all) */
+                /* outside: a candidate seed for an uncovered pixel within `dilate` pixels */
                 double d = 0.0, sum;
-                if (dilate == 0.0 || A->face[pix] >= 0) continue;
+                if (dilate == 0.0) continue;
                 for (k = 0; k < 3; ++k)
                     if (b[k] < 0.0 && elen[k] > 0.0) { double e = -b[k] * fabs(area) / elen[k]; if (e > d) d = e; }
                 if (!(d <= dilate) || !(d < A->cdist[pix])) continue;
-                for (k = 0; k < 3; ++k) if (b[k] < 0.0) b[k] = 0.0;
-                for (k = 0; k < 3; ++k) b[k] *= q[k];
+                for (k = 0; k < 3; ++k) b[k] = (b[k] < 0.0 ? 0.0 : b[k]) * S[k]->q;
                 sum = b[0] + b[1] + b[2];
                 if (!(sum > 0.0)) continue;
                 A->cdist[pix] = (float)d;
                 A->cface[pix] = f;
-                A->cuv[2 * pix] = (float)sfb__an_clamp((b[0] * uu[0] + b[1] * uu[1] + b[2] * uu[2]) / sum, 0.0, 1.0);
-                A->cuv[2 * pix + 1] = (float)sfb__an_clamp((b[0] * vv[0] + b[1] * vv[1] + b[2] * vv[2]) / sum, 0.0, 1.0);
+                A->cuv[2 * pix] = (float)sfb__an_clamp((b[0] * a->u + b[1] * b1->u + b[2] * c2->u) / sum, 0.0, 1.0);
+                A->cuv[2 * pix + 1] = (float)sfb__an_clamp((b[0] * a->v + b[1] * b1->v + b[2] * c2->v) / sum, 0.0, 1.0);
                 continue;
             }
-            den = b[0] * q[0] + b[1] * q[1] + b[2] * q[2];
+            if (pass) continue;
+            den = b[0] * a->q + b[1] * b1->q + b[2] * c2->q;
             if (!(den > 0.0)) continue;
-            z = A->cam.ortho ? b[0] * sz[0] + b[1] * sz[1] + b[2] * sz[2] : 1.0 / den;
+            z = A->cam.ortho ? b[0] * a->z + b[1] * b1->z + b[2] * c2->z : 1.0 / den;
             if (!(z < (double)A->depth[pix])) continue;
-            for (k = 0; k < 3; ++k) b[k] = b[k] * q[k] / den;
+            b[0] *= a->q / den; b[1] *= b1->q / den; b[2] *= c2->q / den;
             A->depth[pix] = (float)z;
             A->face[pix] = f;
-            A->uv[2 * pix] = (float)sfb__an_clamp(b[0] * uu[0] + b[1] * uu[1] + b[2] * uu[2], 0.0, 1.0);
-            A->uv[2 * pix + 1] = (float)sfb__an_clamp(b[0] * vv[0] + b[1] * vv[1] + b[2] * vv[2], 0.0, 1.0);
+            A->uv[2 * pix] = (float)sfb__an_clamp(b[0] * a->u + b[1] * b1->u + b[2] * c2->u, 0.0, 1.0);
+            A->uv[2 * pix + 1] = (float)sfb__an_clamp(b[0] * a->v + b[1] * b1->v + b[2] * c2->v, 0.0, 1.0);
             if (A->ppos) {
                 int c;
                 size_t base = (size_t)f * (size_t)A->per;
@@ -12344,29 +12351,47 @@ static void sfb__an_raster_tri(sfb__an *A, int f, const int *g) {
 }
 
 static sfb_result sfb__an_raster(sfb__an *A) {
-    int f, i, j, R = A->R;
+    int f, i, j, R = A->R, pass;
     sfb_result r;
+    sfb__an_sv *V = (sfb__an_sv *)sfb__alloc(A->ctx, (size_t)A->per * sizeof *V);
+    if (!V) return sfb__oom(A->ctx, "the analysis raster");
+    for (pass = 0; pass < 2; ++pass)
     for (f = 0; f < A->nf; ++f) {
-        if ((f & 63) == 63 && (r = sfb__progress(A->ctx, 0.2f + 0.1f * (float)f / (float)A->nf, "analyze")) != SFB_SUCCESS) return r;
+        if ((f & 63) == 63 && (r = sfb__progress(A->ctx, 0.2f + 0.05f * (pass + (float)f / (float)A->nf), "analyze")) != SFB_SUCCESS) {
+            sfb__free(A->ctx, V);
+            return r;
+        }
         if (A->s->patches.ptex_root[f] == -1) continue;
+        for (i = 0; i < A->per; ++i) {
+            const float *P = A->gpos + 3 * ((size_t)f * (size_t)A->per + (size_t)i);
+            double p[3];
+            V[i].ok = 0;
+            if (!sfb__an_finite3(P)) continue;
+            p[0] = P[0]; p[1] = P[1]; p[2] = P[2];
+            if (!sfb__an_project(&A->cam, p, &V[i].x, &V[i].y, &V[i].z)) continue;
+            V[i].q = A->cam.ortho ? 1.0 : 1.0 / V[i].z;
+            sfb__an_grid_uv(A, i, &V[i].u, &V[i].v);
+            V[i].ok = 1;
+        }
         for (j = 0; j < R; ++j)
             for (i = 0; i < (A->tri ? R - j : R); ++i) {
                 int g[3];
                 if (A->tri) {
                     g[0] = sfb__an_grid_index(A, i, j); g[1] = sfb__an_grid_index(A, i + 1, j); g[2] = sfb__an_grid_index(A, i, j + 1);
-                    sfb__an_raster_tri(A, f, g);
+                    sfb__an_raster_tri(A, f, g, V, pass);
                     if (i + j + 1 < R) {
                         g[0] = sfb__an_grid_index(A, i + 1, j); g[1] = sfb__an_grid_index(A, i + 1, j + 1); g[2] = sfb__an_grid_index(A, i, j + 1);
-                        sfb__an_raster_tri(A, f, g);
+                        sfb__an_raster_tri(A, f, g, V, pass);
                     }
                 } else {
                     g[0] = sfb__an_grid_index(A, i, j); g[1] = sfb__an_grid_index(A, i + 1, j); g[2] = sfb__an_grid_index(A, i + 1, j + 1);
-                    sfb__an_raster_tri(A, f, g);
+                    sfb__an_raster_tri(A, f, g, V, pass);
                     g[1] = g[2]; g[2] = sfb__an_grid_index(A, i, j + 1);
-                    sfb__an_raster_tri(A, f, g);
+                    sfb__an_raster_tri(A, f, g, V, pass);
                 }
             }
     }
+    sfb__free(A->ctx, V);
     return SFB_SUCCESS;
 }
 
@@ -12505,10 +12530,42 @@ static sfb_result sfb__an_newton(sfb__an *A, sfb__an_try *tries, sfb_location *l
     return SFB_SUCCESS;
 }
 
+/* A seed for pixel (x, y) from a hit neighbour of even x and y (of its proxy face, else any):
+ * the neighbour's (u,v) moved by the inverse of its screen Jacobian towards (x, y); loc is kept
+ * when no neighbour is hit or the Jacobian is singular. */
+static void sfb__an_predict(const sfb__an *A, int x, int y, sfb_location *loc) {
+    int dx, dy, best = -1;
+    for (dy = -1; dy <= 1; ++dy)
+        for (dx = -1; dx <= 1; ++dx) {
+            int nx = x + dx, ny = y + dy, k;
+            if (nx < 0 || ny < 0 || nx >= A->w || ny >= A->h || (nx & 1) || (ny & 1)) continue;
+            k = A->hit[ny * A->w + nx];
+            if (k < 0) continue;
+            if (best < 0 || (A->hloc[k].face == loc->face && A->hloc[best].face != loc->face)) best = k;
+        }
+    if (best >= 0) {
+        double p[3], tu[3], tv[3], j00, j01, j10, j11, det, rx, ry, u, v;
+        int c, q = A->hpix[best];
+        for (c = 0; c < 3; ++c) { p[c] = A->hpos[3 * (size_t)best + c]; tu[c] = A->hdu[3 * (size_t)best + c]; tv[c] = A->hdv[3 * (size_t)best + c]; }
+        sfb__an_project_dir(&A->cam, p, tu, &j00, &j10);
+        sfb__an_project_dir(&A->cam, p, tv, &j01, &j11);
+        det = j00 * j11 - j01 * j10;
+        if (!(fabs(det) > 1e-18) || !isfinite(det)) return;
+        rx = x - q % A->w; ry = y - q / A->w;
+        u = A->hloc[best].u + (j11 * rx - j01 * ry) / det;
+        v = A->hloc[best].v + (-j10 * rx + j00 * ry) / det;
+        if (!isfinite(u) || !isfinite(v)) return;
+        sfb__an_clamp_domain(A, &u, &v);
+        loc->face = A->hloc[best].face;
+        loc->u = (float)u;
+        loc->v = (float)v;
+    }
+}
+
 /* Step 2 over every round (see the file's comment). */
 static sfb_result sfb__an_project_all(sfb__an *A, int steps) {
     size_t npix = (size_t)A->w * (size_t)A->h, p;
-    int cap = 0, count = 0, round, first_new;
+    int cap = 0, count = 0, round, first_new, half;
     sfb__an_try *tries = NULL;
     sfb_location *locs = NULL;
     float *buf = NULL;
@@ -12521,27 +12578,31 @@ static sfb_result sfb__an_project_all(sfb__an *A, int steps) {
     buf = (float *)sfb__alloc(A->ctx, (size_t)cap * 12 * sizeof(float));
     mark = (int *)sfb__calloc(A->ctx, npix, 4 * sizeof(int));
     if (!tries || !locs || !buf || !mark) { r = sfb__oom(A->ctx, "the analysis projection"); goto done; }
-    /* round 0: every proxy pixel from its own (face, u, v) */
-    for (p = 0; p < npix; ++p)
-        if (A->face[p] >= 0) {
+    /* round 0, in two halves: first the pixels of even x and y from their proxy (face, u, v);
+     * then every other one from its proxy too, unless a neighbour of the first half was hit:
+     * then from that hit moved by the inverse of its screen Jacobian, which is off by the
+     * second-order term only, so that most of these hit at their first evaluation (about 1.3
+     * evaluations per pixel instead of 2.1) */
+    for (half = 0; half < 2; ++half) {
+        count = 0;
+        for (p = 0; p < npix; ++p) {
+            int x = (int)(p % (size_t)A->w), y = (int)(p / (size_t)A->w), even = !(x & 1) && !(y & 1);
+            if (even != (half == 0)) continue;
+            if (A->face[p] < 0 && A->cface[p] < 0) continue;
             memset(&tries[count], 0, sizeof tries[count]);
             tries[count].pix = (int)p;
-            locs[count].face = A->face[p];
-            locs[count].u = A->uv[2 * p];
-            locs[count].v = A->uv[2 * p + 1];
-            if (A->tri && (double)locs[count].u + (double)locs[count].v > 1.0) locs[count].v = nextafterf(locs[count].v, 0.0f);
-            ++count;
-        } else if (A->cface[p] >= 0) {
-            memset(&tries[count], 0, sizeof tries[count]);
-            tries[count].pix = (int)p;
-            locs[count].face = A->cface[p];
-            locs[count].u = A->cuv[2 * p];
-            locs[count].v = A->cuv[2 * p + 1];
+            if (A->face[p] >= 0) {
+                locs[count].face = A->face[p]; locs[count].u = A->uv[2 * p]; locs[count].v = A->uv[2 * p + 1];
+            } else {
+                locs[count].face = A->cface[p]; locs[count].u = A->cuv[2 * p]; locs[count].v = A->cuv[2 * p + 1];
+            }
+            if (half == 1) sfb__an_predict(A, x, y, &locs[count]);
             if (A->tri && (double)locs[count].u + (double)locs[count].v > 1.0) locs[count].v = nextafterf(locs[count].v, 0.0f);
             ++count;
         }
+        if ((r = sfb__an_newton(A, tries, locs, count, buf, steps)) != SFB_SUCCESS) goto done;
+    }
     first_new = 0;
-    if ((r = sfb__an_newton(A, tries, locs, count, buf, steps)) != SFB_SUCCESS) goto done;
     if ((r = sfb__progress(A->ctx, 0.6f, "analyze")) != SFB_SUCCESS) goto done;
     /* later rounds: the pixels next to the last round's hits, seeded by them */
     for (round = 1; round <= SFB__AN_ROUNDS; ++round) {
