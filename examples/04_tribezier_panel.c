@@ -23,6 +23,7 @@
 #define STB_IMAGE_WRITE_IMPLEMENTATION
 #define STB_IMAGE_WRITE_STATIC
 #include <stb/stb_image_write.h>
+#include "panel_font.h"
 
 #define PANEL_PI 3.14159265358979323846
 #define RINGS 3      /* rings of triangles around the extraordinary vertex */
@@ -251,31 +252,6 @@ done:
     return ok;
 }
 
-/* ---- labels: a 5x7 pixel font of the characters the panel needs ---- */
-static const char glyph_chars[] = "013457.=nceraso";
-static const unsigned char glyphs[][7] = {
-    {14, 17, 19, 21, 25, 17, 14}, {4, 12, 4, 4, 4, 4, 14},  {30, 1, 1, 14, 1, 1, 30},  {2, 6, 10, 18, 31, 2, 2},
-    {31, 16, 30, 1, 1, 17, 14},   {31, 1, 2, 4, 8, 8, 8},   {0, 0, 0, 0, 0, 12, 12},   {0, 0, 31, 0, 31, 0, 0},
-    {0, 0, 22, 25, 17, 17, 17},   {0, 0, 14, 16, 16, 17, 14}, {0, 0, 14, 17, 31, 16, 14}, {0, 0, 22, 25, 16, 16, 16},
-    {0, 0, 14, 1, 15, 17, 15},    {0, 0, 15, 16, 14, 1, 30}, {0, 0, 14, 17, 17, 17, 14}};
-
-static void draw_text(unsigned char *rgba, int width, int x0, int y0, const char *text) {
-    const int scale = 2;
-    int c, row, col, dx, dy;
-    for (c = 0; text[c]; ++c) {
-        const char *g = strchr(glyph_chars, text[c]);
-        if (text[c] == ' ' || !g) continue;
-        for (row = 0; row < 7; ++row)
-            for (col = 0; col < 5; ++col)
-                if (glyphs[g - glyph_chars][row] & (16 >> col))
-                    for (dy = 0; dy < scale; ++dy)
-                        for (dx = 0; dx < scale; ++dx) {
-                            unsigned char *p = rgba + 4 * ((size_t)(y0 + row * scale + dy) * (size_t)width + (size_t)(x0 + (c * 6 + col) * scale + dx));
-                            p[0] = p[1] = p[2] = 255; p[3] = 255;
-                        }
-    }
-}
-
 static void usage(FILE *f) {
     fprintf(f, "usage: 04_tribezier_panel [OUT.png]\n"
                "  Quartic triangular Bezier surfaces (seed 004): a crease through a vertex of valence 4, 5 and 7\n"
@@ -318,7 +294,7 @@ int main(int argc, char **argv) {
                     memcpy(panel + 4 * ((size_t)(row * TILE_H + y) * (size_t)W + (size_t)col * TILE_W), img.rgba + 4 * (size_t)y * TILE_W,
                            4 * (size_t)TILE_W);
                 snprintf(label, sizeof label, "%s s=%g", name, svals[col]);
-                draw_text(panel, W, col * TILE_W + 8, row * TILE_H + 8, label);
+                panel_draw_text(panel, W, H, col * TILE_W + 8, row * TILE_H + 8, label);
             } else if (panel) status = 1;
             sfb_image_free(&img);
             sfb_surface_destroy(surface);

@@ -213,6 +213,7 @@ typedef struct sfb__an {
     unsigned char *state;        /* SFB__AN_* per pixel */
     /* hits (compact) */
     int nhit, cap;
+    int *chg, nchg;              /* hits made or replaced by the last batch of attempts */
     int *hpix;
     sfb_location *hloc;
     float *hpos, *hdu, *hdv, *hnrm, *hdepth;
@@ -566,6 +567,7 @@ static void sfb__an_add_hit(sfb__an *A, int pix, const sfb_location *loc, double
         A->hit[pix] = k;
         A->state[pix] = SFB__AN_HIT;
     }
+    if ((size_t)A->nchg < (size_t)A->w * (size_t)A->h) A->chg[A->nchg++] = k; /* a pixel listed twice is harmless */
     A->hloc[k] = *loc;
     A->hdepth[k] = (float)z;
     for (c = 0; c < 3; ++c) {
@@ -717,7 +719,7 @@ static void sfb__an_predict(const sfb__an *A, int x, int y, sfb_location *loc) {
 /* Step 2 over every round (see the file's comment). */
 static sfb_result sfb__an_project_all(sfb__an *A, int steps) {
     size_t npix = (size_t)A->w * (size_t)A->h, p;
-    int cap = 0, count = 0, round, first_new, half;
+    int cap = 0, count = 0, round, half;
     sfb__an_try *tries = NULL;
     sfb_location *locs = NULL;
     float *buf = NULL;
@@ -752,22 +754,27 @@ static sfb_result sfb__an_project_all(sfb__an *A, int steps) {
             if (A->tri && (double)locs[count].u + (double)locs[count].v > 1.0) locs[count].v = nextafterf(locs[count].v, 0.0f);
             ++count;
         }
+        A->nchg = 0;
         if ((r = sfb__an_newton(A, tries, locs, count, buf, steps)) != SFB_SUCCESS) goto done;
     }
-    first_new = 0;
+    /* round 0's changes: every hit */
+    for (A->nchg = 0; A->nchg < A->nhit; ++A->nchg) A->chg[A->nchg] = A->nchg;
     if ((r = sfb__progress(A->ctx, 0.6f, "analyze")) != SFB_SUCCESS) goto done;
-    /* later rounds: the pixels next to the last round's hits, seeded by them */
+    /* later rounds: the pixels next to the last round's new or nearer hits, seeded by them:
+     * pixels not hit yet, and pixels hit on another face at least 1 % of the bounding radius
+     * farther away (a nearer surface next to them may hide their hit: the proxy's depth order
+     * is not the exact surface's near silhouettes) */
     for (round = 1; round <= SFB__AN_ROUNDS; ++round) {
-        int last_new = A->nhit, h;
+        int ci;
         count = 0;
-        for (h = first_new; h < last_new; ++h) {
-            int pix = A->hpix[h], x = pix % A->w, y = pix / A->w, dx, dy;
+        for (ci = 0; ci < A->nchg; ++ci) {
+            int h = A->chg[ci], pix = A->hpix[h], x = pix % A->w, y = pix / A->w, dx, dy;
             for (dy = -1; dy <= 1; ++dy)
                 for (dx = -1; dx <= 1; ++dx) {
                     int nx = x + dx, ny = y + dy, q, k, *mq, f = A->hloc[h].face;
                     if ((dx | dy) == 0 || nx < 0 || ny < 0 || nx >= A->w || ny >= A->h) continue;
                     q = ny * A->w + nx;
-                    if (A->hit[q] >= 0) continue;
+                    if (A->hit[q] >= 0 && (A->hloc[A->hit[q]].face == f || !(A->hdepth[h] < A->hdepth[A->hit[q]] - 0.01 * A->radius))) continue;
                     mq = mark + 4 * (size_t)q;
                     if (mq[0] != round) { mq[0] = round; mq[1] = mq[2] = mq[3] = -1; }
                     for (k = 1; k <= 3 && mq[k] >= 0 && mq[k] != f; ++k) {}
@@ -793,9 +800,9 @@ static sfb_result sfb__an_project_all(sfb__an *A, int steps) {
                 }
         }
         if (count == 0) break;
-        first_new = A->nhit;
+        A->nchg = 0;
         if ((r = sfb__an_newton(A, tries, locs, count, buf, steps)) != SFB_SUCCESS) goto done;
-        if (A->nhit == first_new) break;
+        if (A->nchg == 0) break;
         if ((r = sfb__progress(A->ctx, 0.6f + 0.1f * (float)round / SFB__AN_ROUNDS, "analyze")) != SFB_SUCCESS) goto done;
     }
 done:
@@ -918,11 +925,13 @@ static void sfb__an_lights(const sfb__an *A, sfb__an_look *L) {
             j->lsize[0] = c->light_size[0] > 0.0f ? c->light_size[0] : 16.0 * R;
             j->lsize[1] = c->light_size[1] > 0.0f ? c->light_size[1] : j->lsize[0];
         } else if (mode == SFB_ANALYZE_REFLECTION) {
-            /* behind the viewer and above (the seed's Fig. 2 lights the surface from above; a plane
-             * the viewer's side of the surface lights what the viewer sees), lines running up it */
-            for (i = 0; i < 3; ++i) ell[i] = 0.6 * cam->up[i] - cam->fwd[i];
-            sfb__an_unit(ell);
-            for (i = 0; i < 3; ++i) { j->lc[i] = A->centre[i] + 3.0 * R * ell[i]; j->lm[i] = -ell[i]; j->lu[i] = cam->right[i]; }
+            /* directly above the surface (the seed's Fig. 2: "an area light source is put directly
+             * above a surface"), up being the world's y (the orbit) or the camera's up; the lines
+             * run away from the viewer (a design studio's ceiling of tubes) */
+            if (c->camera_set) for (i = 0; i < 3; ++i) ell[i] = c->up[i];
+            else { ell[0] = 0.0; ell[1] = 1.0; ell[2] = 0.0; }
+            if (!(sfb__an_unit(ell) > 0.0)) { ell[0] = 0.0; ell[1] = 1.0; ell[2] = 0.0; }
+            for (i = 0; i < 3; ++i) { j->lc[i] = A->centre[i] + 2.5 * R * ell[i]; j->lm[i] = -ell[i]; j->lu[i] = cam->right[i]; }
             j->lsize[0] = j->lsize[1] = 16.0 * R;
         } else {
             /* sfb_render's highlight plane: toward the camera, lines at 30 degrees from vertical */
@@ -1148,7 +1157,7 @@ static void sfb__an_free(sfb__an *A) {
     sfb__free(ctx, A->depth); sfb__free(ctx, A->face); sfb__free(ctx, A->uv); sfb__free(ctx, A->ppos); sfb__free(ctx, A->pnrm);
     sfb__free(ctx, A->hit); sfb__free(ctx, A->state); sfb__free(ctx, A->adj);
     sfb__free(ctx, A->hpix); sfb__free(ctx, A->hloc); sfb__free(ctx, A->hpos); sfb__free(ctx, A->hdu); sfb__free(ctx, A->hdv);
-    sfb__free(ctx, A->hnrm); sfb__free(ctx, A->hdepth);
+    sfb__free(ctx, A->hnrm); sfb__free(ctx, A->hdepth); sfb__free(ctx, A->chg);
 }
 
 /* Bytes the analysis will hold at its peak (checked against the budget before allocating). */
@@ -1217,8 +1226,9 @@ SFB_API sfb_result sfb_surface_analyze(const sfb_surface *s, const sfb_analyze_c
     A.hdv = (float *)sfb__alloc(ctx, npix * 3 * sizeof(float));
     A.hnrm = (float *)sfb__alloc(ctx, npix * 3 * sizeof(float));
     A.hdepth = (float *)sfb__alloc(ctx, npix * sizeof(float));
+    A.chg = (int *)sfb__alloc(ctx, (npix + 1) * sizeof(int));
     if (!A.gpos || !A.gnrm || !A.depth || !A.face || !A.uv || !A.hit || !A.adj || !A.cface || !A.cuv || !A.cdist || !A.state || (c.polygon_based && (!A.ppos || !A.pnrm)) || !A.hpix ||
-        !A.hloc || !A.hpos || !A.hdu || !A.hdv || !A.hnrm || !A.hdepth) {
+        !A.hloc || !A.hpos || !A.hdu || !A.hdv || !A.hnrm || !A.hdepth || !A.chg) {
         r = sfb__oom(ctx, "the analysis buffers");
         goto done;
     }

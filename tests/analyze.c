@@ -392,7 +392,9 @@ static void test_bad(sfb_context *ctx) {
         sfb_result r = sfb_surface_analyze(s, &base, NULL);
         check(r == SFB_INVALID_ARGS, "bad_null_output", "got %s", sfb_result_string(r));
         memset(&a, 0, sizeof a);
-        r = sfb_surface_analyze(s, &base, &a);
+        c = base;
+        top_light(&c);
+        r = sfb_surface_analyze(s, &c, &a);
         check(r == SFB_SUCCESS && a.covered_pixels == 64 * 64, "flat_sheet_covers_the_picture", "%s: %d of %d pixels", sfb_result_string(r),
               a.covered_pixels, 64 * 64);
         sfb_analysis_free(&a);
