@@ -10,6 +10,7 @@ SAN     ?=
 BUILD   ?= build
 LIBS    := -lm -lpthread -ldl
 SHAPES  ?= ../shared/peers/opensubdiv-shapes
+REAL_MESHES ?= $(dir $(SHAPES))real-meshes
 
 SRC_MODULES := src/sfb_api.h src/sfb_internal.h $(wildcard src/*.c src/patch/*.c)
 TEST_SRCS   := $(wildcard tests/test_*.c)
@@ -147,7 +148,7 @@ $(BUILD)/examples/%: examples/%.cpp tests/egl_host.h $(BUILD)/libsfb.o | deps-ex
 	@mkdir -p $(BUILD)/examples
 	$(CXX) $(CXXFLAGS) $(SAN) -I. $< $(BUILD)/libsfb.o -o $@ $(GL_LIBS) $(LIBS)
 
-run: deps $(BUILD)/surfblend $(BUILD)/sfb2gltf $(BUILD)/examples/04_tribezier_panel
+run: deps $(BUILD)/surfblend $(BUILD)/sfb2gltf $(BUILD)/examples/04_tribezier_panel $(BUILD)/examples/05_reflection_panel
 	@mkdir -p out
 	./$(BUILD)/surfblend info examples/data/creased_box.obj
 	./$(BUILD)/surfblend refine --scheme catmark --level 3 --limit examples/data/creased_box.obj -o out/creased_box_level3.obj
@@ -189,6 +190,17 @@ run: deps $(BUILD)/surfblend $(BUILD)/sfb2gltf $(BUILD)/examples/04_tribezier_pa
 	@# the seed's Figs. 8-11 as one panel: a crease at valence 4, 5 and 7 and a corner at valence 3
 	@# (meshes built in the program), each at s = 0, 0.5 and 1, with highlight lines
 	./$(BUILD)/examples/04_tribezier_panel out/tribezier_panel.png
+	@# surface quality (seed 003), evaluated exactly per pixel: the seed's Fig. 7 as one panel (reflection
+	@# lines from proxies subdivided once, twice, three times; top the polygon-based method, bottom ours),
+	@# the close-up of Fig. 8 and a mean-curvature map of the creased box; then the analysis command on a
+	@# real mesh (spot, a Loop surface): reflection lines, zebra and the Gaussian curvature
+	./$(BUILD)/examples/05_reflection_panel out
+	@if [ -f "$(REAL_MESHES)/spot.obj" ]; then \
+	  for m in reflection zebra curvature; do \
+	    echo "./$(BUILD)/surfblend analyze --scheme loop --mode $$m --size 800x600 $(REAL_MESHES)/spot.obj -o out/spot_$$m.png"; \
+	    ./$(BUILD)/surfblend analyze --scheme loop --mode $$m --size 800x600 $(REAL_MESHES)/spot.obj -o out/spot_$$m.png || exit 1; \
+	  done; \
+	else echo "real meshes not found at $(REAL_MESHES): the spot pictures are skipped"; fi
 	@# the main job's end: glTF 2.0 for engines and viewers -- the creased box with subdivision-shading
 	@# normals (hard edges split), and the manifold blend tessellated
 	./$(BUILD)/sfb2gltf --level 3 examples/data/creased_box.obj -o out/creased_box.glb

@@ -680,10 +680,11 @@ typedef struct sfb_analyze_config {
     float light_center[3], light_normal[3], light_axis[3]; /* the plane: centre, normal (toward the surface), its u axis
                                  (the direction across the stripes; projected into the plane) */
     float light_size[2];      /* extent along u and v in model units (0: 16 bounding radii) */
-    float stripes;            /* stripes (or lattice cells, circle rows) across the light's u extent; REFLECTION 0: 24;
-                                 HIGHLIGHT: per bounding-sphere diameter, 0: 8; ZEBRA: per 180 degrees, 0: 16;
+    float stripes;            /* stripes (or lattice cells, circle rows) across the light's u extent; REFLECTION 0: 16;
+                                 HIGHLIGHT: per bounding-sphere diameter, 0: 5; ZEBRA: per 180 degrees, 0: 16;
                                  ISOPHOTE: bands over n.l in [-1,1], 0: 10 */
-    float stripe_width;       /* lit share of each period (0..1), 0: 0.5 (circles: diameter share of the cell) */
+    float stripe_width;       /* lit share of each period (0..1); 0: 0.5 (HIGHLIGHT 0.7, LATTICE 0.2, CIRCLES: the
+                                 circles' diameter share of the cell, 0.6) */
     float light_dir[3];       /* ZEBRA axis, ISOPHOTE light, SHADED key; all 0: from the camera (upper left) */
     const unsigned char *light_rgba; /* SFB_LIGHT_IMAGE: light_width x light_height RGBA, row 0 at the plane's v = 0 */
     int light_width, light_height;
@@ -691,7 +692,8 @@ typedef struct sfb_analyze_config {
     float curvature_range;    /* > 0: the colour map spans [-range, range] ([0, range] for MAX_ABS); 0: the 90th
                                  percentile of |value| over the picture */
     unsigned char background[4]; /* RGBA of uncovered pixels; all 0: opaque dark grey */
-    unsigned char miss[4];       /* REFLECTION: colour of rays that miss the light plane; all 0: near black */
+    unsigned char miss[4];       /* REFLECTION, HIGHLIGHT: colour of rays that miss the light plane, lit a little by the
+                                    key light so that the form reads; all 0: near black */
 } sfb_analyze_config;
 SFB_API sfb_analyze_config sfb_analyze_config_init(int mode);
 typedef struct sfb_analysis {
@@ -12758,7 +12760,7 @@ static void sfb__an_lights(const sfb__an *A, sfb__an_look *L) {
     sfb__an_unit(L->key);
     L->pattern = c->light_pattern;
     L->width = c->stripe_width > 0.0f ? c->stripe_width
-               : L->pattern == SFB_LIGHT_LATTICE ? 0.2 : L->pattern == SFB_LIGHT_CIRCLES ? 0.6 : 0.5;
+               : L->pattern == SFB_LIGHT_LATTICE ? 0.2 : L->pattern == SFB_LIGHT_CIRCLES ? 0.6 : mode == SFB_ANALYZE_HIGHLIGHT ? 0.7 : 0.5;
     for (i = 0; i < 3; ++i) d[i] = c->light_dir[i];
     if (!(sfb__an_unit(d) > 0.0)) {
         /* zebra: bands about the camera's up; isophotes and shading: the key light */
@@ -12766,7 +12768,7 @@ static void sfb__an_lights(const sfb__an *A, sfb__an_look *L) {
     }
     for (i = 0; i < 3; ++i) j->dir[i] = d[i];
     if (mode == SFB_ANALYZE_REFLECTION || mode == SFB_ANALYZE_HIGHLIGHT) {
-        double ell[3], per = c->stripes > 0.0f ? c->stripes : mode == SFB_ANALYZE_REFLECTION ? 24.0 : 8.0, t;
+        double ell[3], per = c->stripes > 0.0f ? c->stripes : mode == SFB_ANALYZE_REFLECTION ? 16.0 : 5.0, t;
         if (c->light_set) {
             for (i = 0; i < 3; ++i) { j->lc[i] = c->light_center[i]; j->lm[i] = c->light_normal[i]; j->lu[i] = c->light_axis[i]; }
             sfb__an_unit(j->lm);
@@ -12803,7 +12805,7 @@ static void sfb__an_lights(const sfb__an *A, sfb__an_look *L) {
     if (c->background[0] | c->background[1] | c->background[2] | c->background[3]) memcpy(L->bg, c->background, 4);
     else { L->bg[0] = 44; L->bg[1] = 48; L->bg[2] = 56; L->bg[3] = 255; }
     if (c->miss[0] | c->miss[1] | c->miss[2] | c->miss[3]) memcpy(L->miss, c->miss, 4);
-    else { L->miss[0] = 14; L->miss[1] = 14; L->miss[2] = 18; L->miss[3] = 255; }
+    else { L->miss[0] = 26; L->miss[1] = 28; L->miss[2] = 34; L->miss[3] = 255; }
 }
 
 /* The k-th smallest of v[0..n) (reorders v; quickselect, median-of-three pivots). */
@@ -12905,8 +12907,9 @@ static void sfb__an_colour(const sfb__an *A, const sfb__an_look *L, const float 
         case SFB_ANALYZE_REFLECTION:
         case SFB_ANALYZE_HIGHLIGHT:
             if (!isfinite(a)) {
+                /* the miss colour, lit a little by the key light so that the form still reads */
                 cl = 1;
-                for (i = 0; i < 3; ++i) rgb[i] = L->miss[i] / 255.0;
+                for (i = 0; i < 3; ++i) rgb[i] = L->miss[i] / 255.0 * (0.55 + 0.9 * diff);
                 break;
             }
             ++*light_hits;

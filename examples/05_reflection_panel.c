@@ -38,6 +38,7 @@ static char *read_file(const char *path, size_t *size) {
 
 /* One picture of the surface; 0 with a message on failure. */
 static int analyze(const sfb_surface *s, int level, int polygon, int mode, float zoom, int w, int h, sfb_analysis *out) {
+    /* the close-up (zoom > 1) looks down onto the top, where the reflected stripes are */
     sfb_analyze_config c = sfb_analyze_config_init(mode);
     c.width = w;
     c.height = h;
@@ -45,7 +46,7 @@ static int analyze(const sfb_surface *s, int level, int polygon, int mode, float
     c.polygon_based = polygon;
     c.view_set = 1;
     c.yaw = 35.0f;
-    c.pitch = 30.0f;
+    c.pitch = zoom > 1.0f ? 50.0f : 30.0f;
     c.zoom = zoom;
     c.curvature = SFB_CURVATURE_MEAN;
     return sfb_surface_analyze(s, &c, out) == SFB_SUCCESS;
@@ -119,7 +120,7 @@ int main(int argc, char **argv) {
     }
     for (row = 0; row < 2 && ok; ++row)
         for (col = 0; col < 3 && ok; ++col) ok = analyze(surf, col + 1, row == 0, SFB_ANALYZE_REFLECTION, 0.0f, TILE_W, TILE_H, &tiles[row][col]);
-    for (i = 0; i < 2 && ok; ++i) ok = analyze(surf, 3, i == 0, SFB_ANALYZE_REFLECTION, 3.0f, TILE_W, TILE_H, &close[i]);
+    for (i = 0; i < 2 && ok; ++i) ok = analyze(surf, 3, i == 0, SFB_ANALYZE_REFLECTION, 2.2f, TILE_W, TILE_H, &close[i]);
     if (ok) ok = analyze(surf, 1, 0, SFB_ANALYZE_CURVATURE, 0.0f, 2 * TILE_W, 2 * TILE_H, &curv);
     if (!ok) { fprintf(stderr, "05_reflection_panel: %s\n", sfb_last_error(ctx)); goto done; }
     poly_agree = agreement(&tiles[0][0], &tiles[0][2]);

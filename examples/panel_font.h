@@ -18,12 +18,21 @@ static const unsigned char panel_glyphs[][7] = {
     {0, 0, 15, 16, 14, 1, 30},    {8, 8, 28, 8, 8, 9, 6},     {0, 0, 17, 17, 17, 19, 13}, {0, 0, 17, 17, 17, 10, 4},
     {0, 0, 17, 10, 4, 10, 17},    {0, 0, 17, 17, 15, 1, 14}};
 
-/* Draws `text` with its top-left corner at (x0, y0) into an RGBA picture `width` pixels wide and
+/* Draws `text` (on a darkened box) with its top-left corner at (x0, y0) into an RGBA picture `width` pixels wide and
  * `height` high (characters it lacks, and spaces, are blanks; what falls outside is clipped). */
 static void panel_draw_text(unsigned char *rgba, int width, int height, int x0, int y0, const char *text) {
     const int scale = 2;
-    int c, row, col, dx, dy;
-    for (c = 0; text[c]; ++c) {
+    int c, row, col, dx, dy, n = (int)strlen(text);
+    /* a darkened box behind the text, so that it reads on any picture */
+    for (dy = -3; dy < 7 * scale + 3; ++dy)
+        for (dx = -4; dx < n * 6 * scale + 2; ++dx) {
+            int x = x0 + dx, y = y0 + dy;
+            unsigned char *p;
+            if (x < 0 || y < 0 || x >= width || y >= height) continue;
+            p = rgba + 4 * ((size_t)y * (size_t)width + (size_t)x);
+            p[0] = (unsigned char)(p[0] / 4); p[1] = (unsigned char)(p[1] / 4); p[2] = (unsigned char)(p[2] / 4); p[3] = 255;
+        }
+    for (c = 0; c < n; ++c) {
         const char *g = strchr(panel_glyph_chars, text[c]);
         if (text[c] == ' ' || !g) continue;
         for (row = 0; row < 7; ++row)

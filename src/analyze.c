@@ -910,7 +910,7 @@ static void sfb__an_lights(const sfb__an *A, sfb__an_look *L) {
     sfb__an_unit(L->key);
     L->pattern = c->light_pattern;
     L->width = c->stripe_width > 0.0f ? c->stripe_width
-               : L->pattern == SFB_LIGHT_LATTICE ? 0.2 : L->pattern == SFB_LIGHT_CIRCLES ? 0.6 : 0.5;
+               : L->pattern == SFB_LIGHT_LATTICE ? 0.2 : L->pattern == SFB_LIGHT_CIRCLES ? 0.6 : mode == SFB_ANALYZE_HIGHLIGHT ? 0.7 : 0.5;
     for (i = 0; i < 3; ++i) d[i] = c->light_dir[i];
     if (!(sfb__an_unit(d) > 0.0)) {
         /* zebra: bands about the camera's up; isophotes and shading: the key light */
@@ -918,7 +918,7 @@ static void sfb__an_lights(const sfb__an *A, sfb__an_look *L) {
     }
     for (i = 0; i < 3; ++i) j->dir[i] = d[i];
     if (mode == SFB_ANALYZE_REFLECTION || mode == SFB_ANALYZE_HIGHLIGHT) {
-        double ell[3], per = c->stripes > 0.0f ? c->stripes : mode == SFB_ANALYZE_REFLECTION ? 24.0 : 8.0, t;
+        double ell[3], per = c->stripes > 0.0f ? c->stripes : mode == SFB_ANALYZE_REFLECTION ? 16.0 : 5.0, t;
         if (c->light_set) {
             for (i = 0; i < 3; ++i) { j->lc[i] = c->light_center[i]; j->lm[i] = c->light_normal[i]; j->lu[i] = c->light_axis[i]; }
             sfb__an_unit(j->lm);
@@ -955,7 +955,7 @@ static void sfb__an_lights(const sfb__an *A, sfb__an_look *L) {
     if (c->background[0] | c->background[1] | c->background[2] | c->background[3]) memcpy(L->bg, c->background, 4);
     else { L->bg[0] = 44; L->bg[1] = 48; L->bg[2] = 56; L->bg[3] = 255; }
     if (c->miss[0] | c->miss[1] | c->miss[2] | c->miss[3]) memcpy(L->miss, c->miss, 4);
-    else { L->miss[0] = 14; L->miss[1] = 14; L->miss[2] = 18; L->miss[3] = 255; }
+    else { L->miss[0] = 26; L->miss[1] = 28; L->miss[2] = 34; L->miss[3] = 255; }
 }
 
 /* The k-th smallest of v[0..n) (reorders v; quickselect, median-of-three pivots). */
@@ -1057,8 +1057,9 @@ static void sfb__an_colour(const sfb__an *A, const sfb__an_look *L, const float 
         case SFB_ANALYZE_REFLECTION:
         case SFB_ANALYZE_HIGHLIGHT:
             if (!isfinite(a)) {
+                /* the miss colour, lit a little by the key light so that the form still reads */
                 cl = 1;
-                for (i = 0; i < 3; ++i) rgb[i] = L->miss[i] / 255.0;
+                for (i = 0; i < 3; ++i) rgb[i] = L->miss[i] / 255.0 * (0.55 + 0.9 * diff);
                 break;
             }
             ++*light_hits;

@@ -667,10 +667,11 @@ typedef struct sfb_analyze_config {
     float light_center[3], light_normal[3], light_axis[3]; /* the plane: centre, normal (toward the surface), its u axis
                                  (the direction across the stripes; projected into the plane) */
     float light_size[2];      /* extent along u and v in model units (0: 16 bounding radii) */
-    float stripes;            /* stripes (or lattice cells, circle rows) across the light's u extent; REFLECTION 0: 24;
-                                 HIGHLIGHT: per bounding-sphere diameter, 0: 8; ZEBRA: per 180 degrees, 0: 16;
+    float stripes;            /* stripes (or lattice cells, circle rows) across the light's u extent; REFLECTION 0: 16;
+                                 HIGHLIGHT: per bounding-sphere diameter, 0: 5; ZEBRA: per 180 degrees, 0: 16;
                                  ISOPHOTE: bands over n.l in [-1,1], 0: 10 */
-    float stripe_width;       /* lit share of each period (0..1), 0: 0.5 (circles: diameter share of the cell) */
+    float stripe_width;       /* lit share of each period (0..1); 0: 0.5 (HIGHLIGHT 0.7, LATTICE 0.2, CIRCLES: the
+                                 circles' diameter share of the cell, 0.6) */
     float light_dir[3];       /* ZEBRA axis, ISOPHOTE light, SHADED key; all 0: from the camera (upper left) */
     const unsigned char *light_rgba; /* SFB_LIGHT_IMAGE: light_width x light_height RGBA, row 0 at the plane's v = 0 */
     int light_width, light_height;
@@ -678,7 +679,8 @@ typedef struct sfb_analyze_config {
     float curvature_range;    /* > 0: the colour map spans [-range, range] ([0, range] for MAX_ABS); 0: the 90th
                                  percentile of |value| over the picture */
     unsigned char background[4]; /* RGBA of uncovered pixels; all 0: opaque dark grey */
-    unsigned char miss[4];       /* REFLECTION: colour of rays that miss the light plane; all 0: near black */
+    unsigned char miss[4];       /* REFLECTION, HIGHLIGHT: colour of rays that miss the light plane, lit a little by the
+                                    key light so that the form reads; all 0: near black */
 } sfb_analyze_config;
 SFB_API sfb_analyze_config sfb_analyze_config_init(int mode);
 typedef struct sfb_analysis {

@@ -39,8 +39,9 @@ cmd_opts() { case $1 in
   tess) echo "--manifold-weights, --weights --rate --tolerance --split-creases --trim --trim-tiles" ;;
   shade) echo "--variant --darts --normals-level --weights-level --p --averaging --all-subdivided --limit" ;;
   render) echo "--normals --highlight --blend-weights, --weights --normal-colors --positions --size --view --zoom --stripes --edges --rate --manifold-weights --trim" ;;
+  analyze) echo "--mode --light --curvature --level --polygon-based --size --view --eye --target --up --fov --orthographic --stripes --band --backend" ;;
   esac; }
-for c in info refine eval tess shade render backends; do
+for c in info refine eval tess shade render analyze backends; do
   check "$c --help succeeds" 0 "$CLI" $c --help
   if [ -s "$TMP/out" ] && [ ! -s "$TMP/err" ]; then P=$((P + 1)); echo "ok $c --help prints on stdout only"; else F=$((F + 1)); echo "FAIL $c --help: empty stdout or output on stderr"; fi
   contains "$c --help shows the command" "$TMP/out" "^  surfblend $c"
@@ -458,6 +459,34 @@ if [ "$(ls "$TMP" | grep -c '\.tmp')" = 0 ]; then P=$((P + 1)); echo "ok no temp
 touch "$TMP/perm.ref"; "$CLI" refine --level 1 examples/data/creased_box.obj -o "$TMP/perm.obj" 2>/dev/null
 if [ "$(stat -c %a "$TMP/perm.obj")" = "$(stat -c %a "$TMP/perm.ref")" ]; then P=$((P + 1)); echo "ok an output file gets the usual permissions"
 else F=$((F + 1)); echo "FAIL output permissions $(stat -c %a "$TMP/perm.obj"), a new file gets $(stat -c %a "$TMP/perm.ref")"; fi
+
+# ---- analyze (seed 003): exact per-pixel surface quality pictures ----
+for mode in reflection highlight zebra isophote curvature normals shaded; do
+  check "analyze --mode $mode succeeds" 0 "$CLI" analyze --mode $mode --size 120x90 examples/data/creased_box.obj -o "$TMP/a$mode.png"
+  s=$(png_size "$TMP/a$mode.png")
+  if [ "$s" = 120x90 ]; then P=$((P + 1)); echo "ok analyze $mode writes a 120x90 PNG"; else F=$((F + 1)); echo "FAIL analyze $mode output: $s"; fi
+done
+contains "analyze reports the pixels it projected" "$TMP/err" "surface pixels (proxy [0-9]*, [0-9]* grown to the exact silhouette"
+for light in stripes lattice circles; do
+  check "analyze --light $light succeeds" 0 "$CLI" analyze --light $light --size 80x60 examples/data/creased_box.obj -o "$TMP/l$light.png"
+done
+mkpng "$TMP/light.png" 8 8 rgb-left
+check "analyze --light FILE.png succeeds" 0 "$CLI" analyze --light "$TMP/light.png" --size 80x60 examples/data/creased_box.obj -o "$TMP/lf.png"
+check "analyze --light of a missing file is bad input" 1 "$CLI" analyze --light "$TMP/none.png" --size 80x60 examples/data/creased_box.obj -o "$TMP/ax.png"
+check "analyze a Loop surface with --eye/--target succeeds" 0 "$CLI" analyze --scheme loop --eye 3,2,4 --target 0,0,0 --up 0,1,0 --fov 40 --size 80x60 "$TMP/tet.obj" -o "$TMP/al.png"
+check "analyze --orthographic --polygon-based succeeds" 0 "$CLI" analyze --orthographic --polygon-based --level 1 --size 80x60 examples/data/creased_box.obj -o "$TMP/ao.png"
+check "analyze --scheme manifold succeeds" 0 "$CLI" analyze --scheme manifold --mode curvature --curvature max --size 80x60 examples/data/manifold_features.obj -o "$TMP/am.png"
+contains "analyze --mode curvature prints the range" "$TMP/err" "curvature .* colour map range"
+check "analyze without -o is a usage error" 2 "$CLI" analyze examples/data/creased_box.obj
+check "analyze --mode bogus is a usage error" 2 "$CLI" analyze --mode bogus examples/data/creased_box.obj -o "$TMP/ax.png"
+check "analyze --eye without --target is a usage error" 2 "$CLI" analyze --eye 1,2,3 examples/data/creased_box.obj -o "$TMP/ax.png"
+check "analyze --eye 1,2 is a usage error" 2 "$CLI" analyze --eye 1,2 --target 0,0,0 examples/data/creased_box.obj -o "$TMP/ax.png"
+check "analyze --curvature without --mode curvature is a usage error" 2 "$CLI" analyze --curvature mean examples/data/creased_box.obj -o "$TMP/ax.png"
+check "analyze --level 9 is a usage error" 2 "$CLI" analyze --level 9 examples/data/creased_box.obj -o "$TMP/ax.png"
+check "analyze --eye at its --target is bad input" 1 "$CLI" analyze --eye 1,1,1 --target 1,1,1 examples/data/creased_box.obj -o "$TMP/ax.png"
+contains "the error names the camera" "$TMP/err" "camera eye equals its target"
+check "analyze --polygon-based --mode curvature is bad input" 1 "$CLI" analyze --polygon-based --mode curvature examples/data/creased_box.obj -o "$TMP/ax.png"
+if [ ! -e "$TMP/ax.png" ]; then P=$((P + 1)); echo "ok a failed analyze leaves no file"; else F=$((F + 1)); echo "FAIL a failed analyze left $TMP/ax.png"; fi
 
 # vertex counts against OpenSubdiv (osd_agree --counts prints "name count" per shape)
 if [ -d "$SHAPES" ] && [ -x "$BUILD/osd_agree" ]; then

@@ -192,14 +192,15 @@ static const opt_spec options[] = {
     { "--stripes", NULL, K_POSITIVE, C_RENDER, O_STRIPES, AT(stripes), "N", NULL, 0, 1e5, 0, "a number in (0, 100000]",
       "highlight lines per object diameter (default 8)" },
     { "--stripes", NULL, K_POSITIVE, C_ANALYZE, O_STRIPES, AT(stripes), "N", NULL, 0, 1e5, 0, "a number in (0, 100000]",
-      "stripes across the light (reflection: 24 over the plane; highlight: 8 per\n"
+      "stripes across the light (reflection: 16 over the plane; highlight: 5 per\n"
       "object diameter; zebra: 16 per 180 degrees; isophote: 10 bands)" },
     { "--mode", NULL, K_CHOICE, C_ANALYZE, O_AMODE, AT(amode), NULL, amode_choices, 0, 0, 0, NULL,
       "what to draw from the exact surface (default reflection: seed 003's area light)" },
     { "--light", NULL, K_STRING, C_ANALYZE, O_LIGHT, AT(light), "stripes|lattice|circles|FILE.png", NULL, 0, 0, 0,
       "stripes, lattice, circles or a PNG file", "the light plane's texture (reflection, highlight; default stripes)" },
     { "--band", NULL, K_POSITIVE, C_ANALYZE, O_BAND, AT(band), "W", NULL, 0, 0.999, 0, "a number in (0, 1)",
-      "lit share of each stripe period (circles: diameter per cell; default 0.5)" },
+      "lit share of each stripe period (default 0.5, highlight 0.7, lattice 0.2;\n"
+      "circles: diameter per cell, 0.6)" },
     { "--curvature", NULL, K_CHOICE, C_ANALYZE, O_CURVATURE, AT(curvature), NULL, curvature_choices, 0, 0, 0, NULL,
       "--mode curvature: Gaussian (default), mean or largest absolute principal" },
     { "--level", NULL, K_INT, C_ANALYZE, O_LEVEL, AT(level), "L", NULL, 1, SFB_ANALYZE_MAX_LEVEL, 0, "a number in 1..8",
