@@ -50,6 +50,7 @@
 #include "gl/manifold.h"
 #include "gl/patches.h"
 #include "gl/normals.h"
+#include "gl/shade.h"
 #include "gl/draw.h"
 #include "gl/vtable.h"
 

@@ -23,6 +23,7 @@
 #include "simd/patches.h"
 #include "simd/manifold.h"
 #include "simd/normals.h"
+#include "simd/shade.h"
 #include "simd/vtable.h"
 
 #endif /* SFB__SIMD_BACKEND_H */

@@ -1274,6 +1274,15 @@ SFB_API sfb_result sfb_surface_analyze(const sfb_surface *s, const sfb_analyze_c
         L.job.duu = o.duu; L.job.duv = o.duv; L.job.dvv = o.dvv;
     }
     if ((r = sfb__an_shade(&A, &L.job, A.nhit)) != SFB_SUCCESS) goto done;
+    if (c.mode == SFB_ANALYZE_CURVATURE && c.curvature == SFB_CURVATURE_GAUSSIAN) {
+        /* the noise floor of float second derivatives: a Gaussian curvature under (1e-4 per
+         * bounding radius)^2 is 0, so that a flat region is flat on every backend (the float
+         * kernels leave K ~1e-10 / R^2 there where ref leaves ~1e-26, and the automatic range
+         * would amplify either) */
+        const double floor_k = 1e-8 / (A.radius * A.radius);
+        for (k = 0; k < A.nhit; ++k)
+            if (fabs(hv1[k]) < floor_k) hv1[k] = 0.0f;
+    }
     if ((r = sfb__progress(ctx, 0.9f, "analyze")) != SFB_SUCCESS) goto done;
     /* 4: colours */
     v1 = (float *)sfb__alloc(ctx, npix * sizeof(float));

@@ -630,7 +630,9 @@ typedef enum sfb_analyze_mode {
                                    and the stripe axis (bands of constant acos(r.axis)) */
     SFB_ANALYZE_ISOPHOTE,       /* isophotes: bands of n.l (l the light direction), coloured blue (n.l = -1) to red (1) */
     SFB_ANALYZE_CURVATURE,      /* Gaussian, mean or largest absolute principal curvature from the exact second
-                                   derivatives, in a diverging map (blue < 0 < red; max: white 0 .. red), range returned */
+                                   derivatives, in a diverging map (blue < 0 < red; max: the blue-to-red map from 0),
+                                   range returned; mean > 0 where the surface bulges toward the viewer; a Gaussian
+                                   curvature under (1e-4 / bounding radius)^2 is 0 (float kernels' noise on flat parts) */
     SFB_ANALYZE_NORMALS,        /* the unit normal as RGB = 0.5 + 0.5 n */
     SFB_ANALYZE_SHADED,         /* diffuse + specular grey */
     SFB_ANALYZE_MODE_COUNT_

@@ -81,6 +81,10 @@ typedef struct sfb__gl {
     sfb__GLint normals_loc[8];
     sfb__GLuint normals_buf[5];     /* finish_normals inputs: tu, tv, ns, ns_index, b */
     size_t normals_cap[5];
+    sfb__GLuint shade_program;      /* seed 003's shade kernel, compiled on first use */
+    sfb__GLint shade_loc[13];
+    sfb__GLuint shade_buf[7];       /* shade inputs: position, normal, du, dv, duu, duv, dvv */
+    size_t shade_cap[7];
     sfb__GLint max_texture;         /* GL_MAX_TEXTURE_SIZE */
     sfb__GLuint mf_program;         /* manifold.comp.glsl's compute stage, compiled on first use */
     sfb__GLint mf_loc[10];
@@ -398,6 +402,12 @@ static void sfb__gl_release_gl(sfb__gl *g) {
         if (g->normals_buf[i]) g->gl.DeleteBuffers(1, &g->normals_buf[i]);
     memset(g->normals_buf, 0, sizeof g->normals_buf);
     memset(g->normals_cap, 0, sizeof g->normals_cap);
+    if (g->shade_program) g->gl.DeleteProgram(g->shade_program);
+    g->shade_program = 0;
+    for (i = 0; i < 7; ++i)
+        if (g->shade_buf[i]) g->gl.DeleteBuffers(1, &g->shade_buf[i]);
+    memset(g->shade_buf, 0, sizeof g->shade_buf);
+    memset(g->shade_cap, 0, sizeof g->shade_cap);
     if (g->scratch_src) g->gl.DeleteBuffers(1, &g->scratch_src);
     if (g->scratch_dst) g->gl.DeleteBuffers(1, &g->scratch_dst);
     if (g->mf_program) g->gl.DeleteProgram(g->mf_program);

@@ -75,6 +75,7 @@ static void sfb__gl_bind_kernels(sfb__backend_vtable *vt) {
     sfb__gl_patches_bind(vt);
     sfb__gl_manifold_bind(vt);
     sfb__gl_normals_bind(vt);
+    sfb__gl_shade_bind(vt);
 }
 
 void sfb__gl_bind(sfb__backend_vtable *vt) {
