@@ -4,21 +4,25 @@
  *    segments per edge (a quad: (n+1)^2 points, a triangle: (n+1)(n+2)/2), evaluated through
  *    the backend's eval_patches; each grid triangle knows its face and its corners' (u,v) in
  *    that face, so rasterising it gives per pixel (face, u, v, depth) with perspective-correct
- *    (u,v). No tessellation index buffers are shared: a pixel's (u,v) is always in its own
- *    face's frame.
- * 2. Projection (beyond the seed, which shades the proxy's (u,v) and leaves gaps, §5): each
- *    pixel is moved onto the exact surface along its own view ray. We solve in the picture
- *    plane: find (u,v) with proj(S(u,v)) = pixel centre, Newton on the 2x2 Jacobian
- *    d proj / d(u,v) = d proj / dP [S_u S_v], steps clamped to a third of the domain and the
- *    iterate clamped into it. Outcomes per attempt: HIT (residual below SFB__AN_TOL pixels),
- *    NEAR (still within half a pixel after the steps: Newton did not converge), MISS (further,
- *    or pushed against the domain's border twice: the point lies in another face).
- *    Round 0 seeds every proxy pixel with its own (face, u, v). Every later round seeds the
- *    pixels that are not hit yet from the hits of their 8 neighbours made in the round
- *    before (up to three distinct faces each): that crosses into neighbouring parametric faces
- *    without any face adjacency, and grows coverage past the proxy's silhouette up to the
- *    exact one (pixels outside it MISS and stop the growth). The rounds end when a round hits
- *    nothing new (at most SFB__AN_ROUNDS).
+ *    (u,v): a pixel's (u,v) is always in its own face's frame. Thin or grazing triangles (near a
+ *    silhouette) also leave a seed in the uncovered pixels within 2 pixels of them. The faces'
+ *    adjacency comes from the proxy too (sides whose ends and middle coincide).
+ * 2. Projection (beyond the seed, which shades the proxy's (u,v), leaves gaps and patches them
+ *    with a 1.7^2 larger viewport, its §5): each pixel is moved onto the exact surface along its
+ *    own view ray. We solve in the picture plane: find (u,v) with proj(S(u,v)) = pixel centre,
+ *    Newton on the 2x2 Jacobian d proj / d(u,v) = d proj / dP [S_u S_v], steps clamped to a
+ *    third of the domain; a step that leaves the face carries on in the neighbour across the
+ *    side it left by (at most 4 crossings), else the iterate is clamped and gives up after two
+ *    steps against the border. Outcomes per attempt: HIT (residual below SFB__AN_TOL pixels),
+ *    NEAR (within half a pixel after the steps: not converged), MISS (further: no surface there).
+ *    Round 0 seeds every proxy pixel with its own (face, u, v) -- the pixels of odd x or y from
+ *    their even neighbours' hits moved by those hits' inverse screen Jacobian when there are
+ *    any. Every later round seeds, from the hits the round before made or replaced, their 8
+ *    neighbours that are not hit yet, or hit on another face at least 1 % of the bounding radius
+ *    farther away (a nearer sheet may hide them: near silhouettes the proxy's depth order is not
+ *    the exact surface's); up to three faces per pixel and round; a pixel keeps its nearest hit.
+ *    That grows coverage past the proxy's silhouette up to the exact one (pixels outside it MISS
+ *    and stop the growth). The rounds end when a round changes nothing (at most SFB__AN_ROUNDS).
  *    Then a proxy pixel without a hit is kept on the proxy's point when one attempt was NEAR
  *    (counted: fallback_pixels), and dropped when all MISSed (the exact surface is not there:
  *    counted: dropped_pixels); hits outside the proxy are counted as grown_pixels.
@@ -30,8 +34,10 @@
  *    a pixel fade to their average colour.
  * polygon_based: step 2 is skipped; position and normal are the proxy's interpolated limit
  * positions and limit normals (the polygon-based method of the seed's Fig. 7b).
- * Choice (the seed is silent): the mean curvature's sign follows the normal turned toward the
- * viewer, so a surface bulging toward the eye has H > 0. */
+ * Choices (the seed is silent): the camera's default orbit and the default light plane come
+ * from the control mesh's bounding box, never the proxy's, so that the picture does not depend
+ * on the level; the mean curvature's sign follows the normal turned toward the viewer, so a
+ * surface bulging toward the eye has H > 0. */
 
 #define SFB__AN_DEFAULT_W 640
 #define SFB__AN_DEFAULT_H 480
@@ -1169,17 +1175,140 @@ static double sfb__an_bytes(const sfb__an *A) {
     return npix * per_pixel + grid * 24.0 + 65536.0 * sizeof(sfb_location) + (double)A->nf * 4 * (sizeof(int) + sizeof(sfb__an_side));
 }
 
+/* The buffers of one analysis (A's sizes set), initialised; 0 when one could not be had. */
+static int sfb__an_alloc(sfb__an *A) {
+    sfb_context *ctx = A->ctx;
+    size_t npix = (size_t)A->w * (size_t)A->h, grid = (size_t)A->nf * (size_t)A->per, p;
+    A->gpos = (float *)sfb__alloc(ctx, grid * 3 * sizeof(float));
+    A->gnrm = (float *)sfb__alloc(ctx, grid * 3 * sizeof(float));
+    A->depth = (float *)sfb__alloc(ctx, npix * sizeof(float));
+    A->face = (int *)sfb__alloc(ctx, npix * sizeof(int));
+    A->uv = (float *)sfb__alloc(ctx, npix * 2 * sizeof(float));
+    A->hit = (int *)sfb__alloc(ctx, npix * sizeof(int));
+    A->adj = (int *)sfb__alloc(ctx, ((size_t)A->nf + 1) * 4 * sizeof(int));
+    A->cface = (int *)sfb__alloc(ctx, npix * sizeof(int));
+    A->cuv = (float *)sfb__alloc(ctx, npix * 2 * sizeof(float));
+    A->cdist = (float *)sfb__alloc(ctx, npix * sizeof(float));
+    A->state = (unsigned char *)sfb__calloc(ctx, npix, 1);
+    if (A->c->polygon_based) {
+        A->ppos = (float *)sfb__alloc(ctx, npix * 3 * sizeof(float));
+        A->pnrm = (float *)sfb__alloc(ctx, npix * 3 * sizeof(float));
+    }
+    A->hpix = (int *)sfb__alloc(ctx, npix * sizeof(int));
+    A->hloc = (sfb_location *)sfb__alloc(ctx, npix * sizeof(sfb_location));
+    A->hpos = (float *)sfb__alloc(ctx, npix * 3 * sizeof(float));
+    A->hdu = (float *)sfb__alloc(ctx, npix * 3 * sizeof(float));
+    A->hdv = (float *)sfb__alloc(ctx, npix * 3 * sizeof(float));
+    A->hnrm = (float *)sfb__alloc(ctx, npix * 3 * sizeof(float));
+    A->hdepth = (float *)sfb__alloc(ctx, npix * sizeof(float));
+    A->chg = (int *)sfb__alloc(ctx, (npix + 1) * sizeof(int));
+    if (!A->gpos || !A->gnrm || !A->depth || !A->face || !A->uv || !A->hit || !A->adj || !A->cface || !A->cuv || !A->cdist || !A->state ||
+        (A->c->polygon_based && (!A->ppos || !A->pnrm)) || !A->hpix || !A->hloc || !A->hpos || !A->hdu || !A->hdv || !A->hnrm || !A->hdepth ||
+        !A->chg)
+        return 0;
+    for (p = 0; p < npix; ++p) {
+        A->depth[p] = A->cdist[p] = (float)HUGE_VAL;
+        A->face[p] = A->cface[p] = -1;
+        A->hit[p] = -1;
+    }
+    return 1;
+}
+
+/* Step 2 for polygon_based: every proxy pixel is a "hit" on its interpolated data. */
+static void sfb__an_polygon_hits(sfb__an *A) {
+    static const float zero[3] = { 0.0f, 0.0f, 0.0f };
+    size_t npix = (size_t)A->w * (size_t)A->h, p;
+    for (p = 0; p < npix; ++p)
+        if (A->face[p] >= 0) {
+            sfb_location l;
+            l.face = A->face[p]; l.u = A->uv[2 * p]; l.v = A->uv[2 * p + 1];
+            sfb__an_add_hit(A, (int)p, &l, A->depth[p], A->ppos + 3 * p, zero, zero, A->pnrm + 3 * p);
+            sfb__an_unit3f(A->hnrm + 3 * (size_t)A->hit[p]);
+        }
+}
+
+/* Step 3: the second derivatives (CURVATURE) and the shade kernel into hv1, hv2 (nhit each). */
+static sfb_result sfb__an_values(sfb__an *A, sfb__an_look *L, float *hv1, float *hv2) {
+    const sfb_analyze_config *c = A->c;
+    float *sec = NULL;
+    sfb_result r = SFB_SUCCESS;
+    int k;
+    L->job.position = A->hpos; L->job.du = A->hdu; L->job.dv = A->hdv; L->job.normal = A->hnrm;
+    L->job.value = hv1; L->job.value2 = hv2;
+    if (c->mode == SFB_ANALYZE_CURVATURE && A->nhit > 0) {
+        sfb_eval_output o;
+        sec = (float *)sfb__alloc(A->ctx, (size_t)A->nhit * 9 * sizeof(float));
+        if (!sec) return sfb__oom(A->ctx, "the analysis second derivatives");
+        memset(&o, 0, sizeof o);
+        o.duu = sec; o.duv = sec + 3 * (size_t)A->nhit; o.dvv = sec + 6 * (size_t)A->nhit;
+        r = sfb__surface_eval_unchecked(A->s, A->hloc, A->nhit, &o);
+        L->job.duu = o.duu; L->job.duv = o.duv; L->job.dvv = o.dvv;
+    }
+    if (r == SFB_SUCCESS) r = sfb__an_shade(A, &L->job, A->nhit);
+    if (r == SFB_SUCCESS && c->mode == SFB_ANALYZE_CURVATURE && c->curvature == SFB_CURVATURE_GAUSSIAN) {
+        /* the noise floor of float second derivatives: a Gaussian curvature under (1e-4 per
+         * bounding radius)^2 is 0, so that a flat region is flat on every backend (the float
+         * kernels leave K ~1e-10 / R^2 there where ref leaves ~1e-26, and the automatic range
+         * would amplify either) */
+        const double floor_k = 1e-8 / (A->radius * A->radius);
+        for (k = 0; k < A->nhit; ++k)
+            if (fabs(hv1[k]) < floor_k) hv1[k] = 0.0f;
+    }
+    L->job.duu = L->job.duv = L->job.dvv = NULL;
+    sfb__free(A->ctx, sec);
+    return r;
+}
+
+/* Step 4: the picture and its per-pixel outputs into out (on success the arrays are out's). */
+static sfb_result sfb__an_picture(sfb__an *A, sfb__an_look *L, const float *hv1, const float *hv2, sfb_analysis *out) {
+    sfb_context *ctx = A->ctx;
+    const sfb_analyze_config *c = A->c;
+    size_t npix = (size_t)A->w * (size_t)A->h, p;
+    float *v1 = (float *)sfb__alloc(ctx, npix * sizeof(float)), *v2 = (float *)sfb__alloc(ctx, npix * sizeof(float));
+    unsigned char *rgba = (unsigned char *)sfb__alloc(ctx, npix * 4), *cls = (unsigned char *)sfb__alloc(ctx, npix);
+    sfb_location *hits = (sfb_location *)sfb__alloc(ctx, npix * sizeof(sfb_location));
+    sfb_result r = SFB_SUCCESS;
+    int k, light_hits = 0;
+    if (!v1 || !v2 || !rgba || !cls || !hits) { r = sfb__oom(ctx, "the analysis picture"); goto done; }
+    for (p = 0; p < npix; ++p) { v1[p] = v2[p] = NAN; hits[p].face = -1; hits[p].u = hits[p].v = 0.0f; }
+    out->value_min = (float)HUGE_VAL; out->value_max = (float)-HUGE_VAL;
+    for (k = 0; k < A->nhit; ++k) {
+        int q = A->hpix[k];
+        v1[q] = hv1[k]; v2[q] = hv2[k]; hits[q] = A->hloc[k];
+        if (isfinite(hv1[k])) {
+            if (hv1[k] < out->value_min) out->value_min = hv1[k];
+            if (hv1[k] > out->value_max) out->value_max = hv1[k];
+        }
+    }
+    if (!(out->value_min <= out->value_max)) out->value_min = out->value_max = 0.0f;
+    L->range = 0.0;
+    if (c->mode == SFB_ANALYZE_CURVATURE && (r = sfb__an_range(A, hv1, A->nhit, &L->range)) != SFB_SUCCESS) goto done;
+    sfb__an_colour(A, L, v1, v2, rgba, cls, &light_hits);
+    if ((c->mode == SFB_ANALYZE_REFLECTION || c->mode == SFB_ANALYZE_HIGHLIGHT) && A->nhit > 0 && light_hits == 0) {
+        r = sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, -1,
+                       "the light plane meets none of the %d rays from the surface: it is parallel to them, behind the surface or too small",
+                       A->nhit);
+        goto done;
+    }
+    out->width = A->w; out->height = A->h;
+    out->rgba = rgba; out->values = v1; out->classes = cls; out->hits = hits;
+    out->light_hits = light_hits;
+    out->range = (float)L->range;
+    rgba = NULL; v1 = NULL; cls = NULL; hits = NULL;
+done:
+    sfb__free(ctx, v1); sfb__free(ctx, v2); sfb__free(ctx, rgba); sfb__free(ctx, cls); sfb__free(ctx, hits);
+    return r;
+}
+
 SFB_API sfb_result sfb_surface_analyze(const sfb_surface *s, const sfb_analyze_config *cfg, sfb_analysis *out) {
     sfb_analyze_config c;
     sfb__an A;
     sfb__an_look L;
     sfb_context *ctx;
     size_t npix, p;
-    float *v1 = NULL, *v2 = NULL, *hv1 = NULL, *hv2 = NULL, *sec = NULL;
-    unsigned char *rgba = NULL, *cls = NULL;
-    sfb_location *hits = NULL;
+    float *hv1 = NULL, *hv2 = NULL;
     sfb_result r;
-    int level = 0, steps, k, fallback = 0, dropped = 0, proxy_pixels = 0, grown = 0, light_hits = 0;
+    int level = 0, k, fallback = 0, dropped = 0, proxy_pixels = 0, grown = 0;
     double need;
     if (out) memset(out, 0, sizeof *out);
     if (!s) return SFB_INVALID_ARGS;
@@ -1195,7 +1324,6 @@ SFB_API sfb_result sfb_surface_analyze(const sfb_surface *s, const sfb_analyze_c
     A.nf = s->patches.nptex;
     A.R = 1 << level;
     A.per = A.tri ? (A.R + 1) * (A.R + 2) / 2 : (A.R + 1) * (A.R + 1);
-    steps = c.newton_steps ? c.newton_steps : SFB__AN_DEFAULT_STEPS;
     npix = (size_t)A.w * (size_t)A.h;
     if ((double)A.nf * A.per > 2147483647.0)
         return sfb__error(ctx, SFB_LIMIT_EXCEEDED, SFB_ELEMENT_NONE, -1, "proxy of %d parametric faces at level %d is too large", A.nf, level);
@@ -1205,35 +1333,7 @@ SFB_API sfb_result sfb_surface_analyze(const sfb_surface *s, const sfb_analyze_c
                           "a %d x %d analysis with a level-%d proxy needs about %.0f MB, over the memory budget (%zu bytes, %zu in use)", A.w,
                           A.h, level, need / 1048576.0, ctx->budget, ctx->live_bytes);
     if ((r = sfb__progress(ctx, 0.0f, "analyze")) != SFB_SUCCESS) return r;
-    A.gpos = (float *)sfb__alloc(ctx, (size_t)A.nf * A.per * 3 * sizeof(float));
-    A.gnrm = (float *)sfb__alloc(ctx, (size_t)A.nf * A.per * 3 * sizeof(float));
-    A.depth = (float *)sfb__alloc(ctx, npix * sizeof(float));
-    A.face = (int *)sfb__alloc(ctx, npix * sizeof(int));
-    A.uv = (float *)sfb__alloc(ctx, npix * 2 * sizeof(float));
-    A.hit = (int *)sfb__alloc(ctx, npix * sizeof(int));
-    A.adj = (int *)sfb__alloc(ctx, ((size_t)A.nf + 1) * 4 * sizeof(int));
-    A.cface = (int *)sfb__alloc(ctx, npix * sizeof(int));
-    A.cuv = (float *)sfb__alloc(ctx, npix * 2 * sizeof(float));
-    A.cdist = (float *)sfb__alloc(ctx, npix * sizeof(float));
-    A.state = (unsigned char *)sfb__calloc(ctx, npix, 1);
-    if (c.polygon_based) {
-        A.ppos = (float *)sfb__alloc(ctx, npix * 3 * sizeof(float));
-        A.pnrm = (float *)sfb__alloc(ctx, npix * 3 * sizeof(float));
-    }
-    A.hpix = (int *)sfb__alloc(ctx, npix * sizeof(int));
-    A.hloc = (sfb_location *)sfb__alloc(ctx, npix * sizeof(sfb_location));
-    A.hpos = (float *)sfb__alloc(ctx, npix * 3 * sizeof(float));
-    A.hdu = (float *)sfb__alloc(ctx, npix * 3 * sizeof(float));
-    A.hdv = (float *)sfb__alloc(ctx, npix * 3 * sizeof(float));
-    A.hnrm = (float *)sfb__alloc(ctx, npix * 3 * sizeof(float));
-    A.hdepth = (float *)sfb__alloc(ctx, npix * sizeof(float));
-    A.chg = (int *)sfb__alloc(ctx, (npix + 1) * sizeof(int));
-    if (!A.gpos || !A.gnrm || !A.depth || !A.face || !A.uv || !A.hit || !A.adj || !A.cface || !A.cuv || !A.cdist || !A.state || (c.polygon_based && (!A.ppos || !A.pnrm)) || !A.hpix ||
-        !A.hloc || !A.hpos || !A.hdu || !A.hdv || !A.hnrm || !A.hdepth || !A.chg) {
-        r = sfb__oom(ctx, "the analysis buffers");
-        goto done;
-    }
-    for (p = 0; p < npix; ++p) { A.depth[p] = A.cdist[p] = (float)HUGE_VAL; A.face[p] = A.cface[p] = -1; A.hit[p] = -1; }
+    if (!sfb__an_alloc(&A)) { r = sfb__oom(ctx, "the analysis buffers"); goto done; }
     /* 1: the proxy and its raster */
     if ((r = sfb__an_proxy(&A)) != SFB_SUCCESS) goto done;
     sfb__an_camera(&A);
@@ -1242,91 +1342,33 @@ SFB_API sfb_result sfb_surface_analyze(const sfb_surface *s, const sfb_analyze_c
     for (p = 0; p < npix; ++p) proxy_pixels += A.face[p] >= 0;
     if ((r = sfb__progress(ctx, 0.3f, "analyze")) != SFB_SUCCESS) goto done;
     /* 2: onto the exact surface (or the polygon-based data) */
-    if (c.polygon_based) {
-        static const float zero[3] = { 0.0f, 0.0f, 0.0f };
-        for (p = 0; p < npix; ++p)
-            if (A.face[p] >= 0) {
-                sfb_location l;
-                l.face = A.face[p]; l.u = A.uv[2 * p]; l.v = A.uv[2 * p + 1];
-                sfb__an_add_hit(&A, (int)p, &l, A.depth[p], A.ppos + 3 * p, zero, zero, A.pnrm + 3 * p);
-                sfb__an_unit3f(A.hnrm + 3 * (size_t)A.hit[p]);
-            }
-    } else {
-        if ((r = sfb__an_project_all(&A, steps)) != SFB_SUCCESS) goto done;
+    if (c.polygon_based) sfb__an_polygon_hits(&A);
+    else {
+        if ((r = sfb__an_project_all(&A, c.newton_steps ? c.newton_steps : SFB__AN_DEFAULT_STEPS)) != SFB_SUCCESS) goto done;
         if ((r = sfb__an_leftovers(&A, &fallback, &dropped)) != SFB_SUCCESS) goto done;
         for (k = 0; k < A.nhit; ++k) grown += A.face[A.hpix[k]] < 0;
     }
     if ((r = sfb__progress(ctx, 0.75f, "analyze")) != SFB_SUCCESS) goto done;
-    /* 3: second derivatives (curvature) and the shade kernel */
+    /* 3: the values */
     sfb__an_lights(&A, &L);
     hv1 = (float *)sfb__alloc(ctx, ((size_t)A.nhit + 1) * sizeof(float));
     hv2 = (float *)sfb__alloc(ctx, ((size_t)A.nhit + 1) * sizeof(float));
     if (!hv1 || !hv2) { r = sfb__oom(ctx, "the analysis values"); goto done; }
-    L.job.position = A.hpos; L.job.du = A.hdu; L.job.dv = A.hdv; L.job.normal = A.hnrm;
-    L.job.value = hv1; L.job.value2 = hv2;
-    if (c.mode == SFB_ANALYZE_CURVATURE && A.nhit > 0) {
-        sfb_eval_output o;
-        sec = (float *)sfb__alloc(ctx, (size_t)A.nhit * 9 * sizeof(float));
-        if (!sec) { r = sfb__oom(ctx, "the analysis second derivatives"); goto done; }
-        memset(&o, 0, sizeof o);
-        o.duu = sec; o.duv = sec + 3 * (size_t)A.nhit; o.dvv = sec + 6 * (size_t)A.nhit;
-        if ((r = sfb__surface_eval_unchecked(s, A.hloc, A.nhit, &o)) != SFB_SUCCESS) goto done;
-        L.job.duu = o.duu; L.job.duv = o.duv; L.job.dvv = o.dvv;
-    }
-    if ((r = sfb__an_shade(&A, &L.job, A.nhit)) != SFB_SUCCESS) goto done;
-    if (c.mode == SFB_ANALYZE_CURVATURE && c.curvature == SFB_CURVATURE_GAUSSIAN) {
-        /* the noise floor of float second derivatives: a Gaussian curvature under (1e-4 per
-         * bounding radius)^2 is 0, so that a flat region is flat on every backend (the float
-         * kernels leave K ~1e-10 / R^2 there where ref leaves ~1e-26, and the automatic range
-         * would amplify either) */
-        const double floor_k = 1e-8 / (A.radius * A.radius);
-        for (k = 0; k < A.nhit; ++k)
-            if (fabs(hv1[k]) < floor_k) hv1[k] = 0.0f;
-    }
+    if ((r = sfb__an_values(&A, &L, hv1, hv2)) != SFB_SUCCESS) goto done;
     if ((r = sfb__progress(ctx, 0.9f, "analyze")) != SFB_SUCCESS) goto done;
     /* 4: colours */
-    v1 = (float *)sfb__alloc(ctx, npix * sizeof(float));
-    v2 = (float *)sfb__alloc(ctx, npix * sizeof(float));
-    rgba = (unsigned char *)sfb__alloc(ctx, npix * 4);
-    cls = (unsigned char *)sfb__alloc(ctx, npix);
-    hits = (sfb_location *)sfb__alloc(ctx, npix * sizeof(sfb_location));
-    if (!v1 || !v2 || !rgba || !cls || !hits) { r = sfb__oom(ctx, "the analysis picture"); goto done; }
-    for (p = 0; p < npix; ++p) { v1[p] = v2[p] = NAN; hits[p].face = -1; hits[p].u = hits[p].v = 0.0f; }
-    out->value_min = (float)HUGE_VAL; out->value_max = (float)-HUGE_VAL;
-    for (k = 0; k < A.nhit; ++k) {
-        int q = A.hpix[k];
-        v1[q] = hv1[k]; v2[q] = hv2[k]; hits[q] = A.hloc[k];
-        if (isfinite(hv1[k])) {
-            if (hv1[k] < out->value_min) out->value_min = hv1[k];
-            if (hv1[k] > out->value_max) out->value_max = hv1[k];
-        }
-    }
-    if (!(out->value_min <= out->value_max)) out->value_min = out->value_max = 0.0f;
-    L.range = 0.0;
-    if (c.mode == SFB_ANALYZE_CURVATURE && (r = sfb__an_range(&A, hv1, A.nhit, &L.range)) != SFB_SUCCESS) goto done;
-    sfb__an_colour(&A, &L, v1, v2, rgba, cls, &light_hits);
-    if ((c.mode == SFB_ANALYZE_REFLECTION || c.mode == SFB_ANALYZE_HIGHLIGHT) && A.nhit > 0 && light_hits == 0) {
-        r = sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, -1,
-                       "the light plane meets none of the %d rays from the surface: it is parallel to them, behind the surface or too small",
-                       A.nhit);
-        goto done;
-    }
-    if ((r = sfb__progress(ctx, 1.0f, "analyze")) != SFB_SUCCESS) goto done;
-    out->width = A.w; out->height = A.h;
-    out->rgba = rgba; out->values = v1; out->classes = cls; out->hits = hits;
+    if ((r = sfb__an_picture(&A, &L, hv1, hv2, out)) != SFB_SUCCESS) goto done;
     out->covered_pixels = A.nhit;
     out->proxy_pixels = proxy_pixels;
     out->grown_pixels = grown;
     out->dropped_pixels = dropped;
     out->fallback_pixels = fallback;
-    out->light_hits = light_hits;
-    out->range = (float)L.range;
     out->ctx_ = ctx;
-    rgba = NULL; v1 = NULL; cls = NULL; hits = NULL;
+    if ((r = sfb__progress(ctx, 1.0f, "analyze")) != SFB_SUCCESS) sfb_analysis_free(out);
 done:
     if (r != SFB_SUCCESS) memset(out, 0, sizeof *out);
     sfb__an_free(&A);
-    sfb__free(ctx, v1); sfb__free(ctx, v2); sfb__free(ctx, hv1); sfb__free(ctx, hv2); sfb__free(ctx, sec);
-    sfb__free(ctx, rgba); sfb__free(ctx, cls); sfb__free(ctx, hits);
+    sfb__free(ctx, hv1);
+    sfb__free(ctx, hv2);
     return r;
 }
