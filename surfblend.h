@@ -725,6 +725,13 @@ typedef struct sfb_analysis {
  * too. On failure `out` is zeroed and nothing is kept. */
 SFB_API sfb_result sfb_surface_analyze(const sfb_surface *surface, const sfb_analyze_config *config, sfb_analysis *out);
 SFB_API void sfb_analysis_free(sfb_analysis *a);
+/* The "zebra view" of an editor: draws an analysis picture into the host's current framebuffer,
+ * stretched over its current viewport (nearest texel), the pixels on the surface only (the rest
+ * keep what the host drew). Depth test, face culling and blending are off for the draw; the
+ * host's state is restored (program, vertex array, texture units 0-2 with their samplers, the
+ * active unit, the unpack state, those three switches), and no GL error is left. Needs the gl
+ * backend on the host's current context (gl_use_current_context), else SFB_UNSUPPORTED. */
+SFB_API sfb_result sfb_analysis_draw_gl(sfb_context *ctx, const sfb_analysis *analysis);
 
 #ifdef __cplusplus
 }
@@ -1792,6 +1799,12 @@ SFB_API sfb_result sfb_surface_draw_gl(const sfb_surface *surface, const sfb_gl_
     if (!surface) return SFB_INVALID_ARGS;
     return sfb__error(surface->ctx, SFB_UNSUPPORTED, SFB_ELEMENT_NONE, -1,
                       "sfb_surface_draw_gl: this build has no gl backend (define SURFBLEND_GL or SURFBLEND_ALL_BACKENDS)");
+}
+SFB_API sfb_result sfb_analysis_draw_gl(sfb_context *ctx, const sfb_analysis *analysis) {
+    (void)analysis;
+    if (!ctx) return SFB_INVALID_ARGS;
+    return sfb__error(ctx, SFB_UNSUPPORTED, SFB_ELEMENT_NONE, -1,
+                      "sfb_analysis_draw_gl: this build has no gl backend (define SURFBLEND_GL or SURFBLEND_ALL_BACKENDS)");
 }
 SFB_API sfb_result sfb_gl_trim_texture(sfb_context *ctx, const struct sfb_trim_mask *mask, unsigned int *texture) {
     (void)mask;

@@ -178,6 +178,12 @@ SFB_API sfb_result sfb_surface_draw_gl(const sfb_surface *surface, const sfb_gl_
     return sfb__error(surface->ctx, SFB_UNSUPPORTED, SFB_ELEMENT_NONE, -1,
                       "sfb_surface_draw_gl: this build has no gl backend (define SURFBLEND_GL or SURFBLEND_ALL_BACKENDS)");
 }
+SFB_API sfb_result sfb_analysis_draw_gl(sfb_context *ctx, const sfb_analysis *analysis) {
+    (void)analysis;
+    if (!ctx) return SFB_INVALID_ARGS;
+    return sfb__error(ctx, SFB_UNSUPPORTED, SFB_ELEMENT_NONE, -1,
+                      "sfb_analysis_draw_gl: this build has no gl backend (define SURFBLEND_GL or SURFBLEND_ALL_BACKENDS)");
+}
 SFB_API sfb_result sfb_gl_trim_texture(sfb_context *ctx, const struct sfb_trim_mask *mask, unsigned int *texture) {
     (void)mask;
     if (texture) *texture = 0;

@@ -37,6 +37,14 @@
  *                             capture buffer that is no object (SFB_INVALID_ARGS); a NaN matrix,
  *                             atlas tiles 1 x 0 or not splitting the texture (SFB_INVALID_VALUE);
  *                             sfb_gl_trim_texture's checks
+ *   analysis/overlay          seed 003's analysis of a creased cube, computed on the host's
+ *                             context, drawn by sfb_analysis_draw_gl over a magenta framebuffer
+ *                             with the host's depth test (GL_NEVER), culling and blending (zero
+ *                             factors) on: the surface's pixels are the picture's (within 1 of
+ *                             255), the others still magenta
+ *   analysis/state            the host's state after sfb_surface_analyze and the overlay, as
+ *                             draw/state (the storage bindings 0..7 shade.comp.glsl uses included)
+ *   analysis/not-host         sfb_analysis_draw_gl on a ref context: SFB_UNSUPPORTED
  * With --bench: frames per second of the draw path, seed 000's Table 3 setting (30 x 30 samples
  * per face, rate 29) on tori of 32, 180 and 442 quads and on peer shapes, 512 x 512 framebuffer
  * object, each frame timed to glFinish (lines starting with "#").
@@ -912,7 +920,71 @@ static const char *const k_draw_checks[] = {"draw/capture/catmark_torus", "draw/
                                             "errors/ref-context", "errors/own-gl-context", "errors/osmesa-context", "errors/rate-negative",
                                             "errors/rate-1025", "errors/faces", "errors/capture-small", "errors/capture-not-a-buffer",
                                             "errors/trim-not-a-texture", "errors/nan-matrix", "errors/tiles", "errors/trim-texture-mask",
-                                            "errors/state", "draw/gles31", "draw/destroy", NULL};
+                                            "errors/state", "draw/gles31", "analysis/overlay", "analysis/state", "analysis/not-host",
+                                            "draw/destroy", NULL};
+
+/* seed 003's analysis drawn over the host's framebuffer (sfb_analysis_draw_gl): the pixels on
+ * the surface are the analysis picture's, the others keep the host's clear colour, with the
+ * host's depth test, culling and blending on and its objects bound, all restored. */
+static void analysis_checks(sfb_context *ctx, sfb_context *ref, const gl_state *set) {
+    static const char cube[] = "v -1 -1 -1\nv 1 -1 -1\nv 1 1 -1\nv -1 1 -1\nv -1 -1 1\nv 1 -1 1\nv 1 1 1\nv -1 1 1\n"
+                               "f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\nt crease 2/1/0 6 7 10\n";
+    sfb_mesh *m = NULL;
+    sfb_surface *s = NULL;
+    sfb_surface_config sc = sfb_surface_config_init(SFB_SCHEME_CATMARK, 0);
+    sfb_analyze_config ac = sfb_analyze_config_init(SFB_ANALYZE_REFLECTION);
+    sfb_analysis a;
+    sfb_result r;
+    char msg[1200];
+    unsigned char *px = NULL;
+    long k, bad = 0, on = 0, kept = 0;
+    memset(&a, 0, sizeof a);
+    sc.flags = SFB_REFINE_PATCHES;
+    ac.width = ac.height = FB_SIZE;
+    if (sfb_mesh_read_obj(ctx, cube, sizeof cube - 1, &m) != SFB_SUCCESS || sfb_surface_create(ctx, m, &sc, &s) != SFB_SUCCESS ||
+        sfb_surface_analyze(s, &ac, &a) != SFB_SUCCESS) {
+        fail("analysis/overlay", "setting up: %s", sfb_last_error(ctx));
+        fail("analysis/state", "not run");
+    } else {
+        glClearColor(1.0f, 0.0f, 1.0f, 1.0f);
+        glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+        glEnable(GL_CULL_FACE);
+        glEnable(GL_BLEND);
+        glBlendFunc(GL_ZERO, GL_ZERO); /* would blacken whatever is drawn with blending on */
+        glDepthFunc(GL_NEVER);         /* would reject every fragment with the depth test on */
+        r = sfb_analysis_draw_gl(ctx, &a);
+        px = (unsigned char *)xmalloc((size_t)FB_SIZE * FB_SIZE * 4);
+        glReadPixels(0, 0, FB_SIZE, FB_SIZE, GL_RGBA, GL_UNSIGNED_BYTE, px);
+        for (k = 0; k < (long)FB_SIZE * FB_SIZE; ++k) {
+            /* framebuffer row 0 is the bottom, the picture's row 0 its top */
+            long x = k % FB_SIZE, y = k / FB_SIZE, q = (FB_SIZE - 1 - y) * FB_SIZE + x;
+            const unsigned char *f = px + 4 * k, *w = a.rgba + 4 * q;
+            if (a.classes[q]) {
+                ++on;
+                if (abs(f[0] - w[0]) > 1 || abs(f[1] - w[1]) > 1 || abs(f[2] - w[2]) > 1) ++bad;
+            } else {
+                ++kept;
+                if (f[0] != 255 || f[1] != 0 || f[2] != 255) ++bad;
+            }
+        }
+        check(r == SFB_SUCCESS && bad == 0 && on > 1000 && kept > 1000, "analysis/overlay",
+              "%s (%s): %ld of %ld pixels wrong (%ld on the surface)", sfb_result_string(r), sfb_last_error(ctx), bad, on + kept, on);
+        glDisable(GL_CULL_FACE);
+        glDisable(GL_BLEND);
+        glBlendFunc(GL_ONE, GL_ZERO);
+        glDepthFunc(GL_LESS);
+        state_diff(set, msg, sizeof msg);
+        if (msg[0]) fail("analysis/state", "host state changed: %s", msg);
+        else pass("analysis/state");
+    }
+    r = sfb_analysis_draw_gl(ref, &a);
+    check(r == SFB_UNSUPPORTED && strstr(sfb_last_error(ref), "gl_use_current_context") != NULL, "analysis/not-host", "got %s (%s)",
+          sfb_result_string(r), sfb_last_error(ref));
+    free(px);
+    sfb_analysis_free(&a);
+    sfb_surface_destroy(s);
+    sfb_mesh_destroy(m);
+}
 
 static void draw_checks(sfb_context *ref, int bench) {
     host h;
@@ -1132,6 +1204,7 @@ static void draw_checks(sfb_context *ref, int bench) {
 
     gles_check(&h, ref);
     glBindFramebuffer(GL_FRAMEBUFFER, h.fbo);
+    analysis_checks(ctx, ref, &set);
 
     if (bench) {
         static const int tori[3][2] = {{8, 4}, {15, 12}, {26, 17}};

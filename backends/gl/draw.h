@@ -326,4 +326,89 @@ SFB_API sfb_result sfb_gl_trim_texture(sfb_context *ctx, const struct sfb_trim_m
     return r;
 }
 
+/* ---- seed 003's analysis on the host's framebuffer (sfb_analysis_draw_gl) ---- */
+static sfb_result sfb__gl_an_program(sfb__gl *g) {
+    static const char *const names[3] = {"u_picture", "u_viewport", "u_size"};
+    sfb__GLuint sh[2], prog;
+    sfb_result r;
+    int i;
+    if (g->an_program) return SFB_SUCCESS;
+    if ((r = sfb__gl_mf_sampler(g)) != SFB_SUCCESS) return r;
+    if ((r = sfb__gl_shader(g, SFB__GL_VERTEX_SHADER, "", sfb__glsl_analysis_draw_vert_glsl, "analysis_draw.vert.glsl", &sh[0])) != SFB_SUCCESS)
+        return r;
+    if ((r = sfb__gl_shader(g, SFB__GL_FRAGMENT_SHADER, "", sfb__glsl_analysis_draw_frag_glsl, "analysis_draw.frag.glsl", &sh[1])) != SFB_SUCCESS) {
+        g->gl.DeleteShader(sh[0]);
+        return r;
+    }
+    if ((r = sfb__gl_link(g, sh, 2, NULL, 0, "the analysis draw program", &prog)) != SFB_SUCCESS) return r;
+    for (i = 0; i < 3; ++i) g->an_loc[i] = g->gl.GetUniformLocation(prog, names[i]);
+    g->an_program = prog;
+    g->gl.GenVertexArrays(1, &g->an_vao);
+    return sfb__gl_check(g, "building the analysis draw program");
+}
+
+/* The picture (with alpha 0 off the surface) as a texture on unit 0, drawn over the viewport;
+ * the host's state saved in ds and by sfb__gl_enter. */
+static sfb_result sfb__gl_an_draw(sfb__gl *g, const sfb_analysis *a, const unsigned char *rgba) {
+    sfb__GLint vp[4] = {0, 0, 0, 0};
+    sfb__GLboolean depth, cull, blend;
+    sfb__GLuint tex;
+    sfb_result r;
+    if ((r = sfb__gl_an_program(g)) != SFB_SUCCESS) return r;
+    g->gl.GetIntegerv(SFB__GL_VIEWPORT, vp);
+    depth = g->gl.IsEnabled(SFB__GL_DEPTH_TEST);
+    cull = g->gl.IsEnabled(SFB__GL_CULL_FACE);
+    blend = g->gl.IsEnabled(SFB__GL_BLEND);
+    sfb__gl_unpack_plain(g, 4);
+    g->gl.ActiveTexture(SFB__GL_TEXTURE0);
+    tex = sfb__gl_mf_texture(g, SFB__GL_RGBA8, a->width, a->height, SFB__GL_RGBA, SFB__GL_UNSIGNED_BYTE, rgba);
+    g->gl.BindSampler(0, g->sampler);
+    g->gl.UseProgram(g->an_program);
+    g->gl.Uniform1i(g->an_loc[0], 0);
+    g->gl.Uniform4f(g->an_loc[1], (float)vp[0], (float)vp[1], (float)(vp[2] > 0 ? vp[2] : 1), (float)(vp[3] > 0 ? vp[3] : 1));
+    g->gl.Uniform2i(g->an_loc[2], a->width, a->height);
+    g->gl.BindVertexArray(g->an_vao);
+    g->gl.Disable(SFB__GL_DEPTH_TEST);
+    g->gl.Disable(SFB__GL_CULL_FACE);
+    g->gl.Disable(SFB__GL_BLEND);
+    g->gl.DrawArraysInstanced(SFB__GL_TRIANGLES, 0, 3, 1);
+    r = sfb__gl_check(g, "drawing the analysis");
+    if (depth) g->gl.Enable(SFB__GL_DEPTH_TEST);
+    if (cull) g->gl.Enable(SFB__GL_CULL_FACE);
+    if (blend) g->gl.Enable(SFB__GL_BLEND);
+    if (tex) g->gl.DeleteTextures(1, &tex);
+    return r;
+}
+
+SFB_API sfb_result sfb_analysis_draw_gl(sfb_context *ctx, const sfb_analysis *a) {
+    sfb__gl *g = NULL;
+    sfb__gl_saved saved;
+    sfb__gl_drawstate ds;
+    unsigned char *rgba;
+    size_t n, k;
+    sfb_result r;
+    if (!ctx) return SFB_INVALID_ARGS;
+    if (!a || !a->rgba || !a->classes || a->width < 1 || a->height < 1)
+        return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "sfb_analysis_draw_gl: %s", a ? "the analysis has no picture" : "analysis is NULL");
+    if ((r = sfb__gl_host_of(ctx, "sfb_analysis_draw_gl", &g)) != SFB_SUCCESS) return r;
+    if (a->width > g->max_texture || a->height > g->max_texture)
+        return sfb__error(ctx, SFB_LIMIT_EXCEEDED, SFB_ELEMENT_NONE, -1, "sfb_analysis_draw_gl: a %d x %d picture exceeds GL_MAX_TEXTURE_SIZE (%d)", a->width,
+                          a->height, (int)g->max_texture);
+    n = (size_t)a->width * (size_t)a->height;
+    rgba = (unsigned char *)sfb__alloc(ctx, n * 4);
+    if (!rgba) return sfb__oom(ctx, "sfb_analysis_draw_gl");
+    for (k = 0; k < n; ++k) {
+        memcpy(rgba + 4 * k, a->rgba + 4 * k, 3);
+        rgba[4 * k + 3] = a->classes[k] ? 255 : 0;
+    }
+    if ((r = sfb__gl_enter(g, &saved)) == SFB_SUCCESS) {
+        sfb__gl_draw_save(g, &ds);
+        r = sfb__gl_an_draw(g, a, rgba);
+        sfb__gl_draw_restore(g, &ds);
+        sfb__gl_leave(g, &saved);
+    }
+    sfb__free(ctx, rgba);
+    return r;
+}
+
 #endif /* SFB__GL_DRAW_H */

@@ -18,7 +18,7 @@
 
 /* ---- the backend state, shared by gl and osmesa ---- */
 enum { SFB__GL_HOST = 0, SFB__GL_OWN_EGL = 1, SFB__GL_OSMESA = 2 };
-enum { SFB__GL_BINDINGS = 6 }; /* SSBO binding points 0..5 used by the shaders */
+enum { SFB__GL_BINDINGS = 8 }; /* SSBO binding points 0..7 used by the shaders (shade.comp.glsl: all 8), saved and restored on the host context */
 
 typedef struct sfb__gl_saved {
     sfb__GLint program, generic;
@@ -95,6 +95,8 @@ typedef struct sfb__gl {
     sfb__GLuint draw_program, draw_vao, draw_ibo, draw_tfo;
     sfb__GLint draw_loc[16];
     int draw_rate;                  /* the grid draw_ibo holds */
+    sfb__GLuint an_program, an_vao; /* sfb_analysis_draw_gl: analysis_draw.{vert,frag}.glsl, made on first use */
+    sfb__GLint an_loc[3];
     char desc[320];
 } sfb__gl;
 
@@ -412,6 +414,9 @@ static void sfb__gl_release_gl(sfb__gl *g) {
     if (g->scratch_dst) g->gl.DeleteBuffers(1, &g->scratch_dst);
     if (g->mf_program) g->gl.DeleteProgram(g->mf_program);
     if (g->sampler) g->gl.DeleteSamplers(1, &g->sampler);
+    if (g->an_program) g->gl.DeleteProgram(g->an_program);
+    if (g->an_vao) g->gl.DeleteVertexArrays(1, &g->an_vao);
+    g->an_program = g->an_vao = 0;
     if (g->draw_program) g->gl.DeleteProgram(g->draw_program);
     if (g->draw_vao) g->gl.DeleteVertexArrays(1, &g->draw_vao);
     if (g->draw_ibo) g->gl.DeleteBuffers(1, &g->draw_ibo);

@@ -7,6 +7,35 @@
 #pragma GCC diagnostic ignored "-Woverlength-strings"
 #endif
 
+/* backends/gl/glsl/analysis_draw.frag.glsl */
+static const char sfb__glsl_analysis_draw_frag_glsl[] =
+    "// sfb_analysis_draw_gl's fragment stage: the analysis picture (RGBA8, texel row 0 the picture's\n"
+    "// top row, alpha 0 off the surface) stretched over the host's viewport, nearest texel; the\n"
+    "// pixels off the surface are discarded, so the host's framebuffer keeps them.\n"
+    "uniform highp sampler2D u_picture;\n"
+    "uniform vec4 u_viewport;   // x, y, width, height of the host's viewport, in window pixels\n"
+    "uniform ivec2 u_size;      // the picture's width and height\n"
+    "layout(location = 0) out vec4 o_color;\n"
+    "\n"
+    "void main() {\n"
+    "    vec2 f = (gl_FragCoord.xy - u_viewport.xy) / u_viewport.zw;  // 0..1 from the viewport's bottom left\n"
+    "    ivec2 t = clamp(ivec2(int(floor(f.x * float(u_size.x))), int(floor((1.0 - f.y) * float(u_size.y)))), ivec2(0), u_size - 1);\n"
+    "    vec4 c = texelFetch(u_picture, t, 0);\n"
+    "    if (c.a < 0.5) discard;\n"
+    "    o_color = vec4(c.rgb, 1.0);\n"
+    "}\n"
+    ;
+
+/* backends/gl/glsl/analysis_draw.vert.glsl */
+static const char sfb__glsl_analysis_draw_vert_glsl[] =
+    "// sfb_analysis_draw_gl's vertex stage: one triangle covering the viewport, from gl_VertexID\n"
+    "// (no attributes): vertices (-1,-1), (3,-1), (-1,3).\n"
+    "void main() {\n"
+    "    vec2 p = vec2(float((gl_VertexID << 1) & 2), float(gl_VertexID & 2));\n"
+    "    gl_Position = vec4(p * 2.0 - 1.0, 0.0, 1.0);\n"
+    "}\n"
+    ;
+
 /* backends/gl/glsl/manifold.comp.glsl */
 static const char sfb__glsl_manifold_comp_glsl[] =
     "// Manifold-based blending surfaces (seed 000 sections V.1-V.4; the MANIFOLD4 patch family): the\n"
