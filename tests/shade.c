@@ -95,12 +95,15 @@ static int is_sharp(const sfb__level *l, int v) { return l->vrule[v] == SFB__RUL
 static double smoothness(const sfb_surface *s, const sfb_mesh_data *d, const float *N, int loop, int *nev) {
     const sfb__level *l = &s->top;
     unsigned char *in = (unsigned char *)calloc((size_t)l->nv + 1, 1);
+    int *first = (int *)malloc(((size_t)l->nv + 1) * sizeof(int)); /* per level vertex: its first output vertex, -1: none */
     double worst = 0.0;
     int v, i, j, k, f;
     *nev = 0;
+    for (v = 0; v < l->nv; ++v) first[v] = -1;
+    for (i = d->vertex_count - 1; i >= 0; --i)
+        if (d->vertex_origin[i] >= 0 && d->vertex_origin[i] < l->nv) first[d->vertex_origin[i]] = i;
     for (v = 0; v < l->nv; ++v) {
-        int o = -1;
-        for (i = 0; i < d->vertex_count; ++i) if (d->vertex_origin[i] == v) { o = i; break; }
+        int o = first[v];
         if (!is_ev(l, v, loop) || is_sharp(l, v) || o < 0 || !(d->blend_weights[o] > 0.0f)) continue;
         (*nev)++;
         in[v] |= 1;
@@ -126,6 +129,7 @@ static double smoothness(const sfb_surface *s, const sfb_mesh_data *d, const flo
         }
     }
     free(in);
+    free(first);
     return worst;
 }
 
