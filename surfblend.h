@@ -1213,6 +1213,17 @@ SFB__IF sfb_result sfb__level_prepare(sfb_context *ctx, const sfb__level *src, i
  * the backend lacks eval_stencils (surface.c). */
 SFB__IF sfb_result sfb__surface_apply(const sfb_surface *s, const sfb__stencils *t, void *handle, int rows, const float *src,
                               sfb_buffer_desc sd, float *dst, sfb_buffer_desc dd);
+/* Small helpers of the software pictures (render.c), shared with the analysis (analyze.c): 3-vector
+ * dot, cross and normalise (returns the length; a zero or non-finite vector is left as it is),
+ * clamp; the share of the footprint [w - fw/2, w + fw/2] a unit-periodic band [a, b] covers (band
+ * filtering); the blue-cyan-green-yellow-red map of t in [0,1]; a [0,1] value as a byte. */
+SFB__IF double sfb__rdot(const double *a, const double *b);
+SFB__IF void sfb__rcross(const double *a, const double *b, double *o);
+SFB__IF double sfb__rnormalize(double *a);
+SFB__IF double sfb__rclamp(double x, double lo, double hi);
+SFB__IF double sfb__band_cover(double w, double fw, double a, double b);
+SFB__IF void sfb__colormap(double t, double *rgb);
+SFB__IF unsigned char sfb__to_byte(double v);
 /* sfb_surface_eval without the per-location checks, for locations the library made itself
  * (analyze.c): the context's backend or ref (surface.c). */
 SFB__IF sfb_result sfb__surface_eval_unchecked(const sfb_surface *s, const sfb_location *loc, int count, const sfb_eval_output *out);
@@ -11315,18 +11326,18 @@ typedef struct sfb__camera {
     int ortho;
 } sfb__camera;
 
-static double sfb__rdot(const double *a, const double *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-static void sfb__rcross(const double *a, const double *b, double *o) {
+double sfb__rdot(const double *a, const double *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+void sfb__rcross(const double *a, const double *b, double *o) {
     o[0] = a[1] * b[2] - a[2] * b[1];
     o[1] = a[2] * b[0] - a[0] * b[2];
     o[2] = a[0] * b[1] - a[1] * b[0];
 }
-static double sfb__rnormalize(double *a) {
+double sfb__rnormalize(double *a) {
     double l = sqrt(sfb__rdot(a, a));
     if (l > 0.0 && isfinite(l)) { a[0] /= l; a[1] /= l; a[2] /= l; }
     return l;
 }
-static double sfb__rclamp(double x, double lo, double hi) { return x < lo ? lo : x > hi ? hi : x; }
+double sfb__rclamp(double x, double lo, double hi) { return x < lo ? lo : x > hi ? hi : x; }
 
 /* Integral over [0, x] of the unit-periodic indicator of the band [a, b] (0 <= a <= b <= 1). */
 static double sfb__band_integral(double x, double a, double b) {
@@ -11334,7 +11345,7 @@ static double sfb__band_integral(double x, double a, double b) {
     return fl * (b - a) + (sfb__rclamp(fr, a, b) - a);
 }
 /* Share of the pixel footprint [w - fw/2, w + fw/2] covered by the periodic band [a, b]. */
-static double sfb__band_cover(double w, double fw, double a, double b) {
+double sfb__band_cover(double w, double fw, double a, double b) {
     if (fw > 64.0) return b - a;
     if (fw < 1e-4) {
         double fr = w - floor(w);
@@ -11344,7 +11355,7 @@ static double sfb__band_cover(double w, double fw, double a, double b) {
 }
 
 /* Colour map for scalars in [0,1]: blue, cyan, green, yellow, red. */
-static void sfb__colormap(double t, double *rgb) {
+void sfb__colormap(double t, double *rgb) {
     static const double stops[5][3] = { {0.10, 0.20, 1.00}, {0.00, 0.85, 1.00}, {0.10, 0.90, 0.15},
                                         {1.00, 0.92, 0.00}, {1.00, 0.10, 0.05} };
     double x = sfb__rclamp(t, 0.0, 1.0) * 4.0;
@@ -11355,7 +11366,7 @@ static void sfb__colormap(double t, double *rgb) {
     for (c = 0; c < 3; ++c) rgb[c] = stops[i][c] * (1.0 - f) + stops[i + 1][c] * f;
 }
 
-static unsigned char sfb__to_byte(double v) {
+unsigned char sfb__to_byte(double v) {
     v = sfb__rclamp(v, 0.0, 1.0);
     return (unsigned char)(v * 255.0 + 0.5);
 }
@@ -11932,22 +11943,10 @@ SFB_API void sfb_analysis_free(sfb_analysis *a) {
     memset(a, 0, sizeof *a);
 }
 
-static double sfb__an_dot(const double *a, const double *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-static void sfb__an_cross(const double *a, const double *b, double *o) {
-    o[0] = a[1] * b[2] - a[2] * b[1];
-    o[1] = a[2] * b[0] - a[0] * b[2];
-    o[2] = a[0] * b[1] - a[1] * b[0];
-}
-static double sfb__an_unit(double *a) {
-    double l = sqrt(sfb__an_dot(a, a));
-    if (l > 0.0 && isfinite(l)) { a[0] /= l; a[1] /= l; a[2] /= l; }
-    return l;
-}
 static void sfb__an_unit3f(float *a) {
     double l = sqrt((double)a[0] * a[0] + (double)a[1] * a[1] + (double)a[2] * a[2]);
     if (l > 0.0 && isfinite(l)) { a[0] = (float)(a[0] / l); a[1] = (float)(a[1] / l); a[2] = (float)(a[2] / l); }
 }
-static double sfb__an_clamp(double x, double lo, double hi) { return x < lo ? lo : x > hi ? hi : x; }
 static int sfb__an_finite3(const float *p) { return isfinite(p[0]) && isfinite(p[1]) && isfinite(p[2]); }
 /* The camera: right/up/forward unit vectors, pixels per unit (focal), the picture centre. */
 typedef struct sfb__an_cam {
@@ -11959,7 +11958,7 @@ typedef struct sfb__an_cam {
 static int sfb__an_project(const sfb__an_cam *c, const double *p, double *sx, double *sy, double *z) {
     double d[3], xc, yc, zc;
     d[0] = p[0] - c->eye[0]; d[1] = p[1] - c->eye[1]; d[2] = p[2] - c->eye[2];
-    xc = sfb__an_dot(d, c->right); yc = sfb__an_dot(d, c->up); zc = sfb__an_dot(d, c->fwd);
+    xc = sfb__rdot(d, c->right); yc = sfb__rdot(d, c->up); zc = sfb__rdot(d, c->fwd);
     *z = zc;
     if (c->ortho) { *sx = c->cx + c->focal * xc; *sy = c->cy - c->focal * yc; return 1; }
     if (!(zc > c->near_z)) return 0;
@@ -11972,10 +11971,10 @@ static int sfb__an_project(const sfb__an_cam *c, const double *p, double *sx, do
 static void sfb__an_project_dir(const sfb__an_cam *c, const double *p, const double *t, double *dx, double *dy) {
     double d[3], xc, yc, zc, tx, ty, tz;
     d[0] = p[0] - c->eye[0]; d[1] = p[1] - c->eye[1]; d[2] = p[2] - c->eye[2];
-    tx = sfb__an_dot(t, c->right); ty = sfb__an_dot(t, c->up);
+    tx = sfb__rdot(t, c->right); ty = sfb__rdot(t, c->up);
     if (c->ortho) { *dx = c->focal * tx; *dy = -c->focal * ty; return; }
-    xc = sfb__an_dot(d, c->right); yc = sfb__an_dot(d, c->up); zc = sfb__an_dot(d, c->fwd);
-    tz = sfb__an_dot(t, c->fwd);
+    xc = sfb__rdot(d, c->right); yc = sfb__rdot(d, c->up); zc = sfb__rdot(d, c->fwd);
+    tz = sfb__rdot(t, c->fwd);
     *dx = c->focal * (tx * zc - xc * tz) / (zc * zc);
     *dy = -c->focal * (ty * zc - yc * tz) / (zc * zc);
 }
@@ -12021,12 +12020,12 @@ static sfb_result sfb__an_check(sfb_context *ctx, const sfb_analyze_config *c, i
         if (!sfb__an_finite_n(c->eye, 3) || !sfb__an_finite_n(c->target, 3) || !sfb__an_finite_n(c->up, 3))
             return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, -1, "camera eye, target or up is not finite");
         for (i = 0; i < 3; ++i) { d[i] = (double)c->target[i] - c->eye[i]; up[i] = c->up[i]; }
-        if (!(sfb__an_unit(d) > 0.0))
+        if (!(sfb__rnormalize(d) > 0.0))
             return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, -1, "camera eye equals its target");
-        if (!(sfb__an_dot(up, up) > 0.0)) up[1] = 1.0;
-        sfb__an_unit(up);
-        sfb__an_cross(d, up, x);
-        if (!(sqrt(sfb__an_dot(x, x)) > 1e-6))
+        if (!(sfb__rdot(up, up) > 0.0)) up[1] = 1.0;
+        sfb__rnormalize(up);
+        sfb__rcross(d, up, x);
+        if (!(sqrt(sfb__rdot(x, x)) > 1e-6))
             return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, -1, "camera up (%g, %g, %g) is parallel to the view direction",
                               (double)c->up[0], (double)c->up[1], (double)c->up[2]);
     }
@@ -12043,11 +12042,11 @@ static sfb_result sfb__an_check(sfb_context *ctx, const sfb_analyze_config *c, i
             !sfb__an_finite_n(c->light_size, 2) || c->light_size[0] < 0.0f || c->light_size[1] < 0.0f)
             return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, -1, "light plane centre, normal, axis or size is not finite (sizes >= 0)");
         for (i = 0; i < 3; ++i) { m[i] = c->light_normal[i]; a[i] = c->light_axis[i]; }
-        if (!(sfb__an_unit(m) > 0.0))
+        if (!(sfb__rnormalize(m) > 0.0))
             return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, -1, "light plane normal is zero");
-        sfb__an_unit(a);
-        sfb__an_cross(m, a, x);
-        if (!(sqrt(sfb__an_dot(x, x)) > 1e-6))
+        sfb__rnormalize(a);
+        sfb__rcross(m, a, x);
+        if (!(sqrt(sfb__rdot(x, x)) > 1e-6))
             return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, -1, "light plane axis (%g, %g, %g) is zero or parallel to its normal",
                               (double)c->light_axis[0], (double)c->light_axis[1], (double)c->light_axis[2]);
     }
@@ -12083,7 +12082,7 @@ typedef struct sfb__an {
     int *adj;                    /* per face and side: (4 * neighbour face + its side) * 2 + reversed, -1: none */
     unsigned char *state;        /* SFB__AN_* per pixel */
     /* hits (compact) */
-    int nhit, cap;
+    int nhit;
     int *chg, nchg;              /* hits made or replaced by the last batch of attempts */
     int *hpix;
     sfb_location *hloc;
@@ -12254,12 +12253,12 @@ static void sfb__an_camera(sfb__an *A) {
     if (c->camera_set) {
         double up[3];
         for (i = 0; i < 3; ++i) { cam->eye[i] = c->eye[i]; cam->fwd[i] = (double)c->target[i] - c->eye[i]; up[i] = c->up[i]; }
-        sfb__an_unit(cam->fwd);
-        if (!(sfb__an_dot(up, up) > 0.0)) up[1] = 1.0;
-        sfb__an_cross(cam->fwd, up, cam->right);
-        sfb__an_unit(cam->right);
-        sfb__an_cross(cam->right, cam->fwd, cam->up);
-        sfb__an_unit(cam->up);
+        sfb__rnormalize(cam->fwd);
+        if (!(sfb__rdot(up, up) > 0.0)) up[1] = 1.0;
+        sfb__rcross(cam->fwd, up, cam->right);
+        sfb__rnormalize(cam->right);
+        sfb__rcross(cam->right, cam->fwd, cam->up);
+        sfb__rnormalize(cam->up);
         if (cam->ortho) cam->focal = c->fov > 0.0f ? h / (double)c->fov : half / A->radius;
         else cam->focal = 0.5 * h / tan(hfov);
     } else {
@@ -12268,8 +12267,8 @@ static void sfb__an_camera(sfb__an *A) {
         dir[0] = cos(pitch) * sin(yaw); dir[1] = sin(pitch); dir[2] = cos(pitch) * cos(yaw);
         for (i = 0; i < 3; ++i) { cam->eye[i] = A->centre[i] + dist * dir[i]; cam->fwd[i] = -dir[i]; }
         cam->right[0] = cos(yaw); cam->right[1] = 0.0; cam->right[2] = -sin(yaw);
-        sfb__an_cross(cam->right, cam->fwd, cam->up);
-        sfb__an_unit(cam->up);
+        sfb__rcross(cam->right, cam->fwd, cam->up);
+        sfb__rnormalize(cam->up);
         cam->focal = cam->ortho ? half * zoom / A->radius : half * zoom / tan(hfov);
     }
     cam->near_z = c->near_plane > 0.0f ? c->near_plane : 1e-3 * A->radius;
@@ -12305,18 +12304,18 @@ static void sfb__an_raster_tri(sfb__an *A, int f, const int *g, const sfb__an_sv
         double longest = elen[0] > elen[1] ? (elen[0] > elen[2] ? elen[0] : elen[2]) : (elen[1] > elen[2] ? elen[1] : elen[2]);
         double e1[3], e2[3], cr[3], a3, sc;
         for (k = 0; k < 3; ++k) { e1[k] = (double)P[1][k] - P[0][k]; e2[k] = (double)P[2][k] - P[0][k]; }
-        sfb__an_cross(e1, e2, cr);
+        sfb__rcross(e1, e2, cr);
         sc = A->cam.ortho ? A->cam.focal : A->cam.focal * 3.0 / (a->z + b1->z + c2->z);
-        a3 = sqrt(sfb__an_dot(cr, cr)) * sc * sc; /* twice the area, in pixels, seen face-on */
+        a3 = sqrt(sfb__rdot(cr, cr)) * sc * sc; /* twice the area, in pixels, seen face-on */
         /* thin (under 2 pixels high) or grazing (seen at under 20 degrees): near the silhouette */
         dilate = fabs(area) < 2.0 * longest || fabs(area) < 0.35 * a3 ? SFB__AN_DILATE : 0.0;
     }
     if (pass == 0) dilate = 0.0;
     else if (dilate == 0.0) return;
-    minx = sfb__an_clamp(ceil(minx - 0.5 - dilate), 0.0, (double)A->w);
-    maxx = sfb__an_clamp(floor(maxx - 0.5 + dilate), -1.0, (double)A->w - 1.0);
-    miny = sfb__an_clamp(ceil(miny - 0.5 - dilate), 0.0, (double)A->h);
-    maxy = sfb__an_clamp(floor(maxy - 0.5 + dilate), -1.0, (double)A->h - 1.0);
+    minx = sfb__rclamp(ceil(minx - 0.5 - dilate), 0.0, (double)A->w);
+    maxx = sfb__rclamp(floor(maxx - 0.5 + dilate), -1.0, (double)A->w - 1.0);
+    miny = sfb__rclamp(ceil(miny - 0.5 - dilate), 0.0, (double)A->h);
+    maxy = sfb__rclamp(floor(maxy - 0.5 + dilate), -1.0, (double)A->h - 1.0);
     ix0 = (int)minx; ix1 = (int)maxx; iy0 = (int)miny; iy1 = (int)maxy;
     inv = 1.0 / area;
     /* barycentric k = ea[k] * px + eb[k] * py + ec[k] (edge k opposite corner k) */
@@ -12347,8 +12346,8 @@ static void sfb__an_raster_tri(sfb__an *A, int f, const int *g, const sfb__an_sv
                 if (!(sum > 0.0)) continue;
                 A->cdist[pix] = (float)d;
                 A->cface[pix] = f;
-                A->cuv[2 * pix] = (float)sfb__an_clamp((b[0] * a->u + b[1] * b1->u + b[2] * c2->u) / sum, 0.0, 1.0);
-                A->cuv[2 * pix + 1] = (float)sfb__an_clamp((b[0] * a->v + b[1] * b1->v + b[2] * c2->v) / sum, 0.0, 1.0);
+                A->cuv[2 * pix] = (float)sfb__rclamp((b[0] * a->u + b[1] * b1->u + b[2] * c2->u) / sum, 0.0, 1.0);
+                A->cuv[2 * pix + 1] = (float)sfb__rclamp((b[0] * a->v + b[1] * b1->v + b[2] * c2->v) / sum, 0.0, 1.0);
                 continue;
             }
             if (pass) continue;
@@ -12359,8 +12358,8 @@ static void sfb__an_raster_tri(sfb__an *A, int f, const int *g, const sfb__an_sv
             b[0] *= a->q / den; b[1] *= b1->q / den; b[2] *= c2->q / den;
             A->depth[pix] = (float)z;
             A->face[pix] = f;
-            A->uv[2 * pix] = (float)sfb__an_clamp(b[0] * a->u + b[1] * b1->u + b[2] * c2->u, 0.0, 1.0);
-            A->uv[2 * pix + 1] = (float)sfb__an_clamp(b[0] * a->v + b[1] * b1->v + b[2] * c2->v, 0.0, 1.0);
+            A->uv[2 * pix] = (float)sfb__rclamp(b[0] * a->u + b[1] * b1->u + b[2] * c2->u, 0.0, 1.0);
+            A->uv[2 * pix + 1] = (float)sfb__rclamp(b[0] * a->v + b[1] * b1->v + b[2] * c2->v, 0.0, 1.0);
             if (A->ppos) {
                 int c;
                 size_t base = (size_t)f * (size_t)A->per;
@@ -12477,7 +12476,7 @@ static int sfb__an_exit_side(const sfb__an *A, double uo, double vo, double u, d
     if (best < 0) return -1;
     if (A->tri) *t = best == 0 ? u : best == 1 ? v : 1.0 - v;
     else *t = best == 0 ? u : best == 1 ? v : best == 2 ? 1.0 - u : 1.0 - v;
-    *t = sfb__an_clamp(*t, 0.0, 1.0);
+    *t = sfb__rclamp(*t, 0.0, 1.0);
     return best;
 }
 
@@ -12725,17 +12724,6 @@ static sfb_result sfb__an_leftovers(sfb__an *A, int *fallback, int *dropped) {
 }
 
 /* ---- step 4: colours ---- */
-/* Integral over [0, x] of the unit-periodic indicator of [a, b] (0 <= a <= b <= 1), and the
- * share of the footprint [w - fw/2, w + fw/2] it covers. */
-static double sfb__an_band_integral(double x, double a, double b) {
-    double fl = floor(x), fr = x - fl;
-    return fl * (b - a) + (sfb__an_clamp(fr, a, b) - a);
-}
-static double sfb__an_band(double w, double fw, double a, double b) {
-    if (fw > 64.0) return b - a;
-    if (fw < 1e-4) { double fr = w - floor(w); return fr >= a && fr < b; }
-    return (sfb__an_band_integral(w + 0.5 * fw, a, b) - sfb__an_band_integral(w - 0.5 * fw, a, b)) / fw;
-}
 /* The footprint of pixel pix in units of the value in v: per axis the smaller one-sided
  * difference (robust at silhouettes and band ends), summed. */
 static double sfb__an_footprint(const float *v, int w, int h, int pix) {
@@ -12749,17 +12737,6 @@ static double sfb__an_footprint(const float *v, int w, int h, int pix) {
     if (dy == HUGE_VAL) dy = 0.0;
     return dx + dy;
 }
-/* Blue, cyan, green, yellow, red for t in [0,1]. */
-static void sfb__an_colormap(double t, double *rgb) {
-    static const double stops[5][3] = { {0.10, 0.20, 1.00}, {0.00, 0.85, 1.00}, {0.10, 0.90, 0.15}, {1.00, 0.92, 0.00}, {1.00, 0.10, 0.05} };
-    double x = sfb__an_clamp(t, 0.0, 1.0) * 4.0, f;
-    int i = (int)x, c;
-    if (i > 3) i = 3;
-    f = x - i;
-    for (c = 0; c < 3; ++c) rgb[c] = stops[i][c] * (1.0 - f) + stops[i + 1][c] * f;
-}
-static unsigned char sfb__an_byte(double v) { return (unsigned char)(sfb__an_clamp(v, 0.0, 1.0) * 255.0 + 0.5); }
-
 /* The looks of one analysis: resolved light and colours. */
 typedef struct sfb__an_look {
     sfb__shade_job job;
@@ -12778,12 +12755,12 @@ static void sfb__an_lights(const sfb__an *A, sfb__an_look *L) {
     j->mode = mode; j->curvature = c->curvature; j->ortho = cam->ortho;
     for (i = 0; i < 3; ++i) { j->eye[i] = cam->eye[i]; j->fwd[i] = cam->fwd[i]; }
     for (i = 0; i < 3; ++i) L->key[i] = -cam->fwd[i] + 0.55 * cam->up[i] - 0.45 * cam->right[i];
-    sfb__an_unit(L->key);
+    sfb__rnormalize(L->key);
     L->pattern = c->light_pattern;
     L->width = c->stripe_width > 0.0f ? c->stripe_width
                : L->pattern == SFB_LIGHT_LATTICE ? 0.2 : L->pattern == SFB_LIGHT_CIRCLES ? 0.6 : mode == SFB_ANALYZE_HIGHLIGHT ? 0.7 : 0.5;
     for (i = 0; i < 3; ++i) d[i] = c->light_dir[i];
-    if (!(sfb__an_unit(d) > 0.0)) {
+    if (!(sfb__rnormalize(d) > 0.0)) {
         /* zebra: bands about the camera's up; isophotes and shading: the key light */
         for (i = 0; i < 3; ++i) d[i] = mode == SFB_ANALYZE_ZEBRA ? cam->up[i] : L->key[i];
     }
@@ -12792,7 +12769,7 @@ static void sfb__an_lights(const sfb__an *A, sfb__an_look *L) {
         double ell[3], per = c->stripes > 0.0f ? c->stripes : mode == SFB_ANALYZE_REFLECTION ? 16.0 : 5.0, t;
         if (c->light_set) {
             for (i = 0; i < 3; ++i) { j->lc[i] = c->light_center[i]; j->lm[i] = c->light_normal[i]; j->lu[i] = c->light_axis[i]; }
-            sfb__an_unit(j->lm);
+            sfb__rnormalize(j->lm);
             j->lsize[0] = c->light_size[0] > 0.0f ? c->light_size[0] : 16.0 * R;
             j->lsize[1] = c->light_size[1] > 0.0f ? c->light_size[1] : j->lsize[0];
         } else if (mode == SFB_ANALYZE_REFLECTION) {
@@ -12801,7 +12778,7 @@ static void sfb__an_lights(const sfb__an *A, sfb__an_look *L) {
              * run away from the viewer (a design studio's ceiling of tubes) */
             if (c->camera_set) for (i = 0; i < 3; ++i) ell[i] = c->up[i];
             else { ell[0] = 0.0; ell[1] = 1.0; ell[2] = 0.0; }
-            if (!(sfb__an_unit(ell) > 0.0)) { ell[0] = 0.0; ell[1] = 1.0; ell[2] = 0.0; }
+            if (!(sfb__rnormalize(ell) > 0.0)) { ell[0] = 0.0; ell[1] = 1.0; ell[2] = 0.0; }
             for (i = 0; i < 3; ++i) { j->lc[i] = A->centre[i] + 2.5 * R * ell[i]; j->lm[i] = -ell[i]; j->lu[i] = cam->right[i]; }
             j->lsize[0] = j->lsize[1] = 16.0 * R;
         } else {
@@ -12812,13 +12789,13 @@ static void sfb__an_lights(const sfb__an *A, sfb__an_look *L) {
                 j->lc[i] = A->centre[i] + 3.0 * R * j->lm[i];
                 e[i] = cos(SFB__PI / 6.0) * cam->up[i] + sin(SFB__PI / 6.0) * cam->right[i];
             }
-            sfb__an_cross(e, j->lm, j->lu);
+            sfb__rcross(e, j->lm, j->lu);
             j->lsize[0] = j->lsize[1] = 2.0 * R;
         }
-        t = sfb__an_dot(j->lu, j->lm);
+        t = sfb__rdot(j->lu, j->lm);
         for (i = 0; i < 3; ++i) j->lu[i] -= t * j->lm[i];
-        sfb__an_unit(j->lu);
-        sfb__an_cross(j->lm, j->lu, j->lv);
+        sfb__rnormalize(j->lu);
+        sfb__rcross(j->lm, j->lu, j->lv);
         j->periods[0] = per;
         j->periods[1] = per * j->lsize[1] / j->lsize[0];
     } else if (mode == SFB_ANALYZE_ZEBRA) j->periods[0] = c->stripes > 0.0f ? c->stripes : 16.0;
@@ -12867,10 +12844,10 @@ static sfb_result sfb__an_range(const sfb__an *A, const float *val, int n, doubl
 
 /* Samples the image light at plane coordinates (s, t) in [0,1] (bilinear, clamped). */
 static void sfb__an_texel(const sfb_analyze_config *c, double s, double t, double *rgba) {
-    double x = sfb__an_clamp(s, 0.0, 1.0) * c->light_width - 0.5, y = sfb__an_clamp(t, 0.0, 1.0) * c->light_height - 0.5, fx, fy;
+    double x = sfb__rclamp(s, 0.0, 1.0) * c->light_width - 0.5, y = sfb__rclamp(t, 0.0, 1.0) * c->light_height - 0.5, fx, fy;
     int x0, y0, x1, y1, k;
-    x = sfb__an_clamp(x, 0.0, c->light_width - 1.0);
-    y = sfb__an_clamp(y, 0.0, c->light_height - 1.0);
+    x = sfb__rclamp(x, 0.0, c->light_width - 1.0);
+    y = sfb__rclamp(y, 0.0, c->light_height - 1.0);
     x0 = (int)x; y0 = (int)y; fx = x - x0; fy = y - y0;
     x1 = x0 + 1 < c->light_width ? x0 + 1 : x0;
     y1 = y0 + 1 < c->light_height ? y0 + 1 : y0;
@@ -12886,7 +12863,7 @@ static void sfb__an_texel(const sfb_analyze_config *c, double s, double t, doubl
 static double sfb__an_pattern(const sfb__an_look *L, double a, double b, double fa, double fb, int *cls) {
     double w = L->width, cover;
     if (L->pattern == SFB_LIGHT_LATTICE) {
-        double ca = sfb__an_band(a, fa, 0.0, w), cb = sfb__an_band(b, fb, 0.0, w);
+        double ca = sfb__band_cover(a, fa, 0.0, w), cb = sfb__band_cover(b, fb, 0.0, w);
         double ra = a - floor(a), rb = b - floor(b);
         *cls = (ra < w || rb < w) ? 3 : 2;
         return ca + cb - ca * cb;
@@ -12895,13 +12872,13 @@ static double sfb__an_pattern(const sfb__an_look *L, double a, double b, double 
         double ua = a - floor(a) - 0.5, ub = b - floor(b) - 0.5, d = sqrt(ua * ua + ub * ub), rad = 0.5 * w;
         double f = fa > fb ? fa : fb, edge, avg = SFB__PI * rad * rad, t;
         *cls = d < rad ? 3 : 2;
-        edge = f > 1e-6 ? sfb__an_clamp((rad - d) / f + 0.5, 0.0, 1.0) : (d < rad);
-        t = sfb__an_clamp((f - 0.25) / 0.25, 0.0, 1.0);
+        edge = f > 1e-6 ? sfb__rclamp((rad - d) / f + 0.5, 0.0, 1.0) : (d < rad);
+        t = sfb__rclamp((f - 0.25) / 0.25, 0.0, 1.0);
         cover = (1.0 - t) * edge + t * avg;
         return cover;
     }
     *cls = (a - floor(a)) < w ? 3 : 2;
-    return sfb__an_band(a, fa, 0.0, w);
+    return sfb__band_cover(a, fa, 0.0, w);
 }
 
 /* Colours every pixel from the values (full-picture arrays v1, v2) and the hits' normals. */
@@ -12920,9 +12897,9 @@ static void sfb__an_colour(const sfb__an *A, const sfb__an_look *L, const float 
             double vv[3];
             if (A->cam.ortho) for (i = 0; i < 3; ++i) vv[i] = -A->cam.fwd[i];
             else for (i = 0; i < 3; ++i) vv[i] = A->cam.eye[i] - A->hpos[3 * (size_t)k + i];
-            if (sfb__an_dot(vv, n) < 0.0) for (i = 0; i < 3; ++i) n[i] = -n[i];
+            if (sfb__rdot(vv, n) < 0.0) for (i = 0; i < 3; ++i) n[i] = -n[i];
         }
-        diff = sfb__an_dot(n, L->key);
+        diff = sfb__rdot(n, L->key);
         if (diff < 0.0) diff = 0.0;
         switch (mode) {
         case SFB_ANALYZE_REFLECTION:
@@ -12953,23 +12930,23 @@ static void sfb__an_colour(const sfb__an *A, const sfb__an_look *L, const float 
             }
             break;
         case SFB_ANALYZE_ZEBRA: {
-            double fa = sfb__an_footprint(v1, A->w, A->h, (int)p), cover = sfb__an_band(a, fa, 0.0, L->width);
+            double fa = sfb__an_footprint(v1, A->w, A->h, (int)p), cover = sfb__band_cover(a, fa, 0.0, L->width);
             cl = (a - floor(a)) < L->width ? 3 : 2;
             for (i = 0; i < 3; ++i) rgb[i] = 0.04 + 0.92 * cover;
             break;
         }
         case SFB_ANALYZE_ISOPHOTE: {
-            double N = L->job.periods[0], x = (sfb__an_clamp(a, -1.0, 1.0) + 1.0) * 0.5 * N, fx = sfb__an_footprint(v1, A->w, A->h, (int)p) * 0.5 * N;
+            double N = L->job.periods[0], x = (sfb__rclamp(a, -1.0, 1.0) + 1.0) * 0.5 * N, fx = sfb__an_footprint(v1, A->w, A->h, (int)p) * 0.5 * N;
             double kb = floor(x), f = x - kb, c0[3], c1[3], m = 0.0;
             int kk = (int)kb, nb = kk;
             if (kk >= (int)N) kk = (int)N - 1;
             cl = 2 + (kk < 0 ? 0 : kk > 200 ? 200 : kk);
-            sfb__an_colormap((kk + 0.5) / N, c0);
+            sfb__colormap((kk + 0.5) / N, c0);
             if (fx > 1e-6 && f < 0.5 * fx) { nb = kk - 1; m = (0.5 * fx - f) / fx; }
             else if (fx > 1e-6 && 1.0 - f < 0.5 * fx) { nb = kk + 1; m = (0.5 * fx - (1.0 - f)) / fx; }
             if (nb < 0) nb = 0;
             if (nb >= (int)N) nb = (int)N - 1;
-            sfb__an_colormap((nb + 0.5) / N, c1);
+            sfb__colormap((nb + 0.5) / N, c1);
             for (i = 0; i < 3; ++i) rgb[i] = c0[i] * (1.0 - m) + c1[i] * m;
             break;
         }
@@ -12977,12 +12954,12 @@ static void sfb__an_colour(const sfb__an *A, const sfb__an_look *L, const float 
             double t, lum = 0.72 + 0.28 * diff;
             if (!isfinite(a)) { cl = 1; rgb[0] = rgb[1] = rgb[2] = 0.5; break; }
             if (c->curvature == SFB_CURVATURE_MAX_ABS) {
-                t = sfb__an_clamp(a / L->range, 0.0, 1.0);
-                cl = 2 + (int)sfb__an_clamp(floor(t * 16.0), 0.0, 15.0);
-                sfb__an_colormap(t, rgb);
+                t = sfb__rclamp(a / L->range, 0.0, 1.0);
+                cl = 2 + (int)sfb__rclamp(floor(t * 16.0), 0.0, 15.0);
+                sfb__colormap(t, rgb);
             } else {
                 static const double neg[3] = { 0.12, 0.30, 1.00 }, pos[3] = { 1.00, 0.16, 0.08 };
-                t = sfb__an_clamp(a / L->range, -1.0, 1.0);
+                t = sfb__rclamp(a / L->range, -1.0, 1.0);
                 cl = 2 + 8 + (int)floor(t * 8.0 + 0.5); /* 17 bins, the middle one centred on 0 */
                 for (i = 0; i < 3; ++i) rgb[i] = (1.0 - fabs(t)) * 0.96 + fabs(t) * (t < 0.0 ? neg[i] : pos[i]);
             }
@@ -12996,17 +12973,17 @@ static void sfb__an_colour(const sfb__an *A, const sfb__an_look *L, const float 
             double hv[3], vv[3], spec;
             if (A->cam.ortho) for (i = 0; i < 3; ++i) vv[i] = -A->cam.fwd[i];
             else for (i = 0; i < 3; ++i) vv[i] = A->cam.eye[i] - A->hpos[3 * (size_t)k + i];
-            sfb__an_unit(vv);
+            sfb__rnormalize(vv);
             for (i = 0; i < 3; ++i) hv[i] = L->key[i] + vv[i];
-            sfb__an_unit(hv);
-            spec = sfb__an_dot(n, hv);
+            sfb__rnormalize(hv);
+            spec = sfb__rdot(n, hv);
             spec = spec > 0.0 ? pow(spec, 48.0) : 0.0;
-            rgb[0] = rgb[1] = rgb[2] = pow(sfb__an_clamp(0.72 * (0.16 + 0.78 * diff) + 0.3 * spec, 0.0, 1.0), 1.0 / 1.6);
+            rgb[0] = rgb[1] = rgb[2] = pow(sfb__rclamp(0.72 * (0.16 + 0.78 * diff) + 0.3 * spec, 0.0, 1.0), 1.0 / 1.6);
             break;
         }
         }
         cls[p] = (unsigned char)cl;
-        o[0] = sfb__an_byte(rgb[0]); o[1] = sfb__an_byte(rgb[1]); o[2] = sfb__an_byte(rgb[2]); o[3] = 255;
+        o[0] = sfb__to_byte(rgb[0]); o[1] = sfb__to_byte(rgb[1]); o[2] = sfb__to_byte(rgb[2]); o[3] = 255;
     }
 }
 

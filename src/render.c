@@ -41,18 +41,18 @@ typedef struct sfb__camera {
     int ortho;
 } sfb__camera;
 
-static double sfb__rdot(const double *a, const double *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-static void sfb__rcross(const double *a, const double *b, double *o) {
+double sfb__rdot(const double *a, const double *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+void sfb__rcross(const double *a, const double *b, double *o) {
     o[0] = a[1] * b[2] - a[2] * b[1];
     o[1] = a[2] * b[0] - a[0] * b[2];
     o[2] = a[0] * b[1] - a[1] * b[0];
 }
-static double sfb__rnormalize(double *a) {
+double sfb__rnormalize(double *a) {
     double l = sqrt(sfb__rdot(a, a));
     if (l > 0.0 && isfinite(l)) { a[0] /= l; a[1] /= l; a[2] /= l; }
     return l;
 }
-static double sfb__rclamp(double x, double lo, double hi) { return x < lo ? lo : x > hi ? hi : x; }
+double sfb__rclamp(double x, double lo, double hi) { return x < lo ? lo : x > hi ? hi : x; }
 
 /* Integral over [0, x] of the unit-periodic indicator of the band [a, b] (0 <= a <= b <= 1). */
 static double sfb__band_integral(double x, double a, double b) {
@@ -60,7 +60,7 @@ static double sfb__band_integral(double x, double a, double b) {
     return fl * (b - a) + (sfb__rclamp(fr, a, b) - a);
 }
 /* Share of the pixel footprint [w - fw/2, w + fw/2] covered by the periodic band [a, b]. */
-static double sfb__band_cover(double w, double fw, double a, double b) {
+double sfb__band_cover(double w, double fw, double a, double b) {
     if (fw > 64.0) return b - a;
     if (fw < 1e-4) {
         double fr = w - floor(w);
@@ -70,7 +70,7 @@ static double sfb__band_cover(double w, double fw, double a, double b) {
 }
 
 /* Colour map for scalars in [0,1]: blue, cyan, green, yellow, red. */
-static void sfb__colormap(double t, double *rgb) {
+void sfb__colormap(double t, double *rgb) {
     static const double stops[5][3] = { {0.10, 0.20, 1.00}, {0.00, 0.85, 1.00}, {0.10, 0.90, 0.15},
                                         {1.00, 0.92, 0.00}, {1.00, 0.10, 0.05} };
     double x = sfb__rclamp(t, 0.0, 1.0) * 4.0;
@@ -81,7 +81,7 @@ static void sfb__colormap(double t, double *rgb) {
     for (c = 0; c < 3; ++c) rgb[c] = stops[i][c] * (1.0 - f) + stops[i + 1][c] * f;
 }
 
-static unsigned char sfb__to_byte(double v) {
+unsigned char sfb__to_byte(double v) {
     v = sfb__rclamp(v, 0.0, 1.0);
     return (unsigned char)(v * 255.0 + 0.5);
 }

@@ -470,6 +470,17 @@ SFB__IF sfb_result sfb__level_prepare(sfb_context *ctx, const sfb__level *src, i
  * the backend lacks eval_stencils (surface.c). */
 SFB__IF sfb_result sfb__surface_apply(const sfb_surface *s, const sfb__stencils *t, void *handle, int rows, const float *src,
                               sfb_buffer_desc sd, float *dst, sfb_buffer_desc dd);
+/* Small helpers of the software pictures (render.c), shared with the analysis (analyze.c): 3-vector
+ * dot, cross and normalise (returns the length; a zero or non-finite vector is left as it is),
+ * clamp; the share of the footprint [w - fw/2, w + fw/2] a unit-periodic band [a, b] covers (band
+ * filtering); the blue-cyan-green-yellow-red map of t in [0,1]; a [0,1] value as a byte. */
+SFB__IF double sfb__rdot(const double *a, const double *b);
+SFB__IF void sfb__rcross(const double *a, const double *b, double *o);
+SFB__IF double sfb__rnormalize(double *a);
+SFB__IF double sfb__rclamp(double x, double lo, double hi);
+SFB__IF double sfb__band_cover(double w, double fw, double a, double b);
+SFB__IF void sfb__colormap(double t, double *rgb);
+SFB__IF unsigned char sfb__to_byte(double v);
 /* sfb_surface_eval without the per-location checks, for locations the library made itself
  * (analyze.c): the context's backend or ref (surface.c). */
 SFB__IF sfb_result sfb__surface_eval_unchecked(const sfb_surface *s, const sfb_location *loc, int count, const sfb_eval_output *out);

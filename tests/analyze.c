@@ -148,7 +148,7 @@ static void test_analytic(sfb_context *ctx, int saddle) {
         c.level = 1;
         if (sfb_surface_analyze(s, &c, &an) != SFB_SUCCESS) { fail(name, "%s", sfb_last_error(ctx)); continue; }
         {
-            double worst = 0.0, scale = 0.0;
+            double worst = 0.0;
             long bad = 0, total = 0;
             for (y = 0; y < size; ++y)
                 for (x = 0; x < size; ++x) {
@@ -160,7 +160,6 @@ static void test_analytic(sfb_context *ctx, int saddle) {
                     H = -((1.0 + t.fx * t.fx) * t.fyy - 2.0 * t.fx * t.fy * t.fxy + (1.0 + t.fy * t.fy) * t.fxx) / (2.0 * pow(W2, 1.5));
                     want = kind ? H : K;
                     got = an.values[y * size + x];
-                    scale = fabs(want) > scale ? fabs(want) : scale;
                     /* relative to the value, or where it passes through 0 (the saddle's mean
                      * curvature on the axes) to a hundredth of the shape's scale a */
                     e = fabs(got - want) / (fabs(want) > 1e-2 * a ? fabs(want) : 1e-2 * a);
