@@ -12,7 +12,7 @@ LIBS    := -lm -lpthread -ldl
 SHAPES  ?= ../shared/peers/opensubdiv-shapes
 REAL_MESHES ?= $(dir $(SHAPES))real-meshes
 
-SRC_MODULES := src/sfb_api.h src/sfb_internal.h $(wildcard src/*.c src/patch/*.c)
+SRC_MODULES := src/sfb_api.h src/sfb_internal.h $(wildcard src/*.c src/patch/*.c src/fillet/*.c)
 TEST_SRCS   := $(wildcard tests/test_*.c)
 BACKEND_HDRS:= $(wildcard backends/*.h backends/*/*.h backends/*/glsl/*.glsl)
 EXAMPLES    := $(patsubst examples/%.c,$(BUILD)/examples/%,$(wildcard examples/*.c))
@@ -280,6 +280,17 @@ $(BUILD)/tribezier: tests/tribezier.c tests/tribezier_mesh.h tests/harness.h src
 $(BUILD)/analyze: tests/analyze.c tests/harness.h $(BUILD)/libsfb.o
 	$(CC) $(CFLAGS) $(SAN) -I. tests/analyze.c $(BUILD)/libsfb.o -o $@ $(LIBS)
 
+# The rolling-ball operator's geometry modules on their own: AABB tree, triangle-triangle
+# intersection, sparse conjugate gradients, mesh normals and mean curvature (tests/geom.c).
+$(BUILD)/geom: tests/geom.c tests/harness.h src/sfb_internal.h $(BUILD)/libsfb_internal.o
+	$(CC) $(CFLAGS) $(SAN) -I. tests/geom.c $(BUILD)/libsfb_internal.o -o $@ $(LIBS)
+
+# Rolling-ball fillets (sfb_mesh_fillet, seed 002): exact quarter cylinders, conics, sharpening,
+# the cylinder-box seam, self-intersection, bad input (tests/fillet.c, shapes from
+# examples/fillet_shapes.h).
+$(BUILD)/fillet: tests/fillet.c tests/harness.h examples/fillet_shapes.h $(BUILD)/libsfb_internal.o
+	$(CC) $(CFLAGS) $(SAN) -I. tests/fillet.c $(BUILD)/libsfb_internal.o -o $@ $(LIBS)
+
 # Manifold blending on gl/osmesa and the vertex-shader draw path (with trimming) on a GL context
 # the test owns (links EGL/GL as gl_host) (tests/gl_manifold.c).
 $(BUILD)/gl_manifold: tests/gl_manifold.c tests/harness.h tests/egl_host.h $(BUILD)/libsfb.o
@@ -291,7 +302,7 @@ $(BUILD)/web/png_iou: tests/web/png_iou.c | deps
 	$(CC) -std=c99 $(OPT) -g -Wall -Wextra $(SAN) $< -o $@ -lm
 
 unit-build: $(BUILD)/web/png_iou $(BUILD)/surfblend $(BUILD)/unit $(BUILD)/osd_agree $(BUILD)/agree $(BUILD)/limit $(BUILD)/eigen $(BUILD)/gl_host \
-            $(BUILD)/gl_errors $(BUILD)/gl_pieces $(BUILD)/shade $(BUILD)/trim $(BUILD)/finish_normals $(BUILD)/manifold $(BUILD)/tribezier $(BUILD)/analyze $(BUILD)/gl_manifold $(EXAMPLES) \
+            $(BUILD)/gl_errors $(BUILD)/gl_pieces $(BUILD)/shade $(BUILD)/trim $(BUILD)/finish_normals $(BUILD)/manifold $(BUILD)/tribezier $(BUILD)/analyze $(BUILD)/geom $(BUILD)/fillet $(BUILD)/gl_manifold $(EXAMPLES) \
             $(EXAMPLES_CXX) $(BUILD)/png_iou $(BUILD)/sfb2gltf $(BUILD)/gltf_check
 
 # On CI (CI set and not false/0) the optional backends must run, not be skipped: the suites
@@ -388,7 +399,7 @@ test-neon: deps-neon amalgamate-check
 	BUILD=$(BUILD) SHAPES=$(SHAPES) ./tests/neon.sh
 
 # ---- benchmark ----
-$(BUILD)/bench: bench/bench.cpp tests/egl_host.h $(BUILD)/libsfb.o
+$(BUILD)/bench: bench/bench.cpp tests/egl_host.h examples/fillet_shapes.h $(BUILD)/libsfb.o
 	$(CXX) $(CXXFLAGS) -I. bench/bench.cpp $(BUILD)/libsfb.o -o $@ $(BENCH_LIBS) $(LIBS)
 
 bench: deps-test

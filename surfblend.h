@@ -733,6 +733,88 @@ SFB_API void sfb_analysis_free(sfb_analysis *a);
  * backend on the host's current context (gl_use_current_context), else SFB_UNSUPPORTED. */
 SFB_API sfb_result sfb_analysis_draw_gl(sfb_context *ctx, const sfb_analysis *analysis);
 
+/* ---- rolling-ball blending (fillets) of sharp features on triangle meshes (seed 002) ----
+ * sfb_mesh_fillet rounds sharp features of a triangle mesh with a rolling ball of radius r
+ * without remeshing: the output has the input's vertices, faces and connectivity; only the
+ * vertices of each blend region move, onto a virtual sweep surface (profiles swept along the
+ * spine, the path of the ball's centre). Pipeline, per curve: blending curve (feature edges whose
+ * dihedral angle exceeds a threshold, chained; or a caller's vertex chain) -> base patches within
+ * alpha*r of the curve -> offset patches (vertex normals, per side) -> their intersection through
+ * an AABB tree: the spine -> spine samples and a profile per sample -> blend region vertices
+ * mapped onto the sweep. Progress stages "fillet curves", "fillet spine", "fillet surface",
+ * "fillet map", "fillet project" (a caller timing the stages reads them from the progress
+ * callback); cancelling returns SFB_CANCELLED and keeps nothing. */
+typedef enum sfb_fillet_profile {
+    SFB_FILLET_ARC = 0,     /* the rolling ball's circular arc (rational quadratic, exact) */
+    SFB_FILLET_CONIC = 1,   /* a conic through the same ends and end tangents: middle weight conic_weight */
+    SFB_FILLET_SHARPEN = 2, /* the two end tangents up to their intersection: turns a rounded feature sharp */
+    SFB_FILLET_HERMITE = 3  /* a cubic Hermite curve between the contact points, tangents scaled by hermite_scale */
+} sfb_fillet_profile;
+typedef struct sfb_fillet_curve {
+    const int *vertices;    /* a chain of mesh edges v0-v1-...; closed when the last vertex equals the first */
+    int count;              /* vertices in the list (>= 2) */
+    float radius;           /* 0: the config's radius */
+    int profile;            /* sfb_fillet_profile + 1; 0: the config's profile */
+    float conic_weight;     /* 0: the config's */
+} sfb_fillet_curve;
+typedef struct sfb_fillet_config {
+    float radius;           /* ball radius, > 0 (required) */
+    float angle;            /* degrees: edges whose dihedral angle exceeds it are features; 0: 30 */
+    int profile;            /* sfb_fillet_profile */
+    float conic_weight;     /* SFB_FILLET_CONIC: weight of the middle control point (< 1 ellipse, 1 parabola,
+                               > 1 hyperbola); 0: the arc's own, cos of half the central angle */
+    float hermite_scale;    /* SFB_FILLET_HERMITE: end tangent length over the chord; 0: the arc's tangents */
+    float alpha;            /* base patches: faces within alpha*radius of the curve; 0: 1.75 (seed Fig. 2) */
+    int samples;            /* initial spine samples by arc length; 0: 40 (seed section 4.1) */
+    float chord_ratio;      /* a spine interval is refined while chord height / chord length exceeds it; 0: 0.002 */
+    const sfb_fillet_curve *curves; /* the caller's blending curves; NULL: features by angle */
+    int curve_count;
+    int map;                /* SFB_FILLET_MAP_*: how blend-region vertices find their place on the sweep */
+} sfb_fillet_config;
+enum {
+    SFB_FILLET_MAP_CONFORMAL = 0, /* default: the direct projection on the region's boundary, a conformal (cotangent)
+                                     map inside it solved by preconditioned conjugate gradients (seed 5); symmetrised
+                                     mean-value weights where that folds, the direct projection where both fold */
+    SFB_FILLET_MAP_DIRECT = 1     /* every vertex by its nearest spine point and its distance from the curve */
+};
+SFB_API sfb_fillet_config sfb_fillet_config_init(float radius);
+typedef struct sfb_fillet_curve_report {
+    int closed;                 /* 1: a closed loop, 0: an open chain */
+    int convex;                 /* 1: the ball is inside the solid (offset against the normals) */
+    int curve_vertices;         /* vertices of the blending curve */
+    float radius;
+    float spine_length;
+    int samples;                /* spine samples after refinement */
+    int vertices_moved;
+    int self_intersections;     /* spine loops cut out (seed section 4.3) */
+    float max_deviation;        /* largest distance of a moved vertex from the ideal sweep surface */
+    int map;                    /* how the region was mapped: 0 direct projection, 1 conformal, 2 mean-value weights */
+} sfb_fillet_curve_report;
+typedef struct sfb_fillet_report {
+    int curve_count;
+    sfb_fillet_curve_report *curves;   /* curve_count entries, freed by sfb_fillet_report_free */
+    int vertices_moved;
+    sfb_context *ctx_;
+} sfb_fillet_report;
+/* Fillets `mesh` (all faces triangles, manifold: SFB_INVALID_TOPOLOGY naming the face or edge
+ * otherwise) into a new mesh *out (same vertices, faces, UVs and tags; positions moved; the
+ * filleted edges lose their crease tags). Errors, with *out NULL, the input untouched and nothing
+ * kept: radius <= 0 or not finite, a bad profile or weight (SFB_INVALID_VALUE); a caller's curve
+ * that is not a chain of mesh edges (SFB_INVALID_TOPOLOGY naming the vertex); no feature found or a
+ * radius too large for the base patches, so that the offsets do not meet (SFB_INVALID_VALUE); the
+ * memory budget (SFB_LIMIT_EXCEEDED, checked before the work). report may be NULL. */
+SFB_API sfb_result sfb_mesh_fillet(sfb_context *ctx, const sfb_mesh *mesh, const sfb_fillet_config *config,
+                                   sfb_mesh **out, sfb_fillet_report *report);
+SFB_API void sfb_fillet_report_free(sfb_fillet_report *report);
+
+/* Measures of a triangle mesh (faces of 3 vertices; SFB_INVALID_TOPOLOGY naming the face
+ * otherwise): angle-weighted unit vertex normals (xyz per vertex; zero for a vertex no face uses),
+ * and the mean curvature per vertex from the cotangent Laplacian with mixed Voronoi areas, signed
+ * positive where the surface bends away from its normal (a sphere with outward normals: +1/R);
+ * boundary and unused vertices get 0. For pictures (sfb_render's WEIGHTS mode) and checks. */
+SFB_API sfb_result sfb_mesh_vertex_normals(sfb_context *ctx, const sfb_mesh *mesh, float *normals);
+SFB_API sfb_result sfb_mesh_mean_curvature(sfb_context *ctx, const sfb_mesh *mesh, float *curvature);
+
 #ifdef __cplusplus
 }
 #endif
@@ -1402,6 +1484,85 @@ SFB__IF sfb_result sfb__pb_eigen_patch(sfb__pbuild *b, sfb__wlevel *w, int type,
 /* Classifies candidate g of the working level: adds its record, or sets *refine. */
 SFB__IF sfb_result sfb__pb_face_quad(sfb__pbuild *b, sfb__wlevel *w, int g, int level, int limit, int *refine);
 SFB__IF sfb_result sfb__pb_face_tri(sfb__pbuild *b, sfb__wlevel *w, int g, int level, int limit, int *refine);
+
+/* ---- an AABB tree over triangles, robust triangle-triangle intersection (aabb.c) ----
+ * Reusable geometry for the rolling-ball operator (seed 002) and its checks. Positions are xyz
+ * doubles; triangles are index triples into them. A built tree is read-only: many threads may
+ * query it at once. */
+typedef struct sfb__aabb_node {
+    double lo[3], hi[3];
+    int left, right;            /* inner node: children; leaf: left = -1, items [first, first+count) */
+    int first, count;
+} sfb__aabb_node;
+typedef struct sfb__aabb {
+    int node_count, item_count;
+    sfb__aabb_node *nodes;      /* node 0 is the root (node_count 0: an empty tree) */
+    int *items;                 /* triangle ids (as passed in `ids`, or 0..count-1) in leaf order */
+} sfb__aabb;
+/* A tree over `count` triangles tri[3*i..3*i+2] of pos (ids: NULL, or the id reported for each).
+ * Triangles with a non-finite vertex are left out. */
+SFB__IF sfb_result sfb__aabb_build(sfb_context *ctx, const double *pos, const int *tri, const int *ids, int count, sfb__aabb *out);
+SFB__IF void sfb__aabb_free(sfb_context *ctx, sfb__aabb *t);
+/* Calls fn(id_a, id_b, user) for every pair of triangles whose boxes, grown by eps, overlap: one of
+ * a, one of b; when b == a, every unordered pair of different ids once. fn returns non-zero to stop;
+ * the function returns 1 when stopped, else 0. */
+SFB__IF int sfb__aabb_pairs(const sfb__aabb *a, const sfb__aabb *b, double eps, int (*fn)(int, int, void *), void *user);
+/* The point of the tree's triangles nearest to p: returns the triangle id (-1 for an empty tree),
+ * writes the point, its squared distance and its barycentric coordinates on that triangle
+ * (any of the out pointers may be NULL). tri is the same array the tree was built on, indexed by
+ * id when ids were NULL, else tri_of_id[id] gives the triangle's row (NULL: id is the row). */
+SFB__IF int sfb__aabb_nearest(const sfb__aabb *t, const double *pos, const int *tri, const int *tri_of_id,
+                              const double p[3], double out_point[3], double *out_dist2, double out_bary[3]);
+/* Closest point to p on triangle (a, b, c), with barycentric coordinates (any pointer may be NULL
+ * but q); degenerate triangles give the closest point on their longest edge. */
+SFB__IF void sfb__closest_on_triangle(const double p[3], const double a[3], const double b[3], const double c[3],
+                                      double q[3], double bary[3]);
+/* Intersection of two triangles. Returns 0 when they do not meet, 1 when they meet in a segment
+ * s0-s1 (a single point gives s0 == s1), 2 when they are coplanar and overlap (no segment written).
+ * Robust: exact zeros from orientation determinants within a tolerance relative to the triangles'
+ * size are treated as on the plane, shared vertices and edges give the shared point or edge, and
+ * degenerate (zero-area) triangles never meet anything. src0/src1 (may be NULL) say where each
+ * endpoint lies: 0..2 edge k (vertex k to k+1) of triangle a, 3..5 edge k-3 of triangle b. */
+SFB__IF int sfb__tri_tri_segment(const double a0[3], const double a1[3], const double a2[3],
+                                 const double b0[3], const double b1[3], const double b2[3],
+                                 double s0[3], double s1[3], int *src0, int *src1);
+/* Pairs of triangles of one mesh that intersect other than in what they share (a common vertex
+ * or edge, compared by index); *pairs gets the count, first[2] (may be NULL) the first pair found
+ * (-1 -1 when none). Coplanar overlaps count, except between triangles that share an edge and lie
+ * on opposite sides of it. */
+SFB__IF sfb_result sfb__trimesh_self_intersections(sfb_context *ctx, const double *pos, const int *tri, int count,
+                                                   long *pairs, int first[2]);
+
+/* ---- sparse symmetric systems (sparse.c) ----
+ * Compressed rows, each row's columns ascending, duplicates summed; for the conformal map of the
+ * rolling-ball operator and whatever else needs a Laplacian solve. */
+typedef struct sfb__sparse {
+    int n;                      /* rows = columns */
+    int *row_off;               /* n + 1 */
+    int *col;
+    double *val;
+} sfb__sparse;
+/* A = sum of the triplets (row[k], col[k], val[k]); indices checked against n (SFB_INVALID_ARGS). */
+SFB__IF sfb_result sfb__sparse_from_triplets(sfb_context *ctx, int n, int count, const int *row, const int *col,
+                                             const double *val, sfb__sparse *out);
+SFB__IF void sfb__sparse_free(sfb_context *ctx, sfb__sparse *m);
+/* y = A x */
+SFB__IF void sfb__sparse_mul(const sfb__sparse *A, const double *x, double *y);
+/* Solves A x = b for symmetric positive definite A by conjugate gradients with a Jacobi
+ * (diagonal) preconditioner, starting from x's contents, until |r| <= tol |b| or max_iter steps.
+ * *iters and *residual (|r|/|b|; may be NULL) say how it went. SFB_INVALID_VALUE (with the error
+ * set) when it did not converge, a diagonal entry is not positive or a non-finite value appears;
+ * x then holds the last iterate. */
+SFB__IF sfb_result sfb__sparse_cg(sfb_context *ctx, const sfb__sparse *A, const double *b, double *x, double tol,
+                                  int max_iter, int *iters, double *residual);
+
+/* ---- triangle-mesh measures (trimesh.c) ---- */
+/* Angle-weighted vertex normals (unit; zero where no face contributes) over faces tri[3f..]. */
+SFB__IF void sfb__trimesh_vertex_normals(int nv, const double *pos, int nf, const int *tri, double *normals);
+/* Mean curvature per vertex from the cotangent Laplacian, H = |Delta x| / 2 with mixed Voronoi
+ * areas (Meyer et al.), signed positive where the surface bends away from its normal (a sphere
+ * with outward normals: +1/R); boundary vertices get 0. */
+SFB__IF sfb_result sfb__trimesh_mean_curvature(sfb_context *ctx, int nv, const double *pos, int nf, const int *tri, double *H);
 #line 1 "src/context.c"
 /* Results, context, allocator with memory budget, errors, logging, progress. */
 
@@ -13213,6 +13374,2600 @@ done:
     sfb__free(ctx, hv1);
     sfb__free(ctx, hv2);
     return r;
+}
+#line 1 "src/aabb.c"
+/* An axis-aligned bounding-box tree over triangles and the robust triangle geometry built on it
+ * (the rolling-ball operator's intersections and projections, seed 002, and the checks of any
+ * triangle mesh): a top-down build by median split on the longest axis of each node's box
+ * (leaves of at most SFB__AABB_LEAF triangles, so the depth is at most about log2(count) and
+ * every traversal runs on a small fixed stack), all pairs of overlapping triangle boxes of two
+ * trees or of one tree with itself by simultaneous descent, the nearest point by branch and
+ * bound, the closest point on one triangle (the Voronoi-region method of Ericson's Real-Time
+ * Collision Detection, written here from the geometry), the intersection segment of two
+ * triangles (the interval method of Moller 1997 with the care of Guigue-Devillers 2003 for
+ * vertices on planes and coplanar pairs) and a mesh's self-intersections. Storage: the node array
+ * holds node_count tree nodes followed by item_count boxes, nodes[node_count + i] being the box of
+ * triangle items[i] (sfb__aabb has no other place for them; the pair query tests them so that it
+ * reports exactly the triangle pairs whose own boxes overlap). Everything is double; a built tree
+ * is read-only and any number of threads may query it at once. */
+
+#define SFB__AABB_LEAF 4
+/* Median splits halve a node (the larger half has ceil(n/2) items), so a tree over at most
+ * INT_MAX triangles with leaves of 4 is at most 30 levels deep: a descent of one tree pushes at
+ * most 2 nodes per level, a simultaneous descent of two at most 3 pairs per step of at most 60. */
+#define SFB__AABB_STACK 256
+
+/* The tolerances of the triangle-triangle test (sfb__tri_tri_segment), relative to s, the
+ * longest edge of the two triangles:
+ *   - a triangle is degenerate (zero area) when |(v1 - v0) x (v2 - v0)| <= SFB__TT_AREA * L^2, L its
+ *     own longest edge: its smallest height is below 1e-12 L (this also catches L = 0);
+ *   - a vertex lies on the other triangle's plane when its signed distance to it (the unit normal
+ *     dotted with the vertex minus a vertex of the plane's triangle) is within SFB__TT_DIST * s;
+ *   - intervals on the line of the two planes, and projections of coplanar triangles on a
+ *     separating axis, touch when their gap is within the same SFB__TT_DIST * s.
+ * Rounding of these distances is a few units of 1e-16 s for triangles that are not needles, so
+ * shared vertices and edges (bitwise equal coordinates) always land on the planes. */
+#define SFB__TT_AREA 1e-12
+#define SFB__TT_DIST 1e-12
+/* A segment between two triangles that share one vertex is more than that vertex when it is
+ * longer than SFB__SELF_LEN * s (sfb__trimesh_self_intersections). */
+#define SFB__SELF_LEN 1e-10
+
+static void aabb_sub3(const double *a, const double *b, double *c) {
+    c[0] = a[0] - b[0];
+    c[1] = a[1] - b[1];
+    c[2] = a[2] - b[2];
+}
+static double aabb_dot3(const double *a, const double *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+static void aabb_cross3(const double *a, const double *b, double *c) {
+    c[0] = a[1] * b[2] - a[2] * b[1];
+    c[1] = a[2] * b[0] - a[0] * b[2];
+    c[2] = a[0] * b[1] - a[1] * b[0];
+}
+static int aabb_finite3(const double *p) {
+    /* x - x is 0 for finite x and NaN for inf and NaN */
+    return p[0] - p[0] == 0.0 && p[1] - p[1] == 0.0 && p[2] - p[2] == 0.0;
+}
+
+/* ---- build ---- */
+
+/* Reorders perm[lo, hi) so that perm[k] holds the item whose key (cen[3 * item + axis]) would be
+ * there sorted, with no larger key before it and no smaller one after (Hoare partitions around
+ * the median of three). */
+static void aabb_select(int *perm, int lo, int hi, int k, const double *cen, int axis) {
+    hi--;
+    while (hi > lo) {
+        const int mid = lo + (hi - lo) / 2;
+        double x = cen[3 * (size_t)perm[lo] + axis], y = cen[3 * (size_t)perm[mid] + axis], z = cen[3 * (size_t)perm[hi] + axis];
+        double pv;
+        int i = lo, j = hi;
+        if (x > y) { double s = x; x = y; y = s; }
+        pv = z < x ? x : z > y ? y : z;
+        while (i <= j) {
+            while (cen[3 * (size_t)perm[i] + axis] < pv) i++;
+            while (cen[3 * (size_t)perm[j] + axis] > pv) j--;
+            if (i <= j) {
+                const int s = perm[i];
+                perm[i] = perm[j];
+                perm[j] = s;
+                i++;
+                j--;
+            }
+        }
+        if (k <= j) hi = j;
+        else if (k >= i) lo = i;
+        else break;
+    }
+}
+
+sfb_result sfb__aabb_build(sfb_context *ctx, const double *pos, const int *tri, const int *ids, int count, sfb__aabb *out) {
+    double *tbox = NULL, *cen = NULL;
+    int *perm = NULL, m = 0, i, sp = 0;
+    int stack[3 * SFB__AABB_STACK];
+    size_t bytes, nodes_cap;
+    sfb__aabb t;
+    if (!out) return ctx ? sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "sfb__aabb_build: NULL tree") : SFB_INVALID_ARGS;
+    memset(out, 0, sizeof *out);
+    if (!ctx) return SFB_INVALID_ARGS;
+    if (count < 0 || (count > 0 && (!pos || !tri)))
+        return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "sfb__aabb_build: %d triangles without their arrays", count);
+    if (count == 0) return SFB_SUCCESS;
+    memset(&t, 0, sizeof t);
+    if (!sfb__mul_size((size_t)count, 6 * sizeof(double), &bytes) || !(tbox = (double *)sfb__alloc(ctx, bytes)) ||
+        !(cen = (double *)sfb__alloc(ctx, bytes / 2)) || !(perm = (int *)sfb__alloc(ctx, (size_t)count * sizeof(int)))) {
+        sfb__free(ctx, tbox);
+        sfb__free(ctx, cen);
+        return sfb__oom(ctx, "an AABB tree's triangle boxes");
+    }
+    /* the finite triangles, each with its box and centroid */
+    for (i = 0; i < count; ++i) {
+        const int *v = tri + 3 * (size_t)i;
+        double *lo = tbox + 6 * (size_t)m, *hi = lo + 3;
+        int c, k, ok = v[0] >= 0 && v[1] >= 0 && v[2] >= 0;
+        for (c = 0; c < 3 && ok; ++c) ok = aabb_finite3(pos + 3 * (size_t)v[c]);
+        if (!ok) continue;
+        for (k = 0; k < 3; ++k) {
+            const double x = pos[3 * (size_t)v[0] + k], y = pos[3 * (size_t)v[1] + k], z = pos[3 * (size_t)v[2] + k];
+            lo[k] = x < y ? (x < z ? x : z) : (y < z ? y : z);
+            hi[k] = x > y ? (x > z ? x : z) : (y > z ? y : z);
+            cen[3 * (size_t)m + k] = (x + y + z) * (1.0 / 3.0);
+        }
+        perm[m] = i;
+        m++;
+    }
+    /* perm[j] is the j-th finite triangle; its box and centroid are at slot j */
+    if (m == 0) goto done;
+    nodes_cap = 2 * (size_t)m - 1 + (size_t)m;
+    if (!sfb__mul_size(nodes_cap, sizeof(sfb__aabb_node), &bytes) || !(t.nodes = (sfb__aabb_node *)sfb__alloc(ctx, bytes)) ||
+        !(t.items = (int *)sfb__alloc(ctx, (size_t)m * sizeof(int)))) {
+        sfb__free(ctx, t.nodes);
+        sfb__free(ctx, tbox);
+        sfb__free(ctx, cen);
+        sfb__free(ctx, perm);
+        return sfb__oom(ctx, "an AABB tree");
+    }
+    {
+        /* slots 0..m-1 sorted in place of ord; the tree refers to slots, items are filled last */
+        int *ord = t.items;
+        for (i = 0; i < m; ++i) ord[i] = i;
+        t.node_count = 1;
+        stack[sp++] = 0; stack[sp++] = 0; stack[sp++] = m;
+        while (sp > 0) {
+            const int e = stack[--sp], b = stack[--sp], nd = stack[--sp];
+            sfb__aabb_node *N = &t.nodes[nd];
+            int k, j, axis = 0;
+            for (k = 0; k < 3; ++k) { N->lo[k] = HUGE_VAL; N->hi[k] = -HUGE_VAL; }
+            for (j = b; j < e; ++j) {
+                const double *bx = tbox + 6 * (size_t)ord[j];
+                for (k = 0; k < 3; ++k) {
+                    if (bx[k] < N->lo[k]) N->lo[k] = bx[k];
+                    if (bx[3 + k] > N->hi[k]) N->hi[k] = bx[3 + k];
+                }
+            }
+            N->first = b;
+            N->count = e - b;
+            if (e - b <= SFB__AABB_LEAF) {
+                N->left = N->right = -1;
+                continue;
+            }
+            for (k = 1; k < 3; ++k)
+                if (N->hi[k] - N->lo[k] > N->hi[axis] - N->lo[axis]) axis = k;
+            aabb_select(ord, b, e, b + (e - b) / 2, cen, axis);
+            N->left = t.node_count++;
+            N->right = t.node_count++;
+            stack[sp++] = N->right; stack[sp++] = b + (e - b) / 2; stack[sp++] = e;
+            stack[sp++] = N->left; stack[sp++] = b; stack[sp++] = b + (e - b) / 2;
+        }
+        t.item_count = m;
+        for (i = 0; i < m; ++i) {
+            const int slot = ord[i];
+            sfb__aabb_node *B = &t.nodes[t.node_count + i];
+            int k;
+            for (k = 0; k < 3; ++k) {
+                B->lo[k] = tbox[6 * (size_t)slot + k];
+                B->hi[k] = tbox[6 * (size_t)slot + 3 + k];
+            }
+            B->left = B->right = -1;
+            B->first = i;
+            B->count = 1;
+            ord[i] = ids ? ids[perm[slot]] : perm[slot];
+        }
+    }
+done:
+    sfb__free(ctx, tbox);
+    sfb__free(ctx, cen);
+    sfb__free(ctx, perm);
+    *out = t;
+    return SFB_SUCCESS;
+}
+
+void sfb__aabb_free(sfb_context *ctx, sfb__aabb *t) {
+    if (!t) return;
+    if (ctx) {
+        sfb__free(ctx, t->nodes);
+        sfb__free(ctx, t->items);
+    }
+    memset(t, 0, sizeof *t);
+}
+
+/* ---- pairs ---- */
+
+static int aabb_overlap(const sfb__aabb_node *p, const sfb__aabb_node *q, double eps) {
+    int k;
+    for (k = 0; k < 3; ++k)
+        if (p->lo[k] - eps > q->hi[k] + eps || q->lo[k] - eps > p->hi[k] + eps) return 0;
+    return 1;
+}
+
+/* The triangles of leaves p of a and q of b (p == q within one tree: each pair of it once). */
+static int aabb_leaf_pairs(const sfb__aabb *a, const sfb__aabb *b, const sfb__aabb_node *p, const sfb__aabb_node *q, int self,
+                           double eps, int (*fn)(int, int, void *), void *user) {
+    int i, j;
+    for (i = p->first; i < p->first + p->count; ++i) {
+        const sfb__aabb_node *bi = &a->nodes[a->node_count + i];
+        for (j = (p == q ? i + 1 : q->first); j < q->first + q->count; ++j) {
+            if (self && a->items[i] == b->items[j]) continue;
+            if (aabb_overlap(bi, &b->nodes[b->node_count + j], eps) && fn(a->items[i], b->items[j], user)) return 1;
+        }
+    }
+    return 0;
+}
+
+int sfb__aabb_pairs(const sfb__aabb *a, const sfb__aabb *b, double eps, int (*fn)(int, int, void *), void *user) {
+    int stack[2 * SFB__AABB_STACK], sp = 0;
+    const int self = a == b;
+    if (!a || !b || !fn || a->node_count == 0 || b->node_count == 0) return 0;
+    if (!(eps >= 0.0)) eps = 0.0;
+    stack[sp++] = 0;
+    stack[sp++] = 0;
+    while (sp > 0) {
+        const int j = stack[--sp], i = stack[--sp];
+        const sfb__aabb_node *P = &a->nodes[i], *Q = &b->nodes[j];
+        if (self && i == j) {
+            /* one subtree with itself: its children with themselves and with each other */
+            if (P->left < 0) {
+                if (aabb_leaf_pairs(a, b, P, P, 1, eps, fn, user)) return 1;
+                continue;
+            }
+            stack[sp++] = P->left; stack[sp++] = P->right;
+            stack[sp++] = P->right; stack[sp++] = P->right;
+            stack[sp++] = P->left; stack[sp++] = P->left;
+            continue;
+        }
+        if (!aabb_overlap(P, Q, eps)) continue;
+        if (P->left < 0 && Q->left < 0) {
+            if (aabb_leaf_pairs(a, b, P, Q, self, eps, fn, user)) return 1;
+        } else if (P->left < 0 || (Q->left >= 0 && Q->count > P->count)) {
+            stack[sp++] = i; stack[sp++] = Q->right;
+            stack[sp++] = i; stack[sp++] = Q->left;
+        } else {
+            stack[sp++] = P->right; stack[sp++] = j;
+            stack[sp++] = P->left; stack[sp++] = j;
+        }
+    }
+    return 0;
+}
+
+/* ---- nearest point ---- */
+
+static double aabb_box_dist2(const sfb__aabb_node *n, const double *p) {
+    double d = 0.0;
+    int k;
+    for (k = 0; k < 3; ++k) {
+        const double e = p[k] < n->lo[k] ? n->lo[k] - p[k] : p[k] > n->hi[k] ? p[k] - n->hi[k] : 0.0;
+        d += e * e;
+    }
+    return d;
+}
+
+int sfb__aabb_nearest(const sfb__aabb *t, const double *pos, const int *tri, const int *tri_of_id, const double p[3],
+                      double out_point[3], double *out_dist2, double out_bary[3]) {
+    int stack[SFB__AABB_STACK], sp = 0, best = -1, k;
+    double bestd = HUGE_VAL, bq[3] = {0, 0, 0}, bb[3] = {0, 0, 0};
+    if (t && t->node_count > 0 && pos && tri && p && aabb_finite3(p)) {
+        stack[sp++] = 0;
+        while (sp > 0) {
+            const sfb__aabb_node *n = &t->nodes[stack[--sp]];
+            if (aabb_box_dist2(n, p) >= bestd) continue;
+            if (n->left < 0) {
+                int i;
+                for (i = n->first; i < n->first + n->count; ++i) {
+                    const int id = t->items[i], row = tri_of_id ? tri_of_id[id] : id;
+                    const int *v = tri + 3 * (size_t)row;
+                    double q[3], bc[3], d[3], d2;
+                    sfb__closest_on_triangle(p, pos + 3 * (size_t)v[0], pos + 3 * (size_t)v[1], pos + 3 * (size_t)v[2], q, bc);
+                    aabb_sub3(q, p, d);
+                    d2 = aabb_dot3(d, d);
+                    if (d2 < bestd) {
+                        bestd = d2;
+                        best = id;
+                        memcpy(bq, q, sizeof q);
+                        memcpy(bb, bc, sizeof bc);
+                    }
+                }
+            } else {
+                const double dl = aabb_box_dist2(&t->nodes[n->left], p), dr = aabb_box_dist2(&t->nodes[n->right], p);
+                /* the nearer child is searched first: pushed last */
+                if (dl <= dr) {
+                    if (dr < bestd) stack[sp++] = n->right;
+                    if (dl < bestd) stack[sp++] = n->left;
+                } else {
+                    if (dl < bestd) stack[sp++] = n->left;
+                    if (dr < bestd) stack[sp++] = n->right;
+                }
+            }
+        }
+    }
+    if (out_point)
+        for (k = 0; k < 3; ++k) out_point[k] = bq[k];
+    if (out_dist2) *out_dist2 = bestd;
+    if (out_bary)
+        for (k = 0; k < 3; ++k) out_bary[k] = bb[k];
+    return best;
+}
+
+/* ---- closest point on a triangle ---- */
+
+/* The point of segment u-v nearest p, at u + s (v - u). */
+static double aabb_closest_on_segment(const double *p, const double *u, const double *v, double *q) {
+    double e[3], w[3], s, l2;
+    aabb_sub3(v, u, e);
+    aabb_sub3(p, u, w);
+    l2 = aabb_dot3(e, e);
+    s = l2 > 0.0 ? aabb_dot3(w, e) / l2 : 0.0;
+    s = s < 0.0 ? 0.0 : s > 1.0 ? 1.0 : s;
+    q[0] = u[0] + s * e[0];
+    q[1] = u[1] + s * e[1];
+    q[2] = u[2] + s * e[2];
+    return s;
+}
+
+void sfb__closest_on_triangle(const double p[3], const double a[3], const double b[3], const double c[3], double q[3],
+                              double bary[3]) {
+    double ab[3], ac[3], bc[3], ap[3], bp[3], cp[3], n[3], w[3] = {0, 0, 0};
+    double lab, lac, lbc, lmax, d1, d2, d3, d4, d5, d6, va, vb, vc;
+    int k;
+    aabb_sub3(b, a, ab);
+    aabb_sub3(c, a, ac);
+    aabb_sub3(c, b, bc);
+    aabb_cross3(ab, ac, n);
+    lab = aabb_dot3(ab, ab);
+    lac = aabb_dot3(ac, ac);
+    lbc = aabb_dot3(bc, bc);
+    lmax = lab > lac ? (lab > lbc ? lab : lbc) : (lac > lbc ? lac : lbc);
+    if (!(aabb_dot3(n, n) > SFB__TT_AREA * SFB__TT_AREA * lmax * lmax)) {
+        /* degenerate: the longest edge */
+        double s;
+        if (lmax == lab) { s = aabb_closest_on_segment(p, a, b, q); w[0] = 1.0 - s; w[1] = s; }
+        else if (lmax == lac) { s = aabb_closest_on_segment(p, a, c, q); w[0] = 1.0 - s; w[2] = s; }
+        else { s = aabb_closest_on_segment(p, b, c, q); w[1] = 1.0 - s; w[2] = s; }
+        if (bary) memcpy(bary, w, sizeof w);
+        return;
+    }
+    /* p's Voronoi region: the corners, then the edges, else the face. d1..d6 are the projections
+     * of p - corner on the two edges from a; va, vb, vc are (up to a common factor) the
+     * barycentric coordinates of p's projection on the plane. */
+    aabb_sub3(p, a, ap);
+    d1 = aabb_dot3(ab, ap);
+    d2 = aabb_dot3(ac, ap);
+    if (d1 <= 0.0 && d2 <= 0.0) { w[0] = 1.0; goto out; }
+    aabb_sub3(p, b, bp);
+    d3 = aabb_dot3(ab, bp);
+    d4 = aabb_dot3(ac, bp);
+    if (d3 >= 0.0 && d4 <= d3) { w[1] = 1.0; goto out; }
+    vc = d1 * d4 - d3 * d2;
+    if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0) {
+        const double s = d1 / (d1 - d3);
+        w[0] = 1.0 - s; w[1] = s;
+        goto out;
+    }
+    aabb_sub3(p, c, cp);
+    d5 = aabb_dot3(ab, cp);
+    d6 = aabb_dot3(ac, cp);
+    if (d6 >= 0.0 && d5 <= d6) { w[2] = 1.0; goto out; }
+    vb = d5 * d2 - d1 * d6;
+    if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0) {
+        const double s = d2 / (d2 - d6);
+        w[0] = 1.0 - s; w[2] = s;
+        goto out;
+    }
+    va = d3 * d6 - d5 * d4;
+    if (va <= 0.0 && d4 - d3 >= 0.0 && d5 - d6 >= 0.0) {
+        const double s = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+        w[1] = 1.0 - s; w[2] = s;
+        goto out;
+    }
+    {
+        const double inv = 1.0 / (va + vb + vc);
+        w[1] = vb * inv;
+        w[2] = vc * inv;
+        w[0] = 1.0 - w[1] - w[2];
+    }
+out:
+    for (k = 0; k < 3; ++k) q[k] = w[0] * a[k] + w[1] * b[k] + w[2] * c[k];
+    if (bary) memcpy(bary, w, sizeof w);
+}
+
+/* ---- triangle-triangle intersection ---- */
+
+/* The points where triangle V (signed distances d to the other plane, snapped: exact zeros are
+ * on it) meets that plane: 1 (a vertex touching it) or 2, with the edge each lies on (off + k
+ * for edge k; a vertex names an edge from it, the edge between them when two vertices are on the
+ * plane). */
+static int tt_plane_points(const double *const V[3], const double d[3], int off, double P[2][3], int src[2]) {
+    int k, n = 0;
+    for (k = 0; k < 3; ++k) {
+        const int k1 = (k + 1) % 3;
+        if (d[k] == 0.0 && d[k1] == 0.0) {
+            memcpy(P[0], V[k], 3 * sizeof(double));
+            memcpy(P[1], V[k1], 3 * sizeof(double));
+            src[0] = src[1] = off + k;
+            return 2;
+        }
+    }
+    for (k = 0; k < 3 && n < 2; ++k)
+        if (d[k] == 0.0) {
+            memcpy(P[n], V[k], 3 * sizeof(double));
+            src[n++] = off + k;
+        }
+    for (k = 0; k < 3 && n < 2; ++k) {
+        const int k1 = (k + 1) % 3;
+        if ((d[k] > 0.0 && d[k1] < 0.0) || (d[k] < 0.0 && d[k1] > 0.0)) {
+            const double s = d[k] / (d[k] - d[k1]);
+            int c;
+            for (c = 0; c < 3; ++c) P[n][c] = V[k][c] + s * (V[k1][c] - V[k][c]);
+            src[n++] = off + k;
+        }
+    }
+    return n;
+}
+
+/* Do coplanar triangles A and B (in the plane of unit normal n) meet, touching included? Their
+ * projections on the coordinate plane across n's largest component, separated by none of the six
+ * edge normals (separating axes of two convex polygons) by more than tol along it. */
+static int tt_coplanar_meet(const double *const A[3], const double *const B[3], const double *n, double tol) {
+    const double ax = fabs(n[0]), ay = fabs(n[1]), az = fabs(n[2]);
+    const int i0 = ax >= ay && ax >= az ? 1 : 0, i1 = ax >= ay && ax >= az ? 2 : ay >= az ? 2 : 1;
+    double P[6][2];
+    int e, k;
+    for (k = 0; k < 3; ++k) {
+        P[k][0] = A[k][i0]; P[k][1] = A[k][i1];
+        P[3 + k][0] = B[k][i0]; P[3 + k][1] = B[k][i1];
+    }
+    for (e = 0; e < 6; ++e) {
+        const double *p = P[e], *q = P[e < 3 ? (e + 1) % 3 : 3 + (e - 2) % 3];
+        const double nx = -(q[1] - p[1]), ny = q[0] - p[0], len = sqrt(nx * nx + ny * ny);
+        double lo[2] = {HUGE_VAL, HUGE_VAL}, hi[2] = {-HUGE_VAL, -HUGE_VAL};
+        if (!(len > 0.0)) continue;
+        for (k = 0; k < 6; ++k) {
+            const double x = (nx * P[k][0] + ny * P[k][1]) / len;
+            const int s = k / 3;
+            if (x < lo[s]) lo[s] = x;
+            if (x > hi[s]) hi[s] = x;
+        }
+        if (lo[1] > hi[0] + tol || lo[0] > hi[1] + tol) return 0;
+    }
+    return 1;
+}
+
+/* Longest squared edge of triangle V; n gets its (unnormalised) normal. */
+static double tt_setup(const double *const V[3], double *n) {
+    double e0[3], e1[3], e2[3], l0, l1, l2;
+    aabb_sub3(V[1], V[0], e0);
+    aabb_sub3(V[2], V[0], e1);
+    aabb_sub3(V[2], V[1], e2);
+    aabb_cross3(e0, e1, n);
+    l0 = aabb_dot3(e0, e0);
+    l1 = aabb_dot3(e1, e1);
+    l2 = aabb_dot3(e2, e2);
+    return l0 > l1 ? (l0 > l2 ? l0 : l2) : (l1 > l2 ? l1 : l2);
+}
+
+int sfb__tri_tri_segment(const double a0[3], const double a1[3], const double a2[3], const double b0[3], const double b1[3],
+                         const double b2[3], double s0[3], double s1[3], int *src0, int *src1) {
+    const double *const A[3] = {a0, a1, a2}, *const B[3] = {b0, b1, b2};
+    double na[3], nb[3], la2, lb2, lna, lnb, s, eps, da[3], db[3], D[3], lD;
+    double PA[2][3], PB[2][3], ta[2], tb[2], lo, hi;
+    int sa[2], sb[2], k, pos_a = 0, neg_a = 0, pos_b = 0, neg_b = 0, nA, nB;
+    const double *plo, *phi;
+    int slo, shi;
+    for (k = 0; k < 3; ++k)
+        if (!aabb_finite3(A[k]) || !aabb_finite3(B[k])) return 0;
+    la2 = tt_setup(A, na);
+    lb2 = tt_setup(B, nb);
+    lna = sqrt(aabb_dot3(na, na));
+    lnb = sqrt(aabb_dot3(nb, nb));
+    if (!(lna > SFB__TT_AREA * la2) || !(lnb > SFB__TT_AREA * lb2)) return 0; /* zero area */
+    s = sqrt(la2 > lb2 ? la2 : lb2);
+    eps = SFB__TT_DIST * s;
+    for (k = 0; k < 3; ++k) {
+        na[k] /= lna;
+        nb[k] /= lnb;
+    }
+    /* signed distances of each triangle's vertices to the other's plane, near zeros made zero */
+    for (k = 0; k < 3; ++k) {
+        double w[3];
+        aabb_sub3(A[k], b0, w);
+        da[k] = aabb_dot3(nb, w);
+        if (fabs(da[k]) <= eps) da[k] = 0.0;
+        pos_a += da[k] > 0.0;
+        neg_a += da[k] < 0.0;
+        aabb_sub3(B[k], a0, w);
+        db[k] = aabb_dot3(na, w);
+        if (fabs(db[k]) <= eps) db[k] = 0.0;
+        pos_b += db[k] > 0.0;
+        neg_b += db[k] < 0.0;
+    }
+    if (pos_a == 3 || neg_a == 3 || pos_b == 3 || neg_b == 3) return 0;
+    aabb_cross3(na, nb, D);
+    lD = sqrt(aabb_dot3(D, D));
+    if (pos_a + neg_a == 0 || pos_b + neg_b == 0 || !(lD > 1e-15))
+        return tt_coplanar_meet(A, B, pos_a + neg_a == 0 ? nb : na, eps) ? 2 : 0;
+    for (k = 0; k < 3; ++k) D[k] /= lD;
+    /* each triangle's piece of the line where the planes meet, as an interval along D */
+    nA = tt_plane_points(A, da, 0, PA, sa);
+    nB = tt_plane_points(B, db, 3, PB, sb);
+    if (nA < 1 || nB < 1) return 0; /* cannot happen with the signs above */
+    if (nA == 1) { memcpy(PA[1], PA[0], sizeof PA[0]); sa[1] = sa[0]; }
+    if (nB == 1) { memcpy(PB[1], PB[0], sizeof PB[0]); sb[1] = sb[0]; }
+    for (k = 0; k < 2; ++k) {
+        ta[k] = aabb_dot3(D, PA[k]);
+        tb[k] = aabb_dot3(D, PB[k]);
+    }
+    if (ta[1] < ta[0]) {
+        double x = ta[0], tmp[3];
+        int si = sa[0];
+        ta[0] = ta[1]; ta[1] = x;
+        sa[0] = sa[1]; sa[1] = si;
+        memcpy(tmp, PA[0], sizeof tmp); memcpy(PA[0], PA[1], sizeof tmp); memcpy(PA[1], tmp, sizeof tmp);
+    }
+    if (tb[1] < tb[0]) {
+        double x = tb[0], tmp[3];
+        int si = sb[0];
+        tb[0] = tb[1]; tb[1] = x;
+        sb[0] = sb[1]; sb[1] = si;
+        memcpy(tmp, PB[0], sizeof tmp); memcpy(PB[0], PB[1], sizeof tmp); memcpy(PB[1], tmp, sizeof tmp);
+    }
+    /* the overlap: each end is the inner of the two, a's on a tie */
+    if (ta[0] >= tb[0]) { lo = ta[0]; plo = PA[0]; slo = sa[0]; }
+    else { lo = tb[0]; plo = PB[0]; slo = sb[0]; }
+    if (ta[1] <= tb[1]) { hi = ta[1]; phi = PA[1]; shi = sa[1]; }
+    else { hi = tb[1]; phi = PB[1]; shi = sb[1]; }
+    if (lo > hi + eps) return 0;
+    if (lo > hi) { phi = plo; shi = slo; } /* touching within the tolerance: one point */
+    if (s0) memcpy(s0, plo, 3 * sizeof(double));
+    if (s1) memcpy(s1, phi, 3 * sizeof(double));
+    if (src0) *src0 = slo;
+    if (src1) *src1 = shi;
+    return 1;
+}
+
+/* ---- a mesh's self-intersections ---- */
+
+typedef struct sfb__aabb_self {
+    const double *pos;
+    const int *tri;
+    long pairs;
+    int first[2];
+} sfb__aabb_self;
+
+/* In the plane of unit normal n: does the corner of triangle (v, p0, p1) at v overlap that of
+ * (v, q0, q1) in more than v (a ray of one inside the other's closed wedge, touching included)? */
+static int self_wedges_meet(const double *n, const double *v, const double *p0, const double *p1, const double *q0,
+                            const double *q1) {
+    double r[4][3], c[3];
+    int w, k;
+    aabb_sub3(p0, v, r[0]);
+    aabb_sub3(p1, v, r[1]);
+    aabb_sub3(q0, v, r[2]);
+    aabb_sub3(q1, v, r[3]);
+    for (k = 0; k < 4; ++k) {
+        const double l = sqrt(aabb_dot3(r[k], r[k]));
+        if (!(l > 0.0)) return 1;
+        r[k][0] /= l; r[k][1] /= l; r[k][2] /= l;
+    }
+    /* orient both wedges counter-clockwise about n */
+    for (w = 0; w < 4; w += 2) {
+        aabb_cross3(r[w], r[w + 1], c);
+        if (aabb_dot3(c, n) < 0.0)
+            for (k = 0; k < 3; ++k) {
+                const double x = r[w][k];
+                r[w][k] = r[w + 1][k];
+                r[w + 1][k] = x;
+            }
+    }
+    for (w = 0; w < 4; ++w) {
+        const double *e0 = r[w < 2 ? 2 : 0], *e1 = r[w < 2 ? 3 : 1];
+        double c0[3], c1[3];
+        aabb_cross3(e0, r[w], c0);
+        aabb_cross3(r[w], e1, c1);
+        if (aabb_dot3(c0, n) >= -SFB__SELF_LEN && aabb_dot3(c1, n) >= -SFB__SELF_LEN) return 1;
+    }
+    return 0;
+}
+
+static int self_pair_cb(int i, int j, void *user) {
+    sfb__aabb_self *S = (sfb__aabb_self *)user;
+    const int *a = S->tri + 3 * (size_t)i, *b = S->tri + 3 * (size_t)j;
+    const double *A[3], *B[3];
+    double s0[3], s1[3];
+    int shared = 0, ia = -1, ib = -1, ja = -1, jb = -1, k, l, r, hit = 0;
+    for (k = 0; k < 3; ++k) {
+        A[k] = S->pos + 3 * (size_t)a[k];
+        B[k] = S->pos + 3 * (size_t)b[k];
+    }
+    r = sfb__tri_tri_segment(A[0], A[1], A[2], B[0], B[1], B[2], s0, s1, NULL, NULL);
+    if (r == 0) return 0;
+    /* both have an area, so each one's three indices differ */
+    for (k = 0; k < 3; ++k)
+        for (l = 0; l < 3; ++l)
+            if (a[k] == b[l]) {
+                if (shared == 0) { ia = k; ib = l; } else { ja = k; jb = l; }
+                shared++;
+            }
+    if (shared == 0 || shared >= 3) hit = 1;
+    else if (shared == 1) {
+        if (r == 1) {
+            /* they meet in a segment through the shared vertex: more than it when it has a length */
+            double d[3], e[3], sc = 0.0;
+            for (k = 0; k < 3; ++k) {
+                aabb_sub3(A[(k + 1) % 3], A[k], e);
+                if (aabb_dot3(e, e) > sc) sc = aabb_dot3(e, e);
+                aabb_sub3(B[(k + 1) % 3], B[k], e);
+                if (aabb_dot3(e, e) > sc) sc = aabb_dot3(e, e);
+            }
+            aabb_sub3(s1, s0, d);
+            hit = sqrt(aabb_dot3(d, d)) > SFB__SELF_LEN * sqrt(sc);
+        } else {
+            double n[3], e0[3], e1[3];
+            aabb_sub3(A[1], A[0], e0);
+            aabb_sub3(A[2], A[0], e1);
+            aabb_cross3(e0, e1, n);
+            hit = self_wedges_meet(n, A[ia], A[(ia + 1) % 3], A[(ia + 2) % 3], B[(ib + 1) % 3], B[(ib + 2) % 3]);
+        }
+    } else {
+        /* an edge in common: coplanar with the third vertices on the same side of it */
+        if (r == 2) {
+            const int pa = 3 - ia - ja, pb = 3 - ib - jb;
+            double e[3], u[3], w[3], cu[3], cw[3];
+            aabb_sub3(A[ja], A[ia], e);
+            aabb_sub3(A[pa], A[ia], u);
+            aabb_sub3(B[pb], A[ia], w);
+            aabb_cross3(e, u, cu);
+            aabb_cross3(e, w, cw);
+            hit = aabb_dot3(cu, cw) > 0.0;
+        }
+    }
+    if (hit) {
+        if (S->pairs == 0) {
+            S->first[0] = i < j ? i : j;
+            S->first[1] = i < j ? j : i;
+        }
+        S->pairs++;
+    }
+    return 0;
+}
+
+sfb_result sfb__trimesh_self_intersections(sfb_context *ctx, const double *pos, const int *tri, int count, long *pairs,
+                                           int first[2]) {
+    sfb__aabb t;
+    sfb__aabb_self S;
+    sfb_result r;
+    double diag = 0.0;
+    int k;
+    if (first) first[0] = first[1] = -1;
+    if (pairs) *pairs = 0;
+    if (!ctx) return SFB_INVALID_ARGS;
+    if (!pairs || count < 0 || (count > 0 && (!pos || !tri)))
+        return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "sfb__trimesh_self_intersections: bad arguments");
+    r = sfb__aabb_build(ctx, pos, tri, NULL, count, &t);
+    if (r != SFB_SUCCESS) return r;
+    S.pos = pos;
+    S.tri = tri;
+    S.pairs = 0;
+    S.first[0] = S.first[1] = -1;
+    if (t.node_count > 0) {
+        for (k = 0; k < 3; ++k) diag += (t.nodes[0].hi[k] - t.nodes[0].lo[k]) * (t.nodes[0].hi[k] - t.nodes[0].lo[k]);
+        sfb__aabb_pairs(&t, &t, SFB__TT_DIST * sqrt(diag), self_pair_cb, &S);
+    }
+    sfb__aabb_free(ctx, &t);
+    *pairs = S.pairs;
+    if (first) {
+        first[0] = S.first[0];
+        first[1] = S.first[1];
+    }
+    return SFB_SUCCESS;
+}
+#line 1 "src/sparse.c"
+/* Sparse symmetric systems: a square matrix in compressed rows (each row's columns ascending,
+ * duplicates summed) assembled from (row, column, value) triplets by two stable counting sorts
+ * (by column, then by row, so that duplicates meet in input order and the result does not depend
+ * on anything but the input), the product with a vector, and a Jacobi-preconditioned conjugate
+ * gradient solver for symmetric positive definite matrices (Hestenes-Stiefel with the diagonal as
+ * preconditioner; when the recurrence says the tolerance is met the true residual b - A x is
+ * recomputed, and the iteration restarts from it if the recurrence had drifted). Used by the
+ * rolling-ball operator's conformal map (seed 002) and whatever else needs a Laplacian solve. All
+ * in double; a built matrix is read-only and may be used by many threads at once. */
+
+sfb_result sfb__sparse_from_triplets(sfb_context *ctx, int n, int count, const int *row, const int *col, const double *val,
+                                     sfb__sparse *out) {
+    int *cnt = NULL, *ord1 = NULL, *ord2 = NULL, k, i, nnz = 0;
+    size_t bytes_i, bytes_d;
+    sfb__sparse m;
+    if (!out) return ctx ? sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "sfb__sparse_from_triplets: NULL matrix") : SFB_INVALID_ARGS;
+    memset(out, 0, sizeof *out);
+    if (!ctx) return SFB_INVALID_ARGS;
+    if (n < 0 || count < 0 || (count > 0 && (!row || !col || !val)))
+        return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "sparse matrix: %d rows and %d triplets without their arrays", n,
+                          count);
+    for (k = 0; k < count; ++k)
+        if (row[k] < 0 || row[k] >= n || col[k] < 0 || col[k] >= n)
+            return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "sparse matrix: triplet %d (%d, %d) outside the %d x %d matrix", k,
+                              row[k], col[k], n, n);
+    memset(&m, 0, sizeof m);
+    m.n = n;
+    if (!sfb__mul_size((size_t)count, sizeof(int), &bytes_i) ||
+        !(cnt = (int *)sfb__calloc(ctx, (size_t)n + 1, sizeof(int))) || !(ord1 = (int *)sfb__alloc(ctx, bytes_i)) ||
+        !(ord2 = (int *)sfb__alloc(ctx, bytes_i)) || !(m.row_off = (int *)sfb__calloc(ctx, (size_t)n + 1, sizeof(int)))) {
+        sfb__free(ctx, cnt);
+        sfb__free(ctx, ord1);
+        sfb__free(ctx, ord2);
+        return sfb__oom(ctx, "a sparse matrix");
+    }
+    /* stable counting sort by column, then by row: rows in order, columns ascending in each,
+     * equal (row, column) in input order */
+    for (k = 0; k < count; ++k) cnt[col[k] + 1]++;
+    for (i = 0; i < n; ++i) cnt[i + 1] += cnt[i];
+    for (k = 0; k < count; ++k) ord1[cnt[col[k]]++] = k;
+    memset(cnt, 0, ((size_t)n + 1) * sizeof(int));
+    for (k = 0; k < count; ++k) cnt[row[k] + 1]++;
+    for (i = 0; i < n; ++i) cnt[i + 1] += cnt[i];
+    for (k = 0; k < count; ++k) {
+        const int t = ord1[k];
+        ord2[cnt[row[t]]++] = t;
+    }
+    /* distinct entries per row */
+    for (k = 0; k < count; ++k) {
+        const int t = ord2[k];
+        if (k == 0 || row[t] != row[ord2[k - 1]] || col[t] != col[ord2[k - 1]]) {
+            m.row_off[row[t] + 1]++;
+            nnz++;
+        }
+    }
+    for (i = 0; i < n; ++i) m.row_off[i + 1] += m.row_off[i];
+    if (!sfb__mul_size((size_t)nnz, sizeof(double), &bytes_d) || !(m.col = (int *)sfb__alloc(ctx, (size_t)nnz * sizeof(int))) ||
+        !(m.val = (double *)sfb__alloc(ctx, bytes_d))) {
+        sfb__free(ctx, cnt);
+        sfb__free(ctx, ord1);
+        sfb__free(ctx, ord2);
+        sfb__sparse_free(ctx, &m);
+        return sfb__oom(ctx, "a sparse matrix");
+    }
+    nnz = 0;
+    for (k = 0; k < count; ++k) {
+        const int t = ord2[k];
+        if (k == 0 || row[t] != row[ord2[k - 1]] || col[t] != col[ord2[k - 1]]) {
+            m.col[nnz] = col[t];
+            m.val[nnz] = val[t];
+            nnz++;
+        } else
+            m.val[nnz - 1] += val[t];
+    }
+    sfb__free(ctx, cnt);
+    sfb__free(ctx, ord1);
+    sfb__free(ctx, ord2);
+    *out = m;
+    return SFB_SUCCESS;
+}
+
+void sfb__sparse_free(sfb_context *ctx, sfb__sparse *m) {
+    if (!m) return;
+    if (ctx) {
+        sfb__free(ctx, m->row_off);
+        sfb__free(ctx, m->col);
+        sfb__free(ctx, m->val);
+    }
+    memset(m, 0, sizeof *m);
+}
+
+void sfb__sparse_mul(const sfb__sparse *A, const double *x, double *y) {
+    int i, k;
+    for (i = 0; i < A->n; ++i) {
+        double s = 0.0;
+        for (k = A->row_off[i]; k < A->row_off[i + 1]; ++k) s += A->val[k] * x[A->col[k]];
+        y[i] = s;
+    }
+}
+
+static double sparse_dot(int n, const double *a, const double *b) {
+    double s = 0.0;
+    int i;
+    for (i = 0; i < n; ++i) s += a[i] * b[i];
+    return s;
+}
+
+sfb_result sfb__sparse_cg(sfb_context *ctx, const sfb__sparse *A, const double *b, double *x, double tol, int max_iter, int *iters,
+                          double *residual) {
+    double *dinv = NULL, *r, *z, *p, *q, bnorm, rz, rnorm, rel = 0.0;
+    int n, i, k, it = 0, fresh = 1;
+    size_t bytes;
+    sfb_result res = SFB_SUCCESS;
+    if (iters) *iters = 0;
+    if (residual) *residual = 0.0;
+    if (!ctx) return SFB_INVALID_ARGS;
+    if (!A || !b || !x || A->n < 0 || (A->n > 0 && (!A->row_off || !A->col || !A->val)) || !(tol >= 0.0) || max_iter < 0)
+        return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "conjugate gradients: bad arguments");
+    n = A->n;
+    if (n == 0) return SFB_SUCCESS;
+    for (i = 0; i < n; ++i)
+        if (!(b[i] - b[i] == 0.0) || !(x[i] - x[i] == 0.0))
+            return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, -1, "conjugate gradients: non-finite %s at row %d",
+                              b[i] - b[i] == 0.0 ? "start value" : "right-hand side", i);
+    if (!sfb__mul_size((size_t)n, 5 * sizeof(double), &bytes) || !(dinv = (double *)sfb__alloc(ctx, bytes)))
+        return sfb__oom(ctx, "conjugate gradients");
+    r = dinv + n;
+    z = r + n;
+    p = z + n;
+    q = p + n;
+    for (i = 0; i < n; ++i) {
+        double d = 0.0;
+        for (k = A->row_off[i]; k < A->row_off[i + 1]; ++k)
+            if (A->col[k] == i) d = A->val[k];
+        if (!(d > 0.0) || !(d - d == 0.0)) {
+            res = sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, -1,
+                             "conjugate gradients: diagonal entry %d is %g, not positive (the matrix is not positive definite)", i, d);
+            goto done;
+        }
+        dinv[i] = 1.0 / d;
+    }
+    bnorm = sqrt(sparse_dot(n, b, b));
+    if (bnorm == 0.0) {
+        /* b = 0: x = 0 exactly */
+        memset(x, 0, (size_t)n * sizeof(double));
+        goto done;
+    }
+    rz = 0.0;
+    for (;;) {
+        if (fresh) {
+            /* r = b - A x, from x itself (the start, or a restart after the recurrence drifted) */
+            sfb__sparse_mul(A, x, r);
+            for (i = 0; i < n; ++i) {
+                r[i] = b[i] - r[i];
+                z[i] = dinv[i] * r[i];
+                p[i] = z[i];
+            }
+            rz = sparse_dot(n, r, z);
+        }
+        rnorm = sqrt(sparse_dot(n, r, r));
+        rel = rnorm / bnorm;
+        if (!(rel - rel == 0.0)) {
+            res = sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, -1, "conjugate gradients: a non-finite value after %d iterations", it);
+            goto done;
+        }
+        if (rel <= tol) {
+            if (fresh) break;
+            fresh = 1; /* confirm with the true residual */
+            continue;
+        }
+        if (it >= max_iter) {
+            res = sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, -1,
+                             "conjugate gradients did not converge in %d iterations (residual %g of |b|, tolerance %g)", it, rel, tol);
+            goto done;
+        }
+        fresh = 0;
+        {
+            double pq, alpha, beta, rz_new;
+            sfb__sparse_mul(A, p, q);
+            pq = sparse_dot(n, p, q);
+            if (!(pq > 0.0)) {
+                res = sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, -1,
+                                 "conjugate gradients: p.Ap = %g after %d iterations (the matrix is not positive definite)", pq, it);
+                goto done;
+            }
+            alpha = rz / pq;
+            for (i = 0; i < n; ++i) {
+                x[i] += alpha * p[i];
+                r[i] -= alpha * q[i];
+                z[i] = dinv[i] * r[i];
+            }
+            rz_new = sparse_dot(n, r, z);
+            beta = rz_new / rz;
+            for (i = 0; i < n; ++i) p[i] = z[i] + beta * p[i];
+            rz = rz_new;
+            it++;
+        }
+    }
+done:
+    if (iters) *iters = it;
+    if (residual) *residual = rel;
+    sfb__free(ctx, dinv);
+    return res;
+}
+#line 1 "src/trimesh.c"
+/* Measures of a triangle mesh: angle-weighted vertex normals (each face's unit normal weighted by
+ * its angle at the vertex, Thurmer and Wuthrich 1998) and the mean curvature per vertex from the
+ * cotangent Laplacian with the mixed Voronoi areas of Meyer, Desbrun, Schroder and Barr 2002
+ * (K(x_i) = 1/(2 A_i) sum_j (cot alpha_ij + cot beta_ij) (x_i - x_j) = 2 H n: |K|/2, signed by
+ * K's side of the vertex normal, so positive where the surface bends away from the normal),
+ * zero at vertices on an edge that does not have exactly two faces (the boundary, non-manifold
+ * edges) and at vertices no face uses; plus the public sfb_mesh_vertex_normals and
+ * sfb_mesh_mean_curvature on an sfb_mesh of triangles. Faces with an index out of range or
+ * repeated, or with no area, contribute nothing. All in double; the functions write only their
+ * outputs, so any number of threads may run them on one mesh at once. */
+
+/* Corner data of face (i, j, k): the edges from corner c to the next two, their cross product. */
+static int trimesh_face(const double *pos, const int *t, double e[3][3], double *twice_area) {
+    const double *p0 = pos + 3 * (size_t)t[0], *p1 = pos + 3 * (size_t)t[1], *p2 = pos + 3 * (size_t)t[2];
+    double n[3];
+    int k;
+    for (k = 0; k < 3; ++k) {
+        e[0][k] = p1[k] - p0[k]; /* edge 0: 0 -> 1 */
+        e[1][k] = p2[k] - p1[k]; /* edge 1: 1 -> 2 */
+        e[2][k] = p0[k] - p2[k]; /* edge 2: 2 -> 0 */
+    }
+    sfb__cross3(e[0], e[1], n);
+    *twice_area = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    return *twice_area > 0.0 && *twice_area - *twice_area == 0.0;
+}
+
+static int trimesh_valid(int nv, const int *t) {
+    return t[0] >= 0 && t[0] < nv && t[1] >= 0 && t[1] < nv && t[2] >= 0 && t[2] < nv && t[0] != t[1] && t[1] != t[2] &&
+           t[0] != t[2];
+}
+
+static double trimesh_dot(const double *a, const double *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+
+void sfb__trimesh_vertex_normals(int nv, const double *pos, int nf, const int *tri, double *normals) {
+    int f, v, c, k;
+    if (nv <= 0 || !normals) return;
+    memset(normals, 0, (size_t)nv * 3 * sizeof(double));
+    if (!pos || !tri) return;
+    for (f = 0; f < nf; ++f) {
+        const int *t = tri + 3 * (size_t)f;
+        double e[3][3], n[3], ta;
+        if (!trimesh_valid(nv, t) || !trimesh_face(pos, t, e, &ta)) continue;
+        sfb__cross3(e[0], e[1], n);
+        for (k = 0; k < 3; ++k) n[k] /= ta;
+        for (c = 0; c < 3; ++c) {
+            /* the angle at corner c, between the edge out of it and the reversed edge into it */
+            const double *out = e[c], *in = e[(c + 2) % 3];
+            double cr[3], ang;
+            sfb__cross3(out, in, cr);
+            ang = atan2(sqrt(trimesh_dot(cr, cr)), -trimesh_dot(out, in));
+            for (k = 0; k < 3; ++k) normals[3 * (size_t)t[c] + k] += ang * n[k];
+        }
+    }
+    for (v = 0; v < nv; ++v) {
+        double *n = normals + 3 * (size_t)v;
+        const double l = sqrt(trimesh_dot(n, n));
+        if (l > 0.0 && l - l == 0.0)
+            for (k = 0; k < 3; ++k) n[k] /= l;
+        else
+            n[0] = n[1] = n[2] = 0.0;
+    }
+}
+
+sfb_result sfb__trimesh_mean_curvature(sfb_context *ctx, int nv, const double *pos, int nf, const int *tri, double *H) {
+    double *S = NULL, *A, *N;
+    int *off = NULL, *other, *cnt;
+    unsigned char *bad;
+    size_t bytes;
+    int f, v, c, k;
+    if (!ctx) return SFB_INVALID_ARGS;
+    if (nv < 0 || nf < 0 || (nv > 0 && (!pos || !H)) || (nf > 0 && !tri))
+        return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "mean curvature: bad arguments");
+    if (nv == 0) return SFB_SUCCESS;
+    /* per vertex: S (3), A (1), N (3) doubles; off (nv + 1), cnt (nv) ints, bad bytes; other: 3 nf ints */
+    if (!sfb__mul_size((size_t)nv, 7 * sizeof(double), &bytes) || !(S = (double *)sfb__calloc(ctx, 1, bytes)) ||
+        !sfb__mul_size((size_t)nv + 1 + (size_t)nv + 3 * (size_t)nf, sizeof(int), &bytes) || bytes > ((size_t)-1) - (size_t)nv ||
+        !(off = (int *)sfb__calloc(ctx, 1, bytes + (size_t)nv))) {
+        sfb__free(ctx, S);
+        return sfb__oom(ctx, "the mean curvature");
+    }
+    A = S + 3 * (size_t)nv;
+    N = A + nv;
+    cnt = off + nv + 1;
+    other = cnt + nv;
+    bad = (unsigned char *)(other + 3 * (size_t)nf);
+    /* edges with other than two faces: each edge (lo, hi) listed at lo, counted through cnt */
+    for (f = 0; f < nf; ++f) {
+        const int *t = tri + 3 * (size_t)f;
+        if (!trimesh_valid(nv, t)) continue;
+        for (c = 0; c < 3; ++c) {
+            const int a = t[c], b = t[(c + 1) % 3];
+            off[(a < b ? a : b) + 1]++;
+        }
+    }
+    for (v = 0; v < nv; ++v) off[v + 1] += off[v];
+    for (f = 0; f < nf; ++f) {
+        const int *t = tri + 3 * (size_t)f;
+        if (!trimesh_valid(nv, t)) continue;
+        for (c = 0; c < 3; ++c) {
+            const int a = t[c], b = t[(c + 1) % 3];
+            other[off[a < b ? a : b]++] = a < b ? b : a;
+        }
+    }
+    for (v = nv; v > 0; --v) off[v] = off[v - 1];
+    off[0] = 0;
+    for (v = 0; v < nv; ++v) {
+        int i;
+        for (i = off[v]; i < off[v + 1]; ++i) cnt[other[i]]++;
+        for (i = off[v]; i < off[v + 1]; ++i)
+            if (cnt[other[i]] != 2) bad[v] = bad[other[i]] = 1;
+        for (i = off[v]; i < off[v + 1]; ++i) cnt[other[i]] = 0;
+    }
+    /* the cotangent sums and the mixed areas */
+    for (f = 0; f < nf; ++f) {
+        const int *t = tri + 3 * (size_t)f;
+        double e[3][3], ta, cot[3], dots[3];
+        if (!trimesh_valid(nv, t) || !trimesh_face(pos, t, e, &ta)) continue;
+        for (c = 0; c < 3; ++c) {
+            /* at corner c: edges out of it (e[c]) and into it reversed (-e[c+2]) */
+            dots[c] = -trimesh_dot(e[c], e[(c + 2) % 3]);
+            cot[c] = dots[c] / ta;
+        }
+        for (c = 0; c < 3; ++c) {
+            const int i = t[c], j = t[(c + 1) % 3], l = t[(c + 2) % 3];
+            const double *xi = pos + 3 * (size_t)i, *xj = pos + 3 * (size_t)j, *xl = pos + 3 * (size_t)l;
+            /* edge i-j faces corner c+2, edge i-l faces corner c+1 */
+            const double cij = cot[(c + 2) % 3], cil = cot[(c + 1) % 3];
+            for (k = 0; k < 3; ++k) S[3 * (size_t)i + k] += cij * (xi[k] - xj[k]) + cil * (xi[k] - xl[k]);
+            if (dots[0] >= 0.0 && dots[1] >= 0.0 && dots[2] >= 0.0)
+                A[i] += (cij * trimesh_dot(e[c], e[c]) + cil * trimesh_dot(e[(c + 2) % 3], e[(c + 2) % 3])) / 8.0;
+            else if (dots[c] < 0.0)
+                A[i] += ta / 4.0; /* obtuse at i: half the area */
+            else
+                A[i] += ta / 8.0; /* obtuse elsewhere: a quarter */
+        }
+    }
+    sfb__trimesh_vertex_normals(nv, pos, nf, tri, N);
+    for (v = 0; v < nv; ++v) {
+        double K[3], h;
+        if (bad[v] || !(A[v] > 0.0)) { H[v] = 0.0; continue; }
+        for (k = 0; k < 3; ++k) K[k] = S[3 * (size_t)v + k] / (2.0 * A[v]);
+        h = 0.5 * sqrt(trimesh_dot(K, K));
+        H[v] = trimesh_dot(K, N + 3 * (size_t)v) < 0.0 ? -h : h;
+        if (!(H[v] - H[v] == 0.0)) H[v] = 0.0;
+    }
+    sfb__free(ctx, S);
+    sfb__free(ctx, off);
+    return SFB_SUCCESS;
+}
+
+/* ---- on an sfb_mesh ---- */
+
+/* The mesh's positions in double, after checking that every face is a triangle. */
+static sfb_result trimesh_of_mesh(sfb_context *ctx, const sfb_mesh *mesh, const void *outp, const char *who, double **pos) {
+    const sfb__level *l;
+    size_t bytes;
+    int f, i;
+    *pos = NULL;
+    if (!ctx) return SFB_INVALID_ARGS;
+    if (!mesh || !outp) return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "%s: NULL argument", who);
+    l = &mesh->base;
+    for (f = 0; f < l->nf; ++f)
+        if (l->fv_off[f + 1] - l->fv_off[f] != 3 || l->fv_off[f] != 3 * f)
+            return sfb__error(ctx, SFB_INVALID_TOPOLOGY, SFB_ELEMENT_FACE, f, "%s needs triangles; this face has %d vertices", who,
+                              l->fv_off[f + 1] - l->fv_off[f]);
+    if (!sfb__mul_size((size_t)l->nv + 1, 3 * sizeof(double), &bytes) || !(*pos = (double *)sfb__alloc(ctx, bytes)))
+        return sfb__oom(ctx, who);
+    for (i = 0; i < 3 * l->nv; ++i) (*pos)[i] = (double)mesh->positions[i];
+    return SFB_SUCCESS;
+}
+
+SFB_API sfb_result sfb_mesh_vertex_normals(sfb_context *ctx, const sfb_mesh *mesh, float *normals) {
+    double *pos, *n;
+    const sfb__level *l;
+    size_t bytes;
+    int i;
+    sfb_result r = trimesh_of_mesh(ctx, mesh, normals, "sfb_mesh_vertex_normals", &pos);
+    if (r != SFB_SUCCESS) return r;
+    l = &mesh->base;
+    if (!sfb__mul_size((size_t)l->nv + 1, 3 * sizeof(double), &bytes) || !(n = (double *)sfb__alloc(ctx, bytes))) {
+        sfb__free(ctx, pos);
+        return sfb__oom(ctx, "sfb_mesh_vertex_normals");
+    }
+    sfb__trimesh_vertex_normals(l->nv, pos, l->nf, l->fv, n);
+    for (i = 0; i < 3 * l->nv; ++i) normals[i] = (float)n[i];
+    sfb__free(ctx, n);
+    sfb__free(ctx, pos);
+    return SFB_SUCCESS;
+}
+
+SFB_API sfb_result sfb_mesh_mean_curvature(sfb_context *ctx, const sfb_mesh *mesh, float *curvature) {
+    double *pos, *h;
+    const sfb__level *l;
+    int i;
+    sfb_result r = trimesh_of_mesh(ctx, mesh, curvature, "sfb_mesh_mean_curvature", &pos);
+    if (r != SFB_SUCCESS) return r;
+    l = &mesh->base;
+    if (!(h = (double *)sfb__calloc(ctx, (size_t)l->nv + 1, sizeof(double)))) {
+        sfb__free(ctx, pos);
+        return sfb__oom(ctx, "sfb_mesh_mean_curvature");
+    }
+    r = sfb__trimesh_mean_curvature(ctx, l->nv, pos, l->nf, l->fv, h);
+    if (r == SFB_SUCCESS)
+        for (i = 0; i < l->nv; ++i) curvature[i] = (float)h[i];
+    sfb__free(ctx, h);
+    sfb__free(ctx, pos);
+    return r;
+}
+#line 1 "src/fillet/fillet.c"
+/* Seed 002: rolling-ball blending (fillets) of sharp features on triangle meshes, connectivity
+ * unchanged. sfb_mesh_fillet runs, per blending curve:
+ *   curves   feature edges over a dihedral angle chained into closed loops and open chains, or
+ *            the caller's vertex chains (fillet_curves_*);
+ *   spine    base patches within d of the curve, one per side; per-side vertex normals; offset
+ *            patches; their intersection through two AABB trees (aabb.c) chained, the longest
+ *            loop (closed curves) or chain (open ones) kept; spine loops cut out (seed 4.3);
+ *   surface  spine samples by arc length, refined by chord height / chord length (seed 4.1); per
+ *            sample the linkage points (the spine point's nearest point on each offset patch,
+ *            carried back to the base face by its barycentric coordinates: seed 3 step 4) and a
+ *            profile (arc, conic, sharpening polyline, Hermite; seed 4.2); ruled surfaces between
+ *            consecutive profiles (seed eq. 1);
+ *   map      each vertex of the blend region gets (t, a): t from its nearest point on the spine
+ *            (the spine's normal plane through the vertex), a its place across the region, by
+ *            distance from the blending curve relative to the linkage point's on its side;
+ *   project  the vertex moves to the ruled surface at (t, a).
+ * Choices where the seed is silent, and why:
+ *  - The map is a direct projection onto the sweep (the issue's "project onto the sweep surface
+ *    directly"), not the seed's conformal map of the split region: it needs no disc topology, so
+ *    blend regions with holes or several boundary loops (seed 7's failure) map like any other,
+ *    and open chains need no splitting. Across the region, a is arc-length-like: the blending
+ *    curve goes to the profile's middle by arc length when both linkage distances are equal.
+ *  - Consecutive profiles are joined at equal arc-length fractions (a ruled surface whose rulings
+ *    join points at the same fraction a), not at equal rational parameter u: profiles of
+ *    different opening angles then still pair corresponding points.
+ *  - d grows with the curve's sharpest dihedral angle: the linkage points lie r tan(delta/2) from
+ *    the curve (delta the dihedral angle between the face normals), beyond alpha r when delta >
+ *    120 degrees; d = alpha r max(1, tan(delta/2)).
+ *  - Sides: the face holding the curve's edge in the curve's direction is side 0. The two base
+ *    patches grow breadth first at the same time, so around the ends of an open chain they meet
+ *    halfway instead of one swallowing the other.
+ *  - Convex or concave per curve: side 1's faces lie below side 0's tangent plane (summed over the
+ *    curve's edges) for a convex edge. Convex: offsets against the normals; concave: along them.
+ *  - Curves are filleted one after the other, each on the positions the earlier ones left. */
+
+
+#define SFB__FIL_TAB 48 /* profile arc-length table intervals */
+
+typedef struct sfb__fil_curve {
+    int *v;           /* vertices, closed: v[n-1] == v[0] */
+    int n, closed;
+    double radius;
+    int profile;
+    double conic_w;
+} sfb__fil_curve;
+
+typedef struct sfb__fil_prof {
+    double P1[3], P0[3], P2[3], C[3], E[3];
+    double w, r, L1, L2;   /* middle weight; radius; linkage distances from the curve, sides 0 and 1 */
+    double T[SFB__FIL_TAB + 1][3];
+    double acc[SFB__FIL_TAB + 1]; /* arc length fractions of T */
+} sfb__fil_prof;
+
+typedef struct sfb__fil {
+    sfb_context *ctx;
+    const sfb_fillet_config *cfg;
+    const sfb__level *l;
+    int nv, nf;
+    const int *tri;
+    double *pos, *fn;      /* current positions; unit face normals */
+    double *npos;          /* positions after the current curve */
+    double scale;          /* bounding-box diagonal */
+    sfb__fil_curve *curves;
+    int ncurves, curves_cap;
+    unsigned char *emark;  /* per edge: on the current curve */
+} sfb__fil;
+
+/* ---- small vector helpers ---- */
+static double fil_dot(const double *a, const double *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+static void fil_sub(const double *a, const double *b, double *o) { o[0] = a[0] - b[0]; o[1] = a[1] - b[1]; o[2] = a[2] - b[2]; }
+static double fil_len(const double *a) { return sqrt(fil_dot(a, a)); }
+static double fil_dist(const double *a, const double *b) {
+    double d[3];
+    fil_sub(a, b, d);
+    return fil_len(d);
+}
+static void fil_lerp(const double *a, const double *b, double t, double *o) {
+    o[0] = a[0] + t * (b[0] - a[0]); o[1] = a[1] + t * (b[1] - a[1]); o[2] = a[2] + t * (b[2] - a[2]);
+}
+static void fil_cross(const double *a, const double *b, double *o) {
+    o[0] = a[1] * b[2] - a[2] * b[1]; o[1] = a[2] * b[0] - a[0] * b[2]; o[2] = a[0] * b[1] - a[1] * b[0];
+}
+/* Nearest point of segment a-b to p: its parameter in [0,1]. */
+static double fil_seg_param(const double *p, const double *a, const double *b) {
+    double ab[3], ap[3], l2, t;
+    fil_sub(b, a, ab); fil_sub(p, a, ap);
+    l2 = fil_dot(ab, ab);
+    if (!(l2 > 0.0)) return 0.0;
+    t = fil_dot(ap, ab) / l2;
+    return t < 0.0 ? 0.0 : t > 1.0 ? 1.0 : t;
+}
+
+static int fil_edge_of(const sfb__level *l, int a, int b) {
+    int k;
+    for (k = l->ve_off[a]; k < l->ve_off[a + 1]; ++k) {
+        const int e = l->ve[k];
+        if (sfb__other_end(l, e, a) == b) return e;
+    }
+    return -1;
+}
+
+static void fil_face_normals(sfb__fil *F) {
+    int f;
+    for (f = 0; f < F->nf; ++f) {
+        const double *a = F->pos + 3 * (size_t)F->tri[3 * f], *b = F->pos + 3 * (size_t)F->tri[3 * f + 1],
+                     *c = F->pos + 3 * (size_t)F->tri[3 * f + 2];
+        double u[3], v[3], n[3], ln;
+        fil_sub(b, a, u); fil_sub(c, a, v); fil_cross(u, v, n);
+        ln = fil_len(n);
+        if (ln > 0.0) { n[0] /= ln; n[1] /= ln; n[2] /= ln; } else n[0] = n[1] = n[2] = 0.0;
+        memcpy(F->fn + 3 * (size_t)f, n, sizeof n);
+    }
+}
+
+/* Angle between the normals of edge e's two faces (radians); -1 for an edge without two faces. */
+static double fil_dihedral(const sfb__fil *F, int e) {
+    const sfb__level *l = F->l;
+    double c;
+    if (l->ef_off[e + 1] - l->ef_off[e] != 2) return -1.0;
+    c = fil_dot(F->fn + 3 * (size_t)l->ef[l->ef_off[e]], F->fn + 3 * (size_t)l->ef[l->ef_off[e] + 1]);
+    c = c > 1.0 ? 1.0 : c < -1.0 ? -1.0 : c;
+    return acos(c);
+}
+
+/* ---- curves ---- */
+static sfb_result fil_add_curve(sfb__fil *F, const int *v, int n, int closed, double radius, int profile, double w) {
+    sfb__fil_curve *c;
+    if (F->ncurves == F->curves_cap) {
+        const int cap = F->curves_cap ? 2 * F->curves_cap : 8;
+        sfb__fil_curve *nc = (sfb__fil_curve *)sfb__realloc(F->ctx, F->curves, (size_t)cap * sizeof *nc);
+        if (!nc) return sfb__oom(F->ctx, "the blending curves");
+        F->curves = nc;
+        F->curves_cap = cap;
+    }
+    c = &F->curves[F->ncurves];
+    c->v = (int *)sfb__alloc(F->ctx, (size_t)n * sizeof(int));
+    if (!c->v) return sfb__oom(F->ctx, "a blending curve");
+    memcpy(c->v, v, (size_t)n * sizeof(int));
+    c->n = n;
+    c->closed = closed;
+    c->radius = radius;
+    c->profile = profile;
+    c->conic_w = w;
+    F->ncurves++;
+    return SFB_SUCCESS;
+}
+
+/* Feature edges (dihedral angle over the threshold, two faces) chained: chains start at vertices
+ * with other than two feature edges; what is left are closed loops. */
+static sfb_result fil_curves_from_angle(sfb__fil *F) {
+    const sfb__level *l = F->l;
+    const double limit = (F->cfg->angle > 0.0f ? F->cfg->angle : 30.0f) * SFB__PI / 180.0;
+    unsigned char *feat = (unsigned char *)sfb__calloc(F->ctx, (size_t)l->ne + 1, 1);
+    int *deg = (int *)sfb__calloc(F->ctx, (size_t)l->nv + 1, sizeof(int));
+    int *chain = (int *)sfb__alloc(F->ctx, ((size_t)l->ne + 2) * sizeof(int));
+    int e, v, pass, total = 0;
+    sfb_result r = SFB_SUCCESS;
+    if (!feat || !deg || !chain) {
+        r = sfb__oom(F->ctx, "the feature edges");
+        goto done;
+    }
+    for (e = 0; e < l->ne; ++e)
+        if (fil_dihedral(F, e) > limit) {
+            feat[e] = 1;
+            deg[l->ev[2 * e]]++;
+            deg[l->ev[2 * e + 1]]++;
+            total++;
+        }
+    if (!total) {
+        r = sfb__error(F->ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, -1,
+                       "no feature edge: no edge's dihedral angle exceeds %g degrees", limit * 180.0 / SFB__PI);
+        goto done;
+    }
+    /* pass 0: chains from end vertices (degree != 2); pass 1: closed loops */
+    for (pass = 0; pass < 2 && r == SFB_SUCCESS; ++pass)
+        for (v = 0; v < l->nv && r == SFB_SUCCESS; ++v) {
+            int k;
+            if (pass == 0 && deg[v] == 2) continue;
+            for (k = l->ve_off[v]; k < l->ve_off[v + 1] && r == SFB_SUCCESS; ++k) {
+                int cur = v, ce = l->ve[k], n = 0;
+                if (!feat[ce]) continue;
+                chain[n++] = v;
+                while (ce >= 0) {
+                    int nx = sfb__other_end(l, ce, cur), j;
+                    feat[ce] = 0;
+                    chain[n++] = nx;
+                    cur = nx;
+                    ce = -1;
+                    if (nx == v || deg[nx] != 2) break;
+                    for (j = l->ve_off[nx]; j < l->ve_off[nx + 1]; ++j)
+                        if (feat[l->ve[j]]) { ce = l->ve[j]; break; }
+                }
+                r = fil_add_curve(F, chain, n, chain[n - 1] == chain[0], F->cfg->radius, F->cfg->profile, F->cfg->conic_weight);
+            }
+        }
+done:
+    sfb__free(F->ctx, feat);
+    sfb__free(F->ctx, deg);
+    sfb__free(F->ctx, chain);
+    return r;
+}
+
+static sfb_result fil_curves_from_caller(sfb__fil *F) {
+    const sfb_fillet_config *cfg = F->cfg;
+    int c, i;
+    for (c = 0; c < cfg->curve_count; ++c) {
+        const sfb_fillet_curve *cc = &cfg->curves[c];
+        sfb_result r;
+        double radius = cc->radius != 0.0f ? cc->radius : cfg->radius;
+        int profile = cc->profile ? cc->profile - 1 : cfg->profile;
+        double w = cc->conic_weight != 0.0f ? cc->conic_weight : cfg->conic_weight;
+        if (!cc->vertices || cc->count < 2)
+            return sfb__error(F->ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "blending curve %d: needs at least 2 vertices", c);
+        if (!(radius > 0.0) || !isfinite(radius))
+            return sfb__error(F->ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, -1, "blending curve %d: radius %g is not a positive number", c, radius);
+        if (profile < 0 || profile > SFB_FILLET_HERMITE)
+            return sfb__error(F->ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, -1, "blending curve %d: unknown profile %d", c, profile);
+        if (!(w >= 0.0) || !isfinite(w))
+            return sfb__error(F->ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, -1, "blending curve %d: conic weight %g is not >= 0", c, w);
+        for (i = 0; i < cc->count; ++i)
+            if (cc->vertices[i] < 0 || cc->vertices[i] >= F->nv)
+                return sfb__error(F->ctx, SFB_INVALID_TOPOLOGY, SFB_ELEMENT_VERTEX, cc->vertices[i],
+                                  "blending curve %d: vertex %d is not a vertex of the mesh", c, cc->vertices[i]);
+        for (i = 0; i + 1 < cc->count; ++i) {
+            const int e = fil_edge_of(F->l, cc->vertices[i], cc->vertices[i + 1]);
+            if (e < 0)
+                return sfb__error(F->ctx, SFB_INVALID_TOPOLOGY, SFB_ELEMENT_VERTEX, cc->vertices[i + 1],
+                                  "blending curve %d is not a chain of mesh edges: no edge from vertex %d to vertex %d", c,
+                                  cc->vertices[i], cc->vertices[i + 1]);
+            if (F->l->ef_off[e + 1] - F->l->ef_off[e] != 2)
+                return sfb__error(F->ctx, SFB_INVALID_TOPOLOGY, SFB_ELEMENT_EDGE, e,
+                                  "blending curve %d: the edge from vertex %d to vertex %d is not between two faces", c,
+                                  cc->vertices[i], cc->vertices[i + 1]);
+        }
+        r = fil_add_curve(F, cc->vertices, cc->count, cc->vertices[0] == cc->vertices[cc->count - 1] && cc->count > 3, radius,
+                          profile, w);
+        if (r != SFB_SUCCESS) return r;
+    }
+    return SFB_SUCCESS;
+}
+
+/* ---- one curve ---- */
+typedef struct sfb__fil_seg { double a[3], b[3]; } sfb__fil_seg;
+typedef struct sfb__fil_pairs {
+    sfb__fil *F;
+    const double *op0, *op1;
+    const int *t0, *t1;
+    sfb__fil_seg *segs;
+    size_t n, cap;
+    int failed;
+} sfb__fil_pairs;
+
+static int fil_pair_cb(int i, int j, void *user) {
+    sfb__fil_pairs *P = (sfb__fil_pairs *)user;
+    const int *a = P->t0 + 3 * (size_t)i, *b = P->t1 + 3 * (size_t)j;
+    double s0[3], s1[3];
+    if (sfb__tri_tri_segment(P->op0 + 3 * (size_t)a[0], P->op0 + 3 * (size_t)a[1], P->op0 + 3 * (size_t)a[2],
+                             P->op1 + 3 * (size_t)b[0], P->op1 + 3 * (size_t)b[1], P->op1 + 3 * (size_t)b[2], s0, s1, NULL,
+                             NULL) != 1)
+        return 0;
+    if (P->n == P->cap) {
+        const size_t cap = P->cap ? 2 * P->cap : 256;
+        sfb__fil_seg *ns = (sfb__fil_seg *)sfb__realloc(P->F->ctx, P->segs, cap * sizeof *ns);
+        if (!ns) { P->failed = 1; return 1; }
+        P->segs = ns;
+        P->cap = cap;
+    }
+    memcpy(P->segs[P->n].a, s0, sizeof s0);
+    memcpy(P->segs[P->n].b, s1, sizeof s1);
+    P->n++;
+    return 0;
+}
+
+typedef struct sfb__fil_key { double x; int id; } sfb__fil_key;
+static int fil_key_cmp(const void *a, const void *b) {
+    const double x = ((const sfb__fil_key *)a)->x, y = ((const sfb__fil_key *)b)->x;
+    return x < y ? -1 : x > y ? 1 : 0;
+}
+
+/* Chains intersection segments into the spine: endpoints welded within tol, duplicate pieces
+ * dropped, then walks along unused pieces (through a node where pieces cross, the straightest way
+ * on); stray bits and non-manifold branches end up in walks of their own and are dropped by
+ * keeping one walk: the longest closed loop when `want_closed` (else the longest walk), the longest
+ * open chain otherwise (a closed loop when there is none). Writes the points (closed: not repeated). */
+static sfb_result fil_chain(sfb_context *ctx, const sfb__fil_seg *segs, size_t ns, double tol, int want_closed, double **out,
+                            int *out_n, int *out_closed) {
+    const size_t np = 2 * ns;
+    sfb__fil_key *keys = (sfb__fil_key *)sfb__alloc(ctx, (np + 1) * sizeof *keys);
+    int *node = (int *)sfb__alloc(ctx, (np + 1) * sizeof(int));
+    int *deg = NULL, *path = NULL, *best = NULL;
+    double *npos = NULL;
+    int nn = 0, best_n = 0, best_closed = 0;
+    double best_len = -1.0;
+    size_t i, k;
+    sfb_result r = SFB_SUCCESS;
+    *out = NULL;
+    *out_n = 0;
+    *out_closed = 0;
+    if (!keys || !node) { r = sfb__oom(ctx, "the spine's points"); goto done; }
+    for (i = 0; i < np; ++i) {
+        keys[i].x = (i & 1) ? segs[i / 2].b[0] : segs[i / 2].a[0];
+        keys[i].id = (int)i;
+        node[i] = -1;
+    }
+    qsort(keys, np, sizeof *keys, fil_key_cmp);
+    npos = (double *)sfb__alloc(ctx, (np + 1) * 3 * sizeof(double));
+    if (!npos) { r = sfb__oom(ctx, "the spine's points"); goto done; }
+    for (i = 0; i < np; ++i) {
+        const int id = keys[i].id;
+        const double *p = (id & 1) ? segs[id / 2].b : segs[id / 2].a;
+        if (node[id] >= 0) continue;
+        node[id] = nn;
+        memcpy(npos + 3 * (size_t)nn, p, 3 * sizeof(double));
+        for (k = i + 1; k < np && keys[k].x - keys[i].x <= tol; ++k) {
+            const int jd = keys[k].id;
+            const double *q = (jd & 1) ? segs[jd / 2].b : segs[jd / 2].a;
+            if (node[jd] < 0 && fil_dist(p, q) <= tol) node[jd] = nn;
+        }
+        nn++;
+    }
+    /* edges between distinct nodes, each once; adjacency lists (compressed) */
+    {
+        int *eu = (int *)sfb__alloc(ctx, (ns + 1) * 2 * sizeof(int)), ne = 0, *off = NULL, *inc = NULL, *fill = NULL;
+        unsigned char *eused = NULL;
+        int s, e;
+        deg = (int *)sfb__calloc(ctx, (size_t)nn + 1, sizeof(int));
+        path = (int *)sfb__alloc(ctx, ((size_t)ns + 2) * sizeof(int));
+        best = (int *)sfb__alloc(ctx, ((size_t)ns + 2) * sizeof(int));
+        off = (int *)sfb__calloc(ctx, (size_t)nn + 2, sizeof(int));
+        if (!eu || !deg || !path || !best || !off) { sfb__free(ctx, eu); sfb__free(ctx, off); r = sfb__oom(ctx, "the spine's chains"); goto done; }
+        for (i = 0; i < ns; ++i) {
+            const int a = node[2 * i], b = node[2 * i + 1];
+            if (a == b) continue;
+            eu[2 * ne] = a < b ? a : b;
+            eu[2 * ne + 1] = a < b ? b : a;
+            ne++;
+        }
+        /* the same piece found from two triangle pairs: drop duplicates (sort by key) */
+        {
+            sfb__fil_key *ek = (sfb__fil_key *)sfb__alloc(ctx, ((size_t)ne + 1) * sizeof *ek);
+            int *keep = (int *)sfb__alloc(ctx, ((size_t)ne + 1) * 2 * sizeof(int)), nk = 0;
+            if (!ek || !keep) { sfb__free(ctx, ek); sfb__free(ctx, keep); sfb__free(ctx, eu); sfb__free(ctx, off); r = sfb__oom(ctx, "the spine's chains"); goto done; }
+            for (e = 0; e < ne; ++e) { ek[e].x = (double)eu[2 * e] * ((double)nn + 1.0) + eu[2 * e + 1]; ek[e].id = e; }
+            qsort(ek, (size_t)ne, sizeof *ek, fil_key_cmp);
+            for (e = 0; e < ne; ++e)
+                if (e == 0 || ek[e].x != ek[e - 1].x) { keep[2 * nk] = eu[2 * ek[e].id]; keep[2 * nk + 1] = eu[2 * ek[e].id + 1]; nk++; }
+            memcpy(eu, keep, (size_t)nk * 2 * sizeof(int));
+            ne = nk;
+            sfb__free(ctx, ek);
+            sfb__free(ctx, keep);
+        }
+        for (e = 0; e < ne; ++e) { off[eu[2 * e] + 1]++; off[eu[2 * e + 1] + 1]++; }
+        for (s = 0; s < nn; ++s) { deg[s] = off[s + 1]; off[s + 1] += off[s]; }
+        inc = (int *)sfb__alloc(ctx, ((size_t)2 * ne + 1) * sizeof(int));
+        fill = (int *)sfb__calloc(ctx, (size_t)nn + 1, sizeof(int));
+        eused = (unsigned char *)sfb__calloc(ctx, (size_t)ne + 1, 1);
+        if (!inc || !fill || !eused) {
+            sfb__free(ctx, eu); sfb__free(ctx, off); sfb__free(ctx, inc); sfb__free(ctx, fill); sfb__free(ctx, eused);
+            r = sfb__oom(ctx, "the spine's chains");
+            goto done;
+        }
+        for (e = 0; e < ne; ++e) {
+            inc[off[eu[2 * e]] + fill[eu[2 * e]]++] = e;
+            inc[off[eu[2 * e + 1]] + fill[eu[2 * e + 1]]++] = e;
+        }
+        /* walks: from ends (odd degree) first, then whatever is left; at a node of degree > 2 (two
+         * pieces crossing: a spine that intersects itself, seed 4.3) the walk goes on along the
+         * straightest unused edge, so a self-crossing spine stays one curve for the loop removal */
+        for (k = 0; k < 2; ++k)
+            for (s = 0; s < nn; ++s) {
+                int n = 0, cur = s, closed = 0;
+                double len = 0.0;
+                if (k == 0 && !(deg[s] & 1)) continue;
+                for (;;) {
+                    int j2, pick = -1, nx;
+                    double bestd = -HUGE_VAL;
+                    path[n++] = cur;
+                    if (n > (int)ns + 1) break;
+                    for (j2 = off[cur]; j2 < off[cur + 1]; ++j2) {
+                        const int ed = inc[j2];
+                        double dir[3], din[3], ld, li, dd;
+                        if (eused[ed]) continue;
+                        nx = eu[2 * ed] == cur ? eu[2 * ed + 1] : eu[2 * ed];
+                        if (n < 2) { pick = ed; break; }
+                        fil_sub(npos + 3 * (size_t)nx, npos + 3 * (size_t)cur, dir);
+                        fil_sub(npos + 3 * (size_t)cur, npos + 3 * (size_t)path[n - 2], din);
+                        ld = fil_len(dir); li = fil_len(din);
+                        dd = (ld > 0 && li > 0) ? fil_dot(dir, din) / (ld * li) : -1.0;
+                        if (dd > bestd) { bestd = dd; pick = ed; }
+                    }
+                    if (pick < 0) break;
+                    eused[pick] = 1;
+                    nx = eu[2 * pick] == cur ? eu[2 * pick + 1] : eu[2 * pick];
+                    len += fil_dist(npos + 3 * (size_t)cur, npos + 3 * (size_t)nx);
+                    cur = nx;
+                    if (cur == s) {
+                        /* back at the start: closed unless the start has more to walk (then go on) */
+                        int more = 0;
+                        for (j2 = off[cur]; j2 < off[cur + 1]; ++j2) more |= !eused[inc[j2]];
+                        if (!more) { closed = 1; break; }
+                    }
+                }
+                if (n < 2) continue;
+                {
+                    const int match = closed == want_closed, best_match = best_closed == want_closed;
+                    if (best_n == 0 || (match && !best_match) || (match == best_match && len > best_len)) {
+                        memcpy(best, path, (size_t)n * sizeof(int));
+                        best_n = n;
+                        best_len = len;
+                        best_closed = closed;
+                    }
+                }
+            }
+        sfb__free(ctx, eu); sfb__free(ctx, off); sfb__free(ctx, inc); sfb__free(ctx, fill); sfb__free(ctx, eused);
+    }
+    if (best_n >= 2) {
+        double *o = (double *)sfb__alloc(ctx, (size_t)best_n * 3 * sizeof(double));
+        if (!o) { r = sfb__oom(ctx, "the spine"); goto done; }
+        for (i = 0; i < (size_t)best_n; ++i) memcpy(o + 3 * i, npos + 3 * (size_t)best[i], 3 * sizeof(double));
+        *out = o;
+        *out_n = best_n;
+        *out_closed = best_closed;
+    }
+done:
+    sfb__free(ctx, keys); sfb__free(ctx, node); sfb__free(ctx, deg); sfb__free(ctx, path); sfb__free(ctx, best); sfb__free(ctx, npos);
+    return r;
+}
+
+/* Nearest point to p on polyline pts (n points; closed: the last joins the first): the segment i
+ * (from point i to i+1 mod n), its parameter and the squared distance. */
+static void fil_polyline_nearest(const double *pts, int n, int closed, const double *p, int *seg, double *t, double *d2) {
+    const int segs = closed ? n : n - 1;
+    int i;
+    *seg = 0; *t = 0.0; *d2 = HUGE_VAL;
+    for (i = 0; i < segs; ++i) {
+        const double *a = pts + 3 * (size_t)i, *b = pts + 3 * (size_t)((i + 1) % n);
+        const double s = fil_seg_param(p, a, b);
+        double q[3], dd;
+        fil_lerp(a, b, s, q);
+        dd = (q[0] - p[0]) * (q[0] - p[0]) + (q[1] - p[1]) * (q[1] - p[1]) + (q[2] - p[2]) * (q[2] - p[2]);
+        if (dd < *d2) { *d2 = dd; *seg = i; *t = s; }
+    }
+}
+
+/* Spine self-intersections (seed 4.3): two spine pieces closer than tol, apart along the spine by
+ * more than `gap`, close a loop; the loop (the shorter way round for a closed spine, the part
+ * between them for an open one) is cut out and its ends Q1, Q2 -- the points `gap` before and
+ * after it -- are joined by a cubic Hermite segment with the spine's tangents there. Then
+ * non-shrinking Taubin smoothing (lambda 0.5, mu -0.53) of the whole spine. Returns the loops cut. */
+static int fil_spine_untangle(sfb_context *ctx, double **pts_io, int *n_io, int closed, double tol, double gap) {
+    int n = *n_io, cuts = 0, guard;
+    double *pts = *pts_io;
+    for (guard = 0; guard < 16; ++guard) {
+        double *acc;
+        int found = 0;
+        int i, j, bi = -1, bj = -1;
+        /* arc length positions */
+        acc = (double *)sfb__alloc(ctx, ((size_t)n + 1) * sizeof(double));
+        if (!acc) break;
+        acc[0] = 0.0;
+        for (i = 1; i < n; ++i) acc[i] = acc[i - 1] + fil_dist(pts + 3 * (size_t)(i - 1), pts + 3 * (size_t)i);
+        acc[n] = acc[n - 1] + (closed ? fil_dist(pts + 3 * (size_t)(n - 1), pts) : 0.0);
+        for (i = 0; i < n && !found; ++i)
+            for (j = i + 2; j < n; ++j) {
+                double along = acc[j] - acc[i];
+                if (closed && acc[n] - along < along) along = acc[n] - along;
+                if (along <= 2.0 * gap) continue;
+                if (fil_dist(pts + 3 * (size_t)i, pts + 3 * (size_t)j) < tol) { bi = i; bj = j; found = 1; break; }
+            }
+        if (!found) { sfb__free(ctx, acc); break; }
+        {
+            /* the loop is i..j (inner), or for a closed spine the shorter of i..j and j..i */
+            int keep_inner = 0, q1, q2, m, k, o = 0;
+            double *np_;
+            if (closed && (acc[bj] - acc[bi]) > acc[n] / 2) keep_inner = 1; /* the outer part is the loop */
+            if (keep_inner) {
+                /* keep bi..bj, drop the wrap-around part */
+                q1 = bi; q2 = bj;
+                while (q1 < bj && acc[q1] - acc[bi] < gap) q1++;
+                while (q2 > q1 && acc[bj] - acc[q2] < gap) q2--;
+                np_ = (double *)sfb__alloc(ctx, ((size_t)(q2 - q1 + 1) + 16) * 3 * sizeof(double));
+                if (!np_) { sfb__free(ctx, acc); break; }
+                for (k = q1; k <= q2; ++k) memcpy(np_ + 3 * (size_t)o++, pts + 3 * (size_t)k, 3 * sizeof(double));
+                /* Hermite from q2 back to q1 across the cut */
+                m = 8;
+                {
+                    const double *A = pts + 3 * (size_t)q2, *B = pts + 3 * (size_t)q1;
+                    double ta[3], tb[3], L = fil_dist(A, B);
+                    fil_sub(pts + 3 * (size_t)q2, pts + 3 * (size_t)(q2 - 1), ta);
+                    fil_sub(pts + 3 * (size_t)(q1 + 1), pts + 3 * (size_t)q1, tb);
+                    {
+                        double la = fil_len(ta), lb = fil_len(tb);
+                        for (k = 0; k < 3; ++k) { ta[k] *= la > 0 ? L / la : 0; tb[k] *= lb > 0 ? L / lb : 0; }
+                    }
+                    for (k = 1; k < m; ++k) {
+                        const double s = (double)k / m, h00 = 2 * s * s * s - 3 * s * s + 1, h10 = s * s * s - 2 * s * s + s,
+                                     h01 = -2 * s * s * s + 3 * s * s, h11 = s * s * s - s * s;
+                        int c;
+                        for (c = 0; c < 3; ++c) np_[3 * (size_t)o + c] = h00 * A[c] + h10 * ta[c] + h01 * B[c] + h11 * tb[c];
+                        o++;
+                    }
+                }
+            } else {
+                q1 = bi; q2 = bj;
+                while (q1 > 0 && acc[bi] - acc[q1] < gap) q1--;
+                while (q2 < n - 1 && acc[q2] - acc[bj] < gap) q2++;
+                np_ = (double *)sfb__alloc(ctx, ((size_t)n + 16) * 3 * sizeof(double));
+                if (!np_) { sfb__free(ctx, acc); break; }
+                for (k = 0; k <= q1; ++k) memcpy(np_ + 3 * (size_t)o++, pts + 3 * (size_t)k, 3 * sizeof(double));
+                m = 8;
+                {
+                    const double *A = pts + 3 * (size_t)q1, *B = pts + 3 * (size_t)q2;
+                    double ta[3], tb[3], L = fil_dist(A, B);
+                    fil_sub(pts + 3 * (size_t)q1, pts + 3 * (size_t)(q1 > 0 ? q1 - 1 : q1), ta);
+                    if (q1 == 0) fil_sub(pts + 3 * (size_t)1, pts, ta);
+                    fil_sub(pts + 3 * (size_t)(q2 + 1 < n ? q2 + 1 : q2), pts + 3 * (size_t)q2, tb);
+                    if (q2 + 1 >= n) fil_sub(pts + 3 * (size_t)q2, pts + 3 * (size_t)(q2 - 1), tb);
+                    {
+                        double la = fil_len(ta), lb = fil_len(tb);
+                        for (k = 0; k < 3; ++k) { ta[k] *= la > 0 ? L / la : 0; tb[k] *= lb > 0 ? L / lb : 0; }
+                    }
+                    for (k = 1; k < m; ++k) {
+                        const double s = (double)k / m, h00 = 2 * s * s * s - 3 * s * s + 1, h10 = s * s * s - 2 * s * s + s,
+                                     h01 = -2 * s * s * s + 3 * s * s, h11 = s * s * s - s * s;
+                        int c;
+                        for (c = 0; c < 3; ++c) np_[3 * (size_t)o + c] = h00 * A[c] + h10 * ta[c] + h01 * B[c] + h11 * tb[c];
+                        o++;
+                    }
+                }
+                for (k = q2; k < n; ++k) memcpy(np_ + 3 * (size_t)o++, pts + 3 * (size_t)k, 3 * sizeof(double));
+            }
+            sfb__free(ctx, pts);
+            pts = np_;
+            n = o;
+        }
+        sfb__free(ctx, acc);
+        cuts++;
+    }
+    if (cuts) {
+        /* Taubin lambda|mu smoothing, ends of an open spine fixed */
+        double *tmp = (double *)sfb__alloc(ctx, (size_t)n * 3 * sizeof(double));
+        int it, i, c;
+        if (tmp)
+            for (it = 0; it < 20; ++it) {
+                const double f = (it & 1) ? -0.53 : 0.5;
+                memcpy(tmp, pts, (size_t)n * 3 * sizeof(double));
+                for (i = 0; i < n; ++i) {
+                    int a = i - 1, b = i + 1;
+                    if (!closed && (i == 0 || i == n - 1)) continue;
+                    if (a < 0) a = n - 1;
+                    if (b >= n) b = 0;
+                    for (c = 0; c < 3; ++c)
+                        pts[3 * (size_t)i + c] = tmp[3 * (size_t)i + c] + f * (0.5 * (tmp[3 * (size_t)a + c] + tmp[3 * (size_t)b + c]) - tmp[3 * (size_t)i + c]);
+                }
+            }
+        sfb__free(ctx, tmp);
+    }
+    *pts_io = pts;
+    *n_io = n;
+    return cuts;
+}
+
+/* ---- profiles (seed 4.2) ---- */
+/* A profile from spine point C and linkage points P1 (u = 0), P2 (u = 1): P0 is the end tangents'
+ * intersection, P0 = C + (a + b) / (1 + cos phi) with a = P1 - C, b = P2 - C (seed eq. 2), phi the
+ * central angle; the arc is the rational quadratic (P1, P0, P2) with middle weight cos(phi / 2)
+ * (ALGORITHMS.md 6: the central angle, not the angle at P0). */
+static void fil_prof_eval(const sfb__fil_prof *P, int kind, double hs, double u, double *o) {
+    int c;
+    if (kind == SFB_FILLET_SHARPEN) {
+        const double l1 = fil_dist(P->P1, P->P0), l2 = fil_dist(P->P0, P->P2), s = u * (l1 + l2);
+        if (s <= l1 && l1 > 0.0) fil_lerp(P->P1, P->P0, s / l1, o);
+        else if (l2 > 0.0) fil_lerp(P->P0, P->P2, (s - l1) / l2, o);
+        else memcpy(o, P->P2, 3 * sizeof(double));
+        return;
+    }
+    if (kind == SFB_FILLET_HERMITE) {
+        double t1[3], t2[3], l1, l2, chord = fil_dist(P->P1, P->P2), len;
+        const double h00 = 2 * u * u * u - 3 * u * u + 1, h10 = u * u * u - 2 * u * u + u, h01 = -2 * u * u * u + 3 * u * u,
+                     h11 = u * u * u - u * u;
+        double phi;
+        fil_sub(P->P0, P->P1, t1);
+        fil_sub(P->P2, P->P0, t2);
+        l1 = fil_len(t1);
+        l2 = fil_len(t2);
+        {
+            double a[3], b[3], cphi;
+            fil_sub(P->P1, P->C, a);
+            fil_sub(P->P2, P->C, b);
+            cphi = fil_dot(a, b) / (fil_len(a) * fil_len(b) + 1e-300);
+            phi = acos(cphi > 1 ? 1 : cphi < -1 ? -1 : cphi);
+        }
+        /* the arc's own: a cubic Bezier arm of 4/3 tan(phi/4) r is a Hermite tangent of 4 tan(phi/4) r */
+        len = hs > 0.0 ? hs * chord : 4.0 * tan(phi / 4.0) * P->r;
+        for (c = 0; c < 3; ++c) {
+            const double a = l1 > 0 ? t1[c] / l1 * len : 0.0, b = l2 > 0 ? t2[c] / l2 * len : 0.0;
+            o[c] = h00 * P->P1[c] + h10 * a + h01 * P->P2[c] + h11 * b;
+        }
+        return;
+    }
+    {
+        const double b0 = (1 - u) * (1 - u), b1 = 2 * u * (1 - u) * P->w, b2 = u * u, den = b0 + b1 + b2;
+        for (c = 0; c < 3; ++c) o[c] = (b0 * P->P1[c] + b1 * P->P0[c] + b2 * P->P2[c]) / den;
+    }
+}
+
+static void fil_prof_build(sfb__fil_prof *P, const double *C, const double *P1, const double *P2, const double *E, int kind,
+                           double conic_w, double hs) {
+    double a[3], b[3], la, lb, cphi;
+    int k;
+    memcpy(P->C, C, sizeof P->C);
+    memcpy(P->P1, P1, sizeof P->P1);
+    memcpy(P->P2, P2, sizeof P->P2);
+    memcpy(P->E, E, sizeof P->E);
+    fil_sub(P1, C, a);
+    fil_sub(P2, C, b);
+    la = fil_len(a);
+    lb = fil_len(b);
+    P->r = 0.5 * (la + lb);
+    cphi = (la > 0 && lb > 0) ? fil_dot(a, b) / (la * lb) : 1.0;
+    cphi = cphi > 1 ? 1 : cphi < -1 ? -1 : cphi;
+    if (1.0 + cphi > 1e-9) {
+        for (k = 0; k < 3; ++k) P->P0[k] = C[k] + (a[k] + b[k]) / (1.0 + cphi);
+        P->w = sqrt(0.5 * (1.0 + cphi)); /* cos(phi / 2) */
+    } else { /* half a turn: no corner to round; a straight profile */
+        fil_lerp(P1, P2, 0.5, P->P0);
+        P->w = 1.0;
+    }
+    if (kind == SFB_FILLET_CONIC && conic_w > 0.0) P->w = conic_w;
+    P->L1 = fil_dist(P1, E);
+    P->L2 = fil_dist(P2, E);
+    P->acc[0] = 0.0;
+    for (k = 0; k <= SFB__FIL_TAB; ++k) {
+        fil_prof_eval(P, kind, hs, (double)k / SFB__FIL_TAB, P->T[k]);
+        if (k) P->acc[k] = P->acc[k - 1] + fil_dist(P->T[k - 1], P->T[k]);
+    }
+    if (P->acc[SFB__FIL_TAB] > 0.0)
+        for (k = 1; k <= SFB__FIL_TAB; ++k) P->acc[k] /= P->acc[SFB__FIL_TAB];
+}
+
+/* The profile's point at arc-length fraction a in [0,1]. The table only finds the parameter: the
+ * point is evaluated on the curve itself, so it lies on the exact arc or conic. */
+static void fil_prof_at(const sfb__fil_prof *P, int kind, double hs, double a, double *o) {
+    int lo = 0, hi = SFB__FIL_TAB;
+    double u, span;
+    if (kind == SFB_FILLET_SHARPEN) { fil_prof_eval(P, kind, hs, a, o); return; }
+    a = a < 0 ? 0 : a > 1 ? 1 : a;
+    while (hi - lo > 1) {
+        const int mid = (lo + hi) / 2;
+        if (P->acc[mid] <= a) lo = mid; else hi = mid;
+    }
+    span = P->acc[hi] - P->acc[lo];
+    u = (lo + (span > 0 ? (a - P->acc[lo]) / span : 0.0)) / SFB__FIL_TAB;
+    fil_prof_eval(P, kind, hs, u, o);
+}
+
+/* Distance from q to profile P's curve (its table, refined around the nearest piece). */
+static double fil_prof_distance(const sfb__fil_prof *P, int kind, double hs, const double *q) {
+    double best = HUGE_VAL;
+    int k, bk = 0;
+    if (kind == SFB_FILLET_ARC) return fabs(fil_dist(q, P->C) - P->r);
+    for (k = 0; k < SFB__FIL_TAB; ++k) {
+        const double t = fil_seg_param(q, P->T[k], P->T[k + 1]);
+        double x[3], d;
+        fil_lerp(P->T[k], P->T[k + 1], t, x);
+        d = fil_dist(x, q);
+        if (d < best) { best = d; bk = k; }
+    }
+    if (kind != SFB_FILLET_SHARPEN) { /* a finer look on the nearest two pieces */
+        const double u0 = (bk > 0 ? bk - 1 : 0) / (double)SFB__FIL_TAB, u1 = (bk + 2 < SFB__FIL_TAB ? bk + 2 : SFB__FIL_TAB) / (double)SFB__FIL_TAB;
+        double prev[3], cur[3];
+        fil_prof_eval(P, kind, hs, u0, prev);
+        for (k = 1; k <= 64; ++k) {
+            double t, x[3], d;
+            fil_prof_eval(P, kind, hs, u0 + (u1 - u0) * k / 64.0, cur);
+            t = fil_seg_param(q, prev, cur);
+            fil_lerp(prev, cur, t, x);
+            d = fil_dist(x, q);
+            if (d < best) best = d;
+            memcpy(prev, cur, sizeof cur);
+        }
+    }
+    return best;
+}
+
+/* ---- spine sampling (seed 4.1) ---- */
+static void fil_point_at(const double *pts, const double *cum, int n, int closed, double s, double *o) {
+    const int segs = closed ? n : n - 1;
+    int lo = 0, hi = segs;
+    double len;
+    if (s <= 0) { memcpy(o, pts, 3 * sizeof(double)); return; }
+    while (hi - lo > 1) {
+        const int mid = (lo + hi) / 2;
+        if (cum[mid] <= s) lo = mid; else hi = mid;
+    }
+    len = cum[lo + 1] - cum[lo];
+    fil_lerp(pts + 3 * (size_t)lo, pts + 3 * (size_t)((lo + 1) % n), len > 0 ? (s - cum[lo]) / len : 0.0, o);
+}
+
+/* Chord height of the spine between arc lengths s0 < s1 over the chord's length. */
+static double fil_chord_ratio(const double *pts, const double *cum, int n, int closed, double s0, double s1) {
+    double a[3], b[3], ab[3], l, h = 0.0;
+    int i;
+    fil_point_at(pts, cum, n, closed, s0, a);
+    fil_point_at(pts, cum, n, closed, s1, b);
+    fil_sub(b, a, ab);
+    l = fil_len(ab);
+    if (!(l > 0)) return 0.0;
+    for (i = 0; i < (closed ? n : n - 1); ++i)
+        if (cum[i] > s0 && cum[i] < s1) {
+            const double t = fil_seg_param(pts + 3 * (size_t)i, a, b);
+            double x[3];
+            fil_lerp(a, b, t, x);
+            if (fil_dist(x, pts + 3 * (size_t)i) > h) h = fil_dist(x, pts + 3 * (size_t)i);
+        }
+    return h / l;
+}
+
+typedef struct sfb__fil_samples {
+    sfb_context *ctx;
+    const double *pts, *cum;
+    int n, closed;
+    double ratio, min_len;
+    double *s;
+    int cnt, cap, failed;
+} sfb__fil_samples;
+
+static void fil_sample_push(sfb__fil_samples *S, double v) {
+    if (S->failed) return;
+    if (S->cnt == S->cap) {
+        const int cap = S->cap ? 2 * S->cap : 128;
+        double *ns = (double *)sfb__realloc(S->ctx, S->s, (size_t)cap * sizeof(double));
+        if (!ns) { S->failed = 1; return; }
+        S->s = ns;
+        S->cap = cap;
+    }
+    S->s[S->cnt++] = v;
+}
+
+/* Halves [a, b] while its chord ratio exceeds the threshold (at most 12 times), pushing the
+ * inner sample arc lengths in order. */
+static void fil_sample_refine(sfb__fil_samples *S, double a, double b, int depth) {
+    double m;
+    if (depth >= 12 || b - a <= S->min_len || fil_chord_ratio(S->pts, S->cum, S->n, S->closed, a, b) <= S->ratio) return;
+    m = 0.5 * (a + b);
+    fil_sample_refine(S, a, m, depth + 1);
+    fil_sample_push(S, m);
+    fil_sample_refine(S, m, b, depth + 1);
+}
+
+/* Sample arc lengths: `want` by arc length, then intervals halved while their chord height over
+ * chord length exceeds `ratio`. Closed spines: samples in [0, L), the last joins the first. */
+static sfb_result fil_sample(sfb_context *ctx, const double *pts, const double *cum, int n, int closed, int want, double ratio,
+                             double **out, int *out_n) {
+    const double L = cum[closed ? n : n - 1];
+    const int intervals = closed ? want : want - 1;
+    sfb__fil_samples S;
+    int k;
+    memset(&S, 0, sizeof S);
+    S.ctx = ctx; S.pts = pts; S.cum = cum; S.n = n; S.closed = closed; S.ratio = ratio;
+    S.min_len = L * 1e-6;
+    for (k = 0; k < intervals; ++k) {
+        const double a = L * k / intervals, b = L * (k + 1) / intervals;
+        fil_sample_push(&S, a);
+        fil_sample_refine(&S, a, b, 0);
+    }
+    if (!closed) fil_sample_push(&S, L);
+    if (S.failed) {
+        sfb__free(ctx, S.s);
+        return sfb__oom(ctx, "the spine samples");
+    }
+    *out = S.s;
+    *out_n = S.cnt;
+    return SFB_SUCCESS;
+}
+
+/* ---- one curve: base patches, offsets, spine, samples, profiles, projection ---- */
+typedef struct sfb__fil_work {
+    int *fside;         /* nf: -1, or the side (0, 1) of a base-patch face */
+    double *vd;         /* nv: distance to the curve (-1: not computed) */
+    int *vdlist;        /* the vertices whose vd was computed */
+    int nvd;
+    int *queue;         /* nf */
+    double *nrm[2];     /* nv x 3 per side: vertex normals of that side's faces */
+    double *op[2];      /* nv x 3 per side: offset positions */
+    int *rows[2];       /* per side: the base-patch triangles (3 vertex indices each) */
+    int nrows[2];
+    unsigned char *vin; /* nv: bit 1 side 0, bit 2 side 1, bit 4 on the curve */
+    int *vlist;         /* the vertices with vin != 0 */
+    int nvlist;
+    double *ta;         /* nv x 2: a blend-region vertex's (t, a) on the sweep (vin bit 8) */
+} sfb__fil_work;
+
+static sfb_result fil_stage(sfb__fil *F, int ci, int stage, const char *name) {
+    return sfb__progress(F->ctx, (float)((ci + stage / 5.0) / (F->ncurves > 0 ? F->ncurves : 1)), name);
+}
+
+static double fil_curve_distance(const double *cp, int m, int closed, const double *p, double *foot) {
+    int seg;
+    double t, d2;
+    fil_polyline_nearest(cp, m, closed, p, &seg, &t, &d2);
+    if (foot) fil_lerp(cp + 3 * (size_t)seg, cp + 3 * (size_t)((seg + 1) % m), t, foot);
+    return sqrt(d2);
+}
+
+/* ---- the conformal map (seed 5), on the direct map's boundary ----
+ * The seed splits the cylinder-like region along a shortest path and maps it onto a rectangle with
+ * its boundary fixed there (so the region's boundary vertices are pulled onto the linkage curves).
+ * Here the region's boundary vertices (blend vertices with a neighbour outside) keep the direct
+ * map's (t, a) -- they stay where they are on the sweep -- and the inside solves the cotangent
+ * Laplace equation for t and a (the discrete conformal map: angle preserving, the seed's "inner
+ * fairness" in one step) by preconditioned conjugate gradients. A closed spine's t is periodic:
+ * instead of cutting the region, every edge carries the jump (0 or +-T) the direct map's values
+ * show across it, so the equations are those of the split region, with no vertex copied; holes and
+ * several boundary loops are just more boundary (seed 7's failure does not arise). When the
+ * cotangent map folds a triangle (negative weights on obtuse triangles) or does not solve, the
+ * symmetrised mean-value weights (positive: no fold with a convex boundary) are tried, then the
+ * direct map is kept. *used gets 1 (conformal), 2 (mean value) or 0 (direct). */
+static double fil_corner_angle(const double *p, const double *a, const double *b) {
+    double u[3], v[3], c, lu, lv;
+    fil_sub(a, p, u);
+    fil_sub(b, p, v);
+    lu = fil_len(u);
+    lv = fil_len(v);
+    if (!(lu > 0 && lv > 0)) return 0.0;
+    c = fil_dot(u, v) / (lu * lv);
+    return acos(c > 1 ? 1 : c < -1 ? -1 : c);
+}
+
+static sfb_result fil_harmonic(sfb__fil *F, sfb__fil_work *W, double T, int periodic, int *used) {
+    sfb_context *ctx = F->ctx;
+    const sfb__level *l = F->l;
+    int *mv = NULL, *inner = NULL, *rowi = NULL, *coli = NULL, *full = NULL;
+    double *val = NULL, *x = NULL, *b = NULL, *sol = NULL;
+    int n = 0, ni = 0, nfull = 0, i, k, pass, f;
+    size_t cap, nt;
+    sfb_result res = SFB_SUCCESS;
+    *used = 0;
+    mv = (int *)sfb__alloc(ctx, ((size_t)W->nvlist + 1) * sizeof(int));
+    if (!mv) { res = sfb__oom(ctx, "the conformal map"); goto done; }
+    /* local ids: blend vertices; inner ones (every face around them all blend) are the unknowns */
+    for (i = 0; i < W->nvlist; ++i)
+        if (W->vin[W->vlist[i]] & 8) mv[n++] = W->vlist[i];
+    if (n == 0) goto done;
+    inner = (int *)sfb__alloc(ctx, (size_t)n * sizeof(int));
+    full = (int *)sfb__alloc(ctx, ((size_t)l->nf + 1) * sizeof(int));
+    if (!inner || !full) { res = sfb__oom(ctx, "the conformal map"); goto done; }
+    for (i = 0; i < n; ++i) {
+        const int v = mv[i];
+        int ok = 1, j;
+        for (j = l->vf_off[v]; j < l->vf_off[v + 1] && ok; ++j) {
+            const int g = l->vf[j];
+            for (k = 0; k < 3; ++k) ok &= (W->vin[F->tri[3 * g + k]] & 8) != 0;
+        }
+        if (l->vf_off[v + 1] == l->vf_off[v]) ok = 0;
+        /* a boundary vertex of the mesh itself stays where the direct map puts it */
+        for (j = l->ve_off[v]; j < l->ve_off[v + 1] && ok; ++j) ok &= l->ef_off[l->ve[j] + 1] - l->ef_off[l->ve[j]] == 2;
+        inner[i] = ok ? ni++ : -1;
+    }
+    if (ni == 0) goto done;
+    /* the faces with three blend vertices (each once: found from its smallest local vertex) */
+    for (i = 0; i < n; ++i) {
+        const int v = mv[i];
+        int j;
+        for (j = l->vf_off[v]; j < l->vf_off[v + 1]; ++j) {
+            const int g = l->vf[j];
+            int all = 1, lowest = 1;
+            for (k = 0; k < 3; ++k) {
+                const int u = F->tri[3 * g + k];
+                all &= (W->vin[u] & 8) != 0;
+                if (u < v) lowest = 0;
+            }
+            if (all && lowest) full[nfull++] = g;
+        }
+    }
+    cap = (size_t)nfull * 12 + 16;
+    rowi = (int *)sfb__alloc(ctx, cap * sizeof(int));
+    coli = (int *)sfb__alloc(ctx, cap * sizeof(int));
+    val = (double *)sfb__alloc(ctx, cap * sizeof(double));
+    x = (double *)sfb__alloc(ctx, (size_t)ni * 2 * sizeof(double));
+    b = (double *)sfb__alloc(ctx, (size_t)ni * 2 * sizeof(double));
+    sol = (double *)sfb__alloc(ctx, (size_t)n * 2 * sizeof(double));
+    if (!rowi || !coli || !val || !x || !b || !sol) { res = sfb__oom(ctx, "the conformal map"); goto done; }
+    /* a blend vertex's local index, kept in vd (the base patches are found: vd is free now; reset below) */
+    for (i = 0; i < n; ++i) W->vd[mv[i]] = (double)i;
+    for (pass = 1; pass <= 2 && *used == 0; ++pass) {
+        sfb__sparse A;
+        int fold = 0, comp, it;
+        double resid, orient = 0.0;
+        memset(&A, 0, sizeof A);
+        nt = 0;
+        for (i = 0; i < 2 * ni; ++i) b[i] = 0.0;
+        /* edge weights per face corner, symmetric */
+        for (k = 0; k < nfull; ++k) {
+            const int g = full[k];
+            int c;
+            for (c = 0; c < 3; ++c) {
+                const int vi = F->tri[3 * g + c], vj = F->tri[3 * g + (c + 1) % 3], vk = F->tri[3 * g + (c + 2) % 3];
+                const double *pi = F->pos + 3 * (size_t)vi, *pj = F->pos + 3 * (size_t)vj, *pk = F->pos + 3 * (size_t)vk;
+                const int li = (int)W->vd[vi], lj = (int)W->vd[vj];
+                double w;
+                if (pass == 1) { /* cot of the angle at k, for edge i-j */
+                    const double ang = fil_corner_angle(pk, pi, pj), sn = sin(ang);
+                    w = sn > 1e-12 ? 0.5 * cos(ang) / sn : 0.0;
+                } else { /* mean value: tan(half the angle at i) / |ij| + tan(half the angle at j) / |ij|, halved */
+                    const double ai = fil_corner_angle(pi, pj, pk), aj = fil_corner_angle(pj, pk, pi), len = fil_dist(pi, pj);
+                    w = len > 0 ? 0.5 * (tan(0.5 * ai) + tan(0.5 * aj)) / len : 0.0;
+                }
+                /* row of each inner endpoint: diagonal +w, the other -w (inner) or into b (boundary) */
+                for (comp = 0; comp < 2; ++comp) {
+                    const int a_ = comp ? lj : li, o_ = comp ? li : lj, ia = inner[a_], io = inner[o_];
+                    const int va = mv[a_], vo = mv[o_];
+                    double jump;
+                    if (ia < 0) continue;
+                    /* t_o as seen from a: t_o + jump, the jump making the difference smallest */
+                    jump = 0.0;
+                    if (periodic && T > 0) {
+                        const double dd = W->ta[2 * (size_t)vo] - W->ta[2 * (size_t)va];
+                        jump = dd > 0.5 * T ? -T : dd < -0.5 * T ? T : 0.0;
+                    }
+                    rowi[nt] = ia; coli[nt] = ia; val[nt] = w; nt++;
+                    if (io >= 0) { rowi[nt] = ia; coli[nt] = io; val[nt] = -w; nt++; }
+                    else {
+                        b[2 * (size_t)ia] += w * W->ta[2 * (size_t)vo];
+                        b[2 * (size_t)ia + 1] += w * W->ta[2 * (size_t)vo + 1];
+                    }
+                    b[2 * (size_t)ia] += w * jump;
+                }
+            }
+        }
+        res = sfb__sparse_from_triplets(ctx, ni, (int)nt, rowi, coli, val, &A);
+        if (res != SFB_SUCCESS) goto done;
+        for (comp = 0; comp < 2 && !fold; ++comp) {
+            double *bb = (double *)sfb__alloc(ctx, (size_t)ni * sizeof(double)), *xx = (double *)sfb__alloc(ctx, (size_t)ni * sizeof(double));
+            sfb_result cr;
+            if (!bb || !xx) { sfb__free(ctx, bb); sfb__free(ctx, xx); sfb__sparse_free(ctx, &A); res = sfb__oom(ctx, "the conformal map"); goto done; }
+            for (i = 0; i < n; ++i)
+                if (inner[i] >= 0) { bb[inner[i]] = b[2 * (size_t)inner[i] + comp]; xx[inner[i]] = W->ta[2 * (size_t)mv[i] + comp]; }
+            cr = sfb__sparse_cg(ctx, &A, bb, xx, 1e-10, 4 * ni + 200, &it, &resid);
+            if (cr != SFB_SUCCESS) fold = 1; /* not positive definite (cotangent weights) or no convergence */
+            for (i = 0; i < ni; ++i) x[2 * (size_t)i + comp] = xx[i];
+            sfb__free(ctx, bb);
+            sfb__free(ctx, xx);
+        }
+        sfb__sparse_free(ctx, &A);
+        if (fold) { sfb_clear_error(ctx); continue; }
+        /* the solution with the boundary's own values; folds: a face whose (t, a) orientation
+         * disagrees with the direct map's prevailing one */
+        for (i = 0; i < n; ++i) {
+            const int q = inner[i];
+            sol[2 * (size_t)i] = q >= 0 ? x[2 * (size_t)q] : W->ta[2 * (size_t)mv[i]];
+            sol[2 * (size_t)i + 1] = q >= 0 ? x[2 * (size_t)q + 1] : W->ta[2 * (size_t)mv[i] + 1];
+        }
+        for (f = 0; f < 2 && !fold; ++f) /* f = 0: the direct map's orientation; f = 1: the solution's */
+            for (k = 0; k < nfull; ++k) {
+                const int g = full[k];
+                double uv[3][2], ar;
+                int c;
+                for (c = 0; c < 3; ++c) {
+                    const int li = (int)W->vd[F->tri[3 * g + c]];
+                    uv[c][0] = f ? sol[2 * (size_t)li] : W->ta[2 * (size_t)mv[li]];
+                    uv[c][1] = f ? sol[2 * (size_t)li + 1] : W->ta[2 * (size_t)mv[li] + 1];
+                    if (periodic && T > 0 && c > 0) {
+                        const double dd = uv[c][0] - uv[0][0];
+                        uv[c][0] += dd > 0.5 * T ? -T : dd < -0.5 * T ? T : 0.0;
+                    }
+                }
+                ar = (uv[1][0] - uv[0][0]) * (uv[2][1] - uv[0][1]) - (uv[2][0] - uv[0][0]) * (uv[1][1] - uv[0][1]);
+                if (f == 0) orient += ar;
+                else if (ar * orient <= 0.0) { fold = 1; break; }
+            }
+        if (fold) continue;
+        for (i = 0; i < n; ++i) {
+            W->ta[2 * (size_t)mv[i]] = sol[2 * (size_t)i];
+            W->ta[2 * (size_t)mv[i] + 1] = sol[2 * (size_t)i + 1];
+        }
+        *used = pass;
+    }
+done:
+    for (i = 0; i < n; ++i) W->vd[mv[i]] = -1.0;
+    sfb__free(ctx, mv); sfb__free(ctx, inner); sfb__free(ctx, full);
+    sfb__free(ctx, rowi); sfb__free(ctx, coli); sfb__free(ctx, val); sfb__free(ctx, x); sfb__free(ctx, b); sfb__free(ctx, sol);
+    return res;
+}
+
+static sfb_result fil_one(sfb__fil *F, sfb__fil_work *W, const sfb__fil_curve *cv, int ci, sfb_fillet_curve_report *rep) {
+    sfb_context *ctx = F->ctx;
+    const sfb__level *l = F->l;
+    const double r = cv->radius;
+    const int kind = cv->profile;
+    const double hs = F->cfg->hermite_scale;
+    const int m = cv->closed ? cv->n - 1 : cv->n; /* distinct curve points */
+    double *cp = NULL, *spine = NULL, *cum = NULL, *sarc = NULL, *C = NULL, *S = NULL;
+    sfb__fil_prof *prof = NULL, *ip = NULL;
+    sfb__aabb tree[2];
+    sfb__fil_pairs P;
+    int *cedge = NULL, nce = 0, i, k, side, qh = 0, qt = 0, ns = 0, sclosed = 0, nsamp = 0, moved = 0, convex;
+    double dmax = 0.0, d, conv = 0.0, maxdev = 0.0;
+    sfb_result res = SFB_SUCCESS;
+    memset(tree, 0, sizeof tree);
+    memset(&P, 0, sizeof P);
+    memset(rep, 0, sizeof *rep);
+    rep->closed = cv->closed;
+    rep->curve_vertices = m;
+    rep->radius = (float)r;
+    if (m < 2) return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "blending curve %d has fewer than 2 vertices", ci);
+
+    res = fil_stage(F, ci, 0, "fillet curves");
+    if (res != SFB_SUCCESS) return res;
+    cp = (double *)sfb__alloc(ctx, (size_t)m * 3 * sizeof(double));
+    cedge = (int *)sfb__alloc(ctx, (size_t)cv->n * sizeof(int));
+    if (!cp || !cedge) { res = sfb__oom(ctx, "the blending curve"); goto done; }
+    for (i = 0; i < m; ++i) memcpy(cp + 3 * (size_t)i, F->pos + 3 * (size_t)cv->v[i], 3 * sizeof(double));
+    /* curve edges, the sides' seed faces, the sharpest dihedral angle */
+    for (i = 0; i + 1 < cv->n; ++i) {
+        const int a = cv->v[i], b = cv->v[i + 1], e = fil_edge_of(l, a, b);
+        int f0, f1, j;
+        if (e < 0 || l->ef_off[e + 1] - l->ef_off[e] != 2) continue; /* checked for callers' curves */
+        cedge[nce++] = e;
+        F->emark[e] = 1;
+        f0 = l->ef[l->ef_off[e]];
+        f1 = l->ef[l->ef_off[e] + 1];
+        for (j = 0; j < 3; ++j) /* side 0 holds a -> b */
+            if (F->tri[3 * f1 + j] == a && F->tri[3 * f1 + (j + 1) % 3] == b) { const int t = f0; f0 = f1; f1 = t; break; }
+        if (fil_dihedral(F, e) > dmax) dmax = fil_dihedral(F, e);
+        if (W->fside[f0] < 0) { W->fside[f0] = 0; W->queue[qt++] = f0; }
+        if (W->fside[f1] < 0) { W->fside[f1] = 1; W->queue[qt++] = f1; }
+        /* convexity: side 1 below side 0's plane (and side 0 below side 1's) */
+        for (j = 0; j < 3; ++j) {
+            const int o1 = F->tri[3 * f1 + j], o0 = F->tri[3 * f0 + j];
+            double dv[3];
+            if (o1 != a && o1 != b) { fil_sub(F->pos + 3 * (size_t)o1, F->pos + 3 * (size_t)a, dv); conv += fil_dot(dv, F->fn + 3 * (size_t)f0); }
+            if (o0 != a && o0 != b) { fil_sub(F->pos + 3 * (size_t)o0, F->pos + 3 * (size_t)a, dv); conv += fil_dot(dv, F->fn + 3 * (size_t)f1); }
+        }
+    }
+    convex = conv < 0.0;
+    rep->convex = convex;
+    if (dmax > 170.0 * SFB__PI / 180.0) dmax = 170.0 * SFB__PI / 180.0;
+    d = (F->cfg->alpha > 0.0f ? F->cfg->alpha : 1.75) * r * (tan(0.5 * dmax) > 1.0 ? tan(0.5 * dmax) : 1.0);
+
+    /* base patches: both sides grow breadth first together through faces within d */
+    while (qh < qt) {
+        const int f = W->queue[qh++];
+        for (k = 0; k < 3; ++k) {
+            const int e = l->fe[l->fv_off[f] + k];
+            int j;
+            if (F->emark[e]) continue;
+            for (j = l->ef_off[e]; j < l->ef_off[e + 1]; ++j) {
+                const int g = l->ef[j];
+                int c, near_ = 0;
+                if (W->fside[g] >= 0) continue;
+                for (c = 0; c < 3; ++c) {
+                    const int v = F->tri[3 * g + c];
+                    if (W->vd[v] < 0) {
+                        W->vd[v] = fil_curve_distance(cp, m, cv->closed, F->pos + 3 * (size_t)v, NULL);
+                        W->vdlist[W->nvd++] = v;
+                    }
+                    if (W->vd[v] < d) near_ = 1;
+                }
+                if (!near_) continue;
+                W->fside[g] = W->fside[f];
+                W->queue[qt++] = g;
+            }
+        }
+    }
+    /* per side: rows, vertex normals (angle weighted over that side's faces), offsets */
+    for (side = 0; side < 2; ++side) {
+        W->rows[side] = (int *)sfb__alloc(ctx, ((size_t)qt + 1) * 3 * sizeof(int));
+        if (!W->rows[side]) { res = sfb__oom(ctx, "the base patches"); goto done; }
+        W->nrows[side] = 0;
+    }
+    for (i = 0; i < qt; ++i) {
+        const int f = W->queue[i], s = W->fside[f];
+        int c;
+        memcpy(W->rows[s] + 3 * (size_t)W->nrows[s], F->tri + 3 * (size_t)f, 3 * sizeof(int));
+        W->nrows[s]++;
+        for (c = 0; c < 3; ++c) {
+            const int v = F->tri[3 * f + c];
+            const double *p = F->pos + 3 * (size_t)v, *pa = F->pos + 3 * (size_t)F->tri[3 * f + (c + 1) % 3],
+                         *pb = F->pos + 3 * (size_t)F->tri[3 * f + (c + 2) % 3];
+            double ea[3], eb[3], la, lb, cang, ang;
+            fil_sub(pa, p, ea); fil_sub(pb, p, eb);
+            la = fil_len(ea); lb = fil_len(eb);
+            cang = (la > 0 && lb > 0) ? fil_dot(ea, eb) / (la * lb) : 1.0;
+            ang = acos(cang > 1 ? 1 : cang < -1 ? -1 : cang);
+            if (!W->vin[v]) W->vlist[W->nvlist++] = v;
+            W->vin[v] |= (unsigned char)(1 << s);
+            W->nrm[s][3 * (size_t)v] += ang * F->fn[3 * (size_t)f];
+            W->nrm[s][3 * (size_t)v + 1] += ang * F->fn[3 * (size_t)f + 1];
+            W->nrm[s][3 * (size_t)v + 2] += ang * F->fn[3 * (size_t)f + 2];
+        }
+    }
+    for (i = 0; i < cv->n; ++i) W->vin[cv->v[i]] |= 4;
+    for (i = 0; i < W->nvlist; ++i) {
+        const int v = W->vlist[i];
+        for (side = 0; side < 2; ++side) {
+            double *n = W->nrm[side] + 3 * (size_t)v, ln = fil_len(n), *o = W->op[side] + 3 * (size_t)v;
+            const double sg = convex ? -r : r;
+            if (ln > 0) { n[0] /= ln; n[1] /= ln; n[2] /= ln; }
+            for (k = 0; k < 3; ++k) o[k] = F->pos[3 * (size_t)v + k] + sg * n[k];
+        }
+    }
+
+    /* CSC: the offset patches' intersection */
+    res = fil_stage(F, ci, 1, "fillet spine");
+    if (res != SFB_SUCCESS) goto done;
+    for (side = 0; side < 2; ++side) {
+        res = sfb__aabb_build(ctx, W->op[side], W->rows[side], NULL, W->nrows[side], &tree[side]);
+        if (res != SFB_SUCCESS) goto done;
+    }
+    P.F = F;
+    P.op0 = W->op[0]; P.op1 = W->op[1];
+    P.t0 = W->rows[0]; P.t1 = W->rows[1];
+    sfb__aabb_pairs(&tree[0], &tree[1], 1e-9 * F->scale, fil_pair_cb, &P);
+    if (P.failed) { res = sfb__oom(ctx, "the offset patches' intersection"); goto done; }
+    res = fil_chain(ctx, P.segs, P.n, 1e-8 * (F->scale + r), cv->closed, &spine, &ns, &sclosed);
+    if (res != SFB_SUCCESS) goto done;
+    if (ns < 2) {
+        res = sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_VERTEX, cv->v[0],
+                         "blending curve %d (from vertex %d): the offset patches at radius %g do not meet -- the radius is too large "
+                         "for the base patches (faces within %g of the curve) or the feature is too flat", ci, cv->v[0], r, d);
+        goto done;
+    }
+    if (!cv->closed && !sclosed) {
+        /* orient the spine like the curve, then clip it to the planes through the curve's ends */
+        double t0[3], t1[3], a[3], b[3];
+        int lo = 0, hi = ns - 1;
+        fil_sub(spine + 3 * (size_t)(ns - 1), spine, a);
+        fil_sub(cp + 3 * (size_t)(m - 1), cp, b);
+        if (fil_dot(a, b) < 0)
+            for (i = 0; i < ns / 2; ++i)
+                for (k = 0; k < 3; ++k) {
+                    const double t = spine[3 * (size_t)i + k];
+                    spine[3 * (size_t)i + k] = spine[3 * (size_t)(ns - 1 - i) + k];
+                    spine[3 * (size_t)(ns - 1 - i) + k] = t;
+                }
+        fil_sub(cp + 3, cp, t0);                                              /* into the curve at its start */
+        fil_sub(cp + 3 * (size_t)(m - 1), cp + 3 * (size_t)(m - 2), t1);       /* out of it at its end */
+        while (lo < ns - 1) {
+            fil_sub(spine + 3 * (size_t)(lo + 1), cp, a);
+            if (fil_dot(a, t0) > 0) break;
+            lo++;
+        }
+        while (hi > lo) {
+            fil_sub(spine + 3 * (size_t)(hi - 1), cp + 3 * (size_t)(m - 1), a);
+            if (fil_dot(a, t1) < 0) break;
+            hi--;
+        }
+        /* points lo and hi may lie beyond the planes: move them onto them */
+        if (hi > lo) {
+            double da, db;
+            fil_sub(spine + 3 * (size_t)lo, cp, a); da = fil_dot(a, t0);
+            fil_sub(spine + 3 * (size_t)(lo + 1), cp, b); db = fil_dot(b, t0);
+            if (da < 0 && db > da) fil_lerp(spine + 3 * (size_t)lo, spine + 3 * (size_t)(lo + 1), da / (da - db), spine + 3 * (size_t)lo);
+            fil_sub(spine + 3 * (size_t)hi, cp + 3 * (size_t)(m - 1), a); da = fil_dot(a, t1);
+            fil_sub(spine + 3 * (size_t)(hi - 1), cp + 3 * (size_t)(m - 1), b); db = fil_dot(b, t1);
+            if (da > 0 && db < da) fil_lerp(spine + 3 * (size_t)hi, spine + 3 * (size_t)(hi - 1), da / (da - db), spine + 3 * (size_t)hi);
+            memmove(spine, spine + 3 * (size_t)lo, (size_t)(hi - lo + 1) * 3 * sizeof(double));
+            ns = hi - lo + 1;
+        }
+    }
+    {
+        /* spine loops (seed 4.3): pieces closer than 1.5 mean spine steps (at most r/10) while apart
+         * along the spine by more than r/2 */
+        double mean = 0.0, tol;
+        for (i = 0; i + 1 < ns; ++i) mean += fil_dist(spine + 3 * (size_t)i, spine + 3 * (size_t)(i + 1));
+        mean /= (ns > 1 ? ns - 1 : 1);
+        tol = 1.5 * mean < 0.1 * r ? 1.5 * mean : 0.1 * r;
+        if (getenv("SFB_DEBUG_SPINE")) { FILE *df = fopen("/tmp/stub/spine_raw.txt", "w"); for (i = 0; i < ns; ++i) fprintf(df, "%g %g %g\n", spine[3 * i], spine[3 * i + 1], spine[3 * i + 2]); fclose(df); }
+        rep->self_intersections = fil_spine_untangle(ctx, &spine, &ns, sclosed, tol, 0.25 * r);
+        if (getenv("SFB_DEBUG_SPINE")) { FILE *df = fopen(getenv("SFB_DEBUG_SPINE"), "w"); for (i = 0; i < ns; ++i) fprintf(df, "%g %g %g\n", spine[3 * i], spine[3 * i + 1], spine[3 * i + 2]); fclose(df); fprintf(stderr, "tol %g ns %d\n", tol, ns); }
+    }
+    cum = (double *)sfb__alloc(ctx, ((size_t)ns + 1) * sizeof(double));
+    if (!cum) { res = sfb__oom(ctx, "the spine"); goto done; }
+    cum[0] = 0.0;
+    for (i = 1; i <= ns; ++i)
+        cum[i] = cum[i - 1] + (i < ns ? fil_dist(spine + 3 * (size_t)(i - 1), spine + 3 * (size_t)i)
+                                      : (sclosed ? fil_dist(spine + 3 * (size_t)(ns - 1), spine) : 0.0));
+    rep->spine_length = (float)cum[sclosed ? ns : ns - 1];
+
+    /* virtual surface: samples and their profiles */
+    res = fil_stage(F, ci, 2, "fillet surface");
+    if (res != SFB_SUCCESS) goto done;
+    res = fil_sample(ctx, spine, cum, ns, sclosed, F->cfg->samples > 0 ? F->cfg->samples : 40,
+                     F->cfg->chord_ratio > 0.0f ? F->cfg->chord_ratio : 0.002, &sarc, &nsamp);
+    if (res != SFB_SUCCESS) goto done;
+    rep->samples = nsamp;
+    C = (double *)sfb__alloc(ctx, (size_t)nsamp * 3 * sizeof(double));
+    prof = (sfb__fil_prof *)sfb__alloc(ctx, (size_t)nsamp * sizeof *prof);
+    if (!C || !prof) { res = sfb__oom(ctx, "the sweep's profiles"); goto done; }
+    for (i = 0; i < nsamp; ++i) {
+        double link[2][3], E[3], bary[3];
+        fil_point_at(spine, cum, ns, sclosed, sarc[i], C + 3 * (size_t)i);
+        for (side = 0; side < 2; ++side) {
+            const int row = sfb__aabb_nearest(&tree[side], W->op[side], W->rows[side], NULL, C + 3 * (size_t)i, NULL, NULL, bary);
+            const int *t = W->rows[side] + 3 * (size_t)(row < 0 ? 0 : row);
+            for (k = 0; k < 3; ++k)
+                link[side][k] = bary[0] * F->pos[3 * (size_t)t[0] + k] + bary[1] * F->pos[3 * (size_t)t[1] + k] +
+                                bary[2] * F->pos[3 * (size_t)t[2] + k];
+        }
+        fil_curve_distance(cp, m, cv->closed, C + 3 * (size_t)i, E);
+        fil_prof_build(&prof[i], C + 3 * (size_t)i, link[0], link[1], E, kind, cv->conic_w, hs);
+    }
+
+    /* map: every base-patch vertex between the linkage curves gets (t, a): t the arc length of its
+     * nearest point on the samples' polyline, a its place across */
+    res = fil_stage(F, ci, 3, "fillet map");
+    if (res != SFB_SUCCESS) goto done;
+    ip = (sfb__fil_prof *)sfb__alloc(ctx, sizeof *ip);
+    S = (double *)sfb__alloc(ctx, ((size_t)nsamp + 1) * sizeof(double));
+    if (!ip || !S) { res = sfb__oom(ctx, "the sweep's profiles"); goto done; }
+    S[0] = 0.0;
+    for (i = 1; i <= nsamp; ++i)
+        S[i] = S[i - 1] + (i < nsamp ? fil_dist(C + 3 * (size_t)(i - 1), C + 3 * (size_t)i) : sclosed ? fil_dist(C + 3 * (size_t)(nsamp - 1), C) : 0.0);
+    for (i = 0; i < W->nvlist; ++i) {
+        const int v = W->vlist[i];
+        const double *p = F->pos + 3 * (size_t)v;
+        int seg, j, vs;
+        double t, d2, E[3], L1, L2, s;
+        fil_polyline_nearest(C, nsamp, sclosed, p, &seg, &t, &d2);
+        j = (seg + 1) % nsamp;
+        if (!sclosed && ((seg == 0 && t <= 0.0) || (seg == nsamp - 2 && t >= 1.0))) {
+            /* beyond an end of an open spine: outside unless on the end plane */
+            const int e = seg == 0 && t <= 0.0 ? 0 : nsamp - 1, e2 = e == 0 ? 1 : nsamp - 2;
+            double out[3], dv[3];
+            fil_sub(C + 3 * (size_t)e, C + 3 * (size_t)e2, out);
+            fil_sub(p, C + 3 * (size_t)e, dv);
+            if (fil_dot(dv, out) > 1e-9 * fil_len(out) * (F->scale + r)) continue;
+        }
+        fil_lerp(prof[seg].E, prof[j].E, t, E);
+        L1 = prof[seg].L1 + t * (prof[j].L1 - prof[seg].L1);
+        L2 = prof[seg].L2 + t * (prof[j].L2 - prof[seg].L2);
+        if (!(L1 + L2 > 0)) continue;
+        if (W->vin[v] & 4) { s = 0.0; vs = 0; }
+        else {
+            s = fil_dist(p, E);
+            vs = (W->vin[v] & 1) ? 0 : 1;
+            if ((W->vin[v] & 3) == 3) { /* both sides (around an open chain's end): the nearer linkage point */
+                double l0[3], l1[3];
+                fil_lerp(prof[seg].P1, prof[j].P1, t, l0);
+                fil_lerp(prof[seg].P2, prof[j].P2, t, l1);
+                vs = fil_dist(p, l0) <= fil_dist(p, l1) ? 0 : 1;
+            }
+            if (s >= (vs == 0 ? L1 : L2)) continue;
+        }
+        W->ta[2 * (size_t)v] = S[seg] + t * (S[seg + 1] - S[seg]);
+        W->ta[2 * (size_t)v + 1] = vs == 0 ? (L1 - s) / (L1 + L2) : (L1 + s) / (L1 + L2);
+        W->vin[v] |= 8;
+        moved++;
+    }
+    rep->map = 0;
+    if (F->cfg->map == SFB_FILLET_MAP_CONFORMAL) {
+        res = fil_harmonic(F, W, S[sclosed ? nsamp : nsamp - 1], sclosed, &rep->map);
+        if (res != SFB_SUCCESS) goto done;
+    }
+
+    /* project: (t, a) onto the ruled surface between the two profiles around t */
+    res = fil_stage(F, ci, 4, "fillet project");
+    if (res != SFB_SUCCESS) goto done;
+    for (i = 0; i < W->nvlist; ++i) {
+        const int v = W->vlist[i];
+        const double T = S[sclosed ? nsamp : nsamp - 1];
+        double t = W->ta[2 * (size_t)v], a = W->ta[2 * (size_t)v + 1], th, qa[3], qb[3], np_[3], Ct[3], P1t[3], P2t[3], Et[3], dev;
+        int lo = 0, hi = sclosed ? nsamp : nsamp - 1, j;
+        if (!(W->vin[v] & 8)) continue;
+        if (sclosed) { t = fmod(t, T); if (t < 0) t += T; }
+        else t = t < 0 ? 0 : t > T ? T : t;
+        a = a < 0 ? 0 : a > 1 ? 1 : a;
+        while (hi - lo > 1) {
+            const int mid = (lo + hi) / 2;
+            if (S[mid] <= t) lo = mid; else hi = mid;
+        }
+        j = (lo + 1) % nsamp;
+        th = S[lo + 1] > S[lo] ? (t - S[lo]) / (S[lo + 1] - S[lo]) : 0.0;
+        th = th < 0 ? 0 : th > 1 ? 1 : th;
+        fil_prof_at(&prof[lo], kind, hs, a, qa);
+        fil_prof_at(&prof[j], kind, hs, a, qb);
+        fil_lerp(qa, qb, th, np_);
+        memcpy(F->npos + 3 * (size_t)v, np_, sizeof np_);
+        /* the ideal surface here: the profile built from the interpolated spine and linkage points */
+        fil_lerp(prof[lo].C, prof[j].C, th, Ct);
+        fil_lerp(prof[lo].P1, prof[j].P1, th, P1t);
+        fil_lerp(prof[lo].P2, prof[j].P2, th, P2t);
+        fil_lerp(prof[lo].E, prof[j].E, th, Et);
+        fil_prof_build(ip, Ct, P1t, P2t, Et, kind, cv->conic_w, hs);
+        if (kind == SFB_FILLET_ARC) ip->r = r; /* the ideal arc has the ball's radius */
+        dev = fil_prof_distance(ip, kind, hs, np_);
+        if (dev > maxdev) maxdev = dev;
+    }
+    for (i = 0; i < W->nvlist; ++i) {
+        const int v = W->vlist[i];
+        if (W->vin[v] & 8) memcpy(F->pos + 3 * (size_t)v, F->npos + 3 * (size_t)v, 3 * sizeof(double));
+    }
+    rep->vertices_moved = moved;
+    rep->max_deviation = (float)maxdev;
+done:
+    /* reset the work arrays for the next curve */
+    for (i = 0; i < qt; ++i) W->fside[W->queue[i]] = -1;
+    for (i = 0; i < W->nvlist; ++i) {
+        const int v = W->vlist[i];
+        int c;
+        W->vin[v] = 0;
+        for (c = 0; c < 3; ++c) W->nrm[0][3 * (size_t)v + c] = W->nrm[1][3 * (size_t)v + c] = 0.0;
+    }
+    for (i = 0; i < cv->n; ++i) W->vin[cv->v[i]] = 0;
+    W->nvlist = 0;
+    for (i = 0; i < W->nvd; ++i) W->vd[W->vdlist[i]] = -1.0;
+    W->nvd = 0;
+    for (i = 0; i < nce; ++i) F->emark[cedge[i]] = 0;
+    for (side = 0; side < 2; ++side) {
+        sfb__aabb_free(ctx, &tree[side]);
+        sfb__free(ctx, W->rows[side]);
+        W->rows[side] = NULL;
+    }
+    sfb__free(ctx, P.segs);
+    sfb__free(ctx, cp); sfb__free(ctx, cedge); sfb__free(ctx, spine); sfb__free(ctx, cum);
+    sfb__free(ctx, sarc); sfb__free(ctx, C); sfb__free(ctx, prof); sfb__free(ctx, ip); sfb__free(ctx, S);
+    return res;
+}
+
+/* ---- the API ---- */
+SFB_API sfb_fillet_config sfb_fillet_config_init(float radius) {
+    sfb_fillet_config c;
+    memset(&c, 0, sizeof c);
+    c.radius = radius;
+    return c;
+}
+
+SFB_API void sfb_fillet_report_free(sfb_fillet_report *report) {
+    if (!report) return;
+    if (report->ctx_) sfb__free(report->ctx_, report->curves);
+    memset(report, 0, sizeof *report);
+}
+
+static sfb_result fil_check(sfb_context *ctx, const sfb_mesh *mesh, const sfb_fillet_config *c) {
+    const sfb__level *l = &mesh->base;
+    int f, e;
+    if (!(c->radius > 0.0f) || !isfinite(c->radius))
+        return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, -1, "fillet radius %g is not a positive number", (double)c->radius);
+    if (!(c->angle >= 0.0f && c->angle < 180.0f))
+        return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, -1, "feature angle %g is not a number of degrees in [0, 180)", (double)c->angle);
+    if (c->profile < 0 || c->profile > SFB_FILLET_HERMITE)
+        return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, -1, "unknown fillet profile %d", c->profile);
+    if (!(c->conic_weight >= 0.0f) || !isfinite(c->conic_weight))
+        return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, -1, "conic weight %g is not a number >= 0", (double)c->conic_weight);
+    if (!(c->hermite_scale >= 0.0f) || !isfinite(c->hermite_scale))
+        return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, -1, "Hermite scale %g is not a number >= 0", (double)c->hermite_scale);
+    if (!(c->alpha == 0.0f || (c->alpha >= 1.0f && c->alpha <= 100.0f)))
+        return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, -1, "base patch factor alpha %g is not 0 or in [1, 100]", (double)c->alpha);
+    if (c->samples < 0 || c->samples == 1 || c->samples > 100000)
+        return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, -1, "spine samples %d is not 0 or in [2, 100000]", c->samples);
+    if (!(c->chord_ratio >= 0.0f && c->chord_ratio < 1.0f))
+        return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, -1, "chord ratio %g is not in [0, 1)", (double)c->chord_ratio);
+    if (c->map != SFB_FILLET_MAP_CONFORMAL && c->map != SFB_FILLET_MAP_DIRECT)
+        return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, -1, "unknown fillet map %d", c->map);
+    if (c->curve_count < 0 || (c->curve_count > 0 && !c->curves))
+        return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "curve_count %d with %s curves", c->curve_count, c->curves ? "its" : "no");
+    if (l->nf == 0) return sfb__error(ctx, SFB_INVALID_TOPOLOGY, SFB_ELEMENT_NONE, -1, "the mesh has no faces");
+    for (f = 0; f < l->nf; ++f)
+        if (l->fv_off[f + 1] - l->fv_off[f] != 3)
+            return sfb__error(ctx, SFB_INVALID_TOPOLOGY, SFB_ELEMENT_FACE, f, "face %d has %d vertices: fillets need a triangle mesh", f,
+                              l->fv_off[f + 1] - l->fv_off[f]);
+    for (e = 0; e < l->ne; ++e)
+        if (l->ef_off[e + 1] - l->ef_off[e] > 2)
+            return sfb__error(ctx, SFB_INVALID_TOPOLOGY, SFB_ELEMENT_EDGE, e, "edge %d (vertices %d-%d) has %d faces: the mesh is not manifold", e,
+                              l->ev[2 * e], l->ev[2 * e + 1], l->ef_off[e + 1] - l->ef_off[e]);
+    {
+        sfb_mesh_info info;
+        sfb_mesh_get_info(mesh, &info);
+        if (info.nonmanifold_vertices > 0)
+            return sfb__error(ctx, SFB_INVALID_TOPOLOGY, SFB_ELEMENT_NONE, -1, "the mesh has %d non-manifold vertices", info.nonmanifold_vertices);
+    }
+    for (e = 0; e < 3 * l->nv; ++e)
+        if (!isfinite(mesh->positions[e]))
+            return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_VERTEX, e / 3, "vertex %d is not finite", e / 3);
+    return SFB_SUCCESS;
+}
+
+SFB_API sfb_result sfb_mesh_fillet(sfb_context *ctx, const sfb_mesh *mesh, const sfb_fillet_config *config, sfb_mesh **out,
+                                   sfb_fillet_report *report) {
+    sfb__fil F;
+    sfb__fil_work W;
+    sfb_fillet_curve_report *reps = NULL;
+    float *fpos = NULL;
+    int *cvert = NULL, i, nc = 0;
+    float *csharp = NULL;
+    sfb_result res;
+    double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL}, need;
+    if (out) *out = NULL;
+    if (report) memset(report, 0, sizeof *report);
+    if (!ctx || !mesh || !config || !out) return ctx ? sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "sfb_mesh_fillet: NULL argument") : SFB_INVALID_ARGS;
+    res = fil_check(ctx, mesh, config);
+    if (res != SFB_SUCCESS) return res;
+    memset(&F, 0, sizeof F);
+    memset(&W, 0, sizeof W);
+    F.ctx = ctx;
+    F.cfg = config;
+    F.l = &mesh->base;
+    F.nv = mesh->base.nv;
+    F.nf = mesh->base.nf;
+    F.tri = mesh->base.fv;
+    /* the memory budget, before the work: per vertex 11 doubles x 3 and some ints, per face a few */
+    need = (double)F.nv * (12.0 * 3 * sizeof(double) + 4 * sizeof(int) + 2) + (double)F.nf * (3 * sizeof(double) + 12 * sizeof(int)) +
+           (double)mesh->base.ne;
+    if (need > (double)ctx->budget - (double)ctx->live_bytes)
+        return sfb__error(ctx, SFB_LIMIT_EXCEEDED, SFB_ELEMENT_NONE, -1,
+                          "filleting a mesh of %d vertices and %d faces needs about %.0f MB, over the memory budget (%zu bytes, %zu in use)",
+                          F.nv, F.nf, need / 1048576.0, ctx->budget, ctx->live_bytes);
+    F.pos = (double *)sfb__alloc(ctx, ((size_t)F.nv + 1) * 3 * sizeof(double));
+    F.npos = (double *)sfb__alloc(ctx, ((size_t)F.nv + 1) * 3 * sizeof(double));
+    F.fn = (double *)sfb__alloc(ctx, ((size_t)F.nf + 1) * 3 * sizeof(double));
+    F.emark = (unsigned char *)sfb__calloc(ctx, (size_t)mesh->base.ne + 1, 1);
+    W.fside = (int *)sfb__alloc(ctx, ((size_t)F.nf + 1) * sizeof(int));
+    W.queue = (int *)sfb__alloc(ctx, ((size_t)F.nf + 1) * sizeof(int));
+    W.vd = (double *)sfb__alloc(ctx, ((size_t)F.nv + 1) * sizeof(double));
+    W.vdlist = (int *)sfb__alloc(ctx, ((size_t)F.nv + 1) * sizeof(int));
+    W.vlist = (int *)sfb__alloc(ctx, ((size_t)F.nv + 1) * sizeof(int));
+    W.vin = (unsigned char *)sfb__calloc(ctx, (size_t)F.nv + 1, 1);
+    W.ta = (double *)sfb__alloc(ctx, ((size_t)F.nv + 1) * 2 * sizeof(double));
+    for (i = 0; i < 2; ++i) {
+        W.nrm[i] = (double *)sfb__calloc(ctx, ((size_t)F.nv + 1) * 3, sizeof(double));
+        W.op[i] = (double *)sfb__alloc(ctx, ((size_t)F.nv + 1) * 3 * sizeof(double));
+    }
+    if (!F.pos || !F.npos || !F.fn || !F.emark || !W.fside || !W.queue || !W.vd || !W.vdlist || !W.vlist || !W.vin || !W.ta || !W.nrm[0] ||
+        !W.nrm[1] || !W.op[0] || !W.op[1]) {
+        res = sfb__oom(ctx, "the fillet's work arrays");
+        goto done;
+    }
+    for (i = 0; i < 3 * F.nv; ++i) {
+        F.pos[i] = mesh->positions[i];
+        if (F.pos[i] < lo[i % 3]) lo[i % 3] = F.pos[i];
+        if (F.pos[i] > hi[i % 3]) hi[i % 3] = F.pos[i];
+    }
+    F.scale = F.nv ? sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) + (hi[2] - lo[2]) * (hi[2] - lo[2])) : 1.0;
+    for (i = 0; i < F.nf; ++i) W.fside[i] = -1;
+    for (i = 0; i < F.nv; ++i) W.vd[i] = -1.0;
+    fil_face_normals(&F);
+    res = config->curves ? fil_curves_from_caller(&F) : fil_curves_from_angle(&F);
+    if (res != SFB_SUCCESS) goto done;
+    reps = (sfb_fillet_curve_report *)sfb__calloc(ctx, (size_t)F.ncurves + 1, sizeof *reps);
+    if (!reps) { res = sfb__oom(ctx, "the fillet report"); goto done; }
+    for (i = 0; i < F.ncurves; ++i) {
+        res = fil_one(&F, &W, &F.curves[i], i, &reps[i]);
+        if (res != SFB_SUCCESS) goto done;
+        fil_face_normals(&F);
+    }
+    res = sfb__progress(ctx, 1.0f, "fillet project");
+    if (res != SFB_SUCCESS) goto done;
+    {
+        /* the output: the input's arrays with the new positions; filleted edges lose their crease tags */
+        sfb_mesh_desc d;
+        int c;
+        sfb_mesh_get_desc(mesh, &d);
+        fpos = (float *)sfb__alloc(ctx, ((size_t)F.nv + 1) * 3 * sizeof(float));
+        cvert = (int *)sfb__alloc(ctx, ((size_t)d.crease_count + 1) * 2 * sizeof(int));
+        csharp = (float *)sfb__alloc(ctx, ((size_t)d.crease_count + 1) * sizeof(float));
+        if (!fpos || !cvert || !csharp) { res = sfb__oom(ctx, "the filleted mesh"); goto done; }
+        for (i = 0; i < 3 * F.nv; ++i) fpos[i] = (float)F.pos[i];
+        for (c = 0; c < F.ncurves; ++c)
+            for (i = 0; i + 1 < F.curves[c].n; ++i) {
+                const int e = fil_edge_of(F.l, F.curves[c].v[i], F.curves[c].v[i + 1]);
+                if (e >= 0) F.emark[e] = 1;
+            }
+        for (i = 0; i < d.crease_count; ++i) {
+            const int e = fil_edge_of(F.l, d.crease_vertices[2 * i], d.crease_vertices[2 * i + 1]);
+            if (e >= 0 && F.emark[e]) continue;
+            cvert[2 * nc] = d.crease_vertices[2 * i];
+            cvert[2 * nc + 1] = d.crease_vertices[2 * i + 1];
+            csharp[nc++] = d.crease_sharpness[i];
+        }
+        d.positions = fpos;
+        d.crease_count = nc;
+        d.crease_vertices = cvert;
+        d.crease_sharpness = csharp;
+        res = sfb_mesh_create(ctx, &d, out);
+        if (res != SFB_SUCCESS) goto done;
+    }
+    if (report) {
+        report->curve_count = F.ncurves;
+        report->curves = reps;
+        report->ctx_ = ctx;
+        for (i = 0; i < F.ncurves; ++i) report->vertices_moved += reps[i].vertices_moved;
+        reps = NULL;
+    }
+done:
+    if (res != SFB_SUCCESS && out && *out) { sfb_mesh_destroy(*out); *out = NULL; }
+    for (i = 0; i < F.ncurves; ++i) sfb__free(ctx, F.curves[i].v);
+    sfb__free(ctx, F.curves);
+    sfb__free(ctx, reps);
+    sfb__free(ctx, F.pos); sfb__free(ctx, F.npos); sfb__free(ctx, F.fn); sfb__free(ctx, F.emark);
+    sfb__free(ctx, W.fside); sfb__free(ctx, W.queue); sfb__free(ctx, W.vd); sfb__free(ctx, W.vdlist);
+    sfb__free(ctx, W.vlist); sfb__free(ctx, W.vin); sfb__free(ctx, W.ta);
+    for (i = 0; i < 2; ++i) { sfb__free(ctx, W.nrm[i]); sfb__free(ctx, W.op[i]); }
+    sfb__free(ctx, fpos); sfb__free(ctx, cvert); sfb__free(ctx, csharp);
+    return res;
 }
 #line 1 "src/backends_include.c"
 /* Optional backends: their code lives in backends/ beside surfblend.h and is compiled here,

@@ -720,6 +720,88 @@ SFB_API void sfb_analysis_free(sfb_analysis *a);
  * backend on the host's current context (gl_use_current_context), else SFB_UNSUPPORTED. */
 SFB_API sfb_result sfb_analysis_draw_gl(sfb_context *ctx, const sfb_analysis *analysis);
 
+/* ---- rolling-ball blending (fillets) of sharp features on triangle meshes (seed 002) ----
+ * sfb_mesh_fillet rounds sharp features of a triangle mesh with a rolling ball of radius r
+ * without remeshing: the output has the input's vertices, faces and connectivity; only the
+ * vertices of each blend region move, onto a virtual sweep surface (profiles swept along the
+ * spine, the path of the ball's centre). Pipeline, per curve: blending curve (feature edges whose
+ * dihedral angle exceeds a threshold, chained; or a caller's vertex chain) -> base patches within
+ * alpha*r of the curve -> offset patches (vertex normals, per side) -> their intersection through
+ * an AABB tree: the spine -> spine samples and a profile per sample -> blend region vertices
+ * mapped onto the sweep. Progress stages "fillet curves", "fillet spine", "fillet surface",
+ * "fillet map", "fillet project" (a caller timing the stages reads them from the progress
+ * callback); cancelling returns SFB_CANCELLED and keeps nothing. */
+typedef enum sfb_fillet_profile {
+    SFB_FILLET_ARC = 0,     /* the rolling ball's circular arc (rational quadratic, exact) */
+    SFB_FILLET_CONIC = 1,   /* a conic through the same ends and end tangents: middle weight conic_weight */
+    SFB_FILLET_SHARPEN = 2, /* the two end tangents up to their intersection: turns a rounded feature sharp */
+    SFB_FILLET_HERMITE = 3  /* a cubic Hermite curve between the contact points, tangents scaled by hermite_scale */
+} sfb_fillet_profile;
+typedef struct sfb_fillet_curve {
+    const int *vertices;    /* a chain of mesh edges v0-v1-...; closed when the last vertex equals the first */
+    int count;              /* vertices in the list (>= 2) */
+    float radius;           /* 0: the config's radius */
+    int profile;            /* sfb_fillet_profile + 1; 0: the config's profile */
+    float conic_weight;     /* 0: the config's */
+} sfb_fillet_curve;
+typedef struct sfb_fillet_config {
+    float radius;           /* ball radius, > 0 (required) */
+    float angle;            /* degrees: edges whose dihedral angle exceeds it are features; 0: 30 */
+    int profile;            /* sfb_fillet_profile */
+    float conic_weight;     /* SFB_FILLET_CONIC: weight of the middle control point (< 1 ellipse, 1 parabola,
+                               > 1 hyperbola); 0: the arc's own, cos of half the central angle */
+    float hermite_scale;    /* SFB_FILLET_HERMITE: end tangent length over the chord; 0: the arc's tangents */
+    float alpha;            /* base patches: faces within alpha*radius of the curve; 0: 1.75 (seed Fig. 2) */
+    int samples;            /* initial spine samples by arc length; 0: 40 (seed section 4.1) */
+    float chord_ratio;      /* a spine interval is refined while chord height / chord length exceeds it; 0: 0.002 */
+    const sfb_fillet_curve *curves; /* the caller's blending curves; NULL: features by angle */
+    int curve_count;
+    int map;                /* SFB_FILLET_MAP_*: how blend-region vertices find their place on the sweep */
+} sfb_fillet_config;
+enum {
+    SFB_FILLET_MAP_CONFORMAL = 0, /* default: the direct projection on the region's boundary, a conformal (cotangent)
+                                     map inside it solved by preconditioned conjugate gradients (seed 5); symmetrised
+                                     mean-value weights where that folds, the direct projection where both fold */
+    SFB_FILLET_MAP_DIRECT = 1     /* every vertex by its nearest spine point and its distance from the curve */
+};
+SFB_API sfb_fillet_config sfb_fillet_config_init(float radius);
+typedef struct sfb_fillet_curve_report {
+    int closed;                 /* 1: a closed loop, 0: an open chain */
+    int convex;                 /* 1: the ball is inside the solid (offset against the normals) */
+    int curve_vertices;         /* vertices of the blending curve */
+    float radius;
+    float spine_length;
+    int samples;                /* spine samples after refinement */
+    int vertices_moved;
+    int self_intersections;     /* spine loops cut out (seed section 4.3) */
+    float max_deviation;        /* largest distance of a moved vertex from the ideal sweep surface */
+    int map;                    /* how the region was mapped: 0 direct projection, 1 conformal, 2 mean-value weights */
+} sfb_fillet_curve_report;
+typedef struct sfb_fillet_report {
+    int curve_count;
+    sfb_fillet_curve_report *curves;   /* curve_count entries, freed by sfb_fillet_report_free */
+    int vertices_moved;
+    sfb_context *ctx_;
+} sfb_fillet_report;
+/* Fillets `mesh` (all faces triangles, manifold: SFB_INVALID_TOPOLOGY naming the face or edge
+ * otherwise) into a new mesh *out (same vertices, faces, UVs and tags; positions moved; the
+ * filleted edges lose their crease tags). Errors, with *out NULL, the input untouched and nothing
+ * kept: radius <= 0 or not finite, a bad profile or weight (SFB_INVALID_VALUE); a caller's curve
+ * that is not a chain of mesh edges (SFB_INVALID_TOPOLOGY naming the vertex); no feature found or a
+ * radius too large for the base patches, so that the offsets do not meet (SFB_INVALID_VALUE); the
+ * memory budget (SFB_LIMIT_EXCEEDED, checked before the work). report may be NULL. */
+SFB_API sfb_result sfb_mesh_fillet(sfb_context *ctx, const sfb_mesh *mesh, const sfb_fillet_config *config,
+                                   sfb_mesh **out, sfb_fillet_report *report);
+SFB_API void sfb_fillet_report_free(sfb_fillet_report *report);
+
+/* Measures of a triangle mesh (faces of 3 vertices; SFB_INVALID_TOPOLOGY naming the face
+ * otherwise): angle-weighted unit vertex normals (xyz per vertex; zero for a vertex no face uses),
+ * and the mean curvature per vertex from the cotangent Laplacian with mixed Voronoi areas, signed
+ * positive where the surface bends away from its normal (a sphere with outward normals: +1/R);
+ * boundary and unused vertices get 0. For pictures (sfb_render's WEIGHTS mode) and checks. */
+SFB_API sfb_result sfb_mesh_vertex_normals(sfb_context *ctx, const sfb_mesh *mesh, float *normals);
+SFB_API sfb_result sfb_mesh_mean_curvature(sfb_context *ctx, const sfb_mesh *mesh, float *curvature);
+
 #ifdef __cplusplus
 }
 #endif

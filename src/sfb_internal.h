@@ -659,3 +659,82 @@ SFB__IF sfb_result sfb__pb_eigen_patch(sfb__pbuild *b, sfb__wlevel *w, int type,
 /* Classifies candidate g of the working level: adds its record, or sets *refine. */
 SFB__IF sfb_result sfb__pb_face_quad(sfb__pbuild *b, sfb__wlevel *w, int g, int level, int limit, int *refine);
 SFB__IF sfb_result sfb__pb_face_tri(sfb__pbuild *b, sfb__wlevel *w, int g, int level, int limit, int *refine);
+
+/* ---- an AABB tree over triangles, robust triangle-triangle intersection (aabb.c) ----
+ * Reusable geometry for the rolling-ball operator (seed 002) and its checks. Positions are xyz
+ * doubles; triangles are index triples into them. A built tree is read-only: many threads may
+ * query it at once. */
+typedef struct sfb__aabb_node {
+    double lo[3], hi[3];
+    int left, right;            /* inner node: children; leaf: left = -1, items [first, first+count) */
+    int first, count;
+} sfb__aabb_node;
+typedef struct sfb__aabb {
+    int node_count, item_count;
+    sfb__aabb_node *nodes;      /* node 0 is the root (node_count 0: an empty tree) */
+    int *items;                 /* triangle ids (as passed in `ids`, or 0..count-1) in leaf order */
+} sfb__aabb;
+/* A tree over `count` triangles tri[3*i..3*i+2] of pos (ids: NULL, or the id reported for each).
+ * Triangles with a non-finite vertex are left out. */
+SFB__IF sfb_result sfb__aabb_build(sfb_context *ctx, const double *pos, const int *tri, const int *ids, int count, sfb__aabb *out);
+SFB__IF void sfb__aabb_free(sfb_context *ctx, sfb__aabb *t);
+/* Calls fn(id_a, id_b, user) for every pair of triangles whose boxes, grown by eps, overlap: one of
+ * a, one of b; when b == a, every unordered pair of different ids once. fn returns non-zero to stop;
+ * the function returns 1 when stopped, else 0. */
+SFB__IF int sfb__aabb_pairs(const sfb__aabb *a, const sfb__aabb *b, double eps, int (*fn)(int, int, void *), void *user);
+/* The point of the tree's triangles nearest to p: returns the triangle id (-1 for an empty tree),
+ * writes the point, its squared distance and its barycentric coordinates on that triangle
+ * (any of the out pointers may be NULL). tri is the same array the tree was built on, indexed by
+ * id when ids were NULL, else tri_of_id[id] gives the triangle's row (NULL: id is the row). */
+SFB__IF int sfb__aabb_nearest(const sfb__aabb *t, const double *pos, const int *tri, const int *tri_of_id,
+                              const double p[3], double out_point[3], double *out_dist2, double out_bary[3]);
+/* Closest point to p on triangle (a, b, c), with barycentric coordinates (any pointer may be NULL
+ * but q); degenerate triangles give the closest point on their longest edge. */
+SFB__IF void sfb__closest_on_triangle(const double p[3], const double a[3], const double b[3], const double c[3],
+                                      double q[3], double bary[3]);
+/* Intersection of two triangles. Returns 0 when they do not meet, 1 when they meet in a segment
+ * s0-s1 (a single point gives s0 == s1), 2 when they are coplanar and overlap (no segment written).
+ * Robust: exact zeros from orientation determinants within a tolerance relative to the triangles'
+ * size are treated as on the plane, shared vertices and edges give the shared point or edge, and
+ * degenerate (zero-area) triangles never meet anything. src0/src1 (may be NULL) say where each
+ * endpoint lies: 0..2 edge k (vertex k to k+1) of triangle a, 3..5 edge k-3 of triangle b. */
+SFB__IF int sfb__tri_tri_segment(const double a0[3], const double a1[3], const double a2[3],
+                                 const double b0[3], const double b1[3], const double b2[3],
+                                 double s0[3], double s1[3], int *src0, int *src1);
+/* Pairs of triangles of one mesh that intersect other than in what they share (a common vertex
+ * or edge, compared by index); *pairs gets the count, first[2] (may be NULL) the first pair found
+ * (-1 -1 when none). Coplanar overlaps count, except between triangles that share an edge and lie
+ * on opposite sides of it. */
+SFB__IF sfb_result sfb__trimesh_self_intersections(sfb_context *ctx, const double *pos, const int *tri, int count,
+                                                   long *pairs, int first[2]);
+
+/* ---- sparse symmetric systems (sparse.c) ----
+ * Compressed rows, each row's columns ascending, duplicates summed; for the conformal map of the
+ * rolling-ball operator and whatever else needs a Laplacian solve. */
+typedef struct sfb__sparse {
+    int n;                      /* rows = columns */
+    int *row_off;               /* n + 1 */
+    int *col;
+    double *val;
+} sfb__sparse;
+/* A = sum of the triplets (row[k], col[k], val[k]); indices checked against n (SFB_INVALID_ARGS). */
+SFB__IF sfb_result sfb__sparse_from_triplets(sfb_context *ctx, int n, int count, const int *row, const int *col,
+                                             const double *val, sfb__sparse *out);
+SFB__IF void sfb__sparse_free(sfb_context *ctx, sfb__sparse *m);
+/* y = A x */
+SFB__IF void sfb__sparse_mul(const sfb__sparse *A, const double *x, double *y);
+/* Solves A x = b for symmetric positive definite A by conjugate gradients with a Jacobi
+ * (diagonal) preconditioner, starting from x's contents, until |r| <= tol |b| or max_iter steps.
+ * *iters and *residual (|r|/|b|; may be NULL) say how it went. SFB_INVALID_VALUE (with the error
+ * set) when it did not converge, a diagonal entry is not positive or a non-finite value appears;
+ * x then holds the last iterate. */
+SFB__IF sfb_result sfb__sparse_cg(sfb_context *ctx, const sfb__sparse *A, const double *b, double *x, double tol,
+                                  int max_iter, int *iters, double *residual);
+
+/* ---- triangle-mesh measures (trimesh.c) ---- */
+/* Angle-weighted vertex normals (unit; zero where no face contributes) over faces tri[3f..]. */
+SFB__IF void sfb__trimesh_vertex_normals(int nv, const double *pos, int nf, const int *tri, double *normals);
+/* Mean curvature per vertex from the cotangent Laplacian, H = |Delta x| / 2 with mixed Voronoi
+ * areas (Meyer et al.), signed positive where the surface bends away from its normal (a sphere
+ * with outward normals: +1/R); boundary vertices get 0. */
+SFB__IF sfb_result sfb__trimesh_mean_curvature(sfb_context *ctx, int nv, const double *pos, int nf, const int *tri, double *H);

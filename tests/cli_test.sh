@@ -40,8 +40,9 @@ cmd_opts() { case $1 in
   shade) echo "--variant --darts --normals-level --weights-level --p --averaging --all-subdivided --limit" ;;
   render) echo "--normals --highlight --blend-weights, --weights --normal-colors --positions --size --view --zoom --stripes --edges --rate --manifold-weights --trim" ;;
   analyze) echo "--mode --light --curvature --level --polygon-based --size --view --eye --target --up --fov --orthographic --stripes --band --backend" ;;
+  fillet) echo "--radius --angle --profile --curve --samples --alpha -o, --output" ;;
   esac; }
-for c in info refine eval tess shade render analyze backends; do
+for c in info refine eval tess shade render analyze fillet backends; do
   check "$c --help succeeds" 0 "$CLI" $c --help
   if [ -s "$TMP/out" ] && [ ! -s "$TMP/err" ]; then P=$((P + 1)); echo "ok $c --help prints on stdout only"; else F=$((F + 1)); echo "FAIL $c --help: empty stdout or output on stderr"; fi
   contains "$c --help shows the command" "$TMP/out" "^  surfblend $c"
@@ -487,6 +488,41 @@ check "analyze --eye at its --target is bad input" 1 "$CLI" analyze --eye 1,1,1 
 contains "the error names the camera" "$TMP/err" "camera eye equals its target"
 check "analyze --polygon-based --mode curvature is bad input" 1 "$CLI" analyze --polygon-based --mode curvature examples/data/creased_box.obj -o "$TMP/ax.png"
 if [ ! -e "$TMP/ax.png" ]; then P=$((P + 1)); echo "ok a failed analyze leaves no file"; else F=$((F + 1)); echo "FAIL a failed analyze left $TMP/ax.png"; fi
+
+# ---- fillet (seed 002): rolling-ball blending of a triangle mesh's sharp features ----
+# a 90-degree fold: faces z = 0 (y in [-1, 0]) and y = 0 (z in [-1, 0]) meeting along the x axis
+awk 'BEGIN { n = 20; m = 10;
+  for (j = 0; j <= m; j++) for (i = 0; i <= n; i++) printf "v %g %g 0\n", 2 * i / n, -j / m;
+  for (j = 1; j <= m; j++) for (i = 0; i <= n; i++) printf "v %g 0 %g\n", 2 * i / n, -j / m;
+  for (j = 0; j < m; j++) for (i = 0; i < n; i++) { a = j * (n + 1) + i + 1; b = a + 1; c = a + n + 1; d = c + 1;
+    printf "f %d %d %d\nf %d %d %d\n", a, c, b, b, c, d }
+  for (j = 0; j < m; j++) for (i = 0; i < n; i++) {
+    a = (j == 0 ? i + 1 : (m + 1) * (n + 1) + (j - 1) * (n + 1) + i + 1); b = a + 1;
+    c = (m + 1) * (n + 1) + j * (n + 1) + i + 1; d = c + 1;
+    printf "f %d %d %d\nf %d %d %d\n", a, b, c, b, d, c } }' > "$TMP/fold.obj"
+check "fillet a fold succeeds" 0 "$CLI" fillet --radius 0.25 "$TMP/fold.obj" -o "$TMP/fold_f.obj"
+contains "fillet reports the curve" "$TMP/err" "curve 0: open convex, 21 vertices, radius 0.25"
+if [ "$(grep -c '^v ' "$TMP/fold_f.obj")" = "$(grep -c '^v ' "$TMP/fold.obj")" ] && [ "$(grep -c '^f ' "$TMP/fold_f.obj")" = "$(grep -c '^f ' "$TMP/fold.obj")" ]; then
+  P=$((P + 1)); echo "ok fillet keeps the vertex and face counts"; else F=$((F + 1)); echo "FAIL fillet changed the counts"; fi
+# the edge's middle vertex (x = 1) moves to the arc's middle: r (1 - 1/sqrt 2) from both faces
+mid=$(awk '/^v /{k++; if (k == 11) print $3, $4}' "$TMP/fold_f.obj")
+if awk -v m="$mid" 'BEGIN { split(m, a, " "); w = -0.25 * (1 - sqrt(0.5)); exit !(a[1] - w < 1e-4 && w - a[1] < 1e-4 && a[2] - w < 1e-4 && w - a[2] < 1e-4) }'; then
+  P=$((P + 1)); echo "ok fillet puts the edge on the arc"; else F=$((F + 1)); echo "FAIL fillet: the edge's middle vertex is at ($mid)"; fi
+check "fillet --profile conic:0.5 succeeds" 0 "$CLI" fillet --radius 0.25 --profile conic:0.5 "$TMP/fold.obj" -o "$TMP/fold_c.obj"
+check "fillet --profile sharpen --curve succeeds" 0 "$CLI" fillet --radius 0.3 --profile sharpen --curve "$(seq -s, 0 20)" "$TMP/fold_f.obj" -o "$TMP/fold_s.obj"
+check "fillet --profile hermite:0.5 --samples 60 --alpha 2 succeeds" 0 "$CLI" fillet --radius 0.25 --profile hermite:0.5 --samples 60 --alpha 2 "$TMP/fold.obj" -o "$TMP/fold_h.obj"
+check "fillet without --radius is a usage error" 2 "$CLI" fillet "$TMP/fold.obj" -o "$TMP/fx.obj"
+check "fillet --radius -1 is a usage error" 2 "$CLI" fillet --radius -1 "$TMP/fold.obj" -o "$TMP/fx.obj"
+check "fillet --profile bogus is a usage error" 2 "$CLI" fillet --radius 0.2 --profile bogus "$TMP/fold.obj" -o "$TMP/fx.obj"
+check "fillet --curve 1,x is a usage error" 2 "$CLI" fillet --radius 0.2 --curve 1,x "$TMP/fold.obj" -o "$TMP/fx.obj"
+check "fillet --radius 10 (too large) is bad input" 1 "$CLI" fillet --radius 10 "$TMP/fold.obj" -o "$TMP/fx.obj"
+contains "the error says the offsets do not meet" "$TMP/err" "do not meet"
+check "fillet a curve that is not a chain of edges is bad input" 1 "$CLI" fillet --radius 0.2 --curve 0,5 "$TMP/fold.obj" -o "$TMP/fx.obj"
+contains "the error names the vertices" "$TMP/err" "no edge from vertex 0 to vertex 5"
+check "fillet a quad mesh is bad input" 1 "$CLI" fillet --radius 0.2 examples/data/creased_box.obj -o "$TMP/fx.obj"
+contains "the error asks for triangles" "$TMP/err" "triangle mesh"
+check "fillet --angle 120 finds no feature" 1 "$CLI" fillet --radius 0.2 --angle 120 "$TMP/fold.obj" -o "$TMP/fx.obj"
+if [ ! -e "$TMP/fx.obj" ]; then P=$((P + 1)); echo "ok a failed fillet leaves no file"; else F=$((F + 1)); echo "FAIL a failed fillet left $TMP/fx.obj"; fi
 
 # vertex counts against OpenSubdiv (osd_agree --counts prints "name count" per shape)
 if [ -d "$SHAPES" ] && [ -x "$BUILD/osd_agree" ]; then

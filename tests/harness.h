@@ -139,6 +139,7 @@ static inline char *slurp(const char *path, size_t *n) {
     return b;
 }
 
+static inline int harness_cmp_int(const void *a, const void *b) { const int x = *(const int *)a, y = *(const int *)b; return (x > y) - (x < y); }
 static inline int harness_cmp_str(const void *a, const void *b) { return strcmp(*(const char *const *)a, *(const char *const *)b); }
 
 /* The names of the .obj files in `dir` (the peer shapes) that start with one of the

@@ -102,6 +102,8 @@ suite counted manifold "$BUILD/manifold" $(with_shapes)
 suite counted tribezier "$BUILD/tribezier" "$(dirname "$SHAPES")/real-meshes"
 suite counted trim "$BUILD/trim" $(with_shapes)
 suite counted analyze "$BUILD/analyze" "$SHAPES"
+suite counted geom "$BUILD/geom"
+suite counted fillet "$BUILD/fillet"
 suite counted agree "$BUILD/agree" $(with_shapes)
 suite counted gl_manifold "$BUILD/gl_manifold" "$SHAPES"
 suite counted cli env BUILD="$BUILD" SHAPES="$SHAPES" ./tests/cli_test.sh

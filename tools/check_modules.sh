@@ -12,13 +12,13 @@ CC=${CC:-cc}
 CXX=${CXX:-c++}
 mkdir -p "$out/c" "$out/cxx"
 objs_c=""; objs_cxx=""
-for f in src/*.c src/patch/*.c; do
+for f in src/*.c src/patch/*.c src/fillet/*.c; do
   b=$(echo "${f#src/}" | sed "s,/,_,g; s,\.c$,,")
   $CC -std=c99 -pedantic -Wall -Wextra -Wmissing-prototypes -Werror -O0 -I. -include src/sfb_module.h -c "$f" -o "$out/c/$b.o"
   $CXX -std=c++11 -Wall -Wextra -Werror -O0 -I. -include src/sfb_module.h -x c++ -c "$f" -o "$out/cxx/$b.o"
   objs_c="$objs_c $out/c/$b.o"; objs_cxx="$objs_cxx $out/cxx/$b.o"
 done
-echo "check-modules: $(ls src/*.c src/patch/*.c | wc -l) modules compile alone (C99 and C++11)"
+echo "check-modules: $(ls src/*.c src/patch/*.c src/fillet/*.c | wc -l) modules compile alone (C99 and C++11)"
 for ex in examples/*.c; do
   b=$(basename "$ex" .c)
   $CC -std=c99 -Wall -Wextra -Werror -O0 -I. "$ex" $objs_c -o "$out/$b" -lm -lpthread -ldl

@@ -25,6 +25,7 @@ enum {
     O_RATE, O_TOLERANCE, O_SPLIT, O_TRIM, O_TILES, O_VARIANT, O_DARTS, O_NORMALS_LEVEL, O_WEIGHTS_LEVEL, O_P,
     O_AVERAGING, O_ALL_SUBDIVIDED, O_NORMALS, O_POSITIONS, O_MODE, O_EDGES, O_SIZE, O_VIEW, O_ZOOM, O_STRIPES, O_CREASE_ANGLE, O_SHARPNESS,
     O_AMODE, O_LIGHT, O_CURVATURE, O_EYE, O_TARGET, O_UP, O_FOV, O_ORTHO, O_POLYGON, O_BAND,
+    O_RADIUS, O_ANGLE, O_PROFILE, O_CURVE, O_SAMPLES, O_ALPHA,
     O_COUNT_
 };
 
@@ -52,13 +53,16 @@ typedef struct cli_opts {
     int amode, curvature, ortho, polygon;                   /* analyze */
     const char *light;
     double eye[3], target[3], up[3], fov, band;
+    double radius, angle, alpha;                            /* fillet */
+    const char *profile, *curve;
+    long samples;
     int seen[O_COUNT_];
 } cli_opts;
 
 /* Command bits: which commands take an option. */
 enum {
     C_INFO = 1, C_REFINE = 2, C_EVAL = 4, C_TESS = 8, C_SHADE = 16, C_RENDER = 32, C_BACKENDS = 64, C_ANALYZE = 128,
-    C_ALL = 255, C_SURFACE = C_REFINE | C_EVAL | C_TESS | C_SHADE | C_RENDER | C_ANALYZE, C_SHADING = C_SHADE | C_RENDER
+    C_FILLET = 256, C_ALL = 511, C_SURFACE = C_REFINE | C_EVAL | C_TESS | C_SHADE | C_RENDER | C_ANALYZE, C_SHADING = C_SHADE | C_RENDER
 };
 
 typedef enum opt_kind {
@@ -230,9 +234,24 @@ static const opt_spec options[] = {
     { "--crease-angle", NULL, K_POSITIVE, C_INFO | C_SURFACE, O_CREASE_ANGLE, AT(crease_angle), "DEG", NULL, 0, 180, 0,
       "degrees in (0, 180]", "edges whose dihedral angle is over DEG become infinitely sharp creases (a faceted\n"
       "mesh with no crease tags; sfb_mesh_crease_by_angle)" },
+    { "--radius", NULL, K_POSITIVE, C_FILLET, O_RADIUS, AT(radius), "R", NULL, 0, 1e30, 0, "a number > 0",
+      "the rolling ball's radius (required)" },
+    { "--angle", NULL, K_POSITIVE, C_FILLET, O_ANGLE, AT(angle), "DEG", NULL, 0, 179.999, 0, "degrees in (0, 180)",
+      "edges whose dihedral angle is over DEG are the features to fillet (default 30)" },
+    { "--profile", NULL, K_STRING, C_FILLET, O_PROFILE, AT(profile), "arc|conic:W|sharpen|hermite[:S]", NULL, 0, 0, 0,
+      "arc, conic:W, sharpen or hermite[:S]", "cross-section: the ball's arc (default), a conic of middle weight W\n"
+      "(< 1 flatter, > 1 fuller), the sharp corner back (sharpen), a Hermite cubic" },
+    { "--curve", NULL, K_STRING, C_FILLET, O_CURVE, AT(curve), "V0,V1,...[;...]", NULL, 0, 0, 0, "vertex indices",
+      "blending curves as chains of mesh edges (0-based vertex indices; a curve\n"
+      "closes when its last vertex is its first; ';' separates curves); default:\n"
+      "the features found by --angle" },
+    { "--samples", NULL, K_LONG, C_FILLET, O_SAMPLES, AT(samples), "N", NULL, 2, 100000, 0, "a number in 2..100000",
+      "initial spine samples by arc length (default 40; refined where the spine bends)" },
+    { "--alpha", NULL, K_POSITIVE, C_FILLET, O_ALPHA, AT(alpha), "A", NULL, 0, 100, 0, "a number in [1, 100]",
+      "base patches: faces within A x radius of the curve (default 1.75)" },
     { "--backend", NULL, K_STRING, C_SURFACE, O_BACKEND, AT(backend), "NAME", NULL, 0, 0, 0, "a name",
       "ref|simd|gl|osmesa, tried first (else SURFBLEND_BACKEND, else the default order)" },
-    { "-o", "--output", K_STRING, C_SURFACE, O_OUTPUT, AT(outp), "FILE", NULL, 0, 0, 0, "a file name",
+    { "-o", "--output", K_STRING, C_SURFACE | C_FILLET, O_OUTPUT, AT(outp), "FILE", NULL, 0, 0, 0, "a file name",
       "the output file ('-': standard output)" },
     { "-h", "--help", K_HELP, C_ALL, O_HELP, 0, NULL, NULL, 0, 0, 0, NULL, "print this command's usage and exit" },
 };
@@ -1302,6 +1321,123 @@ static int cmd_backends(cli_opts *o) {
     return 0;
 }
 
+/* ---- fillet: seed 002's rolling-ball blending on a triangle mesh ---- */
+/* --profile: arc | conic:W | sharpen | hermite[:S]; 0 on a bad value (printed). */
+static int fillet_profile(const char *s, sfb_fillet_config *fc) {
+    char *end;
+    if (!s || strcmp(s, "arc") == 0) { fc->profile = SFB_FILLET_ARC; return 1; }
+    if (strcmp(s, "sharpen") == 0) { fc->profile = SFB_FILLET_SHARPEN; return 1; }
+    if (strcmp(s, "hermite") == 0) { fc->profile = SFB_FILLET_HERMITE; return 1; }
+    if (strncmp(s, "conic:", 6) == 0 || strncmp(s, "hermite:", 8) == 0) {
+        const int conic = s[0] == 'c';
+        const double w = strtod(s + (conic ? 6 : 8), &end);
+        if (end != s + (conic ? 6 : 8) && !*end && w > 0.0 && w < 1e6) {
+            fc->profile = conic ? SFB_FILLET_CONIC : SFB_FILLET_HERMITE;
+            if (conic) fc->conic_weight = (float)w; else fc->hermite_scale = (float)w;
+            return 1;
+        }
+    }
+    cli_error("--profile: '%s' is not arc, conic:W, sharpen or hermite[:S] (W, S numbers > 0)", s);
+    return 0;
+}
+
+/* --curve "a,b,c;d,e,f": the curves and their vertices (malloc'd); 0 on a bad list (printed). */
+static int fillet_curves(const char *s, sfb_fillet_curve **curves, int *count, int **verts) {
+    size_t n = strlen(s) + 2, k = 0;
+    int nc = 0, start = 0, i;
+    const char *p = s;
+    *curves = NULL;
+    *count = 0;
+    *verts = (int *)malloc(n * sizeof(int));
+    if (!*verts) return 0;
+    for (;;) {
+        char *end;
+        long v = strtol(p, &end, 10);
+        if (end == p || v < 0 || v > 2147483646L) {
+            cli_error("--curve: '%s' is not a list of vertex indices (e.g. 0,1,2;5,6)", s);
+            return 0;
+        }
+        (*verts)[k++] = (int)v;
+        p = end;
+        if (*p == ',') { ++p; continue; }
+        if (*p == ';' || !*p) {
+            sfb_fillet_curve *nc_ = (sfb_fillet_curve *)realloc(*curves, (size_t)(nc + 1) * sizeof **curves);
+            if (!nc_) return 0;
+            *curves = nc_;
+            memset(&(*curves)[nc], 0, sizeof **curves);
+            (*curves)[nc].count = (int)k - start;
+            nc++;
+            start = (int)k;
+            if (!*p) break;
+            ++p;
+            continue;
+        }
+        cli_error("--curve: unexpected '%c' in '%s'", *p, s);
+        return 0;
+    }
+    for (i = 0, k = 0; i < nc; ++i) { (*curves)[i].vertices = *verts + k; k += (size_t)(*curves)[i].count; }
+    *count = nc;
+    return 1;
+}
+
+static int cmd_fillet(cli_opts *o) {
+    int rc = 1, i, *verts = NULL, ncurves = 0;
+    sfb_context *ctx = NULL;
+    sfb_mesh *mesh = NULL, *res = NULL;
+    sfb_fillet_config fc;
+    sfb_fillet_curve *curves = NULL;
+    sfb_fillet_report rep;
+    sfb_result r;
+    cli_output out;
+    memset(&out, 0, sizeof out);
+    memset(&rep, 0, sizeof rep);
+    if (!o->seen[O_RADIUS]) return usage_error(o->cmd, "fillet needs --radius R");
+    fc = sfb_fillet_config_init((float)o->radius);
+    if (o->seen[O_ANGLE]) fc.angle = (float)o->angle;
+    if (o->seen[O_SAMPLES]) fc.samples = (int)o->samples;
+    if (o->seen[O_ALPHA]) {
+        if (o->alpha < 1.0) return usage_error(o->cmd, "--alpha needs a number in [1, 100]");
+        fc.alpha = (float)o->alpha;
+    }
+    if (!fillet_profile(o->profile, &fc)) return 2;
+    if (o->curve && !fillet_curves(o->curve, &curves, &ncurves, &verts)) { free(curves); free(verts); return 2; }
+    fc.curves = curves;
+    fc.curve_count = ncurves;
+    ctx = cli_make_context(NULL);
+    if (!ctx) goto done;
+    mesh = cli_load_obj(ctx, o->in);
+    if (!mesh) goto done;
+    r = sfb_mesh_fillet(ctx, mesh, &fc, &res, &rep);
+    if (r != SFB_SUCCESS) {
+        cli_error("%s: %s: %s", o->in, sfb_result_string(r), sfb_last_error(ctx));
+        goto done;
+    }
+    if (!cli_output_open(&out, o->outp)) goto done;
+    r = sfb_mesh_write_obj(res, cli_file_write, out.f);
+    if (r != SFB_SUCCESS) {
+        cli_error("writing '%s' failed: %s", o->outp, sfb_result_string(r));
+        goto done;
+    }
+    for (i = 0; i < rep.curve_count; ++i) {
+        const sfb_fillet_curve_report *c = &rep.curves[i];
+        cli_error("curve %d: %s %s, %d vertices, radius %g: spine %.4g long, %d samples, %d vertices moved, %d spine loops cut, "
+                  "largest deviation from the sweep %.3g",
+                  i, c->closed ? "closed" : "open", c->convex ? "convex" : "concave", c->curve_vertices, (double)c->radius,
+                  (double)c->spine_length, c->samples, c->vertices_moved, c->self_intersections, (double)c->max_deviation);
+    }
+    cli_error("%d curves filleted, %d vertices moved -> %s", rep.curve_count, rep.vertices_moved, o->outp);
+    rc = 0;
+done:
+    rc = cli_output_finish(&out, rc);
+    sfb_fillet_report_free(&rep);
+    sfb_mesh_destroy(res);
+    sfb_mesh_destroy(mesh);
+    sfb_context_destroy(ctx);
+    free(curves);
+    free(verts);
+    return rc;
+}
+
 /* ---- the commands' table, main ---- */
 
 static const cli_command commands[] = {
@@ -1321,6 +1457,9 @@ static const cli_command commands[] = {
     { "analyze", C_ANALYZE, "[options] IN.obj -o OUT.png", "surface quality (seed 003) from the exact limit surface per pixel (PNG)",
       "every pixel is projected onto the exact surface along its view ray and shaded from its exact normal\n"
       "    (and second derivatives): the picture does not depend on --level", 1, "OUT.png", cmd_analyze },
+    { "fillet", C_FILLET, "--radius R [options] IN.obj -o OUT.obj", "rolling-ball fillets of a triangle mesh's sharp features (seed 002)",
+      "the same vertices, faces and connectivity; only the vertices of each blend region move, onto the\n"
+      "    ball's sweep; prints one line per curve", 1, "OUT.obj", cmd_fillet },
     { "backends", C_BACKENDS, "", "list the backends and whether each is available", NULL, 0, NULL, cmd_backends },
 };
 #define COMMAND_COUNT (sizeof commands / sizeof commands[0])
