@@ -241,25 +241,59 @@ done:
  * kept, about n segments per unit length); rays from the kernel point c = (width/2, width/2)
  * through those points carry the slab's top rings out to the slab's rim, the prism's walls go up
  * and its cap's rings shrink toward c. loop: the footprint on z = 0 (the seam), closed. */
+static inline int fs_floor_lprism_round(fs_mesh *m, int n, float half, float thick, float arm, float width, float height, float round);
 static inline int fs_floor_lprism(fs_mesh *m, int n, float half, float thick, float arm, float width, float height) {
+    return fs_floor_lprism_round(m, n, half, thick, arm, width, height, 0.0f);
+}
+/* The same with the footprint's five convex corners rounded by arcs of radius `round` (0: sharp;
+ * < width / 2), so that the prism's walls are smooth there and only the reflex corner is sharp: a
+ * rolling ball in the seam then touches the walls along a curve everywhere (at a sharp convex
+ * corner it touches the prism's vertical edge in one point, where the blend degenerates). */
+static inline int fs_floor_lprism_round(fs_mesh *m, int n, float half, float thick, float arm, float width, float height, float round) {
     const double cx = width / 2.0, cy = width / 2.0;
     const double poly[6][2] = {{0, 0}, {arm, 0}, {arm, width}, {width, width}, {width, arm}, {0, arm}};
-    double *F = NULL, perim = 0.0, seg;
+    double *F = NULL, perim = 0.0, seg, T[6][2][2], C[6][2];
     int M = 0, e, i, k, K, Hw, Kc, Ks, *ring = NULL, *prev = NULL, rc = -1;
     fs_dir up, down, radial;
     memset(m, 0, sizeof *m);
-    if (n < 2 || !(width > 0) || !(arm > width) || !(half > 2 * arm) || !(thick > 0) || !(height > 0)) return -1;
-    for (e = 0; e < 6; ++e) perim += hypot(poly[(e + 1) % 6][0] - poly[e][0], poly[(e + 1) % 6][1] - poly[e][1]);
+    if (n < 2 || !(width > 0) || !(arm > width) || !(half > 2 * arm) || !(thick > 0) || !(height > 0) || !(round >= 0) ||
+        !(round < width / 2))
+        return -1;
+    /* each corner's two tangent points (equal at a sharp corner) and its arc's centre */
+    for (e = 0; e < 6; ++e) {
+        const double *p0 = poly[(e + 5) % 6], *p1 = poly[e], *p2 = poly[(e + 1) % 6];
+        const double l1 = hypot(p1[0] - p0[0], p1[1] - p0[1]), l2 = hypot(p2[0] - p1[0], p2[1] - p1[1]);
+        const double din[2] = {(p1[0] - p0[0]) / l1, (p1[1] - p0[1]) / l1}, dout[2] = {(p2[0] - p1[0]) / l2, (p2[1] - p1[1]) / l2};
+        const double rr = e == 3 ? 0.0 : round; /* corner 3 is the reflex one */
+        T[e][0][0] = p1[0] - din[0] * rr; T[e][0][1] = p1[1] - din[1] * rr;
+        T[e][1][0] = p1[0] + dout[0] * rr; T[e][1][1] = p1[1] + dout[1] * rr;
+        C[e][0] = T[e][0][0] - din[1] * rr; C[e][1] = T[e][0][1] + din[0] * rr; /* interior on the left */
+    }
+    for (e = 0; e < 6; ++e) perim += hypot(T[(e + 1) % 6][0][0] - T[e][1][0], T[(e + 1) % 6][0][1] - T[e][1][1]) + (e == 3 ? 0.0 : 0.5 * 3.14159265358979 * round);
     F = (double *)malloc((size_t)(n * perim + 64) * 2 * sizeof(double));
     if (!F) return -1;
     for (e = 0; e < 6; ++e) {
-        const double *a = poly[e], *b = poly[(e + 1) % 6], len = hypot(b[0] - a[0], b[1] - a[1]);
-        int s = (int)(n * len + 0.5), j;
-        if (s < 2) s = 2;
-        for (j = 0; j < s; ++j) {
-            F[2 * M] = a[0] + (b[0] - a[0]) * j / s;
-            F[2 * M + 1] = a[1] + (b[1] - a[1]) * j / s;
-            M++;
+        /* corner e's arc (a quarter turn counter-clockwise), then the straight piece to corner e + 1 */
+        if (e != 3 && round > 0) {
+            const double a0 = atan2(T[e][0][1] - C[e][1], T[e][0][0] - C[e][0]);
+            int s = (int)(n * 0.5 * 3.14159265358979 * round + 0.5), j;
+            if (s < 2) s = 2;
+            for (j = 0; j < s; ++j) {
+                const double a = a0 + 0.5 * 3.14159265358979 * j / s;
+                F[2 * M] = C[e][0] + round * cos(a);
+                F[2 * M + 1] = C[e][1] + round * sin(a);
+                M++;
+            }
+        }
+        {
+            const double *a = T[e][1], *b = T[(e + 1) % 6][0], len = hypot(b[0] - a[0], b[1] - a[1]);
+            int s = (int)(n * len + 0.5), j;
+            if (s < 2) s = 2;
+            for (j = 0; j < s; ++j) {
+                F[2 * M] = a[0] + (b[0] - a[0]) * j / s;
+                F[2 * M + 1] = a[1] + (b[1] - a[1]) * j / s;
+                M++;
+            }
         }
     }
     seg = perim / M;

@@ -10,16 +10,24 @@
  *            carried back to the base face by its barycentric coordinates: seed 3 step 4) and a
  *            profile (arc, conic, sharpening polyline, Hermite; seed 4.2); ruled surfaces between
  *            consecutive profiles (seed eq. 1);
- *   map      each vertex of the blend region gets (t, a): t from its nearest point on the spine
- *            (the spine's normal plane through the vertex), a its place across the region, by
- *            distance from the blending curve relative to the linkage point's on its side;
+ *   map      each vertex of the blend region gets (t, a): first directly (t from its nearest point
+ *            on its side's linkage polyline, a from how far it lies past its side's linkage point
+ *            toward the curve), then, inside the region, the cotangent (conformal) map with those
+ *            boundary values solved by conjugate gradients (sparse.c); mean-value weights where the
+ *            cotangent map folds, the direct values where both fold;
  *   project  the vertex moves to the ruled surface at (t, a).
  * Choices where the seed is silent, and why:
- *  - The map is a direct projection onto the sweep (the issue's "project onto the sweep surface
- *    directly"), not the seed's conformal map of the split region: it needs no disc topology, so
- *    blend regions with holes or several boundary loops (seed 7's failure) map like any other,
- *    and open chains need no splitting. Across the region, a is arc-length-like: the blending
- *    curve goes to the profile's middle by arc length when both linkage distances are equal.
+ *  - No splitting path: a closed spine's t is periodic and each edge of the map carries its jump
+ *    (the smaller difference), so the region needs no disc topology; blend regions with holes or
+ *    several boundary loops (seed 7's failure) map like any other, and open chains need no
+ *    splitting either. SFB_FILLET_MAP_DIRECT keeps the direct values throughout. Across the
+ *    region, a is arc-length-like: the blending curve goes to the profile's middle by arc length
+ *    when both linkage distances are equal.
+ *  - Region membership is a half-space test at the vertex's own linkage point (past it toward the
+ *    curve), not a distance to the curve: at a reflex corner of the seam the ball sits in the
+ *    corner and the vertices behind it have no profile plane of their own; the distance test left
+ *    single vertices there out and stretched triangles across the corner (8014 intersecting pairs
+ *    on the L prism of tests/fillet.c before, 0 after).
  *  - Consecutive profiles are joined at equal arc-length fractions (a ruled surface whose rulings
  *    join points at the same fraction a), not at equal rational parameter u: profiles of
  *    different opening angles then still pair corresponding points.
@@ -990,7 +998,7 @@ static sfb_result fil_one(sfb__fil *F, sfb__fil_work *W, const sfb__fil_curve *c
     const int kind = cv->profile;
     const double hs = F->cfg->hermite_scale;
     const int m = cv->closed ? cv->n - 1 : cv->n; /* distinct curve points */
-    double *cp = NULL, *spine = NULL, *cum = NULL, *sarc = NULL, *C = NULL, *S = NULL;
+    double *cp = NULL, *spine = NULL, *cum = NULL, *sarc = NULL, *C = NULL, *S = NULL, *LK[2] = {NULL, NULL};
     sfb__fil_prof *prof = NULL, *ip = NULL;
     sfb__aabb tree[2];
     sfb__fil_pairs P;
@@ -1166,9 +1174,7 @@ static sfb_result fil_one(sfb__fil *F, sfb__fil_work *W, const sfb__fil_curve *c
         for (i = 0; i + 1 < ns; ++i) mean += fil_dist(spine + 3 * (size_t)i, spine + 3 * (size_t)(i + 1));
         mean /= (ns > 1 ? ns - 1 : 1);
         tol = 1.5 * mean < 0.1 * r ? 1.5 * mean : 0.1 * r;
-        if (getenv("SFB_DEBUG_SPINE")) { FILE *df = fopen("/tmp/stub/spine_raw.txt", "w"); for (i = 0; i < ns; ++i) fprintf(df, "%g %g %g\n", spine[3 * i], spine[3 * i + 1], spine[3 * i + 2]); fclose(df); }
         rep->self_intersections = fil_spine_untangle(ctx, &spine, &ns, sclosed, tol, 0.25 * r);
-        if (getenv("SFB_DEBUG_SPINE")) { FILE *df = fopen(getenv("SFB_DEBUG_SPINE"), "w"); for (i = 0; i < ns; ++i) fprintf(df, "%g %g %g\n", spine[3 * i], spine[3 * i + 1], spine[3 * i + 2]); fclose(df); fprintf(stderr, "tol %g ns %d\n", tol, ns); }
     }
     cum = (double *)sfb__alloc(ctx, ((size_t)ns + 1) * sizeof(double));
     if (!cum) { res = sfb__oom(ctx, "the spine"); goto done; }
@@ -1208,7 +1214,13 @@ static sfb_result fil_one(sfb__fil *F, sfb__fil_work *W, const sfb__fil_curve *c
     if (res != SFB_SUCCESS) goto done;
     ip = (sfb__fil_prof *)sfb__alloc(ctx, sizeof *ip);
     S = (double *)sfb__alloc(ctx, ((size_t)nsamp + 1) * sizeof(double));
-    if (!ip || !S) { res = sfb__oom(ctx, "the sweep's profiles"); goto done; }
+    LK[0] = (double *)sfb__alloc(ctx, (size_t)nsamp * 3 * sizeof(double));
+    LK[1] = (double *)sfb__alloc(ctx, (size_t)nsamp * 3 * sizeof(double));
+    if (!ip || !S || !LK[0] || !LK[1]) { res = sfb__oom(ctx, "the sweep's profiles"); goto done; }
+    for (i = 0; i < nsamp; ++i) {
+        memcpy(LK[0] + 3 * (size_t)i, prof[i].P1, 3 * sizeof(double));
+        memcpy(LK[1] + 3 * (size_t)i, prof[i].P2, 3 * sizeof(double));
+    }
     S[0] = 0.0;
     for (i = 1; i <= nsamp; ++i)
         S[i] = S[i - 1] + (i < nsamp ? fil_dist(C + 3 * (size_t)(i - 1), C + 3 * (size_t)i) : sclosed ? fil_dist(C + 3 * (size_t)(nsamp - 1), C) : 0.0);
@@ -1227,21 +1239,45 @@ static sfb_result fil_one(sfb__fil *F, sfb__fil_work *W, const sfb__fil_curve *c
             fil_sub(p, C + 3 * (size_t)e, dv);
             if (fil_dot(dv, out) > 1e-9 * fil_len(out) * (F->scale + r)) continue;
         }
+        if (!(W->vin[v] & 4)) {
+            /* t off the curve: the nearest point on the vertex's own side's linkage polyline, not
+             * on the spine. Both agree where the sweep is a plain tube; where the spine was cut and
+             * bridged (a reflex corner, seed 4.3) the profile planes there are not the spine's
+             * normal planes, and the vertices near the linkage curve -- the region's boundary,
+             * which the conformal map keeps -- find their own profile only this way. */
+            int sg0, sg1;
+            double t0, t1, e0, e1;
+            fil_polyline_nearest(LK[0], nsamp, sclosed, p, &sg0, &t0, &e0);
+            fil_polyline_nearest(LK[1], nsamp, sclosed, p, &sg1, &t1, &e1);
+            vs = (W->vin[v] & 1) ? 0 : 1;
+            if ((W->vin[v] & 3) == 3) vs = e0 <= e1 ? 0 : 1; /* both sides (around an open chain's end): the nearer */
+            seg = vs == 0 ? sg0 : sg1;
+            t = vs == 0 ? t0 : t1;
+            j = (seg + 1) % nsamp;
+        }
         fil_lerp(prof[seg].E, prof[j].E, t, E);
         L1 = prof[seg].L1 + t * (prof[j].L1 - prof[seg].L1);
         L2 = prof[seg].L2 + t * (prof[j].L2 - prof[seg].L2);
         if (!(L1 + L2 > 0)) continue;
         if (W->vin[v] & 4) { s = 0.0; vs = 0; }
         else {
-            s = fil_dist(p, E);
-            vs = (W->vin[v] & 1) ? 0 : 1;
-            if ((W->vin[v] & 3) == 3) { /* both sides (around an open chain's end): the nearer linkage point */
-                double l0[3], l1[3];
-                fil_lerp(prof[seg].P1, prof[j].P1, t, l0);
-                fil_lerp(prof[seg].P2, prof[j].P2, t, l1);
-                vs = fil_dist(p, l0) <= fil_dist(p, l1) ? 0 : 1;
-            }
-            if (s >= (vs == 0 ? L1 : L2)) continue;
+            /* s: how far the vertex lies past its side's linkage point toward the curve, measured
+             * along the line from the one to the other. Inside the region when s > 0. (The distance
+             * to the curve's foot E, used before, decides differently for neighbouring vertices
+             * where the spine turns sharply -- a reflex corner of the seam, where the ball sits in
+             * the corner and the vertices behind it have no profile plane of their own -- and left
+             * single vertices out, stretching triangles across the corner.) */
+            double l0[3], l1[3], lk[3], u[3], dv[3], lu;
+            fil_lerp(prof[seg].P1, prof[j].P1, t, l0);
+            fil_lerp(prof[seg].P2, prof[j].P2, t, l1);
+            memcpy(lk, vs == 0 ? l0 : l1, sizeof lk);
+            fil_sub(E, lk, u);
+            lu = fil_len(u);
+            if (!(lu > 0)) continue;
+            fil_sub(p, lk, dv);
+            s = fil_dot(dv, u) / lu;
+            if (s <= 0.0) continue;
+            s = (vs == 0 ? L1 : L2) - (s < lu ? s : lu) * (vs == 0 ? L1 : L2) / lu; /* as a distance from the curve */
         }
         W->ta[2 * (size_t)v] = S[seg] + t * (S[seg + 1] - S[seg]);
         W->ta[2 * (size_t)v + 1] = vs == 0 ? (L1 - s) / (L1 + L2) : (L1 + s) / (L1 + L2);
@@ -1315,6 +1351,7 @@ done:
     sfb__free(ctx, P.segs);
     sfb__free(ctx, cp); sfb__free(ctx, cedge); sfb__free(ctx, spine); sfb__free(ctx, cum);
     sfb__free(ctx, sarc); sfb__free(ctx, C); sfb__free(ctx, prof); sfb__free(ctx, ip); sfb__free(ctx, S);
+    sfb__free(ctx, LK[0]); sfb__free(ctx, LK[1]);
     return res;
 }
 
