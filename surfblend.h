@@ -15278,13 +15278,50 @@ static sfb_result fil_stage(sfb__fil *F, int ci, int stage, const char *name) {
     return sfb__progress(F->ctx, (float)((ci + stage / 5.0) / (F->ncurves > 0 ? F->ncurves : 1)), name);
 }
 
-static double fil_curve_distance(const double *cp, int m, int closed, const double *p, double *foot) {
-    int seg;
-    double t, d2;
-    fil_polyline_nearest(cp, m, closed, p, &seg, &t, &d2);
-    if (foot) fil_lerp(cp + 3 * (size_t)seg, cp + 3 * (size_t)((seg + 1) % m), t, foot);
-    return sqrt(d2);
+/* A polyline with an AABB tree over its segments (each a degenerate triangle i, i+1, i+1, whose
+ * nearest point aabb.c finds on the segment): nearest-point queries in log time. Short polylines
+ * (fewer than 32 segments) are searched linearly. The nearest segment of two at equal distance
+ * may differ from fil_polyline_nearest's choice; the point and distance do not. */
+typedef struct sfb__fil_poly {
+    const double *pts;
+    int n, closed;
+    int *tri;
+    sfb__aabb tree;
+} sfb__fil_poly;
+static sfb_result fil_poly_build(sfb_context *ctx, sfb__fil_poly *P, const double *pts, int n, int closed) {
+    const int segs = closed ? n : n - 1;
+    int i;
+    memset(P, 0, sizeof *P);
+    P->pts = pts;
+    P->n = n;
+    P->closed = closed;
+    if (segs < 32) return SFB_SUCCESS;
+    P->tri = (int *)sfb__alloc(ctx, (size_t)segs * 3 * sizeof(int));
+    if (!P->tri) return sfb__oom(ctx, "a polyline's segment tree");
+    for (i = 0; i < segs; ++i) {
+        P->tri[3 * i] = i;
+        P->tri[3 * i + 1] = P->tri[3 * i + 2] = (i + 1) % n;
+    }
+    return sfb__aabb_build(ctx, pts, P->tri, NULL, segs, &P->tree);
 }
+static void fil_poly_free(sfb_context *ctx, sfb__fil_poly *P) {
+    sfb__aabb_free(ctx, &P->tree);
+    sfb__free(ctx, P->tri);
+    P->tri = NULL;
+}
+static void fil_poly_nearest(const sfb__fil_poly *P, const double *p, int *seg, double *t, double *d2) {
+    double bary[3];
+    int id;
+    if (!P->tri || P->tree.node_count == 0 ||
+        (id = sfb__aabb_nearest(&P->tree, P->pts, P->tri, NULL, p, NULL, d2, bary)) < 0) {
+        fil_polyline_nearest(P->pts, P->n, P->closed, p, seg, t, d2);
+        return;
+    }
+    *seg = id;
+    *t = 1.0 - bary[0];
+    *t = *t < 0.0 ? 0.0 : *t > 1.0 ? 1.0 : *t;
+}
+
 
 /* ---- the conformal map (seed 5), on the direct map's boundary ----
  * The seed splits the cylinder-like region along a shortest path and maps it onto a rectangle with
@@ -15477,11 +15514,15 @@ static sfb_result fil_one(sfb__fil *F, sfb__fil_work *W, const sfb__fil_curve *c
     sfb__fil_prof *prof = NULL, *ip = NULL;
     sfb__aabb tree[2];
     sfb__fil_pairs P;
+    sfb__fil_poly PC, PS, PL[2];
     int *cedge = NULL, nce = 0, i, k, side, qh = 0, qt = 0, ns = 0, sclosed = 0, nsamp = 0, moved = 0, convex;
     double dmax = 0.0, d, conv = 0.0, maxdev = 0.0;
     sfb_result res = SFB_SUCCESS;
     memset(tree, 0, sizeof tree);
     memset(&P, 0, sizeof P);
+    memset(&PC, 0, sizeof PC);
+    memset(&PS, 0, sizeof PS);
+    memset(PL, 0, sizeof PL);
     memset(rep, 0, sizeof *rep);
     rep->closed = cv->closed;
     rep->curve_vertices = m;
@@ -15494,6 +15535,8 @@ static sfb_result fil_one(sfb__fil *F, sfb__fil_work *W, const sfb__fil_curve *c
     cedge = (int *)sfb__alloc(ctx, (size_t)cv->n * sizeof(int));
     if (!cp || !cedge) { res = sfb__oom(ctx, "the blending curve"); goto done; }
     for (i = 0; i < m; ++i) memcpy(cp + 3 * (size_t)i, F->pos + 3 * (size_t)cv->v[i], 3 * sizeof(double));
+    res = fil_poly_build(ctx, &PC, cp, m, cv->closed);
+    if (res != SFB_SUCCESS) goto done;
     /* curve edges, the sides' seed faces, the sharpest dihedral angle */
     for (i = 0; i + 1 < cv->n; ++i) {
         const int a = cv->v[i], b = cv->v[i + 1], e = fil_edge_of(l, a, b);
@@ -15535,7 +15578,12 @@ static sfb_result fil_one(sfb__fil *F, sfb__fil_work *W, const sfb__fil_curve *c
                 for (c = 0; c < 3; ++c) {
                     const int v = F->tri[3 * g + c];
                     if (W->vd[v] < 0) {
-                        W->vd[v] = fil_curve_distance(cp, m, cv->closed, F->pos + 3 * (size_t)v, NULL);
+                        {
+                            int sg;
+                            double tt, dd;
+                            fil_poly_nearest(&PC, F->pos + 3 * (size_t)v, &sg, &tt, &dd);
+                            W->vd[v] = sqrt(dd);
+                        }
                         W->vdlist[W->nvd++] = v;
                     }
                     if (W->vd[v] < d) near_ = 1;
@@ -15679,7 +15727,12 @@ static sfb_result fil_one(sfb__fil *F, sfb__fil_work *W, const sfb__fil_curve *c
                 link[side][k] = bary[0] * F->pos[3 * (size_t)t[0] + k] + bary[1] * F->pos[3 * (size_t)t[1] + k] +
                                 bary[2] * F->pos[3 * (size_t)t[2] + k];
         }
-        fil_curve_distance(cp, m, cv->closed, C + 3 * (size_t)i, E);
+        {
+            int sg;
+            double tt, dd;
+            fil_poly_nearest(&PC, C + 3 * (size_t)i, &sg, &tt, &dd);
+            fil_lerp(cp + 3 * (size_t)sg, cp + 3 * (size_t)((sg + 1) % m), tt, E);
+        }
         fil_prof_build(&prof[i], C + 3 * (size_t)i, link[0], link[1], E, kind, cv->conic_w, hs);
     }
 
@@ -15696,6 +15749,9 @@ static sfb_result fil_one(sfb__fil *F, sfb__fil_work *W, const sfb__fil_curve *c
         memcpy(LK[0] + 3 * (size_t)i, prof[i].P1, 3 * sizeof(double));
         memcpy(LK[1] + 3 * (size_t)i, prof[i].P2, 3 * sizeof(double));
     }
+    if ((res = fil_poly_build(ctx, &PS, C, nsamp, sclosed)) != SFB_SUCCESS || (res = fil_poly_build(ctx, &PL[0], LK[0], nsamp, sclosed)) != SFB_SUCCESS ||
+        (res = fil_poly_build(ctx, &PL[1], LK[1], nsamp, sclosed)) != SFB_SUCCESS)
+        goto done;
     S[0] = 0.0;
     for (i = 1; i <= nsamp; ++i)
         S[i] = S[i - 1] + (i < nsamp ? fil_dist(C + 3 * (size_t)(i - 1), C + 3 * (size_t)i) : sclosed ? fil_dist(C + 3 * (size_t)(nsamp - 1), C) : 0.0);
@@ -15704,7 +15760,7 @@ static sfb_result fil_one(sfb__fil *F, sfb__fil_work *W, const sfb__fil_curve *c
         const double *p = F->pos + 3 * (size_t)v;
         int seg, j, vs;
         double t, d2, E[3], L1, L2, s;
-        fil_polyline_nearest(C, nsamp, sclosed, p, &seg, &t, &d2);
+        fil_poly_nearest(&PS, p, &seg, &t, &d2);
         j = (seg + 1) % nsamp;
         if (!sclosed && ((seg == 0 && t <= 0.0) || (seg == nsamp - 2 && t >= 1.0))) {
             /* beyond an end of an open spine: outside unless on the end plane */
@@ -15722,8 +15778,8 @@ static sfb_result fil_one(sfb__fil *F, sfb__fil_work *W, const sfb__fil_curve *c
              * which the conformal map keeps -- find their own profile only this way. */
             int sg0, sg1;
             double t0, t1, e0, e1;
-            fil_polyline_nearest(LK[0], nsamp, sclosed, p, &sg0, &t0, &e0);
-            fil_polyline_nearest(LK[1], nsamp, sclosed, p, &sg1, &t1, &e1);
+            fil_poly_nearest(&PL[0], p, &sg0, &t0, &e0);
+            fil_poly_nearest(&PL[1], p, &sg1, &t1, &e1);
             vs = (W->vin[v] & 1) ? 0 : 1;
             if ((W->vin[v] & 3) == 3) vs = e0 <= e1 ? 0 : 1; /* both sides (around an open chain's end): the nearer */
             seg = vs == 0 ? sg0 : sg1;
@@ -15827,6 +15883,7 @@ done:
     sfb__free(ctx, cp); sfb__free(ctx, cedge); sfb__free(ctx, spine); sfb__free(ctx, cum);
     sfb__free(ctx, sarc); sfb__free(ctx, C); sfb__free(ctx, prof); sfb__free(ctx, ip); sfb__free(ctx, S);
     sfb__free(ctx, LK[0]); sfb__free(ctx, LK[1]);
+    fil_poly_free(ctx, &PC); fil_poly_free(ctx, &PS); fil_poly_free(ctx, &PL[0]); fil_poly_free(ctx, &PL[1]);
     return res;
 }
 

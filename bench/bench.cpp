@@ -1592,8 +1592,10 @@ static int fillet_progress(float done, const char *stage, void *user) {
     return 0;
 }
 static int fillet_section() {
-    struct Case { const char *label; int n; float radius; };
-    const Case cases[] = {{"8.5k tris", 26, 0.12f}, {"200k+ tris", 130, 0.12f}};
+    /* half: the box's half width -- the third case is the first's seam and blend region on a box
+     * 12 times as wide (the mesh grows, the region does not) */
+    struct Case { const char *label; int n; float radius, half; };
+    const Case cases[] = {{"8.5k tris", 17, 0.14f, 1.0f}, {"200k+ tris", 110, 0.14f, 1.0f}, {"8.5k region", 17, 0.14f, 12.0f}};
     int status = 0;
     printf("\n== rolling-ball fillets (seed 002): box-cylinder seam, arc profile; ms, best of 5\n");
     printf("%-11s %8s %8s %7s %8s %7s %7s %8s %8s %8s %8s %8s\n", "mesh", "tris", "region", "moved", "setup", "curves", "spine",
@@ -1607,7 +1609,7 @@ static int fillet_section() {
         cfg.progress.user = &clk;
         sfb_context *ctx = NULL;
         sfb_mesh *in = NULL;
-        if (fs_box_cylinder(&fm, c.n, 1.0f, 0.6f, 0.5f, 0.6f) != 0 || sfb_context_create(&cfg, &ctx) != SFB_SUCCESS ||
+        if (fs_box_cylinder(&fm, c.n, c.half, 0.6f, 0.5f, 0.6f) != 0 || sfb_context_create(&cfg, &ctx) != SFB_SUCCESS ||
             fs_to_mesh(ctx, &fm, &in) != SFB_SUCCESS) {
             printf("%-11s failed to build the mesh\n", c.label);
             status = 1;
