@@ -143,6 +143,51 @@ static inline int fs_fold(fs_mesh *m, int n, float length, float width, float an
     return 0;
 }
 
+/* A step: the strip z = 0 for y in [-width, 0], the wall y = 0 down to z = -depth, the strip
+ * z = -depth for y in [0, width], all for x in [0, length], outward normals +z, +y, +z: a convex
+ * 90-degree edge along (x, 0, 0) and a concave one along (x, 0, -depth). n segments along x,
+ * about as fine across. Open. loop: the convex edge's vertices, x ascending, then (loop2) the
+ * concave edge's, stored after the first chain: loop[0..n] and loop[n+1..2n+1]. */
+static inline int fs_step(fs_mesh *m, int n, float length, float width, float depth) {
+    const double step = (double)length / n;
+    const double yz[4][2] = {{-(double)width, 0.0}, {0.0, 0.0}, {0.0, -(double)depth}, {(double)width, -(double)depth}};
+    int piece, j, i, rows = 0, *row = NULL, *prev = NULL, rc = -1, edge_row[2] = {0, 0};
+    memset(m, 0, sizeof *m);
+    if (n < 1 || !(length > 0) || !(width > 0) || !(depth > 0)) return -1;
+    row = (int *)malloc((size_t)(n + 1) * sizeof(int));
+    prev = (int *)malloc((size_t)(n + 1) * sizeof(int));
+    m->loop = (int *)malloc((size_t)(2 * n + 2) * sizeof(int));
+    if (!row || !prev || !m->loop) goto done;
+    for (piece = 0; piece < 3; ++piece) {
+        const double *a = yz[piece], *b = yz[piece + 1], len = hypot(b[0] - a[0], b[1] - a[1]);
+        const int k = (int)(len / step + 0.5) < 1 ? 1 : (int)(len / step + 0.5);
+        fs_dir d;
+        memset(&d, 0, sizeof d);
+        /* outward: the piece's direction in (y, z) turned a quarter counter-clockwise */
+        d.v[1] = -(b[1] - a[1]) / len;
+        d.v[2] = (b[0] - a[0]) / len;
+        for (j = piece == 0 ? 0 : 1; j <= k; ++j) {
+            const double y = a[0] + (b[0] - a[0]) * j / k, z = a[1] + (b[1] - a[1]) * j / k;
+            for (i = 0; i <= n; ++i)
+                if ((row[i] = fs_vertex(m, step * i, y, z)) < 0) goto done;
+            if (j > 0 && fs_strip(m, prev, row, n + 1, 0, &d)) goto done;
+            memcpy(prev, row, (size_t)(n + 1) * sizeof(int));
+            rows++;
+            if (j == k && piece < 2) edge_row[piece] = rows - 1;
+        }
+    }
+    for (i = 0; i <= n; ++i) {
+        m->loop[i] = edge_row[0] * (n + 1) + i;
+        m->loop[n + 1 + i] = edge_row[1] * (n + 1) + i;
+    }
+    m->loop_count = n + 1;
+    rc = 0;
+done:
+    free(row);
+    free(prev);
+    return rc;
+}
+
 /* The union of the box [-half, half]^2 x [-height, 0] and a cylinder of `radius` (< half) on its top
  * face from z = 0 to cyl_height, one closed watertight mesh. The top face is cut by rays from the
  * axis at M equal angles (M a multiple of 8, about 4 n: the square's corners lie on rays) into

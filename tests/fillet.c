@@ -203,6 +203,90 @@ static void test_fold_holes(double theta, int flip, int kind, double w, int hole
     fs_free(&fm);
 }
 
+/* Several curves in one call: a step's convex and concave edges. First found by angle (two open
+ * curves, one convex, one concave, the config's radius), then given by the caller with a radius
+ * and a profile each (0.2 arc on the convex edge, 0.3 conic of weight 0.5 on the concave one):
+ * every moved vertex on its own edge's exact profile, within 1 % of that edge's radius. */
+static void test_step(void) {
+    fs_mesh fm;
+    sfb_mesh *in = NULL, *out = NULL;
+    sfb_fillet_config cfg;
+    sfb_fillet_curve curves[2];
+    sfb_fillet_report rep;
+    sfb_result r;
+    const double depth = 1.0;
+    int pass;
+    memset(&fm, 0, sizeof fm);
+    if (fs_step(&fm, 40, 2.0f, 1.0f, (float)depth) != 0 || !(in = make_mesh(&fm))) {
+        fail("step/setup", "no step");
+        fs_free(&fm);
+        return;
+    }
+    for (pass = 0; pass < 2; ++pass) {
+        const char *nm0 = pass ? "step/caller's curves" : "step/by angle";
+        const double rad[2] = {pass ? 0.2 : 0.25, pass ? 0.3 : 0.25};
+        const int kind[2] = {SFB_FILLET_ARC, pass ? SFB_FILLET_CONIC : SFB_FILLET_ARC};
+        const double w[2] = {0.0, pass ? 0.5 : 0.0};
+        char nm[160];
+        cfg = sfb_fillet_config_init(0.25f);
+        if (pass) {
+            memset(curves, 0, sizeof curves);
+            curves[0].vertices = fm.loop;
+            curves[0].count = fm.loop_count;
+            curves[0].radius = 0.2f;
+            curves[1].vertices = fm.loop + fm.loop_count;
+            curves[1].count = fm.loop_count;
+            curves[1].radius = 0.3f;
+            curves[1].profile = SFB_FILLET_CONIC + 1;
+            curves[1].conic_weight = 0.5f;
+            cfg.curves = curves;
+            cfg.curve_count = 2;
+        }
+        r = sfb_mesh_fillet(g_ctx, in, &cfg, &out, &rep);
+        snprintf(nm, sizeof nm, "%s/runs", nm0);
+        check(r == SFB_SUCCESS && out, nm, "%s: %s", sfb_result_string(r), sfb_last_error(g_ctx));
+        if (r != SFB_SUCCESS || !out) continue;
+        {
+            sfb_mesh_desc d;
+            int v, moved[2] = {0, 0}, bad = 0, c, conv = -1;
+            double worst = 0.0;
+            sfb_mesh_get_desc(out, &d);
+            for (c = 0; c < rep.curve_count; ++c)
+                if (rep.curves[c].convex) conv = c;
+            snprintf(nm, sizeof nm, "%s/two open curves, one convex", nm0);
+            check(rep.curve_count == 2 && !rep.curves[0].closed && !rep.curves[1].closed && rep.curves[0].convex != rep.curves[1].convex, nm,
+                  "curves %d", rep.curve_count);
+            if (pass) {
+                snprintf(nm, sizeof nm, "%s/the given radii reported", nm0);
+                check(rep.curve_count == 2 && fabs(rep.curves[0].radius - 0.2) < 1e-6 && fabs(rep.curves[1].radius - 0.3) < 1e-6 && conv == 0, nm,
+                      "radii %g %g, convex curve %d", rep.curves[0].radius, rep.curve_count > 1 ? rep.curves[1].radius : 0.0, conv);
+            }
+            for (v = 0; v < fm.nv; ++v) {
+                const float *p0 = fm.pos + 3 * v, *p1 = d.positions + 3 * v;
+                /* which edge: the nearer one before the fillet; q in that edge's fold frame */
+                const double d0 = hypot(p0[1], p0[2]), d1 = hypot(p0[1], p0[2] + depth);
+                const int e = d0 <= d1 ? 0 : 1;
+                const fold_geo g = fold_geometry(90.0, rad[e]);
+                double q[2], err;
+                if (p0[0] == p1[0] && p0[1] == p1[1] && p0[2] == p1[2]) continue;
+                moved[e]++;
+                if (e == 0) { q[0] = p1[1]; q[1] = p1[2]; }
+                else { q[0] = -p1[1]; q[1] = -(p1[2] + depth); }
+                err = profile_distance(&g, kind[e], w[e], q) / rad[e];
+                if (err > worst) worst = err;
+                if (err > 0.01) bad++;
+            }
+            snprintf(nm, sizeof nm, "%s/each edge on its exact profile", nm0);
+            check(moved[0] > 0 && moved[1] > 0 && bad == 0, nm, "moved %d + %d, %d off by more than 1%% of their radius (worst %.3g)", moved[0],
+                  moved[1], bad, worst);
+            sfb_fillet_report_free(&rep);
+            sfb_mesh_destroy(out);
+        }
+    }
+    sfb_mesh_destroy(in);
+    fs_free(&fm);
+}
+
 /* Fillet the 90-degree fold, then sharpen it back with the former edge as the caller's curve. */
 static void test_sharpen(void) {
     fs_mesh fm;
@@ -604,6 +688,7 @@ int main(void) {
     test_fold(120.0, 0, SFB_FILLET_HERMITE, 0.0, "fold 120 hermite");
     test_fold_holes(90.0, 0, SFB_FILLET_ARC, 0.0, 1, "fold 90 convex arc, 4 holes in the region");
     test_fold_holes(90.0, 1, SFB_FILLET_CONIC, 0.6, 1, "fold 90 concave conic 0.6, 4 holes in the region");
+    test_step();
     test_sharpen();
     test_seam();
     test_self_intersection(0.0f, "self-intersection");
