@@ -148,7 +148,8 @@ $(BUILD)/examples/%: examples/%.cpp tests/egl_host.h $(BUILD)/libsfb.o | deps-ex
 	@mkdir -p $(BUILD)/examples
 	$(CXX) $(CXXFLAGS) $(SAN) -I. $< $(BUILD)/libsfb.o -o $@ $(GL_LIBS) $(LIBS)
 
-run: deps $(BUILD)/surfblend $(BUILD)/sfb2gltf $(BUILD)/examples/04_tribezier_panel $(BUILD)/examples/05_reflection_panel
+run: deps $(BUILD)/surfblend $(BUILD)/sfb2gltf $(BUILD)/examples/04_tribezier_panel $(BUILD)/examples/05_reflection_panel \
+     $(BUILD)/examples/06_fillet_panel
 	@mkdir -p out
 	./$(BUILD)/surfblend info examples/data/creased_box.obj
 	./$(BUILD)/surfblend refine --scheme catmark --level 3 --limit examples/data/creased_box.obj -o out/creased_box_level3.obj
@@ -201,6 +202,11 @@ run: deps $(BUILD)/surfblend $(BUILD)/sfb2gltf $(BUILD)/examples/04_tribezier_pa
 	    ./$(BUILD)/surfblend analyze --scheme loop --mode $$m --size 800x600 $(REAL_MESHES)/spot.obj -o out/spot_$$m.png || exit 1; \
 	  done; \
 	else echo "real meshes not found at $(REAL_MESHES): the spot pictures are skipped"; fi
+	@# rolling-ball fillets (seed 002, as its Fig. 12): a box with a cylinder on top, the concave seam,
+	@# the cylinder's rim and the box's edges (short of its corners) filleted, and every feature by
+	@# dihedral angle (the box's corners crumple: shown, not checked); before and after with highlight
+	@# lines, mean curvature and close-ups; prints mean |H|, sharpest edges, folds and linkage normal jumps
+	./$(BUILD)/examples/06_fillet_panel out/fillet_panel.png
 	@# the main job's end: glTF 2.0 for engines and viewers -- the creased box with subdivision-shading
 	@# normals (hard edges split), and the manifold blend tessellated
 	./$(BUILD)/sfb2gltf --level 3 examples/data/creased_box.obj -o out/creased_box.glb

@@ -780,12 +780,17 @@ typedef struct sfb_fillet_curve_report {
 typedef struct sfb_fillet_report {
     int curve_count;
     sfb_fillet_curve_report *curves;   /* curve_count entries, freed by sfb_fillet_report_free */
-    int vertices_moved;
+    int vertices_moved;         /* all curves' and corners' */
+    int corner_count;           /* corners where three curves end, rounded by the ball's sphere */
+    int corner_vertices_moved;
     sfb_context *ctx_;
 } sfb_fillet_report;
 /* Fillets `mesh` (all faces triangles, manifold: SFB_INVALID_TOPOLOGY naming the face or edge
  * otherwise) into a new mesh *out (same vertices, faces, UVs and tags; positions moved; the
- * filleted edges lose their crease tags). Errors, with *out NULL, the input untouched and nothing
+ * filleted edges lose their crease tags). Every curve is filleted on the input's positions; where
+ * exactly three curves of one convexity and radius end at a vertex whose faces lie on three
+ * planes (a box's corner), each sweep ends where the ball touches the third plane and the
+ * vertices beyond move onto the ball's sphere. Errors, with *out NULL, the input untouched and nothing
  * kept: radius <= 0 or not finite, a bad profile or weight (SFB_INVALID_VALUE); a caller's curve
  * that is not a chain of mesh edges (SFB_INVALID_TOPOLOGY naming the vertex); no feature found or a
  * radius too large for the base patches, so that the offsets do not meet (SFB_INVALID_VALUE); the

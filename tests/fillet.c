@@ -377,6 +377,64 @@ static long self_intersections(const sfb_mesh *m, int nf) {
     return pairs;
 }
 
+/* The box-cylinder union with every feature found by angle: the box's twelve edges end three at a
+ * time at its eight corners, where the ball's sphere joins them. Exact: a vertex of the box (away
+ * from the cylinder) lies r from the box shrunk by r -- on a face, an edge's quarter cylinder or a
+ * corner's sphere -- within 1 % of r; the 8 corners are reported; no triangles intersect. */
+static void test_box_corners(void) {
+    fs_mesh fm;
+    sfb_mesh *in = NULL, *out = NULL;
+    sfb_fillet_config cfg;
+    sfb_fillet_report rep;
+    sfb_result r;
+    const double half = 1.0, height = 0.6, R = 0.5, rad = 0.15;
+    memset(&fm, 0, sizeof fm);
+    if (fs_box_cylinder(&fm, 48, (float)half, (float)height, (float)R, 0.6f) != 0 || !(in = make_mesh(&fm))) {
+        fail("corners/setup", "no box-cylinder");
+        fs_free(&fm);
+        return;
+    }
+    cfg = sfb_fillet_config_init((float)rad);
+    r = sfb_mesh_fillet(g_ctx, in, &cfg, &out, &rep);
+    check(r == SFB_SUCCESS && out, "corners/runs", "%s: %s", sfb_result_string(r), sfb_last_error(g_ctx));
+    if (r == SFB_SUCCESS && out) {
+        sfb_mesh_desc d;
+        int v, n = 0, bad = 0, on_sphere = 0;
+        double worst = 0.0;
+        long pairs;
+        sfb_mesh_get_desc(out, &d);
+        for (v = 0; v < fm.nv; ++v) {
+            const float *p0 = fm.pos + 3 * v, *p = d.positions + 3 * v;
+            const double lo[3] = {-half + rad, -half + rad, -height + rad}, hi[3] = {half - rad, half - rad, -rad};
+            double q[3], dist, e;
+            int k, out_of = 0;
+            if (hypot(p0[0], p0[1]) < R + 2.0 * rad && p0[2] > -2.0 * rad) continue; /* the seam's and the cylinder's */
+            for (k = 0; k < 3; ++k) {
+                q[k] = p[k] < lo[k] ? lo[k] : p[k] > hi[k] ? hi[k] : p[k];
+                out_of += p[k] < lo[k] || p[k] > hi[k];
+            }
+            dist = sqrt((p[0] - q[0]) * (p[0] - q[0]) + (p[1] - q[1]) * (p[1] - q[1]) + (p[2] - q[2]) * (p[2] - q[2]));
+            e = fabs(dist - rad) / rad;
+            if (out_of == 3) on_sphere++;
+            if (e > worst) worst = e;
+            if (e > 0.01) bad++;
+            n++;
+        }
+        printf("corners: %d corners, %d vertices on their spheres (%d beyond all three planes); box vertices %d, worst %.2g r off the rounded box\n",
+               rep.corner_count, rep.corner_vertices_moved, on_sphere, n, worst);
+        check(rep.corner_count == 8 && rep.corner_vertices_moved > 0 && on_sphere == rep.corner_vertices_moved, "corners/eight spheres",
+              "%d corners, %d vertices moved onto spheres, %d found beyond the three planes", rep.corner_count, rep.corner_vertices_moved, on_sphere);
+        check(n > 1000 && bad == 0, "corners/on the exact rounded box", "%d of %d box vertices farther than 1%% of r from it (worst %.3g r)", bad, n,
+              worst);
+        pairs = self_intersections(out, fm.nf);
+        check(pairs == 0, "corners/no self-intersections", "%ld intersecting triangle pairs", pairs);
+        sfb_fillet_report_free(&rep);
+        sfb_mesh_destroy(out);
+    }
+    sfb_mesh_destroy(in);
+    fs_free(&fm);
+}
+
 static void test_seam(void) {
     fs_mesh fm;
     sfb_mesh *in = NULL, *out = NULL;
@@ -689,6 +747,7 @@ int main(void) {
     test_fold_holes(90.0, 0, SFB_FILLET_ARC, 0.0, 1, "fold 90 convex arc, 4 holes in the region");
     test_fold_holes(90.0, 1, SFB_FILLET_CONIC, 0.6, 1, "fold 90 concave conic 0.6, 4 holes in the region");
     test_step();
+    test_box_corners();
     test_sharpen();
     test_seam();
     test_self_intersection(0.0f, "self-intersection");

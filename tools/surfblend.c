@@ -1425,6 +1425,7 @@ static int cmd_fillet(cli_opts *o) {
                   i, c->closed ? "closed" : "open", c->convex ? "convex" : "concave", c->curve_vertices, (double)c->radius,
                   (double)c->spine_length, c->samples, c->vertices_moved, c->self_intersections, (double)c->max_deviation);
     }
+    if (rep.corner_count) cli_error("%d corners rounded by the ball's sphere, %d vertices moved onto them", rep.corner_count, rep.corner_vertices_moved);
     cli_error("%d curves filleted, %d vertices moved -> %s", rep.curve_count, rep.vertices_moved, o->outp);
     rc = 0;
 done:

@@ -39,7 +39,16 @@
  *    halfway instead of one swallowing the other.
  *  - Convex or concave per curve: side 1's faces lie below side 0's tangent plane (summed over the
  *    curve's edges) for a convex edge. Convex: offsets against the normals; concave: along them.
- *  - Curves are filleted one after the other, each on the positions the earlier ones left. */
+ *  - Every curve is filleted on the input's positions (each writes its own region), and base
+ *    patches stop at the edges of the call's other curves: where curves meet at a corner their
+ *    regions then end at the corner's planes instead of wrapping round onto the third face. (One
+ *    after the other, each on the positions the earlier ones left, the box's edges crumpled at
+ *    the corners and the crumples fed the next curves' offsets: spines ran away to 44x their
+ *    length.)
+ *  - Corners (sfb__fil_corner): three arc curves of one convexity and radius ending at a vertex
+ *    on three planes get the ball's sphere (exact: the rolling ball touching all three faces). Other
+ *    junctions (mixed convexity, other profiles, curved faces, more than three curves) keep each
+ *    curve's sweep ending at the plane through the vertex. */
 
 
 #define SFB__FIL_TAB 48 /* profile arc-length table intervals */
@@ -50,7 +59,23 @@ typedef struct sfb__fil_curve {
     double radius;
     int profile;
     double conic_w;
+    int corner[2];    /* per end (v[0], v[n-1]): the corner (sfb__fil_corner) it ends at, or -1 */
 } sfb__fil_curve;
+
+/* A corner: a vertex where exactly three open curves end, all convex or all concave, all with the
+ * arc profile and one radius, around
+ * which the faces lie on three planes (within 2 % of r). The ball touches all three there: its
+ * centre C is r from each plane (inside the solid for convex curves, outside for concave ones),
+ * each curve's sweep ends in the plane through C across its end, and the vertices beyond all
+ * three end planes move onto the ball's sphere. (The seed fillets closed curves only; this is the
+ * rolling ball's own answer at a corner: the three cylinders meet the sphere along their end
+ * circles, tangent-continuous.) */
+typedef struct sfb__fil_corner {
+    int v;            /* the corner vertex */
+    double C[3], r;   /* the ball's centre and radius */
+    double u[3][3];   /* per curve end: unit direction out of the curve into the corner */
+    int moved;
+} sfb__fil_corner;
 
 typedef struct sfb__fil_prof {
     double P1[3], P0[3], P2[3], C[3], E[3];
@@ -65,8 +90,12 @@ typedef struct sfb__fil {
     const sfb__level *l;
     int nv, nf;
     const int *tri;
-    double *pos, *fn;      /* current positions; unit face normals */
+    double *pos, *fn;      /* the input's positions; unit face normals */
     double *npos;          /* positions after the current curve */
+    double *opos;          /* the output's positions: every curve and corner writes its moved vertices */
+    unsigned char *fmark;  /* per edge: on any blending curve of this call (base patches stop there) */
+    sfb__fil_corner *corners;
+    int ncorners;
     double scale;          /* bounding-box diagonal */
     sfb__fil_curve *curves;
     int ncurves, curves_cap;
@@ -146,6 +175,7 @@ static sfb_result fil_add_curve(sfb__fil *F, const int *v, int n, int closed, do
     memcpy(c->v, v, (size_t)n * sizeof(int));
     c->n = n;
     c->closed = closed;
+    c->corner[0] = c->corner[1] = -1;
     c->radius = radius;
     c->profile = profile;
     c->conic_w = w;
@@ -244,6 +274,171 @@ static sfb_result fil_curves_from_caller(sfb__fil *F) {
                           profile, w);
         if (r != SFB_SUCCESS) return r;
     }
+    return SFB_SUCCESS;
+}
+
+/* Edge e (a-b, two faces): negative when convex -- each face's third vertex lies below the other
+ * face's plane -- positive when concave; summed over a curve's edges it decides the curve. */
+static double fil_edge_conv(const sfb__fil *F, int e, int a, int b) {
+    const sfb__level *l = F->l;
+    const int f0 = l->ef[l->ef_off[e]], f1 = l->ef[l->ef_off[e] + 1];
+    double conv = 0.0;
+    int j;
+    for (j = 0; j < 3; ++j) {
+        const int o1 = F->tri[3 * f1 + j], o0 = F->tri[3 * f0 + j];
+        double dv[3];
+        if (o1 != a && o1 != b) { fil_sub(F->pos + 3 * (size_t)o1, F->pos + 3 * (size_t)a, dv); conv += fil_dot(dv, F->fn + 3 * (size_t)f0); }
+        if (o0 != a && o0 != b) { fil_sub(F->pos + 3 * (size_t)o0, F->pos + 3 * (size_t)a, dv); conv += fil_dot(dv, F->fn + 3 * (size_t)f1); }
+    }
+    return conv;
+}
+
+/* The corners (sfb__fil_corner): vertices where exactly three open curves end, with one
+ * convexity, whose faces lie on three planes. Marks every curve's edges in fmark too. */
+static sfb_result fil_find_corners(sfb__fil *F) {
+    const sfb__level *l = F->l;
+    int *ends = (int *)sfb__calloc(F->ctx, (size_t)F->nv + 1, sizeof(int));
+    int c, k, i;
+    if (!ends) return sfb__oom(F->ctx, "the corners");
+    for (c = 0; c < F->ncurves; ++c) {
+        const sfb__fil_curve *cv = &F->curves[c];
+        for (i = 0; i + 1 < cv->n; ++i) {
+            const int e = fil_edge_of(l, cv->v[i], cv->v[i + 1]);
+            if (e >= 0) F->fmark[e] = 1;
+        }
+        if (!cv->closed) { ends[cv->v[0]]++; ends[cv->v[cv->n - 1]]++; }
+    }
+    for (c = 0; c < F->ncurves; ++c) {
+        sfb__fil_curve *cv = &F->curves[c];
+        for (k = 0; k < 2 && !cv->closed; ++k) {
+            const int v = k ? cv->v[cv->n - 1] : cv->v[0];
+            int members[3][2], nm = 0, sign = 0, ok = 1, d, j, known = -1;
+            double A[3][3] = {{0}}, rhs[3] = {0}, det, tr, X[3], r = 0.0;
+            sfb__fil_corner *K;
+            if (ends[v] != 3) continue;
+            for (j = 0; j < F->ncorners; ++j)
+                if (F->corners[j].v == v) known = j;
+            if (known >= 0) { cv->corner[k] = known; continue; }
+            /* the three curve ends at v: one convexity, one radius */
+            for (d = 0; d < F->ncurves && nm <= 3; ++d) {
+                const sfb__fil_curve *w = &F->curves[d];
+                int kk;
+                for (kk = 0; kk < 2 && !w->closed; ++kk)
+                    if ((kk ? w->v[w->n - 1] : w->v[0]) == v && nm < 3) {
+                        double conv = 0.0;
+                        for (j = 0; j + 1 < w->n; ++j) {
+                            const int e = fil_edge_of(l, w->v[j], w->v[j + 1]);
+                            if (e >= 0 && l->ef_off[e + 1] - l->ef_off[e] == 2) conv += fil_edge_conv(F, e, w->v[j], w->v[j + 1]);
+                        }
+                        if (sign == 0) sign = conv < 0 ? -1 : 1;
+                        else if ((conv < 0 ? -1 : 1) != sign) ok = 0;
+                        if (w->profile != SFB_FILLET_ARC) ok = 0; /* the sphere continues the arc only */
+                        if (nm == 0) r = w->radius;
+                        else if (fabs(w->radius - r) > 1e-9 * r) ok = 0;
+                        members[nm][0] = d;
+                        members[nm][1] = kk;
+                        nm++;
+                    }
+            }
+            if (!ok || nm != 3) continue;
+            /* the ball's centre: r from every face plane around v, least squares (angle weighted) */
+            for (j = l->vf_off[v]; j < l->vf_off[v + 1]; ++j) {
+                const int f = l->vf[j];
+                const double *n = F->fn + 3 * (size_t)f;
+                int q, p2;
+                for (q = 0; q < 3; ++q) {
+                    for (p2 = 0; p2 < 3; ++p2) A[q][p2] += n[q] * n[p2];
+                    rhs[q] += n[q] * (fil_dot(n, F->pos + 3 * (size_t)v) + sign * r);
+                }
+            }
+            det = A[0][0] * (A[1][1] * A[2][2] - A[1][2] * A[2][1]) - A[0][1] * (A[1][0] * A[2][2] - A[1][2] * A[2][0]) +
+                  A[0][2] * (A[1][0] * A[2][1] - A[1][1] * A[2][0]);
+            tr = A[0][0] + A[1][1] + A[2][2];
+            if (!(fabs(det) > 1e-3 * tr * tr * tr)) continue; /* fewer than three independent planes */
+            for (j = 0; j < 3; ++j) {
+                double M[3][3];
+                int q;
+                memcpy(M, A, sizeof M);
+                for (q = 0; q < 3; ++q) M[q][j] = rhs[q];
+                X[j] = (M[0][0] * (M[1][1] * M[2][2] - M[1][2] * M[2][1]) - M[0][1] * (M[1][0] * M[2][2] - M[1][2] * M[2][0]) +
+                        M[0][2] * (M[1][0] * M[2][1] - M[1][1] * M[2][0])) / det;
+            }
+            /* every face plane r from it (the faces around v lie on three planes) */
+            for (j = l->vf_off[v]; j < l->vf_off[v + 1] && ok; ++j) {
+                const double *n = F->fn + 3 * (size_t)l->vf[j];
+                double dv[3];
+                fil_sub(X, F->pos + 3 * (size_t)v, dv);
+                if (fabs(fil_dot(n, dv) - sign * r) > 0.02 * r) ok = 0;
+            }
+            if (!ok) continue;
+            if (F->ncorners % 8 == 0) {
+                sfb__fil_corner *nc = (sfb__fil_corner *)sfb__realloc(F->ctx, F->corners, (size_t)(F->ncorners + 8) * sizeof *nc);
+                if (!nc) { sfb__free(F->ctx, ends); return sfb__oom(F->ctx, "the corners"); }
+                F->corners = nc;
+            }
+            K = &F->corners[F->ncorners];
+            memset(K, 0, sizeof *K);
+            K->v = v;
+            K->r = r;
+            memcpy(K->C, X, sizeof X);
+            for (j = 0; j < 3; ++j) {
+                const sfb__fil_curve *w = &F->curves[members[j][0]];
+                const int a = members[j][1] ? w->v[w->n - 1] : w->v[0], b = members[j][1] ? w->v[w->n - 2] : w->v[1];
+                double u[3], lu;
+                fil_sub(F->pos + 3 * (size_t)a, F->pos + 3 * (size_t)b, u);
+                lu = fil_len(u);
+                for (d = 0; d < 3; ++d) K->u[j][d] = lu > 0 ? u[d] / lu : 0.0;
+            }
+            cv->corner[k] = F->ncorners++;
+        }
+    }
+    sfb__free(F->ctx, ends);
+    return SFB_SUCCESS;
+}
+
+/* The corners' spheres: from the corner vertex through the vertices beyond all three end planes
+ * (within 4 r of the ball's centre), each moved to the sphere along the ray from the centre. */
+static sfb_result fil_corners_project(sfb__fil *F) {
+    const sfb__level *l = F->l;
+    int *stack = (int *)sfb__alloc(F->ctx, ((size_t)F->nv + 1) * sizeof(int));
+    unsigned char *seen = (unsigned char *)sfb__calloc(F->ctx, (size_t)F->nv + 1, 1);
+    int k;
+    if (!stack || !seen) { sfb__free(F->ctx, stack); sfb__free(F->ctx, seen); return sfb__oom(F->ctx, "the corners"); }
+    for (k = 0; k < F->ncorners; ++k) {
+        sfb__fil_corner *K = &F->corners[k];
+        int sp = 0, j;
+        stack[sp++] = K->v;
+        seen[K->v] = 1;
+        while (sp > 0) {
+            const int v = stack[--sp];
+            const double *p = F->pos + 3 * (size_t)v;
+            double dv[3], ld;
+            int inside = 1;
+            fil_sub(p, K->C, dv);
+            ld = fil_len(dv);
+            for (j = 0; j < 3; ++j) inside &= fil_dot(dv, K->u[j]) >= -1e-9 * K->r;
+            if (!inside || !(ld > 0) || ld > 4.0 * K->r) continue;
+            for (j = 0; j < 3; ++j) F->opos[3 * (size_t)v + j] = K->C[j] + K->r * dv[j] / ld;
+            K->moved++;
+            for (j = l->ve_off[v]; j < l->ve_off[v + 1]; ++j) {
+                const int w = sfb__other_end(l, l->ve[j], v);
+                if (!seen[w]) { seen[w] = 1; stack[sp++] = w; }
+            }
+        }
+        /* reset seen for the next corner: the visited set is small, walk it again */
+        stack[0] = K->v;
+        sp = 1;
+        seen[K->v] = 0;
+        while (sp > 0) {
+            const int v = stack[--sp];
+            for (j = l->ve_off[v]; j < l->ve_off[v + 1]; ++j) {
+                const int w = sfb__other_end(l, l->ve[j], v);
+                if (seen[w]) { seen[w] = 0; stack[sp++] = w; }
+            }
+        }
+    }
+    sfb__free(F->ctx, stack);
+    sfb__free(F->ctx, seen);
     return SFB_SUCCESS;
 }
 
@@ -1076,13 +1271,7 @@ static sfb_result fil_one(sfb__fil *F, sfb__fil_work *W, const sfb__fil_curve *c
         if (fil_dihedral(F, e) > dmax) dmax = fil_dihedral(F, e);
         if (W->fside[f0] < 0) { W->fside[f0] = 0; W->queue[qt++] = f0; }
         if (W->fside[f1] < 0) { W->fside[f1] = 1; W->queue[qt++] = f1; }
-        /* convexity: side 1 below side 0's plane (and side 0 below side 1's) */
-        for (j = 0; j < 3; ++j) {
-            const int o1 = F->tri[3 * f1 + j], o0 = F->tri[3 * f0 + j];
-            double dv[3];
-            if (o1 != a && o1 != b) { fil_sub(F->pos + 3 * (size_t)o1, F->pos + 3 * (size_t)a, dv); conv += fil_dot(dv, F->fn + 3 * (size_t)f0); }
-            if (o0 != a && o0 != b) { fil_sub(F->pos + 3 * (size_t)o0, F->pos + 3 * (size_t)a, dv); conv += fil_dot(dv, F->fn + 3 * (size_t)f1); }
-        }
+        conv += fil_edge_conv(F, e, a, b);
     }
     convex = conv < 0.0;
     rep->convex = convex;
@@ -1095,7 +1284,7 @@ static sfb_result fil_one(sfb__fil *F, sfb__fil_work *W, const sfb__fil_curve *c
         for (k = 0; k < 3; ++k) {
             const int e = l->fe[l->fv_off[f] + k];
             int j;
-            if (F->emark[e]) continue;
+            if (F->emark[e] || F->fmark[e]) continue;
             for (j = l->ef_off[e]; j < l->ef_off[e + 1]; ++j) {
                 const int g = l->ef[j];
                 int c, near_ = 0;
@@ -1190,26 +1379,30 @@ static sfb_result fil_one(sfb__fil *F, sfb__fil_work *W, const sfb__fil_curve *c
                     spine[3 * (size_t)i + k] = spine[3 * (size_t)(ns - 1 - i) + k];
                     spine[3 * (size_t)(ns - 1 - i) + k] = t;
                 }
+        /* the end planes: through the curve's end point, or through the corner ball's centre where
+         * the end is at a corner (the sweep stops where the ball starts touching the third face) */
+        const double *pl0 = cv->corner[0] >= 0 ? F->corners[cv->corner[0]].C : cp;
+        const double *pl1 = cv->corner[1] >= 0 ? F->corners[cv->corner[1]].C : cp + 3 * (size_t)(m - 1);
         fil_sub(cp + 3, cp, t0);                                              /* into the curve at its start */
         fil_sub(cp + 3 * (size_t)(m - 1), cp + 3 * (size_t)(m - 2), t1);       /* out of it at its end */
         while (lo < ns - 1) {
-            fil_sub(spine + 3 * (size_t)(lo + 1), cp, a);
+            fil_sub(spine + 3 * (size_t)(lo + 1), pl0, a);
             if (fil_dot(a, t0) > 0) break;
             lo++;
         }
         while (hi > lo) {
-            fil_sub(spine + 3 * (size_t)(hi - 1), cp + 3 * (size_t)(m - 1), a);
+            fil_sub(spine + 3 * (size_t)(hi - 1), pl1, a);
             if (fil_dot(a, t1) < 0) break;
             hi--;
         }
         /* points lo and hi may lie beyond the planes: move them onto them */
         if (hi > lo) {
             double da, db;
-            fil_sub(spine + 3 * (size_t)lo, cp, a); da = fil_dot(a, t0);
-            fil_sub(spine + 3 * (size_t)(lo + 1), cp, b); db = fil_dot(b, t0);
+            fil_sub(spine + 3 * (size_t)lo, pl0, a); da = fil_dot(a, t0);
+            fil_sub(spine + 3 * (size_t)(lo + 1), pl0, b); db = fil_dot(b, t0);
             if (da < 0 && db > da) fil_lerp(spine + 3 * (size_t)lo, spine + 3 * (size_t)(lo + 1), da / (da - db), spine + 3 * (size_t)lo);
-            fil_sub(spine + 3 * (size_t)hi, cp + 3 * (size_t)(m - 1), a); da = fil_dot(a, t1);
-            fil_sub(spine + 3 * (size_t)(hi - 1), cp + 3 * (size_t)(m - 1), b); db = fil_dot(b, t1);
+            fil_sub(spine + 3 * (size_t)hi, pl1, a); da = fil_dot(a, t1);
+            fil_sub(spine + 3 * (size_t)(hi - 1), pl1, b); db = fil_dot(b, t1);
             if (da > 0 && db < da) fil_lerp(spine + 3 * (size_t)hi, spine + 3 * (size_t)(hi - 1), da / (da - db), spine + 3 * (size_t)hi);
             memmove(spine, spine + 3 * (size_t)lo, (size_t)(hi - lo + 1) * 3 * sizeof(double));
             ns = hi - lo + 1;
@@ -1381,7 +1574,7 @@ static sfb_result fil_one(sfb__fil *F, sfb__fil_work *W, const sfb__fil_curve *c
     }
     for (i = 0; i < W->nvlist; ++i) {
         const int v = W->vlist[i];
-        if (W->vin[v] & 8) memcpy(F->pos + 3 * (size_t)v, F->npos + 3 * (size_t)v, 3 * sizeof(double));
+        if (W->vin[v] & 8) memcpy(F->opos + 3 * (size_t)v, F->npos + 3 * (size_t)v, 3 * sizeof(double));
     }
     rep->vertices_moved = moved;
     rep->max_deviation = (float)maxdev;
@@ -1494,7 +1687,7 @@ SFB_API sfb_result sfb_mesh_fillet(sfb_context *ctx, const sfb_mesh *mesh, const
     F.nf = mesh->base.nf;
     F.tri = mesh->base.fv;
     /* the memory budget, before the work: per vertex 11 doubles x 3 and some ints, per face a few */
-    need = (double)F.nv * (12.0 * 3 * sizeof(double) + 4 * sizeof(int) + 2) + (double)F.nf * (3 * sizeof(double) + 12 * sizeof(int)) +
+    need = (double)F.nv * (13.0 * 3 * sizeof(double) + 4 * sizeof(int) + 2) + (double)F.nf * (3 * sizeof(double) + 12 * sizeof(int)) +
            (double)mesh->base.ne;
     if (need > (double)ctx->budget - (double)ctx->live_bytes)
         return sfb__error(ctx, SFB_LIMIT_EXCEEDED, SFB_ELEMENT_NONE, -1,
@@ -1502,6 +1695,8 @@ SFB_API sfb_result sfb_mesh_fillet(sfb_context *ctx, const sfb_mesh *mesh, const
                           F.nv, F.nf, need / 1048576.0, ctx->budget, ctx->live_bytes);
     F.pos = (double *)sfb__alloc(ctx, ((size_t)F.nv + 1) * 3 * sizeof(double));
     F.npos = (double *)sfb__alloc(ctx, ((size_t)F.nv + 1) * 3 * sizeof(double));
+    F.opos = (double *)sfb__alloc(ctx, ((size_t)F.nv + 1) * 3 * sizeof(double));
+    F.fmark = (unsigned char *)sfb__calloc(ctx, (size_t)mesh->base.ne + 1, 1);
     F.fn = (double *)sfb__alloc(ctx, ((size_t)F.nf + 1) * 3 * sizeof(double));
     F.emark = (unsigned char *)sfb__calloc(ctx, (size_t)mesh->base.ne + 1, 1);
     W.fside = (int *)sfb__alloc(ctx, ((size_t)F.nf + 1) * sizeof(int));
@@ -1515,13 +1710,13 @@ SFB_API sfb_result sfb_mesh_fillet(sfb_context *ctx, const sfb_mesh *mesh, const
         W.nrm[i] = (double *)sfb__calloc(ctx, ((size_t)F.nv + 1) * 3, sizeof(double));
         W.op[i] = (double *)sfb__alloc(ctx, ((size_t)F.nv + 1) * 3 * sizeof(double));
     }
-    if (!F.pos || !F.npos || !F.fn || !F.emark || !W.fside || !W.queue || !W.vd || !W.vdlist || !W.vlist || !W.vin || !W.ta || !W.nrm[0] ||
+    if (!F.pos || !F.npos || !F.opos || !F.fmark || !F.fn || !F.emark || !W.fside || !W.queue || !W.vd || !W.vdlist || !W.vlist || !W.vin || !W.ta || !W.nrm[0] ||
         !W.nrm[1] || !W.op[0] || !W.op[1]) {
         res = sfb__oom(ctx, "the fillet's work arrays");
         goto done;
     }
     for (i = 0; i < 3 * F.nv; ++i) {
-        F.pos[i] = mesh->positions[i];
+        F.pos[i] = F.opos[i] = mesh->positions[i];
         if (F.pos[i] < lo[i % 3]) lo[i % 3] = F.pos[i];
         if (F.pos[i] > hi[i % 3]) hi[i % 3] = F.pos[i];
     }
@@ -1533,11 +1728,16 @@ SFB_API sfb_result sfb_mesh_fillet(sfb_context *ctx, const sfb_mesh *mesh, const
     if (res != SFB_SUCCESS) goto done;
     reps = (sfb_fillet_curve_report *)sfb__calloc(ctx, (size_t)F.ncurves + 1, sizeof *reps);
     if (!reps) { res = sfb__oom(ctx, "the fillet report"); goto done; }
+    res = fil_find_corners(&F);
+    if (res != SFB_SUCCESS) goto done;
+    /* every curve on the input's positions (each writes its own region into opos; the regions of
+     * curves that meet at a corner end at the corner's planes, so they do not overlap) */
     for (i = 0; i < F.ncurves; ++i) {
         res = fil_one(&F, &W, &F.curves[i], i, &reps[i]);
         if (res != SFB_SUCCESS) goto done;
-        fil_face_normals(&F);
     }
+    res = fil_corners_project(&F);
+    if (res != SFB_SUCCESS) goto done;
     res = sfb__progress(ctx, 1.0f, "fillet project");
     if (res != SFB_SUCCESS) goto done;
     {
@@ -1549,7 +1749,7 @@ SFB_API sfb_result sfb_mesh_fillet(sfb_context *ctx, const sfb_mesh *mesh, const
         cvert = (int *)sfb__alloc(ctx, ((size_t)d.crease_count + 1) * 2 * sizeof(int));
         csharp = (float *)sfb__alloc(ctx, ((size_t)d.crease_count + 1) * sizeof(float));
         if (!fpos || !cvert || !csharp) { res = sfb__oom(ctx, "the filleted mesh"); goto done; }
-        for (i = 0; i < 3 * F.nv; ++i) fpos[i] = (float)F.pos[i];
+        for (i = 0; i < 3 * F.nv; ++i) fpos[i] = (float)F.opos[i];
         for (c = 0; c < F.ncurves; ++c)
             for (i = 0; i + 1 < F.curves[c].n; ++i) {
                 const int e = fil_edge_of(F.l, F.curves[c].v[i], F.curves[c].v[i + 1]);
@@ -1574,6 +1774,9 @@ SFB_API sfb_result sfb_mesh_fillet(sfb_context *ctx, const sfb_mesh *mesh, const
         report->curves = reps;
         report->ctx_ = ctx;
         for (i = 0; i < F.ncurves; ++i) report->vertices_moved += reps[i].vertices_moved;
+        report->corner_count = F.ncorners;
+        for (i = 0; i < F.ncorners; ++i) report->corner_vertices_moved += F.corners[i].moved;
+        report->vertices_moved += report->corner_vertices_moved;
         reps = NULL;
     }
 done:
@@ -1582,6 +1785,7 @@ done:
     sfb__free(ctx, F.curves);
     sfb__free(ctx, reps);
     sfb__free(ctx, F.pos); sfb__free(ctx, F.npos); sfb__free(ctx, F.fn); sfb__free(ctx, F.emark);
+    sfb__free(ctx, F.opos); sfb__free(ctx, F.fmark); sfb__free(ctx, F.corners);
     sfb__free(ctx, W.fside); sfb__free(ctx, W.queue); sfb__free(ctx, W.vd); sfb__free(ctx, W.vdlist);
     sfb__free(ctx, W.vlist); sfb__free(ctx, W.vin); sfb__free(ctx, W.ta);
     for (i = 0; i < 2; ++i) { sfb__free(ctx, W.nrm[i]); sfb__free(ctx, W.op[i]); }
