@@ -202,10 +202,10 @@ run: deps $(BUILD)/surfblend $(BUILD)/sfb2gltf $(BUILD)/examples/04_tribezier_pa
 	    ./$(BUILD)/surfblend analyze --scheme loop --mode $$m --size 800x600 $(REAL_MESHES)/spot.obj -o out/spot_$$m.png || exit 1; \
 	  done; \
 	else echo "real meshes not found at $(REAL_MESHES): the spot pictures are skipped"; fi
-	@# rolling-ball fillets (seed 002, as its Fig. 12): a box with a cylinder on top, the concave seam,
-	@# the cylinder's rim and the box's edges (short of its corners) filleted, and every feature by
-	@# dihedral angle (the box's corners crumple: shown, not checked); before and after with highlight
-	@# lines, mean curvature and close-ups; prints mean |H|, sharpest edges, folds and linkage normal jumps
+	@# rolling-ball fillets (seed 002, as its Fig. 12): a box with a cylinder on top, every feature by
+	@# dihedral angle -- the concave seam, the cylinder's rim, the box's edges and corners -- at r = 0.15
+	@# and 0.25; before and after with highlight lines, mean curvature and close-ups; prints mean |H|,
+	@# sharpest edges, folds and linkage normal jumps
 	./$(BUILD)/examples/06_fillet_panel out/fillet_panel.png
 	@# the main job's end: glTF 2.0 for engines and viewers -- the creased box with subdivision-shading
 	@# normals (hard edges split), and the manifold blend tessellated
