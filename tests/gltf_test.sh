@@ -3,7 +3,9 @@
 # output), every export checked by the Khronos glTF-Validator (0 errors, 0 warnings: every peer
 # shape, the examples, the real meshes, every scheme and option), and read back with tinygltf
 # against the library's own output (build/gltf_check: positions, normals, UVs, counts, split
-# hard edges).
+# hard edges). --fillet (seed 002's rolling-ball fillets before the export): usage and bad input,
+# the input's triangle count kept, --crease-angle as the feature angle, and the export read back
+# against the library's surface of `surfblend fillet`'s mesh.
 set -u
 BUILD=${BUILD:-build}
 SHAPES=${SHAPES:-../shared/peers/opensubdiv-shapes}
@@ -41,6 +43,7 @@ BOX=examples/data/creased_box.obj
 check "--help succeeds" 0 "$TOOL" --help
 contains "--help lists --crease-angle" "$TMP/out" "--crease-angle"
 contains "--help lists --tess" "$TMP/out" "--tess RATE"
+contains "--help lists --fillet" "$TMP/out" "--fillet R"
 check "--version succeeds" 0 "$TOOL" --version
 contains "--version names surfblend" "$TMP/out" "surfblend"
 check "no arguments is a usage error" 2 "$TOOL"
@@ -195,6 +198,89 @@ else
   S=$((S + 1)); echo "SKIP real meshes: not found at $REAL"
 fi
 
+# ---- --fillet: seed 002's rolling-ball fillets (sfb_mesh_fillet) before the export ----
+# a 90-degree fold: a 16 x 8 grid of squares (two triangles each) bent along its middle line, one
+# open convex feature of 9 vertices whose dihedral angle is 90 degrees
+awk -v N=8 -v M=8 'BEGIN {
+  for (j = 0; j <= M; j++) for (i = -N; i <= N; i++) { x = i / N; z = 2 * j / M; if (x <= 0) printf "v %g 0 %g\n", x, z; else printf "v 0 %g %g\n", x, z }
+  W = 2 * N + 1
+  for (j = 0; j < M; j++) for (i = 0; i < 2 * N; i++) { a = j * W + i + 1; b = a + 1; c = a + W + 1; d = a + W; printf "f %d %d %d\nf %d %d %d\n", a, b, c, a, c, d }
+}' > "$TMP/fold.obj"
+FOLD=$TMP/fold.obj
+FOLD_TRIS=$(grep -c '^f ' "$FOLD")
+# the summary line's counts: "..., V vertices, T triangles -> ..."
+tris() { sed -nE 's/.* ([0-9]+) vertices, ([0-9]+) triangles.*/\2/p' "$1" | tail -n 1; }
+verts() { sed -nE 's/.* ([0-9]+) vertices, ([0-9]+) triangles.*/\1/p' "$1" | tail -n 1; }
+rm -f "$TMP/fx.glb"
+check "--fillet -1 is a usage error" 2 "$TOOL" --fillet -1 "$FOLD" -o "$TMP/fx.glb"
+contains "--fillet -1: the message names the option" "$TMP/err" "--fillet needs a radius"
+check "--fillet 0 is a usage error" 2 "$TOOL" --fillet 0 "$FOLD" -o "$TMP/fx.glb"
+check "--fillet nan is a usage error" 2 "$TOOL" --fillet nan "$FOLD" -o "$TMP/fx.glb"
+check "--fillet inf is a usage error" 2 "$TOOL" --fillet inf "$FOLD" -o "$TMP/fx.glb"
+check "--fillet x is a usage error" 2 "$TOOL" --fillet x "$FOLD" -o "$TMP/fx.glb"
+check "--fillet 1e-50 (0 as the library's float) is a usage error" 2 "$TOOL" --fillet 1e-50 "$FOLD" -o "$TMP/fx.glb"
+check "--fillet 1e39 (infinite as a float) is a usage error" 2 "$TOOL" --fillet 1e39 "$FOLD" -o "$TMP/fx.glb"
+check "--fillet without its radius is a usage error" 2 "$TOOL" "$FOLD" -o "$TMP/fx.glb" --fillet
+# the fillet's features are the edges over --crease-angle: 0 and 180 would fillet at the
+# library's default 30 degrees instead of the angle asked for
+check "--fillet with --crease-angle 0 is a usage error" 2 "$TOOL" --fillet 0.3 --crease-angle 0 "$FOLD" -o "$TMP/fx.glb"
+contains "--fillet --crease-angle 0: the message names the angle" "$TMP/err" "crease-angle"
+check "--fillet with --crease-angle 180 is a usage error" 2 "$TOOL" --fillet 0.3 --crease-angle 180 "$FOLD" -o "$TMP/fx.glb"
+absent "refused --fillet options leave no output" "$TMP/fx.glb"
+# bad input: exit 1, one line, no output
+badcase "--fillet on quads" "triangle mesh" "$BOX" --fillet 0.1
+badcase "--fillet where no edge is over --crease-angle" "exceeds 91 degrees" "$FOLD" --fillet 0.3 --crease-angle 91
+badcase "--fillet with a radius too large for the base patches" "too large" "$FOLD" --fillet 50
+badcase "--fillet with --scheme loop on quads" "triangle mesh" "$BOX" --fillet 0.1 --scheme loop
+if [ -e "$REAL/teapot.obj" ] && [ -e "$REAL/suzanne.obj" ]; then
+  badcase "--fillet on the teapot (non-manifold vertices)" "non-manifold" "$REAL/teapot.obj" --fillet 0.05 --crease-angle 60
+  badcase "--fillet on suzanne (quads and triangles)" "triangle mesh" "$REAL/suzanne.obj" --fillet 0.05
+else
+  S=$((S + 1)); echo "SKIP --fillet on the real meshes' refusals: not found at $REAL"
+fi
+# exports (all validated below): the same triangles, the feature rounded
+check "export --fillet 0.3 --level 0" 0 "$TOOL" --level 0 --fillet 0.3 "$FOLD" -o "$TMP/v/fold_fillet_l0.glb"
+contains "--fillet reports the curve and the radius" "$TMP/err" "1 curves filleted at radius 0.3"
+t=$(tris "$TMP/err")
+if [ "$t" = "$FOLD_TRIS" ]; then ok "--fillet --level 0 keeps the input's $FOLD_TRIS triangles"; else bad "--fillet --level 0 wrote '$t' triangles, the input has $FOLD_TRIS"; fi
+check "export the fold --level 0 without --fillet" 0 "$TOOL" -q --level 0 "$FOLD" -o "$TMP/v/fold_l0.glb"
+if [ -f "$TMP/v/fold_l0.glb" ] && [ -f "$TMP/v/fold_fillet_l0.glb" ] && ! cmp -s "$TMP/v/fold_l0.glb" "$TMP/v/fold_fillet_l0.glb"; then ok "--fillet moves vertices"
+else bad "--fillet wrote the same file as without it"; fi
+check "export --fillet -q" 0 "$TOOL" -q --fillet 0.3 "$FOLD" -o "$TMP/v/fold_fillet.glb"
+if [ ! -s "$TMP/err" ]; then ok "--fillet -q prints nothing"; else bad "--fillet -q printed: $(head -n 1 "$TMP/err")"; fi
+# --crease-angle is the fillet's feature angle: the 90-degree fold is a feature at 89, not at 91
+# (above), and the crease that --crease-angle put on the filleted edge is dropped (no split)
+check "export --fillet --crease-angle 89 --level 2" 0 "$TOOL" --level 2 --fillet 0.3 --crease-angle 89 "$FOLD" -o "$TMP/v/fold_fillet_a89.glb"
+contains "--crease-angle 89: the fold is filleted" "$TMP/err" "1 curves filleted"
+t=$(tris "$TMP/err"); v=$(verts "$TMP/err")
+check "export --crease-angle 89 --level 2 without --fillet" 0 "$TOOL" --level 2 --crease-angle 89 "$FOLD" -o "$TMP/v/fold_a89.glb"
+t0=$(tris "$TMP/err"); v0=$(verts "$TMP/err")
+if [ -n "$t" ] && [ "$t" = "$t0" ]; then ok "--fillet keeps the refined triangle count ($t)"; else bad "--fillet --level 2: '$t' triangles, '$t0' without"; fi
+if [ -n "$v" ] && [ -n "$v0" ] && [ "$v" -lt "$v0" ]; then ok "--fillet drops the filleted edge's crease ($v vertices, $v0 split along the crease)"
+else bad "--fillet --crease-angle: '$v' vertices, '$v0' without (the filleted crease should no longer split them)"; fi
+export_ok fold_fillet_qc.glb "$FOLD" --fillet 0.3 --crease-angle 45 --quantize --compress
+export_ok fold_fillet.gltf "$FOLD" --fillet 0.3 --gltf
+export_ok fold_fillet_tess.glb "$FOLD" --fillet 0.3 --crease-angle 45 --tess 6
+export_ok fold_fillet_loop.glb "$FOLD" --fillet 0.3 --scheme loop --level 2
+export_ok fold_fillet_lods.glb "$FOLD" --fillet 0.5 --lods 0,2
+# glTF input: the fold as flat-shaded glTF (its fold edge a hard edge, i.e. an infinite crease)
+check "the fold as flat-shaded glTF" 0 "$TOOL" -q --level 0 --normals flat "$FOLD" -o "$TMP/foldflat.glb"
+check "export --fillet from glTF input" 0 "$TOOL" --level 1 --fillet 0.3 "$TMP/foldflat.glb" -o "$TMP/v/fold_fillet_from_gltf.glb"
+contains "--fillet on glTF input names the primitive" "$TMP/err" "primitive 0: 1 curves filleted"
+# a real triangle mesh with UVs (spot) and --crease-angle: the same triangles, validator-clean
+if [ -e "$REAL/spot.obj" ]; then
+  SPOT_TRIS=$(grep -c '^f ' "$REAL/spot.obj")
+  check "export spot --fillet 0.02 --crease-angle 60 --level 0" 0 "$TOOL" --level 0 --fillet 0.02 --crease-angle 60 "$REAL/spot.obj" -o "$TMP/v/real_spot_fillet_l0.glb"
+  contains "spot --fillet: three curves over 60 degrees" "$TMP/err" "3 curves filleted at radius 0.02"
+  t=$(tris "$TMP/err")
+  if [ "$t" = "$SPOT_TRIS" ]; then ok "spot --fillet --level 0 keeps its $SPOT_TRIS triangles"; else bad "spot --fillet --level 0 wrote '$t' triangles, the input has $SPOT_TRIS"; fi
+  contains "spot --fillet keeps the UVs" "$TMP/err" "UVs"
+  export_ok real_spot_fillet.glb "$REAL/spot.obj" --level 1 --fillet 0.02 --crease-angle 60
+  export_ok real_spot_fillet_qc.glb "$REAL/spot.obj" --level 1 --fillet 0.05 --crease-angle 60 --quantize --compress
+else
+  S=$((S + 1)); echo "SKIP --fillet on spot: not found at $REAL"
+fi
+
 # ---- glTF input ----
 printf 'v -1 -1 1\nv 1 -1 1\nv -1 1 1\nv 1 1 1\nv -1 1 -1\nv 1 1 -1\nv -1 -1 -1\nv 1 -1 -1\nf 1 2 4 3\nf 3 4 6 5\nf 5 6 8 7\nf 7 8 2 1\nf 2 8 6 4\nf 7 1 3 5\n' > "$TMP/qcube.obj"
 # the same cube as triangles (each quad fanned from its first corner), plain and with its 12
@@ -334,6 +420,36 @@ if [ -d "$SHAPES" ]; then
   readback pn.glb "$SHAPES/loop_icosahedron.obj" --scheme pn --tess 6
   readback pn_uv.glb "$SHAPES/loop_chaikin1.obj" --scheme pn --tess 4 -- --uvs yes
   readback noopt.glb "$SHAPES/catmark_chaikin1.obj" --level 2 --no-optimize
+fi
+# --fillet: the export is the library's surface of the mesh `surfblend fillet` writes (the same
+# sfb_mesh_fillet call; the filleted edges carry no crease, with or without --crease-angle)
+fillet_readback() { # name, the filleted OBJ, input, sfb2gltf options..., -- the checker's options
+  local name=$1 ref=$2 in=$3; shift 3
+  local opts=()
+  while [ $# -gt 0 ] && [ "$1" != -- ]; do opts+=("$1"); shift; done
+  [ $# -gt 0 ] && shift
+  if "$TOOL" -q --backend ref "${opts[@]}" "$in" -o "$TMP/r/$name" 2> "$TMP/err"; then
+    count_check "$TMP/r/$name" "$ref" "$@"
+  else
+    bad "export $name for reading back: $(head -n 1 "$TMP/err")"
+  fi
+}
+if "$BUILD/surfblend" fillet --radius 0.3 "$FOLD" -o "$TMP/fold_filleted.obj" 2> "$TMP/err"; then
+  fillet_readback fold_fillet.glb "$TMP/fold_filleted.obj" "$FOLD" --level 2 --fillet 0.3 -- --level 2
+  fillet_readback fold_fillet_a45.glb "$TMP/fold_filleted.obj" "$FOLD" --level 2 --fillet 0.3 --crease-angle 45 -- --level 2
+  fillet_readback fold_fillet_loop.glb "$TMP/fold_filleted.obj" "$FOLD" --scheme loop --level 2 --fillet 0.3 -- --scheme loop --level 2
+  # and not the unfilleted fold's surface
+  if "$CHECK" "$TMP/r/fold_fillet.glb" "$FOLD" --level 2 2>&1 | grep -q '^FAIL.*every vertex is the library'; then ok "the filleted export is not the unfilleted surface"
+  else bad "the filleted export reads back as the unfilleted fold's surface"; fi
+else
+  bad "surfblend fillet on the fold: $(head -n 1 "$TMP/err")"
+fi
+if [ -e "$REAL/spot.obj" ]; then
+  if "$BUILD/surfblend" fillet --radius 0.02 --angle 60 "$REAL/spot.obj" -o "$TMP/spot_filleted.obj" 2> "$TMP/err"; then
+    fillet_readback spot_fillet.glb "$TMP/spot_filleted.obj" "$REAL/spot.obj" --level 1 --fillet 0.02 --crease-angle 60 -- --level 1 --uvs yes
+  else
+    bad "surfblend fillet on spot: $(head -n 1 "$TMP/err")"
+  fi
 fi
 # the default backend gives the same counts (the numbers within the backends' agreement)
 if "$TOOL" -q "$BOX" -o "$TMP/r/default.glb" && "$TOOL" -q --backend ref "$BOX" -o "$TMP/r/ref.glb"; then

@@ -66,9 +66,10 @@ const char *const kUsage =
     "                         limit (exact limit normals; the default with --tess and for manifold) or\n"
     "                         flat (one normal per triangle; the default for bilinear)\n"
     "  --crease-angle DEG     edges whose dihedral angle is over DEG (0..180) become infinitely sharp creases\n"
-    "  --fillet R             round the sharp features (dihedral angle over --crease-angle, default 30) with a\n"
-    "                         rolling ball of radius R before subdividing (seed 002: the same triangles, the\n"
-    "                         blend regions' vertices moved onto the ball's sweep; triangle meshes only)\n"
+    "  --fillet R             round the sharp features (dihedral angle over --crease-angle, which must then be\n"
+    "                         in (0, 180); default 30) with a rolling ball of radius R before subdividing (seed\n"
+    "                         002: the same triangles, the blend regions' vertices moved onto the ball's sweep;\n"
+    "                         manifold triangle meshes only)\n"
     "  --sharpness S          --scheme tribezier: s in [0, 1] for every tagged crease and corner (0: the smooth\n"
     "                         G1 surface, 1: the crease; default: each tag's value clamped to [0, 1])\n"
     "  --trim MASK.png        with --tess: trim the surface by a mask over each parametric face (seed 000)\n"
@@ -198,8 +199,9 @@ int parse_args(int argc, char **argv, Options *o) {
                 return usage_error("--crease-angle needs degrees in 0..180");
             o->have_angle = true;
         } else if (!strcmp(a, "--fillet")) {
-            if (!parse_double(value(a), &o->fillet) || !(o->fillet > 0.0) || !std::isfinite(o->fillet))
-                return usage_error("--fillet needs a radius > 0");
+            // checked as the float the library takes: 1e-50 would be 0 there, 1e39 infinite
+            if (!parse_double(value(a), &o->fillet) || !((float)o->fillet > 0.0f) || !std::isfinite((float)o->fillet))
+                return usage_error("--fillet needs a radius > 0 (a finite float)");
             o->have_fillet = true;
         } else if (!strcmp(a, "--sharpness")) {
             if (!parse_double(value(a), &o->sharpness) || !(o->sharpness >= 0.0 && o->sharpness <= 1.0))
@@ -267,6 +269,10 @@ int parse_args(int argc, char **argv, Options *o) {
         return usage_error("--tess needs a scheme with a limit surface (%s has none)", sfb_scheme_name(o->scheme));
     if (o->have_tolerance && !o->have_tess) return usage_error("--tolerance belongs to --tess");
     if (o->have_sharpness && o->scheme != SFB_SCHEME_TRIBEZIER) return usage_error("--sharpness belongs to --scheme tribezier");
+    // --fillet's features are the edges over --crease-angle: 0 (the library's "default 30") and
+    // 180 (no feature; the library refuses it) would silently fillet at 30 degrees instead
+    if (o->have_fillet && o->have_angle && !((float)o->angle > 0.0f && (float)o->angle < 180.0f))
+        return usage_error("--fillet takes its feature angle from --crease-angle: degrees in (0, 180), not %.12g", o->angle);
     if (o->trim && !o->have_tess) return usage_error("--trim belongs to --tess (trimming cuts the tessellation)");
     if (o->normals == NORMALS_DEFAULT)
         o->normals = o->have_tess ? NORMALS_LIMIT : (caps & SFB_SCHEME_CAN_SHADE) ? NORMALS_SHADING : NORMALS_FLAT;
@@ -1095,7 +1101,7 @@ int fillet_stage(Run &R) {
     R.bar.begin("fillet", 1);
     for (Part &part : R.parts) {
         sfb_fillet_config fc = sfb_fillet_config_init((float)R.o.fillet);
-        if (R.o.have_angle && R.o.angle > 0.0 && R.o.angle < 180.0) fc.angle = (float)R.o.angle;
+        if (R.o.have_angle) fc.angle = (float)R.o.angle; // in (0, 180): parse_args checked
         sfb_fillet_report rep;
         sfb_mesh *out = nullptr;
         sfb_result r = sfb_mesh_fillet(R.ctx, part.mesh, &fc, &out, &rep);
