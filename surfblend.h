@@ -783,9 +783,12 @@ typedef struct sfb_fillet_curve_report {
     int convex;                 /* 1: the ball is inside the solid (offset against the normals) */
     int curve_vertices;         /* vertices of the blending curve */
     float radius;
+    float curve_length;         /* the blending curve's own length */
     float spine_length;
     int samples;                /* spine samples after refinement */
     int vertices_moved;
+    int vertices_kept;          /* region vertices left where they were: the sweep there lay over 2 d away (d: the
+                                   base patches' reach, alpha r), which only an uneven surface gives */
     int self_intersections;     /* spine loops cut out (seed section 4.3) */
     float max_deviation;        /* largest distance of a moved vertex from the ideal sweep surface */
     int map;                    /* how the region was mapped: 0 direct projection, 1 conformal, 2 mean-value weights */
@@ -796,6 +799,8 @@ typedef struct sfb_fillet_report {
     int vertices_moved;         /* all curves' and corners' */
     int corner_count;           /* corners where three curves end, rounded by the ball's sphere */
     int corner_vertices_moved;
+    int faces_folded;           /* faces turned over (normal over 90 degrees from the input's): the radius is too
+                                   large for the surface around some curve; 0 on every generated shape in the tests */
     sfb_context *ctx_;
 } sfb_fillet_report;
 /* Fillets `mesh` (all faces triangles, manifold: SFB_INVALID_TOPOLOGY naming the face or edge
@@ -15735,6 +15740,7 @@ static sfb_result fil_one(sfb__fil *F, sfb__fil_work *W, const sfb__fil_curve *c
     cedge = (int *)sfb__alloc(ctx, (size_t)cv->n * sizeof(int));
     if (!cp || !cedge) { res = sfb__oom(ctx, "the blending curve"); goto done; }
     for (i = 0; i < m; ++i) memcpy(cp + 3 * (size_t)i, F->pos + 3 * (size_t)cv->v[i], 3 * sizeof(double));
+    for (i = 0; i + 1 < cv->n; ++i) rep->curve_length += (float)fil_dist(F->pos + 3 * (size_t)cv->v[i], F->pos + 3 * (size_t)cv->v[i + 1]);
     res = fil_poly_build(ctx, &PC, cp, m, cv->closed);
     if (res != SFB_SUCCESS) goto done;
     /* curve edges, the sides' seed faces, the sharpest dihedral angle */
@@ -15897,6 +15903,33 @@ static sfb_result fil_one(sfb__fil *F, sfb__fil_work *W, const sfb__fil_curve *c
         tol = 1.5 * mean < 0.1 * r ? 1.5 * mean : 0.1 * r;
         rep->self_intersections = fil_spine_untangle(ctx, &spine, &ns, sclosed, tol, 0.25 * r);
     }
+    {
+        /* the spine must follow the curve: the ball's centre lies r / cos(delta / 2) from it, within
+         * d. On real meshes the offsets' intersection can run off along another branch near a
+         * curve's end (spot.obj's short creases: a curve vertex moved 14 r). An open spine keeps its
+         * longest run of points within 1.5 d of the curve; a closed one that strays fails. */
+        int best_lo = 0, best_n = 0, run_lo = 0, run_n = 0, bad = 0;
+        for (i = 0; i < ns; ++i) {
+            int sg;
+            double tt, dd;
+            fil_poly_nearest(&PC, spine + 3 * (size_t)i, &sg, &tt, &dd);
+            if (sqrt(dd) <= 1.5 * d) {
+                if (run_n == 0) run_lo = i;
+                if (++run_n > best_n) { best_n = run_n; best_lo = run_lo; }
+            } else { run_n = 0; bad++; }
+        }
+        if (bad && (sclosed || best_n < 2)) {
+            res = sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_VERTEX, cv->v[0],
+                             "blending curve %d (from vertex %d): the offset patches at radius %g meet away from the curve (%d of %d spine points "
+                             "farther than %g from it) -- the surface around the curve is too uneven for this radius",
+                             ci, cv->v[0], r, bad, ns, 1.5 * d);
+            goto done;
+        }
+        if (bad) {
+            memmove(spine, spine + 3 * (size_t)best_lo, (size_t)best_n * 3 * sizeof(double));
+            ns = best_n;
+        }
+    }
     cum = (double *)sfb__alloc(ctx, ((size_t)ns + 1) * sizeof(double));
     if (!cum) { res = sfb__oom(ctx, "the spine"); goto done; }
     cum[0] = 0.0;
@@ -15956,7 +15989,7 @@ static sfb_result fil_one(sfb__fil *F, sfb__fil_work *W, const sfb__fil_curve *c
     for (i = 0; i < W->nvlist; ++i) {
         const int v = W->vlist[i];
         const double *p = F->pos + 3 * (size_t)v;
-        int seg, j, vs;
+        int seg, j, vs = 0;
         double t, d2, E[3], L1, L2, s;
         fil_poly_nearest(&PS, p, &seg, &t, &d2);
         j = (seg + 1) % nsamp;
@@ -15988,6 +16021,15 @@ static sfb_result fil_one(sfb__fil *F, sfb__fil_work *W, const sfb__fil_curve *c
         L1 = prof[seg].L1 + t * (prof[j].L1 - prof[seg].L1);
         L2 = prof[seg].L2 + t * (prof[j].L2 - prof[seg].L2);
         if (!(L1 + L2 > 0)) continue;
+        if (W->vd[v] < 0) { /* its distance to the curve, if the base patches' search did not need it */
+            int sg;
+            double tt, dd;
+            fil_poly_nearest(&PC, p, &sg, &tt, &dd);
+            W->vd[v] = sqrt(dd);
+            W->vdlist[W->nvd++] = v;
+        }
+        /* a base-patch face's far corner (the patches take whole faces) is no region vertex */
+        if (W->vd[v] > d) continue;
         if (W->vin[v] & 4) { s = 0.0; vs = 0; }
         else {
             /* s: how far the vertex lies past its side's linkage point toward the curve, measured
@@ -16041,6 +16083,12 @@ static sfb_result fil_one(sfb__fil *F, sfb__fil_work *W, const sfb__fil_curve *c
         fil_prof_at(&prof[lo], kind, hs, a, qa);
         fil_prof_at(&prof[j], kind, hs, a, qb);
         fil_lerp(qa, qb, th, np_);
+        if (fil_dist(np_, F->pos + 3 * (size_t)v) > 2.0 * d) { /* no profile near it: it stays (counted) */
+            W->vin[v] &= (unsigned char)~8u;
+            moved--;
+            rep->vertices_kept++;
+            continue;
+        }
         memcpy(F->npos + 3 * (size_t)v, np_, sizeof np_);
         /* the ideal surface here: the profile built from the interpolated spine and linkage points */
         fil_lerp(prof[lo].C, prof[j].C, th, Ct);
@@ -16255,6 +16303,16 @@ SFB_API sfb_result sfb_mesh_fillet(sfb_context *ctx, const sfb_mesh *mesh, const
         report->ctx_ = ctx;
         for (i = 0; i < F.ncurves; ++i) report->vertices_moved += reps[i].vertices_moved;
         report->corner_count = F.ncorners;
+        /* faces the fillet turned over (normal more than 90 degrees from the input's): a radius too
+         * large for the surface around a curve; said, not refused (the caller decides) */
+        for (i = 0; i < F.nf; ++i) {
+            const int *t = F.tri + 3 * (size_t)i;
+            double u[3], w[3], n[3];
+            fil_sub(F.opos + 3 * (size_t)t[1], F.opos + 3 * (size_t)t[0], u);
+            fil_sub(F.opos + 3 * (size_t)t[2], F.opos + 3 * (size_t)t[0], w);
+            fil_cross(u, w, n);
+            if (fil_dot(n, F.fn + 3 * (size_t)i) < 0.0) report->faces_folded++;
+        }
         for (i = 0; i < F.ncorners; ++i) report->corner_vertices_moved += F.corners[i].moved;
         report->vertices_moved += report->corner_vertices_moved;
         reps = NULL;

@@ -770,9 +770,12 @@ typedef struct sfb_fillet_curve_report {
     int convex;                 /* 1: the ball is inside the solid (offset against the normals) */
     int curve_vertices;         /* vertices of the blending curve */
     float radius;
+    float curve_length;         /* the blending curve's own length */
     float spine_length;
     int samples;                /* spine samples after refinement */
     int vertices_moved;
+    int vertices_kept;          /* region vertices left where they were: the sweep there lay over 2 d away (d: the
+                                   base patches' reach, alpha r), which only an uneven surface gives */
     int self_intersections;     /* spine loops cut out (seed section 4.3) */
     float max_deviation;        /* largest distance of a moved vertex from the ideal sweep surface */
     int map;                    /* how the region was mapped: 0 direct projection, 1 conformal, 2 mean-value weights */
@@ -783,6 +786,8 @@ typedef struct sfb_fillet_report {
     int vertices_moved;         /* all curves' and corners' */
     int corner_count;           /* corners where three curves end, rounded by the ball's sphere */
     int corner_vertices_moved;
+    int faces_folded;           /* faces turned over (normal over 90 degrees from the input's): the radius is too
+                                   large for the surface around some curve; 0 on every generated shape in the tests */
     sfb_context *ctx_;
 } sfb_fillet_report;
 /* Fillets `mesh` (all faces triangles, manifold: SFB_INVALID_TOPOLOGY naming the face or edge

@@ -501,7 +501,7 @@ awk 'BEGIN { n = 20; m = 10;
     c = (m + 1) * (n + 1) + j * (n + 1) + i + 1; d = c + 1;
     printf "f %d %d %d\nf %d %d %d\n", a, b, c, b, d, c } }' > "$TMP/fold.obj"
 check "fillet a fold succeeds" 0 "$CLI" fillet --radius 0.25 "$TMP/fold.obj" -o "$TMP/fold_f.obj"
-contains "fillet reports the curve" "$TMP/err" "curve 0: open convex, 21 vertices, radius 0.25"
+contains "fillet reports the curve" "$TMP/err" "curve 0: open convex, 21 vertices (2 long), radius 0.25"
 if [ "$(grep -c '^v ' "$TMP/fold_f.obj")" = "$(grep -c '^v ' "$TMP/fold.obj")" ] && [ "$(grep -c '^f ' "$TMP/fold_f.obj")" = "$(grep -c '^f ' "$TMP/fold.obj")" ]; then
   P=$((P + 1)); echo "ok fillet keeps the vertex and face counts"; else F=$((F + 1)); echo "FAIL fillet changed the counts"; fi
 # the edge's middle vertex (x = 1) moves to the arc's middle: r (1 - 1/sqrt 2) from both faces
@@ -523,6 +523,15 @@ check "fillet a quad mesh is bad input" 1 "$CLI" fillet --radius 0.2 examples/da
 contains "the error asks for triangles" "$TMP/err" "triangle mesh"
 check "fillet --angle 120 finds no feature" 1 "$CLI" fillet --radius 0.2 --angle 120 "$TMP/fold.obj" -o "$TMP/fx.obj"
 if [ ! -e "$TMP/fx.obj" ]; then P=$((P + 1)); echo "ok a failed fillet leaves no file"; else F=$((F + 1)); echo "FAIL a failed fillet left $TMP/fx.obj"; fi
+# a real mesh (made by other people): spot's creases at 60 degrees. A radius that suits them, and one
+# too large for the surface around them: done, with a warning that counts the faces it turned over
+REAL="$(dirname "$SHAPES")/real-meshes"
+if [ -f "$REAL/spot.obj" ]; then
+  check "fillet spot.obj --angle 60 --radius 0.02 succeeds" 0 "$CLI" fillet --angle 60 --radius 0.02 "$REAL/spot.obj" -o "$TMP/spot_f.obj"
+  if grep -q "turned over" "$TMP/err"; then F=$((F + 1)); echo "FAIL fillet spot r 0.02 turned faces over"; else P=$((P + 1)); echo "ok fillet spot r 0.02 turns no face over"; fi
+  check "fillet spot.obj --angle 60 --radius 0.1 succeeds" 0 "$CLI" fillet --angle 60 --radius 0.1 "$REAL/spot.obj" -o "$TMP/spot_f.obj"
+  contains "a radius too large for spot warns of turned faces" "$TMP/err" "warning: [0-9]* faces turned over: the radius is too large"
+else echo "skip fillet on spot.obj: $REAL not found"; fi
 
 # vertex counts against OpenSubdiv (osd_agree --counts prints "name count" per shape)
 if [ -d "$SHAPES" ] && [ -x "$BUILD/osd_agree" ]; then

@@ -189,7 +189,8 @@ static void test_fold_holes(double theta, int flip, int kind, double w, int hole
         snprintf(nm, sizeof nm, "%s/inside the band moved", name);
         check(bad_missed == 0, nm, "%d vertices inside the band did not move", bad_missed);
         snprintf(nm, sizeof nm, "%s/report", name);
-        check(rep.vertices_moved == moved && rep.curves[0].max_deviation < 0.01 * rad && rep.curves[0].samples >= 40 &&
+        check(rep.vertices_moved == moved && rep.faces_folded == 0 && rep.curves[0].vertices_kept == 0 &&
+                  rep.curves[0].max_deviation < 0.01 * rad && rep.curves[0].samples >= 40 &&
                   fabs(rep.curves[0].spine_length - 2.0) < 1e-3,
               nm, "moved %d (counted %d), deviation %g, samples %d, spine %g", rep.vertices_moved, moved, rep.curves[0].max_deviation,
               rep.curves[0].samples, rep.curves[0].spine_length);
@@ -422,8 +423,9 @@ static void test_box_corners(void) {
         }
         printf("corners: %d corners, %d vertices on their spheres (%d beyond all three planes); box vertices %d, worst %.2g r off the rounded box\n",
                rep.corner_count, rep.corner_vertices_moved, on_sphere, n, worst);
-        check(rep.corner_count == 8 && rep.corner_vertices_moved > 0 && on_sphere == rep.corner_vertices_moved, "corners/eight spheres",
-              "%d corners, %d vertices moved onto spheres, %d found beyond the three planes", rep.corner_count, rep.corner_vertices_moved, on_sphere);
+        check(rep.corner_count == 8 && rep.corner_vertices_moved > 0 && on_sphere == rep.corner_vertices_moved && rep.faces_folded == 0,
+              "corners/eight spheres", "%d corners, %d vertices moved onto spheres, %d found beyond the three planes, %d faces folded",
+              rep.corner_count, rep.corner_vertices_moved, on_sphere, rep.faces_folded);
         check(n > 1000 && bad == 0, "corners/on the exact rounded box", "%d of %d box vertices farther than 1%% of r from it (worst %.3g r)", bad, n,
               worst);
         pairs = self_intersections(out, fm.nf);

@@ -1420,11 +1420,14 @@ static int cmd_fillet(cli_opts *o) {
     }
     for (i = 0; i < rep.curve_count; ++i) {
         const sfb_fillet_curve_report *c = &rep.curves[i];
-        cli_error("curve %d: %s %s, %d vertices, radius %g: spine %.4g long, %d samples, %d vertices moved, %d spine loops cut, "
+        cli_error("curve %d: %s %s, %d vertices (%.4g long), radius %g: spine %.4g long, %d samples, %d vertices moved, %d spine loops cut, "
                   "largest deviation from the sweep %.3g",
-                  i, c->closed ? "closed" : "open", c->convex ? "convex" : "concave", c->curve_vertices, (double)c->radius,
+                  i, c->closed ? "closed" : "open", c->convex ? "convex" : "concave", c->curve_vertices, (double)c->curve_length, (double)c->radius,
                   (double)c->spine_length, c->samples, c->vertices_moved, c->self_intersections, (double)c->max_deviation);
     }
+    if (rep.faces_folded)
+        cli_error("warning: %d faces turned over: the radius is too large for the surface around some curve (try a smaller --radius "
+                  "or a larger --angle)", rep.faces_folded);
     if (rep.corner_count) cli_error("%d corners rounded by the ball's sphere, %d vertices moved onto them", rep.corner_count, rep.corner_vertices_moved);
     cli_error("%d curves filleted, %d vertices moved -> %s", rep.curve_count, rep.vertices_moved, o->outp);
     rc = 0;
