@@ -757,6 +757,9 @@ typedef struct sfb_fillet_config {
     const sfb_fillet_curve *curves; /* the caller's blending curves; NULL: features by angle */
     int curve_count;
     int map;                /* SFB_FILLET_MAP_*: how blend-region vertices find their place on the sweep */
+    int skip_failed;        /* non-zero: a curve that cannot be filleted with its radius (its offset patches do not
+                               meet, or meet away from it) is left as it is and reported (skipped) instead of
+                               failing the call; the call fails when every curve is skipped */
 } sfb_fillet_config;
 enum {
     SFB_FILLET_MAP_CONFORMAL = 0, /* default: the direct projection on the region's boundary, a conformal (cotangent)
@@ -779,11 +782,13 @@ typedef struct sfb_fillet_curve_report {
     int self_intersections;     /* spine loops cut out (seed section 4.3) */
     float max_deviation;        /* largest distance of a moved vertex from the ideal sweep surface */
     int map;                    /* how the region was mapped: 0 direct projection, 1 conformal, 2 mean-value weights */
+    int skipped;                /* config.skip_failed: this curve could not be filleted and was left as it was */
 } sfb_fillet_curve_report;
 typedef struct sfb_fillet_report {
     int curve_count;
     sfb_fillet_curve_report *curves;   /* curve_count entries, freed by sfb_fillet_report_free */
     int vertices_moved;         /* all curves' and corners' */
+    int curves_skipped;         /* config.skip_failed: curves left as they were */
     int corner_count;           /* corners where three curves end, rounded by the ball's sphere */
     int corner_vertices_moved;
     int faces_folded;           /* faces turned over (normal over 90 degrees from the input's): the radius is too

@@ -531,6 +531,13 @@ if [ -f "$REAL/spot.obj" ]; then
   if grep -q "turned over" "$TMP/err"; then F=$((F + 1)); echo "FAIL fillet spot r 0.02 turned faces over"; else P=$((P + 1)); echo "ok fillet spot r 0.02 turns no face over"; fi
   check "fillet spot.obj --angle 60 --radius 0.1 succeeds" 0 "$CLI" fillet --angle 60 --radius 0.1 "$REAL/spot.obj" -o "$TMP/spot_f.obj"
   contains "a radius too large for spot warns of turned faces" "$TMP/err" "warning: [0-9]* faces turned over: the radius is too large"
+  # at 30 degrees spot has 114 creases, some too flat or uneven for r = 0.02: refused whole, or with
+  # --skip-failed those stay sharp and the rest are filleted
+  check "fillet spot.obj --angle 30 --radius 0.02 is refused (a curve cannot be filleted)" 1 "$CLI" fillet --angle 30 --radius 0.02 "$REAL/spot.obj" -o "$TMP/spot_s.obj"
+  if [ ! -e "$TMP/spot_s.obj" ]; then P=$((P + 1)); echo "ok the refused fillet wrote nothing"; else F=$((F + 1)); echo "FAIL the refused fillet wrote $TMP/spot_s.obj"; fi
+  check "fillet spot.obj --angle 30 --radius 0.02 --skip-failed succeeds" 0 "$CLI" fillet --angle 30 --radius 0.02 --skip-failed "$REAL/spot.obj" -o "$TMP/spot_s.obj"
+  contains "--skip-failed names the curves left sharp" "$TMP/err" "skipped, left sharp"
+  contains "--skip-failed counts them" "$TMP/err" "curves filleted ([1-9][0-9]* skipped)"
 else echo "skip fillet on spot.obj: $REAL not found"; fi
 
 # vertex counts against OpenSubdiv (osd_agree --counts prints "name count" per shape)

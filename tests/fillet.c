@@ -588,6 +588,58 @@ static void expect_error(sfb_mesh *in, const sfb_fillet_config *cfg, sfb_result 
     free(copy);
 }
 
+/* config.skip_failed: the step's concave edge given a radius its base patches cannot hold (2.0 on
+ * a 1.0 deep step): refused whole without it; with it, that curve is reported skipped and its
+ * vertices stay, the convex edge is filleted; every curve failing is still an error. */
+static void test_skip_failed(void) {
+    fs_mesh fm;
+    sfb_mesh *in = NULL, *out = NULL;
+    sfb_fillet_config cfg;
+    sfb_fillet_curve curves[2];
+    sfb_fillet_report rep;
+    sfb_result r;
+    memset(&fm, 0, sizeof fm);
+    if (fs_step(&fm, 40, 2.0f, 1.0f, 1.0f) != 0 || !(in = make_mesh(&fm))) {
+        fail("skip/setup", "no step");
+        fs_free(&fm);
+        return;
+    }
+    cfg = sfb_fillet_config_init(0.2f);
+    memset(curves, 0, sizeof curves);
+    curves[0].vertices = fm.loop;
+    curves[0].count = fm.loop_count;
+    curves[1].vertices = fm.loop + fm.loop_count;
+    curves[1].count = fm.loop_count;
+    curves[1].radius = 2.0f;
+    cfg.curves = curves;
+    cfg.curve_count = 2;
+    expect_error(in, &cfg, SFB_INVALID_VALUE, "skip/without it the call fails");
+    cfg.skip_failed = 1;
+    r = sfb_mesh_fillet(g_ctx, in, &cfg, &out, &rep);
+    check(r == SFB_SUCCESS && out, "skip/with it the call succeeds", "%s: %s", sfb_result_string(r), sfb_last_error(g_ctx));
+    if (r == SFB_SUCCESS && out) {
+        sfb_mesh_desc d;
+        int v, moved_near[2] = {0, 0};
+        sfb_mesh_get_desc(out, &d);
+        for (v = 0; v < fm.nv; ++v) {
+            const float *p0 = fm.pos + 3 * v, *p1 = d.positions + 3 * v;
+            const int e = hypot(p0[1], p0[2]) <= hypot(p0[1], p0[2] + 1.0) ? 0 : 1;
+            if (p0[0] != p1[0] || p0[1] != p1[1] || p0[2] != p1[2]) moved_near[e]++;
+        }
+        check(rep.curve_count == 2 && !rep.curves[0].skipped && rep.curves[1].skipped && rep.curves_skipped == 1 && moved_near[0] > 0 &&
+                  moved_near[1] == 0 && rep.vertices_moved == moved_near[0],
+              "skip/the failing curve skipped and left as it was", "skipped %d %d (count %d), moved near the edges %d %d, reported %d",
+              rep.curve_count > 0 ? rep.curves[0].skipped : -1, rep.curve_count > 1 ? rep.curves[1].skipped : -1, rep.curves_skipped,
+              moved_near[0], moved_near[1], rep.vertices_moved);
+        sfb_fillet_report_free(&rep);
+        sfb_mesh_destroy(out);
+    }
+    curves[0].radius = 2.0f;
+    expect_error(in, &cfg, SFB_INVALID_VALUE, "skip/every curve failing is still an error");
+    sfb_mesh_destroy(in);
+    fs_free(&fm);
+}
+
 static void test_bad_input(void) {
     fs_mesh fm, flat;
     sfb_mesh *in = NULL, *fl = NULL, *quad = NULL, *nonman = NULL;
@@ -755,6 +807,7 @@ int main(void) {
     test_self_intersection(0.0f, "self-intersection");
     test_self_intersection(0.1f, "self-intersection rounded");
     test_bad_input();
+    test_skip_failed();
     test_progress();
     sfb_context_destroy(g_ctx);
     return close_tests();

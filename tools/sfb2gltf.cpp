@@ -69,7 +69,7 @@ const char *const kUsage =
     "  --fillet R             round the sharp features (dihedral angle over --crease-angle, which must then be\n"
     "                         in (0, 180); default 30) with a rolling ball of radius R before subdividing (seed\n"
     "                         002: the same triangles, the blend regions' vertices moved onto the ball's sweep;\n"
-    "                         manifold triangle meshes only)\n"
+    "                         manifold triangle meshes only; curves the radius cannot fillet stay sharp, said)\n"
     "  --sharpness S          --scheme tribezier: s in [0, 1] for every tagged crease and corner (0: the smooth\n"
     "                         G1 surface, 1: the crease; default: each tag's value clamped to [0, 1])\n"
     "  --trim MASK.png        with --tess: trim the surface by a mask over each parametric face (seed 000)\n"
@@ -1102,15 +1102,23 @@ int fillet_stage(Run &R) {
     for (Part &part : R.parts) {
         sfb_fillet_config fc = sfb_fillet_config_init((float)R.o.fillet);
         if (R.o.have_angle) fc.angle = (float)R.o.angle; // in (0, 180): parse_args checked
+        // a real mesh's many small creases: the ones this radius cannot fillet stay sharp (said below)
+        fc.skip_failed = 1;
         sfb_fillet_report rep;
         sfb_mesh *out = nullptr;
         sfb_result r = sfb_mesh_fillet(R.ctx, part.mesh, &fc, &out, &rep);
         if (r != SFB_SUCCESS) return R.fail_lib(part.name, "--fillet", r);
         if (!R.o.quiet) {
             R.bar.end();
-            cli_error("%s: %d curves filleted at radius %g, %d vertices moved", part.name.c_str(), rep.curve_count, R.o.fillet,
-                      rep.vertices_moved);
+            cli_error("%s: %d curves filleted at radius %g, %d vertices moved", part.name.c_str(), rep.curve_count - rep.curves_skipped,
+                      R.o.fillet, rep.vertices_moved);
         }
+        if (rep.curves_skipped)
+            cli_error("warning: %s: %d of %d curves could not be filleted at radius %g and stay sharp", part.name.c_str(), rep.curves_skipped,
+                      rep.curve_count, R.o.fillet);
+        if (rep.faces_folded)
+            cli_error("warning: %s: the fillet turned %d faces over: the radius is too large for the surface around some curve",
+                      part.name.c_str(), rep.faces_folded);
         sfb_fillet_report_free(&rep);
         sfb_mesh_destroy(part.mesh);
         part.mesh = out;

@@ -25,7 +25,7 @@ enum {
     O_RATE, O_TOLERANCE, O_SPLIT, O_TRIM, O_TILES, O_VARIANT, O_DARTS, O_NORMALS_LEVEL, O_WEIGHTS_LEVEL, O_P,
     O_AVERAGING, O_ALL_SUBDIVIDED, O_NORMALS, O_POSITIONS, O_MODE, O_EDGES, O_SIZE, O_VIEW, O_ZOOM, O_STRIPES, O_CREASE_ANGLE, O_SHARPNESS,
     O_AMODE, O_LIGHT, O_CURVATURE, O_EYE, O_TARGET, O_UP, O_FOV, O_ORTHO, O_POLYGON, O_BAND,
-    O_RADIUS, O_ANGLE, O_PROFILE, O_CURVE, O_SAMPLES, O_ALPHA,
+    O_RADIUS, O_ANGLE, O_PROFILE, O_CURVE, O_SAMPLES, O_ALPHA, O_SKIP_FAILED,
     O_COUNT_
 };
 
@@ -56,6 +56,7 @@ typedef struct cli_opts {
     double radius, angle, alpha;                            /* fillet */
     const char *profile, *curve;
     long samples;
+    int skip_failed;
     int seen[O_COUNT_];
 } cli_opts;
 
@@ -249,6 +250,9 @@ static const opt_spec options[] = {
       "initial spine samples by arc length (default 40; refined where the spine bends)" },
     { "--alpha", NULL, K_POSITIVE, C_FILLET, O_ALPHA, AT(alpha), "A", NULL, 0, 100, 0, "a number in [1, 100]",
       "base patches: faces within A x radius of the curve (default 1.75)" },
+    { "--skip-failed", NULL, K_SET, C_FILLET, O_SKIP_FAILED, AT(skip_failed), NULL, NULL, 0, 0, 1, NULL,
+      "leave a curve the radius cannot fillet sharp and go on (said per curve)\n"
+      "instead of failing; fails only when no curve could be filleted" },
     { "--backend", NULL, K_STRING, C_SURFACE, O_BACKEND, AT(backend), "NAME", NULL, 0, 0, 0, "a name",
       "ref|simd|gl|osmesa, tried first (else SURFBLEND_BACKEND, else the default order)" },
     { "-o", "--output", K_STRING, C_SURFACE | C_FILLET, O_OUTPUT, AT(outp), "FILE", NULL, 0, 0, 0, "a file name",
@@ -1395,6 +1399,7 @@ static int cmd_fillet(cli_opts *o) {
     fc = sfb_fillet_config_init((float)o->radius);
     if (o->seen[O_ANGLE]) fc.angle = (float)o->angle;
     if (o->seen[O_SAMPLES]) fc.samples = (int)o->samples;
+    fc.skip_failed = o->skip_failed;
     if (o->seen[O_ALPHA]) {
         if (o->alpha < 1.0) return usage_error(o->cmd, "--alpha needs a number in [1, 100]");
         fc.alpha = (float)o->alpha;
@@ -1420,6 +1425,11 @@ static int cmd_fillet(cli_opts *o) {
     }
     for (i = 0; i < rep.curve_count; ++i) {
         const sfb_fillet_curve_report *c = &rep.curves[i];
+        if (c->skipped) {
+            cli_error("curve %d: %s, %d vertices (%.4g long): skipped, left sharp (--skip-failed: the radius cannot fillet it)", i,
+                      c->closed ? "closed" : "open", c->curve_vertices, (double)c->curve_length);
+            continue;
+        }
         cli_error("curve %d: %s %s, %d vertices (%.4g long), radius %g: spine %.4g long, %d samples, %d vertices moved, %d spine loops cut, "
                   "largest deviation from the sweep %.3g",
                   i, c->closed ? "closed" : "open", c->convex ? "convex" : "concave", c->curve_vertices, (double)c->curve_length, (double)c->radius,
@@ -1429,7 +1439,8 @@ static int cmd_fillet(cli_opts *o) {
         cli_error("warning: %d faces turned over: the radius is too large for the surface around some curve (try a smaller --radius "
                   "or a larger --angle)", rep.faces_folded);
     if (rep.corner_count) cli_error("%d corners rounded by the ball's sphere, %d vertices moved onto them", rep.corner_count, rep.corner_vertices_moved);
-    cli_error("%d curves filleted, %d vertices moved -> %s", rep.curve_count, rep.vertices_moved, o->outp);
+    cli_error("%d curves filleted (%d skipped), %d vertices moved -> %s", rep.curve_count - rep.curves_skipped, rep.curves_skipped,
+              rep.vertices_moved, o->outp);
     rc = 0;
 done:
     rc = cli_output_finish(&out, rc);

@@ -74,6 +74,7 @@ typedef struct sfb__fil_corner {
     int v;            /* the corner vertex */
     double C[3], r;   /* the ball's centre and radius */
     double u[3][3];   /* per curve end: unit direction out of the curve into the corner */
+    int curve[3];     /* the three curves */
     int moved;
 } sfb__fil_corner;
 
@@ -388,6 +389,7 @@ static sfb_result fil_find_corners(sfb__fil *F) {
                 fil_sub(F->pos + 3 * (size_t)a, F->pos + 3 * (size_t)b, u);
                 lu = fil_len(u);
                 for (d = 0; d < 3; ++d) K->u[j][d] = lu > 0 ? u[d] / lu : 0.0;
+                K->curve[j] = members[j][0];
             }
             cv->corner[k] = F->ncorners++;
         }
@@ -398,7 +400,7 @@ static sfb_result fil_find_corners(sfb__fil *F) {
 
 /* The corners' spheres: from the corner vertex through the vertices beyond all three end planes
  * (within 4 r of the ball's centre), each moved to the sphere along the ray from the centre. */
-static sfb_result fil_corners_project(sfb__fil *F) {
+static sfb_result fil_corners_project(sfb__fil *F, const sfb_fillet_curve_report *reps) {
     const sfb__level *l = F->l;
     int *stack = (int *)sfb__alloc(F->ctx, ((size_t)F->nv + 1) * sizeof(int));
     unsigned char *seen = (unsigned char *)sfb__calloc(F->ctx, (size_t)F->nv + 1, 1);
@@ -407,6 +409,7 @@ static sfb_result fil_corners_project(sfb__fil *F) {
     for (k = 0; k < F->ncorners; ++k) {
         sfb__fil_corner *K = &F->corners[k];
         int sp = 0, j;
+        if (reps[K->curve[0]].skipped || reps[K->curve[1]].skipped || reps[K->curve[2]].skipped) continue; /* left sharp */
         stack[sp++] = K->v;
         seen[K->v] = 1;
         while (sp > 0) {
@@ -1712,7 +1715,7 @@ SFB_API sfb_result sfb_mesh_fillet(sfb_context *ctx, const sfb_mesh *mesh, const
     sfb__fil_work W;
     sfb_fillet_curve_report *reps = NULL;
     float *fpos = NULL;
-    int *cvert = NULL, i, nc = 0;
+    int *cvert = NULL, i, nc = 0, nskip = 0;
     float *csharp = NULL;
     sfb_result res;
     double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL}, need;
@@ -1777,9 +1780,24 @@ SFB_API sfb_result sfb_mesh_fillet(sfb_context *ctx, const sfb_mesh *mesh, const
      * curves that meet at a corner end at the corner's planes, so they do not overlap) */
     for (i = 0; i < F.ncurves; ++i) {
         res = fil_one(&F, &W, &F.curves[i], i, &reps[i]);
+        if (res == SFB_INVALID_VALUE && config->skip_failed) {
+            /* this curve cannot be filleted with this radius (fil_one wrote nothing): left sharp, said */
+            reps[i].skipped = 1;
+            nskip++;
+            sfb_clear_error(ctx);
+            res = SFB_SUCCESS;
+            continue;
+        }
         if (res != SFB_SUCCESS) goto done;
     }
-    res = fil_corners_project(&F);
+    if (nskip == F.ncurves) {
+        res = sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, -1,
+                         "none of the %d blending curves could be filleted: radius %g is too large for the base patches or for the "
+                         "surface around the curves (the offset patches do not meet, or meet away from the curves)", F.ncurves,
+                         (double)config->radius);
+        goto done;
+    }
+    res = fil_corners_project(&F, reps);
     if (res != SFB_SUCCESS) goto done;
     res = sfb__progress(ctx, 1.0f, "fillet project");
     if (res != SFB_SUCCESS) goto done;
@@ -1794,7 +1812,7 @@ SFB_API sfb_result sfb_mesh_fillet(sfb_context *ctx, const sfb_mesh *mesh, const
         if (!fpos || !cvert || !csharp) { res = sfb__oom(ctx, "the filleted mesh"); goto done; }
         for (i = 0; i < 3 * F.nv; ++i) fpos[i] = (float)F.opos[i];
         for (c = 0; c < F.ncurves; ++c)
-            for (i = 0; i + 1 < F.curves[c].n; ++i) {
+            for (i = 0; i + 1 < F.curves[c].n && !reps[c].skipped; ++i) {
                 const int e = fil_edge_of(F.l, F.curves[c].v[i], F.curves[c].v[i + 1]);
                 if (e >= 0) F.emark[e] = 1;
             }
@@ -1817,7 +1835,8 @@ SFB_API sfb_result sfb_mesh_fillet(sfb_context *ctx, const sfb_mesh *mesh, const
         report->curves = reps;
         report->ctx_ = ctx;
         for (i = 0; i < F.ncurves; ++i) report->vertices_moved += reps[i].vertices_moved;
-        report->corner_count = F.ncorners;
+        report->curves_skipped = nskip;
+        for (i = 0; i < F.ncorners; ++i) report->corner_count += F.corners[i].moved > 0;
         /* faces the fillet turned over (normal more than 90 degrees from the input's): a radius too
          * large for the surface around a curve; said, not refused (the caller decides) */
         for (i = 0; i < F.nf; ++i) {
