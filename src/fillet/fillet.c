@@ -1691,7 +1691,7 @@ static sfb_result fil_check(sfb_context *ctx, const sfb_mesh *mesh, const sfb_fi
     if (l->nf == 0) return sfb__error(ctx, SFB_INVALID_TOPOLOGY, SFB_ELEMENT_NONE, -1, "the mesh has no faces");
     for (f = 0; f < l->nf; ++f)
         if (l->fv_off[f + 1] - l->fv_off[f] != 3)
-            return sfb__error(ctx, SFB_INVALID_TOPOLOGY, SFB_ELEMENT_FACE, f, "face %d has %d vertices: fillets need a triangle mesh", f,
+            return sfb__error(ctx, SFB_INVALID_TOPOLOGY, SFB_ELEMENT_FACE, f, "it has %d vertices: fillets need a triangle mesh",
                               l->fv_off[f + 1] - l->fv_off[f]);
     for (e = 0; e < l->ne; ++e)
         if (l->ef_off[e + 1] - l->ef_off[e] > 2)
@@ -1700,8 +1700,14 @@ static sfb_result fil_check(sfb_context *ctx, const sfb_mesh *mesh, const sfb_fi
     {
         sfb_mesh_info info;
         sfb_mesh_get_info(mesh, &info);
-        if (info.nonmanifold_vertices > 0)
-            return sfb__error(ctx, SFB_INVALID_TOPOLOGY, SFB_ELEMENT_NONE, -1, "the mesh has %d non-manifold vertices", info.nonmanifold_vertices);
+        if (info.nonmanifold_vertices > 0) {
+            int v, first = -1;
+            for (v = 0; v < l->nv && first < 0; ++v)
+                if ((l->vtag[v] & SFB__TAG_NONMANIFOLD) && l->vf_off[v + 1] > l->vf_off[v]) first = v;
+            return sfb__error(ctx, SFB_INVALID_TOPOLOGY, SFB_ELEMENT_VERTEX, first,
+                              "the mesh has %d non-manifold vertices (where separate fans of faces meet; this is the first): "
+                              "fillets need a manifold mesh", info.nonmanifold_vertices);
+        }
     }
     for (e = 0; e < 3 * l->nv; ++e)
         if (!isfinite(mesh->positions[e]))
