@@ -15138,6 +15138,23 @@ static void fil_polyline_nearest(const double *pts, int n, int closed, const dou
     }
 }
 
+/* The Hermite segment that reconnects a spine's regressive points (seed 4.3): from A with the
+ * direction ta to B with tb, both tangents scaled to the chord; writes its 7 inner points (8
+ * pieces) to out and returns 7. */
+static int fil_hermite_bridge(const double *A, const double *ta_dir, const double *B, const double *tb_dir, double *out) {
+    const int m = 8;
+    const double L = fil_dist(A, B), la = fil_len(ta_dir), lb = fil_len(tb_dir);
+    double ta[3], tb[3];
+    int k, c;
+    for (c = 0; c < 3; ++c) { ta[c] = ta_dir[c] * (la > 0 ? L / la : 0); tb[c] = tb_dir[c] * (lb > 0 ? L / lb : 0); }
+    for (k = 1; k < m; ++k) {
+        const double s = (double)k / m, h00 = 2 * s * s * s - 3 * s * s + 1, h10 = s * s * s - 2 * s * s + s, h01 = -2 * s * s * s + 3 * s * s,
+                     h11 = s * s * s - s * s;
+        for (c = 0; c < 3; ++c) out[3 * (size_t)(k - 1) + c] = h00 * A[c] + h10 * ta[c] + h01 * B[c] + h11 * tb[c];
+    }
+    return m - 1;
+}
+
 /* Spine self-intersections (seed 4.3): two spine pieces closer than tol, apart along the spine by
  * more than `gap`, close a loop; the loop (the shorter way round for a closed spine, the part
  * between them for an open one) is cut out and its ends Q1, Q2 -- the points `gap` before and
@@ -15166,7 +15183,7 @@ static int fil_spine_untangle(sfb_context *ctx, double **pts_io, int *n_io, int 
         if (!found) { sfb__free(ctx, acc); break; }
         {
             /* the loop is i..j (inner), or for a closed spine the shorter of i..j and j..i */
-            int keep_inner = 0, q1, q2, m, k, o = 0;
+            int keep_inner = 0, q1, q2, k, o = 0;
             double *np_;
             if (closed && (acc[bj] - acc[bi]) > acc[n] / 2) keep_inner = 1; /* the outer part is the loop */
             if (keep_inner) {
@@ -15178,23 +15195,11 @@ static int fil_spine_untangle(sfb_context *ctx, double **pts_io, int *n_io, int 
                 if (!np_) { sfb__free(ctx, acc); break; }
                 for (k = q1; k <= q2; ++k) memcpy(np_ + 3 * (size_t)o++, pts + 3 * (size_t)k, 3 * sizeof(double));
                 /* Hermite from q2 back to q1 across the cut */
-                m = 8;
                 {
-                    const double *A = pts + 3 * (size_t)q2, *B = pts + 3 * (size_t)q1;
-                    double ta[3], tb[3], L = fil_dist(A, B);
+                    double ta[3], tb[3];
                     fil_sub(pts + 3 * (size_t)q2, pts + 3 * (size_t)(q2 - 1), ta);
                     fil_sub(pts + 3 * (size_t)(q1 + 1), pts + 3 * (size_t)q1, tb);
-                    {
-                        double la = fil_len(ta), lb = fil_len(tb);
-                        for (k = 0; k < 3; ++k) { ta[k] *= la > 0 ? L / la : 0; tb[k] *= lb > 0 ? L / lb : 0; }
-                    }
-                    for (k = 1; k < m; ++k) {
-                        const double s = (double)k / m, h00 = 2 * s * s * s - 3 * s * s + 1, h10 = s * s * s - 2 * s * s + s,
-                                     h01 = -2 * s * s * s + 3 * s * s, h11 = s * s * s - s * s;
-                        int c;
-                        for (c = 0; c < 3; ++c) np_[3 * (size_t)o + c] = h00 * A[c] + h10 * ta[c] + h01 * B[c] + h11 * tb[c];
-                        o++;
-                    }
+                    o += fil_hermite_bridge(pts + 3 * (size_t)q2, ta, pts + 3 * (size_t)q1, tb, np_ + 3 * (size_t)o);
                 }
             } else {
                 q1 = bi; q2 = bj;
@@ -15203,25 +15208,13 @@ static int fil_spine_untangle(sfb_context *ctx, double **pts_io, int *n_io, int 
                 np_ = (double *)sfb__alloc(ctx, ((size_t)n + 16) * 3 * sizeof(double));
                 if (!np_) { sfb__free(ctx, acc); break; }
                 for (k = 0; k <= q1; ++k) memcpy(np_ + 3 * (size_t)o++, pts + 3 * (size_t)k, 3 * sizeof(double));
-                m = 8;
                 {
-                    const double *A = pts + 3 * (size_t)q1, *B = pts + 3 * (size_t)q2;
-                    double ta[3], tb[3], L = fil_dist(A, B);
+                    double ta[3], tb[3];
                     fil_sub(pts + 3 * (size_t)q1, pts + 3 * (size_t)(q1 > 0 ? q1 - 1 : q1), ta);
                     if (q1 == 0) fil_sub(pts + 3 * (size_t)1, pts, ta);
                     fil_sub(pts + 3 * (size_t)(q2 + 1 < n ? q2 + 1 : q2), pts + 3 * (size_t)q2, tb);
                     if (q2 + 1 >= n) fil_sub(pts + 3 * (size_t)q2, pts + 3 * (size_t)(q2 - 1), tb);
-                    {
-                        double la = fil_len(ta), lb = fil_len(tb);
-                        for (k = 0; k < 3; ++k) { ta[k] *= la > 0 ? L / la : 0; tb[k] *= lb > 0 ? L / lb : 0; }
-                    }
-                    for (k = 1; k < m; ++k) {
-                        const double s = (double)k / m, h00 = 2 * s * s * s - 3 * s * s + 1, h10 = s * s * s - 2 * s * s + s,
-                                     h01 = -2 * s * s * s + 3 * s * s, h11 = s * s * s - s * s;
-                        int c;
-                        for (c = 0; c < 3; ++c) np_[3 * (size_t)o + c] = h00 * A[c] + h10 * ta[c] + h01 * B[c] + h11 * tb[c];
-                        o++;
-                    }
+                    o += fil_hermite_bridge(pts + 3 * (size_t)q1, ta, pts + 3 * (size_t)q2, tb, np_ + 3 * (size_t)o);
                 }
                 for (k = q2; k < n; ++k) memcpy(np_ + 3 * (size_t)o++, pts + 3 * (size_t)k, 3 * sizeof(double));
             }
