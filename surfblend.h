@@ -763,7 +763,7 @@ typedef struct sfb_fillet_config {
     int profile;            /* sfb_fillet_profile */
     float conic_weight;     /* SFB_FILLET_CONIC: weight of the middle control point (< 1 ellipse, 1 parabola,
                                > 1 hyperbola); 0: the arc's own, cos of half the central angle */
-    float hermite_scale;    /* SFB_FILLET_HERMITE: end tangent length over the chord; 0: the arc's tangents */
+    float hermite_scale;    /* SFB_FILLET_HERMITE: end tangent length over the chord, in [0, 10]; 0: the arc's tangents */
     float alpha;            /* base patches: faces within alpha*radius of the curve; 0: 1.75 (seed Fig. 2) */
     int samples;            /* initial spine samples by arc length; 0: 40 (seed section 4.1) */
     float chord_ratio;      /* a spine interval is refined while chord height / chord length exceeds it; 0: 0.002 */
@@ -14674,25 +14674,49 @@ static sfb_result fil_add_curve(sfb__fil *F, const int *v, int n, int closed, do
     return SFB_SUCCESS;
 }
 
+/* Edge e (a-b, two faces): negative when convex -- each face's third vertex lies below the other
+ * face's plane -- positive when concave; summed over a curve's edges it decides the curve. */
+static double fil_edge_conv(const sfb__fil *F, int e, int a, int b) {
+    const sfb__level *l = F->l;
+    const int f0 = l->ef[l->ef_off[e]], f1 = l->ef[l->ef_off[e] + 1];
+    double conv = 0.0;
+    int j;
+    for (j = 0; j < 3; ++j) {
+        const int o1 = F->tri[3 * f1 + j], o0 = F->tri[3 * f0 + j];
+        double dv[3];
+        if (o1 != a && o1 != b) { fil_sub(F->pos + 3 * (size_t)o1, F->pos + 3 * (size_t)a, dv); conv += fil_dot(dv, F->fn + 3 * (size_t)f0); }
+        if (o0 != a && o0 != b) { fil_sub(F->pos + 3 * (size_t)o0, F->pos + 3 * (size_t)a, dv); conv += fil_dot(dv, F->fn + 3 * (size_t)f1); }
+    }
+    return conv;
+}
+
 /* Feature edges (dihedral angle over the threshold, two faces) chained: chains start at vertices
- * with other than two feature edges; what is left are closed loops. */
+ * with other than two feature edges, or with one convex and one concave (a curve has one
+ * convexity: its offsets go one way); what is left are closed loops. */
 static sfb_result fil_curves_from_angle(sfb__fil *F) {
     const sfb__level *l = F->l;
     const double limit = (F->cfg->angle > 0.0f ? F->cfg->angle : 30.0f) * SFB__PI / 180.0;
     unsigned char *feat = (unsigned char *)sfb__calloc(F->ctx, (size_t)l->ne + 1, 1);
     int *deg = (int *)sfb__calloc(F->ctx, (size_t)l->nv + 1, sizeof(int));
     int *chain = (int *)sfb__alloc(F->ctx, ((size_t)l->ne + 2) * sizeof(int));
+    signed char *vsign = (signed char *)sfb__calloc(F->ctx, (size_t)l->nv + 1, 1); /* 2: both convexities meet here */
     int e, v, pass, total = 0;
     sfb_result r = SFB_SUCCESS;
-    if (!feat || !deg || !chain) {
+    if (!feat || !deg || !chain || !vsign) {
         r = sfb__oom(F->ctx, "the feature edges");
         goto done;
     }
     for (e = 0; e < l->ne; ++e)
         if (fil_dihedral(F, e) > limit) {
+            const signed char sg = fil_edge_conv(F, e, l->ev[2 * e], l->ev[2 * e + 1]) < 0.0 ? -1 : 1;
+            int k;
             feat[e] = 1;
             deg[l->ev[2 * e]]++;
             deg[l->ev[2 * e + 1]]++;
+            for (k = 0; k < 2; ++k) {
+                signed char *vs = &vsign[l->ev[2 * e + k]];
+                *vs = *vs == 0 ? sg : *vs == sg ? *vs : 2;
+            }
             total++;
         }
     if (!total) {
@@ -14704,7 +14728,7 @@ static sfb_result fil_curves_from_angle(sfb__fil *F) {
     for (pass = 0; pass < 2 && r == SFB_SUCCESS; ++pass)
         for (v = 0; v < l->nv && r == SFB_SUCCESS; ++v) {
             int k;
-            if (pass == 0 && deg[v] == 2) continue;
+            if (pass == 0 && deg[v] == 2 && vsign[v] != 2) continue;
             for (k = l->ve_off[v]; k < l->ve_off[v + 1] && r == SFB_SUCCESS; ++k) {
                 int cur = v, ce = l->ve[k], n = 0;
                 if (!feat[ce]) continue;
@@ -14715,7 +14739,7 @@ static sfb_result fil_curves_from_angle(sfb__fil *F) {
                     chain[n++] = nx;
                     cur = nx;
                     ce = -1;
-                    if (nx == v || deg[nx] != 2) break;
+                    if (nx == v || deg[nx] != 2 || vsign[nx] == 2) break;
                     for (j = l->ve_off[nx]; j < l->ve_off[nx + 1]; ++j)
                         if (feat[l->ve[j]]) { ce = l->ve[j]; break; }
                 }
@@ -14726,6 +14750,7 @@ done:
     sfb__free(F->ctx, feat);
     sfb__free(F->ctx, deg);
     sfb__free(F->ctx, chain);
+    sfb__free(F->ctx, vsign);
     return r;
 }
 
@@ -14766,22 +14791,6 @@ static sfb_result fil_curves_from_caller(sfb__fil *F) {
         if (r != SFB_SUCCESS) return r;
     }
     return SFB_SUCCESS;
-}
-
-/* Edge e (a-b, two faces): negative when convex -- each face's third vertex lies below the other
- * face's plane -- positive when concave; summed over a curve's edges it decides the curve. */
-static double fil_edge_conv(const sfb__fil *F, int e, int a, int b) {
-    const sfb__level *l = F->l;
-    const int f0 = l->ef[l->ef_off[e]], f1 = l->ef[l->ef_off[e] + 1];
-    double conv = 0.0;
-    int j;
-    for (j = 0; j < 3; ++j) {
-        const int o1 = F->tri[3 * f1 + j], o0 = F->tri[3 * f0 + j];
-        double dv[3];
-        if (o1 != a && o1 != b) { fil_sub(F->pos + 3 * (size_t)o1, F->pos + 3 * (size_t)a, dv); conv += fil_dot(dv, F->fn + 3 * (size_t)f0); }
-        if (o0 != a && o0 != b) { fil_sub(F->pos + 3 * (size_t)o0, F->pos + 3 * (size_t)a, dv); conv += fil_dot(dv, F->fn + 3 * (size_t)f1); }
-    }
-    return conv;
 }
 
 /* The corners (sfb__fil_corner): vertices where exactly three open curves end, with one
@@ -15764,6 +15773,15 @@ static sfb_result fil_one(sfb__fil *F, sfb__fil_work *W, const sfb__fil_curve *c
     rep->convex = convex;
     if (dmax > 170.0 * SFB__PI / 180.0) dmax = 170.0 * SFB__PI / 180.0;
     d = (F->cfg->alpha > 0.0f ? F->cfg->alpha : 1.75) * r * (tan(0.5 * dmax) > 1.0 ? tan(0.5 * dmax) : 1.0);
+    if (!(d <= F->scale)) {
+        /* base patches reaching past the whole mesh: every face would be one, the offsets lie a
+         * radius away from everything, and no check below could tell (they scale with r) */
+        res = sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_VERTEX, cv->v[0],
+                         "blending curve %d (from vertex %d): radius %g is too large for this mesh: its base patches would reach %g from "
+                         "the curve, beyond the mesh's size (bounding-box diagonal %g), and the offset patches do not meet within it",
+                         ci, cv->v[0], r, d, F->scale);
+        goto done;
+    }
 
     /* base patches: both sides grow breadth first together through faces within d */
     while (qh < qt) {
@@ -16159,8 +16177,9 @@ static sfb_result fil_check(sfb_context *ctx, const sfb_mesh *mesh, const sfb_fi
         return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, -1, "unknown fillet profile %d", c->profile);
     if (!(c->conic_weight >= 0.0f) || !isfinite(c->conic_weight))
         return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, -1, "conic weight %g is not a number >= 0", (double)c->conic_weight);
-    if (!(c->hermite_scale >= 0.0f) || !isfinite(c->hermite_scale))
-        return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, -1, "Hermite scale %g is not a number >= 0", (double)c->hermite_scale);
+    if (!(c->hermite_scale >= 0.0f && c->hermite_scale <= 10.0f))
+        return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, -1, "Hermite scale %g is not in [0, 10] (tangent length over the chord)",
+                          (double)c->hermite_scale);
     if (!(c->alpha == 0.0f || (c->alpha >= 1.0f && c->alpha <= 100.0f)))
         return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, -1, "base patch factor alpha %g is not 0 or in [1, 100]", (double)c->alpha);
     if (c->samples < 0 || c->samples == 1 || c->samples > 100000)

@@ -750,7 +750,7 @@ typedef struct sfb_fillet_config {
     int profile;            /* sfb_fillet_profile */
     float conic_weight;     /* SFB_FILLET_CONIC: weight of the middle control point (< 1 ellipse, 1 parabola,
                                > 1 hyperbola); 0: the arc's own, cos of half the central angle */
-    float hermite_scale;    /* SFB_FILLET_HERMITE: end tangent length over the chord; 0: the arc's tangents */
+    float hermite_scale;    /* SFB_FILLET_HERMITE: end tangent length over the chord, in [0, 10]; 0: the arc's tangents */
     float alpha;            /* base patches: faces within alpha*radius of the curve; 0: 1.75 (seed Fig. 2) */
     int samples;            /* initial spine samples by arc length; 0: 40 (seed section 4.1) */
     float chord_ratio;      /* a spine interval is refined while chord height / chord length exceeds it; 0: 0.002 */

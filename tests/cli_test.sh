@@ -513,6 +513,7 @@ check "fillet --profile sharpen --curve succeeds" 0 "$CLI" fillet --radius 0.3 -
 check "fillet --profile hermite:0.5 --samples 60 --alpha 2 succeeds" 0 "$CLI" fillet --radius 0.25 --profile hermite:0.5 --samples 60 --alpha 2 "$TMP/fold.obj" -o "$TMP/fold_h.obj"
 check "fillet without --radius is a usage error" 2 "$CLI" fillet "$TMP/fold.obj" -o "$TMP/fx.obj"
 check "fillet --radius -1 is a usage error" 2 "$CLI" fillet --radius -1 "$TMP/fold.obj" -o "$TMP/fx.obj"
+check "fillet --profile hermite:50 is a usage error" 2 "$CLI" fillet --radius 0.2 --profile hermite:50 "$TMP/fold.obj" -o "$TMP/fx.obj"
 check "fillet --profile bogus is a usage error" 2 "$CLI" fillet --radius 0.2 --profile bogus "$TMP/fold.obj" -o "$TMP/fx.obj"
 check "fillet --curve 1,x is a usage error" 2 "$CLI" fillet --radius 0.2 --curve 1,x "$TMP/fold.obj" -o "$TMP/fx.obj"
 check "fillet --radius 10 (too large) is bad input" 1 "$CLI" fillet --radius 10 "$TMP/fold.obj" -o "$TMP/fx.obj"

@@ -659,6 +659,14 @@ static void test_bad_input(void) {
     expect_error(in, &cfg, SFB_INVALID_VALUE, "bad/radius infinite");
     cfg.radius = 10.0f;
     expect_error(in, &cfg, SFB_INVALID_VALUE, "bad/radius too large");
+    cfg.radius = 1e30f; /* every face a base patch, the offsets 1e30 away: refused, not a sweep of radius 1e30 */
+    expect_error(in, &cfg, SFB_INVALID_VALUE, "bad/radius far beyond the mesh");
+    cfg.radius = 3.4e38f;
+    expect_error(in, &cfg, SFB_INVALID_VALUE, "bad/radius FLT_MAX");
+    cfg = sfb_fillet_config_init(0.2f);
+    cfg.profile = SFB_FILLET_HERMITE;
+    cfg.hermite_scale = 1e30f;
+    expect_error(in, &cfg, SFB_INVALID_VALUE, "bad/Hermite scale");
     cfg = sfb_fillet_config_init(0.2f);
     cfg.profile = 7;
     expect_error(in, &cfg, SFB_INVALID_VALUE, "bad/profile");

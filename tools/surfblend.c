@@ -1335,13 +1335,13 @@ static int fillet_profile(const char *s, sfb_fillet_config *fc) {
     if (strncmp(s, "conic:", 6) == 0 || strncmp(s, "hermite:", 8) == 0) {
         const int conic = s[0] == 'c';
         const double w = strtod(s + (conic ? 6 : 8), &end);
-        if (end != s + (conic ? 6 : 8) && !*end && w > 0.0 && w < 1e6) {
+        if (end != s + (conic ? 6 : 8) && !*end && w > 0.0 && w < (conic ? 1e6 : 10.000001)) {
             fc->profile = conic ? SFB_FILLET_CONIC : SFB_FILLET_HERMITE;
             if (conic) fc->conic_weight = (float)w; else fc->hermite_scale = (float)w;
             return 1;
         }
     }
-    cli_error("--profile: '%s' is not arc, conic:W, sharpen or hermite[:S] (W, S numbers > 0)", s);
+    cli_error("--profile: '%s' is not arc, conic:W, sharpen or hermite[:S] (W a number > 0, S in (0, 10])", s);
     return 0;
 }
 
