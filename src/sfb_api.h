@@ -757,6 +757,10 @@ typedef struct sfb_fillet_config {
     const sfb_fillet_curve *curves; /* the caller's blending curves; NULL: features by angle */
     int curve_count;
     int map;                /* SFB_FILLET_MAP_*: how blend-region vertices find their place on the sweep */
+    int relax;              /* SFB_FILLET_MAP_CONFORMAL: steps of Laplacian optimisation of the map in 2D (seed 5.2,
+                               Fig. 9: uniform weights even out the triangles' sizes; kept only if no face turns
+                               over); 0: none (the default: the conformal map alone gave the fairer triangles on
+                               the tests' shapes, see fil_relax) */
     int skip_failed;        /* non-zero: a curve that cannot be filleted with its radius (its offset patches do not
                                meet, or meet away from it) is left as it is and reported (skipped) instead of
                                failing the call; the call fails when every curve is skipped */
@@ -783,6 +787,7 @@ typedef struct sfb_fillet_curve_report {
     float max_deviation;        /* largest distance of a moved vertex from the ideal sweep surface */
     int map;                    /* how the region was mapped: 0 direct projection, 1 conformal, 2 mean-value weights */
     int skipped;                /* config.skip_failed: this curve could not be filleted and was left as it was */
+    int relaxed;                /* the 2D Laplacian optimisation was kept (config.relax) */
 } sfb_fillet_curve_report;
 typedef struct sfb_fillet_report {
     int curve_count;

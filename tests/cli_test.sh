@@ -40,7 +40,7 @@ cmd_opts() { case $1 in
   shade) echo "--variant --darts --normals-level --weights-level --p --averaging --all-subdivided --limit" ;;
   render) echo "--normals --highlight --blend-weights, --weights --normal-colors --positions --size --view --zoom --stripes --edges --rate --manifold-weights --trim" ;;
   analyze) echo "--mode --light --curvature --level --polygon-based --size --view --eye --target --up --fov --orthographic --stripes --band --backend" ;;
-  fillet) echo "--radius --angle --profile --curve --samples --alpha -o, --output" ;;
+  fillet) echo "--radius --angle --profile --curve --samples --alpha --relax --skip-failed -o, --output" ;;
   esac; }
 for c in info refine eval tess shade render analyze fillet backends; do
   check "$c --help succeeds" 0 "$CLI" $c --help
@@ -513,6 +513,8 @@ check "fillet --profile sharpen --curve succeeds" 0 "$CLI" fillet --radius 0.3 -
 check "fillet --profile hermite:0.5 --samples 60 --alpha 2 succeeds" 0 "$CLI" fillet --radius 0.25 --profile hermite:0.5 --samples 60 --alpha 2 "$TMP/fold.obj" -o "$TMP/fold_h.obj"
 check "fillet without --radius is a usage error" 2 "$CLI" fillet "$TMP/fold.obj" -o "$TMP/fx.obj"
 check "fillet --radius -1 is a usage error" 2 "$CLI" fillet --radius -1 "$TMP/fold.obj" -o "$TMP/fx.obj"
+check "fillet --relax 10 succeeds" 0 "$CLI" fillet --radius 0.25 --relax 10 "$TMP/fold.obj" -o "$TMP/fold_r.obj"
+check "fillet --relax -1 is a usage error" 2 "$CLI" fillet --radius 0.25 --relax -1 "$TMP/fold.obj" -o "$TMP/fx.obj"
 check "fillet --profile hermite:50 is a usage error" 2 "$CLI" fillet --radius 0.2 --profile hermite:50 "$TMP/fold.obj" -o "$TMP/fx.obj"
 check "fillet --profile bogus is a usage error" 2 "$CLI" fillet --radius 0.2 --profile bogus "$TMP/fold.obj" -o "$TMP/fx.obj"
 check "fillet --curve 1,x is a usage error" 2 "$CLI" fillet --radius 0.2 --curve 1,x "$TMP/fold.obj" -o "$TMP/fx.obj"

@@ -25,7 +25,7 @@ enum {
     O_RATE, O_TOLERANCE, O_SPLIT, O_TRIM, O_TILES, O_VARIANT, O_DARTS, O_NORMALS_LEVEL, O_WEIGHTS_LEVEL, O_P,
     O_AVERAGING, O_ALL_SUBDIVIDED, O_NORMALS, O_POSITIONS, O_MODE, O_EDGES, O_SIZE, O_VIEW, O_ZOOM, O_STRIPES, O_CREASE_ANGLE, O_SHARPNESS,
     O_AMODE, O_LIGHT, O_CURVATURE, O_EYE, O_TARGET, O_UP, O_FOV, O_ORTHO, O_POLYGON, O_BAND,
-    O_RADIUS, O_ANGLE, O_PROFILE, O_CURVE, O_SAMPLES, O_ALPHA, O_SKIP_FAILED,
+    O_RADIUS, O_ANGLE, O_PROFILE, O_CURVE, O_SAMPLES, O_ALPHA, O_SKIP_FAILED, O_RELAX,
     O_COUNT_
 };
 
@@ -55,7 +55,7 @@ typedef struct cli_opts {
     double eye[3], target[3], up[3], fov, band;
     double radius, angle, alpha;                            /* fillet */
     const char *profile, *curve;
-    long samples;
+    long samples, relax;
     int skip_failed;
     int seen[O_COUNT_];
 } cli_opts;
@@ -250,6 +250,9 @@ static const opt_spec options[] = {
       "initial spine samples by arc length (default 40; refined where the spine bends)" },
     { "--alpha", NULL, K_POSITIVE, C_FILLET, O_ALPHA, AT(alpha), "A", NULL, 0, 100, 0, "a number in [1, 100]",
       "base patches: faces within A x radius of the curve (default 1.75)" },
+    { "--relax", NULL, K_LONG, C_FILLET, O_RELAX, AT(relax), "N", NULL, 0, 10000, 0, "a number in 0..10000",
+      "steps of Laplacian optimisation of the map in 2D (seed 5.2; default 0:\n"
+      "the conformal map alone)" },
     { "--skip-failed", NULL, K_SET, C_FILLET, O_SKIP_FAILED, AT(skip_failed), NULL, NULL, 0, 0, 1, NULL,
       "leave a curve the radius cannot fillet sharp and go on (said per curve)\n"
       "instead of failing; fails only when no curve could be filleted" },
@@ -1400,6 +1403,7 @@ static int cmd_fillet(cli_opts *o) {
     if (o->seen[O_ANGLE]) fc.angle = (float)o->angle;
     if (o->seen[O_SAMPLES]) fc.samples = (int)o->samples;
     fc.skip_failed = o->skip_failed;
+    if (o->seen[O_RELAX]) fc.relax = (int)o->relax;
     if (o->seen[O_ALPHA]) {
         if (o->alpha < 1.0) return usage_error(o->cmd, "--alpha needs a number in [1, 100]");
         fc.alpha = (float)o->alpha;
