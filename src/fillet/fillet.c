@@ -60,7 +60,21 @@ typedef struct sfb__fil_curve {
     int profile;
     double conic_w;
     int corner[2];    /* per end (v[0], v[n-1]): the corner (sfb__fil_corner) it ends at, or -1 */
+    double setback[2];/* per end at another junction (sfb__fil_junction): how far before it the sweep stops; 0: none */
 } sfb__fil_curve;
+
+/* A junction: any other vertex where two or more open curves end (curves of both convexities,
+ * other profiles or radii, faces not on three planes, more than three curves: a prism's sharp
+ * vertical edge standing on a filleted floor seam). There is no exact rolling-ball answer the
+ * seed gives; each curve's sweep stops `s` before it (the largest reach of the curves there, r
+ * max(1, tan(delta / 2))), so that their regions do not overlap, and the vertices around it that
+ * no sweep moved take the harmonic interpolation of the moves around them (a membrane patch:
+ * continuous, no exact geometry). Before, every sweep ran to the vertex and the regions overlapped:
+ * the L prism with sharp vertical corners, filleted by angle, had 767 intersecting triangle pairs. */
+typedef struct sfb__fil_junction {
+    int v;
+    double s;
+} sfb__fil_junction;
 
 /* A corner: a vertex where exactly three open curves end, all convex or all concave, all with the
  * arc profile and one radius, around
@@ -97,6 +111,8 @@ typedef struct sfb__fil {
     unsigned char *fmark;  /* per edge: on any blending curve of this call (base patches stop there) */
     sfb__fil_corner *corners;
     int ncorners;
+    sfb__fil_junction *junctions;
+    int njunctions;
     double scale;          /* bounding-box diagonal */
     sfb__fil_curve *curves;
     int ncurves, curves_cap;
@@ -177,6 +193,7 @@ static sfb_result fil_add_curve(sfb__fil *F, const int *v, int n, int closed, do
     c->n = n;
     c->closed = closed;
     c->corner[0] = c->corner[1] = -1;
+    c->setback[0] = c->setback[1] = 0.0;
     c->radius = radius;
     c->profile = profile;
     c->conic_w = w;
@@ -403,8 +420,126 @@ static sfb_result fil_find_corners(sfb__fil *F) {
             cv->corner[k] = F->ncorners++;
         }
     }
+    /* the other junctions: the largest reach of the curves ending there */
+    for (c = 0; c < F->ncurves; ++c) {
+        sfb__fil_curve *cv = &F->curves[c];
+        for (k = 0; k < 2 && !cv->closed; ++k) {
+            const int v = k ? cv->v[cv->n - 1] : cv->v[0];
+            double s = 0.0;
+            int d, j, known = -1;
+            if (ends[v] < 2 || cv->corner[k] >= 0) continue;
+            for (j = 0; j < F->njunctions; ++j)
+                if (F->junctions[j].v == v) known = j;
+            if (known < 0) {
+                for (d = 0; d < F->ncurves; ++d) {
+                    const sfb__fil_curve *w = &F->curves[d];
+                    double dm = 0.0, reach;
+                    if (w->closed || (w->v[0] != v && w->v[w->n - 1] != v)) continue;
+                    for (j = 0; j + 1 < w->n; ++j) {
+                        const int e = fil_edge_of(l, w->v[j], w->v[j + 1]);
+                        if (e >= 0 && fil_dihedral(F, e) > dm) dm = fil_dihedral(F, e);
+                    }
+                    if (dm > 170.0 * SFB__PI / 180.0) dm = 170.0 * SFB__PI / 180.0;
+                    reach = w->radius * (tan(0.5 * dm) > 1.0 ? tan(0.5 * dm) : 1.0);
+                    if (reach > s) s = reach;
+                }
+                if (F->njunctions % 8 == 0) {
+                    sfb__fil_junction *nj = (sfb__fil_junction *)sfb__realloc(F->ctx, F->junctions, (size_t)(F->njunctions + 8) * sizeof *nj);
+                    if (!nj) { sfb__free(F->ctx, ends); return sfb__oom(F->ctx, "the junctions"); }
+                    F->junctions = nj;
+                }
+                F->junctions[F->njunctions].v = v;
+                F->junctions[F->njunctions].s = s;
+                known = F->njunctions++;
+            }
+            cv->setback[k] = F->junctions[known].s;
+        }
+    }
     sfb__free(F->ctx, ends);
     return SFB_SUCCESS;
+}
+
+/* The junctions' membranes: around each junction vertex (within 2 s), the vertices no sweep or
+ * corner moved get the harmonic interpolation (uniform weights, sparse CG) of the moves of the
+ * vertices around them; those at 2 s and beyond keep theirs (mostly none). */
+static sfb_result fil_junctions_fill(sfb__fil *F) {
+    sfb_context *ctx = F->ctx;
+    const sfb__level *l = F->l;
+    int *loc = NULL, *list = NULL, *rowi = NULL, *coli = NULL, jn;
+    double *val = NULL, *b = NULL, *x = NULL;
+    sfb_result res = SFB_SUCCESS;
+    if (F->njunctions == 0) return SFB_SUCCESS;
+    loc = (int *)sfb__alloc(ctx, ((size_t)F->nv + 1) * sizeof(int));
+    list = (int *)sfb__alloc(ctx, ((size_t)F->nv + 1) * sizeof(int));
+    if (!loc || !list) { res = sfb__oom(ctx, "the junctions"); goto done; }
+    for (jn = 0; jn < F->nv; ++jn) loc[jn] = -1;
+    for (jn = 0; jn < F->njunctions; ++jn) {
+        const sfb__fil_junction *J = &F->junctions[jn];
+        const double *V = F->pos + 3 * (size_t)J->v, R = 1.25 * J->s;
+        int head = 0, n = 0, nu = 0, i, j, c, nt = 0, it;
+        double resid;
+        /* the vertices within R of V, reached over edges; loc: -2 seen and fixed, >= 0 unknown */
+        list[n++] = J->v;
+        loc[J->v] = -2;
+        while (head < n) {
+            const int v = list[head++];
+            for (j = l->ve_off[v]; j < l->ve_off[v + 1]; ++j) {
+                const int w = sfb__other_end(l, l->ve[j], v);
+                if (loc[w] != -1 || fil_dist(F->pos + 3 * (size_t)w, V) >= R) continue;
+                loc[w] = -2;
+                list[n++] = w;
+            }
+        }
+        for (i = 0; i < n; ++i) {
+            const int v = list[i];
+            int boundary = 0;
+            for (j = l->ve_off[v]; j < l->ve_off[v + 1]; ++j) boundary |= l->ef_off[l->ve[j] + 1] - l->ef_off[l->ve[j]] != 2;
+            if (!boundary && memcmp(F->pos + 3 * (size_t)v, F->opos + 3 * (size_t)v, 3 * sizeof(double)) == 0) loc[v] = nu++;
+        }
+        if (nu > 0) {
+            size_t cap = 0;
+            sfb__sparse A;
+            memset(&A, 0, sizeof A);
+            for (i = 0; i < n; ++i)
+                if (loc[list[i]] >= 0) cap += (size_t)(l->ve_off[list[i] + 1] - l->ve_off[list[i]]) + 1;
+            rowi = (int *)sfb__alloc(ctx, cap * sizeof(int));
+            coli = (int *)sfb__alloc(ctx, cap * sizeof(int));
+            val = (double *)sfb__alloc(ctx, cap * sizeof(double));
+            b = (double *)sfb__calloc(ctx, (size_t)nu * 3, sizeof(double));
+            x = (double *)sfb__calloc(ctx, (size_t)nu, sizeof(double));
+            if (!rowi || !coli || !val || !b || !x) { res = sfb__oom(ctx, "the junctions"); goto done; }
+            for (i = 0; i < n; ++i) {
+                const int v = list[i], u = loc[v];
+                if (u < 0) continue;
+                rowi[nt] = u; coli[nt] = u; val[nt] = (double)(l->ve_off[v + 1] - l->ve_off[v]); nt++;
+                for (j = l->ve_off[v]; j < l->ve_off[v + 1]; ++j) {
+                    const int w = sfb__other_end(l, l->ve[j], v);
+                    if (loc[w] >= 0) { rowi[nt] = u; coli[nt] = loc[w]; val[nt] = -1.0; nt++; }
+                    else
+                        for (c = 0; c < 3; ++c) b[3 * (size_t)u + c] += F->opos[3 * (size_t)w + c] - F->pos[3 * (size_t)w + c];
+                }
+            }
+            res = sfb__sparse_from_triplets(ctx, nu, nt, rowi, coli, val, &A);
+            for (c = 0; c < 3 && res == SFB_SUCCESS; ++c) {
+                double *bc = (double *)sfb__alloc(ctx, (size_t)nu * sizeof(double));
+                if (!bc) { res = sfb__oom(ctx, "the junctions"); break; }
+                for (i = 0; i < nu; ++i) { bc[i] = b[3 * (size_t)i + c]; x[i] = 0.0; }
+                if (sfb__sparse_cg(ctx, &A, bc, x, 1e-12, 4 * nu + 200, &it, &resid) != SFB_SUCCESS) sfb_clear_error(ctx); /* best effort */
+                for (i = 0; i < n; ++i)
+                    if (loc[list[i]] >= 0 && isfinite(x[loc[list[i]]])) F->opos[3 * (size_t)list[i] + c] = F->pos[3 * (size_t)list[i] + c] + x[loc[list[i]]];
+                sfb__free(ctx, bc);
+            }
+            sfb__sparse_free(ctx, &A);
+            sfb__free(ctx, rowi); sfb__free(ctx, coli); sfb__free(ctx, val); sfb__free(ctx, b); sfb__free(ctx, x);
+            rowi = coli = NULL; val = b = x = NULL;
+            if (res != SFB_SUCCESS) goto done;
+        }
+        for (i = 0; i < n; ++i) loc[list[i]] = -1;
+    }
+done:
+    sfb__free(ctx, loc); sfb__free(ctx, list);
+    sfb__free(ctx, rowi); sfb__free(ctx, coli); sfb__free(ctx, val); sfb__free(ctx, b); sfb__free(ctx, x);
+    return res;
 }
 
 /* The corners' spheres: from the corner vertex through the vertices beyond all three end planes
@@ -1505,8 +1640,20 @@ static sfb_result fil_one(sfb__fil *F, sfb__fil_work *W, const sfb__fil_curve *c
                 }
         /* the end planes: through the curve's end point, or through the corner ball's centre where
          * the end is at a corner (the sweep stops where the ball starts touching the third face) */
+        double jp[2][3];
         const double *pl0 = cv->corner[0] >= 0 ? F->corners[cv->corner[0]].C : cp;
         const double *pl1 = cv->corner[1] >= 0 ? F->corners[cv->corner[1]].C : cp + 3 * (size_t)(m - 1);
+        /* ... or `setback` before another junction (at most 0.45 of the curve's length) */
+        for (k = 0; k < 2; ++k)
+            if (cv->setback[k] > 0.0) {
+                const double *e = k ? cp + 3 * (size_t)(m - 1) : cp, *e2 = k ? cp + 3 * (size_t)(m - 2) : cp + 3;
+                const double sb = cv->setback[k] < 0.45 * rep->curve_length ? cv->setback[k] : 0.45 * rep->curve_length;
+                double u[3], lu;
+                fil_sub(e2, e, u);
+                lu = fil_len(u);
+                for (i = 0; i < 3; ++i) jp[k][i] = e[i] + (lu > 0 ? sb * u[i] / lu : 0.0);
+                if (k) pl1 = jp[1]; else pl0 = jp[0];
+            }
         fil_sub(cp + 3, cp, t0);                                              /* into the curve at its start */
         fil_sub(cp + 3 * (size_t)(m - 1), cp + 3 * (size_t)(m - 2), t1);       /* out of it at its end */
         while (lo < ns - 1) {
@@ -1929,6 +2076,7 @@ SFB_API sfb_result sfb_mesh_fillet(sfb_context *ctx, const sfb_mesh *mesh, const
         goto done;
     }
     res = fil_corners_project(&F, reps);
+    if (res == SFB_SUCCESS) res = fil_junctions_fill(&F);
     if (res != SFB_SUCCESS) goto done;
     res = sfb__progress(ctx, 1.0f, "fillet project");
     if (res != SFB_SUCCESS) goto done;
@@ -1988,7 +2136,7 @@ done:
     sfb__free(ctx, F.curves);
     sfb__free(ctx, reps);
     sfb__free(ctx, F.pos); sfb__free(ctx, F.npos); sfb__free(ctx, F.fn); sfb__free(ctx, F.emark);
-    sfb__free(ctx, F.opos); sfb__free(ctx, F.fmark); sfb__free(ctx, F.corners);
+    sfb__free(ctx, F.opos); sfb__free(ctx, F.fmark); sfb__free(ctx, F.corners); sfb__free(ctx, F.junctions);
     sfb__free(ctx, W.fside); sfb__free(ctx, W.queue); sfb__free(ctx, W.vd); sfb__free(ctx, W.vdlist);
     sfb__free(ctx, W.vlist); sfb__free(ctx, W.vin); sfb__free(ctx, W.ta);
     for (i = 0; i < 2; ++i) { sfb__free(ctx, W.nrm[i]); sfb__free(ctx, W.op[i]); }
