@@ -15050,7 +15050,7 @@ static sfb_result fil_corners_project(sfb__fil *F, const sfb_fillet_curve_report
         int sp = 0, j;
         if (reps[K->curve[0]].skipped || reps[K->curve[1]].skipped || reps[K->curve[2]].skipped) continue; /* left sharp */
         stack[sp++] = K->v;
-        seen[K->v] = 1;
+        seen[K->v] |= 1;
         while (sp > 0) {
             const int v = stack[--sp];
             const double *p = F->pos + 3 * (size_t)v;
@@ -15060,22 +15060,25 @@ static sfb_result fil_corners_project(sfb__fil *F, const sfb_fillet_curve_report
             ld = fil_len(dv);
             for (j = 0; j < 3; ++j) inside &= fil_dot(dv, K->u[j]) >= -1e-9 * K->r;
             if (!inside || !(ld > 0) || ld > 4.0 * K->r) continue;
-            for (j = 0; j < 3; ++j) F->opos[3 * (size_t)v + j] = K->C[j] + K->r * dv[j] / ld;
-            K->moved++;
+            if (!(seen[v] & 2)) { /* a vertex two corners reach (a tiny mesh) moves once, for the first */
+                for (j = 0; j < 3; ++j) F->opos[3 * (size_t)v + j] = K->C[j] + K->r * dv[j] / ld;
+                K->moved++;
+                seen[v] |= 2;
+            }
             for (j = l->ve_off[v]; j < l->ve_off[v + 1]; ++j) {
                 const int w = sfb__other_end(l, l->ve[j], v);
-                if (!seen[w]) { seen[w] = 1; stack[sp++] = w; }
+                if (!(seen[w] & 1)) { seen[w] |= 1; stack[sp++] = w; }
             }
         }
         /* reset seen for the next corner: the visited set is small, walk it again */
         stack[0] = K->v;
         sp = 1;
-        seen[K->v] = 0;
+        seen[K->v] &= (unsigned char)~1u;
         while (sp > 0) {
             const int v = stack[--sp];
             for (j = l->ve_off[v]; j < l->ve_off[v + 1]; ++j) {
                 const int w = sfb__other_end(l, l->ve[j], v);
-                if (seen[w]) { seen[w] = 0; stack[sp++] = w; }
+                if (seen[w] & 1) { seen[w] &= (unsigned char)~1u; stack[sp++] = w; }
             }
         }
     }
