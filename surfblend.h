@@ -14696,6 +14696,14 @@ static sfb_result fil_add_curve(sfb__fil *F, const int *v, int n, int closed, do
     return SFB_SUCCESS;
 }
 
+/* How far from a curve the ball of radius r touches the faces: r tan(delta / 2) for the sharpest
+ * dihedral angle delta (capped at 170 degrees), at least r. The base patches reach alpha times it;
+ * a junction's setback is the largest of its curves'. */
+static double fil_reach(double r, double delta) {
+    const double t = tan(0.5 * (delta < 170.0 * SFB__PI / 180.0 ? delta : 170.0 * SFB__PI / 180.0));
+    return r * (t > 1.0 ? t : 1.0);
+}
+
 /* Edge e (a-b, two faces): negative when convex -- each face's third vertex lies below the other
  * face's plane -- positive when concave; summed over a curve's edges it decides the curve. */
 static double fil_edge_conv(const sfb__fil *F, int e, int a, int b) {
@@ -14934,8 +14942,7 @@ static sfb_result fil_find_corners(sfb__fil *F) {
                         const int e = fil_edge_of(l, w->v[j], w->v[j + 1]);
                         if (e >= 0 && fil_dihedral(F, e) > dm) dm = fil_dihedral(F, e);
                     }
-                    if (dm > 170.0 * SFB__PI / 180.0) dm = 170.0 * SFB__PI / 180.0;
-                    reach = w->radius * (tan(0.5 * dm) > 1.0 ? tan(0.5 * dm) : 1.0);
+                    reach = fil_reach(w->radius, dm);
                     if (reach > s) s = reach;
                 }
                 if (F->njunctions % 8 == 0) {
@@ -16023,8 +16030,7 @@ static sfb_result fil_one(sfb__fil *F, sfb__fil_work *W, const sfb__fil_curve *c
     }
     convex = conv < 0.0;
     rep->convex = convex;
-    if (dmax > 170.0 * SFB__PI / 180.0) dmax = 170.0 * SFB__PI / 180.0;
-    d = (F->cfg->alpha > 0.0f ? F->cfg->alpha : 1.75) * r * (tan(0.5 * dmax) > 1.0 ? tan(0.5 * dmax) : 1.0);
+    d = (F->cfg->alpha > 0.0f ? F->cfg->alpha : 1.75) * fil_reach(r, dmax);
     if (!(d <= F->scale)) {
         /* base patches reaching past the whole mesh: every face would be one, the offsets lie a
          * radius away from everything, and no check below could tell (they scale with r) */
