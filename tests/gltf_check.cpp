@@ -247,6 +247,7 @@ std::string meshopt_decode_file(const std::string &path, std::string *err) {
         if (rc != 0) { *err = "a view does not decode (" + std::to_string(rc) + ")"; return ""; }
         const std::string filter = x.value("filter", std::string("NONE"));
         if (filter == "OCTAHEDRAL") meshopt_decodeFilterOct(dst, count, stride);
+        else if (filter == "EXPONENTIAL") meshopt_decodeFilterExp(dst, count, stride);
         else if (filter != "NONE") { *err = "filter " + filter + " not read"; return ""; }
         v.erase("extensions");
         v["buffer"] = 0;

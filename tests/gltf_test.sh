@@ -403,6 +403,7 @@ if [ -d "$SHAPES" ]; then
   readback car.glb "$SHAPES/catmark_car.obj" --level 2 -- --uvs yes
   readback car_quant.glb "$SHAPES/catmark_car.obj" --level 2 --quantize --uv-bits 10 -- --uvs yes
   readback car_compress.glb "$SHAPES/catmark_car.obj" --level 2 --quantize --compress -- --uvs yes
+  readback car_compress_uv10.glb "$SHAPES/catmark_car.obj" --level 1 --quantize --compress --uv-bits 10 -- --uvs yes
   readback fvar.glb "$SHAPES/catmark_fvar_bound1.obj" --level 2 -- --uvs yes
   readback loop.glb "$SHAPES/loop_cube_creases1.obj" --level 2
   readback loop_tess.glb "$SHAPES/loop_cube_creases1.obj" --tess 5
