@@ -561,7 +561,10 @@ SFB_API sfb_result sfb_render(sfb_context *ctx, const sfb_mesh_data *m, const sf
         goto done;
     }
     for (f = 0; f < m->hole_count; ++f) hole[m->holes[f]] = 1;
-    for (k = 0; k < npix; ++k) R.gb[k * SFB__RENDER_GB] = (float)HUGE_VAL;
+    /* depth "none"; and no stripe coordinate (slot 7): the highlight filter reads the slot of
+     * every neighbour, background ones included, which were left uninitialised (a picture that
+     * depended on what the allocator handed back) */
+    for (k = 0; k < npix; ++k) R.gb[k * SFB__RENDER_GB] = R.gb[k * SFB__RENDER_GB + 7] = (float)HUGE_VAL;
 
     sfb__render_view_setup(m, pos, &c, w, h, &V);
     sfb__render_project(m, pos, &V.cam, pv);
