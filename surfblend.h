@@ -1184,6 +1184,8 @@ SFB__IF int sfb__mask_need_vertex(const sfb__level *l, int v);
 /* Row `row` of `out` = mask m composed with the parent rows prow; 0 on allocation failure or when
  * the accumulator's stamp wrapped (the caller resets it). */
 SFB__IF int sfb__compose_row(sfb_context *ctx, sfb__accum *A, const sfb__rows *prow, const sfb__mask *m, sfb__rows *out, int row);
+/* Mask m as row `row` of out, as sfb__compose_row over identity rows gives it (stencil.c). */
+SFB__IF int sfb__rows_append_mask(sfb_context *ctx, sfb__rows *out, const sfb__mask *m, int row);
 /* The float stencil table of r (over `sources` source elements). */
 SFB__IF sfb_result sfb__rows_to_stencils(sfb_context *ctx, const sfb__rows *r, int sources, sfb__stencils *s);
 
@@ -1296,7 +1298,24 @@ SFB__IF sfb_result sfb__scheme_check_flags(sfb_context *ctx, const sfb__scheme_i
 SFB__IF sfb_result sfb__refine(sfb_context *ctx, const sfb__level *base, const sfb__refine_options *opt, int level,
                        sfb__level *top, sfb__stencils *vertex_table, sfb__stencils *limit_tables /* [3] or NULL */,
                        float progress_from, float progress_to);
+/* What sfb__refine_keep_levels hands over besides `top`: the levels 1 .. level-1 (lev[0] is
+ * left empty: the base is the caller's) and the step tables T[k] from level k to k + 1 (rows over
+ * level k's vertices), in caller-allocated arrays of `level` zeroed entries; the receiver owns
+ * them (freed on failure). The shading build takes them instead of refining again. */
+typedef struct sfb__refine_kept {
+    sfb__level *lev;
+    sfb__stencils *T;
+} sfb__refine_kept;
+SFB__IF sfb_result sfb__refine_keep_levels(sfb_context *ctx, const sfb__level *base, const sfb__refine_options *opt, int level,
+                                   sfb__level *top, sfb__stencils *vertex_table, sfb__stencils *limit_tables,
+                                   sfb__refine_kept *keep, float progress_from, float progress_to);
+SFB__IF void sfb__refine_kept_free(sfb_context *ctx, sfb__refine_kept *keep, int level);
 SFB__IF void sfb__stencils_free(sfb_context *ctx, sfb__stencils *s);
+/* sfb__refine_step that also writes the step's own rows (children over the parent's vertices)
+ * into `local` when not NULL (refine.c). */
+SFB__IF sfb_result sfb__refine_step_local(sfb_context *ctx, const sfb__refine_options *opt, const sfb__level *p,
+                                  const sfb__rows *prow, sfb__level *c, sfb__rows *crow, sfb__rows *local, sfb__accum *A,
+                                  sfb__mask *m, float *ps, float *cs, float p0, float dp);
 /* One refinement step of `p` (composed rows prow) into `c` (composed rows crow); A, m, ps, cs are
  * the caller's scratch; progress from p0 over dp. */
 SFB__IF sfb_result sfb__refine_step(sfb_context *ctx, const sfb__refine_options *opt, const sfb__level *p, const sfb__rows *prow,
@@ -1344,8 +1363,11 @@ SFB__IF void sfb__shading_free(sfb_context *ctx, sfb__shading *sh);
 SFB__IF int sfb__shade_extraordinary(const sfb__level *l, int v, int loop);
 SFB__IF int sfb__shade_held(const sfb__level *l, int v, int loop, int variant, int darts);
 SFB__IF int sfb__shade_spherical_mean(int count, const double *n, const double *w, double out[3]);
+/* The shading tables of `prep` refined `level` times; kept (with top, its last level): the vertex
+ * refinement's levels and steps, taken over (freed on failure) instead of refining again; NULL:
+ * refined here. */
 SFB__IF sfb_result sfb__shading_build(sfb_context *ctx, const sfb__level *prep, const sfb__refine_options *opt, int level,
-                              const sfb_shading_options *o, sfb__shading **out);
+                              const sfb_shading_options *o, sfb__refine_kept *kept, const sfb__level *top, sfb__shading **out);
 
 /* ---- patch tables (patch/) ---- */
 SFB__IF void sfb__patch_table_free(sfb_context *ctx, sfb__patch_table *pt);
@@ -1470,6 +1492,7 @@ typedef struct sfb__pbuild {
     size_t cap_rows;
     sfb__accum A;
     sfb__mask m;
+    sfb__mask cap[3];        /* an end cap's limit masks (position, two tangents), kept between caps */
     int *vrow;               /* point row of each vertex of the working level, -1 if none yet */
 } sfb__pbuild;
 /* A working level of feature-adaptive isolation: its topology, the composed rows of its
@@ -2423,7 +2446,7 @@ int sfb__rows_reserve(sfb_context *ctx, sfb__rows *r, size_t need) {
     cap = r->cap ? r->cap : 1024;
     while (cap < need) {
         if (cap > ((size_t)-1) / 4) return 0;
-        cap = cap + cap / 2 + 16;
+        cap = 2 * cap + 16; /* doubling: a table grown row by row is copied at most once over in all */
     }
     ni = (int *)sfb__realloc(ctx, r->idx, cap * sizeof(int));
     if (!ni) return 0;
@@ -2494,6 +2517,33 @@ int sfb__compose_row(sfb_context *ctx, sfb__accum *A, const sfb__rows *prow, con
         out->w[out->n] = A->acc[b];
         out->n++;
     }
+    out->off[row + 1] = out->n;
+    return 1;
+}
+
+/* Appends local mask m as row `row` of out: what sfb__compose_row gives over identity rows
+ * (entries in the order of first use, duplicates summed in mask order, zero weights and zero
+ * sums dropped) without an accumulator over the sources. Masks are short: the merge is a
+ * linear search. */
+int sfb__rows_append_mask(sfb_context *ctx, sfb__rows *out, const sfb__mask *m, int row) {
+    const size_t at = out->n;
+    size_t k, j;
+    int i;
+    if (!sfb__rows_reserve(ctx, out, out->n + (size_t)m->n)) return 0;
+    for (i = 0; i < m->n; ++i) {
+        if (m->w[i] == 0.0) continue;
+        for (k = at; k < out->n && out->idx[k] != m->idx[i]; ++k) {}
+        if (k < out->n) {
+            out->w[k] += m->w[i];
+        } else {
+            out->idx[out->n] = m->idx[i];
+            out->w[out->n] = 0.0 + m->w[i];
+            out->n++;
+        }
+    }
+    for (j = k = at; k < out->n; ++k)
+        if (out->w[k] != 0.0) { out->idx[j] = out->idx[k]; out->w[j] = out->w[k]; ++j; }
+    out->n = j;
     out->off[row + 1] = out->n;
     return 1;
 }
@@ -2865,6 +2915,14 @@ static int sfb__child_mask(sfb__step *st, int cv, sfb__mask *m, float *ps, float
 sfb_result sfb__refine_step(sfb_context *ctx, const sfb__refine_options *opt, const sfb__level *p, const sfb__rows *prow,
                                    sfb__level *c, sfb__rows *crow, sfb__accum *A, sfb__mask *m, float *ps, float *cs,
                                    float p0, float dp) {
+    return sfb__refine_step_local(ctx, opt, p, prow, c, crow, NULL, A, m, ps, cs, p0, dp);
+}
+
+/* sfb__refine_step that also gives the step's own rows (each child over the parent's
+ * vertices: its local mask, duplicates merged) in `local` when that is not NULL. */
+sfb_result sfb__refine_step_local(sfb_context *ctx, const sfb__refine_options *opt, const sfb__level *p, const sfb__rows *prow,
+                                  sfb__level *c, sfb__rows *crow, sfb__rows *local, sfb__accum *A, sfb__mask *m, float *ps,
+                                  float *cs, float p0, float dp) {
     sfb__step st;
     sfb_result r;
     int cv;
@@ -2877,13 +2935,27 @@ sfb_result sfb__refine_step(sfb_context *ctx, const sfb__refine_options *opt, co
     crow->rows = c->nv;
     crow->n = 0;
     crow->off = (size_t *)sfb__alloc(ctx, ((size_t)c->nv + 1) * sizeof(size_t));
-    if (!crow->off || !sfb__rows_reserve(ctx, crow, (size_t)c->nv * 4 + 16)) {
+    /* room for the child rows at once: a child's row spans about twice its parents' average
+     * (it grows by 1.5x and is copied by realloc where this falls short; growing from 4 per row
+     * copied the table five times over at level 3) */
+    if (!crow->off || !sfb__rows_reserve(ctx, crow, (size_t)c->nv * (2 * (prow->n / (size_t)(prow->rows > 0 ? prow->rows : 1)) + 4) + 16)) {
         sfb__free(ctx, st.half);
         return sfb__oom(ctx, "stencil table");
     }
     crow->off[0] = 0;
+    if (local) {
+        memset(local, 0, sizeof *local);
+        local->rows = c->nv;
+        local->off = (size_t *)sfb__alloc(ctx, ((size_t)c->nv + 1) * sizeof(size_t));
+        if (!local->off || !sfb__rows_reserve(ctx, local, (size_t)c->nv * 8 + 16)) {
+            sfb__free(ctx, st.half);
+            return sfb__oom(ctx, "stencil table");
+        }
+        local->off[0] = 0;
+    }
     for (cv = 0; cv < c->nv; ++cv) {
-        if (!sfb__child_mask(&st, cv, m, ps, cs) || !sfb__compose_row(ctx, A, prow, m, crow, cv)) {
+        if (!sfb__child_mask(&st, cv, m, ps, cs) || !sfb__compose_row(ctx, A, prow, m, crow, cv) ||
+            (local && !sfb__rows_append_mask(ctx, local, m, cv))) {
             sfb__free(ctx, st.half);
             return sfb__oom(ctx, "stencil table");
         }
@@ -3039,14 +3111,28 @@ void sfb__limit_masks(const sfb__level *l, int v, sfb_scheme scheme, sfb__mask *
 
 sfb_result sfb__refine(sfb_context *ctx, const sfb__level *base, const sfb__refine_options *opt, int level,
                        sfb__level *top, sfb__stencils *vt, sfb__stencils *lt, float prog0, float prog1) {
-    sfb__rows prow, crow;
+    return sfb__refine_keep_levels(ctx, base, opt, level, top, vt, lt, NULL, prog0, prog1);
+}
+
+void sfb__refine_kept_free(sfb_context *ctx, sfb__refine_kept *keep, int level) {
+    int k;
+    for (k = 0; k < level; ++k) {
+        sfb__level_free(ctx, &keep->lev[k]);
+        sfb__stencils_free(ctx, &keep->T[k]);
+    }
+}
+
+sfb_result sfb__refine_keep_levels(sfb_context *ctx, const sfb__level *base, const sfb__refine_options *opt, int level,
+                                   sfb__level *top, sfb__stencils *vt, sfb__stencils *lt, sfb__refine_kept *keep, float prog0,
+                                   float prog1) {
+    sfb__rows prow, crow, local;
     sfb__level cur, next;
     sfb__accum A;
     sfb__mask m;
     float *ps = NULL, *cs = NULL;
     sfb_result r = SFB_SUCCESS;
     int L, i, owns_cur = 0;
-    memset(&prow, 0, sizeof prow); memset(&crow, 0, sizeof crow);
+    memset(&prow, 0, sizeof prow); memset(&crow, 0, sizeof crow); memset(&local, 0, sizeof local);
     memset(&A, 0, sizeof A); memset(&m, 0, sizeof m);
     memset(&next, 0, sizeof next);
     cur = *base;
@@ -3067,13 +3153,19 @@ sfb_result sfb__refine(sfb_context *ctx, const sfb__level *base, const sfb__refi
     for (L = 0; L < level; ++L) {
         r = sfb__progress(ctx, prog0 + (prog1 - prog0) * (float)L / (float)(level + 1), "refine");
         if (r != SFB_SUCCESS) goto done;
-        r = sfb__refine_step(ctx, opt, &cur, &prow, &next, &crow, &A, &m, ps, cs, prog0 + (prog1 - prog0) * (float)L / (float)(level + 1),
-                             (prog1 - prog0) / (float)(level + 1));
+        r = sfb__refine_step_local(ctx, opt, &cur, &prow, &next, &crow, keep ? &local : NULL, &A, &m, ps, cs,
+                                   prog0 + (prog1 - prog0) * (float)L / (float)(level + 1), (prog1 - prog0) / (float)(level + 1));
         if (r != SFB_SUCCESS) goto done;
+        if (keep) {
+            r = sfb__rows_to_stencils(ctx, &local, cur.nv, &keep->T[L]);
+            sfb__rows_free(ctx, &local);
+            if (r != SFB_SUCCESS) { if (r == SFB_OUT_OF_MEMORY) r = sfb__oom(ctx, "stencil table"); goto done; }
+        }
         sfb__rows_free(ctx, &prow);
         prow = crow;
         memset(&crow, 0, sizeof crow);
-        if (owns_cur) sfb__level_free(ctx, &cur);
+        if (owns_cur && keep) keep->lev[L] = cur; /* handed over: level L of the caller's copy */
+        else if (owns_cur) sfb__level_free(ctx, &cur);
         cur = next;
         owns_cur = 1;
         memset(&next, 0, sizeof next);
@@ -3125,12 +3217,14 @@ done:
     sfb__level_free(ctx, &next);
     sfb__rows_free(ctx, &prow);
     sfb__rows_free(ctx, &crow);
+    sfb__rows_free(ctx, &local);
     sfb__free(ctx, A.acc); sfb__free(ctx, A.mark); sfb__free(ctx, A.touched);
     sfb__free(ctx, m.idx); sfb__free(ctx, m.w);
     sfb__free(ctx, ps); sfb__free(ctx, cs);
     if (r != SFB_SUCCESS) {
         sfb__stencils_free(ctx, vt);
         if (lt) { sfb__stencils_free(ctx, &lt[0]); sfb__stencils_free(ctx, &lt[1]); sfb__stencils_free(ctx, &lt[2]); }
+        if (keep) sfb__refine_kept_free(ctx, keep, level);
     }
     return r;
 }
@@ -4156,9 +4250,10 @@ static void sfb__kind_eval(const sfb__patch_kind *k, const sfb__patch_table *pt,
 }
 
 /* The ref kernel: one location, double precision throughout. want2: the second derivatives are
- * asked for (a manifold blend only forms them then: they cost it four more blends). */
-static void sfb__ref_eval_one(const sfb__patch_table *pt, const float *pts, const sfb_location *loc, int want2, double res[6][3],
-                              double nrm[3]) {
+ * asked for (a manifold blend only forms them then: they cost it four more blends); want_n: the
+ * normal is (without it nrm stays 0 where the patch kind's normal is work of its own: end caps). */
+static void sfb__ref_eval_one(const sfb__patch_table *pt, const float *pts, const sfb_location *loc, int want2, int want_n,
+                              double res[6][3], double nrm[3]) {
     double s, t, sc, dir[2][3], len;
     int patch = sfb__patch_locate(pt, loc->face, loc->u, loc->v, &s, &t, &sc), c;
     const int *cv;
@@ -4172,7 +4267,8 @@ static void sfb__ref_eval_one(const sfb__patch_table *pt, const float *pts, cons
     } else {
         kind = sfb__patch_kind_of(pt->ptype[patch]);
         sfb__kind_eval(&kind, pt, pts, patch, cv, s, t, res, dir);
-        if (kind.cap_corners) sfb__endcap_normal(pts, cv, kind.cap_corners, s, t, nrm);
+        if (kind.cap_corners && !want_n) { nrm[2] = 1.0; /* not asked for: any unit vector */ }
+        else if (kind.cap_corners) sfb__endcap_normal(pts, cv, kind.cap_corners, s, t, nrm);
         else sfb__cross3(dir[0], dir[1], nrm);
         len = sqrt(nrm[0] * nrm[0] + nrm[1] * nrm[1] + nrm[2] * nrm[2]);
         if (!(len > 0.0) || !isfinite(len)) {
@@ -4202,7 +4298,7 @@ sfb_result sfb__ref_eval_patches(void *state, const sfb__patch_table *pt, void *
     for (q = first; q < last; ++q) {
         double res[6][3], nrm[3];
         size_t o = 3 * (size_t)q;
-        sfb__ref_eval_one(pt, pt->point_data, &locs[q], out->duu || out->duv || out->dvv, res, nrm);
+        sfb__ref_eval_one(pt, pt->point_data, &locs[q], out->duu || out->duv || out->dvv, out->normal != NULL, res, nrm);
         for (c = 0; c < 3; ++c) {
             if (out->position) out->position[o + c] = (float)res[0][c];
             if (out->du) out->du[o + c] = (float)res[1][c];
@@ -4378,29 +4474,29 @@ void sfb__wlevel_free(sfb_context *ctx, sfb__wlevel *w) {
 sfb_result sfb__pb_endcap(sfb__pbuild *b, sfb__wlevel *w, int g, int rot, int n, unsigned param) {
     const sfb__level *l = &w->l;
     int base, k, patch;
-    sfb__mask mp, m1, m2;
+    /* the builder's masks, grown once: a UV layout of placeholder values has vertices of
+     * valence in the thousands, whose masks were allocated and freed at every cap */
+    sfb__mask *mp = &b->cap[0], *m1 = &b->cap[1], *m2 = &b->cap[2];
     sfb_result er = SFB_SUCCESS;
     patch = sfb__pb_patch(b, n == 4 ? SFB__PATCH_ENDCAP : SFB__PATCH_ENDCAP_TRI, param, 0, 3 * n);
     if (patch < 0) return sfb__oom(b->ctx, "patch table");
-    memset(&mp, 0, sizeof mp); memset(&m1, 0, sizeof m1); memset(&m2, 0, sizeof m2);
     base = b->pt->pfirst[patch];
     for (k = 0; k < n && er == SFB_SUCCESS; ++k) {
         int v = l->fv[l->fv_off[g] + (rot + k) % n], r0, r1, r2, need = 3 * sfb__mask_need_vertex(l, v) + 8;
-        if (!sfb__mask_grow(b->ctx, &mp, need) || !sfb__mask_grow(b->ctx, &m1, need) || !sfb__mask_grow(b->ctx, &m2, need)) {
+        mp->n = m1->n = m2->n = 0;
+        if (!sfb__mask_grow(b->ctx, mp, need) || !sfb__mask_grow(b->ctx, m1, need) || !sfb__mask_grow(b->ctx, m2, need)) {
             er = sfb__oom(b->ctx, "patch points");
             break;
         }
-        sfb__limit_masks(l, v, n == 4 ? SFB_SCHEME_CATMARK : SFB_SCHEME_LOOP, &mp, &m1, &m2);
-        r0 = sfb__pb_point(b, &w->rows, &mp);
-        r1 = sfb__pb_point(b, &w->rows, &m1);
-        r2 = sfb__pb_point(b, &w->rows, &m2);
+        sfb__limit_masks(l, v, n == 4 ? SFB_SCHEME_CATMARK : SFB_SCHEME_LOOP, mp, m1, m2);
+        r0 = sfb__pb_point(b, &w->rows, mp);
+        r1 = sfb__pb_point(b, &w->rows, m1);
+        r2 = sfb__pb_point(b, &w->rows, m2);
         if (r0 < 0 || r1 < 0 || r2 < 0) er = sfb__oom(b->ctx, "patch points");
         b->pt->cv[base + k] = r0;
         b->pt->cv[base + n + 2 * k] = r1;
         b->pt->cv[base + n + 1 + 2 * k] = r2;
     }
-    sfb__free(b->ctx, mp.idx); sfb__free(b->ctx, mp.w); sfb__free(b->ctx, m1.idx); sfb__free(b->ctx, m1.w);
-    sfb__free(b->ctx, m2.idx); sfb__free(b->ctx, m2.w);
     if (er != SFB_SUCCESS) return er;
     return sfb__pb_insert(b, w->fptex[g], param, patch) ? SFB_SUCCESS : sfb__oom(b->ctx, "patch table");
 }
@@ -4722,7 +4818,7 @@ sfb_result sfb__patches_build(sfb_context *ctx, const sfb__level *base, const sf
     sfb__wlevel w, nw;
     sfb_result r;
     float *ps = NULL, *cs = NULL;
-    int level, *active = NULL, nactive = 0, tri = opt->scheme == SFB_SCHEME_LOOP;
+    int level, k, *active = NULL, nactive = 0, tri = opt->scheme == SFB_SCHEME_LOOP;
     memset(&b, 0, sizeof b);
     memset(&w, 0, sizeof w);
     memset(&nw, 0, sizeof nw);
@@ -4763,6 +4859,7 @@ sfb_result sfb__patches_build(sfb_context *ctx, const sfb__level *base, const sf
     sfb__rows_free(ctx, &b.prow);
     sfb__free(ctx, b.A.acc); sfb__free(ctx, b.A.mark); sfb__free(ctx, b.A.touched);
     sfb__free(ctx, b.m.idx); sfb__free(ctx, b.m.w);
+    for (k = 0; k < 3; ++k) { sfb__free(ctx, b.cap[k].idx); sfb__free(ctx, b.cap[k].w); }
     sfb__free(ctx, b.vrow);
     sfb__free(ctx, ps); sfb__free(ctx, cs);
     sfb__free(ctx, active);
@@ -10026,10 +10123,24 @@ static sfb_result sfb__surface_build_vertex(sfb_surface *s, const sfb_mesh *mesh
     opt.crease_method = mesh->crease_method;
     opt.triangle_rule = mesh->triangle_rule;
     opt.want_limit = (cfg->flags & SFB_REFINE_LIMIT) != 0;
-    r = sfb__refine(ctx, &prep, &opt, cfg->refine_level, &s->top, &s->tables[SFB_TABLE_VERTEX],
-                    opt.want_limit ? &s->tables[SFB_TABLE_LIMIT] : NULL, 0.0f, 0.8f);
-    if (r == SFB_SUCCESS && (cfg->flags & SFB_REFINE_SHADING))
-        r = sfb__shading_build(ctx, &prep, &opt, cfg->refine_level, &cfg->shading, &s->shading);
+    if ((cfg->flags & SFB_REFINE_SHADING) && cfg->refine_level > 0) {
+        /* the shading tables need every level and each step's own table: the vertex refinement
+         * hands its over instead of the shading build refining a second time */
+        sfb__refine_kept kept;
+        kept.lev = (sfb__level *)sfb__calloc(ctx, (size_t)cfg->refine_level, sizeof *kept.lev);
+        kept.T = (sfb__stencils *)sfb__calloc(ctx, (size_t)cfg->refine_level, sizeof *kept.T);
+        if (!kept.lev || !kept.T) r = sfb__oom(ctx, "refinement");
+        else r = sfb__refine_keep_levels(ctx, &prep, &opt, cfg->refine_level, &s->top, &s->tables[SFB_TABLE_VERTEX],
+                                         opt.want_limit ? &s->tables[SFB_TABLE_LIMIT] : NULL, &kept, 0.0f, 0.8f);
+        if (r == SFB_SUCCESS) r = sfb__shading_build(ctx, &prep, &opt, cfg->refine_level, &cfg->shading, &kept, &s->top, &s->shading);
+        sfb__free(ctx, kept.lev);
+        sfb__free(ctx, kept.T);
+    } else {
+        r = sfb__refine(ctx, &prep, &opt, cfg->refine_level, &s->top, &s->tables[SFB_TABLE_VERTEX],
+                        opt.want_limit ? &s->tables[SFB_TABLE_LIMIT] : NULL, 0.0f, 0.8f);
+        if (r == SFB_SUCCESS && (cfg->flags & SFB_REFINE_SHADING))
+            r = sfb__shading_build(ctx, &prep, &opt, cfg->refine_level, &cfg->shading, NULL, NULL, &s->shading);
+    }
     if (r == SFB_SUCCESS && (cfg->flags & SFB_REFINE_PATCHES)) {
         r = si->build_patches(ctx, &prep, &opt, cfg, s->base_positions, &s->patches);
         if (r == SFB_SUCCESS) { s->has_patches = 1; s->pbase = prep; memset(&prep, 0, sizeof prep); }
@@ -10775,6 +10886,8 @@ typedef struct sfb__shade_build {
     sfb__regions outreg;   /* regions of the last level split by infinitely sharp edges only */
     int **parent;          /* L + 1: parent face of every face of level k (k >= 1) */
     const sfb__level *top; /* the last level */
+    sfb__refine_kept *kept;    /* the vertex refinement's levels and steps, taken over (or NULL) */
+    const sfb__level *kept_top; /* with kept: the vertex refinement's last level, lev[L] borrows it */
     sfb__rows prow, crow;
     sfb__accum A;
     sfb__mask m, mm[3];
@@ -10788,6 +10901,7 @@ static void sfb__shade_build_free(sfb__shade_build *B) {
     sfb_context *ctx = B->ctx;
     int k, t, L = B->L;
     if (B->lev) {
+        if (B->kept_top) memset(&B->lev[L], 0, sizeof B->lev[L]); /* borrowed */
         for (k = 1; k <= L; ++k) sfb__level_free(ctx, &B->lev[k]);
         sfb__free(ctx, B->lev);
     }
@@ -10834,16 +10948,32 @@ static sfb_result sfb__shade_build_levels(sfb__shade_build *B) {
     B->T = (sfb__stencils *)sfb__calloc(ctx, (size_t)L + 1, sizeof *B->T);
     B->reg = (sfb__regions *)sfb__calloc(ctx, (size_t)L + 1, sizeof *B->reg);
     B->parent = (int **)sfb__calloc(ctx, (size_t)L + 1, sizeof *B->parent);
-    if (!sh || !lev || !B->T || !B->reg || !B->parent) return sfb__oom(ctx, "shading tables");
+    if (!sh || !lev || !B->T || !B->reg || !B->parent) {
+        if (B->kept) sfb__refine_kept_free(ctx, B->kept, L);
+        B->kept_top = NULL;
+        return sfb__oom(ctx, "shading tables");
+    }
     sh->normals_level = B->Ln; sh->weights_level = B->Lw; sh->level = L; sh->variant = o->variant; sh->darts = o->darts;
     sh->averaging = o->averaging;
     B->per_level = o->averaging != SFB_SHADE_AVERAGE_LINEAR && L > B->Ln;
 
-    /* the levels, one step at a time, with each step's local stencils */
+    /* the levels, one step at a time, with each step's local stencils: those the vertex
+     * refinement made (taken over; its last level borrowed), or refined here */
     lev[0] = *B->prep; /* borrowed */
+    if (B->kept) {
+        for (k = 0; k < L; ++k) {
+            if (k > 0) lev[k] = B->kept->lev[k];
+            B->T[k] = B->kept->T[k];
+            memset(&B->kept->lev[k], 0, sizeof B->kept->lev[k]);
+            memset(&B->kept->T[k], 0, sizeof B->kept->T[k]);
+        }
+        lev[L] = *B->kept_top;
+    }
     for (k = 0; k < L; ++k) {
-        r = sfb__refine(ctx, &lev[k], B->opt, 1, &lev[k + 1], &B->T[k], NULL, 0.8f, 0.8f);
-        if (r != SFB_SUCCESS) return r;
+        if (!B->kept) {
+            r = sfb__refine(ctx, &lev[k], B->opt, 1, &lev[k + 1], &B->T[k], NULL, 0.8f, 0.8f);
+            if (r != SFB_SUCCESS) return r;
+        }
         B->parent[k + 1] = sfb__shade_parent_faces(ctx, &lev[k], &lev[k + 1], B->loop);
         if (!B->parent[k + 1]) return sfb__oom(ctx, "shading tables");
     }
@@ -10873,6 +11003,7 @@ static sfb_result sfb__shade_normals_level(sfb__shade_build *B) {
     sfb_result r = SFB_SUCCESS;
     int L = B->L, Ln = B->Ln, k, asz;
     if (Ln == 0) r = sfb__level_prepare(ctx, prep, 0, 0, &sh->nlev);
+    else if (Ln == L && B->kept_top) r = sfb__level_prepare(ctx, &B->lev[Ln], 0, 0, &sh->nlev); /* borrowed: a copy */
     else { sh->nlev = B->lev[Ln]; memset(&B->lev[Ln], 0, sizeof B->lev[Ln]); }
     if (r != SFB_SUCCESS) return r;
     if (Ln == L) B->top = &sh->nlev;
@@ -11041,7 +11172,9 @@ static sfb_result sfb__shade_ns_output(sfb__shade_build *B) {
     memset(&B->crow, 0, sizeof B->crow);
     B->crow.rows = sh->nout;
     B->crow.off = (size_t *)sfb__alloc(ctx, ((size_t)sh->nout + 1) * sizeof(size_t));
-    if (!B->crow.off) return sfb__oom(ctx, "shading tables");
+    /* room for rows as long as the composed rows they come from, at once */
+    if (!B->crow.off || !sfb__rows_reserve(ctx, &B->crow, (size_t)sh->nout * (B->prow.n / (size_t)(B->prow.rows > 0 ? B->prow.rows : 1) + 4) + 16))
+        return sfb__oom(ctx, "shading tables");
     B->crow.off[0] = 0;
     for (i = 0; i < sh->nout; ++i) {
         int ov = B->order[i], cv = sh->out_origin[ov], rv, j;
@@ -11147,7 +11280,9 @@ static sfb_result sfb__shade_limits(sfb__shade_build *B) {
     for (t = 0; t < 3; ++t) {
         lr[t].rows = sh->nout;
         lr[t].off = (size_t *)sfb__alloc(ctx, ((size_t)sh->nout + 1) * sizeof(size_t));
-        if (!lr[t].off) r = sfb__oom(ctx, "shading limit tables");
+        /* room for a vertex's masks (9 entries at a regular quad vertex, its tangents 6-8) at once: grown
+         * from nothing, the tables were copied by realloc over and over */
+        if (!lr[t].off || !sfb__rows_reserve(ctx, &lr[t], (size_t)sh->nout * 12 + 16)) r = sfb__oom(ctx, "shading limit tables");
         else lr[t].off[0] = 0;
     }
     for (v = 0; v < top->nv && r == SFB_SUCCESS; ++v) {
@@ -11177,7 +11312,7 @@ static sfb_result sfb__shade_limits(sfb__shade_build *B) {
 }
 
 sfb_result sfb__shading_build(sfb_context *ctx, const sfb__level *prep, const sfb__refine_options *opt, int L,
-                              const sfb_shading_options *o, sfb__shading **out) {
+                              const sfb_shading_options *o, sfb__refine_kept *kept, const sfb__level *top, sfb__shading **out) {
     sfb__shade_build B;
     sfb__shading *sh;
     sfb_result r;
@@ -11185,8 +11320,13 @@ sfb_result sfb__shading_build(sfb_context *ctx, const sfb__level *prep, const sf
     *out = NULL;
     memset(&B, 0, sizeof B);
     B.ctx = ctx; B.prep = prep; B.opt = opt; B.o = o; B.L = L;
+    B.kept = kept && top && L > 0 ? kept : NULL;
+    B.kept_top = B.kept ? top : NULL;
     B.loop = opt->scheme == SFB_SCHEME_LOOP;
-    if ((r = sfb__shade_check_options(ctx, o, L, &B.Ln, &B.Lw)) != SFB_SUCCESS) return r;
+    if ((r = sfb__shade_check_options(ctx, o, L, &B.Ln, &B.Lw)) != SFB_SUCCESS) {
+        if (B.kept) sfb__refine_kept_free(ctx, B.kept, L);
+        return r;
+    }
     if ((r = sfb__shade_build_levels(&B)) != SFB_SUCCESS) goto done;
     if ((r = sfb__shade_normals_level(&B)) != SFB_SUCCESS) goto done;
     /* blend weights from the weights level to the last */
@@ -12027,7 +12167,10 @@ SFB_API sfb_result sfb_render(sfb_context *ctx, const sfb_mesh_data *m, const sf
         goto done;
     }
     for (f = 0; f < m->hole_count; ++f) hole[m->holes[f]] = 1;
-    for (k = 0; k < npix; ++k) R.gb[k * SFB__RENDER_GB] = (float)HUGE_VAL;
+    /* depth "none"; and no stripe coordinate (slot 7): the highlight filter reads the slot of
+     * every neighbour, background ones included, which were left uninitialised (a picture that
+     * depended on what the allocator handed back) */
+    for (k = 0; k < npix; ++k) R.gb[k * SFB__RENDER_GB] = R.gb[k * SFB__RENDER_GB + 7] = (float)HUGE_VAL;
 
     sfb__render_view_setup(m, pos, &c, w, h, &V);
     sfb__render_project(m, pos, &V.cam, pv);

@@ -332,6 +332,14 @@ static int sfb__child_mask(sfb__step *st, int cv, sfb__mask *m, float *ps, float
 sfb_result sfb__refine_step(sfb_context *ctx, const sfb__refine_options *opt, const sfb__level *p, const sfb__rows *prow,
                                    sfb__level *c, sfb__rows *crow, sfb__accum *A, sfb__mask *m, float *ps, float *cs,
                                    float p0, float dp) {
+    return sfb__refine_step_local(ctx, opt, p, prow, c, crow, NULL, A, m, ps, cs, p0, dp);
+}
+
+/* sfb__refine_step that also gives the step's own rows (each child over the parent's
+ * vertices: its local mask, duplicates merged) in `local` when that is not NULL. */
+sfb_result sfb__refine_step_local(sfb_context *ctx, const sfb__refine_options *opt, const sfb__level *p, const sfb__rows *prow,
+                                  sfb__level *c, sfb__rows *crow, sfb__rows *local, sfb__accum *A, sfb__mask *m, float *ps,
+                                  float *cs, float p0, float dp) {
     sfb__step st;
     sfb_result r;
     int cv;
@@ -344,13 +352,27 @@ sfb_result sfb__refine_step(sfb_context *ctx, const sfb__refine_options *opt, co
     crow->rows = c->nv;
     crow->n = 0;
     crow->off = (size_t *)sfb__alloc(ctx, ((size_t)c->nv + 1) * sizeof(size_t));
-    if (!crow->off || !sfb__rows_reserve(ctx, crow, (size_t)c->nv * 4 + 16)) {
+    /* room for the child rows at once: a child's row spans about twice its parents' average
+     * (it grows by 1.5x and is copied by realloc where this falls short; growing from 4 per row
+     * copied the table five times over at level 3) */
+    if (!crow->off || !sfb__rows_reserve(ctx, crow, (size_t)c->nv * (2 * (prow->n / (size_t)(prow->rows > 0 ? prow->rows : 1)) + 4) + 16)) {
         sfb__free(ctx, st.half);
         return sfb__oom(ctx, "stencil table");
     }
     crow->off[0] = 0;
+    if (local) {
+        memset(local, 0, sizeof *local);
+        local->rows = c->nv;
+        local->off = (size_t *)sfb__alloc(ctx, ((size_t)c->nv + 1) * sizeof(size_t));
+        if (!local->off || !sfb__rows_reserve(ctx, local, (size_t)c->nv * 8 + 16)) {
+            sfb__free(ctx, st.half);
+            return sfb__oom(ctx, "stencil table");
+        }
+        local->off[0] = 0;
+    }
     for (cv = 0; cv < c->nv; ++cv) {
-        if (!sfb__child_mask(&st, cv, m, ps, cs) || !sfb__compose_row(ctx, A, prow, m, crow, cv)) {
+        if (!sfb__child_mask(&st, cv, m, ps, cs) || !sfb__compose_row(ctx, A, prow, m, crow, cv) ||
+            (local && !sfb__rows_append_mask(ctx, local, m, cv))) {
             sfb__free(ctx, st.half);
             return sfb__oom(ctx, "stencil table");
         }
@@ -506,14 +528,28 @@ void sfb__limit_masks(const sfb__level *l, int v, sfb_scheme scheme, sfb__mask *
 
 sfb_result sfb__refine(sfb_context *ctx, const sfb__level *base, const sfb__refine_options *opt, int level,
                        sfb__level *top, sfb__stencils *vt, sfb__stencils *lt, float prog0, float prog1) {
-    sfb__rows prow, crow;
+    return sfb__refine_keep_levels(ctx, base, opt, level, top, vt, lt, NULL, prog0, prog1);
+}
+
+void sfb__refine_kept_free(sfb_context *ctx, sfb__refine_kept *keep, int level) {
+    int k;
+    for (k = 0; k < level; ++k) {
+        sfb__level_free(ctx, &keep->lev[k]);
+        sfb__stencils_free(ctx, &keep->T[k]);
+    }
+}
+
+sfb_result sfb__refine_keep_levels(sfb_context *ctx, const sfb__level *base, const sfb__refine_options *opt, int level,
+                                   sfb__level *top, sfb__stencils *vt, sfb__stencils *lt, sfb__refine_kept *keep, float prog0,
+                                   float prog1) {
+    sfb__rows prow, crow, local;
     sfb__level cur, next;
     sfb__accum A;
     sfb__mask m;
     float *ps = NULL, *cs = NULL;
     sfb_result r = SFB_SUCCESS;
     int L, i, owns_cur = 0;
-    memset(&prow, 0, sizeof prow); memset(&crow, 0, sizeof crow);
+    memset(&prow, 0, sizeof prow); memset(&crow, 0, sizeof crow); memset(&local, 0, sizeof local);
     memset(&A, 0, sizeof A); memset(&m, 0, sizeof m);
     memset(&next, 0, sizeof next);
     cur = *base;
@@ -534,13 +570,19 @@ sfb_result sfb__refine(sfb_context *ctx, const sfb__level *base, const sfb__refi
     for (L = 0; L < level; ++L) {
         r = sfb__progress(ctx, prog0 + (prog1 - prog0) * (float)L / (float)(level + 1), "refine");
         if (r != SFB_SUCCESS) goto done;
-        r = sfb__refine_step(ctx, opt, &cur, &prow, &next, &crow, &A, &m, ps, cs, prog0 + (prog1 - prog0) * (float)L / (float)(level + 1),
-                             (prog1 - prog0) / (float)(level + 1));
+        r = sfb__refine_step_local(ctx, opt, &cur, &prow, &next, &crow, keep ? &local : NULL, &A, &m, ps, cs,
+                                   prog0 + (prog1 - prog0) * (float)L / (float)(level + 1), (prog1 - prog0) / (float)(level + 1));
         if (r != SFB_SUCCESS) goto done;
+        if (keep) {
+            r = sfb__rows_to_stencils(ctx, &local, cur.nv, &keep->T[L]);
+            sfb__rows_free(ctx, &local);
+            if (r != SFB_SUCCESS) { if (r == SFB_OUT_OF_MEMORY) r = sfb__oom(ctx, "stencil table"); goto done; }
+        }
         sfb__rows_free(ctx, &prow);
         prow = crow;
         memset(&crow, 0, sizeof crow);
-        if (owns_cur) sfb__level_free(ctx, &cur);
+        if (owns_cur && keep) keep->lev[L] = cur; /* handed over: level L of the caller's copy */
+        else if (owns_cur) sfb__level_free(ctx, &cur);
         cur = next;
         owns_cur = 1;
         memset(&next, 0, sizeof next);
@@ -592,12 +634,14 @@ done:
     sfb__level_free(ctx, &next);
     sfb__rows_free(ctx, &prow);
     sfb__rows_free(ctx, &crow);
+    sfb__rows_free(ctx, &local);
     sfb__free(ctx, A.acc); sfb__free(ctx, A.mark); sfb__free(ctx, A.touched);
     sfb__free(ctx, m.idx); sfb__free(ctx, m.w);
     sfb__free(ctx, ps); sfb__free(ctx, cs);
     if (r != SFB_SUCCESS) {
         sfb__stencils_free(ctx, vt);
         if (lt) { sfb__stencils_free(ctx, &lt[0]); sfb__stencils_free(ctx, &lt[1]); sfb__stencils_free(ctx, &lt[2]); }
+        if (keep) sfb__refine_kept_free(ctx, keep, level);
     }
     return r;
 }

@@ -339,6 +339,8 @@ SFB__IF int sfb__mask_need_vertex(const sfb__level *l, int v);
 /* Row `row` of `out` = mask m composed with the parent rows prow; 0 on allocation failure or when
  * the accumulator's stamp wrapped (the caller resets it). */
 SFB__IF int sfb__compose_row(sfb_context *ctx, sfb__accum *A, const sfb__rows *prow, const sfb__mask *m, sfb__rows *out, int row);
+/* Mask m as row `row` of out, as sfb__compose_row over identity rows gives it (stencil.c). */
+SFB__IF int sfb__rows_append_mask(sfb_context *ctx, sfb__rows *out, const sfb__mask *m, int row);
 /* The float stencil table of r (over `sources` source elements). */
 SFB__IF sfb_result sfb__rows_to_stencils(sfb_context *ctx, const sfb__rows *r, int sources, sfb__stencils *s);
 
@@ -451,7 +453,24 @@ SFB__IF sfb_result sfb__scheme_check_flags(sfb_context *ctx, const sfb__scheme_i
 SFB__IF sfb_result sfb__refine(sfb_context *ctx, const sfb__level *base, const sfb__refine_options *opt, int level,
                        sfb__level *top, sfb__stencils *vertex_table, sfb__stencils *limit_tables /* [3] or NULL */,
                        float progress_from, float progress_to);
+/* What sfb__refine_keep_levels hands over besides `top`: the levels 1 .. level-1 (lev[0] is
+ * left empty: the base is the caller's) and the step tables T[k] from level k to k + 1 (rows over
+ * level k's vertices), in caller-allocated arrays of `level` zeroed entries; the receiver owns
+ * them (freed on failure). The shading build takes them instead of refining again. */
+typedef struct sfb__refine_kept {
+    sfb__level *lev;
+    sfb__stencils *T;
+} sfb__refine_kept;
+SFB__IF sfb_result sfb__refine_keep_levels(sfb_context *ctx, const sfb__level *base, const sfb__refine_options *opt, int level,
+                                   sfb__level *top, sfb__stencils *vertex_table, sfb__stencils *limit_tables,
+                                   sfb__refine_kept *keep, float progress_from, float progress_to);
+SFB__IF void sfb__refine_kept_free(sfb_context *ctx, sfb__refine_kept *keep, int level);
 SFB__IF void sfb__stencils_free(sfb_context *ctx, sfb__stencils *s);
+/* sfb__refine_step that also writes the step's own rows (children over the parent's vertices)
+ * into `local` when not NULL (refine.c). */
+SFB__IF sfb_result sfb__refine_step_local(sfb_context *ctx, const sfb__refine_options *opt, const sfb__level *p,
+                                  const sfb__rows *prow, sfb__level *c, sfb__rows *crow, sfb__rows *local, sfb__accum *A,
+                                  sfb__mask *m, float *ps, float *cs, float p0, float dp);
 /* One refinement step of `p` (composed rows prow) into `c` (composed rows crow); A, m, ps, cs are
  * the caller's scratch; progress from p0 over dp. */
 SFB__IF sfb_result sfb__refine_step(sfb_context *ctx, const sfb__refine_options *opt, const sfb__level *p, const sfb__rows *prow,
@@ -499,8 +518,11 @@ SFB__IF void sfb__shading_free(sfb_context *ctx, sfb__shading *sh);
 SFB__IF int sfb__shade_extraordinary(const sfb__level *l, int v, int loop);
 SFB__IF int sfb__shade_held(const sfb__level *l, int v, int loop, int variant, int darts);
 SFB__IF int sfb__shade_spherical_mean(int count, const double *n, const double *w, double out[3]);
+/* The shading tables of `prep` refined `level` times; kept (with top, its last level): the vertex
+ * refinement's levels and steps, taken over (freed on failure) instead of refining again; NULL:
+ * refined here. */
 SFB__IF sfb_result sfb__shading_build(sfb_context *ctx, const sfb__level *prep, const sfb__refine_options *opt, int level,
-                              const sfb_shading_options *o, sfb__shading **out);
+                              const sfb_shading_options *o, sfb__refine_kept *kept, const sfb__level *top, sfb__shading **out);
 
 /* ---- patch tables (patch/) ---- */
 SFB__IF void sfb__patch_table_free(sfb_context *ctx, sfb__patch_table *pt);
@@ -625,6 +647,7 @@ typedef struct sfb__pbuild {
     size_t cap_rows;
     sfb__accum A;
     sfb__mask m;
+    sfb__mask cap[3];        /* an end cap's limit masks (position, two tangents), kept between caps */
     int *vrow;               /* point row of each vertex of the working level, -1 if none yet */
 } sfb__pbuild;
 /* A working level of feature-adaptive isolation: its topology, the composed rows of its

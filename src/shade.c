@@ -302,6 +302,8 @@ typedef struct sfb__shade_build {
     sfb__regions outreg;   /* regions of the last level split by infinitely sharp edges only */
     int **parent;          /* L + 1: parent face of every face of level k (k >= 1) */
     const sfb__level *top; /* the last level */
+    sfb__refine_kept *kept;    /* the vertex refinement's levels and steps, taken over (or NULL) */
+    const sfb__level *kept_top; /* with kept: the vertex refinement's last level, lev[L] borrows it */
     sfb__rows prow, crow;
     sfb__accum A;
     sfb__mask m, mm[3];
@@ -315,6 +317,7 @@ static void sfb__shade_build_free(sfb__shade_build *B) {
     sfb_context *ctx = B->ctx;
     int k, t, L = B->L;
     if (B->lev) {
+        if (B->kept_top) memset(&B->lev[L], 0, sizeof B->lev[L]); /* borrowed */
         for (k = 1; k <= L; ++k) sfb__level_free(ctx, &B->lev[k]);
         sfb__free(ctx, B->lev);
     }
@@ -361,16 +364,32 @@ static sfb_result sfb__shade_build_levels(sfb__shade_build *B) {
     B->T = (sfb__stencils *)sfb__calloc(ctx, (size_t)L + 1, sizeof *B->T);
     B->reg = (sfb__regions *)sfb__calloc(ctx, (size_t)L + 1, sizeof *B->reg);
     B->parent = (int **)sfb__calloc(ctx, (size_t)L + 1, sizeof *B->parent);
-    if (!sh || !lev || !B->T || !B->reg || !B->parent) return sfb__oom(ctx, "shading tables");
+    if (!sh || !lev || !B->T || !B->reg || !B->parent) {
+        if (B->kept) sfb__refine_kept_free(ctx, B->kept, L);
+        B->kept_top = NULL;
+        return sfb__oom(ctx, "shading tables");
+    }
     sh->normals_level = B->Ln; sh->weights_level = B->Lw; sh->level = L; sh->variant = o->variant; sh->darts = o->darts;
     sh->averaging = o->averaging;
     B->per_level = o->averaging != SFB_SHADE_AVERAGE_LINEAR && L > B->Ln;
 
-    /* the levels, one step at a time, with each step's local stencils */
+    /* the levels, one step at a time, with each step's local stencils: those the vertex
+     * refinement made (taken over; its last level borrowed), or refined here */
     lev[0] = *B->prep; /* borrowed */
+    if (B->kept) {
+        for (k = 0; k < L; ++k) {
+            if (k > 0) lev[k] = B->kept->lev[k];
+            B->T[k] = B->kept->T[k];
+            memset(&B->kept->lev[k], 0, sizeof B->kept->lev[k]);
+            memset(&B->kept->T[k], 0, sizeof B->kept->T[k]);
+        }
+        lev[L] = *B->kept_top;
+    }
     for (k = 0; k < L; ++k) {
-        r = sfb__refine(ctx, &lev[k], B->opt, 1, &lev[k + 1], &B->T[k], NULL, 0.8f, 0.8f);
-        if (r != SFB_SUCCESS) return r;
+        if (!B->kept) {
+            r = sfb__refine(ctx, &lev[k], B->opt, 1, &lev[k + 1], &B->T[k], NULL, 0.8f, 0.8f);
+            if (r != SFB_SUCCESS) return r;
+        }
         B->parent[k + 1] = sfb__shade_parent_faces(ctx, &lev[k], &lev[k + 1], B->loop);
         if (!B->parent[k + 1]) return sfb__oom(ctx, "shading tables");
     }
@@ -400,6 +419,7 @@ static sfb_result sfb__shade_normals_level(sfb__shade_build *B) {
     sfb_result r = SFB_SUCCESS;
     int L = B->L, Ln = B->Ln, k, asz;
     if (Ln == 0) r = sfb__level_prepare(ctx, prep, 0, 0, &sh->nlev);
+    else if (Ln == L && B->kept_top) r = sfb__level_prepare(ctx, &B->lev[Ln], 0, 0, &sh->nlev); /* borrowed: a copy */
     else { sh->nlev = B->lev[Ln]; memset(&B->lev[Ln], 0, sizeof B->lev[Ln]); }
     if (r != SFB_SUCCESS) return r;
     if (Ln == L) B->top = &sh->nlev;
@@ -568,7 +588,9 @@ static sfb_result sfb__shade_ns_output(sfb__shade_build *B) {
     memset(&B->crow, 0, sizeof B->crow);
     B->crow.rows = sh->nout;
     B->crow.off = (size_t *)sfb__alloc(ctx, ((size_t)sh->nout + 1) * sizeof(size_t));
-    if (!B->crow.off) return sfb__oom(ctx, "shading tables");
+    /* room for rows as long as the composed rows they come from, at once */
+    if (!B->crow.off || !sfb__rows_reserve(ctx, &B->crow, (size_t)sh->nout * (B->prow.n / (size_t)(B->prow.rows > 0 ? B->prow.rows : 1) + 4) + 16))
+        return sfb__oom(ctx, "shading tables");
     B->crow.off[0] = 0;
     for (i = 0; i < sh->nout; ++i) {
         int ov = B->order[i], cv = sh->out_origin[ov], rv, j;
@@ -674,7 +696,9 @@ static sfb_result sfb__shade_limits(sfb__shade_build *B) {
     for (t = 0; t < 3; ++t) {
         lr[t].rows = sh->nout;
         lr[t].off = (size_t *)sfb__alloc(ctx, ((size_t)sh->nout + 1) * sizeof(size_t));
-        if (!lr[t].off) r = sfb__oom(ctx, "shading limit tables");
+        /* room for a vertex's masks (9 entries at a regular quad vertex, its tangents 6-8) at once: grown
+         * from nothing, the tables were copied by realloc over and over */
+        if (!lr[t].off || !sfb__rows_reserve(ctx, &lr[t], (size_t)sh->nout * 12 + 16)) r = sfb__oom(ctx, "shading limit tables");
         else lr[t].off[0] = 0;
     }
     for (v = 0; v < top->nv && r == SFB_SUCCESS; ++v) {
@@ -704,7 +728,7 @@ static sfb_result sfb__shade_limits(sfb__shade_build *B) {
 }
 
 sfb_result sfb__shading_build(sfb_context *ctx, const sfb__level *prep, const sfb__refine_options *opt, int L,
-                              const sfb_shading_options *o, sfb__shading **out) {
+                              const sfb_shading_options *o, sfb__refine_kept *kept, const sfb__level *top, sfb__shading **out) {
     sfb__shade_build B;
     sfb__shading *sh;
     sfb_result r;
@@ -712,8 +736,13 @@ sfb_result sfb__shading_build(sfb_context *ctx, const sfb__level *prep, const sf
     *out = NULL;
     memset(&B, 0, sizeof B);
     B.ctx = ctx; B.prep = prep; B.opt = opt; B.o = o; B.L = L;
+    B.kept = kept && top && L > 0 ? kept : NULL;
+    B.kept_top = B.kept ? top : NULL;
     B.loop = opt->scheme == SFB_SCHEME_LOOP;
-    if ((r = sfb__shade_check_options(ctx, o, L, &B.Ln, &B.Lw)) != SFB_SUCCESS) return r;
+    if ((r = sfb__shade_check_options(ctx, o, L, &B.Ln, &B.Lw)) != SFB_SUCCESS) {
+        if (B.kept) sfb__refine_kept_free(ctx, B.kept, L);
+        return r;
+    }
     if ((r = sfb__shade_build_levels(&B)) != SFB_SUCCESS) goto done;
     if ((r = sfb__shade_normals_level(&B)) != SFB_SUCCESS) goto done;
     /* blend weights from the weights level to the last */

@@ -20,7 +20,7 @@ int sfb__rows_reserve(sfb_context *ctx, sfb__rows *r, size_t need) {
     cap = r->cap ? r->cap : 1024;
     while (cap < need) {
         if (cap > ((size_t)-1) / 4) return 0;
-        cap = cap + cap / 2 + 16;
+        cap = 2 * cap + 16; /* doubling: a table grown row by row is copied at most once over in all */
     }
     ni = (int *)sfb__realloc(ctx, r->idx, cap * sizeof(int));
     if (!ni) return 0;
@@ -91,6 +91,33 @@ int sfb__compose_row(sfb_context *ctx, sfb__accum *A, const sfb__rows *prow, con
         out->w[out->n] = A->acc[b];
         out->n++;
     }
+    out->off[row + 1] = out->n;
+    return 1;
+}
+
+/* Appends local mask m as row `row` of out: what sfb__compose_row gives over identity rows
+ * (entries in the order of first use, duplicates summed in mask order, zero weights and zero
+ * sums dropped) without an accumulator over the sources. Masks are short: the merge is a
+ * linear search. */
+int sfb__rows_append_mask(sfb_context *ctx, sfb__rows *out, const sfb__mask *m, int row) {
+    const size_t at = out->n;
+    size_t k, j;
+    int i;
+    if (!sfb__rows_reserve(ctx, out, out->n + (size_t)m->n)) return 0;
+    for (i = 0; i < m->n; ++i) {
+        if (m->w[i] == 0.0) continue;
+        for (k = at; k < out->n && out->idx[k] != m->idx[i]; ++k) {}
+        if (k < out->n) {
+            out->w[k] += m->w[i];
+        } else {
+            out->idx[out->n] = m->idx[i];
+            out->w[out->n] = 0.0 + m->w[i];
+            out->n++;
+        }
+    }
+    for (j = k = at; k < out->n; ++k)
+        if (out->w[k] != 0.0) { out->idx[j] = out->idx[k]; out->w[j] = out->w[k]; ++j; }
+    out->n = j;
     out->off[row + 1] = out->n;
     return 1;
 }

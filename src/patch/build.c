@@ -160,29 +160,29 @@ void sfb__wlevel_free(sfb_context *ctx, sfb__wlevel *w) {
 sfb_result sfb__pb_endcap(sfb__pbuild *b, sfb__wlevel *w, int g, int rot, int n, unsigned param) {
     const sfb__level *l = &w->l;
     int base, k, patch;
-    sfb__mask mp, m1, m2;
+    /* the builder's masks, grown once: a UV layout of placeholder values has vertices of
+     * valence in the thousands, whose masks were allocated and freed at every cap */
+    sfb__mask *mp = &b->cap[0], *m1 = &b->cap[1], *m2 = &b->cap[2];
     sfb_result er = SFB_SUCCESS;
     patch = sfb__pb_patch(b, n == 4 ? SFB__PATCH_ENDCAP : SFB__PATCH_ENDCAP_TRI, param, 0, 3 * n);
     if (patch < 0) return sfb__oom(b->ctx, "patch table");
-    memset(&mp, 0, sizeof mp); memset(&m1, 0, sizeof m1); memset(&m2, 0, sizeof m2);
     base = b->pt->pfirst[patch];
     for (k = 0; k < n && er == SFB_SUCCESS; ++k) {
         int v = l->fv[l->fv_off[g] + (rot + k) % n], r0, r1, r2, need = 3 * sfb__mask_need_vertex(l, v) + 8;
-        if (!sfb__mask_grow(b->ctx, &mp, need) || !sfb__mask_grow(b->ctx, &m1, need) || !sfb__mask_grow(b->ctx, &m2, need)) {
+        mp->n = m1->n = m2->n = 0;
+        if (!sfb__mask_grow(b->ctx, mp, need) || !sfb__mask_grow(b->ctx, m1, need) || !sfb__mask_grow(b->ctx, m2, need)) {
             er = sfb__oom(b->ctx, "patch points");
             break;
         }
-        sfb__limit_masks(l, v, n == 4 ? SFB_SCHEME_CATMARK : SFB_SCHEME_LOOP, &mp, &m1, &m2);
-        r0 = sfb__pb_point(b, &w->rows, &mp);
-        r1 = sfb__pb_point(b, &w->rows, &m1);
-        r2 = sfb__pb_point(b, &w->rows, &m2);
+        sfb__limit_masks(l, v, n == 4 ? SFB_SCHEME_CATMARK : SFB_SCHEME_LOOP, mp, m1, m2);
+        r0 = sfb__pb_point(b, &w->rows, mp);
+        r1 = sfb__pb_point(b, &w->rows, m1);
+        r2 = sfb__pb_point(b, &w->rows, m2);
         if (r0 < 0 || r1 < 0 || r2 < 0) er = sfb__oom(b->ctx, "patch points");
         b->pt->cv[base + k] = r0;
         b->pt->cv[base + n + 2 * k] = r1;
         b->pt->cv[base + n + 1 + 2 * k] = r2;
     }
-    sfb__free(b->ctx, mp.idx); sfb__free(b->ctx, mp.w); sfb__free(b->ctx, m1.idx); sfb__free(b->ctx, m1.w);
-    sfb__free(b->ctx, m2.idx); sfb__free(b->ctx, m2.w);
     if (er != SFB_SUCCESS) return er;
     return sfb__pb_insert(b, w->fptex[g], param, patch) ? SFB_SUCCESS : sfb__oom(b->ctx, "patch table");
 }
@@ -504,7 +504,7 @@ sfb_result sfb__patches_build(sfb_context *ctx, const sfb__level *base, const sf
     sfb__wlevel w, nw;
     sfb_result r;
     float *ps = NULL, *cs = NULL;
-    int level, *active = NULL, nactive = 0, tri = opt->scheme == SFB_SCHEME_LOOP;
+    int level, k, *active = NULL, nactive = 0, tri = opt->scheme == SFB_SCHEME_LOOP;
     memset(&b, 0, sizeof b);
     memset(&w, 0, sizeof w);
     memset(&nw, 0, sizeof nw);
@@ -545,6 +545,7 @@ sfb_result sfb__patches_build(sfb_context *ctx, const sfb__level *base, const sf
     sfb__rows_free(ctx, &b.prow);
     sfb__free(ctx, b.A.acc); sfb__free(ctx, b.A.mark); sfb__free(ctx, b.A.touched);
     sfb__free(ctx, b.m.idx); sfb__free(ctx, b.m.w);
+    for (k = 0; k < 3; ++k) { sfb__free(ctx, b.cap[k].idx); sfb__free(ctx, b.cap[k].w); }
     sfb__free(ctx, b.vrow);
     sfb__free(ctx, ps); sfb__free(ctx, cs);
     sfb__free(ctx, active);

@@ -264,9 +264,10 @@ static void sfb__kind_eval(const sfb__patch_kind *k, const sfb__patch_table *pt,
 }
 
 /* The ref kernel: one location, double precision throughout. want2: the second derivatives are
- * asked for (a manifold blend only forms them then: they cost it four more blends). */
-static void sfb__ref_eval_one(const sfb__patch_table *pt, const float *pts, const sfb_location *loc, int want2, double res[6][3],
-                              double nrm[3]) {
+ * asked for (a manifold blend only forms them then: they cost it four more blends); want_n: the
+ * normal is (without it nrm stays 0 where the patch kind's normal is work of its own: end caps). */
+static void sfb__ref_eval_one(const sfb__patch_table *pt, const float *pts, const sfb_location *loc, int want2, int want_n,
+                              double res[6][3], double nrm[3]) {
     double s, t, sc, dir[2][3], len;
     int patch = sfb__patch_locate(pt, loc->face, loc->u, loc->v, &s, &t, &sc), c;
     const int *cv;
@@ -280,7 +281,8 @@ static void sfb__ref_eval_one(const sfb__patch_table *pt, const float *pts, cons
     } else {
         kind = sfb__patch_kind_of(pt->ptype[patch]);
         sfb__kind_eval(&kind, pt, pts, patch, cv, s, t, res, dir);
-        if (kind.cap_corners) sfb__endcap_normal(pts, cv, kind.cap_corners, s, t, nrm);
+        if (kind.cap_corners && !want_n) { nrm[2] = 1.0; /* not asked for: any unit vector */ }
+        else if (kind.cap_corners) sfb__endcap_normal(pts, cv, kind.cap_corners, s, t, nrm);
         else sfb__cross3(dir[0], dir[1], nrm);
         len = sqrt(nrm[0] * nrm[0] + nrm[1] * nrm[1] + nrm[2] * nrm[2]);
         if (!(len > 0.0) || !isfinite(len)) {
@@ -310,7 +312,7 @@ sfb_result sfb__ref_eval_patches(void *state, const sfb__patch_table *pt, void *
     for (q = first; q < last; ++q) {
         double res[6][3], nrm[3];
         size_t o = 3 * (size_t)q;
-        sfb__ref_eval_one(pt, pt->point_data, &locs[q], out->duu || out->duv || out->dvv, res, nrm);
+        sfb__ref_eval_one(pt, pt->point_data, &locs[q], out->duu || out->duv || out->dvv, out->normal != NULL, res, nrm);
         for (c = 0; c < 3; ++c) {
             if (out->position) out->position[o + c] = (float)res[0][c];
             if (out->du) out->du[o + c] = (float)res[1][c];
