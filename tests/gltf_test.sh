@@ -145,6 +145,16 @@ if [ "$(head -c 4 "$TMP/v/box.glb")" = glTF ]; then ok ".glb is binary glTF"; el
 check "--lods 1,2,3" 0 "$TOOL" --lods 1,2,3 --gltf "$BOX" -o "$TMP/v/lods.gltf"
 contains "--lods writes three meshes" "$TMP/err" "3 meshes"
 for l in 1 2 3; do contains "--lods: a node for level $l" "$TMP/v/lods.gltf" "\"creased_box level $l\""; done
+# MSFT_lod: the scene's node shows the most detailed LOD alone, which names the others from the
+# most detailed down; the extension is used, not required
+check "--lods 2,3,1 (out of order)" 0 "$TOOL" --lods 2,3,1 --gltf "$BOX" -o "$TMP/v/lods_msft.gltf"
+lodtree=$(node -e '
+  const j = JSON.parse(require("fs").readFileSync(process.argv[1], "utf8")), n = j.nodes, root = n[j.scenes[0].nodes[0]];
+  const top = n[root.children[0]], ids = ((top.extensions || {}).MSFT_lod || {}).ids || [];
+  console.log([root.children.length, top.name, ids.map(i => n[i].name).join("+"), (j.extensionsUsed || []).includes("MSFT_lod"),
+               (j.extensionsRequired || []).includes("MSFT_lod")].join("|"));' "$TMP/v/lods_msft.gltf" 2>&1)
+if [ "$lodtree" = "1|creased_box level 3|creased_box level 2+creased_box level 1|true|false" ]; then ok "--lods: MSFT_lod from the most detailed LOD"
+else bad "--lods: MSFT_lod tree: $lodtree"; fi
 check "--lods with --tess gives rates" 0 "$TOOL" --tess 1 --lods 2,6 --gltf "$BOX" -o "$TMP/v/lods_tess.gltf"
 contains "--lods --tess: a node for rate 6" "$TMP/v/lods_tess.gltf" "rate 6"
 export_ok lods_quant.glb "$BOX" --lods 0,2 --quantize --compress

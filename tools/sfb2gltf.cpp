@@ -41,6 +41,9 @@
 #include <vector>
 
 #include <unistd.h>
+#if defined(__GLIBC__)
+#include <malloc.h>
+#endif
 
 #include "cli_common.h"
 
@@ -85,8 +88,9 @@ const char *const kUsage =
     "                         the octahedral filter and UVs in [0,1] through the exponential one (floats,\n"
     "                         a step of 2^-uv-bits or finer); triangles in a strip-friendly order\n"
     "  --lods L0,L1,...       one mesh per level (or per rate with --tess, whose RATE it replaces; up to\n"
-    "                         16), each shown by its own node named \"NAME level L\" (\"NAME rate R\");\n"
-    "                         every LOD evaluates the same surface\n"
+    "                         16), each in a node named \"NAME level L\" (\"NAME rate R\"): the most\n"
+    "                         detailed one in the scene with MSFT_lod naming the others (a viewer without\n"
+    "                         the extension shows the most detailed); every LOD evaluates the same surface\n"
     "  --report FILE.json     per mesh: counts, bytes, and the deviation of what is written (after\n"
     "                         --quantize) from the exact limit surface: positions (model units and share\n"
     "                         of the diagonal) and normals (degrees); a summary line on stderr\n"
@@ -380,14 +384,21 @@ void mesh_from_faces(const sfb_mesh_data &d, const float *normals, bool flat, co
     for (int h = 0; h < d.hole_count; ++h)
         if (d.holes[h] >= 0 && d.holes[h] < d.face_count) hole[(size_t)d.holes[h]] = 1;
     const bool uvs = d.uvs && d.face_uvs && d.uv_count > 0;
-    std::unordered_map<unsigned long long, unsigned> seen;
+    // the glTF vertices made so far of each refined vertex, one per UV it was seen with: a chain
+    // through `next` from `first[v]` (a vertex has one UV but on a seam)
+    std::vector<int> first(flat ? 0 : (size_t)d.vertex_count, -1), next, uv_of;
+    size_t corners = 0;
+    for (int f = 0; f < d.face_count; ++f) corners += (size_t)d.face_sizes[f];
+    const size_t expect = flat ? 3 * corners : (size_t)d.vertex_count + (size_t)d.vertex_count / 8;
+    m->positions.reserve(3 * expect);
+    m->normals.reserve(3 * expect);
+    if (uvs) m->uvs.reserve(2 * expect);
+    m->indices.reserve(3 * corners);
     auto emit = [&](int fvi, const float *flat_n) -> unsigned {
         const int v = d.face_vertices[fvi], t = uvs ? d.face_uvs[fvi] : 0;
-        const unsigned long long key = ((unsigned long long)(unsigned)v << 32) | (unsigned)t;
-        if (!flat) {
-            auto it = seen.find(key);
-            if (it != seen.end()) return it->second;
-        }
+        if (!flat)
+            for (int k = first[(size_t)v]; k >= 0; k = next[(size_t)k])
+                if (uv_of[(size_t)k] == t) return (unsigned)k;
         const unsigned id = (unsigned)(m->positions.size() / 3);
         for (int c = 0; c < 3; ++c) m->positions.push_back(d.positions[3 * (size_t)v + c]);
         if (limit_p && limit_n) {
@@ -405,7 +416,11 @@ void mesh_from_faces(const sfb_mesh_data &d, const float *normals, bool flat, co
             m->uvs.push_back(d.uvs[2 * (size_t)t]);
             m->uvs.push_back(1.0f - d.uvs[2 * (size_t)t + 1]);
         }
-        if (!flat) seen.emplace(key, id);
+        if (!flat) {
+            next.push_back(first[(size_t)v]);
+            uv_of.push_back(t);
+            first[(size_t)v] = (int)id;
+        }
         return id;
     };
     int at = 0;
@@ -423,13 +438,15 @@ void mesh_from_faces(const sfb_mesh_data &d, const float *normals, bool flat, co
 }
 
 // A tessellation into glTF vertices (flat: split per triangle, normals from the triangles).
-void mesh_from_tess(const sfb_tess_data &t, bool flat, OutMesh *m) {
+void mesh_from_tess(const sfb_tess_data &t, bool flat, bool exact, OutMesh *m) {
     if (!flat) {
         m->positions.assign(t.positions, t.positions + 3 * (size_t)t.vertex_count);
         m->normals.assign(t.normals, t.normals + 3 * (size_t)t.vertex_count);
         m->indices.assign(t.triangles, t.triangles + 3 * (size_t)t.triangle_count);
-        m->exact_p = m->positions;
-        m->exact_n.assign(t.normals, t.normals + 3 * (size_t)t.vertex_count);
+        if (exact) {
+            m->exact_p = m->positions;
+            m->exact_n.assign(t.normals, t.normals + 3 * (size_t)t.vertex_count);
+        }
         if (t.uvs) // glTF's v runs down the image
             for (int v = 0; v < t.vertex_count; ++v) {
                 m->uvs.push_back(t.uvs[2 * (size_t)v]);
@@ -452,8 +469,10 @@ void mesh_from_tess(const sfb_tess_data &t, bool flat, OutMesh *m) {
             m->indices.push_back((unsigned)(m->positions.size() / 3));
             for (int q = 0; q < 3; ++q) m->positions.push_back(t.positions[3 * (size_t)c[j] + q]);
             m->normals.insert(m->normals.end(), fn, fn + 3);
-            for (int q = 0; q < 3; ++q) m->exact_p.push_back(t.positions[3 * (size_t)c[j] + q]);
-            for (int q = 0; q < 3; ++q) m->exact_n.push_back(t.normals[3 * (size_t)c[j] + q]);
+            if (exact) {
+                for (int q = 0; q < 3; ++q) m->exact_p.push_back(t.positions[3 * (size_t)c[j] + q]);
+                for (int q = 0; q < 3; ++q) m->exact_n.push_back(t.normals[3 * (size_t)c[j] + q]);
+            }
             if (t.uvs) {
                 m->uvs.push_back(t.uvs[2 * (size_t)c[j]]);
                 m->uvs.push_back(1.0f - t.uvs[2 * (size_t)c[j] + 1]);
@@ -1203,7 +1222,7 @@ int evaluate_part(Run &R, Part &part) {
         sfb_tess_data t;
         memset(&t, 0, sizeof t);
         r = sfb_surface_tessellate(surf, &tc, &t);
-        if (r == SFB_SUCCESS) mesh_from_tess(t, R.o.normals == NORMALS_FLAT, &part.out);
+        if (r == SFB_SUCCESS) mesh_from_tess(t, R.o.normals == NORMALS_FLAT, R.o.report != nullptr, &part.out);
         else rc = R.fail_lib(part.name, "tessellating", r);
         sfb_tess_data_free(&t);
         free(texels);
@@ -1212,13 +1231,14 @@ int evaluate_part(Run &R, Part &part) {
         memset(&data, 0, sizeof data);
         if (R.o.normals == NORMALS_FLAT) {
             r = sfb_surface_refine(surf, &data);
-            if (r == SFB_SUCCESS) mesh_from_faces(data, nullptr, true, data.limit_positions, data.normals, &part.out);
+            if (r == SFB_SUCCESS) mesh_from_faces(data, nullptr, true, R.o.report ? data.limit_positions : nullptr, data.normals, &part.out);
             else rc = R.fail_lib(part.name, "refining", r);
         } else {
             sfb_shade_params sp = sfb_shade_params_init();
             r = sfb_surface_shade(surf, &sp, &data);
             if (r == SFB_SUCCESS)
-                mesh_from_faces(data, R.o.normals == NORMALS_LIMIT ? data.limit_normals : data.normals, false, data.limit_positions,
+                mesh_from_faces(data, R.o.normals == NORMALS_LIMIT ? data.limit_normals : data.normals, false,
+                                R.o.report ? data.limit_positions : nullptr,
                                 data.limit_normals, &part.out);
             else rc = R.fail_lib(part.name, "shading", r);
         }
@@ -1252,6 +1272,7 @@ void assemble(Run &R, tinygltf::Model *model) {
     model->images = k.images;
     model->samplers = k.samplers;
     model->extensionsUsed.clear();
+    if (R.o.lods.size() > 1) model->extensionsUsed.push_back("MSFT_lod"); // used, not required (expand_lods)
     int default_material = -1;
     // --quantize: one grid per output mesh, over the extent of all its parts
     std::vector<Quant> &quant = R.quant;
@@ -1324,9 +1345,14 @@ void assemble(Run &R, tinygltf::Model *model) {
 }
 
 // Every part at its level or rate; with --lods, one copy of each part per entry, each in a mesh
-// of its own ("NAME level L" / "NAME rate R"), and each node that showed a mesh now shows its
-// LODs as child nodes named the same way (glTF has no standard LOD switch: a viewer shows them
-// all; an engine picks one by name). Every LOD evaluates the same limit surface.
+// of its own ("NAME level L" / "NAME rate R"), and a node per LOD named the same way. Each node
+// that showed a mesh has one child, the most detailed LOD (the highest level or rate), which
+// carries MSFT_lod: its `ids` are the other LOD nodes from the most detailed down, outside the
+// node tree. A viewer without the extension shows the most detailed LOD alone (it showed all
+// of them on top of each other before), an engine with it switches; the validator knows no
+// MSFT_lod and says so as an info, and the LOD nodes only the extension names as unused
+// objects (infos too): no warning. No MSFT_screencoverage is written (the switch distances
+// are the engine's to choose). Every LOD evaluates the same limit surface.
 void expand_lods(Run &R) {
     for (Part &p : R.parts) {
         p.level = R.o.level;
@@ -1361,12 +1387,23 @@ void expand_lods(Run &R) {
         if (m < 0 || m >= (int)nm) continue;
         k.nodes[n].mesh = -1;
         const std::string base = k.nodes[n].name.empty() ? "node " + std::to_string(n) : k.nodes[n].name;
-        for (size_t i = 0; i < nl; ++i) {
+        std::vector<size_t> order(nl); // the LODs, most detailed first (a stable sort: repeats keep their order)
+        for (size_t i = 0; i < nl; ++i) order[i] = i;
+        std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return R.o.lods[a] > R.o.lods[b]; });
+        tinygltf::Value::Array ids;
+        const int first = (int)k.nodes.size();
+        for (size_t j = 0; j < nl; ++j) {
             tinygltf::Node child;
-            child.name = base + what(i);
-            child.mesh = (int)(i * nm) + m;
-            k.nodes[n].children.push_back((int)k.nodes.size());
+            child.name = base + what(order[j]);
+            child.mesh = (int)(order[j] * nm) + m;
+            if (j > 0) ids.push_back(tinygltf::Value((int)k.nodes.size()));
             k.nodes.push_back(child);
+        }
+        k.nodes[n].children.push_back(first);
+        if (!ids.empty()) {
+            tinygltf::Value::Object lod;
+            lod["ids"] = tinygltf::Value(ids);
+            k.nodes[(size_t)first].extensions["MSFT_lod"] = tinygltf::Value(lod);
         }
     }
 }
@@ -1479,6 +1516,14 @@ int write_report(const Run &R, size_t bytes) {
 
 int main(int argc, char **argv) {
     cli_program = "sfb2gltf";
+#if defined(__GLIBC__) && defined(M_MMAP_THRESHOLD)
+    // One export allocates and frees tables of tens of megabytes in turn. glibc maps each block
+    // over its threshold afresh and unmaps it on free, so every table is paid again in page
+    // faults (a third of the export's time at catmark_car level 3); kept in the heap, freed
+    // tables are reused. The process exits after one export, so nothing is held for long.
+    mallopt(M_MMAP_THRESHOLD, 1 << 30);
+    mallopt(M_TRIM_THRESHOLD, 1 << 30);
+#endif
     Run R;
     int rc = parse_args(argc, argv, &R.o);
     if (rc) return rc == 1 ? 0 : 2;

@@ -6,6 +6,8 @@
 # as .glb / .gltf (float, KHR_mesh_quantization, EXT_meshopt_compression); the silhouettes' IoU must be >= MIN_IOU,
 # the counts three.js reports must be the OBJ's, the glTF files must validate, and a
 # deliberately different view must fall well below (< BAD_IOU), so that the check can fail.
+# sfb2gltf's own exports (plain, quantized, compressed, and --lods with MSFT_lod, of which the
+# page must draw the most detailed LOD alone) are drawn and counted the same way.
 # Closes with "N passed, N failed, N skipped". Without node, the npm packages, Chromium or
 # WebGL: skipped with the reason (failed instead when SFB_REQUIRE_WEB is set, as on CI).
 set -u
@@ -104,6 +106,14 @@ prepare() {
         job "$name.sfb2gltfc" "$W/$name.sfb2gltfc.glb" "$yaw" "$pitch" "$zoom" "$size"; CHECKS+=("iou $name sfb2gltfc $gv $gt")
       else
         fail "$name: sfb2gltf --quantize --compress"; cat "$W/$name.sfb2gltfc.log"
+      fi
+      # --lods (listed out of order, quantized and compressed): the most detailed LOD is the one
+      # in the scene, MSFT_lod names the others, which three.js does not read: the page must
+      # draw this level alone, with its counts
+      if "$BUILD/sfb2gltf" -q --lods "$((level - 1)),$level,0" --quantize --compress "$src" -o "$W/$name.sfb2gltfl.glb" 2> "$W/$name.sfb2gltfl.log"; then
+        job "$name.sfb2gltfl" "$W/$name.sfb2gltfl.glb" "$yaw" "$pitch" "$zoom" "$size"; CHECKS+=("iou $name sfb2gltfl $gv $gt")
+      else
+        fail "$name: sfb2gltf --lods"; cat "$W/$name.sfb2gltfl.log"
       fi
     else
       fail "$name: sfb2gltf"; cat "$W/$name.sfb2gltf.log"
