@@ -1188,6 +1188,9 @@ SFB__IF int sfb__compose_row(sfb_context *ctx, sfb__accum *A, const sfb__rows *p
 SFB__IF int sfb__rows_append_mask(sfb_context *ctx, sfb__rows *out, const sfb__mask *m, int row);
 /* The float stencil table of r (over `sources` source elements). */
 SFB__IF sfb_result sfb__rows_to_stencils(sfb_context *ctx, const sfb__rows *r, int sources, sfb__stencils *s);
+/* The same for rows the caller would free next: their blocks become the table's (r left empty;
+ * on failure as it was). */
+SFB__IF sfb_result sfb__rows_move_to_stencils(sfb_context *ctx, sfb__rows *r, int sources, sfb__stencils *s);
 
 /* ---- mesh (mesh.c) ---- */
 /* Line numbers of OBJ statements, so that errors found while building the mesh can name the
@@ -2553,6 +2556,54 @@ void sfb__stencils_free(sfb_context *ctx, sfb__stencils *s) {
     memset(s, 0, sizeof *s);
 }
 
+/* sfb__rows_to_stencils for rows the caller frees next: the table takes over their blocks. The
+ * indices are the rows' own (an int array either way); the weights are narrowed to float in
+ * place, into the first half of the doubles' block (value k goes to bytes [4k, 4k+4), which hold
+ * only doubles already read: those below k/2 + 1), through memcpy so that no store can be
+ * moved before a load it overlaps; both blocks are then shrunk. Fresh tables of the same size
+ * cost page faults and a copy: at catmark_car level 3 these tables are tens of megabytes.
+ * On failure r is left as it was. */
+sfb_result sfb__rows_move_to_stencils(sfb_context *ctx, sfb__rows *r, int sources, sfb__stencils *s) {
+    unsigned char *wb = (unsigned char *)r->w;
+    int i;
+    size_t k;
+    void *p;
+    memset(s, 0, sizeof *s);
+    if (r->n > 0x7fffffff)
+        return sfb__error(ctx, SFB_LIMIT_EXCEEDED, SFB_ELEMENT_NONE, -1, "stencil table of %zu entries is over the limit", r->n);
+    if (!r->idx || !r->w) return sfb__rows_to_stencils(ctx, r, sources, s);
+    s->sizes = (int *)sfb__alloc(ctx, ((size_t)r->rows + 1) * sizeof(int));
+    s->offsets = (int *)sfb__alloc(ctx, ((size_t)r->rows + 1) * sizeof(int));
+    if (!s->sizes || !s->offsets) {
+        sfb__stencils_free(ctx, s);
+        return SFB_OUT_OF_MEMORY;
+    }
+    s->rows = r->rows;
+    s->sources = sources;
+    s->entries = r->n;
+    for (i = 0; i < r->rows; ++i) {
+        s->offsets[i] = (int)r->off[i];
+        s->sizes[i] = (int)(r->off[i + 1] - r->off[i]);
+    }
+    s->offsets[r->rows] = (int)r->n; /* end marker: offsets[rows] == entries */
+    s->sizes[r->rows] = 0;
+    for (k = 0; k < r->n; ++k) {
+        double d;
+        float f;
+        memcpy(&d, wb + 8 * k, sizeof d);
+        f = (float)d;
+        memcpy(wb + 4 * k, &f, sizeof f);
+    }
+    p = sfb__realloc(ctx, r->w, (r->n + 1) * sizeof(float));
+    s->weights = p ? (float *)p : (float *)(void *)r->w;
+    p = sfb__realloc(ctx, r->idx, (r->n + 1) * sizeof(int));
+    s->indices = p ? (int *)p : r->idx;
+    r->w = NULL;
+    r->idx = NULL;
+    r->n = r->cap = 0;
+    return SFB_SUCCESS;
+}
+
 sfb_result sfb__rows_to_stencils(sfb_context *ctx, const sfb__rows *r, int sources, sfb__stencils *s) {
     int i;
     size_t k;
@@ -3157,7 +3208,7 @@ sfb_result sfb__refine_keep_levels(sfb_context *ctx, const sfb__level *base, con
                                    prog0 + (prog1 - prog0) * (float)L / (float)(level + 1), (prog1 - prog0) / (float)(level + 1));
         if (r != SFB_SUCCESS) goto done;
         if (keep) {
-            r = sfb__rows_to_stencils(ctx, &local, cur.nv, &keep->T[L]);
+            r = sfb__rows_move_to_stencils(ctx, &local, cur.nv, &keep->T[L]);
             sfb__rows_free(ctx, &local);
             if (r != SFB_SUCCESS) { if (r == SFB_OUT_OF_MEMORY) r = sfb__oom(ctx, "stencil table"); goto done; }
         }
@@ -3170,7 +3221,8 @@ sfb_result sfb__refine_keep_levels(sfb_context *ctx, const sfb__level *base, con
         owns_cur = 1;
         memset(&next, 0, sizeof next);
     }
-    r = sfb__rows_to_stencils(ctx, &prow, base->nv, vt);
+    /* the limit tables below compose over prow: moved only where there are none */
+    r = lt ? sfb__rows_to_stencils(ctx, &prow, base->nv, vt) : sfb__rows_move_to_stencils(ctx, &prow, base->nv, vt);
     if (r != SFB_SUCCESS) { if (r == SFB_OUT_OF_MEMORY) r = sfb__oom(ctx, "stencil table"); goto done; }
     if (lt) {
         sfb__rows out[3];
@@ -3195,7 +3247,7 @@ sfb_result sfb__refine_keep_levels(sfb_context *ctx, const sfb__level *base, con
         }
         for (t = 0; t < 3; ++t) {
             if (r == SFB_SUCCESS) {
-                r = sfb__rows_to_stencils(ctx, &out[t], base->nv, &lt[t]);
+                r = sfb__rows_move_to_stencils(ctx, &out[t], base->nv, &lt[t]);
                 if (r == SFB_OUT_OF_MEMORY) r = sfb__oom(ctx, "limit stencil table");
             }
             sfb__rows_free(ctx, &out[t]);
@@ -11027,7 +11079,7 @@ static sfb_result sfb__shade_normals_level(sfb__shade_build *B) {
             B->prow = B->crow;
             memset(&B->crow, 0, sizeof B->crow);
         }
-        r = sfb__rows_to_stencils(ctx, &B->prow, prep->nv, &sh->npos);
+        r = sfb__rows_move_to_stencils(ctx, &B->prow, prep->nv, &sh->npos);
         if (r != SFB_SUCCESS) return sfb__oom(ctx, "shading tables");
         sfb__rows_free(ctx, &B->prow);
     }
@@ -11145,7 +11197,7 @@ static sfb_result sfb__shade_ns_steps(sfb__shade_build *B) {
             }
         sfb__rows_free(ctx, &B->prow);
         if (B->per_level) {
-            r = sfb__rows_to_stencils(ctx, &B->crow, reg[k].total, &sh->steps[k - Ln]);
+            r = sfb__rows_move_to_stencils(ctx, &B->crow, reg[k].total, &sh->steps[k - Ln]);
             if (r != SFB_SUCCESS) { if (r == SFB_OUT_OF_MEMORY) r = sfb__oom(ctx, "shading tables"); return r; }
             sfb__rows_free(ctx, &B->crow);
             if (!sfb__shade_identity(ctx, &B->prow, reg[k + 1].total)) return sfb__oom(ctx, "shading tables");
@@ -11201,7 +11253,7 @@ static sfb_result sfb__shade_ns_output(sfb__shade_build *B) {
         if (!sfb__compose_row(ctx, &B->A, &B->prow, &B->m, &B->crow, i)) return sfb__oom(ctx, "shading tables");
     }
     if (B->per_level) {
-        r = sfb__rows_to_stencils(ctx, &B->crow, reg[L - 1].total, &sh->steps[sh->nsteps - 1]);
+        r = sfb__rows_move_to_stencils(ctx, &B->crow, reg[L - 1].total, &sh->steps[sh->nsteps - 1]);
         if (r != SFB_SUCCESS) { if (r == SFB_OUT_OF_MEMORY) r = sfb__oom(ctx, "shading tables"); return r; }
         for (k = 0; k < sh->nsteps; ++k) {
             const sfb__stencils *S = &sh->steps[k];
@@ -11211,7 +11263,7 @@ static sfb_result sfb__shade_ns_output(sfb__shade_build *B) {
                 if (S->sizes[i] > sh->step_size_max) sh->step_size_max = S->sizes[i];
         }
     } else {
-        r = sfb__rows_to_stencils(ctx, &B->crow, sh->nsrc, &sh->ns);
+        r = sfb__rows_move_to_stencils(ctx, &B->crow, sh->nsrc, &sh->ns);
         if (r != SFB_SUCCESS) return sfb__oom(ctx, "shading tables");
     }
     sfb__rows_free(ctx, &B->crow);
@@ -11303,7 +11355,7 @@ static sfb_result sfb__shade_limits(sfb__shade_build *B) {
     }
     for (t = 0; t < 3; ++t) {
         if (r == SFB_SUCCESS) {
-            r = sfb__rows_to_stencils(ctx, &lr[t], top->nv, &sh->lim[t]);
+            r = sfb__rows_move_to_stencils(ctx, &lr[t], top->nv, &sh->lim[t]);
             if (r != SFB_SUCCESS) r = sfb__oom(ctx, "shading limit tables");
         }
         sfb__rows_free(ctx, &lr[t]);

@@ -574,7 +574,7 @@ sfb_result sfb__refine_keep_levels(sfb_context *ctx, const sfb__level *base, con
                                    prog0 + (prog1 - prog0) * (float)L / (float)(level + 1), (prog1 - prog0) / (float)(level + 1));
         if (r != SFB_SUCCESS) goto done;
         if (keep) {
-            r = sfb__rows_to_stencils(ctx, &local, cur.nv, &keep->T[L]);
+            r = sfb__rows_move_to_stencils(ctx, &local, cur.nv, &keep->T[L]);
             sfb__rows_free(ctx, &local);
             if (r != SFB_SUCCESS) { if (r == SFB_OUT_OF_MEMORY) r = sfb__oom(ctx, "stencil table"); goto done; }
         }
@@ -587,7 +587,8 @@ sfb_result sfb__refine_keep_levels(sfb_context *ctx, const sfb__level *base, con
         owns_cur = 1;
         memset(&next, 0, sizeof next);
     }
-    r = sfb__rows_to_stencils(ctx, &prow, base->nv, vt);
+    /* the limit tables below compose over prow: moved only where there are none */
+    r = lt ? sfb__rows_to_stencils(ctx, &prow, base->nv, vt) : sfb__rows_move_to_stencils(ctx, &prow, base->nv, vt);
     if (r != SFB_SUCCESS) { if (r == SFB_OUT_OF_MEMORY) r = sfb__oom(ctx, "stencil table"); goto done; }
     if (lt) {
         sfb__rows out[3];
@@ -612,7 +613,7 @@ sfb_result sfb__refine_keep_levels(sfb_context *ctx, const sfb__level *base, con
         }
         for (t = 0; t < 3; ++t) {
             if (r == SFB_SUCCESS) {
-                r = sfb__rows_to_stencils(ctx, &out[t], base->nv, &lt[t]);
+                r = sfb__rows_move_to_stencils(ctx, &out[t], base->nv, &lt[t]);
                 if (r == SFB_OUT_OF_MEMORY) r = sfb__oom(ctx, "limit stencil table");
             }
             sfb__rows_free(ctx, &out[t]);

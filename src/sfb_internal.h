@@ -343,6 +343,9 @@ SFB__IF int sfb__compose_row(sfb_context *ctx, sfb__accum *A, const sfb__rows *p
 SFB__IF int sfb__rows_append_mask(sfb_context *ctx, sfb__rows *out, const sfb__mask *m, int row);
 /* The float stencil table of r (over `sources` source elements). */
 SFB__IF sfb_result sfb__rows_to_stencils(sfb_context *ctx, const sfb__rows *r, int sources, sfb__stencils *s);
+/* The same for rows the caller would free next: their blocks become the table's (r left empty;
+ * on failure as it was). */
+SFB__IF sfb_result sfb__rows_move_to_stencils(sfb_context *ctx, sfb__rows *r, int sources, sfb__stencils *s);
 
 /* ---- mesh (mesh.c) ---- */
 /* Line numbers of OBJ statements, so that errors found while building the mesh can name the

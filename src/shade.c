@@ -443,7 +443,7 @@ static sfb_result sfb__shade_normals_level(sfb__shade_build *B) {
             B->prow = B->crow;
             memset(&B->crow, 0, sizeof B->crow);
         }
-        r = sfb__rows_to_stencils(ctx, &B->prow, prep->nv, &sh->npos);
+        r = sfb__rows_move_to_stencils(ctx, &B->prow, prep->nv, &sh->npos);
         if (r != SFB_SUCCESS) return sfb__oom(ctx, "shading tables");
         sfb__rows_free(ctx, &B->prow);
     }
@@ -561,7 +561,7 @@ static sfb_result sfb__shade_ns_steps(sfb__shade_build *B) {
             }
         sfb__rows_free(ctx, &B->prow);
         if (B->per_level) {
-            r = sfb__rows_to_stencils(ctx, &B->crow, reg[k].total, &sh->steps[k - Ln]);
+            r = sfb__rows_move_to_stencils(ctx, &B->crow, reg[k].total, &sh->steps[k - Ln]);
             if (r != SFB_SUCCESS) { if (r == SFB_OUT_OF_MEMORY) r = sfb__oom(ctx, "shading tables"); return r; }
             sfb__rows_free(ctx, &B->crow);
             if (!sfb__shade_identity(ctx, &B->prow, reg[k + 1].total)) return sfb__oom(ctx, "shading tables");
@@ -617,7 +617,7 @@ static sfb_result sfb__shade_ns_output(sfb__shade_build *B) {
         if (!sfb__compose_row(ctx, &B->A, &B->prow, &B->m, &B->crow, i)) return sfb__oom(ctx, "shading tables");
     }
     if (B->per_level) {
-        r = sfb__rows_to_stencils(ctx, &B->crow, reg[L - 1].total, &sh->steps[sh->nsteps - 1]);
+        r = sfb__rows_move_to_stencils(ctx, &B->crow, reg[L - 1].total, &sh->steps[sh->nsteps - 1]);
         if (r != SFB_SUCCESS) { if (r == SFB_OUT_OF_MEMORY) r = sfb__oom(ctx, "shading tables"); return r; }
         for (k = 0; k < sh->nsteps; ++k) {
             const sfb__stencils *S = &sh->steps[k];
@@ -627,7 +627,7 @@ static sfb_result sfb__shade_ns_output(sfb__shade_build *B) {
                 if (S->sizes[i] > sh->step_size_max) sh->step_size_max = S->sizes[i];
         }
     } else {
-        r = sfb__rows_to_stencils(ctx, &B->crow, sh->nsrc, &sh->ns);
+        r = sfb__rows_move_to_stencils(ctx, &B->crow, sh->nsrc, &sh->ns);
         if (r != SFB_SUCCESS) return sfb__oom(ctx, "shading tables");
     }
     sfb__rows_free(ctx, &B->crow);
@@ -719,7 +719,7 @@ static sfb_result sfb__shade_limits(sfb__shade_build *B) {
     }
     for (t = 0; t < 3; ++t) {
         if (r == SFB_SUCCESS) {
-            r = sfb__rows_to_stencils(ctx, &lr[t], top->nv, &sh->lim[t]);
+            r = sfb__rows_move_to_stencils(ctx, &lr[t], top->nv, &sh->lim[t]);
             if (r != SFB_SUCCESS) r = sfb__oom(ctx, "shading limit tables");
         }
         sfb__rows_free(ctx, &lr[t]);

@@ -127,6 +127,54 @@ void sfb__stencils_free(sfb_context *ctx, sfb__stencils *s) {
     memset(s, 0, sizeof *s);
 }
 
+/* sfb__rows_to_stencils for rows the caller frees next: the table takes over their blocks. The
+ * indices are the rows' own (an int array either way); the weights are narrowed to float in
+ * place, into the first half of the doubles' block (value k goes to bytes [4k, 4k+4), which hold
+ * only doubles already read: those below k/2 + 1), through memcpy so that no store can be
+ * moved before a load it overlaps; both blocks are then shrunk. Fresh tables of the same size
+ * cost page faults and a copy: at catmark_car level 3 these tables are tens of megabytes.
+ * On failure r is left as it was. */
+sfb_result sfb__rows_move_to_stencils(sfb_context *ctx, sfb__rows *r, int sources, sfb__stencils *s) {
+    unsigned char *wb = (unsigned char *)r->w;
+    int i;
+    size_t k;
+    void *p;
+    memset(s, 0, sizeof *s);
+    if (r->n > 0x7fffffff)
+        return sfb__error(ctx, SFB_LIMIT_EXCEEDED, SFB_ELEMENT_NONE, -1, "stencil table of %zu entries is over the limit", r->n);
+    if (!r->idx || !r->w) return sfb__rows_to_stencils(ctx, r, sources, s);
+    s->sizes = (int *)sfb__alloc(ctx, ((size_t)r->rows + 1) * sizeof(int));
+    s->offsets = (int *)sfb__alloc(ctx, ((size_t)r->rows + 1) * sizeof(int));
+    if (!s->sizes || !s->offsets) {
+        sfb__stencils_free(ctx, s);
+        return SFB_OUT_OF_MEMORY;
+    }
+    s->rows = r->rows;
+    s->sources = sources;
+    s->entries = r->n;
+    for (i = 0; i < r->rows; ++i) {
+        s->offsets[i] = (int)r->off[i];
+        s->sizes[i] = (int)(r->off[i + 1] - r->off[i]);
+    }
+    s->offsets[r->rows] = (int)r->n; /* end marker: offsets[rows] == entries */
+    s->sizes[r->rows] = 0;
+    for (k = 0; k < r->n; ++k) {
+        double d;
+        float f;
+        memcpy(&d, wb + 8 * k, sizeof d);
+        f = (float)d;
+        memcpy(wb + 4 * k, &f, sizeof f);
+    }
+    p = sfb__realloc(ctx, r->w, (r->n + 1) * sizeof(float));
+    s->weights = p ? (float *)p : (float *)(void *)r->w;
+    p = sfb__realloc(ctx, r->idx, (r->n + 1) * sizeof(int));
+    s->indices = p ? (int *)p : r->idx;
+    r->w = NULL;
+    r->idx = NULL;
+    r->n = r->cap = 0;
+    return SFB_SUCCESS;
+}
+
 sfb_result sfb__rows_to_stencils(sfb_context *ctx, const sfb__rows *r, int sources, sfb__stencils *s) {
     int i;
     size_t k;
