@@ -353,7 +353,7 @@ sfb_result sfb__refine_step_local(sfb_context *ctx, const sfb__refine_options *o
     crow->n = 0;
     crow->off = (size_t *)sfb__alloc(ctx, ((size_t)c->nv + 1) * sizeof(size_t));
     /* room for the child rows at once: a child's row spans about twice its parents' average
-     * (it grows by 1.5x and is copied by realloc where this falls short; growing from 4 per row
+     * (it grows by doubling, copied by realloc, where this falls short; growing from 4 per row
      * copied the table five times over at level 3) */
     if (!crow->off || !sfb__rows_reserve(ctx, crow, (size_t)c->nv * (2 * (prow->n / (size_t)(prow->rows > 0 ? prow->rows : 1)) + 4) + 16)) {
         sfb__free(ctx, st.half);
