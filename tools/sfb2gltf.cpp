@@ -86,7 +86,8 @@ const char *const kUsage =
     "                         meshoptimizer's codecs (a loader must decode it: three.js with its\n"
     "                         MeshoptDecoder, gltfpack); best with --quantize, where normals go through\n"
     "                         the octahedral filter and UVs in [0,1] through the exponential one (floats,\n"
-    "                         a step of 2^-uv-bits or finer); triangles in a strip-friendly order\n"
+    "                         a step of 2^-uv-bits or finer; twice that beside a coordinate of exactly 1);\n"
+    "                         triangles in a strip-friendly order\n"
     "  --lods L0,L1,...       one mesh per level (or per rate with --tess, whose RATE it replaces; up to\n"
     "                         16), each in a node named \"NAME level L\" (\"NAME rate R\"): the most\n"
     "                         detailed one in the scene with MSFT_lod naming the others (a viewer without\n"
@@ -684,8 +685,10 @@ tinygltf::Primitive add_primitive_quantized(tinygltf::Model *model, const OutMes
         for (float x : m.uvs) unit = unit && x >= 0.0f && x <= 1.0f;
         if (unit && o.compress) {
             // with --compress: floats through the exponential filter (a signed mantissa of
-            // uv_bits + 1 bits and an exponent per vertex), so that a uv in [1/2, 1] keeps the step
-            // 2^-uv_bits of the normalised integers below and smaller ones a finer step. The
+            // uv_bits + 1 bits and an exponent per vertex), so that a uv in [1/2, 1) keeps the step
+            // 2^-uv_bits of the normalised integers below and smaller ones a finer step; a vertex
+            // with a coordinate of exactly 1 (exponent one higher) gets 2^(1 - uv_bits) for both
+            // (one more mantissa bit for that costs 5 % of the uvs' bytes everywhere). The
             // normalised 16-bit integers of a 12-bit grid (round(q * 65535 / 4095)) fill their low
             // bits with the rounding of that scale, which the byte-wise codec cannot predict:
             // catmark_car level 3's uvs take 430 kB this way against 464 kB.
