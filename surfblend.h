@@ -1276,8 +1276,11 @@ enum { SFB__SCHEME_REFINES = SFB_SCHEME_CAN_REFINE,    /* uniform refinement (an
        SFB__SCHEME_SHADES = SFB_SCHEME_CAN_SHADE,      /* subdivision shading (seed 001) */
        SFB__SCHEME_TRIANGLES = SFB_SCHEME_TRIANGLES,   /* faces must be triangles */
        SFB__SCHEME_BOUNDARY_HOLES = 1u << 3, /* boundary NONE makes boundary faces holes (OpenSubdiv) */
-       SFB__SCHEME_LINEAR_UVS = 1u << 4      /* tessellated UVs follow each face linearly (PN: the scheme on a
-                                                planar layout is the linear map, and a UV triangle may be flat) */ };
+       SFB__SCHEME_LINEAR_UVS = 1u << 4,     /* tessellated UVs follow each face linearly (PN: the scheme on a
+                                                planar layout is the linear map, and a UV triangle may be flat) */
+       SFB__SCHEME_UVS_OR_LINEAR = 1u << 5   /* tessellated UVs: the scheme's own surface of the UV layout, or
+                                                linear per face where its builder refuses the layout (tribezier:
+                                                a flat or non-manifold UV triangle) */ };
 typedef struct sfb__scheme_info {
     sfb_scheme scheme;
     const char *name;   /* sfb_scheme_name, sfb_scheme_parse */
@@ -8750,8 +8753,10 @@ static void sfb__tess_uv_linear(const sfb_surface *s, const sfb_location *L, flo
  * of the refined UV layout: the layout's own patch table (sfb__surface_uv_patches, built per
  * call, so a surface that never tessellates UVs does not pay for it), uploaded to and
  * evaluated on the context's backend as the positions are. The manifold blend blends the UV layout as it blends
- * positions (the blend is linear in the data); PN triangles take the linear UVs, which is what
- * they make of a planar layout. */
+ * positions (the blend is linear in the data); tribezier builds its own surface of the layout
+ * (a similarity of a planar mesh's layout gives that map of the positions), linear per face
+ * where its builder refuses the layout; PN triangles take the linear UVs, which is what they
+ * make of a planar layout. */
 static sfb_result sfb__tess_eval_uvs(const sfb_surface *s, sfb_tess_data *out, float p0) {
     sfb_context *ctx = s->ctx;
     size_t v, nv = (size_t)out->vertex_count, done_v;
@@ -8770,7 +8775,17 @@ static sfb_result sfb__tess_eval_uvs(const sfb_surface *s, sfb_tess_data *out, f
     }
     tmp = (float *)sfb__tess_array(ctx, SFB__TESS_EVAL_CHUNK, 3 * sizeof(float));
     if (!tmp) return sfb__oom(ctx, "tessellated UVs");
-    if ((r = sfb__surface_uv_patches(s, &upt)) != SFB_SUCCESS) goto done;
+    if ((r = sfb__surface_uv_patches(s, &upt)) != SFB_SUCCESS) {
+        const sfb__scheme_info *si = sfb__scheme_info_of(s->config.scheme);
+        if (r == SFB_OUT_OF_MEMORY || r == SFB_CANCELLED || !si || !(si->caps & SFB__SCHEME_UVS_OR_LINEAR)) goto done;
+        /* the scheme's builder refused the layout (tribezier: a flat UV triangle, a UV value
+         * shared by faces that are no fan): linear UVs, said at info level */
+        sfb__log(ctx, SFB_LOG_INFO, "tessellated UVs: the %s surface of the UV layout cannot be built (%s): linear per face",
+                 si->name, sfb_last_error(ctx));
+        for (v = 0; v < nv; ++v) sfb__tess_uv_linear(s, &out->locations[v], out->uvs + 2 * v);
+        r = sfb__progress(ctx, 1.0f, "tessellate");
+        goto done;
+    }
     /* on the context's backend, like the positions (ref when it has no patch kernels) */
     if (be && be->upload_patches && be->eval_patches) {
         if ((r = be->upload_patches(ctx->backend_state, &upt, &handle)) != SFB_SUCCESS) goto done;
@@ -9994,7 +10009,7 @@ static const sfb__scheme_info sfb__schemes[] = {
     {SFB_SCHEME_MANIFOLD_BLEND, "manifold", "manifold blending", SFB_SCHEME_CATMARK, SFB__SCHEME_BOUNDARY_HOLES,
      sfb__scheme_build_manifold},
     /* evaluated only (seed 004): its tables are built at level 0, where Loop's rules are the identity */
-    {SFB_SCHEME_TRIBEZIER, "tribezier", "quartic triangular Bezier", SFB_SCHEME_LOOP, SFB__SCHEME_TRIANGLES | SFB__SCHEME_LINEAR_UVS,
+    {SFB_SCHEME_TRIBEZIER, "tribezier", "quartic triangular Bezier", SFB_SCHEME_LOOP, SFB__SCHEME_TRIANGLES | SFB__SCHEME_UVS_OR_LINEAR,
      sfb__scheme_build_tribezier},
     /* evaluated only: its tables are built at level 0, where Loop's rules are the identity */
     {SFB_SCHEME_PN, "pn", "PN triangles", SFB_SCHEME_LOOP, SFB__SCHEME_TRIANGLES | SFB__SCHEME_LINEAR_UVS, sfb__scheme_build_pn}

@@ -40,7 +40,7 @@ static const sfb__scheme_info sfb__schemes[] = {
     {SFB_SCHEME_MANIFOLD_BLEND, "manifold", "manifold blending", SFB_SCHEME_CATMARK, SFB__SCHEME_BOUNDARY_HOLES,
      sfb__scheme_build_manifold},
     /* evaluated only (seed 004): its tables are built at level 0, where Loop's rules are the identity */
-    {SFB_SCHEME_TRIBEZIER, "tribezier", "quartic triangular Bezier", SFB_SCHEME_LOOP, SFB__SCHEME_TRIANGLES | SFB__SCHEME_LINEAR_UVS,
+    {SFB_SCHEME_TRIBEZIER, "tribezier", "quartic triangular Bezier", SFB_SCHEME_LOOP, SFB__SCHEME_TRIANGLES | SFB__SCHEME_UVS_OR_LINEAR,
      sfb__scheme_build_tribezier},
     /* evaluated only: its tables are built at level 0, where Loop's rules are the identity */
     {SFB_SCHEME_PN, "pn", "PN triangles", SFB_SCHEME_LOOP, SFB__SCHEME_TRIANGLES | SFB__SCHEME_LINEAR_UVS, sfb__scheme_build_pn}

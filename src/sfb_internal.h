@@ -431,8 +431,11 @@ enum { SFB__SCHEME_REFINES = SFB_SCHEME_CAN_REFINE,    /* uniform refinement (an
        SFB__SCHEME_SHADES = SFB_SCHEME_CAN_SHADE,      /* subdivision shading (seed 001) */
        SFB__SCHEME_TRIANGLES = SFB_SCHEME_TRIANGLES,   /* faces must be triangles */
        SFB__SCHEME_BOUNDARY_HOLES = 1u << 3, /* boundary NONE makes boundary faces holes (OpenSubdiv) */
-       SFB__SCHEME_LINEAR_UVS = 1u << 4      /* tessellated UVs follow each face linearly (PN: the scheme on a
-                                                planar layout is the linear map, and a UV triangle may be flat) */ };
+       SFB__SCHEME_LINEAR_UVS = 1u << 4,     /* tessellated UVs follow each face linearly (PN: the scheme on a
+                                                planar layout is the linear map, and a UV triangle may be flat) */
+       SFB__SCHEME_UVS_OR_LINEAR = 1u << 5   /* tessellated UVs: the scheme's own surface of the UV layout, or
+                                                linear per face where its builder refuses the layout (tribezier:
+                                                a flat or non-manifold UV triangle) */ };
 typedef struct sfb__scheme_info {
     sfb_scheme scheme;
     const char *name;   /* sfb_scheme_name, sfb_scheme_parse */

@@ -1237,8 +1237,10 @@ static void sfb__tess_uv_linear(const sfb_surface *s, const sfb_location *L, flo
  * of the refined UV layout: the layout's own patch table (sfb__surface_uv_patches, built per
  * call, so a surface that never tessellates UVs does not pay for it), uploaded to and
  * evaluated on the context's backend as the positions are. The manifold blend blends the UV layout as it blends
- * positions (the blend is linear in the data); PN triangles take the linear UVs, which is what
- * they make of a planar layout. */
+ * positions (the blend is linear in the data); tribezier builds its own surface of the layout
+ * (a similarity of a planar mesh's layout gives that map of the positions), linear per face
+ * where its builder refuses the layout; PN triangles take the linear UVs, which is what they
+ * make of a planar layout. */
 static sfb_result sfb__tess_eval_uvs(const sfb_surface *s, sfb_tess_data *out, float p0) {
     sfb_context *ctx = s->ctx;
     size_t v, nv = (size_t)out->vertex_count, done_v;
@@ -1257,7 +1259,17 @@ static sfb_result sfb__tess_eval_uvs(const sfb_surface *s, sfb_tess_data *out, f
     }
     tmp = (float *)sfb__tess_array(ctx, SFB__TESS_EVAL_CHUNK, 3 * sizeof(float));
     if (!tmp) return sfb__oom(ctx, "tessellated UVs");
-    if ((r = sfb__surface_uv_patches(s, &upt)) != SFB_SUCCESS) goto done;
+    if ((r = sfb__surface_uv_patches(s, &upt)) != SFB_SUCCESS) {
+        const sfb__scheme_info *si = sfb__scheme_info_of(s->config.scheme);
+        if (r == SFB_OUT_OF_MEMORY || r == SFB_CANCELLED || !si || !(si->caps & SFB__SCHEME_UVS_OR_LINEAR)) goto done;
+        /* the scheme's builder refused the layout (tribezier: a flat UV triangle, a UV value
+         * shared by faces that are no fan): linear UVs, said at info level */
+        sfb__log(ctx, SFB_LOG_INFO, "tessellated UVs: the %s surface of the UV layout cannot be built (%s): linear per face",
+                 si->name, sfb_last_error(ctx));
+        for (v = 0; v < nv; ++v) sfb__tess_uv_linear(s, &out->locations[v], out->uvs + 2 * v);
+        r = sfb__progress(ctx, 1.0f, "tessellate");
+        goto done;
+    }
     /* on the context's backend, like the positions (ref when it has no patch kernels) */
     if (be && be->upload_patches && be->eval_patches) {
         if ((r = be->upload_patches(ctx->backend_state, &upt, &handle)) != SFB_SUCCESS) goto done;

@@ -1568,7 +1568,8 @@ static void expect_affine_uvs(const sfb_tess_data *t, const char *what)
 Test(tess_uv, limit_uvs_are_the_layout_map_of_the_limit_positions)
 {
     static const struct { sfb_scheme scheme; int loop; const char *name; } cases[] = {
-        { SFB_SCHEME_CATMARK, 0, "Catmull-Clark" }, { SFB_SCHEME_LOOP, 1, "Loop" }, { SFB_SCHEME_MANIFOLD_BLEND, 0, "manifold" } };
+        { SFB_SCHEME_CATMARK, 0, "Catmull-Clark" }, { SFB_SCHEME_LOOP, 1, "Loop" }, { SFB_SCHEME_MANIFOLD_BLEND, 0, "manifold" },
+        { SFB_SCHEME_TRIBEZIER, 1, "tribezier" } };
     for (size_t k = 0; k < sizeof cases / sizeof *cases; ++k) {
         sfb_context *ctx = tx_ctx();
         char *obj = flat_uv_disk(cases[k].loop);
@@ -1585,6 +1586,40 @@ Test(tess_uv, limit_uvs_are_the_layout_map_of_the_limit_positions)
         sfb_context_destroy(ctx);
         free(obj);
     }
+}
+
+/* A UV layout tribezier's builder refuses (every corner given the one UV (0.3, 0.6): one UV
+ * value shared by every face, no fan): the tessellation still succeeds, with the linear UVs
+ * (here that value everywhere), instead of failing. */
+Test(tess_uv, tribezier_falls_back_to_linear_uvs)
+{
+    sfb_context *ctx = tx_ctx();
+    char *obj = flat_uv_disk(1);
+    /* every vt line becomes the same value */
+    size_t n = strlen(obj), at = 0;
+    char *out = malloc(2 * n + 64);
+    const char *p = obj;
+    while (*p) {
+        const char *e = strchr(p, '\n');
+        size_t len = e ? (size_t)(e - p) + 1 : strlen(p);
+        if (!strncmp(p, "vt ", 3)) at += (size_t)sprintf(out + at, "vt 0.3 0.6\n");
+        else { memcpy(out + at, p, len); at += len; }
+        p += len;
+    }
+    out[at] = 0;
+    sfb_mesh *m = tx_mesh(ctx, out);
+    sfb_surface *s = uv_surface(ctx, m, SFB_SCHEME_TRIBEZIER);
+    sfb_tess_data t = tess_ok(s, ctx, 4, 0.0f, SFB_TESS_UVS);
+    cr_assert_not_null(t.uvs);
+    double worst = 0.0;
+    for (int v = 0; v < t.vertex_count; ++v) worst = fmax(worst, fmax(fabs(t.uvs[2 * v] - 0.3), fabs(t.uvs[2 * v + 1] - 0.6)));
+    cr_expect_lt(worst, 1e-6, "linear UVs of one value: %g off", worst);
+    sfb_tess_data_free(&t);
+    sfb_surface_destroy(s);
+    sfb_mesh_destroy(m);
+    sfb_context_destroy(ctx);
+    free(out);
+    free(obj);
 }
 
 /* Seams the flat disk has none of: with SFB_TESS_UVS alone nothing is split, and the
