@@ -1259,6 +1259,20 @@ static sfb_result sfb__tess_eval_uvs(const sfb_surface *s, sfb_tess_data *out, f
     }
     tmp = (float *)sfb__tess_array(ctx, SFB__TESS_EVAL_CHUNK, 3 * sizeof(float));
     if (!tmp) return sfb__oom(ctx, "tessellated UVs");
+    {
+        /* a layout the scheme's builder is known to refuse (tribezier: not a manifold, as
+         * placeholder UVs are) is not offered to it, so that no error is logged for it */
+        const sfb__scheme_info *si = sfb__scheme_info_of(s->config.scheme);
+        int i, refused = 0;
+        if (si && (si->caps & SFB__SCHEME_UVS_OR_LINEAR))
+            for (i = 0; i < s->uv_base.nv && !refused; ++i) refused = (s->uv_base.vtag[i] & SFB__TAG_NONMANIFOLD) != 0;
+        if (refused) {
+            sfb__log(ctx, SFB_LOG_INFO, "tessellated UVs: the UV layout is not a manifold: linear per face (%s)", si->name);
+            for (v = 0; v < nv; ++v) sfb__tess_uv_linear(s, &out->locations[v], out->uvs + 2 * v);
+            r = sfb__progress(ctx, 1.0f, "tessellate");
+            goto done;
+        }
+    }
     if ((r = sfb__surface_uv_patches(s, &upt)) != SFB_SUCCESS) {
         const sfb__scheme_info *si = sfb__scheme_info_of(s->config.scheme);
         if (r == SFB_OUT_OF_MEMORY || r == SFB_CANCELLED || !si || !(si->caps & SFB__SCHEME_UVS_OR_LINEAR)) goto done;

@@ -1622,6 +1622,37 @@ Test(tess_uv, tribezier_falls_back_to_linear_uvs)
     free(obj);
 }
 
+/* A manifold UV layout the tribezier builder refuses (a UV triangle of zero area: the first ring
+ * vertex given the centre's UV): linear UVs again, the tessellation does not fail. */
+Test(tess_uv, tribezier_flat_uv_triangle_falls_back_to_linear_uvs)
+{
+    sfb_context *ctx = tx_ctx();
+    char *obj = flat_uv_disk(1);
+    char *second = strstr(obj, "vt ");
+    cr_assert_not_null(second);
+    second = strstr(second + 3, "vt "); /* the UV of ring vertex 1 */
+    cr_assert_not_null(second);
+    char *end = strchr(second, '\n');
+    size_t head = (size_t)(second - obj);
+    char *out = malloc(strlen(obj) + 64);
+    memcpy(out, obj, head);
+    sprintf(out + head, "vt 0.5 0.5%s", end);
+    sfb_mesh *m = tx_mesh(ctx, out);
+    sfb_surface *s = uv_surface(ctx, m, SFB_SCHEME_TRIBEZIER);
+    sfb_tess_data t = tess_ok(s, ctx, 4, 0.0f, SFB_TESS_UVS);
+    cr_assert_not_null(t.uvs);
+    int outside = 0;
+    for (int v = 0; v < t.vertex_count; ++v)
+        for (int c = 0; c < 2; ++c) outside += !(t.uvs[2 * v + c] >= 0.0f && t.uvs[2 * v + c] <= 1.0f);
+    cr_expect_eq(outside, 0, "%d UV coordinates outside the layout's [0, 1]", outside);
+    sfb_tess_data_free(&t);
+    sfb_surface_destroy(s);
+    sfb_mesh_destroy(m);
+    sfb_context_destroy(ctx);
+    free(out);
+    free(obj);
+}
+
 /* Seams the flat disk has none of: with SFB_TESS_UVS alone nothing is split, and the
  * triangles are those of the plain tessellation. */
 Test(tess_uv, no_seams_no_split)
