@@ -2559,6 +2559,28 @@ void sfb__stencils_free(sfb_context *ctx, sfb__stencils *s) {
     memset(s, 0, sizeof *s);
 }
 
+/* The row index of a stencil table from rows r (rows, sources, entries, sizes, offsets with the
+ * end marker); the indices and weights are the caller's. 0 when out of memory (s freed). */
+static int sfb__stencils_index(sfb_context *ctx, const sfb__rows *r, int sources, sfb__stencils *s) {
+    int i;
+    s->rows = r->rows;
+    s->sources = sources;
+    s->entries = r->n;
+    s->sizes = (int *)sfb__alloc(ctx, ((size_t)r->rows + 1) * sizeof(int));
+    s->offsets = (int *)sfb__alloc(ctx, ((size_t)r->rows + 1) * sizeof(int));
+    if (!s->sizes || !s->offsets) {
+        sfb__stencils_free(ctx, s);
+        return 0;
+    }
+    for (i = 0; i < r->rows; ++i) {
+        s->offsets[i] = (int)r->off[i];
+        s->sizes[i] = (int)(r->off[i + 1] - r->off[i]);
+    }
+    s->offsets[r->rows] = (int)r->n; /* end marker: offsets[rows] == entries */
+    s->sizes[r->rows] = 0;
+    return 1;
+}
+
 /* sfb__rows_to_stencils for rows the caller frees next: the table takes over their blocks. The
  * indices are the rows' own (an int array either way); the weights are narrowed to float in
  * place, into the first half of the doubles' block (value k goes to bytes [4k, 4k+4), which hold
@@ -2568,28 +2590,13 @@ void sfb__stencils_free(sfb_context *ctx, sfb__stencils *s) {
  * On failure r is left as it was. */
 sfb_result sfb__rows_move_to_stencils(sfb_context *ctx, sfb__rows *r, int sources, sfb__stencils *s) {
     unsigned char *wb = (unsigned char *)r->w;
-    int i;
     size_t k;
     void *p;
     memset(s, 0, sizeof *s);
     if (r->n > 0x7fffffff)
         return sfb__error(ctx, SFB_LIMIT_EXCEEDED, SFB_ELEMENT_NONE, -1, "stencil table of %zu entries is over the limit", r->n);
     if (!r->idx || !r->w) return sfb__rows_to_stencils(ctx, r, sources, s);
-    s->sizes = (int *)sfb__alloc(ctx, ((size_t)r->rows + 1) * sizeof(int));
-    s->offsets = (int *)sfb__alloc(ctx, ((size_t)r->rows + 1) * sizeof(int));
-    if (!s->sizes || !s->offsets) {
-        sfb__stencils_free(ctx, s);
-        return SFB_OUT_OF_MEMORY;
-    }
-    s->rows = r->rows;
-    s->sources = sources;
-    s->entries = r->n;
-    for (i = 0; i < r->rows; ++i) {
-        s->offsets[i] = (int)r->off[i];
-        s->sizes[i] = (int)(r->off[i + 1] - r->off[i]);
-    }
-    s->offsets[r->rows] = (int)r->n; /* end marker: offsets[rows] == entries */
-    s->sizes[r->rows] = 0;
+    if (!sfb__stencils_index(ctx, r, sources, s)) return SFB_OUT_OF_MEMORY;
     for (k = 0; k < r->n; ++k) {
         double d;
         float f;
@@ -2608,28 +2615,17 @@ sfb_result sfb__rows_move_to_stencils(sfb_context *ctx, sfb__rows *r, int source
 }
 
 sfb_result sfb__rows_to_stencils(sfb_context *ctx, const sfb__rows *r, int sources, sfb__stencils *s) {
-    int i;
     size_t k;
     memset(s, 0, sizeof *s);
     if (r->n > 0x7fffffff)
         return sfb__error(ctx, SFB_LIMIT_EXCEEDED, SFB_ELEMENT_NONE, -1, "stencil table of %zu entries is over the limit", r->n);
-    s->rows = r->rows;
-    s->sources = sources;
-    s->entries = r->n;
-    s->sizes = (int *)sfb__alloc(ctx, ((size_t)r->rows + 1) * sizeof(int));
-    s->offsets = (int *)sfb__alloc(ctx, ((size_t)r->rows + 1) * sizeof(int));
+    if (!sfb__stencils_index(ctx, r, sources, s)) return SFB_OUT_OF_MEMORY;
     s->indices = (int *)sfb__alloc(ctx, (r->n + 1) * sizeof(int));
     s->weights = (float *)sfb__alloc(ctx, (r->n + 1) * sizeof(float));
-    if (!s->sizes || !s->offsets || !s->indices || !s->weights) {
+    if (!s->indices || !s->weights) {
         sfb__stencils_free(ctx, s);
         return SFB_OUT_OF_MEMORY;
     }
-    for (i = 0; i < r->rows; ++i) {
-        s->offsets[i] = (int)r->off[i];
-        s->sizes[i] = (int)(r->off[i + 1] - r->off[i]);
-    }
-    s->offsets[r->rows] = (int)r->n; /* end marker: offsets[rows] == entries */
-    s->sizes[r->rows] = 0;
     if (r->n) memcpy(s->indices, r->idx, r->n * sizeof(int));
     for (k = 0; k < r->n; ++k) s->weights[k] = (float)r->w[k];
     return SFB_SUCCESS;
@@ -8776,29 +8772,26 @@ static sfb_result sfb__tess_eval_uvs(const sfb_surface *s, sfb_tess_data *out, f
     tmp = (float *)sfb__tess_array(ctx, SFB__TESS_EVAL_CHUNK, 3 * sizeof(float));
     if (!tmp) return sfb__oom(ctx, "tessellated UVs");
     {
-        /* a layout the scheme's builder is known to refuse (tribezier: not a manifold, as
-         * placeholder UVs are) is not offered to it, so that no error is logged for it */
+        /* UVS_OR_LINEAR: linear UVs where the scheme's builder cannot take the layout -- one
+         * that is not a manifold (placeholder UVs) is not offered to it, so that no error is
+         * logged for it; other refusals (a flat UV triangle) come back from the builder */
         const sfb__scheme_info *si = sfb__scheme_info_of(s->config.scheme);
-        int i, refused = 0;
-        if (si && (si->caps & SFB__SCHEME_UVS_OR_LINEAR))
-            for (i = 0; i < s->uv_base.nv && !refused; ++i) refused = (s->uv_base.vtag[i] & SFB__TAG_NONMANIFOLD) != 0;
-        if (refused) {
+        const int fallback = si && (si->caps & SFB__SCHEME_UVS_OR_LINEAR);
+        int i, linear = 0;
+        for (i = 0; fallback && i < s->uv_base.nv && !linear; ++i) linear = (s->uv_base.vtag[i] & SFB__TAG_NONMANIFOLD) != 0;
+        if (linear) {
             sfb__log(ctx, SFB_LOG_INFO, "tessellated UVs: the UV layout is not a manifold: linear per face (%s)", si->name);
+        } else if ((r = sfb__surface_uv_patches(s, &upt)) != SFB_SUCCESS) {
+            if (r == SFB_OUT_OF_MEMORY || r == SFB_CANCELLED || !fallback) goto done;
+            sfb__log(ctx, SFB_LOG_INFO, "tessellated UVs: the %s surface of the UV layout cannot be built (%s): linear per face",
+                     si->name, sfb_last_error(ctx));
+            linear = 1;
+        }
+        if (linear) {
             for (v = 0; v < nv; ++v) sfb__tess_uv_linear(s, &out->locations[v], out->uvs + 2 * v);
             r = sfb__progress(ctx, 1.0f, "tessellate");
             goto done;
         }
-    }
-    if ((r = sfb__surface_uv_patches(s, &upt)) != SFB_SUCCESS) {
-        const sfb__scheme_info *si = sfb__scheme_info_of(s->config.scheme);
-        if (r == SFB_OUT_OF_MEMORY || r == SFB_CANCELLED || !si || !(si->caps & SFB__SCHEME_UVS_OR_LINEAR)) goto done;
-        /* the scheme's builder refused the layout (tribezier: a flat UV triangle, a UV value
-         * shared by faces that are no fan): linear UVs, said at info level */
-        sfb__log(ctx, SFB_LOG_INFO, "tessellated UVs: the %s surface of the UV layout cannot be built (%s): linear per face",
-                 si->name, sfb_last_error(ctx));
-        for (v = 0; v < nv; ++v) sfb__tess_uv_linear(s, &out->locations[v], out->uvs + 2 * v);
-        r = sfb__progress(ctx, 1.0f, "tessellate");
-        goto done;
     }
     /* on the context's backend, like the positions (ref when it has no patch kernels) */
     if (be && be->upload_patches && be->eval_patches) {
@@ -10204,23 +10197,20 @@ static sfb_result sfb__surface_build_vertex(sfb_surface *s, const sfb_mesh *mesh
     opt.crease_method = mesh->crease_method;
     opt.triangle_rule = mesh->triangle_rule;
     opt.want_limit = (cfg->flags & SFB_REFINE_LIMIT) != 0;
-    if ((cfg->flags & SFB_REFINE_SHADING) && cfg->refine_level > 0) {
+    {
         /* the shading tables need every level and each step's own table: the vertex refinement
          * hands its over instead of the shading build refining a second time */
+        const int shading = (cfg->flags & SFB_REFINE_SHADING) != 0, keep = shading && cfg->refine_level > 0;
         sfb__refine_kept kept;
-        kept.lev = (sfb__level *)sfb__calloc(ctx, (size_t)cfg->refine_level, sizeof *kept.lev);
-        kept.T = (sfb__stencils *)sfb__calloc(ctx, (size_t)cfg->refine_level, sizeof *kept.T);
-        if (!kept.lev || !kept.T) r = sfb__oom(ctx, "refinement");
+        kept.lev = keep ? (sfb__level *)sfb__calloc(ctx, (size_t)cfg->refine_level, sizeof *kept.lev) : NULL;
+        kept.T = keep ? (sfb__stencils *)sfb__calloc(ctx, (size_t)cfg->refine_level, sizeof *kept.T) : NULL;
+        if (keep && (!kept.lev || !kept.T)) r = sfb__oom(ctx, "refinement");
         else r = sfb__refine_keep_levels(ctx, &prep, &opt, cfg->refine_level, &s->top, &s->tables[SFB_TABLE_VERTEX],
-                                         opt.want_limit ? &s->tables[SFB_TABLE_LIMIT] : NULL, &kept, 0.0f, 0.8f);
-        if (r == SFB_SUCCESS) r = sfb__shading_build(ctx, &prep, &opt, cfg->refine_level, &cfg->shading, &kept, &s->top, &s->shading);
+                                         opt.want_limit ? &s->tables[SFB_TABLE_LIMIT] : NULL, keep ? &kept : NULL, 0.0f, 0.8f);
+        if (r == SFB_SUCCESS && shading)
+            r = sfb__shading_build(ctx, &prep, &opt, cfg->refine_level, &cfg->shading, keep ? &kept : NULL, &s->top, &s->shading);
         sfb__free(ctx, kept.lev);
         sfb__free(ctx, kept.T);
-    } else {
-        r = sfb__refine(ctx, &prep, &opt, cfg->refine_level, &s->top, &s->tables[SFB_TABLE_VERTEX],
-                        opt.want_limit ? &s->tables[SFB_TABLE_LIMIT] : NULL, 0.0f, 0.8f);
-        if (r == SFB_SUCCESS && (cfg->flags & SFB_REFINE_SHADING))
-            r = sfb__shading_build(ctx, &prep, &opt, cfg->refine_level, &cfg->shading, NULL, NULL, &s->shading);
     }
     if (r == SFB_SUCCESS && (cfg->flags & SFB_REFINE_PATCHES)) {
         r = si->build_patches(ctx, &prep, &opt, cfg, s->base_positions, &s->patches);

@@ -127,6 +127,28 @@ void sfb__stencils_free(sfb_context *ctx, sfb__stencils *s) {
     memset(s, 0, sizeof *s);
 }
 
+/* The row index of a stencil table from rows r (rows, sources, entries, sizes, offsets with the
+ * end marker); the indices and weights are the caller's. 0 when out of memory (s freed). */
+static int sfb__stencils_index(sfb_context *ctx, const sfb__rows *r, int sources, sfb__stencils *s) {
+    int i;
+    s->rows = r->rows;
+    s->sources = sources;
+    s->entries = r->n;
+    s->sizes = (int *)sfb__alloc(ctx, ((size_t)r->rows + 1) * sizeof(int));
+    s->offsets = (int *)sfb__alloc(ctx, ((size_t)r->rows + 1) * sizeof(int));
+    if (!s->sizes || !s->offsets) {
+        sfb__stencils_free(ctx, s);
+        return 0;
+    }
+    for (i = 0; i < r->rows; ++i) {
+        s->offsets[i] = (int)r->off[i];
+        s->sizes[i] = (int)(r->off[i + 1] - r->off[i]);
+    }
+    s->offsets[r->rows] = (int)r->n; /* end marker: offsets[rows] == entries */
+    s->sizes[r->rows] = 0;
+    return 1;
+}
+
 /* sfb__rows_to_stencils for rows the caller frees next: the table takes over their blocks. The
  * indices are the rows' own (an int array either way); the weights are narrowed to float in
  * place, into the first half of the doubles' block (value k goes to bytes [4k, 4k+4), which hold
@@ -136,28 +158,13 @@ void sfb__stencils_free(sfb_context *ctx, sfb__stencils *s) {
  * On failure r is left as it was. */
 sfb_result sfb__rows_move_to_stencils(sfb_context *ctx, sfb__rows *r, int sources, sfb__stencils *s) {
     unsigned char *wb = (unsigned char *)r->w;
-    int i;
     size_t k;
     void *p;
     memset(s, 0, sizeof *s);
     if (r->n > 0x7fffffff)
         return sfb__error(ctx, SFB_LIMIT_EXCEEDED, SFB_ELEMENT_NONE, -1, "stencil table of %zu entries is over the limit", r->n);
     if (!r->idx || !r->w) return sfb__rows_to_stencils(ctx, r, sources, s);
-    s->sizes = (int *)sfb__alloc(ctx, ((size_t)r->rows + 1) * sizeof(int));
-    s->offsets = (int *)sfb__alloc(ctx, ((size_t)r->rows + 1) * sizeof(int));
-    if (!s->sizes || !s->offsets) {
-        sfb__stencils_free(ctx, s);
-        return SFB_OUT_OF_MEMORY;
-    }
-    s->rows = r->rows;
-    s->sources = sources;
-    s->entries = r->n;
-    for (i = 0; i < r->rows; ++i) {
-        s->offsets[i] = (int)r->off[i];
-        s->sizes[i] = (int)(r->off[i + 1] - r->off[i]);
-    }
-    s->offsets[r->rows] = (int)r->n; /* end marker: offsets[rows] == entries */
-    s->sizes[r->rows] = 0;
+    if (!sfb__stencils_index(ctx, r, sources, s)) return SFB_OUT_OF_MEMORY;
     for (k = 0; k < r->n; ++k) {
         double d;
         float f;
@@ -176,28 +183,17 @@ sfb_result sfb__rows_move_to_stencils(sfb_context *ctx, sfb__rows *r, int source
 }
 
 sfb_result sfb__rows_to_stencils(sfb_context *ctx, const sfb__rows *r, int sources, sfb__stencils *s) {
-    int i;
     size_t k;
     memset(s, 0, sizeof *s);
     if (r->n > 0x7fffffff)
         return sfb__error(ctx, SFB_LIMIT_EXCEEDED, SFB_ELEMENT_NONE, -1, "stencil table of %zu entries is over the limit", r->n);
-    s->rows = r->rows;
-    s->sources = sources;
-    s->entries = r->n;
-    s->sizes = (int *)sfb__alloc(ctx, ((size_t)r->rows + 1) * sizeof(int));
-    s->offsets = (int *)sfb__alloc(ctx, ((size_t)r->rows + 1) * sizeof(int));
+    if (!sfb__stencils_index(ctx, r, sources, s)) return SFB_OUT_OF_MEMORY;
     s->indices = (int *)sfb__alloc(ctx, (r->n + 1) * sizeof(int));
     s->weights = (float *)sfb__alloc(ctx, (r->n + 1) * sizeof(float));
-    if (!s->sizes || !s->offsets || !s->indices || !s->weights) {
+    if (!s->indices || !s->weights) {
         sfb__stencils_free(ctx, s);
         return SFB_OUT_OF_MEMORY;
     }
-    for (i = 0; i < r->rows; ++i) {
-        s->offsets[i] = (int)r->off[i];
-        s->sizes[i] = (int)(r->off[i + 1] - r->off[i]);
-    }
-    s->offsets[r->rows] = (int)r->n; /* end marker: offsets[rows] == entries */
-    s->sizes[r->rows] = 0;
     if (r->n) memcpy(s->indices, r->idx, r->n * sizeof(int));
     for (k = 0; k < r->n; ++k) s->weights[k] = (float)r->w[k];
     return SFB_SUCCESS;

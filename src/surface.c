@@ -102,23 +102,20 @@ static sfb_result sfb__surface_build_vertex(sfb_surface *s, const sfb_mesh *mesh
     opt.crease_method = mesh->crease_method;
     opt.triangle_rule = mesh->triangle_rule;
     opt.want_limit = (cfg->flags & SFB_REFINE_LIMIT) != 0;
-    if ((cfg->flags & SFB_REFINE_SHADING) && cfg->refine_level > 0) {
+    {
         /* the shading tables need every level and each step's own table: the vertex refinement
          * hands its over instead of the shading build refining a second time */
+        const int shading = (cfg->flags & SFB_REFINE_SHADING) != 0, keep = shading && cfg->refine_level > 0;
         sfb__refine_kept kept;
-        kept.lev = (sfb__level *)sfb__calloc(ctx, (size_t)cfg->refine_level, sizeof *kept.lev);
-        kept.T = (sfb__stencils *)sfb__calloc(ctx, (size_t)cfg->refine_level, sizeof *kept.T);
-        if (!kept.lev || !kept.T) r = sfb__oom(ctx, "refinement");
+        kept.lev = keep ? (sfb__level *)sfb__calloc(ctx, (size_t)cfg->refine_level, sizeof *kept.lev) : NULL;
+        kept.T = keep ? (sfb__stencils *)sfb__calloc(ctx, (size_t)cfg->refine_level, sizeof *kept.T) : NULL;
+        if (keep && (!kept.lev || !kept.T)) r = sfb__oom(ctx, "refinement");
         else r = sfb__refine_keep_levels(ctx, &prep, &opt, cfg->refine_level, &s->top, &s->tables[SFB_TABLE_VERTEX],
-                                         opt.want_limit ? &s->tables[SFB_TABLE_LIMIT] : NULL, &kept, 0.0f, 0.8f);
-        if (r == SFB_SUCCESS) r = sfb__shading_build(ctx, &prep, &opt, cfg->refine_level, &cfg->shading, &kept, &s->top, &s->shading);
+                                         opt.want_limit ? &s->tables[SFB_TABLE_LIMIT] : NULL, keep ? &kept : NULL, 0.0f, 0.8f);
+        if (r == SFB_SUCCESS && shading)
+            r = sfb__shading_build(ctx, &prep, &opt, cfg->refine_level, &cfg->shading, keep ? &kept : NULL, &s->top, &s->shading);
         sfb__free(ctx, kept.lev);
         sfb__free(ctx, kept.T);
-    } else {
-        r = sfb__refine(ctx, &prep, &opt, cfg->refine_level, &s->top, &s->tables[SFB_TABLE_VERTEX],
-                        opt.want_limit ? &s->tables[SFB_TABLE_LIMIT] : NULL, 0.0f, 0.8f);
-        if (r == SFB_SUCCESS && (cfg->flags & SFB_REFINE_SHADING))
-            r = sfb__shading_build(ctx, &prep, &opt, cfg->refine_level, &cfg->shading, NULL, NULL, &s->shading);
     }
     if (r == SFB_SUCCESS && (cfg->flags & SFB_REFINE_PATCHES)) {
         r = si->build_patches(ctx, &prep, &opt, cfg, s->base_positions, &s->patches);

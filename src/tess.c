@@ -1260,29 +1260,26 @@ static sfb_result sfb__tess_eval_uvs(const sfb_surface *s, sfb_tess_data *out, f
     tmp = (float *)sfb__tess_array(ctx, SFB__TESS_EVAL_CHUNK, 3 * sizeof(float));
     if (!tmp) return sfb__oom(ctx, "tessellated UVs");
     {
-        /* a layout the scheme's builder is known to refuse (tribezier: not a manifold, as
-         * placeholder UVs are) is not offered to it, so that no error is logged for it */
+        /* UVS_OR_LINEAR: linear UVs where the scheme's builder cannot take the layout -- one
+         * that is not a manifold (placeholder UVs) is not offered to it, so that no error is
+         * logged for it; other refusals (a flat UV triangle) come back from the builder */
         const sfb__scheme_info *si = sfb__scheme_info_of(s->config.scheme);
-        int i, refused = 0;
-        if (si && (si->caps & SFB__SCHEME_UVS_OR_LINEAR))
-            for (i = 0; i < s->uv_base.nv && !refused; ++i) refused = (s->uv_base.vtag[i] & SFB__TAG_NONMANIFOLD) != 0;
-        if (refused) {
+        const int fallback = si && (si->caps & SFB__SCHEME_UVS_OR_LINEAR);
+        int i, linear = 0;
+        for (i = 0; fallback && i < s->uv_base.nv && !linear; ++i) linear = (s->uv_base.vtag[i] & SFB__TAG_NONMANIFOLD) != 0;
+        if (linear) {
             sfb__log(ctx, SFB_LOG_INFO, "tessellated UVs: the UV layout is not a manifold: linear per face (%s)", si->name);
+        } else if ((r = sfb__surface_uv_patches(s, &upt)) != SFB_SUCCESS) {
+            if (r == SFB_OUT_OF_MEMORY || r == SFB_CANCELLED || !fallback) goto done;
+            sfb__log(ctx, SFB_LOG_INFO, "tessellated UVs: the %s surface of the UV layout cannot be built (%s): linear per face",
+                     si->name, sfb_last_error(ctx));
+            linear = 1;
+        }
+        if (linear) {
             for (v = 0; v < nv; ++v) sfb__tess_uv_linear(s, &out->locations[v], out->uvs + 2 * v);
             r = sfb__progress(ctx, 1.0f, "tessellate");
             goto done;
         }
-    }
-    if ((r = sfb__surface_uv_patches(s, &upt)) != SFB_SUCCESS) {
-        const sfb__scheme_info *si = sfb__scheme_info_of(s->config.scheme);
-        if (r == SFB_OUT_OF_MEMORY || r == SFB_CANCELLED || !si || !(si->caps & SFB__SCHEME_UVS_OR_LINEAR)) goto done;
-        /* the scheme's builder refused the layout (tribezier: a flat UV triangle, a UV value
-         * shared by faces that are no fan): linear UVs, said at info level */
-        sfb__log(ctx, SFB_LOG_INFO, "tessellated UVs: the %s surface of the UV layout cannot be built (%s): linear per face",
-                 si->name, sfb_last_error(ctx));
-        for (v = 0; v < nv; ++v) sfb__tess_uv_linear(s, &out->locations[v], out->uvs + 2 * v);
-        r = sfb__progress(ctx, 1.0f, "tessellate");
-        goto done;
     }
     /* on the context's backend, like the positions (ref when it has no patch kernels) */
     if (be && be->upload_patches && be->eval_patches) {

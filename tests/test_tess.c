@@ -1588,12 +1588,29 @@ Test(tess_uv, limit_uvs_are_the_layout_map_of_the_limit_positions)
     }
 }
 
+/* The UVs of a tribezier tessellation (rate 4, SFB_TESS_UVS) of obj, copied out (count pairs). */
+static float *tribezier_tess_uvs(const char *obj, int *count)
+{
+    sfb_context *ctx = tx_ctx();
+    sfb_mesh *m = tx_mesh(ctx, obj);
+    sfb_surface *s = uv_surface(ctx, m, SFB_SCHEME_TRIBEZIER);
+    sfb_tess_data t = tess_ok(s, ctx, 4, 0.0f, SFB_TESS_UVS);
+    cr_assert_not_null(t.uvs);
+    float *uv = malloc(2 * sizeof(float) * (size_t)t.vertex_count);
+    memcpy(uv, t.uvs, 2 * sizeof(float) * (size_t)t.vertex_count);
+    *count = t.vertex_count;
+    sfb_tess_data_free(&t);
+    sfb_surface_destroy(s);
+    sfb_mesh_destroy(m);
+    sfb_context_destroy(ctx);
+    return uv;
+}
+
 /* A UV layout tribezier's builder refuses (every corner given the one UV (0.3, 0.6): one UV
  * value shared by every face, no fan): the tessellation still succeeds, with the linear UVs
  * (here that value everywhere), instead of failing. */
 Test(tess_uv, tribezier_falls_back_to_linear_uvs)
 {
-    sfb_context *ctx = tx_ctx();
     char *obj = flat_uv_disk(1);
     /* every vt line becomes the same value */
     size_t n = strlen(obj), at = 0;
@@ -1607,17 +1624,12 @@ Test(tess_uv, tribezier_falls_back_to_linear_uvs)
         p += len;
     }
     out[at] = 0;
-    sfb_mesh *m = tx_mesh(ctx, out);
-    sfb_surface *s = uv_surface(ctx, m, SFB_SCHEME_TRIBEZIER);
-    sfb_tess_data t = tess_ok(s, ctx, 4, 0.0f, SFB_TESS_UVS);
-    cr_assert_not_null(t.uvs);
+    int count = 0;
+    float *uv = tribezier_tess_uvs(out, &count);
     double worst = 0.0;
-    for (int v = 0; v < t.vertex_count; ++v) worst = fmax(worst, fmax(fabs(t.uvs[2 * v] - 0.3), fabs(t.uvs[2 * v + 1] - 0.6)));
+    for (int v = 0; v < count; ++v) worst = fmax(worst, fmax(fabs(uv[2 * v] - 0.3), fabs(uv[2 * v + 1] - 0.6)));
     cr_expect_lt(worst, 1e-6, "linear UVs of one value: %g off", worst);
-    sfb_tess_data_free(&t);
-    sfb_surface_destroy(s);
-    sfb_mesh_destroy(m);
-    sfb_context_destroy(ctx);
+    free(uv);
     free(out);
     free(obj);
 }
@@ -1626,7 +1638,6 @@ Test(tess_uv, tribezier_falls_back_to_linear_uvs)
  * vertex given the centre's UV): linear UVs again, the tessellation does not fail. */
 Test(tess_uv, tribezier_flat_uv_triangle_falls_back_to_linear_uvs)
 {
-    sfb_context *ctx = tx_ctx();
     char *obj = flat_uv_disk(1);
     char *second = strstr(obj, "vt ");
     cr_assert_not_null(second);
@@ -1637,18 +1648,12 @@ Test(tess_uv, tribezier_flat_uv_triangle_falls_back_to_linear_uvs)
     char *out = malloc(strlen(obj) + 64);
     memcpy(out, obj, head);
     sprintf(out + head, "vt 0.5 0.5%s", end);
-    sfb_mesh *m = tx_mesh(ctx, out);
-    sfb_surface *s = uv_surface(ctx, m, SFB_SCHEME_TRIBEZIER);
-    sfb_tess_data t = tess_ok(s, ctx, 4, 0.0f, SFB_TESS_UVS);
-    cr_assert_not_null(t.uvs);
-    int outside = 0;
-    for (int v = 0; v < t.vertex_count; ++v)
-        for (int c = 0; c < 2; ++c) outside += !(t.uvs[2 * v + c] >= 0.0f && t.uvs[2 * v + c] <= 1.0f);
+    int count = 0, outside = 0;
+    float *uv = tribezier_tess_uvs(out, &count);
+    for (int v = 0; v < count; ++v)
+        for (int c = 0; c < 2; ++c) outside += !(uv[2 * v + c] >= 0.0f && uv[2 * v + c] <= 1.0f);
     cr_expect_eq(outside, 0, "%d UV coordinates outside the layout's [0, 1]", outside);
-    sfb_tess_data_free(&t);
-    sfb_surface_destroy(s);
-    sfb_mesh_destroy(m);
-    sfb_context_destroy(ctx);
+    free(uv);
     free(out);
     free(obj);
 }
