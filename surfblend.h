@@ -485,7 +485,9 @@ typedef struct sfb_location { int face; float u, v; } sfb_location;
 /* Output arrays, xyz per location; NULL members are not computed. du/dv are derivatives in
  * the parametric face's (u,v); normal is unit length (du x dv normalised, and at an
  * extraordinary vertex itself the limit normal, where du and dv are the limit tangent
- * directions since the parametric derivatives vanish or diverge there). */
+ * directions since the parametric derivatives vanish or diverge there; SFB_SCHEME_PN: the
+ * method's quadratic normal field normalised, which equals the vertex normals at the corners
+ * but is not du x dv inside). */
 typedef struct sfb_eval_output { float *position, *du, *dv, *normal, *duu, *duv, *dvv; } sfb_eval_output;
 
 SFB_API int sfb_surface_param_face_count(const sfb_surface *surface);
@@ -887,6 +889,7 @@ typedef struct sfb__stencils {
  * (with a log line). Every slot but name/kind/init/shutdown may be NULL. A context keeps its
  * own copy of the bound table (no global state). */
 struct sfb__shade_job;
+struct sfb__raster_job;
 typedef struct sfb__backend_vtable {
     const char *name;
     sfb_backend_kind kind;
@@ -927,6 +930,9 @@ typedef struct sfb__backend_vtable {
     /* Seed 003's per-pixel analysis (analyze.c): items [first,last) of `job` (exact limit
      * position, derivatives and normal per pixel) -> the mode's values (sfb__shade_job). */
     sfb_result (*shade)(void *state, const struct sfb__shade_job *job, int first, int last);
+    /* Seed 003's proxy raster (analyze.c): every triangle of `job` into its per-pixel buffers,
+     * the nearest one kept (sfb__raster_job). */
+    sfb_result (*raster)(void *state, const struct sfb__raster_job *job);
 } sfb__backend_vtable;
 
 /* One analysis's shading (the `shade` slot). Per item i: P = position[3i..], N = normal (unit),
@@ -950,6 +956,39 @@ typedef struct sfb__shade_job {
     float *value, *value2;
 } sfb__shade_job;
 SFB__IF sfb_result sfb__ref_shade(void *state, const sfb__shade_job *job, int first, int last);
+
+/* One analysis's proxy raster (the `raster` slot). Vertices are in the picture: x, y in pixels
+ * (y down, pixel (i, j)'s centre at (i + 0.5, j + 0.5)), z the view depth (> 0), q = 1 / z
+ * (perspective) or 1 (orthographic), (u, v) in the face's frame. A triangle (three vertices
+ * and its parametric face, in order) covers the pixel centres inside it or on its edges; its
+ * attributes there are the vertices' weighted by b_k q_k / sum(b_j q_j) (b the barycentric
+ * coordinates in the picture: perspective-correct), its depth the interpolated z (that is
+ * 1 / sum(b_j q_j) in perspective). A pixel keeps the triangle of the smallest depth below
+ * what it holds (the first of equal ones, in order): depth[pix], face[pix], uv[2 pix..] (clamped
+ * to [0, 1]) and, with apos and anrm (3 per vertex each), pos[3 pix..] and nrm[3 pix..].
+ * The caller fills depth with +inf and face with -1. Triangles whose screen area is below
+ * 1e-12 square pixels cover nothing; kernels may differ from ref on pixels whose centre lies on
+ * an edge (GL's tie rule) and by float rounding of the interpolation. */
+typedef struct sfb__raster_vertex { double x, y, z, q, u, v; } sfb__raster_vertex;
+typedef struct sfb__raster_job {
+    int w, h, ortho;
+    int ntri;
+    const sfb__raster_vertex *vert;
+    const float *apos, *anrm; /* NULL, or the vertices' positions and normals to interpolate */
+    const int *tri;          /* 4 per triangle: three vertices, the parametric face */
+    float *depth;
+    int *face;
+    float *uv, *pos, *nrm;
+} sfb__raster_job;
+/* A triangle's set-up in the picture: its signed doubled area, edge lengths (edge k opposite
+ * corner k), barycentric planes (b_k = ea[k] x + eb[k] y + ec[k]) and the pixel box of the
+ * centres within `grow` pixels of it (x0 > x1 or y0 > y1: none); 0 when it is degenerate. */
+typedef struct sfb__raster_edges {
+    double area, elen[3], ea[3], eb[3], ec[3];
+    int x0, x1, y0, y1;
+} sfb__raster_edges;
+SFB__IF int sfb__raster_setup(const sfb__raster_vertex *const S[3], int w, int h, double grow, sfb__raster_edges *t);
+SFB__IF sfb_result sfb__ref_raster(void *state, const sfb__raster_job *job);
 
 /* Optional backends (backends/sfb_*.h), compiled in by SURFBLEND_SIMD / _GL / _OSMESA or
  * SURFBLEND_ALL_BACKENDS; the headers are included at the end of the implementation. */
@@ -1067,6 +1106,10 @@ typedef struct sfb__patch_table {
     float *point_data;     /* xyz per patch point, for the surface's base positions */
     const sfb__eigen_cc *eig[SFB__STAM_MAX_VALENCE + 1]; /* valences used (the context's cache) */
     const sfb__eigen_loop *eigl[SFB__STAM_MAX_VALENCE + 1]; /* Loop: the same */
+    /* NULL, or a table of the same parametric faces whose evaluated position, normalised, is
+     * the surface's normal in place of du x dv (PN triangles' quadratic normal field); its own
+     * normal_field is NULL. Owned: sfb__patch_table_free frees it. */
+    struct sfb__patch_table *normal_field;
 } sfb__patch_table;
 
 /* ---- context ---- */
@@ -1260,6 +1303,7 @@ struct sfb_surface {
     sfb__level pbase;            /* the prepared base level the patches were built from (tessellation
                                     shares vertices along its edges) */
     void *backend_patches;       /* the backend's uploaded copy */
+    void *backend_normal_field;  /* ... and of patches.normal_field, when there is one */
     sfb__shading *shading;       /* SFB_REFINE_SHADING */
 };
 
@@ -2175,6 +2219,75 @@ sfb_result sfb__ref_shade(void *state, const sfb__shade_job *j, int first, int l
     return SFB_SUCCESS;
 }
 
+/* ---- seed 003's proxy raster (the contract is sfb__raster_job's comment) ---- */
+int sfb__raster_setup(const sfb__raster_vertex *const S[3], int w, int h, double grow, sfb__raster_edges *t) {
+    double minx, maxx, miny, maxy, inv;
+    int k;
+    t->area = (S[1]->x - S[0]->x) * (S[2]->y - S[0]->y) - (S[2]->x - S[0]->x) * (S[1]->y - S[0]->y);
+    if (!(fabs(t->area) > 1e-12) || !isfinite(t->area)) return 0;
+    minx = maxx = S[0]->x;
+    miny = maxy = S[0]->y;
+    for (k = 1; k < 3; ++k) {
+        if (S[k]->x < minx) minx = S[k]->x;
+        if (S[k]->x > maxx) maxx = S[k]->x;
+        if (S[k]->y < miny) miny = S[k]->y;
+        if (S[k]->y > maxy) maxy = S[k]->y;
+    }
+    t->x0 = (int)sfb__rclamp(ceil(minx - 0.5 - grow), 0.0, (double)w);
+    t->x1 = (int)sfb__rclamp(floor(maxx - 0.5 + grow), -1.0, (double)w - 1.0);
+    t->y0 = (int)sfb__rclamp(ceil(miny - 0.5 - grow), 0.0, (double)h);
+    t->y1 = (int)sfb__rclamp(floor(maxy - 0.5 + grow), -1.0, (double)h - 1.0);
+    inv = 1.0 / t->area;
+    for (k = 0; k < 3; ++k) {
+        const sfb__raster_vertex *p0 = S[(k + 1) % 3], *p1 = S[(k + 2) % 3];
+        t->elen[k] = sqrt((p1->x - p0->x) * (p1->x - p0->x) + (p1->y - p0->y) * (p1->y - p0->y));
+        t->ea[k] = -(p1->y - p0->y) * inv;
+        t->eb[k] = (p1->x - p0->x) * inv;
+        t->ec[k] = ((p1->y - p0->y) * p0->x - (p1->x - p0->x) * p0->y) * inv;
+    }
+    return 1;
+}
+
+sfb_result sfb__ref_raster(void *state, const sfb__raster_job *j) {
+    int i;
+    (void)state;
+    for (i = 0; i < j->ntri; ++i) {
+        const int *tv = j->tri + 4 * (size_t)i;
+        const sfb__raster_vertex *S[3];
+        sfb__raster_edges t;
+        int k, x, y;
+        for (k = 0; k < 3; ++k) S[k] = &j->vert[tv[k]];
+        if (!sfb__raster_setup(S, j->w, j->h, 0.0, &t)) continue;
+        for (y = t.y0; y <= t.y1; ++y)
+            for (x = t.x0; x <= t.x1; ++x) {
+                const double px = x + 0.5, py = y + 0.5;
+                const size_t pix = (size_t)y * (size_t)j->w + (size_t)x;
+                double b[3], den, z;
+                for (k = 0; k < 3; ++k) b[k] = t.ea[k] * px + t.eb[k] * py + t.ec[k];
+                if (b[0] < 0.0 || b[1] < 0.0 || b[2] < 0.0) continue;
+                den = b[0] * S[0]->q + b[1] * S[1]->q + b[2] * S[2]->q;
+                if (!(den > 0.0)) continue;
+                z = j->ortho ? b[0] * S[0]->z + b[1] * S[1]->z + b[2] * S[2]->z : 1.0 / den;
+                if (!(z < (double)j->depth[pix])) continue;
+                for (k = 0; k < 3; ++k) b[k] *= S[k]->q / den;
+                j->depth[pix] = (float)z;
+                j->face[pix] = tv[3];
+                j->uv[2 * pix] = (float)sfb__rclamp(b[0] * S[0]->u + b[1] * S[1]->u + b[2] * S[2]->u, 0.0, 1.0);
+                j->uv[2 * pix + 1] = (float)sfb__rclamp(b[0] * S[0]->v + b[1] * S[1]->v + b[2] * S[2]->v, 0.0, 1.0);
+                if (j->apos) {
+                    int c;
+                    for (c = 0; c < 3; ++c) {
+                        j->pos[3 * pix + c] = (float)(b[0] * j->apos[3 * (size_t)tv[0] + c] + b[1] * j->apos[3 * (size_t)tv[1] + c] +
+                                                      b[2] * j->apos[3 * (size_t)tv[2] + c]);
+                        j->nrm[3 * pix + c] = (float)(b[0] * j->anrm[3 * (size_t)tv[0] + c] + b[1] * j->anrm[3 * (size_t)tv[1] + c] +
+                                                      b[2] * j->anrm[3 * (size_t)tv[2] + c]);
+                    }
+                }
+            }
+    }
+    return SFB_SUCCESS;
+}
+
 /* Every kernel (sfb__ref_eval_patches is in patches.c). */
 void sfb__ref_bind(sfb__backend_vtable *vt) {
     vt->name = "ref";
@@ -2185,6 +2298,7 @@ void sfb__ref_bind(sfb__backend_vtable *vt) {
     vt->eval_patches = sfb__ref_eval_patches;
     vt->finish_normals = sfb__ref_finish_normals;
     vt->shade = sfb__ref_shade;
+    vt->raster = sfb__ref_raster;
 }
 #line 1 "src/topology.c"
 /* Topology of one level: adjacency, counter-clockwise ordering around manifold vertices,
@@ -4045,6 +4159,10 @@ void sfb__patch_table_free(sfb_context *ctx, sfb__patch_table *pt) {
     sfb__free(ctx, pt->ptype); sfb__free(ctx, pt->pfirst); sfb__free(ctx, pt->pparam); sfb__free(ctx, pt->pvalence);
     sfb__free(ctx, pt->cv); sfb__free(ctx, pt->ptex_face); sfb__free(ctx, pt->ptex_corner); sfb__free(ctx, pt->face_ptex);
     sfb__free(ctx, pt->ptex_root); sfb__free(ctx, pt->nodes); sfb__free(ctx, pt->point_data); sfb__free(ctx, pt->pcorner);
+    if (pt->normal_field) {
+        sfb__patch_table_free(ctx, pt->normal_field);
+        sfb__free(ctx, pt->normal_field);
+    }
     memset(pt, 0, sizeof *pt);
 }
 
@@ -6159,10 +6277,16 @@ done:
  *     when the surface is built; a mean that cancels (opposite triangles) falls back to the
  *     first incident triangle's normal. PN triangles know no creases: sharpness tags are
  *     ignored, every vertex has one normal.
- *   - the patch's own normals (du x dv) are the surface's normals; at a corner they equal the
- *     vertex normal, since both edge points next to a corner lie in the plane through it normal
- *     to that vertex normal. The quadratic normal field of the method (for shading) is not
- *     evaluated.
+ *   - normals: the method's quadratic normal field (for shading), not du x dv: the patch table
+ *     carries it as its normal_field, a second table of BEZIER_TRI15 patches (the quadratic
+ *     field degree-raised twice) evaluated on the backend like the positions and normalised
+ *     (sfb__surface_eval_unchecked). So tessellation, rendering, the analysis and the glTF export
+ *     shade with what engines shade with. Corners get the vertex normals exactly (so do the
+ *     geometric normals: both edge points next to a corner lie in the plane through it normal to
+ *     that vertex normal); along an edge the field depends on that edge's two vertices only, so
+ *     it is continuous across edges. An edge's middle coefficient normalize(N_i + N_j -
+ *     v_ij (P_j - P_i)) that cancels (normals mirrored into opposite directions) is the
+ *     triangle's unit normal instead. du, dv and the second derivatives stay the cubic geometry's.
  *   - refused: faces that are not triangles, non-manifold edges (more than two triangles),
  *     degenerate triangles (an area below 1e-12 of the squared bounding-box diagonal, or
  *     non-finite positions), since their normals, and so the patch, are undefined.
@@ -6170,7 +6294,7 @@ done:
 
 /* Cubic point (a = exponent of s, b = exponent of t) of triangle (P[0], P[1], P[2]) with
  * vertex normals N: corners P0 (0,0), P1 (3,0), P2 (0,3). */
-static void sfb__pn_cubic(double P[3][3], double N[3][3], double C[4][4][3]) {
+static void sfb__pn_cubic(double P[3][3], double N[3][3], double C[5][5][3]) {
     /* the corner of each (a, b) on the boundary and the corner it points to */
     static const int edge[6][4] = {{1, 0, 0, 1}, {2, 0, 1, 0}, {0, 1, 0, 2}, {0, 2, 2, 0}, {2, 1, 1, 2}, {1, 2, 2, 1}};
     double E[3] = {0, 0, 0}, V[3];
@@ -6193,21 +6317,62 @@ static void sfb__pn_cubic(double P[3][3], double N[3][3], double C[4][4][3]) {
     for (c = 0; c < 3; ++c) C[1][1][c] = E[c] + 0.5 * (E[c] - V[c]);
 }
 
-/* Degree raising to our quartic order (row by row in t, s rising in a row):
- * q(i,j,k) = (i c(i-1,j) + j c(i,j-1) + k c(i,j)) / 4 with k = 4 - i - j the exponent of w. */
-static void sfb__pn_raise(double C[4][4][3], double *out) {
-    int i, j, c, q = 0;
-    for (j = 0; j <= 4; ++j)
-        for (i = 0; i + j <= 4; ++i, ++q) {
-            const int k = 4 - i - j;
+/* Degree raising from degree d to d + 1 (the Bezier triangle's points by exponents (a, b) of s
+ * and t, a + b <= d): r(i,j) = (i c(i-1,j) + j c(i,j-1) + k c(i,j)) / (d + 1), with
+ * k = d + 1 - i - j the exponent of w. */
+static void sfb__pn_raise_degree(int d, double C[5][5][3], double R[5][5][3]) {
+    int i, j, c;
+    for (j = 0; j <= d + 1; ++j)
+        for (i = 0; i + j <= d + 1; ++i) {
+            const int k = d + 1 - i - j;
             for (c = 0; c < 3; ++c) {
                 double v = 0.0;
                 if (i > 0) v += i * C[i - 1][j][c];
                 if (j > 0) v += j * C[i][j - 1][c];
                 if (k > 0) v += k * C[i][j][c];
-                out[3 * q + c] = v / 4.0;
+                R[i][j][c] = v / (d + 1);
             }
         }
+}
+
+/* A cubic raised to our quartic order (row by row in t, s rising in a row), 45 doubles. */
+static void sfb__pn_raise(double C[5][5][3], double *out) {
+    double R[5][5][3];
+    int i, j, c, q = 0;
+    sfb__pn_raise_degree(3, C, R);
+    for (j = 0; j <= 4; ++j)
+        for (i = 0; i + j <= 4; ++i, ++q)
+            for (c = 0; c < 3; ++c) out[3 * q + c] = R[i][j][c];
+}
+
+/* The quadratic normal field of the triangle (its unit normal `fn`), raised to a cubic C for
+ * sfb__pn_raise: Q(a, b) with a + b <= 2, corners N0 (0,0), N1 (2,0), N2 (0,2), the edges'
+ * middles at (1,0) P0P1, (0,1) P0P2, (1,1) P1P2. */
+static void sfb__pn_quadratic_normals(double P[3][3], double N[3][3], const double fn[3], double C[5][5][3]) {
+    static const int mid[3][4] = {{1, 0, 0, 1}, {0, 1, 0, 2}, {1, 1, 1, 2}};
+    double Q[5][5][3];
+    int k, c;
+    for (c = 0; c < 3; ++c) {
+        Q[0][0][c] = N[0][c];
+        Q[2][0][c] = N[1][c];
+        Q[0][2][c] = N[2][c];
+    }
+    for (k = 0; k < 3; ++k) {
+        const int a = mid[k][0], b = mid[k][1], p = mid[k][2], q = mid[k][3];
+        double d[3], h[3], dd = 0.0, dn = 0.0, len = 0.0;
+        for (c = 0; c < 3; ++c) {
+            d[c] = P[q][c] - P[p][c];
+            dd += d[c] * d[c];
+            dn += d[c] * (N[p][c] + N[q][c]);
+        }
+        for (c = 0; c < 3; ++c) {
+            h[c] = N[p][c] + N[q][c] - 2.0 * dn / dd * d[c]; /* dd > 0: degenerate triangles are refused */
+            len += h[c] * h[c];
+        }
+        len = sqrt(len);
+        for (c = 0; c < 3; ++c) Q[a][b][c] = len > 1e-9 ? h[c] / len : fn[c];
+    }
+    sfb__pn_raise_degree(2, Q, C);
 }
 
 static void sfb__pn_face_normal(const float *a, const float *b, const float *c, double n[3]) {
@@ -6256,12 +6421,13 @@ sfb_result sfb__pn_build(sfb_context *ctx, const sfb__level *l, const float *pos
         if (len > 0.0)
             for (c = 0; c < 3; ++c) n[c] /= len;
     }
-    /* the table: one param face and one BEZIER_TRI15 patch (15 points of its own) per triangle */
-    net = (double *)sfb__alloc(ctx, 45 * (size_t)l->nf * sizeof(double) + 1);
+    /* the tables: one param face and one BEZIER_TRI15 patch (15 points of its own) per
+     * triangle, for the geometry and for the normal field */
+    net = (double *)sfb__alloc(ctx, 2 * 45 * (size_t)l->nf * sizeof(double) + 1);
     if (!net) { r = sfb__oom(ctx, "PN triangles"); goto done; }
     for (f = 0; f < l->nf; ++f) {
         const int *fv = l->fv + l->fv_off[f];
-        double P[3][3], N[3][3], C[4][4][3];
+        double P[3][3], N[3][3], C[5][5][3], fn[3], len;
         for (k = 0; k < 3; ++k)
             for (c = 0; c < 3; ++c) {
                 P[k][c] = positions[3 * (size_t)fv[k] + c];
@@ -6269,8 +6435,16 @@ sfb_result sfb__pn_build(sfb_context *ctx, const sfb__level *l, const float *pos
             }
         sfb__pn_cubic(P, N, C);
         sfb__pn_raise(C, net + 45 * (size_t)f);
+        sfb__pn_face_normal(positions + 3 * (size_t)fv[0], positions + 3 * (size_t)fv[1], positions + 3 * (size_t)fv[2], fn);
+        len = sqrt(fn[0] * fn[0] + fn[1] * fn[1] + fn[2] * fn[2]);
+        for (c = 0; c < 3; ++c) fn[c] /= len;
+        sfb__pn_quadratic_normals(P, N, fn, C);
+        sfb__pn_raise(C, net + 45 * ((size_t)l->nf + f));
     }
-    r = sfb__patch_table_beztri_own(ctx, l, net, pt);
+    if ((r = sfb__patch_table_beztri_own(ctx, l, net, pt)) != SFB_SUCCESS) goto done;
+    pt->normal_field = (sfb__patch_table *)sfb__calloc(ctx, 1, sizeof *pt->normal_field);
+    if (!pt->normal_field) { r = sfb__oom(ctx, "PN triangles' normals"); goto done; }
+    r = sfb__patch_table_beztri_own(ctx, l, net + 45 * (size_t)l->nf, pt->normal_field);
 done:
     sfb__free(ctx, vn);
     sfb__free(ctx, net);
@@ -10116,6 +10290,8 @@ SFB_API void sfb_surface_destroy(sfb_surface *s) {
     }
     if (s->backend_patches && s->uploaded_by && s->uploaded_by->release_patches)
         s->uploaded_by->release_patches(ctx->backend_state, s->backend_patches);
+    if (s->backend_normal_field && s->uploaded_by && s->uploaded_by->release_patches)
+        s->uploaded_by->release_patches(ctx->backend_state, s->backend_normal_field);
     sfb__patch_table_free(ctx, &s->patches);
     if (s->shading) {
         int h;
@@ -10344,6 +10520,8 @@ static sfb_result sfb__surface_upload(sfb_surface *s) {
     if (s->has_patches && ctx->backend && ctx->backend->upload_patches) {
         s->uploaded_by = ctx->backend;
         r = ctx->backend->upload_patches(ctx->backend_state, &s->patches, &s->backend_patches);
+        if (r == SFB_SUCCESS && s->patches.normal_field)
+            r = ctx->backend->upload_patches(ctx->backend_state, s->patches.normal_field, &s->backend_normal_field);
         if (r != SFB_SUCCESS) return r;
     }
     return SFB_SUCCESS;
@@ -10408,6 +10586,13 @@ SFB_API sfb_result sfb_surface_param_face_base(const sfb_surface *s, int pf, int
     return SFB_SUCCESS;
 }
 
+/* The memory of a patch table and its points, its normal field's included. */
+static size_t sfb__patch_table_bytes(const sfb__patch_table *pt) {
+    return (size_t)pt->npatch * (4 * sizeof(int)) + (size_t)pt->ncv * sizeof(int) + (size_t)pt->nptex * 3 * sizeof(int) +
+           (size_t)pt->nnodes * 4 * sizeof(int) + (size_t)pt->npoints * 3 * sizeof(float) +
+           (pt->pcorner ? (size_t)pt->npatch * 4 * sizeof(unsigned) : 0) + (pt->normal_field ? sfb__patch_table_bytes(pt->normal_field) : 0);
+}
+
 SFB_API sfb_result sfb_surface_patch_info(const sfb_surface *s, sfb_patch_info *o) {
     const sfb__patch_table *pt;
     if (!s || !o) return SFB_INVALID_ARGS;
@@ -10424,8 +10609,7 @@ SFB_API sfb_result sfb_surface_patch_info(const sfb_surface *s, sfb_patch_info *
     o->max_depth = pt->max_depth;
     o->points = pt->npoints;
     o->domain_sides = pt->domain == SFB__DOMAIN_TRI ? 3 : 4;
-    o->bytes = (size_t)pt->npatch * (4 * sizeof(int)) + (size_t)pt->ncv * sizeof(int) + (size_t)pt->nptex * 3 * sizeof(int) +
-               (size_t)pt->nnodes * 4 * sizeof(int) + (size_t)pt->npoints * 3 * sizeof(float) + (pt->pcorner ? (size_t)pt->npatch * 4 * sizeof(unsigned) : 0);
+    o->bytes = sfb__patch_table_bytes(pt);
     return SFB_SUCCESS;
 }
 
@@ -10455,16 +10639,42 @@ SFB_API sfb_result sfb_surface_eval(const sfb_surface *s, const sfb_location *lo
     return sfb__surface_eval_unchecked(s, loc, count, out);
 }
 
-sfb_result sfb__surface_eval_unchecked(const sfb_surface *s, const sfb_location *loc, int count, const sfb_eval_output *out) {
+/* One of the surface's patch tables (`handle`: its upload) on the context's backend, or on ref
+ * when the backend lacks eval_patches. */
+static sfb_result sfb__surface_eval_table(const sfb_surface *s, const sfb__patch_table *pt, void *handle, const sfb_location *loc,
+                                          int count, const sfb_eval_output *out) {
     sfb_context *ctx = s->ctx;
-    const sfb__backend_vtable *be;
-    if (count == 0) return SFB_SUCCESS;
-    be = ctx->backend;
+    const sfb__backend_vtable *be = ctx->backend;
     if (!be || !be->eval_patches) {
         sfb__log(ctx, SFB_LOG_INFO, "backend %s lacks eval_patches; using ref", be ? be->name : "none");
-        return sfb__ref_eval_patches(NULL, &s->patches, NULL, loc, 0, count, out);
+        return sfb__ref_eval_patches(NULL, pt, NULL, loc, 0, count, out);
     }
-    return be->eval_patches(ctx->backend_state, &s->patches, s->uploaded_by == be ? s->backend_patches : NULL, loc, 0, count, out);
+    return be->eval_patches(ctx->backend_state, pt, s->uploaded_by == be ? handle : NULL, loc, 0, count, out);
+}
+
+/* With a normal field (PN triangles), the normals are that field's values normalised, in
+ * double (a zero vector stays zero), and the patches give the rest. */
+sfb_result sfb__surface_eval_unchecked(const sfb_surface *s, const sfb_location *loc, int count, const sfb_eval_output *out) {
+    const sfb__patch_table *nf = s->patches.normal_field;
+    sfb_eval_output rest;
+    sfb_result r;
+    int q;
+    if (count == 0) return SFB_SUCCESS;
+    if (!nf || !out->normal) return sfb__surface_eval_table(s, &s->patches, s->backend_patches, loc, count, out);
+    memset(&rest, 0, sizeof rest);
+    rest.position = out->normal;
+    if ((r = sfb__surface_eval_table(s, nf, s->backend_normal_field, loc, count, &rest)) != SFB_SUCCESS) return r;
+    for (q = 0; q < count; ++q) {
+        float *n = out->normal + 3 * (size_t)q;
+        const double len = sqrt((double)n[0] * n[0] + (double)n[1] * n[1] + (double)n[2] * n[2]);
+        if (len > 0.0) {
+            n[0] = (float)(n[0] / len); n[1] = (float)(n[1] / len); n[2] = (float)(n[2] / len);
+        }
+    }
+    rest = *out;
+    rest.normal = NULL;
+    if (!rest.position && !rest.du && !rest.dv && !rest.duu && !rest.duv && !rest.dvv) return SFB_SUCCESS;
+    return sfb__surface_eval_table(s, &s->patches, s->backend_patches, loc, count, &rest);
 }
 
 SFB_API sfb_result sfb_surface_stencil_info(const sfb_surface *s, sfb_table t, sfb_stencil_info *out) {
@@ -12275,7 +12485,8 @@ done:
  *    segments per edge (a quad: (n+1)^2 points, a triangle: (n+1)(n+2)/2), evaluated through
  *    the backend's eval_patches; each grid triangle knows its face and its corners' (u,v) in
  *    that face, so rasterising it gives per pixel (face, u, v, depth) with perspective-correct
- *    (u,v): a pixel's (u,v) is always in its own face's frame. Thin or grazing triangles (near a
+ *    (u,v): a pixel's (u,v) is always in its own face's frame. The backend's `raster` kernel
+ *    draws it (ref's on the CPU; gl and osmesa in GL, sfb__raster_job). Thin or grazing triangles (near a
  *    silhouette) also leave a seed in the uncovered pixels within 2 pixels of them. The faces'
  *    adjacency comes from the proxy too (sides whose ends and middle coincide).
  * 2. Projection (beyond the seed, which shades the proxy's (u,v), leaves gaps and patches them
@@ -12466,6 +12677,8 @@ typedef struct sfb__an {
     double centre[3], radius;
     /* the proxy: grid points of every face (NaN for holes) */
     float *gpos, *gnrm;
+    sfb__raster_vertex *rv;      /* the grid points in the picture */
+    int *rtri, ntri;             /* the proxy's triangles (sfb__raster_job) */
     /* per pixel */
     float *depth;                /* +inf: empty */
     int *face;                   /* proxy face, -1: none */
@@ -12669,147 +12882,122 @@ static void sfb__an_camera(sfb__an *A) {
     cam->near_z = c->near_plane > 0.0f ? c->near_plane : 1e-3 * A->radius;
 }
 
-/* A proxy point in the picture: screen x, y, view depth z, the weight q (1/z or 1), its (u,v). */
-typedef struct sfb__an_sv { double x, y, z, q, u, v; int ok; } sfb__an_sv;
-
-/* Step 1b: rasterises one proxy triangle (grid points g[3] of face f, projected in V); pass 1
- * only seeds the uncovered pixels around thin or grazing ones. */
-static void sfb__an_raster_tri(sfb__an *A, int f, const int *g, const sfb__an_sv *V, int pass) {
-    const sfb__an_sv *a = &V[g[0]], *b1 = &V[g[1]], *c2 = &V[g[2]];
-    double area, inv, minx, maxx, miny, maxy, elen[3], dilate, ea[3], eb[3], ec[3];
-    int k, x, y, ix0, ix1, iy0, iy1;
+/* Step 1b, pass 2: the uncovered pixels within SFB__AN_DILATE pixels of a thin or grazing proxy
+ * triangle (near the silhouette, where the exact surface may stick out past it, or where it
+ * covers no pixel centre at all) get it as a seed: its face and the (u,v) of its nearest point
+ * (the barycentric coordinates clamped), nearest triangle first. The others' neighbours are
+ * reached by the projection's rounds. */
+static void sfb__an_seed_tri(sfb__an *A, const int *tv) {
+    const sfb__raster_vertex *S[3];
     const float *P[3];
-    const sfb__an_sv *S[3];
-    S[0] = a; S[1] = b1; S[2] = c2;
-    if (!a->ok || !b1->ok || !c2->ok) return;
-    for (k = 0; k < 3; ++k) P[k] = A->gpos + 3 * ((size_t)f * (size_t)A->per + (size_t)g[k]);
-    area = (b1->x - a->x) * (c2->y - a->y) - (c2->x - a->x) * (b1->y - a->y);
-    if (!(fabs(area) > 1e-12) || !isfinite(area)) return;
-    minx = a->x < b1->x ? (a->x < c2->x ? a->x : c2->x) : (b1->x < c2->x ? b1->x : c2->x);
-    maxx = a->x > b1->x ? (a->x > c2->x ? a->x : c2->x) : (b1->x > c2->x ? b1->x : c2->x);
-    miny = a->y < b1->y ? (a->y < c2->y ? a->y : c2->y) : (b1->y < c2->y ? b1->y : c2->y);
-    maxy = a->y > b1->y ? (a->y > c2->y ? a->y : c2->y) : (b1->y > c2->y ? b1->y : c2->y);
-    elen[0] = sqrt((c2->x - b1->x) * (c2->x - b1->x) + (c2->y - b1->y) * (c2->y - b1->y));
-    elen[1] = sqrt((a->x - c2->x) * (a->x - c2->x) + (a->y - c2->y) * (a->y - c2->y));
-    elen[2] = sqrt((b1->x - a->x) * (b1->x - a->x) + (b1->y - a->y) * (b1->y - a->y));
-    /* thin or grazing triangles (near the silhouette, where the exact surface may stick out past
-     * them, or where they cover no pixel centre at all) also seed the uncovered pixels around
-     * them; the others' neighbours are reached by the rounds */
-    {
-        double longest = elen[0] > elen[1] ? (elen[0] > elen[2] ? elen[0] : elen[2]) : (elen[1] > elen[2] ? elen[1] : elen[2]);
-        double e1[3], e2[3], cr[3], a3, sc;
-        for (k = 0; k < 3; ++k) { e1[k] = (double)P[1][k] - P[0][k]; e2[k] = (double)P[2][k] - P[0][k]; }
-        sfb__rcross(e1, e2, cr);
-        sc = A->cam.ortho ? A->cam.focal : A->cam.focal * 3.0 / (a->z + b1->z + c2->z);
-        a3 = sqrt(sfb__rdot(cr, cr)) * sc * sc; /* twice the area, in pixels, seen face-on */
-        /* thin (under 2 pixels high) or grazing (seen at under 20 degrees): near the silhouette */
-        dilate = fabs(area) < 2.0 * longest || fabs(area) < 0.35 * a3 ? SFB__AN_DILATE : 0.0;
-    }
-    if (pass == 0) dilate = 0.0;
-    else if (dilate == 0.0) return;
-    minx = sfb__rclamp(ceil(minx - 0.5 - dilate), 0.0, (double)A->w);
-    maxx = sfb__rclamp(floor(maxx - 0.5 + dilate), -1.0, (double)A->w - 1.0);
-    miny = sfb__rclamp(ceil(miny - 0.5 - dilate), 0.0, (double)A->h);
-    maxy = sfb__rclamp(floor(maxy - 0.5 + dilate), -1.0, (double)A->h - 1.0);
-    ix0 = (int)minx; ix1 = (int)maxx; iy0 = (int)miny; iy1 = (int)maxy;
-    inv = 1.0 / area;
-    /* barycentric k = ea[k] * px + eb[k] * py + ec[k] (edge k opposite corner k) */
+    sfb__raster_edges t;
+    double longest, e1[3], e2[3], cr[3], a3, sc;
+    int k, x, y;
     for (k = 0; k < 3; ++k) {
-        const sfb__an_sv *p0 = S[(k + 1) % 3], *p1 = S[(k + 2) % 3];
-        ea[k] = -(p1->y - p0->y) * inv;
-        eb[k] = (p1->x - p0->x) * inv;
-        ec[k] = ((p1->y - p0->y) * p0->x - (p1->x - p0->x) * p0->y) * inv;
+        S[k] = &A->rv[tv[k]];
+        P[k] = A->gpos + 3 * (size_t)tv[k];
     }
-    for (y = iy0; y <= iy1; ++y) {
-        double py = y + 0.5, px0 = ix0 + 0.5, b[3], row[3];
-        for (k = 0; k < 3; ++k) row[k] = ea[k] * px0 + eb[k] * py + ec[k];
-        for (x = ix0; x <= ix1; ++x) {
-            double den, z;
-            size_t pix = (size_t)y * (size_t)A->w + (size_t)x;
-            b[0] = row[0]; b[1] = row[1]; b[2] = row[2];
-            row[0] += ea[0]; row[1] += ea[1]; row[2] += ea[2];
-            if (pass && A->face[pix] >= 0) continue;
-            if (b[0] < 0.0 || b[1] < 0.0 || b[2] < 0.0) {
-                /* outside: a candidate seed for an uncovered pixel within `dilate` pixels */
-                double d = 0.0, sum;
-                if (dilate == 0.0) continue;
-                for (k = 0; k < 3; ++k)
-                    if (b[k] < 0.0 && elen[k] > 0.0) { double e = -b[k] * fabs(area) / elen[k]; if (e > d) d = e; }
-                if (!(d <= dilate) || !(d < A->cdist[pix])) continue;
-                for (k = 0; k < 3; ++k) b[k] = (b[k] < 0.0 ? 0.0 : b[k]) * S[k]->q;
-                sum = b[0] + b[1] + b[2];
-                if (!(sum > 0.0)) continue;
-                A->cdist[pix] = (float)d;
-                A->cface[pix] = f;
-                A->cuv[2 * pix] = (float)sfb__rclamp((b[0] * a->u + b[1] * b1->u + b[2] * c2->u) / sum, 0.0, 1.0);
-                A->cuv[2 * pix + 1] = (float)sfb__rclamp((b[0] * a->v + b[1] * b1->v + b[2] * c2->v) / sum, 0.0, 1.0);
-                continue;
-            }
-            if (pass) continue;
-            den = b[0] * a->q + b[1] * b1->q + b[2] * c2->q;
-            if (!(den > 0.0)) continue;
-            z = A->cam.ortho ? b[0] * a->z + b[1] * b1->z + b[2] * c2->z : 1.0 / den;
-            if (!(z < (double)A->depth[pix])) continue;
-            b[0] *= a->q / den; b[1] *= b1->q / den; b[2] *= c2->q / den;
-            A->depth[pix] = (float)z;
-            A->face[pix] = f;
-            A->uv[2 * pix] = (float)sfb__rclamp(b[0] * a->u + b[1] * b1->u + b[2] * c2->u, 0.0, 1.0);
-            A->uv[2 * pix + 1] = (float)sfb__rclamp(b[0] * a->v + b[1] * b1->v + b[2] * c2->v, 0.0, 1.0);
-            if (A->ppos) {
-                int c;
-                size_t base = (size_t)f * (size_t)A->per;
-                for (c = 0; c < 3; ++c) {
-                    A->ppos[3 * pix + c] = (float)(b[0] * P[0][c] + b[1] * P[1][c] + b[2] * P[2][c]);
-                    A->pnrm[3 * pix + c] = (float)(b[0] * A->gnrm[3 * (base + g[0]) + c] + b[1] * A->gnrm[3 * (base + g[1]) + c] +
-                                                   b[2] * A->gnrm[3 * (base + g[2]) + c]);
-                }
-            }
+    if (!sfb__raster_setup(S, A->w, A->h, SFB__AN_DILATE, &t)) return;
+    longest = t.elen[0] > t.elen[1] ? (t.elen[0] > t.elen[2] ? t.elen[0] : t.elen[2]) : (t.elen[1] > t.elen[2] ? t.elen[1] : t.elen[2]);
+    for (k = 0; k < 3; ++k) { e1[k] = (double)P[1][k] - P[0][k]; e2[k] = (double)P[2][k] - P[0][k]; }
+    sfb__rcross(e1, e2, cr);
+    sc = A->cam.ortho ? A->cam.focal : A->cam.focal * 3.0 / (S[0]->z + S[1]->z + S[2]->z);
+    a3 = sqrt(sfb__rdot(cr, cr)) * sc * sc; /* twice the area, in pixels, seen face-on */
+    /* thin (under 2 pixels high) or grazing (seen at under 20 degrees): near the silhouette */
+    if (!(fabs(t.area) < 2.0 * longest || fabs(t.area) < 0.35 * a3)) return;
+    for (y = t.y0; y <= t.y1; ++y)
+        for (x = t.x0; x <= t.x1; ++x) {
+            const double px = x + 0.5, py = y + 0.5;
+            const size_t pix = (size_t)y * (size_t)A->w + (size_t)x;
+            double b[3], d = 0.0, sum;
+            if (A->face[pix] >= 0) continue;
+            for (k = 0; k < 3; ++k) b[k] = t.ea[k] * px + t.eb[k] * py + t.ec[k];
+            if (b[0] >= 0.0 && b[1] >= 0.0 && b[2] >= 0.0) continue; /* inside: the raster's pixel */
+            for (k = 0; k < 3; ++k)
+                if (b[k] < 0.0 && t.elen[k] > 0.0) { double e = -b[k] * fabs(t.area) / t.elen[k]; if (e > d) d = e; }
+            if (!(d <= SFB__AN_DILATE) || !(d < A->cdist[pix])) continue;
+            for (k = 0; k < 3; ++k) b[k] = (b[k] < 0.0 ? 0.0 : b[k]) * S[k]->q;
+            sum = b[0] + b[1] + b[2];
+            if (!(sum > 0.0)) continue;
+            A->cdist[pix] = (float)d;
+            A->cface[pix] = tv[3];
+            A->cuv[2 * pix] = (float)sfb__rclamp((b[0] * S[0]->u + b[1] * S[1]->u + b[2] * S[2]->u) / sum, 0.0, 1.0);
+            A->cuv[2 * pix + 1] = (float)sfb__rclamp((b[0] * S[0]->v + b[1] * S[1]->v + b[2] * S[2]->v) / sum, 0.0, 1.0);
         }
-    }
 }
 
+/* The raster kernel of the context's backend (gl and osmesa draw the triangles in GL), or ref's. */
+static sfb_result sfb__an_raster_kernel(const sfb__an *A, const sfb__raster_job *job) {
+    sfb_context *ctx = A->ctx;
+    const sfb__backend_vtable *be = ctx->backend;
+    if (job->ntri == 0) return SFB_SUCCESS;
+    if (!be || !be->raster) {
+        sfb__log(ctx, SFB_LOG_INFO, "backend %s lacks raster; using ref", be ? be->name : "none");
+        return sfb__ref_raster(NULL, job);
+    }
+    return be->raster(ctx->backend_state, job);
+}
+
+/* Step 1b: the proxy's grid points projected into the picture (x NaN: behind the near plane or
+ * not finite), its triangles (those with three such points, face by face), rasterised by the
+ * backend's kernel, then pass 2's seeds around thin ones. */
 static sfb_result sfb__an_raster(sfb__an *A) {
-    int f, i, j, R = A->R, pass;
+    size_t n = (size_t)A->nf * (size_t)A->per, g;
+    int f, i, j, k, R = A->R;
+    sfb__raster_job job;
     sfb_result r;
-    sfb__an_sv *V = (sfb__an_sv *)sfb__alloc(A->ctx, (size_t)A->per * sizeof *V);
-    if (!V) return sfb__oom(A->ctx, "the analysis raster");
-    for (pass = 0; pass < 2; ++pass)
+    A->ntri = 0;
+    for (g = 0; g < n; ++g) {
+        const float *P = A->gpos + 3 * g;
+        sfb__raster_vertex *V = &A->rv[g];
+        double p[3];
+        V->x = NAN;
+        if (!sfb__an_finite3(P)) continue;
+        p[0] = P[0]; p[1] = P[1]; p[2] = P[2];
+        if (!sfb__an_project(&A->cam, p, &V->x, &V->y, &V->z)) { V->x = NAN; continue; }
+        V->q = A->cam.ortho ? 1.0 : 1.0 / V->z;
+        sfb__an_grid_uv(A, (int)(g % (size_t)A->per), &V->u, &V->v);
+    }
     for (f = 0; f < A->nf; ++f) {
-        if ((f & 63) == 63 && (r = sfb__progress(A->ctx, 0.2f + 0.05f * (pass + (float)f / (float)A->nf), "analyze")) != SFB_SUCCESS) {
-            sfb__free(A->ctx, V);
-            return r;
-        }
+        const size_t base = (size_t)f * (size_t)A->per;
         if (A->s->patches.ptex_root[f] == -1) continue;
-        for (i = 0; i < A->per; ++i) {
-            const float *P = A->gpos + 3 * ((size_t)f * (size_t)A->per + (size_t)i);
-            double p[3];
-            V[i].ok = 0;
-            if (!sfb__an_finite3(P)) continue;
-            p[0] = P[0]; p[1] = P[1]; p[2] = P[2];
-            if (!sfb__an_project(&A->cam, p, &V[i].x, &V[i].y, &V[i].z)) continue;
-            V[i].q = A->cam.ortho ? 1.0 : 1.0 / V[i].z;
-            sfb__an_grid_uv(A, i, &V[i].u, &V[i].v);
-            V[i].ok = 1;
-        }
         for (j = 0; j < R; ++j)
             for (i = 0; i < (A->tri ? R - j : R); ++i) {
-                int g[3];
+                int q[2][3], nt = 1;
                 if (A->tri) {
-                    g[0] = sfb__an_grid_index(A, i, j); g[1] = sfb__an_grid_index(A, i + 1, j); g[2] = sfb__an_grid_index(A, i, j + 1);
-                    sfb__an_raster_tri(A, f, g, V, pass);
+                    q[0][0] = sfb__an_grid_index(A, i, j); q[0][1] = sfb__an_grid_index(A, i + 1, j); q[0][2] = sfb__an_grid_index(A, i, j + 1);
                     if (i + j + 1 < R) {
-                        g[0] = sfb__an_grid_index(A, i + 1, j); g[1] = sfb__an_grid_index(A, i + 1, j + 1); g[2] = sfb__an_grid_index(A, i, j + 1);
-                        sfb__an_raster_tri(A, f, g, V, pass);
+                        q[1][0] = sfb__an_grid_index(A, i + 1, j); q[1][1] = sfb__an_grid_index(A, i + 1, j + 1);
+                        q[1][2] = sfb__an_grid_index(A, i, j + 1);
+                        nt = 2;
                     }
                 } else {
-                    g[0] = sfb__an_grid_index(A, i, j); g[1] = sfb__an_grid_index(A, i + 1, j); g[2] = sfb__an_grid_index(A, i + 1, j + 1);
-                    sfb__an_raster_tri(A, f, g, V, pass);
-                    g[1] = g[2]; g[2] = sfb__an_grid_index(A, i, j + 1);
-                    sfb__an_raster_tri(A, f, g, V, pass);
+                    q[0][0] = sfb__an_grid_index(A, i, j); q[0][1] = sfb__an_grid_index(A, i + 1, j); q[0][2] = sfb__an_grid_index(A, i + 1, j + 1);
+                    q[1][0] = q[0][0]; q[1][1] = q[0][2]; q[1][2] = sfb__an_grid_index(A, i, j + 1);
+                    nt = 2;
+                }
+                for (k = 0; k < nt; ++k) {
+                    int *t = A->rtri + 4 * (size_t)A->ntri, c, ok = 1;
+                    for (c = 0; c < 3; ++c) {
+                        t[c] = (int)(base + (size_t)q[k][c]);
+                        ok &= isfinite(A->rv[t[c]].x) != 0;
+                    }
+                    t[3] = f;
+                    A->ntri += ok;
                 }
             }
     }
-    sfb__free(A->ctx, V);
+    if ((r = sfb__progress(A->ctx, 0.2f, "analyze")) != SFB_SUCCESS) return r;
+    memset(&job, 0, sizeof job);
+    job.w = A->w; job.h = A->h; job.ortho = A->cam.ortho;
+    job.ntri = A->ntri; job.vert = A->rv; job.tri = A->rtri;
+    job.depth = A->depth; job.face = A->face; job.uv = A->uv;
+    if (A->ppos) { job.apos = A->gpos; job.anrm = A->gnrm; job.pos = A->ppos; job.nrm = A->pnrm; }
+    if ((r = sfb__an_raster_kernel(A, &job)) != SFB_SUCCESS) return r;
+    for (k = 0; k < A->ntri; ++k) {
+        if ((k & 4095) == 4095 && (r = sfb__progress(A->ctx, 0.25f + 0.05f * (float)k / (float)A->ntri, "analyze")) != SFB_SUCCESS) return r;
+        sfb__an_seed_tri(A, A->rtri + 4 * (size_t)k);
+    }
     return SFB_SUCCESS;
 }
 
@@ -13396,7 +13584,7 @@ static sfb_result sfb__an_shade(const sfb__an *A, const sfb__shade_job *job, int
 
 static void sfb__an_free(sfb__an *A) {
     sfb_context *ctx = A->ctx;
-    sfb__free(ctx, A->gpos); sfb__free(ctx, A->gnrm);
+    sfb__free(ctx, A->gpos); sfb__free(ctx, A->gnrm); sfb__free(ctx, A->rv); sfb__free(ctx, A->rtri);
     sfb__free(ctx, A->cface); sfb__free(ctx, A->cuv); sfb__free(ctx, A->cdist);
     sfb__free(ctx, A->depth); sfb__free(ctx, A->face); sfb__free(ctx, A->uv); sfb__free(ctx, A->ppos); sfb__free(ctx, A->pnrm);
     sfb__free(ctx, A->hit); sfb__free(ctx, A->state); sfb__free(ctx, A->adj);
@@ -13409,7 +13597,7 @@ static double sfb__an_bytes(const sfb__an *A) {
     double npix = (double)A->w * A->h, grid = (double)A->nf * A->per;
     double per_pixel = 16 + 4 + 4 + 8 + 4 + 1 + 4 + 4 + 1 + 4 + 12 /* buffers, outputs */ + 4 + 12 + 48 + 4 /* hits */ +
                        (A->c->polygon_based ? 24 : 84 + 16) /* proxy data or the projection's attempts and marks */;
-    return npix * per_pixel + grid * 24.0 + 65536.0 * sizeof(sfb_location) + (double)A->nf * 4 * (sizeof(int) + sizeof(sfb__an_side));
+    return npix * per_pixel + grid * (24.0 + sizeof(sfb__raster_vertex) + 2 * 4 * sizeof(int)) + 65536.0 * sizeof(sfb_location) + (double)A->nf * 4 * (sizeof(int) + sizeof(sfb__an_side));
 }
 
 /* The buffers of one analysis (A's sizes set), initialised; 0 when one could not be had. */
@@ -13418,6 +13606,9 @@ static int sfb__an_alloc(sfb__an *A) {
     size_t npix = (size_t)A->w * (size_t)A->h, grid = (size_t)A->nf * (size_t)A->per, p;
     A->gpos = (float *)sfb__alloc(ctx, grid * 3 * sizeof(float));
     A->gnrm = (float *)sfb__alloc(ctx, grid * 3 * sizeof(float));
+    A->rv = (sfb__raster_vertex *)sfb__alloc(ctx, grid * sizeof(sfb__raster_vertex));
+    /* at most two triangles per grid point */
+    A->rtri = (int *)sfb__alloc(ctx, grid * 2 * 4 * sizeof(int));
     A->depth = (float *)sfb__alloc(ctx, npix * sizeof(float));
     A->face = (int *)sfb__alloc(ctx, npix * sizeof(int));
     A->uv = (float *)sfb__alloc(ctx, npix * 2 * sizeof(float));
@@ -13439,7 +13630,7 @@ static int sfb__an_alloc(sfb__an *A) {
     A->hnrm = (float *)sfb__alloc(ctx, npix * 3 * sizeof(float));
     A->hdepth = (float *)sfb__alloc(ctx, npix * sizeof(float));
     A->chg = (int *)sfb__alloc(ctx, (npix + 1) * sizeof(int));
-    if (!A->gpos || !A->gnrm || !A->depth || !A->face || !A->uv || !A->hit || !A->adj || !A->cface || !A->cuv || !A->cdist || !A->state ||
+    if (!A->gpos || !A->gnrm || !A->rv || !A->rtri || !A->depth || !A->face || !A->uv || !A->hit || !A->adj || !A->cface || !A->cuv || !A->cdist || !A->state ||
         (A->c->polygon_based && (!A->ppos || !A->pnrm)) || !A->hpix || !A->hloc || !A->hpos || !A->hdu || !A->hdv || !A->hnrm || !A->hdepth ||
         !A->chg)
         return 0;
@@ -13480,6 +13671,16 @@ static sfb_result sfb__an_values(sfb__an *A, sfb__an_look *L, float *hv1, float 
         o.duu = sec; o.duv = sec + 3 * (size_t)A->nhit; o.dvv = sec + 6 * (size_t)A->nhit;
         r = sfb__surface_eval_unchecked(A->s, A->hloc, A->nhit, &o);
         L->job.duu = o.duu; L->job.duv = o.duv; L->job.dvv = o.dvv;
+        /* curvature is the geometry's: where the normals come from a field of their own (PN
+         * triangles' quadratic normals), the second fundamental form takes du x dv instead */
+        if (A->s->patches.normal_field)
+            for (k = 0; k < A->nhit; ++k) {
+                const float *a = A->hdu + 3 * (size_t)k, *b = A->hdv + 3 * (size_t)k;
+                float *n = A->hnrm + 3 * (size_t)k;
+                const double x = (double)a[1] * b[2] - (double)a[2] * b[1], y = (double)a[2] * b[0] - (double)a[0] * b[2],
+                             z = (double)a[0] * b[1] - (double)a[1] * b[0], len = sqrt(x * x + y * y + z * z);
+                if (len > 0.0) { n[0] = (float)(x / len); n[1] = (float)(y / len); n[2] = (float)(z / len); }
+            }
     }
     if (r == SFB_SUCCESS) r = sfb__an_shade(A, &L->job, A->nhit);
     if (r == SFB_SUCCESS && c->mode == SFB_ANALYZE_CURVATURE && c->curvature == SFB_CURVATURE_GAUSSIAN) {

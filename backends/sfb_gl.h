@@ -38,7 +38,9 @@
  *   gl/patches.h   polynomial patch tables, quad and triangle families (patches.comp.glsl)
  *   gl/manifold.h  MANIFOLD4 tables (seed 000; manifold.comp.glsl's compute stage)
  *   gl/normals.h   seed 001's normal blend, finish_normals (normals.comp.glsl)
+ *   gl/shade.h     seed 003's per-pixel analysis values, shade (shade.comp.glsl)
  *   gl/draw.h      sfb_surface_draw_gl and sfb_gl_trim_texture (manifold.comp.glsl's vertex stage)
+ *   gl/raster.h    seed 003's proxy raster into an offscreen framebuffer, raster (raster.{vert,frag}.glsl)
  *   gl/vtable.h    patch-table slots dispatched by the table's families; sfb__gl_bind
  * backends/sfb_osmesa.h runs the same kernels in an OSMesa context.
  */
@@ -52,6 +54,7 @@
 #include "gl/normals.h"
 #include "gl/shade.h"
 #include "gl/draw.h"
+#include "gl/raster.h"
 #include "gl/vtable.h"
 
 #endif /* SFB__GL_H */

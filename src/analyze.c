@@ -4,7 +4,8 @@
  *    segments per edge (a quad: (n+1)^2 points, a triangle: (n+1)(n+2)/2), evaluated through
  *    the backend's eval_patches; each grid triangle knows its face and its corners' (u,v) in
  *    that face, so rasterising it gives per pixel (face, u, v, depth) with perspective-correct
- *    (u,v): a pixel's (u,v) is always in its own face's frame. Thin or grazing triangles (near a
+ *    (u,v): a pixel's (u,v) is always in its own face's frame. The backend's `raster` kernel
+ *    draws it (ref's on the CPU; gl and osmesa in GL, sfb__raster_job). Thin or grazing triangles (near a
  *    silhouette) also leave a seed in the uncovered pixels within 2 pixels of them. The faces'
  *    adjacency comes from the proxy too (sides whose ends and middle coincide).
  * 2. Projection (beyond the seed, which shades the proxy's (u,v), leaves gaps and patches them
@@ -195,6 +196,8 @@ typedef struct sfb__an {
     double centre[3], radius;
     /* the proxy: grid points of every face (NaN for holes) */
     float *gpos, *gnrm;
+    sfb__raster_vertex *rv;      /* the grid points in the picture */
+    int *rtri, ntri;             /* the proxy's triangles (sfb__raster_job) */
     /* per pixel */
     float *depth;                /* +inf: empty */
     int *face;                   /* proxy face, -1: none */
@@ -398,147 +401,122 @@ static void sfb__an_camera(sfb__an *A) {
     cam->near_z = c->near_plane > 0.0f ? c->near_plane : 1e-3 * A->radius;
 }
 
-/* A proxy point in the picture: screen x, y, view depth z, the weight q (1/z or 1), its (u,v). */
-typedef struct sfb__an_sv { double x, y, z, q, u, v; int ok; } sfb__an_sv;
-
-/* Step 1b: rasterises one proxy triangle (grid points g[3] of face f, projected in V); pass 1
- * only seeds the uncovered pixels around thin or grazing ones. */
-static void sfb__an_raster_tri(sfb__an *A, int f, const int *g, const sfb__an_sv *V, int pass) {
-    const sfb__an_sv *a = &V[g[0]], *b1 = &V[g[1]], *c2 = &V[g[2]];
-    double area, inv, minx, maxx, miny, maxy, elen[3], dilate, ea[3], eb[3], ec[3];
-    int k, x, y, ix0, ix1, iy0, iy1;
+/* Step 1b, pass 2: the uncovered pixels within SFB__AN_DILATE pixels of a thin or grazing proxy
+ * triangle (near the silhouette, where the exact surface may stick out past it, or where it
+ * covers no pixel centre at all) get it as a seed: its face and the (u,v) of its nearest point
+ * (the barycentric coordinates clamped), nearest triangle first. The others' neighbours are
+ * reached by the projection's rounds. */
+static void sfb__an_seed_tri(sfb__an *A, const int *tv) {
+    const sfb__raster_vertex *S[3];
     const float *P[3];
-    const sfb__an_sv *S[3];
-    S[0] = a; S[1] = b1; S[2] = c2;
-    if (!a->ok || !b1->ok || !c2->ok) return;
-    for (k = 0; k < 3; ++k) P[k] = A->gpos + 3 * ((size_t)f * (size_t)A->per + (size_t)g[k]);
-    area = (b1->x - a->x) * (c2->y - a->y) - (c2->x - a->x) * (b1->y - a->y);
-    if (!(fabs(area) > 1e-12) || !isfinite(area)) return;
-    minx = a->x < b1->x ? (a->x < c2->x ? a->x : c2->x) : (b1->x < c2->x ? b1->x : c2->x);
-    maxx = a->x > b1->x ? (a->x > c2->x ? a->x : c2->x) : (b1->x > c2->x ? b1->x : c2->x);
-    miny = a->y < b1->y ? (a->y < c2->y ? a->y : c2->y) : (b1->y < c2->y ? b1->y : c2->y);
-    maxy = a->y > b1->y ? (a->y > c2->y ? a->y : c2->y) : (b1->y > c2->y ? b1->y : c2->y);
-    elen[0] = sqrt((c2->x - b1->x) * (c2->x - b1->x) + (c2->y - b1->y) * (c2->y - b1->y));
-    elen[1] = sqrt((a->x - c2->x) * (a->x - c2->x) + (a->y - c2->y) * (a->y - c2->y));
-    elen[2] = sqrt((b1->x - a->x) * (b1->x - a->x) + (b1->y - a->y) * (b1->y - a->y));
-    /* thin or grazing triangles (near the silhouette, where the exact surface may stick out past
-     * them, or where they cover no pixel centre at all) also seed the uncovered pixels around
-     * them; the others' neighbours are reached by the rounds */
-    {
-        double longest = elen[0] > elen[1] ? (elen[0] > elen[2] ? elen[0] : elen[2]) : (elen[1] > elen[2] ? elen[1] : elen[2]);
-        double e1[3], e2[3], cr[3], a3, sc;
-        for (k = 0; k < 3; ++k) { e1[k] = (double)P[1][k] - P[0][k]; e2[k] = (double)P[2][k] - P[0][k]; }
-        sfb__rcross(e1, e2, cr);
-        sc = A->cam.ortho ? A->cam.focal : A->cam.focal * 3.0 / (a->z + b1->z + c2->z);
-        a3 = sqrt(sfb__rdot(cr, cr)) * sc * sc; /* twice the area, in pixels, seen face-on */
-        /* thin (under 2 pixels high) or grazing (seen at under 20 degrees): near the silhouette */
-        dilate = fabs(area) < 2.0 * longest || fabs(area) < 0.35 * a3 ? SFB__AN_DILATE : 0.0;
-    }
-    if (pass == 0) dilate = 0.0;
-    else if (dilate == 0.0) return;
-    minx = sfb__rclamp(ceil(minx - 0.5 - dilate), 0.0, (double)A->w);
-    maxx = sfb__rclamp(floor(maxx - 0.5 + dilate), -1.0, (double)A->w - 1.0);
-    miny = sfb__rclamp(ceil(miny - 0.5 - dilate), 0.0, (double)A->h);
-    maxy = sfb__rclamp(floor(maxy - 0.5 + dilate), -1.0, (double)A->h - 1.0);
-    ix0 = (int)minx; ix1 = (int)maxx; iy0 = (int)miny; iy1 = (int)maxy;
-    inv = 1.0 / area;
-    /* barycentric k = ea[k] * px + eb[k] * py + ec[k] (edge k opposite corner k) */
+    sfb__raster_edges t;
+    double longest, e1[3], e2[3], cr[3], a3, sc;
+    int k, x, y;
     for (k = 0; k < 3; ++k) {
-        const sfb__an_sv *p0 = S[(k + 1) % 3], *p1 = S[(k + 2) % 3];
-        ea[k] = -(p1->y - p0->y) * inv;
-        eb[k] = (p1->x - p0->x) * inv;
-        ec[k] = ((p1->y - p0->y) * p0->x - (p1->x - p0->x) * p0->y) * inv;
+        S[k] = &A->rv[tv[k]];
+        P[k] = A->gpos + 3 * (size_t)tv[k];
     }
-    for (y = iy0; y <= iy1; ++y) {
-        double py = y + 0.5, px0 = ix0 + 0.5, b[3], row[3];
-        for (k = 0; k < 3; ++k) row[k] = ea[k] * px0 + eb[k] * py + ec[k];
-        for (x = ix0; x <= ix1; ++x) {
-            double den, z;
-            size_t pix = (size_t)y * (size_t)A->w + (size_t)x;
-            b[0] = row[0]; b[1] = row[1]; b[2] = row[2];
-            row[0] += ea[0]; row[1] += ea[1]; row[2] += ea[2];
-            if (pass && A->face[pix] >= 0) continue;
-            if (b[0] < 0.0 || b[1] < 0.0 || b[2] < 0.0) {
-                /* outside: a candidate seed for an uncovered pixel within `dilate` pixels */
-                double d = 0.0, sum;
-                if (dilate == 0.0) continue;
-                for (k = 0; k < 3; ++k)
-                    if (b[k] < 0.0 && elen[k] > 0.0) { double e = -b[k] * fabs(area) / elen[k]; if (e > d) d = e; }
-                if (!(d <= dilate) || !(d < A->cdist[pix])) continue;
-                for (k = 0; k < 3; ++k) b[k] = (b[k] < 0.0 ? 0.0 : b[k]) * S[k]->q;
-                sum = b[0] + b[1] + b[2];
-                if (!(sum > 0.0)) continue;
-                A->cdist[pix] = (float)d;
-                A->cface[pix] = f;
-                A->cuv[2 * pix] = (float)sfb__rclamp((b[0] * a->u + b[1] * b1->u + b[2] * c2->u) / sum, 0.0, 1.0);
-                A->cuv[2 * pix + 1] = (float)sfb__rclamp((b[0] * a->v + b[1] * b1->v + b[2] * c2->v) / sum, 0.0, 1.0);
-                continue;
-            }
-            if (pass) continue;
-            den = b[0] * a->q + b[1] * b1->q + b[2] * c2->q;
-            if (!(den > 0.0)) continue;
-            z = A->cam.ortho ? b[0] * a->z + b[1] * b1->z + b[2] * c2->z : 1.0 / den;
-            if (!(z < (double)A->depth[pix])) continue;
-            b[0] *= a->q / den; b[1] *= b1->q / den; b[2] *= c2->q / den;
-            A->depth[pix] = (float)z;
-            A->face[pix] = f;
-            A->uv[2 * pix] = (float)sfb__rclamp(b[0] * a->u + b[1] * b1->u + b[2] * c2->u, 0.0, 1.0);
-            A->uv[2 * pix + 1] = (float)sfb__rclamp(b[0] * a->v + b[1] * b1->v + b[2] * c2->v, 0.0, 1.0);
-            if (A->ppos) {
-                int c;
-                size_t base = (size_t)f * (size_t)A->per;
-                for (c = 0; c < 3; ++c) {
-                    A->ppos[3 * pix + c] = (float)(b[0] * P[0][c] + b[1] * P[1][c] + b[2] * P[2][c]);
-                    A->pnrm[3 * pix + c] = (float)(b[0] * A->gnrm[3 * (base + g[0]) + c] + b[1] * A->gnrm[3 * (base + g[1]) + c] +
-                                                   b[2] * A->gnrm[3 * (base + g[2]) + c]);
-                }
-            }
+    if (!sfb__raster_setup(S, A->w, A->h, SFB__AN_DILATE, &t)) return;
+    longest = t.elen[0] > t.elen[1] ? (t.elen[0] > t.elen[2] ? t.elen[0] : t.elen[2]) : (t.elen[1] > t.elen[2] ? t.elen[1] : t.elen[2]);
+    for (k = 0; k < 3; ++k) { e1[k] = (double)P[1][k] - P[0][k]; e2[k] = (double)P[2][k] - P[0][k]; }
+    sfb__rcross(e1, e2, cr);
+    sc = A->cam.ortho ? A->cam.focal : A->cam.focal * 3.0 / (S[0]->z + S[1]->z + S[2]->z);
+    a3 = sqrt(sfb__rdot(cr, cr)) * sc * sc; /* twice the area, in pixels, seen face-on */
+    /* thin (under 2 pixels high) or grazing (seen at under 20 degrees): near the silhouette */
+    if (!(fabs(t.area) < 2.0 * longest || fabs(t.area) < 0.35 * a3)) return;
+    for (y = t.y0; y <= t.y1; ++y)
+        for (x = t.x0; x <= t.x1; ++x) {
+            const double px = x + 0.5, py = y + 0.5;
+            const size_t pix = (size_t)y * (size_t)A->w + (size_t)x;
+            double b[3], d = 0.0, sum;
+            if (A->face[pix] >= 0) continue;
+            for (k = 0; k < 3; ++k) b[k] = t.ea[k] * px + t.eb[k] * py + t.ec[k];
+            if (b[0] >= 0.0 && b[1] >= 0.0 && b[2] >= 0.0) continue; /* inside: the raster's pixel */
+            for (k = 0; k < 3; ++k)
+                if (b[k] < 0.0 && t.elen[k] > 0.0) { double e = -b[k] * fabs(t.area) / t.elen[k]; if (e > d) d = e; }
+            if (!(d <= SFB__AN_DILATE) || !(d < A->cdist[pix])) continue;
+            for (k = 0; k < 3; ++k) b[k] = (b[k] < 0.0 ? 0.0 : b[k]) * S[k]->q;
+            sum = b[0] + b[1] + b[2];
+            if (!(sum > 0.0)) continue;
+            A->cdist[pix] = (float)d;
+            A->cface[pix] = tv[3];
+            A->cuv[2 * pix] = (float)sfb__rclamp((b[0] * S[0]->u + b[1] * S[1]->u + b[2] * S[2]->u) / sum, 0.0, 1.0);
+            A->cuv[2 * pix + 1] = (float)sfb__rclamp((b[0] * S[0]->v + b[1] * S[1]->v + b[2] * S[2]->v) / sum, 0.0, 1.0);
         }
-    }
 }
 
+/* The raster kernel of the context's backend (gl and osmesa draw the triangles in GL), or ref's. */
+static sfb_result sfb__an_raster_kernel(const sfb__an *A, const sfb__raster_job *job) {
+    sfb_context *ctx = A->ctx;
+    const sfb__backend_vtable *be = ctx->backend;
+    if (job->ntri == 0) return SFB_SUCCESS;
+    if (!be || !be->raster) {
+        sfb__log(ctx, SFB_LOG_INFO, "backend %s lacks raster; using ref", be ? be->name : "none");
+        return sfb__ref_raster(NULL, job);
+    }
+    return be->raster(ctx->backend_state, job);
+}
+
+/* Step 1b: the proxy's grid points projected into the picture (x NaN: behind the near plane or
+ * not finite), its triangles (those with three such points, face by face), rasterised by the
+ * backend's kernel, then pass 2's seeds around thin ones. */
 static sfb_result sfb__an_raster(sfb__an *A) {
-    int f, i, j, R = A->R, pass;
+    size_t n = (size_t)A->nf * (size_t)A->per, g;
+    int f, i, j, k, R = A->R;
+    sfb__raster_job job;
     sfb_result r;
-    sfb__an_sv *V = (sfb__an_sv *)sfb__alloc(A->ctx, (size_t)A->per * sizeof *V);
-    if (!V) return sfb__oom(A->ctx, "the analysis raster");
-    for (pass = 0; pass < 2; ++pass)
+    A->ntri = 0;
+    for (g = 0; g < n; ++g) {
+        const float *P = A->gpos + 3 * g;
+        sfb__raster_vertex *V = &A->rv[g];
+        double p[3];
+        V->x = NAN;
+        if (!sfb__an_finite3(P)) continue;
+        p[0] = P[0]; p[1] = P[1]; p[2] = P[2];
+        if (!sfb__an_project(&A->cam, p, &V->x, &V->y, &V->z)) { V->x = NAN; continue; }
+        V->q = A->cam.ortho ? 1.0 : 1.0 / V->z;
+        sfb__an_grid_uv(A, (int)(g % (size_t)A->per), &V->u, &V->v);
+    }
     for (f = 0; f < A->nf; ++f) {
-        if ((f & 63) == 63 && (r = sfb__progress(A->ctx, 0.2f + 0.05f * (pass + (float)f / (float)A->nf), "analyze")) != SFB_SUCCESS) {
-            sfb__free(A->ctx, V);
-            return r;
-        }
+        const size_t base = (size_t)f * (size_t)A->per;
         if (A->s->patches.ptex_root[f] == -1) continue;
-        for (i = 0; i < A->per; ++i) {
-            const float *P = A->gpos + 3 * ((size_t)f * (size_t)A->per + (size_t)i);
-            double p[3];
-            V[i].ok = 0;
-            if (!sfb__an_finite3(P)) continue;
-            p[0] = P[0]; p[1] = P[1]; p[2] = P[2];
-            if (!sfb__an_project(&A->cam, p, &V[i].x, &V[i].y, &V[i].z)) continue;
-            V[i].q = A->cam.ortho ? 1.0 : 1.0 / V[i].z;
-            sfb__an_grid_uv(A, i, &V[i].u, &V[i].v);
-            V[i].ok = 1;
-        }
         for (j = 0; j < R; ++j)
             for (i = 0; i < (A->tri ? R - j : R); ++i) {
-                int g[3];
+                int q[2][3], nt = 1;
                 if (A->tri) {
-                    g[0] = sfb__an_grid_index(A, i, j); g[1] = sfb__an_grid_index(A, i + 1, j); g[2] = sfb__an_grid_index(A, i, j + 1);
-                    sfb__an_raster_tri(A, f, g, V, pass);
+                    q[0][0] = sfb__an_grid_index(A, i, j); q[0][1] = sfb__an_grid_index(A, i + 1, j); q[0][2] = sfb__an_grid_index(A, i, j + 1);
                     if (i + j + 1 < R) {
-                        g[0] = sfb__an_grid_index(A, i + 1, j); g[1] = sfb__an_grid_index(A, i + 1, j + 1); g[2] = sfb__an_grid_index(A, i, j + 1);
-                        sfb__an_raster_tri(A, f, g, V, pass);
+                        q[1][0] = sfb__an_grid_index(A, i + 1, j); q[1][1] = sfb__an_grid_index(A, i + 1, j + 1);
+                        q[1][2] = sfb__an_grid_index(A, i, j + 1);
+                        nt = 2;
                     }
                 } else {
-                    g[0] = sfb__an_grid_index(A, i, j); g[1] = sfb__an_grid_index(A, i + 1, j); g[2] = sfb__an_grid_index(A, i + 1, j + 1);
-                    sfb__an_raster_tri(A, f, g, V, pass);
-                    g[1] = g[2]; g[2] = sfb__an_grid_index(A, i, j + 1);
-                    sfb__an_raster_tri(A, f, g, V, pass);
+                    q[0][0] = sfb__an_grid_index(A, i, j); q[0][1] = sfb__an_grid_index(A, i + 1, j); q[0][2] = sfb__an_grid_index(A, i + 1, j + 1);
+                    q[1][0] = q[0][0]; q[1][1] = q[0][2]; q[1][2] = sfb__an_grid_index(A, i, j + 1);
+                    nt = 2;
+                }
+                for (k = 0; k < nt; ++k) {
+                    int *t = A->rtri + 4 * (size_t)A->ntri, c, ok = 1;
+                    for (c = 0; c < 3; ++c) {
+                        t[c] = (int)(base + (size_t)q[k][c]);
+                        ok &= isfinite(A->rv[t[c]].x) != 0;
+                    }
+                    t[3] = f;
+                    A->ntri += ok;
                 }
             }
     }
-    sfb__free(A->ctx, V);
+    if ((r = sfb__progress(A->ctx, 0.2f, "analyze")) != SFB_SUCCESS) return r;
+    memset(&job, 0, sizeof job);
+    job.w = A->w; job.h = A->h; job.ortho = A->cam.ortho;
+    job.ntri = A->ntri; job.vert = A->rv; job.tri = A->rtri;
+    job.depth = A->depth; job.face = A->face; job.uv = A->uv;
+    if (A->ppos) { job.apos = A->gpos; job.anrm = A->gnrm; job.pos = A->ppos; job.nrm = A->pnrm; }
+    if ((r = sfb__an_raster_kernel(A, &job)) != SFB_SUCCESS) return r;
+    for (k = 0; k < A->ntri; ++k) {
+        if ((k & 4095) == 4095 && (r = sfb__progress(A->ctx, 0.25f + 0.05f * (float)k / (float)A->ntri, "analyze")) != SFB_SUCCESS) return r;
+        sfb__an_seed_tri(A, A->rtri + 4 * (size_t)k);
+    }
     return SFB_SUCCESS;
 }
 
@@ -1125,7 +1103,7 @@ static sfb_result sfb__an_shade(const sfb__an *A, const sfb__shade_job *job, int
 
 static void sfb__an_free(sfb__an *A) {
     sfb_context *ctx = A->ctx;
-    sfb__free(ctx, A->gpos); sfb__free(ctx, A->gnrm);
+    sfb__free(ctx, A->gpos); sfb__free(ctx, A->gnrm); sfb__free(ctx, A->rv); sfb__free(ctx, A->rtri);
     sfb__free(ctx, A->cface); sfb__free(ctx, A->cuv); sfb__free(ctx, A->cdist);
     sfb__free(ctx, A->depth); sfb__free(ctx, A->face); sfb__free(ctx, A->uv); sfb__free(ctx, A->ppos); sfb__free(ctx, A->pnrm);
     sfb__free(ctx, A->hit); sfb__free(ctx, A->state); sfb__free(ctx, A->adj);
@@ -1138,7 +1116,7 @@ static double sfb__an_bytes(const sfb__an *A) {
     double npix = (double)A->w * A->h, grid = (double)A->nf * A->per;
     double per_pixel = 16 + 4 + 4 + 8 + 4 + 1 + 4 + 4 + 1 + 4 + 12 /* buffers, outputs */ + 4 + 12 + 48 + 4 /* hits */ +
                        (A->c->polygon_based ? 24 : 84 + 16) /* proxy data or the projection's attempts and marks */;
-    return npix * per_pixel + grid * 24.0 + 65536.0 * sizeof(sfb_location) + (double)A->nf * 4 * (sizeof(int) + sizeof(sfb__an_side));
+    return npix * per_pixel + grid * (24.0 + sizeof(sfb__raster_vertex) + 2 * 4 * sizeof(int)) + 65536.0 * sizeof(sfb_location) + (double)A->nf * 4 * (sizeof(int) + sizeof(sfb__an_side));
 }
 
 /* The buffers of one analysis (A's sizes set), initialised; 0 when one could not be had. */
@@ -1147,6 +1125,9 @@ static int sfb__an_alloc(sfb__an *A) {
     size_t npix = (size_t)A->w * (size_t)A->h, grid = (size_t)A->nf * (size_t)A->per, p;
     A->gpos = (float *)sfb__alloc(ctx, grid * 3 * sizeof(float));
     A->gnrm = (float *)sfb__alloc(ctx, grid * 3 * sizeof(float));
+    A->rv = (sfb__raster_vertex *)sfb__alloc(ctx, grid * sizeof(sfb__raster_vertex));
+    /* at most two triangles per grid point */
+    A->rtri = (int *)sfb__alloc(ctx, grid * 2 * 4 * sizeof(int));
     A->depth = (float *)sfb__alloc(ctx, npix * sizeof(float));
     A->face = (int *)sfb__alloc(ctx, npix * sizeof(int));
     A->uv = (float *)sfb__alloc(ctx, npix * 2 * sizeof(float));
@@ -1168,7 +1149,7 @@ static int sfb__an_alloc(sfb__an *A) {
     A->hnrm = (float *)sfb__alloc(ctx, npix * 3 * sizeof(float));
     A->hdepth = (float *)sfb__alloc(ctx, npix * sizeof(float));
     A->chg = (int *)sfb__alloc(ctx, (npix + 1) * sizeof(int));
-    if (!A->gpos || !A->gnrm || !A->depth || !A->face || !A->uv || !A->hit || !A->adj || !A->cface || !A->cuv || !A->cdist || !A->state ||
+    if (!A->gpos || !A->gnrm || !A->rv || !A->rtri || !A->depth || !A->face || !A->uv || !A->hit || !A->adj || !A->cface || !A->cuv || !A->cdist || !A->state ||
         (A->c->polygon_based && (!A->ppos || !A->pnrm)) || !A->hpix || !A->hloc || !A->hpos || !A->hdu || !A->hdv || !A->hnrm || !A->hdepth ||
         !A->chg)
         return 0;
@@ -1209,6 +1190,16 @@ static sfb_result sfb__an_values(sfb__an *A, sfb__an_look *L, float *hv1, float 
         o.duu = sec; o.duv = sec + 3 * (size_t)A->nhit; o.dvv = sec + 6 * (size_t)A->nhit;
         r = sfb__surface_eval_unchecked(A->s, A->hloc, A->nhit, &o);
         L->job.duu = o.duu; L->job.duv = o.duv; L->job.dvv = o.dvv;
+        /* curvature is the geometry's: where the normals come from a field of their own (PN
+         * triangles' quadratic normals), the second fundamental form takes du x dv instead */
+        if (A->s->patches.normal_field)
+            for (k = 0; k < A->nhit; ++k) {
+                const float *a = A->hdu + 3 * (size_t)k, *b = A->hdv + 3 * (size_t)k;
+                float *n = A->hnrm + 3 * (size_t)k;
+                const double x = (double)a[1] * b[2] - (double)a[2] * b[1], y = (double)a[2] * b[0] - (double)a[0] * b[2],
+                             z = (double)a[0] * b[1] - (double)a[1] * b[0], len = sqrt(x * x + y * y + z * z);
+                if (len > 0.0) { n[0] = (float)(x / len); n[1] = (float)(y / len); n[2] = (float)(z / len); }
+            }
     }
     if (r == SFB_SUCCESS) r = sfb__an_shade(A, &L->job, A->nhit);
     if (r == SFB_SUCCESS && c->mode == SFB_ANALYZE_CURVATURE && c->curvature == SFB_CURVATURE_GAUSSIAN) {

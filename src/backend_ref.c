@@ -137,6 +137,75 @@ sfb_result sfb__ref_shade(void *state, const sfb__shade_job *j, int first, int l
     return SFB_SUCCESS;
 }
 
+/* ---- seed 003's proxy raster (the contract is sfb__raster_job's comment) ---- */
+int sfb__raster_setup(const sfb__raster_vertex *const S[3], int w, int h, double grow, sfb__raster_edges *t) {
+    double minx, maxx, miny, maxy, inv;
+    int k;
+    t->area = (S[1]->x - S[0]->x) * (S[2]->y - S[0]->y) - (S[2]->x - S[0]->x) * (S[1]->y - S[0]->y);
+    if (!(fabs(t->area) > 1e-12) || !isfinite(t->area)) return 0;
+    minx = maxx = S[0]->x;
+    miny = maxy = S[0]->y;
+    for (k = 1; k < 3; ++k) {
+        if (S[k]->x < minx) minx = S[k]->x;
+        if (S[k]->x > maxx) maxx = S[k]->x;
+        if (S[k]->y < miny) miny = S[k]->y;
+        if (S[k]->y > maxy) maxy = S[k]->y;
+    }
+    t->x0 = (int)sfb__rclamp(ceil(minx - 0.5 - grow), 0.0, (double)w);
+    t->x1 = (int)sfb__rclamp(floor(maxx - 0.5 + grow), -1.0, (double)w - 1.0);
+    t->y0 = (int)sfb__rclamp(ceil(miny - 0.5 - grow), 0.0, (double)h);
+    t->y1 = (int)sfb__rclamp(floor(maxy - 0.5 + grow), -1.0, (double)h - 1.0);
+    inv = 1.0 / t->area;
+    for (k = 0; k < 3; ++k) {
+        const sfb__raster_vertex *p0 = S[(k + 1) % 3], *p1 = S[(k + 2) % 3];
+        t->elen[k] = sqrt((p1->x - p0->x) * (p1->x - p0->x) + (p1->y - p0->y) * (p1->y - p0->y));
+        t->ea[k] = -(p1->y - p0->y) * inv;
+        t->eb[k] = (p1->x - p0->x) * inv;
+        t->ec[k] = ((p1->y - p0->y) * p0->x - (p1->x - p0->x) * p0->y) * inv;
+    }
+    return 1;
+}
+
+sfb_result sfb__ref_raster(void *state, const sfb__raster_job *j) {
+    int i;
+    (void)state;
+    for (i = 0; i < j->ntri; ++i) {
+        const int *tv = j->tri + 4 * (size_t)i;
+        const sfb__raster_vertex *S[3];
+        sfb__raster_edges t;
+        int k, x, y;
+        for (k = 0; k < 3; ++k) S[k] = &j->vert[tv[k]];
+        if (!sfb__raster_setup(S, j->w, j->h, 0.0, &t)) continue;
+        for (y = t.y0; y <= t.y1; ++y)
+            for (x = t.x0; x <= t.x1; ++x) {
+                const double px = x + 0.5, py = y + 0.5;
+                const size_t pix = (size_t)y * (size_t)j->w + (size_t)x;
+                double b[3], den, z;
+                for (k = 0; k < 3; ++k) b[k] = t.ea[k] * px + t.eb[k] * py + t.ec[k];
+                if (b[0] < 0.0 || b[1] < 0.0 || b[2] < 0.0) continue;
+                den = b[0] * S[0]->q + b[1] * S[1]->q + b[2] * S[2]->q;
+                if (!(den > 0.0)) continue;
+                z = j->ortho ? b[0] * S[0]->z + b[1] * S[1]->z + b[2] * S[2]->z : 1.0 / den;
+                if (!(z < (double)j->depth[pix])) continue;
+                for (k = 0; k < 3; ++k) b[k] *= S[k]->q / den;
+                j->depth[pix] = (float)z;
+                j->face[pix] = tv[3];
+                j->uv[2 * pix] = (float)sfb__rclamp(b[0] * S[0]->u + b[1] * S[1]->u + b[2] * S[2]->u, 0.0, 1.0);
+                j->uv[2 * pix + 1] = (float)sfb__rclamp(b[0] * S[0]->v + b[1] * S[1]->v + b[2] * S[2]->v, 0.0, 1.0);
+                if (j->apos) {
+                    int c;
+                    for (c = 0; c < 3; ++c) {
+                        j->pos[3 * pix + c] = (float)(b[0] * j->apos[3 * (size_t)tv[0] + c] + b[1] * j->apos[3 * (size_t)tv[1] + c] +
+                                                      b[2] * j->apos[3 * (size_t)tv[2] + c]);
+                        j->nrm[3 * pix + c] = (float)(b[0] * j->anrm[3 * (size_t)tv[0] + c] + b[1] * j->anrm[3 * (size_t)tv[1] + c] +
+                                                      b[2] * j->anrm[3 * (size_t)tv[2] + c]);
+                    }
+                }
+            }
+    }
+    return SFB_SUCCESS;
+}
+
 /* Every kernel (sfb__ref_eval_patches is in patches.c). */
 void sfb__ref_bind(sfb__backend_vtable *vt) {
     vt->name = "ref";
@@ -147,4 +216,5 @@ void sfb__ref_bind(sfb__backend_vtable *vt) {
     vt->eval_patches = sfb__ref_eval_patches;
     vt->finish_normals = sfb__ref_finish_normals;
     vt->shade = sfb__ref_shade;
+    vt->raster = sfb__ref_raster;
 }

@@ -472,7 +472,9 @@ typedef struct sfb_location { int face; float u, v; } sfb_location;
 /* Output arrays, xyz per location; NULL members are not computed. du/dv are derivatives in
  * the parametric face's (u,v); normal is unit length (du x dv normalised, and at an
  * extraordinary vertex itself the limit normal, where du and dv are the limit tangent
- * directions since the parametric derivatives vanish or diverge there). */
+ * directions since the parametric derivatives vanish or diverge there; SFB_SCHEME_PN: the
+ * method's quadratic normal field normalised, which equals the vertex normals at the corners
+ * but is not du x dv inside). */
 typedef struct sfb_eval_output { float *position, *du, *dv, *normal, *duu, *duv, *dvv; } sfb_eval_output;
 
 SFB_API int sfb_surface_param_face_count(const sfb_surface *surface);

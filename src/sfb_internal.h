@@ -42,6 +42,7 @@ typedef struct sfb__stencils {
  * (with a log line). Every slot but name/kind/init/shutdown may be NULL. A context keeps its
  * own copy of the bound table (no global state). */
 struct sfb__shade_job;
+struct sfb__raster_job;
 typedef struct sfb__backend_vtable {
     const char *name;
     sfb_backend_kind kind;
@@ -82,6 +83,9 @@ typedef struct sfb__backend_vtable {
     /* Seed 003's per-pixel analysis (analyze.c): items [first,last) of `job` (exact limit
      * position, derivatives and normal per pixel) -> the mode's values (sfb__shade_job). */
     sfb_result (*shade)(void *state, const struct sfb__shade_job *job, int first, int last);
+    /* Seed 003's proxy raster (analyze.c): every triangle of `job` into its per-pixel buffers,
+     * the nearest one kept (sfb__raster_job). */
+    sfb_result (*raster)(void *state, const struct sfb__raster_job *job);
 } sfb__backend_vtable;
 
 /* One analysis's shading (the `shade` slot). Per item i: P = position[3i..], N = normal (unit),
@@ -105,6 +109,39 @@ typedef struct sfb__shade_job {
     float *value, *value2;
 } sfb__shade_job;
 SFB__IF sfb_result sfb__ref_shade(void *state, const sfb__shade_job *job, int first, int last);
+
+/* One analysis's proxy raster (the `raster` slot). Vertices are in the picture: x, y in pixels
+ * (y down, pixel (i, j)'s centre at (i + 0.5, j + 0.5)), z the view depth (> 0), q = 1 / z
+ * (perspective) or 1 (orthographic), (u, v) in the face's frame. A triangle (three vertices
+ * and its parametric face, in order) covers the pixel centres inside it or on its edges; its
+ * attributes there are the vertices' weighted by b_k q_k / sum(b_j q_j) (b the barycentric
+ * coordinates in the picture: perspective-correct), its depth the interpolated z (that is
+ * 1 / sum(b_j q_j) in perspective). A pixel keeps the triangle of the smallest depth below
+ * what it holds (the first of equal ones, in order): depth[pix], face[pix], uv[2 pix..] (clamped
+ * to [0, 1]) and, with apos and anrm (3 per vertex each), pos[3 pix..] and nrm[3 pix..].
+ * The caller fills depth with +inf and face with -1. Triangles whose screen area is below
+ * 1e-12 square pixels cover nothing; kernels may differ from ref on pixels whose centre lies on
+ * an edge (GL's tie rule) and by float rounding of the interpolation. */
+typedef struct sfb__raster_vertex { double x, y, z, q, u, v; } sfb__raster_vertex;
+typedef struct sfb__raster_job {
+    int w, h, ortho;
+    int ntri;
+    const sfb__raster_vertex *vert;
+    const float *apos, *anrm; /* NULL, or the vertices' positions and normals to interpolate */
+    const int *tri;          /* 4 per triangle: three vertices, the parametric face */
+    float *depth;
+    int *face;
+    float *uv, *pos, *nrm;
+} sfb__raster_job;
+/* A triangle's set-up in the picture: its signed doubled area, edge lengths (edge k opposite
+ * corner k), barycentric planes (b_k = ea[k] x + eb[k] y + ec[k]) and the pixel box of the
+ * centres within `grow` pixels of it (x0 > x1 or y0 > y1: none); 0 when it is degenerate. */
+typedef struct sfb__raster_edges {
+    double area, elen[3], ea[3], eb[3], ec[3];
+    int x0, x1, y0, y1;
+} sfb__raster_edges;
+SFB__IF int sfb__raster_setup(const sfb__raster_vertex *const S[3], int w, int h, double grow, sfb__raster_edges *t);
+SFB__IF sfb_result sfb__ref_raster(void *state, const sfb__raster_job *job);
 
 /* Optional backends (backends/sfb_*.h), compiled in by SURFBLEND_SIMD / _GL / _OSMESA or
  * SURFBLEND_ALL_BACKENDS; the headers are included at the end of the implementation. */
@@ -222,6 +259,10 @@ typedef struct sfb__patch_table {
     float *point_data;     /* xyz per patch point, for the surface's base positions */
     const sfb__eigen_cc *eig[SFB__STAM_MAX_VALENCE + 1]; /* valences used (the context's cache) */
     const sfb__eigen_loop *eigl[SFB__STAM_MAX_VALENCE + 1]; /* Loop: the same */
+    /* NULL, or a table of the same parametric faces whose evaluated position, normalised, is
+     * the surface's normal in place of du x dv (PN triangles' quadratic normal field); its own
+     * normal_field is NULL. Owned: sfb__patch_table_free frees it. */
+    struct sfb__patch_table *normal_field;
 } sfb__patch_table;
 
 /* ---- context ---- */
@@ -415,6 +456,7 @@ struct sfb_surface {
     sfb__level pbase;            /* the prepared base level the patches were built from (tessellation
                                     shares vertices along its edges) */
     void *backend_patches;       /* the backend's uploaded copy */
+    void *backend_normal_field;  /* ... and of patches.normal_field, when there is one */
     sfb__shading *shading;       /* SFB_REFINE_SHADING */
 };
 

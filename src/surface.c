@@ -21,6 +21,8 @@ SFB_API void sfb_surface_destroy(sfb_surface *s) {
     }
     if (s->backend_patches && s->uploaded_by && s->uploaded_by->release_patches)
         s->uploaded_by->release_patches(ctx->backend_state, s->backend_patches);
+    if (s->backend_normal_field && s->uploaded_by && s->uploaded_by->release_patches)
+        s->uploaded_by->release_patches(ctx->backend_state, s->backend_normal_field);
     sfb__patch_table_free(ctx, &s->patches);
     if (s->shading) {
         int h;
@@ -249,6 +251,8 @@ static sfb_result sfb__surface_upload(sfb_surface *s) {
     if (s->has_patches && ctx->backend && ctx->backend->upload_patches) {
         s->uploaded_by = ctx->backend;
         r = ctx->backend->upload_patches(ctx->backend_state, &s->patches, &s->backend_patches);
+        if (r == SFB_SUCCESS && s->patches.normal_field)
+            r = ctx->backend->upload_patches(ctx->backend_state, s->patches.normal_field, &s->backend_normal_field);
         if (r != SFB_SUCCESS) return r;
     }
     return SFB_SUCCESS;
@@ -313,6 +317,13 @@ SFB_API sfb_result sfb_surface_param_face_base(const sfb_surface *s, int pf, int
     return SFB_SUCCESS;
 }
 
+/* The memory of a patch table and its points, its normal field's included. */
+static size_t sfb__patch_table_bytes(const sfb__patch_table *pt) {
+    return (size_t)pt->npatch * (4 * sizeof(int)) + (size_t)pt->ncv * sizeof(int) + (size_t)pt->nptex * 3 * sizeof(int) +
+           (size_t)pt->nnodes * 4 * sizeof(int) + (size_t)pt->npoints * 3 * sizeof(float) +
+           (pt->pcorner ? (size_t)pt->npatch * 4 * sizeof(unsigned) : 0) + (pt->normal_field ? sfb__patch_table_bytes(pt->normal_field) : 0);
+}
+
 SFB_API sfb_result sfb_surface_patch_info(const sfb_surface *s, sfb_patch_info *o) {
     const sfb__patch_table *pt;
     if (!s || !o) return SFB_INVALID_ARGS;
@@ -329,8 +340,7 @@ SFB_API sfb_result sfb_surface_patch_info(const sfb_surface *s, sfb_patch_info *
     o->max_depth = pt->max_depth;
     o->points = pt->npoints;
     o->domain_sides = pt->domain == SFB__DOMAIN_TRI ? 3 : 4;
-    o->bytes = (size_t)pt->npatch * (4 * sizeof(int)) + (size_t)pt->ncv * sizeof(int) + (size_t)pt->nptex * 3 * sizeof(int) +
-               (size_t)pt->nnodes * 4 * sizeof(int) + (size_t)pt->npoints * 3 * sizeof(float) + (pt->pcorner ? (size_t)pt->npatch * 4 * sizeof(unsigned) : 0);
+    o->bytes = sfb__patch_table_bytes(pt);
     return SFB_SUCCESS;
 }
 
@@ -360,16 +370,42 @@ SFB_API sfb_result sfb_surface_eval(const sfb_surface *s, const sfb_location *lo
     return sfb__surface_eval_unchecked(s, loc, count, out);
 }
 
-sfb_result sfb__surface_eval_unchecked(const sfb_surface *s, const sfb_location *loc, int count, const sfb_eval_output *out) {
+/* One of the surface's patch tables (`handle`: its upload) on the context's backend, or on ref
+ * when the backend lacks eval_patches. */
+static sfb_result sfb__surface_eval_table(const sfb_surface *s, const sfb__patch_table *pt, void *handle, const sfb_location *loc,
+                                          int count, const sfb_eval_output *out) {
     sfb_context *ctx = s->ctx;
-    const sfb__backend_vtable *be;
-    if (count == 0) return SFB_SUCCESS;
-    be = ctx->backend;
+    const sfb__backend_vtable *be = ctx->backend;
     if (!be || !be->eval_patches) {
         sfb__log(ctx, SFB_LOG_INFO, "backend %s lacks eval_patches; using ref", be ? be->name : "none");
-        return sfb__ref_eval_patches(NULL, &s->patches, NULL, loc, 0, count, out);
+        return sfb__ref_eval_patches(NULL, pt, NULL, loc, 0, count, out);
     }
-    return be->eval_patches(ctx->backend_state, &s->patches, s->uploaded_by == be ? s->backend_patches : NULL, loc, 0, count, out);
+    return be->eval_patches(ctx->backend_state, pt, s->uploaded_by == be ? handle : NULL, loc, 0, count, out);
+}
+
+/* With a normal field (PN triangles), the normals are that field's values normalised, in
+ * double (a zero vector stays zero), and the patches give the rest. */
+sfb_result sfb__surface_eval_unchecked(const sfb_surface *s, const sfb_location *loc, int count, const sfb_eval_output *out) {
+    const sfb__patch_table *nf = s->patches.normal_field;
+    sfb_eval_output rest;
+    sfb_result r;
+    int q;
+    if (count == 0) return SFB_SUCCESS;
+    if (!nf || !out->normal) return sfb__surface_eval_table(s, &s->patches, s->backend_patches, loc, count, out);
+    memset(&rest, 0, sizeof rest);
+    rest.position = out->normal;
+    if ((r = sfb__surface_eval_table(s, nf, s->backend_normal_field, loc, count, &rest)) != SFB_SUCCESS) return r;
+    for (q = 0; q < count; ++q) {
+        float *n = out->normal + 3 * (size_t)q;
+        const double len = sqrt((double)n[0] * n[0] + (double)n[1] * n[1] + (double)n[2] * n[2]);
+        if (len > 0.0) {
+            n[0] = (float)(n[0] / len); n[1] = (float)(n[1] / len); n[2] = (float)(n[2] / len);
+        }
+    }
+    rest = *out;
+    rest.normal = NULL;
+    if (!rest.position && !rest.du && !rest.dv && !rest.duu && !rest.duv && !rest.dvv) return SFB_SUCCESS;
+    return sfb__surface_eval_table(s, &s->patches, s->backend_patches, loc, count, &rest);
 }
 
 SFB_API sfb_result sfb_surface_stencil_info(const sfb_surface *s, sfb_table t, sfb_stencil_info *out) {

@@ -44,6 +44,10 @@
  *                             255), the others still magenta
  *   analysis/state            the host's state after sfb_surface_analyze and the overlay, as
  *                             draw/state (the storage bindings 0..7 shade.comp.glsl uses included)
+ *   analysis/raster-state     the analysis's proxy raster (an offscreen framebuffer of its own) with
+ *                             the host's scissor box, masks, GL_NEVER, stencil, culling, blending,
+ *                             viewport and pack state set against it: that state is the host's
+ *                             again afterwards, and the picture is a ref context's
  *   analysis/not-host         sfb_analysis_draw_gl on a ref context: SFB_UNSUPPORTED
  * With --bench: frames per second of the draw path, seed 000's Table 3 setting (30 x 30 samples
  * per face, rate 29) on tori of 32, 180 and 442 quads and on peer shapes, 512 x 512 framebuffer
@@ -920,8 +924,101 @@ static const char *const k_draw_checks[] = {"draw/capture/catmark_torus", "draw/
                                             "errors/ref-context", "errors/own-gl-context", "errors/osmesa-context", "errors/rate-negative",
                                             "errors/rate-1025", "errors/faces", "errors/capture-small", "errors/capture-not-a-buffer",
                                             "errors/trim-not-a-texture", "errors/nan-matrix", "errors/tiles", "errors/trim-texture-mask",
-                                            "errors/state", "draw/gles31", "analysis/overlay", "analysis/state", "analysis/not-host",
+                                            "errors/state", "draw/gles31", "analysis/overlay", "analysis/state", "analysis/raster-state", "analysis/not-host",
                                             "draw/destroy", NULL};
+
+/* The analysis's proxy raster draws into a framebuffer of its own on the host's context: the
+ * state that drawing touches, set by the host to values that would spoil the raster (a scissor
+ * box, masks off, GL_NEVER, the stencil test, culling, blending, an odd viewport, pack state),
+ * is the host's again afterwards, and the picture is the one a ref context computes (the
+ * raster ignored the host's state). analysis/raster-state; 1 when `a` was computed. */
+typedef struct raster_state {
+    GLint draw_fbo, read_fbo, viewport[4], depth_func, pack_buffer, pack_align, pack_row;
+    GLboolean depth_mask, color_mask[4], scissor, stencil, cull, blend, depth;
+} raster_state;
+static void raster_state_read(raster_state *r) {
+    memset(r, 0, sizeof *r);
+    glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &r->draw_fbo);
+    glGetIntegerv(GL_READ_FRAMEBUFFER_BINDING, &r->read_fbo);
+    glGetIntegerv(GL_VIEWPORT, r->viewport);
+    glGetIntegerv(GL_DEPTH_FUNC, &r->depth_func);
+    glGetIntegerv(GL_PIXEL_PACK_BUFFER_BINDING, &r->pack_buffer);
+    glGetIntegerv(GL_PACK_ALIGNMENT, &r->pack_align);
+    glGetIntegerv(GL_PACK_ROW_LENGTH, &r->pack_row);
+    glGetBooleanv(GL_DEPTH_WRITEMASK, &r->depth_mask);
+    glGetBooleanv(GL_COLOR_WRITEMASK, r->color_mask);
+    r->scissor = glIsEnabled(GL_SCISSOR_TEST);
+    r->stencil = glIsEnabled(GL_STENCIL_TEST);
+    r->cull = glIsEnabled(GL_CULL_FACE);
+    r->blend = glIsEnabled(GL_BLEND);
+    r->depth = glIsEnabled(GL_DEPTH_TEST);
+}
+static int analysis_raster_state(sfb_context *ctx, sfb_context *ref, sfb_surface *s, const char *obj, size_t len,
+                                 const sfb_analyze_config *ac, sfb_analysis *a) {
+    raster_state want, got;
+    GLuint pack = 0;
+    sfb_mesh *rm = NULL;
+    sfb_surface *rs = NULL;
+    sfb_surface_config sc = sfb_surface_config_init(SFB_SCHEME_CATMARK, 0);
+    sfb_analysis ra;
+    sfb_result r;
+    long k, differ = 0;
+    memset(&ra, 0, sizeof ra);
+    glGenBuffers(1, &pack);
+    glBindBuffer(GL_PIXEL_PACK_BUFFER, pack);
+    glBufferData(GL_PIXEL_PACK_BUFFER, 64, NULL, GL_STREAM_READ);
+    glPixelStorei(GL_PACK_ALIGNMENT, 8);
+    glPixelStorei(GL_PACK_ROW_LENGTH, 3);
+    glViewport(3, 5, 7, 9);
+    glScissor(0, 0, 1, 1);
+    glEnable(GL_SCISSOR_TEST);
+    glEnable(GL_STENCIL_TEST);
+    glEnable(GL_CULL_FACE);
+    glCullFace(GL_FRONT_AND_BACK);
+    glEnable(GL_BLEND);
+    glDepthFunc(GL_NEVER);
+    glDepthMask(GL_FALSE);
+    glColorMask(GL_FALSE, GL_TRUE, GL_FALSE, GL_FALSE);
+    raster_state_read(&want);
+    r = sfb_surface_analyze(s, ac, a);
+    raster_state_read(&got);
+    glBindBuffer(GL_PIXEL_PACK_BUFFER, 0);
+    glDeleteBuffers(1, &pack);
+    glPixelStorei(GL_PACK_ALIGNMENT, 4);
+    glPixelStorei(GL_PACK_ROW_LENGTH, 0);
+    glViewport(0, 0, FB_SIZE, FB_SIZE);
+    glDisable(GL_SCISSOR_TEST);
+    glDisable(GL_STENCIL_TEST);
+    glDisable(GL_CULL_FACE);
+    glCullFace(GL_BACK);
+    glDisable(GL_BLEND);
+    glDepthFunc(GL_LESS);
+    glDepthMask(GL_TRUE);
+    glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+    if (r != SFB_SUCCESS) {
+        fail("analysis/raster-state", "sfb_surface_analyze: %s", sfb_last_error(ctx));
+        return 0;
+    }
+    sc.flags = SFB_REFINE_PATCHES;
+    if (sfb_mesh_read_obj(ref, obj, len, &rm) != SFB_SUCCESS || sfb_surface_create(ref, rm, &sc, &rs) != SFB_SUCCESS ||
+        sfb_surface_analyze(rs, ac, &ra) != SFB_SUCCESS) {
+        fail("analysis/raster-state", "the ref analysis: %s", sfb_last_error(ref));
+    } else {
+        for (k = 0; k < (long)ra.width * ra.height; ++k) differ += ra.classes[k] != a->classes[k];
+        check(memcmp(&want, &got, sizeof want) == 0 && a->proxy_pixels > 1000 &&
+                  labs((long)a->proxy_pixels - (long)ra.proxy_pixels) <= ra.proxy_pixels / 200 && differ <= ra.covered_pixels / 200,
+              "analysis/raster-state",
+              "state %s (viewport %d %d %d %d, depth func 0x%x, scissor %d, colour mask %d%d%d%d, pack %d/%d/%d); proxy pixels %d, ref %d; "
+              "%ld of %d classes differ",
+              memcmp(&want, &got, sizeof want) ? "changed" : "kept", got.viewport[0], got.viewport[1], got.viewport[2], got.viewport[3],
+              got.depth_func, got.scissor, got.color_mask[0], got.color_mask[1], got.color_mask[2], got.color_mask[3], got.pack_buffer,
+              got.pack_align, got.pack_row, a->proxy_pixels, ra.proxy_pixels, differ, ra.covered_pixels);
+    }
+    sfb_analysis_free(&ra);
+    sfb_surface_destroy(rs);
+    sfb_mesh_destroy(rm);
+    return 1;
+}
 
 /* seed 003's analysis drawn over the host's framebuffer (sfb_analysis_draw_gl): the pixels on
  * the surface are the analysis picture's, the others keep the host's clear colour, with the
@@ -942,7 +1039,7 @@ static void analysis_checks(sfb_context *ctx, sfb_context *ref, const gl_state *
     sc.flags = SFB_REFINE_PATCHES;
     ac.width = ac.height = FB_SIZE;
     if (sfb_mesh_read_obj(ctx, cube, sizeof cube - 1, &m) != SFB_SUCCESS || sfb_surface_create(ctx, m, &sc, &s) != SFB_SUCCESS ||
-        sfb_surface_analyze(s, &ac, &a) != SFB_SUCCESS) {
+        !analysis_raster_state(ctx, ref, s, cube, sizeof cube - 1, &ac, &a)) {
         fail("analysis/overlay", "setting up: %s", sfb_last_error(ctx));
         fail("analysis/state", "not run");
     } else {

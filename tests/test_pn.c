@@ -2,7 +2,7 @@
  * the vertices with their angle-weighted normals (recomputed here independently), flat input
  * stays flat, the surface is closed across edges (C0: both triangles give the same edge
  * points) and a cubic along each edge whose tangents at the ends lie in the vertices' tangent
- * planes, the backends agree, and bad input is refused with nothing left behind. */
+ * planes, the normals are the method's quadratic field, the backends agree, and bad input is refused with nothing left behind. */
 #include <criterion/criterion.h>
 #include <math.h>
 #include <stdio.h>
@@ -218,9 +218,14 @@ Test(pn, flat_input_stays_flat)
     sfb_context_destroy(ctx);
 }
 
-Test(pn, backends_agree_with_ref)
+/* one backend against ref at 400 random locations: positions, du (the derivative scaled by
+ * 1/4, as the patch's edges are that much longer than its points' spacing) and normals (the
+ * quadratic field, evaluated on the backend and normalised); skipped when the backend is not
+ * available here */
+static void pn_agree(sfb_backend_kind kind)
 {
-    static const int kinds[3] = { SFB_BACKEND_SIMD, SFB_BACKEND_GL, SFB_BACKEND_OSMESA };
+    sfb_context *c = pn_ctx((int)kind);
+    if (!c) cr_skip_test("backend %s is not available here", kind == SFB_BACKEND_SIMD ? "simd" : kind == SFB_BACKEND_GL ? "gl" : "osmesa");
     char *obj = jittered_octahedron(11);
     sfb_context *rc = pn_ctx(SFB_BACKEND_REF);
     cr_assert_not_null(rc);
@@ -237,36 +242,103 @@ Test(pn, backends_agree_with_ref)
         L[i].u = u;
         L[i].v = v;
     }
-    float P0[3 * N], D0[3 * N], P1[3 * N], D1[3 * N];
+    float P0[3 * N], D0[3 * N], N0[3 * N], P1[3 * N], D1[3 * N], N1[3 * N];
     sfb_eval_output o;
     memset(&o, 0, sizeof o);
     o.position = P0;
     o.du = D0;
+    o.normal = N0;
     cr_assert_eq(sfb_surface_eval(rs, L, N, &o), SFB_SUCCESS);
-    int ran = 0;
-    for (int k = 0; k < 3; ++k) {
-        sfb_context *c = pn_ctx(kinds[k]);
-        if (!c) continue;
-        ran++;
-        sfb_mesh *m = pn_mesh(c, obj);
-        sfb_surface *s = pn_surface(c, m);
-        o.position = P1;
-        o.du = D1;
-        cr_assert_eq(sfb_surface_eval(s, L, N, &o), SFB_SUCCESS, "%s: %s", sfb_context_backend_name(c), sfb_last_error(c));
-        double worst = 0;
-        for (int i = 0; i < 3 * N; ++i) {
-            worst = fmax(worst, fabs(P1[i] - P0[i]));
-            worst = fmax(worst, fabs(D1[i] - D0[i]) * 0.25);
-        }
-        cr_expect_lt(worst, 2e-5, "%s differs from ref by %g", sfb_context_backend_name(c), worst);
-        sfb_surface_destroy(s);
-        sfb_mesh_destroy(m);
-        sfb_context_destroy(c);
+    sfb_mesh *m = pn_mesh(c, obj);
+    sfb_surface *s = pn_surface(c, m);
+    o.position = P1;
+    o.du = D1;
+    o.normal = N1;
+    cr_assert_eq(sfb_surface_eval(s, L, N, &o), SFB_SUCCESS, "%s: %s", sfb_context_backend_name(c), sfb_last_error(c));
+    double worst = 0, worst_n = 0;
+    for (int i = 0; i < 3 * N; ++i) {
+        worst = fmax(worst, fabs(P1[i] - P0[i]));
+        worst = fmax(worst, fabs(D1[i] - D0[i]) * 0.25);
+        worst_n = fmax(worst_n, fabs(N1[i] - N0[i]));
     }
-    (void)ran; /* backends not available here are left out (the agree suite reports them skipped) */
+    cr_expect_lt(worst, 2e-5, "%s differs from ref by %g", sfb_context_backend_name(c), worst);
+    cr_expect_lt(worst_n, 2e-6, "%s's normals differ from ref's by %g", sfb_context_backend_name(c), worst_n);
+    sfb_surface_destroy(s);
+    sfb_mesh_destroy(m);
+    sfb_context_destroy(c);
     sfb_surface_destroy(rs);
     sfb_mesh_destroy(rm);
     sfb_context_destroy(rc);
+    free(obj);
+}
+
+Test(pn, simd_agrees_with_ref) { pn_agree(SFB_BACKEND_SIMD); }
+Test(pn, gl_agrees_with_ref) { pn_agree(SFB_BACKEND_GL); }
+Test(pn, osmesa_agrees_with_ref) { pn_agree(SFB_BACKEND_OSMESA); }
+
+/* the normals are the method's quadratic field (Vlachos et al.), recomputed here: corners N_i,
+ * edge middles h_ij = normalize(N_i + N_j - v_ij (P_j - P_i)), v_ij = 2 (P_j - P_i).(N_i + N_j)
+ * / |P_j - P_i|^2, n(u,v) = normalize(sum of the quadratic Bernstein terms); not the
+ * geometry's du x dv, which this check also shows to differ */
+Test(pn, normals_are_the_quadratic_field)
+{
+    sfb_context *ctx = pn_ctx(-1);
+    char *obj = jittered_octahedron(3);
+    sfb_mesh *m = pn_mesh(ctx, obj);
+    sfb_surface *s = pn_surface(ctx, m);
+    sfb_mesh_desc d;
+    sfb_mesh_get_desc(m, &d);
+    double vn[18], worst = 0, geometric = 0;
+    expected_normals(&d, vn);
+    for (int f = 0; f < 8; ++f) {
+        const int *fv = d.face_vertices + 3 * f;
+        double h[3][3]; /* middles of edges 01, 12, 20 */
+        for (int e = 0; e < 3; ++e) {
+            const int a = fv[e], b = fv[(e + 1) % 3];
+            double dd = 0, dn = 0, l = 0;
+            for (int c = 0; c < 3; ++c) {
+                double x = (double)d.positions[3 * b + c] - d.positions[3 * a + c];
+                dd += x * x;
+                dn += x * (vn[3 * a + c] + vn[3 * b + c]);
+            }
+            for (int c = 0; c < 3; ++c) {
+                h[e][c] = vn[3 * a + c] + vn[3 * b + c] - 2 * dn / dd * ((double)d.positions[3 * b + c] - d.positions[3 * a + c]);
+                l += h[e][c] * h[e][c];
+            }
+            for (int c = 0; c < 3; ++c) h[e][c] /= sqrt(l);
+        }
+        for (int q = 0; q < 12; ++q) {
+            sfb_location L = {f, (float)((q % 4 + 0.5) / 5.0), (float)((q / 4 + 0.3) / 4.0)};
+            if (L.u + L.v > 1.0f) { L.u = 1.0f - L.u; L.v = 1.0f - L.v; }
+            const double u = L.u, v = L.v, w = 1.0 - u - v;
+            float N[3], du[3], dv[3];
+            sfb_eval_output o;
+            memset(&o, 0, sizeof o);
+            o.normal = N;
+            o.du = du;
+            o.dv = dv;
+            cr_assert_eq(sfb_surface_eval(s, &L, 1, &o), SFB_SUCCESS);
+            double want[3], l = 0, g[3], lg = 0;
+            for (int c = 0; c < 3; ++c) {
+                want[c] = w * w * vn[3 * fv[0] + c] + u * u * vn[3 * fv[1] + c] + v * v * vn[3 * fv[2] + c] + 2 * w * u * h[0][c] +
+                          2 * u * v * h[1][c] + 2 * v * w * h[2][c];
+                l += want[c] * want[c];
+            }
+            g[0] = (double)du[1] * dv[2] - (double)du[2] * dv[1];
+            g[1] = (double)du[2] * dv[0] - (double)du[0] * dv[2];
+            g[2] = (double)du[0] * dv[1] - (double)du[1] * dv[0];
+            for (int c = 0; c < 3; ++c) lg += g[c] * g[c];
+            for (int c = 0; c < 3; ++c) {
+                worst = fmax(worst, fabs(N[c] - want[c] / sqrt(l)));
+                geometric = fmax(geometric, fabs(N[c] - g[c] / sqrt(lg)));
+            }
+        }
+    }
+    cr_expect_lt(worst, 2e-6, "normals off the quadratic field by %g", worst);
+    cr_expect_gt(geometric, 1e-3, "the normals are du x dv's (%g): no quadratic field", geometric);
+    sfb_surface_destroy(s);
+    sfb_mesh_destroy(m);
+    sfb_context_destroy(ctx);
     free(obj);
 }
 

@@ -59,7 +59,17 @@ enum {
     SFB__GL_TRANSFORM_FEEDBACK_BUFFER = 0x8C8E, SFB__GL_TRANSFORM_FEEDBACK_BUFFER_BINDING = 0x8C8F,
     SFB__GL_INTERLEAVED_ATTRIBS = 0x8C8C, SFB__GL_RASTERIZER_DISCARD = 0x8C89,
     /* the analysis on the host's framebuffer (sfb_analysis_draw_gl) */
-    SFB__GL_DEPTH_TEST = 0x0B71, SFB__GL_CULL_FACE = 0x0B44, SFB__GL_BLEND = 0x0BE2, SFB__GL_VIEWPORT = 0x0BA2, SFB__GL_RGBA8 = 0x8058
+    SFB__GL_DEPTH_TEST = 0x0B71, SFB__GL_CULL_FACE = 0x0B44, SFB__GL_BLEND = 0x0BE2, SFB__GL_VIEWPORT = 0x0BA2, SFB__GL_RGBA8 = 0x8058,
+    /* the analysis proxy's raster (raster.h): an offscreen framebuffer */
+    SFB__GL_FRAMEBUFFER = 0x8D40, SFB__GL_DRAW_FRAMEBUFFER = 0x8CA9, SFB__GL_READ_FRAMEBUFFER = 0x8CA8,
+    SFB__GL_DRAW_FRAMEBUFFER_BINDING = 0x8CA6, SFB__GL_READ_FRAMEBUFFER_BINDING = 0x8CAA, SFB__GL_FRAMEBUFFER_COMPLETE = 0x8CD5,
+    SFB__GL_COLOR_ATTACHMENT0 = 0x8CE0, SFB__GL_DEPTH_ATTACHMENT = 0x8D00, SFB__GL_NONE = 0,
+    SFB__GL_RGBA32UI = 0x8D70, SFB__GL_DEPTH_COMPONENT32F = 0x8CAC, SFB__GL_DEPTH_COMPONENT = 0x1902,
+    SFB__GL_COLOR = 0x1800, SFB__GL_DEPTH = 0x1801, SFB__GL_LESS = 0x0201, SFB__GL_DEPTH_FUNC = 0x0B74,
+    SFB__GL_DEPTH_WRITEMASK = 0x0B72, SFB__GL_COLOR_WRITEMASK = 0x0C23, SFB__GL_SCISSOR_TEST = 0x0C11, SFB__GL_STENCIL_TEST = 0x0B90,
+    SFB__GL_PACK_ALIGNMENT = 0x0D05, SFB__GL_PACK_ROW_LENGTH = 0x0D02, SFB__GL_PACK_SKIP_ROWS = 0x0D03, SFB__GL_PACK_SKIP_PIXELS = 0x0D04,
+    SFB__GL_PIXEL_PACK_BUFFER = 0x88EB, SFB__GL_PIXEL_PACK_BUFFER_BINDING = 0x88ED,
+    SFB__GL_ARRAY_BUFFER = 0x8892, SFB__GL_ARRAY_BUFFER_BINDING = 0x8894, SFB__GL_MAX_VIEWPORT_DIMS = 0x0D3A
 };
 #define SFB__GL_ALL_BARRIER_BITS 0xFFFFFFFFu
 #define SFB__GL_BUFFER_UPDATE_BARRIER_BIT 0x00000200u
@@ -133,7 +143,26 @@ enum {
     X(void, Uniform3f, (sfb__GLint, float, float, float))                                             \
     X(void, Uniform4f, (sfb__GLint, float, float, float, float))                                      \
     X(void, UniformMatrix3fv, (sfb__GLint, sfb__GLsizei, sfb__GLboolean, const float *))              \
-    X(void, UniformMatrix4fv, (sfb__GLint, sfb__GLsizei, sfb__GLboolean, const float *))
+    X(void, UniformMatrix4fv, (sfb__GLint, sfb__GLsizei, sfb__GLboolean, const float *))              \
+    X(void, Uniform2f, (sfb__GLint, float, float))                                                    \
+    X(void, GetBooleanv, (sfb__GLenum, sfb__GLboolean *))                                             \
+    X(void, GenFramebuffers, (sfb__GLsizei, sfb__GLuint *))                                           \
+    X(void, DeleteFramebuffers, (sfb__GLsizei, const sfb__GLuint *))                                  \
+    X(void, BindFramebuffer, (sfb__GLenum, sfb__GLuint))                                              \
+    X(void, FramebufferTexture2D, (sfb__GLenum, sfb__GLenum, sfb__GLenum, sfb__GLuint, sfb__GLint))   \
+    X(sfb__GLenum, CheckFramebufferStatus, (sfb__GLenum))                                             \
+    X(void, DrawBuffers, (sfb__GLsizei, const sfb__GLenum *))                                         \
+    X(void, ReadBuffer, (sfb__GLenum))                                                                \
+    X(void, ClearBufferuiv, (sfb__GLenum, sfb__GLint, const sfb__GLuint *))                           \
+    X(void, ClearBufferfv, (sfb__GLenum, sfb__GLint, const float *))                                  \
+    X(void, ReadPixels, (sfb__GLint, sfb__GLint, sfb__GLsizei, sfb__GLsizei, sfb__GLenum, sfb__GLenum, void *)) \
+    X(void, Viewport, (sfb__GLint, sfb__GLint, sfb__GLsizei, sfb__GLsizei))                           \
+    X(void, DepthFunc, (sfb__GLenum))                                                                 \
+    X(void, DepthMask, (sfb__GLboolean))                                                              \
+    X(void, ColorMask, (sfb__GLboolean, sfb__GLboolean, sfb__GLboolean, sfb__GLboolean))              \
+    X(void, EnableVertexAttribArray, (sfb__GLuint))                                                   \
+    X(void, VertexAttribPointer, (sfb__GLuint, sfb__GLint, sfb__GLenum, sfb__GLboolean, sfb__GLsizei, const void *)) \
+    X(void, VertexAttribIPointer, (sfb__GLuint, sfb__GLint, sfb__GLenum, sfb__GLsizei, const void *))
 
 typedef struct sfb__glfns {
 #define SFB__GL_MEMBER(ret, name, args) ret(SFB__GLAPI *name) args;

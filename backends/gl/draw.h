@@ -55,19 +55,15 @@ static void sfb__gl_draw_restore(sfb__gl *g, const sfb__gl_drawstate *d) {
  * gl_VertexID and gl_InstanceID), index buffer and transform feedback object. */
 static sfb_result sfb__gl_draw_program(sfb__gl *g) {
     static const char *const varyings[2] = {"v_cap_pos", "v_cap_nrm"};
-    sfb__GLuint sh[2], prog;
+    sfb__GLuint prog;
     sfb_result r;
     int i;
     if (g->draw_program) return SFB_SUCCESS;
     if ((r = sfb__gl_mf_sampler(g)) != SFB_SUCCESS) return r;
-    if ((r = sfb__gl_shader(g, SFB__GL_VERTEX_SHADER, "#define SFB_MF_VERTEX\n", SFB__GL_MANIFOLD_SOURCE, "manifold.comp.glsl (vertex stage)",
-                            &sh[0])) != SFB_SUCCESS)
+    if ((r = sfb__gl_draw_stages(g, "#define SFB_MF_VERTEX\n", SFB__GL_MANIFOLD_SOURCE, "manifold.comp.glsl (vertex stage)",
+                                 SFB__GL_MANIFOLD_FRAG_SOURCE, "manifold_draw.frag.glsl", varyings, 2, "the manifold draw program", &prog)) !=
+        SFB_SUCCESS)
         return r;
-    if ((r = sfb__gl_shader(g, SFB__GL_FRAGMENT_SHADER, "", SFB__GL_MANIFOLD_FRAG_SOURCE, "manifold_draw.frag.glsl", &sh[1])) != SFB_SUCCESS) {
-        g->gl.DeleteShader(sh[0]);
-        return r;
-    }
-    if ((r = sfb__gl_link(g, sh, 2, varyings, 2, "the manifold draw program", &prog)) != SFB_SUCCESS) return r;
     for (i = 0; i < 5; ++i) g->draw_loc[i] = g->gl.GetUniformLocation(prog, sfb__gl_mf_common_uniforms[i]);
     for (i = 0; i < 9; ++i) g->draw_loc[5 + i] = g->gl.GetUniformLocation(prog, sfb__gl_draw_uniforms[i]);
     g->draw_program = prog;
@@ -329,18 +325,14 @@ SFB_API sfb_result sfb_gl_trim_texture(sfb_context *ctx, const struct sfb_trim_m
 /* ---- seed 003's analysis on the host's framebuffer (sfb_analysis_draw_gl) ---- */
 static sfb_result sfb__gl_an_program(sfb__gl *g) {
     static const char *const names[3] = {"u_picture", "u_viewport", "u_size"};
-    sfb__GLuint sh[2], prog;
+    sfb__GLuint prog;
     sfb_result r;
     int i;
     if (g->an_program) return SFB_SUCCESS;
     if ((r = sfb__gl_mf_sampler(g)) != SFB_SUCCESS) return r;
-    if ((r = sfb__gl_shader(g, SFB__GL_VERTEX_SHADER, "", sfb__glsl_analysis_draw_vert_glsl, "analysis_draw.vert.glsl", &sh[0])) != SFB_SUCCESS)
+    if ((r = sfb__gl_draw_stages(g, "", sfb__glsl_analysis_draw_vert_glsl, "analysis_draw.vert.glsl", sfb__glsl_analysis_draw_frag_glsl,
+                                 "analysis_draw.frag.glsl", NULL, 0, "the analysis draw program", &prog)) != SFB_SUCCESS)
         return r;
-    if ((r = sfb__gl_shader(g, SFB__GL_FRAGMENT_SHADER, "", sfb__glsl_analysis_draw_frag_glsl, "analysis_draw.frag.glsl", &sh[1])) != SFB_SUCCESS) {
-        g->gl.DeleteShader(sh[0]);
-        return r;
-    }
-    if ((r = sfb__gl_link(g, sh, 2, NULL, 0, "the analysis draw program", &prog)) != SFB_SUCCESS) return r;
     for (i = 0; i < 3; ++i) g->an_loc[i] = g->gl.GetUniformLocation(prog, names[i]);
     g->an_program = prog;
     g->gl.GenVertexArrays(1, &g->an_vao);

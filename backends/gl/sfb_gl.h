@@ -97,6 +97,8 @@ typedef struct sfb__gl {
     int draw_rate;                  /* the grid draw_ibo holds */
     sfb__GLuint an_program, an_vao; /* sfb_analysis_draw_gl: analysis_draw.{vert,frag}.glsl, made on first use */
     sfb__GLint an_loc[3];
+    sfb__GLuint raster_program, raster_vao, raster_buf[2]; /* seed 003's proxy raster (raster.h), made on first use */
+    sfb__GLint raster_loc[3];
     char desc[320];
 } sfb__gl;
 
@@ -317,6 +319,21 @@ static sfb_result sfb__gl_link(sfb__gl *g, const sfb__GLuint *shaders, int count
     return SFB_SUCCESS;
 }
 
+/* Compiles a vertex and a fragment stage (each with `defines`: vdefs for the vertex one) and
+ * links them into a draw program (see sfb__gl_link for `varyings`). */
+static sfb_result sfb__gl_draw_stages(sfb__gl *g, const char *vdefs, const char *vsrc, const char *vlabel, const char *fsrc, const char *flabel,
+                                      const char *const *varyings, int nvaryings, const char *label, sfb__GLuint *out) {
+    sfb__GLuint sh[2];
+    sfb_result r;
+    *out = 0;
+    if ((r = sfb__gl_shader(g, SFB__GL_VERTEX_SHADER, vdefs, vsrc, vlabel, &sh[0])) != SFB_SUCCESS) return r;
+    if ((r = sfb__gl_shader(g, SFB__GL_FRAGMENT_SHADER, "", fsrc, flabel, &sh[1])) != SFB_SUCCESS) {
+        g->gl.DeleteShader(sh[0]);
+        return r;
+    }
+    return sfb__gl_link(g, sh, 2, varyings, nvaryings, label, out);
+}
+
 /* Compiles and links one compute kernel (see sfb__gl_shader). */
 static sfb_result sfb__gl_compile(sfb__gl *g, const char *defines, const char *source, const char *label, sfb__GLuint *out) {
     sfb__GLuint sh;
@@ -417,6 +434,11 @@ static void sfb__gl_release_gl(sfb__gl *g) {
     if (g->an_program) g->gl.DeleteProgram(g->an_program);
     if (g->an_vao) g->gl.DeleteVertexArrays(1, &g->an_vao);
     g->an_program = g->an_vao = 0;
+    if (g->raster_program) g->gl.DeleteProgram(g->raster_program);
+    if (g->raster_vao) g->gl.DeleteVertexArrays(1, &g->raster_vao);
+    for (i = 0; i < 2; ++i)
+        if (g->raster_buf[i]) g->gl.DeleteBuffers(1, &g->raster_buf[i]);
+    g->raster_program = g->raster_vao = g->raster_buf[0] = g->raster_buf[1] = 0;
     if (g->draw_program) g->gl.DeleteProgram(g->draw_program);
     if (g->draw_vao) g->gl.DeleteVertexArrays(1, &g->draw_vao);
     if (g->draw_ibo) g->gl.DeleteBuffers(1, &g->draw_ibo);

@@ -1006,6 +1006,61 @@ static const char sfb__glsl_patches_comp_glsl[] =
     "}\n"
     ;
 
+/* backends/gl/glsl/raster.frag.glsl */
+static const char sfb__glsl_raster_frag_glsl[] =
+    "// Seed 003's proxy raster, fragment stage: the nearest triangle's (u, v) (clamped to [0, 1]),\n"
+    "// view depth and parametric face (+ 1; 0 is \"none\") as the bits of an RGBA32UI texel, and its\n"
+    "// interpolated position and normal (the polygon-based method) in two more; the depth test keeps\n"
+    "// the smallest view depth (scaled into [0, 1] by u_zscale), the first of equal ones.\n"
+    "uniform float u_zscale;\n"
+    "in vec2 v_uv;\n"
+    "in float v_z;\n"
+    "flat in int v_face;\n"
+    "in vec3 v_pos;\n"
+    "in vec3 v_nrm;\n"
+    "layout(location = 0) out uvec4 o_hit;\n"
+    "layout(location = 1) out uvec4 o_pos;\n"
+    "layout(location = 2) out uvec4 o_nrm;\n"
+    "\n"
+    "void main() {\n"
+    "    vec2 uv = clamp(v_uv, 0.0, 1.0);\n"
+    "    o_hit = uvec4(floatBitsToUint(uv.x), floatBitsToUint(uv.y), floatBitsToUint(v_z), uint(v_face + 1));\n"
+    "    o_pos = uvec4(floatBitsToUint(v_pos), 0u);\n"
+    "    o_nrm = uvec4(floatBitsToUint(v_nrm), 0u);\n"
+    "    gl_FragDepth = clamp(v_z * u_zscale, 0.0, 1.0);\n"
+    "}\n"
+    ;
+
+/* backends/gl/glsl/raster.vert.glsl */
+static const char sfb__glsl_raster_vert_glsl[] =
+    "// Seed 003's proxy raster (the `raster` slot, backends/gl/raster.h), vertex stage: a proxy grid\n"
+    "// point from its picture coordinates (x, y in pixels, y down; z the view depth) to clip space,\n"
+    "// with w = z in perspective (so GL's perspective-correct interpolation weighs each corner by\n"
+    "// q = 1 / z, as ref does) and w = 1 when orthographic.\n"
+    "uniform vec2 u_size;       // the picture's width and height\n"
+    "uniform int u_ortho;\n"
+    "layout(location = 0) in vec3 a_xyz;\n"
+    "layout(location = 1) in vec2 a_uv;\n"
+    "layout(location = 2) in int a_face;\n"
+    "layout(location = 3) in vec3 a_pos;\n"
+    "layout(location = 4) in vec3 a_nrm;\n"
+    "out vec2 v_uv;\n"
+    "out float v_z;\n"
+    "flat out int v_face;\n"
+    "out vec3 v_pos;\n"
+    "out vec3 v_nrm;\n"
+    "\n"
+    "void main() {\n"
+    "    float w = u_ortho != 0 ? 1.0 : a_xyz.z;\n"
+    "    gl_Position = vec4((2.0 * a_xyz.x / u_size.x - 1.0) * w, (1.0 - 2.0 * a_xyz.y / u_size.y) * w, 0.0, w);\n"
+    "    v_uv = a_uv;\n"
+    "    v_z = a_xyz.z;\n"
+    "    v_face = a_face;\n"
+    "    v_pos = a_pos;\n"
+    "    v_nrm = a_nrm;\n"
+    "}\n"
+    ;
+
 /* backends/gl/glsl/shade.comp.glsl */
 static const char sfb__glsl_shade_comp_glsl[] =
     "// Seed 003's per-pixel analysis values (the backend vtable's shade; the ref kernel, in double,\n"

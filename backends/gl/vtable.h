@@ -76,6 +76,7 @@ static void sfb__gl_bind_kernels(sfb__backend_vtable *vt) {
     sfb__gl_manifold_bind(vt);
     sfb__gl_normals_bind(vt);
     sfb__gl_shade_bind(vt);
+    sfb__gl_raster_bind(vt);
 }
 
 void sfb__gl_bind(sfb__backend_vtable *vt) {
