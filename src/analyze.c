@@ -16,9 +16,10 @@
  *    side it left by (at most 4 crossings), else the iterate is clamped and gives up after two
  *    steps against the border. Outcomes per attempt: HIT (residual below SFB__AN_TOL pixels),
  *    NEAR (within half a pixel after the steps: not converged), MISS (further: no surface there).
- *    Round 0 seeds every proxy pixel with its own (face, u, v) -- the pixels of odd x or y from
- *    their even neighbours' hits moved by those hits' inverse screen Jacobian when there are
- *    any. Every later round seeds, from the hits the round before made or replaced, their 8
+ *    Round 0 seeds the proxy pixels on a grid of every 4th pixel with their own (face, u, v),
+ *    then the pixels between those hits from them (cubic Hermite in (u,v) along a picture axis,
+ *    the hits' inverse screen Jacobians as tangents), down to every pixel; an attempt that
+ *    stalls over a pixel away stops early. Every later round seeds, from the hits the round before made or replaced, their 8
  *    neighbours that are not hit yet, or hit on another face at least 1 % of the bounding radius
  *    farther away (a nearer sheet may hide them: near silhouettes the proxy's depth order is not
  *    the exact surface's); up to three faces per pixel and round; a pixel keeps its nearest hit.
@@ -47,6 +48,7 @@
 #define SFB__AN_TOL 2e-3      /* pixels: a hit (looser ones let stripe classes flip where stripes are dense) */
 #define SFB__AN_NEAR 0.5      /* pixels: within this, a non-converged attempt may fall back to the proxy */
 #define SFB__AN_ROUNDS 64
+#define SFB__AN_ANCHOR 4      /* pixels: round 0 starts from the proxy on this grid, the others between its hits */
 #define SFB__AN_DILATE 2.0    /* pixels: uncovered pixels this close to a thin proxy triangle are seeded from it too */
 #define SFB__AN_MARGIN 0.92   /* the bounding sphere's share of the smaller side (as sfb_render) */
 
@@ -523,7 +525,7 @@ static sfb_result sfb__an_raster(sfb__an *A) {
 /* ---- step 2: Newton projection, in batches ---- */
 typedef struct sfb__an_try {
     int pix, steps, pinned, crossed, outcome;   /* outcome: 0 running, 1 hit, 2 near, 3 miss */
-    double res;
+    double res, res2;  /* the residual of the last evaluation, and of the one before (pixels) */
 } sfb__an_try;
 
 /* Records the evaluation at loc as pixel pix's hit at depth z (a pixel already hit keeps the
@@ -607,6 +609,12 @@ static sfb_result sfb__an_newton(sfb__an *A, sfb__an_try *tries, sfb_location *l
                 rx = (x + 0.5) - sx; ry = (y + 0.5) - sy;
                 res = sqrt(rx * rx + ry * ry);
             }
+            /* stalled: an attempt whose residual has not halved over the last two steps and is
+             * over a pixel (a pixel off the exact silhouette, or across a face it cannot reach)
+             * stops as a miss instead of running out its steps (at half a pixel, a few more
+             * silhouette pixels were dropped on catmark_car and spot) */
+            if (ok && it >= 2 && res > 1.0 && !(res < 0.5 * t->res2)) { t->res = res; t->outcome = 3; continue; }
+            t->res2 = t->res;
             t->res = res;
             if (ok && res < SFB__AN_TOL) {
                 sfb__an_add_hit(A, pix, &locs[i], z, pos + 3 * i, du + 3 * i, dv + 3 * i, nrm + 3 * i);
@@ -656,36 +664,70 @@ static sfb_result sfb__an_newton(sfb__an *A, sfb__an_try *tries, sfb_location *l
     return SFB_SUCCESS;
 }
 
-/* A seed for pixel (x, y) from a hit neighbour of even x and y (of its proxy face, else any):
+/* d(u,v)/d(pixel) along the picture's axis `axis` (0: x, 1: y) at hit k: its screen Jacobian's
+ * inverse applied to that axis; 0 when the Jacobian is singular. */
+static int sfb__an_uv_per_pixel(const sfb__an *A, int k, int axis, double m[2]) {
+    double p[3], tu[3], tv[3], j00, j01, j10, j11, det;
+    int c;
+    for (c = 0; c < 3; ++c) { p[c] = A->hpos[3 * (size_t)k + c]; tu[c] = A->hdu[3 * (size_t)k + c]; tv[c] = A->hdv[3 * (size_t)k + c]; }
+    sfb__an_project_dir(&A->cam, p, tu, &j00, &j10);
+    sfb__an_project_dir(&A->cam, p, tv, &j01, &j11);
+    det = j00 * j11 - j01 * j10;
+    if (!(fabs(det) > 1e-18) || !isfinite(det)) return 0;
+    m[0] = (axis ? -j01 : j11) / det;
+    m[1] = (axis ? j00 : -j10) / det;
+    return 1;
+}
+
+/* A seed for pixel (x, y) from a hit neighbour d pixels away (of its proxy face, else any):
  * the neighbour's (u,v) moved by the inverse of its screen Jacobian towards (x, y); loc is kept
  * when no neighbour is hit or the Jacobian is singular. */
-static void sfb__an_predict(const sfb__an *A, int x, int y, sfb_location *loc) {
+static void sfb__an_predict(const sfb__an *A, int x, int y, int d, sfb_location *loc) {
     int dx, dy, best = -1;
-    for (dy = -1; dy <= 1; ++dy)
-        for (dx = -1; dx <= 1; ++dx) {
+    double mx[2], my[2], u, v;
+    for (dy = -d; dy <= d; dy += d)
+        for (dx = -d; dx <= d; dx += d) {
             int nx = x + dx, ny = y + dy, k;
-            if (nx < 0 || ny < 0 || nx >= A->w || ny >= A->h || (nx & 1) || (ny & 1)) continue;
+            if ((dx | dy) == 0 || nx < 0 || ny < 0 || nx >= A->w || ny >= A->h) continue;
             k = A->hit[ny * A->w + nx];
             if (k < 0) continue;
             if (best < 0 || (A->hloc[k].face == loc->face && A->hloc[best].face != loc->face)) best = k;
         }
-    if (best >= 0) {
-        double p[3], tu[3], tv[3], j00, j01, j10, j11, det, rx, ry, u, v;
-        int c, q = A->hpix[best];
-        for (c = 0; c < 3; ++c) { p[c] = A->hpos[3 * (size_t)best + c]; tu[c] = A->hdu[3 * (size_t)best + c]; tv[c] = A->hdv[3 * (size_t)best + c]; }
-        sfb__an_project_dir(&A->cam, p, tu, &j00, &j10);
-        sfb__an_project_dir(&A->cam, p, tv, &j01, &j11);
-        det = j00 * j11 - j01 * j10;
-        if (!(fabs(det) > 1e-18) || !isfinite(det)) return;
-        rx = x - q % A->w; ry = y - q / A->w;
-        u = A->hloc[best].u + (j11 * rx - j01 * ry) / det;
-        v = A->hloc[best].v + (-j10 * rx + j00 * ry) / det;
-        if (!isfinite(u) || !isfinite(v)) return;
-        sfb__an_clamp_domain(A, &u, &v);
-        loc->face = A->hloc[best].face;
-        loc->u = (float)u;
-        loc->v = (float)v;
-    }
+    if (best < 0 || !sfb__an_uv_per_pixel(A, best, 0, mx) || !sfb__an_uv_per_pixel(A, best, 1, my)) return;
+    dx = x - A->hpix[best] % A->w;
+    dy = y - A->hpix[best] / A->w;
+    u = A->hloc[best].u + mx[0] * dx + my[0] * dy;
+    v = A->hloc[best].v + mx[1] * dx + my[1] * dy;
+    if (!isfinite(u) || !isfinite(v)) return;
+    sfb__an_clamp_domain(A, &u, &v);
+    loc->face = A->hloc[best].face;
+    loc->u = (float)u;
+    loc->v = (float)v;
+}
+
+/* A seed for pixel (x, y) between two hits on one face, d pixels either side along `axis`: the
+ * cubic Hermite interpolant of their (u,v) with their d(u,v)/d(pixel) as end tangents, at its
+ * middle, (a + b) / 2 + d (m_a - m_b) / 4 (the hits 2d pixels apart), off by fourth-order terms
+ * only, so that the pixel usually hits at its first evaluation (a one-sided linear prediction
+ * is off by the second-order term, above SFB__AN_TOL where a patch spans under ~100 pixels);
+ * 0 (loc kept) when either is missing, they lie on different faces or a Jacobian is singular. */
+static int sfb__an_hermite(const sfb__an *A, int x, int y, int axis, int d, sfb_location *loc) {
+    const int dx = axis ? 0 : d, dy = axis ? d : 0;
+    double ma[2], mb[2], u, v;
+    int a, b;
+    if (x - dx < 0 || y - dy < 0 || x + dx >= A->w || y + dy >= A->h) return 0;
+    a = A->hit[(y - dy) * A->w + (x - dx)];
+    b = A->hit[(y + dy) * A->w + (x + dx)];
+    if (a < 0 || b < 0 || A->hloc[a].face != A->hloc[b].face) return 0;
+    if (!sfb__an_uv_per_pixel(A, a, axis, ma) || !sfb__an_uv_per_pixel(A, b, axis, mb)) return 0;
+    u = 0.5 * ((double)A->hloc[a].u + A->hloc[b].u) + 0.25 * d * (ma[0] - mb[0]);
+    v = 0.5 * ((double)A->hloc[a].v + A->hloc[b].v) + 0.25 * d * (ma[1] - mb[1]);
+    if (!isfinite(u) || !isfinite(v)) return 0;
+    sfb__an_clamp_domain(A, &u, &v);
+    loc->face = A->hloc[a].face;
+    loc->u = (float)u;
+    loc->v = (float)v;
+    return 1;
 }
 
 /* Step 2 over every round (see the file's comment). */
@@ -704,16 +746,25 @@ static sfb_result sfb__an_project_all(sfb__an *A, int steps) {
     buf = (float *)sfb__alloc(A->ctx, (size_t)cap * 12 * sizeof(float));
     mark = (int *)sfb__calloc(A->ctx, npix, 4 * sizeof(int));
     if (!tries || !locs || !buf || !mark) { r = sfb__oom(A->ctx, "the analysis projection"); goto done; }
-    /* round 0, in two halves: first the pixels of even x and y from their proxy (face, u, v);
-     * then every other one from its proxy too, unless a neighbour of the first half was hit:
-     * then from that hit moved by the inverse of its screen Jacobian, which is off by the
-     * second-order term only, so that most of these hit at their first evaluation (about 1.3
-     * evaluations per pixel instead of 2.1) */
-    for (half = 0; half < 2; ++half) {
+    /* round 0, in five parts: first the anchors, the pixels whose x and y are multiples of
+     * SFB__AN_ANCHOR (4), from their proxy (face, u, v); then, for d = 2 and then 1, the pixels
+     * on the grid of spacing d with one coordinate an odd multiple of d, then those with both,
+     * each between two hits of the parts before, d pixels either side along an axis
+     * (sfb__an_hermite: most hit at their first evaluation), else from a hit anchor-grid
+     * neighbour moved by the inverse of its screen Jacobian (sfb__an_predict), else from the
+     * proxy too. Measured on catmark_car at 1024 x 1024 (200k pixels), every round: 1.64
+     * evaluations per covered pixel; 2.6 with anchors every 2 pixels, the one-sided prediction
+     * alone and no stall rule (sfb__an_newton) */
+    for (half = 0; half < 5; ++half) {
+        const int d = half == 0 ? SFB__AN_ANCHOR : half <= 2 ? 2 : 1, want = half == 0 ? 0 : 2 - (half & 1);
+        int x, y;
         count = 0;
-        for (p = 0; p < npix; ++p) {
-            int x = (int)(p % (size_t)A->w), y = (int)(p / (size_t)A->w), even = !(x & 1) && !(y & 1);
-            if (even != (half == 0)) continue;
+        for (y = 0; y < A->h; y += d)
+        for (x = 0; x < A->w; x += d) {
+            /* d is a power of two */
+            const int ox = half > 0 && (x & (2 * d - 1)) == d, oy = half > 0 && (y & (2 * d - 1)) == d;
+            p = (size_t)y * (size_t)A->w + (size_t)x;
+            if (ox + oy != want) continue;
             if (A->face[p] < 0 && A->cface[p] < 0) continue;
             memset(&tries[count], 0, sizeof tries[count]);
             tries[count].pix = (int)p;
@@ -722,7 +773,8 @@ static sfb_result sfb__an_project_all(sfb__an *A, int steps) {
             } else {
                 locs[count].face = A->cface[p]; locs[count].u = A->cuv[2 * p]; locs[count].v = A->cuv[2 * p + 1];
             }
-            if (half == 1) sfb__an_predict(A, x, y, &locs[count]);
+            if (half > 0 && !sfb__an_hermite(A, x, y, ox ? 0 : 1, d, &locs[count]) && !(ox && oy && sfb__an_hermite(A, x, y, 1, d, &locs[count])))
+                sfb__an_predict(A, x, y, d, &locs[count]);
             if (A->tri && (double)locs[count].u + (double)locs[count].v > 1.0) locs[count].v = nextafterf(locs[count].v, 0.0f);
             ++count;
         }
