@@ -29,8 +29,9 @@
  *   draw/trim-atlas           a 2 x 1 atlas (tile 0 black, tile 1 white): face 0 is trimmed, face 1
  *                             kept, faces past the last tile untrimmed: the covered pixels are the
  *                             untrimmed render's minus face 0's alone (first_face/face_count)
- *   draw/gles31               the compute kernel, the capture and a render on a host OpenGL ES 3.1
- *                             context (the "#version 310 es" shaders)
+ *   draw/gles31               the compute kernel, the capture, a render and seed 003's analysis
+ *                             (its proxy raster drawn in GL) on a host OpenGL ES 3.1 context (the
+ *                             "#version 310 es" shaders)
  *   errors/...                the documented codes: a Catmull-Clark surface and a ref, an own-
  *                             context gl and an osmesa context (SFB_UNSUPPORTED); rates -1 and
  *                             1025, faces out of range, a small capture buffer, a trim texture or
@@ -89,9 +90,17 @@ static int g_verbose;
 static const char *g_shapes = "../shared/peers/opensubdiv-shapes";
 
 /* A context on `kind` alone; use_current: the gl backend on the current (host's) context. */
+/* Log lines saying the analysis's proxy raster ran on the CPU instead of in GL. */
+static int g_cpu_rasters;
+static void raster_logger(int level, const char *msg, void *user) {
+    (void)level; (void)user;
+    if (strstr(msg, "raster runs on the CPU") || strstr(msg, "lacks raster")) ++g_cpu_rasters;
+}
+
 static sfb_context *gl_context(sfb_backend_kind kind, int use_current) {
     sfb_context_config cfg = sfb_context_config_init();
     cfg.gl_use_current_context = use_current;
+    cfg.logger.func = raster_logger;
     return make_context_with(cfg, kind);
 }
 
@@ -897,6 +906,30 @@ static void gles_check(const host *h, sfb_context *ref) {
                 glDeleteBuffers(1, &cap);
             }
             free(nc);
+        }
+        if (!msg[0]) {
+            /* seed 003's analysis on the GLES context: its proxy raster drawn in GL (RGBA32UI and
+             * DEPTH_COMPONENT32F attachments, integer read-back), against a ref context's */
+            sfb_analyze_config ac = sfb_analyze_config_init(SFB_ANALYZE_REFLECTION);
+            sfb_analysis ag, ar;
+            const int before = g_cpu_rasters;
+            long k, differ = 0;
+            memset(&ag, 0, sizeof ag);
+            memset(&ar, 0, sizeof ar);
+            ac.width = 160;
+            ac.height = 120;
+            if (sfb_surface_analyze(sr, &ac, &ar) != SFB_SUCCESS) snprintf(msg, sizeof msg, "ref analysis: %s", sfb_last_error(ref));
+            else if (sfb_surface_analyze(sg, &ac, &ag) != SFB_SUCCESS) snprintf(msg, sizeof msg, "analysis on GLES: %s", sfb_last_error(ctx));
+            else {
+                for (k = 0; k < (long)ar.width * ar.height; ++k) differ += ar.classes[k] != ag.classes[k];
+                if (g_cpu_rasters != before || ag.proxy_pixels < 1000 || labs((long)ag.proxy_pixels - (long)ar.proxy_pixels) > ar.proxy_pixels / 200 ||
+                    differ > ar.covered_pixels / 200)
+                    snprintf(msg, sizeof msg, "analysis on GLES: %s, proxy pixels %d (ref %d), %ld of %d classes differ",
+                             g_cpu_rasters != before ? "rasterised on the CPU" : "rasterised in GL", ag.proxy_pixels, ar.proxy_pixels, differ,
+                             ar.covered_pixels);
+            }
+            sfb_analysis_free(&ag);
+            sfb_analysis_free(&ar);
         }
         if (!msg[0]) {
             GLenum e = glGetError();
