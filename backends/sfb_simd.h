@@ -13,6 +13,8 @@
  *   simd/patches.h    the polynomial patch families (simd/patches_quad.h, simd/patches_tri.h)
  *   simd/manifold.h   MANIFOLD4 (seed 000)
  *   simd/normals.h    finish_normals (seed 001)
+ *   simd/shade.h      shade (seed 003's per-pixel analysis values)
+ *   simd/raster.h     raster (seed 003's proxy raster, in bands of rows over the threads)
  *   simd/vtable.h     patch slots dispatched by the table's families; sfb__simd_bind
  */
 #ifndef SFB__SIMD_BACKEND_H
@@ -24,6 +26,7 @@
 #include "simd/manifold.h"
 #include "simd/normals.h"
 #include "simd/shade.h"
+#include "simd/raster.h"
 #include "simd/vtable.h"
 
 #endif /* SFB__SIMD_BACKEND_H */

@@ -166,16 +166,25 @@ int sfb__raster_setup(const sfb__raster_vertex *const S[3], int w, int h, double
     return 1;
 }
 
-sfb_result sfb__ref_raster(void *state, const sfb__raster_job *j) {
+void sfb__raster_rows(const sfb__raster_job *j, int row0, int row1) {
     int i;
-    (void)state;
     for (i = 0; i < j->ntri; ++i) {
         const int *tv = j->tri + 4 * (size_t)i;
         const sfb__raster_vertex *S[3];
         sfb__raster_edges t;
+        double lo, hi;
         int k, x, y;
         for (k = 0; k < 3; ++k) S[k] = &j->vert[tv[k]];
+        lo = hi = S[0]->y;
+        for (k = 1; k < 3; ++k) {
+            if (S[k]->y < lo) lo = S[k]->y;
+            if (S[k]->y > hi) hi = S[k]->y;
+        }
+        /* no pixel centre of the rows: skipped before the set-up */
+        if (!(hi - 0.5 >= (double)row0 && lo - 0.5 <= (double)row1 - 1.0)) continue;
         if (!sfb__raster_setup(S, j->w, j->h, 0.0, &t)) continue;
+        if (t.y0 < row0) t.y0 = row0;
+        if (t.y1 > row1 - 1) t.y1 = row1 - 1;
         for (y = t.y0; y <= t.y1; ++y)
             for (x = t.x0; x <= t.x1; ++x) {
                 const double px = x + 0.5, py = y + 0.5;
@@ -203,6 +212,11 @@ sfb_result sfb__ref_raster(void *state, const sfb__raster_job *j) {
                 }
             }
     }
+}
+
+sfb_result sfb__ref_raster(void *state, const sfb__raster_job *j) {
+    (void)state;
+    sfb__raster_rows(j, 0, j->h);
     return SFB_SUCCESS;
 }
 

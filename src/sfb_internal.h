@@ -142,6 +142,9 @@ typedef struct sfb__raster_edges {
 } sfb__raster_edges;
 SFB__IF int sfb__raster_setup(const sfb__raster_vertex *const S[3], int w, int h, double grow, sfb__raster_edges *t);
 SFB__IF sfb_result sfb__ref_raster(void *state, const sfb__raster_job *job);
+/* ref's raster of the picture's rows [row0, row1) only (each pixel is written by the triangles
+ * over it in order, so disjoint row ranges may run at once: the simd backend's threads). */
+SFB__IF void sfb__raster_rows(const sfb__raster_job *job, int row0, int row1);
 
 /* Optional backends (backends/sfb_*.h), compiled in by SURFBLEND_SIMD / _GL / _OSMESA or
  * SURFBLEND_ALL_BACKENDS; the headers are included at the end of the implementation. */

@@ -81,4 +81,5 @@ void sfb__simd_bind(sfb__backend_vtable *vt) {
     sfb__simd_patch_tables_bind(vt); /* upload/release/eval_patches: the patch families above */
     sfb__simd_normals_bind(vt);     /* finish_normals (normals.h) */
     sfb__simd_shade_bind(vt);       /* shade (shade.h, seed 003) */
+    sfb__simd_raster_bind(vt);      /* raster (raster.h, seed 003) */
 }
