@@ -286,14 +286,6 @@ static void test_levels(sfb_context *ctx, const shape *shapes, int count) {
 }
 
 /* ---- backends against ref ---- */
-/* The backends' log: lines saying the proxy raster ran on ref's kernel or on the CPU instead of
- * the backend's own kernel (simd's bands, gl's and osmesa's GL raster) are counted. */
-static int g_cpu_rasters;
-static void raster_logger(int level, const char *msg, void *user) {
-    (void)level; (void)user;
-    if (strstr(msg, "raster runs on the CPU") || strstr(msg, "lacks raster")) ++g_cpu_rasters;
-}
-
 /* Modes: 0 reflection, 1 mean and 2 Gaussian curvature (exact per pixel), 3 polygon-based
  * reflection (the raster's own interpolated data, so the raster kernels compared directly). */
 static void test_backends(const shape *shapes, int count) {
@@ -307,7 +299,7 @@ static void test_backends(const shape *shapes, int count) {
                 sfb_surface *sr, *sb;
                 sfb_analyze_config c = sfb_analyze_config_init(mode == 1 || mode == 2 ? SFB_ANALYZE_CURVATURE : SFB_ANALYZE_REFLECTION);
                 sfb_analysis ar, ab;
-                const int cpu_before = g_cpu_rasters;
+                const int cpu_before = *cpu_rasters();
                 snprintf(name, sizeof name, "backend_%s_%s_%s", be->name, shapes[i].label,
                          mode == 3 ? "polygon_reflection" : mode == 2 ? "gaussian_curvature" : mode ? "mean_curvature" : "reflection");
                 c.polygon_based = mode == 3;
@@ -343,7 +335,7 @@ static void test_backends(const shape *shapes, int count) {
                      * simd's is ref's (in bands of rows) and must match it exactly */
                     const long dp = labs((long)ab.proxy_pixels - (long)ar.proxy_pixels),
                                dp_ok = be->kind == SFB_BACKEND_SIMD ? 0 : ar.proxy_pixels / 200;
-                    const int own = g_cpu_rasters == cpu_before; /* every backend has its raster kernel */
+                    const int own = *cpu_rasters() == cpu_before; /* every backend has its raster kernel */
                     if (mode == 1 || mode == 2)
                         check(same >= 0.995 * cov && bad <= 0.005 * both && dp <= dp_ok && own, name,
                               "%.3f %% identical classes, %ld of %ld curvatures off by > 1e-3 relative, proxy pixels %d vs ref %d%s",
@@ -486,7 +478,7 @@ int main(int argc, char **argv) {
     sfb_context_destroy(ctx);
     {
         sfb_context_config bc = sfb_context_config_init();
-        bc.logger.func = raster_logger;
+        bc.logger.func = cpu_raster_logger;
         if (!probe_backends_with(&bc, NULL)) return 1;
     }
     test_backends(shapes, 3);

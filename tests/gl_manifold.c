@@ -90,17 +90,10 @@ static int g_verbose;
 static const char *g_shapes = "../shared/peers/opensubdiv-shapes";
 
 /* A context on `kind` alone; use_current: the gl backend on the current (host's) context. */
-/* Log lines saying the analysis's proxy raster ran on the CPU instead of in GL. */
-static int g_cpu_rasters;
-static void raster_logger(int level, const char *msg, void *user) {
-    (void)level; (void)user;
-    if (strstr(msg, "raster runs on the CPU") || strstr(msg, "lacks raster")) ++g_cpu_rasters;
-}
-
 static sfb_context *gl_context(sfb_backend_kind kind, int use_current) {
     sfb_context_config cfg = sfb_context_config_init();
     cfg.gl_use_current_context = use_current;
-    cfg.logger.func = raster_logger;
+    cfg.logger.func = cpu_raster_logger;
     return make_context_with(cfg, kind);
 }
 
@@ -912,7 +905,7 @@ static void gles_check(const host *h, sfb_context *ref) {
              * DEPTH_COMPONENT32F attachments, integer read-back), against a ref context's */
             sfb_analyze_config ac = sfb_analyze_config_init(SFB_ANALYZE_REFLECTION);
             sfb_analysis ag, ar;
-            const int before = g_cpu_rasters;
+            const int before = *cpu_rasters();
             long k, differ = 0;
             memset(&ag, 0, sizeof ag);
             memset(&ar, 0, sizeof ar);
@@ -922,10 +915,10 @@ static void gles_check(const host *h, sfb_context *ref) {
             else if (sfb_surface_analyze(sg, &ac, &ag) != SFB_SUCCESS) snprintf(msg, sizeof msg, "analysis on GLES: %s", sfb_last_error(ctx));
             else {
                 for (k = 0; k < (long)ar.width * ar.height; ++k) differ += ar.classes[k] != ag.classes[k];
-                if (g_cpu_rasters != before || ag.proxy_pixels < 1000 || labs((long)ag.proxy_pixels - (long)ar.proxy_pixels) > ar.proxy_pixels / 200 ||
+                if (*cpu_rasters() != before || ag.proxy_pixels < 1000 || labs((long)ag.proxy_pixels - (long)ar.proxy_pixels) > ar.proxy_pixels / 200 ||
                     differ > ar.covered_pixels / 200)
                     snprintf(msg, sizeof msg, "analysis on GLES: %s, proxy pixels %d (ref %d), %ld of %d classes differ",
-                             g_cpu_rasters != before ? "rasterised on the CPU" : "rasterised in GL", ag.proxy_pixels, ar.proxy_pixels, differ,
+                             *cpu_rasters() != before ? "rasterised on the CPU" : "rasterised in GL", ag.proxy_pixels, ar.proxy_pixels, differ,
                              ar.covered_pixels);
             }
             sfb_analysis_free(&ag);

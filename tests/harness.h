@@ -274,6 +274,18 @@ static inline sfb_context *make_context_threads(sfb_backend_kind kind, int threa
     return make_context_with(cfg, kind);
 }
 
+/* A logger counting the lines that say seed 003's proxy raster ran on ref's kernel or on the
+ * CPU instead of the context's backend's own (simd's bands, gl's and osmesa's GL raster):
+ * suites check that a backend ran its own. */
+static inline int *cpu_rasters(void) {
+    static int count;
+    return &count;
+}
+static inline void cpu_raster_logger(int level, const char *msg, void *user) {
+    (void)level; (void)user;
+    if (strstr(msg, "raster runs on the CPU") || strstr(msg, "lacks raster")) ++*cpu_rasters();
+}
+
 /* The backends under test, ref first: each with its own context when available. */
 typedef struct backend {
     sfb_backend_kind kind;
