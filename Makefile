@@ -269,6 +269,11 @@ $(BUILD)/trim: tests/trim.c tests/harness.h src/sfb_internal.h $(BUILD)/libsfb_i
 $(BUILD)/finish_normals: tests/finish_normals.c tests/harness.h surfblend.h $(BACKEND_HDRS)
 	$(CC) $(CFLAGS) $(SAN) -I. tests/finish_normals.c -o $@ $(LIBS)
 
+# Seed 003's shade and raster kernels of every backend (each simd instruction set) against ref
+# on random jobs: simd bit for bit, gl/osmesa within float (tests/analysis_kernels.c).
+$(BUILD)/analysis_kernels: tests/analysis_kernels.c tests/harness.h surfblend.h $(BACKEND_HDRS)
+	$(CC) $(CFLAGS) $(SAN) -I. tests/analysis_kernels.c -o $@ $(LIBS)
+
 # Manifold-based blending (SFB_SCHEME_MANIFOLD_BLEND) on every backend: interpolation, continuity,
 # creases/darts/corners, derivatives, agreement; reaches the patch table through
 # src/sfb_internal.h (tests/manifold.c).
@@ -308,7 +313,7 @@ $(BUILD)/web/png_iou: tests/web/png_iou.c | deps
 	$(CC) -std=c99 $(OPT) -g -Wall -Wextra $(SAN) $< -o $@ -lm
 
 unit-build: $(BUILD)/web/png_iou $(BUILD)/surfblend $(BUILD)/unit $(BUILD)/osd_agree $(BUILD)/agree $(BUILD)/limit $(BUILD)/eigen $(BUILD)/gl_host \
-            $(BUILD)/gl_errors $(BUILD)/gl_pieces $(BUILD)/shade $(BUILD)/trim $(BUILD)/finish_normals $(BUILD)/manifold $(BUILD)/tribezier $(BUILD)/analyze $(BUILD)/geom $(BUILD)/fillet $(BUILD)/gl_manifold $(EXAMPLES) \
+            $(BUILD)/gl_errors $(BUILD)/gl_pieces $(BUILD)/shade $(BUILD)/trim $(BUILD)/finish_normals $(BUILD)/analysis_kernels $(BUILD)/manifold $(BUILD)/tribezier $(BUILD)/analyze $(BUILD)/geom $(BUILD)/fillet $(BUILD)/gl_manifold $(EXAMPLES) \
             $(EXAMPLES_CXX) $(BUILD)/png_iou $(BUILD)/sfb2gltf $(BUILD)/gltf_check
 
 # On CI (CI set and not false/0) the optional backends must run, not be skipped: the suites

@@ -111,6 +111,7 @@ suite counted cli env BUILD="$BUILD" SHAPES="$SHAPES" ./tests/cli_test.sh
 suite counted gltf env BUILD="$BUILD" SHAPES="$SHAPES" ./tests/gltf_test.sh
 suite criterion unit "$BUILD/unit" --jobs 1
 suite counted finish_normals "$BUILD/finish_normals"
+suite counted analysis_kernels "$BUILD/analysis_kernels"
 suite counted eigen "$BUILD/eigen"
 # the engine case: the gl backend on the host's own EGL context and GL buffers
 suite counted gl_host "$BUILD/gl_host"
