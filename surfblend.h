@@ -8950,25 +8950,19 @@ static sfb_result sfb__tess_eval_uvs(const sfb_surface *s, sfb_tess_data *out, f
     sfb__patch_table upt;
     const sfb__backend_vtable *be = ctx->backend;
     void *handle = NULL;
-    int uploaded = 0;
+    int uploaded = 0, linear = 0;
     float *tmp = NULL;
     sfb_result r = SFB_SUCCESS;
     out->uvs = (float *)sfb__tess_array(ctx, nv, 2 * sizeof(float));
     if (!out->uvs) return sfb__oom(ctx, "tessellated UVs");
     memset(&upt, 0, sizeof upt);
-    if (!sfb__surface_smooth_uvs(s)) {
-        for (v = 0; v < nv; ++v) sfb__tess_uv_linear(s, &out->locations[v], out->uvs + 2 * v);
-        return sfb__progress(ctx, 1.0f, "tessellate");
-    }
-    tmp = (float *)sfb__tess_array(ctx, SFB__TESS_EVAL_CHUNK, 3 * sizeof(float));
-    if (!tmp) return sfb__oom(ctx, "tessellated UVs");
-    {
+    if (sfb__surface_smooth_uvs(s)) {
         /* UVS_OR_LINEAR: linear UVs where the scheme's builder cannot take the layout -- one
          * that is not a manifold (placeholder UVs) is not offered to it, so that no error is
          * logged for it; other refusals (a flat UV triangle) come back from the builder */
         const sfb__scheme_info *si = sfb__scheme_info_of(s->config.scheme);
         const int fallback = si && (si->caps & SFB__SCHEME_UVS_OR_LINEAR);
-        int i, linear = 0;
+        int i;
         for (i = 0; fallback && i < s->uv_base.nv && !linear; ++i) linear = (s->uv_base.vtag[i] & SFB__TAG_NONMANIFOLD) != 0;
         if (linear) {
             sfb__log(ctx, SFB_LOG_INFO, "tessellated UVs: the UV layout is not a manifold: linear per face (%s)", si->name);
@@ -8978,12 +8972,16 @@ static sfb_result sfb__tess_eval_uvs(const sfb_surface *s, sfb_tess_data *out, f
                      si->name, sfb_last_error(ctx));
             linear = 1;
         }
-        if (linear) {
-            for (v = 0; v < nv; ++v) sfb__tess_uv_linear(s, &out->locations[v], out->uvs + 2 * v);
-            r = sfb__progress(ctx, 1.0f, "tessellate");
-            goto done;
-        }
+    } else {
+        linear = 1;
     }
+    if (linear) {
+        for (v = 0; v < nv; ++v) sfb__tess_uv_linear(s, &out->locations[v], out->uvs + 2 * v);
+        r = sfb__progress(ctx, 1.0f, "tessellate");
+        goto done;
+    }
+    tmp = (float *)sfb__tess_array(ctx, SFB__TESS_EVAL_CHUNK, 3 * sizeof(float));
+    if (!tmp) { r = sfb__oom(ctx, "tessellated UVs"); goto done; }
     /* on the context's backend, like the positions (ref when it has no patch kernels) */
     if (be && be->upload_patches && be->eval_patches) {
         if ((r = be->upload_patches(ctx->backend_state, &upt, &handle)) != SFB_SUCCESS) goto done;
@@ -12503,9 +12501,10 @@ done:
  *    the backend's eval_patches; each grid triangle knows its face and its corners' (u,v) in
  *    that face, so rasterising it gives per pixel (face, u, v, depth) with perspective-correct
  *    (u,v): a pixel's (u,v) is always in its own face's frame. The backend's `raster` kernel
- *    draws it (ref's on the CPU; gl and osmesa in GL, sfb__raster_job). Thin or grazing triangles (near a
- *    silhouette) also leave a seed in the uncovered pixels within 2 pixels of them. The faces'
- *    adjacency comes from the proxy too (sides whose ends and middle coincide).
+ *    draws it (sfb__raster_job: ref's on the CPU, simd's in bands over its threads, gl's and
+ *    osmesa's in GL). Thin or grazing triangles (near a silhouette) also leave a seed in the
+ *    uncovered pixels within 2 pixels of them. The faces' adjacency comes from the proxy too
+ *    (sides whose ends and middle coincide).
  * 2. Projection (beyond the seed, which shades the proxy's (u,v), leaves gaps and patches them
  *    with a 1.7^2 larger viewport, its §5): each pixel is moved onto the exact surface along its
  *    own view ray. We solve in the picture plane: find (u,v) with proj(S(u,v)) = pixel centre,
@@ -12517,10 +12516,11 @@ done:
  *    Round 0 seeds the proxy pixels on a grid of every 4th pixel with their own (face, u, v),
  *    then the pixels between those hits from them (cubic Hermite in (u,v) along a picture axis,
  *    the hits' inverse screen Jacobians as tangents), down to every pixel; an attempt that
- *    stalls over a pixel away stops early. Every later round seeds, from the hits the round before made or replaced, their 8
- *    neighbours that are not hit yet, or hit on another face at least 1 % of the bounding radius
- *    farther away (a nearer sheet may hide them: near silhouettes the proxy's depth order is not
- *    the exact surface's); up to three faces per pixel and round; a pixel keeps its nearest hit.
+ *    stalls over a pixel away stops early. Every later round seeds, from the hits the round
+ *    before made or replaced, their 8 neighbours that are not hit yet, or hit on another face
+ *    at least 1 % of the bounding radius farther away (a nearer sheet may hide them: near
+ *    silhouettes the proxy's depth order is not the exact surface's); up to three faces per
+ *    pixel and round; a pixel keeps its nearest hit.
  *    That grows coverage past the proxy's silhouette up to the exact one (pixels outside it MISS
  *    and stop the growth). The rounds end when a round changes nothing (at most SFB__AN_ROUNDS).
  *    Then a proxy pixel without a hit is kept on the proxy's point when one attempt was NEAR
@@ -12945,7 +12945,7 @@ static void sfb__an_seed_tri(sfb__an *A, const int *tv) {
         }
 }
 
-/* The raster kernel of the context's backend (gl and osmesa draw the triangles in GL), or ref's. */
+/* The raster kernel of the context's backend, or ref's. */
 static sfb_result sfb__an_raster_kernel(const sfb__an *A, const sfb__raster_job *job) {
     sfb_context *ctx = A->ctx;
     const sfb__backend_vtable *be = ctx->backend;

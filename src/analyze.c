@@ -5,9 +5,10 @@
  *    the backend's eval_patches; each grid triangle knows its face and its corners' (u,v) in
  *    that face, so rasterising it gives per pixel (face, u, v, depth) with perspective-correct
  *    (u,v): a pixel's (u,v) is always in its own face's frame. The backend's `raster` kernel
- *    draws it (ref's on the CPU; gl and osmesa in GL, sfb__raster_job). Thin or grazing triangles (near a
- *    silhouette) also leave a seed in the uncovered pixels within 2 pixels of them. The faces'
- *    adjacency comes from the proxy too (sides whose ends and middle coincide).
+ *    draws it (sfb__raster_job: ref's on the CPU, simd's in bands over its threads, gl's and
+ *    osmesa's in GL). Thin or grazing triangles (near a silhouette) also leave a seed in the
+ *    uncovered pixels within 2 pixels of them. The faces' adjacency comes from the proxy too
+ *    (sides whose ends and middle coincide).
  * 2. Projection (beyond the seed, which shades the proxy's (u,v), leaves gaps and patches them
  *    with a 1.7^2 larger viewport, its §5): each pixel is moved onto the exact surface along its
  *    own view ray. We solve in the picture plane: find (u,v) with proj(S(u,v)) = pixel centre,
@@ -19,10 +20,11 @@
  *    Round 0 seeds the proxy pixels on a grid of every 4th pixel with their own (face, u, v),
  *    then the pixels between those hits from them (cubic Hermite in (u,v) along a picture axis,
  *    the hits' inverse screen Jacobians as tangents), down to every pixel; an attempt that
- *    stalls over a pixel away stops early. Every later round seeds, from the hits the round before made or replaced, their 8
- *    neighbours that are not hit yet, or hit on another face at least 1 % of the bounding radius
- *    farther away (a nearer sheet may hide them: near silhouettes the proxy's depth order is not
- *    the exact surface's); up to three faces per pixel and round; a pixel keeps its nearest hit.
+ *    stalls over a pixel away stops early. Every later round seeds, from the hits the round
+ *    before made or replaced, their 8 neighbours that are not hit yet, or hit on another face
+ *    at least 1 % of the bounding radius farther away (a nearer sheet may hide them: near
+ *    silhouettes the proxy's depth order is not the exact surface's); up to three faces per
+ *    pixel and round; a pixel keeps its nearest hit.
  *    That grows coverage past the proxy's silhouette up to the exact one (pixels outside it MISS
  *    and stop the growth). The rounds end when a round changes nothing (at most SFB__AN_ROUNDS).
  *    Then a proxy pixel without a hit is kept on the proxy's point when one attempt was NEAR
@@ -447,7 +449,7 @@ static void sfb__an_seed_tri(sfb__an *A, const int *tv) {
         }
 }
 
-/* The raster kernel of the context's backend (gl and osmesa draw the triangles in GL), or ref's. */
+/* The raster kernel of the context's backend, or ref's. */
 static sfb_result sfb__an_raster_kernel(const sfb__an *A, const sfb__raster_job *job) {
     sfb_context *ctx = A->ctx;
     const sfb__backend_vtable *be = ctx->backend;

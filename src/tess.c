@@ -1247,25 +1247,19 @@ static sfb_result sfb__tess_eval_uvs(const sfb_surface *s, sfb_tess_data *out, f
     sfb__patch_table upt;
     const sfb__backend_vtable *be = ctx->backend;
     void *handle = NULL;
-    int uploaded = 0;
+    int uploaded = 0, linear = 0;
     float *tmp = NULL;
     sfb_result r = SFB_SUCCESS;
     out->uvs = (float *)sfb__tess_array(ctx, nv, 2 * sizeof(float));
     if (!out->uvs) return sfb__oom(ctx, "tessellated UVs");
     memset(&upt, 0, sizeof upt);
-    if (!sfb__surface_smooth_uvs(s)) {
-        for (v = 0; v < nv; ++v) sfb__tess_uv_linear(s, &out->locations[v], out->uvs + 2 * v);
-        return sfb__progress(ctx, 1.0f, "tessellate");
-    }
-    tmp = (float *)sfb__tess_array(ctx, SFB__TESS_EVAL_CHUNK, 3 * sizeof(float));
-    if (!tmp) return sfb__oom(ctx, "tessellated UVs");
-    {
+    if (sfb__surface_smooth_uvs(s)) {
         /* UVS_OR_LINEAR: linear UVs where the scheme's builder cannot take the layout -- one
          * that is not a manifold (placeholder UVs) is not offered to it, so that no error is
          * logged for it; other refusals (a flat UV triangle) come back from the builder */
         const sfb__scheme_info *si = sfb__scheme_info_of(s->config.scheme);
         const int fallback = si && (si->caps & SFB__SCHEME_UVS_OR_LINEAR);
-        int i, linear = 0;
+        int i;
         for (i = 0; fallback && i < s->uv_base.nv && !linear; ++i) linear = (s->uv_base.vtag[i] & SFB__TAG_NONMANIFOLD) != 0;
         if (linear) {
             sfb__log(ctx, SFB_LOG_INFO, "tessellated UVs: the UV layout is not a manifold: linear per face (%s)", si->name);
@@ -1275,12 +1269,16 @@ static sfb_result sfb__tess_eval_uvs(const sfb_surface *s, sfb_tess_data *out, f
                      si->name, sfb_last_error(ctx));
             linear = 1;
         }
-        if (linear) {
-            for (v = 0; v < nv; ++v) sfb__tess_uv_linear(s, &out->locations[v], out->uvs + 2 * v);
-            r = sfb__progress(ctx, 1.0f, "tessellate");
-            goto done;
-        }
+    } else {
+        linear = 1;
     }
+    if (linear) {
+        for (v = 0; v < nv; ++v) sfb__tess_uv_linear(s, &out->locations[v], out->uvs + 2 * v);
+        r = sfb__progress(ctx, 1.0f, "tessellate");
+        goto done;
+    }
+    tmp = (float *)sfb__tess_array(ctx, SFB__TESS_EVAL_CHUNK, 3 * sizeof(float));
+    if (!tmp) { r = sfb__oom(ctx, "tessellated UVs"); goto done; }
     /* on the context's backend, like the positions (ref when it has no patch kernels) */
     if (be && be->upload_patches && be->eval_patches) {
         if ((r = be->upload_patches(ctx->backend_state, &upt, &handle)) != SFB_SUCCESS) goto done;
