@@ -40,7 +40,7 @@ static void sfb__simd_stam_far(const sfb__simd_pjob *j, int q) {
 }
 
 /* Locates location q (in float: exact, as above) and prepares its slot; prefetches the window. */
-static void sfb__simd_prep(const sfb__simd_pjob *j, int q, sfb__simd_slot *o) {
+static SFB__SIMD_FORCEINLINE void sfb__simd_prep(const sfb__simd_pjob *j, int q, sfb__simd_slot *o) {
     const sfb__simd_patches *h = j->h;
     const sfb_location *l = &j->locs[q];
     int node = h->root[l->face], code;

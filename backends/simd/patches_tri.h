@@ -23,7 +23,7 @@ static void sfb__simd_loop_far(const sfb__simd_pjob *j, int q) {
  * operations (so the patch, (s, t) and the Stam-Loop level and sub-patch are ref's), without
  * branches on the child (random here): child c's (u, v) is sg (2u - a_u, 2v - a_v) with
  * sg = -1 for the middle child, whose 1 - 2u is -(2u - 1) exactly. */
-static void sfb__simd_prep_tri(const sfb__simd_pjob *j, int q, sfb__simd_slot *o) {
+static SFB__SIMD_FORCEINLINE void sfb__simd_prep_tri(const sfb__simd_pjob *j, int q, sfb__simd_slot *o) {
     const sfb__simd_patches *h = j->h;
     const sfb_location *l = &j->locs[q];
     int node = h->root[l->face], code;
