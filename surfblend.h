@@ -1457,8 +1457,10 @@ SFB__IF sfb_result sfb__pn_build(sfb_context *ctx, const sfb__level *base, const
 /* Quartic triangular Bezier surfaces with sharpness (patch/tribezier.c, seed 004): the 15 points
  * of every triangle of base (patch order, double, 45 per triangle, freed by the caller) and what
  * the G1 solve did; flags SFB__TBZ_SEED_PLANE builds the seed's smooth net at crease vertices (a
- * tangent plane that ignores the crease, for the undulation measurement). */
-enum { SFB__TBZ_SEED_PLANE = 1 };
+ * tangent plane that ignores the crease, for the undulation measurement), SFB__TBZ_NO_REUSE solves every
+ * component of the sharp net's constraints even where the smooth net solved the same system (for the test
+ * that the reuse changes nothing). */
+enum { SFB__TBZ_SEED_PLANE = 1, SFB__TBZ_NO_REUSE = 2 };
 typedef struct sfb__tbz_stats {
     long iterations;   /* CGLS iterations, all coordinates and nets */
     long unknowns;     /* points moved by the G1 solve, per coordinate and net */
@@ -1467,6 +1469,8 @@ typedef struct sfb__tbz_stats {
     double ours_residual; /* the same within the constraint components around extraordinary crease vertices with
                              our tangent plane */
     int fallbacks;     /* smooth nets rebuilt with the seed's tangent plane (ours unsolvable) */
+    int reused;        /* sharp-net constraint components that were the same system as a smooth-net one and took its
+                          solution (SFB__TBZ_NO_REUSE: none) */
 } sfb__tbz_stats;
 SFB__IF sfb_result sfb__tribezier_points(sfb_context *ctx, const sfb__level *base, const float *positions,
                                          const sfb_tribezier_options *opt, unsigned flags, double **out, sfb__tbz_stats *stats);
@@ -6563,6 +6567,14 @@ typedef struct sfb__tbz {
      * both nets, so their solution is copied rather than solved again */
     const double *reuse_x;
     const unsigned char *reuse_ours;
+    /* the smooth net's solve recorded for the sharp net (tbz_prev): rec while building the
+     * smooth net, prev while building the sharp one */
+    struct tbz_prev *rec;
+    const struct tbz_prev *prev;
+    double scale;              /* the mesh's largest coordinate (of the smooth net's positions): the solves' stopping
+                                  and residuals are relative to it, the same in both nets (so that their systems can
+                                  be compared: tbz_prev); it was the net's own largest point, which differs between
+                                  the nets by their sharp points */
     sfb__tbz_stats st;
 } sfb__tbz;
 
@@ -7274,6 +7286,66 @@ done:
     return res;
 }
 
+/* The smooth net's solve, kept for the sharp net. A component of the sharp net's constraints
+ * whose rows, unknowns, the points its rows read and the scale (T->scale) are those of a smooth-net
+ * component is the very same system: CGLS (the same rows in the same order, the same unknowns,
+ * the same stopping) would repeat the smooth net's iterations bit for bit, so the sharp net takes
+ * that component's smooth solution instead. Most components lie away from every tagged feature,
+ * where both nets have the same points: on the bench's torus this halves the construction.
+ * Recorded only when the smooth net kept our tangent plane (no seed-plane fallback). */
+typedef struct tbz_prev {
+    int ok;
+    double scale;
+    tbz_sys S;         /* the smooth net's rows (owned) */
+    int *erow;         /* per edge: its first row in S, -1: none */
+    double *x0;        /* the smooth net before its solve (3 np) */
+    const double *x1;  /* after it */
+    int *pcomp;        /* per point: its component, -1: not an unknown */
+    int *crows, *cunk; /* per component: its rows and unknowns */
+} tbz_prev;
+
+static void tbz_prev_free(sfb_context *ctx, tbz_prev *P) {
+    sfb__free(ctx, P->S.off); sfb__free(ctx, P->S.edge); sfb__free(ctx, P->S.col); sfb__free(ctx, P->S.w);
+    sfb__free(ctx, P->erow); sfb__free(ctx, P->x0); sfb__free(ctx, P->pcomp); sfb__free(ctx, P->crows); sfb__free(ctx, P->cunk);
+    memset(P, 0, sizeof *P);
+}
+
+/* Per edge its first row in S, -1: none (an edge's rows are consecutive). */
+static void tbz_edge_first_rows(const tbz_sys *S, int ne, int *erow) {
+    int e, r;
+    for (e = 0; e < ne; ++e) erow[e] = -1;
+    for (r = S->rows - 1; r >= 0; --r) erow[S->edge[r]] = r;
+}
+
+/* The smooth-net component that is the same system as the sharp net's component (rows[0..nr),
+ * unk[0..nu)), -1: none (see tbz_prev). erow: the sharp net's tbz_edge_first_rows. */
+static int tbz_same_component(const sfb__tbz *T, const tbz_sys *S, const int *erow, const int *ucol, const int *rows, int nr,
+                              const int *unk, int nu, double scale) {
+    const tbz_prev *P = T->prev;
+    int r, j, pc;
+    if (!P || !P->ok || nr == 0 || nu == 0 || scale != P->scale) return -1;
+    pc = P->pcomp[unk[0]];
+    if (pc < 0 || P->crows[pc] != nr || P->cunk[pc] != nu) return -1;
+    for (j = 1; j < nu; ++j)
+        if (P->pcomp[unk[j]] != pc) return -1;
+    /* every row the same as one of pc's (so, with the counts equal, the same rows and unknowns) */
+    for (r = 0; r < nr; ++r) {
+        const int g = rows[r], e = S->edge[g];
+        size_t k, pk;
+        int pr;
+        if (P->erow[e] < 0) return -1;
+        pr = P->erow[e] + (g - erow[e]);
+        if (pr >= P->S.rows || P->S.edge[pr] != e || S->off[g + 1] - S->off[g] != P->S.off[pr + 1] - P->S.off[pr]) return -1;
+        for (k = S->off[g], pk = P->S.off[pr]; k < S->off[g + 1]; ++k, ++pk) {
+            const int col = S->col[k];
+            if (col != P->S.col[pk] || S->w[k] != P->S.w[pk] || (ucol[col] >= 0) != (P->pcomp[col] >= 0) ||
+                memcmp(T->x + 3 * (size_t)col, P->x0 + 3 * (size_t)col, 3 * sizeof(double)) != 0)
+                return -1;
+        }
+    }
+    return pc;
+}
+
 /* Applies the smallest change of the unknowns that satisfies the constraints: the minimum-norm
  * least-squares solution, per connected component of the constraint graph (the solution of a
  * block-diagonal system is the blocks' solutions; each block converges at its own pace, so a
@@ -7286,7 +7358,8 @@ static sfb_result tbz_solve(sfb__tbz *T) {
     int *lc = NULL;
     double *lw = NULL;
     tbz_comps C;
-    int *ucol = NULL, *rstart, *ustart, *rows, *unk, *local = NULL;
+    int *ucol = NULL, *rstart, *ustart, *rows, *unk, *local = NULL, *erow = NULL;
+    tbz_prev *rec = T->rec && !T->sharp && !T->reuse_x ? T->rec : NULL;
     int nu = 0, e, i, r, nc;
     double *buf = NULL, scale = 0.0;
     sfb_result res = SFB_SUCCESS;
@@ -7302,10 +7375,33 @@ static sfb_result tbz_solve(sfb__tbz *T) {
     local = (int *)sfb__alloc(T->ctx, (size_t)T->np * sizeof(int));
     if (!ucol || !local) { res = sfb__oom(T->ctx, "tribezier constraints"); goto done; }
     for (i = 0; i < T->np; ++i) { ucol[i] = (!T->fixed[i] && T->dist[i] <= TBZ_REACH) ? nu++ : -1; local[i] = -1; }
-    for (i = 0; i < 3 * T->np; ++i) scale = fmax(scale, fabs(T->x[i]));
-    if (scale == 0.0) scale = 1.0;
+    scale = T->scale;
     if ((res = tbz_components(T, &S, ucol, nu, &C)) != SFB_SUCCESS) goto done;
     nc = C.nc; rstart = C.rstart; ustart = C.ustart; rows = C.rows; unk = C.unk;
+    if (rec) {
+        /* the net before the solve, and the components (tbz_prev); S joins them at the end */
+        rec->x0 = (double *)sfb__alloc(T->ctx, 3 * (size_t)T->np * sizeof(double) + 1);
+        rec->erow = (int *)sfb__alloc(T->ctx, ((size_t)T->ne + 1) * sizeof(int));
+        rec->pcomp = (int *)sfb__alloc(T->ctx, ((size_t)T->np + 1) * sizeof(int));
+        rec->crows = (int *)sfb__alloc(T->ctx, ((size_t)nc + 1) * sizeof(int));
+        rec->cunk = (int *)sfb__alloc(T->ctx, ((size_t)nc + 1) * sizeof(int));
+        if (!rec->x0 || !rec->erow || !rec->pcomp || !rec->crows || !rec->cunk) { res = sfb__oom(T->ctx, "tribezier constraints"); goto done; }
+        memcpy(rec->x0, T->x, 3 * (size_t)T->np * sizeof(double));
+        tbz_edge_first_rows(&S, T->ne, rec->erow);
+        for (i = 0; i < T->np; ++i) rec->pcomp[i] = -1;
+        for (i = 0; i < nc; ++i) {
+            int j;
+            rec->crows[i] = rstart[i + 1] - rstart[i];
+            rec->cunk[i] = ustart[i + 1] - ustart[i];
+            for (j = ustart[i]; j < ustart[i + 1]; ++j) rec->pcomp[unk[j]] = i;
+        }
+        rec->scale = scale;
+    }
+    if (T->prev && T->prev->ok) {
+        erow = (int *)sfb__alloc(T->ctx, ((size_t)T->ne + 1) * sizeof(int));
+        if (!erow) { res = sfb__oom(T->ctx, "tribezier constraints"); goto done; }
+        tbz_edge_first_rows(&S, T->ne, erow);
+    }
     lo = (size_t *)sfb__alloc(T->ctx, ((size_t)S.rows + 1) * sizeof(size_t));
     lc = (int *)sfb__alloc(T->ctx, (S.n + 1) * sizeof(int));
     lw = (double *)sfb__alloc(T->ctx, (S.n + 1) * sizeof(double));
@@ -7330,11 +7426,20 @@ static sfb_result tbz_solve(sfb__tbz *T) {
                 for (r = 0; r < 3; ++r) T->x[3 * (size_t)unk[u0 + j] + r] = T->reuse_x[3 * (size_t)unk[u0 + j] + r];
             continue;
         }
+        if (erow) {
+            const int pc = tbz_same_component(T, &S, erow, ucol, rows + rstart[i], rstart[i + 1] - rstart[i], unk + u0, cu, scale);
+            if (pc >= 0) {
+                for (j = 0; j < cu; ++j)
+                    for (r = 0; r < 3; ++r) T->x[3 * (size_t)unk[u0 + j] + r] = T->prev->x1[3 * (size_t)unk[u0 + j] + r];
+                T->st.reused++;
+                continue;
+            }
+        }
         for (j = 0; j < cu; ++j) local[unk[u0 + j]] = j;
         tbz_cgls(T, &S, rows + rstart[i], rstart[i + 1] - rstart[i], unk + u0, cu, local, scale, buf, lo, lc, lw);
         for (j = 0; j < cu; ++j) local[unk[u0 + j]] = -1;
     }
-    /* the residual left, relative to the net's scale; and that of the components around an
+    /* the residual left, relative to T->scale; and that of the components around an
      * extraordinary crease vertex with our tangent plane (vtype CREASE | 16), which decides the
      * fallback to the seed's plane (sfb__tribezier_points) */
     {
@@ -7352,9 +7457,14 @@ static sfb_result tbz_solve(sfb__tbz *T) {
     }
     T->st.unknowns += nu;
     T->st.constraints += S.rows;
+    if (rec) { /* the rows join the record */
+        rec->S = S;
+        memset(&S, 0, sizeof S);
+        rec->ok = 1;
+    }
 done:
     sfb__free(T->ctx, S.off); sfb__free(T->ctx, S.edge); sfb__free(T->ctx, S.col); sfb__free(T->ctx, S.w);
-    sfb__free(T->ctx, ucol); sfb__free(T->ctx, local);
+    sfb__free(T->ctx, ucol); sfb__free(T->ctx, local); sfb__free(T->ctx, erow);
     sfb__free(T->ctx, C.rows); sfb__free(T->ctx, C.unk); sfb__free(T->ctx, C.rstart); sfb__free(T->ctx, C.ustart); sfb__free(T->ctx, buf);
     sfb__free(T->ctx, ours); sfb__free(T->ctx, lo); sfb__free(T->ctx, lc); sfb__free(T->ctx, lw);
     return res;
@@ -7424,12 +7534,16 @@ static sfb_result tbz_vertex_s(sfb__tbz *T, double *vs) {
 static sfb_result tbz_points(sfb_context *ctx, const sfb__level *l, const float *positions, const float *sharp_positions,
                              const sfb_tribezier_options *opt, unsigned flags, double **out, sfb__tbz_stats *stats) {
     sfb__tbz T;
+    tbz_prev prev;
     double *x0 = NULL, *vs = NULL, *res = NULL;
     int v, e, f, c, k, any_tag = 0;
     sfb_result r = SFB_SUCCESS;
     *out = NULL;
     memset(&T, 0, sizeof T);
+    memset(&prev, 0, sizeof prev);
     T.ctx = ctx; T.l = l; T.pos = positions;
+    for (v = 0; v < 3 * l->nv; ++v) T.scale = fmax(T.scale, fabs((double)positions[v]));
+    if (!(T.scale > 0.0)) T.scale = 1.0;
     T.nv = l->nv; T.ne = l->ne; T.nf = l->nf;
     T.np = l->nv + 3 * l->ne + 3 * l->nf;
     T.seed_plane = (flags & SFB__TBZ_SEED_PLANE) != 0;
@@ -7460,7 +7574,10 @@ static sfb_result tbz_points(sfb_context *ctx, const sfb__level *l, const float 
             if (T.corner_s[v] <= 0.0f) T.corner_s[v] = 1e-30f;
             any_tag = 1;
         }
+    /* the smooth net's solve is recorded for the sharp net (tbz_prev), unless asked not to */
+    T.rec = any_tag && !(flags & SFB__TBZ_NO_REUSE) ? &prev : NULL;
     r = tbz_state(&T, 0);
+    T.rec = NULL;
     if (r == SFB_SUCCESS && !T.seed_plane && any_tag && (T.st.ours_residual > 1e-10 || tbz_degenerate(&T))) {
         /* our crease tangent plane left the constraints around it unsolvable or a patch corner
          * degenerate (seen at valence 8 and up with a crease through the vertex): the smooth net
@@ -7470,6 +7587,7 @@ static sfb_result tbz_points(sfb_context *ctx, const sfb__level *l, const float 
         unsigned char *was = (unsigned char *)sfb__calloc(ctx, (size_t)T.nv + 1, 1);
         T.x = (double *)sfb__calloc(ctx, 3 * (size_t)T.np + 1, sizeof(double));
         if (!T.x || !was) { sfb__free(ctx, first); sfb__free(ctx, was); r = sfb__oom(ctx, "tribezier"); goto done; }
+        tbz_prev_free(ctx, &prev); /* the record is of the net now replaced */
         for (v = 0; v < T.nv; ++v) was[v] = (unsigned char)((T.vtype[v] & 16) && T.virr[v]);
         memset(&T.st, 0, sizeof T.st);
         T.seed_plane = 1;
@@ -7490,7 +7608,10 @@ static sfb_result tbz_points(sfb_context *ctx, const sfb__level *l, const float 
         vs = (double *)sfb__calloc(ctx, (size_t)T.nv + 1, sizeof(double));
         if (!T.x || !vs) { r = sfb__oom(ctx, "tribezier"); goto done; }
         T.pos = sharp_positions;
+        prev.x1 = x0;
+        T.prev = &prev;
         r = tbz_state(&T, 1);
+        T.prev = NULL;
         if (r != SFB_SUCCESS) goto done;
         r = tbz_vertex_s(&T, vs);
         if (r != SFB_SUCCESS) goto done;
@@ -7523,6 +7644,7 @@ done:
     sfb__free(ctx, T.efeat); sfb__free(ctx, T.vtype); sfb__free(ctx, T.virr); sfb__free(ctx, T.phi);
     sfb__free(ctx, T.x); sfb__free(ctx, T.fixed); sfb__free(ctx, T.dist); sfb__free(ctx, T.tag_s); sfb__free(ctx, T.corner_s);
     sfb__free(ctx, x0); sfb__free(ctx, vs); sfb__free(ctx, res);
+    tbz_prev_free(ctx, &prev);
     return r;
 }
 

@@ -610,8 +610,10 @@ SFB__IF sfb_result sfb__pn_build(sfb_context *ctx, const sfb__level *base, const
 /* Quartic triangular Bezier surfaces with sharpness (patch/tribezier.c, seed 004): the 15 points
  * of every triangle of base (patch order, double, 45 per triangle, freed by the caller) and what
  * the G1 solve did; flags SFB__TBZ_SEED_PLANE builds the seed's smooth net at crease vertices (a
- * tangent plane that ignores the crease, for the undulation measurement). */
-enum { SFB__TBZ_SEED_PLANE = 1 };
+ * tangent plane that ignores the crease, for the undulation measurement), SFB__TBZ_NO_REUSE solves every
+ * component of the sharp net's constraints even where the smooth net solved the same system (for the test
+ * that the reuse changes nothing). */
+enum { SFB__TBZ_SEED_PLANE = 1, SFB__TBZ_NO_REUSE = 2 };
 typedef struct sfb__tbz_stats {
     long iterations;   /* CGLS iterations, all coordinates and nets */
     long unknowns;     /* points moved by the G1 solve, per coordinate and net */
@@ -620,6 +622,8 @@ typedef struct sfb__tbz_stats {
     double ours_residual; /* the same within the constraint components around extraordinary crease vertices with
                              our tangent plane */
     int fallbacks;     /* smooth nets rebuilt with the seed's tangent plane (ours unsolvable) */
+    int reused;        /* sharp-net constraint components that were the same system as a smooth-net one and took its
+                          solution (SFB__TBZ_NO_REUSE: none) */
 } sfb__tbz_stats;
 SFB__IF sfb_result sfb__tribezier_points(sfb_context *ctx, const sfb__level *base, const float *positions,
                                          const sfb_tribezier_options *opt, unsigned flags, double **out, sfb__tbz_stats *stats);

@@ -642,6 +642,126 @@ static void refined_one(sfb_context *ctx, const char *name, const char *obj) {
     tmesh_free(ctx, &t);
 }
 
+/* The sharp net takes the smooth net's solution of every constraint component that is the same
+ * system in both (tbz_prev): the net must be bit for bit the one solved in full
+ * (SFB__TBZ_NO_REUSE), with components reused and fewer CGLS iterations. obj gets crease tags
+ * on the first edge of every 256th face, so that the nets differ near them (rows, and points the
+ * rows read) and agree away from them. */
+static void reuse_one(sfb_context *ctx, const char *name, const char *obj) {
+    tmesh t;
+    double *a = NULL, *b = NULL;
+    sfb__tbz_stats sa, sb;
+    sfb__level ra, rb;
+    char nm[160], *text;
+    size_t n = strlen(obj), at;
+    const char *fl = obj;
+    int faces = 0, tags = 0;
+    memset(&ra, 0, sizeof ra); memset(&rb, 0, sizeof rb);
+    memset(&sa, 0, sizeof sa); memset(&sb, 0, sizeof sb);
+    text = (char *)malloc(2 * n + 64);
+    if (!text) { fail(name, "out of memory"); return; }
+    memcpy(text, obj, n);
+    at = n;
+    text[at++] = '\n';
+    while ((fl = strstr(fl, "\nf ")) != NULL) {
+        /* its first two vertex indices (v, v/vt or v/vt/vn) */
+        char *e;
+        const long v0 = strtol(fl + 3, &e, 10);
+        long v1;
+        while (*e && *e != ' ' && *e != '\n') ++e;
+        v1 = strtol(e, NULL, 10);
+        ++fl;
+        if (faces++ % 256 != 0 || v0 < 1 || v1 < 1 || at + 64 > 2 * n) continue;
+        at += (size_t)snprintf(text + at, 64, "t crease 2/1/0 %ld %ld 1\n", v0 - 1, v1 - 1);
+        ++tags;
+    }
+    text[at] = 0;
+    snprintf(nm, sizeof nm, "%s/sharp_net_reuse_is_exact", name);
+    if (!tmesh_load(ctx, text, &t)) { fail(nm, "load: %s", sfb_last_error(ctx)); free(text); return; }
+    if (sfb__tribezier_refined_points(ctx, &t.prep, t.m->positions, NULL, 0, &ra, &a, &sa) != SFB_SUCCESS ||
+        sfb__tribezier_refined_points(ctx, &t.prep, t.m->positions, NULL, SFB__TBZ_NO_REUSE, &rb, &b, &sb) != SFB_SUCCESS) {
+        fail(nm, "not built: %s", sfb_last_error(ctx));
+    } else {
+        const int same = ra.nf == rb.nf && memcmp(a, b, 45 * (size_t)ra.nf * sizeof(double)) == 0;
+        check(same && sa.reused > 0 && sb.reused == 0 && sa.iterations < sb.iterations && sa.residual == sb.residual, nm,
+              "identical %d, components reused %d (without: %d), CGLS iterations %ld vs %ld, residual %.3g vs %.3g", same, sa.reused,
+              sb.reused, sa.iterations, sb.iterations, sa.residual, sb.residual);
+        printf("  %s: %d crease tags, %d sharp-net components reused, CGLS iterations %ld instead of %ld\n", name, tags, sa.reused,
+               sa.iterations, sb.iterations);
+    }
+    sfb__free(ctx, a); sfb__free(ctx, b);
+    sfb__level_free(ctx, &ra); sfb__level_free(ctx, &rb);
+    tmesh_free(ctx, &t);
+    free(text);
+}
+
+/* Two OBJ texts in the forms tbm_obj writes (v, f, t crease, t corner) as one mesh: b's
+ * vertex indices moved past a's vertices (malloc'd). */
+static char *obj_join(const char *a, const char *b) {
+    const size_t la = strlen(a), lb = strlen(b), cap = la + 2 * lb + 64;
+    char *s = (char *)malloc(cap), line[512];
+    const char *p;
+    size_t len;
+    int nva = 0;
+    if (!s) return NULL;
+    memcpy(s, a, la);
+    len = la;
+    for (p = a; (p = strstr(p, "v ")) != NULL; ++p)
+        if (p == a || p[-1] == '\n') ++nva;
+    for (p = b; *p; ) {
+        const char *e = strchr(p, '\n');
+        size_t n = e ? (size_t)(e - p) : strlen(p);
+        int i, j, k;
+        double x;
+        if (n >= sizeof line) n = sizeof line - 1;
+        memcpy(line, p, n);
+        line[n] = 0;
+        if (sscanf(line, "f %d %d %d", &i, &j, &k) == 3) len += (size_t)snprintf(s + len, cap - len, "f %d %d %d\n", i + nva, j + nva, k + nva);
+        else if (sscanf(line, "t crease 2/1/0 %d %d %lf", &i, &j, &x) == 3)
+            len += (size_t)snprintf(s + len, cap - len, "t crease 2/1/0 %d %d %.17g\n", i + nva, j + nva, x);
+        else if (sscanf(line, "t corner 1/1/0 %d %lf", &i, &x) == 2) len += (size_t)snprintf(s + len, cap - len, "t corner 1/1/0 %d %.17g\n", i + nva, x);
+        else len += (size_t)snprintf(s + len, cap - len, "%s\n", line);
+        p += e ? (size_t)(e - p) + 1 : n;
+    }
+    return s;
+}
+
+/* The same on two disks in one mesh: a crease through a valence-5 vertex (its component differs
+ * between the nets and must be solved) and an untagged valence-7 vertex (the same system in both:
+ * reused). */
+static void test_reuse_disks(sfb_context *ctx) {
+    tbm_opts o;
+    tmesh t;
+    char *a, *b, *obj;
+    double *x = NULL, *y = NULL;
+    sfb__tbz_stats sa, sb;
+    const char *nm = "sharp_net_reuse_is_exact/crease_disk_and_smooth_disk";
+    memset(&o, 0, sizeof o);
+    o.n = 5; o.R = 5; o.crease_k = 2; o.sharp = 1.0; o.ridge = 0.5; o.bump = 1.0; o.jitter = 0.15; o.seed = 11u;
+    a = tbm_obj(&o);
+    memset(&o, 0, sizeof o);
+    o.n = 7; o.R = 5; o.bump = 1.0; o.jitter = 0.15; o.seed = 12u;
+    b = tbm_obj(&o);
+    obj = a && b ? obj_join(a, b) : NULL;
+    memset(&sa, 0, sizeof sa); memset(&sb, 0, sizeof sb);
+    if (!obj || !tmesh_load(ctx, obj, &t)) {
+        fail(nm, "load");
+    } else {
+        x = net_of(ctx, &t, NULL, 0, &sa);
+        y = net_of(ctx, &t, NULL, SFB__TBZ_NO_REUSE, &sb);
+        if (!x || !y) fail(nm, "not built");
+        else {
+            const int same = memcmp(x, y, 45 * (size_t)t.prep.nf * sizeof(double)) == 0;
+            check(same && sa.reused > 0 && sb.reused == 0 && sa.iterations < sb.iterations, nm,
+                  "identical %d, components reused %d (without: %d), CGLS iterations %ld vs %ld", same, sa.reused, sb.reused, sa.iterations,
+                  sb.iterations);
+        }
+        tmesh_free(ctx, &t);
+    }
+    sfb__free(ctx, x); sfb__free(ctx, y);
+    free(a); free(b); free(obj);
+}
+
 static void test_refined(sfb_context *ctx, const char *dir) {
     char path[4096], *obj;
     size_t n;
@@ -650,6 +770,7 @@ static void test_refined(sfb_context *ctx, const char *dir) {
     obj = slurp(path, &n);
     if (!obj) { skip("touching_evs/spot", "spot.obj not found (pass the real-meshes folder)"); return; }
     refined_one(ctx, "touching_evs/spot", obj);
+    reuse_one(ctx, "touching_evs/spot", obj);
     free(obj);
 }
 
@@ -809,6 +930,7 @@ int main(int argc, char **argv) {
     test_creases(ctx);
     test_crease_evs(ctx);
     test_undulation(ctx);
+    test_reuse_disks(ctx);
     test_bad_input();
     {
         /* a real mesh whose extraordinary vertices of different valences touch: there the
