@@ -28,15 +28,19 @@
  *           |coordinate| of the grid's relative points (the scale of float's rounding errors);
  *           the three Stam windows have disjoint diagonals, so every window finds them there.
  *           Other w lanes are 0; the kernels' w lanes are never stored as results.
- *           Loop tables (triangles) use "triangles" of 16 xyzw points (64 floats, 256 bytes,
- *           64-byte aligned): the 15 control points of a quartic Bezier triangle in the
- *           table's order (row j = 0..4 by row in t, i = 0..4-j rising in s), relative to
- *           their centroid o, then (o.x, o.y, o.z, 4 E) as point 15 (E as above, times
- *           SFB__SIMD_TRI_EFACTOR; at float 63, where 3 cs + 15 finds it with cs = 16).
+ *           Loop tables (triangles) use "triangles" of 48 floats (192 bytes: three cache
+ *           lines, 64-byte aligned; random locations are bound by the lines they miss, and
+ *           the 256-byte xyzw layout took four): the 15 control points of a quartic Bezier
+ *           triangle in the table's order (row j = 0..4 by row in t, i = 0..4-j rising in s),
+ *           relative to the first, o = point 0 in float: points 1..14 as xyz at floats 0..41
+ *           (point 0's relative point is 0 and not stored), o at 42..44, E x
+ *           SFB__SIMD_TRI_EFACTOR at 45 (E as above; 3 cs + 15 finds it with cs = 10), 0 at
+ *           46, 47. The kernels load a point as 4 floats, the 4th being the next float (w
+ *           lanes are never stored as results).
  *           - a Bezier triangle patch (BEZTRI): its 15 points;
  *           - a Stam-Loop patch (EV at frame corner c): for each level n = 1..
  *             SFB__SIMD_LOOP_LEVELS the three sub-patches k = 0, 1, 2 of that level as
- *             triangles (192 floats per level), control points Q[j] = sum_i (lambda_i^m
+ *             triangles (144 floats per level), control points Q[j] = sum_i (lambda_i^m
  *             phi_k[j][i] + m lambda_i^(m-1) phi_k[j][head_i]) c_i, m = n - 1 (the second term
  *             for the second vector of a Jordan block), computed in double once. (Upload
  *             checks that the sub-patches agree on their shared edges, as for Stam.)
@@ -76,7 +80,7 @@
  * that the loads of several locations are in flight at once. Threads: the locations are cut
  * into equal chunks over the pool (calls under SFB__SIMD_INLINE_LOCATIONS stay on the caller). */
 #define SFB__SIMD_STAM_LEVELS 3
-#define SFB__SIMD_LOOP_LEVELS 3     /* Stam-Loop levels packed (192 floats each) */
+#define SFB__SIMD_LOOP_LEVELS 3     /* Stam-Loop levels packed (144 floats each) */
 #define SFB__SIMD_TRI_EFACTOR 4.0f  /* a triangle's E is scaled by this for the normal test */
 #define SFB__SIMD_AHEAD 16
 
@@ -87,7 +91,8 @@
  * corners 1 and 2, rot 4: (-Pv, Pu - Pv), rot 5: (Pv - Pu, -Pu) (second derivatives likewise;
  * det 1, so the normal is unchanged), then multiply by dsc = 2^(n + depth) (Loop: negative
  * after an odd number of middle children). run: the square window kernel (KERNEL), the
- * triangle kernel (TRI: blk is a 16-point triangle, cs 16), or the double paths. */
+ * triangle kernel (TRI: blk is a 48-float triangle, cs 10 so that the normal test finds E),
+ * or the double paths. */
 enum { SFB__SIMD_RUN_REF = 0, SFB__SIMD_RUN_KERNEL = 1, SFB__SIMD_RUN_STAM_FAR = 2, SFB__SIMD_RUN_TRI = 3, SFB__SIMD_RUN_LOOP_FAR = 4 };
 typedef struct sfb__simd_slot {
     const float *blk;
@@ -355,12 +360,12 @@ static void sfb__simd_patches_select(int isa, sfb__simd_prange_fn *range, sfb__s
     }
 }
 
-/* Floats of patch p's grids: 64 (B-spline, Bezier triangle), 100 per level (Stam with its
- * eigen structure), 192 per level (Stam-Loop), 0 (the ref kernel evaluates it). */
+/* Floats of patch p's grids: 64 (B-spline), 48 (Bezier triangle), 100 per level (Stam with its
+ * eigen structure), 144 per level (Stam-Loop), 0 (the ref kernel evaluates it). */
 static size_t sfb__simd_patch_floats(const sfb__patch_table *pt, int p) {
     const int n = pt->pfirst[p + 1] - pt->pfirst[p];
     if (pt->ptype[p] == SFB__PATCH_BSPLINE) return n == 16 ? 64 : 0;
-    if (pt->ptype[p] == SFB__PATCH_BEZTRI) return n == 15 ? 64 : 0;
+    if (pt->ptype[p] == SFB__PATCH_BEZTRI) return n == 15 ? 48 : 0;
     if (pt->ptype[p] == SFB__PATCH_STAM) {
         const int N = pt->pvalence[p];
         const sfb__eigen_cc *e = N >= 3 && N <= SFB__STAM_MAX_VALENCE ? pt->eig[N] : NULL;
@@ -369,7 +374,7 @@ static size_t sfb__simd_patch_floats(const sfb__patch_table *pt, int p) {
     if (pt->ptype[p] == SFB__PATCH_STAM_LOOP) {
         const int N = pt->pvalence[p];
         const sfb__eigen_loop *e = N >= 3 && N <= SFB__STAM_MAX_VALENCE ? pt->eigl[N] : NULL;
-        return e && e->K == n && e->lambda && e->phi && e->head ? 192 * SFB__SIMD_LOOP_LEVELS : 0;
+        return e && e->K == n && e->lambda && e->phi && e->head ? 144 * SFB__SIMD_LOOP_LEVELS : 0;
     }
     return 0;
 }
@@ -417,8 +422,8 @@ static sfb_result sfb__simd_patches_upload(sfb__simd_state *s, const sfb__patch_
             const size_t f = sfb__simd_patch_floats(pt, p);
             const int *cv = pt->cv + pt->pfirst[p];
             if (pass == 0) pcode[p] = -(SFB__SIMD_LEAF_REF + 1);
-            if (f == 0 || (f == 64) != (pass == 0)) continue;
-            if (f == 64 && pt->ptype[p] == SFB__PATCH_BEZTRI) {
+            if (f == 0 || (f == 64 || f == 48) != (pass == 0)) continue;
+            if (f == 48) {
                 double q[15][3];
                 int k, c;
                 for (k = 0; k < 15; ++k)

@@ -40,12 +40,11 @@ static SFB__SIMD_FORCEINLINE void sfb__simd_prep_tri(const sfb__simd_pjob *j, in
     o->run = SFB__SIMD_RUN_REF;
     if ((code & 3) == SFB__SIMD_LEAF_TRI) {
         o->blk = h->blk + 4 * (size_t)(code >> 4);
-        o->s = (float)s; o->t = (float)t; o->dsc = (float)sc; o->cs = 16; o->rot = 0;
+        o->s = (float)s; o->t = (float)t; o->dsc = (float)sc; o->cs = 10; o->rot = 0;
         o->run = SFB__SIMD_RUN_TRI;
         SFB__SIMD_PREFETCH(o->blk);
         SFB__SIMD_PREFETCH(o->blk + 16);
         SFB__SIMD_PREFETCH(o->blk + 32);
-        SFB__SIMD_PREFETCH(o->blk + 48);
     } else if ((code & 3) == SFB__SIMD_LEAF_STAM) {
         /* ref's frame turn ((1 - s) - t written as 1 + (-1) s + (-1) t, exactly the same), its
          * level n (n - 1 doublings bring u + v to [1/2, 1]: read off the exponent of u + v,
@@ -77,15 +76,14 @@ static SFB__SIMD_FORCEINLINE void sfb__simd_prep_tri(const sfb__simd_pjob *j, in
         sg = c2 ? -1.0 : 1.0;
         o->s = (float)((u + u - (double)(c0 | c2)) * sg);
         o->t = (float)((v + v - (double)(c1 | c2)) * sg);
-        o->blk = h->blk + 4 * (size_t)(code >> 4) + (size_t)(n - 1) * 192 + (size_t)(c1 + 2 * c2) * 64;
+        o->blk = h->blk + 4 * (size_t)(code >> 4) + (size_t)(n - 1) * 144 + (size_t)(c1 + 2 * c2) * 48;
         o->dsc = (float)(sc * sg * lv * 2.0);
-        o->cs = 16;
+        o->cs = 10;
         o->rot = corner ? corner + 3 : 0;
         o->run = SFB__SIMD_RUN_TRI;
         SFB__SIMD_PREFETCH(o->blk);
         SFB__SIMD_PREFETCH(o->blk + 16);
         SFB__SIMD_PREFETCH(o->blk + 32);
-        SFB__SIMD_PREFETCH(o->blk + 48);
     }
 }
 
@@ -102,8 +100,9 @@ static void sfb__simd_tri_portable(const float *blk, float s, float t, int secon
     const double w = (1.0 - s) - t;
     double p[15][3];
     int a, c;
-    for (a = 0; a < 15; ++a)
-        for (c = 0; c < 3; ++c) p[a][c] = blk[4 * a + c];
+    for (c = 0; c < 3; ++c) p[0][c] = 0.0;
+    for (a = 1; a < 15; ++a)
+        for (c = 0; c < 3; ++c) p[a][c] = blk[3 * (a - 1) + c];
     for (a = 0; a < 6; ++a) r[a][3] = 0.0f;
     for (c = 0; c < 3; ++c) {
 #define SFB__SIMD_DC_SCALAR(to, from, above) p[to][c] = t * p[above][c] + (s * p[(from) + 1][c] + w * p[from][c]);
@@ -120,7 +119,7 @@ static void sfb__simd_tri_portable(const float *blk, float s, float t, int secon
 #undef SFB__SIMD_DC_SCALAR
         r[1][c] = (float)(4.0 * (p[1][c] - p[0][c]));
         r[2][c] = (float)(4.0 * (p[2][c] - p[0][c]));
-        r[0][c] = (float)((t * p[2][c] + (s * p[1][c] + w * p[0][c])) + blk[60 + c]);
+        r[0][c] = (float)((t * p[2][c] + (s * p[1][c] + w * p[0][c])) + blk[42 + c]);
     }
 }
 
@@ -133,8 +132,9 @@ static SFB__SIMD_FORCEINLINE void sfb__simd_sse2_tri(const float *blk, int cs, f
     __m128d pl[15], ph[15];
     int a;
     (void)cs;
-    for (a = 0; a < 15; ++a) {
-        const __m128 v = _mm_loadu_ps(blk + 4 * a);
+    pl[0] = ph[0] = _mm_setzero_pd();
+    for (a = 1; a < 15; ++a) {
+        const __m128 v = _mm_loadu_ps(blk + 3 * (a - 1));
         pl[a] = _mm_cvtps_pd(v);
         ph[a] = _mm_cvtps_pd(_mm_movehl_ps(v, v));
     }
@@ -157,7 +157,7 @@ static SFB__SIMD_FORCEINLINE void sfb__simd_sse2_tri(const float *blk, int cs, f
     SFB__SIMD_DC2(SFB__SIMD_DC_SSE2)
     {
         const __m128d four = _mm_set1_pd(4.0);
-        const __m128 o = _mm_loadu_ps(blk + 60);
+        const __m128 o = _mm_loadu_ps(blk + 42);
         r[1] = SFB__SIMD_PS2(_mm_mul_pd(four, _mm_sub_pd(pl[1], pl[0])), _mm_mul_pd(four, _mm_sub_pd(ph[1], ph[0])));
         r[2] = SFB__SIMD_PS2(_mm_mul_pd(four, _mm_sub_pd(pl[2], pl[0])), _mm_mul_pd(four, _mm_sub_pd(ph[2], ph[0])));
         r[0] = SFB__SIMD_PS2(_mm_add_pd(_mm_add_pd(_mm_mul_pd(vt, pl[2]), _mm_add_pd(_mm_mul_pd(vs, pl[1]), _mm_mul_pd(vw, pl[0]))), _mm_cvtps_pd(o)),
@@ -179,7 +179,8 @@ static SFB__SIMD_FORCEINLINE void sfb__simd_sse2_tri(const float *blk, int cs, f
         __m256d p[15];                                                                                               \
         int a;                                                                                                       \
         (void)cs;                                                                                                    \
-        for (a = 0; a < 15; ++a) p[a] = _mm256_cvtps_pd(_mm_loadu_ps(blk + 4 * a));                                 \
+        p[0] = _mm256_setzero_pd();                                                                                  \
+        for (a = 1; a < 15; ++a) p[a] = _mm256_cvtps_pd(_mm_loadu_ps(blk + 3 * (a - 1)));                            \
         SFB__SIMD_DC4(SFB__SIMD_DC_PD)                                                                               \
         SFB__SIMD_DC3(SFB__SIMD_DC_PD)                                                                               \
         if (second) {                                                                                                \
@@ -194,7 +195,7 @@ static SFB__SIMD_FORCEINLINE void sfb__simd_sse2_tri(const float *blk, int cs, f
         r[1] = _mm256_cvtpd_ps(_mm256_mul_pd(_mm256_set1_pd(4.0), _mm256_sub_pd(p[1], p[0])));                      \
         r[2] = _mm256_cvtpd_ps(_mm256_mul_pd(_mm256_set1_pd(4.0), _mm256_sub_pd(p[2], p[0])));                      \
         r[0] = _mm256_cvtpd_ps(_mm256_add_pd(_mm256_fmadd_pd(vt, p[2], _mm256_fmadd_pd(vs, p[1], _mm256_mul_pd(vw, p[0]))), \
-                                             _mm256_cvtps_pd(_mm_loadu_ps(blk + 60))));                              \
+                                             _mm256_cvtps_pd(_mm_loadu_ps(blk + 42))));                              \
     }
 #define SFB__SIMD_DC_PD(to, from, above) p[to] = _mm256_fmadd_pd(vt, p[above], _mm256_fmadd_pd(vs, p[(from) + 1], _mm256_mul_pd(vw, p[from])));
 SFB__SIMD_TRI_PD(sfb__simd_avx2_tri, SFB__SIMD_TARGET_AVX2)
@@ -211,8 +212,9 @@ static void sfb__simd_tri_neon(const float *blk, float s, float t, int second, f
     const float64x2_t vs = vdupq_n_f64(sd), vt = vdupq_n_f64(td), vw = vdupq_n_f64((1.0 - sd) - td);
     float64x2_t pl[15], ph[15];
     int a;
-    for (a = 0; a < 15; ++a) {
-        const float32x4_t v = vld1q_f32(blk + 4 * a);
+    pl[0] = ph[0] = vdupq_n_f64(0.0);
+    for (a = 1; a < 15; ++a) {
+        const float32x4_t v = vld1q_f32(blk + 3 * (a - 1));
         pl[a] = vcvt_f64_f32(vget_low_f32(v));
         ph[a] = vcvt_high_f64_f32(v);
     }
@@ -233,7 +235,7 @@ static void sfb__simd_tri_neon(const float *blk, float s, float t, int second, f
     }
     SFB__SIMD_DC2(SFB__SIMD_DC_NEON)
     {
-        const float32x4_t o = vld1q_f32(blk + 60);
+        const float32x4_t o = vld1q_f32(blk + 42);
         SFB__SIMD_ST2(r[1], vmulq_n_f64(vsubq_f64(pl[1], pl[0]), 4.0), vmulq_n_f64(vsubq_f64(ph[1], ph[0]), 4.0));
         SFB__SIMD_ST2(r[2], vmulq_n_f64(vsubq_f64(pl[2], pl[0]), 4.0), vmulq_n_f64(vsubq_f64(ph[2], ph[0]), 4.0));
         SFB__SIMD_ST2(r[0], vaddq_f64(vfmaq_f64(vfmaq_f64(vmulq_f64(vw, pl[0]), vs, pl[1]), vt, pl[2]), vcvt_f64_f32(vget_low_f32(o))),
@@ -245,29 +247,27 @@ static void sfb__simd_tri_neon(const float *blk, float s, float t, int second, f
 #endif
 #endif /* SFB__SIMD_NEON */
 
-/* Packs a quartic Bezier triangle (15 double xyz points, the table's order) into g (64 floats):
- * the points relative to their centroid o, then (o, E x SFB__SIMD_TRI_EFACTOR) as point 15
- * (so E is at g[63], where the square windows of cs = 16 keep it too). Returns E. */
+/* Packs a quartic Bezier triangle (15 double xyz points, the table's order) into g (48 floats,
+ * patches.h): points 1..14 relative to o = point 0 rounded to float, o, E x
+ * SFB__SIMD_TRI_EFACTOR, two zeros. Returns E. (Point 0 is taken as o itself: it differs by
+ * point 0's rounding to float, as the old centroid origin did by its own.) */
 static float sfb__simd_pack_tri(float *g, double (*q)[3]) {
-    double o[3] = {0.0, 0.0, 0.0};
     float E = 0.0f;
     int k, c;
-    for (k = 0; k < 15; ++k)
-        for (c = 0; c < 3; ++c) o[c] += q[k][c] / 15.0;
-    for (c = 0; c < 3; ++c) g[60 + c] = (float)o[c];
-    for (k = 0; k < 15; ++k) {
+    for (c = 0; c < 3; ++c) g[42 + c] = (float)q[0][c];
+    for (k = 1; k < 15; ++k)
         for (c = 0; c < 3; ++c) {
-            g[4 * k + c] = (float)(q[k][c] - (double)g[60 + c]);
-            if (fabsf(g[4 * k + c]) > E) E = fabsf(g[4 * k + c]);
+            float *d = &g[3 * (k - 1) + c];
+            *d = (float)(q[k][c] - (double)g[42 + c]);
+            if (fabsf(*d) > E) E = fabsf(*d);
         }
-        g[4 * k + 3] = 0.0f;
-    }
-    g[63] = E * SFB__SIMD_TRI_EFACTOR;
+    g[45] = E * SFB__SIMD_TRI_EFACTOR;
+    g[46] = g[47] = 0.0f;
     return E;
 }
 
 /* The Stam-Loop triangles of patch p at g: for each level n = 1..SFB__SIMD_LOOP_LEVELS the
- * three sub-patches k = 0, 1, 2 (64 floats each, as sfb__simd_pack_tri), control points
+ * three sub-patches k = 0, 1, 2 (48 floats each, as sfb__simd_pack_tri), control points
  * Q[j] = sum_i (lambda_i^m phi_k[j][i] + m lambda_i^(m-1) phi_k[j][head_i]) c_i, m = n - 1 (the
  * second term only for the second vector of a Jordan block). 0 where the sub-patches of a
  * level do not agree on their shared edges (sub-patch 0's edge s = 0 is the middle's s = 0
@@ -299,7 +299,7 @@ static int sfb__simd_pack_stam_loop(float *g, const sfb__patch_table *pt, int p)
             }
         }
         for (k = 0; k < 3; ++k) {
-            const float E = sfb__simd_pack_tri(g + (size_t)(n - 1) * 192 + (size_t)k * 64, q[k]);
+            const float E = sfb__simd_pack_tri(g + (size_t)(n - 1) * 144 + (size_t)k * 48, q[k]);
             if ((double)E > scale) scale = E;
         }
     }
