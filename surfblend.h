@@ -12669,6 +12669,8 @@ done:
 #define SFB__AN_NEAR 0.5      /* pixels: within this, a non-converged attempt may fall back to the proxy */
 #define SFB__AN_ROUNDS 64
 #define SFB__AN_ANCHOR 4      /* pixels: round 0 starts from the proxy on this grid, the others between its hits */
+#define SFB__AN_BATCH 32768   /* round 0's attempts run in batches of this many (the buffers stay small and warm: at
+                                 1024 x 1024 on catmark_car, one batch per part held 41 MB, freshly faulted in per call) */
 #define SFB__AN_DILATE 2.0    /* pixels: uncovered pixels this close to a thin proxy triangle are seeded from it too */
 #define SFB__AN_MARGIN 0.92   /* the bounding sphere's share of the smaller side (as sfb_render) */
 
@@ -13360,7 +13362,7 @@ static sfb_result sfb__an_project_all(sfb__an *A, int steps) {
     int *mark = NULL;  /* per pixel: the last round that seeded it, and 3 faces it was seeded from */
     sfb_result r = SFB_SUCCESS;
     for (p = 0; p < npix; ++p) if (A->face[p] >= 0 || A->cface[p] >= 0) ++cap;
-    cap = cap > 4096 ? cap : 4096;
+    cap = cap < 4096 ? 4096 : cap > SFB__AN_BATCH ? SFB__AN_BATCH : cap; /* later rounds grow it when they need to */
     tries = (sfb__an_try *)sfb__alloc(A->ctx, (size_t)cap * sizeof *tries);
     locs = (sfb_location *)sfb__alloc(A->ctx, (size_t)cap * sizeof *locs);
     buf = (float *)sfb__alloc(A->ctx, (size_t)cap * 12 * sizeof(float));
@@ -13379,6 +13381,7 @@ static sfb_result sfb__an_project_all(sfb__an *A, int steps) {
         const int d = half == 0 ? SFB__AN_ANCHOR : half <= 2 ? 2 : 1, want = half == 0 ? 0 : 2 - (half & 1);
         int x, y;
         count = 0;
+        A->nchg = 0; /* round 0's changes are every hit (below) */
         for (y = 0; y < A->h; y += d)
         for (x = 0; x < A->w; x += d) {
             /* d is a power of two */
@@ -13396,10 +13399,13 @@ static sfb_result sfb__an_project_all(sfb__an *A, int steps) {
             if (half > 0 && !sfb__an_hermite(A, x, y, ox ? 0 : 1, d, &locs[count]) && !(ox && oy && sfb__an_hermite(A, x, y, 1, d, &locs[count])))
                 sfb__an_predict(A, x, y, d, &locs[count]);
             if (A->tri && (double)locs[count].u + (double)locs[count].v > 1.0) locs[count].v = nextafterf(locs[count].v, 0.0f);
-            ++count;
+            /* a full batch runs at once (its hits then seed the rest of the part too) */
+            if (++count == cap) {
+                if ((r = sfb__an_newton(A, tries, locs, count, buf, steps)) != SFB_SUCCESS) goto done;
+                count = 0;
+            }
         }
-        A->nchg = 0;
-        if ((r = sfb__an_newton(A, tries, locs, count, buf, steps)) != SFB_SUCCESS) goto done;
+        if (count > 0 && (r = sfb__an_newton(A, tries, locs, count, buf, steps)) != SFB_SUCCESS) goto done;
     }
     /* round 0's changes: every hit */
     for (A->nchg = 0; A->nchg < A->nhit; ++A->nchg) A->chg[A->nchg] = A->nchg;

@@ -285,6 +285,36 @@ static void test_levels(sfb_context *ctx, const shape *shapes, int count) {
     }
 }
 
+/* A large picture (800 x 800, over 100k covered pixels): round 0's attempts then run in
+ * several batches (SFB__AN_BATCH, 32768), whose hits seed the rest of their part. Level 1 and
+ * level 6 must still agree on the classes (>= 99.5 %) and on the coverage outside the
+ * one-pixel band, with no enclosed holes at level 1. */
+static void test_large(sfb_context *ctx, const shape *sh) {
+    const char *name = "large_picture_batches_creased_box";
+    sfb_mesh *m = load_shape(ctx, sh->path);
+    sfb_surface *s = m ? patch_surface(ctx, m, sh->scheme) : NULL;
+    sfb_analysis a1, a6;
+    sfb_analyze_config c = sfb_analyze_config_init(SFB_ANALYZE_REFLECTION);
+    long both = 0;
+    memset(&a1, 0, sizeof a1); memset(&a6, 0, sizeof a6);
+    if (!m) { skip(name, "shape not found"); return; }
+    c.width = c.height = 800;
+    c.level = 1;
+    if (!s || sfb_surface_analyze(s, &c, &a1) != SFB_SUCCESS || (c.level = 6, sfb_surface_analyze(s, &c, &a6)) != SFB_SUCCESS) {
+        fail(name, "%s", sfb_last_error(ctx));
+    } else {
+        const double agree = agreement(&a1, &a6, &both);
+        const long holes = enclosed_holes(&a1), off = coverage_off_band(&a1, &a6);
+        check(a1.covered_pixels > 100000 && agree >= 0.995 && holes == 0 && off == 0, name,
+              "%d pixels covered, level 1 vs 6 agree on %.3f %%, %ld enclosed holes, %ld coverage differences outside the band",
+              a1.covered_pixels, 100.0 * agree, holes, off);
+        printf("# %s: %d pixels, level 1 vs 6 agree on %.3f %% (%d dropped)\n", name, a1.covered_pixels, 100.0 * agree, a1.dropped_pixels);
+    }
+    sfb_analysis_free(&a1); sfb_analysis_free(&a6);
+    sfb_surface_destroy(s);
+    sfb_mesh_destroy(m);
+}
+
 /* ---- backends against ref ---- */
 /* Modes: 0 reflection, 1 mean and 2 Gaussian curvature (exact per pixel), 3 polygon-based
  * reflection (the raster's own interpolated data, so the raster kernels compared directly). */
@@ -474,6 +504,7 @@ int main(int argc, char **argv) {
     test_analytic(ctx, 0);
     test_analytic(ctx, 1);
     test_levels(ctx, shapes, 4);
+    test_large(ctx, &shapes[0]);
     test_bad(ctx);
     sfb_context_destroy(ctx);
     {
