@@ -792,6 +792,76 @@ Test(api, scheme_caps_and_domain)
     sfb_context_destroy(ctx);
 }
 
+/* sfb_surface_eval checks every location before writing anything: one bad location among 5000
+ * valid ones, at the first, the last and positions between (either side of 1024, should the
+ * checks ever run in blocks), is refused with SFB_INVALID_VALUE and its index, and the outputs
+ * stay as they were. Kinds: face -1, face
+ * out of range, u NaN, u + v > 1 on a triangle (Loop), a hole (the Catmull-Clark grid's
+ * face 4 is tagged `t hole`). */
+Test(api, eval_checks_every_location_first)
+{
+    static const char *grid =
+        "v 0 0 0\nv 1 0 0\nv 2 0 0\nv 3 0 0\nv 0 1 0\nv 1 1 0.2\nv 2 1 0.1\nv 3 1 0\nv 0 2 0\nv 1 2 0\nv 2 2 0.3\nv 3 2 0\n"
+        "v 0 3 0\nv 1 3 0\nv 2 3 0\nv 3 3 0\n"
+        "f 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 5 6 10 9\nf 6 7 11 10\nf 7 8 12 11\nf 9 10 14 13\nf 10 11 15 14\nf 11 12 16 15\n"
+        "t hole 1/0/0 4\n";
+    static const char *tris =
+        "v 0 0 0\nv 1 0 0\nv 1 1 0.2\nv 0 1 0\nf 1 2 3\nf 1 3 4\n";
+    const int n = 5000, at[5] = { 0, 1023, 1024, 2600, 4999 };
+    sfb_context *ctx = make_ctx();
+    for (int t = 0; t < 2; ++t) {
+        sfb_mesh *m = NULL;
+        sfb_surface *s = NULL;
+        sfb_surface_config sc = sfb_surface_config_init(t ? SFB_SCHEME_LOOP : SFB_SCHEME_CATMARK, 0);
+        const char *obj = t ? tris : grid;
+        sc.flags = SFB_REFINE_PATCHES;
+        cr_assert_eq(sfb_mesh_read_obj(ctx, obj, strlen(obj), &m), SFB_SUCCESS, "%s", sfb_last_error(ctx));
+        cr_assert_eq(sfb_surface_create(ctx, m, &sc, &s), SFB_SUCCESS, "%s", sfb_last_error(ctx));
+        const int nf = sfb_surface_param_face_count(s);
+        sfb_location *L = (sfb_location *)malloc(sizeof *L * (size_t)n);
+        float *P = (float *)malloc(sizeof(float) * 3 * (size_t)n);
+        cr_assert(L && P);
+        for (int q = 0; q < n; ++q) {
+            L[q].face = (q * 7) % nf;
+            if (!t && L[q].face == 4) L[q].face = 3; /* off the hole */
+            L[q].u = (float)((q % 13) / 13.0 * (t ? 0.5 : 1.0));
+            L[q].v = (float)((q % 7) / 7.0 * (t ? 0.5 : 1.0));
+        }
+        sfb_eval_output o;
+        memset(&o, 0, sizeof o);
+        o.position = P;
+        cr_expect_eq(sfb_surface_eval(s, L, n, &o), SFB_SUCCESS, "%s", sfb_last_error(ctx));
+        for (int kind = 0; kind < 5; ++kind) {
+            if (kind == 4 && t) continue;           /* holes: the grid */
+            if (kind == 3 && !t) continue;          /* u + v > 1: the triangles */
+            for (int a = 0; a < 5; ++a) {
+                const sfb_location keep = L[at[a]];
+                switch (kind) {
+                case 0: L[at[a]].face = -1; break;
+                case 1: L[at[a]].face = nf; break;
+                case 2: L[at[a]].u = NAN; break;
+                case 3: L[at[a]].u = 0.75f; L[at[a]].v = 0.25f + 1e-7f; break;
+                default: L[at[a]].face = 4; break;
+                }
+                for (int q = 0; q < 3 * n; ++q) P[q] = -7.0f;
+                cr_expect_eq(sfb_surface_eval(s, L, n, &o), SFB_INVALID_VALUE, "kind %d at %d accepted", kind, at[a]);
+                sfb_error_info e = sfb_last_error_info(ctx);
+                cr_expect_eq(e.index, at[a], "kind %d at %d: index %ld (%s)", kind, at[a], e.index, e.message);
+                int untouched = 1;
+                for (int q = 0; q < 3 * n; ++q) untouched &= P[q] == -7.0f;
+                cr_expect(untouched, "kind %d at %d: outputs written", kind, at[a]);
+                sfb_clear_error(ctx);
+                L[at[a]] = keep;
+            }
+        }
+        free(L);
+        free(P);
+        sfb_surface_destroy(s);
+        sfb_mesh_destroy(m);
+    }
+    sfb_context_destroy(ctx);
+}
+
 /* --crease-angle's library half: the cube's 12 edges (90 degrees) become infinitely sharp for a
  * limit under 90 and none for one over it; sharper edges keep their sharpness (not counted),
  * semi-sharp ones under the limit stay semi-sharp, the rest of the mesh is copied. */
