@@ -7291,7 +7291,7 @@ done:
  * component is the very same system: CGLS (the same rows in the same order, the same unknowns,
  * the same stopping) would repeat the smooth net's iterations bit for bit, so the sharp net takes
  * that component's smooth solution instead. Most components lie away from every tagged feature,
- * where both nets have the same points: on the bench's torus this halves the construction.
+ * where both nets have the same points: on the bench's torus this cuts the construction by a third.
  * Recorded only when the smooth net kept our tangent plane (no seed-plane fallback). */
 typedef struct tbz_prev {
     int ok;
