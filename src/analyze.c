@@ -110,6 +110,15 @@ static void sfb__an_project_dir(const sfb__an_cam *c, const double *p, const dou
     *dy = -c->focal * (ty * zc - yc * tz) / (zc * zc);
 }
 
+/* The screen Jacobian of a surface point p with tangents tu, tv: j = (dsx/du, dsx/dv, dsy/du,
+ * dsy/dv) and its determinant; 0 when it is singular (or not finite). */
+static int sfb__an_jacobian(const sfb__an_cam *c, const double *p, const double *tu, const double *tv, double j[4], double *det) {
+    sfb__an_project_dir(c, p, tu, &j[0], &j[2]);
+    sfb__an_project_dir(c, p, tv, &j[1], &j[3]);
+    *det = j[0] * j[3] - j[1] * j[2];
+    return fabs(*det) > 1e-18 && isfinite(*det);
+}
+
 /* ---- configuration checks ---- */
 static int sfb__an_finite_n(const float *v, int n) {
     int i;
@@ -604,7 +613,7 @@ static sfb_result sfb__an_newton(sfb__an *A, sfb__an_try *tries, sfb_location *l
         for (i = 0; i < active; ++i) {
             sfb__an_try *t = &tries[i];
             int pix = t->pix, x = pix % A->w, y = pix / A->w;
-            double p[3], tu[3], tv[3], sx, sy, z, rx, ry, j00, j01, j10, j11, det, du_, dv_, m, u, v, res;
+            double p[3], tu[3], tv[3], sx, sy, z, rx, ry, jac[4], det, du_, dv_, m, u, v, res;
             int c, ok;
             for (c = 0; c < 3; ++c) { p[c] = pos[3 * i + c]; tu[c] = du[3 * i + c]; tv[c] = dv[3 * i + c]; }
             ok = sfb__an_finite3(pos + 3 * i) && sfb__an_project(&A->cam, p, &sx, &sy, &z);
@@ -626,12 +635,9 @@ static sfb_result sfb__an_newton(sfb__an *A, sfb__an_try *tries, sfb_location *l
                 continue;
             }
             if (!ok || it == steps) { t->outcome = ok && res < SFB__AN_NEAR ? 2 : 3; continue; }
-            sfb__an_project_dir(&A->cam, p, tu, &j00, &j10);
-            sfb__an_project_dir(&A->cam, p, tv, &j01, &j11);
-            det = j00 * j11 - j01 * j10;
-            if (!(fabs(det) > 1e-18) || !isfinite(det)) { t->outcome = res < SFB__AN_NEAR ? 2 : 3; continue; }
-            du_ = (j11 * rx - j01 * ry) / det;
-            dv_ = (-j10 * rx + j00 * ry) / det;
+            if (!sfb__an_jacobian(&A->cam, p, tu, tv, jac, &det)) { t->outcome = res < SFB__AN_NEAR ? 2 : 3; continue; }
+            du_ = (jac[3] * rx - jac[1] * ry) / det;
+            dv_ = (-jac[2] * rx + jac[0] * ry) / det;
             m = fabs(du_) > fabs(dv_) ? fabs(du_) : fabs(dv_);
             if (m > 0.34) { du_ *= 0.34 / m; dv_ *= 0.34 / m; }
             u = locs[i].u + du_;
@@ -671,15 +677,12 @@ static sfb_result sfb__an_newton(sfb__an *A, sfb__an_try *tries, sfb_location *l
 /* d(u,v)/d(pixel) along the picture's axis `axis` (0: x, 1: y) at hit k: its screen Jacobian's
  * inverse applied to that axis; 0 when the Jacobian is singular. */
 static int sfb__an_uv_per_pixel(const sfb__an *A, int k, int axis, double m[2]) {
-    double p[3], tu[3], tv[3], j00, j01, j10, j11, det;
+    double p[3], tu[3], tv[3], jac[4], det;
     int c;
     for (c = 0; c < 3; ++c) { p[c] = A->hpos[3 * (size_t)k + c]; tu[c] = A->hdu[3 * (size_t)k + c]; tv[c] = A->hdv[3 * (size_t)k + c]; }
-    sfb__an_project_dir(&A->cam, p, tu, &j00, &j10);
-    sfb__an_project_dir(&A->cam, p, tv, &j01, &j11);
-    det = j00 * j11 - j01 * j10;
-    if (!(fabs(det) > 1e-18) || !isfinite(det)) return 0;
-    m[0] = (axis ? -j01 : j11) / det;
-    m[1] = (axis ? j00 : -j10) / det;
+    if (!sfb__an_jacobian(&A->cam, p, tu, tv, jac, &det)) return 0;
+    m[0] = (axis ? -jac[1] : jac[3]) / det;
+    m[1] = (axis ? jac[0] : -jac[2]) / det;
     return 1;
 }
 
@@ -737,7 +740,7 @@ static int sfb__an_hermite(const sfb__an *A, int x, int y, int axis, int d, sfb_
 /* Step 2 over every round (see the file's comment). */
 static sfb_result sfb__an_project_all(sfb__an *A, int steps) {
     size_t npix = (size_t)A->w * (size_t)A->h, p;
-    int cap = 0, count = 0, round, half;
+    int cap = 0, count = 0, round, part;
     sfb__an_try *tries = NULL;
     sfb_location *locs = NULL;
     float *buf = NULL;
@@ -759,15 +762,15 @@ static sfb_result sfb__an_project_all(sfb__an *A, int steps) {
      * proxy too. Measured on catmark_car at 1024 x 1024 (200k pixels), every round: 1.64
      * evaluations per covered pixel; 2.6 with anchors every 2 pixels, the one-sided prediction
      * alone and no stall rule (sfb__an_newton) */
-    for (half = 0; half < 5; ++half) {
-        const int d = half == 0 ? SFB__AN_ANCHOR : half <= 2 ? 2 : 1, want = half == 0 ? 0 : 2 - (half & 1);
+    for (part = 0; part < 5; ++part) {
+        const int d = part == 0 ? SFB__AN_ANCHOR : part <= 2 ? 2 : 1, want = part == 0 ? 0 : 2 - (part & 1);
         int x, y;
         count = 0;
         A->nchg = 0; /* round 0's changes are every hit (below) */
         for (y = 0; y < A->h; y += d)
         for (x = 0; x < A->w; x += d) {
             /* d is a power of two */
-            const int ox = half > 0 && (x & (2 * d - 1)) == d, oy = half > 0 && (y & (2 * d - 1)) == d;
+            const int ox = part > 0 && (x & (2 * d - 1)) == d, oy = part > 0 && (y & (2 * d - 1)) == d;
             p = (size_t)y * (size_t)A->w + (size_t)x;
             if (ox + oy != want) continue;
             if (A->face[p] < 0 && A->cface[p] < 0) continue;
@@ -778,7 +781,7 @@ static sfb_result sfb__an_project_all(sfb__an *A, int steps) {
             } else {
                 locs[count].face = A->cface[p]; locs[count].u = A->cuv[2 * p]; locs[count].v = A->cuv[2 * p + 1];
             }
-            if (half > 0 && !sfb__an_hermite(A, x, y, ox ? 0 : 1, d, &locs[count]) && !(ox && oy && sfb__an_hermite(A, x, y, 1, d, &locs[count])))
+            if (part > 0 && !sfb__an_hermite(A, x, y, ox ? 0 : 1, d, &locs[count]) && !(ox && oy && sfb__an_hermite(A, x, y, 1, d, &locs[count])))
                 sfb__an_predict(A, x, y, d, &locs[count]);
             if (A->tri && (double)locs[count].u + (double)locs[count].v > 1.0) locs[count].v = nextafterf(locs[count].v, 0.0f);
             /* a full batch runs at once (its hits then seed the rest of the part too) */

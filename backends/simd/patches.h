@@ -82,6 +82,8 @@
 #define SFB__SIMD_STAM_LEVELS 3
 #define SFB__SIMD_LOOP_LEVELS 3     /* Stam-Loop levels packed (144 floats each) */
 #define SFB__SIMD_TRI_EFACTOR 4.0f  /* a triangle's E is scaled by this for the normal test */
+#define SFB__SIMD_TRI_FLOATS 48     /* a packed Bezier triangle (the layout above) */
+#define SFB__SIMD_TRI_ORIGIN 42     /* its o (E follows, at 3 cs + 15 with cs = 10) */
 #define SFB__SIMD_AHEAD 16
 
 
@@ -365,7 +367,7 @@ static void sfb__simd_patches_select(int isa, sfb__simd_prange_fn *range, sfb__s
 static size_t sfb__simd_patch_floats(const sfb__patch_table *pt, int p) {
     const int n = pt->pfirst[p + 1] - pt->pfirst[p];
     if (pt->ptype[p] == SFB__PATCH_BSPLINE) return n == 16 ? 64 : 0;
-    if (pt->ptype[p] == SFB__PATCH_BEZTRI) return n == 15 ? 48 : 0;
+    if (pt->ptype[p] == SFB__PATCH_BEZTRI) return n == 15 ? SFB__SIMD_TRI_FLOATS : 0;
     if (pt->ptype[p] == SFB__PATCH_STAM) {
         const int N = pt->pvalence[p];
         const sfb__eigen_cc *e = N >= 3 && N <= SFB__STAM_MAX_VALENCE ? pt->eig[N] : NULL;
@@ -374,7 +376,7 @@ static size_t sfb__simd_patch_floats(const sfb__patch_table *pt, int p) {
     if (pt->ptype[p] == SFB__PATCH_STAM_LOOP) {
         const int N = pt->pvalence[p];
         const sfb__eigen_loop *e = N >= 3 && N <= SFB__STAM_MAX_VALENCE ? pt->eigl[N] : NULL;
-        return e && e->K == n && e->lambda && e->phi && e->head ? 144 * SFB__SIMD_LOOP_LEVELS : 0;
+        return e && e->K == n && e->lambda && e->phi && e->head ? 3 * SFB__SIMD_TRI_FLOATS * SFB__SIMD_LOOP_LEVELS : 0;
     }
     return 0;
 }
@@ -422,8 +424,8 @@ static sfb_result sfb__simd_patches_upload(sfb__simd_state *s, const sfb__patch_
             const size_t f = sfb__simd_patch_floats(pt, p);
             const int *cv = pt->cv + pt->pfirst[p];
             if (pass == 0) pcode[p] = -(SFB__SIMD_LEAF_REF + 1);
-            if (f == 0 || (f == 64 || f == 48) != (pass == 0)) continue;
-            if (f == 48) {
+            if (f == 0 || (f == 64 || f == SFB__SIMD_TRI_FLOATS) != (pass == 0)) continue;
+            if (pt->ptype[p] == SFB__PATCH_BEZTRI) {
                 double q[15][3];
                 int k, c;
                 for (k = 0; k < 15; ++k)

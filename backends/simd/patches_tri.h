@@ -76,7 +76,7 @@ static SFB__SIMD_FORCEINLINE void sfb__simd_prep_tri(const sfb__simd_pjob *j, in
         sg = c2 ? -1.0 : 1.0;
         o->s = (float)((u + u - (double)(c0 | c2)) * sg);
         o->t = (float)((v + v - (double)(c1 | c2)) * sg);
-        o->blk = h->blk + 4 * (size_t)(code >> 4) + (size_t)(n - 1) * 144 + (size_t)(c1 + 2 * c2) * 48;
+        o->blk = h->blk + 4 * (size_t)(code >> 4) + (size_t)(n - 1) * 3 * SFB__SIMD_TRI_FLOATS + (size_t)(c1 + 2 * c2) * SFB__SIMD_TRI_FLOATS;
         o->dsc = (float)(sc * sg * lv * 2.0);
         o->cs = 10;
         o->rot = corner ? corner + 3 : 0;
@@ -119,7 +119,7 @@ static void sfb__simd_tri_portable(const float *blk, float s, float t, int secon
 #undef SFB__SIMD_DC_SCALAR
         r[1][c] = (float)(4.0 * (p[1][c] - p[0][c]));
         r[2][c] = (float)(4.0 * (p[2][c] - p[0][c]));
-        r[0][c] = (float)((t * p[2][c] + (s * p[1][c] + w * p[0][c])) + blk[42 + c]);
+        r[0][c] = (float)((t * p[2][c] + (s * p[1][c] + w * p[0][c])) + blk[SFB__SIMD_TRI_ORIGIN + c]);
     }
 }
 
@@ -157,7 +157,7 @@ static SFB__SIMD_FORCEINLINE void sfb__simd_sse2_tri(const float *blk, int cs, f
     SFB__SIMD_DC2(SFB__SIMD_DC_SSE2)
     {
         const __m128d four = _mm_set1_pd(4.0);
-        const __m128 o = _mm_loadu_ps(blk + 42);
+        const __m128 o = _mm_loadu_ps(blk + SFB__SIMD_TRI_ORIGIN);
         r[1] = SFB__SIMD_PS2(_mm_mul_pd(four, _mm_sub_pd(pl[1], pl[0])), _mm_mul_pd(four, _mm_sub_pd(ph[1], ph[0])));
         r[2] = SFB__SIMD_PS2(_mm_mul_pd(four, _mm_sub_pd(pl[2], pl[0])), _mm_mul_pd(four, _mm_sub_pd(ph[2], ph[0])));
         r[0] = SFB__SIMD_PS2(_mm_add_pd(_mm_add_pd(_mm_mul_pd(vt, pl[2]), _mm_add_pd(_mm_mul_pd(vs, pl[1]), _mm_mul_pd(vw, pl[0]))), _mm_cvtps_pd(o)),
@@ -195,7 +195,7 @@ static SFB__SIMD_FORCEINLINE void sfb__simd_sse2_tri(const float *blk, int cs, f
         r[1] = _mm256_cvtpd_ps(_mm256_mul_pd(_mm256_set1_pd(4.0), _mm256_sub_pd(p[1], p[0])));                      \
         r[2] = _mm256_cvtpd_ps(_mm256_mul_pd(_mm256_set1_pd(4.0), _mm256_sub_pd(p[2], p[0])));                      \
         r[0] = _mm256_cvtpd_ps(_mm256_add_pd(_mm256_fmadd_pd(vt, p[2], _mm256_fmadd_pd(vs, p[1], _mm256_mul_pd(vw, p[0]))), \
-                                             _mm256_cvtps_pd(_mm_loadu_ps(blk + 42))));                              \
+                                             _mm256_cvtps_pd(_mm_loadu_ps(blk + SFB__SIMD_TRI_ORIGIN))));                              \
     }
 #define SFB__SIMD_DC_PD(to, from, above) p[to] = _mm256_fmadd_pd(vt, p[above], _mm256_fmadd_pd(vs, p[(from) + 1], _mm256_mul_pd(vw, p[from])));
 SFB__SIMD_TRI_PD(sfb__simd_avx2_tri, SFB__SIMD_TARGET_AVX2)
@@ -235,7 +235,7 @@ static void sfb__simd_tri_neon(const float *blk, float s, float t, int second, f
     }
     SFB__SIMD_DC2(SFB__SIMD_DC_NEON)
     {
-        const float32x4_t o = vld1q_f32(blk + 42);
+        const float32x4_t o = vld1q_f32(blk + SFB__SIMD_TRI_ORIGIN);
         SFB__SIMD_ST2(r[1], vmulq_n_f64(vsubq_f64(pl[1], pl[0]), 4.0), vmulq_n_f64(vsubq_f64(ph[1], ph[0]), 4.0));
         SFB__SIMD_ST2(r[2], vmulq_n_f64(vsubq_f64(pl[2], pl[0]), 4.0), vmulq_n_f64(vsubq_f64(ph[2], ph[0]), 4.0));
         SFB__SIMD_ST2(r[0], vaddq_f64(vfmaq_f64(vfmaq_f64(vmulq_f64(vw, pl[0]), vs, pl[1]), vt, pl[2]), vcvt_f64_f32(vget_low_f32(o))),
@@ -254,15 +254,15 @@ static void sfb__simd_tri_neon(const float *blk, float s, float t, int second, f
 static float sfb__simd_pack_tri(float *g, double (*q)[3]) {
     float E = 0.0f;
     int k, c;
-    for (c = 0; c < 3; ++c) g[42 + c] = (float)q[0][c];
+    for (c = 0; c < 3; ++c) g[SFB__SIMD_TRI_ORIGIN + c] = (float)q[0][c];
     for (k = 1; k < 15; ++k)
         for (c = 0; c < 3; ++c) {
             float *d = &g[3 * (k - 1) + c];
-            *d = (float)(q[k][c] - (double)g[42 + c]);
+            *d = (float)(q[k][c] - (double)g[SFB__SIMD_TRI_ORIGIN + c]);
             if (fabsf(*d) > E) E = fabsf(*d);
         }
-    g[45] = E * SFB__SIMD_TRI_EFACTOR;
-    g[46] = g[47] = 0.0f;
+    g[SFB__SIMD_TRI_ORIGIN + 3] = E * SFB__SIMD_TRI_EFACTOR;
+    g[SFB__SIMD_TRI_ORIGIN + 4] = g[SFB__SIMD_TRI_ORIGIN + 5] = 0.0f;
     return E;
 }
 
@@ -299,7 +299,7 @@ static int sfb__simd_pack_stam_loop(float *g, const sfb__patch_table *pt, int p)
             }
         }
         for (k = 0; k < 3; ++k) {
-            const float E = sfb__simd_pack_tri(g + (size_t)(n - 1) * 144 + (size_t)k * 48, q[k]);
+            const float E = sfb__simd_pack_tri(g + (size_t)(n - 1) * 3 * SFB__SIMD_TRI_FLOATS + (size_t)k * SFB__SIMD_TRI_FLOATS, q[k]);
             if ((double)E > scale) scale = E;
         }
     }

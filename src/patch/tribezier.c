@@ -812,15 +812,14 @@ done:
 }
 
 /* The smooth net's solve, kept for the sharp net. A component of the sharp net's constraints
- * whose rows, unknowns, the points its rows read and the scale (T->scale) are those of a smooth-net
- * component is the very same system: CGLS (the same rows in the same order, the same unknowns,
- * the same stopping) would repeat the smooth net's iterations bit for bit, so the sharp net takes
+ * whose rows, unknowns and the points its rows read are those of a smooth-net component is the
+ * very same system: CGLS (the same rows in the same order, the same unknowns, the same stopping:
+ * T->scale is the same in both nets) would repeat the smooth net's iterations bit for bit, so the sharp net takes
  * that component's smooth solution instead. Most components lie away from every tagged feature,
  * where both nets have the same points: on the bench's torus this cuts the construction by a third.
  * Recorded only when the smooth net kept our tangent plane (no seed-plane fallback). */
 typedef struct tbz_prev {
     int ok;
-    double scale;
     tbz_sys S;         /* the smooth net's rows (owned) */
     int *erow;         /* per edge: its first row in S, -1: none */
     double *x0;        /* the smooth net before its solve (3 np) */
@@ -845,10 +844,10 @@ static void tbz_edge_first_rows(const tbz_sys *S, int ne, int *erow) {
 /* The smooth-net component that is the same system as the sharp net's component (rows[0..nr),
  * unk[0..nu)), -1: none (see tbz_prev). erow: the sharp net's tbz_edge_first_rows. */
 static int tbz_same_component(const sfb__tbz *T, const tbz_sys *S, const int *erow, const int *ucol, const int *rows, int nr,
-                              const int *unk, int nu, double scale) {
+                              const int *unk, int nu) {
     const tbz_prev *P = T->prev;
     int r, j, pc;
-    if (!P || !P->ok || nr == 0 || nu == 0 || scale != P->scale) return -1;
+    if (nr == 0 || nu == 0) return -1;
     pc = P->pcomp[unk[0]];
     if (pc < 0 || P->crows[pc] != nr || P->cunk[pc] != nu) return -1;
     for (j = 1; j < nu; ++j)
@@ -920,7 +919,6 @@ static sfb_result tbz_solve(sfb__tbz *T) {
             rec->cunk[i] = ustart[i + 1] - ustart[i];
             for (j = ustart[i]; j < ustart[i + 1]; ++j) rec->pcomp[unk[j]] = i;
         }
-        rec->scale = scale;
     }
     if (T->prev && T->prev->ok) {
         erow = (int *)sfb__alloc(T->ctx, ((size_t)T->ne + 1) * sizeof(int));
@@ -952,7 +950,7 @@ static sfb_result tbz_solve(sfb__tbz *T) {
             continue;
         }
         if (erow) {
-            const int pc = tbz_same_component(T, &S, erow, ucol, rows + rstart[i], rstart[i + 1] - rstart[i], unk + u0, cu, scale);
+            const int pc = tbz_same_component(T, &S, erow, ucol, rows + rstart[i], rstart[i + 1] - rstart[i], unk + u0, cu);
             if (pc >= 0) {
                 for (j = 0; j < cu; ++j)
                     for (r = 0; r < 3; ++r) T->x[3 * (size_t)unk[u0 + j] + r] = T->prev->x1[3 * (size_t)unk[u0 + j] + r];
