@@ -53,6 +53,8 @@
 #define SFB__AN_ANCHOR 4      /* pixels: round 0 starts from the proxy on this grid, the others between its hits */
 #define SFB__AN_BATCH 32768   /* round 0's attempts run in batches of this many (the buffers stay small and warm: at
                                  1024 x 1024 on catmark_car, one batch per part held 41 MB, freshly faulted in per call) */
+#define SFB__AN_PARALLEL 4096  /* items: from this many on, a per-item loop goes to the backend's threads (sfb__parallel) */
+#define SFB__AN_OUT_NEW_HIT 4
 #define SFB__AN_DILATE 2.0    /* pixels: uncovered pixels this close to a thin proxy triangle are seeded from it too */
 #define SFB__AN_MARGIN 0.92   /* the bounding sphere's share of the smaller side (as sfb_render) */
 
@@ -226,12 +228,20 @@ typedef struct sfb__an {
     /* hits (compact) */
     int nhit;
     int *chg, nchg;              /* hits made or replaced by the last batch of attempts */
+    unsigned char *nbm;          /* per change: the neighbours it seeds (sfb__an_neighbours) */
     int *hpix;
     sfb_location *hloc;
     float *hpos, *hdu, *hdv, *hnrm, *hdepth;
 } sfb__an;
 
 enum { SFB__AN_NONE = 0, SFB__AN_TRIED_NEAR = 1, SFB__AN_HIT = 2 };
+
+/* sfb__parallel when there are enough items to be worth it (`work`, in items of ~100 ns),
+ * else the task as one call. */
+static void sfb__an_run(const sfb__an *A, void (*task)(void *arg, int first, int last), void *arg, int first, int last, double work) {
+    if (work >= SFB__AN_PARALLEL) sfb__parallel(A->ctx, task, arg, first, last);
+    else task(arg, first, last);
+}
 
 static void sfb__an_grid_uv(const sfb__an *A, int k, double *u, double *v) {
     int R = A->R;
@@ -537,8 +547,10 @@ static sfb_result sfb__an_raster(sfb__an *A) {
 
 /* ---- step 2: Newton projection, in batches ---- */
 typedef struct sfb__an_try {
-    int pix, steps, pinned, crossed, outcome;   /* outcome: 0 running, 1 hit, 2 near, 3 miss */
+    int pix, steps, pinned, crossed, outcome;   /* outcome: 0 running, 1 hit, 2 near, 3 miss (SFB__AN_OUT_NEW_HIT: a hit
+                                                   sfb__an_newton has yet to record) */
     double res, res2;  /* the residual of the last evaluation, and of the one before (pixels) */
+    double z;          /* a new hit's depth */
 } sfb__an_try;
 
 /* Records the evaluation at loc as pixel pix's hit at depth z (a pixel already hit keeps the
@@ -597,69 +609,97 @@ static int sfb__an_exit_side(const sfb__an *A, double uo, double vo, double u, d
     return best;
 }
 
+/* One Newton step of the running attempts [a, b) of a batch (sfb__an_step_job), from their
+ * evaluations: the residual, the outcome, or the next (u,v) (crossing into a neighbour face
+ * where the step leaves the face). A hit is not recorded here: its outcome is
+ * SFB__AN_OUT_NEW_HIT, with its depth in z, and sfb__an_newton records it afterwards, in
+ * attempt order, on one thread. */
+typedef struct sfb__an_step_job {
+    const sfb__an *A;
+    sfb__an_try *tries;
+    sfb_location *locs;
+    const float *pos, *du, *dv;
+    int it, steps;
+} sfb__an_step_job;
+
+static void sfb__an_step(void *arg, int a, int b) {
+    const sfb__an_step_job *J = (const sfb__an_step_job *)arg;
+    const sfb__an *A = J->A;
+    const float *pos = J->pos, *du = J->du, *dv = J->dv;
+    const int it = J->it, steps = J->steps;
+    int i;
+    for (i = a; i < b; ++i) {
+        sfb__an_try *t = &J->tries[i];
+        sfb_location *l = &J->locs[i];
+        int pix = t->pix, x = pix % A->w, y = pix / A->w;
+        double p[3], tu[3], tv[3], sx, sy, z, rx, ry, jac[4], det, du_, dv_, m, u, v, res;
+        int c, ok;
+        for (c = 0; c < 3; ++c) { p[c] = pos[3 * i + c]; tu[c] = du[3 * i + c]; tv[c] = dv[3 * i + c]; }
+        ok = sfb__an_finite3(pos + 3 * i) && sfb__an_project(&A->cam, p, &sx, &sy, &z);
+        res = HUGE_VAL;
+        if (ok) {
+            rx = (x + 0.5) - sx; ry = (y + 0.5) - sy;
+            res = sqrt(rx * rx + ry * ry);
+        }
+        /* stalled: an attempt whose residual has not halved over the last two steps and is
+         * over a pixel (a pixel off the exact silhouette, or across a face it cannot reach)
+         * stops as a miss instead of running out its steps (at half a pixel, a few more
+         * silhouette pixels were dropped on catmark_car and spot) */
+        if (ok && it >= 2 && res > 1.0 && !(res < 0.5 * t->res2)) { t->res = res; t->outcome = 3; continue; }
+        t->res2 = t->res;
+        t->res = res;
+        if (ok && res < SFB__AN_TOL) { t->z = z; t->outcome = SFB__AN_OUT_NEW_HIT; continue; }
+        if (!ok || it == steps) { t->outcome = ok && res < SFB__AN_NEAR ? 2 : 3; continue; }
+        if (!sfb__an_jacobian(&A->cam, p, tu, tv, jac, &det)) { t->outcome = res < SFB__AN_NEAR ? 2 : 3; continue; }
+        du_ = (jac[3] * rx - jac[1] * ry) / det;
+        dv_ = (-jac[2] * rx + jac[0] * ry) / det;
+        m = fabs(du_) > fabs(dv_) ? fabs(du_) : fabs(dv_);
+        if (m > 0.34) { du_ *= 0.34 / m; dv_ *= 0.34 / m; }
+        u = l->u + du_;
+        v = l->v + dv_;
+        if (sfb__an_clamp_domain(A, &u, &v)) {
+            /* left the face: carry on in the neighbour across the side it left by (at most
+             * 4 crossings), else give up after two steps against the border */
+            double uo = l->u + du_, vo = l->v + dv_, ts = 0.0;
+            int side = sfb__an_exit_side(A, uo, vo, u, v, &ts), nb = side >= 0 ? A->adj[4 * l->face + side] : -1;
+            if (nb >= 0 && t->crossed < 4) {
+                int nside = (nb >> 1) & 3, nf = nb >> 3;
+                sfb__an_side_point(A->tri, nside, (nb & 1) ? 1.0 - ts : ts, &u, &v);
+                l->face = nf;
+                ++t->crossed;
+                t->pinned = 0;
+            } else if (++t->pinned >= 2) { t->outcome = res < SFB__AN_NEAR ? 2 : 3; continue; }
+        } else t->pinned = 0;
+        l->u = (float)u;
+        l->v = (float)v;
+        if (A->tri && (double)l->u + (double)l->v > 1.0) l->v = nextafterf(l->v, 0.0f);
+        ++t->steps;
+    }
+}
+
 /* Runs the attempts (tries[i] for pixel tries[i].pix from locs[i]) to their outcomes; records
- * hits (a pixel hit by an earlier attempt of the same batch keeps the nearer one). */
+ * hits (a pixel hit by an earlier attempt of the same batch keeps the nearer one). Per step:
+ * the backend evaluates the running attempts, sfb__an_step updates them (on the backend's
+ * threads), the new hits are recorded in attempt order, and the running ones move first. */
 static sfb_result sfb__an_newton(sfb__an *A, sfb__an_try *tries, sfb_location *locs, int count, float *buf, int steps) {
     int active = count, it, i;
     float *pos = buf, *du = buf + 3 * (size_t)count, *dv = buf + 6 * (size_t)count, *nrm = buf + 9 * (size_t)count;
     sfb_eval_output out;
+    sfb__an_step_job J;
     sfb_result r;
-    /* the active attempts are kept first: order[] maps them */
+    J.A = A; J.tries = tries; J.locs = locs; J.pos = pos; J.du = du; J.dv = dv; J.steps = steps;
     for (it = 0; it <= steps && active > 0; ++it) {
         int keep = 0;
         memset(&out, 0, sizeof out);
         out.position = pos; out.du = du; out.dv = dv; out.normal = nrm;
         if ((r = sfb__surface_eval_unchecked(A->s, locs, active, &out)) != SFB_SUCCESS) return r;
-        for (i = 0; i < active; ++i) {
-            sfb__an_try *t = &tries[i];
-            int pix = t->pix, x = pix % A->w, y = pix / A->w;
-            double p[3], tu[3], tv[3], sx, sy, z, rx, ry, jac[4], det, du_, dv_, m, u, v, res;
-            int c, ok;
-            for (c = 0; c < 3; ++c) { p[c] = pos[3 * i + c]; tu[c] = du[3 * i + c]; tv[c] = dv[3 * i + c]; }
-            ok = sfb__an_finite3(pos + 3 * i) && sfb__an_project(&A->cam, p, &sx, &sy, &z);
-            res = HUGE_VAL;
-            if (ok) {
-                rx = (x + 0.5) - sx; ry = (y + 0.5) - sy;
-                res = sqrt(rx * rx + ry * ry);
+        J.it = it;
+        sfb__an_run(A, sfb__an_step, &J, 0, active, (double)active);
+        for (i = 0; i < active; ++i)
+            if (tries[i].outcome == SFB__AN_OUT_NEW_HIT) {
+                sfb__an_add_hit(A, tries[i].pix, &locs[i], tries[i].z, pos + 3 * i, du + 3 * i, dv + 3 * i, nrm + 3 * i);
+                tries[i].outcome = 1;
             }
-            /* stalled: an attempt whose residual has not halved over the last two steps and is
-             * over a pixel (a pixel off the exact silhouette, or across a face it cannot reach)
-             * stops as a miss instead of running out its steps (at half a pixel, a few more
-             * silhouette pixels were dropped on catmark_car and spot) */
-            if (ok && it >= 2 && res > 1.0 && !(res < 0.5 * t->res2)) { t->res = res; t->outcome = 3; continue; }
-            t->res2 = t->res;
-            t->res = res;
-            if (ok && res < SFB__AN_TOL) {
-                sfb__an_add_hit(A, pix, &locs[i], z, pos + 3 * i, du + 3 * i, dv + 3 * i, nrm + 3 * i);
-                t->outcome = 1;
-                continue;
-            }
-            if (!ok || it == steps) { t->outcome = ok && res < SFB__AN_NEAR ? 2 : 3; continue; }
-            if (!sfb__an_jacobian(&A->cam, p, tu, tv, jac, &det)) { t->outcome = res < SFB__AN_NEAR ? 2 : 3; continue; }
-            du_ = (jac[3] * rx - jac[1] * ry) / det;
-            dv_ = (-jac[2] * rx + jac[0] * ry) / det;
-            m = fabs(du_) > fabs(dv_) ? fabs(du_) : fabs(dv_);
-            if (m > 0.34) { du_ *= 0.34 / m; dv_ *= 0.34 / m; }
-            u = locs[i].u + du_;
-            v = locs[i].v + dv_;
-            if (sfb__an_clamp_domain(A, &u, &v)) {
-                /* left the face: carry on in the neighbour across the side it left by (at most
-                 * 4 crossings), else give up after two steps against the border */
-                double uo = locs[i].u + du_, vo = locs[i].v + dv_, ts = 0.0;
-                int side = sfb__an_exit_side(A, uo, vo, u, v, &ts), nb = side >= 0 ? A->adj[4 * locs[i].face + side] : -1;
-                if (nb >= 0 && t->crossed < 4) {
-                    int nside = (nb >> 1) & 3, nf = nb >> 3;
-                    sfb__an_side_point(A->tri, nside, (nb & 1) ? 1.0 - ts : ts, &u, &v);
-                    locs[i].face = nf;
-                    ++t->crossed;
-                    t->pinned = 0;
-                } else if (++t->pinned >= 2) { t->outcome = res < SFB__AN_NEAR ? 2 : 3; continue; }
-            } else t->pinned = 0;
-            locs[i].u = (float)u;
-            locs[i].v = (float)v;
-            if (A->tri && (double)locs[i].u + (double)locs[i].v > 1.0) locs[i].v = nextafterf(locs[i].v, 0.0f);
-            ++t->steps;
-        }
         /* compact the running attempts to the front (finished ones are done with) */
         for (i = 0; i < active; ++i)
             if (tries[i].outcome == 0) {
@@ -737,6 +777,77 @@ static int sfb__an_hermite(const sfb__an *A, int x, int y, int axis, int d, sfb_
     return 1;
 }
 
+/* Round 0's attempts of one part (grid spacing d; `want` of x, y odd multiples of d) on grid
+ * rows [a, b) (row r: y = r d): with fill 0, the count of each row into rowat[r]; with fill 1,
+ * row r's attempts into tries and locs from index rowat[r] on, seeded (the proxy's (face, u,
+ * v), then sfb__an_hermite or sfb__an_predict from the hits so far). Rows are independent:
+ * seeding reads hits, which only sfb__an_newton writes. */
+typedef struct sfb__an_seed_job {
+    const sfb__an *A;
+    sfb__an_try *tries;
+    sfb_location *locs;
+    int *rowat;
+    int part, d, want, fill;
+} sfb__an_seed_job;
+
+static void sfb__an_seed_rows(void *arg, int a, int b) {
+    const sfb__an_seed_job *J = (const sfb__an_seed_job *)arg;
+    const sfb__an *A = J->A;
+    const int d = J->d, part = J->part, want = J->want;
+    int row;
+    for (row = a; row < b; ++row) {
+        /* d is a power of two */
+        const int y = row * d, oy = part > 0 && (y & (2 * d - 1)) == d;
+        int x, n = J->fill ? J->rowat[row] : 0;
+        for (x = 0; x < A->w; x += d) {
+            const int ox = part > 0 && (x & (2 * d - 1)) == d;
+            const size_t p = (size_t)y * (size_t)A->w + (size_t)x;
+            sfb_location *l;
+            if (ox + oy != want) continue;
+            if (A->face[p] < 0 && A->cface[p] < 0) continue;
+            if (!J->fill) { ++n; continue; }
+            memset(&J->tries[n], 0, sizeof J->tries[n]);
+            J->tries[n].pix = (int)p;
+            l = &J->locs[n];
+            if (A->face[p] >= 0) {
+                l->face = A->face[p]; l->u = A->uv[2 * p]; l->v = A->uv[2 * p + 1];
+            } else {
+                l->face = A->cface[p]; l->u = A->cuv[2 * p]; l->v = A->cuv[2 * p + 1];
+            }
+            if (part > 0 && !sfb__an_hermite(A, x, y, ox ? 0 : 1, d, l) && !(ox && oy && sfb__an_hermite(A, x, y, 1, d, l)))
+                sfb__an_predict(A, x, y, d, l);
+            if (A->tri && (double)l->u + (double)l->v > 1.0) l->v = nextafterf(l->v, 0.0f);
+            ++n;
+        }
+        if (!J->fill) J->rowat[row] = n;
+    }
+}
+
+/* For the changes [a, b) of the last round (A->chg), which of their 8 neighbours (bit i: the
+ * i-th of dy, dx = -1..1 in order, the middle skipped) they would seed: not hit yet, or hit on
+ * another face at least 1 % of the bounding radius farther away. */
+static void sfb__an_neighbours(void *arg, int a, int b) {
+    sfb__an *A = (sfb__an *)arg;
+    int ci;
+    for (ci = a; ci < b; ++ci) {
+        const int h = A->chg[ci], pix = A->hpix[h], x = pix % A->w, y = pix / A->w, f = A->hloc[h].face;
+        int dx, dy, bit = 0, m = 0;
+        for (dy = -1; dy <= 1; ++dy)
+            for (dx = -1; dx <= 1; ++dx) {
+                const int nx = x + dx, ny = y + dy;
+                int q, k;
+                if ((dx | dy) == 0) continue;
+                ++bit;
+                if (nx < 0 || ny < 0 || nx >= A->w || ny >= A->h) continue;
+                q = ny * A->w + nx;
+                k = A->hit[q];
+                if (k >= 0 && (A->hloc[k].face == f || !(A->hdepth[h] < A->hdepth[k] - 0.01 * A->radius))) continue;
+                m |= 1 << (bit - 1);
+            }
+        A->nbm[ci] = (unsigned char)m;
+    }
+}
+
 /* Step 2 over every round (see the file's comment). */
 static sfb_result sfb__an_project_all(sfb__an *A, int steps) {
     size_t npix = (size_t)A->w * (size_t)A->h, p;
@@ -745,14 +856,18 @@ static sfb_result sfb__an_project_all(sfb__an *A, int steps) {
     sfb_location *locs = NULL;
     float *buf = NULL;
     int *mark = NULL;  /* per pixel: the last round that seeded it, and 3 faces it was seeded from */
+    int *rowat = NULL; /* round 0: per grid row, its attempts, then where they start in their band */
     sfb_result r = SFB_SUCCESS;
     for (p = 0; p < npix; ++p) if (A->face[p] >= 0 || A->cface[p] >= 0) ++cap;
     cap = cap < 4096 ? 4096 : cap > SFB__AN_BATCH ? SFB__AN_BATCH : cap; /* later rounds grow it when they need to */
+    if (cap < A->w) cap = A->w; /* round 0's bands hold at least a row */
     tries = (sfb__an_try *)sfb__alloc(A->ctx, (size_t)cap * sizeof *tries);
     locs = (sfb_location *)sfb__alloc(A->ctx, (size_t)cap * sizeof *locs);
     buf = (float *)sfb__alloc(A->ctx, (size_t)cap * 12 * sizeof(float));
     mark = (int *)sfb__calloc(A->ctx, npix, 4 * sizeof(int));
-    if (!tries || !locs || !buf || !mark) { r = sfb__oom(A->ctx, "the analysis projection"); goto done; }
+    rowat = (int *)sfb__alloc(A->ctx, ((size_t)A->h + 1) * sizeof(int));
+    A->nbm = (unsigned char *)sfb__alloc(A->ctx, npix + 1);
+    if (!tries || !locs || !buf || !mark || !rowat || !A->nbm) { r = sfb__oom(A->ctx, "the analysis projection"); goto done; }
     /* round 0, in five parts: first the anchors, the pixels whose x and y are multiples of
      * SFB__AN_ANCHOR (4), from their proxy (face, u, v); then, for d = 2 and then 1, the pixels
      * on the grid of spacing d with one coordinate an odd multiple of d, then those with both,
@@ -763,34 +878,29 @@ static sfb_result sfb__an_project_all(sfb__an *A, int steps) {
      * evaluations per covered pixel; 2.6 with anchors every 2 pixels, the one-sided prediction
      * alone and no stall rule (sfb__an_newton) */
     for (part = 0; part < 5; ++part) {
-        const int d = part == 0 ? SFB__AN_ANCHOR : part <= 2 ? 2 : 1, want = part == 0 ? 0 : 2 - (part & 1);
-        int x, y;
-        count = 0;
+        const int d = part == 0 ? SFB__AN_ANCHOR : part <= 2 ? 2 : 1, nrows = (A->h + d - 1) / d;
+        int r0, r1;
+        sfb__an_seed_job J;
+        J.A = A; J.tries = tries; J.locs = locs; J.rowat = rowat;
+        J.part = part; J.d = d; J.want = part == 0 ? 0 : 2 - (part & 1);
         A->nchg = 0; /* round 0's changes are every hit (below) */
-        for (y = 0; y < A->h; y += d)
-        for (x = 0; x < A->w; x += d) {
-            /* d is a power of two */
-            const int ox = part > 0 && (x & (2 * d - 1)) == d, oy = part > 0 && (y & (2 * d - 1)) == d;
-            p = (size_t)y * (size_t)A->w + (size_t)x;
-            if (ox + oy != want) continue;
-            if (A->face[p] < 0 && A->cface[p] < 0) continue;
-            memset(&tries[count], 0, sizeof tries[count]);
-            tries[count].pix = (int)p;
-            if (A->face[p] >= 0) {
-                locs[count].face = A->face[p]; locs[count].u = A->uv[2 * p]; locs[count].v = A->uv[2 * p + 1];
-            } else {
-                locs[count].face = A->cface[p]; locs[count].u = A->cuv[2 * p]; locs[count].v = A->cuv[2 * p + 1];
+        /* the attempts per grid row, then bands of whole rows of at most cap attempts (cap >=
+         * w: a row fits), each seeded over the threads and run at once (its hits then seed the
+         * bands after it too) */
+        J.fill = 0;
+        sfb__an_run(A, sfb__an_seed_rows, &J, 0, nrows, (double)A->w * A->h / ((double)d * d));
+        for (r0 = 0; r0 < nrows; r0 = r1) {
+            int total = 0;
+            for (r1 = r0; r1 < nrows && total + rowat[r1] <= cap; ++r1) {
+                const int n = rowat[r1];
+                rowat[r1] = total;
+                total += n;
             }
-            if (part > 0 && !sfb__an_hermite(A, x, y, ox ? 0 : 1, d, &locs[count]) && !(ox && oy && sfb__an_hermite(A, x, y, 1, d, &locs[count])))
-                sfb__an_predict(A, x, y, d, &locs[count]);
-            if (A->tri && (double)locs[count].u + (double)locs[count].v > 1.0) locs[count].v = nextafterf(locs[count].v, 0.0f);
-            /* a full batch runs at once (its hits then seed the rest of the part too) */
-            if (++count == cap) {
-                if ((r = sfb__an_newton(A, tries, locs, count, buf, steps)) != SFB_SUCCESS) goto done;
-                count = 0;
-            }
+            if (total == 0) continue;
+            J.fill = 1;
+            sfb__an_run(A, sfb__an_seed_rows, &J, r0, r1, (double)total * 4.0);
+            if ((r = sfb__an_newton(A, tries, locs, total, buf, steps)) != SFB_SUCCESS) goto done;
         }
-        if (count > 0 && (r = sfb__an_newton(A, tries, locs, count, buf, steps)) != SFB_SUCCESS) goto done;
     }
     /* round 0's changes: every hit */
     for (A->nchg = 0; A->nchg < A->nhit; ++A->nchg) A->chg[A->nchg] = A->nchg;
@@ -802,14 +912,18 @@ static sfb_result sfb__an_project_all(sfb__an *A, int steps) {
     for (round = 1; round <= SFB__AN_ROUNDS; ++round) {
         int ci;
         count = 0;
+        /* which neighbours each change would seed, over the threads (reads only), then the
+         * seeding in the changes' order, here */
+        sfb__an_run(A, sfb__an_neighbours, A, 0, A->nchg, (double)A->nchg);
         for (ci = 0; ci < A->nchg; ++ci) {
-            int h = A->chg[ci], pix = A->hpix[h], x = pix % A->w, y = pix / A->w, dx, dy;
+            int h = A->chg[ci], pix = A->hpix[h], x = pix % A->w, y = pix / A->w, dx, dy, bit = 0;
+            if (!A->nbm[ci]) continue;
             for (dy = -1; dy <= 1; ++dy)
                 for (dx = -1; dx <= 1; ++dx) {
-                    int nx = x + dx, ny = y + dy, q, k, *mq, f = A->hloc[h].face;
-                    if ((dx | dy) == 0 || nx < 0 || ny < 0 || nx >= A->w || ny >= A->h) continue;
-                    q = ny * A->w + nx;
-                    if (A->hit[q] >= 0 && (A->hloc[A->hit[q]].face == f || !(A->hdepth[h] < A->hdepth[A->hit[q]] - 0.01 * A->radius))) continue;
+                    int q, k, *mq, f = A->hloc[h].face;
+                    if ((dx | dy) == 0) continue;
+                    if (!(A->nbm[ci] & (1 << bit++))) continue;
+                    q = (y + dy) * A->w + (x + dx);
                     mq = mark + 4 * (size_t)q;
                     if (mq[0] != round) { mq[0] = round; mq[1] = mq[2] = mq[3] = -1; }
                     for (k = 1; k <= 3 && mq[k] >= 0 && mq[k] != f; ++k) {}
@@ -845,6 +959,9 @@ done:
     sfb__free(A->ctx, locs);
     sfb__free(A->ctx, buf);
     sfb__free(A->ctx, mark);
+    sfb__free(A->ctx, rowat);
+    sfb__free(A->ctx, A->nbm);
+    A->nbm = NULL;
     return r;
 }
 
@@ -1046,13 +1163,25 @@ static double sfb__an_pattern(const sfb__an_look *L, double a, double b, double 
     return sfb__band_cover(a, fa, 0.0, w);
 }
 
-/* Colours every pixel from the values (full-picture arrays v1, v2) and the hits' normals. */
-static void sfb__an_colour(const sfb__an *A, const sfb__an_look *L, const float *v1, const float *v2, unsigned char *rgba,
-                           unsigned char *cls, int *light_hits) {
+/* Colours the pixels of rows [y0, y1) from the values (full-picture arrays v1, v2) and the
+ * hits' normals (rows are independent: a task of sfb__parallel). */
+typedef struct sfb__an_colour_job {
+    const sfb__an *A;
+    const sfb__an_look *L;
+    const float *v1, *v2;
+    unsigned char *rgba, *cls;
+} sfb__an_colour_job;
+
+static void sfb__an_colour(void *arg, int y0, int y1) {
+    const sfb__an_colour_job *J = (const sfb__an_colour_job *)arg;
+    const sfb__an *A = J->A;
+    const sfb__an_look *L = J->L;
+    const float *v1 = J->v1, *v2 = J->v2;
+    unsigned char *rgba = J->rgba, *cls = J->cls;
     const sfb_analyze_config *c = A->c;
-    size_t npix = (size_t)A->w * (size_t)A->h, p;
+    size_t p, end = (size_t)y1 * (size_t)A->w;
     int mode = c->mode;
-    for (p = 0; p < npix; ++p) {
+    for (p = (size_t)y0 * (size_t)A->w; p < end; ++p) {
         int k = A->hit[p], i, cl = 2;
         double rgb[3] = { 0.0, 0.0, 0.0 }, n[3], diff, a = v1[p];
         unsigned char *o = rgba + 4 * p;
@@ -1075,7 +1204,6 @@ static void sfb__an_colour(const sfb__an *A, const sfb__an_look *L, const float 
                 for (i = 0; i < 3; ++i) rgb[i] = L->miss[i] / 255.0 * (0.55 + 0.9 * diff);
                 break;
             }
-            ++*light_hits;
             if (L->pattern == SFB_LIGHT_IMAGE) {
                 double t[4], base = mode == SFB_ANALYZE_REFLECTION ? 0.08 : 0.3 + 0.4 * diff;
                 sfb__an_texel(c, a / L->job.periods[0], v2[p] / L->job.periods[1], t);
@@ -1178,14 +1306,25 @@ static void sfb__an_free(sfb__an *A) {
 static double sfb__an_bytes(const sfb__an *A) {
     double npix = (double)A->w * A->h, grid = (double)A->nf * A->per;
     double per_pixel = 16 + 4 + 4 + 8 + 4 + 1 + 4 + 4 + 1 + 4 + 12 /* buffers, outputs */ + 4 + 12 + 48 + 4 /* hits */ +
-                       (A->c->polygon_based ? 24 : 84 + 16) /* proxy data or the projection's attempts and marks */;
+                       (A->c->polygon_based ? 24 : 84 + 16 + 1) /* proxy data or the projection's attempts, marks and neighbour masks */;
     return npix * per_pixel + grid * (24.0 + sizeof(sfb__raster_vertex) + 2 * 4 * sizeof(int)) + 65536.0 * sizeof(sfb_location) + (double)A->nf * 4 * (sizeof(int) + sizeof(sfb__an_side));
+}
+
+/* The per-pixel buffers of rows [y0, y1) before the raster: nothing drawn, nothing hit. */
+static void sfb__an_clear_rows(void *arg, int y0, int y1) {
+    sfb__an *A = (sfb__an *)arg;
+    size_t p, end = (size_t)y1 * (size_t)A->w;
+    for (p = (size_t)y0 * (size_t)A->w; p < end; ++p) {
+        A->depth[p] = A->cdist[p] = (float)HUGE_VAL;
+        A->face[p] = A->cface[p] = -1;
+        A->hit[p] = -1;
+    }
 }
 
 /* The buffers of one analysis (A's sizes set), initialised; 0 when one could not be had. */
 static int sfb__an_alloc(sfb__an *A) {
     sfb_context *ctx = A->ctx;
-    size_t npix = (size_t)A->w * (size_t)A->h, grid = (size_t)A->nf * (size_t)A->per, p;
+    size_t npix = (size_t)A->w * (size_t)A->h, grid = (size_t)A->nf * (size_t)A->per;
     A->gpos = (float *)sfb__alloc(ctx, grid * 3 * sizeof(float));
     A->gnrm = (float *)sfb__alloc(ctx, grid * 3 * sizeof(float));
     A->rv = (sfb__raster_vertex *)sfb__alloc(ctx, grid * sizeof(sfb__raster_vertex));
@@ -1216,11 +1355,7 @@ static int sfb__an_alloc(sfb__an *A) {
         (A->c->polygon_based && (!A->ppos || !A->pnrm)) || !A->hpix || !A->hloc || !A->hpos || !A->hdu || !A->hdv || !A->hnrm || !A->hdepth ||
         !A->chg)
         return 0;
-    for (p = 0; p < npix; ++p) {
-        A->depth[p] = A->cdist[p] = (float)HUGE_VAL;
-        A->face[p] = A->cface[p] = -1;
-        A->hit[p] = -1;
-    }
+    sfb__an_run(A, sfb__an_clear_rows, A, 0, A->h, (double)npix * 0.1);
     return 1;
 }
 
@@ -1279,18 +1414,39 @@ static sfb_result sfb__an_values(sfb__an *A, sfb__an_look *L, float *hv1, float 
     return r;
 }
 
+/* The picture's per-pixel outputs on rows [y0, y1) before the hits are written: no value, no hit. */
+typedef struct sfb__an_fill_job {
+    const sfb__an *A;
+    float *v1, *v2;
+    sfb_location *hits;
+} sfb__an_fill_job;
+
+static void sfb__an_fill_picture(void *arg, int y0, int y1) {
+    const sfb__an_fill_job *J = (const sfb__an_fill_job *)arg;
+    size_t p, end = (size_t)y1 * (size_t)J->A->w;
+    for (p = (size_t)y0 * (size_t)J->A->w; p < end; ++p) {
+        J->v1[p] = J->v2[p] = NAN;
+        J->hits[p].face = -1;
+        J->hits[p].u = J->hits[p].v = 0.0f;
+    }
+}
+
 /* Step 4: the picture and its per-pixel outputs into out (on success the arrays are out's). */
 static sfb_result sfb__an_picture(sfb__an *A, sfb__an_look *L, const float *hv1, const float *hv2, sfb_analysis *out) {
     sfb_context *ctx = A->ctx;
     const sfb_analyze_config *c = A->c;
-    size_t npix = (size_t)A->w * (size_t)A->h, p;
+    size_t npix = (size_t)A->w * (size_t)A->h;
     float *v1 = (float *)sfb__alloc(ctx, npix * sizeof(float)), *v2 = (float *)sfb__alloc(ctx, npix * sizeof(float));
     unsigned char *rgba = (unsigned char *)sfb__alloc(ctx, npix * 4), *cls = (unsigned char *)sfb__alloc(ctx, npix);
     sfb_location *hits = (sfb_location *)sfb__alloc(ctx, npix * sizeof(sfb_location));
     sfb_result r = SFB_SUCCESS;
     int k, light_hits = 0;
     if (!v1 || !v2 || !rgba || !cls || !hits) { r = sfb__oom(ctx, "the analysis picture"); goto done; }
-    for (p = 0; p < npix; ++p) { v1[p] = v2[p] = NAN; hits[p].face = -1; hits[p].u = hits[p].v = 0.0f; }
+    {
+        sfb__an_fill_job F;
+        F.A = A; F.v1 = v1; F.v2 = v2; F.hits = hits;
+        sfb__an_run(A, sfb__an_fill_picture, &F, 0, A->h, (double)npix * 0.1);
+    }
     out->value_min = (float)HUGE_VAL; out->value_max = (float)-HUGE_VAL;
     for (k = 0; k < A->nhit; ++k) {
         int q = A->hpix[k];
@@ -1298,12 +1454,18 @@ static sfb_result sfb__an_picture(sfb__an *A, sfb__an_look *L, const float *hv1,
         if (isfinite(hv1[k])) {
             if (hv1[k] < out->value_min) out->value_min = hv1[k];
             if (hv1[k] > out->value_max) out->value_max = hv1[k];
+            ++light_hits; /* REFLECTION, HIGHLIGHT: a finite value is a ray that meets the light */
         }
     }
+    if (c->mode != SFB_ANALYZE_REFLECTION && c->mode != SFB_ANALYZE_HIGHLIGHT) light_hits = 0;
     if (!(out->value_min <= out->value_max)) out->value_min = out->value_max = 0.0f;
     L->range = 0.0;
     if (c->mode == SFB_ANALYZE_CURVATURE && (r = sfb__an_range(A, hv1, A->nhit, &L->range)) != SFB_SUCCESS) goto done;
-    sfb__an_colour(A, L, v1, v2, rgba, cls, &light_hits);
+    {
+        sfb__an_colour_job J;
+        J.A = A; J.L = L; J.v1 = v1; J.v2 = v2; J.rgba = rgba; J.cls = cls;
+        sfb__an_run(A, sfb__an_colour, &J, 0, A->h, (double)A->nhit);
+    }
     if ((c->mode == SFB_ANALYZE_REFLECTION || c->mode == SFB_ANALYZE_HIGHLIGHT) && A->nhit > 0 && light_hits == 0) {
         r = sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, -1,
                        "the light plane meets none of the %d rays from the surface: it is parallel to them, behind the surface or too small",

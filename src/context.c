@@ -134,6 +134,13 @@ sfb_result sfb__progress(sfb_context *ctx, float done, const char *stage) {
     return SFB_SUCCESS;
 }
 
+void sfb__parallel(sfb_context *ctx, void (*task)(void *arg, int first, int last), void *arg, int first, int last) {
+    const sfb__backend_vtable *be = ctx->backend;
+    if (first >= last) return;
+    if (be && be->parallel && be->parallel(ctx->backend_state, task, arg, first, last)) return;
+    task(arg, first, last);
+}
+
 /* sfb_context_create, keeping the backend report (what was tried, why each failed) in
  * report/size when no backend initialises. */
 sfb_result sfb__context_create_reporting(const sfb_context_config *config, sfb_context **out, char *report, size_t size) {

@@ -86,6 +86,11 @@ typedef struct sfb__backend_vtable {
     /* Seed 003's proxy raster (analyze.c): every triangle of `job` into its per-pixel buffers,
      * the nearest one kept (sfb__raster_job). */
     sfb_result (*raster)(void *state, const struct sfb__raster_job *job);
+    /* The backend's CPU threads lent to the core (sfb__parallel): runs task(arg, a, b) over
+     * chunks [a, b) covering [first, last) on its threads, the caller's included, and returns 1
+     * once all have run; returns 0 having run nothing (no threads, or a call of another thread
+     * holds them). Not a kernel: a NULL slot means the core runs the task itself, on ref too. */
+    int (*parallel)(void *state, void (*task)(void *arg, int first, int last), void *arg, int first, int last);
 } sfb__backend_vtable;
 
 /* One analysis's shading (the `shade` slot). Per item i: P = position[3i..], N = normal (unit),
@@ -312,6 +317,12 @@ SFB__IF void sfb__log(sfb_context *ctx, int level, const char *fmt, ...)
 SFB__IF sfb_result sfb__oom(sfb_context *ctx, const char *what);
 /* Returns SFB_CANCELLED (with the error set) when the callback asks to stop. */
 SFB__IF sfb_result sfb__progress(sfb_context *ctx, float done, const char *stage);
+/* Runs task(arg, a, b) over [first, last): in chunks on the backend's threads when it lends
+ * them (the `parallel` slot), else as one call task(arg, first, last) here. The results must
+ * not depend on the chunks: a task writes only its own items' memory (or per-item slots the
+ * caller reduces afterwards) and calls nothing on ctx (errors, logs, allocations, progress:
+ * those are not thread-safe). Worth it from a few thousand items of ~100 ns on. */
+SFB__IF void sfb__parallel(sfb_context *ctx, void (*task)(void *arg, int first, int last), void *arg, int first, int last);
 SFB__IF sfb_result sfb__select_backend(sfb_context *ctx, const char *env_override);
 SFB__IF sfb_result sfb__context_create_reporting(const sfb_context_config *config, sfb_context **out, char *report, size_t size);
 SFB__IF void sfb__eigen_cc_free(sfb_context *ctx, sfb__eigen_cc *e);

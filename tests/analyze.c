@@ -286,7 +286,8 @@ static void test_levels(sfb_context *ctx, const shape *shapes, int count) {
 }
 
 /* A large picture (800 x 800, over 100k covered pixels): round 0's attempts then run in
- * several batches (SFB__AN_BATCH, 32768), whose hits seed the rest of their part. Level 1 and
+ * several bands of rows (SFB__AN_BATCH, 32768, attempts at most), whose hits seed the bands
+ * after them. Level 1 and
  * level 6 must still agree on the classes (>= 99.5 %) and on the coverage outside the
  * one-pixel band, with no enclosed holes at level 1. */
 static void test_large(sfb_context *ctx, const shape *sh) {
@@ -313,6 +314,63 @@ static void test_large(sfb_context *ctx, const shape *sh) {
     sfb_analysis_free(&a1); sfb_analysis_free(&a6);
     sfb_surface_destroy(s);
     sfb_mesh_destroy(m);
+}
+
+/* The core's per-pixel loops run on the backend's threads (sfb__parallel: the seeding, the
+ * Newton updates, the neighbour scans, the colours): a picture must not depend on how many
+ * there are. simd with 1 thread (every loop on the caller) against 2 (the pool), bit for bit:
+ * colours, classes, values, hits and the pixel counts, on a Catmull-Clark and a Loop shape in
+ * three modes, at 640 x 480 (every loop past the size that goes to the threads). */
+static void test_threads(const shape *shapes, int count) {
+    static const int modes[3] = { SFB_ANALYZE_REFLECTION, SFB_ANALYZE_ZEBRA, SFB_ANALYZE_CURVATURE };
+    sfb_context *cx[2] = { NULL, NULL };
+    int t, i, mode;
+    for (t = 0; t < 2; ++t) {
+        sfb_context_config cc = sfb_context_config_init();
+        sfb_backend_kind kind = SFB_BACKEND_SIMD;
+        cc.backends = &kind; cc.backend_count = 1; cc.ignore_environment = 1;
+        cc.threads = t + 1;
+        if (sfb_context_create(&cc, &cx[t]) != SFB_SUCCESS) cx[t] = NULL;
+    }
+    for (i = 0; i < count; ++i)
+        for (mode = 0; mode < 3; ++mode) {
+            char name[160];
+            sfb_mesh *m[2] = { NULL, NULL };
+            sfb_surface *sf[2] = { NULL, NULL };
+            sfb_analysis a[2];
+            sfb_analyze_config c = sfb_analyze_config_init(modes[mode]);
+            int ok = 1;
+            snprintf(name, sizeof name, "threads_1_vs_2_%s_%s", shapes[i].label, mode == 0 ? "reflection" : mode == 1 ? "zebra" : "mean_curvature");
+            if (!cx[0] || !cx[1]) { skip(name, "the simd backend is not available"); continue; }
+            memset(a, 0, sizeof a);
+            c.width = 640; c.height = 480; c.level = 1;
+            c.curvature = SFB_CURVATURE_MEAN;
+            for (t = 0; t < 2; ++t) {
+                m[t] = load_shape(cx[t], shapes[i].path);
+                sf[t] = m[t] ? patch_surface(cx[t], m[t], shapes[i].scheme) : NULL;
+                if (!sf[t] || sfb_surface_analyze(sf[t], &c, &a[t]) != SFB_SUCCESS) ok = 0;
+            }
+            if (!ok) {
+                fail(name, "%s / %s", sfb_last_error(cx[0]), sfb_last_error(cx[1]));
+            } else {
+                const size_t n = (size_t)a[0].width * a[0].height;
+                const int same_counts = a[0].covered_pixels == a[1].covered_pixels && a[0].dropped_pixels == a[1].dropped_pixels &&
+                                        a[0].fallback_pixels == a[1].fallback_pixels && a[0].grown_pixels == a[1].grown_pixels;
+                const int same_rgba = memcmp(a[0].rgba, a[1].rgba, 4 * n) == 0, same_cls = memcmp(a[0].classes, a[1].classes, n) == 0;
+                const int same_val = memcmp(a[0].values, a[1].values, n * sizeof(float)) == 0;
+                const int same_hits = memcmp(a[0].hits, a[1].hits, n * sizeof(sfb_location)) == 0;
+                check(a[0].covered_pixels > 20000 && same_counts && same_rgba && same_cls && same_val && same_hits, name,
+                      "%d pixels covered (1 thread) / %d (2), dropped %d / %d; identical: colours %d, classes %d, values %d, hits %d",
+                      a[0].covered_pixels, a[1].covered_pixels, a[0].dropped_pixels, a[1].dropped_pixels, same_rgba, same_cls, same_val,
+                      same_hits);
+            }
+            for (t = 0; t < 2; ++t) {
+                sfb_analysis_free(&a[t]);
+                sfb_surface_destroy(sf[t]);
+                sfb_mesh_destroy(m[t]);
+            }
+        }
+    for (t = 0; t < 2; ++t) sfb_context_destroy(cx[t]);
 }
 
 /* ---- backends against ref ---- */
@@ -507,6 +565,7 @@ int main(int argc, char **argv) {
     test_large(ctx, &shapes[0]);
     test_bad(ctx);
     sfb_context_destroy(ctx);
+    test_threads(shapes, 3);
     {
         sfb_context_config bc = sfb_context_config_init();
         bc.logger.func = cpu_raster_logger;

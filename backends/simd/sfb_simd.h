@@ -340,6 +340,33 @@ static int sfb__simd_pool_run(sfb__simd_state *s, void (*task)(const struct sfb_
 }
 #endif
 
+/* The `parallel` slot: the pool lent to the core (sfb__parallel). */
+#ifdef SFB__SIMD_THREADS
+typedef struct sfb__simd_lent {
+    void (*task)(void *arg, int first, int last);
+    void *arg;
+} sfb__simd_lent;
+
+static void sfb__simd_lent_task(const sfb__simd_state *s, const void *arg, int a, int b) {
+    const sfb__simd_lent *l = (const sfb__simd_lent *)arg;
+    (void)s;
+    l->task(l->arg, a, b);
+}
+#endif
+
+static int sfb__simd_parallel(void *state, void (*task)(void *arg, int first, int last), void *arg, int first, int last) {
+#ifdef SFB__SIMD_THREADS
+    sfb__simd_lent l;
+    if (!state || !task || first >= last) return 0;
+    l.task = task;
+    l.arg = arg;
+    return sfb__simd_pool_run((sfb__simd_state *)state, sfb__simd_lent_task, &l, first, last, NULL, 0, 0);
+#else
+    (void)state; (void)task; (void)arg; (void)first; (void)last;
+    return 0;
+#endif
+}
+
 static void sfb__simd_describe(void *state, char *buf, size_t size) {
     const sfb__simd_state *s = (const sfb__simd_state *)state;
     if (!s || !buf || size == 0) return;
@@ -352,6 +379,7 @@ static void sfb__simd_runtime_bind(sfb__backend_vtable *vt) {
     vt->init = sfb__simd_init;
     vt->shutdown = sfb__simd_shutdown;
     vt->describe = sfb__simd_describe;
+    vt->parallel = sfb__simd_parallel;
 }
 
 /* ==== the vector operations ====
