@@ -344,28 +344,71 @@ SFB_API sfb_result sfb_surface_patch_info(const sfb_surface *s, sfb_patch_info *
     return SFB_SUCCESS;
 }
 
+/* What is wrong with location l: 0 nothing, 1 its face is out of range, 2 (u,v) is outside
+ * [0,1]^2, 3 outside the triangle u + v <= 1, 4 its face is a hole (holes are whole parametric
+ * faces, since a hole is a base face: the root says it). */
+static int sfb__location_fault(const sfb_surface *s, const sfb_location *l) {
+    if (l->face < 0 || l->face >= s->patches.nptex) return 1;
+    if (!(l->u >= 0.0f && l->u <= 1.0f && l->v >= 0.0f && l->v <= 1.0f)) return 2;
+    if (s->patches.domain == SFB__DOMAIN_TRI && (double)l->u + (double)l->v > 1.0) return 3;
+    if (s->patches.ptex_root[l->face] == -1) return 4;
+    return 0;
+}
+
+/* The location check of sfb_surface_eval in blocks over the backend's threads: block b's first
+ * faulty location (or -1) into first_bad[b]. */
+#define SFB__EVAL_CHECK_BLOCKS 64
+#define SFB__EVAL_CHECK_PARALLEL 131072 /* locations: from this many on the check goes to the threads */
+typedef struct sfb__eval_check_job {
+    const sfb_surface *s;
+    const sfb_location *loc;
+    int count, block;
+    int first_bad[SFB__EVAL_CHECK_BLOCKS];
+} sfb__eval_check_job;
+
+static void sfb__eval_check_blocks(void *arg, int a, int b) {
+    sfb__eval_check_job *J = (sfb__eval_check_job *)arg;
+    int k, q;
+    for (k = a; k < b; ++k) {
+        const int end = (int)((long long)(k + 1) * J->block < J->count ? (long long)(k + 1) * J->block : J->count);
+        J->first_bad[k] = -1;
+        for (q = k * J->block; q < end; ++q)
+            if (sfb__location_fault(J->s, &J->loc[q])) { J->first_bad[k] = q; break; }
+    }
+}
+
 SFB_API sfb_result sfb_surface_eval(const sfb_surface *s, const sfb_location *loc, int count, const sfb_eval_output *out) {
     sfb_context *ctx;
-    int q;
+    int q = -1, fault = 0;
     if (!s) return SFB_INVALID_ARGS;
     ctx = s->ctx;
     if (!s->has_patches) return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "sfb_surface_eval: the surface has no patch table (create it with SFB_REFINE_PATCHES)");
     if (count < 0 || (count > 0 && (!loc || !out)))
         return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "sfb_surface_eval: %s", count < 0 ? "negative count" : "NULL locations or outputs");
-    for (q = 0; q < count; ++q) {
+    /* every location is checked before anything is written; the first faulty one is reported */
+    if (count >= SFB__EVAL_CHECK_PARALLEL) {
+        sfb__eval_check_job J;
+        int k;
+        J.s = s; J.loc = loc; J.count = count;
+        J.block = (count + SFB__EVAL_CHECK_BLOCKS - 1) / SFB__EVAL_CHECK_BLOCKS;
+        sfb__parallel(ctx, sfb__eval_check_blocks, &J, 0, SFB__EVAL_CHECK_BLOCKS);
+        for (k = 0; k < SFB__EVAL_CHECK_BLOCKS && q < 0; ++k) q = J.first_bad[k];
+        if (q >= 0) fault = sfb__location_fault(s, &loc[q]);
+    } else {
+        for (q = 0; q < count && !(fault = sfb__location_fault(s, &loc[q])); ++q) {}
+    }
+    if (fault) {
         const sfb_location *l = &loc[q];
-        if (l->face < 0 || l->face >= s->patches.nptex)
+        if (fault == 1)
             return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, q, "location %d: parametric face %d is out of range (0..%d)", q, l->face,
                               s->patches.nptex - 1);
-        if (!(l->u >= 0.0f && l->u <= 1.0f && l->v >= 0.0f && l->v <= 1.0f))
+        if (fault == 2)
             return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, q, "location %d: (u,v) = (%g,%g) is outside [0,1]^2", q, (double)l->u,
                               (double)l->v);
-        if (s->patches.domain == SFB__DOMAIN_TRI && (double)l->u + (double)l->v > 1.0)
+        if (fault == 3)
             return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, q, "location %d: (u,v) = (%g,%g) is outside the triangle u + v <= 1", q,
                               (double)l->u, (double)l->v);
-        /* holes are whole parametric faces (a hole is a base face), so the root says it */
-        if (s->patches.ptex_root[l->face] == -1)
-            return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, q, "location %d: parametric face %d is a hole", q, l->face);
+        return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, q, "location %d: parametric face %d is a hole", q, l->face);
     }
     return sfb__surface_eval_unchecked(s, loc, count, out);
 }

@@ -792,12 +792,11 @@ Test(api, scheme_caps_and_domain)
     sfb_context_destroy(ctx);
 }
 
-/* sfb_surface_eval checks every location before writing anything: one bad location among 5000
- * valid ones, at the first, the last and positions between (either side of 1024, should the
- * checks ever run in blocks), is refused with SFB_INVALID_VALUE and its index, and the outputs
- * stay as they were. Kinds: face -1, face
- * out of range, u NaN, u + v > 1 on a triangle (Loop), a hole (the Catmull-Clark grid's
- * face 4 is tagged `t hole`). */
+/* sfb_surface_eval checks every location before writing anything: one bad location among
+ * 200000 valid ones, at the first, the last and positions between (either side of 1024 and of
+ * the check's first block end), is refused with SFB_INVALID_VALUE and its index, and the
+ * outputs stay as they were. Kinds: face -1, face out of range, u NaN, u + v > 1 on a triangle
+ * (Loop), a hole (the Catmull-Clark grid's face 4 is tagged `t hole`). */
 Test(api, eval_checks_every_location_first)
 {
     static const char *grid =
@@ -807,8 +806,18 @@ Test(api, eval_checks_every_location_first)
         "t hole 1/0/0 4\n";
     static const char *tris =
         "v 0 0 0\nv 1 0 0\nv 1 1 0.2\nv 0 1 0\nf 1 2 3\nf 1 3 4\n";
-    const int n = 5000, at[5] = { 0, 1023, 1024, 2600, 4999 };
-    sfb_context *ctx = make_ctx();
+    /* 200000 locations: the check runs in 64 blocks of 3125 over the threads (simd, 2 threads,
+     * where simd is built in): either side of a block's end, and two faults in different
+     * blocks, the later block's first (the first one must be reported) */
+    const int n = 200000, at[6] = { 0, 1023, 1024, 3124, 3125, 199999 };
+    sfb_context *ctx = NULL;
+    {
+        sfb_context_config cc = sfb_context_config_init();
+        sfb_backend_kind kind = SFB_BACKEND_SIMD;
+        cc.ignore_environment = 1;
+        cc.backends = &kind; cc.backend_count = 1; cc.threads = 2;
+        if (sfb_context_create(&cc, &ctx) != SFB_SUCCESS) ctx = make_ctx();
+    }
     for (int t = 0; t < 2; ++t) {
         sfb_mesh *m = NULL;
         sfb_surface *s = NULL;
@@ -834,7 +843,7 @@ Test(api, eval_checks_every_location_first)
         for (int kind = 0; kind < 5; ++kind) {
             if (kind == 4 && t) continue;           /* holes: the grid */
             if (kind == 3 && !t) continue;          /* u + v > 1: the triangles */
-            for (int a = 0; a < 5; ++a) {
+            for (int a = 0; a < 6; ++a) {
                 const sfb_location keep = L[at[a]];
                 switch (kind) {
                 case 0: L[at[a]].face = -1; break;
@@ -853,6 +862,17 @@ Test(api, eval_checks_every_location_first)
                 sfb_clear_error(ctx);
                 L[at[a]] = keep;
             }
+        }
+        {
+            const sfb_location k1 = L[150000], k2 = L[3125];
+            L[150000].face = -1;
+            L[3125].u = NAN;
+            cr_expect_eq(sfb_surface_eval(s, L, n, &o), SFB_INVALID_VALUE);
+            sfb_error_info e = sfb_last_error_info(ctx);
+            cr_expect_eq(e.index, 3125, "two faults: index %ld (%s)", e.index, e.message);
+            cr_expect(strstr(e.message, "outside") != NULL, "two faults: %s", e.message);
+            sfb_clear_error(ctx);
+            L[150000] = k1; L[3125] = k2;
         }
         free(L);
         free(P);
