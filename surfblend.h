@@ -13228,6 +13228,7 @@ typedef struct sfb__an_try {
                                                    sfb__an_newton has yet to record) */
     double res, res2;  /* the residual of the last evaluation, and of the one before (pixels) */
     double z;          /* a new hit's depth */
+    int k;             /* its hit slot (fresh batches, sfb__an_newton) */
 } sfb__an_try;
 
 /* Records the evaluation at loc as pixel pix's hit at depth z (a pixel already hit keeps the
@@ -13354,40 +13355,84 @@ static void sfb__an_step(void *arg, int a, int b) {
     }
 }
 
+/* Copies the new hits among attempts [a, b) into their hit slots (tries[i].k, given by
+ * sfb__an_newton) and marks them recorded: the bulk of sfb__an_add_hit for fresh batches. */
+typedef struct sfb__an_record_job {
+    sfb__an *A;
+    sfb__an_try *tries;
+    const sfb_location *locs;
+    const float *pos, *du, *dv, *nrm;
+} sfb__an_record_job;
+
+static void sfb__an_record(void *arg, int a, int b) {
+    const sfb__an_record_job *J = (const sfb__an_record_job *)arg;
+    sfb__an *A = J->A;
+    int i, c;
+    for (i = a; i < b; ++i) {
+        sfb__an_try *t = &J->tries[i];
+        const size_t k = (size_t)t->k, i3 = 3 * (size_t)i;
+        if (t->outcome != SFB__AN_OUT_NEW_HIT) continue;
+        A->hloc[k] = J->locs[i];
+        A->hdepth[k] = (float)t->z;
+        for (c = 0; c < 3; ++c) {
+            A->hpos[3 * k + c] = J->pos[i3 + c]; A->hdu[3 * k + c] = J->du[i3 + c]; A->hdv[3 * k + c] = J->dv[i3 + c];
+            A->hnrm[3 * k + c] = J->nrm[i3 + c];
+        }
+        t->outcome = 1;
+    }
+}
+
 /* Runs the attempts (tries[i] for pixel tries[i].pix from locs[i]) to their outcomes; records
  * hits (a pixel hit by an earlier attempt of the same batch keeps the nearer one). Per step:
  * the backend evaluates the running attempts, sfb__an_step updates them (on the backend's
- * threads), the new hits are recorded in attempt order, and the running ones move first. */
-static sfb_result sfb__an_newton(sfb__an *A, sfb__an_try *tries, sfb_location *locs, int count, float *buf, int steps) {
+ * threads), the new hits are recorded in attempt order, and the running ones move first.
+ * fresh: no attempt's pixel is hit yet and no two attempts share a pixel (round 0), so a new
+ * hit takes the next hit slot, here, and its data is copied over the threads
+ * (sfb__an_record); else sfb__an_add_hit records each. */
+static sfb_result sfb__an_newton(sfb__an *A, sfb__an_try *tries, sfb_location *locs, int count, float *buf, int steps, int fresh) {
     int active = count, it, i;
     float *pos = buf, *du = buf + 3 * (size_t)count, *dv = buf + 6 * (size_t)count, *nrm = buf + 9 * (size_t)count;
     sfb_eval_output out;
     sfb__an_step_job J;
+    sfb__an_record_job R;
     sfb_result r;
     J.A = A; J.tries = tries; J.locs = locs; J.pos = pos; J.du = du; J.dv = dv; J.steps = steps;
+    R.A = A; R.tries = tries; R.locs = locs; R.pos = pos; R.du = du; R.dv = dv; R.nrm = nrm;
     for (it = 0; it <= steps && active > 0; ++it) {
-        int keep = 0;
+        int keep = 0, news = 0;
         memset(&out, 0, sizeof out);
         out.position = pos; out.du = du; out.dv = dv; out.normal = nrm;
         if ((r = sfb__surface_eval_unchecked(A->s, locs, active, &out)) != SFB_SUCCESS) return r;
         J.it = it;
         sfb__an_run(A, sfb__an_step, &J, 0, active, (double)active);
-        for (i = 0; i < active; ++i)
-            if (tries[i].outcome == SFB__AN_OUT_NEW_HIT) {
-                sfb__an_add_hit(A, tries[i].pix, &locs[i], tries[i].z, pos + 3 * i, du + 3 * i, dv + 3 * i, nrm + 3 * i);
-                tries[i].outcome = 1;
+        /* the outcomes in attempt order: new hits recorded (or given their slots), near ones
+         * marked (a later hit of the pixel overrides that), the running ones moved first */
+        for (i = 0; i < active; ++i) {
+            sfb__an_try *t = &tries[i];
+            if (t->outcome == SFB__AN_OUT_NEW_HIT) {
+                if (fresh) {
+                    const int k = A->nhit++;
+                    t->k = k;
+                    A->hpix[k] = t->pix;
+                    A->hit[t->pix] = k;
+                    A->state[t->pix] = SFB__AN_HIT;
+                    ++news;
+                } else {
+                    sfb__an_add_hit(A, t->pix, &locs[i], t->z, pos + 3 * i, du + 3 * i, dv + 3 * i, nrm + 3 * i);
+                    t->outcome = 1;
+                }
+            } else if (t->outcome == 2 && A->state[t->pix] == SFB__AN_NONE) {
+                A->state[t->pix] = SFB__AN_TRIED_NEAR;
             }
-        /* compact the running attempts to the front (finished ones are done with) */
+        }
+        if (news > 0) sfb__an_run(A, sfb__an_record, &R, 0, active, (double)news);
         for (i = 0; i < active; ++i)
             if (tries[i].outcome == 0) {
-                if (keep != i) { sfb__an_try t = tries[keep]; sfb_location l = locs[keep]; tries[keep] = tries[i]; locs[keep] = locs[i]; tries[i] = t; locs[i] = l; }
+                if (keep != i) { tries[keep] = tries[i]; locs[keep] = locs[i]; }
                 ++keep;
             }
-        /* finished attempts moved behind the active ones keep their outcome for the caller */
         active = keep;
     }
-    for (i = 0; i < count; ++i)
-        if (tries[i].outcome == 2 && A->state[tries[i].pix] == SFB__AN_NONE) A->state[tries[i].pix] = SFB__AN_TRIED_NEAR;
     return SFB_SUCCESS;
 }
 
@@ -13576,7 +13621,7 @@ static sfb_result sfb__an_project_all(sfb__an *A, int steps) {
             if (total == 0) continue;
             J.fill = 1;
             sfb__an_run(A, sfb__an_seed_rows, &J, r0, r1, (double)total * 4.0);
-            if ((r = sfb__an_newton(A, tries, locs, total, buf, steps)) != SFB_SUCCESS) goto done;
+            if ((r = sfb__an_newton(A, tries, locs, total, buf, steps, 1)) != SFB_SUCCESS) goto done;
         }
     }
     /* round 0's changes: every hit */
@@ -13627,7 +13672,7 @@ static sfb_result sfb__an_project_all(sfb__an *A, int steps) {
         }
         if (count == 0) break;
         A->nchg = 0;
-        if ((r = sfb__an_newton(A, tries, locs, count, buf, steps)) != SFB_SUCCESS) goto done;
+        if ((r = sfb__an_newton(A, tries, locs, count, buf, steps, 0)) != SFB_SUCCESS) goto done;
         if (A->nchg == 0) break;
         if ((r = sfb__progress(A->ctx, 0.6f + 0.1f * (float)round / SFB__AN_ROUNDS, "analyze")) != SFB_SUCCESS) goto done;
     }
