@@ -10,7 +10,10 @@
  *   - a failure leaves the output zeroed and sets an error message;
  *   - on success the picture has the asked size, covered_pixels equals the pixels whose class is
  *     not 0, every covered pixel's hit names a parametric face in range with (u,v) in its
- *     domain, and uncovered pixels are the background.
+ *     domain, and uncovered pixels are the background;
+ *   - with byte 90 odd, the same analysis through an sfb_analysis_workspace that a picture of
+ *     another size (bytes 91, 92) used first gives the same result code, and on success the same
+ *     picture bit for bit.
  *
  * Build (from the repository root):
  *   clang -g -O1 -fsanitize=fuzzer,address,undefined -I. fuzz/fuzz_analyze.c -x c tools/impl.c -o fuzz_analyze
@@ -138,8 +141,33 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
             if (sc.scheme == SFB_SCHEME_LOOP && (double)l->u + (double)l->v > 1.0 + 1e-6) fail("a Loop hit outside its triangle", NULL);
         }
         if (covered != a.covered_pixels) fail("covered_pixels differs from the classes", NULL);
-        sfb_analysis_free(&a);
     }
+    if (head[90] & 1) {
+        sfb_analysis_workspace *ws = NULL;
+        sfb_analyze_config c2 = c;
+        sfb_analysis b;
+        sfb_result rb;
+        if (sfb_analysis_workspace_create(ctx, &ws) == SFB_SUCCESS) {
+            c2.width = 1 + head[91] % 48;
+            c2.height = 1 + head[92] % 48;
+            c2.workspace = ws;
+            if (sfb_surface_analyze(s, &c2, &b) == SFB_SUCCESS) sfb_analysis_free(&b);
+            c2 = c;
+            c2.workspace = ws;
+            rb = sfb_surface_analyze(s, &c2, &b);
+            if (rb != r) fail("a workspace changed the result code", sfb_result_string(rb));
+            if (r == SFB_SUCCESS) {
+                const size_t n = (size_t)a.width * a.height;
+                if (b.covered_pixels != a.covered_pixels || b.dropped_pixels != a.dropped_pixels || b.fallback_pixels != a.fallback_pixels ||
+                    memcmp(a.rgba, b.rgba, 4 * n) != 0 || memcmp(a.classes, b.classes, n) != 0 || memcmp(a.values, b.values, n * sizeof(float)) != 0 ||
+                    memcmp(a.hits, b.hits, n * sizeof(sfb_location)) != 0)
+                    fail("a workspace changed the picture", NULL);
+                sfb_analysis_free(&b);
+            }
+            sfb_analysis_workspace_destroy(ws);
+        }
+    }
+    if (r == SFB_SUCCESS) sfb_analysis_free(&a);
     sfb_surface_destroy(s);
     sfb_mesh_destroy(mesh);
     sfb_context_destroy(ctx);

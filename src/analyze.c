@@ -206,6 +206,7 @@ static sfb_result sfb__an_check(sfb_context *ctx, const sfb_analyze_config *c, i
 /* ---- state of one analysis ---- */
 typedef struct sfb__an {
     sfb_context *ctx;
+    sfb_analysis_workspace *ws; /* NULL: none */
     const sfb_surface *s;
     const sfb_analyze_config *c;
     int w, h, tri, nf, R, per;   /* picture, triangle domain, parametric faces, grid segments, grid points per face */
@@ -235,6 +236,89 @@ typedef struct sfb__an {
 } sfb__an;
 
 enum { SFB__AN_NONE = 0, SFB__AN_TRIED_NEAR = 1, SFB__AN_HIT = 2 };
+
+/* ---- the workspace (sfb_analysis_workspace): the large scratch buffers, by slot ---- */
+enum {
+    SFB__WS_GPOS, SFB__WS_GNRM, SFB__WS_RV, SFB__WS_RTRI, SFB__WS_DEPTH, SFB__WS_FACE, SFB__WS_UV, SFB__WS_HIT, SFB__WS_CFACE,
+    SFB__WS_CUV, SFB__WS_CDIST, SFB__WS_STATE, SFB__WS_PPOS, SFB__WS_PNRM, SFB__WS_HPIX, SFB__WS_HLOC, SFB__WS_HPOS, SFB__WS_HDU,
+    SFB__WS_HDV, SFB__WS_HNRM, SFB__WS_HDEPTH, SFB__WS_CHG, SFB__WS_TRIES, SFB__WS_LOCS, SFB__WS_BUF, SFB__WS_MARK, SFB__WS_ROWAT,
+    SFB__WS_NBM, SFB__WS_HV1, SFB__WS_HV2, SFB__WS_V2, SFB__WS_SEC, SFB__WS_COUNT
+};
+struct sfb_analysis_workspace {
+    sfb_context *ctx;
+    void *p[SFB__WS_COUNT];
+    size_t n[SFB__WS_COUNT];
+    int mark_base; /* the projection's round tags in the kept mark buffer start above it (sfb__an_project_all) */
+};
+
+SFB_API sfb_result sfb_analysis_workspace_create(sfb_context *ctx, sfb_analysis_workspace **out) {
+    sfb_analysis_workspace *ws;
+    if (out) *out = NULL;
+    if (!ctx) return SFB_INVALID_ARGS;
+    if (!out) return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "sfb_analysis_workspace_create: NULL output");
+    ws = (sfb_analysis_workspace *)sfb__alloc(ctx, sizeof *ws);
+    if (!ws) return sfb__oom(ctx, "the analysis workspace");
+    memset(ws, 0, sizeof *ws);
+    ws->ctx = ctx;
+    *out = ws;
+    return SFB_SUCCESS;
+}
+
+SFB_API void sfb_analysis_workspace_destroy(sfb_analysis_workspace *ws) {
+    int k;
+    if (!ws) return;
+    for (k = 0; k < SFB__WS_COUNT; ++k) sfb__free(ws->ctx, ws->p[k]);
+    sfb__free(ws->ctx, ws);
+}
+
+SFB_API size_t sfb_analysis_workspace_bytes(const sfb_analysis_workspace *ws) {
+    size_t b = 0;
+    int k;
+    if (!ws) return 0;
+    for (k = 0; k < SFB__WS_COUNT; ++k) b += ws->n[k];
+    return b;
+}
+
+/* A scratch buffer of at least `bytes` for slot `slot`: the workspace's (grown when too small:
+ * the old contents are lost), else a fresh allocation. *fresh (when given) says whether the
+ * memory is newly allocated. NULL when the allocation failed. */
+static void *sfb__an_get(const sfb__an *A, int slot, size_t bytes, int *fresh) {
+    sfb_analysis_workspace *ws = A->ws;
+    if (fresh) *fresh = 1;
+    if (!ws) return sfb__alloc(A->ctx, bytes);
+    if (ws->p[slot] && ws->n[slot] >= bytes) {
+        if (fresh) *fresh = 0;
+        return ws->p[slot];
+    }
+    sfb__free(A->ctx, ws->p[slot]);
+    ws->n[slot] = 0;
+    ws->p[slot] = sfb__alloc(A->ctx, bytes);
+    if (ws->p[slot]) ws->n[slot] = bytes;
+    return ws->p[slot];
+}
+
+/* sfb__an_get zeroed (calloc). */
+static void *sfb__an_get_zeroed(const sfb__an *A, int slot, size_t bytes) {
+    void *p;
+    if (!A->ws) return sfb__calloc(A->ctx, bytes, 1);
+    p = sfb__an_get(A, slot, bytes, NULL);
+    if (p) memset(p, 0, bytes);
+    return p;
+}
+
+/* Grows slot's buffer p to `bytes`, keeping its contents (realloc); NULL when it failed (p is
+ * then still valid). */
+static void *sfb__an_regrow(const sfb__an *A, int slot, void *p, size_t bytes) {
+    sfb_analysis_workspace *ws = A->ws;
+    void *q = sfb__realloc(A->ctx, p, bytes);
+    if (ws && q) { ws->p[slot] = q; ws->n[slot] = bytes; }
+    return q;
+}
+
+/* Gives a buffer of sfb__an_get back: freed, unless the workspace keeps it. */
+static void sfb__an_put(const sfb__an *A, void *p) {
+    if (!A->ws) sfb__free(A->ctx, p);
+}
 
 /* sfb__parallel when there are enough items to be worth it (`work`, in items of ~100 ns),
  * else the task as one call. */
@@ -902,16 +986,31 @@ static sfb_result sfb__an_project_all(sfb__an *A, int steps) {
     float *buf = NULL;
     int *mark = NULL;  /* per pixel: the last round that seeded it, and 3 faces it was seeded from */
     int *rowat = NULL; /* round 0: per grid row, its attempts, then where they start in their band */
+    int mark_base = 0;
     sfb_result r = SFB_SUCCESS;
     for (p = 0; p < npix; ++p) if (A->face[p] >= 0 || A->cface[p] >= 0) ++cap;
     cap = cap < 4096 ? 4096 : cap > SFB__AN_BATCH ? SFB__AN_BATCH : cap; /* later rounds grow it when they need to */
     if (cap < A->w) cap = A->w; /* round 0's bands hold at least a row */
-    tries = (sfb__an_try *)sfb__alloc(A->ctx, (size_t)cap * sizeof *tries);
-    locs = (sfb_location *)sfb__alloc(A->ctx, (size_t)cap * sizeof *locs);
-    buf = (float *)sfb__alloc(A->ctx, (size_t)cap * 12 * sizeof(float));
-    mark = (int *)sfb__calloc(A->ctx, npix, 4 * sizeof(int));
-    rowat = (int *)sfb__alloc(A->ctx, ((size_t)A->h + 1) * sizeof(int));
-    A->nbm = (unsigned char *)sfb__alloc(A->ctx, npix + 1);
+    tries = (sfb__an_try *)sfb__an_get(A, SFB__WS_TRIES, (size_t)cap * sizeof *tries, NULL);
+    locs = (sfb_location *)sfb__an_get(A, SFB__WS_LOCS, (size_t)cap * sizeof *locs, NULL);
+    buf = (float *)sfb__an_get(A, SFB__WS_BUF, (size_t)cap * 12 * sizeof(float), NULL);
+    rowat = (int *)sfb__an_get(A, SFB__WS_ROWAT, ((size_t)A->h + 1) * sizeof(int), NULL);
+    A->nbm = (unsigned char *)sfb__an_get(A, SFB__WS_NBM, npix + 1, NULL);
+    /* the marks' round tags are base + round: a workspace's kept marks hold tags of earlier
+     * analyses, all at or below its base, which grows by SFB__AN_ROUNDS per analysis (the
+     * buffer is zeroed when new, or when the tags would overflow) */
+    {
+        int fresh = 1;
+        mark = A->ws ? (int *)sfb__an_get(A, SFB__WS_MARK, npix * 4 * sizeof(int), &fresh) : (int *)sfb__calloc(A->ctx, npix, 4 * sizeof(int));
+        if (mark && A->ws) {
+            if (fresh || A->ws->mark_base > 2147483647 - 2 * (SFB__AN_ROUNDS + 1)) {
+                memset(mark, 0, npix * 4 * sizeof(int));
+                A->ws->mark_base = 0;
+            }
+            mark_base = A->ws->mark_base;
+            A->ws->mark_base += SFB__AN_ROUNDS + 1;
+        }
+    }
     if (!tries || !locs || !buf || !mark || !rowat || !A->nbm) { r = sfb__oom(A->ctx, "the analysis projection"); goto done; }
     /* round 0, in five parts: first the anchors, the pixels whose x and y are multiples of
      * SFB__AN_ANCHOR (4), from their proxy (face, u, v); then, for d = 2 and then 1, the pixels
@@ -970,19 +1069,19 @@ static sfb_result sfb__an_project_all(sfb__an *A, int steps) {
                     if (!(A->nbm[ci] & (1 << bit++))) continue;
                     q = (y + dy) * A->w + (x + dx);
                     mq = mark + 4 * (size_t)q;
-                    if (mq[0] != round) { mq[0] = round; mq[1] = mq[2] = mq[3] = -1; }
+                    if (mq[0] != mark_base + round) { mq[0] = mark_base + round; mq[1] = mq[2] = mq[3] = -1; }
                     for (k = 1; k <= 3 && mq[k] >= 0 && mq[k] != f; ++k) {}
                     if (k > 3 || mq[k] == f) continue; /* three faces tried this round, or this one */
                     mq[k] = f;
                     if (count == cap) {
                         int nc = cap * 2;
-                        void *a = sfb__realloc(A->ctx, tries, (size_t)nc * sizeof *tries);
+                        void *a = sfb__an_regrow(A, SFB__WS_TRIES, tries, (size_t)nc * sizeof *tries);
                         if (!a) { r = sfb__oom(A->ctx, "the analysis projection"); goto done; }
                         tries = (sfb__an_try *)a;
-                        a = sfb__realloc(A->ctx, locs, (size_t)nc * sizeof *locs);
+                        a = sfb__an_regrow(A, SFB__WS_LOCS, locs, (size_t)nc * sizeof *locs);
                         if (!a) { r = sfb__oom(A->ctx, "the analysis projection"); goto done; }
                         locs = (sfb_location *)a;
-                        a = sfb__realloc(A->ctx, buf, (size_t)nc * 12 * sizeof(float));
+                        a = sfb__an_regrow(A, SFB__WS_BUF, buf, (size_t)nc * 12 * sizeof(float));
                         if (!a) { r = sfb__oom(A->ctx, "the analysis projection"); goto done; }
                         buf = (float *)a;
                         cap = nc;
@@ -1000,12 +1099,12 @@ static sfb_result sfb__an_project_all(sfb__an *A, int steps) {
         if ((r = sfb__progress(A->ctx, 0.6f + 0.1f * (float)round / SFB__AN_ROUNDS, "analyze")) != SFB_SUCCESS) goto done;
     }
 done:
-    sfb__free(A->ctx, tries);
-    sfb__free(A->ctx, locs);
-    sfb__free(A->ctx, buf);
-    sfb__free(A->ctx, mark);
-    sfb__free(A->ctx, rowat);
-    sfb__free(A->ctx, A->nbm);
+    sfb__an_put(A, tries);
+    sfb__an_put(A, locs);
+    sfb__an_put(A, buf);
+    sfb__an_put(A, mark);
+    sfb__an_put(A, rowat);
+    sfb__an_put(A, A->nbm);
     A->nbm = NULL;
     return r;
 }
@@ -1339,12 +1438,15 @@ static sfb_result sfb__an_shade(const sfb__an *A, const sfb__shade_job *job, int
 
 static void sfb__an_free(sfb__an *A) {
     sfb_context *ctx = A->ctx;
-    sfb__free(ctx, A->gpos); sfb__free(ctx, A->gnrm); sfb__free(ctx, A->rv); sfb__free(ctx, A->rtri);
-    sfb__free(ctx, A->cface); sfb__free(ctx, A->cuv); sfb__free(ctx, A->cdist);
-    sfb__free(ctx, A->depth); sfb__free(ctx, A->face); sfb__free(ctx, A->uv); sfb__free(ctx, A->ppos); sfb__free(ctx, A->pnrm);
-    sfb__free(ctx, A->hit); sfb__free(ctx, A->state); sfb__free(ctx, A->adj);
-    sfb__free(ctx, A->hpix); sfb__free(ctx, A->hloc); sfb__free(ctx, A->hpos); sfb__free(ctx, A->hdu); sfb__free(ctx, A->hdv);
-    sfb__free(ctx, A->hnrm); sfb__free(ctx, A->hdepth); sfb__free(ctx, A->chg);
+    void *kept[21];
+    int k;
+    kept[0] = A->gpos; kept[1] = A->gnrm; kept[2] = A->rv; kept[3] = A->rtri; kept[4] = A->cface; kept[5] = A->cuv; kept[6] = A->cdist;
+    kept[7] = A->depth; kept[8] = A->face; kept[9] = A->uv; kept[10] = A->ppos; kept[11] = A->pnrm; kept[12] = A->hit; kept[13] = A->state;
+    kept[14] = A->hpix; kept[15] = A->hloc; kept[16] = A->hpos; kept[17] = A->hdu; kept[18] = A->hdv; kept[19] = A->hnrm;
+    kept[20] = A->hdepth;
+    for (k = 0; k < 21; ++k) sfb__an_put(A, kept[k]);
+    sfb__an_put(A, A->chg);
+    sfb__free(ctx, A->adj);
 }
 
 /* Bytes the analysis will hold at its peak (checked against the budget before allocating). */
@@ -1370,32 +1472,32 @@ static void sfb__an_clear_rows(void *arg, int y0, int y1) {
 static int sfb__an_alloc(sfb__an *A) {
     sfb_context *ctx = A->ctx;
     size_t npix = (size_t)A->w * (size_t)A->h, grid = (size_t)A->nf * (size_t)A->per;
-    A->gpos = (float *)sfb__alloc(ctx, grid * 3 * sizeof(float));
-    A->gnrm = (float *)sfb__alloc(ctx, grid * 3 * sizeof(float));
-    A->rv = (sfb__raster_vertex *)sfb__alloc(ctx, grid * sizeof(sfb__raster_vertex));
+    A->gpos = (float *)sfb__an_get(A, SFB__WS_GPOS, grid * 3 * sizeof(float), NULL);
+    A->gnrm = (float *)sfb__an_get(A, SFB__WS_GNRM, grid * 3 * sizeof(float), NULL);
+    A->rv = (sfb__raster_vertex *)sfb__an_get(A, SFB__WS_RV, grid * sizeof(sfb__raster_vertex), NULL);
     /* at most two triangles per grid point */
-    A->rtri = (int *)sfb__alloc(ctx, grid * 2 * 4 * sizeof(int));
-    A->depth = (float *)sfb__alloc(ctx, npix * sizeof(float));
-    A->face = (int *)sfb__alloc(ctx, npix * sizeof(int));
-    A->uv = (float *)sfb__alloc(ctx, npix * 2 * sizeof(float));
-    A->hit = (int *)sfb__alloc(ctx, npix * sizeof(int));
+    A->rtri = (int *)sfb__an_get(A, SFB__WS_RTRI, grid * 2 * 4 * sizeof(int), NULL);
+    A->depth = (float *)sfb__an_get(A, SFB__WS_DEPTH, npix * sizeof(float), NULL);
+    A->face = (int *)sfb__an_get(A, SFB__WS_FACE, npix * sizeof(int), NULL);
+    A->uv = (float *)sfb__an_get(A, SFB__WS_UV, npix * 2 * sizeof(float), NULL);
+    A->hit = (int *)sfb__an_get(A, SFB__WS_HIT, npix * sizeof(int), NULL);
     A->adj = (int *)sfb__alloc(ctx, ((size_t)A->nf + 1) * 4 * sizeof(int));
-    A->cface = (int *)sfb__alloc(ctx, npix * sizeof(int));
-    A->cuv = (float *)sfb__alloc(ctx, npix * 2 * sizeof(float));
-    A->cdist = (float *)sfb__alloc(ctx, npix * sizeof(float));
-    A->state = (unsigned char *)sfb__calloc(ctx, npix, 1);
+    A->cface = (int *)sfb__an_get(A, SFB__WS_CFACE, npix * sizeof(int), NULL);
+    A->cuv = (float *)sfb__an_get(A, SFB__WS_CUV, npix * 2 * sizeof(float), NULL);
+    A->cdist = (float *)sfb__an_get(A, SFB__WS_CDIST, npix * sizeof(float), NULL);
+    A->state = (unsigned char *)sfb__an_get_zeroed(A, SFB__WS_STATE, npix);
     if (A->c->polygon_based) {
-        A->ppos = (float *)sfb__alloc(ctx, npix * 3 * sizeof(float));
-        A->pnrm = (float *)sfb__alloc(ctx, npix * 3 * sizeof(float));
+        A->ppos = (float *)sfb__an_get(A, SFB__WS_PPOS, npix * 3 * sizeof(float), NULL);
+        A->pnrm = (float *)sfb__an_get(A, SFB__WS_PNRM, npix * 3 * sizeof(float), NULL);
     }
-    A->hpix = (int *)sfb__alloc(ctx, npix * sizeof(int));
-    A->hloc = (sfb_location *)sfb__alloc(ctx, npix * sizeof(sfb_location));
-    A->hpos = (float *)sfb__alloc(ctx, npix * 3 * sizeof(float));
-    A->hdu = (float *)sfb__alloc(ctx, npix * 3 * sizeof(float));
-    A->hdv = (float *)sfb__alloc(ctx, npix * 3 * sizeof(float));
-    A->hnrm = (float *)sfb__alloc(ctx, npix * 3 * sizeof(float));
-    A->hdepth = (float *)sfb__alloc(ctx, npix * sizeof(float));
-    A->chg = (int *)sfb__alloc(ctx, (npix + 1) * sizeof(int));
+    A->hpix = (int *)sfb__an_get(A, SFB__WS_HPIX, npix * sizeof(int), NULL);
+    A->hloc = (sfb_location *)sfb__an_get(A, SFB__WS_HLOC, npix * sizeof(sfb_location), NULL);
+    A->hpos = (float *)sfb__an_get(A, SFB__WS_HPOS, npix * 3 * sizeof(float), NULL);
+    A->hdu = (float *)sfb__an_get(A, SFB__WS_HDU, npix * 3 * sizeof(float), NULL);
+    A->hdv = (float *)sfb__an_get(A, SFB__WS_HDV, npix * 3 * sizeof(float), NULL);
+    A->hnrm = (float *)sfb__an_get(A, SFB__WS_HNRM, npix * 3 * sizeof(float), NULL);
+    A->hdepth = (float *)sfb__an_get(A, SFB__WS_HDEPTH, npix * sizeof(float), NULL);
+    A->chg = (int *)sfb__an_get(A, SFB__WS_CHG, (npix + 1) * sizeof(int), NULL);
     if (!A->gpos || !A->gnrm || !A->rv || !A->rtri || !A->depth || !A->face || !A->uv || !A->hit || !A->adj || !A->cface || !A->cuv || !A->cdist || !A->state ||
         (A->c->polygon_based && (!A->ppos || !A->pnrm)) || !A->hpix || !A->hloc || !A->hpos || !A->hdu || !A->hdv || !A->hnrm || !A->hdepth ||
         !A->chg)
@@ -1427,7 +1529,7 @@ static sfb_result sfb__an_values(sfb__an *A, sfb__an_look *L, float *hv1, float 
     L->job.value = hv1; L->job.value2 = hv2;
     if (c->mode == SFB_ANALYZE_CURVATURE && A->nhit > 0) {
         sfb_eval_output o;
-        sec = (float *)sfb__alloc(A->ctx, (size_t)A->nhit * 9 * sizeof(float));
+        sec = (float *)sfb__an_get(A, SFB__WS_SEC, (size_t)A->nhit * 9 * sizeof(float), NULL);
         if (!sec) return sfb__oom(A->ctx, "the analysis second derivatives");
         memset(&o, 0, sizeof o);
         o.duu = sec; o.duv = sec + 3 * (size_t)A->nhit; o.dvv = sec + 6 * (size_t)A->nhit;
@@ -1455,7 +1557,7 @@ static sfb_result sfb__an_values(sfb__an *A, sfb__an_look *L, float *hv1, float 
             if (fabs(hv1[k]) < floor_k) hv1[k] = 0.0f;
     }
     L->job.duu = L->job.duv = L->job.dvv = NULL;
-    sfb__free(A->ctx, sec);
+    sfb__an_put(A, sec);
     return r;
 }
 
@@ -1481,7 +1583,7 @@ static sfb_result sfb__an_picture(sfb__an *A, sfb__an_look *L, const float *hv1,
     sfb_context *ctx = A->ctx;
     const sfb_analyze_config *c = A->c;
     size_t npix = (size_t)A->w * (size_t)A->h;
-    float *v1 = (float *)sfb__alloc(ctx, npix * sizeof(float)), *v2 = (float *)sfb__alloc(ctx, npix * sizeof(float));
+    float *v1 = (float *)sfb__alloc(ctx, npix * sizeof(float)), *v2 = (float *)sfb__an_get(A, SFB__WS_V2, npix * sizeof(float), NULL);
     unsigned char *rgba = (unsigned char *)sfb__alloc(ctx, npix * 4), *cls = (unsigned char *)sfb__alloc(ctx, npix);
     sfb_location *hits = (sfb_location *)sfb__alloc(ctx, npix * sizeof(sfb_location));
     sfb_result r = SFB_SUCCESS;
@@ -1523,7 +1625,7 @@ static sfb_result sfb__an_picture(sfb__an *A, sfb__an_look *L, const float *hv1,
     out->range = (float)L->range;
     rgba = NULL; v1 = NULL; cls = NULL; hits = NULL;
 done:
-    sfb__free(ctx, v1); sfb__free(ctx, v2); sfb__free(ctx, rgba); sfb__free(ctx, cls); sfb__free(ctx, hits);
+    sfb__free(ctx, v1); sfb__an_put(A, v2); sfb__free(ctx, rgba); sfb__free(ctx, cls); sfb__free(ctx, hits);
     return r;
 }
 
@@ -1547,6 +1649,9 @@ SFB_API sfb_result sfb_surface_analyze(const sfb_surface *s, const sfb_analyze_c
     memset(&A, 0, sizeof A);
     if ((r = sfb__an_check(ctx, &c, &A.w, &A.h, &level)) != SFB_SUCCESS) return r;
     A.ctx = ctx; A.s = s; A.c = &c;
+    A.ws = c.workspace;
+    if (A.ws && A.ws->ctx != ctx)
+        return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "sfb_surface_analyze: the workspace was made on another context");
     A.tri = s->patches.domain == SFB__DOMAIN_TRI;
     A.nf = s->patches.nptex;
     A.R = 1 << level;
@@ -1554,7 +1659,7 @@ SFB_API sfb_result sfb_surface_analyze(const sfb_surface *s, const sfb_analyze_c
     npix = (size_t)A.w * (size_t)A.h;
     if ((double)A.nf * A.per > 2147483647.0)
         return sfb__error(ctx, SFB_LIMIT_EXCEEDED, SFB_ELEMENT_NONE, -1, "proxy of %d parametric faces at level %d is too large", A.nf, level);
-    need = sfb__an_bytes(&A);
+    need = sfb__an_bytes(&A) - (double)sfb_analysis_workspace_bytes(A.ws); /* what the workspace holds is in use already */
     if (need > (double)ctx->budget - (double)ctx->live_bytes)
         return sfb__error(ctx, SFB_LIMIT_EXCEEDED, SFB_ELEMENT_NONE, -1,
                           "a %d x %d analysis with a level-%d proxy needs about %.0f MB, over the memory budget (%zu bytes, %zu in use)", A.w,
@@ -1578,8 +1683,8 @@ SFB_API sfb_result sfb_surface_analyze(const sfb_surface *s, const sfb_analyze_c
     if ((r = sfb__progress(ctx, 0.75f, "analyze")) != SFB_SUCCESS) goto done;
     /* 3: the values */
     sfb__an_lights(&A, &L);
-    hv1 = (float *)sfb__alloc(ctx, ((size_t)A.nhit + 1) * sizeof(float));
-    hv2 = (float *)sfb__alloc(ctx, ((size_t)A.nhit + 1) * sizeof(float));
+    hv1 = (float *)sfb__an_get(&A, SFB__WS_HV1, ((size_t)A.nhit + 1) * sizeof(float), NULL);
+    hv2 = (float *)sfb__an_get(&A, SFB__WS_HV2, ((size_t)A.nhit + 1) * sizeof(float), NULL);
     if (!hv1 || !hv2) { r = sfb__oom(ctx, "the analysis values"); goto done; }
     if ((r = sfb__an_values(&A, &L, hv1, hv2)) != SFB_SUCCESS) goto done;
     if ((r = sfb__progress(ctx, 0.9f, "analyze")) != SFB_SUCCESS) goto done;
@@ -1595,7 +1700,7 @@ SFB_API sfb_result sfb_surface_analyze(const sfb_surface *s, const sfb_analyze_c
 done:
     if (r != SFB_SUCCESS) memset(out, 0, sizeof *out);
     sfb__an_free(&A);
-    sfb__free(ctx, hv1);
-    sfb__free(ctx, hv2);
+    sfb__an_put(&A, hv1);
+    sfb__an_put(&A, hv2);
     return r;
 }

@@ -373,6 +373,104 @@ static void test_threads(const shape *shapes, int count) {
     for (t = 0; t < 2; ++t) sfb_context_destroy(cx[t]);
 }
 
+/* Two pictures bit for bit: colours, values, classes, hits and the counts. */
+static int same_picture(const sfb_analysis *a, const sfb_analysis *b) {
+    const size_t n = (size_t)a->width * a->height;
+    return a->width == b->width && a->height == b->height && a->covered_pixels == b->covered_pixels &&
+           a->dropped_pixels == b->dropped_pixels && a->fallback_pixels == b->fallback_pixels && a->grown_pixels == b->grown_pixels &&
+           a->light_hits == b->light_hits && a->range == b->range && memcmp(a->rgba, b->rgba, 4 * n) == 0 &&
+           memcmp(a->classes, b->classes, n) == 0 && memcmp(a->values, b->values, n * sizeof(float)) == 0 &&
+           memcmp(a->hits, b->hits, n * sizeof(sfb_location)) == 0;
+}
+
+/* sfb_analysis_workspace: one workspace through a sequence of analyses that grow and shrink it
+ * (sizes, modes, schemes, the polygon-based path), each bit for bit the picture without it,
+ * twice in a row (the kept mark tags of the first must not leak into the second), and the
+ * first one again at the end;
+ * a call cancelled halfway leaves it usable; a workspace of another context is refused. */
+static int cancel_when_asked(float done, const char *stage, void *user) {
+    return strcmp(stage, "analyze") == 0 && *(int *)user && done > 0.5f;
+}
+
+static void test_workspace(const shape *shapes) {
+    static const struct { int shape, mode, w, h, level, polygon; } runs[6] = {
+        { 1, SFB_ANALYZE_REFLECTION, 640, 480, 1, 0 }, { 2, SFB_ANALYZE_CURVATURE, 200, 150, 2, 0 }, { 0, SFB_ANALYZE_ZEBRA, 800, 600, 1, 0 },
+        { 1, SFB_ANALYZE_REFLECTION, 320, 240, 2, 1 }, { 3, SFB_ANALYZE_ISOPHOTE, 300, 300, 2, 0 }, { 1, SFB_ANALYZE_REFLECTION, 640, 480, 1, 0 }};
+    sfb_context_config cc = sfb_context_config_init();
+    sfb_context *ctx = NULL, *other = NULL;
+    sfb_analysis_workspace *ws = NULL, *foreign = NULL;
+    sfb_mesh *m[4] = { NULL, NULL, NULL, NULL };
+    sfb_surface *sf[4] = { NULL, NULL, NULL, NULL };
+    int cancel = 0, i;
+    size_t held_max = 0;
+    cc.ignore_environment = 1;
+    cc.progress.func = cancel_when_asked;
+    cc.progress.user = &cancel;
+    if (sfb_context_create(&cc, &ctx) != SFB_SUCCESS || sfb_analysis_workspace_create(ctx, &ws) != SFB_SUCCESS) {
+        fail("workspace/create", "no context or workspace");
+        sfb_context_destroy(ctx);
+        return;
+    }
+    for (i = 0; i < 4; ++i) {
+        m[i] = load_shape(ctx, shapes[i].path);
+        sf[i] = m[i] ? patch_surface(ctx, m[i], shapes[i].scheme) : NULL;
+    }
+    for (i = 0; i < 6; ++i) {
+        char name[128];
+        sfb_analyze_config c = sfb_analyze_config_init(runs[i].mode);
+        sfb_analysis a, b, b2;
+        sfb_result ra, rb, rb2;
+        snprintf(name, sizeof name, "workspace/run_%d_%s_%dx%d%s", i, shapes[runs[i].shape].label, runs[i].w, runs[i].h,
+                 runs[i].polygon ? "_polygon" : "");
+        if (!sf[runs[i].shape]) { skip(name, "shape not found"); continue; }
+        memset(&a, 0, sizeof a); memset(&b, 0, sizeof b); memset(&b2, 0, sizeof b2);
+        c.width = runs[i].w; c.height = runs[i].h; c.level = runs[i].level; c.polygon_based = runs[i].polygon;
+        c.curvature = SFB_CURVATURE_MEAN;
+        ra = sfb_surface_analyze(sf[runs[i].shape], &c, &a);
+        c.workspace = ws;
+        rb = sfb_surface_analyze(sf[runs[i].shape], &c, &b);
+        rb2 = sfb_surface_analyze(sf[runs[i].shape], &c, &b2); /* at once again: everything kept is this picture's own */
+        if (sfb_analysis_workspace_bytes(ws) > held_max) held_max = sfb_analysis_workspace_bytes(ws);
+        check(ra == SFB_SUCCESS && rb == SFB_SUCCESS && rb2 == SFB_SUCCESS && a.covered_pixels > 1000 && same_picture(&a, &b) &&
+                  same_picture(&a, &b2),
+              name, "%s / %s / %s: %d / %d / %d pixels covered, the same: %d %d (workspace %zu bytes)", sfb_result_string(ra),
+              sfb_result_string(rb), sfb_result_string(rb2), a.covered_pixels, b.covered_pixels, b2.covered_pixels,
+              rb == SFB_SUCCESS && same_picture(&a, &b), rb2 == SFB_SUCCESS && same_picture(&a, &b2), sfb_analysis_workspace_bytes(ws));
+        sfb_analysis_free(&a); sfb_analysis_free(&b); sfb_analysis_free(&b2);
+        if (i == 2) {
+            /* cancelled halfway with the workspace, then the same picture again */
+            sfb_analysis x;
+            sfb_result rx;
+            memset(&x, 0, sizeof x);
+            cancel = 1;
+            rx = sfb_surface_analyze(sf[runs[i].shape], &c, &x);
+            cancel = 0;
+            check(rx == SFB_CANCELLED && x.rgba == NULL, "workspace/cancelled_call", "%s", sfb_result_string(rx));
+        }
+    }
+    /* the buffers stay at the largest analysis (800 x 600: ~100 bytes per pixel at least) */
+    check(held_max >= (size_t)800 * 600 * 100 && sfb_analysis_workspace_bytes(ws) == held_max, "workspace/keeps_the_largest",
+          "largest %zu bytes, now %zu", held_max, sfb_analysis_workspace_bytes(ws));
+    if (sfb_context_create(&cc, &other) == SFB_SUCCESS && sfb_analysis_workspace_create(other, &foreign) == SFB_SUCCESS && sf[1]) {
+        sfb_analyze_config c = sfb_analyze_config_init(SFB_ANALYZE_REFLECTION);
+        sfb_analysis a;
+        sfb_result r;
+        c.workspace = foreign;
+        r = sfb_surface_analyze(sf[1], &c, &a);
+        check(r == SFB_INVALID_ARGS && a.rgba == NULL && strstr(sfb_last_error(ctx), "another context") != NULL, "workspace/of_another_context",
+              "%s: %s", sfb_result_string(r), sfb_last_error(ctx));
+        sfb_analysis_free(&a);
+    } else {
+        fail("workspace/of_another_context", "no second context");
+    }
+    sfb_analysis_workspace_destroy(foreign);
+    sfb_analysis_workspace_destroy(NULL);
+    sfb_context_destroy(other);
+    sfb_analysis_workspace_destroy(ws);
+    for (i = 0; i < 4; ++i) { sfb_surface_destroy(sf[i]); sfb_mesh_destroy(m[i]); }
+    sfb_context_destroy(ctx);
+}
+
 /* ---- backends against ref ---- */
 /* Modes: 0 reflection, 1 mean and 2 Gaussian curvature (exact per pixel), 3 polygon-based
  * reflection (the raster's own interpolated data, so the raster kernels compared directly). */
@@ -566,6 +664,7 @@ int main(int argc, char **argv) {
     test_bad(ctx);
     sfb_context_destroy(ctx);
     test_threads(shapes, 3);
+    test_workspace(shapes);
     {
         sfb_context_config bc = sfb_context_config_init();
         bc.logger.func = cpu_raster_logger;
