@@ -13327,25 +13327,38 @@ typedef struct sfb__an_try {
     int k;             /* its hit slot (fresh batches, sfb__an_newton) */
 } sfb__an_try;
 
-/* Records the evaluation at loc as pixel pix's hit at depth z (a pixel already hit keeps the
- * nearer one). */
-static void sfb__an_add_hit(sfb__an *A, int pix, const sfb_location *loc, double z, const float *p, const float *du, const float *dv,
-                            const float *n) {
-    int k = A->hit[pix], c;
-    if (k >= 0) {
-        if (!(z < A->hdepth[k] - 1e-6 * A->radius)) return;
-    } else {
-        k = A->nhit++;
-        A->hpix[k] = pix;
-        A->hit[pix] = k;
-        A->state[pix] = SFB__AN_HIT;
-    }
-    if ((size_t)A->nchg < (size_t)A->w * (size_t)A->h) A->chg[A->nchg++] = k; /* a pixel listed twice is harmless */
+/* A new hit slot for pixel pix (not hit yet). */
+static int sfb__an_new_slot(sfb__an *A, int pix) {
+    const int k = A->nhit++;
+    A->hpix[k] = pix;
+    A->hit[pix] = k;
+    A->state[pix] = SFB__AN_HIT;
+    return k;
+}
+
+/* Hit slot k's data: the evaluation at loc, at depth z. */
+static void sfb__an_store_hit(sfb__an *A, size_t k, const sfb_location *loc, double z, const float *p, const float *du, const float *dv,
+                              const float *n) {
+    int c;
     A->hloc[k] = *loc;
     A->hdepth[k] = (float)z;
     for (c = 0; c < 3; ++c) {
         A->hpos[3 * k + c] = p[c]; A->hdu[3 * k + c] = du[c]; A->hdv[3 * k + c] = dv[c]; A->hnrm[3 * k + c] = n[c];
     }
+}
+
+/* Records the evaluation at loc as pixel pix's hit at depth z (a pixel already hit keeps the
+ * nearer one). */
+static void sfb__an_add_hit(sfb__an *A, int pix, const sfb_location *loc, double z, const float *p, const float *du, const float *dv,
+                            const float *n) {
+    int k = A->hit[pix];
+    if (k >= 0) {
+        if (!(z < A->hdepth[k] - 1e-6 * A->radius)) return;
+    } else {
+        k = sfb__an_new_slot(A, pix);
+    }
+    if ((size_t)A->nchg < (size_t)A->w * (size_t)A->h) A->chg[A->nchg++] = k; /* a pixel listed twice is harmless */
+    sfb__an_store_hit(A, (size_t)k, loc, z, p, du, dv, n);
 }
 
 /* Clamps (u,v) into the domain; returns 1 when it had to. */
@@ -13451,8 +13464,8 @@ static void sfb__an_step(void *arg, int a, int b) {
     }
 }
 
-/* Copies the new hits among attempts [a, b) into their hit slots (tries[i].k, given by
- * sfb__an_newton) and marks them recorded: the bulk of sfb__an_add_hit for fresh batches. */
+/* Stores the new hits among attempts [a, b) in their hit slots (tries[i].k, given by
+ * sfb__an_newton) and marks them recorded: sfb__an_add_hit's work for fresh batches. */
 typedef struct sfb__an_record_job {
     sfb__an *A;
     sfb__an_try *tries;
@@ -13463,17 +13476,12 @@ typedef struct sfb__an_record_job {
 static void sfb__an_record(void *arg, int a, int b) {
     const sfb__an_record_job *J = (const sfb__an_record_job *)arg;
     sfb__an *A = J->A;
-    int i, c;
+    int i;
     for (i = a; i < b; ++i) {
         sfb__an_try *t = &J->tries[i];
-        const size_t k = (size_t)t->k, i3 = 3 * (size_t)i;
+        const size_t i3 = 3 * (size_t)i;
         if (t->outcome != SFB__AN_OUT_NEW_HIT) continue;
-        A->hloc[k] = J->locs[i];
-        A->hdepth[k] = (float)t->z;
-        for (c = 0; c < 3; ++c) {
-            A->hpos[3 * k + c] = J->pos[i3 + c]; A->hdu[3 * k + c] = J->du[i3 + c]; A->hdv[3 * k + c] = J->dv[i3 + c];
-            A->hnrm[3 * k + c] = J->nrm[i3 + c];
-        }
+        sfb__an_store_hit(A, (size_t)t->k, &J->locs[i], t->z, J->pos + i3, J->du + i3, J->dv + i3, J->nrm + i3);
         t->outcome = 1;
     }
 }
@@ -13507,11 +13515,7 @@ static sfb_result sfb__an_newton(sfb__an *A, sfb__an_try *tries, sfb_location *l
             sfb__an_try *t = &tries[i];
             if (t->outcome == SFB__AN_OUT_NEW_HIT) {
                 if (fresh) {
-                    const int k = A->nhit++;
-                    t->k = k;
-                    A->hpix[k] = t->pix;
-                    A->hit[t->pix] = k;
-                    A->state[t->pix] = SFB__AN_HIT;
+                    t->k = sfb__an_new_slot(A, t->pix);
                     ++news;
                 } else {
                     sfb__an_add_hit(A, t->pix, &locs[i], t->z, pos + 3 * i, du + 3 * i, dv + 3 * i, nrm + 3 * i);
@@ -14126,16 +14130,13 @@ static sfb_result sfb__an_shade(const sfb__an *A, const sfb__shade_job *job, int
 }
 
 static void sfb__an_free(sfb__an *A) {
-    sfb_context *ctx = A->ctx;
-    void *kept[21];
-    int k;
-    kept[0] = A->gpos; kept[1] = A->gnrm; kept[2] = A->rv; kept[3] = A->rtri; kept[4] = A->cface; kept[5] = A->cuv; kept[6] = A->cdist;
-    kept[7] = A->depth; kept[8] = A->face; kept[9] = A->uv; kept[10] = A->ppos; kept[11] = A->pnrm; kept[12] = A->hit; kept[13] = A->state;
-    kept[14] = A->hpix; kept[15] = A->hloc; kept[16] = A->hpos; kept[17] = A->hdu; kept[18] = A->hdv; kept[19] = A->hnrm;
-    kept[20] = A->hdepth;
-    for (k = 0; k < 21; ++k) sfb__an_put(A, kept[k]);
-    sfb__an_put(A, A->chg);
-    sfb__free(ctx, A->adj);
+    sfb__an_put(A, A->gpos); sfb__an_put(A, A->gnrm); sfb__an_put(A, A->rv); sfb__an_put(A, A->rtri);
+    sfb__an_put(A, A->cface); sfb__an_put(A, A->cuv); sfb__an_put(A, A->cdist);
+    sfb__an_put(A, A->depth); sfb__an_put(A, A->face); sfb__an_put(A, A->uv); sfb__an_put(A, A->ppos); sfb__an_put(A, A->pnrm);
+    sfb__an_put(A, A->hit); sfb__an_put(A, A->state);
+    sfb__an_put(A, A->hpix); sfb__an_put(A, A->hloc); sfb__an_put(A, A->hpos); sfb__an_put(A, A->hdu); sfb__an_put(A, A->hdv);
+    sfb__an_put(A, A->hnrm); sfb__an_put(A, A->hdepth); sfb__an_put(A, A->chg);
+    sfb__free(A->ctx, A->adj); /* not a workspace buffer: per face */
 }
 
 /* Bytes the analysis will hold at its peak (checked against the budget before allocating). */
