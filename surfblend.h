@@ -6565,9 +6565,11 @@ done:
  *   - corners (a `t corner` tag, or three or more sharp edges; a boundary vertex with one
  *     triangle): the sharp net interpolates the vertex (b400 = V), each sector G1 in itself
  *     (the seed's eq. 9 blend is replaced by the constraint solve, which covers every valence).
+ *   - non-manifold vertices (sheets touching at a vertex): one vertex per fan of triangles, each
+ *     sheet built as a manifold mesh of its own (tbz_split).
  *   - refused: faces that are not triangles (split them first: the choice of diagonal is the
- *     modeller's), non-manifold edges and vertices, degenerate triangles (area below 1e-12 of the
- *     squared bounding-box diagonal), non-finite positions, an override s outside [0, 1] or NaN.
+ *     modeller's), non-manifold edges, degenerate triangles (area below 1e-12 of the squared
+ *     bounding-box diagonal), non-finite positions, an override s outside [0, 1] or NaN.
  * Param faces are the triangles, (u,v) barycentric as Loop's: (1-u-v) P0 + u P1 + v P2. */
 
 #define TBZ_REACH 6   /* net distance of the unknowns from an irregular vertex (ALGORITHMS.md 8.4) */
@@ -7567,6 +7569,17 @@ static sfb_result tbz_points(sfb_context *ctx, const sfb__level *l, const float 
     int v, e, f, c, k, any_tag = 0;
     sfb_result r = SFB_SUCCESS;
     *out = NULL;
+    /* the nets read rings in fan order: every vertex with triangles a fan, every edge manifold
+     * (tbz_check and tbz_split see to it on the mesh; a mesh after one Loop step, tbz_refine,
+     * can still fail: two triangles on the same three vertices give four triangles on an edge) */
+    for (e = 0; e < l->ne; ++e)
+        if (l->etag[e] & SFB__TAG_NONMANIFOLD)
+            return sfb__error(ctx, SFB_INVALID_TOPOLOGY, SFB_ELEMENT_EDGE, -1,
+                              "tribezier: after one Loop step an edge is non-manifold (two triangles on the same three vertices?)");
+    for (v = 0; v < l->nv; ++v)
+        if ((l->vtag[v] & SFB__TAG_NONMANIFOLD) && l->vf_off[v + 1] > l->vf_off[v])
+            return sfb__error(ctx, SFB_INVALID_TOPOLOGY, SFB_ELEMENT_VERTEX, -1,
+                              "tribezier: after one Loop step a vertex is non-manifold (two triangles on the same three vertices?)");
     memset(&T, 0, sizeof T);
     memset(&prev, 0, sizeof prev);
     T.ctx = ctx; T.l = l; T.pos = positions;
@@ -7676,21 +7689,124 @@ done:
     return r;
 }
 
-/* The refusals of both entry points: an override s outside [0, 1] or NaN, and
- * sfb__tri_mesh_check's. */
+/* The refusals of every entry point: an override s outside [0, 1] or NaN, and
+ * sfb__tri_mesh_check's (non-manifold vertices are split instead: tbz_split). */
 static sfb_result tbz_check(sfb_context *ctx, const sfb__level *l, const float *positions, const sfb_tribezier_options *opt) {
+    sfb_result r;
+    int e;
     if (opt && opt->sharpness_set && !(opt->sharpness >= 0.0f && opt->sharpness <= 1.0f))
         return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "tribezier: sharpness %g is not in [0, 1]", (double)opt->sharpness);
-    return sfb__tri_mesh_check(ctx, l, positions, "tribezier", 1);
+    if ((r = sfb__tri_mesh_check(ctx, l, positions, "tribezier", 0)) != SFB_SUCCESS) return r;
+    /* two triangles that run their edge the same way (the rest of the non-manifold edges
+     * sfb__tri_mesh_check refused) */
+    for (e = 0; e < l->ne; ++e)
+        if (l->etag[e] & SFB__TAG_NONMANIFOLD)
+            return sfb__error(ctx, SFB_INVALID_TOPOLOGY, SFB_ELEMENT_EDGE, e,
+                              "tribezier: edge %d (%d-%d) is non-manifold (its triangles run it the same way: orient them consistently)", e,
+                              l->ev[2 * e], l->ev[2 * e + 1]);
+    return SFB_SUCCESS;
+}
+
+/* Non-manifold vertices (edges are manifold: tbz_check): a vertex whose triangles form more
+ * than one fan (two sheets touching at a point, pieces sharing a boundary vertex) becomes one
+ * vertex per fan, at the same position, so that every sheet is a manifold mesh of its own: a
+ * closed fan's copy is an interior vertex, an open one's a boundary vertex. The triangles keep
+ * their order and slots (param faces unchanged). The copies carry no corner tag (the base level
+ * gives non-manifold vertices an infinite one, sfb__level_prepare): the subdivision schemes make
+ * such a vertex a corner, which here would be a cone point, whose spokes no polynomial G1 net
+ * holds (a corner tag on a smooth vertex of valence 4 leaves a G1 residual of 2e-3); so each
+ * sheet is smooth through its copy, and sheets that touched there now pass near it (its fans'
+ * limit points). *split = 0: none (sl, *spos untouched). */
+static sfb_result tbz_split(sfb_context *ctx, const sfb__level *l, const float *positions, int *split, sfb__level *sl, float **spos) {
+    int v, j, f, k, nv2 = l->nv, any = 0;
+    int *fan = NULL, *sizes = NULL, *fv = NULL, *parent = NULL, *copy = NULL;
+    sfb_result r = SFB_SUCCESS;
+    *split = 0;
+    for (v = 0; v < l->nv; ++v) any |= (l->vtag[v] & SFB__TAG_NONMANIFOLD) && l->vf_off[v + 1] > l->vf_off[v];
+    if (!any) return SFB_SUCCESS;
+    fan = (int *)sfb__alloc(ctx, ((size_t)l->nfv + 1) * sizeof(int));    /* per vf entry: its vertex id in the split */
+    parent = (int *)sfb__alloc(ctx, ((size_t)l->nfv + 1) * sizeof(int)); /* union-find over vf entries */
+    copy = (int *)sfb__alloc(ctx, ((size_t)l->nfv + 1) * sizeof(int));
+    sizes = (int *)sfb__alloc(ctx, ((size_t)l->nf + 1) * sizeof(int));
+    fv = (int *)sfb__alloc(ctx, ((size_t)l->nfv + 1) * sizeof(int));
+    if (!fan || !parent || !copy || !sizes || !fv) { r = sfb__oom(ctx, "tribezier non-manifold vertices"); goto done; }
+    memcpy(fv, l->fv, (size_t)l->nfv * sizeof(int));
+    for (f = 0; f < l->nf; ++f) sizes[f] = l->fv_off[f + 1] - l->fv_off[f];
+    for (v = 0; v < l->nv; ++v) {
+        const int a = l->vf_off[v], b = l->vf_off[v + 1];
+        if (!(l->vtag[v] & SFB__TAG_NONMANIFOLD) || a == b) continue;
+        for (j = a; j < b; ++j) { parent[j] = j; copy[j] = -1; }
+        /* faces of v sharing an edge of v are in one fan */
+        for (j = l->ve_off[v]; j < l->ve_off[v + 1]; ++j) {
+            const int e = l->ve[j];
+            int ends[2], ne2 = 0, q;
+            if (l->ef_off[e + 1] - l->ef_off[e] != 2) continue;
+            for (k = l->ef_off[e]; k < l->ef_off[e + 1]; ++k)
+                for (q = a; q < b; ++q)
+                    if (l->vf[q] == l->ef[k] && ne2 < 2) { ends[ne2++] = q; break; }
+            if (ne2 == 2) {
+                int x = ends[0], y = ends[1];
+                while (parent[x] != x) x = parent[x];
+                while (parent[y] != y) y = parent[y];
+                if (x != y) parent[y] = x;
+            }
+        }
+        /* the fan of the first face keeps v; the others take new ids */
+        for (j = a; j < b; ++j) {
+            int root = j;
+            while (parent[root] != root) root = parent[root];
+            if (copy[root] < 0) copy[root] = root == a || j == a ? v : nv2++;
+            fan[j] = copy[root];
+            fv[l->fv_off[l->vf[j]] + l->vf_slot[j]] = fan[j];
+        }
+    }
+    *spos = (float *)sfb__alloc(ctx, 3 * (size_t)nv2 * sizeof(float));
+    if (!*spos) { r = sfb__oom(ctx, "tribezier non-manifold vertices"); goto done; }
+    memcpy(*spos, positions, 3 * (size_t)l->nv * sizeof(float));
+    for (v = 0; v < l->nv; ++v)
+        if ((l->vtag[v] & SFB__TAG_NONMANIFOLD) && l->vf_off[v + 1] > l->vf_off[v])
+            for (j = l->vf_off[v]; j < l->vf_off[v + 1]; ++j)
+                if (fan[j] >= l->nv) memcpy(*spos + 3 * (size_t)fan[j], positions + 3 * (size_t)v, 3 * sizeof(float));
+    r = sfb__level_from_faces(ctx, nv2, l->nf, sizes, fv, NULL, SFB_ELEMENT_VERTEX, sl);
+    if (r != SFB_SUCCESS) { sfb__free(ctx, *spos); *spos = NULL; goto done; }
+    /* the tags: an edge keeps its own (the same face slot in both), a vertex its own but for
+     * the split ones (none) */
+    for (f = 0; f < l->nf; ++f)
+        for (k = l->fv_off[f]; k < l->fv_off[f + 1]; ++k) sl->es[sl->fe[k]] = l->es[l->fe[k]];
+    for (v = 0; v < nv2; ++v) sl->vs[v] = v < l->nv && !((l->vtag[v] & SFB__TAG_NONMANIFOLD) && l->vf_off[v + 1] > l->vf_off[v]) ? l->vs[v] : 0.0f;
+    memcpy(sl->fhole, l->fhole, (size_t)l->nf);
+    sfb__level_compute_rules(sl);
+    for (v = 0; v < nv2; ++v)
+        if ((sl->vtag[v] & SFB__TAG_NONMANIFOLD) && sl->vf_off[v + 1] > sl->vf_off[v]) {
+            /* not a fan even so (tbz_check refused the edges that would make one) */
+            const int o = v < l->nv ? v : -1;
+            sfb__level_free(ctx, sl);
+            sfb__free(ctx, *spos);
+            *spos = NULL;
+            r = sfb__error(ctx, SFB_INVALID_TOPOLOGY, SFB_ELEMENT_VERTEX, o, "tribezier: vertex %d is non-manifold (its triangles do not form fans)", o);
+            goto done;
+        }
+    *split = 1;
+done:
+    sfb__free(ctx, fan); sfb__free(ctx, parent); sfb__free(ctx, copy); sfb__free(ctx, sizes); sfb__free(ctx, fv);
+    return r;
 }
 
 sfb_result sfb__tribezier_points(sfb_context *ctx, const sfb__level *l, const float *positions, const sfb_tribezier_options *opt,
                                  unsigned flags, double **out, sfb__tbz_stats *stats) {
+    sfb__level sl;
+    float *spos = NULL;
+    int split;
     sfb_result r;
     *out = NULL;
     r = tbz_check(ctx, l, positions, opt);
+    if (r == SFB_SUCCESS) r = tbz_split(ctx, l, positions, &split, &sl, &spos);
     if (r != SFB_SUCCESS) return r;
-    return tbz_points(ctx, l, positions, positions, opt, flags, out, stats);
+    if (!split) return tbz_points(ctx, l, positions, positions, opt, flags, out, stats);
+    r = tbz_points(ctx, &sl, spos, spos, opt, flags, out, stats);
+    sfb__level_free(ctx, &sl);
+    sfb__free(ctx, spos);
+    return r;
 }
 
 /* One Loop step of the triangle mesh `b` into *rl, with the positions of the smooth net's rules
@@ -7784,14 +7900,19 @@ done:
 
 sfb_result sfb__tribezier_refined_points(sfb_context *ctx, const sfb__level *l, const float *positions, const sfb_tribezier_options *opt,
                                          unsigned flags, sfb__level *rl, double **out, sfb__tbz_stats *stats) {
-    float *ps = NULL, *pp = NULL;
+    float *ps = NULL, *pp = NULL, *spos = NULL;
+    sfb__level sl;
+    int split = 0;
     sfb_result r;
     *out = NULL;
     memset(rl, 0, sizeof *rl);
     r = tbz_check(ctx, l, positions, opt);
-    if (r == SFB_SUCCESS) r = tbz_refine(ctx, l, positions, rl, &ps, &pp);
+    if (r == SFB_SUCCESS) r = tbz_split(ctx, l, positions, &split, &sl, &spos);
+    if (r == SFB_SUCCESS) r = tbz_refine(ctx, split ? &sl : l, split ? spos : positions, rl, &ps, &pp);
     if (r == SFB_SUCCESS) r = tbz_points(ctx, rl, ps, pp, opt, flags, out, stats);
     if (r != SFB_SUCCESS) sfb__level_free(ctx, rl);
+    if (split) sfb__level_free(ctx, &sl);
+    sfb__free(ctx, spos);
     sfb__free(ctx, ps);
     sfb__free(ctx, pp);
     return r;
@@ -7814,13 +7935,35 @@ static int tbz_touching(const sfb__level *l) {
     return 0;
 }
 
+static sfb_result tbz_build(sfb_context *ctx, const sfb__level *l, const float *positions, const sfb_tribezier_options *opt,
+                            sfb__patch_table *pt);
+
 sfb_result sfb__tribezier_build(sfb_context *ctx, const sfb__level *l, const float *positions, const sfb_tribezier_options *opt,
                                 sfb__patch_table *pt) {
+    /* non-manifold vertices split (tbz_split): the same triangles, so the table is the split
+     * mesh's */
+    sfb__level sl;
+    float *spos = NULL;
+    int split;
+    sfb_result r;
+    memset(pt, 0, sizeof *pt);
+    r = tbz_check(ctx, l, positions, opt);
+    if (r == SFB_SUCCESS) r = tbz_split(ctx, l, positions, &split, &sl, &spos);
+    if (r != SFB_SUCCESS) return r;
+    if (!split) return tbz_build(ctx, l, positions, opt, pt);
+    r = tbz_build(ctx, &sl, spos, opt, pt);
+    sfb__level_free(ctx, &sl);
+    sfb__free(ctx, spos);
+    return r;
+}
+
+/* sfb__tribezier_build on a mesh of manifold vertices (checked). */
+static sfb_result tbz_build(sfb_context *ctx, const sfb__level *l, const float *positions, const sfb_tribezier_options *opt,
+                            sfb__patch_table *pt) {
     double *net = NULL, *net4 = NULL;
     sfb__tbz_stats st, st4;
     sfb__level rl;
     sfb_result r;
-    memset(pt, 0, sizeof *pt);
     memset(&st, 0, sizeof st);
     if (tbz_touching(l)) {
         r = sfb__tribezier_refined_points(ctx, l, positions, opt, 0, &rl, &net4, NULL);
@@ -7835,7 +7978,8 @@ sfb_result sfb__tribezier_build(sfb_context *ctx, const sfb__level *l, const flo
     if (st.residual > 1e-10) {
         memset(&st4, 0, sizeof st4);
         r = sfb__tribezier_refined_points(ctx, l, positions, opt, 0, &rl, &net4, &st4);
-        if (r != SFB_SUCCESS) { sfb__free(ctx, net); return r; }
+        if (r == SFB_INVALID_TOPOLOGY) st4.residual = HUGE_VAL; /* not built after one step: the mesh's own net */
+        else if (r != SFB_SUCCESS) { sfb__free(ctx, net); return r; }
         if (st4.residual < st.residual) {
             sfb__free(ctx, net);
             r = sfb__patch_table_beztri_children(ctx, l, net4, pt);

@@ -2,7 +2,7 @@
  * (SFB_SCHEME_TRIBEZIER, seed 004).
  *
  * Input: OBJ text. If sfb_mesh_read_obj accepts it, build the surface (an error is fine, with a
- * message: faces that are not triangles, non-manifold edges or vertices, degenerate triangles),
+ * message: faces that are not triangles, non-manifold edges, degenerate triangles; non-manifold vertices are split),
  * with the tags' sharpness, or, for inputs whose length is a multiple of 3, one override s =
  * (length mod 11) / 10, then:
  *   - evaluate every parametric face (holes excepted) at its corners, edge midpoints and centre: a normal

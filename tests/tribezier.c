@@ -83,7 +83,10 @@ typedef struct g1_result {
 
 /* Normal jumps across the interior edges of l (those with skip_sharp set and sharpness > 0 left
  * out), 11 points per edge. */
-static g1_result g1_measure(const sfb__level *l, const double *net, int skip_sharp) {
+static g1_result g1_measure_ex(const sfb__level *l, const double *net, int skip_sharp, int inner);
+static g1_result g1_measure(const sfb__level *l, const double *net, int skip_sharp) { return g1_measure_ex(l, net, skip_sharp, 0); }
+/* inner: the samples strictly inside the edges (t = 0.1 .. 0.9), not at its end vertices */
+static g1_result g1_measure_ex(const sfb__level *l, const double *net, int skip_sharp, int inner) {
     g1_result g = {0, 0, 1, 0};
     int e, q, c;
     for (e = 0; e < l->ne; ++e) {
@@ -93,7 +96,7 @@ static g1_result g1_measure(const sfb__level *l, const double *net, int skip_sha
         f0 = l->ef[l->ef_off[e]]; s0 = l->ef_slot[l->ef_off[e]];
         f1 = l->ef[l->ef_off[e] + 1]; s1 = l->ef_slot[l->ef_off[e] + 1];
         g.edges++;
-        for (q = 0; q <= 10; ++q) {
+        for (q = inner; q <= 10 - inner; ++q) {
             const double t = q / 10.0;
             double u0, v0, u1, v1, P0[3], P1[3], a0[3], b0[3], a1[3], b1[3], n0[3], n1[3], d[3];
             edge_uv(s0, t, &u0, &v0);
@@ -230,6 +233,125 @@ static void test_g1_closed(sfb_context *ctx) {
     g1_one(ctx, "g1_octahedron_adjacent_valence_4", octahedron, 1e-9);
     g1_one(ctx, "g1_icosahedron_adjacent_valence_5", ico, 1e-9);
     free(ico);
+}
+
+/* Non-manifold vertices: split into one vertex per fan (tbz_split), each sheet built as a mesh
+ * of its own. Two octahedra touching at a vertex: G1 on both, and the corner point of the shared
+ * vertex in each octahedron's triangles is the one a lone octahedron has there (fails when the
+ * fans are not split, or split wrongly); two fans of an open disk touching at a boundary vertex;
+ * and the real meshes with such vertices (cow.obj, teapot.obj: refused before). */
+static void refined_one(sfb_context *ctx, const char *name, const char *obj);
+
+static void test_nonmanifold_vertices(sfb_context *ctx, const char *dir) {
+    /* octahedron A around the origin; B shifted by (2, 0, 0), its vertex (-1, 0, 0) A's (1, 0, 0) */
+    static const char *pinch =
+        "v 1 0 0\nv -1 0 0\nv 0 1 0\nv 0 -1 0\nv 0 0 1\nv 0 0 -1\n"
+        "v 3 0 0\nv 2 1 0\nv 2 -1 0\nv 2 0 1\nv 2 0 -1\n"
+        "f 1 3 5\nf 3 2 5\nf 2 4 5\nf 4 1 5\nf 3 1 6\nf 2 3 6\nf 4 2 6\nf 1 4 6\n"
+        "f 7 8 10\nf 8 1 10\nf 1 9 10\nf 9 7 10\nf 8 7 11\nf 1 8 11\nf 9 1 11\nf 7 9 11\n";
+    /* two fans of three triangles around vertex 1, each with its own boundary */
+    static const char *bowtie =
+        "v 0 0 0\nv 1 0 0.1\nv 0.5 0.8 0.2\nv -0.5 0.8 0.1\nv -1 0 0.3\nv 0.5 -0.8 0.1\nv -0.5 -0.8 0.2\nv 1 -0.1 -0.2\nv -1 -0.1 -0.1\n"
+        "f 1 2 3\nf 1 3 4\nf 1 4 5\nf 1 9 7\nf 1 7 6\nf 1 6 8\n";
+    tmesh t, lone;
+    double *net = NULL, *net1 = NULL;
+    sfb__tbz_stats st;
+    if (tmesh_load(ctx, pinch, &t) && tmesh_load(ctx, octahedron, &lone)) {
+        check((t.prep.vtag[0] & SFB__TAG_NONMANIFOLD) != 0, "nonmanifold/pinch_is_non_manifold", "vertex 0 tag %d", t.prep.vtag[0]);
+        net = net_of(ctx, &t, NULL, 0, &st);
+        net1 = net_of(ctx, &lone, NULL, 0, NULL);
+        if (!net || !net1) fail("nonmanifold/pinch_built", "not built");
+        else {
+            g1_result g = g1_measure(&t.prep, net, 0);
+            double d = 0.0, sep = 0.0;
+            int c;
+            check(g.jump <= 1e-9 && g.gap <= 1e-7 * t.diag && g.flat > 1e-3, "nonmanifold/pinch_g1_on_both_sheets",
+                  "normal jump %.3g rad, gap %.3g, residual %.3g", g.jump, g.gap, st.residual);
+            /* triangle 0 (1 3 5) starts at the shared vertex in both meshes; triangle 9 (8 1 10)
+             * has it second, (u, v) = (1, 0): point q = 4 */
+            for (c = 0; c < 3; ++c) {
+                d = fmax(d, fabs(net[c] - net1[c]));
+                sep = fmax(sep, fabs(net[c] - net[45 * 9 + 3 * 4 + c]));
+            }
+            check(d <= 1e-12, "nonmanifold/pinch_sheet_as_alone", "corner point off the lone octahedron's by %.3g", d);
+            printf("  nonmanifold/pinch: the two sheets' points at the shared vertex %.3g apart (diag %.3g)\n", sep, t.diag);
+        }
+        sfb__free(ctx, net); sfb__free(ctx, net1);
+        net = net1 = NULL;
+        tmesh_free(ctx, &t);
+        tmesh_free(ctx, &lone);
+    } else fail("nonmanifold/pinch_load", "%s", sfb_last_error(ctx));
+    if (tmesh_load(ctx, bowtie, &t)) {
+        net = net_of(ctx, &t, NULL, 0, &st);
+        if (!net) fail("nonmanifold/bowtie_built", "not built");
+        else {
+            g1_result g = g1_measure(&t.prep, net, 0);
+            check(g.jump <= 1e-9 && g.gap <= 1e-7 * t.diag, "nonmanifold/bowtie_g1_inside_both_fans", "normal jump %.3g rad, gap %.3g", g.jump, g.gap);
+        }
+        sfb__free(ctx, net);
+        net = NULL;
+        {
+            /* through the public API: a surface, evaluated on both fans at the shared vertex */
+            sfb_surface *sf = NULL;
+            sfb_surface_config sc = sfb_surface_config_init(SFB_SCHEME_TRIBEZIER, 0);
+            sfb_location loc[2] = {{0, 0.0f, 0.0f}, {3, 0.0f, 0.0f}};
+            sc.flags = SFB_REFINE_PATCHES;
+            float P[6];
+            sfb_eval_output eo;
+            memset(&eo, 0, sizeof eo);
+            eo.position = P;
+            check(sfb_surface_create(ctx, t.m, &sc, &sf) == SFB_SUCCESS && sfb_surface_eval(sf, loc, 2, &eo) == SFB_SUCCESS &&
+                      isfinite(P[0]) && isfinite(P[3]),
+                  "nonmanifold/bowtie_surface", "%s", sfb_last_error(ctx));
+            sfb_surface_destroy(sf);
+        }
+        tmesh_free(ctx, &t);
+    } else fail("nonmanifold/bowtie_load", "%s", sfb_last_error(ctx));
+    {
+        /* two triangles on the same three vertices (a closed pillow), one a hole: after one Loop
+         * step four triangles share each inner edge, so the fallback there is refused and the
+         * mesh's own net kept (it read rings of non-manifold vertices before: fuzz_tribezier) */
+        sfb_mesh *m = NULL;
+        sfb_surface *sf = NULL;
+        sfb_surface_config sc = sfb_surface_config_init(SFB_SCHEME_TRIBEZIER, 0);
+        static const char *pillow = "v 0 1 0\nv 5 -1 0\nv 0 0 -1\nt hole 1/0/0 0\nf 1 2 3\nf 2 1 3\n";
+        sc.flags = SFB_REFINE_PATCHES;
+        check(sfb_mesh_read_obj(ctx, pillow, strlen(pillow), &m) == SFB_SUCCESS && sfb_surface_create(ctx, m, &sc, &sf) == SFB_SUCCESS,
+              "nonmanifold/pillow_after_one_step_refused_own_net_kept", "%s", sfb_last_error(ctx));
+        sfb_surface_destroy(sf);
+        sfb_mesh_destroy(m);
+    }
+    {
+        char path[1024];
+        size_t n;
+        char *obj;
+        /* cow.obj: one vertex where two closed sheets touch; its extraordinary vertices of
+         * different valences touch, as spot's: G1 after one Loop step */
+        snprintf(path, sizeof path, "%s/cow.obj", dir);
+        obj = slurp(path, &n);
+        if (!obj) skip("nonmanifold/real_mesh_cow", "cow.obj not found (pass the real-meshes folder)");
+        else { refined_one(ctx, "nonmanifold/real_mesh_cow", obj); free(obj); }
+        /* teapot.obj: 38 vertices on the seams of its parts, G1 inside every edge. Its open
+         * seams (a boundary vertex whose two boundary neighbours coincide: the boundary curve has
+         * a cusp there) leave degenerate patch corners at those vertices (counted, printed) */
+        snprintf(path, sizeof path, "%s/teapot.obj", dir);
+        obj = slurp(path, &n);
+        if (!obj) skip("nonmanifold/real_mesh_teapot", "teapot.obj not found (pass the real-meshes folder)");
+        else if (tmesh_load(ctx, obj, &t)) {
+            net = net_of(ctx, &t, NULL, 0, &st);
+            if (!net) fail("nonmanifold/real_mesh_teapot", "not built");
+            else {
+                g1_result g = g1_measure_ex(&t.prep, net, 0, 1), ga = g1_measure(&t.prep, net, 0);
+                check(g.jump <= 1e-9 && ga.gap <= 1e-7 * t.diag && st.residual <= 1e-12, "nonmanifold/real_mesh_teapot_g1_inside_edges",
+                      "normal jump %.3g rad inside the edges, gap %.3g, residual %.3g", g.jump, ga.gap, st.residual);
+                printf("  nonmanifold/real_mesh_teapot: inside the edges jump %.3g rad; with their ends %.3g rad (flatness %.3g: the cusps of "
+                       "its open seams)\n", g.jump, ga.jump, ga.flat);
+            }
+            sfb__free(ctx, net);
+            tmesh_free(ctx, &t);
+            free(obj);
+        } else { fail("nonmanifold/real_mesh_teapot", "load: %s", sfb_last_error(ctx)); free(obj); }
+    }
 }
 
 /* Triangles of the disk whose corners all lie in rings lo..hi. */
@@ -867,6 +989,8 @@ static void test_bad_input(void) {
     bad_one("bad/sharpness_nan", tri, (float)NAN, 1, SFB_INVALID_ARGS);
     bad_one("bad/quad", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n", 0, 0, SFB_INVALID_TOPOLOGY);
     bad_one("bad/non_manifold_edge", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 -1 0\nv 0 0 1\nf 1 2 3\nf 2 1 4\nf 1 2 5\n", 0, 0, SFB_INVALID_TOPOLOGY);
+    /* two triangles that run their edge the same way */
+    bad_one("bad/inconsistent_orientation", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 -1 0\nf 1 2 3\nf 1 2 4\n", 0, 0, SFB_INVALID_TOPOLOGY);
     bad_one("bad/degenerate_triangle", "v 0 0 0\nv 1 0 0\nv 2 0 0\nv 0 1 0\nf 1 2 3\nf 1 4 2\n", 0, 0, SFB_INVALID_TOPOLOGY);
 }
 
@@ -945,6 +1069,7 @@ int main(int argc, char **argv) {
         if (!obj) skip("g1_real_mesh_spot_near_g1", "spot.obj not found (pass the real-meshes folder)");
         else { g1_one(ctx, "g1_real_mesh_spot_near_g1", obj, 1e-2); free(obj); }
         test_refined(ctx, dir);
+        test_nonmanifold_vertices(ctx, dir);
     }
     sfb_context_destroy(ctx);
     if (!probe_backends()) return 1;
