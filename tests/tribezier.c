@@ -561,6 +561,44 @@ static void test_crease_evs(sfb_context *ctx) {
         }
 }
 
+/* A corner tag on a vertex without sharp edges (valence 3..8, a bump under it): at s = 1 the
+ * surface passes through the vertex and stays G1 everywhere, its spokes too (the vertex keeps
+ * Loop's smooth tangents: a cone point there, as the tag's subdivision reading has, would need
+ * a normal jump along every spoke, 0.04-0.1 rad with the tangents along the spokes). */
+static void test_corner_only(sfb_context *ctx) {
+    int n;
+    for (n = 3; n <= 8; ++n) {
+        tbm_opts o;
+        tmesh t;
+        char name[96], *obj, *tagged;
+        double *net;
+        sfb_tribezier_options to;
+        memset(&o, 0, sizeof o);
+        o.n = n; o.R = 4; o.bump = 4.0; o.jitter = 0.1; o.seed = 11u + (unsigned)n;
+        obj = tbm_obj(&o);
+        tagged = (char *)malloc(strlen(obj) + 32);
+        sprintf(tagged, "%st corner 1/1/0 0 1\n", obj);
+        snprintf(name, sizeof name, "corner_only/valence_%d", n);
+        if (!tmesh_load(ctx, tagged, &t)) { fail(name, "load"); free(obj); free(tagged); continue; }
+        to.sharpness_set = 1; to.sharpness = 1.0f;
+        net = net_of(ctx, &t, &to, 0, NULL);
+        if (!net) fail(name, "not built");
+        else {
+            g1_result g = g1_measure(&t.prep, net, 0);
+            double d = 0.0;
+            int c;
+            char nm[160];
+            for (c = 0; c < 3; ++c) d += fabs(net[c] - t.m->positions[c]); /* the centre is corner 0 of triangle 0 */
+            snprintf(nm, sizeof nm, "%s/s1_g1_through_the_vertex", name);
+            check(g.jump <= 1e-9 && g.flat > 1e-3 && d <= 1e-12, nm, "normal jump %.3g rad, flatness %.3g, off the vertex by %.3g", g.jump, g.flat, d);
+        }
+        sfb__free(ctx, net);
+        tmesh_free(ctx, &t);
+        free(obj);
+        free(tagged);
+    }
+}
+
 /* The seed's open problem: the crease curve near an extraordinary crease vertex at s = 0.25,
  * 0.5, 0.75: (a) its largest distance from the vertical plane through the (straight) crease
  * line y = 0, (b) the curvature sign changes of its projection into that plane (x, z) within two
@@ -1053,6 +1091,7 @@ int main(int argc, char **argv) {
     test_regular_is_loop(ctx);
     test_creases(ctx);
     test_crease_evs(ctx);
+    test_corner_only(ctx);
     test_undulation(ctx);
     test_reuse_disks(ctx);
     test_bad_input();

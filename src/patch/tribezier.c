@@ -60,6 +60,10 @@
  *   - corners (a `t corner` tag, or three or more sharp edges; a boundary vertex with one
  *     triangle): the sharp net interpolates the vertex (b400 = V), each sector G1 in itself
  *     (the seed's eq. 9 blend is replaced by the constraint solve, which covers every valence).
+ *     A corner tag on a vertex with no sharp edge (or one: a dart) keeps the smooth vertex's
+ *     tangents (8.2) around V, so the surface stays G1 through it: the cone point that the tag
+ *     makes in Loop's limit would need a normal jump along every spoke, which the tangents along
+ *     the spokes had (0.2-0.5 rad on tests/tribezier.c's corner_only bump).
  *   - non-manifold vertices (sheets touching at a vertex): one vertex per fan of triangles, each
  *     sheet built as a manifold mesh of its own (tbz_split).
  *   - refused: faces that are not triangles (split them first: the choice of diagonal is the
@@ -377,7 +381,7 @@ static void tbz_initial(sfb__tbz *T) {
                     for (c = 0; c < 3; ++c)
                         E[c] = (12.0 * V[c] + 4.0 * R[1][c] + 3.0 * (R[2][c] + R[0][c]) + R[3][c] + R[5][c]) / 24.0;
                 }
-            } else if (((T->vtype[v] & 15) == TBZ_SMOOTH || (T->vtype[v] & 15) == TBZ_DART) && !(T->sharp && T->corner_s[v] > 0.0f)) {
+            } else if (((T->vtype[v] & 15) == TBZ_SMOOTH || (T->vtype[v] & 15) == TBZ_DART)) {
                 /* 8.2: P + 3/4 (3 + 2c)/(6n) T_m */
                 const double cn = cos(2.0 * TBZ_PI / n), g = 0.75 * (3.0 + 2.0 * cn) / (6.0 * n);
                 double R[3];
