@@ -6570,7 +6570,7 @@ done:
  *     makes in Loop's limit would need a normal jump along every spoke, which the tangents along
  *     the spokes had (0.2-0.5 rad on tests/tribezier.c's corner_only bump).
  *   - non-manifold vertices (sheets touching at a vertex): one vertex per fan of triangles, each
- *     sheet built as a manifold mesh of its own (tbz_split).
+ *     sheet built as a manifold mesh of its own through the vertex, a corner (tbz_split).
  *   - refused: faces that are not triangles (split them first: the choice of diagonal is the
  *     modeller's), non-manifold edges, degenerate triangles (area below 1e-12 of the squared
  *     bounding-box diagonal), non-finite positions, an override s outside [0, 1] or NaN.
@@ -7715,12 +7715,11 @@ static sfb_result tbz_check(sfb_context *ctx, const sfb__level *l, const float *
  * than one fan (two sheets touching at a point, pieces sharing a boundary vertex) becomes one
  * vertex per fan, at the same position, so that every sheet is a manifold mesh of its own: a
  * closed fan's copy is an interior vertex, an open one's a boundary vertex. The triangles keep
- * their order and slots (param faces unchanged). The copies carry no corner tag (the base level
- * gives non-manifold vertices an infinite one, sfb__level_prepare): the subdivision schemes make
- * such a vertex a corner, which here would be a cone point, whose spokes no polynomial G1 net
- * holds (a corner tag on a smooth vertex of valence 4 leaves a G1 residual of 2e-3); so each
- * sheet is smooth through its copy, and sheets that touched there now pass near it (its fans'
- * limit points). *split = 0: none (sl, *spos untouched). */
+ * their order and slots (param faces unchanged). Every copy keeps the vertex's corner tag (the
+ * base level makes a non-manifold vertex an infinitely sharp corner, sfb__level_prepare, as
+ * OpenSubdiv does), so every sheet passes through the vertex at s = 1 and the sheets still
+ * touch there; a closed fan's copy, a corner without sharp edges, stays G1 (tbz_initial).
+ * *split = 0: none (sl, *spos untouched). */
 static sfb_result tbz_split(sfb_context *ctx, const sfb__level *l, const float *positions, int *split, sfb__level *sl, float **spos) {
     int v, j, f, k, nv2 = l->nv, any = 0;
     int *fan = NULL, *sizes = NULL, *fv = NULL, *parent = NULL, *copy = NULL;
@@ -7773,11 +7772,15 @@ static sfb_result tbz_split(sfb_context *ctx, const sfb__level *l, const float *
                 if (fan[j] >= l->nv) memcpy(*spos + 3 * (size_t)fan[j], positions + 3 * (size_t)v, 3 * sizeof(float));
     r = sfb__level_from_faces(ctx, nv2, l->nf, sizes, fv, NULL, SFB_ELEMENT_VERTEX, sl);
     if (r != SFB_SUCCESS) { sfb__free(ctx, *spos); *spos = NULL; goto done; }
-    /* the tags: an edge keeps its own (the same face slot in both), a vertex its own but for
-     * the split ones (none) */
+    /* the tags: an edge keeps its own (the same face slot in both), a vertex and its copies
+     * the vertex's */
     for (f = 0; f < l->nf; ++f)
         for (k = l->fv_off[f]; k < l->fv_off[f + 1]; ++k) sl->es[sl->fe[k]] = l->es[l->fe[k]];
-    for (v = 0; v < nv2; ++v) sl->vs[v] = v < l->nv && !((l->vtag[v] & SFB__TAG_NONMANIFOLD) && l->vf_off[v + 1] > l->vf_off[v]) ? l->vs[v] : 0.0f;
+    for (v = 0; v < l->nv; ++v) {
+        sl->vs[v] = l->vs[v];
+        if ((l->vtag[v] & SFB__TAG_NONMANIFOLD) && l->vf_off[v + 1] > l->vf_off[v])
+            for (j = l->vf_off[v]; j < l->vf_off[v + 1]; ++j) sl->vs[fan[j]] = l->vs[v];
+    }
     memcpy(sl->fhole, l->fhole, (size_t)l->nf);
     sfb__level_compute_rules(sl);
     for (v = 0; v < nv2; ++v)
