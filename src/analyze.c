@@ -55,6 +55,7 @@
                                  1024 x 1024 on catmark_car, one batch per part held 41 MB, freshly faulted in per call) */
 #define SFB__AN_PARALLEL 4096  /* items: from this many on, a per-item loop goes to the backend's threads (sfb__parallel) */
 #define SFB__AN_OUT_NEW_HIT 4
+#define SFB__AN_CHUNKS 64     /* round 0: a batch runs in at most this many chunks of at least 1024 attempts (sfb__an_fresh) */
 #define SFB__AN_DILATE 2.0    /* pixels: uncovered pixels this close to a thin proxy triangle are seeded from it too */
 #define SFB__AN_MARGIN 0.92   /* the bounding sphere's share of the smaller side (as sfb_render) */
 
@@ -224,6 +225,9 @@ typedef struct sfb__an {
     int *cface;                  /* uncovered pixels within SFB__AN_DILATE pixels of a proxy triangle: its face, */
     float *cuv, *cdist;          /* the (u,v) of its nearest point, the distance in pixels */
     int *hit;                    /* index into the hit arrays, -1: none */
+    sfb_location *hl;            /* per pixel (valid where hit >= 0): its hit's location, and */
+    float *hinv;                 /* d(u,v)/d(pixel x), d(u,v)/d(pixel y) there (NaN: singular): the seeds and neighbour scans
+                                    read these per pixel, row by row (the hit slots lie in round 0's part order, scattered) */
     int *adj;                    /* per face and side: (4 * neighbour face + its side) * 2 + reversed, -1: none */
     unsigned char *state;        /* SFB__AN_* per pixel */
     /* hits (compact) */
@@ -242,7 +246,7 @@ enum {
     SFB__WS_GPOS, SFB__WS_GNRM, SFB__WS_RV, SFB__WS_RTRI, SFB__WS_DEPTH, SFB__WS_FACE, SFB__WS_UV, SFB__WS_HIT, SFB__WS_CFACE,
     SFB__WS_CUV, SFB__WS_CDIST, SFB__WS_STATE, SFB__WS_PPOS, SFB__WS_PNRM, SFB__WS_HPIX, SFB__WS_HLOC, SFB__WS_HPOS, SFB__WS_HDU,
     SFB__WS_HDV, SFB__WS_HNRM, SFB__WS_HDEPTH, SFB__WS_CHG, SFB__WS_TRIES, SFB__WS_LOCS, SFB__WS_BUF, SFB__WS_MARK, SFB__WS_ROWAT,
-    SFB__WS_NBM, SFB__WS_HV1, SFB__WS_HV2, SFB__WS_V2, SFB__WS_SEC, SFB__WS_COUNT
+    SFB__WS_NBM, SFB__WS_HV1, SFB__WS_HV2, SFB__WS_V2, SFB__WS_SEC, SFB__WS_HINV, SFB__WS_HL, SFB__WS_COUNT
 };
 struct sfb_analysis_workspace {
     sfb_context *ctx;
@@ -515,7 +519,7 @@ static void sfb__an_camera(sfb__an *A) {
  * covers no pixel centre at all) get it as a seed: its face and the (u,v) of its nearest point
  * (the barycentric coordinates clamped), nearest triangle first. The others' neighbours are
  * reached by the projection's rounds. */
-static void sfb__an_seed_tri(sfb__an *A, const int *tv) {
+static void sfb__an_seed_tri(sfb__an *A, const int *tv, int row0, int row1) {
     const sfb__raster_vertex *S[3];
     const float *P[3];
     sfb__raster_edges t;
@@ -526,6 +530,9 @@ static void sfb__an_seed_tri(sfb__an *A, const int *tv) {
         P[k] = A->gpos + 3 * (size_t)tv[k];
     }
     if (!sfb__raster_setup(S, A->w, A->h, SFB__AN_DILATE, &t)) return;
+    if (t.y0 < row0) t.y0 = row0;
+    if (t.y1 > row1 - 1) t.y1 = row1 - 1;
+    if (t.y0 > t.y1) return;
     longest = t.elen[0] > t.elen[1] ? (t.elen[0] > t.elen[2] ? t.elen[0] : t.elen[2]) : (t.elen[1] > t.elen[2] ? t.elen[1] : t.elen[2]);
     for (k = 0; k < 3; ++k) { e1[k] = (double)P[1][k] - P[0][k]; e2[k] = (double)P[2][k] - P[0][k]; }
     sfb__rcross(e1, e2, cr);
@@ -554,6 +561,38 @@ static void sfb__an_seed_tri(sfb__an *A, const int *tv) {
         }
 }
 
+/* sfb__an_seed_tri over every proxy triangle, on rows [row0, row1) (bands of rows are
+ * independent: a pixel's triangles are visited in order within its band). */
+static void sfb__an_seed_rows_tri(void *arg, int row0, int row1) {
+    sfb__an *A = (sfb__an *)arg;
+    const double lo = row0 - 0.5 - SFB__AN_DILATE, hi = row1 + 0.5 + SFB__AN_DILATE;
+    int k;
+    for (k = 0; k < A->ntri; ++k) {
+        const int *tv = A->rtri + 4 * (size_t)k;
+        const double y0 = A->rv[tv[0]].y, y1 = A->rv[tv[1]].y, y2 = A->rv[tv[2]].y;
+        if ((y0 < lo && y1 < lo && y2 < lo) || (y0 > hi && y1 > hi && y2 > hi)) continue;
+        sfb__an_seed_tri(A, tv, row0, row1);
+    }
+}
+
+/* The proxy's grid points [a, b) projected into the picture (x NaN: behind the near plane or
+ * not finite). */
+static void sfb__an_project_grid(void *arg, int a, int b) {
+    sfb__an *A = (sfb__an *)arg;
+    int g;
+    for (g = a; g < b; ++g) {
+        const float *P = A->gpos + 3 * (size_t)g;
+        sfb__raster_vertex *V = &A->rv[g];
+        double p[3];
+        V->x = NAN;
+        if (!sfb__an_finite3(P)) continue;
+        p[0] = P[0]; p[1] = P[1]; p[2] = P[2];
+        if (!sfb__an_project(&A->cam, p, &V->x, &V->y, &V->z)) { V->x = NAN; continue; }
+        V->q = A->cam.ortho ? 1.0 : 1.0 / V->z;
+        sfb__an_grid_uv(A, g % A->per, &V->u, &V->v);
+    }
+}
+
 /* The raster kernel of the context's backend, or ref's. */
 static sfb_result sfb__an_raster_kernel(const sfb__an *A, const sfb__raster_job *job) {
     sfb_context *ctx = A->ctx;
@@ -570,22 +609,12 @@ static sfb_result sfb__an_raster_kernel(const sfb__an *A, const sfb__raster_job 
  * not finite), its triangles (those with three such points, face by face), rasterised by the
  * backend's kernel, then pass 2's seeds around thin ones. */
 static sfb_result sfb__an_raster(sfb__an *A) {
-    size_t n = (size_t)A->nf * (size_t)A->per, g;
+    size_t n = (size_t)A->nf * (size_t)A->per;
     int f, i, j, k, R = A->R;
     sfb__raster_job job;
     sfb_result r;
     A->ntri = 0;
-    for (g = 0; g < n; ++g) {
-        const float *P = A->gpos + 3 * g;
-        sfb__raster_vertex *V = &A->rv[g];
-        double p[3];
-        V->x = NAN;
-        if (!sfb__an_finite3(P)) continue;
-        p[0] = P[0]; p[1] = P[1]; p[2] = P[2];
-        if (!sfb__an_project(&A->cam, p, &V->x, &V->y, &V->z)) { V->x = NAN; continue; }
-        V->q = A->cam.ortho ? 1.0 : 1.0 / V->z;
-        sfb__an_grid_uv(A, (int)(g % (size_t)A->per), &V->u, &V->v);
-    }
+    sfb__an_run(A, sfb__an_project_grid, A, 0, (int)n, (double)n); /* n <= INT_MAX: sfb_surface_analyze */
     for (f = 0; f < A->nf; ++f) {
         const size_t base = (size_t)f * (size_t)A->per;
         if (A->s->patches.ptex_root[f] == -1) continue;
@@ -622,10 +651,8 @@ static sfb_result sfb__an_raster(sfb__an *A) {
     job.depth = A->depth; job.face = A->face; job.uv = A->uv;
     if (A->ppos) { job.apos = A->gpos; job.anrm = A->gnrm; job.pos = A->ppos; job.nrm = A->pnrm; }
     if ((r = sfb__an_raster_kernel(A, &job)) != SFB_SUCCESS) return r;
-    for (k = 0; k < A->ntri; ++k) {
-        if ((k & 4095) == 4095 && (r = sfb__progress(A->ctx, 0.25f + 0.05f * (float)k / (float)A->ntri, "analyze")) != SFB_SUCCESS) return r;
-        sfb__an_seed_tri(A, A->rtri + 4 * (size_t)k);
-    }
+    if ((r = sfb__progress(A->ctx, 0.25f, "analyze")) != SFB_SUCCESS) return r;
+    sfb__an_run(A, sfb__an_seed_rows_tri, A, 0, A->h, (double)A->ntri * 4.0);
     return SFB_SUCCESS;
 }
 
@@ -635,7 +662,7 @@ typedef struct sfb__an_try {
                                                    sfb__an_newton has yet to record) */
     double res, res2;  /* the residual of the last evaluation, and of the one before (pixels) */
     double z;          /* a new hit's depth */
-    int k;             /* its hit slot (fresh batches, sfb__an_newton) */
+    int k;             /* its hit slot (round 0, sfb__an_fresh) */
 } sfb__an_try;
 
 /* A new hit slot for pixel pix (not hit yet). */
@@ -647,15 +674,25 @@ static int sfb__an_new_slot(sfb__an *A, int pix) {
     return k;
 }
 
-/* Hit slot k's data: the evaluation at loc, at depth z. */
+/* Hit slot k's data: the evaluation at loc, at depth z; and per pixel its location and the
+ * inverse of its screen Jacobian (computed once here: every seed taken from the hit reads it). */
 static void sfb__an_store_hit(sfb__an *A, size_t k, const sfb_location *loc, double z, const float *p, const float *du, const float *dv,
                               const float *n) {
+    double pd[3], tu[3], tv[3], jac[4], det;
+    const size_t pix = (size_t)A->hpix[k];
+    float *m = A->hinv + 4 * pix;
     int c;
     A->hloc[k] = *loc;
+    A->hl[pix] = *loc;
     A->hdepth[k] = (float)z;
     for (c = 0; c < 3; ++c) {
         A->hpos[3 * k + c] = p[c]; A->hdu[3 * k + c] = du[c]; A->hdv[3 * k + c] = dv[c]; A->hnrm[3 * k + c] = n[c];
+        pd[c] = p[c]; tu[c] = du[c]; tv[c] = dv[c];
     }
+    if (sfb__an_jacobian(&A->cam, pd, tu, tv, jac, &det)) {
+        m[0] = (float)(jac[3] / det); m[1] = (float)(-jac[2] / det);
+        m[2] = (float)(-jac[1] / det); m[3] = (float)(jac[0] / det);
+    } else m[0] = m[1] = m[2] = m[3] = NAN;
 }
 
 /* Records the evaluation at loc as pixel pix's hit at depth z (a pixel already hit keeps the
@@ -710,8 +747,8 @@ static int sfb__an_exit_side(const sfb__an *A, double uo, double vo, double u, d
 /* One Newton step of the running attempts [a, b) of a batch (sfb__an_step_job), from their
  * evaluations: the residual, the outcome, or the next (u,v) (crossing into a neighbour face
  * where the step leaves the face). A hit is not recorded here: its outcome is
- * SFB__AN_OUT_NEW_HIT, with its depth in z, and sfb__an_newton records it afterwards, in
- * attempt order, on one thread. */
+ * SFB__AN_OUT_NEW_HIT, with its depth in z, and the caller records it (sfb__an_newton, in
+ * attempt order on one thread; sfb__an_fresh, in its own slot). */
 typedef struct sfb__an_step_job {
     const sfb__an *A;
     sfb__an_try *tries;
@@ -775,68 +812,123 @@ static void sfb__an_step(void *arg, int a, int b) {
     }
 }
 
-/* Stores the new hits among attempts [a, b) in their hit slots (tries[i].k, given by
- * sfb__an_newton) and marks them recorded: sfb__an_add_hit's work for fresh batches. */
-typedef struct sfb__an_record_job {
+/* Round 0's attempts (sfb__an_project_all): no attempt's pixel is hit yet and no two share a
+ * pixel, so attempt i of a batch owns hit slot base + i (tries[i].k), which it fills when it
+ * hits and leaves a hole (hpix -1) when it does not; sfb__an_fill_holes closes the holes after
+ * round 0. The batch is cut into chunks of `chunk` attempts, each run to its outcomes on its
+ * own (evaluate, step, record, move the running ones first, within the chunk), over the
+ * backend's threads: no step waits for the whole batch, and nothing runs on one thread
+ * between steps. One chunk when the backend lends no threads (a GPU evaluates a batch at
+ * once). res[c]: chunk c's evaluation result. */
+typedef struct sfb__an_fresh_job {
     sfb__an *A;
     sfb__an_try *tries;
-    const sfb_location *locs;
-    const float *pos, *du, *dv, *nrm;
-} sfb__an_record_job;
+    sfb_location *locs;
+    float *pos, *du, *dv, *nrm;
+    int count, chunk, steps;
+    sfb_result *res;
+} sfb__an_fresh_job;
 
-static void sfb__an_record(void *arg, int a, int b) {
-    const sfb__an_record_job *J = (const sfb__an_record_job *)arg;
-    sfb__an *A = J->A;
-    int i;
-    for (i = a; i < b; ++i) {
-        sfb__an_try *t = &J->tries[i];
-        const size_t i3 = 3 * (size_t)i;
-        if (t->outcome != SFB__AN_OUT_NEW_HIT) continue;
-        sfb__an_store_hit(A, (size_t)t->k, &J->locs[i], t->z, J->pos + i3, J->du + i3, J->dv + i3, J->nrm + i3);
-        t->outcome = 1;
+static void sfb__an_fresh(void *arg, int c0, int c1) {
+    const sfb__an_fresh_job *F = (const sfb__an_fresh_job *)arg;
+    sfb__an *A = F->A;
+    int c;
+    for (c = c0; c < c1; ++c) {
+        const int a = c * F->chunk, n = F->count - a < F->chunk ? F->count - a : F->chunk;
+        sfb__an_try *tries = F->tries + a;
+        sfb_location *locs = F->locs + a;
+        float *pos = F->pos + 3 * (size_t)a, *du = F->du + 3 * (size_t)a, *dv = F->dv + 3 * (size_t)a, *nrm = F->nrm + 3 * (size_t)a;
+        sfb__an_step_job J;
+        int active = n, it, i;
+        F->res[c] = SFB_SUCCESS;
+        J.A = A; J.tries = tries; J.locs = locs; J.pos = pos; J.du = du; J.dv = dv; J.steps = F->steps;
+        for (it = 0; it <= F->steps && active > 0; ++it) {
+            sfb_eval_output out;
+            int keep = 0;
+            memset(&out, 0, sizeof out);
+            out.position = pos; out.du = du; out.dv = dv; out.normal = nrm;
+            if ((F->res[c] = sfb__surface_eval_unchecked(A->s, locs, active, &out)) != SFB_SUCCESS) {
+                for (i = 0; i < active; ++i) A->hpix[tries[i].k] = -1;
+                break;
+            }
+            J.it = it;
+            sfb__an_step(&J, 0, active);
+            for (i = 0; i < active; ++i) {
+                sfb__an_try *t = &tries[i];
+                if (t->outcome == 0) {
+                    if (keep != i) { tries[keep] = *t; locs[keep] = locs[i]; }
+                    ++keep;
+                    continue;
+                }
+                if (t->outcome == SFB__AN_OUT_NEW_HIT) {
+                    A->hpix[t->k] = t->pix;
+                    A->hit[t->pix] = t->k;
+                    A->state[t->pix] = SFB__AN_HIT;
+                    sfb__an_store_hit(A, (size_t)t->k, &locs[i], t->z, pos + 3 * i, du + 3 * i, dv + 3 * i, nrm + 3 * i);
+                } else {
+                    A->hpix[t->k] = -1;
+                    if (t->outcome == 2) A->state[t->pix] = SFB__AN_TRIED_NEAR;
+                }
+            }
+            active = keep;
+        }
     }
 }
 
+/* Closes the holes round 0 left in the hit slots (sfb__an_fresh): the last slots move into
+ * them (the slots' order means nothing: the per-pixel arrays say which pixel has which). */
+static void sfb__an_fill_holes(sfb__an *A) {
+    int k = 0, last = A->nhit - 1;
+    for (;;) {
+        while (last >= 0 && A->hpix[last] < 0) --last;
+        while (k < last && A->hpix[k] >= 0) ++k;
+        if (k >= last) break;
+        {
+            const size_t to = (size_t)k, from = (size_t)last;
+            int c;
+            A->hpix[to] = A->hpix[from];
+            A->hloc[to] = A->hloc[from];
+            A->hdepth[to] = A->hdepth[from];
+            for (c = 0; c < 3; ++c) {
+                A->hpos[3 * to + c] = A->hpos[3 * from + c]; A->hdu[3 * to + c] = A->hdu[3 * from + c];
+                A->hdv[3 * to + c] = A->hdv[3 * from + c]; A->hnrm[3 * to + c] = A->hnrm[3 * from + c];
+            }
+            A->hit[A->hpix[to]] = k;
+            A->hpix[from] = -1;
+        }
+    }
+    A->nhit = last + 1;
+}
+
 /* Runs the attempts (tries[i] for pixel tries[i].pix from locs[i]) to their outcomes; records
- * hits (a pixel hit by an earlier attempt of the same batch keeps the nearer one). Per step:
- * the backend evaluates the running attempts, sfb__an_step updates them (on the backend's
- * threads), the new hits are recorded in attempt order, and the running ones move first.
- * fresh: no attempt's pixel is hit yet and no two attempts share a pixel (round 0), so a new
- * hit takes the next hit slot, here, and its data is copied over the threads
- * (sfb__an_record); else sfb__an_add_hit records each. */
-static sfb_result sfb__an_newton(sfb__an *A, sfb__an_try *tries, sfb_location *locs, int count, float *buf, int steps, int fresh) {
+ * hits (sfb__an_add_hit: a pixel already hit keeps the nearer one). Per step: the backend
+ * evaluates the running attempts, sfb__an_step updates them (on the backend's threads), the
+ * new hits are recorded in attempt order, and the running ones move first. */
+static sfb_result sfb__an_newton(sfb__an *A, sfb__an_try *tries, sfb_location *locs, int count, float *buf, int steps) {
     int active = count, it, i;
     float *pos = buf, *du = buf + 3 * (size_t)count, *dv = buf + 6 * (size_t)count, *nrm = buf + 9 * (size_t)count;
     sfb_eval_output out;
     sfb__an_step_job J;
-    sfb__an_record_job R;
     sfb_result r;
     J.A = A; J.tries = tries; J.locs = locs; J.pos = pos; J.du = du; J.dv = dv; J.steps = steps;
-    R.A = A; R.tries = tries; R.locs = locs; R.pos = pos; R.du = du; R.dv = dv; R.nrm = nrm;
     for (it = 0; it <= steps && active > 0; ++it) {
-        int keep = 0, news = 0;
+        int keep = 0;
         memset(&out, 0, sizeof out);
         out.position = pos; out.du = du; out.dv = dv; out.normal = nrm;
         if ((r = sfb__surface_eval_unchecked(A->s, locs, active, &out)) != SFB_SUCCESS) return r;
         J.it = it;
         sfb__an_run(A, sfb__an_step, &J, 0, active, (double)active);
-        /* the outcomes in attempt order: new hits recorded (or given their slots), near ones
-         * marked (a later hit of the pixel overrides that), the running ones moved first */
+        /* the outcomes in attempt order: new hits recorded, near ones marked (a later hit of
+         * the pixel overrides that), the running ones moved first */
         for (i = 0; i < active; ++i) {
             sfb__an_try *t = &tries[i];
             if (t->outcome == SFB__AN_OUT_NEW_HIT) {
-                if (fresh) {
-                    t->k = sfb__an_new_slot(A, t->pix);
-                    ++news;
-                } else {
-                    sfb__an_add_hit(A, t->pix, &locs[i], t->z, pos + 3 * i, du + 3 * i, dv + 3 * i, nrm + 3 * i);
-                    t->outcome = 1;
-                }
+                sfb__an_add_hit(A, t->pix, &locs[i], t->z, pos + 3 * i, du + 3 * i, dv + 3 * i, nrm + 3 * i);
+                t->outcome = 1;
             } else if (t->outcome == 2 && A->state[t->pix] == SFB__AN_NONE) {
                 A->state[t->pix] = SFB__AN_TRIED_NEAR;
             }
         }
-        if (news > 0) sfb__an_run(A, sfb__an_record, &R, 0, active, (double)news);
         for (i = 0; i < active; ++i)
             if (tries[i].outcome == 0) {
                 if (keep != i) { tries[keep] = tries[i]; locs[keep] = locs[i]; }
@@ -847,15 +939,13 @@ static sfb_result sfb__an_newton(sfb__an *A, sfb__an_try *tries, sfb_location *l
     return SFB_SUCCESS;
 }
 
-/* d(u,v)/d(pixel) along the picture's axis `axis` (0: x, 1: y) at hit k: its screen Jacobian's
- * inverse applied to that axis; 0 when the Jacobian is singular. */
-static int sfb__an_uv_per_pixel(const sfb__an *A, int k, int axis, double m[2]) {
-    double p[3], tu[3], tv[3], jac[4], det;
-    int c;
-    for (c = 0; c < 3; ++c) { p[c] = A->hpos[3 * (size_t)k + c]; tu[c] = A->hdu[3 * (size_t)k + c]; tv[c] = A->hdv[3 * (size_t)k + c]; }
-    if (!sfb__an_jacobian(&A->cam, p, tu, tv, jac, &det)) return 0;
-    m[0] = (axis ? -jac[1] : jac[3]) / det;
-    m[1] = (axis ? jac[0] : -jac[2]) / det;
+/* d(u,v)/d(pixel) along the picture's axis `axis` (0: x, 1: y) at the hit of pixel pix: its
+ * screen Jacobian's inverse applied to that axis (sfb__an_store_hit); 0 when it is singular. */
+static int sfb__an_uv_per_pixel(const sfb__an *A, size_t pix, int axis, double m[2]) {
+    const float *h = A->hinv + 4 * pix + 2 * axis;
+    if (!(isfinite(h[0]) && isfinite(h[1]))) return 0;
+    m[0] = h[0];
+    m[1] = h[1];
     return 1;
 }
 
@@ -863,24 +953,22 @@ static int sfb__an_uv_per_pixel(const sfb__an *A, int k, int axis, double m[2]) 
  * the neighbour's (u,v) moved by the inverse of its screen Jacobian towards (x, y); loc is kept
  * when no neighbour is hit or the Jacobian is singular. */
 static void sfb__an_predict(const sfb__an *A, int x, int y, int d, sfb_location *loc) {
-    int dx, dy, best = -1;
+    int dx, dy, best = -1, bdx = 0, bdy = 0;
     double mx[2], my[2], u, v;
     for (dy = -d; dy <= d; dy += d)
         for (dx = -d; dx <= d; dx += d) {
-            int nx = x + dx, ny = y + dy, k;
+            int nx = x + dx, ny = y + dy, q;
             if ((dx | dy) == 0 || nx < 0 || ny < 0 || nx >= A->w || ny >= A->h) continue;
-            k = A->hit[ny * A->w + nx];
-            if (k < 0) continue;
-            if (best < 0 || (A->hloc[k].face == loc->face && A->hloc[best].face != loc->face)) best = k;
+            q = ny * A->w + nx;
+            if (A->hit[q] < 0) continue;
+            if (best < 0 || (A->hl[q].face == loc->face && A->hl[best].face != loc->face)) { best = q; bdx = dx; bdy = dy; }
         }
-    if (best < 0 || !sfb__an_uv_per_pixel(A, best, 0, mx) || !sfb__an_uv_per_pixel(A, best, 1, my)) return;
-    dx = x - A->hpix[best] % A->w;
-    dy = y - A->hpix[best] / A->w;
-    u = A->hloc[best].u + mx[0] * dx + my[0] * dy;
-    v = A->hloc[best].v + mx[1] * dx + my[1] * dy;
+    if (best < 0 || !sfb__an_uv_per_pixel(A, (size_t)best, 0, mx) || !sfb__an_uv_per_pixel(A, (size_t)best, 1, my)) return;
+    u = A->hl[best].u - mx[0] * bdx - my[0] * bdy;
+    v = A->hl[best].v - mx[1] * bdx - my[1] * bdy;
     if (!isfinite(u) || !isfinite(v)) return;
     sfb__an_clamp_domain(A, &u, &v);
-    loc->face = A->hloc[best].face;
+    loc->face = A->hl[best].face;
     loc->u = (float)u;
     loc->v = (float)v;
 }
@@ -894,17 +982,17 @@ static void sfb__an_predict(const sfb__an *A, int x, int y, int d, sfb_location 
 static int sfb__an_hermite(const sfb__an *A, int x, int y, int axis, int d, sfb_location *loc) {
     const int dx = axis ? 0 : d, dy = axis ? d : 0;
     double ma[2], mb[2], u, v;
-    int a, b;
+    size_t a, b;
     if (x - dx < 0 || y - dy < 0 || x + dx >= A->w || y + dy >= A->h) return 0;
-    a = A->hit[(y - dy) * A->w + (x - dx)];
-    b = A->hit[(y + dy) * A->w + (x + dx)];
-    if (a < 0 || b < 0 || A->hloc[a].face != A->hloc[b].face) return 0;
+    a = (size_t)(y - dy) * (size_t)A->w + (size_t)(x - dx);
+    b = (size_t)(y + dy) * (size_t)A->w + (size_t)(x + dx);
+    if (A->hit[a] < 0 || A->hit[b] < 0 || A->hl[a].face != A->hl[b].face) return 0;
     if (!sfb__an_uv_per_pixel(A, a, axis, ma) || !sfb__an_uv_per_pixel(A, b, axis, mb)) return 0;
-    u = 0.5 * ((double)A->hloc[a].u + A->hloc[b].u) + 0.25 * d * (ma[0] - mb[0]);
-    v = 0.5 * ((double)A->hloc[a].v + A->hloc[b].v) + 0.25 * d * (ma[1] - mb[1]);
+    u = 0.5 * ((double)A->hl[a].u + A->hl[b].u) + 0.25 * d * (ma[0] - mb[0]);
+    v = 0.5 * ((double)A->hl[a].v + A->hl[b].v) + 0.25 * d * (ma[1] - mb[1]);
     if (!isfinite(u) || !isfinite(v)) return 0;
     sfb__an_clamp_domain(A, &u, &v);
-    loc->face = A->hloc[a].face;
+    loc->face = A->hl[a].face;
     loc->u = (float)u;
     loc->v = (float)v;
     return 1;
@@ -920,7 +1008,7 @@ typedef struct sfb__an_seed_job {
     sfb__an_try *tries;
     sfb_location *locs;
     int *rowat;
-    int part, d, want, fill;
+    int part, d, want, fill, base;
 } sfb__an_seed_job;
 
 static void sfb__an_seed_rows(void *arg, int a, int b) {
@@ -931,16 +1019,18 @@ static void sfb__an_seed_rows(void *arg, int a, int b) {
     for (row = a; row < b; ++row) {
         /* d is a power of two */
         const int y = row * d, oy = part > 0 && (y & (2 * d - 1)) == d;
+        /* the row's pixels of the part: x an odd multiple of d when ox (= want - oy) is 1, a
+         * multiple of 2d when it is 0 (part 0: every multiple of d) */
+        const int ox = want - oy, step = part > 0 ? 2 * d : d;
         int x, n = J->fill ? J->rowat[row] : 0;
-        for (x = 0; x < A->w; x += d) {
-            const int ox = part > 0 && (x & (2 * d - 1)) == d;
+        for (x = ox == 1 ? d : 0; x < A->w && (ox == 0 || ox == 1); x += step) {
             const size_t p = (size_t)y * (size_t)A->w + (size_t)x;
             sfb_location *l;
-            if (ox + oy != want) continue;
             if (A->face[p] < 0 && A->cface[p] < 0) continue;
             if (!J->fill) { ++n; continue; }
             memset(&J->tries[n], 0, sizeof J->tries[n]);
             J->tries[n].pix = (int)p;
+            J->tries[n].k = J->base + n;
             l = &J->locs[n];
             if (A->face[p] >= 0) {
                 l->face = A->face[p]; l->u = A->uv[2 * p]; l->v = A->uv[2 * p + 1];
@@ -963,7 +1053,7 @@ static void sfb__an_neighbours(void *arg, int a, int b) {
     sfb__an *A = (sfb__an *)arg;
     int ci;
     for (ci = a; ci < b; ++ci) {
-        const int h = A->chg[ci], pix = A->hpix[h], x = pix % A->w, y = pix / A->w, f = A->hloc[h].face;
+        const int h = A->chg[ci], pix = A->hpix[h], x = pix % A->w, y = pix / A->w, f = A->hl[pix].face;
         int dx, dy, bit = 0, m = 0;
         for (dy = -1; dy <= 1; ++dy)
             for (dx = -1; dx <= 1; ++dx) {
@@ -974,7 +1064,7 @@ static void sfb__an_neighbours(void *arg, int a, int b) {
                 if (nx < 0 || ny < 0 || nx >= A->w || ny >= A->h) continue;
                 q = ny * A->w + nx;
                 k = A->hit[q];
-                if (k >= 0 && (A->hloc[k].face == f || !(A->hdepth[h] < A->hdepth[k] - 0.01 * A->radius))) continue;
+                if (k >= 0 && (A->hl[q].face == f || !(A->hdepth[h] < A->hdepth[k] - 0.01 * A->radius))) continue;
                 m |= 1 << (bit - 1);
             }
         A->nbm[ci] = (unsigned char)m;
@@ -1046,12 +1136,30 @@ static sfb_result sfb__an_project_all(sfb__an *A, int steps) {
             }
             if (total == 0) continue;
             J.fill = 1;
+            J.base = A->nhit;
             sfb__an_run(A, sfb__an_seed_rows, &J, r0, r1, (double)total * 4.0);
-            if ((r = sfb__an_newton(A, tries, locs, total, buf, steps, 1)) != SFB_SUCCESS) goto done;
+            {
+                sfb__an_fresh_job F;
+                sfb_result res[SFB__AN_CHUNKS];
+                const int nck = A->ctx->backend && A->ctx->backend->parallel ? (total + 1023) / 1024 : 1;
+                int c;
+                F.A = A; F.tries = tries; F.locs = locs; F.count = total; F.steps = steps; F.res = res;
+                F.pos = buf; F.du = buf + 3 * (size_t)total; F.dv = buf + 6 * (size_t)total; F.nrm = buf + 9 * (size_t)total;
+                F.chunk = (total + (nck < SFB__AN_CHUNKS ? nck : SFB__AN_CHUNKS) - 1) / (nck < SFB__AN_CHUNKS ? nck : SFB__AN_CHUNKS);
+                A->nhit += total; /* the batch's slots (holes where it misses) */
+                sfb__an_run(A, sfb__an_fresh, &F, 0, (total + F.chunk - 1) / F.chunk, (double)total * 8.0);
+                for (c = 0; c < (total + F.chunk - 1) / F.chunk; ++c)
+                    if (res[c] != SFB_SUCCESS) { r = res[c]; goto done; }
+            }
         }
     }
-    /* round 0's changes: every hit */
-    for (A->nchg = 0; A->nchg < A->nhit; ++A->nchg) A->chg[A->nchg] = A->nchg;
+    sfb__an_fill_holes(A);
+    /* round 0's changes: every hit, in the picture's order (the neighbour scans then read the
+     * per-pixel arrays row by row; the hit slots are in round 0's part order, scattered over
+     * the picture: that order cost cache misses on every neighbour read) */
+    A->nchg = 0;
+    for (p = 0; p < npix; ++p)
+        if (A->hit[p] >= 0) A->chg[A->nchg++] = A->hit[p];
     if ((r = sfb__progress(A->ctx, 0.6f, "analyze")) != SFB_SUCCESS) goto done;
     /* later rounds: the pixels next to the last round's new or nearer hits, seeded by them:
      * pixels not hit yet, and pixels hit on another face at least 1 % of the bounding radius
@@ -1064,8 +1172,9 @@ static sfb_result sfb__an_project_all(sfb__an *A, int steps) {
          * seeding in the changes' order, here */
         sfb__an_run(A, sfb__an_neighbours, A, 0, A->nchg, (double)A->nchg);
         for (ci = 0; ci < A->nchg; ++ci) {
-            int h = A->chg[ci], pix = A->hpix[h], x = pix % A->w, y = pix / A->w, dx, dy, bit = 0;
+            int h, pix, x, y, dx, dy, bit = 0;
             if (!A->nbm[ci]) continue;
+            h = A->chg[ci]; pix = A->hpix[h]; x = pix % A->w; y = pix / A->w;
             for (dy = -1; dy <= 1; ++dy)
                 for (dx = -1; dx <= 1; ++dx) {
                     int q, k, *mq, f = A->hloc[h].face;
@@ -1098,7 +1207,7 @@ static sfb_result sfb__an_project_all(sfb__an *A, int steps) {
         }
         if (count == 0) break;
         A->nchg = 0;
-        if ((r = sfb__an_newton(A, tries, locs, count, buf, steps, 0)) != SFB_SUCCESS) goto done;
+        if ((r = sfb__an_newton(A, tries, locs, count, buf, steps)) != SFB_SUCCESS) goto done;
         if (A->nchg == 0) break;
         if ((r = sfb__progress(A->ctx, 0.6f + 0.1f * (float)round / SFB__AN_ROUNDS, "analyze")) != SFB_SUCCESS) goto done;
     }
@@ -1446,14 +1555,14 @@ static void sfb__an_free(sfb__an *A) {
     sfb__an_put(A, A->depth); sfb__an_put(A, A->face); sfb__an_put(A, A->uv); sfb__an_put(A, A->ppos); sfb__an_put(A, A->pnrm);
     sfb__an_put(A, A->hit); sfb__an_put(A, A->state);
     sfb__an_put(A, A->hpix); sfb__an_put(A, A->hloc); sfb__an_put(A, A->hpos); sfb__an_put(A, A->hdu); sfb__an_put(A, A->hdv);
-    sfb__an_put(A, A->hnrm); sfb__an_put(A, A->hdepth); sfb__an_put(A, A->chg);
+    sfb__an_put(A, A->hnrm); sfb__an_put(A, A->hdepth); sfb__an_put(A, A->hinv); sfb__an_put(A, A->hl); sfb__an_put(A, A->chg);
     sfb__free(A->ctx, A->adj); /* not a workspace buffer: per face */
 }
 
 /* Bytes the analysis will hold at its peak (checked against the budget before allocating). */
 static double sfb__an_bytes(const sfb__an *A) {
     double npix = (double)A->w * A->h, grid = (double)A->nf * A->per;
-    double per_pixel = 16 + 4 + 4 + 8 + 4 + 1 + 4 + 4 + 1 + 4 + 12 /* buffers, outputs */ + 4 + 12 + 48 + 4 /* hits */ +
+    double per_pixel = 16 + 4 + 4 + 8 + 4 + 1 + 4 + 4 + 1 + 4 + 12 /* buffers, outputs */ + 4 + 12 + 48 + 4 + 16 + 12 /* hits */ +
                        (A->c->polygon_based ? 24 : 84 + 16 + 1) /* proxy data or the projection's attempts, marks and neighbour masks */;
     return npix * per_pixel + grid * (24.0 + sizeof(sfb__raster_vertex) + 2 * 4 * sizeof(int)) + 65536.0 * sizeof(sfb_location) + (double)A->nf * 4 * (sizeof(int) + sizeof(sfb__an_side));
 }
@@ -1498,10 +1607,12 @@ static int sfb__an_alloc(sfb__an *A) {
     A->hdv = (float *)sfb__an_get(A, SFB__WS_HDV, npix * 3 * sizeof(float), NULL);
     A->hnrm = (float *)sfb__an_get(A, SFB__WS_HNRM, npix * 3 * sizeof(float), NULL);
     A->hdepth = (float *)sfb__an_get(A, SFB__WS_HDEPTH, npix * sizeof(float), NULL);
+    A->hinv = (float *)sfb__an_get(A, SFB__WS_HINV, npix * 4 * sizeof(float), NULL);
+    A->hl = (sfb_location *)sfb__an_get(A, SFB__WS_HL, npix * sizeof(sfb_location), NULL);
     A->chg = (int *)sfb__an_get(A, SFB__WS_CHG, (npix + 1) * sizeof(int), NULL);
     if (!A->gpos || !A->gnrm || !A->rv || !A->rtri || !A->depth || !A->face || !A->uv || !A->hit || !A->adj || !A->cface || !A->cuv || !A->cdist || !A->state ||
         (A->c->polygon_based && (!A->ppos || !A->pnrm)) || !A->hpix || !A->hloc || !A->hpos || !A->hdu || !A->hdv || !A->hnrm || !A->hdepth ||
-        !A->chg)
+        !A->hinv || !A->hl || !A->chg)
         return 0;
     sfb__an_run(A, sfb__an_clear_rows, A, 0, A->h, (double)npix * 0.1);
     return 1;
