@@ -13081,7 +13081,7 @@ typedef struct sfb__an {
     unsigned char *nbm;          /* per change: the neighbours it seeds (sfb__an_neighbours) */
     int *hpix;
     sfb_location *hloc;
-    float *hpos, *hdu, *hdv, *hnrm, *hdepth;
+    float *hpos, *hdu, *hdv, *hnrm, *hdepth; /* hdu, hdv: CURVATURE only (else NULL) */
 } sfb__an;
 
 enum { SFB__AN_NONE = 0, SFB__AN_TRIED_NEAR = 1, SFB__AN_HIT = 2 };
@@ -13531,9 +13531,11 @@ static void sfb__an_store_hit(sfb__an *A, size_t k, const sfb_location *loc, dou
     A->hl[pix] = *loc;
     A->hdepth[k] = (float)z;
     for (c = 0; c < 3; ++c) {
-        A->hpos[3 * k + c] = p[c]; A->hdu[3 * k + c] = du[c]; A->hdv[3 * k + c] = dv[c]; A->hnrm[3 * k + c] = n[c];
+        A->hpos[3 * k + c] = p[c]; A->hnrm[3 * k + c] = n[c];
         pd[c] = p[c]; tu[c] = du[c]; tv[c] = dv[c];
     }
+    if (A->hdu)
+        for (c = 0; c < 3; ++c) { A->hdu[3 * k + c] = du[c]; A->hdv[3 * k + c] = dv[c]; }
     if (sfb__an_jacobian(&A->cam, pd, tu, tv, jac, &det)) {
         m[0] = (float)(jac[3] / det); m[1] = (float)(-jac[2] / det);
         m[2] = (float)(-jac[1] / det); m[3] = (float)(jac[0] / det);
@@ -13626,6 +13628,10 @@ static void sfb__an_step(void *arg, int a, int b) {
          * stops as a miss instead of running out its steps (at half a pixel, a few more
          * silhouette pixels were dropped on catmark_car and spot) */
         if (ok && it >= 2 && res > 1.0 && !(res < 0.5 * t->res2)) { t->res = res; t->outcome = 3; continue; }
+        /* and one within a pixel of the pixel but not converging (not halved over two steps by
+         * its fifth evaluation: beside a silhouette, where round 1 tries thousands of pixels)
+         * stops too, as near or a miss (catmark_car: round 1's evaluations -15 %, coverage the same) */
+        if (ok && it >= 4 && res > 0.05 && !(res < 0.5 * t->res2)) { t->res = res; t->outcome = res < SFB__AN_NEAR ? 2 : 3; continue; }
         t->res2 = t->res;
         t->res = res;
         if (ok && res < SFB__AN_TOL) { t->z = z; t->outcome = SFB__AN_OUT_NEW_HIT; continue; }
@@ -13735,8 +13741,8 @@ static void sfb__an_fill_holes(sfb__an *A) {
             A->hloc[to] = A->hloc[from];
             A->hdepth[to] = A->hdepth[from];
             for (c = 0; c < 3; ++c) {
-                A->hpos[3 * to + c] = A->hpos[3 * from + c]; A->hdu[3 * to + c] = A->hdu[3 * from + c];
-                A->hdv[3 * to + c] = A->hdv[3 * from + c]; A->hnrm[3 * to + c] = A->hnrm[3 * from + c];
+                A->hpos[3 * to + c] = A->hpos[3 * from + c]; A->hnrm[3 * to + c] = A->hnrm[3 * from + c];
+                if (A->hdu) { A->hdu[3 * to + c] = A->hdu[3 * from + c]; A->hdv[3 * to + c] = A->hdv[3 * from + c]; }
             }
             A->hit[A->hpix[to]] = k;
             A->hpix[from] = -1;
@@ -13891,29 +13897,40 @@ static void sfb__an_seed_rows(void *arg, int a, int b) {
     }
 }
 
-/* For the changes [a, b) of the last round (A->chg), which of their 8 neighbours (bit i: the
- * i-th of dy, dx = -1..1 in order, the middle skipped) they would seed: not hit yet, or hit on
- * another face at least 1 % of the bounding radius farther away. */
+/* Which of hit pixel pix's 8 neighbours (bit i: the i-th of dy, dx = -1..1 in order, the
+ * middle skipped) its hit would seed: not hit yet, or hit on another face at least 1 % of the
+ * bounding radius farther away. */
+static unsigned char sfb__an_neighbour_mask(const sfb__an *A, int pix) {
+    const int x = pix % A->w, y = pix / A->w, f = A->hl[pix].face;
+    int dx, dy, bit = 0, m = 0;
+    for (dy = -1; dy <= 1; ++dy)
+        for (dx = -1; dx <= 1; ++dx) {
+            const int nx = x + dx, ny = y + dy;
+            int q, k;
+            if ((dx | dy) == 0) continue;
+            ++bit;
+            if (nx < 0 || ny < 0 || nx >= A->w || ny >= A->h) continue;
+            q = ny * A->w + nx;
+            k = A->hit[q];
+            if (k >= 0 && (A->hl[q].face == f || !(A->hdepth[A->hit[pix]] < A->hdepth[k] - 0.01 * A->radius))) continue;
+            m |= 1 << (bit - 1);
+        }
+    return (unsigned char)m;
+}
+
+/* sfb__an_neighbour_mask of the changes [a, b) of the last round (A->chg) into A->nbm. */
 static void sfb__an_neighbours(void *arg, int a, int b) {
     sfb__an *A = (sfb__an *)arg;
     int ci;
-    for (ci = a; ci < b; ++ci) {
-        const int h = A->chg[ci], pix = A->hpix[h], x = pix % A->w, y = pix / A->w, f = A->hl[pix].face;
-        int dx, dy, bit = 0, m = 0;
-        for (dy = -1; dy <= 1; ++dy)
-            for (dx = -1; dx <= 1; ++dx) {
-                const int nx = x + dx, ny = y + dy;
-                int q, k;
-                if ((dx | dy) == 0) continue;
-                ++bit;
-                if (nx < 0 || ny < 0 || nx >= A->w || ny >= A->h) continue;
-                q = ny * A->w + nx;
-                k = A->hit[q];
-                if (k >= 0 && (A->hl[q].face == f || !(A->hdepth[h] < A->hdepth[k] - 0.01 * A->radius))) continue;
-                m |= 1 << (bit - 1);
-            }
-        A->nbm[ci] = (unsigned char)m;
-    }
+    for (ci = a; ci < b; ++ci) A->nbm[ci] = sfb__an_neighbour_mask(A, A->hpix[A->chg[ci]]);
+}
+
+/* The same per pixel on rows [y0, y1), 0 where no hit (round 1: every hit is a change, read
+ * row by row here). */
+static void sfb__an_neighbour_rows(void *arg, int y0, int y1) {
+    sfb__an *A = (sfb__an *)arg;
+    size_t p, end = (size_t)y1 * (size_t)A->w;
+    for (p = (size_t)y0 * (size_t)A->w; p < end; ++p) A->nbm[p] = A->hit[p] >= 0 ? sfb__an_neighbour_mask(A, (int)p) : 0;
 }
 
 /* Step 2 over every round (see the file's comment). */
@@ -13999,12 +14016,17 @@ static sfb_result sfb__an_project_all(sfb__an *A, int steps) {
         }
     }
     sfb__an_fill_holes(A);
-    /* round 0's changes: every hit, in the picture's order (the neighbour scans then read the
-     * per-pixel arrays row by row; the hit slots are in round 0's part order, scattered over
-     * the picture: that order cost cache misses on every neighbour read) */
+    /* round 0's changes: every hit, scanned per pixel row by row over the threads; those that
+     * seed a neighbour listed in the picture's order (the hit slots lie in round 0's part
+     * order, scattered over the picture: scanning them in that order cost a cache miss on
+     * every neighbour read) */
+    sfb__an_run(A, sfb__an_neighbour_rows, A, 0, A->h, (double)npix);
     A->nchg = 0;
     for (p = 0; p < npix; ++p)
-        if (A->hit[p] >= 0) A->chg[A->nchg++] = A->hit[p];
+        if (A->nbm[p]) {
+            A->chg[A->nchg] = A->hit[p];
+            A->nbm[A->nchg++] = A->nbm[p]; /* nchg <= p */
+        }
     if ((r = sfb__progress(A->ctx, 0.6f, "analyze")) != SFB_SUCCESS) goto done;
     /* later rounds: the pixels next to the last round's new or nearer hits, seeded by them:
      * pixels not hit yet, and pixels hit on another face at least 1 % of the bounding radius
@@ -14013,9 +14035,9 @@ static sfb_result sfb__an_project_all(sfb__an *A, int steps) {
     for (round = 1; round <= SFB__AN_ROUNDS; ++round) {
         int ci;
         count = 0;
-        /* which neighbours each change would seed, over the threads (reads only), then the
-         * seeding in the changes' order, here */
-        sfb__an_run(A, sfb__an_neighbours, A, 0, A->nchg, (double)A->nchg);
+        /* which neighbours each change would seed, over the threads (reads only; round 1's
+         * are known), then the seeding in the changes' order, here */
+        if (round > 1) sfb__an_run(A, sfb__an_neighbours, A, 0, A->nchg, (double)A->nchg);
         for (ci = 0; ci < A->nchg; ++ci) {
             int h, pix, x, y, dx, dy, bit = 0;
             if (!A->nbm[ci]) continue;
@@ -14407,7 +14429,8 @@ static void sfb__an_free(sfb__an *A) {
 /* Bytes the analysis will hold at its peak (checked against the budget before allocating). */
 static double sfb__an_bytes(const sfb__an *A) {
     double npix = (double)A->w * A->h, grid = (double)A->nf * A->per;
-    double per_pixel = 16 + 4 + 4 + 8 + 4 + 1 + 4 + 4 + 1 + 4 + 12 /* buffers, outputs */ + 4 + 12 + 48 + 4 + 16 + 12 /* hits */ +
+    double per_pixel = 16 + 4 + 4 + 8 + 4 + 1 + 4 + 4 + 1 + 4 + 12 /* buffers, outputs */ + 4 + 12 + 24 + 4 + 16 + 12 /* hits */ +
+                       (A->c->mode == SFB_ANALYZE_CURVATURE ? 24 : 0) /* their first derivatives */ +
                        (A->c->polygon_based ? 24 : 84 + 16 + 1) /* proxy data or the projection's attempts, marks and neighbour masks */;
     return npix * per_pixel + grid * (24.0 + sizeof(sfb__raster_vertex) + 2 * 4 * sizeof(int)) + 65536.0 * sizeof(sfb_location) + (double)A->nf * 4 * (sizeof(int) + sizeof(sfb__an_side));
 }
@@ -14448,15 +14471,17 @@ static int sfb__an_alloc(sfb__an *A) {
     A->hpix = (int *)sfb__an_get(A, SFB__WS_HPIX, npix * sizeof(int), NULL);
     A->hloc = (sfb_location *)sfb__an_get(A, SFB__WS_HLOC, npix * sizeof(sfb_location), NULL);
     A->hpos = (float *)sfb__an_get(A, SFB__WS_HPOS, npix * 3 * sizeof(float), NULL);
-    A->hdu = (float *)sfb__an_get(A, SFB__WS_HDU, npix * 3 * sizeof(float), NULL);
-    A->hdv = (float *)sfb__an_get(A, SFB__WS_HDV, npix * 3 * sizeof(float), NULL);
+    if (A->c->mode == SFB_ANALYZE_CURVATURE) { /* the first derivatives: only curvature reads them after the projection */
+        A->hdu = (float *)sfb__an_get(A, SFB__WS_HDU, npix * 3 * sizeof(float), NULL);
+        A->hdv = (float *)sfb__an_get(A, SFB__WS_HDV, npix * 3 * sizeof(float), NULL);
+    }
     A->hnrm = (float *)sfb__an_get(A, SFB__WS_HNRM, npix * 3 * sizeof(float), NULL);
     A->hdepth = (float *)sfb__an_get(A, SFB__WS_HDEPTH, npix * sizeof(float), NULL);
     A->hinv = (float *)sfb__an_get(A, SFB__WS_HINV, npix * 4 * sizeof(float), NULL);
     A->hl = (sfb_location *)sfb__an_get(A, SFB__WS_HL, npix * sizeof(sfb_location), NULL);
     A->chg = (int *)sfb__an_get(A, SFB__WS_CHG, (npix + 1) * sizeof(int), NULL);
     if (!A->gpos || !A->gnrm || !A->rv || !A->rtri || !A->depth || !A->face || !A->uv || !A->hit || !A->adj || !A->cface || !A->cuv || !A->cdist || !A->state ||
-        (A->c->polygon_based && (!A->ppos || !A->pnrm)) || !A->hpix || !A->hloc || !A->hpos || !A->hdu || !A->hdv || !A->hnrm || !A->hdepth ||
+        (A->c->polygon_based && (!A->ppos || !A->pnrm)) || !A->hpix || !A->hloc || !A->hpos || (A->c->mode == SFB_ANALYZE_CURVATURE && (!A->hdu || !A->hdv)) || !A->hnrm || !A->hdepth ||
         !A->hinv || !A->hl || !A->chg)
         return 0;
     sfb__an_run(A, sfb__an_clear_rows, A, 0, A->h, (double)npix * 0.1);
