@@ -2305,16 +2305,18 @@ void sfb__raster_rows(const sfb__raster_job *j, int row0, int row1) {
         if (t.y0 < row0) t.y0 = row0;
         if (t.y1 > row1 - 1) t.y1 = row1 - 1;
         for (y = t.y0; y <= t.y1; ++y) {
+            const double py = y + 0.5;
+            double e[3];
             int in = 0;
-            for (x = t.x0; x <= t.x1; ++x) {
-                const double px = x + 0.5, py = y + 0.5;
+            /* the edge functions at the row's first pixel centre, then stepped by ea per pixel */
+            for (k = 0; k < 3; ++k) e[k] = t.ea[k] * (t.x0 + 0.5) + t.eb[k] * py + t.ec[k];
+            for (x = t.x0; x <= t.x1; ++x, e[0] += t.ea[0], e[1] += t.ea[1], e[2] += t.ea[2]) {
                 const size_t pix = (size_t)y * (size_t)j->w + (size_t)x;
                 double b[3], den, z;
-                for (k = 0; k < 3; ++k) b[k] = t.ea[k] * px + t.eb[k] * py + t.ec[k];
-                /* each b[k] is monotonic along the row (rounding is), so the inside pixels are one
-                 * run: the first outside one after it ends the row */
-                if (b[0] < 0.0 || b[1] < 0.0 || b[2] < 0.0) { if (in) break; continue; }
+                /* the inside pixels of a row are one run: the first outside one after it ends the row */
+                if (e[0] < 0.0 || e[1] < 0.0 || e[2] < 0.0) { if (in) break; continue; }
                 in = 1;
+                b[0] = e[0]; b[1] = e[1]; b[2] = e[2];
                 den = b[0] * S[0]->q + b[1] * S[1]->q + b[2] * S[2]->q;
                 if (!(den > 0.0)) continue;
                 z = j->ortho ? b[0] * S[0]->z + b[1] * S[1]->z + b[2] * S[2]->z : 1.0 / den;
@@ -12946,23 +12948,24 @@ static int sfb__an_project(const sfb__an_cam *c, const double *p, double *sx, do
     return 1;
 }
 
-/* The Jacobian of the projection at p times t: d(sx, sy) along t. */
-static void sfb__an_project_dir(const sfb__an_cam *c, const double *p, const double *t, double *dx, double *dy) {
-    double d[3], xc, yc, zc, tx, ty, tz;
-    d[0] = p[0] - c->eye[0]; d[1] = p[1] - c->eye[1]; d[2] = p[2] - c->eye[2];
-    tx = sfb__rdot(t, c->right); ty = sfb__rdot(t, c->up);
-    if (c->ortho) { *dx = c->focal * tx; *dy = -c->focal * ty; return; }
-    xc = sfb__rdot(d, c->right); yc = sfb__rdot(d, c->up); zc = sfb__rdot(d, c->fwd);
-    tz = sfb__rdot(t, c->fwd);
-    *dx = c->focal * (tx * zc - xc * tz) / (zc * zc);
-    *dy = -c->focal * (ty * zc - yc * tz) / (zc * zc);
-}
-
 /* The screen Jacobian of a surface point p with tangents tu, tv: j = (dsx/du, dsx/dv, dsy/du,
  * dsy/dv) and its determinant; 0 when it is singular (or not finite). */
 static int sfb__an_jacobian(const sfb__an_cam *c, const double *p, const double *tu, const double *tv, double j[4], double *det) {
-    sfb__an_project_dir(c, p, tu, &j[0], &j[2]);
-    sfb__an_project_dir(c, p, tv, &j[1], &j[3]);
+    const double tux = sfb__rdot(tu, c->right), tuy = sfb__rdot(tu, c->up), tvx = sfb__rdot(tv, c->right), tvy = sfb__rdot(tv, c->up);
+    if (c->ortho) {
+        j[0] = c->focal * tux; j[2] = -c->focal * tuy;
+        j[1] = c->focal * tvx; j[3] = -c->focal * tvy;
+    } else {
+        double d[3], xc, yc, zc, tuz, tvz, zz;
+        d[0] = p[0] - c->eye[0]; d[1] = p[1] - c->eye[1]; d[2] = p[2] - c->eye[2];
+        xc = sfb__rdot(d, c->right); yc = sfb__rdot(d, c->up); zc = sfb__rdot(d, c->fwd);
+        tuz = sfb__rdot(tu, c->fwd); tvz = sfb__rdot(tv, c->fwd);
+        zz = zc * zc;
+        j[0] = c->focal * (tux * zc - xc * tuz) / zz;
+        j[2] = -c->focal * (tuy * zc - yc * tuz) / zz;
+        j[1] = c->focal * (tvx * zc - xc * tvz) / zz;
+        j[3] = -c->focal * (tvy * zc - yc * tvz) / zz;
+    }
     *det = j[0] * j[3] - j[1] * j[2];
     return fabs(*det) > 1e-18 && isfinite(*det);
 }
@@ -13503,7 +13506,7 @@ static sfb_result sfb__an_raster(sfb__an *A) {
 
 /* ---- step 2: Newton projection, in batches ---- */
 typedef struct sfb__an_try {
-    int pix, steps, pinned, crossed, outcome;   /* outcome: 0 running, 1 hit, 2 near, 3 miss (SFB__AN_OUT_NEW_HIT: a hit
+    int pix, x, y, steps, pinned, crossed, outcome;   /* the pixel, its column and row; outcome: 0 running, 1 hit, 2 near, 3 miss (SFB__AN_OUT_NEW_HIT: a hit
                                                    sfb__an_newton has yet to record) */
     double res, res2;  /* the residual of the last evaluation, and of the one before (pixels) */
     double z;          /* a new hit's depth */
@@ -13613,7 +13616,7 @@ static void sfb__an_step(void *arg, int a, int b) {
     for (i = a; i < b; ++i) {
         sfb__an_try *t = &J->tries[i];
         sfb_location *l = &J->locs[i];
-        int pix = t->pix, x = pix % A->w, y = pix / A->w;
+        const int x = t->x, y = t->y;
         double p[3], tu[3], tv[3], sx, sy, z, rx, ry, jac[4], det, du_, dv_, m, u, v, res;
         int c, ok;
         for (c = 0; c < 3; ++c) { p[c] = pos[3 * i + c]; tu[c] = du[3 * i + c]; tv[c] = dv[3 * i + c]; }
@@ -13881,6 +13884,8 @@ static void sfb__an_seed_rows(void *arg, int a, int b) {
             if (!J->fill) { ++n; continue; }
             memset(&J->tries[n], 0, sizeof J->tries[n]);
             J->tries[n].pix = (int)p;
+            J->tries[n].x = x;
+            J->tries[n].y = y;
             J->tries[n].k = J->base + n;
             l = &J->locs[n];
             if (A->face[p] >= 0) {
@@ -14068,6 +14073,8 @@ static sfb_result sfb__an_project_all(sfb__an *A, int steps) {
                     }
                     memset(&tries[count], 0, sizeof tries[count]);
                     tries[count].pix = q;
+                    tries[count].x = x + dx;
+                    tries[count].y = y + dy;
                     locs[count] = A->hloc[h];
                     ++count;
                 }

@@ -186,16 +186,18 @@ void sfb__raster_rows(const sfb__raster_job *j, int row0, int row1) {
         if (t.y0 < row0) t.y0 = row0;
         if (t.y1 > row1 - 1) t.y1 = row1 - 1;
         for (y = t.y0; y <= t.y1; ++y) {
+            const double py = y + 0.5;
+            double e[3];
             int in = 0;
-            for (x = t.x0; x <= t.x1; ++x) {
-                const double px = x + 0.5, py = y + 0.5;
+            /* the edge functions at the row's first pixel centre, then stepped by ea per pixel */
+            for (k = 0; k < 3; ++k) e[k] = t.ea[k] * (t.x0 + 0.5) + t.eb[k] * py + t.ec[k];
+            for (x = t.x0; x <= t.x1; ++x, e[0] += t.ea[0], e[1] += t.ea[1], e[2] += t.ea[2]) {
                 const size_t pix = (size_t)y * (size_t)j->w + (size_t)x;
                 double b[3], den, z;
-                for (k = 0; k < 3; ++k) b[k] = t.ea[k] * px + t.eb[k] * py + t.ec[k];
-                /* each b[k] is monotonic along the row (rounding is), so the inside pixels are one
-                 * run: the first outside one after it ends the row */
-                if (b[0] < 0.0 || b[1] < 0.0 || b[2] < 0.0) { if (in) break; continue; }
+                /* the inside pixels of a row are one run: the first outside one after it ends the row */
+                if (e[0] < 0.0 || e[1] < 0.0 || e[2] < 0.0) { if (in) break; continue; }
                 in = 1;
+                b[0] = e[0]; b[1] = e[1]; b[2] = e[2];
                 den = b[0] * S[0]->q + b[1] * S[1]->q + b[2] * S[2]->q;
                 if (!(den > 0.0)) continue;
                 z = j->ortho ? b[0] * S[0]->z + b[1] * S[1]->z + b[2] * S[2]->z : 1.0 / den;
