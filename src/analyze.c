@@ -231,12 +231,12 @@ typedef struct sfb__an {
                                     read these per pixel, row by row (the hit slots lie in round 0's part order, scattered) */
     int *adj;                    /* per face and side: (4 * neighbour face + its side) * 2 + reversed, -1: none */
     unsigned char *state;        /* SFB__AN_* per pixel */
+    unsigned char *cand;         /* per pixel: 2 drawn by the proxy (face), 1 seeded beside a thin triangle (cface), 0 neither */
     /* hits (compact) */
     int nhit;
     int *chg, nchg;              /* hits made or replaced by the last batch of attempts */
     unsigned char *nbm;          /* per change: the neighbours it seeds (sfb__an_neighbours) */
     int *hpix;
-    sfb_location *hloc;
     float *hpos, *hdu, *hdv, *hnrm, *hdepth; /* hdu, hdv: CURVATURE only (else NULL) */
 } sfb__an;
 
@@ -247,7 +247,7 @@ enum {
     SFB__WS_GPOS, SFB__WS_GNRM, SFB__WS_RV, SFB__WS_RTRI, SFB__WS_DEPTH, SFB__WS_FACE, SFB__WS_UV, SFB__WS_HIT, SFB__WS_CFACE,
     SFB__WS_CUV, SFB__WS_CDIST, SFB__WS_STATE, SFB__WS_PPOS, SFB__WS_PNRM, SFB__WS_HPIX, SFB__WS_HLOC, SFB__WS_HPOS, SFB__WS_HDU,
     SFB__WS_HDV, SFB__WS_HNRM, SFB__WS_HDEPTH, SFB__WS_CHG, SFB__WS_TRIES, SFB__WS_LOCS, SFB__WS_BUF, SFB__WS_MARK, SFB__WS_ROWAT,
-    SFB__WS_NBM, SFB__WS_HV1, SFB__WS_HV2, SFB__WS_V2, SFB__WS_SEC, SFB__WS_HINV, SFB__WS_HL, SFB__WS_COUNT
+    SFB__WS_NBM, SFB__WS_HV1, SFB__WS_HV2, SFB__WS_V2, SFB__WS_SEC, SFB__WS_HINV, SFB__WS_HL, SFB__WS_CAND, SFB__WS_COUNT
 };
 struct sfb_analysis_workspace {
     sfb_context *ctx;
@@ -594,6 +594,28 @@ static void sfb__an_project_grid(void *arg, int a, int b) {
     }
 }
 
+/* Rows [y0, y1) after the raster: cand per pixel, and the row's proxy pixels into rowcnt[y]. */
+typedef struct sfb__an_cand_job {
+    sfb__an *A;
+    int *rowcnt;
+} sfb__an_cand_job;
+
+static void sfb__an_candidates(void *arg, int y0, int y1) {
+    const sfb__an_cand_job *J = (const sfb__an_cand_job *)arg;
+    sfb__an *A = J->A;
+    int y, x;
+    for (y = y0; y < y1; ++y) {
+        const size_t row = (size_t)y * (size_t)A->w;
+        int n = 0;
+        for (x = 0; x < A->w; ++x) {
+            const int f = A->face[row + x];
+            n += f >= 0;
+            A->cand[row + x] = (unsigned char)(f >= 0 ? 2 : A->cface[row + x] >= 0 ? 1 : 0);
+        }
+        J->rowcnt[y] = n;
+    }
+}
+
 /* The raster kernel of the context's backend, or ref's. */
 static sfb_result sfb__an_raster_kernel(const sfb__an *A, const sfb__raster_job *job) {
     sfb_context *ctx = A->ctx;
@@ -683,7 +705,6 @@ static void sfb__an_store_hit(sfb__an *A, size_t k, const sfb_location *loc, dou
     const size_t pix = (size_t)A->hpix[k];
     float *m = A->hinv + 4 * pix;
     int c;
-    A->hloc[k] = *loc;
     A->hl[pix] = *loc;
     A->hdepth[k] = (float)z;
     for (c = 0; c < 3; ++c) {
@@ -894,7 +915,6 @@ static void sfb__an_fill_holes(sfb__an *A) {
             const size_t to = (size_t)k, from = (size_t)last;
             int c;
             A->hpix[to] = A->hpix[from];
-            A->hloc[to] = A->hloc[from];
             A->hdepth[to] = A->hdepth[from];
             for (c = 0; c < 3; ++c) {
                 A->hpos[3 * to + c] = A->hpos[3 * from + c]; A->hnrm[3 * to + c] = A->hnrm[3 * from + c];
@@ -1033,7 +1053,7 @@ static void sfb__an_seed_rows(void *arg, int a, int b) {
         for (x = ox == 1 ? d : 0; x < A->w && (ox == 0 || ox == 1); x += step) {
             const size_t p = (size_t)y * (size_t)A->w + (size_t)x;
             sfb_location *l;
-            if (A->face[p] < 0 && A->cface[p] < 0) continue;
+            if (!A->cand[p]) continue;
             if (!J->fill) { ++n; continue; }
             memset(&J->tries[n], 0, sizeof J->tries[n]);
             J->tries[n].pix = (int)p;
@@ -1041,7 +1061,7 @@ static void sfb__an_seed_rows(void *arg, int a, int b) {
             J->tries[n].y = y;
             J->tries[n].k = J->base + n;
             l = &J->locs[n];
-            if (A->face[p] >= 0) {
+            if (A->cand[p] == 2) {
                 l->face = A->face[p]; l->u = A->uv[2 * p]; l->v = A->uv[2 * p + 1];
             } else {
                 l->face = A->cface[p]; l->u = A->cuv[2 * p]; l->v = A->cuv[2 * p + 1];
@@ -1102,8 +1122,8 @@ static sfb_result sfb__an_project_all(sfb__an *A, int steps) {
     int *rowat = NULL; /* round 0: per grid row, its attempts, then where they start in their band */
     int mark_base = 0;
     sfb_result r = SFB_SUCCESS;
-    for (p = 0; p < npix; ++p) if (A->face[p] >= 0 || A->cface[p] >= 0) ++cap;
-    cap = cap < 4096 ? 4096 : cap > SFB__AN_BATCH ? SFB__AN_BATCH : cap; /* later rounds grow it when they need to */
+    cap = npix < SFB__AN_BATCH ? (int)npix : SFB__AN_BATCH; /* later rounds grow it when they need to */
+    if (cap < 4096) cap = 4096;
     if (cap < A->w) cap = A->w; /* round 0's bands hold at least a row */
     tries = (sfb__an_try *)sfb__an_get(A, SFB__WS_TRIES, (size_t)cap * sizeof *tries, NULL);
     locs = (sfb_location *)sfb__an_get(A, SFB__WS_LOCS, (size_t)cap * sizeof *locs, NULL);
@@ -1202,7 +1222,7 @@ static sfb_result sfb__an_project_all(sfb__an *A, int steps) {
             h = A->chg[ci]; pix = A->hpix[h]; x = pix % A->w; y = pix / A->w;
             for (dy = -1; dy <= 1; ++dy)
                 for (dx = -1; dx <= 1; ++dx) {
-                    int q, k, *mq, f = A->hloc[h].face;
+                    int q, k, *mq, f = A->hl[pix].face;
                     if ((dx | dy) == 0) continue;
                     if (!(A->nbm[ci] & (1 << bit++))) continue;
                     q = (y + dy) * A->w + (x + dx);
@@ -1228,7 +1248,7 @@ static sfb_result sfb__an_project_all(sfb__an *A, int steps) {
                     tries[count].pix = q;
                     tries[count].x = x + dx;
                     tries[count].y = y + dy;
-                    locs[count] = A->hloc[h];
+                    locs[count] = A->hl[pix];
                     ++count;
                 }
         }
@@ -1580,8 +1600,8 @@ static void sfb__an_free(sfb__an *A) {
     sfb__an_put(A, A->gpos); sfb__an_put(A, A->gnrm); sfb__an_put(A, A->rv); sfb__an_put(A, A->rtri);
     sfb__an_put(A, A->cface); sfb__an_put(A, A->cuv); sfb__an_put(A, A->cdist);
     sfb__an_put(A, A->depth); sfb__an_put(A, A->face); sfb__an_put(A, A->uv); sfb__an_put(A, A->ppos); sfb__an_put(A, A->pnrm);
-    sfb__an_put(A, A->hit); sfb__an_put(A, A->state);
-    sfb__an_put(A, A->hpix); sfb__an_put(A, A->hloc); sfb__an_put(A, A->hpos); sfb__an_put(A, A->hdu); sfb__an_put(A, A->hdv);
+    sfb__an_put(A, A->hit); sfb__an_put(A, A->state); sfb__an_put(A, A->cand);
+    sfb__an_put(A, A->hpix); sfb__an_put(A, A->hpos); sfb__an_put(A, A->hdu); sfb__an_put(A, A->hdv);
     sfb__an_put(A, A->hnrm); sfb__an_put(A, A->hdepth); sfb__an_put(A, A->hinv); sfb__an_put(A, A->hl); sfb__an_put(A, A->chg);
     sfb__free(A->ctx, A->adj); /* not a workspace buffer: per face */
 }
@@ -1589,9 +1609,9 @@ static void sfb__an_free(sfb__an *A) {
 /* Bytes the analysis will hold at its peak (checked against the budget before allocating). */
 static double sfb__an_bytes(const sfb__an *A) {
     double npix = (double)A->w * A->h, grid = (double)A->nf * A->per;
-    double per_pixel = 16 + 4 + 4 + 8 + 4 + 1 + 4 + 4 + 1 + 4 + 12 /* buffers, outputs */ + 4 + 12 + 24 + 4 + 16 + 12 /* hits */ +
-                       (A->c->mode == SFB_ANALYZE_CURVATURE ? 24 : 0) /* their first derivatives */ +
-                       (A->c->polygon_based ? 24 : 84 + 16 + 1) /* proxy data or the projection's attempts, marks and neighbour masks */;
+    double per_pixel = 16 + 4 + 4 + 8 + 4 + 1 + 1 + 4 + 4 + 1 + 4 + 12 /* buffers, outputs */ + 4 + 24 + 4 + 16 + 12 /* hits */ +
+                       (A->c->mode == SFB_ANALYZE_CURVATURE ? 24 + 12 + 36 : 0) /* their first and second derivatives */ +
+                       (A->c->polygon_based ? 24 : 92 + 16 + 1) /* proxy data or the projection's attempts, marks and neighbour masks */;
     return npix * per_pixel + grid * (24.0 + sizeof(sfb__raster_vertex) + 2 * 4 * sizeof(int)) + 65536.0 * sizeof(sfb_location) + (double)A->nf * 4 * (sizeof(int) + sizeof(sfb__an_side));
 }
 
@@ -1624,12 +1644,12 @@ static int sfb__an_alloc(sfb__an *A) {
     A->cuv = (float *)sfb__an_get(A, SFB__WS_CUV, npix * 2 * sizeof(float), NULL);
     A->cdist = (float *)sfb__an_get(A, SFB__WS_CDIST, npix * sizeof(float), NULL);
     A->state = (unsigned char *)sfb__an_get_zeroed(A, SFB__WS_STATE, npix);
+    A->cand = (unsigned char *)sfb__an_get(A, SFB__WS_CAND, npix, NULL);
     if (A->c->polygon_based) {
         A->ppos = (float *)sfb__an_get(A, SFB__WS_PPOS, npix * 3 * sizeof(float), NULL);
         A->pnrm = (float *)sfb__an_get(A, SFB__WS_PNRM, npix * 3 * sizeof(float), NULL);
     }
     A->hpix = (int *)sfb__an_get(A, SFB__WS_HPIX, npix * sizeof(int), NULL);
-    A->hloc = (sfb_location *)sfb__an_get(A, SFB__WS_HLOC, npix * sizeof(sfb_location), NULL);
     A->hpos = (float *)sfb__an_get(A, SFB__WS_HPOS, npix * 3 * sizeof(float), NULL);
     if (A->c->mode == SFB_ANALYZE_CURVATURE) { /* the first derivatives: only curvature reads them after the projection */
         A->hdu = (float *)sfb__an_get(A, SFB__WS_HDU, npix * 3 * sizeof(float), NULL);
@@ -1640,8 +1660,8 @@ static int sfb__an_alloc(sfb__an *A) {
     A->hinv = (float *)sfb__an_get(A, SFB__WS_HINV, npix * 4 * sizeof(float), NULL);
     A->hl = (sfb_location *)sfb__an_get(A, SFB__WS_HL, npix * sizeof(sfb_location), NULL);
     A->chg = (int *)sfb__an_get(A, SFB__WS_CHG, (npix + 1) * sizeof(int), NULL);
-    if (!A->gpos || !A->gnrm || !A->rv || !A->rtri || !A->depth || !A->face || !A->uv || !A->hit || !A->adj || !A->cface || !A->cuv || !A->cdist || !A->state ||
-        (A->c->polygon_based && (!A->ppos || !A->pnrm)) || !A->hpix || !A->hloc || !A->hpos || (A->c->mode == SFB_ANALYZE_CURVATURE && (!A->hdu || !A->hdv)) || !A->hnrm || !A->hdepth ||
+    if (!A->gpos || !A->gnrm || !A->rv || !A->rtri || !A->depth || !A->face || !A->uv || !A->hit || !A->adj || !A->cface || !A->cuv || !A->cdist || !A->state || !A->cand ||
+        (A->c->polygon_based && (!A->ppos || !A->pnrm)) || !A->hpix || !A->hpos || (A->c->mode == SFB_ANALYZE_CURVATURE && (!A->hdu || !A->hdv)) || !A->hnrm || !A->hdepth ||
         !A->hinv || !A->hl || !A->chg)
         return 0;
     sfb__an_run(A, sfb__an_clear_rows, A, 0, A->h, (double)npix * 0.1);
@@ -1671,11 +1691,14 @@ static sfb_result sfb__an_values(sfb__an *A, sfb__an_look *L, float *hv1, float 
     L->job.value = hv1; L->job.value2 = hv2;
     if (c->mode == SFB_ANALYZE_CURVATURE && A->nhit > 0) {
         sfb_eval_output o;
+        sfb_location *loc = (sfb_location *)sfb__an_get(A, SFB__WS_HLOC, (size_t)A->nhit * sizeof(sfb_location), NULL);
         sec = (float *)sfb__an_get(A, SFB__WS_SEC, (size_t)A->nhit * 9 * sizeof(float), NULL);
-        if (!sec) return sfb__oom(A->ctx, "the analysis second derivatives");
+        if (!sec || !loc) { sfb__an_put(A, loc); sfb__an_put(A, sec); return sfb__oom(A->ctx, "the analysis second derivatives"); }
+        for (k = 0; k < A->nhit; ++k) loc[k] = A->hl[A->hpix[k]]; /* the hits' locations, in slot order */
         memset(&o, 0, sizeof o);
         o.duu = sec; o.duv = sec + 3 * (size_t)A->nhit; o.dvv = sec + 6 * (size_t)A->nhit;
-        r = sfb__surface_eval_unchecked(A->s, A->hloc, A->nhit, &o);
+        r = sfb__surface_eval_unchecked(A->s, loc, A->nhit, &o);
+        sfb__an_put(A, loc);
         L->job.duu = o.duu; L->job.duv = o.duv; L->job.dvv = o.dvv;
         /* curvature is the geometry's: where the normals come from a field of their own (PN
          * triangles' quadratic normals), the second fundamental form takes du x dv instead */
@@ -1703,20 +1726,29 @@ static sfb_result sfb__an_values(sfb__an *A, sfb__an_look *L, float *hv1, float 
     return r;
 }
 
-/* The picture's per-pixel outputs on rows [y0, y1) before the hits are written: no value, no hit. */
+/* The picture's per-pixel values and hits on rows [y0, y1): the pixel's hit's, else no value,
+ * no hit. */
 typedef struct sfb__an_fill_job {
     const sfb__an *A;
+    const float *hv1, *hv2;
     float *v1, *v2;
     sfb_location *hits;
 } sfb__an_fill_job;
 
 static void sfb__an_fill_picture(void *arg, int y0, int y1) {
     const sfb__an_fill_job *J = (const sfb__an_fill_job *)arg;
-    size_t p, end = (size_t)y1 * (size_t)J->A->w;
-    for (p = (size_t)y0 * (size_t)J->A->w; p < end; ++p) {
-        J->v1[p] = J->v2[p] = NAN;
-        J->hits[p].face = -1;
-        J->hits[p].u = J->hits[p].v = 0.0f;
+    const sfb__an *A = J->A;
+    size_t p, end = (size_t)y1 * (size_t)A->w;
+    for (p = (size_t)y0 * (size_t)A->w; p < end; ++p) {
+        const int k = A->hit[p];
+        if (k >= 0) {
+            J->v1[p] = J->hv1[k]; J->v2[p] = J->hv2[k];
+            J->hits[p] = A->hl[p];
+        } else {
+            J->v1[p] = J->v2[p] = NAN;
+            J->hits[p].face = -1;
+            J->hits[p].u = J->hits[p].v = 0.0f;
+        }
     }
 }
 
@@ -1733,13 +1765,11 @@ static sfb_result sfb__an_picture(sfb__an *A, sfb__an_look *L, const float *hv1,
     if (!v1 || !v2 || !rgba || !cls || !hits) { r = sfb__oom(ctx, "the analysis picture"); goto done; }
     {
         sfb__an_fill_job F;
-        F.A = A; F.v1 = v1; F.v2 = v2; F.hits = hits;
+        F.A = A; F.hv1 = hv1; F.hv2 = hv2; F.v1 = v1; F.v2 = v2; F.hits = hits;
         sfb__an_run(A, sfb__an_fill_picture, &F, 0, A->h, (double)npix * 0.1);
     }
     out->value_min = (float)HUGE_VAL; out->value_max = (float)-HUGE_VAL;
     for (k = 0; k < A->nhit; ++k) {
-        int q = A->hpix[k];
-        v1[q] = hv1[k]; v2[q] = hv2[k]; hits[q] = A->hloc[k];
         if (isfinite(hv1[k])) {
             if (hv1[k] < out->value_min) out->value_min = hv1[k];
             if (hv1[k] > out->value_max) out->value_max = hv1[k];
@@ -1776,7 +1806,7 @@ SFB_API sfb_result sfb_surface_analyze(const sfb_surface *s, const sfb_analyze_c
     sfb__an A;
     sfb__an_look L;
     sfb_context *ctx;
-    size_t npix, p;
+    size_t npix;
     float *hv1 = NULL, *hv2 = NULL;
     sfb_result r;
     int level = 0, k, fallback = 0, dropped = 0, proxy_pixels = 0, grown = 0;
@@ -1813,7 +1843,17 @@ SFB_API sfb_result sfb_surface_analyze(const sfb_surface *s, const sfb_analyze_c
     sfb__an_camera(&A);
     if (!c.polygon_based && (r = sfb__an_adjacency(&A)) != SFB_SUCCESS) goto done;
     if ((r = sfb__an_raster(&A)) != SFB_SUCCESS) goto done;
-    for (p = 0; p < npix; ++p) proxy_pixels += A.face[p] >= 0;
+    {
+        /* the candidates of the projection and the proxy's pixels, row by row over the threads */
+        sfb__an_cand_job J;
+        int y;
+        J.A = &A;
+        J.rowcnt = (int *)sfb__alloc(ctx, ((size_t)A.h + 1) * sizeof(int));
+        if (!J.rowcnt) { r = sfb__oom(ctx, "the analysis rows"); goto done; }
+        sfb__an_run(&A, sfb__an_candidates, &J, 0, A.h, (double)npix * 0.2);
+        for (y = 0; y < A.h; ++y) proxy_pixels += J.rowcnt[y];
+        sfb__free(ctx, J.rowcnt);
+    }
     if ((r = sfb__progress(ctx, 0.3f, "analyze")) != SFB_SUCCESS) goto done;
     /* 2: onto the exact surface (or the polygon-based data) */
     if (c.polygon_based) sfb__an_polygon_hits(&A);
