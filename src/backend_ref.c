@@ -193,16 +193,17 @@ void sfb__raster_rows(const sfb__raster_job *j, int row0, int row1) {
             for (k = 0; k < 3; ++k) e[k] = t.ea[k] * (t.x0 + 0.5) + t.eb[k] * py + t.ec[k];
             for (x = t.x0; x <= t.x1; ++x, e[0] += t.ea[0], e[1] += t.ea[1], e[2] += t.ea[2]) {
                 const size_t pix = (size_t)y * (size_t)j->w + (size_t)x;
-                double b[3], den, z;
+                double b[3], den, inv, z;
                 /* the inside pixels of a row are one run: the first outside one after it ends the row */
                 if (e[0] < 0.0 || e[1] < 0.0 || e[2] < 0.0) { if (in) break; continue; }
                 in = 1;
                 b[0] = e[0]; b[1] = e[1]; b[2] = e[2];
                 den = b[0] * S[0]->q + b[1] * S[1]->q + b[2] * S[2]->q;
                 if (!(den > 0.0)) continue;
-                z = j->ortho ? b[0] * S[0]->z + b[1] * S[1]->z + b[2] * S[2]->z : 1.0 / den;
+                inv = 1.0 / den;
+                z = j->ortho ? b[0] * S[0]->z + b[1] * S[1]->z + b[2] * S[2]->z : inv;
                 if (!(z < (double)j->depth[pix])) continue;
-                for (k = 0; k < 3; ++k) b[k] *= S[k]->q / den;
+                for (k = 0; k < 3; ++k) b[k] *= S[k]->q * inv;
                 j->depth[pix] = (float)z;
                 j->face[pix] = tv[3];
                 j->uv[2 * pix] = (float)sfb__rclamp(b[0] * S[0]->u + b[1] * S[1]->u + b[2] * S[2]->u, 0.0, 1.0);
