@@ -113,11 +113,11 @@ static int sfb__an_jacobian(const sfb__an_cam *c, const double *p, const double 
         d[0] = p[0] - c->eye[0]; d[1] = p[1] - c->eye[1]; d[2] = p[2] - c->eye[2];
         xc = sfb__rdot(d, c->right); yc = sfb__rdot(d, c->up); zc = sfb__rdot(d, c->fwd);
         tuz = sfb__rdot(tu, c->fwd); tvz = sfb__rdot(tv, c->fwd);
-        zz = zc * zc;
-        j[0] = c->focal * (tux * zc - xc * tuz) / zz;
-        j[2] = -c->focal * (tuy * zc - yc * tuz) / zz;
-        j[1] = c->focal * (tvx * zc - xc * tvz) / zz;
-        j[3] = -c->focal * (tvy * zc - yc * tvz) / zz;
+        zz = c->focal / (zc * zc);
+        j[0] = (tux * zc - xc * tuz) * zz;
+        j[2] = -(tuy * zc - yc * tuz) * zz;
+        j[1] = (tvx * zc - xc * tvz) * zz;
+        j[3] = -(tvy * zc - yc * tvz) * zz;
     }
     *det = j[0] * j[3] - j[1] * j[2];
     return fabs(*det) > 1e-18 && isfinite(*det);
@@ -1078,8 +1078,8 @@ static void sfb__an_seed_rows(void *arg, int a, int b) {
 /* Which of hit pixel pix's 8 neighbours (bit i: the i-th of dy, dx = -1..1 in order, the
  * middle skipped) its hit would seed: not hit yet, or hit on another face at least 1 % of the
  * bounding radius farther away. */
-static unsigned char sfb__an_neighbour_mask(const sfb__an *A, int pix) {
-    const int x = pix % A->w, y = pix / A->w, f = A->hl[pix].face;
+static unsigned char sfb__an_neighbour_mask(const sfb__an *A, int x, int y) {
+    const int pix = y * A->w + x, f = A->hl[pix].face;
     int dx, dy, bit = 0, m = 0;
     for (dy = -1; dy <= 1; ++dy)
         for (dx = -1; dx <= 1; ++dx) {
@@ -1100,15 +1100,22 @@ static unsigned char sfb__an_neighbour_mask(const sfb__an *A, int pix) {
 static void sfb__an_neighbours(void *arg, int a, int b) {
     sfb__an *A = (sfb__an *)arg;
     int ci;
-    for (ci = a; ci < b; ++ci) A->nbm[ci] = sfb__an_neighbour_mask(A, A->hpix[A->chg[ci]]);
+    for (ci = a; ci < b; ++ci) {
+        const int pix = A->hpix[A->chg[ci]];
+        A->nbm[ci] = sfb__an_neighbour_mask(A, pix % A->w, pix / A->w);
+    }
 }
 
 /* The same per pixel on rows [y0, y1), 0 where no hit (round 1: every hit is a change, read
  * row by row here). */
 static void sfb__an_neighbour_rows(void *arg, int y0, int y1) {
     sfb__an *A = (sfb__an *)arg;
-    size_t p, end = (size_t)y1 * (size_t)A->w;
-    for (p = (size_t)y0 * (size_t)A->w; p < end; ++p) A->nbm[p] = A->hit[p] >= 0 ? sfb__an_neighbour_mask(A, (int)p) : 0;
+    int x, y;
+    for (y = y0; y < y1; ++y)
+        for (x = 0; x < A->w; ++x) {
+            const size_t p = (size_t)y * (size_t)A->w + (size_t)x;
+            A->nbm[p] = A->hit[p] >= 0 ? sfb__an_neighbour_mask(A, x, y) : 0;
+        }
 }
 
 /* Step 2 over every round (see the file's comment). */
@@ -1312,8 +1319,8 @@ static sfb_result sfb__an_leftovers(sfb__an *A, int *fallback, int *dropped) {
 /* ---- step 4: colours ---- */
 /* The footprint of pixel pix in units of the value in v: per axis the smaller one-sided
  * difference (robust at silhouettes and band ends), summed. */
-static double sfb__an_footprint(const float *v, int w, int h, int pix) {
-    int x = pix % w, y = pix / w;
+static double sfb__an_footprint(const float *v, int w, int h, int x, int y) {
+    const int pix = y * w + x;
     double c = v[pix], dx = HUGE_VAL, dy = HUGE_VAL, d;
     if (x > 0 && isfinite(v[pix - 1])) { d = fabs(c - v[pix - 1]); if (d < dx) dx = d; }
     if (x + 1 < w && isfinite(v[pix + 1])) { d = fabs(c - v[pix + 1]); if (d < dx) dx = d; }
@@ -1484,8 +1491,8 @@ static void sfb__an_colour(void *arg, int y0, int y1) {
     unsigned char *rgba = J->rgba, *cls = J->cls;
     const sfb_analyze_config *c = A->c;
     size_t p, end = (size_t)y1 * (size_t)A->w;
-    int mode = c->mode;
-    for (p = (size_t)y0 * (size_t)A->w; p < end; ++p) {
+    int mode = c->mode, x = 0, y = y0; /* p's column and row */
+    for (p = (size_t)y0 * (size_t)A->w; p < end; ++p, x = x + 1 == A->w ? 0 : x + 1, y += x == 0) {
         int k = A->hit[p], i, cl = 2;
         double rgb[3] = { 0.0, 0.0, 0.0 }, n[3], diff, a = v1[p];
         unsigned char *o = rgba + 4 * p;
@@ -1514,7 +1521,7 @@ static void sfb__an_colour(void *arg, int y0, int y1) {
                 for (i = 0; i < 3; ++i) rgb[i] = base * (1.0 - t[3]) + t[i] * t[3];
                 cl = 2 + (0.299 * t[0] + 0.587 * t[1] + 0.114 * t[2] >= 0.5);
             } else {
-                double fa = sfb__an_footprint(v1, A->w, A->h, (int)p), fb = sfb__an_footprint(v2, A->w, A->h, (int)p);
+                double fa = sfb__an_footprint(v1, A->w, A->h, x, y), fb = sfb__an_footprint(v2, A->w, A->h, x, y);
                 double cover = sfb__an_pattern(L, a, v2[p], fa, fb, &cl);
                 if (mode == SFB_ANALYZE_REFLECTION) {
                     double dark = 0.07 + 0.16 * diff;
@@ -1527,13 +1534,13 @@ static void sfb__an_colour(void *arg, int y0, int y1) {
             }
             break;
         case SFB_ANALYZE_ZEBRA: {
-            double fa = sfb__an_footprint(v1, A->w, A->h, (int)p), cover = sfb__band_cover(a, fa, 0.0, L->width);
+            double fa = sfb__an_footprint(v1, A->w, A->h, x, y), cover = sfb__band_cover(a, fa, 0.0, L->width);
             cl = (a - floor(a)) < L->width ? 3 : 2;
             for (i = 0; i < 3; ++i) rgb[i] = 0.04 + 0.92 * cover;
             break;
         }
         case SFB_ANALYZE_ISOPHOTE: {
-            double N = L->job.periods[0], x = (sfb__rclamp(a, -1.0, 1.0) + 1.0) * 0.5 * N, fx = sfb__an_footprint(v1, A->w, A->h, (int)p) * 0.5 * N;
+            double N = L->job.periods[0], x = (sfb__rclamp(a, -1.0, 1.0) + 1.0) * 0.5 * N, fx = sfb__an_footprint(v1, A->w, A->h, x, y) * 0.5 * N;
             double kb = floor(x), f = x - kb, c0[3], c1[3], m = 0.0;
             int kk = (int)kb, nb = kk;
             if (kk >= (int)N) kk = (int)N - 1;
