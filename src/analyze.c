@@ -681,11 +681,12 @@ static sfb_result sfb__an_raster(sfb__an *A) {
 
 /* ---- step 2: Newton projection, in batches ---- */
 typedef struct sfb__an_try {
-    int pix, x, y, steps, pinned, crossed, outcome;   /* the pixel, its column and row; outcome: 0 running, 1 hit, 2 near, 3 miss (SFB__AN_OUT_NEW_HIT: a hit
-                                                   sfb__an_newton has yet to record) */
-    double res, res2;  /* the residual of the last evaluation, and of the one before (pixels) */
-    double z;          /* a new hit's depth */
+    int pix, x, y;     /* the pixel, its column and row */
     int k;             /* its hit slot (round 0, sfb__an_fresh) */
+    double z;          /* a new hit's depth */
+    float res, res2;   /* the residual of the last evaluation, and of the one before (pixels) */
+    unsigned char pinned, crossed; /* steps against the border, face crossings */
+    unsigned char outcome; /* 0 running, 1 hit, 2 near, 3 miss (SFB__AN_OUT_NEW_HIT: a hit the caller has yet to record) */
 } sfb__an_try;
 
 /* A new hit slot for pixel pix (not hit yet). */
@@ -804,13 +805,13 @@ static void sfb__an_step(void *arg, int a, int b) {
          * over a pixel (a pixel off the exact silhouette, or across a face it cannot reach)
          * stops as a miss instead of running out its steps (at half a pixel, a few more
          * silhouette pixels were dropped on catmark_car and spot) */
-        if (ok && it >= 2 && res > 1.0 && !(res < 0.5 * t->res2)) { t->res = res; t->outcome = 3; continue; }
+        if (ok && it >= 2 && res > 1.0 && !(res < 0.5 * t->res2)) { t->res = (float)res; t->outcome = 3; continue; }
         /* and one within a pixel of the pixel but not converging (not halved over two steps by
          * its fifth evaluation: beside a silhouette, where round 1 tries thousands of pixels)
          * stops too, as near or a miss (catmark_car: round 1's evaluations -15 %, coverage the same) */
-        if (ok && it >= 4 && res > 0.05 && !(res < 0.5 * t->res2)) { t->res = res; t->outcome = res < SFB__AN_NEAR ? 2 : 3; continue; }
+        if (ok && it >= 4 && res > 0.05 && !(res < 0.5 * t->res2)) { t->res = (float)res; t->outcome = res < SFB__AN_NEAR ? 2 : 3; continue; }
         t->res2 = t->res;
-        t->res = res;
+        t->res = (float)res;
         if (ok && res < SFB__AN_TOL) { t->z = z; t->outcome = SFB__AN_OUT_NEW_HIT; continue; }
         if (!ok || it == steps) { t->outcome = ok && res < SFB__AN_NEAR ? 2 : 3; continue; }
         if (!sfb__an_jacobian(&A->cam, p, tu, tv, jac, &det)) { t->outcome = res < SFB__AN_NEAR ? 2 : 3; continue; }
@@ -836,7 +837,6 @@ static void sfb__an_step(void *arg, int a, int b) {
         l->u = (float)u;
         l->v = (float)v;
         if (A->tri && (double)l->u + (double)l->v > 1.0) l->v = nextafterf(l->v, 0.0f);
-        ++t->steps;
     }
 }
 
