@@ -2314,7 +2314,7 @@ void sfb__raster_rows(const sfb__raster_job *j, int row0, int row1) {
                 const size_t pix = (size_t)y * (size_t)j->w + (size_t)x;
                 double b[3], den, inv, z;
                 /* the inside pixels of a row are one run: the first outside one after it ends the row */
-                if (e[0] < 0.0 || e[1] < 0.0 || e[2] < 0.0) { if (in) break; continue; }
+                if (!((e[0] >= 0.0) & (e[1] >= 0.0) & (e[2] >= 0.0))) { if (in) break; continue; }
                 in = 1;
                 b[0] = e[0]; b[1] = e[1]; b[2] = e[2];
                 den = b[0] * S[0]->q + b[1] * S[1]->q + b[2] * S[2]->q;
