@@ -1491,8 +1491,8 @@ static void sfb__an_colour(void *arg, int y0, int y1) {
     unsigned char *rgba = J->rgba, *cls = J->cls;
     const sfb_analyze_config *c = A->c;
     size_t p, end = (size_t)y1 * (size_t)A->w;
-    int mode = c->mode, x = 0, y = y0; /* p's column and row */
-    for (p = (size_t)y0 * (size_t)A->w; p < end; ++p, x = x + 1 == A->w ? 0 : x + 1, y += x == 0) {
+    int mode = c->mode, col = 0, row = y0; /* p's column and row */
+    for (p = (size_t)y0 * (size_t)A->w; p < end; ++p, col = col + 1 == A->w ? 0 : col + 1, row += col == 0) {
         int k = A->hit[p], i, cl = 2;
         double rgb[3] = { 0.0, 0.0, 0.0 }, n[3], diff, a = v1[p];
         unsigned char *o = rgba + 4 * p;
@@ -1521,7 +1521,7 @@ static void sfb__an_colour(void *arg, int y0, int y1) {
                 for (i = 0; i < 3; ++i) rgb[i] = base * (1.0 - t[3]) + t[i] * t[3];
                 cl = 2 + (0.299 * t[0] + 0.587 * t[1] + 0.114 * t[2] >= 0.5);
             } else {
-                double fa = sfb__an_footprint(v1, A->w, A->h, x, y), fb = sfb__an_footprint(v2, A->w, A->h, x, y);
+                double fa = sfb__an_footprint(v1, A->w, A->h, col, row), fb = sfb__an_footprint(v2, A->w, A->h, col, row);
                 double cover = sfb__an_pattern(L, a, v2[p], fa, fb, &cl);
                 if (mode == SFB_ANALYZE_REFLECTION) {
                     double dark = 0.07 + 0.16 * diff;
@@ -1534,13 +1534,13 @@ static void sfb__an_colour(void *arg, int y0, int y1) {
             }
             break;
         case SFB_ANALYZE_ZEBRA: {
-            double fa = sfb__an_footprint(v1, A->w, A->h, x, y), cover = sfb__band_cover(a, fa, 0.0, L->width);
+            double fa = sfb__an_footprint(v1, A->w, A->h, col, row), cover = sfb__band_cover(a, fa, 0.0, L->width);
             cl = (a - floor(a)) < L->width ? 3 : 2;
             for (i = 0; i < 3; ++i) rgb[i] = 0.04 + 0.92 * cover;
             break;
         }
         case SFB_ANALYZE_ISOPHOTE: {
-            double N = L->job.periods[0], x = (sfb__rclamp(a, -1.0, 1.0) + 1.0) * 0.5 * N, fx = sfb__an_footprint(v1, A->w, A->h, x, y) * 0.5 * N;
+            double N = L->job.periods[0], x = (sfb__rclamp(a, -1.0, 1.0) + 1.0) * 0.5 * N, fx = sfb__an_footprint(v1, A->w, A->h, col, row) * 0.5 * N;
             double kb = floor(x), f = x - kb, c0[3], c1[3], m = 0.0;
             int kk = (int)kb, nb = kk;
             if (kk >= (int)N) kk = (int)N - 1;
