@@ -5,6 +5,13 @@
 #include <stdlib.h>
 #include <string.h>
 #include <math.h>
+/* Transparent huge pages for the default allocator's big blocks (sfb__alloc): madvise and
+ * MADV_HUGEPAGE are declared when the implementation's translation unit sees the BSD/GNU names
+ * (C++, gnu99/gnu11, or _DEFAULT_SOURCE defined first); under strict -std=c99 they are not, and
+ * the advice is simply left out. SFB_NO_HUGE_PAGES leaves it out everywhere. */
+#if defined(__linux__) && !defined(SFB_NO_HUGE_PAGES)
+#  include <sys/mman.h>
+#endif
 
 #ifndef SFB__PI
 #define SFB__PI 3.14159265358979323846
