@@ -223,6 +223,7 @@ typedef struct sfb__an {
     float *gpos, *gnrm;
     sfb__raster_vertex *rv;      /* the grid points in the picture */
     int *rtri, ntri;             /* the proxy's triangles (sfb__raster_job) */
+    float *zmax;                 /* the raster's scratch (sfb__raster_job) */
     /* per pixel */
     float *depth;                /* +inf: empty */
     int *face;                   /* proxy face, -1: none */
@@ -252,7 +253,7 @@ enum {
     SFB__WS_GPOS, SFB__WS_GNRM, SFB__WS_RV, SFB__WS_RTRI, SFB__WS_DEPTH, SFB__WS_FACE, SFB__WS_UV, SFB__WS_HIT, SFB__WS_CFACE,
     SFB__WS_CUV, SFB__WS_CDIST, SFB__WS_STATE, SFB__WS_PPOS, SFB__WS_PNRM, SFB__WS_HPIX, SFB__WS_HLOC, SFB__WS_HPOS, SFB__WS_HDU,
     SFB__WS_HDV, SFB__WS_HNRM, SFB__WS_HDEPTH, SFB__WS_CHG, SFB__WS_TRIES, SFB__WS_LOCS, SFB__WS_BUF, SFB__WS_MARK, SFB__WS_ROWAT,
-    SFB__WS_NBM, SFB__WS_HV1, SFB__WS_HV2, SFB__WS_V2, SFB__WS_SEC, SFB__WS_HINV, SFB__WS_HL, SFB__WS_CAND, SFB__WS_COUNT
+    SFB__WS_NBM, SFB__WS_HV1, SFB__WS_HV2, SFB__WS_V2, SFB__WS_SEC, SFB__WS_HINV, SFB__WS_HL, SFB__WS_CAND, SFB__WS_ZMAX, SFB__WS_COUNT
 };
 struct sfb_analysis_workspace {
     sfb_context *ctx;
@@ -529,23 +530,29 @@ static void sfb__an_seed_tri(sfb__an *A, const int *tv, int row0, int row1) {
     const sfb__raster_vertex *S[3];
     const float *P[3];
     sfb__raster_edges t;
-    double longest, e1[3], e2[3], cr[3], a3, sc;
+    double area, longest, elen[3], e1[3], e2[3], cr[3], a3, sc;
     int k, x, y;
     for (k = 0; k < 3; ++k) {
         S[k] = &A->rv[tv[k]];
         P[k] = A->gpos + 3 * (size_t)tv[k];
     }
-    if (!sfb__raster_setup(S, A->w, A->h, SFB__AN_DILATE, &t)) return;
-    if (t.y0 < row0) t.y0 = row0;
-    if (t.y1 > row1 - 1) t.y1 = row1 - 1;
-    if (t.y0 > t.y1) return;
-    longest = t.elen[0] > t.elen[1] ? (t.elen[0] > t.elen[2] ? t.elen[0] : t.elen[2]) : (t.elen[1] > t.elen[2] ? t.elen[1] : t.elen[2]);
+    /* thin or grazing first (most are neither): area as sfb__raster_setup has it */
+    area = (S[1]->x - S[0]->x) * (S[2]->y - S[0]->y) - (S[2]->x - S[0]->x) * (S[1]->y - S[0]->y);
+    for (k = 0; k < 3; ++k) { /* edge k, opposite corner k */
+        const sfb__raster_vertex *p0 = S[(k + 1) % 3], *p1 = S[(k + 2) % 3];
+        elen[k] = sqrt((p1->x - p0->x) * (p1->x - p0->x) + (p1->y - p0->y) * (p1->y - p0->y));
+    }
+    longest = elen[0] > elen[1] ? (elen[0] > elen[2] ? elen[0] : elen[2]) : (elen[1] > elen[2] ? elen[1] : elen[2]);
     for (k = 0; k < 3; ++k) { e1[k] = (double)P[1][k] - P[0][k]; e2[k] = (double)P[2][k] - P[0][k]; }
     sfb__rcross(e1, e2, cr);
     sc = A->cam.ortho ? A->cam.focal : A->cam.focal * 3.0 / (S[0]->z + S[1]->z + S[2]->z);
     a3 = sqrt(sfb__rdot(cr, cr)) * sc * sc; /* twice the area, in pixels, seen face-on */
     /* thin (under 2 pixels high) or grazing (seen at under 20 degrees): near the silhouette */
-    if (!(fabs(t.area) < 2.0 * longest || fabs(t.area) < 0.35 * a3)) return;
+    if (!(fabs(area) < 2.0 * longest || fabs(area) < 0.35 * a3)) return;
+    if (!sfb__raster_setup(S, A->w, A->h, SFB__AN_DILATE, &t)) return;
+    if (t.y0 < row0) t.y0 = row0;
+    if (t.y1 > row1 - 1) t.y1 = row1 - 1;
+    if (t.y0 > t.y1) return;
     for (y = t.y0; y <= t.y1; ++y)
         for (x = t.x0; x <= t.x1; ++x) {
             const double px = x + 0.5, py = y + 0.5;
@@ -555,7 +562,7 @@ static void sfb__an_seed_tri(sfb__an *A, const int *tv, int row0, int row1) {
             for (k = 0; k < 3; ++k) b[k] = t.ea[k] * px + t.eb[k] * py + t.ec[k];
             if (b[0] >= 0.0 && b[1] >= 0.0 && b[2] >= 0.0) continue; /* inside: the raster's pixel */
             for (k = 0; k < 3; ++k)
-                if (b[k] < 0.0 && t.elen[k] > 0.0) { double e = -b[k] * fabs(t.area) / t.elen[k]; if (e > d) d = e; }
+                if (b[k] < 0.0 && elen[k] > 0.0) { double e = -b[k] * fabs(t.area) / elen[k]; if (e > d) d = e; }
             if (!(d <= SFB__AN_DILATE) || !(d < A->cdist[pix])) continue;
             for (k = 0; k < 3; ++k) b[k] = (b[k] < 0.0 ? 0.0 : b[k]) * S[k]->q;
             sum = b[0] + b[1] + b[2];
@@ -621,6 +628,48 @@ static void sfb__an_candidates(void *arg, int y0, int y1) {
     }
 }
 
+/* Step 1b: the proxy's triangles reordered into ord[] (4 ints each) for the raster: those facing
+ * the eye first, then those facing away (each part in rtri's order); the count of the first part.
+ * "Facing" takes the outward side from the sign of the whole proxy's signed volume (+ when it is
+ * about zero). On a closed proxy seen from outside, a view ray's first crossing enters it, so the
+ * triangles facing away are never nearest; on an open one (catmark_car's wheel arches) some are.
+ * Either way the raster draws the first part, then skips the triangles of the second that the
+ * depth already drawn hides over their whole box (sfb__raster_job's nfront and zmax): the same
+ * buffers, but for which of two triangles at exactly equal depth a pixel keeps. */
+static int sfb__an_order(sfb__an *A, int *ord) {
+    unsigned char *away = (unsigned char *)sfb__alloc(A->ctx, (size_t)A->ntri + 1);
+    double vol = 0.0, mag = 0.0;
+    int k, n = 0, sg;
+    if (!away) { memcpy(ord, A->rtri, (size_t)A->ntri * 4 * sizeof(int)); return A->ntri; } /* one part */
+    for (k = 0; k < A->ntri; ++k) {
+        const int *tv = A->rtri + 4 * (size_t)k;
+        double p[3][3], nr[3], d[3], e1[3], e2[3], t;
+        int i, c;
+        for (i = 0; i < 3; ++i)
+            for (c = 0; c < 3; ++c) p[i][c] = (double)A->gpos[3 * (size_t)tv[i] + c] - A->centre[c];
+        for (c = 0; c < 3; ++c) {
+            e1[c] = p[1][c] - p[0][c];
+            e2[c] = p[2][c] - p[0][c];
+            d[c] = A->cam.ortho ? -A->cam.fwd[c] : A->cam.eye[c] - A->centre[c] - p[0][c];
+        }
+        sfb__rcross(e1, e2, nr);
+        t = sfb__rdot(nr, p[0]); /* six times the signed volume of (centre, triangle) */
+        vol += t;
+        mag += fabs(t);
+        away[k] = (unsigned char)(sfb__rdot(nr, d) < 0.0);
+    }
+    sg = vol < -1e-6 * mag; /* 1: the proxy is inward-facing, "away" means facing the eye */
+    for (k = 0; k < A->ntri; ++k)
+        if (away[k] == sg) memcpy(ord + 4 * (size_t)n++, A->rtri + 4 * (size_t)k, 4 * sizeof(int));
+    {
+        int m = n;
+        for (k = 0; k < A->ntri; ++k)
+            if (away[k] != sg) memcpy(ord + 4 * (size_t)m++, A->rtri + 4 * (size_t)k, 4 * sizeof(int));
+    }
+    sfb__free(A->ctx, away);
+    return n;
+}
+
 /* The raster kernel of the context's backend, or ref's. */
 static sfb_result sfb__an_raster_kernel(const sfb__an *A, const sfb__raster_job *job) {
     sfb_context *ctx = A->ctx;
@@ -676,6 +725,9 @@ static sfb_result sfb__an_raster(sfb__an *A) {
     memset(&job, 0, sizeof job);
     job.w = A->w; job.h = A->h; job.ortho = A->cam.ortho;
     job.ntri = A->ntri; job.vert = A->rv; job.tri = A->rtri;
+    job.tri = A->rtri + (size_t)A->nf * (size_t)A->per * 2 * 4;
+    job.nfront = sfb__an_order(A, (int *)job.tri);
+    job.zmax = A->zmax;
     job.depth = A->depth; job.face = A->face; job.uv = A->uv;
     if (A->ppos) { job.apos = A->gpos; job.anrm = A->gnrm; job.pos = A->ppos; job.nrm = A->pnrm; }
     if ((r = sfb__an_raster_kernel(A, &job)) != SFB_SUCCESS) return r;
@@ -1115,11 +1167,24 @@ static void sfb__an_neighbours(void *arg, int a, int b) {
  * row by row here). */
 static void sfb__an_neighbour_rows(void *arg, int y0, int y1) {
     sfb__an *A = (sfb__an *)arg;
+    const int w = A->w;
     int x, y;
     for (y = y0; y < y1; ++y)
-        for (x = 0; x < A->w; ++x) {
-            const size_t p = (size_t)y * (size_t)A->w + (size_t)x;
-            A->nbm[p] = A->hit[p] >= 0 ? sfb__an_neighbour_mask(A, x, y) : 0;
+        for (x = 0; x < w; ++x) {
+            const size_t p = (size_t)y * (size_t)w + (size_t)x;
+            if (A->hit[p] < 0) { A->nbm[p] = 0; continue; }
+            if (x > 0 && y > 0 && x + 1 < w && y + 1 < A->h) {
+                /* inside the surface's picture every neighbour is hit on the same face: none
+                 * to seed (the mask's first test), without the general scan */
+                const int f = A->hl[p].face, *hu = A->hit + p - w, *hm = A->hit + p, *hd = A->hit + p + w;
+                const sfb_location *lu = A->hl + p - w, *lm = A->hl + p, *ld = A->hl + p + w;
+                if (((hu[-1] | hu[0] | hu[1] | hm[-1] | hm[1] | hd[-1] | hd[0] | hd[1]) >= 0) && lu[-1].face == f && lu[0].face == f &&
+                    lu[1].face == f && lm[-1].face == f && lm[1].face == f && ld[-1].face == f && ld[0].face == f && ld[1].face == f) {
+                    A->nbm[p] = 0;
+                    continue;
+                }
+            }
+            A->nbm[p] = sfb__an_neighbour_mask(A, x, y);
         }
 }
 
@@ -1528,7 +1593,9 @@ static void sfb__an_colour(void *arg, int y0, int y1) {
                 for (i = 0; i < 3; ++i) rgb[i] = base * (1.0 - t[3]) + t[i] * t[3];
                 cl = 2 + (0.299 * t[0] + 0.587 * t[1] + 0.114 * t[2] >= 0.5);
             } else {
-                double fa = sfb__an_footprint(v1, A->w, A->h, col, row), fb = sfb__an_footprint(v2, A->w, A->h, col, row);
+                /* stripes read only the first value's footprint */
+                double fa = sfb__an_footprint(v1, A->w, A->h, col, row),
+                       fb = L->pattern == SFB_LIGHT_LATTICE || L->pattern == SFB_LIGHT_CIRCLES ? sfb__an_footprint(v2, A->w, A->h, col, row) : 0.0;
                 double cover = sfb__an_pattern(L, a, v2[p], fa, fb, &cl);
                 if (mode == SFB_ANALYZE_REFLECTION) {
                     double dark = 0.07 + 0.16 * diff;
@@ -1614,7 +1681,7 @@ static void sfb__an_free(sfb__an *A) {
     sfb__an_put(A, A->gpos); sfb__an_put(A, A->gnrm); sfb__an_put(A, A->rv); sfb__an_put(A, A->rtri);
     sfb__an_put(A, A->cface); sfb__an_put(A, A->cuv); sfb__an_put(A, A->cdist);
     sfb__an_put(A, A->depth); sfb__an_put(A, A->face); sfb__an_put(A, A->uv); sfb__an_put(A, A->ppos); sfb__an_put(A, A->pnrm);
-    sfb__an_put(A, A->hit); sfb__an_put(A, A->state); sfb__an_put(A, A->cand);
+    sfb__an_put(A, A->hit); sfb__an_put(A, A->state); sfb__an_put(A, A->cand); sfb__an_put(A, A->zmax);
     sfb__an_put(A, A->hpix); sfb__an_put(A, A->hpos); sfb__an_put(A, A->hdu); sfb__an_put(A, A->hdv);
     sfb__an_put(A, A->hnrm); sfb__an_put(A, A->hdepth); sfb__an_put(A, A->hinv); sfb__an_put(A, A->hl); sfb__an_put(A, A->chg);
     sfb__free(A->ctx, A->adj); /* not a workspace buffer: per face */
@@ -1623,10 +1690,10 @@ static void sfb__an_free(sfb__an *A) {
 /* Bytes the analysis will hold at its peak (checked against the budget before allocating). */
 static double sfb__an_bytes(const sfb__an *A) {
     double npix = (double)A->w * A->h, grid = (double)A->nf * A->per;
-    double per_pixel = 16 + 4 + 4 + 8 + 4 + 1 + 1 + 4 + 4 + 1 + 4 + 12 /* buffers, outputs */ + 4 + 24 + 4 + 16 + 12 /* hits */ +
+    double per_pixel = 16 + 4 + 4 + 8 + 4 + 1 + 1 + 1 /* zmax */ + 4 + 4 + 1 + 4 + 12 /* buffers, outputs */ + 4 + 24 + 4 + 16 + 12 /* hits */ +
                        (A->c->mode == SFB_ANALYZE_CURVATURE ? 24 + 12 + 36 : 0) /* their first and second derivatives */ +
                        (A->c->polygon_based ? 24 : 92 + 16 + 1) /* proxy data or the projection's attempts, marks and neighbour masks */;
-    return npix * per_pixel + grid * (24.0 + sizeof(sfb__raster_vertex) + 2 * 4 * sizeof(int)) + 65536.0 * sizeof(sfb_location) + (double)A->nf * 4 * (sizeof(int) + sizeof(sfb__an_side));
+    return npix * per_pixel + grid * (24.0 + sizeof(sfb__raster_vertex) + 2 * 2 * 4 * sizeof(int)) + 65536.0 * sizeof(sfb_location) + (double)A->nf * 4 * (sizeof(int) + sizeof(sfb__an_side));
 }
 
 /* The per-pixel buffers of rows [y0, y1) before the raster: nothing drawn, nothing hit. */
@@ -1647,8 +1714,8 @@ static int sfb__an_alloc(sfb__an *A) {
     A->gpos = (float *)sfb__an_get(A, SFB__WS_GPOS, grid * 3 * sizeof(float), NULL);
     A->gnrm = (float *)sfb__an_get(A, SFB__WS_GNRM, grid * 3 * sizeof(float), NULL);
     A->rv = (sfb__raster_vertex *)sfb__an_get(A, SFB__WS_RV, grid * sizeof(sfb__raster_vertex), NULL);
-    /* at most two triangles per grid point */
-    A->rtri = (int *)sfb__an_get(A, SFB__WS_RTRI, grid * 2 * 4 * sizeof(int), NULL);
+    /* at most two triangles per grid point, then as many in the raster's order (sfb__an_order) */
+    A->rtri = (int *)sfb__an_get(A, SFB__WS_RTRI, grid * 2 * 2 * 4 * sizeof(int), NULL);
     A->depth = (float *)sfb__an_get(A, SFB__WS_DEPTH, npix * sizeof(float), NULL);
     A->face = (int *)sfb__an_get(A, SFB__WS_FACE, npix * sizeof(int), NULL);
     A->uv = (float *)sfb__an_get(A, SFB__WS_UV, npix * 2 * sizeof(float), NULL);
@@ -1659,6 +1726,7 @@ static int sfb__an_alloc(sfb__an *A) {
     A->cdist = (float *)sfb__an_get(A, SFB__WS_CDIST, npix * sizeof(float), NULL);
     A->state = (unsigned char *)sfb__an_get_zeroed(A, SFB__WS_STATE, npix);
     A->cand = (unsigned char *)sfb__an_get(A, SFB__WS_CAND, npix, NULL);
+    A->zmax = (float *)sfb__an_get(A, SFB__WS_ZMAX, (size_t)A->h * (size_t)((A->w + 7) / 8) * sizeof(float) + 1, NULL);
     if (A->c->polygon_based) {
         A->ppos = (float *)sfb__an_get(A, SFB__WS_PPOS, npix * 3 * sizeof(float), NULL);
         A->pnrm = (float *)sfb__an_get(A, SFB__WS_PNRM, npix * 3 * sizeof(float), NULL);
@@ -1674,7 +1742,7 @@ static int sfb__an_alloc(sfb__an *A) {
     A->hinv = (float *)sfb__an_get(A, SFB__WS_HINV, npix * 4 * sizeof(float), NULL);
     A->hl = (sfb_location *)sfb__an_get(A, SFB__WS_HL, npix * sizeof(sfb_location), NULL);
     A->chg = (int *)sfb__an_get(A, SFB__WS_CHG, (npix + 1) * sizeof(int), NULL);
-    if (!A->gpos || !A->gnrm || !A->rv || !A->rtri || !A->depth || !A->face || !A->uv || !A->hit || !A->adj || !A->cface || !A->cuv || !A->cdist || !A->state || !A->cand ||
+    if (!A->gpos || !A->gnrm || !A->rv || !A->rtri || !A->depth || !A->face || !A->uv || !A->hit || !A->adj || !A->cface || !A->cuv || !A->cdist || !A->state || !A->cand || !A->zmax ||
         (A->c->polygon_based && (!A->ppos || !A->pnrm)) || !A->hpix || !A->hpos || (A->c->mode == SFB_ANALYZE_CURVATURE && (!A->hdu || !A->hdv)) || !A->hnrm || !A->hdepth ||
         !A->hinv || !A->hl || !A->chg)
         return 0;

@@ -158,7 +158,6 @@ int sfb__raster_setup(const sfb__raster_vertex *const S[3], int w, int h, double
     inv = 1.0 / t->area;
     for (k = 0; k < 3; ++k) {
         const sfb__raster_vertex *p0 = S[(k + 1) % 3], *p1 = S[(k + 2) % 3];
-        t->elen[k] = sqrt((p1->x - p0->x) * (p1->x - p0->x) + (p1->y - p0->y) * (p1->y - p0->y));
         t->ea[k] = -(p1->y - p0->y) * inv;
         t->eb[k] = (p1->x - p0->x) * inv;
         t->ec[k] = ((p1->y - p0->y) * p0->x - (p1->x - p0->x) * p0->y) * inv;
@@ -166,9 +165,12 @@ int sfb__raster_setup(const sfb__raster_vertex *const S[3], int w, int h, double
     return 1;
 }
 
-void sfb__raster_rows(const sfb__raster_job *j, int row0, int row1) {
+/* Triangles [first, last) of the job on rows [row0, row1); with zmax, each is first tested
+ * against the largest depth per 8 pixels of the rows it spans (sfb__raster_job's hint). */
+static void sfb__raster_range(const sfb__raster_job *j, int row0, int row1, int first, int last, const float *zmax) {
+    const int nb = (j->w + 7) / 8;
     int i;
-    for (i = 0; i < j->ntri; ++i) {
+    for (i = first; i < last; ++i) {
         const int *tv = j->tri + 4 * (size_t)i;
         const sfb__raster_vertex *S[3];
         sfb__raster_edges t;
@@ -182,6 +184,28 @@ void sfb__raster_rows(const sfb__raster_job *j, int row0, int row1) {
         }
         /* no pixel centre of the rows: skipped before the set-up */
         if (!(hi - 0.5 >= (double)row0 && lo - 0.5 <= (double)row1 - 1.0)) continue;
+        if (zmax) {
+            /* hidden over its whole box: every pixel there holds a depth at or below the
+             * triangle's smallest (the interpolated depth is never below its vertices'; the
+             * margin covers rounding), so none would pass the depth test */
+            double zl = S[0]->z, xl = S[0]->x, xh = S[0]->x;
+            int ya, yb, ba, bb, b, hidden = 1;
+            for (k = 1; k < 3; ++k) {
+                if (S[k]->z < zl) zl = S[k]->z;
+                if (S[k]->x < xl) xl = S[k]->x;
+                if (S[k]->x > xh) xh = S[k]->x;
+            }
+            zl -= 1e-6 * fabs(zl);
+            ya = (int)sfb__rclamp(ceil(lo - 0.5), (double)row0, (double)row1);
+            yb = (int)sfb__rclamp(floor(hi - 0.5), (double)row0 - 1.0, (double)row1 - 1.0);
+            ba = (int)sfb__rclamp(ceil(xl - 0.5), 0.0, (double)j->w) / 8;
+            bb = (int)sfb__rclamp(floor(xh - 0.5), -8.0, (double)j->w - 1.0);
+            bb = bb < 0 ? -1 : bb / 8;
+            for (y = ya; y <= yb && hidden; ++y)
+                for (b = ba; b <= bb; ++b)
+                    if (!(zmax[(size_t)y * nb + b] <= zl)) { hidden = 0; break; }
+            if (hidden) continue;
+        }
         if (!sfb__raster_setup(S, j->w, j->h, 0.0, &t)) continue;
         if (t.y0 < row0) t.y0 = row0;
         if (t.y1 > row1 - 1) t.y1 = row1 - 1;
@@ -219,6 +243,27 @@ void sfb__raster_rows(const sfb__raster_job *j, int row0, int row1) {
                 }
             }
         }
+    }
+}
+
+void sfb__raster_rows(const sfb__raster_job *j, int row0, int row1) {
+    const int nf = j->zmax && j->nfront > 0 && j->nfront < j->ntri ? j->nfront : j->ntri;
+    sfb__raster_range(j, row0, row1, 0, nf, NULL);
+    if (nf < j->ntri) {
+        /* the largest depth per 8 pixels of each row (+inf where one is empty), then the rest */
+        const int nb = (j->w + 7) / 8;
+        int y, b, x;
+        for (y = row0; y < row1; ++y) {
+            const float *d = j->depth + (size_t)y * (size_t)j->w;
+            float *m = j->zmax + (size_t)y * (size_t)nb;
+            for (b = 0; b < nb; ++b) {
+                const int xe = 8 * b + 8 < j->w ? 8 * b + 8 : j->w;
+                float mx = d[8 * b];
+                for (x = 8 * b + 1; x < xe; ++x) mx = d[x] > mx ? d[x] : mx;
+                m[b] = mx;
+            }
+        }
+        sfb__raster_range(j, row0, row1, nf, j->ntri, j->zmax);
     }
 }
 

@@ -133,23 +133,27 @@ SFB__IF sfb_result sfb__ref_shade(void *state, const sfb__shade_job *job, int fi
  * to [0, 1]) and, with apos and anrm (3 per vertex each), pos[3 pix..] and nrm[3 pix..].
  * The caller fills depth with +inf and face with -1. Triangles whose screen area is below
  * 1e-12 square pixels cover nothing; kernels may differ from ref on pixels whose centre lies on
- * an edge (GL's tie rule) and by float rounding of the interpolation. */
+ * an edge (GL's tie rule) and by float rounding of the interpolation.
+ * nfront (0: all) and zmax (NULL: none; h rows of (w + 7) / 8 floats of scratch) are a hint: the
+ * triangles from nfront on are likely hidden by those before, and a kernel may skip any whose
+ * pixels would all fail the depth test (ref's: the largest depth per 8 pixels of a row, taken
+ * after the first nfront triangles, against the triangle's smallest vertex depth). */
 typedef struct sfb__raster_vertex { double x, y, z, q, u, v; } sfb__raster_vertex;
 typedef struct sfb__raster_job {
     int w, h, ortho;
-    int ntri;
+    int ntri, nfront;
     const sfb__raster_vertex *vert;
     const float *apos, *anrm; /* NULL, or the vertices' positions and normals to interpolate */
     const int *tri;          /* 4 per triangle: three vertices, the parametric face */
     float *depth;
     int *face;
     float *uv, *pos, *nrm;
+    float *zmax;
 } sfb__raster_job;
-/* A triangle's set-up in the picture: its signed doubled area, edge lengths (edge k opposite
- * corner k), barycentric planes (b_k = ea[k] x + eb[k] y + ec[k]) and the pixel box of the
+/* A triangle's set-up in the picture: its signed doubled area, barycentric planes (b_k = ea[k] x + eb[k] y + ec[k]) and the pixel box of the
  * centres within `grow` pixels of it (x0 > x1 or y0 > y1: none); 0 when it is degenerate. */
 typedef struct sfb__raster_edges {
-    double area, elen[3], ea[3], eb[3], ec[3];
+    double area, ea[3], eb[3], ec[3];
     int x0, x1, y0, y1;
 } sfb__raster_edges;
 SFB__IF int sfb__raster_setup(const sfb__raster_vertex *const S[3], int w, int h, double grow, sfb__raster_edges *t);

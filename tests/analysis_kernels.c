@@ -19,7 +19,10 @@
  *                        overlapping at one depth) in a 97 x 61 picture: simd's face, (u,v) and
  *                        depth buffers are ref's bit for bit; gl's and osmesa's agree on at
  *                        least 99 % of the covered pixels (GL's tie rule on edges, float), their
- *                        depths within 1e-5 relative where the faces agree
+ *                        depths within 1e-5 relative where the faces agree (each target runs
+ *                        with the hint that the second half is likely hidden: nfront, zmax)
+ *   ref/raster/hint/CAMERA  ref's raster with that hint is ref's without it, bit for bit (half of
+ *                        the second half pushed behind, so that the hint skips some)
  * A backend that is unavailable prints one SKIP line (a FAIL when SFB_REQUIRE_BACKENDS names it).
  *
  * Build: cc -std=c99 -I. tests/analysis_kernels.c -o build/analysis_kernels -lm -lpthread -ldl
@@ -176,13 +179,17 @@ static void rjob_random(rjob *R, rng *g, int ortho, int ties) {
     }
 }
 
-static void rjob_run(const rjob *R, rjob *out, int ortho, const sfb__backend_vtable *vt, void *state, sfb_result *r) {
+/* hint: the job says its second half is likely hidden (nfront, zmax: kernels may skip the
+ * triangles there that would draw nothing), which must not change a bit */
+static void rjob_run(const rjob *R, rjob *out, int ortho, const sfb__backend_vtable *vt, void *state, int hint, sfb_result *r) {
+    static float zmax[RH * ((RW + 7) / 8)];
     sfb__raster_job j;
     int p;
     for (p = 0; p < RW * RH; ++p) { out->depth[p] = (float)HUGE_VAL; out->face[p] = -1; out->uv[2 * p] = out->uv[2 * p + 1] = -1.0f; }
     memset(&j, 0, sizeof j);
     j.w = RW; j.h = RH; j.ortho = ortho; j.ntri = NTRI; j.vert = R->vert; j.tri = R->tri;
     j.depth = out->depth; j.face = out->face; j.uv = out->uv;
+    if (hint) { j.nfront = NTRI / 2; j.zmax = zmax; }
     *r = vt ? vt->raster(state, &j) : sfb__ref_raster(NULL, &j);
 }
 
@@ -196,8 +203,8 @@ static void check_raster(const target *t) {
         sfb_result r0, r1;
         snprintf(name, sizeof name, "%s/raster/%s", t->name, ortho ? "orthographic" : "perspective");
         rjob_random(&R, &g, ortho, t->exact);
-        rjob_run(&R, &A, ortho, NULL, NULL, &r0);
-        rjob_run(&R, &B, ortho, t->vt, t->state, &r1);
+        rjob_run(&R, &A, ortho, NULL, NULL, 0, &r0);
+        rjob_run(&R, &B, ortho, t->vt, t->state, 1, &r1);
         if (r0 != SFB_SUCCESS || r1 != SFB_SUCCESS) { fail(name, "%s / %s", sfb_result_string(r0), sfb_result_string(r1)); continue; }
         for (p = 0; p < RW * RH; ++p) {
             if (A.face[p] < 0 && B.face[p] < 0) continue;
@@ -212,6 +219,36 @@ static void check_raster(const target *t) {
         else
             check(same >= 0.99 * cov && zoff <= cov / 1000 && cov > 1000, name, "%ld of %ld covered pixels on ref's face, %ld depths off", same,
                   cov, zoff);
+    }
+}
+
+/* ref/raster/hint/CAMERA: ref's raster with the hint (the second half of the triangles likely
+ * hidden, half of those pushed behind) is ref's without it, bit for bit, ties included */
+static void check_raster_hint(void) {
+    static rjob R, A, B;
+    int ortho, p, t, k;
+    for (ortho = 0; ortho < 2; ++ortho) {
+        char name[160];
+        rng g = rng_for(g_seed, (unsigned long long)(17 + ortho));
+        long cov = 0, bits = 0;
+        sfb_result r0, r1;
+        snprintf(name, sizeof name, "ref/raster/hint/%s", ortho ? "orthographic" : "perspective");
+        rjob_random(&R, &g, ortho, 1);
+        for (t = NTRI / 2; t < NTRI; t += 2)
+            for (k = 0; k < 3; ++k) {
+                sfb__raster_vertex *v = &R.vert[3 * t + k];
+                v->z += 2.0;
+                v->q = ortho ? 1.0 : 1.0 / v->z;
+            }
+        rjob_run(&R, &A, ortho, NULL, NULL, 0, &r0);
+        rjob_run(&R, &B, ortho, NULL, NULL, 1, &r1);
+        if (r0 != SFB_SUCCESS || r1 != SFB_SUCCESS) { fail(name, "%s / %s", sfb_result_string(r0), sfb_result_string(r1)); continue; }
+        for (p = 0; p < RW * RH; ++p) {
+            if (A.face[p] < 0 && B.face[p] < 0) continue;
+            ++cov;
+            bits += A.face[p] != B.face[p] || A.depth[p] != B.depth[p] || A.uv[2 * p] != B.uv[2 * p] || A.uv[2 * p + 1] != B.uv[2 * p + 1];
+        }
+        check(bits == 0 && cov > 1000, name, "%ld of %ld covered pixels differ with the hint", bits, cov);
     }
 }
 
@@ -243,6 +280,7 @@ int main(int argc, char **argv) {
     printf("# seed %llu\n", g_seed);
     g = rng_for(g_seed, 1);
     pixels_random(&px, &g, lm);
+    check_raster_hint();
     snprintf(saved, sizeof saved, "%s", pinned ? pinned : "");
     for (k = 0; k < 5; ++k) {
         if (saved[0] && strcmp(saved, isas[k]) != 0) continue;
