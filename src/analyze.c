@@ -240,7 +240,7 @@ typedef struct sfb__an {
     unsigned char *cand;         /* per pixel: 2 drawn by the proxy (face), 1 seeded beside a thin triangle (cface), 0 neither */
     /* hits (compact) */
     int nhit;
-    int *chg, nchg;              /* hits made or replaced by the last batch of attempts */
+    int *chg, nchg;              /* the pixels of the hits made or replaced by the last batch of attempts */
     unsigned char *nbm;          /* per change: the neighbours it seeds (sfb__an_neighbours) */
     int *hpix;
     float *hpos, *hdu, *hdv, *hnrm, *hdepth; /* hdu, hdv: CURVATURE only (else NULL) */
@@ -253,7 +253,7 @@ enum {
     SFB__WS_GPOS, SFB__WS_GNRM, SFB__WS_RV, SFB__WS_RTRI, SFB__WS_DEPTH, SFB__WS_FACE, SFB__WS_UV, SFB__WS_HIT, SFB__WS_CFACE,
     SFB__WS_CUV, SFB__WS_CDIST, SFB__WS_STATE, SFB__WS_PPOS, SFB__WS_PNRM, SFB__WS_HPIX, SFB__WS_HLOC, SFB__WS_HPOS, SFB__WS_HDU,
     SFB__WS_HDV, SFB__WS_HNRM, SFB__WS_HDEPTH, SFB__WS_CHG, SFB__WS_TRIES, SFB__WS_LOCS, SFB__WS_BUF, SFB__WS_MARK, SFB__WS_ROWAT,
-    SFB__WS_NBM, SFB__WS_HV1, SFB__WS_HV2, SFB__WS_V2, SFB__WS_SEC, SFB__WS_HINV, SFB__WS_HL, SFB__WS_CAND, SFB__WS_ZMAX, SFB__WS_COUNT
+    SFB__WS_NBM, SFB__WS_HV1, SFB__WS_HV2, SFB__WS_V2, SFB__WS_SEC, SFB__WS_HINV, SFB__WS_HL, SFB__WS_CAND, SFB__WS_ZMAX, SFB__WS_NBC, SFB__WS_COUNT
 };
 struct sfb_analysis_workspace {
     sfb_context *ctx;
@@ -574,10 +574,13 @@ static void sfb__an_seed_tri(sfb__an *A, const int *tv, int row0, int row1) {
         }
 }
 
-/* sfb__an_seed_tri over every proxy triangle, on rows [row0, row1) (bands of rows are
- * independent: a pixel's triangles are visited in order within its band). */
-static void sfb__an_seed_rows_tri(void *arg, int row0, int row1) {
+/* sfb__an_seed_tri over every proxy triangle, on the rows of bands [b0, b1) of
+ * SFB__AN_SEED_BANDS (bands of rows are independent: a pixel's triangles are visited in order
+ * within its band; each band scans every triangle, so they are few). */
+#define SFB__AN_SEED_BANDS 8
+static void sfb__an_seed_rows_tri(void *arg, int b0, int b1) {
     sfb__an *A = (sfb__an *)arg;
+    const int row0 = (int)((long long)A->h * b0 / SFB__AN_SEED_BANDS), row1 = (int)((long long)A->h * b1 / SFB__AN_SEED_BANDS);
     const double lo = row0 - 0.5 - SFB__AN_DILATE, hi = row1 + 0.5 + SFB__AN_DILATE;
     int k;
     for (k = 0; k < A->ntri; ++k) {
@@ -732,7 +735,7 @@ static sfb_result sfb__an_raster(sfb__an *A) {
     if (A->ppos) { job.apos = A->gpos; job.anrm = A->gnrm; job.pos = A->ppos; job.nrm = A->pnrm; }
     if ((r = sfb__an_raster_kernel(A, &job)) != SFB_SUCCESS) return r;
     if ((r = sfb__progress(A->ctx, 0.25f, "analyze")) != SFB_SUCCESS) return r;
-    sfb__an_run(A, sfb__an_seed_rows_tri, A, 0, A->h, (double)A->ntri * 4.0);
+    sfb__an_run(A, sfb__an_seed_rows_tri, A, 0, SFB__AN_SEED_BANDS, (double)A->ntri * 4.0);
     return SFB_SUCCESS;
 }
 
@@ -787,7 +790,7 @@ static void sfb__an_add_hit(sfb__an *A, int pix, const sfb_location *loc, double
     } else {
         k = sfb__an_new_slot(A, pix);
     }
-    if ((size_t)A->nchg < (size_t)A->w * (size_t)A->h) A->chg[A->nchg++] = k; /* a pixel listed twice is harmless */
+    if ((size_t)A->nchg < (size_t)A->w * (size_t)A->h) A->chg[A->nchg++] = pix; /* a pixel listed twice is harmless */
     sfb__an_store_hit(A, (size_t)k, loc, z, p, du, dv, n);
 }
 
@@ -1158,21 +1161,41 @@ static void sfb__an_neighbours(void *arg, int a, int b) {
     sfb__an *A = (sfb__an *)arg;
     int ci;
     for (ci = a; ci < b; ++ci) {
-        const int pix = A->hpix[A->chg[ci]];
+        const int pix = A->chg[ci];
         A->nbm[ci] = sfb__an_neighbour_mask(A, pix % A->w, pix / A->w);
     }
 }
 
-/* The same per pixel on rows [y0, y1), 0 where no hit (round 1: every hit is a change, read
- * row by row here). */
+/* The same per pixel on rows [y0, y1) into J->mask, 0 where no hit (round 1: every hit is a
+ * change, read row by row here), and each row's count of masks that are not 0 into
+ * J->rowcnt[y]; with J->list, instead, rows [y0, y1)'s hits of masks not 0, in order, into
+ * A->chg and J->list from J->rowcnt[y] (their first index) on. */
+typedef struct sfb__an_nb_job {
+    sfb__an *A;
+    unsigned char *mask, *list;
+    int *rowcnt;
+} sfb__an_nb_job;
 static void sfb__an_neighbour_rows(void *arg, int y0, int y1) {
-    sfb__an *A = (sfb__an *)arg;
+    const sfb__an_nb_job *J = (const sfb__an_nb_job *)arg;
+    sfb__an *A = J->A;
+    unsigned char *nbm = J->mask;
     const int w = A->w;
     int x, y;
-    for (y = y0; y < y1; ++y)
+    if (J->list) {
+        for (y = y0; y < y1; ++y) {
+            int o = J->rowcnt[y];
+            for (x = 0; x < w; ++x) {
+                const size_t p = (size_t)y * (size_t)w + (size_t)x;
+                if (nbm[p]) { A->chg[o] = (int)p; J->list[o++] = nbm[p]; }
+            }
+        }
+        return;
+    }
+    for (y = y0; y < y1; ++y) {
+        int n = 0;
         for (x = 0; x < w; ++x) {
             const size_t p = (size_t)y * (size_t)w + (size_t)x;
-            if (A->hit[p] < 0) { A->nbm[p] = 0; continue; }
+            if (A->hit[p] < 0) { nbm[p] = 0; continue; }
             if (x > 0 && y > 0 && x + 1 < w && y + 1 < A->h) {
                 /* inside the surface's picture every neighbour is hit on the same face: none
                  * to seed (the mask's first test), without the general scan */
@@ -1180,23 +1203,27 @@ static void sfb__an_neighbour_rows(void *arg, int y0, int y1) {
                 const sfb_location *lu = A->hl + p - w, *lm = A->hl + p, *ld = A->hl + p + w;
                 if (((hu[-1] | hu[0] | hu[1] | hm[-1] | hm[1] | hd[-1] | hd[0] | hd[1]) >= 0) && lu[-1].face == f && lu[0].face == f &&
                     lu[1].face == f && lm[-1].face == f && lm[1].face == f && ld[-1].face == f && ld[0].face == f && ld[1].face == f) {
-                    A->nbm[p] = 0;
+                    nbm[p] = 0;
                     continue;
                 }
             }
-            A->nbm[p] = sfb__an_neighbour_mask(A, x, y);
+            nbm[p] = sfb__an_neighbour_mask(A, x, y);
+            n += nbm[p] != 0;
         }
+        J->rowcnt[y] = n;
+    }
 }
 
 /* Step 2 over every round (see the file's comment). */
 static sfb_result sfb__an_project_all(sfb__an *A, int steps) {
-    size_t npix = (size_t)A->w * (size_t)A->h, p;
+    size_t npix = (size_t)A->w * (size_t)A->h;
     int cap = 0, count = 0, round, part;
     sfb__an_try *tries = NULL;
     sfb_location *locs = NULL;
     float *buf = NULL;
     int *mark = NULL;  /* per pixel: the last round that seeded it, and 3 faces it was seeded from */
     int *rowat = NULL; /* round 0: per grid row, its attempts, then where they start in their band */
+    unsigned char *nbc = NULL; /* round 1's changes' masks (sfb__an_neighbour_rows) */
     int mark_base = 0;
     sfb_result r = SFB_SUCCESS;
     cap = npix < SFB__AN_BATCH ? (int)npix : SFB__AN_BATCH; /* later rounds grow it when they need to */
@@ -1207,6 +1234,7 @@ static sfb_result sfb__an_project_all(sfb__an *A, int steps) {
     buf = (float *)sfb__an_get(A, SFB__WS_BUF, (size_t)cap * 12 * sizeof(float), NULL);
     rowat = (int *)sfb__an_get(A, SFB__WS_ROWAT, ((size_t)A->h + 1) * sizeof(int), NULL);
     A->nbm = (unsigned char *)sfb__an_get(A, SFB__WS_NBM, npix + 1, NULL);
+    nbc = (unsigned char *)sfb__an_get(A, SFB__WS_NBC, npix + 1, NULL);
     /* the marks' round tags are base + round: a workspace's kept marks hold tags of earlier
      * analyses, all at or below its base, which grows by SFB__AN_ROUNDS per analysis (the
      * buffer is zeroed when new, or when the tags would overflow) */
@@ -1222,7 +1250,7 @@ static sfb_result sfb__an_project_all(sfb__an *A, int steps) {
             A->ws->mark_base += SFB__AN_ROUNDS + 1;
         }
     }
-    if (!tries || !locs || !buf || !mark || !rowat || !A->nbm) { r = sfb__oom(A->ctx, "the analysis projection"); goto done; }
+    if (!tries || !locs || !buf || !mark || !rowat || !A->nbm || !nbc) { r = sfb__oom(A->ctx, "the analysis projection"); goto done; }
     /* round 0, in five parts: first the anchors, the pixels whose x and y are multiples of
      * SFB__AN_ANCHOR (4), from their proxy (face, u, v); then, for d = 2 and then 1, the pixels
      * on the grid of spacing d with one coordinate an odd multiple of d, then those with both,
@@ -1277,13 +1305,18 @@ static sfb_result sfb__an_project_all(sfb__an *A, int steps) {
      * seed a neighbour listed in the picture's order (the hit slots lie in round 0's part
      * order, scattered over the picture: scanning them in that order cost a cache miss on
      * every neighbour read) */
-    sfb__an_run(A, sfb__an_neighbour_rows, A, 0, A->h, (double)npix);
-    A->nchg = 0;
-    for (p = 0; p < npix; ++p)
-        if (A->nbm[p]) {
-            A->chg[A->nchg] = A->hit[p];
-            A->nbm[A->nchg++] = A->nbm[p]; /* nchg <= p */
-        }
+    {
+        sfb__an_nb_job N;
+        int y, total = 0;
+        N.A = A; N.mask = A->nbm; N.list = NULL; N.rowcnt = rowat;
+        sfb__an_run(A, sfb__an_neighbour_rows, &N, 0, A->h, (double)npix);
+        for (y = 0; y < A->h; ++y) { const int n = rowat[y]; rowat[y] = total; total += n; }
+        N.list = nbc;
+        sfb__an_run(A, sfb__an_neighbour_rows, &N, 0, A->h, (double)npix * 0.25);
+        A->nchg = total;
+        A->nbm = nbc; /* per change from here on */
+        nbc = N.mask;
+    }
     if ((r = sfb__progress(A->ctx, 0.6f, "analyze")) != SFB_SUCCESS) goto done;
     /* later rounds: the pixels next to the last round's new or nearer hits, seeded by them:
      * pixels not hit yet, and pixels hit on another face at least 1 % of the bounding radius
@@ -1296,9 +1329,9 @@ static sfb_result sfb__an_project_all(sfb__an *A, int steps) {
          * are known), then the seeding in the changes' order, here */
         if (round > 1) sfb__an_run(A, sfb__an_neighbours, A, 0, A->nchg, (double)A->nchg);
         for (ci = 0; ci < A->nchg; ++ci) {
-            int h, pix, x, y, dx, dy, bit = 0;
+            int pix, x, y, dx, dy, bit = 0;
             if (!A->nbm[ci]) continue;
-            h = A->chg[ci]; pix = A->hpix[h]; x = pix % A->w; y = pix / A->w;
+            pix = A->chg[ci]; x = pix % A->w; y = pix / A->w;
             for (dy = -1; dy <= 1; ++dy)
                 for (dx = -1; dx <= 1; ++dx) {
                     int q, k, *mq, f = A->hl[pix].face;
@@ -1344,38 +1377,74 @@ done:
     sfb__an_put(A, mark);
     sfb__an_put(A, rowat);
     sfb__an_put(A, A->nbm);
+    sfb__an_put(A, nbc);
     A->nbm = NULL;
     return r;
 }
 
 /* Proxy pixels left without a hit: NEAR ones fall back to the proxy's point (evaluated there),
  * the others are dropped. polygon_based: every proxy pixel is a "hit" on its interpolated data. */
-static sfb_result sfb__an_leftovers(sfb__an *A, int *fallback, int *dropped) {
-    size_t npix = (size_t)A->w * (size_t)A->h, p;
-    int n = 0, i;
+/* Rows [y0, y1): per row y, its proxy pixels left near (to fall back), left far (dropped) and
+ * its hits off the proxy (grown) into cnt[3 y ..]. */
+typedef struct sfb__an_left_job {
+    const sfb__an *A;
+    int *cnt;
+} sfb__an_left_job;
+static void sfb__an_left_rows(void *arg, int y0, int y1) {
+    const sfb__an_left_job *J = (const sfb__an_left_job *)arg;
+    const sfb__an *A = J->A;
+    int x, y;
+    for (y = y0; y < y1; ++y) {
+        int near = 0, far = 0, grown = 0;
+        for (x = 0; x < A->w; ++x) {
+            const size_t p = (size_t)y * (size_t)A->w + (size_t)x;
+            const int drawn = A->face[p] >= 0, hit = A->hit[p] >= 0;
+            grown += hit && !drawn;
+            if (drawn && !hit) {
+                if (A->state[p] == SFB__AN_TRIED_NEAR) ++near;
+                else ++far;
+            }
+        }
+        J->cnt[3 * y] = near; J->cnt[3 * y + 1] = far; J->cnt[3 * y + 2] = grown;
+    }
+}
+
+static sfb_result sfb__an_leftovers(sfb__an *A, int *fallback, int *dropped, int *grown) {
+    size_t p;
+    int n = 0, i, y;
     sfb_location *loc;
     float *buf;
-    int *pix;
+    int *pix, *cnt = (int *)sfb__alloc(A->ctx, ((size_t)A->h + 1) * 3 * sizeof(int));
     sfb_eval_output out;
     sfb_result r;
-    *fallback = *dropped = 0;
-    for (p = 0; p < npix; ++p)
-        if (A->face[p] >= 0 && A->hit[p] < 0) {
-            if (A->state[p] == SFB__AN_TRIED_NEAR) ++n;
-            else ++*dropped;
-        }
-    if (n == 0) return SFB_SUCCESS;
+    *fallback = *dropped = *grown = 0;
+    if (!cnt) return sfb__oom(A->ctx, "the analysis fallback");
+    {
+        sfb__an_left_job J;
+        J.A = A; J.cnt = cnt;
+        sfb__an_run(A, sfb__an_left_rows, &J, 0, A->h, (double)A->w * A->h * 0.25);
+    }
+    for (y = 0; y < A->h; ++y) { n += cnt[3 * y]; *dropped += cnt[3 * y + 1]; *grown += cnt[3 * y + 2]; }
+    if (n == 0) { sfb__free(A->ctx, cnt); return SFB_SUCCESS; }
     loc = (sfb_location *)sfb__alloc(A->ctx, (size_t)n * sizeof *loc);
     buf = (float *)sfb__alloc(A->ctx, (size_t)n * 12 * sizeof(float));
     pix = (int *)sfb__alloc(A->ctx, (size_t)n * sizeof(int));
-    if (!loc || !buf || !pix) { sfb__free(A->ctx, loc); sfb__free(A->ctx, buf); sfb__free(A->ctx, pix); return sfb__oom(A->ctx, "the analysis fallback"); }
-    for (p = 0, i = 0; p < npix; ++p)
-        if (A->face[p] >= 0 && A->hit[p] < 0 && A->state[p] == SFB__AN_TRIED_NEAR) {
-            pix[i] = (int)p;
-            loc[i].face = A->face[p]; loc[i].u = A->uv[2 * p]; loc[i].v = A->uv[2 * p + 1];
-            if (A->tri && (double)loc[i].u + (double)loc[i].v > 1.0) loc[i].v = nextafterf(loc[i].v, 0.0f);
-            ++i;
-        }
+    if (!loc || !buf || !pix) {
+        sfb__free(A->ctx, loc); sfb__free(A->ctx, buf); sfb__free(A->ctx, pix); sfb__free(A->ctx, cnt);
+        return sfb__oom(A->ctx, "the analysis fallback");
+    }
+    for (y = 0, i = 0; y < A->h; ++y) {
+        const size_t end = ((size_t)y + 1) * (size_t)A->w;
+        if (!cnt[3 * y]) continue;
+        for (p = (size_t)y * (size_t)A->w; p < end; ++p)
+            if (A->face[p] >= 0 && A->hit[p] < 0 && A->state[p] == SFB__AN_TRIED_NEAR) {
+                pix[i] = (int)p;
+                loc[i].face = A->face[p]; loc[i].u = A->uv[2 * p]; loc[i].v = A->uv[2 * p + 1];
+                if (A->tri && (double)loc[i].u + (double)loc[i].v > 1.0) loc[i].v = nextafterf(loc[i].v, 0.0f);
+                ++i;
+            }
+    }
+    sfb__free(A->ctx, cnt);
     memset(&out, 0, sizeof out);
     out.position = buf; out.du = buf + 3 * (size_t)n; out.dv = buf + 6 * (size_t)n; out.normal = buf + 9 * (size_t)n;
     r = sfb__surface_eval_unchecked(A->s, loc, n, &out);
@@ -1692,7 +1761,7 @@ static double sfb__an_bytes(const sfb__an *A) {
     double npix = (double)A->w * A->h, grid = (double)A->nf * A->per;
     double per_pixel = 16 + 4 + 4 + 8 + 4 + 1 + 1 + 1 /* zmax */ + 4 + 4 + 1 + 4 + 12 /* buffers, outputs */ + 4 + 24 + 4 + 16 + 12 /* hits */ +
                        (A->c->mode == SFB_ANALYZE_CURVATURE ? 24 + 12 + 36 : 0) /* their first and second derivatives */ +
-                       (A->c->polygon_based ? 24 : 92 + 16 + 1) /* proxy data or the projection's attempts, marks and neighbour masks */;
+                       (A->c->polygon_based ? 24 : 92 + 16 + 2) /* proxy data or the projection's attempts, marks and neighbour masks */;
     return npix * per_pixel + grid * (24.0 + sizeof(sfb__raster_vertex) + 2 * 2 * 4 * sizeof(int)) + 65536.0 * sizeof(sfb_location) + (double)A->nf * 4 * (sizeof(int) + sizeof(sfb__an_side));
 }
 
@@ -1835,6 +1904,30 @@ static void sfb__an_fill_picture(void *arg, int y0, int y1) {
 }
 
 /* Step 4: the picture and its per-pixel outputs into out (on success the arrays are out's). */
+/* The finite values' smallest, largest and count, of parts [c0, c1) of SFB__AN_CHUNKS of v[0..n). */
+typedef struct sfb__an_range_job {
+    const float *v;
+    int n;
+    float *mn, *mx;
+    int *cnt;
+} sfb__an_range_job;
+static void sfb__an_value_range(void *arg, int c0, int c1) {
+    const sfb__an_range_job *R = (const sfb__an_range_job *)arg;
+    int c, k;
+    for (c = c0; c < c1; ++c) {
+        const int a = (int)((long long)R->n * c / SFB__AN_CHUNKS), b = (int)((long long)R->n * (c + 1) / SFB__AN_CHUNKS);
+        float mn = (float)HUGE_VAL, mx = (float)-HUGE_VAL;
+        int n = 0;
+        for (k = a; k < b; ++k)
+            if (isfinite(R->v[k])) {
+                if (R->v[k] < mn) mn = R->v[k];
+                if (R->v[k] > mx) mx = R->v[k];
+                ++n;
+            }
+        R->mn[c] = mn; R->mx[c] = mx; R->cnt[c] = n;
+    }
+}
+
 static sfb_result sfb__an_picture(sfb__an *A, sfb__an_look *L, const float *hv1, const float *hv2, sfb_analysis *out) {
     sfb_context *ctx = A->ctx;
     const sfb_analyze_config *c = A->c;
@@ -1850,12 +1943,18 @@ static sfb_result sfb__an_picture(sfb__an *A, sfb__an_look *L, const float *hv1,
         F.A = A; F.hv1 = hv1; F.hv2 = hv2; F.v1 = v1; F.v2 = v2; F.hits = hits;
         sfb__an_run(A, sfb__an_fill_picture, &F, 0, A->h, (double)npix * 0.1);
     }
-    out->value_min = (float)HUGE_VAL; out->value_max = (float)-HUGE_VAL;
-    for (k = 0; k < A->nhit; ++k) {
-        if (isfinite(hv1[k])) {
-            if (hv1[k] < out->value_min) out->value_min = hv1[k];
-            if (hv1[k] > out->value_max) out->value_max = hv1[k];
-            ++light_hits; /* REFLECTION, HIGHLIGHT: a finite value is a ray that meets the light */
+    {
+        /* over the threads in SFB__AN_CHUNKS parts, combined in order */
+        sfb__an_range_job R;
+        float mn[SFB__AN_CHUNKS], mx[SFB__AN_CHUNKS];
+        int cnt[SFB__AN_CHUNKS];
+        R.v = hv1; R.n = A->nhit; R.mn = mn; R.mx = mx; R.cnt = cnt;
+        sfb__an_run(A, sfb__an_value_range, &R, 0, SFB__AN_CHUNKS, (double)A->nhit);
+        out->value_min = (float)HUGE_VAL; out->value_max = (float)-HUGE_VAL;
+        for (k = 0; k < SFB__AN_CHUNKS; ++k) {
+            if (mn[k] < out->value_min) out->value_min = mn[k];
+            if (mx[k] > out->value_max) out->value_max = mx[k];
+            light_hits += cnt[k]; /* REFLECTION, HIGHLIGHT: a finite value is a ray that meets the light */
         }
     }
     if (c->mode != SFB_ANALYZE_REFLECTION && c->mode != SFB_ANALYZE_HIGHLIGHT) light_hits = 0;
@@ -1891,7 +1990,7 @@ SFB_API sfb_result sfb_surface_analyze(const sfb_surface *s, const sfb_analyze_c
     size_t npix;
     float *hv1 = NULL, *hv2 = NULL;
     sfb_result r;
-    int level = 0, k, fallback = 0, dropped = 0, proxy_pixels = 0, grown = 0;
+    int level = 0, fallback = 0, dropped = 0, proxy_pixels = 0, grown = 0;
     double need;
     if (out) memset(out, 0, sizeof *out);
     if (!s) return SFB_INVALID_ARGS;
@@ -1941,8 +2040,8 @@ SFB_API sfb_result sfb_surface_analyze(const sfb_surface *s, const sfb_analyze_c
     if (c.polygon_based) sfb__an_polygon_hits(&A);
     else {
         if ((r = sfb__an_project_all(&A, c.newton_steps ? c.newton_steps : SFB__AN_DEFAULT_STEPS)) != SFB_SUCCESS) goto done;
-        if ((r = sfb__an_leftovers(&A, &fallback, &dropped)) != SFB_SUCCESS) goto done;
-        for (k = 0; k < A.nhit; ++k) grown += A.face[A.hpix[k]] < 0;
+        /* grown: counted before the fallback, whose hits are all on the proxy */
+        if ((r = sfb__an_leftovers(&A, &fallback, &dropped, &grown)) != SFB_SUCCESS) goto done;
     }
     if ((r = sfb__progress(ctx, 0.75f, "analyze")) != SFB_SUCCESS) goto done;
     /* 3: the values */
