@@ -663,9 +663,11 @@ typedef enum sfb_curvature_kind { SFB_CURVATURE_GAUSSIAN = 0, SFB_CURVATURE_MEAN
  * analysis view redrawn per frame takes its buffers from here instead of allocating and
  * touching ~100 bytes per pixel afresh per call (about a fifth of a 1024 x 1024 analysis on
  * the simd backend). The buffers grow to the largest analysis run with it and stay (counted
- * against the context's memory budget) until sfb_analysis_workspace_destroy. A workspace
- * belongs to the context it was made on and, like that context, to one thread at a time;
- * results are bit for bit those without it. */
+ * against the context's memory budget) until sfb_analysis_workspace_destroy. It also keeps the
+ * last surface's proxy and face adjacency (they depend on the surface and the proxy level, not
+ * on the view: a surface never changes), so a surface analysed again, from any view, skips
+ * their evaluation. A workspace belongs to the context it was made on and, like that context,
+ * to one thread at a time; results are bit for bit those without it. */
 typedef struct sfb_analysis_workspace sfb_analysis_workspace;
 SFB_API sfb_result sfb_analysis_workspace_create(sfb_context *ctx, sfb_analysis_workspace **out);
 SFB_API void sfb_analysis_workspace_destroy(sfb_analysis_workspace *workspace); /* NULL: nothing */
@@ -1150,6 +1152,7 @@ struct sfb_context {
     sfb_progress progress;
     size_t budget, live_bytes, peak_bytes;
     int budget_refused;                /* the last failed allocation was refused by the budget */
+    unsigned long surfaces_made;       /* sfb_surface.serial */
     int threads, gl_use_current_context;
     sfb_backend_kind order[SFB_BACKEND_KIND_COUNT_];
     int order_count;
@@ -1323,6 +1326,8 @@ typedef struct sfb__shading {
 /* ---- surfaces ---- */
 struct sfb_surface {
     sfb_context *ctx;
+    unsigned long serial;        /* the context's count of surfaces at its creation (from 1): a surface never changes,
+                                    so data derived from it alone may be kept under it (sfb_analysis_workspace) */
     sfb_surface_config config;
     int base_vertex_count, base_uv_count, base_face_count;
     float *base_positions, *base_uvs;
@@ -10939,6 +10944,7 @@ SFB_API sfb_result sfb_surface_create(sfb_context *ctx, const sfb_mesh *mesh, co
     s = (sfb_surface *)sfb__calloc(ctx, 1, sizeof *s);
     if (!s) return sfb__oom(ctx, "surface");
     s->ctx = ctx;
+    s->serial = ++ctx->surfaces_made;
     s->config = *cfg;
     s->boundary = mesh->boundary; s->crease_method = mesh->crease_method;
     s->triangle_rule = mesh->triangle_rule; s->uv_interp = mesh->uv_interp;
@@ -13178,13 +13184,18 @@ enum {
     SFB__WS_GPOS, SFB__WS_GNRM, SFB__WS_RV, SFB__WS_RTRI, SFB__WS_DEPTH, SFB__WS_FACE, SFB__WS_UV, SFB__WS_HIT, SFB__WS_CFACE,
     SFB__WS_CUV, SFB__WS_CDIST, SFB__WS_STATE, SFB__WS_PPOS, SFB__WS_PNRM, SFB__WS_HPIX, SFB__WS_HLOC, SFB__WS_HPOS, SFB__WS_HDU,
     SFB__WS_HDV, SFB__WS_HNRM, SFB__WS_HDEPTH, SFB__WS_CHG, SFB__WS_TRIES, SFB__WS_LOCS, SFB__WS_BUF, SFB__WS_MARK, SFB__WS_ROWAT,
-    SFB__WS_NBM, SFB__WS_HV1, SFB__WS_HV2, SFB__WS_V2, SFB__WS_SEC, SFB__WS_HINV, SFB__WS_HL, SFB__WS_CAND, SFB__WS_ZMAX, SFB__WS_NBC, SFB__WS_COUNT
+    SFB__WS_NBM, SFB__WS_HV1, SFB__WS_HV2, SFB__WS_V2, SFB__WS_SEC, SFB__WS_HINV, SFB__WS_HL, SFB__WS_CAND, SFB__WS_ZMAX, SFB__WS_NBC, SFB__WS_ADJ, SFB__WS_COUNT
 };
 struct sfb_analysis_workspace {
     sfb_context *ctx;
     void *p[SFB__WS_COUNT];
     size_t n[SFB__WS_COUNT];
     int mark_base; /* the projection's round tags in the kept mark buffer start above it (sfb__an_project_all) */
+    /* the proxy (GPOS, GNRM) and the face adjacency (ADJ) in the slots belong to the surface of
+     * this serial at this level when proxy_ok (adj_ok): they depend on nothing else (not on the
+     * view), so an analysis of it from another view reuses them (0: none kept) */
+    unsigned long proxy_serial;
+    int proxy_level, proxy_ok, adj_ok;
 };
 
 SFB_API sfb_result sfb_analysis_workspace_create(sfb_context *ctx, sfb_analysis_workspace **out) {
@@ -14678,7 +14689,7 @@ static void sfb__an_free(sfb__an *A) {
     sfb__an_put(A, A->hit); sfb__an_put(A, A->state); sfb__an_put(A, A->cand); sfb__an_put(A, A->zmax);
     sfb__an_put(A, A->hpix); sfb__an_put(A, A->hpos); sfb__an_put(A, A->hdu); sfb__an_put(A, A->hdv);
     sfb__an_put(A, A->hnrm); sfb__an_put(A, A->hdepth); sfb__an_put(A, A->hinv); sfb__an_put(A, A->hl); sfb__an_put(A, A->chg);
-    sfb__free(A->ctx, A->adj); /* not a workspace buffer: per face */
+    sfb__an_put(A, A->adj);
 }
 
 /* Bytes the analysis will hold at its peak (checked against the budget before allocating). */
@@ -14703,7 +14714,6 @@ static void sfb__an_clear_rows(void *arg, int y0, int y1) {
 
 /* The buffers of one analysis (A's sizes set), initialised; 0 when one could not be had. */
 static int sfb__an_alloc(sfb__an *A) {
-    sfb_context *ctx = A->ctx;
     size_t npix = (size_t)A->w * (size_t)A->h, grid = (size_t)A->nf * (size_t)A->per;
     A->gpos = (float *)sfb__an_get(A, SFB__WS_GPOS, grid * 3 * sizeof(float), NULL);
     A->gnrm = (float *)sfb__an_get(A, SFB__WS_GNRM, grid * 3 * sizeof(float), NULL);
@@ -14714,7 +14724,7 @@ static int sfb__an_alloc(sfb__an *A) {
     A->face = (int *)sfb__an_get(A, SFB__WS_FACE, npix * sizeof(int), NULL);
     A->uv = (float *)sfb__an_get(A, SFB__WS_UV, npix * 2 * sizeof(float), NULL);
     A->hit = (int *)sfb__an_get(A, SFB__WS_HIT, npix * sizeof(int), NULL);
-    A->adj = (int *)sfb__alloc(ctx, ((size_t)A->nf + 1) * 4 * sizeof(int));
+    A->adj = (int *)sfb__an_get(A, SFB__WS_ADJ, ((size_t)A->nf + 1) * 4 * sizeof(int), NULL);
     A->cface = (int *)sfb__an_get(A, SFB__WS_CFACE, npix * sizeof(int), NULL);
     A->cuv = (float *)sfb__an_get(A, SFB__WS_CUV, npix * 2 * sizeof(float), NULL);
     A->cdist = (float *)sfb__an_get(A, SFB__WS_CDIST, npix * sizeof(float), NULL);
@@ -14943,11 +14953,30 @@ SFB_API sfb_result sfb_surface_analyze(const sfb_surface *s, const sfb_analyze_c
                           "a %d x %d analysis with a level-%d proxy needs about %.0f MB, over the memory budget (%zu bytes, %zu in use)", A.w,
                           A.h, level, need / 1048576.0, ctx->budget, ctx->live_bytes);
     if ((r = sfb__progress(ctx, 0.0f, "analyze")) != SFB_SUCCESS) return r;
-    if (!sfb__an_alloc(&A)) { r = sfb__oom(ctx, "the analysis buffers"); goto done; }
-    /* 1: the proxy and its raster */
-    if ((r = sfb__an_proxy(&A)) != SFB_SUCCESS) goto done;
-    sfb__an_camera(&A);
-    if (!c.polygon_based && (r = sfb__an_adjacency(&A)) != SFB_SUCCESS) goto done;
+    {
+        /* the workspace's proxy and adjacency: kept when they are this surface's at this level */
+        sfb_analysis_workspace *ws = A.ws;
+        const int same = ws && s->serial != 0 && ws->proxy_serial == s->serial && ws->proxy_level == level;
+        const int proxy_kept = same && ws->proxy_ok, adj_kept = same && ws->adj_ok;
+        if (ws) {
+            if (!same) ws->adj_ok = 0;
+            ws->proxy_ok = 0; /* until computed (or kept) below */
+            ws->proxy_serial = s->serial;
+            ws->proxy_level = level;
+        }
+        if (!sfb__an_alloc(&A)) { r = sfb__oom(ctx, "the analysis buffers"); goto done; }
+        /* 1: the proxy and its raster */
+        if (proxy_kept) r = sfb__progress(ctx, 0.2f, "analyze");
+        else r = sfb__an_proxy(&A);
+        if (r != SFB_SUCCESS) goto done;
+        if (ws) ws->proxy_ok = 1;
+        sfb__an_camera(&A);
+        if (!c.polygon_based && !adj_kept) {
+            if (ws) ws->adj_ok = 0;
+            if ((r = sfb__an_adjacency(&A)) != SFB_SUCCESS) goto done;
+            if (ws) ws->adj_ok = 1;
+        }
+    }
     if ((r = sfb__an_raster(&A)) != SFB_SUCCESS) goto done;
     {
         /* the candidates of the projection and the proxy's pixels, row by row over the threads */

@@ -253,13 +253,18 @@ enum {
     SFB__WS_GPOS, SFB__WS_GNRM, SFB__WS_RV, SFB__WS_RTRI, SFB__WS_DEPTH, SFB__WS_FACE, SFB__WS_UV, SFB__WS_HIT, SFB__WS_CFACE,
     SFB__WS_CUV, SFB__WS_CDIST, SFB__WS_STATE, SFB__WS_PPOS, SFB__WS_PNRM, SFB__WS_HPIX, SFB__WS_HLOC, SFB__WS_HPOS, SFB__WS_HDU,
     SFB__WS_HDV, SFB__WS_HNRM, SFB__WS_HDEPTH, SFB__WS_CHG, SFB__WS_TRIES, SFB__WS_LOCS, SFB__WS_BUF, SFB__WS_MARK, SFB__WS_ROWAT,
-    SFB__WS_NBM, SFB__WS_HV1, SFB__WS_HV2, SFB__WS_V2, SFB__WS_SEC, SFB__WS_HINV, SFB__WS_HL, SFB__WS_CAND, SFB__WS_ZMAX, SFB__WS_NBC, SFB__WS_COUNT
+    SFB__WS_NBM, SFB__WS_HV1, SFB__WS_HV2, SFB__WS_V2, SFB__WS_SEC, SFB__WS_HINV, SFB__WS_HL, SFB__WS_CAND, SFB__WS_ZMAX, SFB__WS_NBC, SFB__WS_ADJ, SFB__WS_COUNT
 };
 struct sfb_analysis_workspace {
     sfb_context *ctx;
     void *p[SFB__WS_COUNT];
     size_t n[SFB__WS_COUNT];
     int mark_base; /* the projection's round tags in the kept mark buffer start above it (sfb__an_project_all) */
+    /* the proxy (GPOS, GNRM) and the face adjacency (ADJ) in the slots belong to the surface of
+     * this serial at this level when proxy_ok (adj_ok): they depend on nothing else (not on the
+     * view), so an analysis of it from another view reuses them (0: none kept) */
+    unsigned long proxy_serial;
+    int proxy_level, proxy_ok, adj_ok;
 };
 
 SFB_API sfb_result sfb_analysis_workspace_create(sfb_context *ctx, sfb_analysis_workspace **out) {
@@ -1753,7 +1758,7 @@ static void sfb__an_free(sfb__an *A) {
     sfb__an_put(A, A->hit); sfb__an_put(A, A->state); sfb__an_put(A, A->cand); sfb__an_put(A, A->zmax);
     sfb__an_put(A, A->hpix); sfb__an_put(A, A->hpos); sfb__an_put(A, A->hdu); sfb__an_put(A, A->hdv);
     sfb__an_put(A, A->hnrm); sfb__an_put(A, A->hdepth); sfb__an_put(A, A->hinv); sfb__an_put(A, A->hl); sfb__an_put(A, A->chg);
-    sfb__free(A->ctx, A->adj); /* not a workspace buffer: per face */
+    sfb__an_put(A, A->adj);
 }
 
 /* Bytes the analysis will hold at its peak (checked against the budget before allocating). */
@@ -1778,7 +1783,6 @@ static void sfb__an_clear_rows(void *arg, int y0, int y1) {
 
 /* The buffers of one analysis (A's sizes set), initialised; 0 when one could not be had. */
 static int sfb__an_alloc(sfb__an *A) {
-    sfb_context *ctx = A->ctx;
     size_t npix = (size_t)A->w * (size_t)A->h, grid = (size_t)A->nf * (size_t)A->per;
     A->gpos = (float *)sfb__an_get(A, SFB__WS_GPOS, grid * 3 * sizeof(float), NULL);
     A->gnrm = (float *)sfb__an_get(A, SFB__WS_GNRM, grid * 3 * sizeof(float), NULL);
@@ -1789,7 +1793,7 @@ static int sfb__an_alloc(sfb__an *A) {
     A->face = (int *)sfb__an_get(A, SFB__WS_FACE, npix * sizeof(int), NULL);
     A->uv = (float *)sfb__an_get(A, SFB__WS_UV, npix * 2 * sizeof(float), NULL);
     A->hit = (int *)sfb__an_get(A, SFB__WS_HIT, npix * sizeof(int), NULL);
-    A->adj = (int *)sfb__alloc(ctx, ((size_t)A->nf + 1) * 4 * sizeof(int));
+    A->adj = (int *)sfb__an_get(A, SFB__WS_ADJ, ((size_t)A->nf + 1) * 4 * sizeof(int), NULL);
     A->cface = (int *)sfb__an_get(A, SFB__WS_CFACE, npix * sizeof(int), NULL);
     A->cuv = (float *)sfb__an_get(A, SFB__WS_CUV, npix * 2 * sizeof(float), NULL);
     A->cdist = (float *)sfb__an_get(A, SFB__WS_CDIST, npix * sizeof(float), NULL);
@@ -2018,11 +2022,30 @@ SFB_API sfb_result sfb_surface_analyze(const sfb_surface *s, const sfb_analyze_c
                           "a %d x %d analysis with a level-%d proxy needs about %.0f MB, over the memory budget (%zu bytes, %zu in use)", A.w,
                           A.h, level, need / 1048576.0, ctx->budget, ctx->live_bytes);
     if ((r = sfb__progress(ctx, 0.0f, "analyze")) != SFB_SUCCESS) return r;
-    if (!sfb__an_alloc(&A)) { r = sfb__oom(ctx, "the analysis buffers"); goto done; }
-    /* 1: the proxy and its raster */
-    if ((r = sfb__an_proxy(&A)) != SFB_SUCCESS) goto done;
-    sfb__an_camera(&A);
-    if (!c.polygon_based && (r = sfb__an_adjacency(&A)) != SFB_SUCCESS) goto done;
+    {
+        /* the workspace's proxy and adjacency: kept when they are this surface's at this level */
+        sfb_analysis_workspace *ws = A.ws;
+        const int same = ws && s->serial != 0 && ws->proxy_serial == s->serial && ws->proxy_level == level;
+        const int proxy_kept = same && ws->proxy_ok, adj_kept = same && ws->adj_ok;
+        if (ws) {
+            if (!same) ws->adj_ok = 0;
+            ws->proxy_ok = 0; /* until computed (or kept) below */
+            ws->proxy_serial = s->serial;
+            ws->proxy_level = level;
+        }
+        if (!sfb__an_alloc(&A)) { r = sfb__oom(ctx, "the analysis buffers"); goto done; }
+        /* 1: the proxy and its raster */
+        if (proxy_kept) r = sfb__progress(ctx, 0.2f, "analyze");
+        else r = sfb__an_proxy(&A);
+        if (r != SFB_SUCCESS) goto done;
+        if (ws) ws->proxy_ok = 1;
+        sfb__an_camera(&A);
+        if (!c.polygon_based && !adj_kept) {
+            if (ws) ws->adj_ok = 0;
+            if ((r = sfb__an_adjacency(&A)) != SFB_SUCCESS) goto done;
+            if (ws) ws->adj_ok = 1;
+        }
+    }
     if ((r = sfb__an_raster(&A)) != SFB_SUCCESS) goto done;
     {
         /* the candidates of the projection and the proxy's pixels, row by row over the threads */

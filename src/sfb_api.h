@@ -650,9 +650,11 @@ typedef enum sfb_curvature_kind { SFB_CURVATURE_GAUSSIAN = 0, SFB_CURVATURE_MEAN
  * analysis view redrawn per frame takes its buffers from here instead of allocating and
  * touching ~100 bytes per pixel afresh per call (about a fifth of a 1024 x 1024 analysis on
  * the simd backend). The buffers grow to the largest analysis run with it and stay (counted
- * against the context's memory budget) until sfb_analysis_workspace_destroy. A workspace
- * belongs to the context it was made on and, like that context, to one thread at a time;
- * results are bit for bit those without it. */
+ * against the context's memory budget) until sfb_analysis_workspace_destroy. It also keeps the
+ * last surface's proxy and face adjacency (they depend on the surface and the proxy level, not
+ * on the view: a surface never changes), so a surface analysed again, from any view, skips
+ * their evaluation. A workspace belongs to the context it was made on and, like that context,
+ * to one thread at a time; results are bit for bit those without it. */
 typedef struct sfb_analysis_workspace sfb_analysis_workspace;
 SFB_API sfb_result sfb_analysis_workspace_create(sfb_context *ctx, sfb_analysis_workspace **out);
 SFB_API void sfb_analysis_workspace_destroy(sfb_analysis_workspace *workspace); /* NULL: nothing */

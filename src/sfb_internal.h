@@ -291,6 +291,7 @@ struct sfb_context {
     sfb_progress progress;
     size_t budget, live_bytes, peak_bytes;
     int budget_refused;                /* the last failed allocation was refused by the budget */
+    unsigned long surfaces_made;       /* sfb_surface.serial */
     int threads, gl_use_current_context;
     sfb_backend_kind order[SFB_BACKEND_KIND_COUNT_];
     int order_count;
@@ -464,6 +465,8 @@ typedef struct sfb__shading {
 /* ---- surfaces ---- */
 struct sfb_surface {
     sfb_context *ctx;
+    unsigned long serial;        /* the context's count of surfaces at its creation (from 1): a surface never changes,
+                                    so data derived from it alone may be kept under it (sfb_analysis_workspace) */
     sfb_surface_config config;
     int base_vertex_count, base_uv_count, base_face_count;
     float *base_positions, *base_uvs;

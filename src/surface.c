@@ -269,6 +269,7 @@ SFB_API sfb_result sfb_surface_create(sfb_context *ctx, const sfb_mesh *mesh, co
     s = (sfb_surface *)sfb__calloc(ctx, 1, sizeof *s);
     if (!s) return sfb__oom(ctx, "surface");
     s->ctx = ctx;
+    s->serial = ++ctx->surfaces_made;
     s->config = *cfg;
     s->boundary = mesh->boundary; s->crease_method = mesh->crease_method;
     s->triangle_rule = mesh->triangle_rule; s->uv_interp = mesh->uv_interp;

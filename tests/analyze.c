@@ -383,6 +383,74 @@ static int same_picture(const sfb_analysis *a, const sfb_analysis *b) {
            memcmp(a->hits, b->hits, n * sizeof(sfb_location)) == 0;
 }
 
+/* The workspace's kept proxy and adjacency (they belong to a surface at a level, whatever the
+ * view): one workspace through views A and B of two surfaces, the polygon-based path between,
+ * a call cancelled as the proxy is done, and a surface destroyed and another made in its place;
+ * each picture bit for bit the one without a workspace. */
+static int cancel_at(float done, const char *stage, void *user) {
+    const float at = *(const float *)user;
+    return strcmp(stage, "analyze") == 0 && at > 0.0f && done >= at;
+}
+static void test_workspace_proxy(const shape *shapes) {
+    static const struct { int surf, view, polygon, level; float cancel; } runs[9] = {
+        { 0, 0, 0, 2, 0.0f }, { 0, 1, 0, 2, 0.0f }, { 0, 0, 1, 2, 0.0f }, { 0, 1, 0, 2, 0.0f }, { 1, 1, 0, 2, 0.0f },
+        { 0, 1, 0, 2, 0.0f }, { 0, 0, 0, 1, 0.0f }, { 0, 1, 0, 1, 0.2f }, { 0, 1, 0, 1, 0.0f } };
+    sfb_context_config cc = sfb_context_config_init();
+    sfb_context *ctx = NULL;
+    sfb_analysis_workspace *ws = NULL;
+    sfb_mesh *m[3] = { NULL, NULL, NULL };
+    sfb_surface *sf[2] = { NULL, NULL };
+    float cancel = 0.0f;
+    int i;
+    cc.ignore_environment = 1;
+    cc.progress.func = cancel_at;
+    cc.progress.user = &cancel;
+    if (sfb_context_create(&cc, &ctx) != SFB_SUCCESS || sfb_analysis_workspace_create(ctx, &ws) != SFB_SUCCESS) {
+        fail("workspace_proxy/create", "no context or workspace");
+        sfb_context_destroy(ctx);
+        return;
+    }
+    for (i = 0; i < 3; ++i) m[i] = load_shape(ctx, shapes[i].path);
+    for (i = 0; i < 2; ++i) sf[i] = m[i] ? patch_surface(ctx, m[i], shapes[i].scheme) : NULL;
+    for (i = 0; i <= 9; ++i) {
+        char name[128];
+        const int k = i < 9 ? i : 4, sh = i < 9 ? runs[k].surf : 2;
+        sfb_analyze_config c = sfb_analyze_config_init(SFB_ANALYZE_REFLECTION);
+        sfb_analysis a, b;
+        sfb_result ra, rb;
+        if (i == 9) {
+            /* surface 1 destroyed and another (shape 2's) made, perhaps at its address */
+            sfb_surface_destroy(sf[1]);
+            sf[1] = m[2] ? patch_surface(ctx, m[2], shapes[2].scheme) : NULL;
+        }
+        snprintf(name, sizeof name, "workspace_proxy/run_%d_%s_view_%d_level_%d%s%s", i, shapes[sh].label, runs[k].view, runs[k].level,
+                 runs[k].polygon ? "_polygon" : "", runs[k].cancel > 0.0f ? "_cancelled" : "");
+        if (!sf[runs[k].surf]) { skip(name, "shape not found"); continue; }
+        memset(&a, 0, sizeof a); memset(&b, 0, sizeof b);
+        c.width = 240; c.height = 180; c.level = runs[k].level; c.polygon_based = runs[k].polygon;
+        c.view_set = 1; c.yaw = runs[k].view ? 130.0f : 30.0f; c.pitch = runs[k].view ? -15.0f : 25.0f;
+        c.workspace = ws;
+        if (runs[k].cancel > 0.0f) {
+            cancel = runs[k].cancel;
+            rb = sfb_surface_analyze(sf[runs[k].surf], &c, &b);
+            cancel = 0.0f;
+            check(rb == SFB_CANCELLED && b.rgba == NULL, name, "%s", sfb_result_string(rb));
+            continue;
+        }
+        rb = sfb_surface_analyze(sf[runs[k].surf], &c, &b);
+        c.workspace = NULL;
+        ra = sfb_surface_analyze(sf[runs[k].surf], &c, &a);
+        check(ra == SFB_SUCCESS && rb == SFB_SUCCESS && a.covered_pixels > 1000 && same_picture(&a, &b), name,
+              "%s / %s: %d / %d pixels covered, the same: %d", sfb_result_string(ra), sfb_result_string(rb), a.covered_pixels,
+              b.covered_pixels, ra == SFB_SUCCESS && rb == SFB_SUCCESS && same_picture(&a, &b));
+        sfb_analysis_free(&a); sfb_analysis_free(&b);
+    }
+    sfb_analysis_workspace_destroy(ws);
+    for (i = 0; i < 2; ++i) sfb_surface_destroy(sf[i]);
+    for (i = 0; i < 3; ++i) sfb_mesh_destroy(m[i]);
+    sfb_context_destroy(ctx);
+}
+
 /* sfb_analysis_workspace: one workspace through a sequence of analyses that grow and shrink it
  * (sizes, modes, schemes, the polygon-based path), each bit for bit the picture without it,
  * twice in a row (the kept mark tags of the first must not leak into the second), and the
@@ -665,6 +733,7 @@ int main(int argc, char **argv) {
     sfb_context_destroy(ctx);
     test_threads(shapes, 3);
     test_workspace(shapes);
+    test_workspace_proxy(shapes);
     {
         sfb_context_config bc = sfb_context_config_init();
         bc.logger.func = cpu_raster_logger;
