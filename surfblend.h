@@ -13164,7 +13164,8 @@ typedef struct sfb__an {
     float *cuv, *cdist;          /* the (u,v) of its nearest point, the distance in pixels */
     int *hit;                    /* index into the hit arrays, -1: none */
     sfb_location *hl;            /* per pixel (valid where hit >= 0): its hit's location, and */
-    float *hinv;                 /* d(u,v)/d(pixel x), d(u,v)/d(pixel y) there (NaN: singular): the seeds and neighbour scans
+    int seeding;                 /* round 0 runs: hinv is kept up to date (sfb__an_store_hit) */
+    float *hinv;                 /* d(u,v)/d(pixel x), d(u,v)/d(pixel y) there (NaN: singular): round 0's seeds and neighbour scans
                                     read these per pixel, row by row (the hit slots lie in round 0's part order, scattered) */
     int *adj;                    /* per face and side: (4 * neighbour face + its side) * 2 + reversed, -1: none */
     unsigned char *state;        /* SFB__AN_* per pixel */
@@ -13694,8 +13695,10 @@ static int sfb__an_new_slot(sfb__an *A, int pix) {
     return k;
 }
 
-/* Hit slot k's data: the evaluation at loc, at depth z; and per pixel its location and the
- * inverse of its screen Jacobian (computed once here: every seed taken from the hit reads it). */
+/* Hit slot k's data: the evaluation at loc, at depth z; and per pixel its location and, in
+ * round 0 (A->seeding), the inverse of its screen Jacobian (computed once here: every seed taken
+ * from the hit reads it; round 0's seeds are its only readers, so the later rounds, whose hits
+ * are recorded on one thread, leave it, stale where they replace a hit). */
 static void sfb__an_store_hit(sfb__an *A, size_t k, const sfb_location *loc, double z, const float *p, const float *du, const float *dv,
                               const float *n) {
     double pd[3], tu[3], tv[3], jac[4], det;
@@ -13710,6 +13713,7 @@ static void sfb__an_store_hit(sfb__an *A, size_t k, const sfb_location *loc, dou
     }
     if (A->hdu)
         for (c = 0; c < 3; ++c) { A->hdu[3 * k + c] = du[c]; A->hdv[3 * k + c] = dv[c]; }
+    if (!A->seeding) return;
     if (sfb__an_jacobian(&A->cam, pd, tu, tv, jac, &det)) {
         m[0] = (float)(jac[3] / det); m[1] = (float)(-jac[2] / det);
         m[2] = (float)(-jac[1] / det); m[3] = (float)(jac[0] / det);
@@ -14198,6 +14202,7 @@ static sfb_result sfb__an_project_all(sfb__an *A, int steps) {
      * the pixels between two faces saved 2 % of round 0's time and put 0.04 % of the pixels on
      * a farther sheet, which the later rounds then had to correct: not kept); 2.6 with anchors
      * every 2 pixels, the one-sided prediction alone and no stall rule (sfb__an_step) */
+    A->seeding = 1;
     for (part = 0; part < 5; ++part) {
         const int d = part == 0 ? SFB__AN_ANCHOR : part <= 2 ? 2 : 1, nrows = (A->h + d - 1) / d;
         int r0, r1;
@@ -14236,6 +14241,7 @@ static sfb_result sfb__an_project_all(sfb__an *A, int steps) {
             }
         }
     }
+    A->seeding = 0;
     sfb__an_fill_holes(A);
     /* round 0's changes: every hit, scanned per pixel row by row over the threads; those that
      * seed a neighbour listed in the picture's order (the hit slots lie in round 0's part
