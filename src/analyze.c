@@ -236,7 +236,7 @@ typedef struct sfb__an {
     float *cuv, *cdist;          /* the (u,v) of its nearest point, the distance in pixels */
     int *hit;                    /* index into the hit arrays, -1: none */
     sfb_location *hl;            /* per pixel (valid where hit >= 0): its hit's location, and */
-    int seeding;                 /* round 0 runs: hinv is kept up to date (sfb__an_store_hit) */
+    int seeding;                 /* round 0 runs a part that seeds later ones: hinv is kept up to date (sfb__an_store_hit) */
     float *hinv;                 /* d(u,v)/d(pixel x), d(u,v)/d(pixel y) there (NaN: singular): round 0's seeds and neighbour scans
                                     read these per pixel, row by row (the hit slots lie in round 0's part order, scattered) */
     int *adj;                    /* per face and side: (4 * neighbour face + its side) * 2 + reversed, -1: none */
@@ -768,9 +768,10 @@ static int sfb__an_new_slot(sfb__an *A, int pix) {
 }
 
 /* Hit slot k's data: the evaluation at loc, at depth z; and per pixel its location and, in
- * round 0 (A->seeding), the inverse of its screen Jacobian (computed once here: every seed taken
- * from the hit reads it; round 0's seeds are its only readers, so the later rounds, whose hits
- * are recorded on one thread, leave it, stale where they replace a hit). */
+ * round 0's parts whose hits seed later parts (A->seeding), the inverse of its screen Jacobian
+ * (computed once here: every seed taken from the hit reads it; those seeds are its only
+ * readers, so round 0's last part and the later rounds, whose hits are recorded on one thread,
+ * leave it, stale where they replace a hit). */
 static void sfb__an_store_hit(sfb__an *A, size_t k, const sfb_location *loc, double z, const float *p, const float *du, const float *dv,
                               const float *n) {
     double pd[3], tu[3], tv[3], jac[4], det;
@@ -1286,13 +1287,13 @@ static sfb_result sfb__an_project_all(sfb__an *A, int steps) {
      * the pixels between two faces saved 2 % of round 0's time and put 0.04 % of the pixels on
      * a farther sheet, which the later rounds then had to correct: not kept); 2.6 with anchors
      * every 2 pixels, the one-sided prediction alone and no stall rule (sfb__an_step) */
-    A->seeding = 1;
     for (part = 0; part < 5; ++part) {
         const int d = part == 0 ? SFB__AN_ANCHOR : part <= 2 ? 2 : 1, nrows = (A->h + d - 1) / d;
         int r0, r1;
         sfb__an_seed_job J;
         J.A = A; J.tries = tries; J.locs = locs; J.rowat = rowat;
         J.part = part; J.d = d; J.want = part == 0 ? 0 : 2 - (part & 1);
+        A->seeding = part < 4; /* the last part's hits seed no pixel of round 0 */
         A->nchg = 0; /* round 0's changes are every hit (below) */
         /* the attempts per grid row, then bands of whole rows of at most cap attempts (cap >=
          * w: a row fits), each seeded over the threads and run at once (its hits then seed the
