@@ -13158,6 +13158,7 @@ typedef struct sfb__an {
     sfb__raster_vertex *rv;      /* the grid points in the picture */
     int *rtri, ntri;             /* the proxy's triangles (sfb__raster_job) */
     float *zmax;                 /* the raster's scratch (sfb__raster_job) */
+    unsigned char *ucov;         /* per 8 pixels of a row after the raster: 1 where one is not drawn (sfb__an_ucov_rows) */
     /* per pixel */
     float *depth;                /* +inf: empty */
     int *face;                   /* proxy face, -1: none */
@@ -13188,7 +13189,7 @@ enum {
     SFB__WS_GPOS, SFB__WS_GNRM, SFB__WS_RV, SFB__WS_RTRI, SFB__WS_DEPTH, SFB__WS_FACE, SFB__WS_UV, SFB__WS_HIT, SFB__WS_CFACE,
     SFB__WS_CUV, SFB__WS_CDIST, SFB__WS_STATE, SFB__WS_PPOS, SFB__WS_PNRM, SFB__WS_HPIX, SFB__WS_HLOC, SFB__WS_HPOS, SFB__WS_HDU,
     SFB__WS_HDV, SFB__WS_HNRM, SFB__WS_HDEPTH, SFB__WS_CHG, SFB__WS_TRIES, SFB__WS_LOCS, SFB__WS_BUF, SFB__WS_MARK, SFB__WS_ROWAT,
-    SFB__WS_NBM, SFB__WS_HV1, SFB__WS_HV2, SFB__WS_V2, SFB__WS_SEC, SFB__WS_HINV, SFB__WS_HL, SFB__WS_CAND, SFB__WS_ZMAX, SFB__WS_NBC, SFB__WS_ADJ, SFB__WS_COUNT
+    SFB__WS_NBM, SFB__WS_HV1, SFB__WS_HV2, SFB__WS_V2, SFB__WS_SEC, SFB__WS_HINV, SFB__WS_HL, SFB__WS_CAND, SFB__WS_ZMAX, SFB__WS_NBC, SFB__WS_ADJ, SFB__WS_UCOV, SFB__WS_COUNT
 };
 struct sfb_analysis_workspace {
     sfb_context *ctx;
@@ -13498,6 +13499,8 @@ static void sfb__an_seed_tri(sfb__an *A, const int *tv, int row0, int row1) {
             const double px = x + 0.5, py = y + 0.5;
             const size_t pix = (size_t)y * (size_t)A->w + (size_t)x;
             double b[3], d = 0.0, sum;
+            /* most of a thin triangle's box is drawn: whole drawn blocks of 8 skipped */
+            if (!A->ucov[(size_t)y * (size_t)((A->w + 7) / 8) + (size_t)(x >> 3)]) { x |= 7; continue; }
             if (A->face[pix] >= 0) continue;
             for (k = 0; k < 3; ++k) b[k] = t.ea[k] * px + t.eb[k] * py + t.ec[k];
             if (b[0] >= 0.0 && b[1] >= 0.0 && b[2] >= 0.0) continue; /* inside: the raster's pixel */
@@ -13512,6 +13515,23 @@ static void sfb__an_seed_tri(sfb__an *A, const int *tv, int row0, int row1) {
             A->cuv[2 * pix] = (float)sfb__rclamp((b[0] * S[0]->u + b[1] * S[1]->u + b[2] * S[2]->u) / sum, 0.0, 1.0);
             A->cuv[2 * pix + 1] = (float)sfb__rclamp((b[0] * S[0]->v + b[1] * S[1]->v + b[2] * S[2]->v) / sum, 0.0, 1.0);
         }
+}
+
+/* Rows [y0, y1) after the raster: per block of 8 pixels of a row, whether one is not drawn. */
+static void sfb__an_ucov_rows(void *arg, int y0, int y1) {
+    sfb__an *A = (sfb__an *)arg;
+    const int nb = (A->w + 7) / 8;
+    int y, b, x;
+    for (y = y0; y < y1; ++y) {
+        const int *f = A->face + (size_t)y * (size_t)A->w;
+        unsigned char *u = A->ucov + (size_t)y * (size_t)nb;
+        for (b = 0; b < nb; ++b) {
+            const int xe = 8 * b + 8 < A->w ? 8 * b + 8 : A->w;
+            int m = 0;
+            for (x = 8 * b; x < xe; ++x) m |= f[x];
+            u[b] = (unsigned char)(m < 0); /* a face of -1 sets the sign bit */
+        }
+    }
 }
 
 /* sfb__an_seed_tri over every proxy triangle, on the rows of bands [b0, b1) of
@@ -13675,6 +13695,7 @@ static sfb_result sfb__an_raster(sfb__an *A) {
     if (A->ppos) { job.apos = A->gpos; job.anrm = A->gnrm; job.pos = A->ppos; job.nrm = A->pnrm; }
     if ((r = sfb__an_raster_kernel(A, &job)) != SFB_SUCCESS) return r;
     if ((r = sfb__progress(A->ctx, 0.25f, "analyze")) != SFB_SUCCESS) return r;
+    sfb__an_run(A, sfb__an_ucov_rows, A, 0, A->h, (double)A->w * A->h * 0.1);
     sfb__an_run(A, sfb__an_seed_rows_tri, A, 0, SFB__AN_SEED_BANDS, (double)A->ntri * 4.0);
     return SFB_SUCCESS;
 }
@@ -14708,7 +14729,7 @@ static void sfb__an_free(sfb__an *A) {
     sfb__an_put(A, A->gpos); sfb__an_put(A, A->gnrm); sfb__an_put(A, A->rv); sfb__an_put(A, A->rtri);
     sfb__an_put(A, A->cface); sfb__an_put(A, A->cuv); sfb__an_put(A, A->cdist);
     sfb__an_put(A, A->depth); sfb__an_put(A, A->face); sfb__an_put(A, A->uv); sfb__an_put(A, A->ppos); sfb__an_put(A, A->pnrm);
-    sfb__an_put(A, A->hit); sfb__an_put(A, A->state); sfb__an_put(A, A->cand); sfb__an_put(A, A->zmax);
+    sfb__an_put(A, A->hit); sfb__an_put(A, A->state); sfb__an_put(A, A->cand); sfb__an_put(A, A->zmax); sfb__an_put(A, A->ucov);
     sfb__an_put(A, A->hpix); sfb__an_put(A, A->hpos); sfb__an_put(A, A->hdu); sfb__an_put(A, A->hdv);
     sfb__an_put(A, A->hnrm); sfb__an_put(A, A->hdepth); sfb__an_put(A, A->hinv); sfb__an_put(A, A->hl); sfb__an_put(A, A->chg);
     sfb__an_put(A, A->adj);
@@ -14717,7 +14738,7 @@ static void sfb__an_free(sfb__an *A) {
 /* Bytes the analysis will hold at its peak (checked against the budget before allocating). */
 static double sfb__an_bytes(const sfb__an *A) {
     double npix = (double)A->w * A->h, grid = (double)A->nf * A->per;
-    double per_pixel = 16 + 4 + 4 + 8 + 4 + 1 + 1 + 1 /* zmax */ + 4 + 4 + 1 + 4 + 12 /* buffers, outputs */ + 4 + 24 + 4 + 16 + 12 /* hits */ +
+    double per_pixel = 16 + 4 + 4 + 8 + 4 + 1 + 1 + 1 /* zmax, ucov */ + 4 + 4 + 1 + 4 + 12 /* buffers, outputs */ + 4 + 24 + 4 + 16 + 12 /* hits */ +
                        (A->c->mode == SFB_ANALYZE_CURVATURE ? 24 + 12 + 36 : 0) /* their first and second derivatives */ +
                        (A->c->polygon_based ? 24 : 92 + 16 + 2) /* proxy data or the projection's attempts, marks and neighbour masks */;
     return npix * per_pixel + grid * (24.0 + sizeof(sfb__raster_vertex) + 2 * 2 * 4 * sizeof(int)) + 65536.0 * sizeof(sfb_location) + (double)A->nf * 4 * (sizeof(int) + sizeof(sfb__an_side));
@@ -14753,6 +14774,7 @@ static int sfb__an_alloc(sfb__an *A) {
     A->state = (unsigned char *)sfb__an_get_zeroed(A, SFB__WS_STATE, npix);
     A->cand = (unsigned char *)sfb__an_get(A, SFB__WS_CAND, npix, NULL);
     A->zmax = (float *)sfb__an_get(A, SFB__WS_ZMAX, (size_t)A->h * (size_t)((A->w + 7) / 8) * sizeof(float) + 1, NULL);
+    A->ucov = (unsigned char *)sfb__an_get(A, SFB__WS_UCOV, (size_t)A->h * (size_t)((A->w + 7) / 8) + 1, NULL);
     if (A->c->polygon_based) {
         A->ppos = (float *)sfb__an_get(A, SFB__WS_PPOS, npix * 3 * sizeof(float), NULL);
         A->pnrm = (float *)sfb__an_get(A, SFB__WS_PNRM, npix * 3 * sizeof(float), NULL);
@@ -14768,7 +14790,7 @@ static int sfb__an_alloc(sfb__an *A) {
     A->hinv = (float *)sfb__an_get(A, SFB__WS_HINV, npix * 4 * sizeof(float), NULL);
     A->hl = (sfb_location *)sfb__an_get(A, SFB__WS_HL, npix * sizeof(sfb_location), NULL);
     A->chg = (int *)sfb__an_get(A, SFB__WS_CHG, (npix + 1) * sizeof(int), NULL);
-    if (!A->gpos || !A->gnrm || !A->rv || !A->rtri || !A->depth || !A->face || !A->uv || !A->hit || !A->adj || !A->cface || !A->cuv || !A->cdist || !A->state || !A->cand || !A->zmax ||
+    if (!A->gpos || !A->gnrm || !A->rv || !A->rtri || !A->depth || !A->face || !A->uv || !A->hit || !A->adj || !A->cface || !A->cuv || !A->cdist || !A->state || !A->cand || !A->zmax || !A->ucov ||
         (A->c->polygon_based && (!A->ppos || !A->pnrm)) || !A->hpix || !A->hpos || (A->c->mode == SFB_ANALYZE_CURVATURE && (!A->hdu || !A->hdv)) || !A->hnrm || !A->hdepth ||
         !A->hinv || !A->hl || !A->chg)
         return 0;
