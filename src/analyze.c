@@ -63,7 +63,7 @@
                                  depend on the batch size (sfb__an_predict) */
 #define SFB__AN_PARALLEL 4096  /* items: from this many on, a per-item loop goes to the backend's threads (sfb__parallel) */
 #define SFB__AN_OUT_NEW_HIT 4
-#define SFB__AN_CHUNKS 64     /* round 0: a batch runs in at most this many chunks of at least 1024 attempts (sfb__an_fresh) */
+#define SFB__AN_CHUNKS 64     /* round 0: a batch runs in at most this many chunks, of 1024 attempts or more on average (sfb__an_fresh) */
 #define SFB__AN_DILATE 2.0    /* pixels: uncovered pixels this close to a thin proxy triangle are seeded from it too */
 #define SFB__AN_MARGIN 0.92   /* the bounding sphere's share of the smaller side (as sfb_render) */
 
@@ -937,26 +937,34 @@ static void sfb__an_step(void *arg, int a, int b) {
 /* Round 0's attempts (sfb__an_project_all): no attempt's pixel is hit yet and no two share a
  * pixel, so attempt i of a batch owns hit slot base + i (tries[i].k), which it fills when it
  * hits and leaves a hole (hpix -1) when it does not; sfb__an_fill_holes closes the holes after
- * round 0. The batch is cut into chunks of `chunk` attempts, each run to its outcomes on its
- * own (evaluate, step, record, move the running ones first, within the chunk), over the
- * backend's threads: no step waits for the whole batch, and nothing runs on one thread
- * between steps. One chunk when the backend lends no threads (a GPU evaluates a batch at
- * once). res[c]: chunk c's evaluation result. */
+ * round 0. The batch is cut into `nchunks` chunks, each run to its outcomes on its own
+ * (evaluate, step, record, move the running ones first, within the chunk), over the backend's
+ * threads: no step waits for the whole batch, and nothing runs on one thread between steps.
+ * The chunks shrink from about twice the mean to a few attempts (chunk c starts at
+ * count (1 - (1 - c / nchunks)^2)): the backend hands its threads runs of equally many chunks,
+ * so the last run taken is short and the other threads wait less for it. One chunk when the
+ * backend lends no threads (a GPU evaluates a batch at once). res[c]: chunk c's evaluation
+ * result. */
 typedef struct sfb__an_fresh_job {
     sfb__an *A;
     sfb__an_try *tries;
     sfb_location *locs;
     float *pos, *du, *dv, *nrm;
-    int count, chunk, steps;
+    int count, nchunks, steps;
     sfb_result *res;
 } sfb__an_fresh_job;
+
+static int sfb__an_fresh_start(const sfb__an_fresh_job *F, int c) {
+    const long long x = F->nchunks - c, n2 = (long long)F->nchunks * F->nchunks;
+    return F->count - (int)((long long)F->count * x * x / n2);
+}
 
 static void sfb__an_fresh(void *arg, int c0, int c1) {
     const sfb__an_fresh_job *F = (const sfb__an_fresh_job *)arg;
     sfb__an *A = F->A;
     int c;
     for (c = c0; c < c1; ++c) {
-        const int a = c * F->chunk, n = F->count - a < F->chunk ? F->count - a : F->chunk;
+        const int a = sfb__an_fresh_start(F, c), n = sfb__an_fresh_start(F, c + 1) - a;
         sfb__an_try *tries = F->tries + a;
         sfb_location *locs = F->locs + a;
         float *pos = F->pos + 3 * (size_t)a, *du = F->du + 3 * (size_t)a, *dv = F->dv + 3 * (size_t)a, *nrm = F->nrm + 3 * (size_t)a;
@@ -1339,10 +1347,10 @@ static sfb_result sfb__an_project_all(sfb__an *A, int steps) {
                 int c;
                 F.A = A; F.tries = tries; F.locs = locs; F.count = total; F.steps = steps; F.res = res;
                 F.pos = buf; F.du = buf + 3 * (size_t)total; F.dv = buf + 6 * (size_t)total; F.nrm = buf + 9 * (size_t)total;
-                F.chunk = (total + (nck < SFB__AN_CHUNKS ? nck : SFB__AN_CHUNKS) - 1) / (nck < SFB__AN_CHUNKS ? nck : SFB__AN_CHUNKS);
+                F.nchunks = nck < SFB__AN_CHUNKS ? nck : SFB__AN_CHUNKS;
                 A->nhit += total; /* the batch's slots (holes where it misses) */
-                sfb__an_run(A, sfb__an_fresh, &F, 0, (total + F.chunk - 1) / F.chunk, (double)total * 8.0);
-                for (c = 0; c < (total + F.chunk - 1) / F.chunk; ++c)
+                sfb__an_run(A, sfb__an_fresh, &F, 0, F.nchunks, (double)total * 8.0);
+                for (c = 0; c < F.nchunks; ++c)
                     if (res[c] != SFB_SUCCESS) { r = res[c]; goto done; }
             }
         }
