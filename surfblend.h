@@ -13189,7 +13189,7 @@ enum {
     SFB__WS_GPOS, SFB__WS_GNRM, SFB__WS_RV, SFB__WS_RTRI, SFB__WS_DEPTH, SFB__WS_FACE, SFB__WS_UV, SFB__WS_HIT, SFB__WS_CFACE,
     SFB__WS_CUV, SFB__WS_CDIST, SFB__WS_STATE, SFB__WS_PPOS, SFB__WS_PNRM, SFB__WS_HPIX, SFB__WS_HLOC, SFB__WS_HPOS, SFB__WS_HDU,
     SFB__WS_HDV, SFB__WS_HNRM, SFB__WS_HDEPTH, SFB__WS_CHG, SFB__WS_TRIES, SFB__WS_LOCS, SFB__WS_BUF, SFB__WS_MARK, SFB__WS_ROWAT,
-    SFB__WS_NBM, SFB__WS_HV1, SFB__WS_HV2, SFB__WS_V2, SFB__WS_SEC, SFB__WS_HINV, SFB__WS_HL, SFB__WS_CAND, SFB__WS_ZMAX, SFB__WS_NBC, SFB__WS_ADJ, SFB__WS_UCOV, SFB__WS_COUNT
+    SFB__WS_NBM, SFB__WS_HV1, SFB__WS_HV2, SFB__WS_V2, SFB__WS_SEC, SFB__WS_HINV, SFB__WS_HL, SFB__WS_CAND, SFB__WS_ZMAX, SFB__WS_NBC, SFB__WS_ADJ, SFB__WS_UCOV, SFB__WS_DONE, SFB__WS_COUNT
 };
 struct sfb_analysis_workspace {
     sfb_context *ctx;
@@ -13876,6 +13876,16 @@ static void sfb__an_step(void *arg, int a, int b) {
  * so the last run taken is short and the other threads wait less for it. One chunk when the
  * backend lends no threads (a GPU evaluates a batch at once). res[c]: chunk c's evaluation
  * result. */
+/* An attempt's outcome for a later round's recording (sfb__an_newton): its pixel, outcome and,
+ * for a hit, the evaluation and depth. */
+typedef struct sfb__an_done {
+    float p[3], du[3], dv[3], n[3];
+    double z;
+    sfb_location loc;
+    int pix;
+    unsigned char outcome;
+} sfb__an_done;
+
 typedef struct sfb__an_fresh_job {
     sfb__an *A;
     sfb__an_try *tries;
@@ -13883,6 +13893,8 @@ typedef struct sfb__an_fresh_job {
     float *pos, *du, *dv, *nrm;
     int count, nchunks, steps;
     sfb_result *res;
+    sfb__an_done *done; /* NULL: round 0 (the attempts record their own hits); else the later rounds: attempt
+                           tries[i].k's outcome into done[tries[i].k], recorded after the chunks */
 } sfb__an_fresh_job;
 
 static int sfb__an_fresh_start(const sfb__an_fresh_job *F, int c) {
@@ -13909,7 +13921,8 @@ static void sfb__an_fresh(void *arg, int c0, int c1) {
             memset(&out, 0, sizeof out);
             out.position = pos; out.du = du; out.dv = dv; out.normal = nrm;
             if ((F->res[c] = sfb__surface_eval_unchecked(A->s, locs, active, &out)) != SFB_SUCCESS) {
-                for (i = 0; i < active; ++i) A->hpix[tries[i].k] = -1;
+                if (!F->done)
+                    for (i = 0; i < active; ++i) A->hpix[tries[i].k] = -1;
                 break;
             }
             J.it = it;
@@ -13919,6 +13932,20 @@ static void sfb__an_fresh(void *arg, int c0, int c1) {
                 if (t->outcome == 0) {
                     if (keep != i) { tries[keep] = *t; locs[keep] = locs[i]; }
                     ++keep;
+                    continue;
+                }
+                if (F->done) {
+                    sfb__an_done *o = &F->done[t->k];
+                    int q;
+                    o->pix = t->pix;
+                    o->outcome = t->outcome;
+                    if (t->outcome == SFB__AN_OUT_NEW_HIT) {
+                        for (q = 0; q < 3; ++q) {
+                            o->p[q] = pos[3 * i + q]; o->du[q] = du[3 * i + q]; o->dv[q] = dv[3 * i + q]; o->n[q] = nrm[3 * i + q];
+                        }
+                        o->z = t->z;
+                        o->loc = locs[i];
+                    }
                     continue;
                 }
                 if (t->outcome == SFB__AN_OUT_NEW_HIT) {
@@ -13960,42 +13987,34 @@ static void sfb__an_fill_holes(sfb__an *A) {
     A->nhit = last + 1;
 }
 
-/* Runs the attempts (tries[i] for pixel tries[i].pix from locs[i]) to their outcomes; records
- * hits (sfb__an_add_hit: a pixel already hit keeps the nearer one). Per step: the backend
- * evaluates the running attempts, sfb__an_step updates them (on the backend's threads), the
- * new hits are recorded in attempt order, and the running ones move first. */
+/* Runs a later round's attempts (tries[i] for pixel tries[i].pix from locs[i]) to their
+ * outcomes, then records the hits in attempt order (sfb__an_add_hit: a pixel already hit keeps
+ * the nearer one). The attempts run as round 0's do (sfb__an_fresh: in shrinking chunks over
+ * the backend's threads, each chunk to its outcomes), but, since several attempts may share a
+ * pixel here, leave their outcomes in a list that is recorded afterwards on one thread. */
 static sfb_result sfb__an_newton(sfb__an *A, sfb__an_try *tries, sfb_location *locs, int count, float *buf, int steps) {
-    int active = count, it, i;
-    float *pos = buf, *du = buf + 3 * (size_t)count, *dv = buf + 6 * (size_t)count, *nrm = buf + 9 * (size_t)count;
-    sfb_eval_output out;
-    sfb__an_step_job J;
-    sfb_result r;
-    J.A = A; J.tries = tries; J.locs = locs; J.pos = pos; J.du = du; J.dv = dv; J.steps = steps;
-    for (it = 0; it <= steps && active > 0; ++it) {
-        int keep = 0;
-        memset(&out, 0, sizeof out);
-        out.position = pos; out.du = du; out.dv = dv; out.normal = nrm;
-        if ((r = sfb__surface_eval_unchecked(A->s, locs, active, &out)) != SFB_SUCCESS) return r;
-        J.it = it;
-        sfb__an_run(A, sfb__an_step, &J, 0, active, (double)active);
-        /* the outcomes in attempt order: new hits recorded, near ones marked (a later hit of
-         * the pixel overrides that), the running ones moved first */
-        for (i = 0; i < active; ++i) {
-            sfb__an_try *t = &tries[i];
-            if (t->outcome == SFB__AN_OUT_NEW_HIT) {
-                sfb__an_add_hit(A, t->pix, &locs[i], t->z, pos + 3 * i, du + 3 * i, dv + 3 * i, nrm + 3 * i);
-                t->outcome = 1;
-            } else if (t->outcome == 2 && A->state[t->pix] == SFB__AN_NONE) {
-                A->state[t->pix] = SFB__AN_TRIED_NEAR;
-            }
-        }
-        for (i = 0; i < active; ++i)
-            if (tries[i].outcome == 0) {
-                if (keep != i) { tries[keep] = tries[i]; locs[keep] = locs[i]; }
-                ++keep;
-            }
-        active = keep;
+    sfb__an_fresh_job F;
+    sfb_result res[SFB__AN_CHUNKS];
+    sfb__an_done *done = (sfb__an_done *)sfb__an_get(A, SFB__WS_DONE, (size_t)count * sizeof *done, NULL);
+    const int nck = A->ctx->backend && A->ctx->backend->parallel ? (count + 511) / 512 : 1;
+    int i, c;
+    if (!done) return sfb__oom(A->ctx, "the analysis projection");
+    for (i = 0; i < count; ++i) tries[i].k = i; /* each attempt's index in the round, for its outcome */
+    memset(&F, 0, sizeof F);
+    F.A = A; F.tries = tries; F.locs = locs; F.count = count; F.steps = steps; F.res = res; F.done = done;
+    F.pos = buf; F.du = buf + 3 * (size_t)count; F.dv = buf + 6 * (size_t)count; F.nrm = buf + 9 * (size_t)count;
+    F.nchunks = nck < SFB__AN_CHUNKS ? nck : SFB__AN_CHUNKS;
+    sfb__an_run(A, sfb__an_fresh, &F, 0, F.nchunks, (double)count * 8.0);
+    for (c = 0; c < F.nchunks; ++c)
+        if (res[c] != SFB_SUCCESS) { sfb__an_put(A, done); return res[c]; }
+    /* the outcomes in attempt order: new hits recorded, near ones marked (a later hit of the
+     * pixel overrides that) */
+    for (i = 0; i < count; ++i) {
+        const sfb__an_done *o = &done[i];
+        if (o->outcome == SFB__AN_OUT_NEW_HIT) sfb__an_add_hit(A, o->pix, &o->loc, o->z, o->p, o->du, o->dv, o->n);
+        else if (o->outcome == 2 && A->state[o->pix] == SFB__AN_NONE) A->state[o->pix] = SFB__AN_TRIED_NEAR;
     }
+    sfb__an_put(A, done);
     return SFB_SUCCESS;
 }
 
@@ -14276,7 +14295,7 @@ static sfb_result sfb__an_project_all(sfb__an *A, int steps) {
                 sfb_result res[SFB__AN_CHUNKS];
                 const int nck = A->ctx->backend && A->ctx->backend->parallel ? (total + 1023) / 1024 : 1;
                 int c;
-                F.A = A; F.tries = tries; F.locs = locs; F.count = total; F.steps = steps; F.res = res;
+                F.A = A; F.tries = tries; F.locs = locs; F.count = total; F.steps = steps; F.res = res; F.done = NULL;
                 F.pos = buf; F.du = buf + 3 * (size_t)total; F.dv = buf + 6 * (size_t)total; F.nrm = buf + 9 * (size_t)total;
                 F.nchunks = nck < SFB__AN_CHUNKS ? nck : SFB__AN_CHUNKS;
                 A->nhit += total; /* the batch's slots (holes where it misses) */
