@@ -809,8 +809,9 @@ static void sfb__an_store_hit(sfb__an *A, size_t k, const sfb_location *loc, dou
         for (c = 0; c < 3; ++c) { A->hdu[3 * k + c] = du[c]; A->hdv[3 * k + c] = dv[c]; }
     if (!A->seeding) return;
     if (sfb__an_jacobian(&A->cam, pd, tu, tv, jac, &det)) {
-        m[0] = (float)(jac[3] / det); m[1] = (float)(-jac[2] / det);
-        m[2] = (float)(-jac[1] / det); m[3] = (float)(jac[0] / det);
+        const double inv = 1.0 / det; /* one division (a hit's inverse is kept in float) */
+        m[0] = (float)(jac[3] * inv); m[1] = (float)(-jac[2] * inv);
+        m[2] = (float)(-jac[1] * inv); m[3] = (float)(jac[0] * inv);
     } else m[0] = m[1] = m[2] = m[3] = NAN;
 }
 
