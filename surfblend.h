@@ -13534,13 +13534,10 @@ static void sfb__an_ucov_rows(void *arg, int y0, int y1) {
     }
 }
 
-/* sfb__an_seed_tri over every proxy triangle, on the rows of bands [b0, b1) of
- * SFB__AN_SEED_BANDS (bands of rows are independent: a pixel's triangles are visited in order
- * within its band; each band scans every triangle, so they are few). */
-#define SFB__AN_SEED_BANDS 8
-static void sfb__an_seed_rows_tri(void *arg, int b0, int b1) {
+/* sfb__an_seed_tri over every proxy triangle, on rows [row0, row1) (bands of rows are
+ * independent: a pixel's triangles are visited in order within its band). */
+static void sfb__an_seed_rows_tri(void *arg, int row0, int row1) {
     sfb__an *A = (sfb__an *)arg;
-    const int row0 = (int)((long long)A->h * b0 / SFB__AN_SEED_BANDS), row1 = (int)((long long)A->h * b1 / SFB__AN_SEED_BANDS);
     const double lo = row0 - 0.5 - SFB__AN_DILATE, hi = row1 + 0.5 + SFB__AN_DILATE;
     int k;
     for (k = 0; k < A->ntri; ++k) {
@@ -13687,8 +13684,8 @@ static sfb_result sfb__an_raster(sfb__an *A) {
     if ((r = sfb__progress(A->ctx, 0.2f, "analyze")) != SFB_SUCCESS) return r;
     memset(&job, 0, sizeof job);
     job.w = A->w; job.h = A->h; job.ortho = A->cam.ortho;
-    job.ntri = A->ntri; job.vert = A->rv; job.tri = A->rtri;
-    job.tri = A->rtri + (size_t)A->nf * (size_t)A->per * 2 * 4;
+    job.ntri = A->ntri; job.vert = A->rv;
+    job.tri = A->rtri + (size_t)A->nf * (size_t)A->per * 2 * 4; /* the second half: the raster's order */
     job.nfront = sfb__an_order(A, (int *)job.tri);
     job.zmax = A->zmax;
     job.depth = A->depth; job.face = A->face; job.uv = A->uv;
@@ -13696,7 +13693,7 @@ static sfb_result sfb__an_raster(sfb__an *A) {
     if ((r = sfb__an_raster_kernel(A, &job)) != SFB_SUCCESS) return r;
     if ((r = sfb__progress(A->ctx, 0.25f, "analyze")) != SFB_SUCCESS) return r;
     sfb__an_run(A, sfb__an_ucov_rows, A, 0, A->h, (double)A->w * A->h * 0.1);
-    sfb__an_run(A, sfb__an_seed_rows_tri, A, 0, SFB__AN_SEED_BANDS, (double)A->ntri * 4.0);
+    sfb__an_run(A, sfb__an_seed_rows_tri, A, 0, A->h, (double)A->ntri * 4.0);
     return SFB_SUCCESS;
 }
 
@@ -13866,17 +13863,6 @@ static void sfb__an_step(void *arg, int a, int b) {
     }
 }
 
-/* Round 0's attempts (sfb__an_project_all): no attempt's pixel is hit yet and no two share a
- * pixel, so attempt i of a batch owns hit slot base + i (tries[i].k), which it fills when it
- * hits and leaves a hole (hpix -1) when it does not; sfb__an_fill_holes closes the holes after
- * round 0. The batch is cut into `nchunks` chunks, each run to its outcomes on its own
- * (evaluate, step, record, move the running ones first, within the chunk), over the backend's
- * threads: no step waits for the whole batch, and nothing runs on one thread between steps.
- * The chunks shrink from about twice the mean to a few attempts (chunk c starts at
- * count (1 - (1 - c / nchunks)^2)): the backend hands its threads runs of equally many chunks,
- * so the last run taken is short and the other threads wait less for it. One chunk when the
- * backend lends no threads (a GPU evaluates a batch at once). res[c]: chunk c's evaluation
- * result. */
 /* An attempt's outcome for a later round's recording (sfb__an_newton): its pixel, outcome and,
  * for a hit, the evaluation and depth. */
 typedef struct sfb__an_done {
@@ -13887,6 +13873,17 @@ typedef struct sfb__an_done {
     unsigned char outcome;
 } sfb__an_done;
 
+/* Round 0's attempts (sfb__an_project_all): no attempt's pixel is hit yet and no two share a
+ * pixel, so attempt i of a batch owns hit slot base + i (tries[i].k), which it fills when it
+ * hits and leaves a hole (hpix -1) when it does not; sfb__an_fill_holes closes the holes after
+ * round 0. The batch is cut into `nchunks` chunks, each run to its outcomes on its own
+ * (evaluate, step, record, move the running ones first, within the chunk), over the backend's
+ * threads: no step waits for the whole batch, and nothing runs on one thread between steps.
+ * The chunks shrink from about twice the mean to a few attempts (chunk c starts at
+ * count (1 - (1 - c / nchunks)^2)): the backend hands its threads runs of equally many chunks,
+ * so the last run taken is short and the other threads wait less for it. One chunk when the
+ * backend lends no threads (a GPU evaluates a batch at once). res[c]: chunk c's evaluation
+ * result. The later rounds' attempts run here too, with `done` (sfb__an_newton). */
 typedef struct sfb__an_fresh_job {
     sfb__an *A;
     sfb__an_try *tries;
@@ -14170,31 +14167,34 @@ static void sfb__an_neighbours(void *arg, int a, int b) {
     }
 }
 
-/* The same per pixel on rows [y0, y1) into J->mask, 0 where no hit (round 1: every hit is a
- * change, read row by row here), and each row's count of masks that are not 0 into
- * J->rowcnt[y]; with J->list, instead, rows [y0, y1)'s hits of masks not 0, in order, into
- * A->chg and J->list from J->rowcnt[y] (their first index) on. */
+/* Round 1's changes: every hit, scanned row by row. sfb__an_neighbour_rows: the mask per pixel
+ * on rows [y0, y1) into J->mask, 0 where no hit, and each row's count of masks that are not 0
+ * into J->rowcnt[y]; sfb__an_neighbour_list: then, rows [y0, y1)'s pixels of masks not 0, in
+ * order, into A->chg and their masks into J->list, from J->rowcnt[y] (by then their first
+ * index) on. */
 typedef struct sfb__an_nb_job {
     sfb__an *A;
     unsigned char *mask, *list;
     int *rowcnt;
 } sfb__an_nb_job;
+static void sfb__an_neighbour_list(void *arg, int y0, int y1) {
+    const sfb__an_nb_job *J = (const sfb__an_nb_job *)arg;
+    const int w = J->A->w;
+    int x, y;
+    for (y = y0; y < y1; ++y) {
+        int o = J->rowcnt[y];
+        for (x = 0; x < w; ++x) {
+            const size_t p = (size_t)y * (size_t)w + (size_t)x;
+            if (J->mask[p]) { J->A->chg[o] = (int)p; J->list[o++] = J->mask[p]; }
+        }
+    }
+}
 static void sfb__an_neighbour_rows(void *arg, int y0, int y1) {
     const sfb__an_nb_job *J = (const sfb__an_nb_job *)arg;
     sfb__an *A = J->A;
     unsigned char *nbm = J->mask;
     const int w = A->w;
     int x, y;
-    if (J->list) {
-        for (y = y0; y < y1; ++y) {
-            int o = J->rowcnt[y];
-            for (x = 0; x < w; ++x) {
-                const size_t p = (size_t)y * (size_t)w + (size_t)x;
-                if (nbm[p]) { A->chg[o] = (int)p; J->list[o++] = nbm[p]; }
-            }
-        }
-        return;
-    }
     for (y = y0; y < y1; ++y) {
         int n = 0;
         for (x = 0; x < w; ++x) {
@@ -14306,7 +14306,6 @@ static sfb_result sfb__an_project_all(sfb__an *A, int steps) {
             }
         }
     }
-    A->seeding = 0;
     sfb__an_fill_holes(A);
     /* round 0's changes: every hit, scanned per pixel row by row over the threads; those that
      * seed a neighbour listed in the picture's order (the hit slots lie in round 0's part
@@ -14315,11 +14314,10 @@ static sfb_result sfb__an_project_all(sfb__an *A, int steps) {
     {
         sfb__an_nb_job N;
         int y, total = 0;
-        N.A = A; N.mask = A->nbm; N.list = NULL; N.rowcnt = rowat;
+        N.A = A; N.mask = A->nbm; N.list = nbc; N.rowcnt = rowat;
         sfb__an_run(A, sfb__an_neighbour_rows, &N, 0, A->h, (double)npix);
         for (y = 0; y < A->h; ++y) { const int n = rowat[y]; rowat[y] = total; total += n; }
-        N.list = nbc;
-        sfb__an_run(A, sfb__an_neighbour_rows, &N, 0, A->h, (double)npix * 0.25);
+        sfb__an_run(A, sfb__an_neighbour_list, &N, 0, A->h, (double)npix * 0.25);
         A->nchg = total;
         A->nbm = nbc; /* per change from here on */
         nbc = N.mask;
@@ -14389,8 +14387,6 @@ done:
     return r;
 }
 
-/* Proxy pixels left without a hit: NEAR ones fall back to the proxy's point (evaluated there),
- * the others are dropped. polygon_based: every proxy pixel is a "hit" on its interpolated data. */
 /* Rows [y0, y1): per row y, its proxy pixels left near (to fall back), left far (dropped) and
  * its hits off the proxy (grown) into cnt[3 y ..]. */
 typedef struct sfb__an_left_job {
@@ -14416,6 +14412,9 @@ static void sfb__an_left_rows(void *arg, int y0, int y1) {
     }
 }
 
+/* Proxy pixels left without a hit: NEAR ones fall back to the proxy's point (evaluated there),
+ * the others are dropped (counted into dropped); hits off the proxy are counted into grown.
+ * polygon_based: every proxy pixel is a "hit" on its interpolated data. */
 static sfb_result sfb__an_leftovers(sfb__an *A, int *fallback, int *dropped, int *grown) {
     size_t p;
     int n = 0, i, y;
@@ -14910,7 +14909,6 @@ static void sfb__an_fill_picture(void *arg, int y0, int y1) {
     }
 }
 
-/* Step 4: the picture and its per-pixel outputs into out (on success the arrays are out's). */
 /* The finite values' smallest, largest and count, of parts [c0, c1) of SFB__AN_CHUNKS of v[0..n). */
 typedef struct sfb__an_range_job {
     const float *v;
@@ -14935,6 +14933,7 @@ static void sfb__an_value_range(void *arg, int c0, int c1) {
     }
 }
 
+/* Step 4: the picture and its per-pixel outputs into out (on success the arrays are out's). */
 static sfb_result sfb__an_picture(sfb__an *A, sfb__an_look *L, const float *hv1, const float *hv2, sfb_analysis *out) {
     sfb_context *ctx = A->ctx;
     const sfb_analyze_config *c = A->c;
