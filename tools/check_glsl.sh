@@ -21,8 +21,12 @@ else
     for variant in desktop es; do
       for n in $lengths; do
         out="$TMP/$(basename "$f" .glsl)-$variant-$n.glsl"
-        if [ $variant = desktop ]; then printf '#version 430 core\n' > "$out"
-        else printf '#version 310 es\nprecision highp float;\nprecision highp int;\n' > "$out"; fi
+        # the header sfb__gl_shader puts before every kernel (backends/gl/sfb_gl.h)
+        if [ $variant = desktop ]; then printf '#version 430 core\n#define SFB_PRECISE precise\n' > "$out"
+        else printf '%s\n' '#version 310 es' \
+          '#if defined(GL_EXT_gpu_shader5)' '#extension GL_EXT_gpu_shader5 : enable' '#define SFB_PRECISE precise' \
+          '#elif defined(GL_OES_gpu_shader5)' '#extension GL_OES_gpu_shader5 : enable' '#define SFB_PRECISE precise' \
+          '#else' '#define SFB_PRECISE' '#endif' 'precision highp float;' 'precision highp int;' > "$out"; fi
         if [ "$n" != - ]; then printf '#define SFB_LENGTH %d\n' "$n" >> "$out"; fi
         cat "$f" >> "$out"
         what="$f $variant"; if [ "$n" != - ]; then what="$what SFB_LENGTH=$n"; fi

@@ -6,19 +6,24 @@
  * directly. The framebuffer: an RGBA32UI texture of (u, v, view depth, face + 1) bits per
  * pixel (integer textures are colour-renderable in GLES 3 without extensions, float ones are
  * not), two more for the polygon-based method's interpolated position and normal, and a 32-bit
- * float depth texture holding the view depth scaled into [0, 1]. The vertices are the job's in
- * one attribute buffer (x, y, z, u, v in float, the face as an integer: a proxy grid point
- * belongs to the triangles of one parametric face, which the kernel checks), the triangles an
- * index buffer. Where GL differs from ref (sfb__ref_raster): float interpolation (GL's
- * perspective-correct weights are ref's b_k q_k / sum in float), the tie rule for pixel centres
- * on an edge, and the depth test in float. A picture larger than GL_MAX_TEXTURE_SIZE or
- * GL_MAX_VIEWPORT_DIMS, vertices shared by faces, or an incomplete framebuffer go to ref's
- * kernel (with a log line). On the host's context (gl_use_current_context) every state the
- * raster changes is put back: framebuffer bindings, viewport, depth, scissor, stencil, cull
- * and blend switches, depth function and masks, the array and pixel-pack buffers and pack
- * storage, besides sfb__gl_enter's and the draw path's state (sfb__gl_draw_save). Desktop GL's
- * glPolygonMode is not touched: a host that leaves it at GL_LINE gets a ref-like result only
- * where lines cover. */
+ * float depth texture holding the view depth scaled into [0, 1]. The triangles are an RGBA32F
+ * texture of 5 texels each (11 with the polygon data), drawn with no vertex attributes
+ * (gl_VertexID), in batches of up to 2^17. GL decides only which pixels a triangle covers: the
+ * fragment stage computes the barycentric coordinates at the pixel centre from the triangle's
+ * own corners, and every value from them, as ref does. (Leaving that to GL's interpolation
+ * failed on NVIDIA's driver: with w = view depth the perspective-correct varyings came back
+ * without their division by the interpolated 1 / w, a depth of 1 at every pixel, and the
+ * corners snapped to its 8-bit sub-pixel grid moved the values by 1e-5 relative besides.)
+ * Where GL differs from ref (sfb__ref_raster): the arithmetic in float, the tie rule for pixel
+ * centres on an edge and GL's snapping of the edges, and the depth test in float. A picture
+ * larger than GL_MAX_TEXTURE_SIZE or GL_MAX_VIEWPORT_DIMS, a parametric face number of 2^24 or
+ * more (the texture holds it as a float), or an incomplete framebuffer go to ref's kernel
+ * (with a log line). On the host's context (gl_use_current_context) every state the raster
+ * changes is put back: framebuffer bindings, viewport, depth, scissor, stencil, cull and blend
+ * switches, depth function and masks, the array and pixel-pack buffers and pack storage,
+ * besides sfb__gl_enter's and the draw path's state (sfb__gl_draw_save: texture units, samplers,
+ * unpack storage). Desktop GL's glPolygonMode is not touched: a host that leaves it at GL_LINE
+ * gets a ref-like result only where lines cover. */
 #ifndef SFB__GL_RASTER_H
 #define SFB__GL_RASTER_H
 
@@ -73,7 +78,7 @@ static void sfb__gl_raster_restore(sfb__gl *g, const sfb__gl_rstate *r) {
 }
 
 static sfb_result sfb__gl_raster_program(sfb__gl *g) {
-    static const char *const names[3] = {"u_size", "u_ortho", "u_zscale"};
+    static const char *const names[7] = {"u_tris", "u_size", "u_nt", "u_tpr", "u_ortho", "u_polygon", "u_zscale"};
     sfb__GLuint prog;
     sfb_result r;
     int i;
@@ -81,68 +86,62 @@ static sfb_result sfb__gl_raster_program(sfb__gl *g) {
     if ((r = sfb__gl_draw_stages(g, "", sfb__glsl_raster_vert_glsl, "raster.vert.glsl", sfb__glsl_raster_frag_glsl, "raster.frag.glsl", NULL,
                                  0, "the analysis raster program", &prog)) != SFB_SUCCESS)
         return r;
-    for (i = 0; i < 3; ++i) g->raster_loc[i] = g->gl.GetUniformLocation(prog, names[i]);
+    for (i = 0; i < 7; ++i) g->raster_loc[i] = g->gl.GetUniformLocation(prog, names[i]);
     g->raster_program = prog;
-    g->gl.GenVertexArrays(1, &g->raster_vao);
-    g->gl.GenBuffers(2, g->raster_buf);
+    g->gl.GenVertexArrays(1, &g->raster_vao); /* bound empty: the vertex stage reads the texture */
     return sfb__gl_check(g, "building the analysis raster program");
 }
 
-/* The vertices the triangles use, as the attribute buffer's words (stride: 6, or 12 with the
- * position and normal), the face as an int's bits; the indices; the largest depth. 0 when a
- * vertex is shared by two faces (the kernel's assumption), -1 out of memory. */
-static int sfb__gl_raster_data(sfb__gl *g, const sfb__raster_job *j, int stride, int nvert, float **vdata, sfb__GLuint **idx,
-                               double *zmax) {
-    float *v;
-    sfb__GLuint *ix;
+/* Triangles [first, first + count) of the job as the triangle texture's texels (raster.frag.glsl
+ * says which), `tpr` triangles of `nt` texels a row; the rest of the last row zero. */
+static void sfb__gl_raster_texels(const sfb__raster_job *j, int first, int count, int nt, int tpr, float *out) {
+    const size_t rows = ((size_t)count + (size_t)tpr - 1) / (size_t)tpr;
     int t, k, c;
-    *vdata = v = (float *)sfb__calloc(g->ctx, (size_t)nvert * (size_t)stride + 1, sizeof(float));
-    *idx = ix = (sfb__GLuint *)sfb__alloc(g->ctx, (size_t)j->ntri * 3 * sizeof(sfb__GLuint) + 1);
-    if (!v || !ix) return -1;
-    *zmax = 0.0;
-    for (t = 0; t < nvert; ++t) {
-        const int none = -1;
-        memcpy(&v[(size_t)t * (size_t)stride + 5], &none, sizeof none);
-    }
-    for (t = 0; t < j->ntri; ++t) {
-        const int *tv = j->tri + 4 * (size_t)t;
+    memset(out, 0, rows * (size_t)tpr * (size_t)nt * 4 * sizeof(float));
+    for (t = 0; t < count; ++t) {
+        const int *tv = j->tri + 4 * ((size_t)first + (size_t)t);
+        float *o = out + ((size_t)(t / tpr) * (size_t)tpr + (size_t)(t % tpr)) * (size_t)nt * 4;
         for (k = 0; k < 3; ++k) {
             const sfb__raster_vertex *q = &j->vert[tv[k]];
-            float *o = v + (size_t)tv[k] * (size_t)stride;
-            int face;
-            memcpy(&face, &o[5], sizeof face);
-            if (face != -1 && face != tv[3]) return 0;
-            ix[3 * (size_t)t + (size_t)k] = (sfb__GLuint)tv[k];
-            if (face != -1) continue;
-            o[0] = (float)q->x; o[1] = (float)q->y; o[2] = (float)q->z; o[3] = (float)q->u; o[4] = (float)q->v;
-            memcpy(&o[5], &tv[3], sizeof(int));
-            if (q->z > *zmax) *zmax = q->z;
+            o[4 * k] = (float)q->x; o[4 * k + 1] = (float)q->y; o[4 * k + 2] = (float)q->q; o[4 * k + 3] = (float)q->z;
+            o[12 + 2 * k] = (float)q->u; o[12 + 2 * k + 1] = (float)q->v;
             if (j->apos)
                 for (c = 0; c < 3; ++c) {
-                    o[6 + c] = j->apos[3 * (size_t)tv[k] + c];
-                    o[9 + c] = j->anrm[3 * (size_t)tv[k] + c];
+                    o[20 + 4 * k + c] = j->apos[3 * (size_t)tv[k] + c];
+                    o[32 + 4 * k + c] = j->anrm[3 * (size_t)tv[k] + c];
                 }
         }
+        o[18] = (float)tv[3]; /* the face, exact below 2^24 (checked by the caller) */
     }
-    return 1;
 }
 
-/* Draws the triangles into a framebuffer of fresh textures and reads it back (the context
- * current, the state saved by the caller). */
-static sfb_result sfb__gl_raster_draw(sfb__gl *g, const sfb__raster_job *j, const float *vdata, int nvert, int stride,
-                                      const sfb__GLuint *idx, double zmax) {
+/* Draws the triangles, in batches that fit one triangle texture, into a framebuffer of fresh
+ * textures and reads it back (the context current, the state saved by the caller). */
+static sfb_result sfb__gl_raster_draw(sfb__gl *g, const sfb__raster_job *j, double zmax) {
     static const sfb__GLenum bufs[3] = {SFB__GL_COLOR_ATTACHMENT0, SFB__GL_COLOR_ATTACHMENT0 + 1, SFB__GL_COLOR_ATTACHMENT0 + 2};
     const sfb__GLuint clear_hit[4] = {0, 0, 0, 0};
     const float clear_depth = 1.0f;
-    const int nout = j->apos ? 3 : 1;
-    const size_t npix = (size_t)j->w * (size_t)j->h, bytes = (size_t)stride * sizeof(float);
-    sfb__GLuint tex[4] = {0, 0, 0, 0}, fbo = 0, *px = NULL;
+    const int nout = j->apos ? 3 : 1, nt = j->apos ? 11 : 5;
+    /* rows of up to 4096 texels (or GL's limit), batches of up to 2^17 triangles (23 MB of
+     * texels with the polygon data) and as many rows as GL allows */
+    const int tw = (g->max_texture < 4096 ? g->max_texture : 4096) / nt * nt, tpr = tw / nt;
+    const long long most = (long long)tpr * g->max_texture < (1 << 17) ? (long long)tpr * g->max_texture : (1 << 17);
+    const int batch = (int)(most > (long long)j->ntri ? j->ntri : most);
+    const size_t npix = (size_t)j->w * (size_t)j->h;
+    sfb__GLuint tex[5] = {0, 0, 0, 0, 0}, fbo = 0, *px = NULL;
+    float *texels = NULL;
     sfb_result r;
-    int i;
+    int i, first;
     size_t p;
     if ((r = sfb__gl_raster_program(g)) != SFB_SUCCESS) return r;
+    if ((r = sfb__gl_mf_sampler(g)) != SFB_SUCCESS) return r;
     px = (sfb__GLuint *)sfb__alloc(g->ctx, npix * 4 * sizeof(sfb__GLuint) + 1);
-    if (!px) return sfb__oom(g->ctx, "the gl raster's read-back");
+    texels = (float *)sfb__alloc(g->ctx, ((size_t)batch + (size_t)tpr) * (size_t)nt * 4 * sizeof(float));
+    if (!px || !texels) {
+        sfb__free(g->ctx, px);
+        sfb__free(g->ctx, texels);
+        return sfb__oom(g->ctx, "the gl raster's read-back");
+    }
     g->gl.ActiveTexture(SFB__GL_TEXTURE0); /* unit 0 is among those sfb__gl_draw_save keeps */
     for (i = 0; i < nout; ++i)
         tex[i] = sfb__gl_mf_texture(g, SFB__GL_RGBA32UI, j->w, j->h, SFB__GL_RGBA_INTEGER, SFB__GL_UNSIGNED_INT, NULL);
@@ -170,28 +169,27 @@ static sfb_result sfb__gl_raster_draw(sfb__gl *g, const sfb__raster_job *j, cons
     for (i = 0; i < nout; ++i) g->gl.ClearBufferuiv(SFB__GL_COLOR, i, clear_hit);
     g->gl.ClearBufferfv(SFB__GL_DEPTH, 0, &clear_depth);
     g->gl.UseProgram(g->raster_program);
-    g->gl.Uniform2f(g->raster_loc[0], (float)j->w, (float)j->h);
-    g->gl.Uniform1i(g->raster_loc[1], j->ortho);
-    g->gl.Uniform1f(g->raster_loc[2], (float)(1.0 / (zmax * 1.0001)));
+    g->gl.Uniform1i(g->raster_loc[0], 0);
+    g->gl.Uniform2f(g->raster_loc[1], (float)j->w, (float)j->h);
+    g->gl.Uniform1i(g->raster_loc[2], nt);
+    g->gl.Uniform1i(g->raster_loc[3], tpr);
+    g->gl.Uniform1i(g->raster_loc[4], j->ortho);
+    g->gl.Uniform1i(g->raster_loc[5], j->apos != NULL);
+    g->gl.Uniform1f(g->raster_loc[6], (float)(1.0 / (zmax * 1.0001)));
     g->gl.BindVertexArray(g->raster_vao);
-    g->gl.BindBuffer(SFB__GL_ARRAY_BUFFER, g->raster_buf[0]);
-    g->gl.BufferData(SFB__GL_ARRAY_BUFFER, (sfb__GLsizeiptr)((size_t)nvert * bytes), vdata, SFB__GL_STREAM_DRAW);
-    g->gl.EnableVertexAttribArray(0);
-    g->gl.VertexAttribPointer(0, 3, SFB__GL_FLOAT, 0, (sfb__GLsizei)bytes, (const void *)0);
-    g->gl.EnableVertexAttribArray(1);
-    g->gl.VertexAttribPointer(1, 2, SFB__GL_FLOAT, 0, (sfb__GLsizei)bytes, (const void *)(3 * sizeof(float)));
-    g->gl.EnableVertexAttribArray(2);
-    g->gl.VertexAttribIPointer(2, 1, SFB__GL_INT, (sfb__GLsizei)bytes, (const void *)(5 * sizeof(float)));
-    if (j->apos) {
-        g->gl.EnableVertexAttribArray(3);
-        g->gl.VertexAttribPointer(3, 3, SFB__GL_FLOAT, 0, (sfb__GLsizei)bytes, (const void *)(6 * sizeof(float)));
-        g->gl.EnableVertexAttribArray(4);
-        g->gl.VertexAttribPointer(4, 3, SFB__GL_FLOAT, 0, (sfb__GLsizei)bytes, (const void *)(9 * sizeof(float)));
+    g->gl.BindSampler(0, g->sampler);
+    sfb__gl_unpack_plain(g, 4);
+    tex[4] = sfb__gl_mf_texture(g, SFB__GL_RGBA32F, tw, 1, SFB__GL_RGBA, SFB__GL_FLOAT, NULL);
+    /* batches in the job's order, so that the first of equal depths keeps a pixel */
+    for (first = 0; first < j->ntri && r == SFB_SUCCESS; first += batch) {
+        const int count = j->ntri - first < batch ? j->ntri - first : batch, rows = (count + tpr - 1) / tpr;
+        sfb__gl_raster_texels(j, first, count, nt, tpr, texels);
+        g->gl.BindTexture(SFB__GL_TEXTURE_2D, tex[4]);
+        g->gl.TexImage2D(SFB__GL_TEXTURE_2D, 0, SFB__GL_RGBA32F, tw, rows, 0, SFB__GL_RGBA, SFB__GL_FLOAT, texels);
+        g->gl.DrawArraysInstanced(SFB__GL_TRIANGLES, 0, 3 * count, 1);
+        r = sfb__gl_check(g, "drawing the analysis raster");
     }
-    g->gl.BindBuffer(SFB__GL_ELEMENT_ARRAY_BUFFER, g->raster_buf[1]);
-    g->gl.BufferData(SFB__GL_ELEMENT_ARRAY_BUFFER, (sfb__GLsizeiptr)((size_t)j->ntri * 3 * sizeof(sfb__GLuint)), idx, SFB__GL_STREAM_DRAW);
-    g->gl.DrawElementsInstanced(SFB__GL_TRIANGLES, 3 * j->ntri, SFB__GL_UNSIGNED_INT, NULL, 1);
-    if ((r = sfb__gl_check(g, "drawing the analysis raster")) != SFB_SUCCESS) goto done;
+    if (r != SFB_SUCCESS) goto done;
     g->gl.BindBuffer(SFB__GL_PIXEL_PACK_BUFFER, 0);
     g->gl.PixelStorei(SFB__GL_PACK_ALIGNMENT, 4);
     g->gl.PixelStorei(SFB__GL_PACK_ROW_LENGTH, 0);
@@ -227,9 +225,10 @@ static sfb_result sfb__gl_raster_draw(sfb__gl *g, const sfb__raster_job *j, cons
 done:
     g->gl.BindFramebuffer(SFB__GL_FRAMEBUFFER, 0);
     if (fbo) g->gl.DeleteFramebuffers(1, &fbo);
-    for (i = 0; i < 4; ++i)
+    for (i = 0; i < 5; ++i)
         if (tex[i]) g->gl.DeleteTextures(1, &tex[i]);
     sfb__free(g->ctx, px);
+    sfb__free(g->ctx, texels);
     return r;
 }
 
@@ -239,36 +238,29 @@ static sfb_result sfb__gl_raster(void *state, const sfb__raster_job *j) {
     sfb__gl_drawstate ds;
     sfb__gl_rstate rs;
     sfb__GLint dims[2] = {0, 0};
-    sfb__GLuint *idx = NULL;
-    float *vdata = NULL;
     double zmax = 0.0;
-    int nvert = 0, t, k, ok;
-    const int stride = j && j->apos ? 12 : 6;
+    int t, k;
     const char *why = NULL;
     sfb_result r;
     if (!g || !j || j->w < 1 || j->h < 1 || j->ntri < 0) return SFB_INVALID_ARGS;
     if (j->ntri == 0) return SFB_SUCCESS;
-    for (t = 0; t < j->ntri; ++t)
+    for (t = 0; t < j->ntri && !why; ++t) {
+        if (j->tri[4 * (size_t)t + 3] < 0 || j->tri[4 * (size_t)t + 3] >= (1 << 24)) why = "a parametric face number is 2^24 or more";
         for (k = 0; k < 3; ++k)
-            if (j->tri[4 * (size_t)t + (size_t)k] >= nvert) nvert = j->tri[4 * (size_t)t + (size_t)k] + 1;
+            if (j->vert[j->tri[4 * (size_t)t + (size_t)k]].z > zmax) zmax = j->vert[j->tri[4 * (size_t)t + (size_t)k]].z;
+    }
     if ((r = sfb__gl_enter(g, &saved)) != SFB_SUCCESS) return r;
     g->gl.GetIntegerv(SFB__GL_MAX_VIEWPORT_DIMS, dims);
     if (j->w > g->max_texture || j->h > g->max_texture || j->w > dims[0] || j->h > dims[1]) why = "the picture exceeds GL's texture or viewport size";
-    else if ((size_t)nvert * (size_t)stride * sizeof(float) > (size_t)0x7fffffff || (size_t)j->ntri * 12 > (size_t)0x7fffffff)
-        why = "the proxy exceeds one GL buffer";
-    else if ((ok = sfb__gl_raster_data(g, j, stride, nvert, &vdata, &idx, &zmax)) < 0) r = sfb__oom(g->ctx, "the gl raster's vertices");
-    else if (ok == 0) why = "a proxy vertex is shared by two faces";
-    if (r == SFB_SUCCESS && !why) {
+    if (!why) {
         sfb__gl_draw_save(g, &ds);
         sfb__gl_raster_save(g, &rs);
-        r = sfb__gl_raster_draw(g, j, vdata, nvert, stride, idx, zmax > 0.0 ? zmax : 1.0);
+        r = sfb__gl_raster_draw(g, j, zmax > 0.0 ? zmax : 1.0);
         sfb__gl_raster_restore(g, &rs);
         sfb__gl_draw_restore(g, &ds);
         if (r == SFB_UNSUPPORTED) { why = "the framebuffer is incomplete"; r = SFB_SUCCESS; }
     }
     sfb__gl_leave(g, &saved);
-    sfb__free(g->ctx, vdata);
-    sfb__free(g->ctx, idx);
     if (r != SFB_SUCCESS) return r;
     if (why) {
         sfb__log(g->ctx, SFB_LOG_INFO, "%s: the analysis raster runs on the CPU (%s)", g->mode == SFB__GL_OSMESA ? "osmesa" : "gl", why);

@@ -97,8 +97,8 @@ typedef struct sfb__gl {
     int draw_rate;                  /* the grid draw_ibo holds */
     sfb__GLuint an_program, an_vao; /* sfb_analysis_draw_gl: analysis_draw.{vert,frag}.glsl, made on first use */
     sfb__GLint an_loc[3];
-    sfb__GLuint raster_program, raster_vao, raster_buf[2]; /* seed 003's proxy raster (raster.h), made on first use */
-    sfb__GLint raster_loc[3];
+    sfb__GLuint raster_program, raster_vao; /* seed 003's proxy raster (raster.h), made on first use */
+    sfb__GLint raster_loc[7];
     char desc[320];
 } sfb__gl;
 
@@ -261,14 +261,23 @@ static void sfb__gl_trim(char *log) {
  * `source`. `label` names it in errors, which carry the driver's log. */
 static sfb_result sfb__gl_shader(sfb__gl *g, sfb__GLenum type, const char *defines, const char *source, const char *label,
                                  sfb__GLuint *out) {
-    char header[160];
+    char header[512];
     const sfb__GLchar *parts[2];
     sfb__GLuint sh;
     sfb__GLint ok = 0, len = 0;
     const char *what = type == SFB__GL_COMPUTE_SHADER ? "GL_COMPUTE_SHADER" : type == SFB__GL_VERTEX_SHADER ? "GL_VERTEX_SHADER" : "GL_FRAGMENT_SHADER";
     *out = 0;
+    /* SFB_PRECISE: GLSL's `precise`, so that a compiler that fuses a * b - c * d into one
+     * fused multiply-add (NVIDIA's does) keeps a cross product of parallel vectors exactly zero,
+     * as ref's is; GLSL ES 3.1 has the keyword with (EXT|OES)_gpu_shader5 only (whose #extension
+     * comes before the first statement), and without either the kernels run unqualified */
     snprintf(header, sizeof header, "%s%s",
-             g->es ? "#version 310 es\nprecision highp float;\nprecision highp int;\n" : "#version 430 core\n", defines);
+             g->es ? "#version 310 es\n"
+                     "#if defined(GL_EXT_gpu_shader5)\n#extension GL_EXT_gpu_shader5 : enable\n#define SFB_PRECISE precise\n"
+                     "#elif defined(GL_OES_gpu_shader5)\n#extension GL_OES_gpu_shader5 : enable\n#define SFB_PRECISE precise\n"
+                     "#else\n#define SFB_PRECISE\n#endif\nprecision highp float;\nprecision highp int;\n"
+                   : "#version 430 core\n#define SFB_PRECISE precise\n",
+             defines);
     parts[0] = header;
     parts[1] = source;
     sh = g->gl.CreateShader(type);
@@ -436,9 +445,7 @@ static void sfb__gl_release_gl(sfb__gl *g) {
     g->an_program = g->an_vao = 0;
     if (g->raster_program) g->gl.DeleteProgram(g->raster_program);
     if (g->raster_vao) g->gl.DeleteVertexArrays(1, &g->raster_vao);
-    for (i = 0; i < 2; ++i)
-        if (g->raster_buf[i]) g->gl.DeleteBuffers(1, &g->raster_buf[i]);
-    g->raster_program = g->raster_vao = g->raster_buf[0] = g->raster_buf[1] = 0;
+    g->raster_program = g->raster_vao = 0;
     if (g->draw_program) g->gl.DeleteProgram(g->draw_program);
     if (g->draw_vao) g->gl.DeleteVertexArrays(1, &g->draw_vao);
     if (g->draw_ibo) g->gl.DeleteBuffers(1, &g->draw_ibo);

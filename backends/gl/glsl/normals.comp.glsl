@@ -69,7 +69,9 @@ void main() {
     // each tangent scaled on its own first: the cross product's direction is unchanged
     vec3 a = sfb_scaled(vec3(tu[3 * i], tu[3 * i + 1], tu[3 * i + 2]));
     vec3 d = sfb_scaled(vec3(tv[3 * i], tv[3 * i + 1], tv[3 * i + 2]));
-    vec3 L = sfb_unit(vec3(a.y * d.z - a.z * d.y, a.z * d.x - a.x * d.z, a.x * d.y - a.y * d.x));
+    // precise: exactly zero for parallel tangents, as ref (no fused multiply-add)
+    SFB_PRECISE vec3 c = vec3(a.y * d.z - a.z * d.y, a.z * d.x - a.x * d.z, a.x * d.y - a.y * d.x);
+    vec3 L = sfb_unit(c);
     vec3 S = vec3(0.0);
     vec3 B = L;
     int k = (u_flags & 1) != 0 ? ns_index[i] : -1;

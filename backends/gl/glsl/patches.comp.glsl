@@ -420,7 +420,8 @@ void sfb_eval(ivec4 rec, float s, float t, bool second, out vec3 res[6], out vec
 vec3 sfb_normal_dir(vec3 a, vec3 b) {
     float ma = max(max(abs(a.x), abs(a.y)), abs(a.z)), mb = max(max(abs(b.x), abs(b.y)), abs(b.z));
     if (!(ma > 0.0) || !(mb > 0.0) || isinf(ma) || isinf(mb)) return vec3(0.0);
-    return cross(a / ma, b / mb);
+    SFB_PRECISE vec3 n = cross(a / ma, b / mb); // precise: exactly zero for parallel tangents
+    return n;
 }
 
 bool sfb_usable(vec3 n) {

@@ -52,10 +52,11 @@ float sfb_curvature(int i, vec3 n) {
     vec3 pu = sfb_get(2, i), pv = sfb_get(3, i);
     float E = dot(pu, pu), F = dot(pu, pv), G = dot(pv, pv);
     float L = dot(sfb_get(4, i), n), M = dot(sfb_get(5, i), n), N = dot(sfb_get(6, i), n);
-    float det = E * G - F * F;
+    // precise: the differences cancel near flat and parabolic points; as written, as ref's
+    SFB_PRECISE float det = E * G - F * F;
     if (!(det > 1e-30 * E * G) || isinf(det) || isnan(det)) return sfb_nan();
-    float K = (L * N - M * M) / det;
-    float H = -(E * N - 2.0 * F * M + G * L) / (2.0 * det);
+    SFB_PRECISE float K = (L * N - M * M) / det;
+    SFB_PRECISE float H = -(E * N - 2.0 * F * M + G * L) / (2.0 * det);
     if (u_curvature == 0) return K;
     if (u_curvature == 1) return H;
     return abs(H) + sqrt(max(H * H - K, 0.0));
