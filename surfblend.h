@@ -115,7 +115,7 @@ typedef struct sfb_context_config {
     sfb_progress progress;             /* NULL func: no reports, no cancel */
     const sfb_backend_kind *backends;  /* ordered preference; NULL: default order */
     int backend_count;
-    int threads;                       /* 0: one per core, 1: no threads (simd); negative: invalid */
+    int threads;                       /* 0: one per core, 1: no threads (simd; gl, osmesa: the CPU work between kernels); negative: invalid */
     size_t memory_budget;              /* bytes; 0: SFB_DEFAULT_MEMORY_BUDGET */
     int gl_use_current_context;        /* gl backend: run on the caller's current context */
     int ignore_environment;            /* 1: do not read SURFBLEND_BACKEND (SURFBLEND_SIMD_ISA,
@@ -894,6 +894,46 @@ SFB_API sfb_result sfb_mesh_mean_curvature(sfb_context *ctx, const sfb_mesh *mes
 #  define SFB__IF static
 #endif
 
+/* ---- a CPU thread pool a backend owns and lends (src/pool.c) ---- */
+#if !defined(_WIN32) && (defined(__unix__) || defined(__unix) || defined(__APPLE__))
+#  define SFB__THREADS 1
+#  include <pthread.h>
+#  include <unistd.h>
+#endif
+#define SFB__POOL_MAX_THREADS 64
+typedef struct sfb__pool {
+    int threads; /* threads sharing one run, the caller included (1: no workers) */
+#ifdef SFB__THREADS
+    int workers; /* pool threads running (threads - 1 once started) */
+    pthread_t tid[SFB__POOL_MAX_THREADS];
+    pthread_mutex_t busy; /* held by the one run using the pool */
+    pthread_mutex_t lock; /* guards everything below */
+    pthread_cond_t wake, done;
+    unsigned long generation; /* bumped per job; idle workers wait for a change */
+    int quit;
+    /* the current job: items [first, last) cut into `chunks`, each run by task(owner, arg, a, b);
+     * with `offsets` (stencil rows) chunks hold about equal entry counts, else equal items */
+    void (*task)(const void *owner, const void *arg, int a, int b);
+    const void *owner, *arg;
+    const int *offsets;
+    int first, last, chunks, next_chunk, chunks_done;
+    size_t entry0, entries;
+#endif
+} sfb__pool;
+/* Threads for a requested count (0: one per online core), at most SFB__POOL_MAX_THREADS; 1
+ * where no thread support is known. */
+SFB__IF int sfb__pool_threads(int requested);
+/* Starts threads - 1 workers (a zeroed pool of one thread for threads <= 1): 1, or 0 with
+ * `why` filled and nothing left running. */
+SFB__IF int sfb__pool_start(sfb__pool *p, int threads, char *why, size_t why_size);
+SFB__IF void sfb__pool_stop(sfb__pool *p);
+/* Runs task over [first, last) on the pool, the caller included, and returns 1; returns 0
+ * having run nothing when the pool has one thread or another run holds it. */
+SFB__IF int sfb__pool_run(sfb__pool *p, void (*task)(const void *owner, const void *arg, int a, int b), const void *owner,
+                          const void *arg, int first, int last, const int *offsets, size_t e0, size_t entries);
+/* The `parallel` slot's contract on a backend's pool: task(arg, a, b) over [first, last). */
+SFB__IF int sfb__pool_lend(sfb__pool *p, void (*task)(void *arg, int first, int last), void *arg, int first, int last);
+
 /* ---- backend vtable ---- */
 struct sfb__patch_table;
 /* A stencil table: row r reads sizes[r] entries starting at offsets[r] from indices/weights. */
@@ -959,6 +999,10 @@ typedef struct sfb__backend_vtable {
      * once all have run; returns 0 having run nothing (no threads, or a call of another thread
      * holds them). Not a kernel: a NULL slot means the core runs the task itself, on ref too. */
     int (*parallel)(void *state, void (*task)(void *arg, int first, int last), void *arg, int first, int last);
+    /* 1: the kernels may also be called inside a task lent through `parallel` (each call then
+     * runs on that one thread: simd, whose analysis rounds run in chunks so); 0: from the
+     * calling thread only (gl, osmesa: their GL context is current there alone). */
+    int kernels_in_tasks;
 } sfb__backend_vtable;
 
 /* One analysis's shading (the `shade` slot). Per item i: P = position[3i..], N = normal (unit),
@@ -1957,6 +2001,197 @@ SFB_API void sfb_clear_error(sfb_context *ctx) {
     ctx->error_info.result = SFB_SUCCESS;
     ctx->error_info.element = SFB_ELEMENT_NONE;
     ctx->error_info.index = -1;
+}
+#line 1 "src/pool.c"
+/* A CPU thread pool that a backend owns and lends (the simd backend's kernels and the
+ * `parallel` slot of simd, gl and osmesa; sfb__pool in src/sfb_internal.h).
+ *
+ * threads - 1 workers are started by sfb__pool_start and joined by sfb__pool_stop. A run cuts
+ * [first, last) into 4 chunks per thread, of about equal entry counts (with `offsets`: stencil
+ * rows) or of equal items; the caller and the workers claim chunks until none is left, and the
+ * caller returns once every claimed chunk is done (it never waits for a worker still asleep).
+ * A run while another thread's run holds the pool (pthread_mutex_trylock) returns 0 having run
+ * nothing, and so does every run of a pool of one thread: the caller then runs the work
+ * itself. Where no thread support is known (SFB__THREADS undefined: _WIN32 and others), a pool
+ * always has one thread. */
+
+int sfb__pool_threads(int requested) {
+    long n = requested;
+    if (n <= 0) {
+#if defined(SFB__THREADS) && defined(_SC_NPROCESSORS_ONLN)
+        n = sysconf(_SC_NPROCESSORS_ONLN);
+#else
+        n = 1;
+#endif
+    }
+    if (n < 1) n = 1;
+    if (n > SFB__POOL_MAX_THREADS) n = SFB__POOL_MAX_THREADS;
+#ifndef SFB__THREADS
+    n = 1; /* no thread support known here: single-threaded */
+#endif
+    return (int)n;
+}
+
+#ifdef SFB__THREADS
+/* First row in [first, last) whose entries start at or after `e` (last when none). */
+static int sfb__pool_row_at(const int *offsets, int first, int last, size_t e) {
+    int lo = first, hi = last;
+    while (lo < hi) {
+        int mid = lo + (hi - lo) / 2;
+        if ((size_t)offsets[mid] < e) lo = mid + 1;
+        else hi = mid;
+    }
+    return lo;
+}
+
+/* First item of chunk c of the current job: chunks hold about equal numbers of entries
+ * (stencil rows) or of items. */
+static int sfb__pool_chunk_start(const sfb__pool *p, int c) {
+    if (c <= 0) return p->first;
+    if (c >= p->chunks) return p->last;
+    if (!p->offsets) return p->first + (int)((long long)(p->last - p->first) * c / p->chunks);
+    return sfb__pool_row_at(p->offsets, p->first, p->last, p->entry0 + p->entries / (size_t)p->chunks * (size_t)c);
+}
+
+/* Runs chunks of the current job until none is left to claim. Called and returns with
+ * p->lock held. A worker that wakes late finds nothing to claim (or joins the next job):
+ * the job is only touched between claiming a chunk and counting it done. */
+static void sfb__pool_drain(sfb__pool *p) {
+    while (p->next_chunk < p->chunks) {
+        const int c = p->next_chunk++;
+        const int a = sfb__pool_chunk_start(p, c), b = sfb__pool_chunk_start(p, c + 1);
+        void (*task)(const void *, const void *, int, int) = p->task;
+        const void *owner = p->owner, *arg = p->arg;
+        pthread_mutex_unlock(&p->lock);
+        if (a < b) task(owner, arg, a, b);
+        pthread_mutex_lock(&p->lock);
+        if (++p->chunks_done == p->chunks) pthread_cond_signal(&p->done);
+    }
+}
+
+static void *sfb__pool_worker(void *arg) {
+    sfb__pool *p = (sfb__pool *)arg;
+    unsigned long seen = 0;
+    pthread_mutex_lock(&p->lock);
+    for (;;) {
+        while (!p->quit && p->generation == seen) pthread_cond_wait(&p->wake, &p->lock);
+        if (p->quit) break;
+        seen = p->generation;
+        sfb__pool_drain(p);
+    }
+    pthread_mutex_unlock(&p->lock);
+    return NULL;
+}
+#endif /* SFB__THREADS */
+
+void sfb__pool_stop(sfb__pool *p) {
+#ifdef SFB__THREADS
+    int i;
+    if (p->threads <= 1) return;
+    pthread_mutex_lock(&p->lock);
+    p->quit = 1;
+    pthread_cond_broadcast(&p->wake);
+    pthread_mutex_unlock(&p->lock);
+    for (i = 0; i < p->workers; ++i) pthread_join(p->tid[i], NULL);
+    p->workers = 0;
+    pthread_cond_destroy(&p->done);
+    pthread_cond_destroy(&p->wake);
+    pthread_mutex_destroy(&p->lock);
+    pthread_mutex_destroy(&p->busy);
+#endif
+    p->threads = 1;
+}
+
+int sfb__pool_start(sfb__pool *p, int threads, char *why, size_t why_size) {
+#ifdef SFB__THREADS
+    int i, e;
+#endif
+    memset(p, 0, sizeof *p);
+    p->threads = threads < 1 ? 1 : threads;
+#ifdef SFB__THREADS
+    if (p->threads == 1) return 1;
+    if (pthread_mutex_init(&p->busy, NULL) != 0) goto fail0;
+    if (pthread_mutex_init(&p->lock, NULL) != 0) goto fail1;
+    if (pthread_cond_init(&p->wake, NULL) != 0) goto fail2;
+    if (pthread_cond_init(&p->done, NULL) != 0) goto fail3;
+    for (i = 0; i < p->threads - 1; ++i) {
+        e = pthread_create(&p->tid[i], NULL, sfb__pool_worker, p);
+        if (e != 0) {
+            snprintf(why, why_size, "could not start worker thread %d of %d: %s", i + 1, p->threads - 1, strerror(e));
+            sfb__pool_stop(p); /* joins the i already running */
+            return 0;
+        }
+        p->workers = i + 1;
+    }
+    return 1;
+fail3:
+    pthread_cond_destroy(&p->wake);
+fail2:
+    pthread_mutex_destroy(&p->lock);
+fail1:
+    pthread_mutex_destroy(&p->busy);
+fail0:
+    snprintf(why, why_size, "could not create the thread pool's locks");
+    p->threads = 1;
+    return 0;
+#else
+    (void)why; (void)why_size;
+    p->threads = 1;
+    return 1;
+#endif
+}
+
+int sfb__pool_run(sfb__pool *p, void (*task)(const void *owner, const void *arg, int a, int b), const void *owner, const void *arg, int first,
+                  int last, const int *offsets, size_t e0, size_t entries) {
+#ifdef SFB__THREADS
+    if (p->threads <= 1 || pthread_mutex_trylock(&p->busy) != 0) return 0;
+    pthread_mutex_lock(&p->lock);
+    p->task = task;
+    p->owner = owner;
+    p->arg = arg;
+    p->offsets = offsets;
+    p->first = first;
+    p->last = last;
+    p->entry0 = e0;
+    p->entries = entries;
+    p->chunks = 4 * p->threads; /* several per thread: a late or slow thread takes fewer */
+    p->next_chunk = 0;
+    p->chunks_done = 0;
+    ++p->generation;
+    pthread_cond_broadcast(&p->wake);
+    sfb__pool_drain(p);
+    /* wait for chunks still running on workers, not for workers still asleep */
+    while (p->chunks_done < p->chunks) pthread_cond_wait(&p->done, &p->lock);
+    p->task = NULL;
+    p->owner = NULL;
+    p->arg = NULL;
+    pthread_mutex_unlock(&p->lock);
+    pthread_mutex_unlock(&p->busy);
+    return 1;
+#else
+    (void)p; (void)task; (void)owner; (void)arg; (void)first; (void)last; (void)offsets; (void)e0; (void)entries;
+    return 0;
+#endif
+}
+
+/* The `parallel` slot's body for a backend that owns `p`: task(arg, a, b) over its chunks. */
+typedef struct sfb__pool_lent {
+    void (*task)(void *arg, int first, int last);
+    void *arg;
+} sfb__pool_lent;
+
+static void sfb__pool_lent_task(const void *owner, const void *arg, int a, int b) {
+    const sfb__pool_lent *l = (const sfb__pool_lent *)arg;
+    (void)owner;
+    l->task(l->arg, a, b);
+}
+
+int sfb__pool_lend(sfb__pool *p, void (*task)(void *arg, int first, int last), void *arg, int first, int last) {
+    sfb__pool_lent l;
+    if (!p || !task || first >= last) return 0;
+    l.task = task;
+    l.arg = arg;
+    return sfb__pool_run(p, sfb__pool_lent_task, NULL, &l, first, last, NULL, 0, 0);
 }
 #line 1 "src/backend.c"
 /* Backend registry: ordered probing, first that initialises wins, every attempt reported. */
@@ -13279,6 +13514,15 @@ static void sfb__an_run(const sfb__an *A, void (*task)(void *arg, int first, int
     else task(arg, first, last);
 }
 
+/* Whether the Newton attempts run in chunks over the backend's lent threads, each chunk
+ * calling the backend's eval there (simd: that call then runs on that one thread); else in one
+ * chunk on the calling thread, where a GPU backend's context is current and which evaluates a
+ * batch at once. */
+static int sfb__an_chunked(const sfb__an *A) {
+    const sfb__backend_vtable *b = A->ctx->backend;
+    return b && b->parallel && b->kernels_in_tasks;
+}
+
 static void sfb__an_grid_uv(const sfb__an *A, int k, double *u, double *v) {
     int R = A->R;
     if (!A->tri) { *u = (double)(k % (R + 1)) / R; *v = (double)(k / (R + 1)) / R; return; }
@@ -13881,8 +14125,9 @@ typedef struct sfb__an_done {
  * threads: no step waits for the whole batch, and nothing runs on one thread between steps.
  * The chunks shrink from about twice the mean to a few attempts (chunk c starts at
  * count (1 - (1 - c / nchunks)^2)): the backend hands its threads runs of equally many chunks,
- * so the last run taken is short and the other threads wait less for it. One chunk when the
- * backend lends no threads (a GPU evaluates a batch at once). res[c]: chunk c's evaluation
+ * so the last run taken is short and the other threads wait less for it. One chunk, on the
+ * calling thread, when the backend's kernels may not run in lent tasks (sfb__an_chunked: a GPU
+ * evaluates a batch at once, and its context is current on the calling thread alone). res[c]: chunk c's evaluation
  * result. The later rounds' attempts run here too, with `done` (sfb__an_newton). */
 typedef struct sfb__an_fresh_job {
     sfb__an *A;
@@ -13900,6 +14145,54 @@ static int sfb__an_fresh_start(const sfb__an_fresh_job *F, int c) {
     return F->count - (int)((long long)F->count * x * x / n2);
 }
 
+/* The attempts of a chunk that ended this step (outcome != 0), each into its own slot: round
+ * 0's hit slot tries[i].k and pixel (no two of its attempts share one), or a later round's
+ * done[tries[i].k]; so they may run in parallel, and the chunk moves its running attempts
+ * first afterwards. */
+typedef struct sfb__an_record_job {
+    const sfb__an_fresh_job *F;
+    const sfb__an_try *tries;
+    const sfb_location *locs;
+    const float *pos, *du, *dv, *nrm;
+} sfb__an_record_job;
+
+static void sfb__an_record(void *arg, int a, int b) {
+    const sfb__an_record_job *R = (const sfb__an_record_job *)arg;
+    const sfb__an_fresh_job *F = R->F;
+    sfb__an *A = F->A;
+    const sfb__an_try *tries = R->tries;
+    const sfb_location *locs = R->locs;
+    const float *pos = R->pos, *du = R->du, *dv = R->dv, *nrm = R->nrm;
+    int i;
+    for (i = a; i < b; ++i) {
+        const sfb__an_try *t = &tries[i];
+        if (t->outcome == 0) continue;
+        if (F->done) {
+            sfb__an_done *o = &F->done[t->k];
+            int q;
+            o->pix = t->pix;
+            o->outcome = t->outcome;
+            if (t->outcome == SFB__AN_OUT_NEW_HIT) {
+                for (q = 0; q < 3; ++q) {
+                    o->p[q] = pos[3 * i + q]; o->du[q] = du[3 * i + q]; o->dv[q] = dv[3 * i + q]; o->n[q] = nrm[3 * i + q];
+                }
+                o->z = t->z;
+                o->loc = locs[i];
+            }
+            continue;
+        }
+        if (t->outcome == SFB__AN_OUT_NEW_HIT) {
+            A->hpix[t->k] = t->pix;
+            A->hit[t->pix] = t->k;
+            A->state[t->pix] = SFB__AN_HIT;
+            sfb__an_store_hit(A, (size_t)t->k, &locs[i], t->z, pos + 3 * i, du + 3 * i, dv + 3 * i, nrm + 3 * i);
+        } else {
+            A->hpix[t->k] = -1;
+            if (t->outcome == 2) A->state[t->pix] = SFB__AN_TRIED_NEAR;
+        }
+    }
+}
+
 static void sfb__an_fresh(void *arg, int c0, int c1) {
     const sfb__an_fresh_job *F = (const sfb__an_fresh_job *)arg;
     sfb__an *A = F->A;
@@ -13910,8 +14203,10 @@ static void sfb__an_fresh(void *arg, int c0, int c1) {
         sfb_location *locs = F->locs + a;
         float *pos = F->pos + 3 * (size_t)a, *du = F->du + 3 * (size_t)a, *dv = F->dv + 3 * (size_t)a, *nrm = F->nrm + 3 * (size_t)a;
         sfb__an_step_job J;
+        sfb__an_record_job R;
         int active = n, it, i;
         F->res[c] = SFB_SUCCESS;
+        R.F = F;
         J.A = A; J.tries = tries; J.locs = locs; J.pos = pos; J.du = du; J.dv = dv; J.steps = F->steps;
         for (it = 0; it <= F->steps && active > 0; ++it) {
             sfb_eval_output out;
@@ -13924,38 +14219,20 @@ static void sfb__an_fresh(void *arg, int c0, int c1) {
                 break;
             }
             J.it = it;
-            sfb__an_step(&J, 0, active);
-            for (i = 0; i < active; ++i) {
-                sfb__an_try *t = &tries[i];
-                if (t->outcome == 0) {
-                    if (keep != i) { tries[keep] = *t; locs[keep] = locs[i]; }
-                    ++keep;
-                    continue;
-                }
-                if (F->done) {
-                    sfb__an_done *o = &F->done[t->k];
-                    int q;
-                    o->pix = t->pix;
-                    o->outcome = t->outcome;
-                    if (t->outcome == SFB__AN_OUT_NEW_HIT) {
-                        for (q = 0; q < 3; ++q) {
-                            o->p[q] = pos[3 * i + q]; o->du[q] = du[3 * i + q]; o->dv[q] = dv[3 * i + q]; o->n[q] = nrm[3 * i + q];
-                        }
-                        o->z = t->z;
-                        o->loc = locs[i];
-                    }
-                    continue;
-                }
-                if (t->outcome == SFB__AN_OUT_NEW_HIT) {
-                    A->hpix[t->k] = t->pix;
-                    A->hit[t->pix] = t->k;
-                    A->state[t->pix] = SFB__AN_HIT;
-                    sfb__an_store_hit(A, (size_t)t->k, &locs[i], t->z, pos + 3 * i, du + 3 * i, dv + 3 * i, nrm + 3 * i);
-                } else {
-                    A->hpix[t->k] = -1;
-                    if (t->outcome == 2) A->state[t->pix] = SFB__AN_TRIED_NEAR;
-                }
+            R.tries = tries; R.locs = locs; R.pos = pos; R.du = du; R.dv = dv; R.nrm = nrm;
+            if (F->nchunks == 1) {
+                /* one chunk on the calling thread (sfb__an_chunked): its loops go to the threads */
+                sfb__an_run(A, sfb__an_step, &J, 0, active, (double)active * 8.0);
+                sfb__an_run(A, sfb__an_record, &R, 0, active, (double)active * 4.0);
+            } else {
+                sfb__an_step(&J, 0, active);
+                sfb__an_record(&R, 0, active);
             }
+            for (i = 0; i < active; ++i)
+                if (tries[i].outcome == 0) {
+                    if (keep != i) { tries[keep] = tries[i]; locs[keep] = locs[i]; }
+                    ++keep;
+                }
             active = keep;
         }
     }
@@ -13994,7 +14271,7 @@ static sfb_result sfb__an_newton(sfb__an *A, sfb__an_try *tries, sfb_location *l
     sfb__an_fresh_job F;
     sfb_result res[SFB__AN_CHUNKS];
     sfb__an_done *done = (sfb__an_done *)sfb__an_get(A, SFB__WS_DONE, (size_t)count * sizeof *done, NULL);
-    const int nck = A->ctx->backend && A->ctx->backend->parallel ? (count + 511) / 512 : 1;
+    const int nck = sfb__an_chunked(A) ? (count + 511) / 512 : 1;
     int i, c;
     if (!done) return sfb__oom(A->ctx, "the analysis projection");
     for (i = 0; i < count; ++i) tries[i].k = i; /* each attempt's index in the round, for its outcome */
@@ -14002,7 +14279,8 @@ static sfb_result sfb__an_newton(sfb__an *A, sfb__an_try *tries, sfb_location *l
     F.A = A; F.tries = tries; F.locs = locs; F.count = count; F.steps = steps; F.res = res; F.done = done;
     F.pos = buf; F.du = buf + 3 * (size_t)count; F.dv = buf + 6 * (size_t)count; F.nrm = buf + 9 * (size_t)count;
     F.nchunks = nck < SFB__AN_CHUNKS ? nck : SFB__AN_CHUNKS;
-    sfb__an_run(A, sfb__an_fresh, &F, 0, F.nchunks, (double)count * 8.0);
+    if (F.nchunks > 1) sfb__an_run(A, sfb__an_fresh, &F, 0, F.nchunks, (double)count * 8.0);
+    else sfb__an_fresh(&F, 0, 1); /* on this thread (sfb__an_chunked) */
     for (c = 0; c < F.nchunks; ++c)
         if (res[c] != SFB_SUCCESS) { sfb__an_put(A, done); return res[c]; }
     /* the outcomes in attempt order: new hits recorded, near ones marked (a later hit of the
@@ -14294,13 +14572,14 @@ static sfb_result sfb__an_project_all(sfb__an *A, int steps) {
             {
                 sfb__an_fresh_job F;
                 sfb_result res[SFB__AN_CHUNKS];
-                const int nck = A->ctx->backend && A->ctx->backend->parallel ? (total + 1023) / 1024 : 1;
+                const int nck = sfb__an_chunked(A) ? (total + 1023) / 1024 : 1;
                 int c;
                 F.A = A; F.tries = tries; F.locs = locs; F.count = total; F.steps = steps; F.res = res; F.done = NULL;
                 F.pos = buf; F.du = buf + 3 * (size_t)total; F.dv = buf + 6 * (size_t)total; F.nrm = buf + 9 * (size_t)total;
                 F.nchunks = nck < SFB__AN_CHUNKS ? nck : SFB__AN_CHUNKS;
                 A->nhit += total; /* the batch's slots (holes where it misses) */
-                sfb__an_run(A, sfb__an_fresh, &F, 0, F.nchunks, (double)total * 8.0);
+                if (F.nchunks > 1) sfb__an_run(A, sfb__an_fresh, &F, 0, F.nchunks, (double)total * 8.0);
+                else sfb__an_fresh(&F, 0, 1); /* on this thread (sfb__an_chunked) */
                 for (c = 0; c < F.nchunks; ++c)
                     if (res[c] != SFB_SUCCESS) { r = res[c]; goto done; }
             }

@@ -88,6 +88,7 @@ static sfb_result sfb__osmesa_init(sfb_context *ctx, void **state, char *why, si
     if (!g) { snprintf(why, why_size, "out of memory"); return SFB_OUT_OF_MEMORY; }
     g->ctx = ctx;
     r = sfb__osmesa_open(g, why, why_size);
+    if (r == SFB_SUCCESS) r = sfb__gl_pool_open(g, why, why_size);
     if (r != SFB_SUCCESS) {
         sfb__gl_close(g);
         sfb__free(ctx, g);

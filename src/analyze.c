@@ -348,6 +348,15 @@ static void sfb__an_run(const sfb__an *A, void (*task)(void *arg, int first, int
     else task(arg, first, last);
 }
 
+/* Whether the Newton attempts run in chunks over the backend's lent threads, each chunk
+ * calling the backend's eval there (simd: that call then runs on that one thread); else in one
+ * chunk on the calling thread, where a GPU backend's context is current and which evaluates a
+ * batch at once. */
+static int sfb__an_chunked(const sfb__an *A) {
+    const sfb__backend_vtable *b = A->ctx->backend;
+    return b && b->parallel && b->kernels_in_tasks;
+}
+
 static void sfb__an_grid_uv(const sfb__an *A, int k, double *u, double *v) {
     int R = A->R;
     if (!A->tri) { *u = (double)(k % (R + 1)) / R; *v = (double)(k / (R + 1)) / R; return; }
@@ -950,8 +959,9 @@ typedef struct sfb__an_done {
  * threads: no step waits for the whole batch, and nothing runs on one thread between steps.
  * The chunks shrink from about twice the mean to a few attempts (chunk c starts at
  * count (1 - (1 - c / nchunks)^2)): the backend hands its threads runs of equally many chunks,
- * so the last run taken is short and the other threads wait less for it. One chunk when the
- * backend lends no threads (a GPU evaluates a batch at once). res[c]: chunk c's evaluation
+ * so the last run taken is short and the other threads wait less for it. One chunk, on the
+ * calling thread, when the backend's kernels may not run in lent tasks (sfb__an_chunked: a GPU
+ * evaluates a batch at once, and its context is current on the calling thread alone). res[c]: chunk c's evaluation
  * result. The later rounds' attempts run here too, with `done` (sfb__an_newton). */
 typedef struct sfb__an_fresh_job {
     sfb__an *A;
@@ -969,6 +979,54 @@ static int sfb__an_fresh_start(const sfb__an_fresh_job *F, int c) {
     return F->count - (int)((long long)F->count * x * x / n2);
 }
 
+/* The attempts of a chunk that ended this step (outcome != 0), each into its own slot: round
+ * 0's hit slot tries[i].k and pixel (no two of its attempts share one), or a later round's
+ * done[tries[i].k]; so they may run in parallel, and the chunk moves its running attempts
+ * first afterwards. */
+typedef struct sfb__an_record_job {
+    const sfb__an_fresh_job *F;
+    const sfb__an_try *tries;
+    const sfb_location *locs;
+    const float *pos, *du, *dv, *nrm;
+} sfb__an_record_job;
+
+static void sfb__an_record(void *arg, int a, int b) {
+    const sfb__an_record_job *R = (const sfb__an_record_job *)arg;
+    const sfb__an_fresh_job *F = R->F;
+    sfb__an *A = F->A;
+    const sfb__an_try *tries = R->tries;
+    const sfb_location *locs = R->locs;
+    const float *pos = R->pos, *du = R->du, *dv = R->dv, *nrm = R->nrm;
+    int i;
+    for (i = a; i < b; ++i) {
+        const sfb__an_try *t = &tries[i];
+        if (t->outcome == 0) continue;
+        if (F->done) {
+            sfb__an_done *o = &F->done[t->k];
+            int q;
+            o->pix = t->pix;
+            o->outcome = t->outcome;
+            if (t->outcome == SFB__AN_OUT_NEW_HIT) {
+                for (q = 0; q < 3; ++q) {
+                    o->p[q] = pos[3 * i + q]; o->du[q] = du[3 * i + q]; o->dv[q] = dv[3 * i + q]; o->n[q] = nrm[3 * i + q];
+                }
+                o->z = t->z;
+                o->loc = locs[i];
+            }
+            continue;
+        }
+        if (t->outcome == SFB__AN_OUT_NEW_HIT) {
+            A->hpix[t->k] = t->pix;
+            A->hit[t->pix] = t->k;
+            A->state[t->pix] = SFB__AN_HIT;
+            sfb__an_store_hit(A, (size_t)t->k, &locs[i], t->z, pos + 3 * i, du + 3 * i, dv + 3 * i, nrm + 3 * i);
+        } else {
+            A->hpix[t->k] = -1;
+            if (t->outcome == 2) A->state[t->pix] = SFB__AN_TRIED_NEAR;
+        }
+    }
+}
+
 static void sfb__an_fresh(void *arg, int c0, int c1) {
     const sfb__an_fresh_job *F = (const sfb__an_fresh_job *)arg;
     sfb__an *A = F->A;
@@ -979,8 +1037,10 @@ static void sfb__an_fresh(void *arg, int c0, int c1) {
         sfb_location *locs = F->locs + a;
         float *pos = F->pos + 3 * (size_t)a, *du = F->du + 3 * (size_t)a, *dv = F->dv + 3 * (size_t)a, *nrm = F->nrm + 3 * (size_t)a;
         sfb__an_step_job J;
+        sfb__an_record_job R;
         int active = n, it, i;
         F->res[c] = SFB_SUCCESS;
+        R.F = F;
         J.A = A; J.tries = tries; J.locs = locs; J.pos = pos; J.du = du; J.dv = dv; J.steps = F->steps;
         for (it = 0; it <= F->steps && active > 0; ++it) {
             sfb_eval_output out;
@@ -993,38 +1053,20 @@ static void sfb__an_fresh(void *arg, int c0, int c1) {
                 break;
             }
             J.it = it;
-            sfb__an_step(&J, 0, active);
-            for (i = 0; i < active; ++i) {
-                sfb__an_try *t = &tries[i];
-                if (t->outcome == 0) {
-                    if (keep != i) { tries[keep] = *t; locs[keep] = locs[i]; }
-                    ++keep;
-                    continue;
-                }
-                if (F->done) {
-                    sfb__an_done *o = &F->done[t->k];
-                    int q;
-                    o->pix = t->pix;
-                    o->outcome = t->outcome;
-                    if (t->outcome == SFB__AN_OUT_NEW_HIT) {
-                        for (q = 0; q < 3; ++q) {
-                            o->p[q] = pos[3 * i + q]; o->du[q] = du[3 * i + q]; o->dv[q] = dv[3 * i + q]; o->n[q] = nrm[3 * i + q];
-                        }
-                        o->z = t->z;
-                        o->loc = locs[i];
-                    }
-                    continue;
-                }
-                if (t->outcome == SFB__AN_OUT_NEW_HIT) {
-                    A->hpix[t->k] = t->pix;
-                    A->hit[t->pix] = t->k;
-                    A->state[t->pix] = SFB__AN_HIT;
-                    sfb__an_store_hit(A, (size_t)t->k, &locs[i], t->z, pos + 3 * i, du + 3 * i, dv + 3 * i, nrm + 3 * i);
-                } else {
-                    A->hpix[t->k] = -1;
-                    if (t->outcome == 2) A->state[t->pix] = SFB__AN_TRIED_NEAR;
-                }
+            R.tries = tries; R.locs = locs; R.pos = pos; R.du = du; R.dv = dv; R.nrm = nrm;
+            if (F->nchunks == 1) {
+                /* one chunk on the calling thread (sfb__an_chunked): its loops go to the threads */
+                sfb__an_run(A, sfb__an_step, &J, 0, active, (double)active * 8.0);
+                sfb__an_run(A, sfb__an_record, &R, 0, active, (double)active * 4.0);
+            } else {
+                sfb__an_step(&J, 0, active);
+                sfb__an_record(&R, 0, active);
             }
+            for (i = 0; i < active; ++i)
+                if (tries[i].outcome == 0) {
+                    if (keep != i) { tries[keep] = tries[i]; locs[keep] = locs[i]; }
+                    ++keep;
+                }
             active = keep;
         }
     }
@@ -1063,7 +1105,7 @@ static sfb_result sfb__an_newton(sfb__an *A, sfb__an_try *tries, sfb_location *l
     sfb__an_fresh_job F;
     sfb_result res[SFB__AN_CHUNKS];
     sfb__an_done *done = (sfb__an_done *)sfb__an_get(A, SFB__WS_DONE, (size_t)count * sizeof *done, NULL);
-    const int nck = A->ctx->backend && A->ctx->backend->parallel ? (count + 511) / 512 : 1;
+    const int nck = sfb__an_chunked(A) ? (count + 511) / 512 : 1;
     int i, c;
     if (!done) return sfb__oom(A->ctx, "the analysis projection");
     for (i = 0; i < count; ++i) tries[i].k = i; /* each attempt's index in the round, for its outcome */
@@ -1071,7 +1113,8 @@ static sfb_result sfb__an_newton(sfb__an *A, sfb__an_try *tries, sfb_location *l
     F.A = A; F.tries = tries; F.locs = locs; F.count = count; F.steps = steps; F.res = res; F.done = done;
     F.pos = buf; F.du = buf + 3 * (size_t)count; F.dv = buf + 6 * (size_t)count; F.nrm = buf + 9 * (size_t)count;
     F.nchunks = nck < SFB__AN_CHUNKS ? nck : SFB__AN_CHUNKS;
-    sfb__an_run(A, sfb__an_fresh, &F, 0, F.nchunks, (double)count * 8.0);
+    if (F.nchunks > 1) sfb__an_run(A, sfb__an_fresh, &F, 0, F.nchunks, (double)count * 8.0);
+    else sfb__an_fresh(&F, 0, 1); /* on this thread (sfb__an_chunked) */
     for (c = 0; c < F.nchunks; ++c)
         if (res[c] != SFB_SUCCESS) { sfb__an_put(A, done); return res[c]; }
     /* the outcomes in attempt order: new hits recorded, near ones marked (a later hit of the
@@ -1363,13 +1406,14 @@ static sfb_result sfb__an_project_all(sfb__an *A, int steps) {
             {
                 sfb__an_fresh_job F;
                 sfb_result res[SFB__AN_CHUNKS];
-                const int nck = A->ctx->backend && A->ctx->backend->parallel ? (total + 1023) / 1024 : 1;
+                const int nck = sfb__an_chunked(A) ? (total + 1023) / 1024 : 1;
                 int c;
                 F.A = A; F.tries = tries; F.locs = locs; F.count = total; F.steps = steps; F.res = res; F.done = NULL;
                 F.pos = buf; F.du = buf + 3 * (size_t)total; F.dv = buf + 6 * (size_t)total; F.nrm = buf + 9 * (size_t)total;
                 F.nchunks = nck < SFB__AN_CHUNKS ? nck : SFB__AN_CHUNKS;
                 A->nhit += total; /* the batch's slots (holes where it misses) */
-                sfb__an_run(A, sfb__an_fresh, &F, 0, F.nchunks, (double)total * 8.0);
+                if (F.nchunks > 1) sfb__an_run(A, sfb__an_fresh, &F, 0, F.nchunks, (double)total * 8.0);
+                else sfb__an_fresh(&F, 0, 1); /* on this thread (sfb__an_chunked) */
                 for (c = 0; c < F.nchunks; ++c)
                     if (res[c] != SFB_SUCCESS) { r = res[c]; goto done; }
             }

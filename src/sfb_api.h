@@ -102,7 +102,7 @@ typedef struct sfb_context_config {
     sfb_progress progress;             /* NULL func: no reports, no cancel */
     const sfb_backend_kind *backends;  /* ordered preference; NULL: default order */
     int backend_count;
-    int threads;                       /* 0: one per core, 1: no threads (simd); negative: invalid */
+    int threads;                       /* 0: one per core, 1: no threads (simd; gl, osmesa: the CPU work between kernels); negative: invalid */
     size_t memory_budget;              /* bytes; 0: SFB_DEFAULT_MEMORY_BUDGET */
     int gl_use_current_context;        /* gl backend: run on the caller's current context */
     int ignore_environment;            /* 1: do not read SURFBLEND_BACKEND (SURFBLEND_SIMD_ISA,

@@ -33,6 +33,46 @@
 #  define SFB__IF static
 #endif
 
+/* ---- a CPU thread pool a backend owns and lends (src/pool.c) ---- */
+#if !defined(_WIN32) && (defined(__unix__) || defined(__unix) || defined(__APPLE__))
+#  define SFB__THREADS 1
+#  include <pthread.h>
+#  include <unistd.h>
+#endif
+#define SFB__POOL_MAX_THREADS 64
+typedef struct sfb__pool {
+    int threads; /* threads sharing one run, the caller included (1: no workers) */
+#ifdef SFB__THREADS
+    int workers; /* pool threads running (threads - 1 once started) */
+    pthread_t tid[SFB__POOL_MAX_THREADS];
+    pthread_mutex_t busy; /* held by the one run using the pool */
+    pthread_mutex_t lock; /* guards everything below */
+    pthread_cond_t wake, done;
+    unsigned long generation; /* bumped per job; idle workers wait for a change */
+    int quit;
+    /* the current job: items [first, last) cut into `chunks`, each run by task(owner, arg, a, b);
+     * with `offsets` (stencil rows) chunks hold about equal entry counts, else equal items */
+    void (*task)(const void *owner, const void *arg, int a, int b);
+    const void *owner, *arg;
+    const int *offsets;
+    int first, last, chunks, next_chunk, chunks_done;
+    size_t entry0, entries;
+#endif
+} sfb__pool;
+/* Threads for a requested count (0: one per online core), at most SFB__POOL_MAX_THREADS; 1
+ * where no thread support is known. */
+SFB__IF int sfb__pool_threads(int requested);
+/* Starts threads - 1 workers (a zeroed pool of one thread for threads <= 1): 1, or 0 with
+ * `why` filled and nothing left running. */
+SFB__IF int sfb__pool_start(sfb__pool *p, int threads, char *why, size_t why_size);
+SFB__IF void sfb__pool_stop(sfb__pool *p);
+/* Runs task over [first, last) on the pool, the caller included, and returns 1; returns 0
+ * having run nothing when the pool has one thread or another run holds it. */
+SFB__IF int sfb__pool_run(sfb__pool *p, void (*task)(const void *owner, const void *arg, int a, int b), const void *owner,
+                          const void *arg, int first, int last, const int *offsets, size_t e0, size_t entries);
+/* The `parallel` slot's contract on a backend's pool: task(arg, a, b) over [first, last). */
+SFB__IF int sfb__pool_lend(sfb__pool *p, void (*task)(void *arg, int first, int last), void *arg, int first, int last);
+
 /* ---- backend vtable ---- */
 struct sfb__patch_table;
 /* A stencil table: row r reads sizes[r] entries starting at offsets[r] from indices/weights. */
@@ -98,6 +138,10 @@ typedef struct sfb__backend_vtable {
      * once all have run; returns 0 having run nothing (no threads, or a call of another thread
      * holds them). Not a kernel: a NULL slot means the core runs the task itself, on ref too. */
     int (*parallel)(void *state, void (*task)(void *arg, int first, int last), void *arg, int first, int last);
+    /* 1: the kernels may also be called inside a task lent through `parallel` (each call then
+     * runs on that one thread: simd, whose analysis rounds run in chunks so); 0: from the
+     * calling thread only (gl, osmesa: their GL context is current there alone). */
+    int kernels_in_tasks;
 } sfb__backend_vtable;
 
 /* One analysis's shading (the `shade` slot). Per item i: P = position[3i..], N = normal (unit),

@@ -3,7 +3,7 @@
 # SURFBLEND_IMPLEMENTATION. Usage: tools/amalgamate.sh > surfblend.h
 set -e
 cd "$(dirname "$0")/.."
-MODULES="sfb_internal.h context.c backend.c backend_ref.c topology.c stencil.c refine.c patch/eigen.c patch/table.c patch/build.c patch/quad.c patch/tri.c patch/manifold.c patch/pn.c patch/tribezier.c tess.c mesh.c obj.c scheme.c surface.c shade.c render.c analyze.c aabb.c sparse.c trimesh.c fillet/fillet.c backends_include.c"
+MODULES="sfb_internal.h context.c pool.c backend.c backend_ref.c topology.c stencil.c refine.c patch/eigen.c patch/table.c patch/build.c patch/quad.c patch/tri.c patch/manifold.c patch/pn.c patch/tribezier.c tess.c mesh.c obj.c scheme.c surface.c shade.c render.c analyze.c aabb.c sparse.c trimesh.c fillet/fillet.c backends_include.c"
 cat <<'HDR'
 /* surfblend.h -- subdivision surfaces with sharp and semi-sharp creases, evaluated on
  * several backends. Single-header library: GENERATED from src/ by `make amalgamate`; edit

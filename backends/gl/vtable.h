@@ -77,6 +77,7 @@ static void sfb__gl_bind_kernels(sfb__backend_vtable *vt) {
     sfb__gl_normals_bind(vt);
     sfb__gl_shade_bind(vt);
     sfb__gl_raster_bind(vt);
+    vt->parallel = sfb__gl_parallel; /* not a kernel: the CPU threads lent to the core */
 }
 
 void sfb__gl_bind(sfb__backend_vtable *vt) {

@@ -40,7 +40,7 @@
  * without kernels of its own for an instruction set runs its portable ones (or, for NEON on
  * 32-bit ARM, those the family has there).
  *
- * Threads: a pool of ctx->threads - 1 workers (0: one thread per online core, at most 64;
+ * Threads: a pool (src/pool.c) of ctx->threads - 1 workers (0: one thread per online core, at most 64;
  * 1: no pool), started in init and joined in shutdown. A call cuts its rows into 4 chunks per
  * thread of about equal entry counts (from offsets; eval_patches and finish_normals: equal
  * numbers of locations or elements); the caller and the workers claim chunks until none is
@@ -71,10 +71,8 @@
 #  define SFB__SIMD_NEON 1
 #  include <arm_neon.h>
 #endif
-#if !defined(_WIN32) && (defined(__unix__) || defined(__unix) || defined(__APPLE__))
+#ifdef SFB__THREADS /* the core's thread pool (src/pool.c) runs here */
 #  define SFB__SIMD_THREADS 1
-#  include <pthread.h>
-#  include <unistd.h>
 #endif
 
 #if defined(__GNUC__) || defined(__clang__)
@@ -85,7 +83,7 @@
 #  define SFB__SIMD_FORCEINLINE inline
 #endif
 
-#define SFB__SIMD_MAX_THREADS 64
+#define SFB__SIMD_MAX_THREADS SFB__POOL_MAX_THREADS
 
 /* ---- instruction set choice ---- */
 enum { SFB__SIMD_PORTABLE, SFB__SIMD_ISA_SSE2, SFB__SIMD_AVX2, SFB__SIMD_AVX512, SFB__SIMD_ISA_NEON, SFB__SIMD_ISA_COUNT };
@@ -145,137 +143,10 @@ static int sfb__simd_choose_isa(sfb_context *ctx) {
 /* ---- backend state and thread pool ---- */
 typedef struct sfb__simd_state {
     sfb_context *ctx;
-    int isa;                     /* every family runs its kernels of this instruction set */
-    int threads;                 /* threads sharing one call, the caller included */
-#ifdef SFB__SIMD_THREADS
-    int workers;                 /* pool threads running (threads - 1 once init succeeded) */
-    pthread_t tid[SFB__SIMD_MAX_THREADS];
-    pthread_mutex_t busy;        /* held by the one call using the pool */
-    pthread_mutex_t lock;        /* guards everything below */
-    pthread_cond_t wake, done;
-    unsigned long generation;    /* bumped per job; idle workers wait for a change */
-    int quit;
-    /* the current job: items [first, last) cut into `chunks`, each run by task(arg, a, b);
-     * with `offsets` (stencil rows) chunks hold about equal entry counts, else equal items */
-    void (*task)(const struct sfb__simd_state *s, const void *arg, int a, int b);
-    const void *arg;
-    const int *offsets;
-    int first, last, chunks, next_chunk, chunks_done;
-    size_t entry0, entries;
-#endif
+    int isa;       /* every family runs its kernels of this instruction set */
+    int threads;   /* threads sharing one call, the caller included */
+    sfb__pool pool; /* threads - 1 workers (src/pool.c) */
 } sfb__simd_state;
-
-#ifdef SFB__SIMD_THREADS
-/* First row in [first, last) whose entries start at or after `e` (last when none). */
-static int sfb__simd_row_at(const int *offsets, int first, int last, size_t e) {
-    int lo = first, hi = last;
-    while (lo < hi) {
-        int mid = lo + (hi - lo) / 2;
-        if ((size_t)offsets[mid] < e) lo = mid + 1;
-        else hi = mid;
-    }
-    return lo;
-}
-
-/* First item of chunk c of the current job: chunks hold about equal numbers of entries
- * (stencil rows) or of items. */
-static int sfb__simd_chunk_start(const sfb__simd_state *s, int c) {
-    if (c <= 0) return s->first;
-    if (c >= s->chunks) return s->last;
-    if (!s->offsets) return s->first + (int)((long long)(s->last - s->first) * c / s->chunks);
-    return sfb__simd_row_at(s->offsets, s->first, s->last, s->entry0 + s->entries / (size_t)s->chunks * (size_t)c);
-}
-
-/* Runs chunks of the current job until none is left to claim. Called and returns with
- * s->lock held. A worker that wakes late finds nothing to claim (or joins the next job):
- * the job is only touched between claiming a chunk and counting it done. */
-static void sfb__simd_drain(sfb__simd_state *s) {
-    while (s->next_chunk < s->chunks) {
-        const int c = s->next_chunk++;
-        const int a = sfb__simd_chunk_start(s, c), b = sfb__simd_chunk_start(s, c + 1);
-        void (*task)(const struct sfb__simd_state *, const void *, int, int) = s->task;
-        const void *arg = s->arg;
-        pthread_mutex_unlock(&s->lock);
-        if (a < b) task(s, arg, a, b);
-        pthread_mutex_lock(&s->lock);
-        if (++s->chunks_done == s->chunks) pthread_cond_signal(&s->done);
-    }
-}
-
-static void *sfb__simd_worker(void *arg) {
-    sfb__simd_state *s = (sfb__simd_state *)arg;
-    unsigned long seen = 0;
-    pthread_mutex_lock(&s->lock);
-    for (;;) {
-        while (!s->quit && s->generation == seen) pthread_cond_wait(&s->wake, &s->lock);
-        if (s->quit) break;
-        seen = s->generation;
-        sfb__simd_drain(s);
-    }
-    pthread_mutex_unlock(&s->lock);
-    return NULL;
-}
-
-/* Stops and joins the workers, destroys the sync objects. */
-static void sfb__simd_pool_stop(sfb__simd_state *s) {
-    int i;
-    pthread_mutex_lock(&s->lock);
-    s->quit = 1;
-    pthread_cond_broadcast(&s->wake);
-    pthread_mutex_unlock(&s->lock);
-    for (i = 0; i < s->workers; ++i) pthread_join(s->tid[i], NULL);
-    s->workers = 0;
-    pthread_cond_destroy(&s->done);
-    pthread_cond_destroy(&s->wake);
-    pthread_mutex_destroy(&s->lock);
-    pthread_mutex_destroy(&s->busy);
-}
-
-/* Starts threads - 1 workers; on failure nothing is left running or allocated. */
-static int sfb__simd_pool_start(sfb__simd_state *s, char *why, size_t why_size) {
-    int i, e;
-    if (pthread_mutex_init(&s->busy, NULL) != 0) goto fail0;
-    if (pthread_mutex_init(&s->lock, NULL) != 0) goto fail1;
-    if (pthread_cond_init(&s->wake, NULL) != 0) goto fail2;
-    if (pthread_cond_init(&s->done, NULL) != 0) goto fail3;
-    for (i = 0; i < s->threads - 1; ++i) {
-        e = pthread_create(&s->tid[i], NULL, sfb__simd_worker, s);
-        if (e != 0) {
-            snprintf(why, why_size, "could not start worker thread %d of %d: %s", i + 1, s->threads - 1, strerror(e));
-            sfb__simd_pool_stop(s); /* joins the i already running */
-            return 0;
-        }
-        s->workers = i + 1;
-    }
-    return 1;
-fail3:
-    pthread_cond_destroy(&s->wake);
-fail2:
-    pthread_mutex_destroy(&s->lock);
-fail1:
-    pthread_mutex_destroy(&s->busy);
-fail0:
-    snprintf(why, why_size, "could not create the thread pool's locks");
-    return 0;
-}
-#endif /* SFB__SIMD_THREADS */
-
-static int sfb__simd_thread_count(int requested) {
-    long n = requested;
-    if (n <= 0) {
-#if defined(SFB__SIMD_THREADS) && defined(_SC_NPROCESSORS_ONLN)
-        n = sysconf(_SC_NPROCESSORS_ONLN);
-#else
-        n = 1;
-#endif
-    }
-    if (n < 1) n = 1;
-    if (n > SFB__SIMD_MAX_THREADS) n = SFB__SIMD_MAX_THREADS;
-#ifndef SFB__SIMD_THREADS
-    n = 1; /* no thread support known here (_WIN32 and others): single-threaded */
-#endif
-    return (int)n;
-}
 
 static sfb_result sfb__simd_init(sfb_context *ctx, void **state, char *why, size_t why_size) {
     sfb__simd_state *s;
@@ -290,13 +161,11 @@ static sfb_result sfb__simd_init(sfb_context *ctx, void **state, char *why, size
     memset(s, 0, sizeof *s);
     s->ctx = ctx;
     s->isa = sfb__simd_choose_isa(ctx);
-    s->threads = sfb__simd_thread_count(ctx->threads);
-#ifdef SFB__SIMD_THREADS
-    if (s->threads > 1 && !sfb__simd_pool_start(s, why, why_size)) {
+    s->threads = sfb__pool_threads(ctx->threads);
+    if (!sfb__pool_start(&s->pool, s->threads, why, why_size)) {
         sfb__free(ctx, s);
         return SFB_BACKEND_UNAVAILABLE;
     }
-#endif
     *state = s;
     return SFB_SUCCESS;
 }
@@ -304,67 +173,35 @@ static sfb_result sfb__simd_init(sfb_context *ctx, void **state, char *why, size
 static void sfb__simd_shutdown(sfb_context *ctx, void *state) {
     sfb__simd_state *s = (sfb__simd_state *)state;
     if (!s) return;
-#ifdef SFB__SIMD_THREADS
-    if (s->threads > 1) sfb__simd_pool_stop(s);
-#endif
+    sfb__pool_stop(&s->pool);
     sfb__free(ctx, s);
 }
 
 #ifdef SFB__SIMD_THREADS
 /* Runs task over items [first, last) on the pool (the caller takes chunks too) and returns 1,
  * or returns 0 without running anything when there is no pool or another call holds it. */
+typedef struct sfb__simd_job_of {
+    void (*task)(const struct sfb__simd_state *, const void *, int, int);
+    const void *arg;
+} sfb__simd_job_of;
+
+static void sfb__simd_job_run(const void *owner, const void *arg, int a, int b) {
+    const sfb__simd_job_of *j = (const sfb__simd_job_of *)arg;
+    j->task((const sfb__simd_state *)owner, j->arg, a, b);
+}
+
 static int sfb__simd_pool_run(sfb__simd_state *s, void (*task)(const struct sfb__simd_state *, const void *, int, int),
                               const void *arg, int first, int last, const int *offsets, size_t e0, size_t entries) {
-    if (s->threads <= 1 || pthread_mutex_trylock(&s->busy) != 0) return 0;
-    pthread_mutex_lock(&s->lock);
-    s->task = task;
-    s->arg = arg;
-    s->offsets = offsets;
-    s->first = first;
-    s->last = last;
-    s->entry0 = e0;
-    s->entries = entries;
-    s->chunks = 4 * s->threads; /* several per thread: a late or slow thread takes fewer */
-    s->next_chunk = 0;
-    s->chunks_done = 0;
-    ++s->generation;
-    pthread_cond_broadcast(&s->wake);
-    sfb__simd_drain(s);
-    /* wait for chunks still running on workers, not for workers still asleep */
-    while (s->chunks_done < s->chunks) pthread_cond_wait(&s->done, &s->lock);
-    s->task = NULL;
-    s->arg = NULL;
-    pthread_mutex_unlock(&s->lock);
-    pthread_mutex_unlock(&s->busy);
-    return 1;
+    sfb__simd_job_of j;
+    j.task = task;
+    j.arg = arg;
+    return sfb__pool_run(&s->pool, sfb__simd_job_run, s, &j, first, last, offsets, e0, entries);
 }
 #endif
 
 /* The `parallel` slot: the pool lent to the core (sfb__parallel). */
-#ifdef SFB__SIMD_THREADS
-typedef struct sfb__simd_lent {
-    void (*task)(void *arg, int first, int last);
-    void *arg;
-} sfb__simd_lent;
-
-static void sfb__simd_lent_task(const sfb__simd_state *s, const void *arg, int a, int b) {
-    const sfb__simd_lent *l = (const sfb__simd_lent *)arg;
-    (void)s;
-    l->task(l->arg, a, b);
-}
-#endif
-
 static int sfb__simd_parallel(void *state, void (*task)(void *arg, int first, int last), void *arg, int first, int last) {
-#ifdef SFB__SIMD_THREADS
-    sfb__simd_lent l;
-    if (!state || !task || first >= last) return 0;
-    l.task = task;
-    l.arg = arg;
-    return sfb__simd_pool_run((sfb__simd_state *)state, sfb__simd_lent_task, &l, first, last, NULL, 0, 0);
-#else
-    (void)state; (void)task; (void)arg; (void)first; (void)last;
-    return 0;
-#endif
+    return state ? sfb__pool_lend(&((sfb__simd_state *)state)->pool, task, arg, first, last) : 0;
 }
 
 static void sfb__simd_describe(void *state, char *buf, size_t size) {
@@ -380,6 +217,7 @@ static void sfb__simd_runtime_bind(sfb__backend_vtable *vt) {
     vt->shutdown = sfb__simd_shutdown;
     vt->describe = sfb__simd_describe;
     vt->parallel = sfb__simd_parallel;
+    vt->kernels_in_tasks = 1; /* a kernel called in a lent task runs on that thread alone */
 }
 
 /* ==== the vector operations ====
