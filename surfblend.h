@@ -14127,8 +14127,9 @@ typedef struct sfb__an_done {
  * count (1 - (1 - c / nchunks)^2)): the backend hands its threads runs of equally many chunks,
  * so the last run taken is short and the other threads wait less for it. One chunk, on the
  * calling thread, when the backend's kernels may not run in lent tasks (sfb__an_chunked: a GPU
- * evaluates a batch at once, and its context is current on the calling thread alone). res[c]: chunk c's evaluation
- * result. The later rounds' attempts run here too, with `done` (sfb__an_newton). */
+ * evaluates a batch at once, and its context is current on the calling thread alone); its
+ * step and record loops then go to the threads. res[c]: chunk c's evaluation result. The later
+ * rounds' attempts run here too, with `done` (sfb__an_newton). */
 typedef struct sfb__an_fresh_job {
     sfb__an *A;
     sfb__an_try *tries;
