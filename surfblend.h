@@ -635,7 +635,9 @@ SFB_API void sfb_image_free(sfb_image *img);
  * Long analyses report progress (stage "analyze": 0.3 once the proxy is evaluated and
  * rasterised, 0.75 once every pixel is projected and evaluated, 0.9 after the shade kernel) and
  * can be cancelled (SFB_CANCELLED, nothing kept). The camera is sfb_render's (an orbit around the
- * centre of the control mesh's bounding box, y up) unless eye, target and up are given. */
+ * centre of the control mesh's bounding box, y up) unless eye, target and up are given; `up`
+ * alone (camera_set 0, up not zero) turns the orbit about that axis instead of y (0, 0, 1 for a
+ * z-up model: the same yaw and pitch then see it as a y-up one is seen). */
 typedef enum sfb_analyze_mode {
     SFB_ANALYZE_REFLECTION = 0, /* seed 003: the view ray's reflection r = v - 2(v.n)n meets a finite light plane carrying a
                                    texture (stripes, lattice, circles or an RGBA image); rays that miss show the miss colour */
@@ -686,7 +688,7 @@ typedef struct sfb_analyze_config {
     int view_set;
     float yaw, pitch, zoom;
     int camera_set;
-    float eye[3], target[3], up[3];
+    float eye[3], target[3], up[3]; /* up without camera_set: the orbit's axis (zero: y) */
     float fov;                /* degrees, full vertical angle, 0: 30; orthographic: the picture's height in model units
                                  (0: the bounding sphere fits) */
     int orthographic;
@@ -13332,6 +13334,9 @@ static sfb_result sfb__an_check(sfb_context *ctx, const sfb_analyze_config *c, i
                           (double)c->yaw, (double)c->pitch, (double)c->zoom, (double)c->fov);
     if (!isfinite(c->near_plane) || c->near_plane < 0.0f)
         return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, -1, "near plane %g must be finite and >= 0 (0: automatic)", (double)c->near_plane);
+    if (!c->camera_set && !sfb__an_finite_n(c->up, 3))
+        return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_NONE, -1, "the orbit's up direction (%g, %g, %g) is not finite", (double)c->up[0],
+                          (double)c->up[1], (double)c->up[2]);
     if (c->camera_set) {
         double d[3], up[3], x[3];
         int i;
@@ -13523,6 +13528,34 @@ static int sfb__an_chunked(const sfb__an *A) {
     return b && b->parallel && b->kernels_in_tasks;
 }
 
+/* The orbit about `up` (zero, or +y: the default y-up orbit, untouched): the orbit's
+ * direction and right vector, made about +y, turned by the shortest rotation that takes +y to
+ * up (about x by pi when up is -y). A z-up model (CAD, catmark_car) is then seen from its side
+ * and above, as a y-up one is by default. */
+static void sfb__an_orbit_up(const float up[3], double dir[3], double right[3]) {
+    double u[3], ax[3], len, c, s, t, *v[2];
+    int i, k;
+    for (i = 0; i < 3; ++i) u[i] = up[i];
+    len = sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+    if (!(len > 0.0) || (u[0] == 0.0 && u[2] == 0.0 && u[1] > 0.0)) return;
+    for (i = 0; i < 3; ++i) u[i] /= len;
+    /* axis +y x u, sine its length, cosine u.y */
+    ax[0] = u[2]; ax[1] = 0.0; ax[2] = -u[0];
+    s = sqrt(ax[0] * ax[0] + ax[2] * ax[2]);
+    c = u[1];
+    if (s > 0.0) { ax[0] /= s; ax[2] /= s; }
+    else { ax[0] = 1.0; ax[2] = 0.0; } /* up is -y */
+    v[0] = dir; v[1] = right;
+    for (k = 0; k < 2; ++k) {
+        /* Rodrigues: v c + (ax x v) s + ax (ax.v)(1 - c) */
+        double *x = v[k], cr[3], r[3];
+        cr[0] = ax[1] * x[2] - ax[2] * x[1]; cr[1] = ax[2] * x[0] - ax[0] * x[2]; cr[2] = ax[0] * x[1] - ax[1] * x[0];
+        t = (ax[0] * x[0] + ax[1] * x[1] + ax[2] * x[2]) * (1.0 - c);
+        for (i = 0; i < 3; ++i) r[i] = x[i] * c + cr[i] * s + ax[i] * t;
+        for (i = 0; i < 3; ++i) x[i] = r[i];
+    }
+}
+
 static void sfb__an_grid_uv(const sfb__an *A, int k, double *u, double *v) {
     int R = A->R;
     if (!A->tri) { *u = (double)(k % (R + 1)) / R; *v = (double)(k / (R + 1)) / R; return; }
@@ -13697,8 +13730,9 @@ static void sfb__an_camera(sfb__an *A) {
         double yaw = (c->view_set ? c->yaw : 30.0f) * SFB__PI / 180.0, pitch = (c->view_set ? c->pitch : 25.0f) * SFB__PI / 180.0;
         double dir[3], dist = A->radius / sin(hfov);
         dir[0] = cos(pitch) * sin(yaw); dir[1] = sin(pitch); dir[2] = cos(pitch) * cos(yaw);
-        for (i = 0; i < 3; ++i) { cam->eye[i] = A->centre[i] + dist * dir[i]; cam->fwd[i] = -dir[i]; }
         cam->right[0] = cos(yaw); cam->right[1] = 0.0; cam->right[2] = -sin(yaw);
+        sfb__an_orbit_up(c->up, dir, cam->right);
+        for (i = 0; i < 3; ++i) { cam->eye[i] = A->centre[i] + dist * dir[i]; cam->fwd[i] = -dir[i]; }
         sfb__rcross(cam->right, cam->fwd, cam->up);
         sfb__rnormalize(cam->up);
         cam->focal = cam->ortho ? half * zoom / A->radius : half * zoom / tan(hfov);
@@ -14794,10 +14828,10 @@ static void sfb__an_lights(const sfb__an *A, sfb__an_look *L) {
             j->lsize[1] = c->light_size[1] > 0.0f ? c->light_size[1] : j->lsize[0];
         } else if (mode == SFB_ANALYZE_REFLECTION) {
             /* directly above the surface (the seed's Fig. 2: "an area light source is put directly
-             * above a surface"), up being the world's y (the orbit) or the camera's up; the lines
-             * run away from the viewer (a design studio's ceiling of tubes) */
-            if (c->camera_set) for (i = 0; i < 3; ++i) ell[i] = c->up[i];
-            else { ell[0] = 0.0; ell[1] = 1.0; ell[2] = 0.0; }
+             * above a surface"), up being the camera's up, or the orbit's (the world's y unless
+             * `up` is given); the lines run away from the viewer (a design studio's ceiling of
+             * tubes) */
+            for (i = 0; i < 3; ++i) ell[i] = c->up[i];
             if (!(sfb__rnormalize(ell) > 0.0)) { ell[0] = 0.0; ell[1] = 1.0; ell[2] = 0.0; }
             for (i = 0; i < 3; ++i) { j->lc[i] = A->centre[i] + 2.5 * R * ell[i]; j->lm[i] = -ell[i]; j->lu[i] = cam->right[i]; }
             j->lsize[0] = j->lsize[1] = 16.0 * R;

@@ -622,7 +622,9 @@ SFB_API void sfb_image_free(sfb_image *img);
  * Long analyses report progress (stage "analyze": 0.3 once the proxy is evaluated and
  * rasterised, 0.75 once every pixel is projected and evaluated, 0.9 after the shade kernel) and
  * can be cancelled (SFB_CANCELLED, nothing kept). The camera is sfb_render's (an orbit around the
- * centre of the control mesh's bounding box, y up) unless eye, target and up are given. */
+ * centre of the control mesh's bounding box, y up) unless eye, target and up are given; `up`
+ * alone (camera_set 0, up not zero) turns the orbit about that axis instead of y (0, 0, 1 for a
+ * z-up model: the same yaw and pitch then see it as a y-up one is seen). */
 typedef enum sfb_analyze_mode {
     SFB_ANALYZE_REFLECTION = 0, /* seed 003: the view ray's reflection r = v - 2(v.n)n meets a finite light plane carrying a
                                    texture (stripes, lattice, circles or an RGBA image); rays that miss show the miss colour */
@@ -673,7 +675,7 @@ typedef struct sfb_analyze_config {
     int view_set;
     float yaw, pitch, zoom;
     int camera_set;
-    float eye[3], target[3], up[3];
+    float eye[3], target[3], up[3]; /* up without camera_set: the orbit's axis (zero: y) */
     float fov;                /* degrees, full vertical angle, 0: 30; orthographic: the picture's height in model units
                                  (0: the bounding sphere fits) */
     int orthographic;

@@ -383,6 +383,83 @@ static int same_picture(const sfb_analysis *a, const sfb_analysis *b) {
            memcmp(a->hits, b->hits, n * sizeof(sfb_location)) == 0;
 }
 
+/* The orbit about `up` (camera_set 0): up = +y is the default orbit, bit for bit; a model
+ * turned z-up ((x, y, z) -> (x, -z, y), exact in float) and seen with up = +z gives the y-up
+ * model's default picture (classes of >= 99.5 % of the pixels, the camera equal up to the
+ * rotation's rounding); a non-finite up is refused. */
+static sfb_mesh *load_turned_z_up(sfb_context *ctx, const char *path) {
+    size_t n, i = 0, o = 0;
+    char *t = slurp(path, &n), *out;
+    sfb_mesh *m = NULL;
+    if (!t) return NULL;
+    out = (char *)malloc(2 * n + 64);
+    while (i < n) {
+        size_t e = i;
+        while (e < n && t[e] != '\n') ++e;
+        if (e - i > 2 && t[i] == 'v' && t[i + 1] == ' ') {
+            char *q = t + i + 2;
+            double x = strtod(q, &q), y = strtod(q, &q), z = strtod(q, &q);
+            o += (size_t)sprintf(out + o, "v %.9g %.9g %.9g", x, z == 0.0 ? 0.0 : -z, y);
+        } else {
+            memcpy(out + o, t + i, e - i);
+            o += e - i;
+        }
+        if (e < n) out[o++] = '\n';
+        i = e + 1;
+    }
+    if (sfb_mesh_read_obj(ctx, out, o, &m) != SFB_SUCCESS) m = NULL;
+    free(out);
+    free(t);
+    return m;
+}
+
+static void test_orbit_up(const shape *sh) {
+    sfb_context_config cc = sfb_context_config_init();
+    sfb_context *ctx = NULL;
+    sfb_mesh *m = NULL, *mz = NULL;
+    sfb_surface *s = NULL, *sz = NULL;
+    sfb_analysis a, b, z;
+    sfb_analyze_config c = sfb_analyze_config_init(SFB_ANALYZE_REFLECTION);
+    sfb_result ra, rb, rz, rn;
+    long k, np, same = 0, cov = 0;
+    cc.ignore_environment = 1;
+    memset(&a, 0, sizeof a); memset(&b, 0, sizeof b); memset(&z, 0, sizeof z);
+    if (sfb_context_create(&cc, &ctx) != SFB_SUCCESS) { fail("orbit_up", "no context"); return; }
+    m = load_shape(ctx, sh->path);
+    mz = load_turned_z_up(ctx, sh->path);
+    s = m ? patch_surface(ctx, m, sh->scheme) : NULL;
+    sz = mz ? patch_surface(ctx, mz, sh->scheme) : NULL;
+    if (!s || !sz) { fail("orbit_up", "%s not loaded", sh->path); goto done; }
+    c.width = 240; c.height = 180; c.view_set = 1; c.yaw = 35.0f; c.pitch = 20.0f;
+    ra = sfb_surface_analyze(s, &c, &a);
+    c.up[1] = 1.0f;
+    rb = sfb_surface_analyze(s, &c, &b);
+    check(ra == SFB_SUCCESS && rb == SFB_SUCCESS && a.covered_pixels > 1000 && same_picture(&a, &b), "orbit_up/plus_y_is_the_default",
+          "%s / %s, %d / %d pixels", sfb_result_string(ra), sfb_result_string(rb), a.covered_pixels, b.covered_pixels);
+    c.up[1] = 0.0f; c.up[2] = 1.0f;
+    rz = sfb_surface_analyze(sz, &c, &z);
+    if (ra == SFB_SUCCESS && rz == SFB_SUCCESS) {
+        np = (long)a.width * a.height;
+        for (k = 0; k < np; ++k)
+            if (a.classes[k] || z.classes[k]) { ++cov; same += a.classes[k] == z.classes[k]; }
+    }
+    check(rz == SFB_SUCCESS && same >= 0.995 * cov && cov > 1000 && labs((long)z.covered_pixels - a.covered_pixels) <= a.covered_pixels / 200,
+          "orbit_up/z_up_model_as_y_up", "%s: %.3f %% of %ld pixels in the same class, covered %d against %d", sfb_result_string(rz),
+          100.0 * same / (cov ? cov : 1), cov, z.covered_pixels, a.covered_pixels);
+    printf("# orbit_up: the z-up model seen about up = z: %.3f %% of %ld pixels in the y-up picture's class\n", 100.0 * same / (cov ? cov : 1),
+           cov);
+    sfb_analysis_free(&z);
+    c.up[2] = NAN;
+    rn = sfb_surface_analyze(s, &c, &z);
+    check(rn == SFB_INVALID_VALUE && z.rgba == NULL && strstr(sfb_last_error(ctx), "up direction") != NULL, "orbit_up/not_finite", "%s: %s",
+          sfb_result_string(rn), sfb_last_error(ctx));
+done:
+    sfb_analysis_free(&a); sfb_analysis_free(&b); sfb_analysis_free(&z);
+    sfb_surface_destroy(s); sfb_surface_destroy(sz);
+    sfb_mesh_destroy(m); sfb_mesh_destroy(mz);
+    sfb_context_destroy(ctx);
+}
+
 /* The workspace's kept proxy and adjacency (they belong to a surface at a level, whatever the
  * view): one workspace through views A and B of two surfaces, the polygon-based path between,
  * a call cancelled as the proxy is done, and a surface destroyed and another made in its place;
@@ -734,6 +811,7 @@ int main(int argc, char **argv) {
     test_threads(shapes, 3);
     test_workspace(shapes);
     test_workspace_proxy(shapes);
+    test_orbit_up(&shapes[1]);
     {
         sfb_context_config bc = sfb_context_config_init();
         bc.logger.func = cpu_raster_logger;

@@ -475,6 +475,8 @@ mkpng "$TMP/light.png" 8 8 rgb-left
 check "analyze --light FILE.png succeeds" 0 "$CLI" analyze --light "$TMP/light.png" --size 80x60 examples/data/creased_box.obj -o "$TMP/lf.png"
 check "analyze --light of a missing file is bad input" 1 "$CLI" analyze --light "$TMP/none.png" --size 80x60 examples/data/creased_box.obj -o "$TMP/ax.png"
 check "analyze a Loop surface with --eye/--target succeeds" 0 "$CLI" analyze --scheme loop --eye 3,2,4 --target 0,0,0 --up 0,1,0 --fov 40 --size 80x60 "$TMP/tet.obj" -o "$TMP/al.png"
+check "analyze --up without --eye turns the --view orbit about it" 0 "$CLI" analyze --up 0,0,1 --view 30,20 --size 80x60 examples/data/creased_box.obj -o "$TMP/au.png"
+check "analyze --up with a NaN is a usage error" 2 "$CLI" analyze --up 0,nan,1 --size 80x60 examples/data/creased_box.obj -o "$TMP/aun.png"
 check "analyze --orthographic --polygon-based succeeds" 0 "$CLI" analyze --orthographic --polygon-based --level 1 --size 80x60 examples/data/creased_box.obj -o "$TMP/ao.png"
 check "analyze --scheme manifold succeeds" 0 "$CLI" analyze --scheme manifold --mode curvature --curvature max --size 80x60 examples/data/manifold_features.obj -o "$TMP/am.png"
 contains "analyze --mode curvature prints the range" "$TMP/err" "curvature .* colour map range"

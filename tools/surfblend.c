@@ -216,7 +216,7 @@ static const opt_spec options[] = {
       "shows to be wrong; for comparison)" },
     { "--eye", NULL, K_VEC3, C_ANALYZE, O_EYE, AT(eye), "X,Y,Z", NULL, 0, 0, 0, "X,Y,Z, e.g. 0,2,5", "camera position (with --target)" },
     { "--target", NULL, K_VEC3, C_ANALYZE, O_TARGET, AT(target), "X,Y,Z", NULL, 0, 0, 0, "X,Y,Z, e.g. 0,0,0", "point the camera looks at" },
-    { "--up", NULL, K_VEC3, C_ANALYZE, O_UP, AT(up), "X,Y,Z", NULL, 0, 0, 0, "X,Y,Z, e.g. 0,1,0", "camera up direction (default 0,1,0)" },
+    { "--up", NULL, K_VEC3, C_ANALYZE, O_UP, AT(up), "X,Y,Z", NULL, 0, 0, 0, "X,Y,Z, e.g. 0,0,1", "camera up direction (default 0,1,0); without --eye the --view orbit turns about it (0,0,1 for a z-up model)" },
     { "--fov", NULL, K_POSITIVE, C_ANALYZE, O_FOV, AT(fov), "DEG", NULL, 0, 178, 0, "degrees in (0, 178]",
       "vertical field of view (default 30; --orthographic: the picture's height in model units)" },
     { "--orthographic", NULL, K_SET, C_ANALYZE, O_ORTHO, AT(ortho), NULL, NULL, 0, 0, 1, NULL, "orthographic camera (default perspective)" },
@@ -1247,7 +1247,6 @@ static int cmd_analyze(cli_opts *o) {
     memset(&an, 0, sizeof an);
     memset(&out, 0, sizeof out);
     if (o->seen[O_EYE] != o->seen[O_TARGET]) return usage_error(o->cmd, "--eye and --target go together");
-    if (o->seen[O_UP] && !o->seen[O_EYE]) return usage_error(o->cmd, "--up needs --eye and --target");
     if (o->seen[O_EYE] && (o->seen[O_VIEW] || o->seen[O_ZOOM])) return usage_error(o->cmd, "--eye/--target replace --view and --zoom");
     if (o->seen[O_CURVATURE] && o->amode != SFB_ANALYZE_CURVATURE) return usage_error(o->cmd, "--curvature belongs to --mode curvature");
     if (o->seen[O_LIGHT] && o->amode != SFB_ANALYZE_REFLECTION && o->amode != SFB_ANALYZE_HIGHLIGHT)
@@ -1271,6 +1270,8 @@ static int cmd_analyze(cli_opts *o) {
             ac.target[i] = (float)o->target[i];
             ac.up[i] = o->seen[O_UP] ? (float)o->up[i] : (i == 1 ? 1.0f : 0.0f);
         }
+    } else if (o->seen[O_UP]) {
+        for (i = 0; i < 3; ++i) ac.up[i] = (float)o->up[i]; /* the orbit (--view) turns about it */
     }
     ctx = cli_make_context(o->backend);
     if (!ctx) goto done;
