@@ -20,7 +20,7 @@
  * more (the texture holds it as a float), or an incomplete framebuffer go to ref's kernel
  * (with a log line). On the host's context (gl_use_current_context) every state the raster
  * changes is put back: framebuffer bindings, viewport, depth, scissor, stencil, cull and blend
- * switches, depth function and masks, the array and pixel-pack buffers and pack storage,
+ * switches, depth function and masks, the pixel-pack buffer and pack storage,
  * besides sfb__gl_enter's and the draw path's state (sfb__gl_draw_save: texture units, samplers,
  * unpack storage). Desktop GL's glPolygonMode is not touched: a host that leaves it at GL_LINE
  * gets a ref-like result only where lines cover. */
@@ -28,7 +28,7 @@
 #define SFB__GL_RASTER_H
 
 typedef struct sfb__gl_rstate {
-    sfb__GLint draw_fbo, read_fbo, viewport[4], depth_func, array_buffer, pack_buffer, pack[4];
+    sfb__GLint draw_fbo, read_fbo, viewport[4], depth_func, pack_buffer, pack[4];
     sfb__GLboolean depth_test, scissor, stencil, cull, blend, depth_mask, color_mask[4];
 } sfb__gl_rstate;
 
@@ -37,7 +37,6 @@ static void sfb__gl_raster_save(sfb__gl *g, sfb__gl_rstate *r) {
     g->gl.GetIntegerv(SFB__GL_READ_FRAMEBUFFER_BINDING, &r->read_fbo);
     g->gl.GetIntegerv(SFB__GL_VIEWPORT, r->viewport);
     g->gl.GetIntegerv(SFB__GL_DEPTH_FUNC, &r->depth_func);
-    g->gl.GetIntegerv(SFB__GL_ARRAY_BUFFER_BINDING, &r->array_buffer);
     g->gl.GetIntegerv(SFB__GL_PIXEL_PACK_BUFFER_BINDING, &r->pack_buffer);
     g->gl.GetIntegerv(SFB__GL_PACK_ALIGNMENT, &r->pack[0]);
     g->gl.GetIntegerv(SFB__GL_PACK_ROW_LENGTH, &r->pack[1]);
@@ -62,7 +61,6 @@ static void sfb__gl_raster_restore(sfb__gl *g, const sfb__gl_rstate *r) {
     g->gl.BindFramebuffer(SFB__GL_READ_FRAMEBUFFER, (sfb__GLuint)r->read_fbo);
     g->gl.Viewport(r->viewport[0], r->viewport[1], r->viewport[2], r->viewport[3]);
     g->gl.DepthFunc((sfb__GLenum)r->depth_func);
-    g->gl.BindBuffer(SFB__GL_ARRAY_BUFFER, (sfb__GLuint)r->array_buffer);
     g->gl.BindBuffer(SFB__GL_PIXEL_PACK_BUFFER, (sfb__GLuint)r->pack_buffer);
     g->gl.PixelStorei(SFB__GL_PACK_ALIGNMENT, r->pack[0]);
     g->gl.PixelStorei(SFB__GL_PACK_ROW_LENGTH, r->pack[1]);

@@ -83,8 +83,6 @@
 #  define SFB__SIMD_FORCEINLINE inline
 #endif
 
-#define SFB__SIMD_MAX_THREADS SFB__POOL_MAX_THREADS
-
 /* ---- instruction set choice ---- */
 enum { SFB__SIMD_PORTABLE, SFB__SIMD_ISA_SSE2, SFB__SIMD_AVX2, SFB__SIMD_AVX512, SFB__SIMD_ISA_NEON, SFB__SIMD_ISA_COUNT };
 static const char *const sfb__simd_isa_names[SFB__SIMD_ISA_COUNT] = {"portable", "sse2", "avx2", "avx512", "neon"};
@@ -143,9 +141,8 @@ static int sfb__simd_choose_isa(sfb_context *ctx) {
 /* ---- backend state and thread pool ---- */
 typedef struct sfb__simd_state {
     sfb_context *ctx;
-    int isa;       /* every family runs its kernels of this instruction set */
-    int threads;   /* threads sharing one call, the caller included */
-    sfb__pool pool; /* threads - 1 workers (src/pool.c) */
+    int isa;        /* every family runs its kernels of this instruction set */
+    sfb__pool pool; /* pool.threads share one call, the caller included (src/pool.c) */
 } sfb__simd_state;
 
 static sfb_result sfb__simd_init(sfb_context *ctx, void **state, char *why, size_t why_size) {
@@ -161,8 +158,7 @@ static sfb_result sfb__simd_init(sfb_context *ctx, void **state, char *why, size
     memset(s, 0, sizeof *s);
     s->ctx = ctx;
     s->isa = sfb__simd_choose_isa(ctx);
-    s->threads = sfb__pool_threads(ctx->threads);
-    if (!sfb__pool_start(&s->pool, s->threads, why, why_size)) {
+    if (!sfb__pool_start(&s->pool, sfb__pool_threads(ctx->threads), why, why_size)) {
         sfb__free(ctx, s);
         return SFB_BACKEND_UNAVAILABLE;
     }
@@ -207,7 +203,7 @@ static int sfb__simd_parallel(void *state, void (*task)(void *arg, int first, in
 static void sfb__simd_describe(void *state, char *buf, size_t size) {
     const sfb__simd_state *s = (const sfb__simd_state *)state;
     if (!s || !buf || size == 0) return;
-    snprintf(buf, size, "%s kernels, %d thread%s", sfb__simd_isa_names[s->isa], s->threads, s->threads == 1 ? "" : "s");
+    snprintf(buf, size, "%s kernels, %d thread%s", sfb__simd_isa_names[s->isa], s->pool.threads, s->pool.threads == 1 ? "" : "s");
 }
 
 static void sfb__simd_runtime_bind(sfb__backend_vtable *vt) {
