@@ -19,7 +19,8 @@
  *    NEAR (within half a pixel after the steps: not converged), MISS (further: no surface there).
  *    Round 0 seeds the proxy pixels on a grid of every 4th pixel with their own (face, u, v),
  *    then the pixels between those hits from them (cubic Hermite in (u,v) along a picture axis,
- *    the hits' inverse screen Jacobians as tangents), down to every pixel; an attempt that
+ *    the hits' inverse screen Jacobians as tangents, across a face side in the two faces'
+ *    unfolded frame), down to every pixel; an attempt that
  *    stalls over a pixel away stops early. Every later round seeds, from the hits the round
  *    before made or replaced, their 8 neighbours that are not hit yet, or hit on another face
  *    at least 1 % of the bounding radius farther away (a nearer sheet may hide them: near
@@ -229,6 +230,7 @@ typedef struct sfb__an {
     float *gpos, *gnrm;
     sfb__raster_vertex *rv;      /* the grid points in the picture */
     int *rtri, ntri;             /* the proxy's triangles (sfb__raster_job) */
+    float *ybox;                 /* their y boxes (sfb__raster_job): rtri's, then the raster order's */
     float *zmax;                 /* the raster's scratch (sfb__raster_job) */
     unsigned char *ucov;         /* per 8 pixels of a row after the raster: 1 where one is not drawn (sfb__an_ucov_rows) */
     /* per pixel */
@@ -261,7 +263,7 @@ enum {
     SFB__WS_GPOS, SFB__WS_GNRM, SFB__WS_RV, SFB__WS_RTRI, SFB__WS_DEPTH, SFB__WS_FACE, SFB__WS_UV, SFB__WS_HIT, SFB__WS_CFACE,
     SFB__WS_CUV, SFB__WS_CDIST, SFB__WS_STATE, SFB__WS_PPOS, SFB__WS_PNRM, SFB__WS_HPIX, SFB__WS_HLOC, SFB__WS_HPOS, SFB__WS_HDU,
     SFB__WS_HDV, SFB__WS_HNRM, SFB__WS_HDEPTH, SFB__WS_CHG, SFB__WS_TRIES, SFB__WS_LOCS, SFB__WS_BUF, SFB__WS_MARK, SFB__WS_ROWAT,
-    SFB__WS_NBM, SFB__WS_HV1, SFB__WS_HV2, SFB__WS_V2, SFB__WS_SEC, SFB__WS_HINV, SFB__WS_HL, SFB__WS_CAND, SFB__WS_ZMAX, SFB__WS_NBC, SFB__WS_ADJ, SFB__WS_UCOV, SFB__WS_DONE, SFB__WS_COUNT
+    SFB__WS_NBM, SFB__WS_HV1, SFB__WS_HV2, SFB__WS_V2, SFB__WS_SEC, SFB__WS_HINV, SFB__WS_HL, SFB__WS_CAND, SFB__WS_ZMAX, SFB__WS_NBC, SFB__WS_ADJ, SFB__WS_UCOV, SFB__WS_DONE, SFB__WS_YBOX, SFB__WS_COUNT
 };
 struct sfb_analysis_workspace {
     sfb_context *ctx;
@@ -651,10 +653,36 @@ static void sfb__an_seed_rows_tri(void *arg, int row0, int row1) {
     const double lo = row0 - 0.5 - SFB__AN_DILATE, hi = row1 + 0.5 + SFB__AN_DILATE;
     int k;
     for (k = 0; k < A->ntri; ++k) {
-        const int *tv = A->rtri + 4 * (size_t)k;
-        const double y0 = A->rv[tv[0]].y, y1 = A->rv[tv[1]].y, y2 = A->rv[tv[2]].y;
-        if ((y0 < lo && y1 < lo && y2 < lo) || (y0 > hi && y1 > hi && y2 > hi)) continue;
-        sfb__an_seed_tri(A, tv, row0, row1);
+        /* the box's test is the vertices' (below or above the band), conservative */
+        if ((double)A->ybox[2 * (size_t)k + 1] < lo || (double)A->ybox[2 * (size_t)k] > hi) continue;
+        sfb__an_seed_tri(A, A->rtri + 4 * (size_t)k, row0, row1);
+    }
+}
+
+/* The y boxes of triangles [a, b) of the list `tri` into box (sfb__raster_job's ybox). */
+typedef struct sfb__an_ybox_job {
+    const sfb__an *A;
+    const int *tri;
+    float *box;
+} sfb__an_ybox_job;
+static void sfb__an_ybox(void *arg, int a, int b) {
+    const sfb__an_ybox_job *J = (const sfb__an_ybox_job *)arg;
+    const sfb__raster_vertex *rv = J->A->rv;
+    int k;
+    for (k = a; k < b; ++k) {
+        const int *tv = J->tri + 4 * (size_t)k;
+        double lo = rv[tv[0]].y, hi = lo;
+        float l, h;
+        if (rv[tv[1]].y < lo) lo = rv[tv[1]].y;
+        if (rv[tv[1]].y > hi) hi = rv[tv[1]].y;
+        if (rv[tv[2]].y < lo) lo = rv[tv[2]].y;
+        if (rv[tv[2]].y > hi) hi = rv[tv[2]].y;
+        l = (float)lo;
+        h = (float)hi;
+        if ((double)l > lo) l = nextafterf(l, -HUGE_VALF);
+        if ((double)h < hi) h = nextafterf(h, HUGE_VALF);
+        J->box[2 * (size_t)k] = l;
+        J->box[2 * (size_t)k + 1] = h;
     }
 }
 
@@ -797,6 +825,15 @@ static sfb_result sfb__an_raster(sfb__an *A) {
     job.ntri = A->ntri; job.vert = A->rv;
     job.tri = A->rtri + (size_t)A->nf * (size_t)A->per * 2 * 4; /* the second half: the raster's order */
     job.nfront = sfb__an_order(A, (int *)job.tri);
+    {
+        sfb__an_ybox_job Y;
+        Y.A = A;
+        Y.tri = A->rtri; Y.box = A->ybox;
+        sfb__an_run(A, sfb__an_ybox, &Y, 0, A->ntri, (double)A->ntri * 2.0);
+        Y.tri = job.tri; Y.box = A->ybox + 2 * (size_t)A->ntri;
+        sfb__an_run(A, sfb__an_ybox, &Y, 0, A->ntri, (double)A->ntri * 2.0);
+        job.ybox = Y.box;
+    }
     job.zmax = A->zmax;
     job.depth = A->depth; job.face = A->face; job.uv = A->uv;
     if (A->ppos) { job.apos = A->gpos; job.anrm = A->gnrm; job.pos = A->ppos; job.nrm = A->pnrm; }
@@ -1206,26 +1243,111 @@ static void sfb__an_predict(const sfb__an *A, int x, int y, int d, int part, sfb
     loc->v = (float)v;
 }
 
-/* A seed for pixel (x, y) between two hits on one face, d pixels either side along `axis`: the
- * cubic Hermite interpolant of their (u,v) with their d(u,v)/d(pixel) as end tangents, at its
+/* Side k's own frame of a face's point (u, v): t along the side (sfb__an_side_point's t), s
+ * from the side inward (1 at the opposite corner or side); and back. */
+static void sfb__an_side_frame(int tri, int k, double u, double v, double *t, double *s) {
+    if (tri) {
+        if (k == 0) { *t = u; *s = v; }
+        else if (k == 1) { *t = v; *s = 1.0 - u - v; }
+        else { *t = 1.0 - v; *s = u; }
+        return;
+    }
+    if (k == 0) { *t = u; *s = v; }
+    else if (k == 1) { *t = v; *s = 1.0 - u; }
+    else if (k == 2) { *t = 1.0 - u; *s = 1.0 - v; }
+    else { *t = 1.0 - v; *s = u; }
+}
+static void sfb__an_side_unframe(int tri, int k, double t, double s, double *u, double *v) {
+    if (tri) {
+        if (k == 0) { *u = t; *v = s; }
+        else if (k == 1) { *u = 1.0 - s - t; *v = t; }
+        else { *u = s; *v = 1.0 - t; }
+        return;
+    }
+    if (k == 0) { *u = t; *v = s; }
+    else if (k == 1) { *u = 1.0 - s; *v = t; }
+    else if (k == 2) { *u = 1.0 - t; *v = 1.0 - s; }
+    else { *u = s; *v = 1.0 - t; }
+}
+
+/* A point (u, v) of face G in the frame of its neighbour F across G's side kg (F's side kf; rev:
+ * the sides run opposite ways, as A->adj has it), F's domain extended over the side: the two
+ * faces unfolded into one plane, G's side onto F's and G's inside beyond it, as two squares of
+ * a regular grid (Catmull-Clark), or two triangles of a regular lattice, which make a
+ * parallelogram (Loop: G's opposite corner lands on F's corner point-reflected through the
+ * side's middle). The same call with F and G swapped is its inverse. */
+static void sfb__an_unfold(int tri, int kg, int kf, int rev, double u, double v, double *uf, double *vf) {
+    double t, s, tf;
+    sfb__an_side_frame(tri, kg, u, v, &t, &s);
+    tf = rev ? 1.0 - t : t;
+    if (tri) {
+        /* the opposite corner's t per side: (0, 1), (0, 0), (1, 0) */
+        const double og = kg == 2 ? 1.0 : 0.0, of = kf == 2 ? 1.0 : 0.0;
+        tf += ((1.0 - of) - (rev ? 1.0 - og : og)) * s;
+    }
+    sfb__an_side_unframe(tri, kf, tf, -s, uf, vf);
+}
+
+/* Whether (u, v) lies in the face's domain, within eps. */
+static int sfb__an_in_domain(const sfb__an *A, double u, double v, double eps) {
+    if (!(u >= -eps && v >= -eps)) return 0;
+    return A->tri ? u + v <= 1.0 + eps : u <= 1.0 + eps && v <= 1.0 + eps;
+}
+
+/* A seed for pixel (x, y) between two hits, d pixels either side along `axis`: the cubic
+ * Hermite interpolant of their (u,v) with their d(u,v)/d(pixel) as end tangents, at its
  * middle, (a + b) / 2 + d (m_a - m_b) / 4 (the hits 2d pixels apart), off by fourth-order terms
  * only, so that the pixel usually hits at its first evaluation (a one-sided linear prediction
- * is off by the second-order term, above SFB__AN_TOL where a patch spans under ~100 pixels);
- * 0 (loc kept) when either is missing, they lie on different faces or a Jacobian is singular. */
+ * is off by the second-order term, above SFB__AN_TOL where a patch spans under ~100 pixels).
+ * Two hits on neighbouring faces (across a side of A->adj) are interpolated with b's (u,v) and
+ * tangent unfolded into a's frame (sfb__an_unfold), and the middle is put on the face it lands
+ * in (catmark_car at 1024 x 1024: 9 % of round 0's pixels have their two hits on two faces,
+ * and took 2.2 evaluations each from the one-sided prediction). 0 (loc kept) when either hit is
+ * missing, they lie on faces that are not neighbours, the middle lands on neither face (next to
+ * a corner) or a Jacobian is singular. */
 static int sfb__an_hermite(const sfb__an *A, int x, int y, int axis, int d, sfb_location *loc) {
     const int dx = axis ? 0 : d, dy = axis ? d : 0;
-    double ma[2], mb[2], u, v;
+    double ma[2], mb[2], ub, vb, u, v;
     size_t a, b;
+    int fa, fb;
     if (x - dx < 0 || y - dy < 0 || x + dx >= A->w || y + dy >= A->h) return 0;
     a = (size_t)(y - dy) * (size_t)A->w + (size_t)(x - dx);
     b = (size_t)(y + dy) * (size_t)A->w + (size_t)(x + dx);
-    if (A->hit[a] < 0 || A->hit[b] < 0 || A->hl[a].face != A->hl[b].face) return 0;
+    if (A->hit[a] < 0 || A->hit[b] < 0) return 0;
     if (!sfb__an_uv_per_pixel(A, a, axis, ma) || !sfb__an_uv_per_pixel(A, b, axis, mb)) return 0;
-    u = 0.5 * ((double)A->hl[a].u + A->hl[b].u) + 0.25 * d * (ma[0] - mb[0]);
-    v = 0.5 * ((double)A->hl[a].v + A->hl[b].v) + 0.25 * d * (ma[1] - mb[1]);
-    if (!isfinite(u) || !isfinite(v)) return 0;
+    fa = A->hl[a].face;
+    fb = A->hl[b].face;
+    ub = A->hl[b].u;
+    vb = A->hl[b].v;
+    if (fa != fb) {
+        const int ns = A->tri ? 3 : 4;
+        double u1, v1;
+        int kf, nb = -1;
+        for (kf = 0; kf < ns; ++kf) {
+            nb = A->adj[4 * fa + kf];
+            if (nb >= 0 && (nb >> 3) == fb) break;
+        }
+        if (kf == ns) return 0;
+        sfb__an_unfold(A->tri, (nb >> 1) & 3, kf, nb & 1, ub + mb[0], vb + mb[1], &u1, &v1);
+        sfb__an_unfold(A->tri, (nb >> 1) & 3, kf, nb & 1, ub, vb, &ub, &vb);
+        mb[0] = u1 - ub;
+        mb[1] = v1 - vb;
+        u = 0.5 * ((double)A->hl[a].u + ub) + 0.25 * d * (ma[0] - mb[0]);
+        v = 0.5 * ((double)A->hl[a].v + vb) + 0.25 * d * (ma[1] - mb[1]);
+        if (!isfinite(u) || !isfinite(v)) return 0;
+        if (!sfb__an_in_domain(A, u, v, 1e-6)) {
+            /* beyond a's side: back into b's frame */
+            sfb__an_unfold(A->tri, kf, (nb >> 1) & 3, nb & 1, u, v, &u, &v);
+            if (!sfb__an_in_domain(A, u, v, 1e-6)) return 0;
+            fa = fb;
+        }
+    } else {
+        u = 0.5 * ((double)A->hl[a].u + ub) + 0.25 * d * (ma[0] - mb[0]);
+        v = 0.5 * ((double)A->hl[a].v + vb) + 0.25 * d * (ma[1] - mb[1]);
+        if (!isfinite(u) || !isfinite(v)) return 0;
+    }
     sfb__an_clamp_domain(A, &u, &v);
-    loc->face = A->hl[a].face;
+    loc->face = fa;
     loc->u = (float)u;
     loc->v = (float)v;
     return 1;
@@ -1408,10 +1530,13 @@ static sfb_result sfb__an_project_all(sfb__an *A, int steps) {
      * (sfb__an_hermite: most hit at their first evaluation), else from a hit anchor-grid
      * neighbour moved by the inverse of its screen Jacobian (sfb__an_predict), else from the
      * proxy too. Measured on catmark_car at 1024 x 1024 (413k covered pixels), every round:
-     * 1.41 evaluations per covered pixel (round 0: 1.27; a one-sided cubic extrapolation for
-     * the pixels between two faces saved 2 % of round 0's time and put 0.04 % of the pixels on
-     * a farther sheet, which the later rounds then had to correct: not kept); 2.6 with anchors
-     * every 2 pixels, the one-sided prediction alone and no stall rule (sfb__an_step) */
+     * 1.35 evaluations per covered pixel (round 0: 1.21); 1.41 (1.27) when the two hits of a
+     * Hermite seed had to lie on one face, the others predicted from one side (a one-sided
+     * cubic extrapolation for those saved 2 % of round 0's time and put 0.04 % of the pixels
+     * on a farther sheet, which the later rounds then had to correct: not kept); 2.6 with
+     * anchors every 2 pixels, the one-sided prediction alone and no stall rule (sfb__an_step).
+     * The seeds the prediction still makes (next to silhouettes, face corners, and faces not
+     * neighbours) take 2.2 evaluations each, Hermite seeds 1.05 to 1.15 */
     for (part = 0; part < 5; ++part) {
         const int d = part == 0 ? SFB__AN_ANCHOR : part <= 2 ? 2 : 1, nrows = (A->h + d - 1) / d;
         int r0, r1;
@@ -1899,7 +2024,7 @@ static sfb_result sfb__an_shade(const sfb__an *A, const sfb__shade_job *job, int
 }
 
 static void sfb__an_free(sfb__an *A) {
-    sfb__an_put(A, A->gpos); sfb__an_put(A, A->gnrm); sfb__an_put(A, A->rv); sfb__an_put(A, A->rtri);
+    sfb__an_put(A, A->gpos); sfb__an_put(A, A->gnrm); sfb__an_put(A, A->rv); sfb__an_put(A, A->rtri); sfb__an_put(A, A->ybox);
     sfb__an_put(A, A->cface); sfb__an_put(A, A->cuv); sfb__an_put(A, A->cdist);
     sfb__an_put(A, A->depth); sfb__an_put(A, A->face); sfb__an_put(A, A->uv); sfb__an_put(A, A->ppos); sfb__an_put(A, A->pnrm);
     sfb__an_put(A, A->hit); sfb__an_put(A, A->state); sfb__an_put(A, A->cand); sfb__an_put(A, A->zmax); sfb__an_put(A, A->ucov);
@@ -1914,7 +2039,7 @@ static double sfb__an_bytes(const sfb__an *A) {
     double per_pixel = 16 + 4 + 4 + 8 + 4 + 1 + 1 + 1 /* zmax, ucov */ + 4 + 4 + 1 + 4 + 12 /* buffers, outputs */ + 4 + 24 + 4 + 16 + 12 /* hits */ +
                        (A->c->mode == SFB_ANALYZE_CURVATURE ? 24 + 12 + 36 : 0) /* their first and second derivatives */ +
                        (A->c->polygon_based ? 24 : 92 + 16 + 2) /* proxy data or the projection's attempts, marks and neighbour masks */;
-    return npix * per_pixel + grid * (24.0 + sizeof(sfb__raster_vertex) + 2 * 2 * 4 * sizeof(int)) + 65536.0 * sizeof(sfb_location) + (double)A->nf * 4 * (sizeof(int) + sizeof(sfb__an_side));
+    return npix * per_pixel + grid * (24.0 + sizeof(sfb__raster_vertex) + 2 * 2 * 4 * sizeof(int) + 2 * 2 * 2 * sizeof(float)) + 65536.0 * sizeof(sfb_location) + (double)A->nf * 4 * (sizeof(int) + sizeof(sfb__an_side));
 }
 
 /* The per-pixel buffers of rows [y0, y1) before the raster: nothing drawn, nothing hit. */
@@ -1936,6 +2061,7 @@ static int sfb__an_alloc(sfb__an *A) {
     A->rv = (sfb__raster_vertex *)sfb__an_get(A, SFB__WS_RV, grid * sizeof(sfb__raster_vertex), NULL);
     /* at most two triangles per grid point, then as many in the raster's order (sfb__an_order) */
     A->rtri = (int *)sfb__an_get(A, SFB__WS_RTRI, grid * 2 * 2 * 4 * sizeof(int), NULL);
+    A->ybox = (float *)sfb__an_get(A, SFB__WS_YBOX, grid * 2 * 2 * 2 * sizeof(float), NULL);
     A->depth = (float *)sfb__an_get(A, SFB__WS_DEPTH, npix * sizeof(float), NULL);
     A->face = (int *)sfb__an_get(A, SFB__WS_FACE, npix * sizeof(int), NULL);
     A->uv = (float *)sfb__an_get(A, SFB__WS_UV, npix * 2 * sizeof(float), NULL);
@@ -1963,7 +2089,7 @@ static int sfb__an_alloc(sfb__an *A) {
     A->hinv = (float *)sfb__an_get(A, SFB__WS_HINV, npix * 4 * sizeof(float), NULL);
     A->hl = (sfb_location *)sfb__an_get(A, SFB__WS_HL, npix * sizeof(sfb_location), NULL);
     A->chg = (int *)sfb__an_get(A, SFB__WS_CHG, (npix + 1) * sizeof(int), NULL);
-    if (!A->gpos || !A->gnrm || !A->rv || !A->rtri || !A->depth || !A->face || !A->uv || !A->hit || !A->adj || !A->cface || !A->cuv || !A->cdist || !A->state || !A->cand || !A->zmax || !A->ucov ||
+    if (!A->gpos || !A->gnrm || !A->rv || !A->rtri || !A->ybox || !A->depth || !A->face || !A->uv || !A->hit || !A->adj || !A->cface || !A->cuv || !A->cdist || !A->state || !A->cand || !A->zmax || !A->ucov ||
         (A->c->polygon_based && (!A->ppos || !A->pnrm)) || !A->hpix || !A->hpos || (A->c->mode == SFB_ANALYZE_CURVATURE && (!A->hdu || !A->hdv)) || !A->hnrm || !A->hdepth ||
         !A->hinv || !A->hl || !A->chg)
         return 0;

@@ -176,6 +176,8 @@ static void sfb__raster_range(const sfb__raster_job *j, int row0, int row1, int 
         sfb__raster_edges t;
         double lo, hi;
         int k, x, y;
+        /* the box first: each band of rows scans every triangle */
+        if (j->ybox && !((double)j->ybox[2 * (size_t)i + 1] - 0.5 >= (double)row0 && (double)j->ybox[2 * (size_t)i] - 0.5 <= (double)row1 - 1.0)) continue;
         for (k = 0; k < 3; ++k) S[k] = &j->vert[tv[k]];
         lo = hi = S[0]->y;
         for (k = 1; k < 3; ++k) {

@@ -193,6 +193,8 @@ typedef struct sfb__raster_job {
     int *face;
     float *uv, *pos, *nrm;
     float *zmax;
+    const float *ybox; /* NULL, or per triangle (in order) its vertices' smallest and largest y, rounded outward to
+                          float: a hint for skipping the triangles outside a band of rows before reading them */
 } sfb__raster_job;
 /* A triangle's set-up in the picture: its signed doubled area, barycentric planes (b_k = ea[k] x + eb[k] y + ec[k]) and the pixel box of the
  * centres within `grow` pixels of it (x0 > x1 or y0 > y1: none); 0 when it is degenerate. */

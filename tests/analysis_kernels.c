@@ -261,6 +261,80 @@ static void run_target(target *t, const pixels *px) {
     check_raster(t);
 }
 
+/* The analysis's unfolding of a neighbour face into a face's frame (sfb__an_unfold, the
+ * cross-face Hermite seeds): for every pair of sides and both directions, a point on the shared
+ * side lands on the same point of the other side; the neighbour's inside lands beyond the side
+ * (outside the face); the neighbour's opposite corner lands where a regular grid (two squares)
+ * or lattice (two triangles making a parallelogram) puts it; and the reverse call undoes it. */
+static void check_unfold(void) {
+    int tri, kg, kf, rev, bad_side = 0, bad_out = 0, bad_corner = 0, bad_back = 0, n = 0;
+    rng g = rng_for(g_seed, 7);
+    for (tri = 0; tri < 2; ++tri) {
+        const int ns = tri ? 3 : 4;
+        sfb__an A;
+        memset(&A, 0, sizeof A);
+        A.tri = tri;
+        for (kg = 0; kg < ns; ++kg)
+            for (kf = 0; kf < ns; ++kf)
+                for (rev = 0; rev < 2; ++rev) {
+                    int i;
+                    double t, ug, vg, uf, vf, ex, ey, u2, v2;
+                    /* the shared side */
+                    for (i = 0; i < 5; ++i) {
+                        t = i / 4.0;
+                        sfb__an_side_point(tri, kg, t, &ug, &vg);
+                        sfb__an_unfold(tri, kg, kf, rev, ug, vg, &uf, &vf);
+                        sfb__an_side_point(tri, kf, rev ? 1.0 - t : t, &ex, &ey);
+                        bad_side += !(fabs(uf - ex) < 1e-12 && fabs(vf - ey) < 1e-12);
+                    }
+                    /* random inside points: beyond the side, and back */
+                    for (i = 0; i < 50; ++i) {
+                        ug = rnd_in(&g, 0.01, 0.99);
+                        vg = rnd_in(&g, 0.01, tri ? 0.99 - ug : 0.99);
+                        sfb__an_unfold(tri, kg, kf, rev, ug, vg, &uf, &vf);
+                        bad_out += sfb__an_in_domain(&A, uf, vf, 1e-9);
+                        sfb__an_unfold(tri, kf, kg, rev, uf, vf, &u2, &v2);
+                        bad_back += !(fabs(u2 - ug) < 1e-12 && fabs(v2 - vg) < 1e-12);
+                        ++n;
+                    }
+                    /* the neighbour's corners off the side: squares side by side (the side's
+                     * ends moved across it by one), or F's own opposite corner point-reflected
+                     * through the side's middle */
+                    if (tri) {
+                        double cu, cv, au, av, bu, bv, ou, ov;
+                        /* G's opposite corner: the start of its side kg + 2 */
+                        sfb__an_side_point(tri, (kg + 2) % 3, 0.0, &cu, &cv);
+                        sfb__an_unfold(tri, kg, kf, rev, cu, cv, &uf, &vf);
+                        sfb__an_side_point(tri, kf, 0.0, &au, &av);
+                        sfb__an_side_point(tri, kf, 1.0, &bu, &bv);
+                        sfb__an_side_point(tri, (kf + 2) % 3, 0.0, &ou, &ov); /* F's opposite corner */
+                        bad_corner += !(fabs(uf - (au + bu - ou)) < 1e-12 && fabs(vf - (av + bv - ov)) < 1e-12);
+                    } else {
+                        double pu, pv, qu, qv, au, av, bu, bv, nu, nv;
+                        /* G's corners off the side: the ends of side kg + 2 (it runs opposite) */
+                        sfb__an_side_point(tri, (kg + 2) % 4, 1.0, &pu, &pv); /* off t = 0 */
+                        sfb__an_side_point(tri, (kg + 2) % 4, 0.0, &qu, &qv); /* off t = 1 */
+                        sfb__an_side_point(tri, kf, rev ? 1.0 : 0.0, &au, &av);
+                        sfb__an_side_point(tri, kf, rev ? 0.0 : 1.0, &bu, &bv);
+                        /* F's outward normal of side kf, one unit long in (u, v) */
+                        sfb__an_side_point(tri, (kf + 2) % 4, 0.5, &nu, &nv);
+                        {
+                            double mu = 0.5 * (au + bu), mv = 0.5 * (av + bv);
+                            double ou = mu - nu, ov = mv - nv;
+                            sfb__an_unfold(tri, kg, kf, rev, pu, pv, &uf, &vf);
+                            bad_corner += !(fabs(uf - (au + ou)) < 1e-12 && fabs(vf - (av + ov)) < 1e-12);
+                            sfb__an_unfold(tri, kg, kf, rev, qu, qv, &uf, &vf);
+                            bad_corner += !(fabs(uf - (bu + ou)) < 1e-12 && fabs(vf - (bv + ov)) < 1e-12);
+                        }
+                    }
+                }
+    }
+    check(bad_side == 0, "unfold/shared_side", "%d shared-side points moved", bad_side);
+    check(bad_out == 0, "unfold/beyond_the_side", "%d of %d neighbour points landed inside the face", bad_out, n);
+    check(bad_corner == 0, "unfold/grid_corners", "%d neighbour corners off the regular grid", bad_corner);
+    check(bad_back == 0, "unfold/inverse", "%d of %d points not restored by the reverse call", bad_back, n);
+}
+
 int main(int argc, char **argv) {
     static const char *const isas[5] = {"portable", "sse2", "avx2", "avx512", "neon"};
     static const double lm[3] = {0.0, 0.0, 1.0};
@@ -281,6 +355,7 @@ int main(int argc, char **argv) {
     g = rng_for(g_seed, 1);
     pixels_random(&px, &g, lm);
     check_raster_hint();
+    check_unfold();
     snprintf(saved, sizeof saved, "%s", pinned ? pinned : "");
     for (k = 0; k < 5; ++k) {
         if (saved[0] && strcmp(saved, isas[k]) != 0) continue;
