@@ -13849,10 +13849,9 @@ static void sfb__an_ybox(void *arg, int a, int b) {
         if (rv[tv[1]].y > hi) hi = rv[tv[1]].y;
         if (rv[tv[2]].y < lo) lo = rv[tv[2]].y;
         if (rv[tv[2]].y > hi) hi = rv[tv[2]].y;
-        l = (float)lo;
-        h = (float)hi;
-        if ((double)l > lo) l = nextafterf(l, -HUGE_VALF);
-        if ((double)h < hi) h = nextafterf(h, HUGE_VALF);
+        /* widened by more than float's rounding (2^-24 relative) before the conversion */
+        l = (float)(lo - (1e-6 * fabs(lo) + 1e-3));
+        h = (float)(hi + (1e-6 * fabs(hi) + 1e-3));
         J->box[2 * (size_t)k] = l;
         J->box[2 * (size_t)k + 1] = h;
     }
@@ -13898,43 +13897,79 @@ static void sfb__an_candidates(void *arg, int y0, int y1) {
     }
 }
 
-/* Step 1b: the proxy's triangles reordered into ord[] (4 ints each) for the raster: those facing
- * the eye first, then those facing away (each part in rtri's order); the count of the first part.
+/* Triangles of chunks [c0, c1) of SFB__AN_CHUNKS: whether each faces away (away[k]), and each
+ * chunk's sum of six times the signed volumes of (centre, triangle) and of their sizes. */
+typedef struct sfb__an_away_job {
+    const sfb__an *A;
+    unsigned char *away;
+    double vol[SFB__AN_CHUNKS], mag[SFB__AN_CHUNKS];
+} sfb__an_away_job;
+static void sfb__an_away(void *arg, int c0, int c1) {
+    sfb__an_away_job *J = (sfb__an_away_job *)arg;
+    const sfb__an *A = J->A;
+    int c, k;
+    for (c = c0; c < c1; ++c) {
+        const int a = (int)((long long)A->ntri * c / SFB__AN_CHUNKS), b = (int)((long long)A->ntri * (c + 1) / SFB__AN_CHUNKS);
+        double vol = 0.0, mag = 0.0;
+        for (k = a; k < b; ++k) {
+            const int *tv = A->rtri + 4 * (size_t)k;
+            double p[3][3], nr[3], d[3], e1[3], e2[3], t;
+            int i, q;
+            for (i = 0; i < 3; ++i)
+                for (q = 0; q < 3; ++q) p[i][q] = (double)A->gpos[3 * (size_t)tv[i] + q] - A->centre[q];
+            for (q = 0; q < 3; ++q) {
+                e1[q] = p[1][q] - p[0][q];
+                e2[q] = p[2][q] - p[0][q];
+                d[q] = A->cam.ortho ? -A->cam.fwd[q] : A->cam.eye[q] - A->centre[q] - p[0][q];
+            }
+            sfb__rcross(e1, e2, nr);
+            t = sfb__rdot(nr, p[0]);
+            vol += t;
+            mag += fabs(t);
+            J->away[k] = (unsigned char)(sfb__rdot(nr, d) < 0.0);
+        }
+        J->vol[c] = vol;
+        J->mag[c] = mag;
+    }
+}
+
+/* Step 1b: the proxy's triangles reordered into ord[] (4 ints each; their y boxes into obox)
+ * for the raster: those facing the eye first, then those facing away (each part in rtri's
+ * order); the count of the first part.
  * "Facing" takes the outward side from the sign of the whole proxy's signed volume (+ when it is
  * about zero). On a closed proxy seen from outside, a view ray's first crossing enters it, so the
  * triangles facing away are never nearest; on an open one (catmark_car's wheel arches) some are.
  * Either way the raster draws the first part, then skips the triangles of the second that the
  * depth already drawn hides over their whole box (sfb__raster_job's nfront and zmax): the same
  * buffers, but for which of two triangles at exactly equal depth a pixel keeps. */
-static int sfb__an_order(sfb__an *A, int *ord) {
+static int sfb__an_order(sfb__an *A, int *ord, float *obox) {
+    sfb__an_away_job J;
     unsigned char *away = (unsigned char *)sfb__alloc(A->ctx, (size_t)A->ntri + 1);
     double vol = 0.0, mag = 0.0;
     int k, n = 0, sg;
-    if (!away) { memcpy(ord, A->rtri, (size_t)A->ntri * 4 * sizeof(int)); return A->ntri; } /* one part */
-    for (k = 0; k < A->ntri; ++k) {
-        const int *tv = A->rtri + 4 * (size_t)k;
-        double p[3][3], nr[3], d[3], e1[3], e2[3], t;
-        int i, c;
-        for (i = 0; i < 3; ++i)
-            for (c = 0; c < 3; ++c) p[i][c] = (double)A->gpos[3 * (size_t)tv[i] + c] - A->centre[c];
-        for (c = 0; c < 3; ++c) {
-            e1[c] = p[1][c] - p[0][c];
-            e2[c] = p[2][c] - p[0][c];
-            d[c] = A->cam.ortho ? -A->cam.fwd[c] : A->cam.eye[c] - A->centre[c] - p[0][c];
-        }
-        sfb__rcross(e1, e2, nr);
-        t = sfb__rdot(nr, p[0]); /* six times the signed volume of (centre, triangle) */
-        vol += t;
-        mag += fabs(t);
-        away[k] = (unsigned char)(sfb__rdot(nr, d) < 0.0);
+    if (!away) { /* one part */
+        memcpy(ord, A->rtri, (size_t)A->ntri * 4 * sizeof(int));
+        memcpy(obox, A->ybox, (size_t)A->ntri * 2 * sizeof(float));
+        return A->ntri;
     }
+    /* over the threads in SFB__AN_CHUNKS parts, the sums combined in order */
+    J.A = A;
+    J.away = away;
+    sfb__an_run(A, sfb__an_away, &J, 0, SFB__AN_CHUNKS, (double)A->ntri * 4.0);
+    for (k = 0; k < SFB__AN_CHUNKS; ++k) { vol += J.vol[k]; mag += J.mag[k]; }
     sg = vol < -1e-6 * mag; /* 1: the proxy is inward-facing, "away" means facing the eye */
     for (k = 0; k < A->ntri; ++k)
-        if (away[k] == sg) memcpy(ord + 4 * (size_t)n++, A->rtri + 4 * (size_t)k, 4 * sizeof(int));
+        if (away[k] == sg) {
+            memcpy(ord + 4 * (size_t)n, A->rtri + 4 * (size_t)k, 4 * sizeof(int));
+            memcpy(obox + 2 * (size_t)n++, A->ybox + 2 * (size_t)k, 2 * sizeof(float));
+        }
     {
         int m = n;
         for (k = 0; k < A->ntri; ++k)
-            if (away[k] != sg) memcpy(ord + 4 * (size_t)m++, A->rtri + 4 * (size_t)k, 4 * sizeof(int));
+            if (away[k] != sg) {
+                memcpy(ord + 4 * (size_t)m, A->rtri + 4 * (size_t)k, 4 * sizeof(int));
+                memcpy(obox + 2 * (size_t)m++, A->ybox + 2 * (size_t)k, 2 * sizeof(float));
+            }
     }
     sfb__free(A->ctx, away);
     return n;
@@ -13996,16 +14031,13 @@ static sfb_result sfb__an_raster(sfb__an *A) {
     job.w = A->w; job.h = A->h; job.ortho = A->cam.ortho;
     job.ntri = A->ntri; job.vert = A->rv;
     job.tri = A->rtri + (size_t)A->nf * (size_t)A->per * 2 * 4; /* the second half: the raster's order */
-    job.nfront = sfb__an_order(A, (int *)job.tri);
     {
         sfb__an_ybox_job Y;
-        Y.A = A;
-        Y.tri = A->rtri; Y.box = A->ybox;
+        Y.A = A; Y.tri = A->rtri; Y.box = A->ybox;
         sfb__an_run(A, sfb__an_ybox, &Y, 0, A->ntri, (double)A->ntri * 2.0);
-        Y.tri = job.tri; Y.box = A->ybox + 2 * (size_t)A->ntri;
-        sfb__an_run(A, sfb__an_ybox, &Y, 0, A->ntri, (double)A->ntri * 2.0);
-        job.ybox = Y.box;
     }
+    job.ybox = A->ybox + 2 * (size_t)A->ntri;
+    job.nfront = sfb__an_order(A, (int *)job.tri, A->ybox + 2 * (size_t)A->ntri);
     job.zmax = A->zmax;
     job.depth = A->depth; job.face = A->face; job.uv = A->uv;
     if (A->ppos) { job.apos = A->gpos; job.anrm = A->gnrm; job.pos = A->ppos; job.nrm = A->pnrm; }
