@@ -362,34 +362,6 @@ static int sfb__an_chunked(const sfb__an *A) {
     return b && b->parallel && b->kernels_in_tasks;
 }
 
-/* The orbit about `up` (zero, or +y: the default y-up orbit, untouched): the orbit's
- * direction and right vector, made about +y, turned by the shortest rotation that takes +y to
- * up (about x by pi when up is -y). A z-up model (CAD, catmark_car) is then seen from its side
- * and above, as a y-up one is by default. */
-static void sfb__an_orbit_up(const float up[3], double dir[3], double right[3]) {
-    double u[3], ax[3], len, c, s, t, *v[2];
-    int i, k;
-    for (i = 0; i < 3; ++i) u[i] = up[i];
-    len = sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
-    if (!(len > 0.0) || (u[0] == 0.0 && u[2] == 0.0 && u[1] > 0.0)) return;
-    for (i = 0; i < 3; ++i) u[i] /= len;
-    /* axis +y x u, sine its length, cosine u.y */
-    ax[0] = u[2]; ax[1] = 0.0; ax[2] = -u[0];
-    s = sqrt(ax[0] * ax[0] + ax[2] * ax[2]);
-    c = u[1];
-    if (s > 0.0) { ax[0] /= s; ax[2] /= s; }
-    else { ax[0] = 1.0; ax[2] = 0.0; } /* up is -y */
-    v[0] = dir; v[1] = right;
-    for (k = 0; k < 2; ++k) {
-        /* Rodrigues: v c + (ax x v) s + ax (ax.v)(1 - c) */
-        double *x = v[k], cr[3], r[3];
-        cr[0] = ax[1] * x[2] - ax[2] * x[1]; cr[1] = ax[2] * x[0] - ax[0] * x[2]; cr[2] = ax[0] * x[1] - ax[1] * x[0];
-        t = (ax[0] * x[0] + ax[1] * x[1] + ax[2] * x[2]) * (1.0 - c);
-        for (i = 0; i < 3; ++i) r[i] = x[i] * c + cr[i] * s + ax[i] * t;
-        for (i = 0; i < 3; ++i) x[i] = r[i];
-    }
-}
-
 static void sfb__an_grid_uv(const sfb__an *A, int k, double *u, double *v) {
     int R = A->R;
     if (!A->tri) { *u = (double)(k % (R + 1)) / R; *v = (double)(k / (R + 1)) / R; return; }
@@ -565,7 +537,7 @@ static void sfb__an_camera(sfb__an *A) {
         double dir[3], dist = A->radius / sin(hfov);
         dir[0] = cos(pitch) * sin(yaw); dir[1] = sin(pitch); dir[2] = cos(pitch) * cos(yaw);
         cam->right[0] = cos(yaw); cam->right[1] = 0.0; cam->right[2] = -sin(yaw);
-        sfb__an_orbit_up(c->up, dir, cam->right);
+        sfb__orbit_up(c->up, dir, cam->right);
         for (i = 0; i < 3; ++i) { cam->eye[i] = A->centre[i] + dist * dir[i]; cam->fwd[i] = -dir[i]; }
         sfb__rcross(cam->right, cam->fwd, cam->up);
         sfb__rnormalize(cam->up);

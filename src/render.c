@@ -205,6 +205,9 @@ static sfb_result sfb__render_check(sfb_context *ctx, const sfb_mesh_data *m, co
     if (!isfinite(c->yaw) || !isfinite(c->pitch) || !isfinite(c->zoom) || c->zoom < 0.0f)
         return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "view (yaw %g, pitch %g, zoom %g): angles must be finite, zoom finite and >= 0",
                           (double)c->yaw, (double)c->pitch, (double)c->zoom);
+    if (!isfinite(c->up[0]) || !isfinite(c->up[1]) || !isfinite(c->up[2]))
+        return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "the orbit's up direction (%g, %g, %g) is not finite", (double)c->up[0],
+                          (double)c->up[1], (double)c->up[2]);
     if (!isfinite(c->stripes) || c->stripes < 0.0f || c->stripes > 1e5f || !isfinite(c->light_distance) || c->light_distance < 0.0f)
         return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "highlight stripes %g and light distance %g must be finite and >= 0 (stripes <= 1e5)",
                           (double)c->stripes, (double)c->light_distance);
@@ -279,6 +282,34 @@ typedef struct sfb__render_view {
     double light_m[3], light_e[3], light_d[3], light_a[3], spacing, lightdist;
 } sfb__render_view;
 
+/* The orbit about `up` (zero, or +y: the default y-up orbit, untouched): the orbit's
+ * direction and right vector, made about +y, turned by the shortest rotation that takes +y to
+ * up (about x by pi when up is -y). A z-up model (CAD, catmark_car) is then seen from its side
+ * and above, as a y-up one is by default (sfb_render and sfb_surface_analyze). */
+void sfb__orbit_up(const float up[3], double dir[3], double right[3]) {
+    double u[3], ax[3], len, c, s, t, *v[2];
+    int i, k;
+    for (i = 0; i < 3; ++i) u[i] = up[i];
+    len = sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+    if (!(len > 0.0) || (u[0] == 0.0 && u[2] == 0.0 && u[1] > 0.0)) return;
+    for (i = 0; i < 3; ++i) u[i] /= len;
+    /* axis +y x u, sine its length, cosine u.y */
+    ax[0] = u[2]; ax[1] = 0.0; ax[2] = -u[0];
+    s = sqrt(ax[0] * ax[0] + ax[2] * ax[2]);
+    c = u[1];
+    if (s > 0.0) { ax[0] /= s; ax[2] /= s; }
+    else { ax[0] = 1.0; ax[2] = 0.0; } /* up is -y */
+    v[0] = dir; v[1] = right;
+    for (k = 0; k < 2; ++k) {
+        /* Rodrigues: v c + (ax x v) s + ax (ax.v)(1 - c) */
+        double *x = v[k], cr[3], r[3];
+        cr[0] = ax[1] * x[2] - ax[2] * x[1]; cr[1] = ax[2] * x[0] - ax[0] * x[2]; cr[2] = ax[0] * x[1] - ax[1] * x[0];
+        t = (ax[0] * x[0] + ax[1] * x[1] + ax[2] * x[2]) * (1.0 - c);
+        for (i = 0; i < 3; ++i) r[i] = x[i] * c + cr[i] * s + ax[i] * t;
+        for (i = 0; i < 3; ++i) x[i] = r[i];
+    }
+}
+
 /* The orbit camera around the bounding box of what the faces use and the lights (config c, a
  * w x h picture). */
 static void sfb__render_view_setup(const sfb_mesh_data *m, const float *pos, const sfb_render_config *c, int w, int h,
@@ -299,8 +330,9 @@ static void sfb__render_view_setup(const sfb_mesh_data *m, const float *pos, con
         double dir[3], dist = V->radius / sin(SFB__RENDER_HALF_FOV * SFB__PI / 180.0);
         double zoom = c->zoom > 0.0f ? c->zoom : 1.0, half = 0.5 * (w < h ? w : h) * SFB__RENDER_MARGIN;
         dir[0] = cos(pitch) * sin(yaw); dir[1] = sin(pitch); dir[2] = cos(pitch) * cos(yaw);
-        for (i = 0; i < 3; ++i) { cam->eye[i] = V->centre[i] + dist * dir[i]; cam->fwd[i] = -dir[i]; }
         cam->right[0] = cos(yaw); cam->right[1] = 0.0; cam->right[2] = -sin(yaw);
+        sfb__orbit_up(c->up, dir, cam->right);
+        for (i = 0; i < 3; ++i) { cam->eye[i] = V->centre[i] + dist * dir[i]; cam->fwd[i] = -dir[i]; }
         sfb__rcross(cam->right, cam->fwd, cam->up);
         sfb__rnormalize(cam->up);
         cam->focal = cam->ortho ? half * zoom / V->radius : half * zoom / tan(SFB__RENDER_HALF_FOV * SFB__PI / 180.0);

@@ -578,7 +578,7 @@ typedef struct sfb_render_config {
     const float *scalars;    /* SFB_RENDER_WEIGHTS: one per vertex, clamped to [0,1] (non-finite: 0); NULL:
                                 mesh->blend_weights (required in that mode) */
     int view_set;            /* 0: the default view (yaw 30, pitch 25); 1: yaw and pitch below */
-    float yaw, pitch;        /* degrees: yaw turns the camera about the y axis from +z toward +x, pitch raises it */
+    float yaw, pitch;        /* degrees: yaw turns the camera about the y axis (or up, below) from +z toward +x, pitch raises it */
     float zoom;              /* > 0: magnification; 0: 1, the bounding sphere just fits the smaller side */
     int orthographic;        /* 0: perspective (30 degree view of the bounding sphere); 1: orthographic */
     float stripes;           /* SFB_RENDER_HIGHLIGHT: light lines per bounding-sphere diameter in the light plane;
@@ -589,6 +589,8 @@ typedef struct sfb_render_config {
                                 depends on the normal alone (a flat face is one colour) */
     int draw_edges;          /* 1: overlay the polygons' edges (not the triangulation's diagonals) */
     unsigned char background[4]; /* RGBA of uncovered pixels; all 0: default opaque dark grey */
+    float up[3];             /* the orbit's axis: zero (or +y): yaw turns about y; (0, 0, 1) for a z-up model, which the
+                                same yaw and pitch then show as a y-up one is shown (finite) */
 } sfb_render_config;
 SFB_API sfb_render_config sfb_render_config_init(int mode);
 typedef struct sfb_image {

@@ -619,6 +619,7 @@ SFB__IF double sfb__rdot(const double *a, const double *b);
 SFB__IF void sfb__rcross(const double *a, const double *b, double *o);
 SFB__IF double sfb__rnormalize(double *a);
 SFB__IF double sfb__rclamp(double x, double lo, double hi);
+SFB__IF void sfb__orbit_up(const float up[3], double dir[3], double right[3]);
 SFB__IF double sfb__band_cover(double w, double fw, double a, double b);
 SFB__IF void sfb__colormap(double t, double *rgb);
 SFB__IF unsigned char sfb__to_byte(double v);

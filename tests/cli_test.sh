@@ -38,7 +38,7 @@ cmd_opts() { case $1 in
   eval) echo "--manifold-weights, --weights --locations --random --seed --derivatives --backend" ;;
   tess) echo "--manifold-weights, --weights --rate --tolerance --split-creases --trim --trim-tiles" ;;
   shade) echo "--variant --darts --normals-level --weights-level --p --averaging --all-subdivided --limit" ;;
-  render) echo "--normals --highlight --blend-weights, --weights --normal-colors --positions --size --view --zoom --stripes --edges --rate --manifold-weights --trim" ;;
+  render) echo "--normals --highlight --blend-weights, --weights --normal-colors --positions --size --view --zoom --stripes --up --edges --rate --manifold-weights --trim" ;;
   analyze) echo "--mode --light --curvature --level --polygon-based --size --view --eye --target --up --fov --orthographic --stripes --band --backend" ;;
   fillet) echo "--radius --angle --profile --curve --samples --alpha --relax --skip-failed -o, --output" ;;
   esac; }
@@ -342,6 +342,8 @@ for n in limit subdivided blended; do
 done
 if ! cmp -s "$TMP/nlimit.png" "$TMP/nblended.png" && ! cmp -s "$TMP/nsubdivided.png" "$TMP/nblended.png"; then
   P=$((P + 1)); echo "ok the three normal fields give three pictures"; else F=$((F + 1)); echo "FAIL the normal fields give the same picture"; fi
+check "render --up turns the --view orbit about it" 0 "$CLI" render --level 2 --up 0,0,1 --view 30,20 --size 120x90 examples/data/creased_box.obj -o "$TMP/ru.png"
+check "render --up with a NaN is a usage error" 2 "$CLI" render --up nan,0,1 --size 80x60 examples/data/creased_box.obj -o "$TMP/run.png"
 check "render --positions refined succeeds" 0 "$CLI" render --level 2 --positions refined --size 160x120 --view 60,30 --highlight examples/data/creased_box.obj -o "$TMP/pr.png"
 if ! cmp -s "$TMP/pr.png" "$TMP/nblended.png"; then P=$((P + 1)); echo "ok --positions refined differs from limit"; else F=$((F + 1)); echo "FAIL --positions refined changes nothing"; fi
 check "render with shading options succeeds" 0 "$CLI" render --level 2 --variant A --darts sharp --normals-level 0 --weights-level 0 --p 3 \

@@ -376,6 +376,57 @@ Test(render, orthographic_square_is_centred_and_zoom_grows_it)
     sfb_context_destroy(ctx);
 }
 
+/* `up` turns the orbit: a 2 x 1 x 0.5 box with y up is the default picture with up = +y (bit for
+ * bit), and the same box turned z-up, (x, y, z) -> (x, -z, y), seen about up = z is the y-up
+ * picture (the lights follow the camera), which it is not about y; a non-finite up is refused. */
+Test(render, up_turns_the_orbit)
+{
+    static int sizes[6] = { 4, 4, 4, 4, 4, 4 };
+    static int fv[24] = { 0, 1, 3, 2, 4, 6, 7, 5, 0, 4, 5, 1, 2, 3, 7, 6, 0, 2, 6, 4, 1, 5, 7, 3 };
+    float py[24], pz[24];
+    for (int i = 0; i < 8; ++i) {
+        const float x = (i & 1) ? 1.0f : -1.0f, y = (i & 2) ? 0.5f : -0.5f, z = (i & 4) ? 0.25f : -0.25f;
+        py[3 * i] = x; py[3 * i + 1] = y; py[3 * i + 2] = z;
+        pz[3 * i] = x; pz[3 * i + 1] = -z; pz[3 * i + 2] = y;
+    }
+    sfb_context *ctx = rn_ctx();
+    sfb_mesh_data my = rn_view(8, py, 6, sizes, fv), mz = rn_view(8, pz, 6, sizes, fv);
+    sfb_render_config c = rn_config(SFB_RENDER_SHADED, 160, 120);
+    c.view_set = 1;
+    c.yaw = 35.0f;
+    c.pitch = 20.0f;
+    sfb_image a = rn_render_ok(ctx, &my, &c);
+    c.up[1] = 1.0f;
+    sfb_image b = rn_render_ok(ctx, &my, &c);
+    cr_expect(memcmp(a.rgba, b.rgba, (size_t)160 * 120 * 4) == 0, "up = +y is the default view");
+    sfb_image_free(&b);
+    long n = 160 * 120, same[2] = { 0, 0 }, cov[2] = { 0, 0 };
+    for (int k = 0; k < 2; ++k) {
+        c.up[0] = 0.0f; c.up[1] = k ? 1.0f : 0.0f; c.up[2] = k ? 0.0f : 1.0f;
+        sfb_image z = rn_render_ok(ctx, &mz, &c);
+        for (long p = 0; p < n; ++p) {
+            const unsigned char *pa = a.rgba + 4 * p, *pb = z.rgba + 4 * p;
+            const int oa = pa[0] != rn_bg[0] || pa[1] != rn_bg[1] || pa[2] != rn_bg[2];
+            const int ob = pb[0] != rn_bg[0] || pb[1] != rn_bg[1] || pb[2] != rn_bg[2];
+            if (!oa && !ob) continue;
+            ++cov[k];
+            same[k] += oa && ob && abs(pa[0] - pb[0]) <= 2 && abs(pa[1] - pb[1]) <= 2 && abs(pa[2] - pb[2]) <= 2;
+        }
+        sfb_image_free(&z);
+    }
+    printf("# render up: the z-up box about z matches the y-up picture on %.3f %% of %ld pixels, about y on %.3f %%\n",
+           100.0 * same[0] / (double)(cov[0] ? cov[0] : 1), cov[0], 100.0 * same[1] / (double)(cov[1] ? cov[1] : 1));
+    cr_expect(cov[0] > 2000 && same[0] >= 0.995 * cov[0], "about z: %ld of %ld pixels the same", same[0], cov[0]);
+    cr_expect(same[1] < 0.9 * cov[1], "about y the z-up box is seen otherwise: %ld of %ld pixels the same", same[1], cov[1]);
+    sfb_image_free(&a);
+    c.up[0] = 0.0f; c.up[1] = NAN; c.up[2] = 0.0f;
+    sfb_image bad;
+    cr_expect_eq(sfb_render(ctx, &my, &c, &bad), SFB_INVALID_ARGS);
+    cr_expect_null(bad.rgba);
+    cr_expect(strstr(sfb_last_error(ctx), "up direction") != NULL, "%s", sfb_last_error(ctx));
+    sfb_context_destroy(ctx);
+}
+
 Test(render, edges_overlay_draws_polygon_sides_not_diagonals)
 {
     sfb_context *ctx = rn_ctx();

@@ -216,7 +216,7 @@ static const opt_spec options[] = {
       "shows to be wrong; for comparison)" },
     { "--eye", NULL, K_VEC3, C_ANALYZE, O_EYE, AT(eye), "X,Y,Z", NULL, 0, 0, 0, "X,Y,Z, e.g. 0,2,5", "camera position (with --target)" },
     { "--target", NULL, K_VEC3, C_ANALYZE, O_TARGET, AT(target), "X,Y,Z", NULL, 0, 0, 0, "X,Y,Z, e.g. 0,0,0", "point the camera looks at" },
-    { "--up", NULL, K_VEC3, C_ANALYZE, O_UP, AT(up), "X,Y,Z", NULL, 0, 0, 0, "X,Y,Z, e.g. 0,0,1", "camera up direction (default 0,1,0); without --eye the --view orbit turns about it (0,0,1 for a z-up model)" },
+    { "--up", NULL, K_VEC3, C_RENDER | C_ANALYZE, O_UP, AT(up), "X,Y,Z", NULL, 0, 0, 0, "X,Y,Z, e.g. 0,0,1", "camera up direction (default 0,1,0); without --eye the --view orbit turns about it (0,0,1 for a z-up model)" },
     { "--fov", NULL, K_POSITIVE, C_ANALYZE, O_FOV, AT(fov), "DEG", NULL, 0, 178, 0, "degrees in (0, 178]",
       "vertical field of view (default 30; --orthographic: the picture's height in model units)" },
     { "--orthographic", NULL, K_SET, C_ANALYZE, O_ORTHO, AT(ortho), NULL, NULL, 0, 0, 1, NULL, "orthographic camera (default perspective)" },
@@ -1147,6 +1147,7 @@ static int render_draw(const cli_opts *o, render_state *s) {
     rcfg.view_set = o->seen[O_VIEW] > 0;
     rcfg.yaw = (float)o->view[0];
     rcfg.pitch = (float)o->view[1];
+    if (o->seen[O_UP]) { rcfg.up[0] = (float)o->up[0]; rcfg.up[1] = (float)o->up[1]; rcfg.up[2] = (float)o->up[2]; }
     rcfg.zoom = (float)o->zoom;
     rcfg.stripes = (float)o->stripes;
     rcfg.draw_edges = o->edges;
