@@ -454,6 +454,28 @@ if limited true 2>/dev/null; then
 else
   S=$((S + 1)); echo "SKIP a file size limit (ulimit -f) is not available"
 fi
+# killed by a signal: the temporary file goes too (SIGPIPE: the summary line's pipe closed, as
+# `surfblend ... 2>&1 | head` does; SIGTERM in the middle of writing a large OBJ)
+for c in "analyze --size 400x300 examples/data/creased_box.obj" "render --level 2 --size 400x300 examples/data/creased_box.obj"; do
+  name=${c%% *}
+  rm -f "$TMP/sig.out"*
+  "$CLI" $c -o "$TMP/sig.out" 2>&1 | head -c 0
+  st=${PIPESTATUS[0]}
+  left=$(ls "$TMP" | grep -c '^sig\.out')
+  if [ "$st" = 141 ] && [ "$left" = 0 ]; then P=$((P + 1)); echo "ok $name ended by SIGPIPE leaves no file"
+  else F=$((F + 1)); echo "FAIL $name ended by SIGPIPE: exit $st, left $(ls "$TMP" | grep '^sig\.out' | tr '\n' ' ')"; fi
+done
+rm -f "$TMP/term.obj"*
+"$CLI" tess --rate 48 examples/data/creased_box.obj -o "$TMP/term.obj" 2> /dev/null &
+pid=$!
+for i in $(seq 1 3000); do ls "$TMP" | grep -q '^term\.obj\.tmp' && break; kill -0 $pid 2> /dev/null || break; sleep 0.01; done
+kill -TERM $pid 2> /dev/null
+wait $pid
+st=$?
+left=$(ls "$TMP" | grep -c '^term\.obj')
+if [ "$st" = 143 ] && [ "$left" = 0 ]; then P=$((P + 1)); echo "ok tess killed (SIGTERM) while writing leaves no file"
+elif [ "$st" = 0 ]; then S=$((S + 1)); echo "SKIP tess finished writing before SIGTERM arrived"
+else F=$((F + 1)); echo "FAIL tess killed while writing: exit $st, left $(ls "$TMP" | grep '^term\.obj' | tr '\n' ' ')"; fi
 check "refine -o /dev/null (not a regular file) succeeds" 0 "$CLI" refine --level 1 examples/data/creased_box.obj -o /dev/null
 if [ -c /dev/null ]; then P=$((P + 1)); echo "ok /dev/null is still a device"; else F=$((F + 1)); echo "FAIL -o /dev/null replaced /dev/null"; fi
 check "refine -o - writes standard output" 0 "$CLI" refine --level 1 examples/data/creased_box.obj -o -

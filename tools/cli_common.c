@@ -19,6 +19,7 @@
 #include <stdlib.h>
 #include <string.h>
 #ifndef _WIN32
+#include <signal.h>
 #include <sys/stat.h>
 #include <sys/types.h>
 #include <unistd.h>
@@ -146,6 +147,52 @@ sfb_scheme cli_scheme_for(const char *path, int have_scheme, sfb_scheme scheme) 
 
 /* ---- atomic output ---- */
 
+#ifndef _WIN32
+/* The temporary files being written, removed when a signal that ends the program arrives before
+ * they are finished (SIGINT, SIGTERM, SIGHUP, SIGQUIT, and SIGPIPE: `surfblend ... 2>&1 | head`
+ * closes the pipe its summary line goes to): a killed command leaves no PATH.tmpXXXXXX behind.
+ * The handler unlinks them (async-signal-safe), then the signal, its handler reset, ends the
+ * program as it would have. Signals a caller set to be ignored (nohup) stay ignored. SIGKILL
+ * cannot be caught. */
+#define CLI_MAX_TEMPS 8
+static char *volatile cli_temps[CLI_MAX_TEMPS];
+
+static void cli_on_signal(int sig) {
+    int i;
+    for (i = 0; i < CLI_MAX_TEMPS; ++i) {
+        char *t = cli_temps[i];
+        if (t) unlink(t);
+    }
+    raise(sig); /* delivered, with the default action, once this handler returns */
+}
+
+static void cli_temp_track(char *name) {
+    static int installed = 0;
+    int i;
+    if (!installed) {
+        static const int sigs[5] = { SIGINT, SIGTERM, SIGHUP, SIGQUIT, SIGPIPE };
+        for (i = 0; i < 5; ++i) {
+            struct sigaction old, sa;
+            if (sigaction(sigs[i], NULL, &old) != 0 || old.sa_handler != SIG_DFL) continue;
+            memset(&sa, 0, sizeof sa);
+            sa.sa_handler = cli_on_signal;
+            sigemptyset(&sa.sa_mask);
+            sa.sa_flags = SA_RESETHAND;
+            (void)sigaction(sigs[i], &sa, NULL);
+        }
+        installed = 1;
+    }
+    for (i = 0; i < CLI_MAX_TEMPS; ++i)
+        if (!cli_temps[i]) { cli_temps[i] = name; return; }
+}
+
+static void cli_temp_untrack(const char *name) {
+    int i;
+    for (i = 0; i < CLI_MAX_TEMPS; ++i)
+        if (cli_temps[i] == name) cli_temps[i] = NULL;
+}
+#endif
+
 /* A temporary file beside `path`, created new (PATH.tmpXXXXXX, with the permissions a plain
  * fopen would give); NULL on failure, errno set. */
 static FILE *open_temporary(const char *path, char **tmp_name) {
@@ -176,6 +223,9 @@ static FILE *open_temporary(const char *path, char **tmp_name) {
     }
 #endif
     if (!f) { free(name); return NULL; }
+#ifndef _WIN32
+    cli_temp_track(name);
+#endif
     *tmp_name = name;
     return f;
 }
@@ -219,6 +269,9 @@ int cli_output_finish(cli_output *out, int rc) {
 #endif
         if (rc == 0 && rename(out->tmp, out->path) != 0) { cli_error("cannot write '%s': %s", out->path, strerror(errno)); rc = 1; }
         if (rc != 0) remove(out->tmp);
+#ifndef _WIN32
+        cli_temp_untrack(out->tmp); /* after the rename: a signal before it still removes the file */
+#endif
         free(out->tmp);
         out->tmp = NULL;
     }
