@@ -13227,8 +13227,8 @@ done:
  *    Round 0 seeds the proxy pixels on a grid of every 4th pixel with their own (face, u, v),
  *    then the pixels between those hits from them (cubic Hermite in (u,v) along a picture axis,
  *    the hits' inverse screen Jacobians as tangents, across a face side in the two faces'
- *    unfolded frame), down to every pixel; an attempt that
- *    stalls over a pixel away stops early. Every later round seeds, from the hits the round
+ *    unfolded frame), down to every pixel; an attempt that stalls over a pixel away stops
+ *    early. Every later round seeds, from the hits the round
  *    before made or replaced, their 8 neighbours that are not hit yet, or hit on another face
  *    at least 1 % of the bounding radius farther away (a nearer sheet may hide them: near
  *    silhouettes the proxy's depth order is not the exact surface's); up to three faces per
@@ -13838,18 +13838,14 @@ static void sfb__an_seed_rows_tri(void *arg, int row0, int row1) {
     }
 }
 
-/* The y boxes of triangles [a, b) of the list `tri` into box (sfb__raster_job's ybox). */
-typedef struct sfb__an_ybox_job {
-    const sfb__an *A;
-    const int *tri;
-    float *box;
-} sfb__an_ybox_job;
+/* The y boxes of the proxy's triangles [a, b) (rtri's) into A->ybox (sfb__raster_job's ybox;
+ * sfb__an_order carries them into the raster's order). */
 static void sfb__an_ybox(void *arg, int a, int b) {
-    const sfb__an_ybox_job *J = (const sfb__an_ybox_job *)arg;
-    const sfb__raster_vertex *rv = J->A->rv;
+    sfb__an *A = (sfb__an *)arg;
+    const sfb__raster_vertex *rv = A->rv;
     int k;
     for (k = a; k < b; ++k) {
-        const int *tv = J->tri + 4 * (size_t)k;
+        const int *tv = A->rtri + 4 * (size_t)k;
         double lo = rv[tv[0]].y, hi = lo;
         float l, h;
         if (rv[tv[1]].y < lo) lo = rv[tv[1]].y;
@@ -13859,8 +13855,8 @@ static void sfb__an_ybox(void *arg, int a, int b) {
         /* widened by more than float's rounding (2^-24 relative) before the conversion */
         l = (float)(lo - (1e-6 * fabs(lo) + 1e-3));
         h = (float)(hi + (1e-6 * fabs(hi) + 1e-3));
-        J->box[2 * (size_t)k] = l;
-        J->box[2 * (size_t)k + 1] = h;
+        A->ybox[2 * (size_t)k] = l;
+        A->ybox[2 * (size_t)k + 1] = h;
     }
 }
 
@@ -14038,11 +14034,7 @@ static sfb_result sfb__an_raster(sfb__an *A) {
     job.w = A->w; job.h = A->h; job.ortho = A->cam.ortho;
     job.ntri = A->ntri; job.vert = A->rv;
     job.tri = A->rtri + (size_t)A->nf * (size_t)A->per * 2 * 4; /* the second half: the raster's order */
-    {
-        sfb__an_ybox_job Y;
-        Y.A = A; Y.tri = A->rtri; Y.box = A->ybox;
-        sfb__an_run(A, sfb__an_ybox, &Y, 0, A->ntri, (double)A->ntri * 2.0);
-    }
+    sfb__an_run(A, sfb__an_ybox, A, 0, A->ntri, (double)A->ntri * 2.0);
     job.ybox = A->ybox + 2 * (size_t)A->ntri;
     job.nfront = sfb__an_order(A, (int *)job.tri, A->ybox + 2 * (size_t)A->ntri);
     job.zmax = A->zmax;
@@ -14518,9 +14510,10 @@ static int sfb__an_in_domain(const sfb__an *A, double u, double v, double eps) {
  * a corner) or a Jacobian is singular. */
 static int sfb__an_hermite(const sfb__an *A, int x, int y, int axis, int d, sfb_location *loc) {
     const int dx = axis ? 0 : d, dy = axis ? d : 0;
+    const int ns = A->tri ? 3 : 4;
     double ma[2], mb[2], ub, vb, u, v;
     size_t a, b;
-    int fa, fb;
+    int fa, fb, kf = 0, nb = -1;
     if (x - dx < 0 || y - dy < 0 || x + dx >= A->w || y + dy >= A->h) return 0;
     a = (size_t)(y - dy) * (size_t)A->w + (size_t)(x - dx);
     b = (size_t)(y + dy) * (size_t)A->w + (size_t)(x + dx);
@@ -14531,9 +14524,8 @@ static int sfb__an_hermite(const sfb__an *A, int x, int y, int axis, int d, sfb_
     ub = A->hl[b].u;
     vb = A->hl[b].v;
     if (fa != fb) {
-        const int ns = A->tri ? 3 : 4;
+        /* b's point and tangent into a's frame, across their shared side */
         double u1, v1;
-        int kf, nb = -1;
         for (kf = 0; kf < ns; ++kf) {
             nb = A->adj[4 * fa + kf];
             if (nb >= 0 && (nb >> 3) == fb) break;
@@ -14543,19 +14535,15 @@ static int sfb__an_hermite(const sfb__an *A, int x, int y, int axis, int d, sfb_
         sfb__an_unfold(A->tri, (nb >> 1) & 3, kf, nb & 1, ub, vb, &ub, &vb);
         mb[0] = u1 - ub;
         mb[1] = v1 - vb;
-        u = 0.5 * ((double)A->hl[a].u + ub) + 0.25 * d * (ma[0] - mb[0]);
-        v = 0.5 * ((double)A->hl[a].v + vb) + 0.25 * d * (ma[1] - mb[1]);
-        if (!isfinite(u) || !isfinite(v)) return 0;
-        if (!sfb__an_in_domain(A, u, v, 1e-6)) {
-            /* beyond a's side: back into b's frame */
-            sfb__an_unfold(A->tri, kf, (nb >> 1) & 3, nb & 1, u, v, &u, &v);
-            if (!sfb__an_in_domain(A, u, v, 1e-6)) return 0;
-            fa = fb;
-        }
-    } else {
-        u = 0.5 * ((double)A->hl[a].u + ub) + 0.25 * d * (ma[0] - mb[0]);
-        v = 0.5 * ((double)A->hl[a].v + vb) + 0.25 * d * (ma[1] - mb[1]);
-        if (!isfinite(u) || !isfinite(v)) return 0;
+    }
+    u = 0.5 * ((double)A->hl[a].u + ub) + 0.25 * d * (ma[0] - mb[0]);
+    v = 0.5 * ((double)A->hl[a].v + vb) + 0.25 * d * (ma[1] - mb[1]);
+    if (!isfinite(u) || !isfinite(v)) return 0;
+    if (fa != fb && !sfb__an_in_domain(A, u, v, 1e-6)) {
+        /* beyond a's side: back into b's frame */
+        sfb__an_unfold(A->tri, kf, (nb >> 1) & 3, nb & 1, u, v, &u, &v);
+        if (!sfb__an_in_domain(A, u, v, 1e-6)) return 0;
+        fa = fb;
     }
     sfb__an_clamp_domain(A, &u, &v);
     loc->face = fa;
