@@ -319,6 +319,13 @@ static void test_nonmanifold_vertices(sfb_context *ctx, const char *dir) {
         sc.flags = SFB_REFINE_PATCHES;
         check(sfb_mesh_read_obj(ctx, pillow, strlen(pillow), &m) == SFB_SUCCESS && sfb_surface_create(ctx, m, &sc, &sf) == SFB_SUCCESS,
               "nonmanifold/pillow_after_one_step_refused_own_net_kept", "%s", sfb_last_error(ctx));
+        /* the refused step is not reported as the context's last failure: an earlier one stays */
+        sfb_surface_destroy(sf);
+        sf = NULL;
+        (void)sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "an earlier failure");
+        check(sfb_surface_create(ctx, m, &sc, &sf) == SFB_SUCCESS && strcmp(sfb_last_error(ctx), "an earlier failure") == 0 &&
+                  sfb_last_error_info(ctx).result == SFB_INVALID_ARGS,
+              "nonmanifold/pillow_refused_step_keeps_the_last_error", "last error \"%s\"", sfb_last_error(ctx));
         sfb_surface_destroy(sf);
         sfb_mesh_destroy(m);
     }
