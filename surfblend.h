@@ -1238,6 +1238,15 @@ SFB__IF void sfb__log(sfb_context *ctx, int level, const char *fmt, ...)
 /* Reports a failed allocation: SFB_LIMIT_EXCEEDED when the memory budget refused it,
  * SFB_OUT_OF_MEMORY when the allocator itself failed. */
 SFB__IF sfb_result sfb__oom(sfb_context *ctx, const char *what);
+/* The context's last error, kept across an internal attempt whose failure the caller recovers
+ * from (the caller's earlier error, not the attempt's, is what sfb_last_error reads after a
+ * successful call): sfb__error_keep before the attempt, sfb__error_put_back after it failed. */
+typedef struct sfb__error_state {
+    char message[sizeof(((sfb_context *)0)->error)];
+    sfb_error_info info;
+} sfb__error_state;
+SFB__IF void sfb__error_keep(const sfb_context *ctx, sfb__error_state *st);
+SFB__IF void sfb__error_put_back(sfb_context *ctx, const sfb__error_state *st);
 /* Returns SFB_CANCELLED (with the error set) when the callback asks to stop. */
 SFB__IF sfb_result sfb__progress(sfb_context *ctx, float done, const char *stage);
 /* Runs task(arg, a, b) over [first, last): in chunks on the backend's threads when it lends
@@ -1883,6 +1892,16 @@ sfb_result sfb__error(sfb_context *ctx, sfb_result r, sfb_element_kind kind, lon
     ctx->error_info.message = ctx->error;
     if (ctx->logger.func) ctx->logger.func(SFB_LOG_ERROR, ctx->error, ctx->logger.user);
     return r;
+}
+
+void sfb__error_keep(const sfb_context *ctx, sfb__error_state *st) {
+    memcpy(st->message, ctx->error, sizeof st->message);
+    st->info = ctx->error_info;
+}
+void sfb__error_put_back(sfb_context *ctx, const sfb__error_state *st) {
+    memcpy(ctx->error, st->message, sizeof ctx->error);
+    ctx->error_info = st->info;
+    ctx->error_info.message = ctx->error;
 }
 
 sfb_result sfb__oom(sfb_context *ctx, const char *what) {
@@ -8317,19 +8336,16 @@ static sfb_result tbz_build(sfb_context *ctx, const sfb__level *l, const float *
     r = sfb__tribezier_points(ctx, l, positions, opt, 0, &net, &st);
     if (r != SFB_SUCCESS) return r;
     if (st.residual > 1e-10) {
-        /* the context's last error as it was: a refused step is this build's own business, not
-         * a failure the caller should read after a successful create */
-        char saved[sizeof ctx->error];
-        const sfb_error_info saved_info = ctx->error_info;
-        memcpy(saved, ctx->error, sizeof saved);
+        /* a refused step is this build's own business, not a failure the caller should read
+         * after a successful create */
+        sfb__error_state kept;
+        sfb__error_keep(ctx, &kept);
         memset(&st4, 0, sizeof st4);
         r = sfb__tribezier_refined_points(ctx, l, positions, opt, 0, &rl, &net4, &st4);
         if (r == SFB_INVALID_TOPOLOGY) { /* not built after one step: the mesh's own net */
             sfb__log(ctx, SFB_LOG_INFO, "tribezier: the net after one Loop step is refused (%s); the mesh's own net is kept (G1 residual %.3g)",
                      ctx->error, st.residual);
-            memcpy(ctx->error, saved, sizeof saved);
-            ctx->error_info = saved_info;
-            ctx->error_info.message = ctx->error;
+            sfb__error_put_back(ctx, &kept);
             st4.residual = HUGE_VAL;
         } else if (r != SFB_SUCCESS) { sfb__free(ctx, net); return r; }
         if (st4.residual < st.residual) {

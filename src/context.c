@@ -129,6 +129,16 @@ sfb_result sfb__error(sfb_context *ctx, sfb_result r, sfb_element_kind kind, lon
     return r;
 }
 
+void sfb__error_keep(const sfb_context *ctx, sfb__error_state *st) {
+    memcpy(st->message, ctx->error, sizeof st->message);
+    st->info = ctx->error_info;
+}
+void sfb__error_put_back(sfb_context *ctx, const sfb__error_state *st) {
+    memcpy(ctx->error, st->message, sizeof ctx->error);
+    ctx->error_info = st->info;
+    ctx->error_info.message = ctx->error;
+}
+
 sfb_result sfb__oom(sfb_context *ctx, const char *what) {
     int budget = ctx->budget_refused;
     ctx->budget_refused = 0;

@@ -373,6 +373,15 @@ SFB__IF void sfb__log(sfb_context *ctx, int level, const char *fmt, ...)
 /* Reports a failed allocation: SFB_LIMIT_EXCEEDED when the memory budget refused it,
  * SFB_OUT_OF_MEMORY when the allocator itself failed. */
 SFB__IF sfb_result sfb__oom(sfb_context *ctx, const char *what);
+/* The context's last error, kept across an internal attempt whose failure the caller recovers
+ * from (the caller's earlier error, not the attempt's, is what sfb_last_error reads after a
+ * successful call): sfb__error_keep before the attempt, sfb__error_put_back after it failed. */
+typedef struct sfb__error_state {
+    char message[sizeof(((sfb_context *)0)->error)];
+    sfb_error_info info;
+} sfb__error_state;
+SFB__IF void sfb__error_keep(const sfb_context *ctx, sfb__error_state *st);
+SFB__IF void sfb__error_put_back(sfb_context *ctx, const sfb__error_state *st);
 /* Returns SFB_CANCELLED (with the error set) when the callback asks to stop. */
 SFB__IF sfb_result sfb__progress(sfb_context *ctx, float done, const char *stage);
 /* Runs task(arg, a, b) over [first, last): in chunks on the backend's threads when it lends

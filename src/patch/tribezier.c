@@ -1478,19 +1478,16 @@ static sfb_result tbz_build(sfb_context *ctx, const sfb__level *l, const float *
     r = sfb__tribezier_points(ctx, l, positions, opt, 0, &net, &st);
     if (r != SFB_SUCCESS) return r;
     if (st.residual > 1e-10) {
-        /* the context's last error as it was: a refused step is this build's own business, not
-         * a failure the caller should read after a successful create */
-        char saved[sizeof ctx->error];
-        const sfb_error_info saved_info = ctx->error_info;
-        memcpy(saved, ctx->error, sizeof saved);
+        /* a refused step is this build's own business, not a failure the caller should read
+         * after a successful create */
+        sfb__error_state kept;
+        sfb__error_keep(ctx, &kept);
         memset(&st4, 0, sizeof st4);
         r = sfb__tribezier_refined_points(ctx, l, positions, opt, 0, &rl, &net4, &st4);
         if (r == SFB_INVALID_TOPOLOGY) { /* not built after one step: the mesh's own net */
             sfb__log(ctx, SFB_LOG_INFO, "tribezier: the net after one Loop step is refused (%s); the mesh's own net is kept (G1 residual %.3g)",
                      ctx->error, st.residual);
-            memcpy(ctx->error, saved, sizeof saved);
-            ctx->error_info = saved_info;
-            ctx->error_info.message = ctx->error;
+            sfb__error_put_back(ctx, &kept);
             st4.residual = HUGE_VAL;
         } else if (r != SFB_SUCCESS) { sfb__free(ctx, net); return r; }
         if (st4.residual < st.residual) {
