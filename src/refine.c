@@ -336,7 +336,8 @@ sfb_result sfb__refine_step(sfb_context *ctx, const sfb__refine_options *opt, co
 }
 
 /* sfb__refine_step that also gives the step's own rows (each child over the parent's
- * vertices: its local mask, duplicates merged) in `local` when that is not NULL. */
+ * vertices: its local mask, duplicates merged) in `local` when that is not NULL. With prow
+ * NULL (and local given) only the local rows are made: crow and A are not read. */
 sfb_result sfb__refine_step_local(sfb_context *ctx, const sfb__refine_options *opt, const sfb__level *p, const sfb__rows *prow,
                                   sfb__level *c, sfb__rows *crow, sfb__rows *local, sfb__accum *A, sfb__mask *m, float *ps,
                                   float *cs, float p0, float dp) {
@@ -349,17 +350,22 @@ sfb_result sfb__refine_step_local(sfb_context *ctx, const sfb__refine_options *o
         sfb__free(ctx, st.half);
         return r == SFB_OUT_OF_MEMORY ? sfb__oom(ctx, "refinement topology") : r;
     }
-    crow->rows = c->nv;
-    crow->n = 0;
-    crow->off = (size_t *)sfb__alloc(ctx, ((size_t)c->nv + 1) * sizeof(size_t));
-    /* room for the child rows at once: a child's row spans about twice its parents' average
-     * (it grows by doubling, copied by realloc, where this falls short; growing from 4 per row
-     * copied the table five times over at level 3) */
-    if (!crow->off || !sfb__rows_reserve(ctx, crow, (size_t)c->nv * (2 * (prow->n / (size_t)(prow->rows > 0 ? prow->rows : 1)) + 4) + 16)) {
+    if (prow) {
+        crow->rows = c->nv;
+        crow->n = 0;
+        crow->off = (size_t *)sfb__alloc(ctx, ((size_t)c->nv + 1) * sizeof(size_t));
+        /* room for the child rows at once: a child's row spans about twice its parents' average
+         * (it grows by doubling, copied by realloc, where this falls short; growing from 4 per row
+         * copied the table five times over at level 3) */
+        if (!crow->off || !sfb__rows_reserve(ctx, crow, (size_t)c->nv * (2 * (prow->n / (size_t)(prow->rows > 0 ? prow->rows : 1)) + 4) + 16)) {
+            sfb__free(ctx, st.half);
+            return sfb__oom(ctx, "stencil table");
+        }
+        crow->off[0] = 0;
+    } else if (!local) {
         sfb__free(ctx, st.half);
-        return sfb__oom(ctx, "stencil table");
+        return sfb__error(ctx, SFB_BACKEND_ERROR, SFB_ELEMENT_NONE, -1, "refinement step with neither composed nor local rows");
     }
-    crow->off[0] = 0;
     if (local) {
         memset(local, 0, sizeof *local);
         local->rows = c->nv;
@@ -371,7 +377,7 @@ sfb_result sfb__refine_step_local(sfb_context *ctx, const sfb__refine_options *o
         local->off[0] = 0;
     }
     for (cv = 0; cv < c->nv; ++cv) {
-        if (!sfb__child_mask(&st, cv, m, ps, cs) || !sfb__compose_row(ctx, A, prow, m, crow, cv) ||
+        if (!sfb__child_mask(&st, cv, m, ps, cs) || (prow && !sfb__compose_row(ctx, A, prow, m, crow, cv)) ||
             (local && !sfb__rows_append_mask(ctx, local, m, cv))) {
             sfb__free(ctx, st.half);
             return sfb__oom(ctx, "stencil table");

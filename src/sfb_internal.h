@@ -598,7 +598,7 @@ SFB__IF sfb_result sfb__refine_keep_levels(sfb_context *ctx, const sfb__level *b
 SFB__IF void sfb__refine_kept_free(sfb_context *ctx, sfb__refine_kept *keep, int level);
 SFB__IF void sfb__stencils_free(sfb_context *ctx, sfb__stencils *s);
 /* sfb__refine_step that also writes the step's own rows (children over the parent's vertices)
- * into `local` when not NULL (refine.c). */
+ * into `local` when not NULL; with prow NULL only `local` (crow and A unused) (refine.c). */
 SFB__IF sfb_result sfb__refine_step_local(sfb_context *ctx, const sfb__refine_options *opt, const sfb__level *p,
                                   const sfb__rows *prow, sfb__level *c, sfb__rows *crow, sfb__rows *local, sfb__accum *A,
                                   sfb__mask *m, float *ps, float *cs, float p0, float dp);
@@ -774,23 +774,23 @@ SFB__IF void sfb__stam_finish(double J[2][2], double sc1, double sc2, double sr[
 /* Classes of a face's corner for the regular records. */
 enum { SFB__CORNER_R1 = 1, SFB__CORNER_R2_D1 = 2, SFB__CORNER_R2_D2 = 3, SFB__CORNER_R3 = 4, SFB__CORNER_EV = 5,
        SFB__CORNER_IRREGULAR = 0 };
-/* The builder: the table under construction and the rows of its points over base vertices. */
+/* The builder: the table under construction and its points (xyz floats, each computed in double
+ * from the working level's double positions). */
 typedef struct sfb__pbuild {
     sfb_context *ctx;
     sfb__patch_table *pt;
     int cap_patch, cap_cv, cap_nodes;
-    sfb__rows prow;          /* patch point rows over base vertices */
-    size_t cap_rows;
-    sfb__accum A;
+    float *pts;              /* the points, 3 per point */
+    int npts, cap_pts;
     sfb__mask m;
     sfb__mask cap[3];        /* an end cap's limit masks (position, two tangents), kept between caps */
     int *vrow;               /* point row of each vertex of the working level, -1 if none yet */
 } sfb__pbuild;
-/* A working level of feature-adaptive isolation: its topology, the composed rows of its
- * vertices, and its candidate faces. */
+/* A working level of feature-adaptive isolation: its topology, the positions of its vertices
+ * (xyz doubles), and its candidate faces. */
 typedef struct sfb__wlevel {
     sfb__level l;
-    sfb__rows rows;
+    double *pos;
     int *fptex;          /* param face of a candidate face, -1 otherwise */
     unsigned *fparam;    /* depth, i, j and rotation (in the corner bits) of candidates */
     unsigned char *vcomp, *ecomp;
@@ -802,9 +802,9 @@ SFB__IF int sfb__is_inf(float s);                                          /* s 
 SFB__IF int sfb__face_n(const sfb__level *l, int f);                       /* corners of face f */
 SFB__IF int sfb__fan_pos(const sfb__level *l, int v, int g, int slot);     /* g's position around v, or -1 */
 SFB__IF int sfb__face_semisharp(const sfb__level *l, int g);               /* something at g's corners still decays */
-/* A point row = mask m over working-level vertices composed with their rows (a single vertex
- * with weight 1 is shared); -1 on allocation failure. */
-SFB__IF int sfb__pb_point(sfb__pbuild *b, const sfb__rows *wrows, const sfb__mask *m);
+/* A point = mask m over working-level vertices applied to their positions wpos (a single vertex
+ * with weight 1 is shared); its index, or -1 on allocation failure. */
+SFB__IF int sfb__pb_point(sfb__pbuild *b, const double *wpos, const sfb__mask *m);
 /* A new record of `type` with ncv points; its index, or -1 on allocation failure. */
 SFB__IF int sfb__pb_patch(sfb__pbuild *b, int type, unsigned param, int valence, int ncv);
 /* Inserts record `patch` (-1: a hole) at (ptex, depth, i, j of param) in the tree; 0 on failure. */

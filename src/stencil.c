@@ -2,8 +2,9 @@
  * of double weights over source vertices (sfb__rows), local masks of (vertex, weight) pairs
  * (sfb__mask), the composition of a mask with its parents' rows through a dense accumulator
  * (sfb__compose_row), and the conversion of rows into a backend's float stencil table
- * (sfb__rows_to_stencils). Refinement (refine.c), patch points (patches.c), shading (shade.c)
- * and manifold blending (manifold.c) build their tables with it. */
+ * (sfb__rows_to_stencils). Refinement (refine.c), shading (shade.c) and manifold blending
+ * (manifold.c) build their tables with it; the patch builder (patch/build.c) takes only each
+ * step's local masks. */
 
 /* ---- composed rows (double weights) ---- */
 

@@ -1,5 +1,5 @@
 /* The Catmull-Clark and Loop scheme builders' common part: the patch-table builder (records,
- * points composed through the stencil algebra, the quadtree), the shared corner helpers, and
+ * points from the working levels' double positions, the quadtree), the shared corner helpers, and
  * feature-adaptive isolation (sfb__patches_build). The record kinds themselves are built and
  * evaluated in patch/quad.c (BSPLINE16, STAM, ENDCAP) and patch/tri.c (BEZTRI15, STAM_LOOP,
  * ENDCAP_TRI); patch/table.c reads a finished table.
@@ -69,22 +69,36 @@ static int sfb__pb_grow_int(sfb_context *ctx, int **a, int *cap, int need) {
     return 1;
 }
 
-/* Adds a point row = mask over working-level vertices composed with their rows. A single
- * vertex with weight 1 is shared through vrow. Returns the row or -1 on allocation failure. */
-int sfb__pb_point(sfb__pbuild *b, const sfb__rows *wrows, const sfb__mask *m) {
-    int row;
+/* Adds a point: mask m over working-level vertices applied to their double positions, rounded
+ * to float once. A single vertex with weight 1 is shared through vrow. Returns the point's index
+ * or -1 on allocation failure. Positions rather than rows composed over the base vertices:
+ * nothing needs the rows once the points are made, and on a triangle mesh under Catmull-Clark
+ * (an extraordinary vertex in every face) composing them was most of the build's time and
+ * memory. */
+int sfb__pb_point(sfb__pbuild *b, const double *wpos, const sfb__mask *m) {
+    double acc[3] = {0.0, 0.0, 0.0};
+    int i, c, row;
     if (m->n == 1 && m->w[0] == 1.0 && b->vrow[m->idx[0]] >= 0) return b->vrow[m->idx[0]];
-    row = b->prow.rows;
-    if ((size_t)row + 2 > b->cap_rows) {
-        size_t nc = b->cap_rows ? b->cap_rows * 2 : 1024;
-        size_t *no = (size_t *)sfb__realloc(b->ctx, b->prow.off, nc * sizeof(size_t));
-        if (!no) return -1;
-        b->prow.off = no;
-        b->cap_rows = nc;
-        if (row == 0) b->prow.off[0] = 0;
+    row = b->npts;
+    if (row + 1 > b->cap_pts) {
+        int nc = b->cap_pts ? b->cap_pts : 1024;
+        float *np;
+        while (nc < row + 1) {
+            if (nc > 0x3fffffff) return -1; /* the int indices of cv */
+            nc *= 2;
+        }
+        np = (float *)sfb__realloc(b->ctx, b->pts, (size_t)nc * 3 * sizeof(float));
+        if (!np) return -1;
+        b->pts = np;
+        b->cap_pts = nc;
     }
-    if (!sfb__compose_row(b->ctx, &b->A, wrows, m, &b->prow, row)) return -1;
-    b->prow.rows = row + 1;
+    for (i = 0; i < m->n; ++i) {
+        const double wi = m->w[i], *q = wpos + 3 * (size_t)m->idx[i];
+        if (wi == 0.0) continue;
+        for (c = 0; c < 3; ++c) acc[c] += wi * q[c];
+    }
+    for (c = 0; c < 3; ++c) b->pts[3 * (size_t)row + c] = (float)acc[c];
+    b->npts = row + 1;
     if (m->n == 1 && m->w[0] == 1.0) b->vrow[m->idx[0]] = row;
     return row;
 }
@@ -149,7 +163,7 @@ int sfb__pb_insert(sfb__pbuild *b, int ptex, unsigned param, int patch) {
 
 void sfb__wlevel_free(sfb_context *ctx, sfb__wlevel *w) {
     if (w->owns_level) sfb__level_free(ctx, &w->l);
-    sfb__rows_free(ctx, &w->rows);
+    sfb__free(ctx, w->pos);
     sfb__free(ctx, w->fptex); sfb__free(ctx, w->fparam); sfb__free(ctx, w->vcomp); sfb__free(ctx, w->ecomp);
     memset(w, 0, sizeof *w);
 }
@@ -175,9 +189,9 @@ sfb_result sfb__pb_endcap(sfb__pbuild *b, sfb__wlevel *w, int g, int rot, int n,
             break;
         }
         sfb__limit_masks(l, v, n == 4 ? SFB_SCHEME_CATMARK : SFB_SCHEME_LOOP, mp, m1, m2);
-        r0 = sfb__pb_point(b, &w->rows, mp);
-        r1 = sfb__pb_point(b, &w->rows, m1);
-        r2 = sfb__pb_point(b, &w->rows, m2);
+        r0 = sfb__pb_point(b, w->pos, mp);
+        r1 = sfb__pb_point(b, w->pos, m1);
+        r2 = sfb__pb_point(b, w->pos, m2);
         if (r0 < 0 || r1 < 0 || r2 < 0) er = sfb__oom(b->ctx, "patch points");
         b->pt->cv[base + k] = r0;
         b->pt->cv[base + n + 2 * k] = r1;
@@ -201,7 +215,7 @@ sfb_result sfb__pb_eigen_patch(sfb__pbuild *b, sfb__wlevel *w, int type, int pte
             double wgt = vinv[(size_t)i * K + m];
             if (wgt != 0.0) SFB__MASK_ADD(&b->m, C[m], wgt);
         }
-        row = sfb__pb_point(b, &w->rows, &b->m);
+        row = sfb__pb_point(b, w->pos, &b->m);
         if (row < 0) { sfb__free(b->ctx, C); return sfb__oom(b->ctx, "patch points"); }
         b->pt->cv[base + i] = row;
     }
@@ -300,31 +314,26 @@ static sfb_result sfb__pb_param_faces(sfb_context *ctx, const sfb__level *base, 
     return SFB_SUCCESS;
 }
 
-/* Level 0: the base level with identity rows, its faces the candidates, and the builder's
- * scratch (accumulator, mask, vertex rows; ps/cs for the refinement steps). */
-static sfb_result sfb__pb_start(sfb__pbuild *b, sfb__wlevel *w, const sfb__level *base, int tri, float **ps, float **cs) {
+/* Level 0: the base level with its positions in double, its faces the candidates, and the
+ * builder's scratch (mask, vertex points; ps/cs for the refinement steps). */
+static sfb_result sfb__pb_start(sfb__pbuild *b, sfb__wlevel *w, const sfb__level *base, int tri, const float *positions, float **ps,
+                                float **cs) {
     sfb_context *ctx = b->ctx;
-    int f, k;
+    int f;
+    size_t k;
     w->l = *base;
     w->owns_level = 0;
-    w->rows.rows = base->nv;
-    w->rows.off = (size_t *)sfb__alloc(ctx, ((size_t)base->nv + 1) * sizeof(size_t));
+    w->pos = (double *)sfb__alloc(ctx, ((size_t)base->nv + 1) * 3 * sizeof(double));
     w->fptex = (int *)sfb__alloc(ctx, ((size_t)base->nf + 1) * sizeof(int));
     w->fparam = (unsigned *)sfb__calloc(ctx, (size_t)base->nf + 1, sizeof(unsigned));
     w->vcomp = (unsigned char *)sfb__alloc(ctx, (size_t)base->nv + 1);
     w->ecomp = (unsigned char *)sfb__alloc(ctx, (size_t)base->ne + 1);
-    b->A.acc = (double *)sfb__alloc(ctx, ((size_t)base->nv + 1) * sizeof(double));
-    b->A.mark = (unsigned *)sfb__calloc(ctx, (size_t)base->nv + 1, sizeof(unsigned));
-    b->A.touched = (int *)sfb__alloc(ctx, ((size_t)base->nv + 1) * sizeof(int));
     *ps = (float *)sfb__alloc(ctx, (SFB_MAX_VALENCE + 2) * sizeof(float));
     *cs = (float *)sfb__alloc(ctx, (SFB_MAX_VALENCE + 2) * sizeof(float));
     b->vrow = (int *)sfb__alloc(ctx, ((size_t)base->nv + 1) * sizeof(int));
-    if (!w->rows.off || !w->fptex || !w->fparam || !w->vcomp || !w->ecomp || !b->A.acc || !b->A.mark || !b->A.touched || !*ps || !*cs ||
-        !b->vrow || !sfb__rows_reserve(ctx, &w->rows, (size_t)base->nv + 1) || !sfb__mask_grow(ctx, &b->m, 64))
+    if (!w->pos || !w->fptex || !w->fparam || !w->vcomp || !w->ecomp || !*ps || !*cs || !b->vrow || !sfb__mask_grow(ctx, &b->m, 64))
         return sfb__oom(ctx, "patch table");
-    for (k = 0; k < base->nv; ++k) { w->rows.off[k] = (size_t)k; w->rows.idx[k] = k; w->rows.w[k] = 1.0; }
-    w->rows.off[base->nv] = (size_t)base->nv;
-    w->rows.n = (size_t)base->nv;
+    for (k = 0; k < 3 * (size_t)base->nv; ++k) w->pos[k] = (double)positions[k];
     memset(w->vcomp, 1, (size_t)base->nv + 1);
     memset(w->ecomp, 1, (size_t)base->ne + 1);
     for (f = 0; f < base->nf; ++f) w->fptex[f] = (tri || sfb__face_n(base, f) == 4) ? b->pt->face_ptex[f] : -1;
@@ -366,29 +375,15 @@ static sfb_result sfb__pb_mark_ring(sfb_context *ctx, const sfb__wlevel *w, cons
     return SFB_SUCCESS;
 }
 
-/* The composed rows of the sub-mesh's vertices (vmap: working-level vertex -> sub-mesh vertex). */
-static sfb_result sfb__pb_sub_rows(sfb_context *ctx, const sfb__wlevel *w, const int *vmap, int nsub, sfb__rows *subrows) {
-    int v, *inv;
-    sfb_result r = SFB_SUCCESS;
-    memset(subrows, 0, sizeof *subrows);
-    subrows->rows = nsub;
-    subrows->off = (size_t *)sfb__alloc(ctx, ((size_t)nsub + 1) * sizeof(size_t));
-    if (!subrows->off) return sfb__oom(ctx, "adaptive refinement");
-    subrows->off[0] = 0;
-    inv = (int *)sfb__alloc(ctx, ((size_t)nsub + 1) * sizeof(int));
-    if (!inv) return sfb__oom(ctx, "adaptive refinement");
+/* The positions of the sub-mesh's vertices (vmap: working-level vertex -> sub-mesh vertex). */
+static double *sfb__pb_sub_pos(sfb_context *ctx, const sfb__wlevel *w, const int *vmap, int nsub) {
+    int v, c;
+    double *sp = (double *)sfb__alloc(ctx, ((size_t)nsub + 1) * 3 * sizeof(double));
+    if (!sp) return NULL;
     for (v = 0; v < w->l.nv; ++v)
-        if (vmap[v] >= 0) inv[vmap[v]] = v;
-    for (v = 0; v < nsub; ++v) {
-        size_t a = w->rows.off[inv[v]], z = w->rows.off[inv[v] + 1];
-        if (!sfb__rows_reserve(ctx, subrows, subrows->n + (z - a))) { r = sfb__oom(ctx, "adaptive refinement"); break; }
-        memcpy(subrows->idx + subrows->n, w->rows.idx + a, (z - a) * sizeof(int));
-        memcpy(subrows->w + subrows->n, w->rows.w + a, (z - a) * sizeof(double));
-        subrows->n += z - a;
-        subrows->off[v + 1] = subrows->n;
-    }
-    sfb__free(ctx, inv);
-    return r;
+        if (vmap[v] >= 0)
+            for (c = 0; c < 3; ++c) sp[3 * (size_t)vmap[v] + c] = w->pos[3 * (size_t)v + c];
+    return sp;
 }
 
 /* Completeness flags and candidates of the child level nw of sub-mesh p: the children of the
@@ -442,8 +437,9 @@ static sfb_result sfb__pb_children(sfb_context *ctx, const sfb__patch_table *pt,
     return SFB_SUCCESS;
 }
 
-/* The next working level nw: the active faces and their 1-ring refined one step (rows composed
- * through the step), with the children of the active faces as its candidates. */
+/* The next working level nw: the active faces and their 1-ring refined one step (positions
+ * through the step's own masks, in double), with the children of the active faces as its
+ * candidates. */
 static sfb_result sfb__pb_next_level(sfb__pbuild *b, const sfb__refine_options *opt, const sfb__wlevel *w, sfb__wlevel *nw,
                                      const int *active, int nactive, int level, int tri, float *ps, float *cs) {
     sfb_context *ctx = b->ctx;
@@ -451,10 +447,11 @@ static sfb_result sfb__pb_next_level(sfb__pbuild *b, const sfb__refine_options *
     unsigned char *mark, *vc, *ec;
     int *vmap, *emap, *fmap;
     sfb__level sub;
-    sfb__rows subrows;
+    sfb__rows local;
+    double *subpos = NULL;
     sfb_result r;
     memset(&sub, 0, sizeof sub);
-    memset(&subrows, 0, sizeof subrows);
+    memset(&local, 0, sizeof local);
     mark = (unsigned char *)sfb__calloc(ctx, (size_t)l->nf + 1, 1);
     vmap = (int *)sfb__alloc(ctx, ((size_t)l->nv + 1) * sizeof(int));
     emap = (int *)sfb__alloc(ctx, ((size_t)l->ne + 1) * sizeof(int));
@@ -464,36 +461,30 @@ static sfb_result sfb__pb_next_level(sfb__pbuild *b, const sfb__refine_options *
     if (!mark || !vmap || !emap || !fmap || !vc || !ec) r = sfb__oom(ctx, "patch table");
     else r = sfb__pb_mark_ring(ctx, w, active, nactive, mark);
     if (r == SFB_SUCCESS) r = sfb__pb_submesh(ctx, w, mark, &sub, vmap, emap, fmap, vc, ec);
-    if (r == SFB_SUCCESS) r = sfb__pb_sub_rows(ctx, w, vmap, sub.nv, &subrows);
+    if (r == SFB_SUCCESS && !(subpos = sfb__pb_sub_pos(ctx, w, vmap, sub.nv))) r = sfb__oom(ctx, "adaptive refinement");
     if (r == SFB_SUCCESS) {
         memset(nw, 0, sizeof *nw);
-        r = sfb__refine_step(ctx, opt, &sub, &subrows, &nw->l, &nw->rows, &b->A, &b->m, ps, cs, 0.0f, 0.0f);
+        r = sfb__refine_step_local(ctx, opt, &sub, NULL, &nw->l, NULL, &local, NULL, &b->m, ps, cs, 0.0f, 0.0f);
         nw->owns_level = 1;
     }
+    if (r == SFB_SUCCESS) {
+        int v, c;
+        nw->pos = (double *)sfb__alloc(ctx, ((size_t)nw->l.nv + 1) * 3 * sizeof(double));
+        if (!nw->pos) r = sfb__oom(ctx, "adaptive refinement");
+        for (v = 0; r == SFB_SUCCESS && v < nw->l.nv; ++v) {
+            double acc[3] = {0.0, 0.0, 0.0};
+            size_t q;
+            for (q = local.off[v]; q < local.off[v + 1]; ++q)
+                for (c = 0; c < 3; ++c) acc[c] += local.w[q] * subpos[3 * (size_t)local.idx[q] + c];
+            for (c = 0; c < 3; ++c) nw->pos[3 * (size_t)v + c] = acc[c];
+        }
+    }
     if (r == SFB_SUCCESS) r = sfb__pb_children(ctx, b->pt, w, &sub, nw, active, nactive, fmap, vc, ec, level, tri);
-    sfb__rows_free(ctx, &subrows);
+    sfb__rows_free(ctx, &local);
+    sfb__free(ctx, subpos);
     sfb__level_free(ctx, &sub);
     sfb__free(ctx, mark); sfb__free(ctx, vmap); sfb__free(ctx, emap); sfb__free(ctx, fmap); sfb__free(ctx, vc); sfb__free(ctx, ec);
     return r;
-}
-
-/* The points straight from the double rows (no float stencil table): a Stam point is an eigen
- * coefficient, a combination with weights of both signs summing to 0 whose result is small next
- * to the coordinates; float weights would cost it its precision (normals off by ~1e-4 rad on
- * meshes far from the origin). */
-static sfb_result sfb__pb_points(sfb_context *ctx, const sfb__rows *prow, const float *positions, sfb__patch_table *pt) {
-    int row, c;
-    pt->npoints = prow->rows;
-    pt->point_data = (float *)sfb__alloc(ctx, ((size_t)prow->rows + 1) * 3 * sizeof(float));
-    if (!pt->point_data) return sfb__oom(ctx, "patch points");
-    for (row = 0; row < prow->rows; ++row) {
-        double acc[3] = {0.0, 0.0, 0.0};
-        size_t q;
-        for (q = prow->off[row]; q < prow->off[row + 1]; ++q)
-            for (c = 0; c < 3; ++c) acc[c] += prow->w[q] * positions[3 * (size_t)prow->idx[q] + c];
-        for (c = 0; c < 3; ++c) pt->point_data[3 * (size_t)row + c] = (float)acc[c];
-    }
-    return SFB_SUCCESS;
 }
 
 /* Catmull-Clark and Loop patch tables by feature-adaptive isolation (see the top of this file):
@@ -514,7 +505,7 @@ sfb_result sfb__patches_build(sfb_context *ctx, const sfb__level *base, const sf
     pt->domain = tri ? SFB__DOMAIN_TRI : SFB__DOMAIN_QUAD;
     pt->isolation = limit;
     r = sfb__pb_param_faces(ctx, base, tri, pt);
-    if (r == SFB_SUCCESS) r = sfb__pb_start(&b, &w, base, tri, &ps, &cs);
+    if (r == SFB_SUCCESS) r = sfb__pb_start(&b, &w, base, tri, positions, &ps, &cs);
     for (level = 0; r == SFB_SUCCESS; ++level) {
         int k, *nv;
         r = sfb__progress(ctx, 0.8f + 0.15f * (float)level / (float)(SFB_MAX_LEVEL + 2), "patches");
@@ -539,11 +530,15 @@ sfb_result sfb__patches_build(sfb_context *ctx, const sfb__level *base, const sf
         b.vrow = nv;
         if (level + 1 > pt->max_depth) pt->max_depth = level + 1;
     }
-    if (r == SFB_SUCCESS) r = sfb__pb_points(ctx, &b.prow, positions, pt);
+    if (r == SFB_SUCCESS) {
+        pt->npoints = b.npts;
+        pt->point_data = b.npts > 0 ? (float *)sfb__realloc(ctx, b.pts, (size_t)b.npts * 3 * sizeof(float)) : NULL; /* the table takes them */
+        if (pt->point_data) b.pts = NULL;
+        if (!pt->point_data && !(pt->point_data = (float *)sfb__alloc(ctx, 3 * sizeof(float)))) r = sfb__oom(ctx, "patch points");
+    }
     sfb__wlevel_free(ctx, &w);
     sfb__wlevel_free(ctx, &nw);
-    sfb__rows_free(ctx, &b.prow);
-    sfb__free(ctx, b.A.acc); sfb__free(ctx, b.A.mark); sfb__free(ctx, b.A.touched);
+    sfb__free(ctx, b.pts);
     sfb__free(ctx, b.m.idx); sfb__free(ctx, b.m.w);
     for (k = 0; k < 3; ++k) { sfb__free(ctx, b.cap[k].idx); sfb__free(ctx, b.cap[k].w); }
     sfb__free(ctx, b.vrow);

@@ -190,7 +190,7 @@ sfb_result sfb__pb_face_quad(sfb__pbuild *b, sfb__wlevel *w, int g, int level, i
                 int t, row;
                 b->m.n = 0;
                 for (t = 0; t < c->n; ++t) SFB__MASK_ADD(&b->m, c->v[t], c->w[t]);
-                row = sfb__pb_point(b, &w->rows, &b->m);
+                row = sfb__pb_point(b, w->pos, &b->m);
                 if (row < 0) return sfb__oom(b->ctx, "patch points");
                 b->pt->cv[base + 4 * y + x] = row;
             }

@@ -123,7 +123,7 @@ static int sfb__gather_tri(const sfb__level *l, int g, int rot, const int cls[3]
 }
 
 /* Adds one point: the combination sum_i w[i]/24 cell(box12[i]) of the grid (Sabin's rules). */
-static int sfb__pb_bez_point(sfb__pbuild *b, const sfb__rows *rows, sfb__cell grid[5][5], const unsigned char w[12]) {
+static int sfb__pb_bez_point(sfb__pbuild *b, const double *pos, sfb__cell grid[5][5], const unsigned char w[12]) {
     int i, t;
     b->m.n = 0;
     for (i = 0; i < 12; ++i) {
@@ -131,7 +131,7 @@ static int sfb__pb_bez_point(sfb__pbuild *b, const sfb__rows *rows, sfb__cell gr
         if (!w[i]) continue;
         for (t = 0; t < c->n; ++t) SFB__MASK_ADD(&b->m, c->v[t], c->w[t] * w[i] / 24.0);
     }
-    return sfb__pb_point(b, rows, &b->m);
+    return sfb__pb_point(b, pos, &b->m);
 }
 
 /* Classifies candidate triangle g; adds its patch, or returns 1 in *refine. */
@@ -155,7 +155,7 @@ sfb_result sfb__pb_face_tri(sfb__pbuild *b, sfb__wlevel *w, int g, int level, in
         if (patch < 0) return sfb__oom(b->ctx, "patch table");
         base = b->pt->pfirst[patch];
         for (j = 0; j < 15; ++j) {
-            int row = sfb__pb_bez_point(b, &w->rows, grid, sfb__bez15_from_box[j]);
+            int row = sfb__pb_bez_point(b, w->pos, grid, sfb__bez15_from_box[j]);
             if (row < 0) return sfb__oom(b->ctx, "patch points");
             b->pt->cv[base + j] = row;
         }
