@@ -669,8 +669,8 @@ static int tbz_root(int *parent, int i) {
  * still move are the near-null directions, which only make the net wilder). */
 #define TBZ_STALL 40
 #define TBZ_MAX(a, b) ((a) > (b) ? (a) : (b))
-static void tbz_cgls(sfb__tbz *T, const tbz_sys *S, const int *rows, int nr, const int *unk, int nu, const int *local, double scale,
-                     double *w, size_t *lo, int *lc, double *lw) {
+static int tbz_cgls(sfb__tbz *T, const tbz_sys *S, const int *rows, int nr, const int *unk, int nu, const int *local, double scale,
+                    double *w, size_t *lo, int *lc, double *lw) {
     double *rr = w, *q = w + 3 * (size_t)nr, *xs = q + 3 * (size_t)nr, *sv = xs + 3 * (size_t)nu, *p = sv + 3 * (size_t)nu;
     double *hist = p + 3 * (size_t)nu;
     double gamma[3], gamma0[3];
@@ -751,9 +751,9 @@ static void tbz_cgls(sfb__tbz *T, const tbz_sys *S, const int *rows, int nr, con
             gamma[c] = g2[c];
         }
     }
-    T->st.iterations += it;
     for (i = 0; i < nu; ++i)
         for (c = 0; c < 3; ++c) T->x[3 * (size_t)unk[i] + c] += xs[3 * i + c];
+    return it;
 }
 
 /* The connected components of the constraints: rows sharing an unknown are in one. rows[] and
@@ -814,6 +814,90 @@ static sfb_result tbz_components(sfb__tbz *T, const tbz_sys *S, const int *ucol,
 done:
     sfb__free(T->ctx, parent);
     sfb__free(T->ctx, comp);
+    return res;
+}
+
+/* The entries of component i's rows in S (its local matrix has at most as many). */
+static size_t tbz_comp_entries(const tbz_sys *S, const tbz_comps *C, int i) {
+    size_t n = 0;
+    int r;
+    for (r = C->rstart[i]; r < C->rstart[i + 1]; ++r) n += S->off[C->rows[r] + 1] - S->off[C->rows[r]];
+    return n;
+}
+
+/* The components to solve, in blocks over the backend's threads (sfb__parallel): components
+ * are independent (a component's rows read only its own unknowns, which it alone writes, and
+ * points no component moves), so the net is bit for bit that of solving them one by one. A
+ * block holds consecutive components of about equal work and its own scratch (tbz_cgls's w, lo,
+ * lc, lw, sized for its largest component); local maps every unknown to its column within its
+ * component. */
+#define TBZ_BLOCKS 32
+typedef struct tbz_block {
+    double *w, *lw;
+    size_t *lo;
+    int *lc;
+} tbz_block;
+typedef struct tbz_job {
+    sfb__tbz *T;
+    const tbz_sys *S;
+    const tbz_comps *C;
+    const int *local, *todo, *bstart; /* todo[bstart[b] .. bstart[b + 1]): block b's components */
+    double scale;
+    tbz_block *blk;
+    int *its; /* per todo entry: its iterations */
+} tbz_job;
+
+static void tbz_solve_blocks(void *arg, int first, int last) {
+    const tbz_job *J = (const tbz_job *)arg;
+    int b, t;
+    for (b = first; b < last; ++b)
+        for (t = J->bstart[b]; t < J->bstart[b + 1]; ++t) {
+            const int i = J->todo[t], r0 = J->C->rstart[i], u0 = J->C->ustart[i];
+            J->its[t] = tbz_cgls(J->T, J->S, J->C->rows + r0, J->C->rstart[i + 1] - r0, J->C->unk + u0, J->C->ustart[i + 1] - u0, J->local,
+                                 J->scale, J->blk[b].w, J->blk[b].lo, J->blk[b].lc, J->blk[b].lw);
+        }
+}
+
+/* Solves the components todo[0 .. nt) (see tbz_job). */
+static sfb_result tbz_solve_todo(sfb__tbz *T, const tbz_sys *S, const tbz_comps *C, const int *local, const int *todo, int nt, double scale) {
+    tbz_job J;
+    int bstart[TBZ_BLOCKS + 1], nb = nt < TBZ_BLOCKS ? nt : TBZ_BLOCKS, b, t;
+    tbz_block blk[TBZ_BLOCKS];
+    size_t total = 0, acc = 0;
+    sfb_result res = SFB_SUCCESS;
+    if (nt == 0) return SFB_SUCCESS;
+    memset(blk, 0, sizeof blk);
+    J.its = (int *)sfb__alloc(T->ctx, (size_t)nt * sizeof(int));
+    if (!J.its) return sfb__oom(T->ctx, "tribezier constraints");
+    /* a component's work ~ the entries of its rows */
+    for (t = 0; t < nt; ++t) total += tbz_comp_entries(S, C, todo[t]) + 1;
+    bstart[0] = 0;
+    for (b = 1, t = 0; b < nb; ++b) {
+        const size_t goal = total / (size_t)nb * (size_t)b;
+        while (t < nt && acc < goal) acc += tbz_comp_entries(S, C, todo[t++]) + 1;
+        bstart[b] = t;
+    }
+    bstart[nb] = nt;
+    for (b = 0; b < nb && res == SFB_SUCCESS; ++b) {
+        size_t mr = 0, mu = 0, me = 0;
+        for (t = bstart[b]; t < bstart[b + 1]; ++t) {
+            const int i = todo[t];
+            const size_t nr = (size_t)(C->rstart[i + 1] - C->rstart[i]), nu = (size_t)(C->ustart[i + 1] - C->ustart[i]), ne = tbz_comp_entries(S, C, i);
+            mr = nr > mr ? nr : mr; mu = nu > mu ? nu : mu; me = ne > me ? ne : me;
+        }
+        blk[b].w = (double *)sfb__alloc(T->ctx, (6 * mr + 12 * mu + 3 * TBZ_STALL + 1) * sizeof(double));
+        blk[b].lo = (size_t *)sfb__alloc(T->ctx, (mr + 1) * sizeof(size_t));
+        blk[b].lc = (int *)sfb__alloc(T->ctx, (me + 1) * sizeof(int));
+        blk[b].lw = (double *)sfb__alloc(T->ctx, (me + 1) * sizeof(double));
+        if (!blk[b].w || !blk[b].lo || !blk[b].lc || !blk[b].lw) res = sfb__oom(T->ctx, "tribezier constraints");
+    }
+    if (res == SFB_SUCCESS) {
+        J.T = T; J.S = S; J.C = C; J.local = local; J.todo = todo; J.bstart = bstart; J.scale = scale; J.blk = blk;
+        sfb__parallel(T->ctx, tbz_solve_blocks, &J, 0, nb);
+        for (t = 0; t < nt; ++t) T->st.iterations += J.its[t];
+    }
+    for (b = 0; b < nb; ++b) { sfb__free(T->ctx, blk[b].w); sfb__free(T->ctx, blk[b].lo); sfb__free(T->ctx, blk[b].lc); sfb__free(T->ctx, blk[b].lw); }
+    sfb__free(T->ctx, J.its);
     return res;
 }
 
@@ -884,14 +968,11 @@ static sfb_result tbz_solve(sfb__tbz *T) {
     const sfb__level *l = T->l;
     tbz_sys S;
     unsigned char *ours = NULL;
-    size_t *lo = NULL;
-    int *lc = NULL;
-    double *lw = NULL;
     tbz_comps C;
-    int *ucol = NULL, *rstart, *ustart, *rows, *unk, *local = NULL, *erow = NULL;
+    int *ucol = NULL, *rstart, *ustart, *rows, *unk, *local = NULL, *erow = NULL, *todo = NULL;
     tbz_prev *rec = T->rec && !T->sharp && !T->reuse_x ? T->rec : NULL;
-    int nu = 0, e, i, r, nc;
-    double *buf = NULL, scale = 0.0;
+    int nu = 0, e, i, r, nc, nt = 0;
+    double scale = 0.0;
     sfb_result res = SFB_SUCCESS;
     memset(&S, 0, sizeof S);
     memset(&C, 0, sizeof C);
@@ -931,12 +1012,8 @@ static sfb_result tbz_solve(sfb__tbz *T) {
         if (!erow) { res = sfb__oom(T->ctx, "tribezier constraints"); goto done; }
         tbz_edge_first_rows(&S, T->ne, erow);
     }
-    lo = (size_t *)sfb__alloc(T->ctx, ((size_t)S.rows + 1) * sizeof(size_t));
-    lc = (int *)sfb__alloc(T->ctx, (S.n + 1) * sizeof(int));
-    lw = (double *)sfb__alloc(T->ctx, (S.n + 1) * sizeof(double));
-    if (!lo || !lc || !lw) { res = sfb__oom(T->ctx, "tribezier constraints"); goto done; }
-    buf = (double *)sfb__alloc(T->ctx, ((size_t)6 * C.maxr + 12 * (size_t)C.maxu + 3 * TBZ_STALL + 1) * sizeof(double));
-    if (!buf) { res = sfb__oom(T->ctx, "tribezier constraints"); goto done; }
+    todo = (int *)sfb__alloc(T->ctx, ((size_t)nc + 1) * sizeof(int));
+    if (!todo) { res = sfb__oom(T->ctx, "tribezier constraints"); goto done; }
     /* components at an extraordinary crease vertex with our plane (this net's, or in the
      * fallback the first net's) */
     ours = (unsigned char *)sfb__calloc(T->ctx, (size_t)nc + 1, 1);
@@ -965,9 +1042,9 @@ static sfb_result tbz_solve(sfb__tbz *T) {
             }
         }
         for (j = 0; j < cu; ++j) local[unk[u0 + j]] = j;
-        tbz_cgls(T, &S, rows + rstart[i], rstart[i + 1] - rstart[i], unk + u0, cu, local, scale, buf, lo, lc, lw);
-        for (j = 0; j < cu; ++j) local[unk[u0 + j]] = -1;
+        todo[nt++] = i;
     }
+    if ((res = tbz_solve_todo(T, &S, &C, local, todo, nt, scale)) != SFB_SUCCESS) goto done;
     /* the residual left, relative to T->scale; and that of the components around an
      * extraordinary crease vertex with our tangent plane (vtype CREASE | 16), which decides the
      * fallback to the seed's plane (sfb__tribezier_points) */
@@ -994,8 +1071,8 @@ static sfb_result tbz_solve(sfb__tbz *T) {
 done:
     sfb__free(T->ctx, S.off); sfb__free(T->ctx, S.edge); sfb__free(T->ctx, S.col); sfb__free(T->ctx, S.w);
     sfb__free(T->ctx, ucol); sfb__free(T->ctx, local); sfb__free(T->ctx, erow);
-    sfb__free(T->ctx, C.rows); sfb__free(T->ctx, C.unk); sfb__free(T->ctx, C.rstart); sfb__free(T->ctx, C.ustart); sfb__free(T->ctx, buf);
-    sfb__free(T->ctx, ours); sfb__free(T->ctx, lo); sfb__free(T->ctx, lc); sfb__free(T->ctx, lw);
+    sfb__free(T->ctx, C.rows); sfb__free(T->ctx, C.unk); sfb__free(T->ctx, C.rstart); sfb__free(T->ctx, C.ustart);
+    sfb__free(T->ctx, ours); sfb__free(T->ctx, todo);
     return res;
 }
 
