@@ -810,24 +810,16 @@ static void refined_one(sfb_context *ctx, const char *name, const char *obj) {
     tmesh_free(ctx, &t);
 }
 
-/* The sharp net takes the smooth net's solution of every constraint component that is the same
- * system in both (tbz_prev): the net must be bit for bit the one solved in full
- * (SFB__TBZ_NO_REUSE), with components reused and fewer CGLS iterations. obj gets crease tags
- * on the first edge of every 256th face, so that the nets differ near them (rows, and points the
- * rows read) and agree away from them. */
-static void reuse_one(sfb_context *ctx, const char *name, const char *obj) {
-    tmesh t;
-    double *a = NULL, *b = NULL;
-    sfb__tbz_stats sa, sb;
-    sfb__level ra, rb;
-    char nm[160], *text;
-    size_t n = strlen(obj), at;
+/* obj (malloc'd copy) with an s = 1 crease tag on the first edge of every `every`-th face;
+ * *tags: how many. NULL when out of memory. */
+static char *obj_tag_creases(const char *obj, int every, int *tags) {
+    const size_t n = strlen(obj);
+    size_t at;
     const char *fl = obj;
-    int faces = 0, tags = 0;
-    memset(&ra, 0, sizeof ra); memset(&rb, 0, sizeof rb);
-    memset(&sa, 0, sizeof sa); memset(&sb, 0, sizeof sb);
-    text = (char *)malloc(2 * n + 64);
-    if (!text) { fail(name, "out of memory"); return; }
+    int faces = 0;
+    char *text = (char *)malloc(2 * n + 64);
+    *tags = 0;
+    if (!text) return NULL;
     memcpy(text, obj, n);
     at = n;
     text[at++] = '\n';
@@ -839,11 +831,30 @@ static void reuse_one(sfb_context *ctx, const char *name, const char *obj) {
         while (*e && *e != ' ' && *e != '\n') ++e;
         v1 = strtol(e, NULL, 10);
         ++fl;
-        if (faces++ % 256 != 0 || v0 < 1 || v1 < 1 || at + 64 > 2 * n) continue;
+        if (faces++ % every != 0 || v0 < 1 || v1 < 1 || at + 64 > 2 * n) continue;
         at += (size_t)snprintf(text + at, 64, "t crease 2/1/0 %ld %ld 1\n", v0 - 1, v1 - 1);
-        ++tags;
+        ++*tags;
     }
     text[at] = 0;
+    return text;
+}
+
+/* The sharp net takes the smooth net's solution of every constraint component that is the same
+ * system in both (tbz_prev): the net must be bit for bit the one solved in full
+ * (SFB__TBZ_NO_REUSE), with components reused and fewer CGLS iterations. obj gets crease tags
+ * on the first edge of every 256th face, so that the nets differ near them (rows, and points the
+ * rows read) and agree away from them. */
+static void reuse_one(sfb_context *ctx, const char *name, const char *obj) {
+    tmesh t;
+    double *a = NULL, *b = NULL;
+    sfb__tbz_stats sa, sb;
+    sfb__level ra, rb;
+    char nm[160], *text;
+    int tags = 0;
+    memset(&ra, 0, sizeof ra); memset(&rb, 0, sizeof rb);
+    memset(&sa, 0, sizeof sa); memset(&sb, 0, sizeof sb);
+    text = obj_tag_creases(obj, 256, &tags);
+    if (!text) { fail(name, "out of memory"); return; }
     snprintf(nm, sizeof nm, "%s/sharp_net_reuse_is_exact", name);
     if (!tmesh_load(ctx, text, &t)) { fail(nm, "load: %s", sfb_last_error(ctx)); free(text); return; }
     if (sfb__tribezier_refined_points(ctx, &t.prep, t.m->positions, NULL, 0, &ra, &a, &sa) != SFB_SUCCESS ||
@@ -1088,6 +1099,68 @@ static void test_backends(void) {
     free(obj);
 }
 
+/* The constraint regions are solved in blocks on the backend's threads (tbz_solve_todo): the
+ * nets must be bit for bit those of a context that lends no threads (ref, one thread), the
+ * smooth and the sharp (crease tags on every 64th face's first edge, so the sharp net has its
+ * own regions) net after one Loop step of spot.obj, whose many regions fill several blocks. */
+static void test_threads(const char *dir) {
+    static const sfb_backend_kind kinds[2] = {SFB_BACKEND_REF, SFB_BACKEND_SIMD};
+    sfb_context *c[2] = {NULL, NULL};
+    double *net[2][2] = {{NULL, NULL}, {NULL, NULL}};
+    sfb__level rl[2][2];
+    sfb__tbz_stats st[2][2];
+    char path[1024], *obj, *tagged = NULL;
+    size_t n;
+    int k, j, ok = 1, ntags = 0;
+    snprintf(path, sizeof path, "%s/spot.obj", dir);
+    obj = slurp(path, &n);
+    if (!obj) { skip("threads/net_bit_for_bit_spot", "spot.obj not found (pass the real-meshes folder)"); return; }
+    memset(rl, 0, sizeof rl);
+    memset(st, 0, sizeof st);
+    tagged = obj_tag_creases(obj, 64, &ntags);
+    if (!tagged || ntags == 0) { fail("threads/net_bit_for_bit_spot", "no crease tags"); free(obj); free(tagged); return; }
+    for (k = 0; k < 2; ++k) {
+        sfb_context_config cc = sfb_context_config_init();
+        cc.ignore_environment = 1;
+        cc.backends = &kinds[k];
+        cc.backend_count = 1;
+        cc.threads = k ? 4 : 1;
+        if (sfb_context_create(&cc, &c[k]) != SFB_SUCCESS) {
+            if (k) skip("threads/net_bit_for_bit_spot", "no simd backend here");
+            else fail("threads/net_bit_for_bit_spot", "no ref context");
+            ok = 0;
+            break;
+        }
+        for (j = 0; j < 2; ++j) {
+            tmesh t;
+            if (!tmesh_load(c[k], j ? tagged : obj, &t)) { fail("threads/net_bit_for_bit_spot", "load: %s", sfb_last_error(c[k])); ok = 0; continue; }
+            if (sfb__tribezier_refined_points(c[k], &t.prep, t.m->positions, NULL, 0, &rl[k][j], &net[k][j], &st[k][j]) != SFB_SUCCESS) {
+                fail("threads/net_bit_for_bit_spot", "build: %s", sfb_last_error(c[k]));
+                ok = 0;
+            }
+            tmesh_free(c[k], &t);
+        }
+    }
+    if (ok) {
+        for (j = 0; j < 2; ++j) {
+            const size_t nd = (size_t)rl[0][j].nf * 45;
+            const int same = rl[0][j].nf == rl[1][j].nf && memcmp(net[0][j], net[1][j], nd * sizeof(double)) == 0;
+            check(same && st[0][j].iterations == st[1][j].iterations && st[0][j].iterations > 0,
+                  j ? "threads/net_bit_for_bit_spot_creased" : "threads/net_bit_for_bit_spot",
+                  "%d child faces, %ld CGLS iterations on one thread, %ld on four; nets %s", rl[0][j].nf, st[0][j].iterations,
+                  st[1][j].iterations, same ? "equal" : "differ");
+        }
+    }
+    for (k = 0; k < 2; ++k) {
+        for (j = 0; j < 2; ++j) {
+            if (c[k]) { sfb__free(c[k], net[k][j]); sfb__level_free(c[k], &rl[k][j]); }
+        }
+        sfb_context_destroy(c[k]);
+    }
+    free(obj);
+    free(tagged);
+}
+
 int main(int argc, char **argv) {
     sfb_context *ctx = NULL;
     sfb_context_config cc = sfb_context_config_init();
@@ -1117,6 +1190,7 @@ int main(int argc, char **argv) {
         else { g1_one(ctx, "g1_real_mesh_spot_near_g1", obj, 1e-2); free(obj); }
         test_refined(ctx, dir);
         test_nonmanifold_vertices(ctx, dir);
+        test_threads(dir);
     }
     sfb_context_destroy(ctx);
     if (!probe_backends()) return 1;
