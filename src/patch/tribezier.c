@@ -91,6 +91,8 @@ typedef struct sfb__tbz {
     double *x;                 /* np * 3: the net */
     unsigned char *fixed;      /* per point */
     int *dist;                 /* per point: net distance to an irregular vertex */
+    int *grid;                 /* per face: its 15 points (tbz_patch), made once (the topology is the same in every
+                                  state) */
     float *tag_s;              /* per edge: s of a tagged edge (0: none) */
     float *corner_s;           /* per vertex: s of a corner tag (0: none) */
     /* the seed-plane fallback of the smooth net: the first (our-plane) solution and its vertices
@@ -626,26 +628,30 @@ static int tbz_edge_rows(sfb__tbz *T, tbz_sys *S, int e) {
     return 1;
 }
 
-/* Net distances (in steps of the Bezier net) from the irregular vertices' corner points. */
+/* Net distances (in steps of the Bezier net) from the irregular vertices' corner points: sweeps
+ * over the 30 neighbouring pairs of every face's net (Bellman-Ford: after k sweeps every
+ * distance up to k is exact and the others are larger, so the unknowns, dist <= TBZ_REACH, do
+ * not depend on the order of the pairs). */
 static void tbz_distances(sfb__tbz *T) {
-    int i, f, it, q;
     static const int nb[3][2] = {{1, 0}, {0, 1}, {-1, 1}};
+    int pa[30], pb[30], npair = 0, i, f, it, q, jj, a;
+    for (jj = 0; jj <= 4; ++jj)
+        for (a = 0; a + jj <= 4; ++a)
+            for (q = 0; q < 3; ++q) {
+                const int i2 = a + nb[q][0], j2 = jj + nb[q][1];
+                if (i2 < 0 || i2 + j2 > 4) continue;
+                pa[npair] = tbz_qij(a, jj); pb[npair++] = tbz_qij(i2, j2);
+            }
     for (i = 0; i < T->np; ++i) T->dist[i] = i < T->nv && T->virr[i] ? 0 : 1000;
     for (it = 0; it < TBZ_REACH + 2; ++it) {
         int changed = 0;
         for (f = 0; f < T->nf; ++f) {
-            int g[15], a, jj;
-            tbz_patch(T, f, g);
-            for (jj = 0; jj <= 4; ++jj)
-                for (a = 0; a + jj <= 4; ++a)
-                    for (q = 0; q < 3; ++q) {
-                        const int i2 = a + nb[q][0], j2 = jj + nb[q][1];
-                        int p0, p1;
-                        if (i2 < 0 || i2 + j2 > 4) continue;
-                        p0 = g[tbz_qij(a, jj)]; p1 = g[tbz_qij(i2, j2)];
-                        if (T->dist[p0] + 1 < T->dist[p1]) { T->dist[p1] = T->dist[p0] + 1; changed = 1; }
-                        if (T->dist[p1] + 1 < T->dist[p0]) { T->dist[p0] = T->dist[p1] + 1; changed = 1; }
-                    }
+            const int *g = T->grid + 15 * (size_t)f;
+            for (q = 0; q < npair; ++q) {
+                const int p0 = g[pa[q]], p1 = g[pb[q]];
+                if (T->dist[p0] + 1 < T->dist[p1]) { T->dist[p1] = T->dist[p0] + 1; changed = 1; }
+                if (T->dist[p1] + 1 < T->dist[p0]) { T->dist[p0] = T->dist[p1] + 1; changed = 1; }
+            }
         }
         if (!changed) break;
     }
@@ -670,7 +676,7 @@ static int tbz_root(int *parent, int i) {
 #define TBZ_STALL 40
 #define TBZ_MAX(a, b) ((a) > (b) ? (a) : (b))
 static int tbz_cgls(sfb__tbz *T, const tbz_sys *S, const int *rows, int nr, const int *unk, int nu, const int *local, double scale,
-                    double *w, size_t *lo, int *lc, double *lw) {
+                    double *w, size_t *lo, int *lc, double *lw, size_t *co, int *cr, double *cw) {
     double *rr = w, *q = w + 3 * (size_t)nr, *xs = q + 3 * (size_t)nr, *sv = xs + 3 * (size_t)nu, *p = sv + 3 * (size_t)nu;
     double *hist = p + 3 * (size_t)nu;
     double gamma[3], gamma0[3];
@@ -692,6 +698,19 @@ static int tbz_cgls(sfb__tbz *T, const tbz_sys *S, const int *rows, int nr, cons
         for (c = 0; c < 3; ++c) rr[3 * r + c] = -v[c];
     }
     lo[nr] = n;
+    /* its transpose (co/cr/cw), each column's entries in row order: A^T r gathered per unknown
+     * adds the very terms in the very order the row-by-row scatter did */
+    for (i = 0; i <= nu; ++i) co[i] = 0;
+    for (k = 0; k < n; ++k) ++co[lc[k] + 1];
+    for (i = 0; i < nu; ++i) co[i + 1] += co[i];
+    for (r = 0; r < nr; ++r)
+        for (k = lo[r]; k < lo[r + 1]; ++k) {
+            const size_t at = co[lc[k]]++;
+            cr[at] = r;
+            cw[at] = lw[k];
+        }
+    for (i = nu; i > 0; --i) co[i] = co[i - 1];
+    co[0] = 0;
     for (i = 0; i < 3 * nu; ++i) xs[i] = sv[i] = 0.0;
     for (r = 0; r < nr; ++r)
         for (k = lo[r]; k < lo[r + 1]; ++k)
@@ -734,13 +753,13 @@ static int tbz_cgls(sfb__tbz *T, const tbz_sys *S, const int *rows, int nr, cons
             h[it % TBZ_STALL] = r2[c];
         }
         if (left == 0) { ++it; break; }
-        for (i = 0; i < 3 * nu; ++i) sv[i] = 0.0;
-        for (r = 0; r < nr; ++r) {
-            const double r0 = rr[3 * r], r1 = rr[3 * r + 1], r2b = rr[3 * r + 2];
-            for (k = lo[r]; k < lo[r + 1]; ++k) {
-                double *ss = sv + 3 * lc[k];
-                ss[0] += lw[k] * r0; ss[1] += lw[k] * r1; ss[2] += lw[k] * r2b;
+        for (i = 0; i < nu; ++i) {
+            double s0 = 0.0, s1 = 0.0, s2 = 0.0;
+            for (k = co[i]; k < co[i + 1]; ++k) {
+                const double *rv = rr + 3 * (size_t)cr[k];
+                s0 += cw[k] * rv[0]; s1 += cw[k] * rv[1]; s2 += cw[k] * rv[2];
             }
+            sv[3 * i] = s0; sv[3 * i + 1] = s1; sv[3 * i + 2] = s2;
         }
         for (i = 0; i < nu; ++i)
             for (c = 0; c < 3; ++c) g2[c] += sv[3 * i + c] * sv[3 * i + c];
@@ -833,9 +852,9 @@ static size_t tbz_comp_entries(const tbz_sys *S, const tbz_comps *C, int i) {
  * component. */
 #define TBZ_BLOCKS 32
 typedef struct tbz_block {
-    double *w, *lw;
-    size_t *lo;
-    int *lc;
+    double *w, *lw, *cw;
+    size_t *lo, *co;
+    int *lc, *cr;
 } tbz_block;
 typedef struct tbz_job {
     sfb__tbz *T;
@@ -854,7 +873,7 @@ static void tbz_solve_blocks(void *arg, int first, int last) {
         for (t = J->bstart[b]; t < J->bstart[b + 1]; ++t) {
             const int i = J->todo[t], r0 = J->C->rstart[i], u0 = J->C->ustart[i];
             J->its[t] = tbz_cgls(J->T, J->S, J->C->rows + r0, J->C->rstart[i + 1] - r0, J->C->unk + u0, J->C->ustart[i + 1] - u0, J->local,
-                                 J->scale, J->blk[b].w, J->blk[b].lo, J->blk[b].lc, J->blk[b].lw);
+                                 J->scale, J->blk[b].w, J->blk[b].lo, J->blk[b].lc, J->blk[b].lw, J->blk[b].co, J->blk[b].cr, J->blk[b].cw);
         }
 }
 
@@ -889,14 +908,20 @@ static sfb_result tbz_solve_todo(sfb__tbz *T, const tbz_sys *S, const tbz_comps 
         blk[b].lo = (size_t *)sfb__alloc(T->ctx, (mr + 1) * sizeof(size_t));
         blk[b].lc = (int *)sfb__alloc(T->ctx, (me + 1) * sizeof(int));
         blk[b].lw = (double *)sfb__alloc(T->ctx, (me + 1) * sizeof(double));
-        if (!blk[b].w || !blk[b].lo || !blk[b].lc || !blk[b].lw) res = sfb__oom(T->ctx, "tribezier constraints");
+        blk[b].co = (size_t *)sfb__alloc(T->ctx, (mu + 1) * sizeof(size_t));
+        blk[b].cr = (int *)sfb__alloc(T->ctx, (me + 1) * sizeof(int));
+        blk[b].cw = (double *)sfb__alloc(T->ctx, (me + 1) * sizeof(double));
+        if (!blk[b].w || !blk[b].lo || !blk[b].lc || !blk[b].lw || !blk[b].co || !blk[b].cr || !blk[b].cw) res = sfb__oom(T->ctx, "tribezier constraints");
     }
     if (res == SFB_SUCCESS) {
         J.T = T; J.S = S; J.C = C; J.local = local; J.todo = todo; J.bstart = bstart; J.scale = scale; J.blk = blk;
         sfb__parallel(T->ctx, tbz_solve_blocks, &J, 0, nb);
         for (t = 0; t < nt; ++t) T->st.iterations += J.its[t];
     }
-    for (b = 0; b < nb; ++b) { sfb__free(T->ctx, blk[b].w); sfb__free(T->ctx, blk[b].lo); sfb__free(T->ctx, blk[b].lc); sfb__free(T->ctx, blk[b].lw); }
+    for (b = 0; b < nb; ++b) {
+        sfb__free(T->ctx, blk[b].w); sfb__free(T->ctx, blk[b].lo); sfb__free(T->ctx, blk[b].lc); sfb__free(T->ctx, blk[b].lw);
+        sfb__free(T->ctx, blk[b].co); sfb__free(T->ctx, blk[b].cr); sfb__free(T->ctx, blk[b].cw);
+    }
     sfb__free(T->ctx, J.its);
     return res;
 }
@@ -1171,13 +1196,15 @@ static sfb_result tbz_points(sfb_context *ctx, const sfb__level *l, const float 
     T.x = (double *)sfb__calloc(ctx, 3 * (size_t)T.np + 1, sizeof(double));
     T.fixed = (unsigned char *)sfb__calloc(ctx, (size_t)T.np + 1, 1);
     T.dist = (int *)sfb__calloc(ctx, (size_t)T.np + 1, sizeof(int));
+    T.grid = (int *)sfb__alloc(ctx, 15 * (size_t)T.nf * sizeof(int) + 1);
     T.tag_s = (float *)sfb__calloc(ctx, (size_t)T.ne + 1, sizeof(float));
     T.corner_s = (float *)sfb__calloc(ctx, (size_t)T.nv + 1, sizeof(float));
     res = (double *)sfb__alloc(ctx, 45 * (size_t)T.nf * sizeof(double) + 1);
-    if (!T.efeat || !T.vtype || !T.virr || !T.phi || !T.x || !T.fixed || !T.dist || !T.tag_s || !T.corner_s || !res) {
+    if (!T.efeat || !T.vtype || !T.virr || !T.phi || !T.x || !T.fixed || !T.dist || !T.grid || !T.tag_s || !T.corner_s || !res) {
         r = sfb__oom(ctx, "tribezier");
         goto done;
     }
+    for (f = 0; f < T.nf; ++f) tbz_patch(&T, f, T.grid + 15 * (size_t)f);
     /* s per feature: the tag clamped to [0, 1] (infinite: 1), or the override */
     for (e = 0; e < T.ne; ++e)
         if (l->ef_off[e + 1] - l->ef_off[e] == 2 && l->es[e] > 0.0f) {
@@ -1235,8 +1262,8 @@ static sfb_result tbz_points(sfb_context *ctx, const sfb__level *l, const float 
     }
     for (f = 0; f < T.nf; ++f) {
         const int *fv = l->fv + l->fv_off[f];
-        int g[15], i, j, q = 0;
-        tbz_patch(&T, f, g);
+        const int *g = T.grid + 15 * (size_t)f;
+        int i, j, q = 0;
         for (j = 0; j <= 4; ++j)
             for (i = 0; i + j <= 4; ++i, ++q) {
                 double s = 0.0, wsum = 0.0;
@@ -1259,7 +1286,7 @@ static sfb_result tbz_points(sfb_context *ctx, const sfb__level *l, const float 
     if (stats) *stats = T.st;
 done:
     sfb__free(ctx, T.efeat); sfb__free(ctx, T.vtype); sfb__free(ctx, T.virr); sfb__free(ctx, T.phi);
-    sfb__free(ctx, T.x); sfb__free(ctx, T.fixed); sfb__free(ctx, T.dist); sfb__free(ctx, T.tag_s); sfb__free(ctx, T.corner_s);
+    sfb__free(ctx, T.x); sfb__free(ctx, T.fixed); sfb__free(ctx, T.dist); sfb__free(ctx, T.grid); sfb__free(ctx, T.tag_s); sfb__free(ctx, T.corner_s);
     sfb__free(ctx, x0); sfb__free(ctx, vs); sfb__free(ctx, res);
     tbz_prev_free(ctx, &prev);
     return r;
