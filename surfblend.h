@@ -5426,9 +5426,14 @@ sfb_result sfb__patches_build(sfb_context *ctx, const sfb__level *base, const sf
     }
     if (r == SFB_SUCCESS) {
         pt->npoints = b.npts;
-        pt->point_data = b.npts > 0 ? (float *)sfb__realloc(ctx, b.pts, (size_t)b.npts * 3 * sizeof(float)) : NULL; /* the table takes them */
-        if (pt->point_data) b.pts = NULL;
-        if (!pt->point_data && !(pt->point_data = (float *)sfb__alloc(ctx, 3 * sizeof(float)))) r = sfb__oom(ctx, "patch points");
+        if (b.npts > 0) {
+            /* the table takes the points, trimmed to their count (or as grown, if trimming fails) */
+            float *trimmed = (float *)sfb__realloc(ctx, b.pts, (size_t)b.npts * 3 * sizeof(float));
+            pt->point_data = trimmed ? trimmed : b.pts;
+            b.pts = NULL;
+        } else if (!(pt->point_data = (float *)sfb__alloc(ctx, 3 * sizeof(float)))) {
+            r = sfb__oom(ctx, "patch points");
+        }
     }
     sfb__wlevel_free(ctx, &w);
     sfb__wlevel_free(ctx, &nw);
