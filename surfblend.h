@@ -4963,15 +4963,28 @@ static int sfb__pb_grow_int(sfb_context *ctx, int **a, int *cap, int need) {
     return 1;
 }
 
+/* acc = the weighted sum of the xyz points pos[idx[i]] (zero weights skipped), in double. */
+static void sfb__pb_combine(const int *idx, const double *w, size_t n, const double *pos, double acc[3]) {
+    size_t i;
+    int c;
+    acc[0] = acc[1] = acc[2] = 0.0;
+    for (i = 0; i < n; ++i) {
+        const double *q = pos + 3 * (size_t)idx[i];
+        if (w[i] == 0.0) continue;
+        for (c = 0; c < 3; ++c) acc[c] += w[i] * q[c];
+    }
+}
+
 /* Adds a point: mask m over working-level vertices applied to their double positions, rounded
- * to float once. A single vertex with weight 1 is shared through vrow. Returns the point's index
+ * to float once (a Stam point is an eigen coefficient, weights of both signs summing to 0 and a
+ * result small next to the coordinates: it needs the double sum). A single vertex with weight 1 is shared through vrow. Returns the point's index
  * or -1 on allocation failure. Positions rather than rows composed over the base vertices:
  * nothing needs the rows once the points are made, and on a triangle mesh under Catmull-Clark
  * (an extraordinary vertex in every face) composing them was most of the build's time and
  * memory. */
 int sfb__pb_point(sfb__pbuild *b, const double *wpos, const sfb__mask *m) {
-    double acc[3] = {0.0, 0.0, 0.0};
-    int i, c, row;
+    double acc[3];
+    int c, row;
     if (m->n == 1 && m->w[0] == 1.0 && b->vrow[m->idx[0]] >= 0) return b->vrow[m->idx[0]];
     row = b->npts;
     if (row + 1 > b->cap_pts) {
@@ -4986,11 +4999,7 @@ int sfb__pb_point(sfb__pbuild *b, const double *wpos, const sfb__mask *m) {
         b->pts = np;
         b->cap_pts = nc;
     }
-    for (i = 0; i < m->n; ++i) {
-        const double wi = m->w[i], *q = wpos + 3 * (size_t)m->idx[i];
-        if (wi == 0.0) continue;
-        for (c = 0; c < 3; ++c) acc[c] += wi * q[c];
-    }
+    sfb__pb_combine(m->idx, m->w, (size_t)m->n, wpos, acc);
     for (c = 0; c < 3; ++c) b->pts[3 * (size_t)row + c] = (float)acc[c];
     b->npts = row + 1;
     if (m->n == 1 && m->w[0] == 1.0) b->vrow[m->idx[0]] = row;
@@ -5362,16 +5371,11 @@ static sfb_result sfb__pb_next_level(sfb__pbuild *b, const sfb__refine_options *
         nw->owns_level = 1;
     }
     if (r == SFB_SUCCESS) {
-        int v, c;
+        int v;
         nw->pos = (double *)sfb__alloc(ctx, ((size_t)nw->l.nv + 1) * 3 * sizeof(double));
         if (!nw->pos) r = sfb__oom(ctx, "adaptive refinement");
-        for (v = 0; r == SFB_SUCCESS && v < nw->l.nv; ++v) {
-            double acc[3] = {0.0, 0.0, 0.0};
-            size_t q;
-            for (q = local.off[v]; q < local.off[v + 1]; ++q)
-                for (c = 0; c < 3; ++c) acc[c] += local.w[q] * subpos[3 * (size_t)local.idx[q] + c];
-            for (c = 0; c < 3; ++c) nw->pos[3 * (size_t)v + c] = acc[c];
-        }
+        for (v = 0; r == SFB_SUCCESS && v < nw->l.nv; ++v)
+            sfb__pb_combine(local.idx + local.off[v], local.w + local.off[v], local.off[v + 1] - local.off[v], subpos, nw->pos + 3 * (size_t)v);
     }
     if (r == SFB_SUCCESS) r = sfb__pb_children(ctx, b->pt, w, &sub, nw, active, nactive, fmap, vc, ec, level, tri);
     sfb__rows_free(ctx, &local);
@@ -7540,6 +7544,21 @@ static int tbz_root(int *parent, int i) {
  * still move are the near-null directions, which only make the net wilder). */
 #define TBZ_STALL 40
 #define TBZ_MAX(a, b) ((a) > (b) ? (a) : (b))
+/* sv = A^T r, three coordinates, gathered per unknown from the transpose (co, cr, cw: each
+ * column's entries in row order, so each sum adds the terms a row-by-row scatter would, in its
+ * order). */
+static void tbz_atr(const size_t *co, const int *cr, const double *cw, const double *rr, int nu, double *sv) {
+    int i;
+    size_t k;
+    for (i = 0; i < nu; ++i) {
+        double s0 = 0.0, s1 = 0.0, s2 = 0.0;
+        for (k = co[i]; k < co[i + 1]; ++k) {
+            const double *rv = rr + 3 * (size_t)cr[k];
+            s0 += cw[k] * rv[0]; s1 += cw[k] * rv[1]; s2 += cw[k] * rv[2];
+        }
+        sv[3 * i] = s0; sv[3 * i + 1] = s1; sv[3 * i + 2] = s2;
+    }
+}
 static int tbz_cgls(sfb__tbz *T, const tbz_sys *S, const int *rows, int nr, const int *unk, int nu, const int *local, double scale,
                     double *w, size_t *lo, int *lc, double *lw, size_t *co, int *cr, double *cw) {
     double *rr = w, *q = w + 3 * (size_t)nr, *xs = q + 3 * (size_t)nr, *sv = xs + 3 * (size_t)nu, *p = sv + 3 * (size_t)nu;
@@ -7563,8 +7582,7 @@ static int tbz_cgls(sfb__tbz *T, const tbz_sys *S, const int *rows, int nr, cons
         for (c = 0; c < 3; ++c) rr[3 * r + c] = -v[c];
     }
     lo[nr] = n;
-    /* its transpose (co/cr/cw), each column's entries in row order: A^T r gathered per unknown
-     * adds the very terms in the very order the row-by-row scatter did */
+    /* its transpose (co/cr/cw), each column's entries in row order (tbz_atr) */
     for (i = 0; i <= nu; ++i) co[i] = 0;
     for (k = 0; k < n; ++k) ++co[lc[k] + 1];
     for (i = 0; i < nu; ++i) co[i + 1] += co[i];
@@ -7576,10 +7594,8 @@ static int tbz_cgls(sfb__tbz *T, const tbz_sys *S, const int *rows, int nr, cons
         }
     for (i = nu; i > 0; --i) co[i] = co[i - 1];
     co[0] = 0;
-    for (i = 0; i < 3 * nu; ++i) xs[i] = sv[i] = 0.0;
-    for (r = 0; r < nr; ++r)
-        for (k = lo[r]; k < lo[r + 1]; ++k)
-            for (c = 0; c < 3; ++c) sv[3 * lc[k] + c] += lw[k] * rr[3 * r + c];
+    for (i = 0; i < 3 * nu; ++i) xs[i] = 0.0;
+    tbz_atr(co, cr, cw, rr, nu, sv);
     for (c = 0; c < 3; ++c) { gamma[c] = 0.0; active[c] = 1; }
     for (i = 0; i < nu; ++i)
         for (c = 0; c < 3; ++c) { p[3 * i + c] = sv[3 * i + c]; gamma[c] += sv[3 * i + c] * sv[3 * i + c]; }
@@ -7618,14 +7634,7 @@ static int tbz_cgls(sfb__tbz *T, const tbz_sys *S, const int *rows, int nr, cons
             h[it % TBZ_STALL] = r2[c];
         }
         if (left == 0) { ++it; break; }
-        for (i = 0; i < nu; ++i) {
-            double s0 = 0.0, s1 = 0.0, s2 = 0.0;
-            for (k = co[i]; k < co[i + 1]; ++k) {
-                const double *rv = rr + 3 * (size_t)cr[k];
-                s0 += cw[k] * rv[0]; s1 += cw[k] * rv[1]; s2 += cw[k] * rv[2];
-            }
-            sv[3 * i] = s0; sv[3 * i + 1] = s1; sv[3 * i + 2] = s2;
-        }
+        tbz_atr(co, cr, cw, rr, nu, sv);
         for (i = 0; i < nu; ++i)
             for (c = 0; c < 3; ++c) g2[c] += sv[3 * i + c] * sv[3 * i + c];
         for (c = 0; c < 3; ++c) {
@@ -7642,9 +7651,9 @@ static int tbz_cgls(sfb__tbz *T, const tbz_sys *S, const int *rows, int nr, cons
 
 /* The connected components of the constraints: rows sharing an unknown are in one. rows[] and
  * unk[] list the rows and the unknowns' points component by component, [rstart[i], rstart[i+1])
- * and [ustart[i], ustart[i+1]); maxr, maxu the largest component's counts. */
+ * and [ustart[i], ustart[i+1]). */
 typedef struct tbz_comps {
-    int nc, maxr, maxu;
+    int nc;
     int *rstart, *ustart, *rows, *unk;
 } tbz_comps;
 
@@ -7683,8 +7692,6 @@ static sfb_result tbz_components(sfb__tbz *T, const tbz_sys *S, const int *ucol,
     }
     for (i = 0; i < nu; ++i) ++C->ustart[parent[i] + 1];
     for (i = 0; i < nc; ++i) {
-        C->maxr = C->rstart[i + 1] > C->maxr ? C->rstart[i + 1] : C->maxr;
-        C->maxu = C->ustart[i + 1] > C->maxu ? C->ustart[i + 1] : C->maxu;
         C->rstart[i + 1] += C->rstart[i];
         C->ustart[i + 1] += C->ustart[i];
     }
@@ -7747,18 +7754,20 @@ static sfb_result tbz_solve_todo(sfb__tbz *T, const tbz_sys *S, const tbz_comps 
     tbz_job J;
     int bstart[TBZ_BLOCKS + 1], nb = nt < TBZ_BLOCKS ? nt : TBZ_BLOCKS, b, t;
     tbz_block blk[TBZ_BLOCKS];
-    size_t total = 0, acc = 0;
+    size_t total = 0, acc = 0, *ent;
     sfb_result res = SFB_SUCCESS;
     if (nt == 0) return SFB_SUCCESS;
     memset(blk, 0, sizeof blk);
     J.its = (int *)sfb__alloc(T->ctx, (size_t)nt * sizeof(int));
     if (!J.its) return sfb__oom(T->ctx, "tribezier constraints");
-    /* a component's work ~ the entries of its rows */
-    for (t = 0; t < nt; ++t) total += tbz_comp_entries(S, C, todo[t]) + 1;
+    /* a component's work ~ the entries of its rows (ent, per todo entry, in its for now) */
+    ent = (size_t *)sfb__alloc(T->ctx, (size_t)nt * sizeof(size_t));
+    if (!ent) { sfb__free(T->ctx, J.its); return sfb__oom(T->ctx, "tribezier constraints"); }
+    for (t = 0; t < nt; ++t) total += (ent[t] = tbz_comp_entries(S, C, todo[t])) + 1;
     bstart[0] = 0;
     for (b = 1, t = 0; b < nb; ++b) {
         const size_t goal = total / (size_t)nb * (size_t)b;
-        while (t < nt && acc < goal) acc += tbz_comp_entries(S, C, todo[t++]) + 1;
+        while (t < nt && acc < goal) acc += ent[t++] + 1;
         bstart[b] = t;
     }
     bstart[nb] = nt;
@@ -7766,8 +7775,8 @@ static sfb_result tbz_solve_todo(sfb__tbz *T, const tbz_sys *S, const tbz_comps 
         size_t mr = 0, mu = 0, me = 0;
         for (t = bstart[b]; t < bstart[b + 1]; ++t) {
             const int i = todo[t];
-            const size_t nr = (size_t)(C->rstart[i + 1] - C->rstart[i]), nu = (size_t)(C->ustart[i + 1] - C->ustart[i]), ne = tbz_comp_entries(S, C, i);
-            mr = nr > mr ? nr : mr; mu = nu > mu ? nu : mu; me = ne > me ? ne : me;
+            const size_t nr = (size_t)(C->rstart[i + 1] - C->rstart[i]), nu = (size_t)(C->ustart[i + 1] - C->ustart[i]);
+            mr = nr > mr ? nr : mr; mu = nu > mu ? nu : mu; me = ent[t] > me ? ent[t] : me;
         }
         blk[b].w = (double *)sfb__alloc(T->ctx, (6 * mr + 12 * mu + 3 * TBZ_STALL + 1) * sizeof(double));
         blk[b].lo = (size_t *)sfb__alloc(T->ctx, (mr + 1) * sizeof(size_t));
@@ -7788,6 +7797,7 @@ static sfb_result tbz_solve_todo(sfb__tbz *T, const tbz_sys *S, const tbz_comps 
         sfb__free(T->ctx, blk[b].co); sfb__free(T->ctx, blk[b].cr); sfb__free(T->ctx, blk[b].cw);
     }
     sfb__free(T->ctx, J.its);
+    sfb__free(T->ctx, ent);
     return res;
 }
 

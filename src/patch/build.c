@@ -69,15 +69,28 @@ static int sfb__pb_grow_int(sfb_context *ctx, int **a, int *cap, int need) {
     return 1;
 }
 
+/* acc = the weighted sum of the xyz points pos[idx[i]] (zero weights skipped), in double. */
+static void sfb__pb_combine(const int *idx, const double *w, size_t n, const double *pos, double acc[3]) {
+    size_t i;
+    int c;
+    acc[0] = acc[1] = acc[2] = 0.0;
+    for (i = 0; i < n; ++i) {
+        const double *q = pos + 3 * (size_t)idx[i];
+        if (w[i] == 0.0) continue;
+        for (c = 0; c < 3; ++c) acc[c] += w[i] * q[c];
+    }
+}
+
 /* Adds a point: mask m over working-level vertices applied to their double positions, rounded
- * to float once. A single vertex with weight 1 is shared through vrow. Returns the point's index
+ * to float once (a Stam point is an eigen coefficient, weights of both signs summing to 0 and a
+ * result small next to the coordinates: it needs the double sum). A single vertex with weight 1 is shared through vrow. Returns the point's index
  * or -1 on allocation failure. Positions rather than rows composed over the base vertices:
  * nothing needs the rows once the points are made, and on a triangle mesh under Catmull-Clark
  * (an extraordinary vertex in every face) composing them was most of the build's time and
  * memory. */
 int sfb__pb_point(sfb__pbuild *b, const double *wpos, const sfb__mask *m) {
-    double acc[3] = {0.0, 0.0, 0.0};
-    int i, c, row;
+    double acc[3];
+    int c, row;
     if (m->n == 1 && m->w[0] == 1.0 && b->vrow[m->idx[0]] >= 0) return b->vrow[m->idx[0]];
     row = b->npts;
     if (row + 1 > b->cap_pts) {
@@ -92,11 +105,7 @@ int sfb__pb_point(sfb__pbuild *b, const double *wpos, const sfb__mask *m) {
         b->pts = np;
         b->cap_pts = nc;
     }
-    for (i = 0; i < m->n; ++i) {
-        const double wi = m->w[i], *q = wpos + 3 * (size_t)m->idx[i];
-        if (wi == 0.0) continue;
-        for (c = 0; c < 3; ++c) acc[c] += wi * q[c];
-    }
+    sfb__pb_combine(m->idx, m->w, (size_t)m->n, wpos, acc);
     for (c = 0; c < 3; ++c) b->pts[3 * (size_t)row + c] = (float)acc[c];
     b->npts = row + 1;
     if (m->n == 1 && m->w[0] == 1.0) b->vrow[m->idx[0]] = row;
@@ -468,16 +477,11 @@ static sfb_result sfb__pb_next_level(sfb__pbuild *b, const sfb__refine_options *
         nw->owns_level = 1;
     }
     if (r == SFB_SUCCESS) {
-        int v, c;
+        int v;
         nw->pos = (double *)sfb__alloc(ctx, ((size_t)nw->l.nv + 1) * 3 * sizeof(double));
         if (!nw->pos) r = sfb__oom(ctx, "adaptive refinement");
-        for (v = 0; r == SFB_SUCCESS && v < nw->l.nv; ++v) {
-            double acc[3] = {0.0, 0.0, 0.0};
-            size_t q;
-            for (q = local.off[v]; q < local.off[v + 1]; ++q)
-                for (c = 0; c < 3; ++c) acc[c] += local.w[q] * subpos[3 * (size_t)local.idx[q] + c];
-            for (c = 0; c < 3; ++c) nw->pos[3 * (size_t)v + c] = acc[c];
-        }
+        for (v = 0; r == SFB_SUCCESS && v < nw->l.nv; ++v)
+            sfb__pb_combine(local.idx + local.off[v], local.w + local.off[v], local.off[v + 1] - local.off[v], subpos, nw->pos + 3 * (size_t)v);
     }
     if (r == SFB_SUCCESS) r = sfb__pb_children(ctx, b->pt, w, &sub, nw, active, nactive, fmap, vc, ec, level, tri);
     sfb__rows_free(ctx, &local);

@@ -675,6 +675,21 @@ static int tbz_root(int *parent, int i) {
  * still move are the near-null directions, which only make the net wilder). */
 #define TBZ_STALL 40
 #define TBZ_MAX(a, b) ((a) > (b) ? (a) : (b))
+/* sv = A^T r, three coordinates, gathered per unknown from the transpose (co, cr, cw: each
+ * column's entries in row order, so each sum adds the terms a row-by-row scatter would, in its
+ * order). */
+static void tbz_atr(const size_t *co, const int *cr, const double *cw, const double *rr, int nu, double *sv) {
+    int i;
+    size_t k;
+    for (i = 0; i < nu; ++i) {
+        double s0 = 0.0, s1 = 0.0, s2 = 0.0;
+        for (k = co[i]; k < co[i + 1]; ++k) {
+            const double *rv = rr + 3 * (size_t)cr[k];
+            s0 += cw[k] * rv[0]; s1 += cw[k] * rv[1]; s2 += cw[k] * rv[2];
+        }
+        sv[3 * i] = s0; sv[3 * i + 1] = s1; sv[3 * i + 2] = s2;
+    }
+}
 static int tbz_cgls(sfb__tbz *T, const tbz_sys *S, const int *rows, int nr, const int *unk, int nu, const int *local, double scale,
                     double *w, size_t *lo, int *lc, double *lw, size_t *co, int *cr, double *cw) {
     double *rr = w, *q = w + 3 * (size_t)nr, *xs = q + 3 * (size_t)nr, *sv = xs + 3 * (size_t)nu, *p = sv + 3 * (size_t)nu;
@@ -698,8 +713,7 @@ static int tbz_cgls(sfb__tbz *T, const tbz_sys *S, const int *rows, int nr, cons
         for (c = 0; c < 3; ++c) rr[3 * r + c] = -v[c];
     }
     lo[nr] = n;
-    /* its transpose (co/cr/cw), each column's entries in row order: A^T r gathered per unknown
-     * adds the very terms in the very order the row-by-row scatter did */
+    /* its transpose (co/cr/cw), each column's entries in row order (tbz_atr) */
     for (i = 0; i <= nu; ++i) co[i] = 0;
     for (k = 0; k < n; ++k) ++co[lc[k] + 1];
     for (i = 0; i < nu; ++i) co[i + 1] += co[i];
@@ -711,10 +725,8 @@ static int tbz_cgls(sfb__tbz *T, const tbz_sys *S, const int *rows, int nr, cons
         }
     for (i = nu; i > 0; --i) co[i] = co[i - 1];
     co[0] = 0;
-    for (i = 0; i < 3 * nu; ++i) xs[i] = sv[i] = 0.0;
-    for (r = 0; r < nr; ++r)
-        for (k = lo[r]; k < lo[r + 1]; ++k)
-            for (c = 0; c < 3; ++c) sv[3 * lc[k] + c] += lw[k] * rr[3 * r + c];
+    for (i = 0; i < 3 * nu; ++i) xs[i] = 0.0;
+    tbz_atr(co, cr, cw, rr, nu, sv);
     for (c = 0; c < 3; ++c) { gamma[c] = 0.0; active[c] = 1; }
     for (i = 0; i < nu; ++i)
         for (c = 0; c < 3; ++c) { p[3 * i + c] = sv[3 * i + c]; gamma[c] += sv[3 * i + c] * sv[3 * i + c]; }
@@ -753,14 +765,7 @@ static int tbz_cgls(sfb__tbz *T, const tbz_sys *S, const int *rows, int nr, cons
             h[it % TBZ_STALL] = r2[c];
         }
         if (left == 0) { ++it; break; }
-        for (i = 0; i < nu; ++i) {
-            double s0 = 0.0, s1 = 0.0, s2 = 0.0;
-            for (k = co[i]; k < co[i + 1]; ++k) {
-                const double *rv = rr + 3 * (size_t)cr[k];
-                s0 += cw[k] * rv[0]; s1 += cw[k] * rv[1]; s2 += cw[k] * rv[2];
-            }
-            sv[3 * i] = s0; sv[3 * i + 1] = s1; sv[3 * i + 2] = s2;
-        }
+        tbz_atr(co, cr, cw, rr, nu, sv);
         for (i = 0; i < nu; ++i)
             for (c = 0; c < 3; ++c) g2[c] += sv[3 * i + c] * sv[3 * i + c];
         for (c = 0; c < 3; ++c) {
@@ -777,9 +782,9 @@ static int tbz_cgls(sfb__tbz *T, const tbz_sys *S, const int *rows, int nr, cons
 
 /* The connected components of the constraints: rows sharing an unknown are in one. rows[] and
  * unk[] list the rows and the unknowns' points component by component, [rstart[i], rstart[i+1])
- * and [ustart[i], ustart[i+1]); maxr, maxu the largest component's counts. */
+ * and [ustart[i], ustart[i+1]). */
 typedef struct tbz_comps {
-    int nc, maxr, maxu;
+    int nc;
     int *rstart, *ustart, *rows, *unk;
 } tbz_comps;
 
@@ -818,8 +823,6 @@ static sfb_result tbz_components(sfb__tbz *T, const tbz_sys *S, const int *ucol,
     }
     for (i = 0; i < nu; ++i) ++C->ustart[parent[i] + 1];
     for (i = 0; i < nc; ++i) {
-        C->maxr = C->rstart[i + 1] > C->maxr ? C->rstart[i + 1] : C->maxr;
-        C->maxu = C->ustart[i + 1] > C->maxu ? C->ustart[i + 1] : C->maxu;
         C->rstart[i + 1] += C->rstart[i];
         C->ustart[i + 1] += C->ustart[i];
     }
@@ -882,18 +885,20 @@ static sfb_result tbz_solve_todo(sfb__tbz *T, const tbz_sys *S, const tbz_comps 
     tbz_job J;
     int bstart[TBZ_BLOCKS + 1], nb = nt < TBZ_BLOCKS ? nt : TBZ_BLOCKS, b, t;
     tbz_block blk[TBZ_BLOCKS];
-    size_t total = 0, acc = 0;
+    size_t total = 0, acc = 0, *ent;
     sfb_result res = SFB_SUCCESS;
     if (nt == 0) return SFB_SUCCESS;
     memset(blk, 0, sizeof blk);
     J.its = (int *)sfb__alloc(T->ctx, (size_t)nt * sizeof(int));
     if (!J.its) return sfb__oom(T->ctx, "tribezier constraints");
-    /* a component's work ~ the entries of its rows */
-    for (t = 0; t < nt; ++t) total += tbz_comp_entries(S, C, todo[t]) + 1;
+    /* a component's work ~ the entries of its rows (ent, per todo entry, in its for now) */
+    ent = (size_t *)sfb__alloc(T->ctx, (size_t)nt * sizeof(size_t));
+    if (!ent) { sfb__free(T->ctx, J.its); return sfb__oom(T->ctx, "tribezier constraints"); }
+    for (t = 0; t < nt; ++t) total += (ent[t] = tbz_comp_entries(S, C, todo[t])) + 1;
     bstart[0] = 0;
     for (b = 1, t = 0; b < nb; ++b) {
         const size_t goal = total / (size_t)nb * (size_t)b;
-        while (t < nt && acc < goal) acc += tbz_comp_entries(S, C, todo[t++]) + 1;
+        while (t < nt && acc < goal) acc += ent[t++] + 1;
         bstart[b] = t;
     }
     bstart[nb] = nt;
@@ -901,8 +906,8 @@ static sfb_result tbz_solve_todo(sfb__tbz *T, const tbz_sys *S, const tbz_comps 
         size_t mr = 0, mu = 0, me = 0;
         for (t = bstart[b]; t < bstart[b + 1]; ++t) {
             const int i = todo[t];
-            const size_t nr = (size_t)(C->rstart[i + 1] - C->rstart[i]), nu = (size_t)(C->ustart[i + 1] - C->ustart[i]), ne = tbz_comp_entries(S, C, i);
-            mr = nr > mr ? nr : mr; mu = nu > mu ? nu : mu; me = ne > me ? ne : me;
+            const size_t nr = (size_t)(C->rstart[i + 1] - C->rstart[i]), nu = (size_t)(C->ustart[i + 1] - C->ustart[i]);
+            mr = nr > mr ? nr : mr; mu = nu > mu ? nu : mu; me = ent[t] > me ? ent[t] : me;
         }
         blk[b].w = (double *)sfb__alloc(T->ctx, (6 * mr + 12 * mu + 3 * TBZ_STALL + 1) * sizeof(double));
         blk[b].lo = (size_t *)sfb__alloc(T->ctx, (mr + 1) * sizeof(size_t));
@@ -923,6 +928,7 @@ static sfb_result tbz_solve_todo(sfb__tbz *T, const tbz_sys *S, const tbz_comps 
         sfb__free(T->ctx, blk[b].co); sfb__free(T->ctx, blk[b].cr); sfb__free(T->ctx, blk[b].cw);
     }
     sfb__free(T->ctx, J.its);
+    sfb__free(T->ctx, ent);
     return res;
 }
 
