@@ -127,7 +127,10 @@ typedef struct sfb_error_info {
     const char *message;      /* full message, includes the element */
 } sfb_error_info;
 
-/* Message of the last failure on this context ("" if none). Valid until the next call. */
+/* Message of the last failure on this context ("" if none). Valid until the next call. A call
+ * that succeeds leaves it as it was, also when it recovered from an internal failure (an eigen
+ * basis that could not be built, a fillet curve skipped by skip_failed, a map's solve that fell
+ * back to the next): those reasons go to the context's logger. */
 SFB_API const char *sfb_last_error(const sfb_context *ctx);
 SFB_API sfb_error_info sfb_last_error_info(const sfb_context *ctx);
 SFB_API void sfb_clear_error(sfb_context *ctx);

@@ -192,6 +192,51 @@ static void check_loop_regular(sfb_context *ctx) {
     check(worst[2] < 1e-4, "loop/6/stam_second_derivatives", "second derivatives off by %.3g", worst[2]);
 }
 
+/* A basis that cannot be built (here: the memory budget refuses it) is recovered from: get
+ * returns NULL (its faces are then isolated adaptively), the reason goes to the logger as a
+ * warning, and the caller's last error is left as it was, not wiped. */
+typedef struct warn_log {
+    int n;
+    char msg[1024];
+} warn_log;
+static void warn_logger(int level, const char *msg, void *user) {
+    warn_log *l = (warn_log *)user;
+    if (level != SFB_LOG_WARN) return;
+    l->n++;
+    snprintf(l->msg, sizeof l->msg, "%s", msg);
+}
+static void check_failed_build_keeps_the_last_error(void) {
+    int loop;
+    for (loop = 0; loop < 2; ++loop) {
+        sfb_context_config cc = sfb_context_config_init();
+        sfb_context *ctx = NULL;
+        sfb_mesh *m = NULL;
+        warn_log lg;
+        char earlier[1024], name[96];
+        const void *got;
+        size_t budget;
+        memset(&lg, 0, sizeof lg);
+        cc.logger.func = warn_logger;
+        cc.logger.user = &lg;
+        snprintf(name, sizeof name, "%s/failed_build_keeps_the_last_error", loop ? "loop" : "catmark");
+        if (sfb_context_create(&cc, &ctx) != SFB_SUCCESS) { fail(name, "no context"); continue; }
+        /* an earlier failure of the caller's */
+        snprintf(earlier, sizeof earlier, "%s", sfb_mesh_read_obj(ctx, "v 0 0 0\nf 1 2 3\n", 18, &m) != SFB_SUCCESS ? sfb_last_error(ctx) : "");
+        if (m) sfb_mesh_destroy(m);
+        budget = ctx->budget;
+        ctx->budget = ctx->live_bytes + 64; /* the build's first allocation is refused */
+        got = loop ? (const void *)sfb__eigen_loop_get(ctx, 7) : (const void *)sfb__eigen_cc_get(ctx, 7);
+        ctx->budget = budget;
+        check(got == NULL && earlier[0] && strcmp(sfb_last_error(ctx), earlier) == 0 && lg.n == 1 && strstr(lg.msg, "valence 7"), name,
+              "basis %p, last error '%s' (earlier '%s'), %d warnings, last '%s'", got, sfb_last_error(ctx), earlier, lg.n, lg.msg);
+        /* the failure is remembered: no second attempt, no second warning */
+        got = loop ? (const void *)sfb__eigen_loop_get(ctx, 7) : (const void *)sfb__eigen_cc_get(ctx, 7);
+        snprintf(name, sizeof name, "%s/failed_build_remembered", loop ? "loop" : "catmark");
+        check(got == NULL && lg.n == 1, name, "basis %p, %d warnings", got, lg.n);
+        sfb_context_destroy(ctx);
+    }
+}
+
 int main(void) {
     sfb_context *ctx = make_context(SFB_BACKEND_REF);
     double wcc = 0.0, wloop = 0.0;
@@ -209,5 +254,6 @@ int main(void) {
     printf("# worst |AV - VJ| / max|A|: Catmull-Clark %.3g, Loop %.3g\n", wcc, wloop);
     check_loop_regular(ctx);
     sfb_context_destroy(ctx);
+    check_failed_build_keeps_the_last_error();
     return close_tests();
 }

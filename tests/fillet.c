@@ -699,6 +699,19 @@ static void test_junctions(void) {
     fs_free(&fm);
 }
 
+/* A logger that counts the skip_failed lines and keeps the last. */
+typedef struct skip_log {
+    int skips;
+    char msg[1024];
+} skip_log;
+static void skip_logger(int level, const char *msg, void *user) {
+    skip_log *l = (skip_log *)user;
+    if (level == SFB_LOG_WARN && strstr(msg, "left sharp (skip_failed)")) {
+        l->skips++;
+        snprintf(l->msg, sizeof l->msg, "%s", msg);
+    }
+}
+
 /* config.skip_failed: the step's concave edge given a radius its base patches cannot hold (2.0 on
  * a 1.0 deep step): refused whole without it; with it, that curve is reported skipped and its
  * vertices stay, the convex edge is filleted; every curve failing is still an error. */
@@ -744,6 +757,29 @@ static void test_skip_failed(void) {
               moved_near[0], moved_near[1], rep.vertices_moved);
         sfb_fillet_report_free(&rep);
         sfb_mesh_destroy(out);
+    }
+    {
+        /* the skipped curve's reason goes to the logger, and the caller's last error is left as
+         * it was (a context of its own, with a logger) */
+        sfb_context_config cc = sfb_context_config_init();
+        sfb_context *lc = NULL;
+        skip_log lg;
+        memset(&lg, 0, sizeof lg);
+        cc.logger.func = skip_logger;
+        cc.logger.user = &lg;
+        if (sfb_context_create(&cc, &lc) != SFB_SUCCESS) fail("skip/logger context", "none");
+        else {
+            sfb_fillet_config bad = sfb_fillet_config_init(-1.0f);
+            sfb_mesh *o2 = NULL;
+            char earlier[1024];
+            snprintf(earlier, sizeof earlier, "%s", sfb_mesh_fillet(lc, in, &bad, &o2, NULL) != SFB_SUCCESS ? sfb_last_error(lc) : "");
+            r = sfb_mesh_fillet(lc, in, &cfg, &o2, NULL);
+            check(r == SFB_SUCCESS && o2 && earlier[0] && strcmp(sfb_last_error(lc), earlier) == 0 && lg.skips == 1 && strstr(lg.msg, "curve 1"),
+                  "skip/the reason logged, the caller's last error kept", "%s; last error '%s' (earlier '%s'); %d skip lines, last '%s'",
+                  sfb_result_string(r), sfb_last_error(lc), earlier, lg.skips, lg.msg);
+            if (o2) sfb_mesh_destroy(o2);
+            sfb_context_destroy(lc);
+        }
     }
     curves[0].radius = 2.0f;
     expect_error(in, &cfg, SFB_INVALID_VALUE, "skip/every curve failing is still an error");

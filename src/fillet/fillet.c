@@ -531,7 +531,16 @@ static sfb_result fil_junctions_fill(sfb__fil *F) {
                 double *bc = (double *)sfb__alloc(ctx, (size_t)nu * sizeof(double));
                 if (!bc) { res = sfb__oom(ctx, "the junctions"); break; }
                 for (i = 0; i < nu; ++i) { bc[i] = b[3 * (size_t)i + c]; x[i] = 0.0; }
-                if (sfb__sparse_cg(ctx, &A, bc, x, 1e-12, 4 * nu + 200, &it, &resid) != SFB_SUCCESS) sfb_clear_error(ctx); /* best effort */
+                {
+                    /* best effort: a solve that does not converge keeps its last iterate, said to
+                     * the logger; the caller's last error is put back */
+                    sfb__error_state kept;
+                    sfb__error_keep(ctx, &kept);
+                    if (sfb__sparse_cg(ctx, &A, bc, x, 1e-12, 4 * nu + 200, &it, &resid) != SFB_SUCCESS) {
+                        sfb__log(ctx, SFB_LOG_INFO, "fillet junctions: %s; the last iterate is kept", ctx->error);
+                        sfb__error_put_back(ctx, &kept);
+                    }
+                }
                 for (i = 0; i < n; ++i)
                     if (loc[list[i]] >= 0 && isfinite(x[loc[list[i]]])) F->opos[3 * (size_t)list[i] + c] = F->pos[3 * (size_t)list[i] + c] + x[loc[list[i]]];
                 sfb__free(ctx, bc);
@@ -1225,6 +1234,7 @@ static sfb_result fil_harmonic(sfb__fil *F, sfb__fil_work *W, double T, int peri
     int n = 0, ni = 0, nfull = 0, i, k, pass, f;
     size_t cap, nt;
     sfb_result res = SFB_SUCCESS;
+    sfb__error_state kept;
     *used = 0;
     mv = (int *)sfb__alloc(ctx, ((size_t)W->nvlist + 1) * sizeof(int));
     if (!mv) { res = sfb__oom(ctx, "the conformal map"); goto done; }
@@ -1326,14 +1336,19 @@ static sfb_result fil_harmonic(sfb__fil *F, sfb__fil_work *W, double T, int peri
             if (!bb || !xx) { sfb__free(ctx, bb); sfb__free(ctx, xx); sfb__sparse_free(ctx, &A); res = sfb__oom(ctx, "the conformal map"); goto done; }
             for (i = 0; i < n; ++i)
                 if (inner[i] >= 0) { bb[inner[i]] = b[2 * (size_t)inner[i] + comp]; xx[inner[i]] = W->ta[2 * (size_t)mv[i] + comp]; }
+            sfb__error_keep(ctx, &kept);
             cr = sfb__sparse_cg(ctx, &A, bb, xx, 1e-10, 4 * ni + 200, &it, &resid);
-            if (cr != SFB_SUCCESS) fold = 1; /* not positive definite (cotangent weights) or no convergence */
+            if (cr != SFB_SUCCESS) { /* not positive definite (cotangent weights) or no convergence: the next map */
+                sfb__log(ctx, SFB_LOG_INFO, "fillet: the %s map's solve failed (%s); trying the next", pass == 1 ? "conformal" : "mean-value", ctx->error);
+                sfb__error_put_back(ctx, &kept);
+                fold = 1;
+            }
             for (i = 0; i < ni; ++i) x[2 * (size_t)i + comp] = xx[i];
             sfb__free(ctx, bb);
             sfb__free(ctx, xx);
         }
         sfb__sparse_free(ctx, &A);
-        if (fold) { sfb_clear_error(ctx); continue; }
+        if (fold) continue;
         /* the solution with the boundary's own values; folds: a face whose (t, a) orientation
          * disagrees with the direct map's prevailing one */
         for (i = 0; i < n; ++i) {
@@ -2005,6 +2020,7 @@ SFB_API sfb_result sfb_mesh_fillet(sfb_context *ctx, const sfb_mesh *mesh, const
     int *cvert = NULL, i, nc = 0, nskip = 0;
     float *csharp = NULL;
     sfb_result res;
+    sfb__error_state kept;
     double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL}, need;
     if (out) *out = NULL;
     if (report) memset(report, 0, sizeof *report);
@@ -2065,13 +2081,16 @@ SFB_API sfb_result sfb_mesh_fillet(sfb_context *ctx, const sfb_mesh *mesh, const
     if (res != SFB_SUCCESS) goto done;
     /* every curve on the input's positions (each writes its own region into opos; the regions of
      * curves that meet at a corner end at the corner's planes, so they do not overlap) */
+    sfb__error_keep(ctx, &kept);
     for (i = 0; i < F.ncurves; ++i) {
         res = fil_one(&F, &W, &F.curves[i], i, &reps[i]);
         if (res == SFB_INVALID_VALUE && config->skip_failed) {
             /* this curve cannot be filleted with this radius (fil_one wrote nothing): left sharp, said */
             reps[i].skipped = 1;
             nskip++;
-            sfb_clear_error(ctx);
+            /* the reason goes to the logger; the caller's last error is put back (the call succeeds) */
+            sfb__log(ctx, SFB_LOG_WARN, "fillet: curve %d left sharp (skip_failed): %s", i, ctx->error);
+            sfb__error_put_back(ctx, &kept);
             res = SFB_SUCCESS;
             continue;
         }

@@ -440,13 +440,17 @@ oom:
 /* The context's cache: built on first use of a valence, kept until the context goes. */
 const sfb__eigen_cc *sfb__eigen_cc_get(sfb_context *ctx, int N) {
     sfb__eigen_cc *e;
+    sfb__error_state kept;
     if (N < 3 || N > SFB__STAM_MAX_VALENCE) return NULL;
     if (ctx->eigen_cc[N]) return ctx->eigen_cc[N];
     if (ctx->eigen_cc_failed[N]) return NULL;
+    sfb__error_keep(ctx, &kept);
     if (sfb__eigen_cc_build(ctx, N, 0, &e) != SFB_SUCCESS) {
+        /* recovered here: said to the logger, and the caller's last error put back (the call
+         * that needed the basis still succeeds) */
         ctx->eigen_cc_failed[N] = 1;
         sfb__log(ctx, SFB_LOG_WARN, "valence %d: %s; its faces are isolated adaptively instead", N, ctx->error);
-        sfb_clear_error(ctx);
+        sfb__error_put_back(ctx, &kept);
         return NULL;
     }
     ctx->eigen_cc[N] = e;
@@ -740,13 +744,17 @@ oom:
 
 const sfb__eigen_loop *sfb__eigen_loop_get(sfb_context *ctx, int N) {
     sfb__eigen_loop *e;
+    sfb__error_state kept;
     if (N < 3 || N > SFB__STAM_MAX_VALENCE) return NULL;
     if (ctx->eigen_loop[N]) return ctx->eigen_loop[N];
     if (ctx->eigen_loop_failed[N]) return NULL;
+    sfb__error_keep(ctx, &kept);
     if (sfb__eigen_loop_build(ctx, N, 0, &e) != SFB_SUCCESS) {
+        /* recovered here: said to the logger, and the caller's last error put back (the call
+         * that needed the basis still succeeds) */
         ctx->eigen_loop_failed[N] = 1;
         sfb__log(ctx, SFB_LOG_WARN, "valence %d: %s; its faces are isolated adaptively instead", N, ctx->error);
-        sfb_clear_error(ctx);
+        sfb__error_put_back(ctx, &kept);
         return NULL;
     }
     ctx->eigen_loop[N] = e;
