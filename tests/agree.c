@@ -24,6 +24,9 @@
  *                            every simd kernel (simd-ISA/..., SURFBLEND_SIMD_ISA) the CPU has.
  *   simd/threads/T           threads = 1, 2 and 0 (one per core) on a large mesh, and several
  *                            application threads calling eval on one surface at once
+ *   simd/threads/patches-S   the simd patch upload over its pool: Catmull-Clark and Loop surfaces of
+ *                            a triangulated torus built on 1 and on 4 threads evaluate the same bit
+ *                            for bit (position, derivatives, normal)
  *   BACKEND/eval_gl          sfb_surface_eval_stencils_gl returns SFB_UNSUPPORTED (no host context)
  * and, independent of availability:
  *   env/bogus                SURFBLEND_BACKEND=bogus: the context is still created on the default
@@ -857,6 +860,89 @@ static void *call_thread(void *arg) {
     return NULL;
 }
 
+/* simd/threads/patches-SCHEME: the simd patch upload packs its patches over the pool (from 2048
+ * patches on): a Catmull-Clark surface of a triangulated torus (every patch a Stam one) and a
+ * Loop one (Stam-Loop patches at its valence-4 and -8 vertices), each built on one thread and on
+ * four, evaluate (position, first and second derivatives, normal) the same bit for bit at 20000
+ * random locations; the table must be large enough for the pool to be used. */
+static void run_patch_threads(void) {
+    backend *simd = NULL;
+    int b, scheme;
+    for (b = 0; b < g_backend_count; ++b)
+        if (strcmp(g_backends[b].name, "simd") == 0) simd = &g_backends[b];
+    for (scheme = 0; scheme < 2; ++scheme) {
+        const char *name = scheme ? "simd/threads/patches-loop" : "simd/threads/patches-catmark";
+        enum { NU = 48, NV = 32, NLOC = 20000 };
+        char *obj;
+        size_t used = 0, cap = (size_t)NU * NV * 80 + 64;
+        sfb_mesh *mesh = NULL;
+        float *out[2] = {NULL, NULL};
+        sfb_location *loc = NULL;
+        int i, j, t, npatch[2] = {0, 0}, ok = 1;
+        rng g = rng_for(g_seed, 0x7A7Cull + (unsigned long long)scheme);
+        if (!simd || !simd->available) {
+            if (simd) backend_missing(simd, name);
+            else skip(name, "no simd backend compiled in");
+            continue;
+        }
+        /* a torus, every cell two triangles, the diagonals alternating (valences 4, 6 and 8) */
+        obj = (char *)xmalloc(cap);
+        for (i = 0; i < NU; ++i)
+            for (j = 0; j < NV; ++j) {
+                const double a = 2.0 * 3.14159265358979 * i / NU, c = 2.0 * 3.14159265358979 * j / NV, r = 1.0 + 0.35 * cos(c);
+                used += (size_t)snprintf(obj + used, cap - used, "v %.6f %.6f %.6f\n", r * cos(a), r * sin(a), 0.35 * sin(c) + 0.01 * rng_int(&g, 7));
+            }
+        for (i = 0; i < NU; ++i)
+            for (j = 0; j < NV; ++j) {
+                const int v00 = i * NV + j + 1, v10 = ((i + 1) % NU) * NV + j + 1, v01 = i * NV + (j + 1) % NV + 1, v11 = ((i + 1) % NU) * NV + (j + 1) % NV + 1;
+                if ((i + j) & 1) used += (size_t)snprintf(obj + used, cap - used, "f %d %d %d\nf %d %d %d\n", v00, v10, v11, v00, v11, v01);
+                else used += (size_t)snprintf(obj + used, cap - used, "f %d %d %d\nf %d %d %d\n", v00, v10, v01, v10, v11, v01);
+            }
+        if (sfb_mesh_read_obj(g_ref, obj, used, &mesh) != SFB_SUCCESS) {
+            fail(name, "the torus: %s", sfb_last_error(g_ref));
+            free(obj);
+            continue;
+        }
+        free(obj);
+        loc = (sfb_location *)xmalloc(NLOC * sizeof *loc);
+        for (t = 0; t < 2 && ok; ++t) {
+            sfb_context *ctx = make_context_threads(SFB_BACKEND_SIMD, t ? 4 : 1);
+            sfb_surface_config cfg = sfb_surface_config_init(scheme ? SFB_SCHEME_LOOP : SFB_SCHEME_CATMARK, 0);
+            sfb_surface *s = NULL;
+            sfb_patch_info pi;
+            sfb_eval_output o;
+            cfg.flags = SFB_REFINE_PATCHES;
+            if (!ctx || sfb_surface_create(ctx, mesh, &cfg, &s) != SFB_SUCCESS || sfb_surface_patch_info(s, &pi) != SFB_SUCCESS) {
+                fail(name, "threads %d: %s", t ? 4 : 1, ctx ? sfb_last_error(ctx) : "no simd context");
+                ok = 0;
+            } else {
+                const int np = sfb_surface_param_face_count(s);
+                npatch[t] = pi.patches;
+                if (t == 0)
+                    for (i = 0; i < NLOC; ++i) {
+                        /* multiples of 1/1024: exact, so u + v <= 1 holds exactly on Loop's triangles */
+                        const int a = rng_int(&g, 1025);
+                        loc[i].face = rng_int(&g, np);
+                        loc[i].u = (float)a / 1024.0f;
+                        loc[i].v = (float)rng_int(&g, scheme ? 1025 - a : 1025) / 1024.0f;
+                    }
+                out[t] = (float *)xmalloc((size_t)NLOC * 21 * sizeof(float));
+                o.position = out[t]; o.du = out[t] + 3 * NLOC; o.dv = out[t] + 6 * NLOC; o.normal = out[t] + 9 * NLOC;
+                o.duu = out[t] + 12 * NLOC; o.duv = out[t] + 15 * NLOC; o.dvv = out[t] + 18 * NLOC;
+                if (sfb_surface_eval(s, loc, NLOC, &o) != SFB_SUCCESS) { fail(name, "eval: %s", sfb_last_error(ctx)); ok = 0; }
+            }
+            sfb_surface_destroy(s);
+            if (ctx) sfb_context_destroy(ctx);
+        }
+        if (ok)
+            check(npatch[0] >= 2048 && npatch[0] == npatch[1] && memcmp(out[0], out[1], (size_t)NLOC * 21 * sizeof(float)) == 0, name,
+                  "%d and %d patches (the pool packs from 2048 on); evaluations %s", npatch[0], npatch[1],
+                  memcmp(out[0], out[1], (size_t)NLOC * 21 * sizeof(float)) == 0 ? "the same" : "DIFFER between 1 and 4 threads");
+        free(out[0]); free(out[1]); free(loc);
+        sfb_mesh_destroy(mesh);
+    }
+}
+
 static void run_threads(void) {
     static const int thread_counts[3] = {1, 2, 0};
     const backend *simd = &g_backends[0];
@@ -1137,6 +1223,7 @@ int main(int argc, char **argv) {
     if (g_verbose) printf("# layouts: %.1f s\n", now_s() - t);
     t = now_s();
     run_threads();
+    run_patch_threads();
     if (g_verbose) printf("# threads: %.1f s\n", now_s() - t);
     t = now_s();
     run_random(cases);

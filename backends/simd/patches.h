@@ -381,15 +381,75 @@ static size_t sfb__simd_patch_floats(const sfb__patch_table *pt, int p) {
     return 0;
 }
 
+/* Packs patches [first, last) of a table at their offsets (poff, floats into blk), each its leaf
+ * code into pcode: patches are independent, so ranges of them may be packed at once (the upload's
+ * threads). lp: scratch of the largest Stam K doubles. */
+typedef struct sfb__simd_pack_job {
+    const sfb__patch_table *pt;
+    float *blk;
+    const size_t *poff;
+    int *pcode;
+} sfb__simd_pack_job;
+
+static void sfb__simd_pack_range(const sfb__simd_pack_job *J, int first, int last, double *lp) {
+    const sfb__patch_table *pt = J->pt;
+    int p;
+    for (p = first; p < last; ++p) {
+        const size_t f = sfb__simd_patch_floats(pt, p), at = J->poff[p];
+        const int *cv = pt->cv + pt->pfirst[p];
+        J->pcode[p] = -(SFB__SIMD_LEAF_REF + 1);
+        if (f == 0) continue;
+        if (pt->ptype[p] == SFB__PATCH_BEZTRI) {
+            double q[15][3];
+            int k, c;
+            for (k = 0; k < 15; ++k)
+                for (c = 0; c < 3; ++c) q[k][c] = pt->point_data[3 * (size_t)cv[k] + c];
+            sfb__simd_pack_tri(J->blk + at, q);
+            J->pcode[p] = -((int)((at / 4) << 4 | SFB__SIMD_LEAF_TRI) + 1);
+        } else if (f == 64) {
+            static const int win[1][2] = {{0, 0}};
+            double q[16][3];
+            unsigned char set[16];
+            int k, c;
+            for (k = 0; k < 16; ++k) {
+                const int slot = (k % 4) * 4 + k / 4; /* cv[4 j + i] is point (i, j) */
+                for (c = 0; c < 3; ++c) q[slot][c] = pt->point_data[3 * (size_t)cv[k] + c];
+                set[k] = 1;
+            }
+            sfb__simd_pack_grid(J->blk + at, 4, 4, q, set, win, 1);
+            J->pcode[p] = -((int)((at / 4) << 4 | SFB__SIMD_LEAF_BSPLINE) + 1);
+        } else if (pt->ptype[p] == SFB__PATCH_STAM_LOOP ? SFB__PARAM_CORNER(pt->pparam[p]) < 3 && sfb__simd_pack_stam_loop(J->blk + at, pt, p)
+                                                         : sfb__simd_pack_stam(J->blk + at, pt, p, lp)) {
+            J->pcode[p] = -((int)((at / 4) << 4 | (size_t)SFB__PARAM_CORNER(pt->pparam[p]) << 2 | SFB__SIMD_LEAF_STAM) + 1);
+        }
+    }
+}
+
+#ifdef SFB__SIMD_THREADS
+static void sfb__simd_pack_task(const sfb__simd_state *s, const void *arg, int a, int b) {
+    double lp[2 * SFB__STAM_MAX_VALENCE + 8]; /* Catmull-Clark Stam: K = 2 N + 8 */
+    (void)s;
+    sfb__simd_pack_range((const sfb__simd_pack_job *)arg, a, b, lp);
+}
+#endif
+
+/* Patches from which the upload packs over the pool (fewer: on the caller's thread). */
+#define SFB__SIMD_INLINE_PACK 2048
+
 /* upload for quad and triangle tables: the grids and triangles (B-spline and Bezier triangle
  * ones first, all 64-byte aligned, then the Stam and Stam-Loop ones) and the quadtree with
- * leaf codes (vtable.h has checked the arguments and that there is something to pack). */
+ * leaf codes (vtable.h has checked the arguments and that there is something to pack). The
+ * offsets are laid out first, then the patches packed, over the pool from SFB__SIMD_INLINE_PACK
+ * patches on: every patch writes only its own floats and code, so the blocks are the same bit
+ * for bit whatever the threads (a Catmull-Clark mesh of triangles, all of whose patches are
+ * Stam ones after the first step, spent a fifth of its surface creation here on one thread). */
 static sfb_result sfb__simd_patches_upload(sfb__simd_state *s, const sfb__patch_table *pt, void **handle) {
     sfb_context *ctx = s->ctx;
     sfb__simd_patches *h;
+    sfb__simd_pack_job J;
     double *lp = NULL;
     int *pcode = NULL;
-    size_t nf = 0, at;
+    size_t nf = 0, at, *poff = NULL;
     int p, maxK = 0, pass;
     for (p = 0; p < pt->npatch; ++p) {
         const size_t f = sfb__simd_patch_floats(pt, p);
@@ -407,53 +467,38 @@ static sfb_result sfb__simd_patches_upload(sfb__simd_state *s, const sfb__patch_
     h->node = (int *)sfb__alloc(ctx, ((size_t)pt->nnodes * 4 + 1) * sizeof(int));
     h->raw = sfb__alloc(ctx, nf * sizeof(float) + 64);
     pcode = (int *)sfb__alloc(ctx, (size_t)pt->npatch * sizeof(int));
+    poff = (size_t *)sfb__alloc(ctx, ((size_t)pt->npatch + 1) * sizeof(size_t));
     if (maxK > 0) lp = (double *)sfb__alloc(ctx, (size_t)maxK * sizeof(double));
-    if (!h->root || !h->node || !h->raw || !pcode || (maxK > 0 && !lp)) {
+    if (!h->root || !h->node || !h->raw || !pcode || !poff || (maxK > 0 && !lp)) {
         sfb__free(ctx, lp);
         sfb__free(ctx, pcode);
+        sfb__free(ctx, poff);
         sfb__simd_release_patches(s, h);
         return sfb__oom(ctx, "the simd backend's patch data");
     }
     h->bytes = sizeof *h + ((size_t)pt->nptex + (size_t)pt->nnodes * 4 + 1) * sizeof(int) + nf * sizeof(float) + 64;
     /* 64-byte alignment: a B-spline column is then one cache line */
     h->blk = (float *)(void *)((char *)h->raw + ((64 - ((uintptr_t)h->raw & 63)) & 63));
-    /* B-spline grids first (all 64-byte aligned), then the Stam ones */
+    /* the offsets: B-spline grids and triangles first (all 64-byte aligned), then the Stam ones */
     at = 0;
     for (pass = 0; pass < 2; ++pass)
         for (p = 0; p < pt->npatch; ++p) {
             const size_t f = sfb__simd_patch_floats(pt, p);
-            const int *cv = pt->cv + pt->pfirst[p];
-            if (pass == 0) pcode[p] = -(SFB__SIMD_LEAF_REF + 1);
+            if (pass == 0) poff[p] = 0;
             if (f == 0 || (f == 64 || f == SFB__SIMD_TRI_FLOATS) != (pass == 0)) continue;
-            if (pt->ptype[p] == SFB__PATCH_BEZTRI) {
-                double q[15][3];
-                int k, c;
-                for (k = 0; k < 15; ++k)
-                    for (c = 0; c < 3; ++c) q[k][c] = pt->point_data[3 * (size_t)cv[k] + c];
-                sfb__simd_pack_tri(h->blk + at, q);
-                pcode[p] = -((int)((at / 4) << 4 | SFB__SIMD_LEAF_TRI) + 1);
-            } else if (f == 64) {
-                static const int win[1][2] = {{0, 0}};
-                double q[16][3];
-                unsigned char set[16];
-                int k, c;
-                for (k = 0; k < 16; ++k) {
-                    const int slot = (k % 4) * 4 + k / 4; /* cv[4 j + i] is point (i, j) */
-                    for (c = 0; c < 3; ++c) q[slot][c] = pt->point_data[3 * (size_t)cv[k] + c];
-                    set[k] = 1;
-                }
-                sfb__simd_pack_grid(h->blk + at, 4, 4, q, set, win, 1);
-                pcode[p] = -((int)((at / 4) << 4 | SFB__SIMD_LEAF_BSPLINE) + 1);
-            } else if (pt->ptype[p] == SFB__PATCH_STAM_LOOP ? SFB__PARAM_CORNER(pt->pparam[p]) < 3 && sfb__simd_pack_stam_loop(h->blk + at, pt, p)
-                                                             : sfb__simd_pack_stam(h->blk + at, pt, p, lp)) {
-                pcode[p] = -((int)((at / 4) << 4 | (size_t)SFB__PARAM_CORNER(pt->pparam[p]) << 2 | SFB__SIMD_LEAF_STAM) + 1);
-            }
+            poff[p] = at;
             at += f;
         }
+    J.pt = pt; J.blk = h->blk; J.poff = poff; J.pcode = pcode;
+#ifdef SFB__SIMD_THREADS
+    if (pt->npatch < SFB__SIMD_INLINE_PACK || !sfb__simd_pool_run(s, sfb__simd_pack_task, &J, 0, pt->npatch, NULL, 0, 0))
+#endif
+        sfb__simd_pack_range(&J, 0, pt->npatch, lp);
     for (p = 0; p < pt->nptex; ++p) h->root[p] = sfb__simd_leaf(pcode, pt->ptex_root[p]);
     for (p = 0; p < 4 * pt->nnodes; ++p) h->node[p] = sfb__simd_leaf(pcode, pt->nodes[p]);
     sfb__free(ctx, lp);
     sfb__free(ctx, pcode);
+    sfb__free(ctx, poff);
     *handle = h;
     return SFB_SUCCESS;
 }

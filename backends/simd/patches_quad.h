@@ -344,26 +344,32 @@ static int sfb__simd_pack_stam(float *g, const sfb__patch_table *pt, int p, doub
     static const int win[3][2] = {{1, 0}, {1, 1}, {0, 1}}; /* sub-patch k = 1, 2, 3: lattice (0,-1), (0,0), (-1,0) */
     const sfb__eigen_cc *e = pt->eig[pt->pvalence[p]];
     const int K = e->K, *cv = pt->cv + pt->pfirst[p];
-    double q[25][3], scale = 0.0, diff = 0.0;
+    double q[25][3], x[48][3], scale = 0.0, diff = 0.0;
     unsigned char set[25];
     int n, k, i, jj, c;
     for (i = 0; i < K; ++i) lp[i] = 1.0;
     for (n = 1; n <= SFB__SIMD_STAM_LEVELS; ++n) {
+        /* control point jj = 4 b + a of sub-patch k + 1 (x[16 k + jj]): sum_i lambda_i^(n-1)
+         * phi[jj][i] c_i, the sums over i in order, all 48 at once (independent chains: the
+         * same sums bit for bit as one point after the other) */
+        for (k = 0; k < 48; ++k) x[k][0] = x[k][1] = x[k][2] = 0.0;
+        for (i = 0; i < K; ++i) {
+            const float *c_i = pt->point_data + 3 * (size_t)cv[i];
+            const double c0 = c_i[0], c1 = c_i[1], c2 = c_i[2], l = lp[i];
+            const double *phi = e->phi + i;
+            for (k = 0; k < 48; ++k) {
+                const double w = l * phi[(size_t)k * (size_t)K];
+                x[k][0] += w * c0; x[k][1] += w * c1; x[k][2] += w * c2;
+            }
+        }
         memset(set, 0, sizeof set);
         for (k = 0; k < 3; ++k)
             for (jj = 0; jj < 16; ++jj) {
-                /* control point jj = 4 b + a of sub-patch k + 1: sum_i lambda_i^(n-1) phi[jj][i] c_i */
-                const double *phi = e->phi + ((size_t)k * 16 + (size_t)jj) * (size_t)K;
                 const int slot = (win[k][0] + jj % 4) * 5 + win[k][1] + jj / 4;
-                double x[3] = {0.0, 0.0, 0.0};
-                for (i = 0; i < K; ++i) {
-                    const double w = lp[i] * phi[i];
-                    const float *c_i = pt->point_data + 3 * (size_t)cv[i];
-                    for (c = 0; c < 3; ++c) x[c] += w * c_i[c];
-                }
+                const double *xk = x[16 * k + jj];
                 for (c = 0; c < 3; ++c) {
-                    if (set[slot] && fabs(x[c] - q[slot][c]) > diff) diff = fabs(x[c] - q[slot][c]);
-                    q[slot][c] = x[c];
+                    if (set[slot] && fabs(xk[c] - q[slot][c]) > diff) diff = fabs(xk[c] - q[slot][c]);
+                    q[slot][c] = xk[c];
                 }
                 set[slot] = 1;
             }

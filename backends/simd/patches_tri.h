@@ -279,17 +279,25 @@ static int sfb__simd_pack_stam_loop(float *g, const sfb__patch_table *pt, int p)
     int n, k, i, jj, c;
     for (n = 1; n <= SFB__SIMD_LOOP_LEVELS; ++n) {
         const int m = n - 1;
+        /* the 45 points' sums over i in order, all at once (independent chains: the same sums
+         * bit for bit as one point after the other) */
         for (k = 0; k < 3; ++k)
-            for (jj = 0; jj < 15; ++jj) {
-                const double *phi = e->phi + ((size_t)k * 15 + (size_t)jj) * (size_t)K;
+            for (jj = 0; jj < 15; ++jj)
                 for (c = 0; c < 3; ++c) q[k][jj][c] = 0.0;
-                for (i = 0; i < K; ++i) {
-                    const float *c_i = pt->point_data + 3 * (size_t)cv[i];
-                    double w = sfb__ipow(e->lambda[i], m) * phi[i];
-                    if (e->head[i] >= 0 && e->head[i] < K && m > 0) w += m * sfb__ipow(e->lambda[i], m - 1) * phi[e->head[i]];
-                    for (c = 0; c < 3; ++c) q[k][jj][c] += w * c_i[c];
-                }
+        for (i = 0; i < K; ++i) {
+            const float *c_i = pt->point_data + 3 * (size_t)cv[i];
+            const double c0 = c_i[0], c1 = c_i[1], c2 = c_i[2], l = sfb__ipow(e->lambda[i], m);
+            const int hd = e->head[i] >= 0 && e->head[i] < K && m > 0 ? e->head[i] : -1;
+            const double lh = hd >= 0 ? m * sfb__ipow(e->lambda[i], m - 1) : 0.0;
+            int r;
+            for (r = 0; r < 45; ++r) {
+                const double *phi = e->phi + (size_t)r * (size_t)K;
+                double *qr = q[r / 15][r % 15];
+                double w = l * phi[i];
+                if (hd >= 0) w += lh * phi[hd];
+                qr[0] += w * c0; qr[1] += w * c1; qr[2] += w * c2;
             }
+        }
         for (jj = 0; jj < 5; ++jj) {
             /* row index of (i, j): j (11 - j) / 2 + i */
             const int e0 = jj * (11 - jj) / 2, e2 = (4 - jj) * (11 - (4 - jj)) / 2; /* (0, jj), (0, 4 - jj) */
