@@ -1179,6 +1179,50 @@ static int limit_section(double diag, int kind) {
                osd_p_max, osd_p_mean, osd_du_max, osd_du_mean, osd_dv_max, osd_dv_mean, osd_find_ms,
                not_found);
     fflush(stdout);
+
+    /* ---- the same locations in engine-sized calls: what a call costs the backend's thread pool ---- */
+    {
+        const int call = 4096, ncalls = npoints / call;
+        printf("\nlimit evaluation (%s) in calls of %d locations (%d calls, the first %d of the locations above; an engine's\n"
+               "per-frame call): microseconds per call, best of %d; 'x 1 thread': how many times faster than simd on one thread,\n"
+               "which shows what the pool's hand-over costs a call of this size (waking a sleeping worker: 30-60 us here)\n",
+               scheme_name, call, ncalls, ncalls * call, reps);
+        printf("%-38s | %9s | %11s | %s\n", "eval calls of 4096", "us/call", "x 1 thread", "what runs");
+        struct CallCase { const char *name; int threads; };
+        const CallCase cc[2] = {{"surfblend simd, 1 thread", 1}, {"surfblend simd, all threads", 0}};
+        double one = 0.0;
+        std::vector<float> cp((size_t)call * 3), cdu((size_t)call * 3), cdv((size_t)call * 3);
+        for (int k = 0; k < 2 && ncalls > 0; ++k) {
+            sfb_context *c = eval_context(SFB_BACKEND_SIMD, cc[k].threads, 0, &why);
+            sfb_mesh *m = NULL;
+            sfb_surface *s = NULL;
+            if (!c) { printf("%-38s | unavailable: %s\n", cc[k].name, why.c_str()); continue; }
+            if (sfb_mesh_create(c, &desc, &m) != SFB_SUCCESS || sfb_surface_create(c, m, &pcfg, &s) != SFB_SUCCESS) {
+                printf("%-38s | error: %s\n", cc[k].name, sfb_last_error(c));
+                status = 1;
+            } else {
+                sfb_eval_output o;
+                bool ok = true;
+                memset(&o, 0, sizeof o);
+                o.position = cp.data(); o.du = cdu.data(); o.dv = cdv.data();
+                double best = best_of(warm, reps, 4000.0, [&]() {
+                    for (int q = 0; q < ncalls; ++q)
+                        if (sfb_surface_eval(s, &locs[(size_t)q * call], call, &o) != SFB_SUCCESS) return false;
+                    return true;
+                }, &ok);
+                if (!ok) { printf("%-38s | error: %s\n", cc[k].name, sfb_last_error(c)); status = 1; }
+                else {
+                    const double us = best * 1e3 / ncalls;
+                    if (k == 0) one = us;
+                    printf("%-38s | %9.1f | %11.2f | %s\n", cc[k].name, us, one > 0 ? one / us : 0.0, why.c_str());
+                }
+            }
+            sfb_surface_destroy(s);
+            sfb_mesh_destroy(m);
+            sfb_context_destroy(c);
+        }
+        fflush(stdout);
+    }
     fprintf(stderr, "limit eval done (%.1f s)\n", ms_since(t_sec) / 1000.0);
 
     /* ---- tessellation ---- */
