@@ -383,7 +383,7 @@ static size_t sfb__simd_patch_floats(const sfb__patch_table *pt, int p) {
 
 /* Packs patches [first, last) of a table at their offsets (poff, floats into blk), each its leaf
  * code into pcode: patches are independent, so ranges of them may be packed at once (the upload's
- * threads). lp: scratch of the largest Stam K doubles. */
+ * threads). */
 typedef struct sfb__simd_pack_job {
     const sfb__patch_table *pt;
     float *blk;
@@ -391,8 +391,9 @@ typedef struct sfb__simd_pack_job {
     int *pcode;
 } sfb__simd_pack_job;
 
-static void sfb__simd_pack_range(const sfb__simd_pack_job *J, int first, int last, double *lp) {
+static void sfb__simd_pack_range(const sfb__simd_pack_job *J, int first, int last) {
     const sfb__patch_table *pt = J->pt;
+    double lp[2 * SFB__STAM_MAX_VALENCE + 8]; /* sfb__simd_pack_stam's scratch: Catmull-Clark Stam K = 2 N + 8 */
     int p;
     for (p = first; p < last; ++p) {
         const size_t f = sfb__simd_patch_floats(pt, p), at = J->poff[p];
@@ -427,9 +428,8 @@ static void sfb__simd_pack_range(const sfb__simd_pack_job *J, int first, int las
 
 #ifdef SFB__SIMD_THREADS
 static void sfb__simd_pack_task(const sfb__simd_state *s, const void *arg, int a, int b) {
-    double lp[2 * SFB__STAM_MAX_VALENCE + 8]; /* Catmull-Clark Stam: K = 2 N + 8 */
     (void)s;
-    sfb__simd_pack_range((const sfb__simd_pack_job *)arg, a, b, lp);
+    sfb__simd_pack_range((const sfb__simd_pack_job *)arg, a, b);
 }
 #endif
 
@@ -447,15 +447,10 @@ static sfb_result sfb__simd_patches_upload(sfb__simd_state *s, const sfb__patch_
     sfb_context *ctx = s->ctx;
     sfb__simd_patches *h;
     sfb__simd_pack_job J;
-    double *lp = NULL;
     int *pcode = NULL;
     size_t nf = 0, at, *poff = NULL;
-    int p, maxK = 0, pass;
-    for (p = 0; p < pt->npatch; ++p) {
-        const size_t f = sfb__simd_patch_floats(pt, p);
-        nf += f;
-        if (pt->ptype[p] == SFB__PATCH_STAM && f > 0 && pt->pfirst[p + 1] - pt->pfirst[p] > maxK) maxK = pt->pfirst[p + 1] - pt->pfirst[p];
-    }
+    int p, pass;
+    for (p = 0; p < pt->npatch; ++p) nf += sfb__simd_patch_floats(pt, p);
     if (nf / 4 >= ((size_t)1 << 27)) /* leaf codes hold offset / 4 in 27 bits */
         return sfb__error(ctx, SFB_LIMIT_EXCEEDED, SFB_ELEMENT_NONE, -1, "simd: the patch table is too large to pack (%zu floats)", nf);
     h = (sfb__simd_patches *)sfb__alloc(ctx, sizeof *h);
@@ -468,9 +463,7 @@ static sfb_result sfb__simd_patches_upload(sfb__simd_state *s, const sfb__patch_
     h->raw = sfb__alloc(ctx, nf * sizeof(float) + 64);
     pcode = (int *)sfb__alloc(ctx, (size_t)pt->npatch * sizeof(int));
     poff = (size_t *)sfb__alloc(ctx, ((size_t)pt->npatch + 1) * sizeof(size_t));
-    if (maxK > 0) lp = (double *)sfb__alloc(ctx, (size_t)maxK * sizeof(double));
-    if (!h->root || !h->node || !h->raw || !pcode || !poff || (maxK > 0 && !lp)) {
-        sfb__free(ctx, lp);
+    if (!h->root || !h->node || !h->raw || !pcode || !poff) {
         sfb__free(ctx, pcode);
         sfb__free(ctx, poff);
         sfb__simd_release_patches(s, h);
@@ -493,10 +486,9 @@ static sfb_result sfb__simd_patches_upload(sfb__simd_state *s, const sfb__patch_
 #ifdef SFB__SIMD_THREADS
     if (pt->npatch < SFB__SIMD_INLINE_PACK || !sfb__simd_pool_run(s, sfb__simd_pack_task, &J, 0, pt->npatch, NULL, 0, 0))
 #endif
-        sfb__simd_pack_range(&J, 0, pt->npatch, lp);
+        sfb__simd_pack_range(&J, 0, pt->npatch);
     for (p = 0; p < pt->nptex; ++p) h->root[p] = sfb__simd_leaf(pcode, pt->ptex_root[p]);
     for (p = 0; p < 4 * pt->nnodes; ++p) h->node[p] = sfb__simd_leaf(pcode, pt->nodes[p]);
-    sfb__free(ctx, lp);
     sfb__free(ctx, pcode);
     sfb__free(ctx, poff);
     *handle = h;
