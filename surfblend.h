@@ -13980,6 +13980,29 @@ static void sfb__an_seed_tri(sfb__an *A, const int *tv, int row0, int row1) {
         S[k] = &A->rv[tv[k]];
         P[k] = A->gpos + 3 * (size_t)tv[k];
     }
+    {
+        /* the tiles of 8 x 8 pixels under the dilated box first: inside the surface's picture
+         * every pixel is drawn and the triangle has nothing to seed (the box is a pixel wider
+         * than sfb__raster_setup's; the tiles are sfb__an_ucov_rows') */
+        const int nb = (A->w + 7) / 8;
+        const unsigned char *tile = A->ucov + (size_t)A->h * (size_t)nb;
+        double lx = S[0]->x, hx = lx, ly = S[0]->y, hy = ly;
+        int tx0, tx1, ty0, ty1, any = 0;
+        for (k = 1; k < 3; ++k) {
+            if (S[k]->x < lx) lx = S[k]->x;
+            if (S[k]->x > hx) hx = S[k]->x;
+            if (S[k]->y < ly) ly = S[k]->y;
+            if (S[k]->y > hy) hy = S[k]->y;
+        }
+        tx0 = (int)sfb__rclamp(floor(lx - 1.5 - SFB__AN_DILATE), 0.0, (double)A->w - 1.0) >> 3;
+        tx1 = (int)sfb__rclamp(ceil(hx + 0.5 + SFB__AN_DILATE), 0.0, (double)A->w - 1.0) >> 3;
+        ty0 = (int)sfb__rclamp(floor(ly - 1.5 - SFB__AN_DILATE), (double)row0, (double)row1 - 1.0) >> 3;
+        ty1 = (int)sfb__rclamp(ceil(hy + 0.5 + SFB__AN_DILATE), (double)row0, (double)row1 - 1.0) >> 3;
+        for (y = ty0; y <= ty1 && !any; ++y)
+            for (x = tx0; x <= tx1; ++x)
+                if (tile[(size_t)y * (size_t)nb + (size_t)x]) { any = 1; break; }
+        if (!any) return;
+    }
     /* thin or grazing first (most are neither): area as sfb__raster_setup has it */
     area = (S[1]->x - S[0]->x) * (S[2]->y - S[0]->y) - (S[2]->x - S[0]->x) * (S[1]->y - S[0]->y);
     for (k = 0; k < 3; ++k) { /* edge k, opposite corner k */
@@ -14020,19 +14043,28 @@ static void sfb__an_seed_tri(sfb__an *A, const int *tv, int row0, int row1) {
         }
 }
 
-/* Rows [y0, y1) after the raster: per block of 8 pixels of a row, whether one is not drawn. */
-static void sfb__an_ucov_rows(void *arg, int y0, int y1) {
+/* Tile rows [t0, t1) (8 pixel rows each) after the raster: per block of 8 pixels of a row,
+ * whether one is not drawn; and per tile of 8 x 8 pixels, whether one of its blocks is (after
+ * the rows' blocks in A->ucov). */
+static void sfb__an_ucov_rows(void *arg, int t0, int t1) {
     sfb__an *A = (sfb__an *)arg;
     const int nb = (A->w + 7) / 8;
-    int y, b, x;
-    for (y = y0; y < y1; ++y) {
-        const int *f = A->face + (size_t)y * (size_t)A->w;
-        unsigned char *u = A->ucov + (size_t)y * (size_t)nb;
-        for (b = 0; b < nb; ++b) {
-            const int xe = 8 * b + 8 < A->w ? 8 * b + 8 : A->w;
-            int m = 0;
-            for (x = 8 * b; x < xe; ++x) m |= f[x];
-            u[b] = (unsigned char)(m < 0); /* a face of -1 sets the sign bit */
+    unsigned char *tile = A->ucov + (size_t)A->h * (size_t)nb;
+    int ty, y, b, x;
+    for (ty = t0; ty < t1; ++ty) {
+        const int ye = 8 * ty + 8 < A->h ? 8 * ty + 8 : A->h;
+        unsigned char *tu = tile + (size_t)ty * (size_t)nb;
+        memset(tu, 0, (size_t)nb);
+        for (y = 8 * ty; y < ye; ++y) {
+            const int *f = A->face + (size_t)y * (size_t)A->w;
+            unsigned char *u = A->ucov + (size_t)y * (size_t)nb;
+            for (b = 0; b < nb; ++b) {
+                const int xe = 8 * b + 8 < A->w ? 8 * b + 8 : A->w;
+                int m = 0;
+                for (x = 8 * b; x < xe; ++x) m |= f[x];
+                u[b] = (unsigned char)(m < 0); /* a face of -1 sets the sign bit */
+                tu[b] |= u[b];
+            }
         }
     }
 }
@@ -14254,7 +14286,7 @@ static sfb_result sfb__an_raster(sfb__an *A) {
     if (A->ppos) { job.apos = A->gpos; job.anrm = A->gnrm; job.pos = A->ppos; job.nrm = A->pnrm; }
     if ((r = sfb__an_raster_kernel(A, &job)) != SFB_SUCCESS) return r;
     if ((r = sfb__progress(A->ctx, 0.25f, "analyze")) != SFB_SUCCESS) return r;
-    sfb__an_run(A, sfb__an_ucov_rows, A, 0, A->h, (double)A->w * A->h * 0.1);
+    sfb__an_run(A, sfb__an_ucov_rows, A, 0, (A->h + 7) / 8, (double)A->w * A->h * 0.1);
     sfb__an_run(A, sfb__an_seed_rows_tri, A, 0, A->h, (double)A->ntri * 4.0);
     return SFB_SUCCESS;
 }
@@ -15150,13 +15182,12 @@ static sfb_result sfb__an_leftovers(sfb__an *A, int *fallback, int *dropped, int
  * difference (robust at silhouettes and band ends), summed. */
 static double sfb__an_footprint(const float *v, int w, int h, int x, int y) {
     const int pix = y * w + x;
-    double c = v[pix], dx = HUGE_VAL, dy = HUGE_VAL, d;
-    if (x > 0 && isfinite(v[pix - 1])) { d = fabs(c - v[pix - 1]); if (d < dx) dx = d; }
-    if (x + 1 < w && isfinite(v[pix + 1])) { d = fabs(c - v[pix + 1]); if (d < dx) dx = d; }
-    if (y > 0 && isfinite(v[pix - w])) { d = fabs(c - v[pix - w]); if (d < dy) dy = d; }
-    if (y + 1 < h && isfinite(v[pix + w])) { d = fabs(c - v[pix + w]); if (d < dy) dy = d; }
-    if (dx == HUGE_VAL) dx = 0.0;
-    if (dy == HUGE_VAL) dy = 0.0;
+    const double c = v[pix];
+    /* a neighbour off the picture or not finite gives +inf (|c - inf|, or the NaN's failed
+     * comparison below leaves the other side's); none on an axis gives 0 */
+    const double l = x > 0 ? fabs(c - v[pix - 1]) : HUGE_VAL, r = x + 1 < w ? fabs(c - v[pix + 1]) : HUGE_VAL;
+    const double u = y > 0 ? fabs(c - v[pix - w]) : HUGE_VAL, o = y + 1 < h ? fabs(c - v[pix + w]) : HUGE_VAL;
+    double dx = l < r ? l : r < HUGE_VAL ? r : l < HUGE_VAL ? l : 0.0, dy = u < o ? u : o < HUGE_VAL ? o : u < HUGE_VAL ? u : 0.0;
     return dx + dy;
 }
 /* The looks of one analysis: resolved light and colours. */
@@ -15319,18 +15350,25 @@ static void sfb__an_colour(void *arg, int y0, int y1) {
     const float *v1 = J->v1, *v2 = J->v2;
     unsigned char *rgba = J->rgba, *cls = J->cls;
     const sfb_analyze_config *c = A->c;
-    size_t p, end = (size_t)y1 * (size_t)A->w;
-    int mode = c->mode, col = 0, row = y0; /* p's column and row */
-    for (p = (size_t)y0 * (size_t)A->w; p < end; ++p, col = col + 1 == A->w ? 0 : col + 1, row += col == 0) {
+    const int mode = c->mode, w = A->w, ortho = A->cam.ortho;
+    int col, row;
+    for (row = y0; row < y1; ++row)
+    for (col = 0; col < w; ++col) {
+        const size_t p = (size_t)row * (size_t)w + (size_t)col;
         int k = A->hit[p], i, cl = 2;
-        double rgb[3] = { 0.0, 0.0, 0.0 }, n[3], diff, a = v1[p];
+        double rgb[3] = { 0.0, 0.0, 0.0 }, n[3], diff, a;
         unsigned char *o = rgba + 4 * p;
         if (k < 0) { memcpy(o, L->bg, 4); cls[p] = 0; continue; }
-        for (i = 0; i < 3; ++i) n[i] = A->hnrm[3 * (size_t)k + i];
+        a = v1[p];
         {
+            const float *hn = A->hnrm + 3 * (size_t)k;
             double vv[3];
-            if (A->cam.ortho) for (i = 0; i < 3; ++i) vv[i] = -A->cam.fwd[i];
-            else for (i = 0; i < 3; ++i) vv[i] = A->cam.eye[i] - A->hpos[3 * (size_t)k + i];
+            n[0] = hn[0]; n[1] = hn[1]; n[2] = hn[2];
+            if (ortho) for (i = 0; i < 3; ++i) vv[i] = -A->cam.fwd[i];
+            else {
+                const float *hp = A->hpos + 3 * (size_t)k;
+                for (i = 0; i < 3; ++i) vv[i] = A->cam.eye[i] - hp[i];
+            }
             if (sfb__rdot(vv, n) < 0.0) for (i = 0; i < 3; ++i) n[i] = -n[i];
         }
         diff = sfb__rdot(n, L->key);
@@ -15484,7 +15522,7 @@ static int sfb__an_alloc(sfb__an *A) {
     A->state = (unsigned char *)sfb__an_get_zeroed(A, SFB__WS_STATE, npix);
     A->cand = (unsigned char *)sfb__an_get(A, SFB__WS_CAND, npix, NULL);
     A->zmax = (float *)sfb__an_get(A, SFB__WS_ZMAX, (size_t)A->h * (size_t)((A->w + 7) / 8) * sizeof(float) + 1, NULL);
-    A->ucov = (unsigned char *)sfb__an_get(A, SFB__WS_UCOV, (size_t)A->h * (size_t)((A->w + 7) / 8) + 1, NULL);
+    A->ucov = (unsigned char *)sfb__an_get(A, SFB__WS_UCOV, ((size_t)A->h + (size_t)(A->h + 7) / 8) * (size_t)((A->w + 7) / 8) + 1, NULL);
     if (A->c->polygon_based) {
         A->ppos = (float *)sfb__an_get(A, SFB__WS_PPOS, npix * 3 * sizeof(float), NULL);
         A->pnrm = (float *)sfb__an_get(A, SFB__WS_PNRM, npix * 3 * sizeof(float), NULL);
