@@ -1572,8 +1572,9 @@ static int analyze_section() {
                           {"spot (Loop)", "../shared/peers/real-meshes/spot.obj", SFB_SCHEME_LOOP, 0}};
     const sfb_backend_kind kinds[4] = {SFB_BACKEND_REF, SFB_BACKEND_SIMD, SFB_BACKEND_GL, SFB_BACKEND_OSMESA};
     int status = 0;
-    printf("\n== surface analysis (seed 003): 1024 x 1024 reflection lines, level-2 proxy, exact per pixel; ms, best of 3\n");
-    printf("%-12s %-9s %9s %9s %10s %10s %10s %10s %9s\n", "mesh", "backend", "pixels", "raster", "eval", "shade", "total",
+    printf("\n== surface analysis (seed 003): 1024 x 1024 reflection lines, exact per pixel, the default proxy level\n"
+           "   (chosen from the view; \"L\": the level used); ms, best of 3\n");
+    printf("%-12s %-9s %9s %2s %9s %10s %10s %10s %10s %9s\n", "mesh", "backend", "pixels", "L", "raster", "eval", "shade", "total",
            "polygon", "vs ref");
     for (const Case &c : cases) {
         FILE *f = fopen(c.path, "rb");
@@ -1620,13 +1621,14 @@ static int analyze_section() {
                     if (with_ws && sfb_analysis_workspace_create(ctx, &ws) != SFB_SUCCESS) { printf("%s\n", sfb_last_error(ctx)); status = 1; break; }
                     ac.workspace = ws;
                     double best[4] = {1e30, 1e30, 1e30, 1e30}, poly = 1e30;
-                    int pixels = 0;
+                    int pixels = 0, plevel = 0;
                     for (int rep = 0; rep < 3 + with_ws && status == 0; ++rep) {
                         sfb_analysis an;
                         ac.polygon_based = 0;
                         if (sfb_surface_analyze(surf, &ac, &an) != SFB_SUCCESS) { printf("%s\n", sfb_last_error(ctx)); status = 1; break; }
                         Clock::time_point end = Clock::now();
                         pixels = an.covered_pixels;
+                        plevel = an.proxy_level;
                         sfb_analysis_free(&an);
                         double st[4];
                         st[0] = std::chrono::duration<double, std::milli>(clk.at[0] - clk.t0).count();
@@ -1641,8 +1643,8 @@ static int analyze_section() {
                         sfb_analysis_free(&an);
                     }
                     if (kind == SFB_BACKEND_REF) ref_total = best[3];
-                    printf("%-12s %-9s %9d %9.1f %10.1f %10.1f %10.1f %10.1f %8.2fx\n", c.label, with_ws ? "simd+ws" : sfb_backend_kind_name(kind), pixels,
-                           best[0], best[1], best[2], best[3], poly, ref_total > 0.0 ? ref_total / best[3] : 0.0);
+                    printf("%-12s %-9s %9d %2d %9.1f %10.1f %10.1f %10.1f %10.1f %8.2fx\n", c.label, with_ws ? "simd+ws" : sfb_backend_kind_name(kind), pixels,
+                           plevel, best[0], best[1], best[2], best[3], poly, ref_total > 0.0 ? ref_total / best[3] : 0.0);
                     ac.workspace = NULL;
                     sfb_analysis_workspace_destroy(ws);
                 }
@@ -1654,11 +1656,11 @@ static int analyze_section() {
     }
     printf("(raster: proxy evaluated + rasterised into (face, u, v, depth); eval: every pixel projected onto the exact surface\n"
            " (Newton) and evaluated; shade: the shade kernel + colours; polygon: the same picture from the proxy's interpolated\n"
-           " normals, no projection. simd+ws: simd with an sfb_analysis_workspace kept over the runs (no buffer allocated or\n"
-           " faulted in per picture, and the surface's proxy and face adjacency, which do not depend on the view, evaluated\n"
-           " once: an editor redrawing any view of a surface gets this; simd shows a first picture). vs ref: ref's total / this\n"
-           " total. Target: simd <= 50 ms total. Seed 003, Tables 1-2 (GeForce\n"
-           " FX 5900 Ultra): 700 x 700 fragments 0.13 s positions + 0.52 s colours; parameters of 4800 faces 0.012 s)\n");
+           " normals (its default level, 2), no projection. simd+ws: simd with an sfb_analysis_workspace kept over the runs\n"
+           " (no buffer allocated or faulted in per picture, and the surface's proxy and face adjacency, which do not depend\n"
+           " on the view, evaluated once: an editor redrawing any view of a surface gets this; simd shows a first picture).\n"
+           " vs ref: ref's total / this total. Target: simd <= 50 ms total. Seed 003, Tables 1-2 (GeForce FX 5900 Ultra):\n"
+           " 700 x 700 fragments 0.13 s positions + 0.52 s colours; parameters of 4800 faces 0.012 s)\n");
     return status;
 }
 

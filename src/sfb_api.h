@@ -671,8 +671,11 @@ SFB_API size_t sfb_analysis_workspace_bytes(const sfb_analysis_workspace *worksp
 typedef struct sfb_analyze_config {
     int width, height;        /* pixels; both 0: 640 x 480; one of them 0 or either negative: SFB_INVALID_ARGS */
     int mode;                 /* sfb_analyze_mode */
-    int level;                /* proxy: each parametric face sampled on 2^level segments per edge; 0: 2 (1 is the
-                                 coarsest, "subdivided once") */
+    int level;                /* proxy: each parametric face sampled on 2^level segments per edge (1 is the coarsest,
+                                 "subdivided once"); 0: chosen from the view, the coarsest of 1..4 whose grid triangles
+                                 cover about 256 pixels or fewer (the picture does not depend on it; the proxy only seeds
+                                 the projection and fewer, larger triangles raster faster: 1 on meshes of a few hundred
+                                 faces or more seen whole), 2 with polygon_based; sfb_analysis.proxy_level reports it */
     int polygon_based;        /* 1: shade from the proxy's interpolated limit positions and normals (the polygon-based
                                  method the seed shows to be wrong), for comparison */
     int newton_steps;         /* Newton steps per seed; 0: 8 */
@@ -722,6 +725,7 @@ typedef struct sfb_analysis {
     int grown_pixels;         /* covered by the exact surface beyond the proxy's silhouette */
     int dropped_pixels;       /* covered by the proxy, but no view ray through them meets the exact surface */
     int fallback_pixels;      /* Newton did not converge: the proxy's point was used */
+    int proxy_level;          /* the proxy level used (sfb_analyze_config.level, or the one chosen for 0) */
     int light_hits;           /* REFLECTION/HIGHLIGHT: pixels whose ray met the light plane */
     float value_min, value_max; /* over covered pixels */
     float range;              /* CURVATURE: the colour map's range used */

@@ -316,6 +316,49 @@ static void test_large(sfb_context *ctx, const shape *sh) {
     sfb_mesh_destroy(m);
 }
 
+/* The default proxy level (sfb_analyze_config.level 0) is chosen from the view: reported in
+ * proxy_level, within 1..4; finer on a coarse mesh (a 6-face cube: its level-1 triangles
+ * would cover thousands of pixels) than on a fine one (catmark_car's 1575 faces: level 1);
+ * an explicit level is used as given, a polygon-based picture's default is 2; and the picture
+ * at the chosen level agrees with the level-4 one (>= 99.5 % of the pixels both cover). */
+static void test_auto_level(sfb_context *ctx, const shape *shapes, int count) {
+    char car[1024];
+    shape all[8];
+    int i, n = 0, coarse = -1, fine = -1;
+    for (i = 0; i < count && n < 7; ++i) all[n++] = shapes[i];
+    snprintf(car, sizeof car, "%s/catmark_car.obj", g_shapes);
+    all[n].label = "catmark_car"; all[n].path = car; all[n].scheme = SFB_SCHEME_CATMARK; ++n;
+    for (i = 0; i < n; ++i) {
+        char name[160];
+        sfb_mesh *m = load_shape(ctx, all[i].path);
+        sfb_surface *s = m ? patch_surface(ctx, m, all[i].scheme) : NULL;
+        sfb_analysis a, b, e, pg;
+        sfb_analyze_config c = sfb_analyze_config_init(SFB_ANALYZE_REFLECTION);
+        long both = 0;
+        memset(&a, 0, sizeof a); memset(&b, 0, sizeof b); memset(&e, 0, sizeof e); memset(&pg, 0, sizeof pg);
+        snprintf(name, sizeof name, "auto_level/%s", all[i].label);
+        if (!m) { skip(name, "shape not found"); continue; }
+        if (!s || sfb_surface_analyze(s, &c, &a) != SFB_SUCCESS || (c.level = 4, sfb_surface_analyze(s, &c, &b)) != SFB_SUCCESS ||
+            (c.level = 3, sfb_surface_analyze(s, &c, &e)) != SFB_SUCCESS || (c.level = 0, c.polygon_based = 1, sfb_surface_analyze(s, &c, &pg)) != SFB_SUCCESS) {
+            fail(name, "%s", sfb_last_error(ctx));
+        } else {
+            const double agree = agreement(&a, &b, &both);
+            check(a.proxy_level >= 1 && a.proxy_level <= 4 && b.proxy_level == 4 && e.proxy_level == 3 && pg.proxy_level == 2 && agree >= 0.995 &&
+                      both > 1000,
+                  name, "chosen level %d (explicit 4 and 3 reported as %d and %d, polygon-based default %d), agrees with level 4 on %.3f %% of %ld pixels",
+                  a.proxy_level, b.proxy_level, e.proxy_level, pg.proxy_level, 100.0 * agree, both);
+            printf("# %s: level %d chosen at 640 x 480, %.3f %% as level 4\n", name, a.proxy_level, 100.0 * agree);
+            if (strcmp(all[i].label, "catmark_cube_creases1") == 0) coarse = a.proxy_level;
+            if (strcmp(all[i].label, "catmark_car") == 0) fine = a.proxy_level;
+        }
+        sfb_analysis_free(&a); sfb_analysis_free(&b); sfb_analysis_free(&e); sfb_analysis_free(&pg);
+        sfb_surface_destroy(s);
+        sfb_mesh_destroy(m);
+    }
+    if (coarse < 0 || fine < 0) skip("auto_level/coarse_finer_than_fine", "a shape not found");
+    else check(fine == 1 && coarse > fine, "auto_level/coarse_finer_than_fine", "6-face cube: level %d, catmark_car: level %d", coarse, fine);
+}
+
 /* The core's per-pixel loops run on the backend's threads (sfb__parallel: the seeding, the
  * Newton updates, the neighbour scans, the colours): a picture must not depend on how many
  * there are. simd with 1 thread (every loop on the caller) against 2 (the pool), bit for bit:
@@ -806,6 +849,7 @@ int main(int argc, char **argv) {
     test_analytic(ctx, 1);
     test_levels(ctx, shapes, 4);
     test_large(ctx, &shapes[0]);
+    test_auto_level(ctx, shapes, 4);
     test_bad(ctx);
     sfb_context_destroy(ctx);
     test_threads(shapes, 3);

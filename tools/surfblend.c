@@ -209,8 +209,10 @@ static const opt_spec options[] = {
     { "--curvature", NULL, K_CHOICE, C_ANALYZE, O_CURVATURE, AT(curvature), NULL, curvature_choices, 0, 0, 0, NULL,
       "--mode curvature: Gaussian (default), mean or largest absolute principal" },
     { "--level", NULL, K_INT, C_ANALYZE, O_LEVEL, AT(level), "L", NULL, 1, SFB_ANALYZE_MAX_LEVEL, 0, "a number in 1..8",
-      "proxy: 2^L segments per parametric-face edge (default 2); the picture\n"
-      "does not depend on it (every pixel is projected onto the exact surface)" },
+      "proxy: 2^L segments per parametric-face edge (default: chosen from the\n"
+      "view, about 256 pixels per proxy triangle or fewer; --polygon-based: 2);\n"
+      "the picture does not depend on it (every pixel is projected onto the\n"
+      "exact surface)" },
     { "--polygon-based", NULL, K_SET, C_ANALYZE, O_POLYGON, AT(polygon), NULL, NULL, 0, 0, 1, NULL,
       "shade the proxy's interpolated limit normals instead (the method seed 003\n"
       "shows to be wrong; for comparison)" },
@@ -476,7 +478,7 @@ static void opts_init(cli_opts *o, const cli_command *c) {
     o->mode = SFB_RENDER_SHADED;
     o->size[0] = 640;
     o->size[1] = 480;
-    if (c->bit & C_ANALYZE) o->level = 2;
+    if (c->bit & C_ANALYZE) o->level = 0; /* chosen from the view (sfb_analyze_config.level) */
 }
 
 /* Reads command c's arguments into *o. Returns 0; 2 after a usage error (printed); -1 after
@@ -1293,7 +1295,7 @@ static int cmd_analyze(cli_opts *o) {
     cli_error("analyze %s%s%s of the %s surface (%s, level-%d proxy), %dx%d: %d surface pixels (proxy %d, %d grown to the exact "
               "silhouette, %d dropped, %d on the proxy's point)%s -> %s (backend %s)",
               o->amode == SFB_ANALYZE_CURVATURE ? curv_names[o->curvature] : "", o->amode == SFB_ANALYZE_CURVATURE ? " " : "",
-              mode_names[o->amode], sfb_scheme_name(scheme), o->polygon ? "polygon-based" : "exact per pixel", o->level, an.width, an.height,
+              mode_names[o->amode], sfb_scheme_name(scheme), o->polygon ? "polygon-based" : "exact per pixel", an.proxy_level, an.width, an.height,
               an.covered_pixels, an.proxy_pixels, an.grown_pixels, an.dropped_pixels, an.fallback_pixels, "", o->outp,
               sfb_context_backend_name(ctx));
     if (o->amode == SFB_ANALYZE_CURVATURE)
