@@ -2651,7 +2651,7 @@ static void sfb__raster_range(const sfb__raster_job *j, int row0, int row1, int 
         const int *tv = j->tri + 4 * (size_t)i;
         const sfb__raster_vertex *S[3];
         sfb__raster_edges t;
-        double lo, hi;
+        double lo, hi, rea[3];
         int k, x, y;
         /* the box first: each band of rows scans every triangle */
         if (j->ybox && !((double)j->ybox[2 * (size_t)i + 1] - 0.5 >= (double)row0 && (double)j->ybox[2 * (size_t)i] - 0.5 <= (double)row1 - 1.0)) continue;
@@ -2688,13 +2688,29 @@ static void sfb__raster_range(const sfb__raster_job *j, int row0, int row1, int 
         if (!sfb__raster_setup(S, j->w, j->h, 0.0, &t)) continue;
         if (t.y0 < row0) t.y0 = row0;
         if (t.y1 > row1 - 1) t.y1 = row1 - 1;
+        for (k = 0; k < 3; ++k) rea[k] = t.ea[k] != 0.0 ? 1.0 / t.ea[k] : 0.0;
         for (y = t.y0; y <= t.y1; ++y) {
             const double py = y + 0.5;
-            double e[3];
-            int in = 0;
-            /* the edge functions at the row's first pixel centre, then stepped by ea per pixel */
-            for (k = 0; k < 3; ++k) e[k] = t.ea[k] * (t.x0 + 0.5) + t.eb[k] * py + t.ec[k];
-            for (x = t.x0; x <= t.x1; ++x, e[0] += t.ea[0], e[1] += t.ea[1], e[2] += t.ea[2]) {
+            double e[3], xl = t.x0 - 1.0, xh = t.x1 + 1.0;
+            int in = 0, xa, xb;
+            /* the row's inside run from the edge functions' zeros (e_k = ea_k (x + 0.5) + c_k
+             * >= 0: x >= or <= -c_k / ea_k - 0.5 by the sign of ea_k), a pixel wider on each
+             * side against rounding; the pixels between are still tested one by one (a thin
+             * triangle's box is mostly outside it: catmark_car's level-1 proxy at 1024 x 1024
+             * visited 2.5M pixels for 0.76M inside) */
+            for (k = 0; k < 3; ++k) {
+                const double z0 = -(t.eb[k] * py + t.ec[k]) * rea[k] - 0.5;
+                if (t.ea[k] > 0.0) { if (z0 > xl) xl = z0; }
+                else if (t.ea[k] < 0.0) { if (z0 < xh) xh = z0; }
+            }
+            if (!(xl <= xh)) continue; /* (NaN bounds are never taken) */
+            xa = (int)xl - 1; /* x0 - 1 <= xl <= xh <= x1 + 1: the casts are safe, xa below ceil(xl), xb above floor(xh) */
+            xb = (int)xh + 1;
+            if (xa < t.x0) xa = t.x0;
+            if (xb > t.x1) xb = t.x1;
+            /* the edge functions at the run's first pixel centre, then stepped by ea per pixel */
+            for (k = 0; k < 3; ++k) e[k] = t.ea[k] * (xa + 0.5) + t.eb[k] * py + t.ec[k];
+            for (x = xa; x <= xb; ++x, e[0] += t.ea[0], e[1] += t.ea[1], e[2] += t.ea[2]) {
                 const size_t pix = (size_t)y * (size_t)j->w + (size_t)x;
                 double b[3], den, inv, z;
                 /* the inside pixels of a row are one run: the first outside one after it ends the row */
