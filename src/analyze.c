@@ -963,7 +963,7 @@ static void sfb__an_add_hit(sfb__an *A, int pix, const sfb_location *loc, double
 }
 
 /* Clamps (u,v) into the domain; returns 1 when it had to. */
-static int sfb__an_clamp_domain(const sfb__an *A, double *u, double *v) {
+static inline int sfb__an_clamp_domain(const sfb__an *A, double *u, double *v) {
     int moved = 0;
     if (*u < 0.0) { *u = 0.0; moved = 1; }
     if (*v < 0.0) { *v = 0.0; moved = 1; }
