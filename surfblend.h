@@ -14346,7 +14346,7 @@ typedef struct sfb__an_try {
     int pix, x, y;     /* the pixel, its column and row */
     int k;             /* its hit slot (round 0, sfb__an_fresh) */
     double z;          /* a new hit's depth */
-    float res, res2;   /* the residual of the last evaluation, and of the one before (pixels) */
+    float res, res2;   /* the squared residual of the last evaluation, and of the one before (pixels^2) */
     unsigned char pinned, crossed; /* steps against the border, face crossings */
     unsigned char outcome; /* 0 running, 1 hit, 2 near, 3 miss (SFB__AN_OUT_NEW_HIT: a hit the caller has yet to record) */
 } sfb__an_try;
@@ -14460,28 +14460,33 @@ static void sfb__an_step(void *arg, int a, int b) {
         sfb_location *l = &J->locs[i];
         const int x = t->x, y = t->y;
         double p[3], tu[3], tv[3], sx, sy, z, rx, ry, jac[4], det, du_, dv_, m, u, v, res;
+        /* res: the squared residual (pixels^2), so that no square root waits before the tests */
         int c, ok;
         for (c = 0; c < 3; ++c) { p[c] = pos[3 * i + c]; tu[c] = du[3 * i + c]; tv[c] = dv[3 * i + c]; }
         ok = sfb__an_finite3(pos + 3 * i) && sfb__an_project(&A->cam, p, &sx, &sy, &z);
         res = HUGE_VAL;
         if (ok) {
             rx = (x + 0.5) - sx; ry = (y + 0.5) - sy;
-            res = sqrt(rx * rx + ry * ry);
+            res = rx * rx + ry * ry;
         }
         /* stalled: an attempt whose residual has not halved over the last two steps and is
          * over a pixel (a pixel off the exact silhouette, or across a face it cannot reach)
          * stops as a miss instead of running out its steps (at half a pixel, a few more
          * silhouette pixels were dropped on catmark_car and spot) */
-        if (ok && it >= 2 && res > 1.0 && !(res < 0.5 * t->res2)) { t->res = (float)res; t->outcome = 3; continue; }
+        if (ok && it >= 2 && res > 1.0 && !(res < 0.25 * t->res2)) { t->res = (float)res; t->outcome = 3; continue; }
         /* and one within a pixel of the pixel but not converging (not halved over two steps by
          * its fifth evaluation: beside a silhouette, where round 1 tries thousands of pixels)
          * stops too, as near or a miss (catmark_car: round 1's evaluations -15 %, coverage the same) */
-        if (ok && it >= 4 && res > 0.05 && !(res < 0.5 * t->res2)) { t->res = (float)res; t->outcome = res < SFB__AN_NEAR ? 2 : 3; continue; }
+        if (ok && it >= 4 && res > 0.05 * 0.05 && !(res < 0.25 * t->res2)) {
+            t->res = (float)res;
+            t->outcome = res < SFB__AN_NEAR * SFB__AN_NEAR ? 2 : 3;
+            continue;
+        }
         t->res2 = t->res;
         t->res = (float)res;
-        if (ok && res < SFB__AN_TOL) { t->z = z; t->outcome = SFB__AN_OUT_NEW_HIT; continue; }
-        if (!ok || it == steps) { t->outcome = ok && res < SFB__AN_NEAR ? 2 : 3; continue; }
-        if (!sfb__an_jacobian(&A->cam, p, tu, tv, jac, &det)) { t->outcome = res < SFB__AN_NEAR ? 2 : 3; continue; }
+        if (ok && res < SFB__AN_TOL * SFB__AN_TOL) { t->z = z; t->outcome = SFB__AN_OUT_NEW_HIT; continue; }
+        if (!ok || it == steps) { t->outcome = ok && res < SFB__AN_NEAR * SFB__AN_NEAR ? 2 : 3; continue; }
+        if (!sfb__an_jacobian(&A->cam, p, tu, tv, jac, &det)) { t->outcome = res < SFB__AN_NEAR * SFB__AN_NEAR ? 2 : 3; continue; }
         du_ = (jac[3] * rx - jac[1] * ry) / det;
         dv_ = (-jac[2] * rx + jac[0] * ry) / det;
         m = fabs(du_) > fabs(dv_) ? fabs(du_) : fabs(dv_);
@@ -14499,7 +14504,7 @@ static void sfb__an_step(void *arg, int a, int b) {
                 l->face = nf;
                 ++t->crossed;
                 t->pinned = 0;
-            } else if (++t->pinned >= 2) { t->outcome = res < SFB__AN_NEAR ? 2 : 3; continue; }
+            } else if (++t->pinned >= 2) { t->outcome = res < SFB__AN_NEAR * SFB__AN_NEAR ? 2 : 3; continue; }
         } else t->pinned = 0;
         l->u = (float)u;
         l->v = (float)v;
