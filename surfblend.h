@@ -13537,7 +13537,7 @@ typedef struct sfb__an_cam {
 } sfb__an_cam;
 
 /* Projects p: screen x, y (pixels, y down) and view depth z; returns 0 behind the near plane. */
-static int sfb__an_project(const sfb__an_cam *c, const double *p, double *sx, double *sy, double *z) {
+static inline int sfb__an_project(const sfb__an_cam *c, const double *p, double *sx, double *sy, double *z) {
     double d[3], xc, yc, zc;
     d[0] = p[0] - c->eye[0]; d[1] = p[1] - c->eye[1]; d[2] = p[2] - c->eye[2];
     xc = sfb__rdot(d, c->right); yc = sfb__rdot(d, c->up); zc = sfb__rdot(d, c->fwd);
@@ -13551,7 +13551,7 @@ static int sfb__an_project(const sfb__an_cam *c, const double *p, double *sx, do
 
 /* The screen Jacobian of a surface point p with tangents tu, tv: j = (dsx/du, dsx/dv, dsy/du,
  * dsy/dv) and its determinant; 0 when it is singular (or not finite). */
-static int sfb__an_jacobian(const sfb__an_cam *c, const double *p, const double *tu, const double *tv, double j[4], double *det) {
+static inline int sfb__an_jacobian(const sfb__an_cam *c, const double *p, const double *tu, const double *tv, double j[4], double *det) {
     const double tux = sfb__rdot(tu, c->right), tuy = sfb__rdot(tu, c->up), tvx = sfb__rdot(tv, c->right), tvy = sfb__rdot(tv, c->up);
     if (c->ortho) {
         j[0] = c->focal * tux; j[2] = -c->focal * tuy;
