@@ -1617,14 +1617,22 @@ static int analyze_section() {
                 /* simd twice: as every backend, then with a workspace kept over the runs (the
                  * editor's case: its first run grows the buffers, the best of the others counts) */
                 for (int with_ws = 0; with_ws < (kind == SFB_BACKEND_SIMD ? 2 : 1) && status == 0; ++with_ws) {
-                    sfb_analysis_workspace *ws = NULL;
-                    if (with_ws && sfb_analysis_workspace_create(ctx, &ws) != SFB_SUCCESS) { printf("%s\n", sfb_last_error(ctx)); status = 1; break; }
-                    ac.workspace = ws;
+                    /* the polygon-based pictures keep their own workspace: their proxy is level 2
+                     * (their default), the exact pictures' the one chosen from the view, and a
+                     * workspace keeps one surface's proxy at one level */
+                    sfb_analysis_workspace *ws = NULL, *ws_poly = NULL;
+                    if (with_ws && (sfb_analysis_workspace_create(ctx, &ws) != SFB_SUCCESS || sfb_analysis_workspace_create(ctx, &ws_poly) != SFB_SUCCESS)) {
+                        printf("%s\n", sfb_last_error(ctx));
+                        sfb_analysis_workspace_destroy(ws);
+                        status = 1;
+                        break;
+                    }
                     double best[4] = {1e30, 1e30, 1e30, 1e30}, poly = 1e30;
                     int pixels = 0, plevel = 0;
                     for (int rep = 0; rep < 3 + with_ws && status == 0; ++rep) {
                         sfb_analysis an;
                         ac.polygon_based = 0;
+                        ac.workspace = ws;
                         if (sfb_surface_analyze(surf, &ac, &an) != SFB_SUCCESS) { printf("%s\n", sfb_last_error(ctx)); status = 1; break; }
                         Clock::time_point end = Clock::now();
                         pixels = an.covered_pixels;
@@ -1637,6 +1645,7 @@ static int analyze_section() {
                         st[3] = std::chrono::duration<double, std::milli>(end - clk.t0).count();
                         if (st[3] < best[3] && !(with_ws && rep == 0)) for (int k = 0; k < 4; ++k) best[k] = st[k];
                         ac.polygon_based = 1;
+                        ac.workspace = ws_poly;
                         Clock::time_point t0 = Clock::now();
                         if (sfb_surface_analyze(surf, &ac, &an) != SFB_SUCCESS) { status = 1; break; }
                         if (!(with_ws && rep == 0)) poly = std::min(poly, ms_since(t0));
@@ -1647,6 +1656,7 @@ static int analyze_section() {
                            plevel, best[0], best[1], best[2], best[3], poly, ref_total > 0.0 ? ref_total / best[3] : 0.0);
                     ac.workspace = NULL;
                     sfb_analysis_workspace_destroy(ws);
+                    sfb_analysis_workspace_destroy(ws_poly);
                 }
             }
             sfb_surface_destroy(surf);
