@@ -1564,13 +1564,25 @@ static void sfb__an_neighbour_rows(void *arg, int y0, int y1) {
 }
 
 /* Step 2 over every round (see the file's comment). */
+/* The projection's round tags of rows [y0, y1) cleared (the faces after them are read only
+ * where the tag is the round's, so they are left as they are). */
+typedef struct sfb__an_tags_job {
+    int *tags;
+    int w;
+} sfb__an_tags_job;
+static void sfb__an_clear_tags(void *arg, int y0, int y1) {
+    const sfb__an_tags_job *J = (const sfb__an_tags_job *)arg;
+    memset(J->tags + (size_t)y0 * (size_t)J->w, 0, (size_t)(y1 - y0) * (size_t)J->w * sizeof(int));
+}
+
 static sfb_result sfb__an_project_all(sfb__an *A, int steps) {
     size_t npix = (size_t)A->w * (size_t)A->h;
     int cap = 0, count = 0, round, part;
     sfb__an_try *tries = NULL;
     sfb_location *locs = NULL;
     float *buf = NULL;
-    int *mark = NULL;  /* per pixel: the last round that seeded it, and 3 faces it was seeded from */
+    int *mark = NULL;  /* per pixel the last round that seeded it (its tag), then per pixel 3 faces it was seeded
+                          from in that round (read only where the tag is this round's: only the tags are cleared) */
     int *rowat = NULL; /* round 0: per grid row, its attempts, then where they start in their band */
     unsigned char *nbc = NULL; /* round 1's changes' masks (sfb__an_neighbour_rows) */
     int mark_base = 0;
@@ -1590,10 +1602,16 @@ static sfb_result sfb__an_project_all(sfb__an *A, int steps) {
      * buffer is zeroed when new, or when the tags would overflow) */
     {
         int fresh = 1;
-        mark = A->ws ? (int *)sfb__an_get(A, SFB__WS_MARK, npix * 4 * sizeof(int), &fresh) : (int *)sfb__calloc(A->ctx, npix, 4 * sizeof(int));
+        mark = (int *)sfb__an_get(A, SFB__WS_MARK, npix * 4 * sizeof(int), &fresh);
+        if (mark && !A->ws) {
+            sfb__an_tags_job T;
+            T.tags = mark;
+            T.w = A->w;
+            sfb__an_run(A, sfb__an_clear_tags, &T, 0, A->h, (double)npix * 0.05);
+        }
         if (mark && A->ws) {
             if (fresh || A->ws->mark_base > 2147483647 - 2 * (SFB__AN_ROUNDS + 1)) {
-                memset(mark, 0, npix * 4 * sizeof(int));
+                memset(mark, 0, npix * sizeof(int));
                 A->ws->mark_base = 0;
             }
             mark_base = A->ws->mark_base;
@@ -1692,10 +1710,10 @@ static sfb_result sfb__an_project_all(sfb__an *A, int steps) {
                     if ((dx | dy) == 0) continue;
                     if (!(A->nbm[ci] & (1 << bit++))) continue;
                     q = (y + dy) * A->w + (x + dx);
-                    mq = mark + 4 * (size_t)q;
-                    if (mq[0] != mark_base + round) { mq[0] = mark_base + round; mq[1] = mq[2] = mq[3] = -1; }
-                    for (k = 1; k <= 3 && mq[k] >= 0 && mq[k] != f; ++k) {}
-                    if (k > 3 || mq[k] == f) continue; /* three faces tried this round, or this one */
+                    mq = mark + npix + 3 * (size_t)q;
+                    if (mark[q] != mark_base + round) { mark[q] = mark_base + round; mq[0] = mq[1] = mq[2] = -1; }
+                    for (k = 0; k < 3 && mq[k] >= 0 && mq[k] != f; ++k) {}
+                    if (k == 3 || mq[k] == f) continue; /* three faces tried this round, or this one */
                     mq[k] = f;
                     if (count == cap) {
                         int nc = cap * 2;
