@@ -377,56 +377,56 @@ static int sfb__an_grid_index(const sfb__an *A, int i, int j) {
     return A->tri ? j * (R + 1) - j * (j - 1) / 2 + i : j * (R + 1) + i;
 }
 
-/* Step 1a: the proxy's grid points, evaluated on the backend. */
+/* Step 1a: the proxy's grid points, evaluated on the backend: face by face (a hole face's
+ * points stay NaN), in runs of whole faces that lie one after another in the grid, at most
+ * max(65536, points per face) locations a call; each face's (u,v) are the same grid. */
 static sfb_result sfb__an_proxy(sfb__an *A) {
     const sfb__patch_table *pt = &A->s->patches;
-    size_t n = (size_t)A->nf * (size_t)A->per, k, chunk = 1u << 16;
+    const size_t per = (size_t)A->per, chunk = per > ((size_t)1 << 16) ? per : ((size_t)1 << 16), n = (size_t)A->nf * per;
     sfb_location *loc = (sfb_location *)sfb__alloc(A->ctx, chunk * sizeof(sfb_location));
+    float *gu = (float *)sfb__alloc(A->ctx, per * 2 * sizeof(float));
     sfb_result r = SFB_SUCCESS;
-    if (!loc) return sfb__oom(A->ctx, "the analysis proxy");
-    for (k = 0; k < n && r == SFB_SUCCESS; k += chunk) {
-        size_t m = n - k < chunk ? n - k : chunk, q, cnt = 0;
-        sfb_eval_output out;
-        size_t first_eval = k;
-        /* holes: skip (their points stay NaN) -- evaluate runs of non-hole locations */
-        for (q = 0; q < m; ++q) {
-            size_t g = k + q;
-            int f = (int)(g / (size_t)A->per);
-            double u, v;
-            if (pt->ptex_root[f] == -1) {
-                int c;
-                for (c = 0; c < 3; ++c) A->gpos[3 * g + c] = A->gnrm[3 * g + c] = NAN;
-                continue;
-            }
-            sfb__an_grid_uv(A, (int)(g % (size_t)A->per), &u, &v);
-            loc[cnt].face = f;
-            loc[cnt].u = (float)u;
-            loc[cnt].v = (float)v;
-            if (A->tri && (double)loc[cnt].u + (double)loc[cnt].v > 1.0) loc[cnt].v = nextafterf(loc[cnt].v, 0.0f);
-            /* evaluate into place: the run must be contiguous in g */
-            if (cnt == 0) first_eval = g;
-            if (g != first_eval + cnt) {
-                /* flush the run before this location */
-                sfb_location keep = loc[cnt];
-                memset(&out, 0, sizeof out);
-                out.position = A->gpos + 3 * first_eval;
-                out.normal = A->gnrm + 3 * first_eval;
-                if ((r = sfb__surface_eval_unchecked(A->s, loc, (int)cnt, &out)) != SFB_SUCCESS) break;
-                loc[0] = keep;
-                cnt = 0;
-                first_eval = g;
-            }
-            ++cnt;
-        }
-        if (r == SFB_SUCCESS && cnt > 0) {
+    size_t first = 0, cnt = 0, q;
+    int f;
+    if (!loc || !gu) {
+        sfb__free(A->ctx, loc); sfb__free(A->ctx, gu);
+        return sfb__oom(A->ctx, "the analysis proxy");
+    }
+    for (q = 0; q < per; ++q) {
+        double u, v;
+        sfb__an_grid_uv(A, (int)q, &u, &v);
+        gu[2 * q] = (float)u;
+        gu[2 * q + 1] = (float)v;
+        if (A->tri && (double)gu[2 * q] + (double)gu[2 * q + 1] > 1.0) gu[2 * q + 1] = nextafterf(gu[2 * q + 1], 0.0f);
+    }
+    for (f = 0; f <= A->nf && r == SFB_SUCCESS; ++f) {
+        const size_t base = (size_t)f * per;
+        const int hole = f < A->nf && pt->ptex_root[f] == -1;
+        /* the run so far is evaluated into place before a hole, before a face it has no room
+         * for, and at the end */
+        if (cnt > 0 && (f == A->nf || hole || cnt + per > chunk)) {
+            sfb_eval_output out;
             memset(&out, 0, sizeof out);
-            out.position = A->gpos + 3 * first_eval;
-            out.normal = A->gnrm + 3 * first_eval;
+            out.position = A->gpos + 3 * first;
+            out.normal = A->gnrm + 3 * first;
             r = sfb__surface_eval_unchecked(A->s, loc, (int)cnt, &out);
+            if (r == SFB_SUCCESS) r = sfb__progress(A->ctx, 0.2f * (float)(first + cnt) / (float)n, "analyze");
+            cnt = 0;
         }
-        if (r == SFB_SUCCESS) r = sfb__progress(A->ctx, 0.2f * (float)(k + m) / (float)n, "analyze");
+        if (f == A->nf || r != SFB_SUCCESS) break;
+        if (hole) {
+            for (q = 3 * base; q < 3 * (base + per); ++q) A->gpos[q] = A->gnrm[q] = NAN;
+            continue;
+        }
+        if (cnt == 0) first = base;
+        for (q = 0; q < per; ++q, ++cnt) {
+            loc[cnt].face = f;
+            loc[cnt].u = gu[2 * q];
+            loc[cnt].v = gu[2 * q + 1];
+        }
     }
     sfb__free(A->ctx, loc);
+    sfb__free(A->ctx, gu);
     return r;
 }
 
