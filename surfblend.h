@@ -13493,6 +13493,8 @@ done:
 #define SFB__AN_DEFAULT_STEPS 8
 #define SFB__AN_TOL 2e-3      /* pixels: a hit (looser ones let stripe classes flip where stripes are dense) */
 #define SFB__AN_NEAR 0.5      /* pixels: within this, a non-converged attempt may fall back to the proxy */
+#define SFB__AN_TOL2 (SFB__AN_TOL * SFB__AN_TOL)   /* the same, squared (sfb__an_step compares squared residuals) */
+#define SFB__AN_NEAR2 (SFB__AN_NEAR * SFB__AN_NEAR)
 #define SFB__AN_ROUNDS 64
 #define SFB__AN_ANCHOR 4      /* pixels: round 0 starts from the proxy on this grid, the others between its hits */
 #define SFB__AN_BATCH 32768   /* round 0's attempts run in batches of this many (the buffers stay small and warm: at
@@ -14498,14 +14500,14 @@ static void sfb__an_step(void *arg, int a, int b) {
          * stops too, as near or a miss (catmark_car: round 1's evaluations -15 %, coverage the same) */
         if (ok && it >= 4 && res > 0.05 * 0.05 && !(res < 0.25 * t->res2)) {
             t->res = (float)res;
-            t->outcome = res < SFB__AN_NEAR * SFB__AN_NEAR ? 2 : 3;
+            t->outcome = res < SFB__AN_NEAR2 ? 2 : 3;
             continue;
         }
         t->res2 = t->res;
         t->res = (float)res;
-        if (ok && res < SFB__AN_TOL * SFB__AN_TOL) { t->z = z; t->outcome = SFB__AN_OUT_NEW_HIT; continue; }
-        if (!ok || it == steps) { t->outcome = ok && res < SFB__AN_NEAR * SFB__AN_NEAR ? 2 : 3; continue; }
-        if (!sfb__an_jacobian(&A->cam, p, tu, tv, jac, &det)) { t->outcome = res < SFB__AN_NEAR * SFB__AN_NEAR ? 2 : 3; continue; }
+        if (ok && res < SFB__AN_TOL2) { t->z = z; t->outcome = SFB__AN_OUT_NEW_HIT; continue; }
+        if (!ok || it == steps) { t->outcome = ok && res < SFB__AN_NEAR2 ? 2 : 3; continue; }
+        if (!sfb__an_jacobian(&A->cam, p, tu, tv, jac, &det)) { t->outcome = res < SFB__AN_NEAR2 ? 2 : 3; continue; }
         du_ = (jac[3] * rx - jac[1] * ry) / det;
         dv_ = (-jac[2] * rx + jac[0] * ry) / det;
         m = fabs(du_) > fabs(dv_) ? fabs(du_) : fabs(dv_);
@@ -14523,7 +14525,7 @@ static void sfb__an_step(void *arg, int a, int b) {
                 l->face = nf;
                 ++t->crossed;
                 t->pinned = 0;
-            } else if (++t->pinned >= 2) { t->outcome = res < SFB__AN_NEAR * SFB__AN_NEAR ? 2 : 3; continue; }
+            } else if (++t->pinned >= 2) { t->outcome = res < SFB__AN_NEAR2 ? 2 : 3; continue; }
         } else t->pinned = 0;
         l->u = (float)u;
         l->v = (float)v;
@@ -15272,15 +15274,17 @@ static sfb_result sfb__an_leftovers(sfb__an *A, int *fallback, int *dropped, int
 /* ---- step 4: colours ---- */
 /* The footprint of pixel pix in units of the value in v: per axis the smaller one-sided
  * difference (robust at silhouettes and band ends), summed. */
+/* The smaller of two one-sided differences of an axis, each +inf (off the picture, or an infinite
+ * neighbour) or NaN (a NaN neighbour) when it does not count; 0 when neither does. */
+static double sfb__an_smaller_side(double a, double b) {
+    return a < b ? a : b < HUGE_VAL ? b : a < HUGE_VAL ? a : 0.0;
+}
 static double sfb__an_footprint(const float *v, int w, int h, int x, int y) {
     const int pix = y * w + x;
     const double c = v[pix];
-    /* a neighbour off the picture or not finite gives +inf (|c - inf|, or the NaN's failed
-     * comparison below leaves the other side's); none on an axis gives 0 */
     const double l = x > 0 ? fabs(c - v[pix - 1]) : HUGE_VAL, r = x + 1 < w ? fabs(c - v[pix + 1]) : HUGE_VAL;
     const double u = y > 0 ? fabs(c - v[pix - w]) : HUGE_VAL, o = y + 1 < h ? fabs(c - v[pix + w]) : HUGE_VAL;
-    double dx = l < r ? l : r < HUGE_VAL ? r : l < HUGE_VAL ? l : 0.0, dy = u < o ? u : o < HUGE_VAL ? o : u < HUGE_VAL ? u : 0.0;
-    return dx + dy;
+    return sfb__an_smaller_side(l, r) + sfb__an_smaller_side(u, o);
 }
 /* The looks of one analysis: resolved light and colours. */
 typedef struct sfb__an_look {
@@ -15445,111 +15449,111 @@ static void sfb__an_colour(void *arg, int y0, int y1) {
     const int mode = c->mode, w = A->w, ortho = A->cam.ortho;
     int col, row;
     for (row = y0; row < y1; ++row)
-    for (col = 0; col < w; ++col) {
-        const size_t p = (size_t)row * (size_t)w + (size_t)col;
-        int k = A->hit[p], i, cl = 2;
-        double rgb[3] = { 0.0, 0.0, 0.0 }, n[3], diff, a;
-        unsigned char *o = rgba + 4 * p;
-        if (k < 0) { memcpy(o, L->bg, 4); cls[p] = 0; continue; }
-        a = v1[p];
-        {
-            const float *hn = A->hnrm + 3 * (size_t)k;
-            double vv[3];
-            n[0] = hn[0]; n[1] = hn[1]; n[2] = hn[2];
-            if (ortho) for (i = 0; i < 3; ++i) vv[i] = -A->cam.fwd[i];
-            else {
-                const float *hp = A->hpos + 3 * (size_t)k;
-                for (i = 0; i < 3; ++i) vv[i] = A->cam.eye[i] - hp[i];
+        for (col = 0; col < w; ++col) {
+            const size_t p = (size_t)row * (size_t)w + (size_t)col;
+            int k = A->hit[p], i, cl = 2;
+            double rgb[3] = { 0.0, 0.0, 0.0 }, n[3], diff, a;
+            unsigned char *o = rgba + 4 * p;
+            if (k < 0) { memcpy(o, L->bg, 4); cls[p] = 0; continue; }
+            a = v1[p];
+            {
+                const float *hn = A->hnrm + 3 * (size_t)k;
+                double vv[3];
+                n[0] = hn[0]; n[1] = hn[1]; n[2] = hn[2];
+                if (ortho) for (i = 0; i < 3; ++i) vv[i] = -A->cam.fwd[i];
+                else {
+                    const float *hp = A->hpos + 3 * (size_t)k;
+                    for (i = 0; i < 3; ++i) vv[i] = A->cam.eye[i] - hp[i];
+                }
+                if (sfb__rdot(vv, n) < 0.0) for (i = 0; i < 3; ++i) n[i] = -n[i];
             }
-            if (sfb__rdot(vv, n) < 0.0) for (i = 0; i < 3; ++i) n[i] = -n[i];
-        }
-        diff = sfb__rdot(n, L->key);
-        if (diff < 0.0) diff = 0.0;
-        switch (mode) {
-        case SFB_ANALYZE_REFLECTION:
-        case SFB_ANALYZE_HIGHLIGHT:
-            if (!isfinite(a)) {
-                /* the miss colour, lit a little by the key light so that the form still reads */
-                cl = 1;
-                for (i = 0; i < 3; ++i) rgb[i] = L->miss[i] / 255.0 * (0.55 + 0.9 * diff);
+            diff = sfb__rdot(n, L->key);
+            if (diff < 0.0) diff = 0.0;
+            switch (mode) {
+            case SFB_ANALYZE_REFLECTION:
+            case SFB_ANALYZE_HIGHLIGHT:
+                if (!isfinite(a)) {
+                    /* the miss colour, lit a little by the key light so that the form still reads */
+                    cl = 1;
+                    for (i = 0; i < 3; ++i) rgb[i] = L->miss[i] / 255.0 * (0.55 + 0.9 * diff);
+                    break;
+                }
+                if (L->pattern == SFB_LIGHT_IMAGE) {
+                    double t[4], base = mode == SFB_ANALYZE_REFLECTION ? 0.08 : 0.3 + 0.4 * diff;
+                    sfb__an_texel(c, a / L->job.periods[0], v2[p] / L->job.periods[1], t);
+                    for (i = 0; i < 3; ++i) rgb[i] = base * (1.0 - t[3]) + t[i] * t[3];
+                    cl = 2 + (0.299 * t[0] + 0.587 * t[1] + 0.114 * t[2] >= 0.5);
+                } else {
+                    /* stripes read only the first value's footprint */
+                    double fa = sfb__an_footprint(v1, A->w, A->h, col, row),
+                           fb = L->pattern == SFB_LIGHT_LATTICE || L->pattern == SFB_LIGHT_CIRCLES ? sfb__an_footprint(v2, A->w, A->h, col, row) : 0.0;
+                    double cover = sfb__an_pattern(L, a, v2[p], fa, fb, &cl);
+                    if (mode == SFB_ANALYZE_REFLECTION) {
+                        double dark = 0.07 + 0.16 * diff;
+                        for (i = 0; i < 3; ++i) rgb[i] = dark * (1.0 - cover) + 0.97 * cover;
+                    } else {
+                        double base = 0.45 + 0.5 * diff, blue[3];
+                        blue[0] = 0.05 * base; blue[1] = 0.12 * base; blue[2] = 0.70 * base;
+                        for (i = 0; i < 3; ++i) rgb[i] = base * cover + blue[i] * (1.0 - cover);
+                    }
+                }
+                break;
+            case SFB_ANALYZE_ZEBRA: {
+                double fa = sfb__an_footprint(v1, A->w, A->h, col, row), cover = sfb__band_cover(a, fa, 0.0, L->width);
+                cl = (a - floor(a)) < L->width ? 3 : 2;
+                for (i = 0; i < 3; ++i) rgb[i] = 0.04 + 0.92 * cover;
                 break;
             }
-            if (L->pattern == SFB_LIGHT_IMAGE) {
-                double t[4], base = mode == SFB_ANALYZE_REFLECTION ? 0.08 : 0.3 + 0.4 * diff;
-                sfb__an_texel(c, a / L->job.periods[0], v2[p] / L->job.periods[1], t);
-                for (i = 0; i < 3; ++i) rgb[i] = base * (1.0 - t[3]) + t[i] * t[3];
-                cl = 2 + (0.299 * t[0] + 0.587 * t[1] + 0.114 * t[2] >= 0.5);
-            } else {
-                /* stripes read only the first value's footprint */
-                double fa = sfb__an_footprint(v1, A->w, A->h, col, row),
-                       fb = L->pattern == SFB_LIGHT_LATTICE || L->pattern == SFB_LIGHT_CIRCLES ? sfb__an_footprint(v2, A->w, A->h, col, row) : 0.0;
-                double cover = sfb__an_pattern(L, a, v2[p], fa, fb, &cl);
-                if (mode == SFB_ANALYZE_REFLECTION) {
-                    double dark = 0.07 + 0.16 * diff;
-                    for (i = 0; i < 3; ++i) rgb[i] = dark * (1.0 - cover) + 0.97 * cover;
+            case SFB_ANALYZE_ISOPHOTE: {
+                double N = L->job.periods[0], x = (sfb__rclamp(a, -1.0, 1.0) + 1.0) * 0.5 * N, fx = sfb__an_footprint(v1, A->w, A->h, col, row) * 0.5 * N;
+                double kb = floor(x), f = x - kb, c0[3], c1[3], m = 0.0;
+                int kk = (int)kb, nb = kk;
+                if (kk >= (int)N) kk = (int)N - 1;
+                cl = 2 + (kk < 0 ? 0 : kk > 200 ? 200 : kk);
+                sfb__colormap((kk + 0.5) / N, c0);
+                if (fx > 1e-6 && f < 0.5 * fx) { nb = kk - 1; m = (0.5 * fx - f) / fx; }
+                else if (fx > 1e-6 && 1.0 - f < 0.5 * fx) { nb = kk + 1; m = (0.5 * fx - (1.0 - f)) / fx; }
+                if (nb < 0) nb = 0;
+                if (nb >= (int)N) nb = (int)N - 1;
+                sfb__colormap((nb + 0.5) / N, c1);
+                for (i = 0; i < 3; ++i) rgb[i] = c0[i] * (1.0 - m) + c1[i] * m;
+                break;
+            }
+            case SFB_ANALYZE_CURVATURE: {
+                double t, lum = 0.72 + 0.28 * diff;
+                if (!isfinite(a)) { cl = 1; rgb[0] = rgb[1] = rgb[2] = 0.5; break; }
+                if (c->curvature == SFB_CURVATURE_MAX_ABS) {
+                    t = sfb__rclamp(a / L->range, 0.0, 1.0);
+                    cl = 2 + (int)sfb__rclamp(floor(t * 16.0), 0.0, 15.0);
+                    sfb__colormap(t, rgb);
                 } else {
-                    double base = 0.45 + 0.5 * diff, blue[3];
-                    blue[0] = 0.05 * base; blue[1] = 0.12 * base; blue[2] = 0.70 * base;
-                    for (i = 0; i < 3; ++i) rgb[i] = base * cover + blue[i] * (1.0 - cover);
+                    static const double neg[3] = { 0.12, 0.30, 1.00 }, pos[3] = { 1.00, 0.16, 0.08 };
+                    t = sfb__rclamp(a / L->range, -1.0, 1.0);
+                    cl = 2 + 8 + (int)floor(t * 8.0 + 0.5); /* 17 bins, the middle one centred on 0 */
+                    for (i = 0; i < 3; ++i) rgb[i] = (1.0 - fabs(t)) * 0.96 + fabs(t) * (t < 0.0 ? neg[i] : pos[i]);
                 }
+                for (i = 0; i < 3; ++i) rgb[i] *= lum;
+                break;
             }
-            break;
-        case SFB_ANALYZE_ZEBRA: {
-            double fa = sfb__an_footprint(v1, A->w, A->h, col, row), cover = sfb__band_cover(a, fa, 0.0, L->width);
-            cl = (a - floor(a)) < L->width ? 3 : 2;
-            for (i = 0; i < 3; ++i) rgb[i] = 0.04 + 0.92 * cover;
-            break;
-        }
-        case SFB_ANALYZE_ISOPHOTE: {
-            double N = L->job.periods[0], x = (sfb__rclamp(a, -1.0, 1.0) + 1.0) * 0.5 * N, fx = sfb__an_footprint(v1, A->w, A->h, col, row) * 0.5 * N;
-            double kb = floor(x), f = x - kb, c0[3], c1[3], m = 0.0;
-            int kk = (int)kb, nb = kk;
-            if (kk >= (int)N) kk = (int)N - 1;
-            cl = 2 + (kk < 0 ? 0 : kk > 200 ? 200 : kk);
-            sfb__colormap((kk + 0.5) / N, c0);
-            if (fx > 1e-6 && f < 0.5 * fx) { nb = kk - 1; m = (0.5 * fx - f) / fx; }
-            else if (fx > 1e-6 && 1.0 - f < 0.5 * fx) { nb = kk + 1; m = (0.5 * fx - (1.0 - f)) / fx; }
-            if (nb < 0) nb = 0;
-            if (nb >= (int)N) nb = (int)N - 1;
-            sfb__colormap((nb + 0.5) / N, c1);
-            for (i = 0; i < 3; ++i) rgb[i] = c0[i] * (1.0 - m) + c1[i] * m;
-            break;
-        }
-        case SFB_ANALYZE_CURVATURE: {
-            double t, lum = 0.72 + 0.28 * diff;
-            if (!isfinite(a)) { cl = 1; rgb[0] = rgb[1] = rgb[2] = 0.5; break; }
-            if (c->curvature == SFB_CURVATURE_MAX_ABS) {
-                t = sfb__rclamp(a / L->range, 0.0, 1.0);
-                cl = 2 + (int)sfb__rclamp(floor(t * 16.0), 0.0, 15.0);
-                sfb__colormap(t, rgb);
-            } else {
-                static const double neg[3] = { 0.12, 0.30, 1.00 }, pos[3] = { 1.00, 0.16, 0.08 };
-                t = sfb__rclamp(a / L->range, -1.0, 1.0);
-                cl = 2 + 8 + (int)floor(t * 8.0 + 0.5); /* 17 bins, the middle one centred on 0 */
-                for (i = 0; i < 3; ++i) rgb[i] = (1.0 - fabs(t)) * 0.96 + fabs(t) * (t < 0.0 ? neg[i] : pos[i]);
+            case SFB_ANALYZE_NORMALS:
+                for (i = 0; i < 3; ++i) rgb[i] = 0.5 + 0.5 * A->hnrm[3 * (size_t)k + i];
+                break;
+            default: {
+                double hv[3], vv[3], spec;
+                if (A->cam.ortho) for (i = 0; i < 3; ++i) vv[i] = -A->cam.fwd[i];
+                else for (i = 0; i < 3; ++i) vv[i] = A->cam.eye[i] - A->hpos[3 * (size_t)k + i];
+                sfb__rnormalize(vv);
+                for (i = 0; i < 3; ++i) hv[i] = L->key[i] + vv[i];
+                sfb__rnormalize(hv);
+                spec = sfb__rdot(n, hv);
+                spec = spec > 0.0 ? pow(spec, 48.0) : 0.0;
+                rgb[0] = rgb[1] = rgb[2] = pow(sfb__rclamp(0.72 * (0.16 + 0.78 * diff) + 0.3 * spec, 0.0, 1.0), 1.0 / 1.6);
+                break;
             }
-            for (i = 0; i < 3; ++i) rgb[i] *= lum;
-            break;
+            }
+            cls[p] = (unsigned char)cl;
+            o[0] = sfb__to_byte(rgb[0]); o[1] = sfb__to_byte(rgb[1]); o[2] = sfb__to_byte(rgb[2]); o[3] = 255;
         }
-        case SFB_ANALYZE_NORMALS:
-            for (i = 0; i < 3; ++i) rgb[i] = 0.5 + 0.5 * A->hnrm[3 * (size_t)k + i];
-            break;
-        default: {
-            double hv[3], vv[3], spec;
-            if (A->cam.ortho) for (i = 0; i < 3; ++i) vv[i] = -A->cam.fwd[i];
-            else for (i = 0; i < 3; ++i) vv[i] = A->cam.eye[i] - A->hpos[3 * (size_t)k + i];
-            sfb__rnormalize(vv);
-            for (i = 0; i < 3; ++i) hv[i] = L->key[i] + vv[i];
-            sfb__rnormalize(hv);
-            spec = sfb__rdot(n, hv);
-            spec = spec > 0.0 ? pow(spec, 48.0) : 0.0;
-            rgb[0] = rgb[1] = rgb[2] = pow(sfb__rclamp(0.72 * (0.16 + 0.78 * diff) + 0.3 * spec, 0.0, 1.0), 1.0 / 1.6);
-            break;
-        }
-        }
-        cls[p] = (unsigned char)cl;
-        o[0] = sfb__to_byte(rgb[0]); o[1] = sfb__to_byte(rgb[1]); o[2] = sfb__to_byte(rgb[2]); o[3] = 255;
-    }
 }
 
 /* The shade kernel of the context's backend, or ref's. */
