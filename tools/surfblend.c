@@ -777,7 +777,11 @@ static int cmd_info(cli_opts *o) {
     if (in.nonmanifold_edges) { printf(" %d non-manifold edges;", in.nonmanifold_edges); problems++; }
     if (in.nonmanifold_vertices) { printf(" %d non-manifold vertices (treated as corners);", in.nonmanifold_vertices); problems++; }
     if (in.bare_vertices) { printf(" %d vertices in no face;", in.bare_vertices); problems++; }
-    if (in.triangles + in.ngons > 0 && in.quads > 0) { printf(" mixed face sizes (Loop needs all triangles);"); problems++; }
+    if ((in.triangles > 0 && in.quads + in.ngons > 0) || (in.quads > 0 && in.ngons > 0)) {
+        printf(" mixed face sizes: %d of %d faces are not triangles (loop, tribezier and pn take triangles only);", in.quads + in.ngons,
+               in.triangles + in.quads + in.ngons);
+        problems++;
+    }
     if (!problems) printf(" none");
     printf("\n");
     sfb_mesh_destroy(mesh);
