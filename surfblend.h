@@ -15004,7 +15004,6 @@ static void sfb__an_neighbour_rows(void *arg, int y0, int y1) {
     }
 }
 
-/* Step 2 over every round (see the file's comment). */
 /* The projection's round tags of rows [y0, y1) cleared (the faces after them are read only
  * where the tag is the round's, so they are left as they are). */
 typedef struct sfb__an_tags_job {
@@ -15016,6 +15015,7 @@ static void sfb__an_clear_tags(void *arg, int y0, int y1) {
     memset(J->tags + (size_t)y0 * (size_t)J->w, 0, (size_t)(y1 - y0) * (size_t)J->w * sizeof(int));
 }
 
+/* Step 2 over every round (see the file's comment). */
 static sfb_result sfb__an_project_all(sfb__an *A, int steps) {
     size_t npix = (size_t)A->w * (size_t)A->h;
     int cap = 0, count = 0, round, part;
@@ -15272,13 +15272,13 @@ static sfb_result sfb__an_leftovers(sfb__an *A, int *fallback, int *dropped, int
 }
 
 /* ---- step 4: colours ---- */
-/* The footprint of pixel pix in units of the value in v: per axis the smaller one-sided
- * difference (robust at silhouettes and band ends), summed. */
 /* The smaller of two one-sided differences of an axis, each +inf (off the picture, or an infinite
  * neighbour) or NaN (a NaN neighbour) when it does not count; 0 when neither does. */
 static double sfb__an_smaller_side(double a, double b) {
     return a < b ? a : b < HUGE_VAL ? b : a < HUGE_VAL ? a : 0.0;
 }
+/* The footprint of pixel pix in units of the value in v: per axis the smaller one-sided
+ * difference (robust at silhouettes and band ends), summed. */
 static double sfb__an_footprint(const float *v, int w, int h, int x, int y) {
     const int pix = y * w + x;
     const double c = v[pix];
