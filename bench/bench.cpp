@@ -72,6 +72,7 @@
 #include <opensubdiv/osd/ompEvaluator.h>
 
 #include <algorithm>
+#include <map>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -104,6 +105,18 @@ static double ms_since(Clock::time_point t0) {
     return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
 }
 
+/* The whole file as text; false when it cannot be opened. */
+static bool read_text(const char *path, std::string *text) {
+    FILE *f = fopen(path, "rb");
+    if (!f) return false;
+    char buf[65536];
+    size_t n;
+    text->clear();
+    while ((n = fread(buf, 1, sizeof buf, f)) > 0) text->append(buf, n);
+    fclose(f);
+    return true;
+}
+
 static double median(std::vector<double> v) {
     if (v.empty()) return 0.0;
     std::sort(v.begin(), v.end());
@@ -123,6 +136,21 @@ struct TorusMesh {
     std::vector<float> corner_sharpness;
 
     int vid(int i, int j) const { return ((i + nu) % nu) * nv + ((j + nv) % nv); }
+
+    /* Any mesh (nu = nv = 0), a copy of desc's arrays: for OpenSubdiv beside surfblend on meshes
+     * read from files (the tribezier section's real meshes). */
+    TorusMesh() : nu(0), nv(0) {}
+    void assign(const sfb_mesh_desc &d) {
+        size_t nfv = 0;
+        for (int f = 0; f < d.face_count; ++f) nfv += (size_t)d.face_sizes[f];
+        positions.assign(d.positions, d.positions + 3 * (size_t)d.vertex_count);
+        face_sizes.assign(d.face_sizes, d.face_sizes + d.face_count);
+        face_vertices.assign(d.face_vertices, d.face_vertices + nfv);
+        crease_vertices.assign(d.crease_vertices, d.crease_vertices + 2 * (size_t)d.crease_count);
+        crease_sharpness.assign(d.crease_sharpness, d.crease_sharpness + d.crease_count);
+        corner_vertices.assign(d.corner_vertices, d.corner_vertices + d.corner_count);
+        corner_sharpness.assign(d.corner_sharpness, d.corner_sharpness + d.corner_count);
+    }
 
     /* extraordinary = true: the variant for limit evaluation (see make_extraordinary) */
     TorusMesh(int nu_, int nv_, bool extraordinary = false) : nu(nu_), nv(nv_) {
@@ -233,11 +261,11 @@ struct TorusMesh {
         d.face_sizes = &face_sizes[0];
         d.face_vertices = &face_vertices[0];
         d.crease_count = crease_count();
-        d.crease_vertices = &crease_vertices[0];
-        d.crease_sharpness = &crease_sharpness[0];
+        d.crease_vertices = crease_vertices.data();
+        d.crease_sharpness = crease_sharpness.data();
         d.corner_count = (int)corner_vertices.size();
-        d.corner_vertices = &corner_vertices[0];
-        d.corner_sharpness = &corner_sharpness[0];
+        d.corner_vertices = corner_vertices.data();
+        d.corner_sharpness = corner_sharpness.data();
         d.boundary = SFB_BOUNDARY_EDGE_ONLY;
         d.crease_method = SFB_CREASE_UNIFORM;
         d.triangle_rule = SFB_TRI_CATMARK;
@@ -250,11 +278,11 @@ struct TorusMesh {
         d.numVertsPerFace = &face_sizes[0];
         d.vertIndicesPerFace = &face_vertices[0];
         d.numCreases = crease_count();
-        d.creaseVertexIndexPairs = &crease_vertices[0];
-        d.creaseWeights = &crease_sharpness[0];
+        d.creaseVertexIndexPairs = crease_vertices.data();
+        d.creaseWeights = crease_sharpness.data();
         d.numCorners = (int)corner_vertices.size();
-        d.cornerVertexIndices = &corner_vertices[0];
-        d.cornerWeights = &corner_sharpness[0];
+        d.cornerVertexIndices = corner_vertices.data();
+        d.cornerWeights = corner_sharpness.data();
         return d;
     }
 };
@@ -1307,13 +1335,8 @@ static int shade_section() {
            "shade ms", "ratio", "split");
     int status = 0;
     for (const Case &c : cases) {
-        FILE *f = fopen(c.path, "rb");
-        if (!f) { printf("%-14s skipped: %s not found\n", "", c.path); continue; }
         std::string text;
-        char buf[65536];
-        size_t n;
-        while ((n = fread(buf, 1, sizeof buf, f)) > 0) text.append(buf, n);
-        fclose(f);
+        if (!read_text(c.path, &text)) { printf("%-14s skipped: %s not found\n", "", c.path); continue; }
         std::string name = c.path;
         name = name.substr(name.find_last_of('/') + 1);
         name = name.substr(0, name.size() - 4);
@@ -1418,13 +1441,8 @@ static void manifold_draw_row(const char *name, int kind, int a, int b) {
     if (!ctx) { printf("%-14s %6s %-8s skipped: %s\n", name, "", "gl-draw", why.c_str()); return; }
     sfb_mesh *mesh = NULL;
     if (kind == 0) {
-        FILE *f = fopen("../shared/peers/opensubdiv-shapes/catmark_torus.obj", "rb");
-        if (f) {
-            std::string text;
-            char buf[65536];
-            size_t n;
-            while ((n = fread(buf, 1, sizeof buf, f)) > 0) text.append(buf, n);
-            fclose(f);
+        std::string text;
+        if (read_text("../shared/peers/opensubdiv-shapes/catmark_torus.obj", &text)) {
             if (sfb_mesh_read_obj(ctx, text.data(), text.size(), &mesh) != SFB_SUCCESS) mesh = NULL;
         } else mesh = bench_torus_mesh(ctx, 4, 8);
     } else if (kind == 1) mesh = bench_torus_mesh(ctx, a, b);
@@ -1495,13 +1513,8 @@ static int manifold_section() {
             if (!ctx) { printf("%-14s %6s %-8s skipped: %s\n", c.name, "", sfb_backend_kind_name(kind), why.c_str()); continue; }
             sfb_mesh *mesh = NULL;
             if (c.kind == 0) {
-                FILE *f = fopen("../shared/peers/opensubdiv-shapes/catmark_torus.obj", "rb");
-                if (f) {
-                    std::string text;
-                    char buf[65536];
-                    size_t n;
-                    while ((n = fread(buf, 1, sizeof buf, f)) > 0) text.append(buf, n);
-                    fclose(f);
+                std::string text;
+                if (read_text("../shared/peers/opensubdiv-shapes/catmark_torus.obj", &text)) {
                     if (sfb_mesh_read_obj(ctx, text.data(), text.size(), &mesh) != SFB_SUCCESS) mesh = NULL;
                 } else mesh = bench_torus_mesh(ctx, 4, 8);
             } else if (c.kind == 1) mesh = bench_torus_mesh(ctx, c.a, c.b);
@@ -1577,13 +1590,8 @@ static int analyze_section() {
     printf("%-12s %-9s %9s %2s %9s %10s %10s %10s %10s %9s\n", "mesh", "backend", "pixels", "L", "raster", "eval", "shade", "total",
            "polygon", "vs ref");
     for (const Case &c : cases) {
-        FILE *f = fopen(c.path, "rb");
-        if (!f) { printf("%-12s skipped: %s not found\n", c.label, c.path); continue; }
         std::string text;
-        char buf[65536];
-        size_t n;
-        while ((n = fread(buf, 1, sizeof buf, f)) > 0) text.append(buf, n);
-        fclose(f);
+        if (!read_text(c.path, &text)) { printf("%-12s skipped: %s not found\n", c.label, c.path); continue; }
         double ref_total = 0.0;
         for (sfb_backend_kind kind : kinds) {
             AnalyzeClock clk;
@@ -1787,6 +1795,159 @@ static double bbox_diagonal(const TorusMesh &t) {
     return std::sqrt(d);
 }
 
+/* A remeshed-looking triangle mesh: the torus nu x nv cut into triangles (every vertex of valence
+ * 6), then a fraction `frac` of its edges flipped at random (a flip keeps valences in 4..8 and
+ * never makes an edge twice), so that extraordinary vertices are everywhere and touch, as on
+ * scanned or remeshed models. */
+static TorusMesh flipped_torus(int nu, int nv, double frac, unsigned long long seed) {
+    TorusMesh t(nu, nv);
+    t.triangulate();
+    t.crease_vertices.clear(); t.crease_sharpness.clear(); t.corner_vertices.clear(); t.corner_sharpness.clear();
+    const int nf = t.face_count();
+    std::vector<int> &fv = t.face_vertices;
+    std::vector<int> val((size_t)t.vertex_count(), 0);
+    std::map<std::pair<int, int>, std::vector<int> > edges; /* (low, high) -> its faces */
+    auto key = [](int a, int b) { return std::make_pair(std::min(a, b), std::max(a, b)); };
+    for (int f = 0; f < nf; ++f)
+        for (int k = 0; k < 3; ++k) edges[key(fv[3 * f + k], fv[3 * f + (k + 1) % 3])].push_back(f);
+    for (const auto &e : edges) { ++val[(size_t)e.first.first]; ++val[(size_t)e.first.second]; }
+    std::vector<std::pair<int, int> > order;
+    for (const auto &e : edges) order.push_back(e.first);
+    SplitMix rng(seed);
+    for (size_t i = order.size(); i > 1; --i) std::swap(order[i - 1], order[(size_t)rng.below((int)i)]);
+    const size_t want = (size_t)(frac * (double)order.size());
+    size_t done = 0;
+    for (size_t i = 0; i < order.size() && done < want; ++i) {
+        auto it = edges.find(order[i]);
+        if (it == edges.end() || it->second.size() != 2) continue;
+        const int a = it->first.first, b = it->first.second, f0 = it->second[0], f1 = it->second[1];
+        int c = -1, d = -1;
+        for (int k = 0; k < 3; ++k) {
+            if (fv[3 * f0 + k] != a && fv[3 * f0 + k] != b) c = fv[3 * f0 + k];
+            if (fv[3 * f1 + k] != a && fv[3 * f1 + k] != b) d = fv[3 * f1 + k];
+        }
+        if (edges.count(key(c, d)) || val[(size_t)a] <= 4 || val[(size_t)b] <= 4 || val[(size_t)c] >= 8 || val[(size_t)d] >= 8) continue;
+        /* f0 runs p -> q -> c with {p, q} = {a, b}: the new faces (c, p, d) and (d, q, c) */
+        int k0 = 0;
+        while (fv[3 * f0 + k0] == c) ++k0;
+        const int p = fv[3 * f0 + k0], q = fv[3 * f0 + (k0 + 1) % 3] == c ? fv[3 * f0 + (k0 + 2) % 3] : fv[3 * f0 + (k0 + 1) % 3];
+        const int pp = fv[3 * f0 + (k0 + 1) % 3] == c ? q : p, qq = pp == p ? q : p; /* pp -> qq is f0's order */
+        const int n0[3] = {c, pp, d}, n1[3] = {d, qq, c};
+        edges.erase(it);
+        for (int k = 0; k < 3; ++k) { fv[3 * f0 + k] = n0[k]; fv[3 * f1 + k] = n1[k]; }
+        /* the four outer edges: f0 keeps (c, pp) and takes (pp, d); f1 keeps (d, qq) and takes (qq, c) */
+        std::vector<int> &e1 = edges[key(pp, d)], &e2 = edges[key(qq, c)];
+        std::replace(e1.begin(), e1.end(), f1, f0);
+        std::replace(e2.begin(), e2.end(), f0, f1);
+        edges[key(c, d)] = {f0, f1};
+        --val[(size_t)a]; --val[(size_t)b]; ++val[(size_t)c]; ++val[(size_t)d];
+        ++done;
+    }
+    return t;
+}
+
+/* Issue 16's construction on meshes with extraordinary vertices everywhere, beside the torus row:
+ * real models (../shared/peers/real-meshes) and the flipped torus; ms per 1,000 triangles, median
+ * of 3, one thread (ref context) and all threads (simd), surfblend's Loop and OpenSubdiv's Loop
+ * refine + patch table on the same mesh. */
+static int tribezier_meshes_section() {
+    struct Case { const char *label, *path; int nu, nv; };
+    const Case cases[] = {{"cow", "../shared/peers/real-meshes/cow.obj", 0, 0},
+                          {"spot", "../shared/peers/real-meshes/spot.obj", 0, 0},
+                          {"teapot", "../shared/peers/real-meshes/teapot.obj", 0, 0},
+                          {"flipped torus 60x40", NULL, 60, 40},
+                          {"flipped torus 120x80", NULL, 120, 80}};
+    int status = 0;
+    std::string why, mt_why;
+    sfb_context *rctx = eval_context(SFB_BACKEND_REF, 1, 0, &why), *mctx = eval_context(SFB_BACKEND_SIMD, 0, 0, &mt_why);
+    printf("\ntribezier construction on meshes with extraordinary vertices everywhere (ms per 1,000 triangles, median of 3;\n"
+           "'x OSD' = OpenSubdiv's / tribezier one thread; where extraordinary vertices of different valences touch, the net\n"
+           "is built after one Loop step, 4 patches per triangle):\n");
+    printf("%-22s %7s %6s %6s | %10s %10s %10s %10s | %6s\n", "mesh", "tris", "EVs", "solve", "tribezier", "simd all", "sfb Loop",
+           "OSD Loop", "x OSD");
+    for (const Case &c : cases) {
+        if (!rctx) { printf("%-22s skipped: no ref context: %s\n", c.label, why.c_str()); break; }
+        TorusMesh tm;
+        sfb_mesh *m = NULL;
+        if (c.path) {
+            std::string text;
+            if (!read_text(c.path, &text)) { printf("%-22s skipped: %s not found\n", c.label, c.path); continue; }
+            sfb_mesh *fm = NULL;
+            if (sfb_mesh_read_obj(rctx, text.data(), text.size(), &fm) != SFB_SUCCESS) {
+                printf("%-22s failed: %s\n", c.label, sfb_last_error(rctx));
+                status = 1;
+                continue;
+            }
+            sfb_mesh_desc d;
+            sfb_mesh_get_desc(fm, &d);
+            tm.assign(d);
+            sfb_mesh_destroy(fm);
+        } else {
+            tm = flipped_torus(c.nu, c.nv, 0.15, 0x7e57ull);
+        }
+        sfb_mesh_desc desc = tm.sfb_desc();
+        desc.boundary = SFB_BOUNDARY_EDGE_ONLY;
+        if (sfb_mesh_create(rctx, &desc, &m) != SFB_SUCCESS) { printf("%-22s failed: %s\n", c.label, sfb_last_error(rctx)); status = 1; continue; }
+        sfb_mesh_info mi;
+        sfb_mesh_get_info(m, &mi);
+        sfb_surface_config tc = sfb_surface_config_init(SFB_SCHEME_TRIBEZIER, 0), lc = sfb_surface_config_init(SFB_SCHEME_LOOP, 0);
+        tc.flags = lc.flags = SFB_REFINE_PATCHES;
+        std::vector<double> t1, tl, tmt, to;
+        int depth = 0;
+        for (int rep = 0; rep < 3 && status == 0; ++rep) {
+            sfb_surface *s = NULL;
+            Clock::time_point t0 = Clock::now();
+            if (sfb_surface_create(rctx, m, &tc, &s) != SFB_SUCCESS) { printf("%-22s failed: %s\n", c.label, sfb_last_error(rctx)); status = 1; break; }
+            t1.push_back(ms_since(t0));
+            sfb_patch_info pi;
+            memset(&pi, 0, sizeof pi);
+            sfb_surface_patch_info(s, &pi);
+            depth = pi.max_depth;
+            sfb_surface_destroy(s);
+            s = NULL;
+            t0 = Clock::now();
+            if (sfb_surface_create(rctx, m, &lc, &s) == SFB_SUCCESS) tl.push_back(ms_since(t0));
+            sfb_surface_destroy(s);
+        }
+        if (mctx && status == 0) {
+            sfb_mesh *mm = NULL;
+            if (sfb_mesh_create(mctx, &desc, &mm) == SFB_SUCCESS)
+                for (int rep = 0; rep < 3; ++rep) {
+                    sfb_surface *s = NULL;
+                    Clock::time_point t0 = Clock::now();
+                    if (sfb_surface_create(mctx, mm, &tc, &s) != SFB_SUCCESS) break;
+                    tmt.push_back(ms_since(t0));
+                    sfb_surface_destroy(s);
+                }
+            sfb_mesh_destroy(mm);
+        }
+        OsdPatches osd;
+        for (int rep = 0; rep < 3; ++rep) {
+            Clock::time_point t0 = Clock::now();
+            if (!osd.build_patches(tm, false, Sdc::SCHEME_LOOP)) break;
+            to.push_back(ms_since(t0));
+        }
+        sfb_mesh_destroy(m);
+        if (t1.empty()) continue;
+        const double k = 1000.0 / mi.triangles, a = median(t1), o = to.empty() ? 0.0 : median(to);
+        auto cell = [&](const std::vector<double> &v) {
+            static char b[4][32];
+            static int i = 0;
+            i = (i + 1) % 4;
+            if (v.empty()) snprintf(b[i], sizeof b[i], "%10s", "-");
+            else snprintf(b[i], sizeof b[i], "%10.2f", median(v) * k);
+            return b[i];
+        };
+        printf("%-22s %7d %6d %6s | %10.2f %s %s %s | %6.2f\n", c.label, mi.triangles, mi.extraordinary_loop, depth > 0 ? "Loop 1" : "mesh",
+               a * k, cell(tmt), cell(tl), cell(to), o > 0 && a > 0 ? o / a : 0.0);
+        fflush(stdout);
+    }
+    if (mctx) printf("(simd all: %s)\n", mt_why.c_str());
+    sfb_context_destroy(rctx);
+    sfb_context_destroy(mctx);
+    return status;
+}
+
 int main(int argc, char **argv) {
     int max_level = 4;
     bool limit_only = false;
@@ -1803,15 +1964,18 @@ int main(int argc, char **argv) {
     if (argc > 1 && strcmp(argv[1], "--manifold") == 0) return manifold_section();
     if (argc > 1 && strcmp(argv[1], "--analyze") == 0) return analyze_section();
     if (argc > 1 && strcmp(argv[1], "--fillet") == 0) return fillet_section();
+    if (argc > 1 && strcmp(argv[1], "--tribezier-meshes") == 0) return tribezier_meshes_section();
     if (argc > 1 && strcmp(argv[1], "--tribezier") == 0) {
         TorusMesh t(100, 60);
-        return limit_section(bbox_diagonal(t), LIMIT_TRIBEZIER);
+        int st = limit_section(bbox_diagonal(t), LIMIT_TRIBEZIER);
+        if (tribezier_meshes_section() != 0) st = 1;
+        return st;
     }
     if (argc > 1) {
         limit_only = strcmp(argv[1], "--limit") == 0;
         max_level = limit_only ? 0 : atoi(argv[1]);
         if (argc > 2 || (!limit_only && (max_level < 1 || max_level > 6))) {
-            fprintf(stderr, "usage: bench [MAX_LEVEL 1..6, default 4 | --limit (the limit evaluation section alone) | --shade (the shading section alone) | --manifold (the manifold blending section alone) | --tribezier (the tribezier section alone) | --analyze (the analysis section alone) | --fillet (the fillet section alone)]\n");
+            fprintf(stderr, "usage: bench [MAX_LEVEL 1..6, default 4 | --limit (the limit evaluation section alone) | --shade (the shading section alone) | --manifold (the manifold blending section alone) | --tribezier (the tribezier section alone) | --tribezier-meshes (its real and remeshed meshes alone) | --analyze (the analysis section alone) | --fillet (the fillet section alone)]\n");
             return 2;
         }
     }
@@ -1980,6 +2144,7 @@ int main(int argc, char **argv) {
     if (limit_section(diag, LIMIT_CATMARK) != 0) status = 1;
     if (limit_section(diag, LIMIT_LOOP) != 0) status = 1;
     if (limit_section(diag, LIMIT_TRIBEZIER) != 0) status = 1;
+    if (tribezier_meshes_section() != 0) status = 1;
     if (shade_section() != 0) status = 1;
     if (manifold_section() != 0) status = 1;
     if (analyze_section() != 0) status = 1;
