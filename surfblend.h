@@ -1565,8 +1565,10 @@ SFB__IF sfb_result sfb__pn_build(sfb_context *ctx, const sfb__level *base, const
  * the G1 solve did; flags SFB__TBZ_SEED_PLANE builds the seed's smooth net at crease vertices (a
  * tangent plane that ignores the crease, for the undulation measurement), SFB__TBZ_NO_REUSE solves every
  * component of the sharp net's constraints even where the smooth net solved the same system (for the test
- * that the reuse changes nothing). */
-enum { SFB__TBZ_SEED_PLANE = 1, SFB__TBZ_NO_REUSE = 2 };
+ * that the reuse changes nothing), SFB__TBZ_PAR_SMALL runs the loops of every component of 1024 unknowns or
+ * more on the backend's threads (for the test that the net stays bit for bit the same there; the
+ * default is 65536). */
+enum { SFB__TBZ_SEED_PLANE = 1, SFB__TBZ_NO_REUSE = 2, SFB__TBZ_PAR_SMALL = 4 };
 typedef struct sfb__tbz_stats {
     long iterations;   /* CGLS iterations, all coordinates and nets */
     long unknowns;     /* points moved by the G1 solve, per coordinate and net */
@@ -1577,6 +1579,8 @@ typedef struct sfb__tbz_stats {
     int fallbacks;     /* smooth nets rebuilt with the seed's tangent plane (ours unsolvable) */
     int reused;        /* sharp-net constraint components that were the same system as a smooth-net one and took its
                           solution (SFB__TBZ_NO_REUSE: none) */
+    int large;         /* components solved with each iteration's loops on the backend's threads (65536 unknowns
+                          or more, 1024 with SFB__TBZ_PAR_SMALL) */
 } sfb__tbz_stats;
 SFB__IF sfb_result sfb__tribezier_points(sfb_context *ctx, const sfb__level *base, const float *positions,
                                          const sfb_tribezier_options *opt, unsigned flags, double **out, sfb__tbz_stats *stats);
@@ -7035,6 +7039,7 @@ typedef struct sfb__tbz {
     const float *pos;
     int nv, ne, nf, np;
     int seed_plane;
+    int par_unknowns;          /* components of this many unknowns or more: each iteration's loops on the threads */
     /* per state */
     int sharp;                 /* building the sharp net */
     unsigned char *efeat;      /* per edge: sharp in this net */
@@ -7616,6 +7621,130 @@ static int tbz_root(int *parent, int i) {
     return i;
 }
 
+#define TBZ_STALL 40
+#define TBZ_MAX(a, b) ((a) > (b) ? (a) : (b))
+/* The loops of an iteration run over TBZ_CHUNKS fixed chunks of the rows and of the unknowns,
+ * each chunk keeping its own partial sums, added in chunk order: so the arithmetic is the same
+ * whether the chunks run on one thread or on the backend's threads (a component of at least
+ * TBZ_PAR_UNKNOWNS unknowns runs its chunks on them, tbz_solve_todo), and the net is the same bit
+ * for bit on every backend and thread count. The threshold: an iteration hands its loops to the
+ * threads four times, and waking a worker costs 30-60 us (bench), so the loops must be long
+ * enough to pay for it; below it, components are solved whole, several at a time. */
+#define TBZ_CHUNKS 64
+#define TBZ_PAR_UNKNOWNS 65536
+#define TBZ_PAR_UNKNOWNS_SMALL 1024 /* SFB__TBZ_PAR_SMALL */
+typedef struct tbz_cg {
+    int nr, nu;
+    const size_t *lo, *co; /* the local CSR and its transpose (each column's entries in row order) */
+    const int *lc, *cr;
+    const double *lw, *cw;
+    double *rr, *q, *xs, *sv, *p;
+    double alpha[3], beta[3];
+    int active[3];
+    double part[TBZ_CHUNKS][3][3]; /* per chunk: its partial sums (three kinds, three coordinates) */
+} tbz_cg;
+static void tbz_span(int n, int ch, int *a, int *b) {
+    *a = (int)((long long)n * ch / TBZ_CHUNKS);
+    *b = (int)((long long)n * (ch + 1) / TBZ_CHUNKS);
+}
+/* out = the sums of w[k] vec[idx[k]] over k in [k0, k1), three coordinates (in k order). */
+static void tbz_dot3(const int *idx, const double *w, size_t k0, size_t k1, const double *vec, double out[3]) {
+    double s0 = 0.0, s1 = 0.0, s2 = 0.0;
+    size_t k;
+    for (k = k0; k < k1; ++k) {
+        const double *x = vec + 3 * (size_t)idx[k];
+        s0 += w[k] * x[0]; s1 += w[k] * x[1]; s2 += w[k] * x[2];
+    }
+    out[0] = s0; out[1] = s1; out[2] = s2;
+}
+/* q = A p over the chunks' rows; part[.][0] = |q|^2. */
+static void tbz_cg_aq(void *arg, int first, int last) {
+    tbz_cg *G = (tbz_cg *)arg;
+    const size_t *lo = G->lo;
+    const int *lc = G->lc;
+    const double *lw = G->lw, *p = G->p;
+    double *q = G->q;
+    int ch, r, r0, r1;
+    for (ch = first; ch < last; ++ch) {
+        double qq0 = 0.0, qq1 = 0.0, qq2 = 0.0;
+        tbz_span(G->nr, ch, &r0, &r1);
+        for (r = r0; r < r1; ++r) {
+            double *v = q + 3 * r;
+            tbz_dot3(lc, lw, lo[r], lo[r + 1], p, v);
+            qq0 += v[0] * v[0]; qq1 += v[1] * v[1]; qq2 += v[2] * v[2];
+        }
+        G->part[ch][0][0] = qq0; G->part[ch][0][1] = qq1; G->part[ch][0][2] = qq2;
+    }
+}
+/* r -= alpha q over the chunks' rows; part[.][1] = max |r|, part[.][2] = |r|^2. */
+static void tbz_cg_r(void *arg, int first, int last) {
+    tbz_cg *G = (tbz_cg *)arg;
+    const double *q = G->q, a[3] = {G->alpha[0], G->alpha[1], G->alpha[2]};
+    double *rr = G->rr;
+    int ch, r, r0, r1, c;
+    for (ch = first; ch < last; ++ch) {
+        double rn[3] = {0.0, 0.0, 0.0}, r2[3] = {0.0, 0.0, 0.0};
+        tbz_span(G->nr, ch, &r0, &r1);
+        for (r = r0; r < r1; ++r)
+            for (c = 0; c < 3; ++c) {
+                const double v = rr[3 * r + c] - a[c] * q[3 * r + c];
+                rr[3 * r + c] = v;
+                rn[c] = TBZ_MAX(rn[c], fabs(v));
+                r2[c] += v * v;
+            }
+        for (c = 0; c < 3; ++c) { G->part[ch][1][c] = rn[c]; G->part[ch][2][c] = r2[c]; }
+    }
+}
+/* Over the chunks' unknowns: x += alpha p, then sv = A^T r (gathered per unknown from the
+ * transpose, so each sum adds the terms a row-by-row scatter would, in its order); part[.][0] =
+ * |sv|^2. */
+static void tbz_cg_atr(void *arg, int first, int last) {
+    tbz_cg *G = (tbz_cg *)arg;
+    const size_t *co = G->co;
+    const int *cr = G->cr;
+    const double *cw = G->cw, *rr = G->rr, *p = G->p, a[3] = {G->alpha[0], G->alpha[1], G->alpha[2]};
+    double *xs = G->xs, *sv = G->sv;
+    int ch, i, i0, i1, c;
+    for (ch = first; ch < last; ++ch) {
+        double g0 = 0.0, g1 = 0.0, g2 = 0.0;
+        tbz_span(G->nu, ch, &i0, &i1);
+        for (i = i0; i < i1; ++i) {
+            double *v = sv + 3 * i;
+            for (c = 0; c < 3; ++c) xs[3 * i + c] += a[c] * p[3 * i + c];
+            tbz_dot3(cr, cw, co[i], co[i + 1], rr, v);
+            g0 += v[0] * v[0]; g1 += v[1] * v[1]; g2 += v[2] * v[2];
+        }
+        G->part[ch][0][0] = g0; G->part[ch][0][1] = g1; G->part[ch][0][2] = g2;
+    }
+}
+/* p = sv + beta p over the chunks' unknowns, for the active coordinates. */
+static void tbz_cg_p(void *arg, int first, int last) {
+    tbz_cg *G = (tbz_cg *)arg;
+    const double *sv = G->sv;
+    double *p = G->p;
+    int ch, i, i0, i1, c;
+    for (ch = first; ch < last; ++ch) {
+        tbz_span(G->nu, ch, &i0, &i1);
+        for (c = 0; c < 3; ++c)
+            if (G->active[c]) {
+                const double b = G->beta[c];
+                for (i = i0; i < i1; ++i) p[3 * i + c] = sv[3 * i + c] + b * p[3 * i + c];
+            }
+    }
+}
+/* Runs a phase over every chunk, on the backend's threads (ctx) or here (NULL). */
+static void tbz_cg_run(sfb_context *ctx, tbz_cg *G, void (*phase)(void *, int, int)) {
+    if (ctx) sfb__parallel(ctx, phase, G, 0, TBZ_CHUNKS);
+    else phase(G, 0, TBZ_CHUNKS);
+}
+/* s[c] = the sum (kind 0 or 2) or the largest (kind 1) of the chunks' part[.][kind][c], in chunk
+ * order. */
+static void tbz_cg_sum(const tbz_cg *G, int kind, double s[3]) {
+    int ch, c;
+    for (c = 0; c < 3; ++c) s[c] = 0.0;
+    for (ch = 0; ch < TBZ_CHUNKS; ++ch)
+        for (c = 0; c < 3; ++c) s[c] = kind == 1 ? TBZ_MAX(s[c], G->part[ch][1][c]) : s[c] + G->part[ch][kind][c];
+}
 /* CGLS from zero on one connected component of the constraints (rows `rows[0..nr)`, unknowns
  * `unk[0..nu)` with local[] mapping a point to its column or -1), the three coordinates at once
  * (one matrix, three right-hand sides, each with its own recurrence); adds the change to T->x.
@@ -7625,30 +7754,14 @@ static int tbz_root(int *parent, int i) {
  * (consistent: exactly G1), when A^T r has fallen by 1e-13, or when |r|^2 has fallen by less
  * than 1e-5 of itself over the last TBZ_STALL iterations (inconsistent -- touching extraordinary
  * vertices of different valences --: the least-squares residual is reached; what CGLS would
- * still move are the near-null directions, which only make the net wilder). */
-#define TBZ_STALL 40
-#define TBZ_MAX(a, b) ((a) > (b) ? (a) : (b))
-/* sv = A^T r, three coordinates, gathered per unknown from the transpose (co, cr, cw: each
- * column's entries in row order, so each sum adds the terms a row-by-row scatter would, in its
- * order). */
-static void tbz_atr(const size_t *co, const int *cr, const double *cw, const double *rr, int nu, double *sv) {
-    int i;
-    size_t k;
-    for (i = 0; i < nu; ++i) {
-        double s0 = 0.0, s1 = 0.0, s2 = 0.0;
-        for (k = co[i]; k < co[i + 1]; ++k) {
-            const double *rv = rr + 3 * (size_t)cr[k];
-            s0 += cw[k] * rv[0]; s1 += cw[k] * rv[1]; s2 += cw[k] * rv[2];
-        }
-        sv[3 * i] = s0; sv[3 * i + 1] = s1; sv[3 * i + 2] = s2;
-    }
-}
+ * still move are the near-null directions, which only make the net wilder). par: the context
+ * whose threads run each iteration's loops (tbz_cg), or NULL: here. */
 static int tbz_cgls(sfb__tbz *T, const tbz_sys *S, const int *rows, int nr, const int *unk, int nu, const int *local, double scale,
-                    double *w, size_t *lo, int *lc, double *lw, size_t *co, int *cr, double *cw) {
-    double *rr = w, *q = w + 3 * (size_t)nr, *xs = q + 3 * (size_t)nr, *sv = xs + 3 * (size_t)nu, *p = sv + 3 * (size_t)nu;
-    double *hist = p + 3 * (size_t)nu;
+                    double *w, size_t *lo, int *lc, double *lw, size_t *co, int *cr, double *cw, sfb_context *par) {
+    tbz_cg G;
+    double *rr = w, *hist = w + 6 * (size_t)nr + 12 * (size_t)nu;
     double gamma[3], gamma0[3];
-    int active[3], it, i, r, c, left = 3;
+    int it, i, r, c, left = 3;
     const int maxit = 20 * nu + 200 < 5000 ? 20 * nu + 200 : 5000;
     size_t n = 0, k, k2;
     /* the local matrix, and the residual of the initial net b = -A x0 (fixed points included) */
@@ -7666,7 +7779,7 @@ static int tbz_cgls(sfb__tbz *T, const tbz_sys *S, const int *rows, int nr, cons
         for (c = 0; c < 3; ++c) rr[3 * r + c] = -v[c];
     }
     lo[nr] = n;
-    /* its transpose (co/cr/cw), each column's entries in row order (tbz_atr) */
+    /* its transpose (co/cr/cw), each column's entries in row order (tbz_cg_atr) */
     for (i = 0; i <= nu; ++i) co[i] = 0;
     for (k = 0; k < n; ++k) ++co[lc[k] + 1];
     for (i = 0; i < nu; ++i) co[i + 1] += co[i];
@@ -7678,58 +7791,48 @@ static int tbz_cgls(sfb__tbz *T, const tbz_sys *S, const int *rows, int nr, cons
         }
     for (i = nu; i > 0; --i) co[i] = co[i - 1];
     co[0] = 0;
-    for (i = 0; i < 3 * nu; ++i) xs[i] = 0.0;
-    tbz_atr(co, cr, cw, rr, nu, sv);
-    for (c = 0; c < 3; ++c) { gamma[c] = 0.0; active[c] = 1; }
-    for (i = 0; i < nu; ++i)
-        for (c = 0; c < 3; ++c) { p[3 * i + c] = sv[3 * i + c]; gamma[c] += sv[3 * i + c] * sv[3 * i + c]; }
+    G.nr = nr; G.nu = nu; G.lo = lo; G.co = co; G.lc = lc; G.cr = cr; G.lw = lw; G.cw = cw;
+    G.rr = rr; G.q = rr + 3 * (size_t)nr; G.xs = G.q + 3 * (size_t)nr; G.sv = G.xs + 3 * (size_t)nu; G.p = G.sv + 3 * (size_t)nu;
+    for (i = 0; i < 3 * nu; ++i) { G.xs[i] = 0.0; G.p[i] = 0.0; }
+    for (c = 0; c < 3; ++c) { G.alpha[c] = 0.0; G.beta[c] = 0.0; G.active[c] = 1; }
+    tbz_cg_run(par, &G, tbz_cg_atr); /* sv = A^T r (x stays 0: alpha = 0) */
+    tbz_cg_sum(&G, 0, gamma);
+    tbz_cg_run(par, &G, tbz_cg_p);   /* p = sv */
     for (c = 0; c < 3; ++c) {
         gamma0[c] = gamma[c];
-        if (!(gamma[c] > 0.0)) { active[c] = 0; --left; }
+        if (!(gamma[c] > 0.0)) { G.active[c] = 0; --left; }
     }
     for (it = 0; it < maxit && left > 0; ++it) {
-        double qq[3] = {0.0, 0.0, 0.0}, rn[3] = {0.0, 0.0, 0.0}, r2[3] = {0.0, 0.0, 0.0}, g2[3] = {0.0, 0.0, 0.0}, alpha[3];
-        for (r = 0; r < nr; ++r) {
-            double v0 = 0.0, v1 = 0.0, v2 = 0.0;
-            for (k = lo[r]; k < lo[r + 1]; ++k) {
-                const double *pp = p + 3 * lc[k];
-                v0 += lw[k] * pp[0]; v1 += lw[k] * pp[1]; v2 += lw[k] * pp[2];
-            }
-            q[3 * r] = v0; q[3 * r + 1] = v1; q[3 * r + 2] = v2;
-            qq[0] += v0 * v0; qq[1] += v1 * v1; qq[2] += v2 * v2;
-        }
+        double qq[3], rn[3], r2[3], g2[3];
+        tbz_cg_run(par, &G, tbz_cg_aq);
+        tbz_cg_sum(&G, 0, qq);
         for (c = 0; c < 3; ++c) {
-            if (active[c] && !(qq[c] > 0.0)) { active[c] = 0; --left; }
-            alpha[c] = active[c] ? gamma[c] / qq[c] : 0.0;
+            if (G.active[c] && !(qq[c] > 0.0)) { G.active[c] = 0; --left; }
+            G.alpha[c] = G.active[c] ? gamma[c] / qq[c] : 0.0;
         }
-        for (i = 0; i < nu; ++i)
-            for (c = 0; c < 3; ++c) xs[3 * i + c] += alpha[c] * p[3 * i + c];
-        for (r = 0; r < nr; ++r)
-            for (c = 0; c < 3; ++c) {
-                const double v = rr[3 * r + c] - alpha[c] * q[3 * r + c];
-                rr[3 * r + c] = v;
-                rn[c] = TBZ_MAX(rn[c], fabs(v));
-                r2[c] += v * v;
-            }
+        tbz_cg_run(par, &G, tbz_cg_r);
+        tbz_cg_sum(&G, 1, rn);
+        tbz_cg_sum(&G, 2, r2);
         for (c = 0; c < 3; ++c) {
             double *h = hist + (size_t)c * TBZ_STALL;
-            if (!active[c]) continue;
-            if (rn[c] <= 1e-15 * scale || (it >= TBZ_STALL && h[it % TBZ_STALL] - r2[c] <= 1e-5 * r2[c])) { active[c] = 0; --left; }
+            if (!G.active[c]) continue;
+            if (rn[c] <= 1e-15 * scale || (it >= TBZ_STALL && h[it % TBZ_STALL] - r2[c] <= 1e-5 * r2[c])) { G.active[c] = 0; --left; }
             h[it % TBZ_STALL] = r2[c];
         }
+        /* x += alpha p (every coordinate that moved this iteration), sv = A^T r */
+        tbz_cg_run(par, &G, tbz_cg_atr);
+        tbz_cg_sum(&G, 0, g2);
         if (left == 0) { ++it; break; }
-        tbz_atr(co, cr, cw, rr, nu, sv);
-        for (i = 0; i < nu; ++i)
-            for (c = 0; c < 3; ++c) g2[c] += sv[3 * i + c] * sv[3 * i + c];
         for (c = 0; c < 3; ++c) {
-            if (active[c] && g2[c] <= 1e-26 * gamma0[c]) { active[c] = 0; --left; }
-            if (!active[c]) continue;
-            for (i = 0; i < nu; ++i) p[3 * i + c] = sv[3 * i + c] + (g2[c] / gamma[c]) * p[3 * i + c];
+            if (G.active[c] && g2[c] <= 1e-26 * gamma0[c]) { G.active[c] = 0; --left; }
+            if (!G.active[c]) continue;
+            G.beta[c] = g2[c] / gamma[c];
             gamma[c] = g2[c];
         }
+        tbz_cg_run(par, &G, tbz_cg_p);
     }
     for (i = 0; i < nu; ++i)
-        for (c = 0; c < 3; ++c) T->x[3 * (size_t)unk[i] + c] += xs[3 * i + c];
+        for (c = 0; c < 3; ++c) T->x[3 * (size_t)unk[i] + c] += G.xs[3 * i + c];
     return it;
 }
 
@@ -7800,12 +7903,14 @@ static size_t tbz_comp_entries(const tbz_sys *S, const tbz_comps *C, int i) {
     return n;
 }
 
-/* The components to solve, in blocks over the backend's threads (sfb__parallel): components
- * are independent (a component's rows read only its own unknowns, which it alone writes, and
- * points no component moves), so the net is bit for bit that of solving them one by one. A
- * block holds consecutive components of about equal work and its own scratch (tbz_cgls's w, lo,
- * lc, lw, sized for its largest component); local maps every unknown to its column within its
- * component. */
+/* The components to solve: the small ones in blocks over the backend's threads (sfb__parallel;
+ * components are independent: a component's rows read only its own unknowns, which it alone
+ * writes, and points no component moves), then the large ones (T->par_unknowns unknowns or
+ * more: on a mesh with extraordinary vertices everywhere the regions merge into a few large
+ * ones) one by one, each iteration's loops on the threads (tbz_cg); the net is bit for bit that
+ * of solving them one by one on one thread. A block holds consecutive components of about equal
+ * work and its own scratch (tbz_cgls's w, lo, lc, lw, co, cr, cw, sized for its largest
+ * component); local maps every unknown to its column within its component. */
 #define TBZ_BLOCKS 32
 typedef struct tbz_block {
     double *w, *lw, *cw;
@@ -7822,46 +7927,57 @@ typedef struct tbz_job {
     int *its; /* per todo entry: its iterations */
 } tbz_job;
 
-static void tbz_solve_blocks(void *arg, int first, int last) {
-    const tbz_job *J = (const tbz_job *)arg;
+/* Blocks [first, last) of J; par: the context whose threads run each iteration's loops, or NULL. */
+static void tbz_solve_range(const tbz_job *J, int first, int last, sfb_context *par) {
     int b, t;
     for (b = first; b < last; ++b)
         for (t = J->bstart[b]; t < J->bstart[b + 1]; ++t) {
             const int i = J->todo[t], r0 = J->C->rstart[i], u0 = J->C->ustart[i];
             J->its[t] = tbz_cgls(J->T, J->S, J->C->rows + r0, J->C->rstart[i + 1] - r0, J->C->unk + u0, J->C->ustart[i + 1] - u0, J->local,
-                                 J->scale, J->blk[b].w, J->blk[b].lo, J->blk[b].lc, J->blk[b].lw, J->blk[b].co, J->blk[b].cr, J->blk[b].cw);
+                                 J->scale, J->blk[b].w, J->blk[b].lo, J->blk[b].lc, J->blk[b].lw, J->blk[b].co, J->blk[b].cr, J->blk[b].cw,
+                                 par);
         }
 }
+static void tbz_solve_blocks(void *arg, int first, int last) { tbz_solve_range((const tbz_job *)arg, first, last, NULL); }
 
 /* Solves the components todo[0 .. nt) (see tbz_job). */
 static sfb_result tbz_solve_todo(sfb__tbz *T, const tbz_sys *S, const tbz_comps *C, const int *local, const int *todo, int nt, double scale) {
     tbz_job J;
-    int bstart[TBZ_BLOCKS + 1], nb = nt < TBZ_BLOCKS ? nt : TBZ_BLOCKS, b, t;
-    tbz_block blk[TBZ_BLOCKS];
+    int bstart[TBZ_BLOCKS + 2], nb, ns = 0, b, t, *order;
+    tbz_block blk[TBZ_BLOCKS + 1];
     size_t total = 0, acc = 0, *ent;
     sfb_result res = SFB_SUCCESS;
     if (nt == 0) return SFB_SUCCESS;
     memset(blk, 0, sizeof blk);
     J.its = (int *)sfb__alloc(T->ctx, (size_t)nt * sizeof(int));
-    if (!J.its) return sfb__oom(T->ctx, "tribezier constraints");
-    /* a component's work ~ the entries of its rows (ent, per todo entry, in its for now) */
+    order = (int *)sfb__alloc(T->ctx, (size_t)nt * sizeof(int));
+    /* a component's work ~ the entries of its rows (ent, per order entry) */
     ent = (size_t *)sfb__alloc(T->ctx, (size_t)nt * sizeof(size_t));
-    if (!ent) { sfb__free(T->ctx, J.its); return sfb__oom(T->ctx, "tribezier constraints"); }
-    for (t = 0; t < nt; ++t) total += (ent[t] = tbz_comp_entries(S, C, todo[t])) + 1;
+    if (!J.its || !order || !ent) { res = sfb__oom(T->ctx, "tribezier constraints"); goto done; }
+    /* the small components first, then the large ones */
+    for (t = 0; t < nt; ++t)
+        if (C->ustart[todo[t] + 1] - C->ustart[todo[t]] < T->par_unknowns) order[ns++] = todo[t];
+    for (t = 0, b = ns; t < nt; ++t)
+        if (C->ustart[todo[t] + 1] - C->ustart[todo[t]] >= T->par_unknowns) order[b++] = todo[t];
+    for (t = 0; t < nt; ++t) ent[t] = tbz_comp_entries(S, C, order[t]);
+    for (t = 0; t < ns; ++t) total += ent[t] + 1;
+    nb = ns < TBZ_BLOCKS ? ns : TBZ_BLOCKS;
     bstart[0] = 0;
     for (b = 1, t = 0; b < nb; ++b) {
         const size_t goal = total / (size_t)nb * (size_t)b;
-        while (t < nt && acc < goal) acc += ent[t++] + 1;
+        while (t < ns && acc < goal) acc += ent[t++] + 1;
         bstart[b] = t;
     }
-    bstart[nb] = nt;
-    for (b = 0; b < nb && res == SFB_SUCCESS; ++b) {
+    bstart[nb] = ns;
+    bstart[nb + 1] = nt; /* block nb: the large components */
+    for (b = 0; b <= nb && res == SFB_SUCCESS; ++b) {
         size_t mr = 0, mu = 0, me = 0;
         for (t = bstart[b]; t < bstart[b + 1]; ++t) {
-            const int i = todo[t];
+            const int i = order[t];
             const size_t nr = (size_t)(C->rstart[i + 1] - C->rstart[i]), nu = (size_t)(C->ustart[i + 1] - C->ustart[i]);
             mr = nr > mr ? nr : mr; mu = nu > mu ? nu : mu; me = ent[t] > me ? ent[t] : me;
         }
+        if (bstart[b] == bstart[b + 1]) continue;
         blk[b].w = (double *)sfb__alloc(T->ctx, (6 * mr + 12 * mu + 3 * TBZ_STALL + 1) * sizeof(double));
         blk[b].lo = (size_t *)sfb__alloc(T->ctx, (mr + 1) * sizeof(size_t));
         blk[b].lc = (int *)sfb__alloc(T->ctx, (me + 1) * sizeof(int));
@@ -7872,15 +7988,19 @@ static sfb_result tbz_solve_todo(sfb__tbz *T, const tbz_sys *S, const tbz_comps 
         if (!blk[b].w || !blk[b].lo || !blk[b].lc || !blk[b].lw || !blk[b].co || !blk[b].cr || !blk[b].cw) res = sfb__oom(T->ctx, "tribezier constraints");
     }
     if (res == SFB_SUCCESS) {
-        J.T = T; J.S = S; J.C = C; J.local = local; J.todo = todo; J.bstart = bstart; J.scale = scale; J.blk = blk;
+        J.T = T; J.S = S; J.C = C; J.local = local; J.todo = order; J.bstart = bstart; J.scale = scale; J.blk = blk;
         sfb__parallel(T->ctx, tbz_solve_blocks, &J, 0, nb);
+        tbz_solve_range(&J, nb, nb + 1, T->ctx);
+        T->st.large += nt - ns;
         for (t = 0; t < nt; ++t) T->st.iterations += J.its[t];
     }
-    for (b = 0; b < nb; ++b) {
+    for (b = 0; b <= TBZ_BLOCKS; ++b) {
         sfb__free(T->ctx, blk[b].w); sfb__free(T->ctx, blk[b].lo); sfb__free(T->ctx, blk[b].lc); sfb__free(T->ctx, blk[b].lw);
         sfb__free(T->ctx, blk[b].co); sfb__free(T->ctx, blk[b].cr); sfb__free(T->ctx, blk[b].cw);
     }
+done:
     sfb__free(T->ctx, J.its);
+    sfb__free(T->ctx, order);
     sfb__free(T->ctx, ent);
     return res;
 }
@@ -8148,6 +8268,7 @@ static sfb_result tbz_points(sfb_context *ctx, const sfb__level *l, const float 
     T.nv = l->nv; T.ne = l->ne; T.nf = l->nf;
     T.np = l->nv + 3 * l->ne + 3 * l->nf;
     T.seed_plane = (flags & SFB__TBZ_SEED_PLANE) != 0;
+    T.par_unknowns = flags & SFB__TBZ_PAR_SMALL ? TBZ_PAR_UNKNOWNS_SMALL : TBZ_PAR_UNKNOWNS;
     T.efeat = (unsigned char *)sfb__calloc(ctx, (size_t)T.ne + 1, 1);
     T.vtype = (unsigned char *)sfb__calloc(ctx, (size_t)T.nv + 1, 1);
     T.virr = (unsigned char *)sfb__calloc(ctx, (size_t)T.nv + 1, 1);

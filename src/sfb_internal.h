@@ -693,8 +693,10 @@ SFB__IF sfb_result sfb__pn_build(sfb_context *ctx, const sfb__level *base, const
  * the G1 solve did; flags SFB__TBZ_SEED_PLANE builds the seed's smooth net at crease vertices (a
  * tangent plane that ignores the crease, for the undulation measurement), SFB__TBZ_NO_REUSE solves every
  * component of the sharp net's constraints even where the smooth net solved the same system (for the test
- * that the reuse changes nothing). */
-enum { SFB__TBZ_SEED_PLANE = 1, SFB__TBZ_NO_REUSE = 2 };
+ * that the reuse changes nothing), SFB__TBZ_PAR_SMALL runs the loops of every component of 1024 unknowns or
+ * more on the backend's threads (for the test that the net stays bit for bit the same there; the
+ * default is 65536). */
+enum { SFB__TBZ_SEED_PLANE = 1, SFB__TBZ_NO_REUSE = 2, SFB__TBZ_PAR_SMALL = 4 };
 typedef struct sfb__tbz_stats {
     long iterations;   /* CGLS iterations, all coordinates and nets */
     long unknowns;     /* points moved by the G1 solve, per coordinate and net */
@@ -705,6 +707,8 @@ typedef struct sfb__tbz_stats {
     int fallbacks;     /* smooth nets rebuilt with the seed's tangent plane (ours unsolvable) */
     int reused;        /* sharp-net constraint components that were the same system as a smooth-net one and took its
                           solution (SFB__TBZ_NO_REUSE: none) */
+    int large;         /* components solved with each iteration's loops on the backend's threads (65536 unknowns
+                          or more, 1024 with SFB__TBZ_PAR_SMALL) */
 } sfb__tbz_stats;
 SFB__IF sfb_result sfb__tribezier_points(sfb_context *ctx, const sfb__level *base, const float *positions,
                                          const sfb_tribezier_options *opt, unsigned flags, double **out, sfb__tbz_stats *stats);
