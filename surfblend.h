@@ -314,7 +314,9 @@ SFB_API sfb_surface_config sfb_surface_config_init(sfb_scheme scheme, int level)
 typedef struct sfb_surface sfb_surface;
 
 /* Compiles the tables (topology of the refined mesh, stencil tables) on the CPU. The surface
- * keeps a reference to nothing in `mesh`: the mesh may be destroyed afterwards. */
+ * keeps a reference to nothing in `mesh`: the mesh may be destroyed afterwards. SFB_SCHEME_TRIBEZIER's
+ * build, which can take seconds on meshes with many extraordinary vertices, reports progress
+ * (stage "tribezier", rising to 1) and can be cancelled there (SFB_CANCELLED, nothing kept). */
 SFB_API sfb_result sfb_surface_create(sfb_context *ctx, const sfb_mesh *mesh,
                                       const sfb_surface_config *config, sfb_surface **out);
 SFB_API void sfb_surface_destroy(sfb_surface *surface);
@@ -1567,8 +1569,10 @@ SFB__IF sfb_result sfb__pn_build(sfb_context *ctx, const sfb__level *base, const
  * component of the sharp net's constraints even where the smooth net solved the same system (for the test
  * that the reuse changes nothing), SFB__TBZ_PAR_SMALL runs the loops of every component of 1024 unknowns or
  * more on the backend's threads (for the test that the net stays bit for bit the same there; the
- * default is 65536). */
-enum { SFB__TBZ_SEED_PLANE = 1, SFB__TBZ_NO_REUSE = 2, SFB__TBZ_PAR_SMALL = 4 };
+ * default is 65536). Progress (stage "tribezier") runs over [0, 1], or [0, 0.5] with
+ * SFB__TBZ_PROGRESS_LOW and [0.5, 1] with SFB__TBZ_PROGRESS_HIGH (sfb__tribezier_build: the mesh's
+ * own net, then the one after a Loop step); a cancel returns SFB_CANCELLED. */
+enum { SFB__TBZ_SEED_PLANE = 1, SFB__TBZ_NO_REUSE = 2, SFB__TBZ_PAR_SMALL = 4, SFB__TBZ_PROGRESS_LOW = 8, SFB__TBZ_PROGRESS_HIGH = 16 };
 typedef struct sfb__tbz_stats {
     long iterations;   /* CGLS iterations, all coordinates and nets */
     long unknowns;     /* points moved by the G1 solve, per coordinate and net */
@@ -7040,6 +7044,11 @@ typedef struct sfb__tbz {
     int nv, ne, nf, np;
     int seed_plane;
     int par_unknowns;          /* components of this many unknowns or more: each iteration's loops on the threads */
+    /* progress (stage "tribezier", tbz_progress): this solve's window [p0, p1], the value last
+     * reported (never less after), and the solve's work (entries of its components' rows): all,
+     * done, and the large component being solved */
+    float p0, p1, plast;
+    double work_all, work_done, work_cur;
     /* per state */
     int sharp;                 /* building the sharp net */
     unsigned char *efeat;      /* per edge: sharp in this net */
@@ -7745,6 +7754,13 @@ static void tbz_cg_sum(const tbz_cg *G, int kind, double s[3]) {
     for (ch = 0; ch < TBZ_CHUNKS; ++ch)
         for (c = 0; c < 3; ++c) s[c] = kind == 1 ? TBZ_MAX(s[c], G->part[ch][1][c]) : s[c] + G->part[ch][kind][c];
 }
+/* Reports the solve's progress: fraction f of its work done, mapped into [p0, p1]. */
+static sfb_result tbz_progress(sfb__tbz *T, double f) {
+    float v = T->p0 + (T->p1 - T->p0) * (float)(f < 0.0 ? 0.0 : f > 1.0 ? 1.0 : f);
+    if (v < T->plast) v = T->plast;
+    T->plast = v;
+    return sfb__progress(T->ctx, v, "tribezier");
+}
 /* CGLS from zero on one connected component of the constraints (rows `rows[0..nr)`, unknowns
  * `unk[0..nu)` with local[] mapping a point to its column or -1), the three coordinates at once
  * (one matrix, three right-hand sides, each with its own recurrence); adds the change to T->x.
@@ -7755,7 +7771,8 @@ static void tbz_cg_sum(const tbz_cg *G, int kind, double s[3]) {
  * than 1e-5 of itself over the last TBZ_STALL iterations (inconsistent -- touching extraordinary
  * vertices of different valences --: the least-squares residual is reached; what CGLS would
  * still move are the near-null directions, which only make the net wilder). par: the context
- * whose threads run each iteration's loops (tbz_cg), or NULL: here. */
+ * whose threads run each iteration's loops (tbz_cg), or NULL: here; with par (called on the
+ * caller's thread) it reports progress every 16 iterations and returns -1 when cancelled. */
 static int tbz_cgls(sfb__tbz *T, const tbz_sys *S, const int *rows, int nr, const int *unk, int nu, const int *local, double scale,
                     double *w, size_t *lo, int *lc, double *lw, size_t *co, int *cr, double *cw, sfb_context *par) {
     tbz_cg G;
@@ -7804,6 +7821,11 @@ static int tbz_cgls(sfb__tbz *T, const tbz_sys *S, const int *rows, int nr, cons
     }
     for (it = 0; it < maxit && left > 0; ++it) {
         double qq[3], rn[3], r2[3], g2[3];
+        /* a large component's share of the work counted as done over 600 iterations (about
+         * what one takes), at most 95% of it before it ends */
+        if (par && (it & 15) == 15 &&
+            tbz_progress(T, (T->work_done + T->work_cur * (it < 570 ? it / 600.0 : 0.95)) / T->work_all) != SFB_SUCCESS)
+            return -1;
         tbz_cg_run(par, &G, tbz_cg_aq);
         tbz_cg_sum(&G, 0, qq);
         for (c = 0; c < 3; ++c) {
@@ -7912,6 +7934,7 @@ static size_t tbz_comp_entries(const tbz_sys *S, const tbz_comps *C, int i) {
  * work and its own scratch (tbz_cgls's w, lo, lc, lw, co, cr, cw, sized for its largest
  * component); local maps every unknown to its column within its component. */
 #define TBZ_BLOCKS 32
+#define TBZ_ROUNDS 4
 typedef struct tbz_block {
     double *w, *lw, *cw;
     size_t *lo, *co;
@@ -7927,18 +7950,20 @@ typedef struct tbz_job {
     int *its; /* per todo entry: its iterations */
 } tbz_job;
 
-/* Blocks [first, last) of J; par: the context whose threads run each iteration's loops, or NULL. */
-static void tbz_solve_range(const tbz_job *J, int first, int last, sfb_context *par) {
+/* Todo entry t of J with block b's scratch; par: the context whose threads run each iteration's
+ * loops, or NULL (tbz_cgls). */
+static void tbz_solve_one(const tbz_job *J, int b, int t, sfb_context *par) {
+    const int i = J->todo[t], r0 = J->C->rstart[i], u0 = J->C->ustart[i];
+    J->its[t] = tbz_cgls(J->T, J->S, J->C->rows + r0, J->C->rstart[i + 1] - r0, J->C->unk + u0, J->C->ustart[i + 1] - u0, J->local, J->scale,
+                         J->blk[b].w, J->blk[b].lo, J->blk[b].lc, J->blk[b].lw, J->blk[b].co, J->blk[b].cr, J->blk[b].cw, par);
+}
+/* Blocks [first, last) of J, each component whole on the calling thread. */
+static void tbz_solve_blocks(void *arg, int first, int last) {
+    const tbz_job *J = (const tbz_job *)arg;
     int b, t;
     for (b = first; b < last; ++b)
-        for (t = J->bstart[b]; t < J->bstart[b + 1]; ++t) {
-            const int i = J->todo[t], r0 = J->C->rstart[i], u0 = J->C->ustart[i];
-            J->its[t] = tbz_cgls(J->T, J->S, J->C->rows + r0, J->C->rstart[i + 1] - r0, J->C->unk + u0, J->C->ustart[i + 1] - u0, J->local,
-                                 J->scale, J->blk[b].w, J->blk[b].lo, J->blk[b].lc, J->blk[b].lw, J->blk[b].co, J->blk[b].cr, J->blk[b].cw,
-                                 par);
-        }
+        for (t = J->bstart[b]; t < J->bstart[b + 1]; ++t) tbz_solve_one(J, b, t, NULL);
 }
-static void tbz_solve_blocks(void *arg, int first, int last) { tbz_solve_range((const tbz_job *)arg, first, last, NULL); }
 
 /* Solves the components todo[0 .. nt) (see tbz_job). */
 static sfb_result tbz_solve_todo(sfb__tbz *T, const tbz_sys *S, const tbz_comps *C, const int *local, const int *todo, int nt, double scale) {
@@ -7988,11 +8013,29 @@ static sfb_result tbz_solve_todo(sfb__tbz *T, const tbz_sys *S, const tbz_comps 
         if (!blk[b].w || !blk[b].lo || !blk[b].lc || !blk[b].lw || !blk[b].co || !blk[b].cr || !blk[b].cw) res = sfb__oom(T->ctx, "tribezier constraints");
     }
     if (res == SFB_SUCCESS) {
+        /* the small components in TBZ_ROUNDS rounds of blocks, progress reported (and a cancel
+         * taken) after each; then the large ones, which report as they go (tbz_cgls) */
+        double work_all = 0.0;
+        int round;
         J.T = T; J.S = S; J.C = C; J.local = local; J.todo = order; J.bstart = bstart; J.scale = scale; J.blk = blk;
-        sfb__parallel(T->ctx, tbz_solve_blocks, &J, 0, nb);
-        tbz_solve_range(&J, nb, nb + 1, T->ctx);
-        T->st.large += nt - ns;
-        for (t = 0; t < nt; ++t) T->st.iterations += J.its[t];
+        for (t = 0; t < nt; ++t) work_all += (double)ent[t] + 1.0;
+        T->work_all = work_all;
+        T->work_done = 0.0;
+        for (round = 0; round < TBZ_ROUNDS && res == SFB_SUCCESS; ++round) {
+            const int b0 = nb * round / TBZ_ROUNDS, b1 = nb * (round + 1) / TBZ_ROUNDS;
+            sfb__parallel(T->ctx, tbz_solve_blocks, &J, b0, b1);
+            for (t = bstart[b0]; t < bstart[b1]; ++t) T->work_done += (double)ent[t] + 1.0;
+            res = tbz_progress(T, T->work_done / work_all);
+        }
+        for (t = ns; t < nt && res == SFB_SUCCESS; ++t) {
+            T->work_cur = (double)ent[t] + 1.0;
+            tbz_solve_one(&J, nb, t, T->ctx); /* block nb: the large components' scratch */
+            if (J.its[t] < 0) { res = SFB_CANCELLED; break; }
+            T->work_done += T->work_cur;
+            T->st.large++;
+            res = tbz_progress(T, T->work_done / work_all);
+        }
+        for (t = 0; t < nt && res == SFB_SUCCESS; ++t) T->st.iterations += J.its[t];
     }
     for (b = 0; b <= TBZ_BLOCKS; ++b) {
         sfb__free(T->ctx, blk[b].w); sfb__free(T->ctx, blk[b].lo); sfb__free(T->ctx, blk[b].lc); sfb__free(T->ctx, blk[b].lw);
@@ -8298,6 +8341,15 @@ static sfb_result tbz_points(sfb_context *ctx, const sfb__level *l, const float 
             if (T.corner_s[v] <= 0.0f) T.corner_s[v] = 1e-30f;
             any_tag = 1;
         }
+    /* progress: this call's window (sfb_internal.h), the smooth net's solve in its first half
+     * where a sharp net follows (the seed-plane fallback reports in the same half again, never
+     * below what was reported) */
+    {
+        const float w0 = flags & SFB__TBZ_PROGRESS_HIGH ? 0.5f : 0.0f, w1 = flags & SFB__TBZ_PROGRESS_LOW ? 0.5f : 1.0f;
+        T.p0 = T.plast = w0;
+        T.p1 = any_tag ? 0.5f * (w0 + w1) : w1;
+        if ((r = sfb__progress(ctx, w0, "tribezier")) != SFB_SUCCESS) goto done;
+    }
     /* the smooth net's solve is recorded for the sharp net (tbz_prev), unless asked not to */
     T.rec = any_tag && !(flags & SFB__TBZ_NO_REUSE) ? &prev : NULL;
     r = tbz_state(&T, 0);
@@ -8334,6 +8386,8 @@ static sfb_result tbz_points(sfb_context *ctx, const sfb__level *l, const float 
         T.pos = sharp_positions;
         prev.x1 = x0;
         T.prev = &prev;
+        T.p0 = T.p1;
+        T.p1 = flags & SFB__TBZ_PROGRESS_LOW ? 0.5f : 1.0f;
         r = tbz_state(&T, 1);
         T.prev = NULL;
         if (r != SFB_SUCCESS) goto done;
@@ -8651,15 +8705,17 @@ static sfb_result tbz_build(sfb_context *ctx, const sfb__level *l, const float *
     sfb__level rl;
     sfb_result r;
     memset(&st, 0, sizeof st);
+    /* progress (stage "tribezier"): the mesh's own net over [0, 0.5], the one after a Loop step
+     * over [0.5, 1] (over [0, 1] where it is the only one) */
     if (tbz_touching(l)) {
         r = sfb__tribezier_refined_points(ctx, l, positions, opt, 0, &rl, &net4, NULL);
         if (r != SFB_SUCCESS) return r;
-        r = sfb__patch_table_beztri_children(ctx, l, net4, pt);
+        if ((r = sfb__progress(ctx, 1.0f, "tribezier")) == SFB_SUCCESS) r = sfb__patch_table_beztri_children(ctx, l, net4, pt);
         sfb__free(ctx, net4);
         sfb__level_free(ctx, &rl);
         return r;
     }
-    r = sfb__tribezier_points(ctx, l, positions, opt, 0, &net, &st);
+    r = sfb__tribezier_points(ctx, l, positions, opt, SFB__TBZ_PROGRESS_LOW, &net, &st);
     if (r != SFB_SUCCESS) return r;
     if (st.residual > 1e-10) {
         /* a refused step is this build's own business, not a failure the caller should read
@@ -8667,7 +8723,7 @@ static sfb_result tbz_build(sfb_context *ctx, const sfb__level *l, const float *
         sfb__error_state kept;
         sfb__error_keep(ctx, &kept);
         memset(&st4, 0, sizeof st4);
-        r = sfb__tribezier_refined_points(ctx, l, positions, opt, 0, &rl, &net4, &st4);
+        r = sfb__tribezier_refined_points(ctx, l, positions, opt, SFB__TBZ_PROGRESS_HIGH, &rl, &net4, &st4);
         if (r == SFB_INVALID_TOPOLOGY) { /* not built after one step: the mesh's own net */
             sfb__log(ctx, SFB_LOG_INFO, "tribezier: the net after one Loop step is refused (%s); the mesh's own net is kept (G1 residual %.3g)",
                      ctx->error, st.residual);
@@ -8676,7 +8732,7 @@ static sfb_result tbz_build(sfb_context *ctx, const sfb__level *l, const float *
         } else if (r != SFB_SUCCESS) { sfb__free(ctx, net); return r; }
         if (st4.residual < st.residual) {
             sfb__free(ctx, net);
-            r = sfb__patch_table_beztri_children(ctx, l, net4, pt);
+            if ((r = sfb__progress(ctx, 1.0f, "tribezier")) == SFB_SUCCESS) r = sfb__patch_table_beztri_children(ctx, l, net4, pt);
             sfb__free(ctx, net4);
             sfb__level_free(ctx, &rl);
             return r;
@@ -8684,7 +8740,7 @@ static sfb_result tbz_build(sfb_context *ctx, const sfb__level *l, const float *
         sfb__free(ctx, net4);
         sfb__level_free(ctx, &rl);
     }
-    r = sfb__patch_table_beztri_own(ctx, l, net, pt);
+    if ((r = sfb__progress(ctx, 1.0f, "tribezier")) == SFB_SUCCESS) r = sfb__patch_table_beztri_own(ctx, l, net, pt);
     sfb__free(ctx, net);
     return r;
 }

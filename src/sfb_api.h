@@ -301,7 +301,9 @@ SFB_API sfb_surface_config sfb_surface_config_init(sfb_scheme scheme, int level)
 typedef struct sfb_surface sfb_surface;
 
 /* Compiles the tables (topology of the refined mesh, stencil tables) on the CPU. The surface
- * keeps a reference to nothing in `mesh`: the mesh may be destroyed afterwards. */
+ * keeps a reference to nothing in `mesh`: the mesh may be destroyed afterwards. SFB_SCHEME_TRIBEZIER's
+ * build, which can take seconds on meshes with many extraordinary vertices, reports progress
+ * (stage "tribezier", rising to 1) and can be cancelled there (SFB_CANCELLED, nothing kept). */
 SFB_API sfb_result sfb_surface_create(sfb_context *ctx, const sfb_mesh *mesh,
                                       const sfb_surface_config *config, sfb_surface **out);
 SFB_API void sfb_surface_destroy(sfb_surface *surface);

@@ -695,8 +695,10 @@ SFB__IF sfb_result sfb__pn_build(sfb_context *ctx, const sfb__level *base, const
  * component of the sharp net's constraints even where the smooth net solved the same system (for the test
  * that the reuse changes nothing), SFB__TBZ_PAR_SMALL runs the loops of every component of 1024 unknowns or
  * more on the backend's threads (for the test that the net stays bit for bit the same there; the
- * default is 65536). */
-enum { SFB__TBZ_SEED_PLANE = 1, SFB__TBZ_NO_REUSE = 2, SFB__TBZ_PAR_SMALL = 4 };
+ * default is 65536). Progress (stage "tribezier") runs over [0, 1], or [0, 0.5] with
+ * SFB__TBZ_PROGRESS_LOW and [0.5, 1] with SFB__TBZ_PROGRESS_HIGH (sfb__tribezier_build: the mesh's
+ * own net, then the one after a Loop step); a cancel returns SFB_CANCELLED. */
+enum { SFB__TBZ_SEED_PLANE = 1, SFB__TBZ_NO_REUSE = 2, SFB__TBZ_PAR_SMALL = 4, SFB__TBZ_PROGRESS_LOW = 8, SFB__TBZ_PROGRESS_HIGH = 16 };
 typedef struct sfb__tbz_stats {
     long iterations;   /* CGLS iterations, all coordinates and nets */
     long unknowns;     /* points moved by the G1 solve, per coordinate and net */

@@ -1259,6 +1259,108 @@ static void test_threads(const char *dir, const char *mesh) {
     free(tagged);
 }
 
+/* Progress and cancellation of the build (stage "tribezier"): a recorder counts the reports,
+ * checks that they never fall and that the last is 1, and cancels at report `cancel_at` (0:
+ * never). */
+typedef struct tbz_rec {
+    int count, cancel_at, falls;
+    float first, last;
+} tbz_rec;
+static int tbz_rec_cb(float done, const char *stage, void *user) {
+    tbz_rec *R = (tbz_rec *)user;
+    if (strcmp(stage, "tribezier") != 0) return 0;
+    if (R->count == 0) R->first = done;
+    else if (done < R->last) R->falls++;
+    R->last = done;
+    return ++R->count == R->cancel_at;
+}
+/* One build of obj on a ref context with the recorder (cancel_at as given); internal: through
+ * sfb__tribezier_refined_points with SFB__TBZ_PAR_SMALL (so that the reports inside a large
+ * component's CGLS iterations come too), else sfb_surface_create. Returns the result; made: a
+ * net or surface came back; says_cancelled: the context's last error says so. */
+static sfb_result tbz_rec_build(const char *obj, int internal, tbz_rec *R, int *made, int *says_cancelled) {
+    static const sfb_backend_kind ref = SFB_BACKEND_REF;
+    sfb_context_config cc = sfb_context_config_init();
+    sfb_context *ctx = NULL;
+    sfb_result r = SFB_NO_BACKEND; /* no ref context */
+    *made = 0;
+    *says_cancelled = 0;
+    cc.ignore_environment = 1;
+    cc.backends = &ref;
+    cc.backend_count = 1;
+    cc.progress.func = tbz_rec_cb;
+    cc.progress.user = R;
+    if (sfb_context_create(&cc, &ctx) != SFB_SUCCESS) return r;
+    if (internal) {
+        tmesh t;
+        sfb__level rl;
+        double *net = NULL;
+        if (tmesh_load(ctx, obj, &t)) {
+            r = sfb__tribezier_refined_points(ctx, &t.prep, t.m->positions, NULL, SFB__TBZ_PAR_SMALL, &rl, &net, NULL);
+            *made = net != NULL;
+            *says_cancelled = strstr(sfb_last_error(ctx), "cancelled") != NULL;
+            if (r == SFB_SUCCESS) sfb__level_free(ctx, &rl);
+            sfb__free(ctx, net);
+        }
+        tmesh_free(ctx, &t);
+    } else {
+        sfb_mesh *m = NULL;
+        sfb_surface *sf = NULL;
+        sfb_surface_config sc = sfb_surface_config_init(SFB_SCHEME_TRIBEZIER, 0);
+        sc.flags = SFB_REFINE_PATCHES;
+        if (sfb_mesh_read_obj(ctx, obj, strlen(obj), &m) == SFB_SUCCESS) {
+            r = sfb_surface_create(ctx, m, &sc, &sf);
+            *made = sf != NULL;
+            *says_cancelled = strstr(sfb_last_error(ctx), "cancelled") != NULL;
+        }
+        sfb_surface_destroy(sf);
+        sfb_mesh_destroy(m);
+    }
+    sfb_context_destroy(ctx);
+    return r;
+}
+/* Builds on spot.obj (after one Loop step: its regions' CGLS on the threads' path with
+ * SFB__TBZ_PAR_SMALL) and on a creased disk (the mesh's own smooth and sharp nets): the reports
+ * rise to 1; a cancel at the first report, one in the middle and the last gives SFB_CANCELLED and
+ * nothing made (what the build allocated is freed: the sanitizer run checks it). */
+static void test_progress(const char *dir) {
+    char path[1024], *spot;
+    size_t n;
+    int c, made, said;
+    tbm_opts o;
+    char *disk;
+    memset(&o, 0, sizeof o);
+    o.n = 5; o.R = 4; o.crease_k = 2; o.sharp = 0.5; o.ridge = 0.5; o.bump = 1.0;
+    disk = tbm_obj(&o);
+    snprintf(path, sizeof path, "%s/spot.obj", dir);
+    spot = slurp(path, &n);
+    for (c = 0; c < 3; ++c) {
+        const char *obj = c == 2 ? disk : spot, *what = c == 0 ? "spot_surface" : c == 1 ? "spot_refined_net_large_path" : "creased_disk_surface";
+        char name[128];
+        tbz_rec R;
+        sfb_result r;
+        int k;
+        snprintf(name, sizeof name, "progress/%s/rises_to_1", what);
+        if (!obj) { skip(name, "spot.obj not found (pass the real-meshes folder)"); continue; }
+        memset(&R, 0, sizeof R);
+        r = tbz_rec_build(obj, c == 1, &R, &made, &said);
+        check(r == SFB_SUCCESS && made && R.count >= 3 && R.falls == 0 && R.first == 0.0f && (c == 1 || R.last == 1.0f) && R.last > 0.9f, name,
+              "%s, %d reports from %g to %g, %d falls", sfb_result_string(r), R.count, R.first, R.last, R.falls);
+        for (k = 0; k < 3 && R.count >= 3; ++k) {
+            const int at = k == 0 ? 1 : k == 1 ? R.count / 2 : R.count;
+            tbz_rec C;
+            memset(&C, 0, sizeof C);
+            C.cancel_at = at;
+            snprintf(name, sizeof name, "progress/%s/cancel_at_report_%d_of_%d", what, at, R.count);
+            r = tbz_rec_build(obj, c == 1, &C, &made, &said);
+            check(r == SFB_CANCELLED && !made && said && C.count == at, name, "%s, %d reports, %s", sfb_result_string(r), C.count,
+                  made ? "made" : "nothing made");
+        }
+    }
+    free(spot);
+    free(disk);
+}
+
 int main(int argc, char **argv) {
     sfb_context *ctx = NULL;
     sfb_context_config cc = sfb_context_config_init();
@@ -1289,6 +1391,7 @@ int main(int argc, char **argv) {
         test_refined(ctx, dir);
         test_nonmanifold_vertices(ctx, dir);
         test_threads(dir, "spot");
+        test_progress(dir);
     }
     sfb_context_destroy(ctx);
     if (!probe_backends()) return 1;
