@@ -7947,7 +7947,7 @@ typedef struct tbz_job {
     const int *local, *todo, *bstart; /* todo[bstart[b] .. bstart[b + 1]): block b's components */
     double scale;
     tbz_block *blk;
-    int *its; /* per todo entry: its iterations */
+    int *its; /* per todo entry: its iterations (-1: cancelled) */
 } tbz_job;
 
 /* Todo entry t of J with block b's scratch; par: the context whose threads run each iteration's
