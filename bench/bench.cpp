@@ -72,6 +72,7 @@
 #include <opensubdiv/osd/ompEvaluator.h>
 
 #include <algorithm>
+#include <initializer_list>
 #include <map>
 #include <chrono>
 #include <cmath>
@@ -1930,16 +1931,12 @@ static int tribezier_meshes_section() {
         sfb_mesh_destroy(m);
         if (t1.empty()) continue;
         const double k = 1000.0 / mi.triangles, a = median(t1), o = to.empty() ? 0.0 : median(to);
-        auto cell = [&](const std::vector<double> &v) {
-            static char b[4][32];
-            static int i = 0;
-            i = (i + 1) % 4;
-            if (v.empty()) snprintf(b[i], sizeof b[i], "%10s", "-");
-            else snprintf(b[i], sizeof b[i], "%10.2f", median(v) * k);
-            return b[i];
-        };
-        printf("%-22s %7d %6d %6s | %10.2f %s %s %s | %6.2f\n", c.label, mi.triangles, mi.extraordinary_loop, depth > 0 ? "Loop 1" : "mesh",
-               a * k, cell(tmt), cell(tl), cell(to), o > 0 && a > 0 ? o / a : 0.0);
+        printf("%-22s %7d %6d %6s | %10.2f", c.label, mi.triangles, mi.extraordinary_loop, depth > 0 ? "Loop 1" : "mesh", a * k);
+        for (const std::vector<double> *v : {&tmt, &tl, &to}) {
+            if (v->empty()) printf(" %10s", "-");
+            else printf(" %10.2f", median(*v) * k);
+        }
+        printf(" | %6.2f\n", o > 0 && a > 0 ? o / a : 0.0);
         fflush(stdout);
     }
     if (mctx) printf("(simd all: %s)\n", mt_why.c_str());

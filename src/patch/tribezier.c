@@ -1729,10 +1729,13 @@ sfb_result sfb__tribezier_build(sfb_context *ctx, const sfb__level *l, const flo
     r = tbz_check(ctx, l, positions, opt);
     if (r == SFB_SUCCESS) r = tbz_split(ctx, l, positions, &split, &sl, &spos);
     if (r != SFB_SUCCESS) return r;
-    if (!split) return tbz_build(ctx, l, positions, opt, pt);
-    r = tbz_build(ctx, &sl, spos, opt, pt);
-    sfb__level_free(ctx, &sl);
-    sfb__free(ctx, spos);
+    r = split ? tbz_build(ctx, &sl, spos, opt, pt) : tbz_build(ctx, l, positions, opt, pt);
+    if (split) {
+        sfb__level_free(ctx, &sl);
+        sfb__free(ctx, spos);
+    }
+    /* the build's last report; a cancel there keeps nothing either */
+    if (r == SFB_SUCCESS && (r = sfb__progress(ctx, 1.0f, "tribezier")) != SFB_SUCCESS) sfb__patch_table_free(ctx, pt);
     return r;
 }
 
@@ -1749,7 +1752,7 @@ static sfb_result tbz_build(sfb_context *ctx, const sfb__level *l, const float *
     if (tbz_touching(l)) {
         r = sfb__tribezier_refined_points(ctx, l, positions, opt, 0, &rl, &net4, NULL);
         if (r != SFB_SUCCESS) return r;
-        if ((r = sfb__progress(ctx, 1.0f, "tribezier")) == SFB_SUCCESS) r = sfb__patch_table_beztri_children(ctx, l, net4, pt);
+        r = sfb__patch_table_beztri_children(ctx, l, net4, pt);
         sfb__free(ctx, net4);
         sfb__level_free(ctx, &rl);
         return r;
@@ -1771,7 +1774,7 @@ static sfb_result tbz_build(sfb_context *ctx, const sfb__level *l, const float *
         } else if (r != SFB_SUCCESS) { sfb__free(ctx, net); return r; }
         if (st4.residual < st.residual) {
             sfb__free(ctx, net);
-            if ((r = sfb__progress(ctx, 1.0f, "tribezier")) == SFB_SUCCESS) r = sfb__patch_table_beztri_children(ctx, l, net4, pt);
+            r = sfb__patch_table_beztri_children(ctx, l, net4, pt);
             sfb__free(ctx, net4);
             sfb__level_free(ctx, &rl);
             return r;
@@ -1779,7 +1782,7 @@ static sfb_result tbz_build(sfb_context *ctx, const sfb__level *l, const float *
         sfb__free(ctx, net4);
         sfb__level_free(ctx, &rl);
     }
-    if ((r = sfb__progress(ctx, 1.0f, "tribezier")) == SFB_SUCCESS) r = sfb__patch_table_beztri_own(ctx, l, net, pt);
+    r = sfb__patch_table_beztri_own(ctx, l, net, pt);
     sfb__free(ctx, net);
     return r;
 }
