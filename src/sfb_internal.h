@@ -664,9 +664,12 @@ SFB__IF sfb_result sfb__tri_mesh_check(sfb_context *ctx, const sfb__level *l, co
 /* One BEZIER_TRI15 patch of its own 15 points (net: 45 doubles per triangle) per triangle of l that
  * is not a hole (patch/table.c; PN triangles, tribezier). */
 SFB__IF sfb_result sfb__patch_table_beztri_own(sfb_context *ctx, const sfb__level *l, const double *net, sfb__patch_table *pt);
-/* The same with four child patches per triangle f (45 doubles each at net + 180 f + 45 i, child i
- * of the parametric triangle's quadtree: corners 0, 1, 2, the middle 3). */
-SFB__IF sfb_result sfb__patch_table_beztri_children(sfb_context *ctx, const sfb__level *l, const double *net, sfb__patch_table *pt);
+/* The same with the 4 (depth 1) or 16 (depth 2) child patches of every triangle f: 45 doubles
+ * each at net + 45 (4 f + i), child i of the parametric triangle's quadtree (corners 0, 1, 2,
+ * the middle 3), or at net + 45 (16 f + 4 i + j), child j of child i (sfb__tribezier_refined_points
+ * after one or two Loop steps). */
+SFB__IF sfb_result sfb__patch_table_beztri_children(sfb_context *ctx, const sfb__level *l, const double *net, int depth,
+                                                    sfb__patch_table *pt);
 /* The families present in a table, as bits 1 << SFB__FAMILY_*. */
 static inline unsigned sfb__patch_families(const sfb__patch_table *pt) {
     unsigned m = 0;
@@ -695,10 +698,13 @@ SFB__IF sfb_result sfb__pn_build(sfb_context *ctx, const sfb__level *base, const
  * component of the sharp net's constraints even where the smooth net solved the same system (for the test
  * that the reuse changes nothing), SFB__TBZ_PAR_SMALL runs the loops of every component of 1024 unknowns or
  * more on the backend's threads (for the test that the net stays bit for bit the same there; the
- * default is 65536). Progress (stage "tribezier") runs over [0, 1], or [0, 0.5] with
+ * default is 65536), SFB__TBZ_NO_TEMPLATES solves every component by CGLS (for the test that the
+ * templates give the same net), SFB__TBZ_TWO_STEPS makes sfb__tribezier_refined_points take two
+ * Loop steps. Progress (stage "tribezier") runs over [0, 1], or [0, 0.5] with
  * SFB__TBZ_PROGRESS_LOW and [0.5, 1] with SFB__TBZ_PROGRESS_HIGH (sfb__tribezier_build: the mesh's
  * own net, then the one after a Loop step); a cancel returns SFB_CANCELLED. */
-enum { SFB__TBZ_SEED_PLANE = 1, SFB__TBZ_NO_REUSE = 2, SFB__TBZ_PAR_SMALL = 4, SFB__TBZ_PROGRESS_LOW = 8, SFB__TBZ_PROGRESS_HIGH = 16 };
+enum { SFB__TBZ_SEED_PLANE = 1, SFB__TBZ_NO_REUSE = 2, SFB__TBZ_PAR_SMALL = 4, SFB__TBZ_PROGRESS_LOW = 8, SFB__TBZ_PROGRESS_HIGH = 16,
+       SFB__TBZ_NO_TEMPLATES = 32, SFB__TBZ_TWO_STEPS = 64 };
 typedef struct sfb__tbz_stats {
     long iterations;   /* CGLS iterations, all coordinates and nets */
     long unknowns;     /* points moved by the G1 solve, per coordinate and net */
@@ -709,18 +715,21 @@ typedef struct sfb__tbz_stats {
     int fallbacks;     /* smooth nets rebuilt with the seed's tangent plane (ours unsolvable) */
     int reused;        /* sharp-net constraint components that were the same system as a smooth-net one and took its
                           solution (SFB__TBZ_NO_REUSE: none) */
+    int templates;     /* templates made (tbz_templates: one dense solve per shape of neighbourhood met twice or more) */
+    int templated;     /* components solved with a template (SFB__TBZ_NO_TEMPLATES: none, every one by CGLS) */
     int large;         /* components solved with each iteration's loops on the backend's threads (65536 unknowns
                           or more, 1024 with SFB__TBZ_PAR_SMALL) */
 } sfb__tbz_stats;
 SFB__IF sfb_result sfb__tribezier_points(sfb_context *ctx, const sfb__level *base, const float *positions,
                                          const sfb_tribezier_options *opt, unsigned flags, double **out, sfb__tbz_stats *stats);
-/* The same on the mesh after one Loop step (*rl, free with sfb__level_free): 45 doubles per child
- * face 4 f + i (child i of triangle f in its parametric triangle's quadtree frame). */
+/* The same on the mesh after one Loop step, or two with SFB__TBZ_TWO_STEPS (*rl, free with
+ * sfb__level_free): 45 doubles per child face 4 f + i (child i of triangle f in its parametric
+ * triangle's quadtree frame), or per grandchild face 16 f + 4 i + j (child j of child i). */
 SFB__IF sfb_result sfb__tribezier_refined_points(sfb_context *ctx, const sfb__level *base, const float *positions,
                                                  const sfb_tribezier_options *opt, unsigned flags, sfb__level *rl, double **out,
                                                  sfb__tbz_stats *stats);
-/* The same as one BEZIER_TRI15 patch per triangle, or four (one Loop step) where the mesh's own
- * G1 constraints have no exact solution. */
+/* The same as one BEZIER_TRI15 patch per triangle, or sixteen (two Loop steps) where the mesh's
+ * own G1 constraints have no exact solution. */
 SFB__IF sfb_result sfb__tribezier_build(sfb_context *ctx, const sfb__level *base, const float *positions,
                                         const sfb_tribezier_options *opt, sfb__patch_table *pt);
 SFB__IF sfb_result sfb__manifold_build(sfb_context *ctx, const sfb__level *base, int weights, const float *positions, sfb__patch_table *pt);

@@ -121,26 +121,33 @@ sfb_result sfb__patch_table_beztri_own(sfb_context *ctx, const sfb__level *l, co
     return SFB_SUCCESS;
 }
 
-sfb_result sfb__patch_table_beztri_children(sfb_context *ctx, const sfb__level *l, const double *net, sfb__patch_table *pt) {
+sfb_result sfb__patch_table_beztri_children(sfb_context *ctx, const sfb__level *l, const double *net, int depth, sfb__patch_table *pt) {
+    const int per = depth == 2 ? 16 : 4, nodes = depth == 2 ? 5 : 1;
     int f, k, i, p = 0, nn = 0, npatch = 0;
     memset(pt, 0, sizeof *pt);
-    for (f = 0; f < l->nf; ++f) npatch += l->fhole[f] ? 0 : 4;
-    if (!sfb__beztri_alloc(ctx, l->nf, npatch, npatch / 4, pt)) return sfb__oom(ctx, "patch table");
-    pt->max_depth = 1;
+    for (f = 0; f < l->nf; ++f) npatch += l->fhole[f] ? 0 : per;
+    if (!sfb__beztri_alloc(ctx, l->nf, npatch, npatch / per * nodes, pt)) return sfb__oom(ctx, "patch table");
+    pt->max_depth = depth;
     for (f = 0; f < l->nf; ++f) {
         pt->face_ptex[f] = pt->ptex_face[f] = f;
         pt->ptex_corner[f] = -1;
         if (l->fhole[f]) { pt->ptex_root[f] = -1; continue; }
         pt->ptex_root[f] = nn;
-        for (i = 0; i < 4; ++i, ++p) {
-            for (k = 0; k < 45; ++k) pt->point_data[45 * (size_t)p + k] = (float)net[180 * (size_t)f + 45 * (size_t)i + k];
+        if (depth == 2)
+            for (i = 0; i < 4; ++i) pt->nodes[4 * nn + i] = nn + 1 + i;
+        for (i = 0; i < per; ++i, ++p) {
+            /* child i (depth 1), or grandchild i & 3 of child i >> 2 (depth 2); quadrant x + 2y
+             * per level, the first level in the high bit (sfb__pb_insert's encoding) */
+            const int c0 = depth == 2 ? i >> 2 : i, c1 = i & 3;
+            for (k = 0; k < 45; ++k) pt->point_data[45 * (size_t)p + k] = (float)net[45 * ((size_t)per * f + (size_t)i) + k];
             pt->ptype[p] = SFB__PATCH_BEZTRI;
             pt->pfirst[p] = 15 * p;
-            pt->pparam[p] = SFB__PARAM(1, i & 1, i >> 1, 0); /* quadrant x + 2y = i: sfb__pb_insert's encoding */
+            pt->pparam[p] = depth == 2 ? SFB__PARAM(2, (c0 & 1) << 1 | (c1 & 1), (c0 >> 1) << 1 | (c1 >> 1), 0) : SFB__PARAM(1, i & 1, i >> 1, 0);
             for (k = 0; k < 15; ++k) pt->cv[15 * p + k] = 15 * p + k;
-            pt->nodes[4 * nn + i] = -(p + 2);
+            if (depth == 2) pt->nodes[4 * (nn + 1 + c0) + c1] = -(p + 2);
+            else pt->nodes[4 * nn + i] = -(p + 2);
         }
-        ++nn;
+        nn += nodes;
     }
     pt->face_ptex[l->nf] = l->nf;
     pt->pfirst[npatch] = 15 * npatch;
