@@ -1863,7 +1863,7 @@ static int tribezier_meshes_section() {
     sfb_context *rctx = eval_context(SFB_BACKEND_REF, 1, 0, &why), *mctx = eval_context(SFB_BACKEND_SIMD, 0, 0, &mt_why);
     printf("\ntribezier construction on meshes with extraordinary vertices everywhere (ms per 1,000 triangles, median of 3;\n"
            "'x OSD' = OpenSubdiv's / tribezier one thread; where extraordinary vertices of different valences touch, the net\n"
-           "is built after one Loop step, 4 patches per triangle):\n");
+           "is built after one Loop step, 4 patches per triangle, or two, 16, where they come in groups of more than 8):\n");
     printf("%-22s %7s %6s %6s | %10s %10s %10s %10s | %6s\n", "mesh", "tris", "EVs", "solve", "tribezier", "simd all", "sfb Loop",
            "OSD Loop", "x OSD");
     for (const Case &c : cases) {
@@ -1931,7 +1931,7 @@ static int tribezier_meshes_section() {
         sfb_mesh_destroy(m);
         if (t1.empty()) continue;
         const double k = 1000.0 / mi.triangles, a = median(t1), o = to.empty() ? 0.0 : median(to);
-        printf("%-22s %7d %6d %6s | %10.2f", c.label, mi.triangles, mi.extraordinary_loop, depth > 0 ? "Loop 1" : "mesh", a * k);
+        printf("%-22s %7d %6d %6s | %10.2f", c.label, mi.triangles, mi.extraordinary_loop, depth == 2 ? "Loop 2" : depth == 1 ? "Loop 1" : "mesh", a * k);
         for (const std::vector<double> *v : {&tmt, &tl, &to}) {
             if (v->empty()) printf(" %10s", "-");
             else printf(" %10.2f", median(*v) * k);
