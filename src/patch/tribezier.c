@@ -132,35 +132,26 @@ static int tbz_vp(const sfb__tbz *T, int v) { (void)T; return v; }
 static int tbz_ep(const sfb__tbz *T, int e, int q) { return T->nv + 3 * e + q; }
 static int tbz_fp(const sfb__tbz *T, int f, int k) { return T->nv + 3 * T->ne + 3 * f + k; }
 
-/* Global index of the point of triangle f with weights w[k] on its corner k (sum 4). */
-static int tbz_pt(const sfb__tbz *T, int f, const int w[3]) {
-    const sfb__level *l = T->l;
-    const int *fv = l->fv + l->fv_off[f];
-    int k;
-    for (k = 0; k < 3; ++k)
-        if (w[k] == 4) return tbz_vp(T, fv[k]);
-    for (k = 0; k < 3; ++k)
-        if (w[(k + 2) % 3] == 0) { /* on edge k: fv[k] -> fv[k+1] */
-            const int e = l->fe[l->fv_off[f] + k], near = w[k]; /* weight of fv[k] */
-            return l->ev[2 * e] == fv[k] ? tbz_ep(T, e, 4 - near - 1) : tbz_ep(T, e, near - 1);
-        }
-    for (k = 0; k < 3; ++k)
-        if (w[k] == 2) return tbz_fp(T, f, k);
-    return -1;
-}
-
-/* The 15 global indices of triangle f in our patch order (row by row in v, u rising). */
+/* The 15 global indices of triangle f in our patch order (row by row in v, u rising; position
+ * (i, j) has weights 4 - i - j, i, j on corners 0, 1, 2): a corner's vertex point, an edge's
+ * three points in the edge's direction, a face point per corner (weight 2). */
 static void tbz_patch(const sfb__tbz *T, int f, int g[15]) {
-    int i, j, q = 0;
-    for (j = 0; j <= 4; ++j)
-        for (i = 0; i + j <= 4; ++i, ++q) {
-            int w[3];
-            w[0] = 4 - i - j; w[1] = i; w[2] = j;
-            g[q] = tbz_pt(T, f, w);
-        }
+    static const int eq[3][3] = {{1, 2, 3}, {8, 11, 13}, {12, 9, 5}}; /* edge k's points, fv[k]'s weight 3, 2, 1 */
+    const sfb__level *l = T->l;
+    const int *fv = l->fv + l->fv_off[f], *fe = l->fe + l->fv_off[f];
+    int k, q;
+    g[0] = tbz_vp(T, fv[0]); g[4] = tbz_vp(T, fv[1]); g[14] = tbz_vp(T, fv[2]);
+    for (k = 0; k < 3; ++k) {
+        const int e = fe[k], fwd = l->ev[2 * e] == fv[k];
+        for (q = 0; q < 3; ++q) g[eq[k][q]] = tbz_ep(T, e, fwd ? q : 2 - q);
+    }
+    g[6] = tbz_fp(T, f, 0); g[7] = tbz_fp(T, f, 1); g[10] = tbz_fp(T, f, 2);
 }
 
 static int tbz_qij(int i, int j) { return 5 * j - j * (j - 1) / 2 + i; }
+/* The global index of the point of triangle f with weights w[k] on its corner k (sum 4), from
+ * the faces' grids (T->grid, made once per net by tbz_patch). */
+static int tbz_gpt(const sfb__tbz *T, int f, const int w[3]) { return T->grid[15 * (size_t)f + tbz_qij(w[1], w[2])]; }
 
 static int tbz_ring(const sfb__level *l, int v, int j) { return sfb__other_end(l, l->ve[l->ve_off[v] + j], v); }
 static int tbz_nf(const sfb__level *l, int v) { return l->vf_off[v + 1] - l->vf_off[v]; }
@@ -353,15 +344,44 @@ static void tbz_ours_offset(sfb__tbz *T) {
 }
 
 /* The initial net (and its fixed points) for the current state. */
+/* A regular smooth vertex (valence 6, no feature): Sabin's rules (ALGORITHMS.md 8.1) for its
+ * corner, its end of every spoke and its corner of every triangle, its ring read once (the
+ * loops of tbz_initial read it again for every point: a fifth of the nets' setup after two
+ * Loop steps, where nearly every vertex is one of these). */
+#define TBZ_FAST(T, v) (!(T)->virr[v] && (T)->vtype[v] == TBZ_SMOOTH && tbz_nf((T)->l, v) == 6 && !tbz_boundary((T)->l, v))
+static void tbz_regular_vertex(sfb__tbz *T, int v) {
+    const sfb__level *l = T->l;
+    double R[6][3], V[3], *P = T->x + 3 * (size_t)tbz_vp(T, v);
+    int j, c;
+    tbz_get(T, v, V);
+    for (j = 0; j < 6; ++j) tbz_get(T, tbz_ring(l, v, j), R[j]);
+    for (c = 0; c < 3; ++c) P[c] = (6.0 * V[c] + R[0][c] + R[1][c] + R[2][c] + R[3][c] + R[4][c] + R[5][c]) / 12.0;
+    for (j = 0; j < 6; ++j) {
+        const int e = l->ve[l->ve_off[v] + j], f = l->vf[l->vf_off[v] + j], *fv = l->fv + l->fv_off[f];
+        const int j1 = (j + 1) % 6, j2 = (j + 2) % 6, j4 = (j + 4) % 6, j5 = (j + 5) % 6;
+        double *E = T->x + 3 * (size_t)tbz_ep(T, e, l->ev[2 * e] == v ? 0 : 2), *F;
+        int k = 0;
+        while (fv[k] != v) ++k;
+        F = T->x + 3 * (size_t)tbz_fp(T, f, k);
+        for (c = 0; c < 3; ++c) {
+            E[c] = (12.0 * V[c] + 4.0 * R[j][c] + 3.0 * (R[j1][c] + R[j5][c]) + R[j2][c] + R[j4][c]) / 24.0;
+            F[c] = (10.0 * V[c] + 6.0 * R[j][c] + 6.0 * R[j1][c] + R[j5][c] + R[j2][c]) / 24.0;
+        }
+    }
+}
+
 static void tbz_initial(sfb__tbz *T) {
     const sfb__level *l = T->l;
     int v, e, f, j, c, k;
     memset(T->fixed, 0, (size_t)T->np);
+    for (v = 0; v < T->nv; ++v)
+        if (TBZ_FAST(T, v)) tbz_regular_vertex(T, v);
     /* corners */
     for (v = 0; v < T->nv; ++v) {
         double *P = T->x + 3 * (size_t)tbz_vp(T, v);
         const int type = T->vtype[v] & 15, n = tbz_nf(l, v);
         if (n == 0) { tbz_get(T, v, P); continue; }
+        if (TBZ_FAST(T, v)) continue;
         if (!T->virr[v]) {
             double R[6][3], V[3];
             tbz_ring6(T, v, 0, R);
@@ -385,8 +405,9 @@ static void tbz_initial(sfb__tbz *T) {
         for (end = 0; end < 2; ++end) {
             const int v = end ? b : a, w = end ? a : b, q = end ? 2 : 0;
             double *E = T->x + 3 * (size_t)tbz_ep(T, e, q), V[3], W[3];
-            const int m = tbz_spoke(l, v, e), n = tbz_nf(l, v);
+            const int m = TBZ_FAST(T, v) ? 0 : tbz_spoke(l, v, e), n = tbz_nf(l, v);
             const double *P = T->x + 3 * (size_t)v;
+            if (TBZ_FAST(T, v)) continue;
             tbz_get(T, v, V); tbz_get(T, w, W);
             if (!T->virr[v]) {
                 double R[6][3];
@@ -507,6 +528,7 @@ static void tbz_initial(sfb__tbz *T) {
             const int v = fv[k], n = tbz_nf(l, v), bnd = tbz_boundary(l, v);
             double *F = T->x + 3 * (size_t)tbz_fp(T, f, k), V[3];
             int m = -1;
+            if (TBZ_FAST(T, v)) continue;
             for (j = l->vf_off[v]; j < l->vf_off[v + 1]; ++j)
                 if (l->vf[j] == f) { m = j - l->vf_off[v]; break; }
             tbz_get(T, v, V);
@@ -611,14 +633,14 @@ static int tbz_edge_rows(sfb__tbz *T, tbz_sys *S, int e) {
     for (j = 0; j <= 4; ++j) {
         int w[3];
         w[sL] = 4 - j; w[(sL + 1) % 3] = j; w[(sL + 2) % 3] = 0;
-        Ei[j] = tbz_pt(T, fL, w);
+        Ei[j] = tbz_gpt(T, fL, w);
     }
     for (j = 0; j <= 3; ++j) {
         int w[3];
         w[sL] = 3 - j; w[(sL + 1) % 3] = j; w[(sL + 2) % 3] = 1;
-        Li[j] = tbz_pt(T, fL, w);
+        Li[j] = tbz_gpt(T, fL, w);
         w[(sR + 1) % 3] = 3 - j; w[sR] = j; w[(sR + 2) % 3] = 1;
-        Ri[j] = tbz_pt(T, fR, w);
+        Ri[j] = tbz_gpt(T, fR, w);
     }
     {
         int any = 0;
@@ -646,12 +668,11 @@ static int tbz_edge_rows(sfb__tbz *T, tbz_sys *S, int e) {
 }
 
 /* Net distances (in steps of the Bezier net) from the irregular vertices' corner points, exact
- * up to TBZ_DIST_CUT and 1000 beyond: breadth first over the points, each point's neighbours
- * the points next to it (the six directions of the lattice) in the triangles it belongs to. The
- * unknowns are dist <= TBZ_REACH, and an edge with none has both ends farther than
- * TBZ_REACH + 3 (tbz_solve). (Sweeps over every triangle, as before, took 25 ms on the cow after
- * two Loop steps; this touches only the points near irregular vertices.) */
-#define TBZ_DIST_CUT (TBZ_REACH + 3)
+ * up to TBZ_REACH (the unknowns: dist <= TBZ_REACH) and larger beyond: breadth first over the
+ * points, each point's neighbours the points next to it (the six directions of the lattice) in
+ * the triangles it belongs to. (Sweeps over every triangle, as before, took 25 ms on the cow
+ * after two Loop steps; this touches only the points near irregular vertices.) */
+#define TBZ_DIST_CUT TBZ_REACH
 static sfb_result tbz_distances(sfb__tbz *T) {
     static const int dir[6][2] = {{1, 0}, {0, 1}, {-1, 1}, {-1, 0}, {0, -1}, {1, -1}};
     const sfb__level *l = T->l;
@@ -1191,14 +1212,16 @@ static int tbz_same_component(const sfb__tbz *T, const tbz_sys *S, const int *er
  * After a Loop step or two (and on most meshes' own nets) nearly every component of the
  * constraints is the neighbourhood of one extraordinary vertex, and neighbourhoods of the same
  * shape (the same triangles around the vertex, valences, features, characteristic angles, and
- * the same points unknown or fixed) are the same system A dx = b up to the numbering of its
- * points: its minimum-norm solution is dx = A^T (A A^T)^+ b with one matrix per shape. CGLS
- * takes 70-600 iterations on each such component (A is nearly square: kappa ~ 50, and a
- * quarter of its rows are dependent), so a shape seen twice or more is solved once densely (a
- * template) and each of its components then costs one product with its residual (tbz_templates).
- * tbz_walk numbers a neighbourhood's points the same way wherever the shape is the same and
- * hashes the shape; every component a template solves is checked (its largest row residual
- * left, as CGLS's stopping rule), and one that fails is solved by CGLS instead. */
+ * the same points unknown) are the same system A dx = b up to the numbering of its points (and
+ * the direction its edges' rows are written in, which spans the same rows): its minimum-norm
+ * solution is dx = A_I^T (A_I A_I^T)^-1 b_I, I a maximal set of independent rows (the others
+ * follow, the system being consistent). CGLS takes 70-600 iterations on each such component (A
+ * is nearly square: kappa ~ 50, and a quarter of its rows are dependent), so for a shape seen
+ * twice or more I and the Cholesky factor of A_I A_I^T are found once (a template), and each of
+ * its components then costs two triangular solves with its residual (tbz_templates). tbz_walk
+ * numbers a neighbourhood's points the same way wherever the shape is the same and hashes the
+ * shape; every component a template solves is checked (its largest row residual left, as
+ * CGLS's stopping rule), and one that fails is solved by CGLS instead. */
 #define TBZ_WALK_FACES 256     /* the most triangles a walk covers (valence 12 with regular rings: 108) */
 #define TBZ_TPL_MAX_UNK 1024   /* larger components are left to CGLS */
 typedef struct tbz_walk {
@@ -1284,7 +1307,7 @@ static int tbz_walk_run(const sfb__tbz *T, int v, tbz_walk *W) {
             for (i = 0; i + j <= 4; ++i, ++q) {
                 int w[3], p;
                 w[r] = 4 - i - j; w[(r + 1) % 3] = i; w[(r + 2) % 3] = j;
-                p = tbz_pt(T, f, w);
+                p = tbz_gpt(T, f, w);
                 if (W->plab[p] < 0) { W->plab[p] = W->nlab; W->lab[W->nlab++] = p; }
                 tbz_walk_mix(&h, W->plab[p] | (long long)W->mine[p] << 32);
             }
@@ -1306,14 +1329,14 @@ typedef struct tbz_tpl {
     int nlab, nu, nrow, nrank; /* the shape's labels, unknowns, rows, independent rows */
     int *ulab;                  /* per unknown column: its label */
     unsigned char *isunk;       /* per label */
-    size_t *ro;                 /* the independent rows (nrank), entries over labels, fixed ones included */
-    int *rl;
+    size_t *ro;                 /* the independent rows (nrank, in pivot order), entries over labels, fixed ones included */
+    int *rl, *ru;               /* per entry: its label, and its unknown column (-1: a fixed point) */
     double *rw;
-    double *pt;                 /* nrank x nu: dx = sum over independent rows a of b_a pt[a] */
+    double *lf;                 /* nrank x nrank: the Cholesky factor of those rows' A A^T (row a: its first a + 1) */
 } tbz_tpl;
 static void tbz_tpl_free(sfb_context *ctx, tbz_tpl *P) {
     sfb__free(ctx, P->ulab); sfb__free(ctx, P->isunk); sfb__free(ctx, P->ro); sfb__free(ctx, P->rl); sfb__free(ctx, P->rw);
-    sfb__free(ctx, P->pt);
+    sfb__free(ctx, P->ru); sfb__free(ctx, P->lf);
     memset(P, 0, sizeof *P);
 }
 
@@ -1384,36 +1407,23 @@ static int tbz_tpl_make(sfb__tbz *T, const tbz_sys *S, const tbz_comps *C, int i
             }
     }
     P->nrank = rank;
-    P->pt = (double *)sfb__alloc(T->ctx, ((size_t)rank * nu + 1) * sizeof(double));
+    P->lf = (double *)sfb__alloc(T->ctx, ((size_t)rank * rank + 1) * sizeof(double));
     P->ro = (size_t *)sfb__alloc(T->ctx, ((size_t)rank + 1) * sizeof(size_t));
     P->rl = (int *)sfb__alloc(T->ctx, (n + 1) * sizeof(int));
+    P->ru = (int *)sfb__alloc(T->ctx, (n + 1) * sizeof(int));
     P->rw = (double *)sfb__alloc(T->ctx, (n + 1) * sizeof(double));
-    if (!P->pt || !P->ro || !P->rl || !P->rw) goto done;
-    /* pt = L^-T L^-1 A_I (rows in pivot order), forward then backward */
-    for (a = 0; a < rank; ++a) {
-        double *z = P->pt + (size_t)a * nu;
-        const double *Lr = L + (size_t)piv[a] * nr;
-        memcpy(z, A + (size_t)piv[a] * nu, (size_t)nu * sizeof(double));
-        for (b = 0; b < a; ++b) {
-            const double f = Lr[b], *zb = P->pt + (size_t)b * nu;
-            for (u = 0; u < nu; ++u) z[u] -= f * zb[u];
-        }
-        for (u = 0; u < nu; ++u) z[u] /= Lr[a];
-    }
-    for (a = rank - 1; a >= 0; --a) {
-        double *z = P->pt + (size_t)a * nu;
-        for (b = a + 1; b < rank; ++b) {
-            const double f = L[(size_t)piv[b] * nr + a], *zb = P->pt + (size_t)b * nu;
-            for (u = 0; u < nu; ++u) z[u] -= f * zb[u];
-        }
-        for (u = 0; u < nu; ++u) z[u] /= L[(size_t)piv[a] * nr + a];
-    }
-    /* the independent rows over labels */
+    if (!P->lf || !P->ro || !P->rl || !P->ru || !P->rw) goto done;
+    /* the factor in pivot order, and the independent rows over labels */
     n = 0;
     for (a = 0; a < rank; ++a) {
         const int g = rows[piv[a]];
+        for (b = 0; b <= a; ++b) P->lf[(size_t)a * rank + b] = L[(size_t)piv[a] * nr + b];
         P->ro[a] = n;
-        for (e = S->off[g]; e < S->off[g + 1]; ++e) { P->rl[n] = W->plab[S->col[e]]; P->rw[n++] = S->w[e]; }
+        for (e = S->off[g]; e < S->off[g + 1]; ++e) {
+            P->rl[n] = W->plab[S->col[e]];
+            P->ru[n] = uidx[P->rl[n]];
+            P->rw[n++] = S->w[e];
+        }
     }
     P->ro[rank] = n;
     ok = 1;
@@ -1424,41 +1434,55 @@ done:
     return ok;
 }
 
-/* Solves component i (walked: W's labels are its) with template P: 1 when its rows are then
- * met (largest row residual at most 1e-15 of the scale, CGLS's rule), else 0 with the net as
- * it was. dx: 3 nu doubles. */
-static int tbz_tpl_apply(sfb__tbz *T, const tbz_sys *S, const tbz_comps *C, int i, const tbz_walk *W, const tbz_tpl *P, double *dx) {
+/* Solves component i with template P, lab[0 .. nlab) the points of its walk's labels: 1 when its
+ * rows are then met (largest row residual at most 1e-15 of the scale, CGLS's rule), else 0 with
+ * the net as it was. dx: 3 nu doubles, y: 3 P->nrank; mine: per point 0, and 0 again after. */
+static int tbz_tpl_apply(sfb__tbz *T, const tbz_sys *S, const tbz_comps *C, int i, const int *lab, int nlab, const tbz_tpl *P, double *dx,
+                         double *y, unsigned char *mine) {
     const int nr = C->rstart[i + 1] - C->rstart[i], nu = C->ustart[i + 1] - C->ustart[i];
     const int *rows = C->rows + C->rstart[i], *unk = C->unk + C->ustart[i];
-    int a, u, c, r;
+    int a, u, c, r, same = 1;
     size_t e;
-    if (W->nlab != P->nlab || nu != P->nu || nr != P->nrow) return 0;
-    for (u = 0; u < nu; ++u) {
-        const int lb = W->plab[unk[u]];
-        if (lb < 0 || !P->isunk[lb]) return 0;
-    }
-    for (u = 0; u < 3 * nu; ++u) dx[u] = 0.0;
+    if (nlab != P->nlab || nu != P->nu || nr != P->nrow) return 0;
+    /* the template's unknowns are the component's (as many, and each one of them) */
+    for (u = 0; u < nu; ++u) mine[unk[u]] = 1;
+    for (u = 0; u < nu; ++u) same &= mine[lab[P->ulab[u]]];
+    for (u = 0; u < nu; ++u) mine[unk[u]] = 0;
+    if (!same) return 0;
+    /* y = the independent rows' residual b; L L^T y' = y (forward, then backward with L's
+     * rows); dx = A^T y' over the unknown entries */
     for (a = 0; a < P->nrank; ++a) {
         double bv[3] = {0.0, 0.0, 0.0};
-        const double *pr = P->pt + (size_t)a * nu;
-        for (e = P->ro[a]; e < P->ro[a + 1]; ++e) tbz_axpy(bv, -P->rw[e], T->x + 3 * (size_t)W->lab[P->rl[e]]);
-        if (bv[0] == 0.0 && bv[1] == 0.0 && bv[2] == 0.0) continue;
-        for (u = 0; u < nu; ++u) tbz_axpy(dx + 3 * u, pr[u], bv);
+        const double *lr = P->lf + (size_t)a * P->nrank;
+        int b;
+        for (e = P->ro[a]; e < P->ro[a + 1]; ++e) tbz_axpy(bv, -P->rw[e], T->x + 3 * (size_t)lab[P->rl[e]]);
+        for (b = 0; b < a; ++b) tbz_axpy(bv, -lr[b], y + 3 * b);
+        for (c = 0; c < 3; ++c) y[3 * a + c] = bv[c] / lr[a];
     }
-    for (u = 0; u < nu; ++u) tbz_axpy(T->x + 3 * (size_t)W->lab[P->ulab[u]], 1.0, dx + 3 * u);
+    for (a = P->nrank - 1; a >= 0; --a) {
+        const double *lr = P->lf + (size_t)a * P->nrank;
+        int b;
+        for (c = 0; c < 3; ++c) y[3 * a + c] /= lr[a];
+        for (b = 0; b < a; ++b) tbz_axpy(y + 3 * b, -lr[b], y + 3 * a);
+    }
+    for (u = 0; u < 3 * nu; ++u) dx[u] = 0.0;
+    for (a = 0; a < P->nrank; ++a)
+        for (e = P->ro[a]; e < P->ro[a + 1]; ++e)
+            if (P->ru[e] >= 0) tbz_axpy(dx + 3 * P->ru[e], P->rw[e], y + 3 * a);
+    for (u = 0; u < nu; ++u) tbz_axpy(T->x + 3 * (size_t)lab[P->ulab[u]], 1.0, dx + 3 * u);
     for (r = 0; r < nr; ++r) {
         double v[3];
         tbz_dot3(S->col, S->w, S->off[rows[r]], S->off[rows[r] + 1], T->x, v);
         for (c = 0; c < 3; ++c)
             if (!(fabs(v[c]) <= 1e-15 * T->scale)) {
-                for (u = 0; u < nu; ++u) tbz_axpy(T->x + 3 * (size_t)W->lab[P->ulab[u]], -1.0, dx + 3 * u);
+                for (u = 0; u < nu; ++u) tbz_axpy(T->x + 3 * (size_t)lab[P->ulab[u]], -1.0, dx + 3 * u);
                 return 0;
             }
     }
     return 1;
 }
 
-typedef struct tbz_key { unsigned long long hash; int t; } tbz_key;
+typedef struct tbz_key { unsigned long long hash; int t; size_t lab; int nlab; } tbz_key; /* lab: its walk's labels in labs */
 static int tbz_key_cmp(const void *pa, const void *pb) {
     const tbz_key *a = (const tbz_key *)pa, *b = (const tbz_key *)pb;
     if (a->hash != b->hash) return a->hash < b->hash ? -1 : 1;
@@ -1476,7 +1500,9 @@ static sfb_result tbz_templates(sfb__tbz *T, const tbz_sys *S, const tbz_comps *
     int *centre = (int *)sfb__alloc(T->ctx, ((size_t)*nt + 1) * sizeof(int));
     unsigned char *done = (unsigned char *)sfb__calloc(T->ctx, (size_t)*nt + 1, 1);
     double *dx = NULL;
-    int t, nk = 0, g, i, m = 0, maxu = 0, tried = 0;
+    int *labs = NULL; /* every walk's label -> point map, one after the other */
+    size_t nlabs = 0, caplabs = 0;
+    int t, nk = 0, g, i, m = 0, maxu = 0, maxr = 0, tried = 0;
     sfb_result res = SFB_SUCCESS;
     if (W) { W->fidx = NULL; W->plab = NULL; W->vdist = NULL; W->mine = NULL; }
     if (!W || !key || !centre || !done) { res = sfb__oom(T->ctx, "tribezier templates"); goto out; }
@@ -1503,13 +1529,23 @@ static sfb_result tbz_templates(sfb__tbz *T, const tbz_sys *S, const tbz_comps *
             }
         }
         if (v < 0 || two || !tbz_walk_comp(T, C, c, v, W)) continue;
+        if (nlabs + (size_t)W->nlab > caplabs) {
+            const size_t nc = 2 * caplabs + (size_t)W->nlab + 4096;
+            int *l2 = (int *)sfb__realloc(T->ctx, labs, nc * sizeof(int));
+            if (!l2) { tbz_walk_reset(W); res = sfb__oom(T->ctx, "tribezier templates"); goto out; }
+            labs = l2;
+            caplabs = nc;
+        }
+        memcpy(labs + nlabs, W->lab, (size_t)W->nlab * sizeof(int));
         centre[t] = v;
-        key[nk].hash = W->hash; key[nk++].t = t;
+        key[nk].hash = W->hash; key[nk].t = t; key[nk].lab = nlabs; key[nk++].nlab = W->nlab;
+        nlabs += (size_t)W->nlab;
         maxu = nu > maxu ? nu : maxu;
+        maxr = C->rstart[c + 1] - C->rstart[c] > maxr ? C->rstart[c + 1] - C->rstart[c] : maxr;
         tbz_walk_reset(W);
     }
     qsort(key, (size_t)nk, sizeof *key, tbz_key_cmp);
-    dx = (double *)sfb__alloc(T->ctx, (3 * (size_t)maxu + 1) * sizeof(double));
+    dx = (double *)sfb__alloc(T->ctx, (3 * (size_t)maxu + 3 * (size_t)maxr + 1) * sizeof(double)); /* and y (rank <= rows) */
     if (!dx) { res = sfb__oom(T->ctx, "tribezier templates"); goto out; }
     /* per shape met twice or more: its template, from its first component, used on every one */
     for (g = 0; g < nk && res == SFB_SUCCESS; g = m) {
@@ -1524,9 +1560,7 @@ static sfb_result tbz_templates(sfb__tbz *T, const tbz_sys *S, const tbz_comps *
         T->st.templates++;
         for (i = g; i < m && res == SFB_SUCCESS; ++i) {
             const int ti = key[i].t;
-            tbz_walk_comp(T, C, todo[ti], centre[ti], W);
-            if (W->hash == key[i].hash && tbz_tpl_apply(T, S, C, todo[ti], W, &P, dx)) { done[ti] = 1; T->st.templated++; }
-            tbz_walk_reset(W);
+            if (tbz_tpl_apply(T, S, C, todo[ti], labs + key[i].lab, key[i].nlab, &P, dx, dx + 3 * (size_t)maxu, W->mine)) { done[ti] = 1; T->st.templated++; }
             /* progress (and a cancel) every 64 components, over the share of the components */
             if ((++tried & 63) == 0) res = tbz_progress(T, (double)tried / *nt);
         }
@@ -1540,6 +1574,7 @@ static sfb_result tbz_templates(sfb__tbz *T, const tbz_sys *S, const tbz_comps *
 out:
     if (W) { sfb__free(T->ctx, W->fidx); sfb__free(T->ctx, W->plab); sfb__free(T->ctx, W->vdist); sfb__free(T->ctx, W->mine); }
     sfb__free(T->ctx, W); sfb__free(T->ctx, key); sfb__free(T->ctx, centre); sfb__free(T->ctx, done); sfb__free(T->ctx, dx);
+    sfb__free(T->ctx, labs);
     return res;
 }
 
@@ -1554,16 +1589,23 @@ static sfb_result tbz_solve(sfb__tbz *T) {
     tbz_comps C;
     int *ucol = NULL, *rstart, *ustart, *rows, *unk, *local = NULL, *erow = NULL, *todo = NULL;
     tbz_prev *rec = T->rec && !T->sharp && !T->reuse_x ? T->rec : NULL;
+    unsigned char *near = NULL;
     int nu = 0, e, i, r, nc, nt = 0;
     double scale = 0.0;
     sfb_result res = SFB_SUCCESS;
     memset(&S, 0, sizeof S);
     memset(&C, 0, sizeof C);
-    /* an edge's rows read points within three net steps of an end (its middle point is two
-     * from each, the triangles' first inner row one more): with both ends farther than
-     * TBZ_REACH + 3 from every irregular vertex it has no unknown (tbz_edge_rows) */
-#define TBZ_ROW_EDGE(e) (l->ef_off[(e) + 1] - l->ef_off[e] == 2 && !T->efeat[e] && \
-                         (T->dist[tbz_vp(T, l->ev[2 * (e)])] <= TBZ_REACH + 3 || T->dist[tbz_vp(T, l->ev[2 * (e) + 1])] <= TBZ_REACH + 3))
+    /* an edge's rows read points of its two triangles only: with no unknown in either it has
+     * none (tbz_edge_rows); near[f]: triangle f has one */
+    near = (unsigned char *)sfb__alloc(T->ctx, (size_t)T->nf + 1);
+    if (!near) { res = sfb__oom(T->ctx, "tribezier constraints"); goto done; }
+    for (i = 0; i < T->nf; ++i) {
+        const int *g = T->grid + 15 * (size_t)i;
+        int q, any = 0;
+        for (q = 0; q < 15; ++q) any |= !T->fixed[g[q]] && T->dist[g[q]] <= TBZ_REACH;
+        near[i] = (unsigned char)any;
+    }
+#define TBZ_ROW_EDGE(e) (l->ef_off[(e) + 1] - l->ef_off[e] == 2 && !T->efeat[e] && (near[l->ef[l->ef_off[e]]] || near[l->ef[l->ef_off[e] + 1]]))
     {
         /* room for every candidate's five rows of 16 entries at once (growing by doubling
          * copied them over and over: a third of the rows' time after two Loop steps) */
@@ -1672,6 +1714,7 @@ static sfb_result tbz_solve(sfb__tbz *T) {
     }
 done:
     T->pbase = 0.0;
+    sfb__free(T->ctx, near);
     sfb__free(T->ctx, S.off); sfb__free(T->ctx, S.edge); sfb__free(T->ctx, S.col); sfb__free(T->ctx, S.w);
     sfb__free(T->ctx, ucol); sfb__free(T->ctx, local); sfb__free(T->ctx, erow);
     sfb__free(T->ctx, C.rows); sfb__free(T->ctx, C.unk); sfb__free(T->ctx, C.rstart); sfb__free(T->ctx, C.ustart);
@@ -1697,11 +1740,11 @@ static int tbz_degenerate(const sfb__tbz *T) {
             int w[3], p0, p1, p2;
             double a[3], b[3], x[3], la = 0, lb = 0;
             w[k] = 4; w[(k + 1) % 3] = 0; w[(k + 2) % 3] = 0;
-            p0 = tbz_pt(T, f, w);
+            p0 = tbz_gpt(T, f, w);
             w[k] = 3; w[(k + 1) % 3] = 1;
-            p1 = tbz_pt(T, f, w);
+            p1 = tbz_gpt(T, f, w);
             w[(k + 1) % 3] = 0; w[(k + 2) % 3] = 1;
-            p2 = tbz_pt(T, f, w);
+            p2 = tbz_gpt(T, f, w);
             for (c = 0; c < 3; ++c) {
                 a[c] = T->x[3 * (size_t)p1 + c] - T->x[3 * (size_t)p0 + c];
                 b[c] = T->x[3 * (size_t)p2 + c] - T->x[3 * (size_t)p0 + c];
