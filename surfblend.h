@@ -8481,6 +8481,10 @@ static sfb_result tbz_templates(sfb__tbz *T, const tbz_sys *S, const tbz_comps *
     size_t nlabs = 0, caplabs = 0;
     int t, nk = 0, g, i, m = 0, maxu = 0, maxr = 0, tried = 0;
     sfb_result res = SFB_SUCCESS;
+    if (*nt < 2) { /* no shape can be met twice: nothing to allocate */
+        sfb__free(T->ctx, W); sfb__free(T->ctx, key); sfb__free(T->ctx, centre); sfb__free(T->ctx, done);
+        return SFB_SUCCESS;
+    }
     if (W) { W->fidx = NULL; W->plab = NULL; W->vdist = NULL; W->mine = NULL; }
     if (!W || !key || !centre || !done) { res = sfb__oom(T->ctx, "tribezier templates"); goto out; }
     W->fidx = (int *)sfb__alloc(T->ctx, ((size_t)T->nf + 1) * sizeof(int));
