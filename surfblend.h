@@ -7326,24 +7326,35 @@ static void tbz_ours_offset(sfb__tbz *T) {
  * loops of tbz_initial read it again for every point: a fifth of the nets' setup after two
  * Loop steps, where nearly every vertex is one of these). */
 #define TBZ_FAST(T, v) (!(T)->virr[v] && (T)->vtype[v] == TBZ_SMOOTH && tbz_nf((T)->l, v) == 6 && !tbz_boundary((T)->l, v))
+/* Sabin's rules on a regular ring R (ALGORITHMS.md 8.1): the corner, the edge point on the spoke
+ * to R[j], the interior point of the triangle (V, R[j], R[j+1]). */
+static void tbz_sabin_corner(const double V[3], double R[6][3], double *P) {
+    int c;
+    for (c = 0; c < 3; ++c) P[c] = (6.0 * V[c] + R[0][c] + R[1][c] + R[2][c] + R[3][c] + R[4][c] + R[5][c]) / 12.0;
+}
+static void tbz_sabin_edge(const double V[3], double R[6][3], int j, double *E) {
+    const int j1 = (j + 1) % 6, j2 = (j + 2) % 6, j4 = (j + 4) % 6, j5 = (j + 5) % 6;
+    int c;
+    for (c = 0; c < 3; ++c) E[c] = (12.0 * V[c] + 4.0 * R[j][c] + 3.0 * (R[j1][c] + R[j5][c]) + R[j2][c] + R[j4][c]) / 24.0;
+}
+static void tbz_sabin_face(const double V[3], double R[6][3], int j, double *F) {
+    const int j1 = (j + 1) % 6, j2 = (j + 2) % 6, j5 = (j + 5) % 6;
+    int c;
+    for (c = 0; c < 3; ++c) F[c] = (10.0 * V[c] + 6.0 * R[j][c] + 6.0 * R[j1][c] + R[j5][c] + R[j2][c]) / 24.0;
+}
 static void tbz_regular_vertex(sfb__tbz *T, int v) {
     const sfb__level *l = T->l;
-    double R[6][3], V[3], *P = T->x + 3 * (size_t)tbz_vp(T, v);
-    int j, c;
+    double R[6][3], V[3];
+    int j;
     tbz_get(T, v, V);
     for (j = 0; j < 6; ++j) tbz_get(T, tbz_ring(l, v, j), R[j]);
-    for (c = 0; c < 3; ++c) P[c] = (6.0 * V[c] + R[0][c] + R[1][c] + R[2][c] + R[3][c] + R[4][c] + R[5][c]) / 12.0;
+    tbz_sabin_corner(V, R, T->x + 3 * (size_t)tbz_vp(T, v));
     for (j = 0; j < 6; ++j) {
         const int e = l->ve[l->ve_off[v] + j], f = l->vf[l->vf_off[v] + j], *fv = l->fv + l->fv_off[f];
-        const int j1 = (j + 1) % 6, j2 = (j + 2) % 6, j4 = (j + 4) % 6, j5 = (j + 5) % 6;
-        double *E = T->x + 3 * (size_t)tbz_ep(T, e, l->ev[2 * e] == v ? 0 : 2), *F;
         int k = 0;
         while (fv[k] != v) ++k;
-        F = T->x + 3 * (size_t)tbz_fp(T, f, k);
-        for (c = 0; c < 3; ++c) {
-            E[c] = (12.0 * V[c] + 4.0 * R[j][c] + 3.0 * (R[j1][c] + R[j5][c]) + R[j2][c] + R[j4][c]) / 24.0;
-            F[c] = (10.0 * V[c] + 6.0 * R[j][c] + 6.0 * R[j1][c] + R[j5][c] + R[j2][c]) / 24.0;
-        }
+        tbz_sabin_edge(V, R, j, T->x + 3 * (size_t)tbz_ep(T, e, l->ev[2 * e] == v ? 0 : 2));
+        tbz_sabin_face(V, R, j, T->x + 3 * (size_t)tbz_fp(T, f, k));
     }
 }
 
@@ -7363,7 +7374,7 @@ static void tbz_initial(sfb__tbz *T) {
             double R[6][3], V[3];
             tbz_ring6(T, v, 0, R);
             tbz_get(T, v, V);
-            for (c = 0; c < 3; ++c) P[c] = (6.0 * V[c] + R[0][c] + R[1][c] + R[2][c] + R[3][c] + R[4][c] + R[5][c]) / 12.0;
+            tbz_sabin_corner(V, R, P);
         } else if (type == TBZ_CREASE || type == TBZ_CORNER) {
             tbz_crease_point(T, v, type, P);
         } else if (T->sharp && T->corner_s[v] > 0.0f) {
@@ -7382,21 +7393,21 @@ static void tbz_initial(sfb__tbz *T) {
         for (end = 0; end < 2; ++end) {
             const int v = end ? b : a, w = end ? a : b, q = end ? 2 : 0;
             double *E = T->x + 3 * (size_t)tbz_ep(T, e, q), V[3], W[3];
-            const int m = TBZ_FAST(T, v) ? 0 : tbz_spoke(l, v, e), n = tbz_nf(l, v);
             const double *P = T->x + 3 * (size_t)v;
-            if (TBZ_FAST(T, v)) continue;
+            int m, n;
+            if (TBZ_FAST(T, v)) continue; /* tbz_regular_vertex */
+            m = tbz_spoke(l, v, e);
+            n = tbz_nf(l, v);
             tbz_get(T, v, V); tbz_get(T, w, W);
             if (!T->virr[v]) {
                 double R[6][3];
                 /* a slot whose triangle has the spoke as R[0] or R[1] */
                 if (m < n) {
                     tbz_ring6(T, v, m, R);
-                    for (c = 0; c < 3; ++c)
-                        E[c] = (12.0 * V[c] + 4.0 * R[0][c] + 3.0 * (R[1][c] + R[5][c]) + R[2][c] + R[4][c]) / 24.0;
+                    tbz_sabin_edge(V, R, 0, E);
                 } else {
                     tbz_ring6(T, v, m - 1, R);
-                    for (c = 0; c < 3; ++c)
-                        E[c] = (12.0 * V[c] + 4.0 * R[1][c] + 3.0 * (R[2][c] + R[0][c]) + R[3][c] + R[5][c]) / 24.0;
+                    tbz_sabin_edge(V, R, 1, E);
                 }
             } else if (((T->vtype[v] & 15) == TBZ_SMOOTH || (T->vtype[v] & 15) == TBZ_DART)) {
                 /* 8.2: P + 3/4 (3 + 2c)/(6n) T_m */
@@ -7512,7 +7523,7 @@ static void tbz_initial(sfb__tbz *T) {
             if (!T->virr[v]) {
                 double R[6][3];
                 tbz_ring6(T, v, m, R);
-                for (c = 0; c < 3; ++c) F[c] = (10.0 * V[c] + 6.0 * R[0][c] + 6.0 * R[1][c] + R[5][c] + R[2][c]) / 24.0;
+                tbz_sabin_face(V, R, 0, F);
             } else {
                 double A[3], B[3], Cm[3], D[3];
                 tbz_get(T, tbz_ring(l, v, m), A);
@@ -7649,7 +7660,6 @@ static int tbz_edge_rows(sfb__tbz *T, tbz_sys *S, int e) {
  * points, each point's neighbours the points next to it (the six directions of the lattice) in
  * the triangles it belongs to. (Sweeps over every triangle, as before, took 25 ms on the cow
  * after two Loop steps; this touches only the points near irregular vertices.) */
-#define TBZ_DIST_CUT TBZ_REACH
 static sfb_result tbz_distances(sfb__tbz *T) {
     static const int dir[6][2] = {{1, 0}, {0, 1}, {-1, 1}, {-1, 0}, {0, -1}, {1, -1}};
     const sfb__level *l = T->l;
@@ -7675,7 +7685,7 @@ static sfb_result tbz_distances(sfb__tbz *T) {
         const int p = queue[head++], d = T->dist[p];
         int f0, f1, fi;
         const int *fl;
-        if (d >= TBZ_DIST_CUT) continue;
+        if (d >= TBZ_REACH) continue;
         /* the triangles p belongs to */
         if (p < T->nv) { fl = l->vf; f0 = l->vf_off[p]; f1 = l->vf_off[p + 1]; }
         else if (p < T->nv + 3 * T->ne) { const int e = (p - T->nv) / 3; fl = l->ef; f0 = l->ef_off[e]; f1 = l->ef_off[e + 1]; }
@@ -8305,14 +8315,13 @@ static int tbz_walk_comp(const sfb__tbz *T, const tbz_comps *C, int c, int v, tb
 typedef struct tbz_tpl {
     int nlab, nu, nrow, nrank; /* the shape's labels, unknowns, rows, independent rows */
     int *ulab;                  /* per unknown column: its label */
-    unsigned char *isunk;       /* per label */
     size_t *ro;                 /* the independent rows (nrank, in pivot order), entries over labels, fixed ones included */
     int *rl, *ru;               /* per entry: its label, and its unknown column (-1: a fixed point) */
     double *rw;
     double *lf;                 /* nrank x nrank: the Cholesky factor of those rows' A A^T (row a: its first a + 1) */
 } tbz_tpl;
 static void tbz_tpl_free(sfb_context *ctx, tbz_tpl *P) {
-    sfb__free(ctx, P->ulab); sfb__free(ctx, P->isunk); sfb__free(ctx, P->ro); sfb__free(ctx, P->rl); sfb__free(ctx, P->rw);
+    sfb__free(ctx, P->ulab); sfb__free(ctx, P->ro); sfb__free(ctx, P->rl); sfb__free(ctx, P->rw);
     sfb__free(ctx, P->ru); sfb__free(ctx, P->lf);
     memset(P, 0, sizeof *P);
 }
@@ -8337,12 +8346,11 @@ static int tbz_tpl_make(sfb__tbz *T, const tbz_sys *S, const tbz_comps *C, int i
     for (k = 0; k < W->nlab; ++k) uidx[k] = -1;
     P->nlab = W->nlab; P->nu = nu; P->nrow = nr;
     P->ulab = (int *)sfb__alloc(T->ctx, ((size_t)nu + 1) * sizeof(int));
-    P->isunk = (unsigned char *)sfb__calloc(T->ctx, (size_t)W->nlab + 1, 1);
-    if (!P->ulab || !P->isunk) goto done;
+    if (!P->ulab) goto done;
     for (u = 0; u < nu; ++u) {
         const int lb = W->plab[unk[u]];
         if (lb < 0) goto done;
-        P->ulab[u] = lb; P->isunk[lb] = 1; uidx[lb] = u;
+        P->ulab[u] = lb; uidx[lb] = u;
     }
     /* the dense A over the unknowns; every point its rows read labelled */
     for (r = 0; r < nr; ++r)
@@ -8605,6 +8613,7 @@ static sfb_result tbz_solve(sfb__tbz *T) {
             S.cur_edge = e;
             if (!tbz_edge_rows(T, &S, e)) { res = sfb__oom(T->ctx, "tribezier constraints"); goto done; }
         }
+#undef TBZ_ROW_EDGE
     if (S.rows == 0) goto done;
     ucol = (int *)sfb__alloc(T->ctx, (size_t)T->np * sizeof(int));
     local = (int *)sfb__alloc(T->ctx, (size_t)T->np * sizeof(int));
@@ -9236,13 +9245,14 @@ static sfb_result tbz_build(sfb_context *ctx, const sfb__level *l, const float *
     sfb__tbz_stats st, st4;
     sfb__level rl;
     sfb_result r;
+    unsigned two;
     memset(&st, 0, sizeof st);
     /* progress (stage "tribezier"): the mesh's own net over [0, 0.5], the one after a Loop step
-     * over [0.5, 1] (over [0, 1] where it is the only one) */
-    /* one Loop step or two (the top of this file): two where a group of more than
-     * TBZ_ONE_STEP_GROUP extraordinary vertices would merge into one large component after one */
-    const unsigned two = tbz_largest_group(ctx, l) > TBZ_ONE_STEP_GROUP ? SFB__TBZ_TWO_STEPS : 0;
+     * over [0.5, 1] (over [0, 1] where it is the only one). One Loop step or two (the top of
+     * this file): two where a group of more than TBZ_ONE_STEP_GROUP extraordinary vertices would
+     * merge into one large component after one (decided only where a step is taken) */
     if (tbz_touching(l)) {
+        two = tbz_largest_group(ctx, l) > TBZ_ONE_STEP_GROUP ? SFB__TBZ_TWO_STEPS : 0;
         r = sfb__tribezier_refined_points(ctx, l, positions, opt, two, &rl, &net4, NULL);
         if (r != SFB_SUCCESS) return r;
         r = sfb__patch_table_beztri_children(ctx, l, net4, two ? 2 : 1, pt);
@@ -9256,6 +9266,7 @@ static sfb_result tbz_build(sfb_context *ctx, const sfb__level *l, const float *
         /* a refused step is this build's own business, not a failure the caller should read
          * after a successful create */
         sfb__error_state kept;
+        two = tbz_largest_group(ctx, l) > TBZ_ONE_STEP_GROUP ? SFB__TBZ_TWO_STEPS : 0;
         sfb__error_keep(ctx, &kept);
         memset(&st4, 0, sizeof st4);
         r = sfb__tribezier_refined_points(ctx, l, positions, opt, SFB__TBZ_PROGRESS_HIGH | two, &rl, &net4, &st4);
