@@ -1574,11 +1574,12 @@ SFB__IF sfb_result sfb__pn_build(sfb_context *ctx, const sfb__level *base, const
  * more on the backend's threads (for the test that the net stays bit for bit the same there; the
  * default is 65536), SFB__TBZ_NO_TEMPLATES solves every component by CGLS (for the test that the
  * templates give the same net), SFB__TBZ_TWO_STEPS makes sfb__tribezier_refined_points take two
- * Loop steps. Progress (stage "tribezier") runs over [0, 1], or [0, 0.5] with
+ * Loop steps, SFB__TBZ_BOTH_NETS builds the smooth net even where s = 1 at every vertex (for the
+ * test that skipping it gives the same net). Progress (stage "tribezier") runs over [0, 1], or [0, 0.5] with
  * SFB__TBZ_PROGRESS_LOW and [0.5, 1] with SFB__TBZ_PROGRESS_HIGH (sfb__tribezier_build: the mesh's
  * own net, then the one after a Loop step); a cancel returns SFB_CANCELLED. */
 enum { SFB__TBZ_SEED_PLANE = 1, SFB__TBZ_NO_REUSE = 2, SFB__TBZ_PAR_SMALL = 4, SFB__TBZ_PROGRESS_LOW = 8, SFB__TBZ_PROGRESS_HIGH = 16,
-       SFB__TBZ_NO_TEMPLATES = 32, SFB__TBZ_TWO_STEPS = 64 };
+       SFB__TBZ_NO_TEMPLATES = 32, SFB__TBZ_TWO_STEPS = 64, SFB__TBZ_BOTH_NETS = 128 };
 typedef struct sfb__tbz_stats {
     long iterations;   /* CGLS iterations, all coordinates and nets */
     long unknowns;     /* points moved by the G1 solve, per coordinate and net */
@@ -1591,6 +1592,7 @@ typedef struct sfb__tbz_stats {
                           solution (SFB__TBZ_NO_REUSE: none) */
     int templates;     /* templates made (tbz_templates: one dense solve per shape of neighbourhood met twice or more) */
     int templated;     /* components solved with a template (SFB__TBZ_NO_TEMPLATES: none, every one by CGLS) */
+    int sharp_only;    /* 1: s = 1 at every vertex, the sharp net alone built (SFB__TBZ_BOTH_NETS: never) */
     int large;         /* components solved with each iteration's loops on the backend's threads (65536 unknowns
                           or more, 1024 with SFB__TBZ_PAR_SMALL) */
 } sfb__tbz_stats;
@@ -8779,7 +8781,7 @@ static sfb_result tbz_points(sfb_context *ctx, const sfb__level *l, const float 
     sfb__tbz T;
     tbz_prev prev;
     double *x0 = NULL, *vs = NULL, *res = NULL;
-    int v, e, f, c, k, any_tag = 0;
+    int v, e, f, c, k, any_tag = 0, sharp_only = 0;
     sfb_result r = SFB_SUCCESS;
     *out = NULL;
     /* the nets read rings in fan order: every vertex with triangles a fan, every edge manifold
@@ -8832,14 +8834,33 @@ static sfb_result tbz_points(sfb_context *ctx, const sfb__level *l, const float 
             if (T.corner_s[v] <= 0.0f) T.corner_s[v] = 1e-30f;
             any_tag = 1;
         }
+    /* s per vertex (tbz_vertex_s) follows from the tags alone. Where it is 1 at every vertex
+     * (every tag s = 1: infinitely sharp creases, the corners of split non-manifold vertices --
+     * cow.obj and teapot.obj have only those --, an override of 1) every point's blend is the
+     * sharp net's, so the smooth net is not built (SFB__TBZ_BOTH_NETS: built all the same, for
+     * the test that the net is the same) */
+    if (any_tag) {
+        vs = (double *)sfb__calloc(ctx, (size_t)T.nv + 1, sizeof(double));
+        if (!vs) { r = sfb__oom(ctx, "tribezier"); goto done; }
+        if ((r = tbz_vertex_s(&T, vs)) != SFB_SUCCESS) goto done;
+        sharp_only = !(flags & SFB__TBZ_BOTH_NETS);
+        for (v = 0; v < T.nv && sharp_only; ++v) sharp_only = vs[v] == 1.0;
+    }
     /* progress: this call's window (sfb_internal.h), the smooth net's solve in its first half
      * where a sharp net follows (the seed-plane fallback reports in the same half again, never
      * below what was reported) */
     {
         const float w0 = flags & SFB__TBZ_PROGRESS_HIGH ? 0.5f : 0.0f, w1 = flags & SFB__TBZ_PROGRESS_LOW ? 0.5f : 1.0f;
         T.p0 = T.plast = w0;
-        T.p1 = any_tag ? 0.5f * (w0 + w1) : w1;
+        T.p1 = any_tag && !sharp_only ? 0.5f * (w0 + w1) : w1;
         if ((r = sfb__progress(ctx, w0, "tribezier")) != SFB_SUCCESS) goto done;
+    }
+    if (sharp_only) {
+        T.pos = sharp_positions;
+        if ((r = tbz_state(&T, 1)) != SFB_SUCCESS) goto done;
+        T.st.sharp_only = 1;
+        any_tag = 0; /* the blend below: the one net as it is */
+        goto blend;
     }
     /* the smooth net's solve is recorded for the sharp net (tbz_prev), unless asked not to */
     T.rec = any_tag && !(flags & SFB__TBZ_NO_REUSE) ? &prev : NULL;
@@ -8872,8 +8893,7 @@ static sfb_result tbz_points(sfb_context *ctx, const sfb__level *l, const float 
     if (any_tag) {
         x0 = T.x;
         T.x = (double *)sfb__calloc(ctx, 3 * (size_t)T.np + 1, sizeof(double));
-        vs = (double *)sfb__calloc(ctx, (size_t)T.nv + 1, sizeof(double));
-        if (!T.x || !vs) { r = sfb__oom(ctx, "tribezier"); goto done; }
+        if (!T.x) { r = sfb__oom(ctx, "tribezier"); goto done; }
         T.pos = sharp_positions;
         prev.x1 = x0;
         T.prev = &prev;
@@ -8882,9 +8902,8 @@ static sfb_result tbz_points(sfb_context *ctx, const sfb__level *l, const float 
         r = tbz_state(&T, 1);
         T.prev = NULL;
         if (r != SFB_SUCCESS) goto done;
-        r = tbz_vertex_s(&T, vs);
-        if (r != SFB_SUCCESS) goto done;
     }
+blend:
     for (f = 0; f < T.nf; ++f) {
         const int *fv = l->fv + l->fv_off[f];
         const int *g = T.grid + 15 * (size_t)f;

@@ -975,9 +975,9 @@ static void templates_one(sfb_context *ctx, const char *name, const char *obj, u
     tmesh_free(ctx, &t);
 }
 
-/* obj (malloc'd copy) with an s = 1 crease tag on the first edge of every `every`-th face;
- * *tags: how many. NULL when out of memory. */
-static char *obj_tag_creases(const char *obj, int every, int *tags) {
+/* obj (malloc'd copy) with a crease tag of sharpness `s` on the first edge of every `every`-th
+ * face; *tags: how many. NULL when out of memory. */
+static char *obj_tag_creases(const char *obj, int every, double s, int *tags) {
     const size_t n = strlen(obj);
     size_t at;
     const char *fl = obj;
@@ -997,7 +997,7 @@ static char *obj_tag_creases(const char *obj, int every, int *tags) {
         v1 = strtol(e, NULL, 10);
         ++fl;
         if (faces++ % every != 0 || v0 < 1 || v1 < 1 || at + 64 > 2 * n) continue;
-        at += (size_t)snprintf(text + at, 64, "t crease 2/1/0 %ld %ld 1\n", v0 - 1, v1 - 1);
+        at += (size_t)snprintf(text + at, 64, "t crease 2/1/0 %ld %ld %g\n", v0 - 1, v1 - 1, s);
         ++*tags;
     }
     text[at] = 0;
@@ -1007,8 +1007,9 @@ static char *obj_tag_creases(const char *obj, int every, int *tags) {
 /* The sharp net takes the smooth net's solution of every constraint component that is the same
  * system in both (tbz_prev): the net must be bit for bit the one solved in full
  * (SFB__TBZ_NO_REUSE), with components reused and fewer CGLS iterations. obj gets crease tags
- * on the first edge of every 256th face, so that the nets differ near them (rows, and points the
- * rows read) and agree away from them. */
+ * of s = 0.5 (so that both nets are built: with s = 1 everywhere the smooth net is not) on the
+ * first edge of every 256th face, so that the nets differ near them (rows, and points the rows
+ * read) and agree away from them. */
 static void reuse_one(sfb_context *ctx, const char *name, const char *obj) {
     tmesh t;
     double *a = NULL, *b = NULL;
@@ -1018,7 +1019,7 @@ static void reuse_one(sfb_context *ctx, const char *name, const char *obj) {
     int tags = 0;
     memset(&ra, 0, sizeof ra); memset(&rb, 0, sizeof rb);
     memset(&sa, 0, sizeof sa); memset(&sb, 0, sizeof sb);
-    text = obj_tag_creases(obj, 256, &tags);
+    text = obj_tag_creases(obj, 256, 0.5, &tags);
     if (!text) { fail(name, "out of memory"); return; }
     snprintf(nm, sizeof nm, "%s/sharp_net_reuse_is_exact", name);
     if (!tmesh_load(ctx, text, &t)) { fail(nm, "load: %s", sfb_last_error(ctx)); free(text); return; }
@@ -1027,11 +1028,54 @@ static void reuse_one(sfb_context *ctx, const char *name, const char *obj) {
         fail(nm, "not built: %s", sfb_last_error(ctx));
     } else {
         const int same = ra.nf == rb.nf && memcmp(a, b, 45 * (size_t)ra.nf * sizeof(double)) == 0;
-        check(same && sa.reused > 0 && sb.reused == 0 && sa.iterations < sb.iterations && sa.residual == sb.residual, nm,
+        check(same && sa.reused > 0 && sb.reused == 0 && sa.iterations < sb.iterations && sa.residual == sb.residual && !sa.sharp_only, nm,
               "identical %d, components reused %d (without: %d), CGLS iterations %ld vs %ld, residual %.3g vs %.3g", same, sa.reused,
               sb.reused, sa.iterations, sb.iterations, sa.residual, sb.residual);
         printf("  %s: %d crease tags, %d sharp-net components reused, CGLS iterations %ld instead of %ld\n", name, tags, sa.reused,
                sa.iterations, sb.iterations);
+    }
+    sfb__free(ctx, a); sfb__free(ctx, b);
+    sfb__level_free(ctx, &ra); sfb__level_free(ctx, &rb);
+    tmesh_free(ctx, &t);
+    free(text);
+}
+
+/* Where s = 1 at every vertex the blend is the sharp net everywhere and the smooth net is not
+ * built (tbz_points): the net must be the one built with both (SFB__TBZ_BOTH_NETS) within
+ * 1e-12 x diagonal (the same systems; a template may come from another component of its shape).
+ * `every` > 0: obj gets s = 1 crease tags on
+ * every `every`-th face's first edge, 0: its own tags (the corners of its split non-manifold
+ * vertices); refined: the net after Loop steps (one, two with steps = SFB__TBZ_TWO_STEPS), else
+ * the mesh's own. */
+static void sharp_only_one(sfb_context *ctx, const char *name, const char *obj, int every, int refined, unsigned steps) {
+    tmesh t;
+    double *a = NULL, *b = NULL, worst = 0.0;
+    sfb__tbz_stats sa, sb;
+    sfb__level ra, rb;
+    char nm[160], *text = NULL;
+    size_t i, n = 0;
+    int tags = 0;
+    memset(&ra, 0, sizeof ra); memset(&rb, 0, sizeof rb);
+    memset(&sa, 0, sizeof sa); memset(&sb, 0, sizeof sb);
+    snprintf(nm, sizeof nm, "sharp_only/%s/same_net_as_both_nets", name);
+    if (every > 0 && !(text = obj_tag_creases(obj, every, 1.0, &tags))) { fail(nm, "out of memory"); return; }
+    if (!tmesh_load(ctx, text ? text : obj, &t)) { fail(nm, "load: %s", sfb_last_error(ctx)); free(text); return; }
+    if (refined) {
+        if (sfb__tribezier_refined_points(ctx, &t.prep, t.m->positions, NULL, steps, &ra, &a, &sa) == SFB_SUCCESS &&
+            sfb__tribezier_refined_points(ctx, &t.prep, t.m->positions, NULL, steps | SFB__TBZ_BOTH_NETS, &rb, &b, &sb) == SFB_SUCCESS)
+            n = 45 * (size_t)ra.nf;
+    } else {
+        a = net_of(ctx, &t, NULL, 0, &sa);
+        b = net_of(ctx, &t, NULL, SFB__TBZ_BOTH_NETS, &sb);
+        n = 45 * (size_t)t.prep.nf;
+    }
+    if (!a || !b || n == 0) {
+        fail(nm, "not built: %s", sfb_last_error(ctx));
+    } else {
+        for (i = 0; i < n; ++i) worst = fmax(worst, fabs(a[i] - b[i]));
+        check(worst <= 1e-12 * t.diag && sa.sharp_only && !sb.sharp_only && sa.residual <= 1e-12 + sb.residual, nm,
+              "largest difference %.3g (diag %.3g); %d tags added; CGLS iterations %ld vs %ld, templates %d vs %d, residual %.3g vs %.3g",
+              worst, t.diag, tags, sa.iterations, sb.iterations, sa.templates, sb.templates, sa.residual, sb.residual);
     }
     sfb__free(ctx, a); sfb__free(ctx, b);
     sfb__level_free(ctx, &ra); sfb__level_free(ctx, &rb);
@@ -1115,12 +1159,14 @@ static void test_refined(sfb_context *ctx, const char *dir) {
     if (!obj) { skip("touching_evs/spot", "spot.obj not found (pass the real-meshes folder)"); return; }
     refined_one(ctx, "touching_evs/spot", obj);
     reuse_one(ctx, "touching_evs/spot", obj);
+    sharp_only_one(ctx, "spot_one_loop_step", obj, 256, 1, 0);
     templates_one(ctx, "spot_two_loop_steps", obj, SFB__TBZ_TWO_STEPS);
     free(obj);
     snprintf(path, sizeof path, "%s/teapot.obj", dir);
     obj = slurp(path, &n);
     if (!obj) { skip("templates/teapot_own_net/same_net_as_cgls", "teapot.obj not found (pass the real-meshes folder)"); return; }
     templates_one(ctx, "teapot_own_net", obj, 0);
+    sharp_only_one(ctx, "teapot_own_net", obj, 0, 0, 0);
     free(obj);
 }
 
@@ -1323,7 +1369,7 @@ static void test_threads(const char *dir, const char *mesh) {
     if (!obj) { skip(name, "the mesh was not found (pass the real-meshes folder)"); return; }
     memset(rl, 0, sizeof rl);
     memset(st, 0, sizeof st);
-    tagged = obj_tag_creases(obj, 64, &ntags);
+    tagged = obj_tag_creases(obj, 64, 0.5, &ntags);
     if (!tagged || ntags == 0) { fail(name, "no crease tags"); free(obj); free(tagged); return; }
     for (k = 0; k < 2; ++k) {
         sfb_context_config cc = sfb_context_config_init();

@@ -1802,7 +1802,7 @@ static sfb_result tbz_points(sfb_context *ctx, const sfb__level *l, const float 
     sfb__tbz T;
     tbz_prev prev;
     double *x0 = NULL, *vs = NULL, *res = NULL;
-    int v, e, f, c, k, any_tag = 0;
+    int v, e, f, c, k, any_tag = 0, sharp_only = 0;
     sfb_result r = SFB_SUCCESS;
     *out = NULL;
     /* the nets read rings in fan order: every vertex with triangles a fan, every edge manifold
@@ -1855,14 +1855,33 @@ static sfb_result tbz_points(sfb_context *ctx, const sfb__level *l, const float 
             if (T.corner_s[v] <= 0.0f) T.corner_s[v] = 1e-30f;
             any_tag = 1;
         }
+    /* s per vertex (tbz_vertex_s) follows from the tags alone. Where it is 1 at every vertex
+     * (every tag s = 1: infinitely sharp creases, the corners of split non-manifold vertices --
+     * cow.obj and teapot.obj have only those --, an override of 1) every point's blend is the
+     * sharp net's, so the smooth net is not built (SFB__TBZ_BOTH_NETS: built all the same, for
+     * the test that the net is the same) */
+    if (any_tag) {
+        vs = (double *)sfb__calloc(ctx, (size_t)T.nv + 1, sizeof(double));
+        if (!vs) { r = sfb__oom(ctx, "tribezier"); goto done; }
+        if ((r = tbz_vertex_s(&T, vs)) != SFB_SUCCESS) goto done;
+        sharp_only = !(flags & SFB__TBZ_BOTH_NETS);
+        for (v = 0; v < T.nv && sharp_only; ++v) sharp_only = vs[v] == 1.0;
+    }
     /* progress: this call's window (sfb_internal.h), the smooth net's solve in its first half
      * where a sharp net follows (the seed-plane fallback reports in the same half again, never
      * below what was reported) */
     {
         const float w0 = flags & SFB__TBZ_PROGRESS_HIGH ? 0.5f : 0.0f, w1 = flags & SFB__TBZ_PROGRESS_LOW ? 0.5f : 1.0f;
         T.p0 = T.plast = w0;
-        T.p1 = any_tag ? 0.5f * (w0 + w1) : w1;
+        T.p1 = any_tag && !sharp_only ? 0.5f * (w0 + w1) : w1;
         if ((r = sfb__progress(ctx, w0, "tribezier")) != SFB_SUCCESS) goto done;
+    }
+    if (sharp_only) {
+        T.pos = sharp_positions;
+        if ((r = tbz_state(&T, 1)) != SFB_SUCCESS) goto done;
+        T.st.sharp_only = 1;
+        any_tag = 0; /* the blend below: the one net as it is */
+        goto blend;
     }
     /* the smooth net's solve is recorded for the sharp net (tbz_prev), unless asked not to */
     T.rec = any_tag && !(flags & SFB__TBZ_NO_REUSE) ? &prev : NULL;
@@ -1895,8 +1914,7 @@ static sfb_result tbz_points(sfb_context *ctx, const sfb__level *l, const float 
     if (any_tag) {
         x0 = T.x;
         T.x = (double *)sfb__calloc(ctx, 3 * (size_t)T.np + 1, sizeof(double));
-        vs = (double *)sfb__calloc(ctx, (size_t)T.nv + 1, sizeof(double));
-        if (!T.x || !vs) { r = sfb__oom(ctx, "tribezier"); goto done; }
+        if (!T.x) { r = sfb__oom(ctx, "tribezier"); goto done; }
         T.pos = sharp_positions;
         prev.x1 = x0;
         T.prev = &prev;
@@ -1905,9 +1923,8 @@ static sfb_result tbz_points(sfb_context *ctx, const sfb__level *l, const float 
         r = tbz_state(&T, 1);
         T.prev = NULL;
         if (r != SFB_SUCCESS) goto done;
-        r = tbz_vertex_s(&T, vs);
-        if (r != SFB_SUCCESS) goto done;
     }
+blend:
     for (f = 0; f < T.nf; ++f) {
         const int *fv = l->fv + l->fv_off[f];
         const int *g = T.grid + 15 * (size_t)f;
