@@ -1592,6 +1592,7 @@ typedef struct sfb__tbz_stats {
                           solution (SFB__TBZ_NO_REUSE: none) */
     int templates;     /* templates made (tbz_templates: one dense solve per shape of neighbourhood met twice or more) */
     int templated;     /* components solved with a template (SFB__TBZ_NO_TEMPLATES: none, every one by CGLS) */
+    int direct;        /* templates made for one component alone (a shape met once; TBZ_DIRECT_ROWS rows at most) */
     int sharp_only;    /* 1: s = 1 at every vertex, the sharp net alone built (SFB__TBZ_BOTH_NETS: never) */
     int large;         /* components solved with each iteration's loops on the backend's threads (65536 unknowns
                           or more, 1024 with SFB__TBZ_PAR_SMALL) */
@@ -8209,10 +8210,16 @@ static int tbz_same_component(const sfb__tbz *T, const tbz_sys *S, const int *er
  * twice or more I and the Cholesky factor of A_I A_I^T are found once (a template), and each of
  * its components then costs two triangular solves with its residual (tbz_templates). tbz_walk
  * numbers a neighbourhood's points the same way wherever the shape is the same and hashes the
- * shape; every component a template solves is checked (its largest row residual left, as
- * CGLS's stopping rule), and one that fails is solved by CGLS instead. */
+ * shape; every component a template solves is checked (its largest row residual left:
+ * tbz_tpl_apply), and one that fails is solved by CGLS instead. */
 #define TBZ_WALK_FACES 256     /* the most triangles a walk covers (valence 12 with regular rings: 108) */
 #define TBZ_TPL_MAX_UNK 1024   /* larger components are left to CGLS */
+/* A component of a shape met once (or not around one extraordinary vertex) of at most this many
+ * rows is solved the same way, its template made for it alone: its factor (within the
+ * envelopes of tbz_tpl_make's ordering) costs less than CGLS's 70-600 iterations of ~100 nr
+ * multiply-adds each (teapot.obj's own net, whose components of 13 to 600 rows are each of its
+ * own shape: 0.46 G instructions by CGLS, 0.21 G so) */
+#define TBZ_DIRECT_ROWS 640
 typedef struct tbz_walk {
     int *fidx;  /* per face: its index in the walk, -1 (every entry -1 between walks) */
     int *plab;  /* per point: its label, -1 */
@@ -8317,118 +8324,196 @@ static int tbz_walk_comp(const sfb__tbz *T, const tbz_comps *C, int c, int v, tb
 typedef struct tbz_tpl {
     int nlab, nu, nrow, nrank; /* the shape's labels, unknowns, rows, independent rows */
     int *ulab;                  /* per unknown column: its label */
-    size_t *ro;                 /* the independent rows (nrank, in pivot order), entries over labels, fixed ones included */
+    size_t *ro;                 /* the kept (independent) rows, nrank of them in factor order, entries over labels, fixed ones included */
     int *rl, *ru;               /* per entry: its label, and its unknown column (-1: a fixed point) */
     double *rw;
-    double *lf;                 /* nrank x nrank: the Cholesky factor of those rows' A A^T (row a: its first a + 1) */
+    double *lf;                 /* the Cholesky factor of those rows' A A^T, row a's envelope (columns lfirst[a] .. a) at lo[a] */
+    int *lfirst;
+    size_t *lo;
 } tbz_tpl;
 static void tbz_tpl_free(sfb_context *ctx, tbz_tpl *P) {
     sfb__free(ctx, P->ulab); sfb__free(ctx, P->ro); sfb__free(ctx, P->rl); sfb__free(ctx, P->rw);
+    sfb__free(ctx, P->lfirst); sfb__free(ctx, P->lo);
     sfb__free(ctx, P->ru); sfb__free(ctx, P->lf);
     memset(P, 0, sizeof *P);
 }
 
-/* Builds template P from component i (walked: W's labels are its). 0: out of memory or a point
- * of its rows outside the walk (P left empty). */
-static int tbz_tpl_make(sfb__tbz *T, const tbz_sys *S, const tbz_comps *C, int i, const tbz_walk *W, tbz_tpl *P) {
+/* sum a[k] b[k], k < n, in four partial sums (a single one waits on each add in turn) */
+static double tbz_dot(const double *a, const double *b, int n) {
+    double s0 = 0.0, s1 = 0.0, s2 = 0.0, s3 = 0.0;
+    int k;
+    for (k = 0; k + 4 <= n; k += 4) {
+        s0 += a[k] * b[k]; s1 += a[k + 1] * b[k + 1]; s2 += a[k + 2] * b[k + 2]; s3 += a[k + 3] * b[k + 3];
+    }
+    for (; k < n; ++k) s0 += a[k] * b[k];
+    return (s0 + s1) + (s2 + s3);
+}
+
+/* The reverse Cuthill-McKee order of the graph of the symmetric nr x nr matrix B (i ~ j where
+ * B[i][j] != 0) into ord: breadth first from a node of least degree at the far end of the graph
+ * (one pass of George and Liu's search for a peripheral node), each node's new neighbours by
+ * rising degree, the whole reversed; each connected part in turn. deg: nr ints, mark: 2 nr. */
+static void tbz_rcm(const double *B, int nr, int *ord, int *deg, int *mark) {
+    int *lev = mark + nr, i, j, n = 0;
+    for (i = 0; i < nr; ++i) {
+        deg[i] = 0;
+        for (j = 0; j < nr; ++j) deg[i] += j != i && B[(size_t)i * nr + j] != 0.0;
+        mark[i] = 0;
+    }
+    while (n < nr) {
+        int start = -1, pass, head, n0 = n;
+        for (i = 0; i < nr; ++i)
+            if (!mark[i] && (start < 0 || deg[i] < deg[start])) start = i;
+        for (pass = 0; pass < 2; ++pass) {
+            /* breadth first from start, levels in lev; the first pass only finds the far end */
+            n = n0;
+            ord[n++] = start;
+            mark[start] = pass + 1;
+            lev[start] = 0;
+            for (head = n0; head < n; ++head) {
+                const int u = ord[head], from = n;
+                const double *Bu = B + (size_t)u * nr;
+                for (j = 0; j < nr; ++j)
+                    if (mark[j] != pass + 1 && Bu[j] != 0.0) {
+                        int q = n++;
+                        mark[j] = pass + 1;
+                        lev[j] = lev[u] + 1;
+                        while (q > from && deg[ord[q - 1]] > deg[j]) { ord[q] = ord[q - 1]; --q; }
+                        ord[q] = j;
+                    }
+            }
+            if (pass == 0) {
+                /* the last level's node of least degree */
+                start = ord[n - 1];
+                for (i = n - 1; i >= n0 && lev[ord[i]] == lev[ord[n - 1]]; --i)
+                    if (deg[ord[i]] < deg[start]) start = ord[i];
+            }
+        }
+    }
+    for (i = 0, j = nr - 1; i < j; ++i, --j) { const int t = ord[i]; ord[i] = ord[j]; ord[j] = t; }
+}
+
+/* Builds template P from component i, plab its points' labels (nlab of them: a walk's, or
+ * tbz_direct's). 0: out of memory or a point of its rows unlabelled (P left empty). */
+static int tbz_tpl_make(sfb__tbz *T, const tbz_sys *S, const tbz_comps *C, int i, const int *plab, int nlab, tbz_tpl *P) {
     const int nr = C->rstart[i + 1] - C->rstart[i], nu = C->ustart[i + 1] - C->ustart[i];
     const int *rows = C->rows + C->rstart[i], *unk = C->unk + C->ustart[i];
-    int *uidx = (int *)sfb__alloc(T->ctx, ((size_t)W->nlab + 1) * sizeof(int));
-    int *piv = (int *)sfb__alloc(T->ctx, ((size_t)nr + 1) * sizeof(int));
-    unsigned char *used = (unsigned char *)sfb__calloc(T->ctx, (size_t)nr + 1, 1);
-    double *A = (double *)sfb__calloc(T->ctx, (size_t)nr * nu + 1, sizeof(double));
-    double *B = (double *)sfb__alloc(T->ctx, ((size_t)nr * nr + 1) * sizeof(double));
-    double *L = (double *)sfb__calloc(T->ctx, (size_t)nr * nr + 1, sizeof(double));
-    double *d = (double *)sfb__alloc(T->ctx, ((size_t)nr + 1) * sizeof(double));
-    int ok = 0, r, s, a, b, u, k, rank = 0;
-    size_t e, n = 0;
+    const size_t ent = tbz_comp_entries(S, C, i);
+    int *uidx = (int *)sfb__alloc(T->ctx, ((size_t)nlab + 1) * sizeof(int));
+    int *piv = (int *)sfb__alloc(T->ctx, (3 * (size_t)nr + 1) * sizeof(int)), *kept = piv + nr, *first = kept + nr;
+    int *used = (int *)sfb__alloc(T->ctx, (2 * (size_t)nr + 1) * sizeof(int)); /* tbz_rcm's scratch */
+    size_t *cst = (size_t *)sfb__calloc(T->ctx, (size_t)nu + 2, sizeof(size_t));
+    int *crow = (int *)sfb__alloc(T->ctx, (ent + 1) * sizeof(int));
+    double *cw = (double *)sfb__alloc(T->ctx, (ent + 1) * sizeof(double));
+    double *B = (double *)sfb__calloc(T->ctx, (size_t)nr * nr + 1, sizeof(double));
+    double *L = (double *)sfb__alloc(T->ctx, ((size_t)nr * nr + 1) * sizeof(double)); /* entries read only once written */
+    int *d = (int *)sfb__alloc(T->ctx, ((size_t)nr + 1) * sizeof(int)); /* tbz_rcm's degrees */
+    int ok = 0, r, a, b, u, k, rank = 0;
+    size_t e, e2, n = 0;
     double dmax = 0.0;
     memset(P, 0, sizeof *P);
-    if (!uidx || !piv || !used || !A || !B || !L || !d) goto done;
-    for (k = 0; k < W->nlab; ++k) uidx[k] = -1;
-    P->nlab = W->nlab; P->nu = nu; P->nrow = nr;
+    if (!uidx || !piv || !used || !cst || !crow || !cw || !B || !L || !d) goto done;
+    for (k = 0; k < nlab; ++k) uidx[k] = -1;
+    P->nlab = nlab; P->nu = nu; P->nrow = nr;
     P->ulab = (int *)sfb__alloc(T->ctx, ((size_t)nu + 1) * sizeof(int));
     if (!P->ulab) goto done;
     for (u = 0; u < nu; ++u) {
-        const int lb = W->plab[unk[u]];
+        const int lb = plab[unk[u]];
         if (lb < 0) goto done;
         P->ulab[u] = lb; uidx[lb] = u;
     }
-    /* the dense A over the unknowns; every point its rows read labelled */
+    /* A by columns: per unknown its row entries (a row's entries on one point are summed by
+     * the products below, A A^T being bilinear); every point its rows read labelled */
     for (r = 0; r < nr; ++r)
         for (e = S->off[rows[r]]; e < S->off[rows[r] + 1]; ++e) {
-            const int lb = W->plab[S->col[e]];
+            const int lb = plab[S->col[e]];
             if (lb < 0) goto done;
-            if (uidx[lb] >= 0) A[(size_t)r * nu + uidx[lb]] += S->w[e];
+            if (uidx[lb] >= 0) ++cst[uidx[lb] + 2];
             ++n;
         }
-    /* B = A A^T, each entry from row r's entries (sparse) and row s (dense) */
+    for (u = 0; u < nu; ++u) cst[u + 2] += cst[u + 1];
     for (r = 0; r < nr; ++r)
-        for (s = 0; s < nr; ++s) {
-            double v = 0.0;
-            for (e = S->off[rows[r]]; e < S->off[rows[r] + 1]; ++e) {
-                const int ui = uidx[W->plab[S->col[e]]];
-                if (ui >= 0) v += S->w[e] * A[(size_t)s * nu + ui];
-            }
-            B[(size_t)r * nr + s] = v;
+        for (e = S->off[rows[r]]; e < S->off[rows[r] + 1]; ++e) {
+            const int ui = uidx[plab[S->col[e]]];
+            if (ui >= 0) { crow[cst[ui + 1]] = r; cw[cst[ui + 1]++] = S->w[e]; }
         }
-    /* Cholesky with diagonal pivoting (B is semidefinite: dependent rows end it; their b follows
-     * from the others' when the system is consistent, which the check after each use confirms) */
-    for (r = 0; r < nr; ++r) { d[r] = B[(size_t)r * nr + r]; dmax = TBZ_MAX(dmax, d[r]); }
-    for (k = 0; k < nr; ++k) {
-        int j = -1;
-        double lkk;
-        for (r = 0; r < nr; ++r)
-            if (!used[r] && (j < 0 || d[r] > d[j])) j = r;
-        if (j < 0 || !(d[j] > 1e-11 * dmax)) break;
-        used[j] = 1; piv[k] = j; rank = k + 1;
-        lkk = sqrt(d[j]);
-        L[(size_t)j * nr + k] = lkk;
-        for (r = 0; r < nr; ++r)
-            if (!used[r]) {
-                double v = B[(size_t)r * nr + j];
-                for (a = 0; a < k; ++a) v -= L[(size_t)r * nr + a] * L[(size_t)j * nr + a];
-                v /= lkk;
-                L[(size_t)r * nr + k] = v;
-                d[r] -= v * v;
-            }
+    /* B = A A^T, from each column's pairs of entries (a column has a handful: a few thousand
+     * products where the dense product took nr^2 x 16) */
+    for (u = 0; u < nu; ++u)
+        for (e = cst[u]; e < cst[u + 1]; ++e)
+            for (e2 = cst[u]; e2 < cst[u + 1]; ++e2) B[(size_t)crow[e] * nr + crow[e2]] += cw[e] * cw[e2];
+    /* the rows in reverse Cuthill-McKee order of B's graph (rows sharing an unknown), which
+     * keeps each row of the factor within a narrow envelope: its first nonzero is that of B's
+     * row, and the products below run over the envelopes alone (a 300-row component: about a
+     * tenth of the dense factor's multiply-adds, and the same for the solves of each use) */
+    tbz_rcm(B, nr, piv, d, used);
+    for (r = 0; r < nr; ++r) dmax = TBZ_MAX(dmax, B[(size_t)r * nr + r]);
+    /* Cholesky, row by row in that order (up-looking), a row that depends on those before it
+     * (what is left of its diagonal at most 1e-11 of B's largest: some rows' weights on the
+     * unknowns are rounding residue, of norm 1e-16, and must go too) dropped: B is semidefinite
+     * and a quarter of its rows are dependent; their b follows from the others' when the system
+     * is consistent, which the check after each use confirms. L's row k (the k-th kept row, of
+     * row kept[k]) holds columns first[k] .. k. */
+    for (k = 0, a = 0; a < nr; ++a) {
+        const int p = piv[a];
+        const double *Bp = B + (size_t)p * nr;
+        double *Lk = L + (size_t)k * nr, dd;
+        int f = k;
+        for (b = 0; b < k; ++b)
+            if (Bp[kept[b]] != 0.0) { f = b; break; }
+        for (b = f; b < k; ++b) {
+            const int lo2 = first[b] > f ? first[b] : f;
+            Lk[b] = (Bp[kept[b]] - tbz_dot(Lk + lo2, L + (size_t)b * nr + lo2, b - lo2)) / L[(size_t)b * nr + b];
+        }
+        dd = Bp[p] - tbz_dot(Lk + f, Lk + f, k - f);
+        if (!(dd > 1e-11 * dmax)) continue;
+        Lk[k] = sqrt(dd);
+        first[k] = f;
+        kept[k++] = p;
     }
+    rank = k;
     P->nrank = rank;
-    P->lf = (double *)sfb__alloc(T->ctx, ((size_t)rank * rank + 1) * sizeof(double));
+    P->lfirst = (int *)sfb__alloc(T->ctx, ((size_t)rank + 1) * sizeof(int));
+    P->lo = (size_t *)sfb__alloc(T->ctx, ((size_t)rank + 1) * sizeof(size_t));
+    for (a = 0, e = 0; a < rank; ++a) e += (size_t)(a - first[a] + 1);
+    P->lf = (double *)sfb__alloc(T->ctx, (e + 1) * sizeof(double));
     P->ro = (size_t *)sfb__alloc(T->ctx, ((size_t)rank + 1) * sizeof(size_t));
     P->rl = (int *)sfb__alloc(T->ctx, (n + 1) * sizeof(int));
     P->ru = (int *)sfb__alloc(T->ctx, (n + 1) * sizeof(int));
     P->rw = (double *)sfb__alloc(T->ctx, (n + 1) * sizeof(double));
-    if (!P->lf || !P->ro || !P->rl || !P->ru || !P->rw) goto done;
-    /* the factor in pivot order, and the independent rows over labels */
+    if (!P->lfirst || !P->lo || !P->lf || !P->ro || !P->rl || !P->ru || !P->rw) goto done;
+    /* the factor's envelopes, and the kept rows over labels */
     n = 0;
-    for (a = 0; a < rank; ++a) {
-        const int g = rows[piv[a]];
-        for (b = 0; b <= a; ++b) P->lf[(size_t)a * rank + b] = L[(size_t)piv[a] * nr + b];
+    for (a = 0, e = 0; a < rank; ++a) {
+        const int g = rows[kept[a]];
+        P->lfirst[a] = first[a];
+        P->lo[a] = e;
+        for (b = first[a]; b <= a; ++b) P->lf[e++] = L[(size_t)a * nr + b];
         P->ro[a] = n;
-        for (e = S->off[g]; e < S->off[g + 1]; ++e) {
-            P->rl[n] = W->plab[S->col[e]];
+        for (e2 = S->off[g]; e2 < S->off[g + 1]; ++e2) {
+            P->rl[n] = plab[S->col[e2]];
             P->ru[n] = uidx[P->rl[n]];
-            P->rw[n++] = S->w[e];
+            P->rw[n++] = S->w[e2];
         }
     }
     P->ro[rank] = n;
     ok = 1;
 done:
     if (!ok) tbz_tpl_free(T->ctx, P);
-    sfb__free(T->ctx, uidx); sfb__free(T->ctx, piv); sfb__free(T->ctx, used); sfb__free(T->ctx, A); sfb__free(T->ctx, B);
-    sfb__free(T->ctx, L); sfb__free(T->ctx, d);
+    sfb__free(T->ctx, uidx); sfb__free(T->ctx, piv); sfb__free(T->ctx, used); sfb__free(T->ctx, cst); sfb__free(T->ctx, crow);
+    sfb__free(T->ctx, cw); sfb__free(T->ctx, B); sfb__free(T->ctx, L); sfb__free(T->ctx, d);
     return ok;
 }
 
 /* Solves component i with template P, lab[0 .. nlab) the points of its walk's labels: 1 when its
- * rows are then met (largest row residual at most 1e-15 of the scale, CGLS's rule), else 0 with
- * the net as it was. dx: 3 nu doubles, y: 3 P->nrank; mine: per point 0, and 0 again after. */
+ * rows are then met (the rule below), else 0 with
+ * the net as it was. dx: 6 nu doubles, y: 3 P->nrank; mine: per point 0, and 0 again after. */
 static int tbz_tpl_apply(sfb__tbz *T, const tbz_sys *S, const tbz_comps *C, int i, const int *lab, int nlab, const tbz_tpl *P, double *dx,
                          double *y, unsigned char *mine) {
     const int nr = C->rstart[i + 1] - C->rstart[i], nu = C->ustart[i + 1] - C->ustart[i];
     const int *rows = C->rows + C->rstart[i], *unk = C->unk + C->ustart[i];
-    int a, u, c, r, same = 1;
+    double *step = dx + 3 * (size_t)nu;
+    int a, u, c, r, same = 1, pass, ok;
     size_t e;
     if (nlab != P->nlab || nu != P->nu || nr != P->nrow) return 0;
     /* the template's unknowns are the component's (as many, and each one of them) */
@@ -8436,37 +8521,52 @@ static int tbz_tpl_apply(sfb__tbz *T, const tbz_sys *S, const tbz_comps *C, int 
     for (u = 0; u < nu; ++u) same &= mine[lab[P->ulab[u]]];
     for (u = 0; u < nu; ++u) mine[unk[u]] = 0;
     if (!same) return 0;
-    /* y = the independent rows' residual b; L L^T y' = y (forward, then backward with L's
-     * rows); dx = A^T y' over the unknown entries */
-    for (a = 0; a < P->nrank; ++a) {
-        double bv[3] = {0.0, 0.0, 0.0};
-        const double *lr = P->lf + (size_t)a * P->nrank;
-        int b;
-        for (e = P->ro[a]; e < P->ro[a + 1]; ++e) tbz_axpy(bv, -P->rw[e], T->x + 3 * (size_t)lab[P->rl[e]]);
-        for (b = 0; b < a; ++b) tbz_axpy(bv, -lr[b], y + 3 * b);
-        for (c = 0; c < 3; ++c) y[3 * a + c] = bv[c] / lr[a];
-    }
-    for (a = P->nrank - 1; a >= 0; --a) {
-        const double *lr = P->lf + (size_t)a * P->nrank;
-        int b;
-        for (c = 0; c < 3; ++c) y[3 * a + c] /= lr[a];
-        for (b = 0; b < a; ++b) tbz_axpy(y + 3 * b, -lr[b], y + 3 * a);
-    }
+    /* y = the kept rows' residual b; L L^T y' = y (forward, then backward with L's rows);
+     * dx = A^T y' over the unknown entries. Where a row is left above the rule a second pass
+     * solves for what the first left (one step of iterative refinement: 3 of cow.obj's 1,444
+     * components pass after it). The rule: each row's residual at most 1e-15 of the scale times
+     * the sum of its weights' magnitudes (at least 1), which is about the rounding of evaluating
+     * the row at all: with 1e-15 of the scale alone (CGLS's stopping rule, which iterates until
+     * rounding happens to fall under it) half of spot.obj's components failed, by 1-2e-15 */
     for (u = 0; u < 3 * nu; ++u) dx[u] = 0.0;
-    for (a = 0; a < P->nrank; ++a)
-        for (e = P->ro[a]; e < P->ro[a + 1]; ++e)
-            if (P->ru[e] >= 0) tbz_axpy(dx + 3 * P->ru[e], P->rw[e], y + 3 * a);
-    for (u = 0; u < nu; ++u) tbz_axpy(T->x + 3 * (size_t)lab[P->ulab[u]], 1.0, dx + 3 * u);
-    for (r = 0; r < nr; ++r) {
-        double v[3];
-        tbz_dot3(S->col, S->w, S->off[rows[r]], S->off[rows[r] + 1], T->x, v);
-        for (c = 0; c < 3; ++c)
-            if (!(fabs(v[c]) <= 1e-15 * T->scale)) {
-                for (u = 0; u < nu; ++u) tbz_axpy(T->x + 3 * (size_t)lab[P->ulab[u]], -1.0, dx + 3 * u);
-                return 0;
+    for (pass = 0; pass < 2; ++pass) {
+        for (a = 0; a < P->nrank; ++a) {
+            double bv[3] = {0.0, 0.0, 0.0};
+            const double *lr = P->lf + P->lo[a] - P->lfirst[a]; /* lr[b]: column b, lfirst[a] <= b <= a */
+            double b2[3] = {0.0, 0.0, 0.0}; /* two partial sums (one waits on each add in turn) */
+            int b;
+            for (e = P->ro[a]; e < P->ro[a + 1]; ++e) tbz_axpy(bv, -P->rw[e], T->x + 3 * (size_t)lab[P->rl[e]]);
+            for (b = P->lfirst[a]; b + 2 <= a; b += 2) {
+                tbz_axpy(bv, -lr[b], y + 3 * b);
+                tbz_axpy(b2, -lr[b + 1], y + 3 * b + 3);
             }
+            if (b < a) tbz_axpy(bv, -lr[b], y + 3 * b);
+            for (c = 0; c < 3; ++c) y[3 * a + c] = (bv[c] + b2[c]) / lr[a];
+        }
+        for (a = P->nrank - 1; a >= 0; --a) {
+            const double *lr = P->lf + P->lo[a] - P->lfirst[a];
+            int b;
+            for (c = 0; c < 3; ++c) y[3 * a + c] /= lr[a];
+            for (b = P->lfirst[a]; b < a; ++b) tbz_axpy(y + 3 * b, -lr[b], y + 3 * a);
+        }
+        for (u = 0; u < 3 * nu; ++u) step[u] = 0.0;
+        for (a = 0; a < P->nrank; ++a)
+            for (e = P->ro[a]; e < P->ro[a + 1]; ++e)
+                if (P->ru[e] >= 0) tbz_axpy(step + 3 * P->ru[e], P->rw[e], y + 3 * a);
+        for (u = 0; u < nu; ++u) {
+            tbz_axpy(T->x + 3 * (size_t)lab[P->ulab[u]], 1.0, step + 3 * u);
+            tbz_axpy(dx + 3 * u, 1.0, step + 3 * u);
+        }
+        for (r = 0, ok = 1; r < nr && ok; ++r) {
+            double v[3], wsum = 0.0;
+            tbz_dot3(S->col, S->w, S->off[rows[r]], S->off[rows[r] + 1], T->x, v);
+            for (e = S->off[rows[r]]; e < S->off[rows[r] + 1]; ++e) wsum += fabs(S->w[e]);
+            for (c = 0; c < 3; ++c) ok &= fabs(v[c]) <= 1e-15 * T->scale * TBZ_MAX(1.0, wsum);
+        }
+        if (ok) return 1;
     }
-    return 1;
+    for (u = 0; u < nu; ++u) tbz_axpy(T->x + 3 * (size_t)lab[P->ulab[u]], -1.0, dx + 3 * u);
+    return 0;
 }
 
 typedef struct tbz_key { unsigned long long hash; int t; size_t lab; int nlab; } tbz_key; /* lab: its walk's labels in labs */
@@ -8477,9 +8577,10 @@ static int tbz_key_cmp(const void *pa, const void *pb) {
 }
 
 /* Solves the components todo[0 .. *nt) that a template can (see above) and leaves the others
- * in todo, in order. A component qualifies when its rows' edges have exactly one irregular
- * end among them (the centre of its walk) and it has at most TBZ_TPL_MAX_UNK unknowns; a
- * shape met once is left to CGLS (a template costs about three CGLS solves of its component). */
+ * in todo, in order. A component shares a template when its rows' edges have exactly one
+ * irregular end among them (the centre of its walk), it has at most TBZ_TPL_MAX_UNK unknowns
+ * and its shape is met twice or more; the others of at most TBZ_DIRECT_ROWS rows get one of
+ * their own; what fails its check is left to CGLS. */
 static sfb_result tbz_templates(sfb__tbz *T, const tbz_sys *S, const tbz_comps *C, int *todo, int *nt) {
     const sfb__level *l = T->l;
     tbz_walk *W = (tbz_walk *)sfb__alloc(T->ctx, sizeof(tbz_walk));
@@ -8488,10 +8589,11 @@ static sfb_result tbz_templates(sfb__tbz *T, const tbz_sys *S, const tbz_comps *
     unsigned char *done = (unsigned char *)sfb__calloc(T->ctx, (size_t)*nt + 1, 1);
     double *dx = NULL;
     int *labs = NULL; /* every walk's label -> point map, one after the other */
-    size_t nlabs = 0, caplabs = 0;
+    int *dl = NULL;   /* a directly solved component's label -> point map */
+    size_t nlabs = 0, caplabs = 0, capdl = 0, capdx = 0;
     int t, nk = 0, g, i, m = 0, maxu = 0, maxr = 0, tried = 0;
     sfb_result res = SFB_SUCCESS;
-    if (*nt < 2) { /* no shape can be met twice: nothing to allocate */
+    if (*nt == 0 || (*nt == 1 && C->rstart[todo[0] + 1] - C->rstart[todo[0]] > TBZ_DIRECT_ROWS)) { /* nothing to do here: nothing to allocate */
         sfb__free(T->ctx, W); sfb__free(T->ctx, key); sfb__free(T->ctx, centre); sfb__free(T->ctx, done);
         return SFB_SUCCESS;
     }
@@ -8536,7 +8638,8 @@ static sfb_result tbz_templates(sfb__tbz *T, const tbz_sys *S, const tbz_comps *
         tbz_walk_reset(W);
     }
     qsort(key, (size_t)nk, sizeof *key, tbz_key_cmp);
-    dx = (double *)sfb__alloc(T->ctx, (3 * (size_t)maxu + 3 * (size_t)maxr + 1) * sizeof(double)); /* and y (rank <= rows) */
+    capdx = 6 * (size_t)maxu + 3 * (size_t)maxr; /* and y (rank <= rows) */
+    dx = (double *)sfb__alloc(T->ctx, (capdx + 1) * sizeof(double));
     if (!dx) { res = sfb__oom(T->ctx, "tribezier templates"); goto out; }
     /* per shape met twice or more: its template, from its first component, used on every one */
     for (g = 0; g < nk && res == SFB_SUCCESS; g = m) {
@@ -8545,17 +8648,50 @@ static sfb_result tbz_templates(sfb__tbz *T, const tbz_sys *S, const tbz_comps *
         for (m = g + 1; m < nk && key[m].hash == key[g].hash; ++m) {}
         if (m - g < 2) continue;
         tbz_walk_comp(T, C, todo[key[g].t], centre[key[g].t], W);
-        made = tbz_tpl_make(T, S, C, todo[key[g].t], W, &P);
+        made = tbz_tpl_make(T, S, C, todo[key[g].t], W->plab, W->nlab, &P);
         tbz_walk_reset(W);
         if (!made) continue;
         T->st.templates++;
         for (i = g; i < m && res == SFB_SUCCESS; ++i) {
             const int ti = key[i].t;
-            if (tbz_tpl_apply(T, S, C, todo[ti], labs + key[i].lab, key[i].nlab, &P, dx, dx + 3 * (size_t)maxu, W->mine)) { done[ti] = 1; T->st.templated++; }
+            if (tbz_tpl_apply(T, S, C, todo[ti], labs + key[i].lab, key[i].nlab, &P, dx, dx + 6 * (size_t)maxu, W->mine)) { done[ti] = 1; T->st.templated++; }
             /* progress (and a cancel) every 64 components, over the share of the components */
             if ((++tried & 63) == 0) res = tbz_progress(T, (double)tried / *nt);
         }
         tbz_tpl_free(T->ctx, &P);
+    }
+    /* the components left (a shape met once, or not around one extraordinary vertex) of up to
+     * TBZ_DIRECT_ROWS rows: the same solve with a template made for each alone, its points
+     * labelled in the order its rows read them */
+    for (t = 0; t < *nt && res == SFB_SUCCESS; ++t) {
+        const int c = todo[t], nr = C->rstart[c + 1] - C->rstart[c], nu = C->ustart[c + 1] - C->ustart[c];
+        const size_t need = tbz_comp_entries(S, C, c), nd = 6 * (size_t)nu + 3 * (size_t)nr;
+        tbz_tpl P;
+        int nl = 0, r, made;
+        size_t e;
+        if (done[t] || nr == 0 || nr > TBZ_DIRECT_ROWS) continue;
+        if (need > capdl) {
+            int *l2 = (int *)sfb__realloc(T->ctx, dl, (need + 1) * sizeof(int));
+            if (!l2) { res = sfb__oom(T->ctx, "tribezier templates"); break; }
+            dl = l2;
+            capdl = need;
+        }
+        if (nd > capdx) {
+            double *d2 = (double *)sfb__realloc(T->ctx, dx, (nd + 1) * sizeof(double));
+            if (!d2) { res = sfb__oom(T->ctx, "tribezier templates"); break; }
+            dx = d2;
+            capdx = nd;
+        }
+        for (r = C->rstart[c]; r < C->rstart[c + 1]; ++r)
+            for (e = S->off[C->rows[r]]; e < S->off[C->rows[r] + 1]; ++e)
+                if (W->plab[S->col[e]] < 0) { W->plab[S->col[e]] = nl; dl[nl++] = S->col[e]; }
+        made = tbz_tpl_make(T, S, C, c, W->plab, nl, &P);
+        for (i = 0; i < nl; ++i) W->plab[dl[i]] = -1;
+        if (!made) continue;
+        T->st.direct++;
+        if (tbz_tpl_apply(T, S, C, c, dl, nl, &P, dx, dx + 6 * (size_t)nu, W->mine)) { done[t] = 1; T->st.templated++; }
+        tbz_tpl_free(T->ctx, &P);
+        if ((++tried & 63) == 0) res = tbz_progress(T, (double)tried / *nt);
     }
     if (res != SFB_SUCCESS) goto out;
     for (t = 0, i = 0; t < *nt; ++t)
@@ -8565,7 +8701,7 @@ static sfb_result tbz_templates(sfb__tbz *T, const tbz_sys *S, const tbz_comps *
 out:
     if (W) { sfb__free(T->ctx, W->fidx); sfb__free(T->ctx, W->plab); sfb__free(T->ctx, W->vdist); sfb__free(T->ctx, W->mine); }
     sfb__free(T->ctx, W); sfb__free(T->ctx, key); sfb__free(T->ctx, centre); sfb__free(T->ctx, done); sfb__free(T->ctx, dx);
-    sfb__free(T->ctx, labs);
+    sfb__free(T->ctx, labs); sfb__free(T->ctx, dl);
     return res;
 }
 

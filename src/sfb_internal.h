@@ -718,6 +718,7 @@ typedef struct sfb__tbz_stats {
                           solution (SFB__TBZ_NO_REUSE: none) */
     int templates;     /* templates made (tbz_templates: one dense solve per shape of neighbourhood met twice or more) */
     int templated;     /* components solved with a template (SFB__TBZ_NO_TEMPLATES: none, every one by CGLS) */
+    int direct;        /* templates made for one component alone (a shape met once; TBZ_DIRECT_ROWS rows at most) */
     int sharp_only;    /* 1: s = 1 at every vertex, the sharp net alone built (SFB__TBZ_BOTH_NETS: never) */
     int large;         /* components solved with each iteration's loops on the backend's threads (65536 unknowns
                           or more, 1024 with SFB__TBZ_PAR_SMALL) */
