@@ -670,6 +670,9 @@ SFB__IF sfb_result sfb__patch_table_beztri_own(sfb_context *ctx, const sfb__leve
  * after one or two Loop steps). */
 SFB__IF sfb_result sfb__patch_table_beztri_children(sfb_context *ctx, const sfb__level *l, const double *net, int depth,
                                                     sfb__patch_table *pt);
+/* The same with net NULL: pt's point_data left for the caller to write, 45 floats per patch,
+ * the patches of the triangles that are not holes in their order, each triangle's children in
+ * net's order (sfb__tribezier_build writes them there directly). */
 /* The families present in a table, as bits 1 << SFB__FAMILY_*. */
 static inline unsigned sfb__patch_families(const sfb__patch_table *pt) {
     unsigned m = 0;

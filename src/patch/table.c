@@ -139,7 +139,8 @@ sfb_result sfb__patch_table_beztri_children(sfb_context *ctx, const sfb__level *
             /* child i (depth 1), or grandchild i & 3 of child i >> 2 (depth 2); quadrant x + 2y
              * per level, the first level in the high bit (sfb__pb_insert's encoding) */
             const int c0 = depth == 2 ? i >> 2 : i, c1 = i & 3;
-            for (k = 0; k < 45; ++k) pt->point_data[45 * (size_t)p + k] = (float)net[45 * ((size_t)per * f + (size_t)i) + k];
+            if (net)
+                for (k = 0; k < 45; ++k) pt->point_data[45 * (size_t)p + k] = (float)net[45 * ((size_t)per * f + (size_t)i) + k];
             pt->ptype[p] = SFB__PATCH_BEZTRI;
             pt->pfirst[p] = 15 * p;
             pt->pparam[p] = depth == 2 ? SFB__PARAM(2, (c0 & 1) << 1 | (c1 & 1), (c0 >> 1) << 1 | (c1 >> 1), 0) : SFB__PARAM(1, i & 1, i >> 1, 0);

@@ -1932,8 +1932,11 @@ static sfb_result tbz_vertex_s(sfb__tbz *T, double *vs) {
     return SFB_SUCCESS;
 }
 
+/* fout: NULL, the net into *out (45 doubles per triangle); else the net into fout, 45 floats
+ * per triangle that is not a hole, in order (sfb__patch_table_beztri_children's point data),
+ * and *out left NULL (the doubles, a net as large again, never made) */
 static sfb_result tbz_points(sfb_context *ctx, const sfb__level *l, const float *positions, const float *sharp_positions,
-                             const sfb_tribezier_options *opt, unsigned flags, double **out, sfb__tbz_stats *stats) {
+                             const sfb_tribezier_options *opt, unsigned flags, double **out, float *fout, sfb__tbz_stats *stats) {
     sfb__tbz T;
     tbz_prev prev;
     double *x0 = NULL, *vs = NULL, *res = NULL;
@@ -1971,8 +1974,8 @@ static sfb_result tbz_points(sfb_context *ctx, const sfb__level *l, const float 
     T.grid = (int *)sfb__alloc(ctx, 15 * (size_t)T.nf * sizeof(int) + 1);
     T.tag_s = (float *)sfb__calloc(ctx, (size_t)T.ne + 1, sizeof(float));
     T.corner_s = (float *)sfb__calloc(ctx, (size_t)T.nv + 1, sizeof(float));
-    res = (double *)sfb__alloc(ctx, 45 * (size_t)T.nf * sizeof(double) + 1);
-    if (!T.efeat || !T.vtype || !T.virr || !T.phi || !T.x || !T.fixed || !T.dist || !T.grid || !T.tag_s || !T.corner_s || !res) {
+    if (!fout) res = (double *)sfb__alloc(ctx, 45 * (size_t)T.nf * sizeof(double) + 1);
+    if (!T.efeat || !T.vtype || !T.virr || !T.phi || !T.x || !T.fixed || !T.dist || !T.grid || !T.tag_s || !T.corner_s || (!fout && !res)) {
         r = sfb__oom(ctx, "tribezier");
         goto done;
     }
@@ -2060,24 +2063,28 @@ static sfb_result tbz_points(sfb_context *ctx, const sfb__level *l, const float 
         if (r != SFB_SUCCESS) goto done;
     }
 blend:
-    for (f = 0; f < T.nf; ++f) {
+    for (f = 0, k = 0; f < T.nf; ++f) {
         const int *fv = l->fv + l->fv_off[f];
         const int *g = T.grid + 15 * (size_t)f;
-        int i, j, q = 0;
+        int i, j, q = 0, kk;
+        float *fo = fout ? fout + 45 * (size_t)k : NULL;
+        if (fout && l->fhole[f]) continue;
+        k += fout != NULL;
         for (j = 0; j <= 4; ++j)
             for (i = 0; i + j <= 4; ++i, ++q) {
                 double s = 0.0, wsum = 0.0;
                 if (any_tag) {
                     /* the point's home vertices: weights > 0 */
                     const int w[3] = {4 - i - j, i, j};
-                    for (k = 0; k < 3; ++k)
-                        if (w[k] > 0 && (w[0] == 4 || w[1] == 4 || w[2] == 4 ? w[k] == 4 : 1)) { s += vs[fv[k]]; wsum += 1.0; }
+                    for (kk = 0; kk < 3; ++kk)
+                        if (w[kk] > 0 && (w[0] == 4 || w[1] == 4 || w[2] == 4 ? w[kk] == 4 : 1)) { s += vs[fv[kk]]; wsum += 1.0; }
                     s = wsum > 0.0 ? s / wsum : 0.0;
                     if (s < 1e-20) s = 0.0;
                 }
                 for (c = 0; c < 3; ++c) {
-                    const double sh = T.x[3 * (size_t)g[q] + c];
-                    res[45 * (size_t)f + 3 * q + c] = any_tag ? (1.0 - s) * x0[3 * (size_t)g[q] + c] + s * sh : sh;
+                    const double sh = T.x[3 * (size_t)g[q] + c], b = any_tag ? (1.0 - s) * x0[3 * (size_t)g[q] + c] + s * sh : sh;
+                    if (fo) fo[3 * q + c] = (float)b;
+                    else res[45 * (size_t)f + 3 * q + c] = b;
                 }
             }
     }
@@ -2208,8 +2215,8 @@ sfb_result sfb__tribezier_points(sfb_context *ctx, const sfb__level *l, const fl
     r = tbz_check(ctx, l, positions, opt);
     if (r == SFB_SUCCESS) r = tbz_split(ctx, l, positions, &split, &sl, &spos);
     if (r != SFB_SUCCESS) return r;
-    if (!split) return tbz_points(ctx, l, positions, positions, opt, flags, out, stats);
-    r = tbz_points(ctx, &sl, spos, spos, opt, flags, out, stats);
+    if (!split) return tbz_points(ctx, l, positions, positions, opt, flags, out, NULL, stats);
+    r = tbz_points(ctx, &sl, spos, spos, opt, flags, out, NULL, stats);
     sfb__level_free(ctx, &sl);
     sfb__free(ctx, spos);
     return r;
@@ -2225,31 +2232,82 @@ sfb_result sfb__tribezier_points(sfb_context *ctx, const sfb__level *l, const fl
 static sfb_result tbz_refine(sfb_context *ctx, const sfb__level *b, const float *psm, const float *psh, sfb__level *rl, float **ps,
                              float **pp) {
     const int nv = b->nv, nf = b->nf, ne = b->ne, nv2 = nv + ne;
-    int *sizes = (int *)sfb__alloc(ctx, (size_t)4 * nf * sizeof(int) + 1);
-    int *fv = (int *)sfb__alloc(ctx, (size_t)12 * nf * sizeof(int) + 1);
     int f, e, v, k, c, net;
-    sfb_result r;
+    sfb_result r = SFB_SUCCESS;
     memset(rl, 0, sizeof *rl);
     *ps = (float *)sfb__alloc(ctx, (size_t)3 * nv2 * sizeof(float) + 1);
     *pp = (float *)sfb__alloc(ctx, (size_t)3 * nv2 * sizeof(float) + 1);
-    if (!sizes || !fv || !*ps || !*pp) { r = sfb__oom(ctx, "tribezier refinement"); goto done; }
+    if ((size_t)4 * nf * 3 > SFB_MAX_ELEMENTS || (size_t)2 * ne + 3 * (size_t)nf > SFB_MAX_ELEMENTS) {
+        r = sfb__error(ctx, SFB_LIMIT_EXCEEDED, SFB_ELEMENT_NONE, -1, "tribezier: the mesh after a Loop step would have %zu face-vertices, over the limit of %d",
+                       (size_t)12 * nf, SFB_MAX_ELEMENTS);
+        goto done;
+    }
+    /* the child topology written directly (as refine.c's Loop step does; sfb__level_from_faces
+     * would find the edges again by hashing): the half of parent edge e at its end ev[2e + h]
+     * is child edge 2e + h, the inner edges of triangle f are 2 ne + 3 f + (0: E20-E01 at V0,
+     * 1: E01-E12 at V1, 2: E12-E20 at V2) */
+    rl->nv = nv2; rl->nf = 4 * nf; rl->ne = 2 * ne + 3 * nf; rl->nfv = 12 * nf;
+    rl->fv_off = (int *)sfb__alloc(ctx, ((size_t)rl->nf + 1) * sizeof(int));
+    rl->fv = (int *)sfb__alloc(ctx, ((size_t)rl->nfv + 1) * sizeof(int));
+    rl->fe = (int *)sfb__alloc(ctx, ((size_t)rl->nfv + 1) * sizeof(int));
+    rl->ev = (int *)sfb__alloc(ctx, (2 * (size_t)rl->ne + 1) * sizeof(int));
+    rl->es = (float *)sfb__alloc(ctx, ((size_t)rl->ne + 1) * sizeof(float));
+    rl->vs = (float *)sfb__alloc(ctx, ((size_t)nv2 + 1) * sizeof(float));
+    rl->fhole = (unsigned char *)sfb__alloc(ctx, (size_t)rl->nf + 1);
+    if (!*ps || !*pp || !rl->fv_off || !rl->fv || !rl->fe || !rl->ev || !rl->es || !rl->vs || !rl->fhole) {
+        r = sfb__oom(ctx, "tribezier refinement");
+        goto done;
+    }
+    for (e = 0; e < ne; ++e) {
+        rl->ev[4 * e] = b->ev[2 * e]; rl->ev[4 * e + 1] = nv + e;
+        rl->ev[4 * e + 2] = nv + e; rl->ev[4 * e + 3] = b->ev[2 * e + 1];
+        rl->es[2 * e] = rl->es[2 * e + 1] = b->es[e]; /* child edges keep their parent edge's tag */
+    }
     for (f = 0; f < nf; ++f) {
         const int *V = b->fv + b->fv_off[f], *E = b->fe + b->fv_off[f]; /* E[k]: edge V[k] -> V[k+1] */
+        const int ie = 2 * ne + 3 * f;
+        /* hv(k, j): the half of edge E[k] at V[j] */
+#define TBZ_HALF(k, j) (2 * E[k] + (b->ev[2 * E[k]] == V[j] ? 0 : 1))
         const int ch[4][3] = {{V[0], nv + E[0], nv + E[2]}, {nv + E[0], V[1], nv + E[1]}, {nv + E[2], nv + E[1], V[2]},
                               {nv + E[1], nv + E[2], nv + E[0]}};
+        const int ce[4][3] = {{TBZ_HALF(0, 0), ie, TBZ_HALF(2, 0)}, {TBZ_HALF(0, 1), TBZ_HALF(1, 1), ie + 1},
+                              {ie + 2, TBZ_HALF(1, 2), TBZ_HALF(2, 2)}, {ie + 2, ie, ie + 1}};
+#undef TBZ_HALF
         for (k = 0; k < 4; ++k) {
-            sizes[4 * f + k] = 3;
-            for (c = 0; c < 3; ++c) fv[12 * f + 3 * k + c] = ch[k][c];
+            rl->fv_off[4 * f + k] = 12 * f + 3 * k;
+            rl->fhole[4 * f + k] = b->fhole[f];
+            for (c = 0; c < 3; ++c) {
+                rl->fv[12 * f + 3 * k + c] = ch[k][c];
+                rl->fe[12 * f + 3 * k + c] = ce[k][c];
+            }
         }
+        rl->ev[2 * ie] = nv + E[2]; rl->ev[2 * ie + 1] = nv + E[0];
+        rl->ev[2 * ie + 2] = nv + E[0]; rl->ev[2 * ie + 3] = nv + E[1];
+        rl->ev[2 * ie + 4] = nv + E[1]; rl->ev[2 * ie + 5] = nv + E[2];
+        rl->es[ie] = rl->es[ie + 1] = rl->es[ie + 2] = 0.0f;
     }
-    r = sfb__level_from_faces(ctx, nv2, 4 * nf, sizes, fv, NULL, SFB_ELEMENT_VERTEX, rl);
-    if (r != SFB_SUCCESS) goto done;
-    for (e = 0; e < rl->ne; ++e) {
-        const int a = rl->ev[2 * e], d = rl->ev[2 * e + 1], old = a < nv ? a : d, mid = a < nv ? d : a;
-        rl->es[e] = (old < nv && mid >= nv) ? b->es[mid - nv] : 0.0f;
-    }
+    rl->fv_off[rl->nf] = rl->nfv;
     for (v = 0; v < nv2; ++v) rl->vs[v] = v < nv ? b->vs[v] : 0.0f;
-    for (f = 0; f < 4 * nf; ++f) rl->fhole[f] = b->fhole[f / 4];
+    if ((r = sfb__level_complete(ctx, rl)) != SFB_SUCCESS) goto done;
+    {
+        /* two triangles on the same three vertices give two inner edges on the same two
+         * vertices (one edge of four triangles, had the edges been found by their ends): both
+         * tagged non-manifold, which tbz_points refuses */
+        int *seen = (int *)sfb__alloc(ctx, (2 * (size_t)nv2 + 1) * sizeof(int)), *by = seen + nv2, j; /* per vertex: the ring it was last met in, by which edge */
+        if (!seen) { r = sfb__oom(ctx, "tribezier refinement"); goto done; }
+        for (v = 0; v < nv2; ++v) seen[v] = -1;
+        for (v = 0; v < nv2; ++v)
+            for (j = rl->ve_off[v]; j < rl->ve_off[v + 1]; ++j) {
+                const int w = sfb__other_end(rl, rl->ve[j], v);
+                if (seen[w] == v) {
+                    rl->etag[rl->ve[j]] |= SFB__TAG_NONMANIFOLD;
+                    rl->etag[by[w]] |= SFB__TAG_NONMANIFOLD;
+                }
+                seen[w] = v;
+                by[w] = rl->ve[j];
+            }
+        sfb__free(ctx, seen);
+    }
     for (net = 0; net < 2; ++net) {
         float *out = net ? *pp : *ps;
         const float *pos = net ? psh : psm;
@@ -2296,8 +2354,6 @@ static sfb_result tbz_refine(sfb_context *ctx, const sfb__level *b, const float 
         }
     }
 done:
-    sfb__free(ctx, sizes);
-    sfb__free(ctx, fv);
     if (r != SFB_SUCCESS) {
         sfb__level_free(ctx, rl);
         sfb__free(ctx, *ps); sfb__free(ctx, *pp);
@@ -2306,8 +2362,9 @@ done:
     return r;
 }
 
-sfb_result sfb__tribezier_refined_points(sfb_context *ctx, const sfb__level *l, const float *positions, const sfb_tribezier_options *opt,
-                                         unsigned flags, sfb__level *rl, double **out, sfb__tbz_stats *stats) {
+/* sfb__tribezier_refined_points, the net into *out or (fout not NULL) into fout (tbz_points) */
+static sfb_result tbz_refined(sfb_context *ctx, const sfb__level *l, const float *positions, const sfb_tribezier_options *opt,
+                              unsigned flags, sfb__level *rl, double **out, float *fout, sfb__tbz_stats *stats) {
     float *ps = NULL, *pp = NULL, *spos = NULL;
     sfb__level sl;
     int split = 0;
@@ -2326,13 +2383,18 @@ sfb_result sfb__tribezier_refined_points(sfb_context *ctx, const sfb__level *l, 
         sfb__free(ctx, ps1);
         sfb__free(ctx, pp1);
     }
-    if (r == SFB_SUCCESS) r = tbz_points(ctx, rl, ps, pp, opt, flags, out, stats);
+    if (r == SFB_SUCCESS) r = tbz_points(ctx, rl, ps, pp, opt, flags, out, fout, stats);
     if (r != SFB_SUCCESS) sfb__level_free(ctx, rl);
     if (split) sfb__level_free(ctx, &sl);
     sfb__free(ctx, spos);
     sfb__free(ctx, ps);
     sfb__free(ctx, pp);
     return r;
+}
+
+sfb_result sfb__tribezier_refined_points(sfb_context *ctx, const sfb__level *l, const float *positions, const sfb_tribezier_options *opt,
+                                         unsigned flags, sfb__level *rl, double **out, sfb__tbz_stats *stats) {
+    return tbz_refined(ctx, l, positions, opt, flags, rl, out, NULL, stats);
 }
 
 /* One patch per triangle where the G1 constraints are solvable on the mesh itself; where they
@@ -2428,10 +2490,10 @@ static sfb_result tbz_build(sfb_context *ctx, const sfb__level *l, const float *
      * merge into one large component after one (decided only where a step is taken) */
     if (tbz_touching(l)) {
         two = tbz_largest_group(ctx, l) > TBZ_ONE_STEP_GROUP ? SFB__TBZ_TWO_STEPS : 0;
-        r = sfb__tribezier_refined_points(ctx, l, positions, opt, two, &rl, &net4, NULL);
-        if (r != SFB_SUCCESS) return r;
-        r = sfb__patch_table_beztri_children(ctx, l, net4, two ? 2 : 1, pt);
-        sfb__free(ctx, net4);
+        /* the table first, the net written into its point data (tbz_points) */
+        if ((r = sfb__patch_table_beztri_children(ctx, l, NULL, two ? 2 : 1, pt)) != SFB_SUCCESS) return r;
+        r = tbz_refined(ctx, l, positions, opt, two, &rl, &net4, pt->point_data, NULL);
+        if (r != SFB_SUCCESS) { sfb__patch_table_free(ctx, pt); return r; }
         sfb__level_free(ctx, &rl);
         return r;
     }
