@@ -7357,9 +7357,7 @@ static void tbz_regular_vertex(sfb__tbz *T, int v) {
     for (j = 0; j < 6; ++j) tbz_get(T, tbz_ring(l, v, j), R[j]);
     tbz_sabin_corner(V, R, T->x + 3 * (size_t)tbz_vp(T, v));
     for (j = 0; j < 6; ++j) {
-        const int e = l->ve[l->ve_off[v] + j], f = l->vf[l->vf_off[v] + j], *fv = l->fv + l->fv_off[f];
-        int k = 0;
-        while (fv[k] != v) ++k;
+        const int e = l->ve[l->ve_off[v] + j], f = l->vf[l->vf_off[v] + j], k = l->vf_slot[l->vf_off[v] + j];
         tbz_sabin_edge(V, R, j, T->x + 3 * (size_t)tbz_ep(T, e, l->ev[2 * e] == v ? 0 : 2));
         tbz_sabin_face(V, R, j, T->x + 3 * (size_t)tbz_fp(T, f, k));
     }
@@ -8279,10 +8277,12 @@ static int tbz_walk_run(const sfb__tbz *T, int v, tbz_walk *W) {
         for (k = 0; k < 3; ++k) {
             const int s = (r + k) % 3, c = fv[s], e = l->fe[l->fv_off[f] + s], ne2 = l->ef_off[e + 1] - l->ef_off[e];
             int g = -1, nb = -2;
-            for (j = l->vf_off[c]; j < l->vf_off[c + 1] && l->vf[j] != f; ++j) {}
             tbz_walk_mix(&h, tbz_nf(l, c) | tbz_boundary(l, c) << 8 | T->virr[c] << 9 | (long long)T->vtype[c] << 10 | (long long)(W->vdist[c] + 1) << 18);
-            {
+            if ((T->vtype[c] & 15) != TBZ_SMOOTH && (T->vtype[c] & 15) != TBZ_DART) {
+                /* this corner's characteristic angle (a smooth or dart vertex's are all 2 pi / n,
+                 * told by the valence and type already) */
                 long long bits;
+                for (j = l->vf_off[c]; j < l->vf_off[c + 1] && l->vf[j] != f; ++j) {}
                 memcpy(&bits, T->phi + j, sizeof bits);
                 tbz_walk_mix(&h, bits);
             }
@@ -8511,9 +8511,10 @@ done:
 
 /* Solves component i with template P, lab[0 .. nlab) the points of its walk's labels: 1 when its
  * rows are then met (the rule below), else 0 with
- * the net as it was. dx: 6 nu doubles, y: 3 P->nrank; mine: per point 0, and 0 again after. */
+ * the net as it was. dx: 6 nu doubles, y: 3 P->nrank; mine: per point 0, and 0 again after;
+ * *worst: the largest row residual left, relative to the scale (as tbz_solve's stats). */
 static int tbz_tpl_apply(sfb__tbz *T, const tbz_sys *S, const tbz_comps *C, int i, const int *lab, int nlab, const tbz_tpl *P, double *dx,
-                         double *y, unsigned char *mine) {
+                         double *y, unsigned char *mine, double *worst) {
     const int nr = C->rstart[i + 1] - C->rstart[i], nu = C->ustart[i + 1] - C->ustart[i];
     const int *rows = C->rows + C->rstart[i], *unk = C->unk + C->ustart[i];
     double *step = dx + 3 * (size_t)nu;
@@ -8561,11 +8562,14 @@ static int tbz_tpl_apply(sfb__tbz *T, const tbz_sys *S, const tbz_comps *C, int 
             tbz_axpy(T->x + 3 * (size_t)lab[P->ulab[u]], 1.0, step + 3 * u);
             tbz_axpy(dx + 3 * u, 1.0, step + 3 * u);
         }
-        for (r = 0, ok = 1; r < nr && ok; ++r) {
+        for (r = 0, ok = 1, *worst = 0.0; r < nr && ok; ++r) {
             double v[3], wsum = 0.0;
             tbz_dot3(S->col, S->w, S->off[rows[r]], S->off[rows[r] + 1], T->x, v);
             for (e = S->off[rows[r]]; e < S->off[rows[r] + 1]; ++e) wsum += fabs(S->w[e]);
-            for (c = 0; c < 3; ++c) ok &= fabs(v[c]) <= 1e-15 * T->scale * TBZ_MAX(1.0, wsum);
+            for (c = 0; c < 3; ++c) {
+                ok &= fabs(v[c]) <= 1e-15 * T->scale * TBZ_MAX(1.0, wsum);
+                *worst = TBZ_MAX(*worst, fabs(v[c]) / T->scale);
+            }
         }
         if (ok) return 1;
     }
@@ -8581,11 +8585,11 @@ static int tbz_key_cmp(const void *pa, const void *pb) {
 }
 
 /* Solves the components todo[0 .. *nt) that a template can (see above) and leaves the others
- * in todo, in order. A component shares a template when its rows' edges have exactly one
+ * in todo, in order; cres[c]: component c's largest row residual left, where solved here. A component shares a template when its rows' edges have exactly one
  * irregular end among them (the centre of its walk), it has at most TBZ_TPL_MAX_UNK unknowns
  * and its shape is met twice or more; the others of at most TBZ_DIRECT_ROWS rows get one of
  * their own; what fails its check is left to CGLS. */
-static sfb_result tbz_templates(sfb__tbz *T, const tbz_sys *S, const tbz_comps *C, int *todo, int *nt) {
+static sfb_result tbz_templates(sfb__tbz *T, const tbz_sys *S, const tbz_comps *C, int *todo, int *nt, double *cres) {
     const sfb__level *l = T->l;
     tbz_walk *W = (tbz_walk *)sfb__alloc(T->ctx, sizeof(tbz_walk));
     tbz_key *key = (tbz_key *)sfb__alloc(T->ctx, ((size_t)*nt + 1) * sizeof(tbz_key));
@@ -8658,7 +8662,10 @@ static sfb_result tbz_templates(sfb__tbz *T, const tbz_sys *S, const tbz_comps *
         T->st.templates++;
         for (i = g; i < m && res == SFB_SUCCESS; ++i) {
             const int ti = key[i].t;
-            if (tbz_tpl_apply(T, S, C, todo[ti], labs + key[i].lab, key[i].nlab, &P, dx, dx + 6 * (size_t)maxu, W->mine)) { done[ti] = 1; T->st.templated++; }
+            if (tbz_tpl_apply(T, S, C, todo[ti], labs + key[i].lab, key[i].nlab, &P, dx, dx + 6 * (size_t)maxu, W->mine, cres + todo[ti])) {
+                done[ti] = 1;
+                T->st.templated++;
+            }
             /* progress (and a cancel) every 64 components, over the share of the components */
             if ((++tried & 63) == 0) res = tbz_progress(T, (double)tried / *nt);
         }
@@ -8693,7 +8700,7 @@ static sfb_result tbz_templates(sfb__tbz *T, const tbz_sys *S, const tbz_comps *
         for (i = 0; i < nl; ++i) W->plab[dl[i]] = -1;
         if (!made) continue;
         T->st.direct++;
-        if (tbz_tpl_apply(T, S, C, c, dl, nl, &P, dx, dx + 6 * (size_t)nu, W->mine)) { done[t] = 1; T->st.templated++; }
+        if (tbz_tpl_apply(T, S, C, c, dl, nl, &P, dx, dx + 6 * (size_t)nu, W->mine, cres + c)) { done[t] = 1; T->st.templated++; }
         tbz_tpl_free(T->ctx, &P);
         if ((++tried & 63) == 0) res = tbz_progress(T, (double)tried / *nt);
     }
@@ -8722,7 +8729,7 @@ static sfb_result tbz_solve(sfb__tbz *T) {
     tbz_prev *rec = T->rec && !T->sharp && !T->reuse_x ? T->rec : NULL;
     unsigned char *near = NULL;
     int nu = 0, e, i, r, nc, nt = 0;
-    double scale = 0.0;
+    double scale = 0.0, *cres = NULL; /* per component: its residual where a template solved it, else -1 */
     sfb_result res = SFB_SUCCESS;
     memset(&S, 0, sizeof S);
     memset(&C, 0, sizeof C);
@@ -8819,13 +8826,21 @@ static sfb_result tbz_solve(sfb__tbz *T) {
         for (j = 0; j < cu; ++j) local[unk[u0 + j]] = j;
         todo[nt++] = i;
     }
-    if (!(T->flags & SFB__TBZ_NO_TEMPLATES) && (res = tbz_templates(T, &S, &C, todo, &nt)) != SFB_SUCCESS) goto done;
+    cres = (double *)sfb__alloc(T->ctx, ((size_t)nc + 1) * sizeof(double));
+    if (!cres) { res = sfb__oom(T->ctx, "tribezier constraints"); goto done; }
+    for (i = 0; i < nc; ++i) cres[i] = -1.0;
+    if (!(T->flags & SFB__TBZ_NO_TEMPLATES) && (res = tbz_templates(T, &S, &C, todo, &nt, cres)) != SFB_SUCCESS) goto done;
     if ((res = tbz_solve_todo(T, &S, &C, local, todo, nt, scale)) != SFB_SUCCESS) goto done;
     /* the residual left, relative to T->scale; and that of the components around an
      * extraordinary crease vertex with our tangent plane (vtype CREASE | 16), which decides the
      * fallback to the seed's plane (sfb__tribezier_points) */
     {
-        for (i = 0; i < nc; ++i)
+        for (i = 0; i < nc; ++i) {
+            if (cres[i] >= 0.0) { /* a template's, found by its check */
+                T->st.residual = TBZ_MAX(T->st.residual, cres[i]);
+                if (ours[i]) T->st.ours_residual = TBZ_MAX(T->st.ours_residual, cres[i]);
+                continue;
+            }
             for (r = rstart[i]; r < rstart[i + 1]; ++r) {
                 int c;
                 for (c = 0; c < 3; ++c) {
@@ -8836,6 +8851,7 @@ static sfb_result tbz_solve(sfb__tbz *T) {
                     if (ours[i]) T->st.ours_residual = TBZ_MAX(T->st.ours_residual, fabs(v) / scale);
                 }
             }
+        }
     }
     T->st.unknowns += nu;
     T->st.constraints += S.rows;
@@ -8850,7 +8866,7 @@ done:
     sfb__free(T->ctx, S.off); sfb__free(T->ctx, S.edge); sfb__free(T->ctx, S.col); sfb__free(T->ctx, S.w);
     sfb__free(T->ctx, ucol); sfb__free(T->ctx, local); sfb__free(T->ctx, erow);
     sfb__free(T->ctx, C.rows); sfb__free(T->ctx, C.unk); sfb__free(T->ctx, C.rstart); sfb__free(T->ctx, C.ustart);
-    sfb__free(T->ctx, ours); sfb__free(T->ctx, todo);
+    sfb__free(T->ctx, ours); sfb__free(T->ctx, todo); sfb__free(T->ctx, cres);
     return res;
 }
 
