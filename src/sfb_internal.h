@@ -704,11 +704,12 @@ SFB__IF sfb_result sfb__pn_build(sfb_context *ctx, const sfb__level *base, const
  * default is 65536), SFB__TBZ_NO_TEMPLATES solves every component by CGLS (for the test that the
  * templates give the same net), SFB__TBZ_TWO_STEPS makes sfb__tribezier_refined_points take two
  * Loop steps, SFB__TBZ_BOTH_NETS builds the smooth net even where s = 1 at every vertex (for the
- * test that skipping it gives the same net). Progress (stage "tribezier") runs over [0, 1], or [0, 0.5] with
+ * test that skipping it gives the same net), SFB__TBZ_REJECT_TEMPLATES fails every template's
+ * check (for the test that what fails goes to CGLS from the net as it was). Progress (stage "tribezier") runs over [0, 1], or [0, 0.5] with
  * SFB__TBZ_PROGRESS_LOW and [0.5, 1] with SFB__TBZ_PROGRESS_HIGH (sfb__tribezier_build: the mesh's
  * own net, then the one after a Loop step); a cancel returns SFB_CANCELLED. */
 enum { SFB__TBZ_SEED_PLANE = 1, SFB__TBZ_NO_REUSE = 2, SFB__TBZ_PAR_SMALL = 4, SFB__TBZ_PROGRESS_LOW = 8, SFB__TBZ_PROGRESS_HIGH = 16,
-       SFB__TBZ_NO_TEMPLATES = 32, SFB__TBZ_TWO_STEPS = 64, SFB__TBZ_BOTH_NETS = 128 };
+       SFB__TBZ_NO_TEMPLATES = 32, SFB__TBZ_TWO_STEPS = 64, SFB__TBZ_BOTH_NETS = 128, SFB__TBZ_REJECT_TEMPLATES = 256 };
 typedef struct sfb__tbz_stats {
     long iterations;   /* CGLS iterations, all coordinates and nets */
     long unknowns;     /* points moved by the G1 solve, per coordinate and net */

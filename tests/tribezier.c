@@ -988,6 +988,30 @@ static void templates_one(sfb_context *ctx, const char *name, const char *obj, u
     tmesh_free(ctx, &t);
 }
 
+/* A template or factor whose check fails leaves the net bit for bit as it was, and CGLS solves
+ * its region: with every check failed (SFB__TBZ_REJECT_TEMPLATES) the net must be bit for bit
+ * the one CGLS alone builds (SFB__TBZ_NO_TEMPLATES), teapot's own net (templates and regions'
+ * own factors both made). */
+static void templates_rejected(sfb_context *ctx, const char *obj) {
+    const char *nm = "templates/teapot_own_net/rejected_regions_go_to_cgls";
+    tmesh t;
+    double *a = NULL, *b = NULL;
+    sfb__tbz_stats sa, sb;
+    if (!tmesh_load(ctx, obj, &t)) { fail(nm, "load: %s", sfb_last_error(ctx)); return; }
+    memset(&sa, 0, sizeof sa); memset(&sb, 0, sizeof sb);
+    a = net_of(ctx, &t, NULL, SFB__TBZ_REJECT_TEMPLATES, &sa);
+    b = net_of(ctx, &t, NULL, SFB__TBZ_NO_TEMPLATES, &sb);
+    if (!a || !b) fail(nm, "not built: %s", sfb_last_error(ctx));
+    else {
+        const int same = memcmp(a, b, 45 * (size_t)t.prep.nf * sizeof(double)) == 0;
+        check(same && sa.templated == 0 && sa.templates > 0 && sa.direct > 0 && sa.iterations == sb.iterations, nm,
+              "nets %s; %d templates and %d factors made, %d used; CGLS iterations %ld vs %ld", same ? "equal" : "differ", sa.templates,
+              sa.direct, sa.templated, sa.iterations, sb.iterations);
+    }
+    sfb__free(ctx, a); sfb__free(ctx, b);
+    tmesh_free(ctx, &t);
+}
+
 /* obj (malloc'd copy) with a crease tag of sharpness `s` on the first edge of every `every`-th
  * face; *tags: how many. NULL when out of memory. */
 static char *obj_tag_creases(const char *obj, int every, double s, int *tags) {
@@ -1172,6 +1196,7 @@ static void test_refined(sfb_context *ctx, const char *dir) {
     obj = slurp(path, &n);
     if (!obj) { skip("templates/teapot_own_net/same_net_as_cgls", "teapot.obj not found (pass the real-meshes folder)"); return; }
     templates_one(ctx, "teapot_own_net", obj, 0, 1);
+    templates_rejected(ctx, obj);
     sharp_only_one(ctx, "teapot_own_net", obj, 0, 0, 0);
     free(obj);
 }

@@ -1549,7 +1549,10 @@ static int tbz_tpl_apply(sfb__tbz *T, const tbz_sys *S, const tbz_comps *C, int 
      * the sum of its weights' magnitudes (at least 1), which is about the rounding of evaluating
      * the row at all: with 1e-15 of the scale alone (CGLS's stopping rule, which iterates until
      * rounding happens to fall under it) half of spot.obj's components failed, by 1-2e-15 */
-    for (u = 0; u < 3 * nu; ++u) dx[u] = 0.0;
+    /* dx: the unknowns as they were, put back bit for bit where the check fails (subtracting
+     * the change again would not: CGLS would then start from a net a rounding away) */
+    for (u = 0; u < nu; ++u)
+        for (c = 0; c < 3; ++c) dx[3 * u + c] = T->x[3 * (size_t)lab[P->ulab[u]] + c];
     for (pass = 0; pass < 2; ++pass) {
         for (a = 0; a < P->nrank; ++a) {
             double bv[3] = {0.0, 0.0, 0.0};
@@ -1574,10 +1577,7 @@ static int tbz_tpl_apply(sfb__tbz *T, const tbz_sys *S, const tbz_comps *C, int 
         for (a = 0; a < P->nrank; ++a)
             for (e = P->ro[a]; e < P->ro[a + 1]; ++e)
                 if (P->ru[e] >= 0) tbz_axpy(step + 3 * P->ru[e], P->rw[e], y + 3 * a);
-        for (u = 0; u < nu; ++u) {
-            tbz_axpy(T->x + 3 * (size_t)lab[P->ulab[u]], 1.0, step + 3 * u);
-            tbz_axpy(dx + 3 * u, 1.0, step + 3 * u);
-        }
+        for (u = 0; u < nu; ++u) tbz_axpy(T->x + 3 * (size_t)lab[P->ulab[u]], 1.0, step + 3 * u);
         for (r = 0, ok = 1, *worst = 0.0; r < nr && ok; ++r) {
             double v[3], wsum = 0.0;
             tbz_dot3(S->col, S->w, S->off[rows[r]], S->off[rows[r] + 1], T->x, v);
@@ -1587,9 +1587,10 @@ static int tbz_tpl_apply(sfb__tbz *T, const tbz_sys *S, const tbz_comps *C, int 
                 *worst = TBZ_MAX(*worst, fabs(v[c]) / T->scale);
             }
         }
-        if (ok) return 1;
+        if (ok && !(T->flags & SFB__TBZ_REJECT_TEMPLATES)) return 1;
     }
-    for (u = 0; u < nu; ++u) tbz_axpy(T->x + 3 * (size_t)lab[P->ulab[u]], -1.0, dx + 3 * u);
+    for (u = 0; u < nu; ++u)
+        for (c = 0; c < 3; ++c) T->x[3 * (size_t)lab[P->ulab[u]] + c] = dx[3 * u + c];
     return 0;
 }
 
