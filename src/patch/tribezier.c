@@ -2249,7 +2249,7 @@ sfb_result sfb__tribezier_points(sfb_context *ctx, const sfb__level *l, const fl
 static sfb_result tbz_refine(sfb_context *ctx, const sfb__level *b, const float *psm, const float *psh, sfb__level *rl, float **ps,
                              float **pp) {
     const int nv = b->nv, nf = b->nf, ne = b->ne, nv2 = nv + ne;
-    int f, e, v, k, c, net;
+    int f, e, v, k, c, net, nets = 2;
     sfb_result r = SFB_SUCCESS;
     memset(rl, 0, sizeof *rl);
     *ps = (float *)sfb__alloc(ctx, (size_t)3 * nv2 * sizeof(float) + 1);
@@ -2325,7 +2325,15 @@ static sfb_result tbz_refine(sfb_context *ctx, const sfb__level *b, const float 
             }
         sfb__free(ctx, seen);
     }
-    for (net = 0; net < 2; ++net) {
+    {
+        /* with no tag the sharp net's rules are the smooth net's (boundaries alone sharp): where
+         * its positions are the same too, they are copied, not computed again */
+        int tagged = psh != psm && memcmp(psh, psm, 3 * (size_t)nv * sizeof(float)) != 0;
+        for (e = 0; e < ne && !tagged; ++e) tagged = b->es[e] > 0.0f && b->ef_off[e + 1] - b->ef_off[e] == 2;
+        for (v = 0; v < nv && !tagged; ++v) tagged = b->vs[v] > 0.0f;
+        if (!tagged) nets = 1;
+    }
+    for (net = 0; net < nets; ++net) {
         float *out = net ? *pp : *ps;
         const float *pos = net ? psh : psm;
         /* the sharp edges of this net's rules */
@@ -2370,6 +2378,7 @@ static sfb_result tbz_refine(sfb_context *ctx, const sfb__level *b, const float 
             for (c = 0; c < 3; ++c) out[3 * (size_t)v + c] = (float)P[c];
         }
     }
+    if (nets == 1) memcpy(*pp, *ps, 3 * (size_t)nv2 * sizeof(float));
 done:
     if (r != SFB_SUCCESS) {
         sfb__level_free(ctx, rl);
