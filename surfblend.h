@@ -8398,8 +8398,9 @@ static void tbz_rcm(const double *B, int nr, int *ord, int *deg, int *mark) {
     for (i = 0, j = nr - 1; i < j; ++i, --j) { const int t = ord[i]; ord[i] = ord[j]; ord[j] = t; }
 }
 
-/* Builds template P from component i, plab its points' labels (nlab of them: a walk's, or
- * tbz_direct's). 0: out of memory or a point of its rows unlabelled (P left empty). */
+/* Builds template P from component i, plab its points' labels (nlab of them: a walk's, or the
+ * order its rows read them in for a factor of its own: tbz_templates). 0: out of memory or a
+ * point of its rows unlabelled (P left empty). */
 static int tbz_tpl_make(sfb__tbz *T, const tbz_sys *S, const tbz_comps *C, int i, const int *plab, int nlab, tbz_tpl *P) {
     const int nr = C->rstart[i + 1] - C->rstart[i], nu = C->ustart[i + 1] - C->ustart[i];
     const int *rows = C->rows + C->rstart[i], *unk = C->unk + C->ustart[i];
