@@ -1541,12 +1541,11 @@ SFB__IF sfb_result sfb__patch_table_beztri_own(sfb_context *ctx, const sfb__leve
 /* The same with the 4 (depth 1) or 16 (depth 2) child patches of every triangle f: 45 doubles
  * each at net + 45 (4 f + i), child i of the parametric triangle's quadtree (corners 0, 1, 2,
  * the middle 3), or at net + 45 (16 f + 4 i + j), child j of child i (sfb__tribezier_refined_points
- * after one or two Loop steps). */
+ * after one or two Loop steps). net NULL: pt's point_data left for the caller to write, 45 floats
+ * per patch, the patches of the triangles that are not holes in their order, each triangle's
+ * children in net's order (sfb__tribezier_build writes them there directly). */
 SFB__IF sfb_result sfb__patch_table_beztri_children(sfb_context *ctx, const sfb__level *l, const double *net, int depth,
                                                     sfb__patch_table *pt);
-/* The same with net NULL: pt's point_data left for the caller to write, 45 floats per patch,
- * the patches of the triangles that are not holes in their order, each triangle's children in
- * net's order (sfb__tribezier_build writes them there directly). */
 /* The families present in a table, as bits 1 << SFB__FAMILY_*. */
 static inline unsigned sfb__patch_families(const sfb__patch_table *pt) {
     unsigned m = 0;
@@ -1579,9 +1578,10 @@ SFB__IF sfb_result sfb__pn_build(sfb_context *ctx, const sfb__level *base, const
  * templates give the same net), SFB__TBZ_TWO_STEPS makes sfb__tribezier_refined_points take two
  * Loop steps, SFB__TBZ_BOTH_NETS builds the smooth net even where s = 1 at every vertex (for the
  * test that skipping it gives the same net), SFB__TBZ_REJECT_TEMPLATES fails every template's
- * check (for the test that what fails goes to CGLS from the net as it was). Progress (stage "tribezier") runs over [0, 1], or [0, 0.5] with
- * SFB__TBZ_PROGRESS_LOW and [0.5, 1] with SFB__TBZ_PROGRESS_HIGH (sfb__tribezier_build: the mesh's
- * own net, then the one after a Loop step); a cancel returns SFB_CANCELLED. */
+ * check (for the test that what fails goes to CGLS from the net as it was). Progress (stage
+ * "tribezier") runs over [0, 1], or [0, 0.5] with SFB__TBZ_PROGRESS_LOW and [0.5, 1] with
+ * SFB__TBZ_PROGRESS_HIGH (sfb__tribezier_build: the mesh's own net, then the one after a Loop
+ * step); a cancel returns SFB_CANCELLED. */
 enum { SFB__TBZ_SEED_PLANE = 1, SFB__TBZ_NO_REUSE = 2, SFB__TBZ_PAR_SMALL = 4, SFB__TBZ_PROGRESS_LOW = 8, SFB__TBZ_PROGRESS_HIGH = 16,
        SFB__TBZ_NO_TEMPLATES = 32, SFB__TBZ_TWO_STEPS = 64, SFB__TBZ_BOTH_NETS = 128, SFB__TBZ_REJECT_TEMPLATES = 256 };
 typedef struct sfb__tbz_stats {
@@ -8407,18 +8407,18 @@ static int tbz_tpl_make(sfb__tbz *T, const tbz_sys *S, const tbz_comps *C, int i
     const size_t ent = tbz_comp_entries(S, C, i);
     int *uidx = (int *)sfb__alloc(T->ctx, ((size_t)nlab + 1) * sizeof(int));
     int *piv = (int *)sfb__alloc(T->ctx, (3 * (size_t)nr + 1) * sizeof(int)), *kept = piv + nr, *first = kept + nr;
-    int *used = (int *)sfb__alloc(T->ctx, (2 * (size_t)nr + 1) * sizeof(int)); /* tbz_rcm's scratch */
+    int *mark = (int *)sfb__alloc(T->ctx, (2 * (size_t)nr + 1) * sizeof(int)); /* tbz_rcm's scratch */
     size_t *cst = (size_t *)sfb__calloc(T->ctx, (size_t)nu + 2, sizeof(size_t));
     int *crow = (int *)sfb__alloc(T->ctx, (ent + 1) * sizeof(int));
     double *cw = (double *)sfb__alloc(T->ctx, (ent + 1) * sizeof(double));
     double *B = (double *)sfb__calloc(T->ctx, (size_t)nr * nr + 1, sizeof(double));
     double *L = (double *)sfb__alloc(T->ctx, ((size_t)nr * nr + 1) * sizeof(double)); /* entries read only once written */
-    int *d = (int *)sfb__alloc(T->ctx, ((size_t)nr + 1) * sizeof(int)); /* tbz_rcm's degrees */
+    int *deg = (int *)sfb__alloc(T->ctx, ((size_t)nr + 1) * sizeof(int)); /* tbz_rcm's degrees */
     int ok = 0, r, a, b, u, k, rank = 0;
     size_t e, e2, n = 0;
     double dmax = 0.0;
     memset(P, 0, sizeof *P);
-    if (!uidx || !piv || !used || !cst || !crow || !cw || !B || !L || !d) goto done;
+    if (!uidx || !piv || !mark || !cst || !crow || !cw || !B || !L || !deg) goto done;
     for (k = 0; k < nlab; ++k) uidx[k] = -1;
     P->nlab = nlab; P->nu = nu; P->nrow = nr;
     P->ulab = (int *)sfb__alloc(T->ctx, ((size_t)nu + 1) * sizeof(int));
@@ -8452,7 +8452,7 @@ static int tbz_tpl_make(sfb__tbz *T, const tbz_sys *S, const tbz_comps *C, int i
      * keeps each row of the factor within a narrow envelope: its first nonzero is that of B's
      * row, and the products below run over the envelopes alone (a 300-row component: about a
      * tenth of the dense factor's multiply-adds, and the same for the solves of each use) */
-    tbz_rcm(B, nr, piv, d, used);
+    tbz_rcm(B, nr, piv, deg, mark);
     for (r = 0; r < nr; ++r) dmax = TBZ_MAX(dmax, B[(size_t)r * nr + r]);
     /* Cholesky, row by row in that order (up-looking), a row that depends on those before it
      * (what is left of its diagonal at most 1e-11 of B's largest: some rows' weights on the
@@ -8506,8 +8506,8 @@ static int tbz_tpl_make(sfb__tbz *T, const tbz_sys *S, const tbz_comps *C, int i
     ok = 1;
 done:
     if (!ok) tbz_tpl_free(T->ctx, P);
-    sfb__free(T->ctx, uidx); sfb__free(T->ctx, piv); sfb__free(T->ctx, used); sfb__free(T->ctx, cst); sfb__free(T->ctx, crow);
-    sfb__free(T->ctx, cw); sfb__free(T->ctx, B); sfb__free(T->ctx, L); sfb__free(T->ctx, d);
+    sfb__free(T->ctx, uidx); sfb__free(T->ctx, piv); sfb__free(T->ctx, mark); sfb__free(T->ctx, cst); sfb__free(T->ctx, crow);
+    sfb__free(T->ctx, cw); sfb__free(T->ctx, B); sfb__free(T->ctx, L); sfb__free(T->ctx, deg);
     return ok;
 }
 

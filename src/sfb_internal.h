@@ -667,12 +667,11 @@ SFB__IF sfb_result sfb__patch_table_beztri_own(sfb_context *ctx, const sfb__leve
 /* The same with the 4 (depth 1) or 16 (depth 2) child patches of every triangle f: 45 doubles
  * each at net + 45 (4 f + i), child i of the parametric triangle's quadtree (corners 0, 1, 2,
  * the middle 3), or at net + 45 (16 f + 4 i + j), child j of child i (sfb__tribezier_refined_points
- * after one or two Loop steps). */
+ * after one or two Loop steps). net NULL: pt's point_data left for the caller to write, 45 floats
+ * per patch, the patches of the triangles that are not holes in their order, each triangle's
+ * children in net's order (sfb__tribezier_build writes them there directly). */
 SFB__IF sfb_result sfb__patch_table_beztri_children(sfb_context *ctx, const sfb__level *l, const double *net, int depth,
                                                     sfb__patch_table *pt);
-/* The same with net NULL: pt's point_data left for the caller to write, 45 floats per patch,
- * the patches of the triangles that are not holes in their order, each triangle's children in
- * net's order (sfb__tribezier_build writes them there directly). */
 /* The families present in a table, as bits 1 << SFB__FAMILY_*. */
 static inline unsigned sfb__patch_families(const sfb__patch_table *pt) {
     unsigned m = 0;
@@ -705,9 +704,10 @@ SFB__IF sfb_result sfb__pn_build(sfb_context *ctx, const sfb__level *base, const
  * templates give the same net), SFB__TBZ_TWO_STEPS makes sfb__tribezier_refined_points take two
  * Loop steps, SFB__TBZ_BOTH_NETS builds the smooth net even where s = 1 at every vertex (for the
  * test that skipping it gives the same net), SFB__TBZ_REJECT_TEMPLATES fails every template's
- * check (for the test that what fails goes to CGLS from the net as it was). Progress (stage "tribezier") runs over [0, 1], or [0, 0.5] with
- * SFB__TBZ_PROGRESS_LOW and [0.5, 1] with SFB__TBZ_PROGRESS_HIGH (sfb__tribezier_build: the mesh's
- * own net, then the one after a Loop step); a cancel returns SFB_CANCELLED. */
+ * check (for the test that what fails goes to CGLS from the net as it was). Progress (stage
+ * "tribezier") runs over [0, 1], or [0, 0.5] with SFB__TBZ_PROGRESS_LOW and [0.5, 1] with
+ * SFB__TBZ_PROGRESS_HIGH (sfb__tribezier_build: the mesh's own net, then the one after a Loop
+ * step); a cancel returns SFB_CANCELLED. */
 enum { SFB__TBZ_SEED_PLANE = 1, SFB__TBZ_NO_REUSE = 2, SFB__TBZ_PAR_SMALL = 4, SFB__TBZ_PROGRESS_LOW = 8, SFB__TBZ_PROGRESS_HIGH = 16,
        SFB__TBZ_NO_TEMPLATES = 32, SFB__TBZ_TWO_STEPS = 64, SFB__TBZ_BOTH_NETS = 128, SFB__TBZ_REJECT_TEMPLATES = 256 };
 typedef struct sfb__tbz_stats {

@@ -1422,18 +1422,18 @@ static int tbz_tpl_make(sfb__tbz *T, const tbz_sys *S, const tbz_comps *C, int i
     const size_t ent = tbz_comp_entries(S, C, i);
     int *uidx = (int *)sfb__alloc(T->ctx, ((size_t)nlab + 1) * sizeof(int));
     int *piv = (int *)sfb__alloc(T->ctx, (3 * (size_t)nr + 1) * sizeof(int)), *kept = piv + nr, *first = kept + nr;
-    int *used = (int *)sfb__alloc(T->ctx, (2 * (size_t)nr + 1) * sizeof(int)); /* tbz_rcm's scratch */
+    int *mark = (int *)sfb__alloc(T->ctx, (2 * (size_t)nr + 1) * sizeof(int)); /* tbz_rcm's scratch */
     size_t *cst = (size_t *)sfb__calloc(T->ctx, (size_t)nu + 2, sizeof(size_t));
     int *crow = (int *)sfb__alloc(T->ctx, (ent + 1) * sizeof(int));
     double *cw = (double *)sfb__alloc(T->ctx, (ent + 1) * sizeof(double));
     double *B = (double *)sfb__calloc(T->ctx, (size_t)nr * nr + 1, sizeof(double));
     double *L = (double *)sfb__alloc(T->ctx, ((size_t)nr * nr + 1) * sizeof(double)); /* entries read only once written */
-    int *d = (int *)sfb__alloc(T->ctx, ((size_t)nr + 1) * sizeof(int)); /* tbz_rcm's degrees */
+    int *deg = (int *)sfb__alloc(T->ctx, ((size_t)nr + 1) * sizeof(int)); /* tbz_rcm's degrees */
     int ok = 0, r, a, b, u, k, rank = 0;
     size_t e, e2, n = 0;
     double dmax = 0.0;
     memset(P, 0, sizeof *P);
-    if (!uidx || !piv || !used || !cst || !crow || !cw || !B || !L || !d) goto done;
+    if (!uidx || !piv || !mark || !cst || !crow || !cw || !B || !L || !deg) goto done;
     for (k = 0; k < nlab; ++k) uidx[k] = -1;
     P->nlab = nlab; P->nu = nu; P->nrow = nr;
     P->ulab = (int *)sfb__alloc(T->ctx, ((size_t)nu + 1) * sizeof(int));
@@ -1467,7 +1467,7 @@ static int tbz_tpl_make(sfb__tbz *T, const tbz_sys *S, const tbz_comps *C, int i
      * keeps each row of the factor within a narrow envelope: its first nonzero is that of B's
      * row, and the products below run over the envelopes alone (a 300-row component: about a
      * tenth of the dense factor's multiply-adds, and the same for the solves of each use) */
-    tbz_rcm(B, nr, piv, d, used);
+    tbz_rcm(B, nr, piv, deg, mark);
     for (r = 0; r < nr; ++r) dmax = TBZ_MAX(dmax, B[(size_t)r * nr + r]);
     /* Cholesky, row by row in that order (up-looking), a row that depends on those before it
      * (what is left of its diagonal at most 1e-11 of B's largest: some rows' weights on the
@@ -1521,8 +1521,8 @@ static int tbz_tpl_make(sfb__tbz *T, const tbz_sys *S, const tbz_comps *C, int i
     ok = 1;
 done:
     if (!ok) tbz_tpl_free(T->ctx, P);
-    sfb__free(T->ctx, uidx); sfb__free(T->ctx, piv); sfb__free(T->ctx, used); sfb__free(T->ctx, cst); sfb__free(T->ctx, crow);
-    sfb__free(T->ctx, cw); sfb__free(T->ctx, B); sfb__free(T->ctx, L); sfb__free(T->ctx, d);
+    sfb__free(T->ctx, uidx); sfb__free(T->ctx, piv); sfb__free(T->ctx, mark); sfb__free(T->ctx, cst); sfb__free(T->ctx, crow);
+    sfb__free(T->ctx, cw); sfb__free(T->ctx, B); sfb__free(T->ctx, L); sfb__free(T->ctx, deg);
     return ok;
 }
 
