@@ -420,6 +420,12 @@ typedef struct sfb__level {
 SFB__IF void sfb__level_free(sfb_context *ctx, sfb__level *l);
 /* From nv, nf, fv_off, fv, fe, ne, ev: builds every adjacency array and the tags. */
 SFB__IF sfb_result sfb__level_complete(sfb_context *ctx, sfb__level *l);
+/* The same where the caller has set vf_off, vf, vf_slot, ve_off and ve already, each manifold
+ * vertex's rings as sfb__level_complete orders them (counter-clockwise, from the face of the
+ * lowest index, or at a boundary from the face whose outgoing edge is a boundary edge); only
+ * their counts are checked (the non-manifold and boundary tags). A refinement step that knows
+ * its children's rings from the parent's spares the walk around every vertex. */
+SFB__IF sfb_result sfb__level_complete_ordered(sfb_context *ctx, sfb__level *l);
 /* Sharpness/rule helpers shared by refinement and info. */
 SFB__IF int sfb__rule_from(float vertex_sharpness, int sharp_edge_count);
 SFB__IF void sfb__level_compute_rules(sfb__level *l);

@@ -86,18 +86,22 @@ static int sfb__order_vertex(sfb__level *l, int v, int *tf, int *ts, int *te) {
     return 1;
 }
 
-sfb_result sfb__level_complete(sfb_context *ctx, sfb__level *l) {
+/* sfb__level_complete, or with ordered set sfb__level_complete_ordered: the rings are the
+ * caller's, and only checked by their counts */
+static sfb_result sfb__level_finish(sfb_context *ctx, sfb__level *l, int ordered) {
     int v, f, e, i, maxval = 0;
     int *fill = NULL, *tf = NULL, *ts = NULL, *te = NULL;
     l->nfv = l->fv_off[l->nf];
     l->ef_off = (int *)sfb__calloc(ctx, (size_t)l->ne + 1, sizeof(int));
     l->ef = (int *)sfb__alloc(ctx, ((size_t)l->nfv + 1) * sizeof(int));
     l->ef_slot = (int *)sfb__alloc(ctx, ((size_t)l->nfv + 1) * sizeof(int));
-    l->vf_off = (int *)sfb__calloc(ctx, (size_t)l->nv + 1, sizeof(int));
-    l->vf = (int *)sfb__alloc(ctx, ((size_t)l->nfv + 1) * sizeof(int));
-    l->vf_slot = (int *)sfb__alloc(ctx, ((size_t)l->nfv + 1) * sizeof(int));
-    l->ve_off = (int *)sfb__calloc(ctx, (size_t)l->nv + 1, sizeof(int));
-    l->ve = (int *)sfb__alloc(ctx, ((size_t)l->ne * 2 + 1) * sizeof(int));
+    if (!ordered) {
+        l->vf_off = (int *)sfb__calloc(ctx, (size_t)l->nv + 1, sizeof(int));
+        l->vf = (int *)sfb__alloc(ctx, ((size_t)l->nfv + 1) * sizeof(int));
+        l->vf_slot = (int *)sfb__alloc(ctx, ((size_t)l->nfv + 1) * sizeof(int));
+        l->ve_off = (int *)sfb__calloc(ctx, (size_t)l->nv + 1, sizeof(int));
+        l->ve = (int *)sfb__alloc(ctx, ((size_t)l->ne * 2 + 1) * sizeof(int));
+    }
     l->etag = (unsigned char *)sfb__calloc(ctx, (size_t)l->ne + 1, 1);
     l->vtag = (unsigned char *)sfb__calloc(ctx, (size_t)l->nv + 1, 1);
     l->vrule = (unsigned char *)sfb__calloc(ctx, (size_t)l->nv + 1, 1);
@@ -115,6 +119,7 @@ sfb_result sfb__level_complete(sfb_context *ctx, sfb__level *l) {
             l->ef[at] = f;
             l->ef_slot[at] = i - l->fv_off[f];
         }
+    if (ordered) goto tags;
     /* vertex -> faces (face order) */
     for (i = 0; i < l->nfv; ++i) l->vf_off[l->fv[i] + 1]++;
     for (v = 0; v < l->nv; ++v) l->vf_off[v + 1] += l->vf_off[v];
@@ -134,6 +139,7 @@ sfb_result sfb__level_complete(sfb_context *ctx, sfb__level *l) {
         l->ve[l->ve_off[a] + fill[a]++] = e;
         l->ve[l->ve_off[b] + fill[b]++] = e;
     }
+tags:
     /* edge tags: boundary (one face), non-manifold (more than two faces, two faces running the
      * same direction, or no face at all) */
     for (e = 0; e < l->ne; ++e) {
@@ -163,7 +169,7 @@ sfb_result sfb__level_complete(sfb_context *ctx, sfb__level *l) {
             if (l->etag[l->ve[i]] & SFB__TAG_BOUNDARY) bnd++;
         }
         if (bnd) l->vtag[v] |= SFB__TAG_BOUNDARY;
-        if (nm || k == 0 || !((m == k && bnd == 0) || (m == k + 1 && bnd == 2)) || !sfb__order_vertex(l, v, tf, ts, te))
+        if (nm || k == 0 || !((m == k && bnd == 0) || (m == k + 1 && bnd == 2)) || (!ordered && !sfb__order_vertex(l, v, tf, ts, te)))
             l->vtag[v] |= SFB__TAG_NONMANIFOLD;
     }
     sfb__free(ctx, fill); sfb__free(ctx, tf); sfb__free(ctx, ts); sfb__free(ctx, te);
@@ -172,6 +178,9 @@ oom:
     sfb__free(ctx, fill); sfb__free(ctx, tf); sfb__free(ctx, ts); sfb__free(ctx, te);
     return sfb__oom(ctx, "building topology");
 }
+
+sfb_result sfb__level_complete(sfb_context *ctx, sfb__level *l) { return sfb__level_finish(ctx, l, 0); }
+sfb_result sfb__level_complete_ordered(sfb_context *ctx, sfb__level *l) { return sfb__level_finish(ctx, l, 1); }
 
 static void *sfb__dup(sfb_context *ctx, const void *p, size_t bytes) {
     void *q = sfb__alloc(ctx, bytes ? bytes : 1);

@@ -896,6 +896,34 @@ static const char *tri_cube =
     "v -1 -1 -1\nv 1 -1 -1\nv 1 1 -1\nv -1 1 -1\nv -1 -1 1\nv 1 -1 1\nv 1 1 1\nv -1 1 1\n"
     "f 1 4 3\nf 1 3 2\nf 5 6 7\nf 5 7 8\nf 1 2 6\nf 1 6 5\nf 2 3 7\nf 2 7 6\nf 3 4 8\nf 3 8 7\nf 4 1 5\nf 4 5 8\n";
 
+/* The refined level's rings, which tbz_refine writes from the parent's (tbz_child_rings), are
+ * the ones sfb__level_complete finds by walking around every vertex: the same arrays, entry for
+ * entry (so the nets are bit for bit what they were). */
+static void rings_as_walked(sfb_context *ctx, const char *name, const sfb__level *rl) {
+    sfb__level c;
+    int same = 1, bad = -1;
+    memset(&c, 0, sizeof c);
+    c.nv = rl->nv; c.nf = rl->nf; c.ne = rl->ne;
+    c.fv_off = (int *)sfb__alloc(ctx, ((size_t)rl->nf + 1) * sizeof(int));
+    c.fv = (int *)sfb__alloc(ctx, ((size_t)rl->nfv + 1) * sizeof(int));
+    c.fe = (int *)sfb__alloc(ctx, ((size_t)rl->nfv + 1) * sizeof(int));
+    c.ev = (int *)sfb__alloc(ctx, (2 * (size_t)rl->ne + 1) * sizeof(int));
+    if (!c.fv_off || !c.fv || !c.fe || !c.ev) { fail(name, "out of memory"); sfb__level_free(ctx, &c); return; }
+    memcpy(c.fv_off, rl->fv_off, ((size_t)rl->nf + 1) * sizeof(int));
+    memcpy(c.fv, rl->fv, (size_t)rl->nfv * sizeof(int));
+    memcpy(c.fe, rl->fe, (size_t)rl->nfv * sizeof(int));
+    memcpy(c.ev, rl->ev, 2 * (size_t)rl->ne * sizeof(int));
+    if (sfb__level_complete(ctx, &c) != SFB_SUCCESS) { fail(name, "sfb__level_complete: %s", sfb_last_error(ctx)); sfb__level_free(ctx, &c); return; }
+#define RINGS_SAME(field, count) \
+    if (same && memcmp(c.field, rl->field, (size_t)(count) * sizeof(*c.field)) != 0) { same = 0; bad = __LINE__; }
+    RINGS_SAME(vf_off, rl->nv + 1) RINGS_SAME(vf, rl->nfv) RINGS_SAME(vf_slot, rl->nfv) RINGS_SAME(ve_off, rl->nv + 1)
+    RINGS_SAME(ve, 2 * rl->ne) RINGS_SAME(ef_off, rl->ne + 1) RINGS_SAME(ef, rl->nfv) RINGS_SAME(ef_slot, rl->nfv)
+    RINGS_SAME(etag, rl->ne) RINGS_SAME(vtag, rl->nv)
+#undef RINGS_SAME
+    check(same, name, "%d vertices, %d triangles; first array that differs: line %d", rl->nv, rl->nf, bad);
+    sfb__level_free(ctx, &c);
+}
+
 static void refined_one(sfb_context *ctx, const char *name, const char *obj) {
     tmesh t;
     double *net = NULL, *net4 = NULL;
@@ -909,6 +937,8 @@ static void refined_one(sfb_context *ctx, const char *name, const char *obj) {
         fail(name, "not built: %s", sfb_last_error(ctx));
     } else {
         g1_result g0 = g1_measure(&t.prep, net, 0), g = g1_measure(&rl, net4, 0);
+        snprintf(nm, sizeof nm, "%s_one_loop_step_rings_as_walked", name);
+        rings_as_walked(ctx, nm, &rl);
         snprintf(nm, sizeof nm, "%s_unrefined_is_not_g1", name);
         check(st.residual > 1e-10 && g0.jump > 1e-6, nm, "residual %.3g, normal jump %.3g rad", st.residual, g0.jump);
         snprintf(nm, sizeof nm, "%s_after_one_loop_step_is_g1", name);
@@ -928,6 +958,9 @@ static void refined_one(sfb_context *ctx, const char *name, const char *obj) {
         fail(nm, "not built: %s", sfb_last_error(ctx));
     } else {
         g1_result g = g1_measure(&rl, net4, 0);
+        char rn[160];
+        snprintf(rn, sizeof rn, "%s_two_loop_steps_rings_as_walked", name);
+        rings_as_walked(ctx, rn, &rl);
         check(rl.nf == 16 * t.prep.nf && g.jump <= 1e-9 && g.gap <= 1e-7 * t.diag && g.flat > 1e-3 && st4.residual <= 1e-12 && st4.templated > 0, nm,
               "%d triangles, normal jump %.3g rad, gap %.3g, flatness %.3g, residual %.3g, %d components by %d templates, %ld CGLS iterations",
               rl.nf, g.jump, g.gap, g.flat, st4.residual, st4.templated, st4.templates, st4.iterations);
@@ -1196,6 +1229,29 @@ static void test_refined(sfb_context *ctx, const char *dir) {
     obj = slurp(path, &n);
     if (!obj) { skip("templates/teapot_own_net/same_net_as_cgls", "teapot.obj not found (pass the real-meshes folder)"); return; }
     templates_one(ctx, "teapot_own_net", obj, 0, 1);
+    {
+        /* its open parts (boundary edges and vertices) and split non-manifold vertices, refined
+         * twice for the rings alone */
+        tmesh t;
+        sfb__level rl;
+        double *net = NULL;
+        sfb__tbz_stats st;
+        memset(&rl, 0, sizeof rl);
+        if (!tmesh_load(ctx, obj, &t)) fail("refine/teapot_two_loop_steps_rings_as_walked", "load: %s", sfb_last_error(ctx));
+        else {
+            if (sfb__tribezier_refined_points(ctx, &t.prep, t.m->positions, NULL, SFB__TBZ_TWO_STEPS, &rl, &net, &st) != SFB_SUCCESS)
+                fail("refine/teapot_two_loop_steps_rings_as_walked", "not built: %s", sfb_last_error(ctx));
+            else {
+                int bnd = 0, e;
+                for (e = 0; e < rl.ne; ++e) bnd += (rl.etag[e] & SFB__TAG_BOUNDARY) != 0;
+                check(bnd > 0, "refine/teapot_two_loop_steps_has_boundary_edges", "%d boundary edges", bnd);
+                rings_as_walked(ctx, "refine/teapot_two_loop_steps_rings_as_walked", &rl);
+            }
+            sfb__free(ctx, net);
+            sfb__level_free(ctx, &rl);
+            tmesh_free(ctx, &t);
+        }
+    }
     templates_rejected(ctx, obj);
     sharp_only_one(ctx, "teapot_own_net", obj, 0, 0, 0);
     free(obj);
