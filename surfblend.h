@@ -7152,6 +7152,12 @@ static int tbz_qij(int i, int j) { return 5 * j - j * (j - 1) / 2 + i; }
 /* The global index of the point of triangle f with weights w[k] on its corner k (sum 4), from
  * the faces' grids (T->grid, made once per net by tbz_patch). */
 static int tbz_gpt(const sfb__tbz *T, int f, const int w[3]) { return T->grid[15 * (size_t)f + tbz_qij(w[1], w[2])]; }
+/* The lattice place (tbz_qij order) of the point with weights w[r] = 4 - i - j, w[r + 1] = i,
+ * w[r + 2] = j, where q = tbz_qij(i, j): place q of the frame turned to start at corner r. */
+static int tbz_rot_q(int r, int q) {
+    static const signed char tab[3][15] = {{0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14}, {4, 8, 11, 13, 14, 3, 7, 10, 12, 2, 6, 9, 1, 5, 0}, {14, 12, 9, 5, 0, 13, 10, 6, 1, 11, 7, 2, 8, 3, 4}};
+    return tab[r][q];
+}
 
 static int tbz_ring(const sfb__level *l, int v, int j) { return sfb__other_end(l, l->ve[l->ve_off[v] + j], v); }
 static int tbz_nf(const sfb__level *l, int v) { return l->vf_off[v + 1] - l->vf_off[v]; }
@@ -8245,7 +8251,8 @@ typedef struct tbz_walk {
     unsigned char *mine; /* per point: an unknown of the component walked (set by the caller) */
     int face[TBZ_WALK_FACES], rot[TBZ_WALK_FACES], nface;
     int vert[3 * TBZ_WALK_FACES], nvert;
-    int lab[15 * TBZ_WALK_FACES], nlab; /* label -> point */
+    int lab[15 * TBZ_WALK_FACES], nlab; /* label -> point (tbz_walk_run with labels) */
+    int lq[15 * TBZ_WALK_FACES];        /* label -> where first met: 15 x its triangle's place in the walk + its lattice place */
     unsigned long long hash;
 } tbz_walk;
 static void tbz_walk_mix(unsigned long long *h, long long v) {
@@ -8262,9 +8269,15 @@ static void tbz_walk_reset(tbz_walk *W) {
 }
 /* Walks the triangles with a vertex within two edges of v, breadth first across their edges
  * from v's first triangle, each entered at a fixed corner (the first: v; a neighbour: the end of
- * the edge it was entered by), labelling points in the order met; hashes what the constraints
- * and the unknowns depend on. 0: too large (the marks are cleared). */
-static int tbz_walk_run(const sfb__tbz *T, int v, tbz_walk *W) {
+ * the edge it was entered by), and hashes what the constraints depend on: per corner its
+ * valence, type, distance from v and (where not told by those) characteristic angle, per edge
+ * the triangle across it and its features. With `label` it also labels the triangles' points in
+ * the order met (lab, lq). The points' own part (which coincide, which are unknowns) is left
+ * out of the hash: the triangles' adjacency tells the first, the region's numbers of rows and
+ * unknowns go into its key (tbz_templates), and tbz_tpl_apply checks that the template's
+ * unknowns are the region's and that its rows are met. (Labelling every region's points took
+ * half the walks' time, a cache miss per point.) 0: too large (the marks are cleared). */
+static int tbz_walk_run(const sfb__tbz *T, int v, tbz_walk *W, int label) {
     const sfb__level *l = T->l;
     int i, j, k, q, head;
     unsigned long long h = 14695981039346656037ull;
@@ -8319,26 +8332,25 @@ static int tbz_walk_run(const sfb__tbz *T, int v, tbz_walk *W) {
             }
             tbz_walk_mix(&h, nb | (long long)T->efeat[e] << 32 | (long long)(T->tag_s[e] > 0.0f) << 33 | (long long)ne2 << 34);
         }
-        for (j = 0, q = 0; j <= 4; ++j)
-            for (i = 0; i + j <= 4; ++i, ++q) {
-                int w[3], p;
-                w[r] = 4 - i - j; w[(r + 1) % 3] = i; w[(r + 2) % 3] = j;
-                p = tbz_gpt(T, f, w);
-                if (W->plab[p] < 0) { W->plab[p] = W->nlab; W->lab[W->nlab++] = p; }
-                tbz_walk_mix(&h, W->plab[p] | (long long)W->mine[p] << 32);
+        if (label)
+            for (q = 0; q < 15; ++q) {
+                const int p = T->grid[15 * (size_t)f + tbz_rot_q(r, q)];
+                if (W->plab[p] < 0) { W->plab[p] = W->nlab; W->lq[W->nlab] = 15 * head + q; W->lab[W->nlab++] = p; }
             }
     }
+    tbz_walk_mix(&h, W->nface);
     W->hash = h;
     return 1;
 }
 
-/* The walk of component c of C around v, its unknowns marked for the hash meanwhile. */
-static int tbz_walk_comp(const sfb__tbz *T, const tbz_comps *C, int c, int v, tbz_walk *W) {
-    int u, ok;
-    for (u = C->ustart[c]; u < C->ustart[c + 1]; ++u) W->mine[C->unk[u]] = 1;
-    ok = tbz_walk_run(T, v, W);
-    for (u = C->ustart[c]; u < C->ustart[c + 1]; ++u) W->mine[C->unk[u]] = 0;
-    return ok;
+/* The labels' points of a region whose walk met the triangles face[0 .. ) at corners rot[]
+ * (tbz_walk_run), from where the template's walk first met each label (lq[0 .. nlab)). */
+static void tbz_walk_points(const sfb__tbz *T, const int *face, const int *rot, const int *lq, int nlab, int *lab) {
+    int k;
+    for (k = 0; k < nlab; ++k) {
+        const int fi = lq[k] / 15;
+        lab[k] = T->grid[15 * (size_t)face[fi] + tbz_rot_q(rot[fi], lq[k] - 15 * fi)];
+    }
 }
 
 typedef struct tbz_tpl {
@@ -8595,7 +8607,18 @@ static int tbz_tpl_apply(sfb__tbz *T, const tbz_sys *S, const tbz_comps *C, int 
     return 0;
 }
 
-typedef struct tbz_key { unsigned long long hash; int t; size_t lab; int nlab; } tbz_key; /* lab: its walk's labels in labs */
+/* Asks for the net's points at idx[0 .. n) ahead of their use (the next region's, while this one
+ * is solved: its points lie scattered over the net, each a cache miss on first touch). */
+static void tbz_prefetch_points(const sfb__tbz *T, const int *idx, int n) {
+#if defined(__GNUC__) || defined(__clang__)
+    int k;
+    for (k = 0; k < n; ++k) __builtin_prefetch(T->x + 3 * (size_t)idx[k]);
+#else
+    (void)T; (void)idx; (void)n;
+#endif
+}
+
+typedef struct tbz_key { unsigned long long hash; int t; size_t at; int nface; } tbz_key; /* at: its walk's triangles and corners in wfr */
 static int tbz_key_cmp(const void *pa, const void *pb) {
     const tbz_key *a = (const tbz_key *)pa, *b = (const tbz_key *)pb;
     if (a->hash != b->hash) return a->hash < b->hash ? -1 : 1;
@@ -8614,9 +8637,10 @@ static sfb_result tbz_templates(sfb__tbz *T, const tbz_sys *S, const tbz_comps *
     int *centre = (int *)sfb__alloc(T->ctx, ((size_t)*nt + 1) * sizeof(int));
     unsigned char *done = (unsigned char *)sfb__calloc(T->ctx, (size_t)*nt + 1, 1);
     double *dx = NULL;
-    int *labs = NULL; /* every walk's label -> point map, one after the other */
-    int *dl = NULL;   /* a directly solved component's label -> point map */
-    size_t nlabs = 0, caplabs = 0, capdl = 0, capdx = 0;
+    int *wfr = NULL; /* every walk's triangles, then the corners they were entered at, one walk after the other */
+    int *dl = NULL;  /* a directly solved component's label -> point map */
+    int *lq = NULL, *lab2 = NULL; /* a template's labels, where its walk met them; two regions' label -> point maps */
+    size_t nwfr = 0, capwfr = 0, capdl = 0, capdx = 0;
     int t, nk = 0, g, i, m = 0, maxu = 0, maxr = 0, tried = 0;
     sfb_result res = SFB_SUCCESS;
     if (*nt == 0 || (*nt == 1 && C->rstart[todo[0] + 1] - C->rstart[todo[0]] > TBZ_DIRECT_ROWS)) { /* nothing to do here: nothing to allocate */
@@ -8629,7 +8653,9 @@ static sfb_result tbz_templates(sfb__tbz *T, const tbz_sys *S, const tbz_comps *
     W->plab = (int *)sfb__alloc(T->ctx, ((size_t)T->np + 1) * sizeof(int));
     W->vdist = (int *)sfb__alloc(T->ctx, ((size_t)T->nv + 1) * sizeof(int));
     W->mine = (unsigned char *)sfb__calloc(T->ctx, (size_t)T->np + 1, 1);
-    if (!W->fidx || !W->plab || !W->vdist || !W->mine) { res = sfb__oom(T->ctx, "tribezier templates"); goto out; }
+    lq = (int *)sfb__alloc(T->ctx, 15 * TBZ_WALK_FACES * sizeof(int));
+    lab2 = (int *)sfb__alloc(T->ctx, 2 * 15 * TBZ_WALK_FACES * sizeof(int));
+    if (!W->fidx || !W->plab || !W->vdist || !W->mine || !lq || !lab2) { res = sfb__oom(T->ctx, "tribezier templates"); goto out; }
     for (i = 0; i < T->nf; ++i) W->fidx[i] = -1;
     for (i = 0; i < T->np; ++i) W->plab[i] = -1;
     for (i = 0; i < T->nv; ++i) W->vdist[i] = -1;
@@ -8647,18 +8673,22 @@ static sfb_result tbz_templates(sfb__tbz *T, const tbz_sys *S, const tbz_comps *
                 if (T->virr[w]) { if (v < 0) v = w; else if (w != v) two = 1; }
             }
         }
-        if (v < 0 || two || !tbz_walk_comp(T, C, c, v, W)) continue;
-        if (nlabs + (size_t)W->nlab > caplabs) {
-            const size_t nc = 2 * caplabs + (size_t)W->nlab + 4096;
-            int *l2 = (int *)sfb__realloc(T->ctx, labs, nc * sizeof(int));
+        if (v < 0 || two || !tbz_walk_run(T, v, W, 0)) continue;
+        if (nwfr + 2 * (size_t)W->nface > capwfr) {
+            const size_t nc = 2 * capwfr + 2 * (size_t)W->nface + 4096;
+            int *l2 = (int *)sfb__realloc(T->ctx, wfr, nc * sizeof(int));
             if (!l2) { tbz_walk_reset(W); res = sfb__oom(T->ctx, "tribezier templates"); goto out; }
-            labs = l2;
-            caplabs = nc;
+            wfr = l2;
+            capwfr = nc;
         }
-        memcpy(labs + nlabs, W->lab, (size_t)W->nlab * sizeof(int));
+        memcpy(wfr + nwfr, W->face, (size_t)W->nface * sizeof(int));
+        memcpy(wfr + nwfr + W->nface, W->rot, (size_t)W->nface * sizeof(int));
         centre[t] = v;
-        key[nk].hash = W->hash; key[nk].t = t; key[nk].lab = nlabs; key[nk++].nlab = W->nlab;
-        nlabs += (size_t)W->nlab;
+        /* the shape: the walk's, and the region's numbers of unknowns and rows */
+        tbz_walk_mix(&W->hash, nu);
+        tbz_walk_mix(&W->hash, C->rstart[c + 1] - C->rstart[c]);
+        key[nk].hash = W->hash; key[nk].t = t; key[nk].at = nwfr; key[nk++].nface = W->nface;
+        nwfr += 2 * (size_t)W->nface;
         maxu = nu > maxu ? nu : maxu;
         maxr = C->rstart[c + 1] - C->rstart[c] > maxr ? C->rstart[c + 1] - C->rstart[c] : maxr;
         tbz_walk_reset(W);
@@ -8670,22 +8700,30 @@ static sfb_result tbz_templates(sfb__tbz *T, const tbz_sys *S, const tbz_comps *
     /* per shape met twice or more: its template, from its first component, used on every one */
     for (g = 0; g < nk && res == SFB_SUCCESS; g = m) {
         tbz_tpl P;
-        int made;
+        int made, nlab, *cur = lab2, *next = lab2 + 15 * TBZ_WALK_FACES;
         for (m = g + 1; m < nk && key[m].hash == key[g].hash; ++m) {}
         if (m - g < 2) continue;
-        tbz_walk_comp(T, C, todo[key[g].t], centre[key[g].t], W);
-        made = tbz_tpl_make(T, S, C, todo[key[g].t], W->plab, W->nlab, &P);
+        made = tbz_walk_run(T, centre[key[g].t], W, 1) && tbz_tpl_make(T, S, C, todo[key[g].t], W->plab, W->nlab, &P);
+        nlab = W->nlab;
+        memcpy(lq, W->lq, (size_t)nlab * sizeof(int));
         tbz_walk_reset(W);
         if (!made) continue;
         T->st.templates++;
+        /* each region's points from its walk; the next region's asked for while this one is solved */
+        tbz_walk_points(T, wfr + key[g].at, wfr + key[g].at + key[g].nface, lq, nlab, cur);
         for (i = g; i < m && res == SFB_SUCCESS; ++i) {
             const int ti = key[i].t;
-            if (tbz_tpl_apply(T, S, C, todo[ti], labs + key[i].lab, key[i].nlab, &P, dx, dx + 6 * (size_t)maxu, W->mine, cres + todo[ti])) {
+            if (i + 1 < m) {
+                tbz_walk_points(T, wfr + key[i + 1].at, wfr + key[i + 1].at + key[i + 1].nface, lq, nlab, next);
+                tbz_prefetch_points(T, next, nlab);
+            }
+            if (tbz_tpl_apply(T, S, C, todo[ti], cur, nlab, &P, dx, dx + 6 * (size_t)maxu, W->mine, cres + todo[ti])) {
                 done[ti] = 1;
                 T->st.templated++;
             }
             /* progress (and a cancel) every 64 components, over the share of the components */
             if ((++tried & 63) == 0) res = tbz_progress(T, (double)tried / *nt);
+            { int *sw = cur; cur = next; next = sw; }
         }
         tbz_tpl_free(T->ctx, &P);
     }
@@ -8730,7 +8768,7 @@ static sfb_result tbz_templates(sfb__tbz *T, const tbz_sys *S, const tbz_comps *
 out:
     if (W) { sfb__free(T->ctx, W->fidx); sfb__free(T->ctx, W->plab); sfb__free(T->ctx, W->vdist); sfb__free(T->ctx, W->mine); }
     sfb__free(T->ctx, W); sfb__free(T->ctx, key); sfb__free(T->ctx, centre); sfb__free(T->ctx, done); sfb__free(T->ctx, dx);
-    sfb__free(T->ctx, labs); sfb__free(T->ctx, dl);
+    sfb__free(T->ctx, wfr); sfb__free(T->ctx, dl); sfb__free(T->ctx, lq); sfb__free(T->ctx, lab2);
     return res;
 }
 
