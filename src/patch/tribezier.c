@@ -80,6 +80,7 @@
  *     bounding-box diagonal), non-finite positions, an override s outside [0, 1] or NaN.
  * Param faces are the triangles, (u,v) barycentric as Loop's: (1-u-v) P0 + u P1 + v P2. */
 
+#define TBZ_USIN 32  /* valences below this have their uniform sines made once (tbz_usin) */
 #define TBZ_REACH 6   /* net distance of the unknowns from an irregular vertex (ALGORITHMS.md 8.4) */
 #define TBZ_PI 3.14159265358979323846
 
@@ -126,7 +127,20 @@ typedef struct sfb__tbz {
                                   be compared: tbz_prev); it was the net's own largest point, which differs between
                                   the nets by their sharp points */
     sfb__tbz_stats st;
+    double usin[TBZ_USIN][2]; /* per valence n: sin(2 pi / n) and sin(4 pi / n) as tbz_coef computes them (tbz_usin) */
 } sfb__tbz;
+
+/* T->usin: what tbz_coef would compute at a spoke with the uniform angles 2 pi / n of a smooth
+ * vertex on both sides, the same bits (six sines per edge of rows were a sixth of their time) */
+static void tbz_usin(sfb__tbz *T) {
+    int n;
+    T->usin[0][0] = T->usin[0][1] = 0.0;
+    for (n = 1; n < TBZ_USIN; ++n) {
+        const double a = 2.0 * TBZ_PI / n;
+        T->usin[n][0] = sin(a);
+        T->usin[n][1] = sin(a + a);
+    }
+}
 
 static int tbz_vp(const sfb__tbz *T, int v) { (void)T; return v; }
 static int tbz_ep(const sfb__tbz *T, int e, int q) { return T->nv + 3 * e + q; }
@@ -619,13 +633,19 @@ static void tbz_coef(const sfb__tbz *T, int v, int e, int at_end, double out[3])
     const int n = tbz_nf(l, v), m = tbz_spoke(l, v, e);
     const double *phi = T->phi + l->vf_off[v];
     const double after = phi[m % n], before = phi[(m + n - 1) % n];
-    double mu, nu, la, s;
+    double mu, nu, la, s, sa, sb, sab;
+    if (after == before && n < TBZ_USIN && after == 2.0 * TBZ_PI / n) {
+        sa = sb = T->usin[n][0];
+        sab = T->usin[n][1];
+    } else {
+        sa = sin(after); sb = sin(before); sab = sin(after + before);
+    }
     if (!at_end) {
         /* at t = 0: sin(before) T_{m+1} + sin(after) T_{m-1} = sin(after + before) T_m */
-        mu = sin(before); nu = sin(after); la = sin(after + before);
+        mu = sb; nu = sa; la = sab;
     } else {
         /* at t = 1 (seen from the far end, X towards its ring's previous, Y towards its next) */
-        mu = sin(after); nu = sin(before); la = mu + nu - sin(after + before);
+        mu = sa; nu = sb; la = mu + nu - sab;
     }
     s = 2.0 / (mu + nu);
     out[0] = mu * s; out[1] = nu * s; out[2] = la * s;
@@ -1784,7 +1804,7 @@ static sfb_result tbz_solve(sfb__tbz *T) {
     int *ucol = NULL, *rstart, *ustart, *rows, *unk, *local = NULL, *erow = NULL, *todo = NULL;
     tbz_prev *rec = T->rec && !T->sharp && !T->reuse_x ? T->rec : NULL;
     unsigned char *near = NULL;
-    int nu = 0, e, i, r, nc, nt = 0;
+    int nu = 0, e, i, r, nc, nc0, nt = 0;
     double scale = 0.0, *cres = NULL; /* per component: its residual where a template solved it, else -1 */
     sfb_result res = SFB_SUCCESS;
     memset(&S, 0, sizeof S);
@@ -1821,12 +1841,11 @@ static sfb_result tbz_solve(sfb__tbz *T) {
 #undef TBZ_ROW_EDGE
     if (S.rows == 0) goto done;
     ucol = (int *)sfb__alloc(T->ctx, (size_t)T->np * sizeof(int));
-    local = (int *)sfb__alloc(T->ctx, (size_t)T->np * sizeof(int));
-    if (!ucol || !local) { res = sfb__oom(T->ctx, "tribezier constraints"); goto done; }
-    for (i = 0; i < T->np; ++i) { ucol[i] = (!T->fixed[i] && T->dist[i] <= TBZ_REACH) ? nu++ : -1; local[i] = -1; }
+    if (!ucol) { res = sfb__oom(T->ctx, "tribezier constraints"); goto done; }
+    for (i = 0; i < T->np; ++i) ucol[i] = (!T->fixed[i] && T->dist[i] <= TBZ_REACH) ? nu++ : -1;
     scale = T->scale;
     if ((res = tbz_components(T, &S, ucol, nu, &C)) != SFB_SUCCESS) goto done;
-    nc = C.nc; rstart = C.rstart; ustart = C.ustart; rows = C.rows; unk = C.unk;
+    nc = nc0 = C.nc; rstart = C.rstart; ustart = C.ustart; rows = C.rows; unk = C.unk;
     if (rec) {
         /* the net before the solve, and the components (tbz_prev); S joins them at the end */
         rec->x0 = (double *)sfb__alloc(T->ctx, 3 * (size_t)T->np * sizeof(double) + 1);
@@ -1856,7 +1875,12 @@ static sfb_result tbz_solve(sfb__tbz *T) {
      * fallback the first net's) */
     ours = (unsigned char *)sfb__calloc(T->ctx, (size_t)nc + 1, 1);
     if (!ours) { res = sfb__oom(T->ctx, "tribezier constraints"); goto done; }
-    for (i = 0; i < nc; ++i)
+    {
+        int any = T->reuse_ours != NULL;
+        for (i = 0; i < T->nv && !any; ++i) any = (T->vtype[i] & 16) && T->virr[i];
+        if (!any) nc0 = 0; /* none: no row to look at */
+    }
+    for (i = 0; i < nc0; ++i)
         for (r = rstart[i]; r < rstart[i + 1] && !ours[i]; ++r) {
             const int e2 = S.edge[rows[r]], a = l->ev[2 * e2], b = l->ev[2 * e2 + 1];
             ours[i] = (unsigned char)(((T->vtype[a] & 16) && T->virr[a]) || ((T->vtype[b] & 16) && T->virr[b]) ||
@@ -1879,13 +1903,22 @@ static sfb_result tbz_solve(sfb__tbz *T) {
                 continue;
             }
         }
-        for (j = 0; j < cu; ++j) local[unk[u0 + j]] = j;
         todo[nt++] = i;
     }
     cres = (double *)sfb__alloc(T->ctx, ((size_t)nc + 1) * sizeof(double));
     if (!cres) { res = sfb__oom(T->ctx, "tribezier constraints"); goto done; }
     for (i = 0; i < nc; ++i) cres[i] = -1.0;
     if (!(T->flags & SFB__TBZ_NO_TEMPLATES) && (res = tbz_templates(T, &S, &C, todo, &nt, cres)) != SFB_SUCCESS) goto done;
+    if (nt > 0) {
+        /* what is left for CGLS: each unknown's column in its component, -1 elsewhere */
+        local = (int *)sfb__alloc(T->ctx, (size_t)T->np * sizeof(int));
+        if (!local) { res = sfb__oom(T->ctx, "tribezier constraints"); goto done; }
+        for (i = 0; i < T->np; ++i) local[i] = -1;
+        for (i = 0; i < nt; ++i) {
+            int j;
+            for (j = ustart[todo[i]]; j < ustart[todo[i] + 1]; ++j) local[unk[j]] = j - ustart[todo[i]];
+        }
+    }
     if ((res = tbz_solve_todo(T, &S, &C, local, todo, nt, scale)) != SFB_SUCCESS) goto done;
     /* the residual left, relative to T->scale; and that of the components around an
      * extraordinary crease vertex with our tangent plane (vtype CREASE | 16), which decides the
@@ -2015,6 +2048,7 @@ static sfb_result tbz_points(sfb_context *ctx, const sfb__level *l, const float 
     T.ctx = ctx; T.l = l; T.pos = positions;
     for (v = 0; v < 3 * l->nv; ++v) T.scale = fmax(T.scale, fabs((double)positions[v]));
     if (!(T.scale > 0.0)) T.scale = 1.0;
+    tbz_usin(&T);
     T.nv = l->nv; T.ne = l->ne; T.nf = l->nf;
     T.np = l->nv + 3 * l->ne + 3 * l->nf;
     T.seed_plane = (flags & SFB__TBZ_SEED_PLANE) != 0;
