@@ -8402,14 +8402,16 @@ static double tbz_dot(const double *a, const double *b, int n) {
 }
 
 /* The reverse Cuthill-McKee order of the graph of the symmetric nr x nr matrix B (i ~ j where
- * B[i][j] != 0) into ord: breadth first from a node of least degree at the far end of the graph
- * (one pass of George and Liu's search for a peripheral node), each node's new neighbours by
- * rising degree, the whole reversed; each connected part in turn. deg: nr ints, mark: 2 nr. */
-static void tbz_rcm(const double *B, int nr, int *ord, int *deg, int *mark) {
-    int *lev = mark + nr, i, j, n = 0;
+ * B[i][j] != 0; row i's columns bj[bo[i] .. bo[i + 1]), rising, its diagonal among them) into
+ * ord: breadth first from a node of least degree at the far end of the graph (one pass of George
+ * and Liu's search for a peripheral node), each node's new neighbours by rising degree, the
+ * whole reversed; each connected part in turn. deg: nr ints, mark: 2 nr. */
+static void tbz_rcm(const size_t *bo, const int *bj, int nr, int *ord, int *deg, int *mark) {
+    int *lev = mark + nr, i, n = 0;
+    size_t k;
     for (i = 0; i < nr; ++i) {
         deg[i] = 0;
-        for (j = 0; j < nr; ++j) deg[i] += j != i && B[(size_t)i * nr + j] != 0.0;
+        for (k = bo[i]; k < bo[i + 1]; ++k) deg[i] += bj[k] != i;
         mark[i] = 0;
     }
     while (n < nr) {
@@ -8424,15 +8426,16 @@ static void tbz_rcm(const double *B, int nr, int *ord, int *deg, int *mark) {
             lev[start] = 0;
             for (head = n0; head < n; ++head) {
                 const int u = ord[head], from = n;
-                const double *Bu = B + (size_t)u * nr;
-                for (j = 0; j < nr; ++j)
-                    if (mark[j] != pass + 1 && Bu[j] != 0.0) {
+                for (k = bo[u]; k < bo[u + 1]; ++k) {
+                    const int j = bj[k];
+                    if (mark[j] != pass + 1) {
                         int q = n++;
                         mark[j] = pass + 1;
                         lev[j] = lev[u] + 1;
                         while (q > from && deg[ord[q - 1]] > deg[j]) { ord[q] = ord[q - 1]; --q; }
                         ord[q] = j;
                     }
+                }
             }
             if (pass == 0) {
                 /* the last level's node of least degree */
@@ -8442,30 +8445,39 @@ static void tbz_rcm(const double *B, int nr, int *ord, int *deg, int *mark) {
             }
         }
     }
-    for (i = 0, j = nr - 1; i < j; ++i, --j) { const int t = ord[i]; ord[i] = ord[j]; ord[j] = t; }
+    for (i = 0, n = nr - 1; i < n; ++i, --n) { const int t = ord[i]; ord[i] = ord[n]; ord[n] = t; }
 }
 
 /* Builds template P from component i, plab its points' labels (nlab of them: a walk's, or the
  * order its rows read them in for a factor of its own: tbz_templates). 0: out of memory or a
- * point of its rows unlabelled (P left empty). */
+ * point of its rows unlabelled (P left empty). Sparse throughout: B = A A^T by rows (a row
+ * meets a dozen others), the factor within its envelopes (teapot.obj's regions of their own
+ * shape, up to 640 rows: the dense B and factor, nr^2 each to clear and scan, were a third of
+ * its build). */
 static int tbz_tpl_make(sfb__tbz *T, const tbz_sys *S, const tbz_comps *C, int i, const int *plab, int nlab, tbz_tpl *P) {
     const int nr = C->rstart[i + 1] - C->rstart[i], nu = C->ustart[i + 1] - C->ustart[i];
     const int *rows = C->rows + C->rstart[i], *unk = C->unk + C->ustart[i];
     const size_t ent = tbz_comp_entries(S, C, i);
     int *uidx = (int *)sfb__alloc(T->ctx, ((size_t)nlab + 1) * sizeof(int));
-    int *piv = (int *)sfb__alloc(T->ctx, (3 * (size_t)nr + 1) * sizeof(int)), *kept = piv + nr, *first = kept + nr;
+    /* per row: its place in the factor order, the kept rows, their first columns, the kept
+     * place of a row (-1: not (yet) kept), B's touched columns */
+    int *piv = (int *)sfb__alloc(T->ctx, (5 * (size_t)nr + 1) * sizeof(int)), *kept = piv + nr, *first = kept + nr, *kpos = first + nr,
+        *touch = kpos + nr;
     int *mark = (int *)sfb__alloc(T->ctx, (2 * (size_t)nr + 1) * sizeof(int)); /* tbz_rcm's scratch */
     size_t *cst = (size_t *)sfb__calloc(T->ctx, (size_t)nu + 2, sizeof(size_t));
-    int *crow = (int *)sfb__alloc(T->ctx, (ent + 1) * sizeof(int));
-    double *cw = (double *)sfb__alloc(T->ctx, (ent + 1) * sizeof(double));
-    double *B = (double *)sfb__calloc(T->ctx, (size_t)nr * nr + 1, sizeof(double));
-    double *L = (double *)sfb__alloc(T->ctx, ((size_t)nr * nr + 1) * sizeof(double)); /* entries read only once written */
+    size_t *rst = (size_t *)sfb__calloc(T->ctx, (size_t)nr + 2, sizeof(size_t));
+    size_t *bo = (size_t *)sfb__alloc(T->ctx, ((size_t)nr + 1) * sizeof(size_t));
+    int *crow = (int *)sfb__alloc(T->ctx, (ent + 1) * sizeof(int)), *rcol = (int *)sfb__alloc(T->ctx, (ent + 1) * sizeof(int)), *bj = NULL;
+    double *cw = (double *)sfb__alloc(T->ctx, (ent + 1) * sizeof(double)), *rw = (double *)sfb__alloc(T->ctx, (ent + 1) * sizeof(double));
+    double *acc = (double *)sfb__calloc(T->ctx, (size_t)nr + 1, sizeof(double)); /* a row of B, by row; zero between uses */
+    double *lk = (double *)sfb__alloc(T->ctx, ((size_t)nr + 1) * sizeof(double)); /* the factor's row being made, by kept place */
+    double *bv = NULL;
     int *deg = (int *)sfb__alloc(T->ctx, ((size_t)nr + 1) * sizeof(int)); /* tbz_rcm's degrees */
     int ok = 0, r, a, b, u, k, rank = 0;
-    size_t e, e2, n = 0;
+    size_t e, e2, n = 0, nb = 0, capb = 0, env = 0;
     double dmax = 0.0;
     memset(P, 0, sizeof *P);
-    if (!uidx || !piv || !mark || !cst || !crow || !cw || !B || !L || !deg) goto done;
+    if (!uidx || !piv || !mark || !cst || !rst || !bo || !crow || !rcol || !cw || !rw || !acc || !lk || !deg) goto done;
     for (k = 0; k < nlab; ++k) uidx[k] = -1;
     P->nlab = nlab; P->nu = nu; P->nrow = nr;
     P->ulab = (int *)sfb__alloc(T->ctx, ((size_t)nu + 1) * sizeof(int));
@@ -8481,67 +8493,120 @@ static int tbz_tpl_make(sfb__tbz *T, const tbz_sys *S, const tbz_comps *C, int i
         for (e = S->off[rows[r]]; e < S->off[rows[r] + 1]; ++e) {
             const int lb = plab[S->col[e]];
             if (lb < 0) goto done;
-            if (uidx[lb] >= 0) ++cst[uidx[lb] + 2];
+            if (uidx[lb] >= 0) { ++cst[uidx[lb] + 2]; ++rst[r + 2]; }
             ++n;
         }
     for (u = 0; u < nu; ++u) cst[u + 2] += cst[u + 1];
+    for (r = 0; r < nr; ++r) rst[r + 2] += rst[r + 1];
     for (r = 0; r < nr; ++r)
         for (e = S->off[rows[r]]; e < S->off[rows[r] + 1]; ++e) {
             const int ui = uidx[plab[S->col[e]]];
             if (ui >= 0) { crow[cst[ui + 1]] = r; cw[cst[ui + 1]++] = S->w[e]; }
         }
-    /* B = A A^T, from each column's pairs of entries (a column has a handful: a few thousand
-     * products where the dense product took nr^2 x 16) */
+    /* and by rows, each row's entries by rising column (so B's sums below add their terms in
+     * the order of a column-by-column product) */
     for (u = 0; u < nu; ++u)
-        for (e = cst[u]; e < cst[u + 1]; ++e)
-            for (e2 = cst[u]; e2 < cst[u + 1]; ++e2) B[(size_t)crow[e] * nr + crow[e2]] += cw[e] * cw[e2];
+        for (e = cst[u]; e < cst[u + 1]; ++e) { rcol[rst[crow[e] + 1]] = u; rw[rst[crow[e] + 1]++] = cw[e]; }
+    /* B = A A^T row by row: row r's entries times their columns' entries (a few hundred
+     * products), its nonzero columns rising; mark[r2] = r + 1 once row r touched r2 */
+    for (r = 0; r < nr; ++r) mark[r] = 0;
+    for (r = 0; r < nr; ++r) {
+        int nt = 0, t;
+        bo[r] = nb;
+        for (e = rst[r]; e < rst[r + 1]; ++e) {
+            const int cu = rcol[e];
+            for (e2 = cst[cu]; e2 < cst[cu + 1]; ++e2) {
+                const int r2 = crow[e2];
+                if (mark[r2] != r + 1) { mark[r2] = r + 1; touch[nt++] = r2; }
+                acc[r2] += rw[e] * cw[e2];
+            }
+        }
+        /* rising (a row has a few dozen) */
+        for (t = 1; t < nt; ++t) {
+            const int x = touch[t];
+            int q = t;
+            while (q > 0 && touch[q - 1] > x) { touch[q] = touch[q - 1]; --q; }
+            touch[q] = x;
+        }
+        if (nb + (size_t)nt > capb) {
+            const size_t nc = 2 * capb + (size_t)nt + 1024;
+            int *j2 = (int *)sfb__realloc(T->ctx, bj, nc * sizeof(int));
+            double *v2;
+            if (!j2) goto done;
+            bj = j2;
+            v2 = (double *)sfb__realloc(T->ctx, bv, nc * sizeof(double));
+            if (!v2) goto done;
+            bv = v2;
+            capb = nc;
+        }
+        for (t = 0; t < nt; ++t) {
+            const int r2 = touch[t];
+            if (acc[r2] != 0.0) { bj[nb] = r2; bv[nb++] = acc[r2]; }
+            if (r2 == r) dmax = TBZ_MAX(dmax, acc[r2]);
+            acc[r2] = 0.0;
+        }
+    }
+    bo[nr] = nb;
     /* the rows in reverse Cuthill-McKee order of B's graph (rows sharing an unknown), which
      * keeps each row of the factor within a narrow envelope: its first nonzero is that of B's
      * row, and the products below run over the envelopes alone (a 300-row component: about a
      * tenth of the dense factor's multiply-adds, and the same for the solves of each use) */
-    tbz_rcm(B, nr, piv, deg, mark);
-    for (r = 0; r < nr; ++r) dmax = TBZ_MAX(dmax, B[(size_t)r * nr + r]);
+    tbz_rcm(bo, bj, nr, piv, deg, mark);
+    /* the factor's room: each row's envelope in that order with no row dropped (dropping only
+     * narrows them) */
+    for (a = 0; a < nr; ++a) kpos[piv[a]] = a;
+    for (a = 0; a < nr; ++a) {
+        int f = a;
+        for (e = bo[piv[a]]; e < bo[piv[a] + 1]; ++e) f = kpos[bj[e]] < f ? kpos[bj[e]] : f;
+        env += (size_t)(a - f + 1);
+    }
+    P->lf = (double *)sfb__alloc(T->ctx, (env + 1) * sizeof(double));
+    P->lfirst = (int *)sfb__alloc(T->ctx, ((size_t)nr + 1) * sizeof(int));
+    P->lo = (size_t *)sfb__alloc(T->ctx, ((size_t)nr + 1) * sizeof(size_t));
+    if (!P->lf || !P->lfirst || !P->lo) goto done;
+    for (r = 0; r < nr; ++r) kpos[r] = -1;
     /* Cholesky, row by row in that order (up-looking), a row that depends on those before it
      * (what is left of its diagonal at most 1e-11 of B's largest: some rows' weights on the
      * unknowns are rounding residue, of norm 1e-16, and must go too) dropped: B is semidefinite
      * and a quarter of its rows are dependent; their b follows from the others' when the system
-     * is consistent, which the check after each use confirms. L's row k (the k-th kept row, of
-     * row kept[k]) holds columns first[k] .. k. */
-    for (k = 0, a = 0; a < nr; ++a) {
+     * is consistent, which the check after each use confirms. Row k of the factor (the k-th
+     * kept row, of row kept[k]) holds columns first[k] .. k, at P->lo[k] of P->lf; B's row is
+     * spread into acc meanwhile. */
+    for (k = 0, a = 0, e2 = 0; a < nr; ++a) {
         const int p = piv[a];
-        const double *Bp = B + (size_t)p * nr;
-        double *Lk = L + (size_t)k * nr, dd;
+        double dd = 0.0;
         int f = k;
-        for (b = 0; b < k; ++b)
-            if (Bp[kept[b]] != 0.0) { f = b; break; }
+        for (e = bo[p]; e < bo[p + 1]; ++e) {
+            acc[bj[e]] = bv[e];
+            if (kpos[bj[e]] >= 0 && kpos[bj[e]] < f) f = kpos[bj[e]];
+        }
         for (b = f; b < k; ++b) {
             const int lo2 = first[b] > f ? first[b] : f;
-            Lk[b] = (Bp[kept[b]] - tbz_dot(Lk + lo2, L + (size_t)b * nr + lo2, b - lo2)) / L[(size_t)b * nr + b];
+            const double *lb = P->lf + P->lo[b] - first[b]; /* lb[c]: column c of row b */
+            lk[b] = (acc[kept[b]] - tbz_dot(lk + lo2, lb + lo2, b - lo2)) / lb[b];
         }
-        dd = Bp[p] - tbz_dot(Lk + f, Lk + f, k - f);
+        dd = acc[p] - tbz_dot(lk + f, lk + f, k - f);
+        for (e = bo[p]; e < bo[p + 1]; ++e) acc[bj[e]] = 0.0;
         if (!(dd > 1e-11 * dmax)) continue;
-        Lk[k] = sqrt(dd);
+        lk[k] = sqrt(dd);
         first[k] = f;
+        P->lo[k] = e2;
+        for (b = f; b <= k; ++b) P->lf[e2++] = lk[b];
+        kpos[p] = k;
         kept[k++] = p;
     }
     rank = k;
     P->nrank = rank;
-    P->lfirst = (int *)sfb__alloc(T->ctx, ((size_t)rank + 1) * sizeof(int));
-    P->lo = (size_t *)sfb__alloc(T->ctx, ((size_t)rank + 1) * sizeof(size_t));
-    for (a = 0, e = 0; a < rank; ++a) e += (size_t)(a - first[a] + 1);
-    P->lf = (double *)sfb__alloc(T->ctx, (e + 1) * sizeof(double));
     P->ro = (size_t *)sfb__alloc(T->ctx, ((size_t)rank + 1) * sizeof(size_t));
     P->rl = (int *)sfb__alloc(T->ctx, (n + 1) * sizeof(int));
     P->ru = (int *)sfb__alloc(T->ctx, (n + 1) * sizeof(int));
     P->rw = (double *)sfb__alloc(T->ctx, (n + 1) * sizeof(double));
-    if (!P->lfirst || !P->lo || !P->lf || !P->ro || !P->rl || !P->ru || !P->rw) goto done;
-    /* the factor's envelopes, and the kept rows over labels */
+    if (!P->ro || !P->rl || !P->ru || !P->rw) goto done;
+    /* the factor's first columns, and the kept rows over labels */
     n = 0;
-    for (a = 0, e = 0; a < rank; ++a) {
+    for (a = 0; a < rank; ++a) {
         const int g = rows[kept[a]];
         P->lfirst[a] = first[a];
-        P->lo[a] = e;
-        for (b = first[a]; b <= a; ++b) P->lf[e++] = L[(size_t)a * nr + b];
         P->ro[a] = n;
         for (e2 = S->off[g]; e2 < S->off[g + 1]; ++e2) {
             P->rl[n] = plab[S->col[e2]];
@@ -8553,8 +8618,9 @@ static int tbz_tpl_make(sfb__tbz *T, const tbz_sys *S, const tbz_comps *C, int i
     ok = 1;
 done:
     if (!ok) tbz_tpl_free(T->ctx, P);
-    sfb__free(T->ctx, uidx); sfb__free(T->ctx, piv); sfb__free(T->ctx, mark); sfb__free(T->ctx, cst); sfb__free(T->ctx, crow);
-    sfb__free(T->ctx, cw); sfb__free(T->ctx, B); sfb__free(T->ctx, L); sfb__free(T->ctx, deg);
+    sfb__free(T->ctx, uidx); sfb__free(T->ctx, piv); sfb__free(T->ctx, mark); sfb__free(T->ctx, cst); sfb__free(T->ctx, rst);
+    sfb__free(T->ctx, bo); sfb__free(T->ctx, crow); sfb__free(T->ctx, rcol); sfb__free(T->ctx, cw); sfb__free(T->ctx, rw);
+    sfb__free(T->ctx, acc); sfb__free(T->ctx, lk); sfb__free(T->ctx, bj); sfb__free(T->ctx, bv); sfb__free(T->ctx, deg);
     return ok;
 }
 
