@@ -1015,6 +1015,9 @@ static void templates_one(sfb_context *ctx, const char *name, const char *obj, u
                   sa.iterations < sb.iterations && sa.residual <= 1e-12 + sb.residual && (!want_direct || sa.direct > 0), nm,
               "largest difference %.3g (diag %.3g); %d components by %d templates and %d factors of their own, CGLS iterations %ld vs %ld, "
               "residual %.3g vs %.3g", worst, t.diag, sa.templated, sa.templates, sa.direct, sa.iterations, sb.iterations, sa.residual, sb.residual);
+        printf("  %s: largest difference from CGLS alone %.3g of the diagonal; %d regions by %d templates and %d factors of their own, "
+               "%ld CGLS iterations left (CGLS alone: %ld); residual %.3g (CGLS alone %.3g)\n",
+               nm, worst / t.diag, sa.templated, sa.templates, sa.direct, sa.iterations, sb.iterations, sa.residual, sb.residual);
     }
     sfb__free(ctx, a); sfb__free(ctx, b);
     sfb__level_free(ctx, &ra); sfb__level_free(ctx, &rb);
