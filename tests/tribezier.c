@@ -913,7 +913,11 @@ static void rings_as_walked(sfb_context *ctx, const char *name, const sfb__level
     memcpy(c.fv, rl->fv, (size_t)rl->nfv * sizeof(int));
     memcpy(c.fe, rl->fe, (size_t)rl->nfv * sizeof(int));
     memcpy(c.ev, rl->ev, 2 * (size_t)rl->ne * sizeof(int));
-    if (sfb__level_complete(ctx, &c) != SFB_SUCCESS) { fail(name, "sfb__level_complete: %s", sfb_last_error(ctx)); sfb__level_free(ctx, &c); return; }
+    if (sfb__level_complete(ctx, &c) != SFB_SUCCESS) {
+        fail(name, "sfb__level_complete: %s", sfb_last_error(ctx));
+        sfb__level_free(ctx, &c);
+        return;
+    }
 #define RINGS_SAME(field, count) \
     if (same && memcmp(c.field, rl->field, (size_t)(count) * sizeof(*c.field)) != 0) { same = 0; bad = __LINE__; }
     RINGS_SAME(vf_off, rl->nv + 1) RINGS_SAME(vf, rl->nfv) RINGS_SAME(vf_slot, rl->nfv) RINGS_SAME(ve_off, rl->nv + 1)

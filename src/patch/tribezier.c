@@ -169,7 +169,9 @@ static int tbz_gpt(const sfb__tbz *T, int f, const int w[3]) { return T->grid[15
 /* The lattice place (tbz_qij order) of the point with weights w[r] = 4 - i - j, w[r + 1] = i,
  * w[r + 2] = j, where q = tbz_qij(i, j): place q of the frame turned to start at corner r. */
 static int tbz_rot_q(int r, int q) {
-    static const signed char tab[3][15] = {{0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14}, {4, 8, 11, 13, 14, 3, 7, 10, 12, 2, 6, 9, 1, 5, 0}, {14, 12, 9, 5, 0, 13, 10, 6, 1, 11, 7, 2, 8, 3, 4}};
+    static const signed char tab[3][15] = {{0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14},
+                                           {4, 8, 11, 13, 14, 3, 7, 10, 12, 2, 6, 9, 1, 5, 0},
+                                           {14, 12, 9, 5, 0, 13, 10, 6, 1, 11, 7, 2, 8, 3, 4}};
     return tab[r][q];
 }
 
@@ -1270,7 +1272,7 @@ typedef struct tbz_walk {
     int *fidx;  /* per face: its index in the walk, -1 (every entry -1 between walks) */
     int *plab;  /* per point: its label, -1 */
     int *vdist; /* per vertex: its distance from the centre (0 to 2), -1 */
-    unsigned char *mine; /* per point: an unknown of the component walked (set by the caller) */
+    unsigned char *mine; /* per point: 0, and 1 meanwhile for a region's unknowns (tbz_tpl_apply) */
     int face[TBZ_WALK_FACES], rot[TBZ_WALK_FACES], nface;
     int vert[3 * TBZ_WALK_FACES], nvert;
     int lab[15 * TBZ_WALK_FACES], nlab; /* label -> point (tbz_walk_run with labels) */
@@ -2394,13 +2396,6 @@ sfb_result sfb__tribezier_points(sfb_context *ctx, const sfb__level *l, const fl
     return r;
 }
 
-/* One Loop step of the triangle mesh `b` into *rl: the smooth net's positions psm by its rules
- * (only boundaries sharp) into *ps, and the sharp net's psh by its rules (boundaries, every
- * tagged edge and corner tag) into *pp. Child face 4f + i of triangle f = (V0, V1, V2), edge points E01, E12,
- * E20: i = 0 (V0, E01, E20), 1 (E01, V1, E12), 2 (E20, E12, V2), 3 (E12, E20, E01) -- each in
- * the frame of quadtree child i of the parametric triangle (sfb__patch_locate), so its 15
- * points are that child patch's. Child edges keep their parent edge's tag, the old vertices
- * their corner tags. */
 /* The adjacency of child level rl (its faces, face edges and edge ends written by tbz_refine)
  * of b. Where every vertex of b with triangles has its rings in order and no edge is
  * non-manifold, each child vertex's rings follow from its parent's, in the order
@@ -2474,6 +2469,13 @@ static sfb_result tbz_child_rings(sfb_context *ctx, const sfb__level *b, sfb__le
     return sfb__level_complete_ordered(ctx, rl);
 }
 
+/* One Loop step of the triangle mesh `b` into *rl: the smooth net's positions psm by its rules
+ * (only boundaries sharp) into *ps, and the sharp net's psh by its rules (boundaries, every
+ * tagged edge and corner tag) into *pp. Child face 4f + i of triangle f = (V0, V1, V2), edge points E01, E12,
+ * E20: i = 0 (V0, E01, E20), 1 (E01, V1, E12), 2 (E20, E12, V2), 3 (E12, E20, E01) -- each in
+ * the frame of quadtree child i of the parametric triangle (sfb__patch_locate), so its 15
+ * points are that child patch's. Child edges keep their parent edge's tag, the old vertices
+ * their corner tags. */
 static sfb_result tbz_refine(sfb_context *ctx, const sfb__level *b, const float *psm, const float *psh, sfb__level *rl, float **ps,
                              float **pp) {
     const int nv = b->nv, nf = b->nf, ne = b->ne, nv2 = nv + ne;
