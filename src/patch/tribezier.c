@@ -1902,11 +1902,12 @@ static sfb_result tbz_solve(sfb__tbz *T) {
     }
 #define TBZ_ROW_EDGE(e) (l->ef_off[(e) + 1] - l->ef_off[e] == 2 && !T->efeat[e] && (near[l->ef[l->ef_off[e]]] || near[l->ef[l->ef_off[e] + 1]]))
     {
-        /* room for every candidate's five rows of 16 entries at once (growing by doubling
-         * copied them over and over: a third of the rows' time after two Loop steps) */
+        /* room for every candidate's five rows at once, 32 entries (tbz_edge_rows: 4, 8, 8, 8
+         * and 4; growing by doubling copied them over and over: a third of the rows' time after
+         * two Loop steps) */
         size_t cand = 0;
         for (e = 0; e < T->ne; ++e) cand += TBZ_ROW_EDGE(e);
-        S.cap = 80 * cand + 1;
+        S.cap = 32 * cand + 1;
         S.cap_rows = (int)(5 * cand + 2);
         S.col = (int *)sfb__alloc(T->ctx, S.cap * sizeof(int));
         S.w = (double *)sfb__alloc(T->ctx, S.cap * sizeof(double));
