@@ -8824,7 +8824,7 @@ static sfb_result tbz_templates(sfb__tbz *T, const tbz_sys *S, const tbz_comps *
         const int c = todo[t], nr = C->rstart[c + 1] - C->rstart[c], nu = C->ustart[c + 1] - C->ustart[c];
         const size_t need = tbz_comp_entries(S, C, c), nd = 6 * (size_t)nu + 3 * (size_t)nr;
         tbz_tpl P;
-        int nl = 0, r, made;
+        int nl = 0, r, made, k;
         size_t e;
         if (done[t] || nr == 0 || nr > TBZ_DIRECT_ROWS) continue;
         if (need > capdl) {
@@ -8842,20 +8842,16 @@ static sfb_result tbz_templates(sfb__tbz *T, const tbz_sys *S, const tbz_comps *
         for (r = C->rstart[c]; r < C->rstart[c + 1]; ++r)
             for (e = S->off[C->rows[r]]; e < S->off[C->rows[r] + 1]; ++e)
                 if (W->plab[S->col[e]] < 0) { W->plab[S->col[e]] = nl; dl[nl++] = S->col[e]; }
-        made = tbz_tpl_make(T, S, C, c, W->plab, nl, TBZ_DROP, &P);
-        if (made) {
-            T->st.direct++;
+        /* a factor dropping rows down to TBZ_DROP, and where its check fails once more keeping
+         * rows down to TBZ_DROP_RETRY. A row left just above TBZ_DROP can be independent by a
+         * little: dropping it left one of teapot.obj's regions (564 rows) at 4e-15 of the scale
+         * against the check's 2e-15, and CGLS then took 363 iterations (a third of its build)
+         * for what the factor keeping it meets; kept, the check decides as always */
+        for (made = 0, k = 0; k < 2 && !done[t]; ++k) {
+            if (!tbz_tpl_make(T, S, C, c, W->plab, nl, k ? TBZ_DROP_RETRY : TBZ_DROP, &P)) break;
+            if (!k) { made = 1; T->st.direct++; }
             if (tbz_tpl_apply(T, S, C, c, dl, nl, &P, dx, dx + 6 * (size_t)nu, W->mine, cres + c)) { done[t] = 1; T->st.templated++; }
             tbz_tpl_free(T->ctx, &P);
-            /* failed: once more keeping rows down to TBZ_DROP_RETRY. A row left just above
-             * TBZ_DROP can be independent by a little: dropping it left one of teapot.obj's
-             * regions (564 rows) at 4e-15 of the scale against the check's 2e-15, and CGLS
-             * then took 363 iterations (a third of its build) for what the factor keeping it
-             * meets; kept, the check decides as always */
-            if (!done[t] && tbz_tpl_make(T, S, C, c, W->plab, nl, TBZ_DROP_RETRY, &P)) {
-                if (tbz_tpl_apply(T, S, C, c, dl, nl, &P, dx, dx + 6 * (size_t)nu, W->mine, cres + c)) { done[t] = 1; T->st.templated++; }
-                tbz_tpl_free(T->ctx, &P);
-            }
         }
         for (i = 0; i < nl; ++i) W->plab[dl[i]] = -1;
         if (!made) continue;
@@ -8885,7 +8881,7 @@ static sfb_result tbz_solve(sfb__tbz *T) {
     int *ucol = NULL, *rstart, *ustart, *rows, *unk, *local = NULL, *erow = NULL, *todo = NULL;
     tbz_prev *rec = T->rec && !T->sharp && !T->reuse_x ? T->rec : NULL;
     unsigned char *near = NULL;
-    int nu = 0, e, i, r, nc, nc0, nt = 0;
+    int nu = 0, e, i, r, nc, nt = 0, any16;
     double scale = 0.0, *cres = NULL; /* per component: its residual where a template solved it, else -1 */
     sfb_result res = SFB_SUCCESS;
     memset(&S, 0, sizeof S);
@@ -8927,7 +8923,7 @@ static sfb_result tbz_solve(sfb__tbz *T) {
     for (i = 0; i < T->np; ++i) ucol[i] = (!T->fixed[i] && T->dist[i] <= TBZ_REACH) ? nu++ : -1;
     scale = T->scale;
     if ((res = tbz_components(T, &S, ucol, nu, &C)) != SFB_SUCCESS) goto done;
-    nc = nc0 = C.nc; rstart = C.rstart; ustart = C.ustart; rows = C.rows; unk = C.unk;
+    nc = C.nc; rstart = C.rstart; ustart = C.ustart; rows = C.rows; unk = C.unk;
     if (rec) {
         /* the net before the solve, and the components (tbz_prev); S joins them at the end */
         rec->x0 = (double *)sfb__alloc(T->ctx, 3 * (size_t)T->np * sizeof(double) + 1);
@@ -8957,12 +8953,9 @@ static sfb_result tbz_solve(sfb__tbz *T) {
      * fallback the first net's) */
     ours = (unsigned char *)sfb__calloc(T->ctx, (size_t)nc + 1, 1);
     if (!ours) { res = sfb__oom(T->ctx, "tribezier constraints"); goto done; }
-    {
-        int any = T->reuse_ours != NULL;
-        for (i = 0; i < T->nv && !any; ++i) any = (T->vtype[i] & 16) && T->virr[i];
-        if (!any) nc0 = 0; /* none: no row to look at */
-    }
-    for (i = 0; i < nc0; ++i)
+    any16 = T->reuse_ours != NULL; /* none: no row to look at */
+    for (i = 0; i < T->nv && !any16; ++i) any16 = (T->vtype[i] & 16) && T->virr[i];
+    for (i = 0; i < nc && any16; ++i)
         for (r = rstart[i]; r < rstart[i + 1] && !ours[i]; ++r) {
             const int e2 = S.edge[rows[r]], a = l->ev[2 * e2], b = l->ev[2 * e2 + 1];
             ours[i] = (unsigned char)(((T->vtype[a] & 16) && T->virr[a]) || ((T->vtype[b] & 16) && T->virr[b]) ||
