@@ -63,9 +63,13 @@
  * sub-patch), and their kernels run de Casteljau in double on the float relative points: a
  * quartic's second derivatives (12 x second differences, times 4^depth) lose too much in
  * float at depth 8, and in double they cost AVX2/AVX-512 about as many instructions (one xyzw
- * point per 256-bit register). A normal is made from float tangents only when the estimated angle
+ * point per 256-bit register). Without second derivatives, avx2 and avx512 evaluate two
+ * triangle locations in a row at once in float (sfb__simd_avx2_tri2: two points per 256-bit
+ * register, half the instructions; its error and measurements are beside it). A normal is
+ * made from float tangents only when the estimated angle
  * error, ~2e-7 E (|Pu| + |Pv|) / |Pu x Pv|, is below 1e-4 rad (triangles: 4 E, their
- * derivatives weigh the points by up to 8 where a B-spline's weigh them by 1); otherwise
+ * derivatives weigh the points by up to 8 where a B-spline's weigh them by 1; the float pair
+ * kernel's: 16 E); otherwise
  * (collapsed or nearly parallel tangents, overflow, NaN) the location goes to ref, whose
  * double evaluation and degenerate-tangent rule then decide the normal.
  *
@@ -75,16 +79,18 @@
  * (They work on a window's points with shuffles and horizontal sums, which the lane-per-
  * location vector operations of sfb_simd.h do not express: they stay intrinsics.)
  * Triangles: one point per 256-bit register of doubles (avx2, avx512), two 128-bit ones (sse2,
- * neon on AArch64), scalar double (portable, 32-bit neon).
- * Locations are prepared (located, grids prefetched) SFB__SIMD_AHEAD ahead of the kernel, so
- * that the loads of several locations are in flight at once. Threads: the locations are cut
- * into equal chunks over the pool (calls under SFB__SIMD_INLINE_LOCATIONS stay on the caller). */
+ * neon on AArch64), scalar double (portable, 32-bit neon); the float pair kernel (avx2, avx512).
+ * Locations are prepared (located, grids prefetched) in batches of SFB__SIMD_BATCH, a batch
+ * ahead of the kernels, so that the loads of many locations are in flight at once and their
+ * descents overlap (sfb__simd_prep_batch). Threads: the locations are cut into equal chunks
+ * over the pool (calls under SFB__SIMD_INLINE_LOCATIONS stay on the caller). */
 #define SFB__SIMD_STAM_LEVELS 3
 #define SFB__SIMD_LOOP_LEVELS 3     /* Stam-Loop levels packed (144 floats each) */
 #define SFB__SIMD_TRI_EFACTOR 4.0f  /* a triangle's E is scaled by this for the normal test */
 #define SFB__SIMD_TRI_FLOATS 48     /* a packed Bezier triangle (the layout above) */
 #define SFB__SIMD_TRI_ORIGIN 42     /* its o (E follows, at 3 cs + 15 with cs = 10) */
-#define SFB__SIMD_AHEAD 16
+#define SFB__SIMD_BATCH 64        /* locations prepared in one go, a batch ahead of the kernels */
+#define SFB__SIMD_TRI2_EFACTOR 4.0f /* the float pair kernel's E factor beyond SFB__SIMD_TRI_EFACTOR */
 
 
 /* One location made ready for a kernel: the window, where to evaluate it, and how to map its
@@ -195,30 +201,40 @@ static int sfb__simd_put_generic(const sfb__simd_pjob *j, int q, float r[6][4], 
 #include "patches_quad.h"
 #include "patches_tri.h"
 
-static void sfb__simd_prange_generic(const sfb__simd_pjob *j, int first, int last) {
-    sfb__simd_slot ring[SFB__SIMD_AHEAD];
+/* Prepares locations [a, b) into sl[0 .. b - a): one tight loop, so that the out-of-order core
+ * overlaps the descents of many locations (their dependent quadtree loads), where one prep
+ * between two kernels left each descent's latency exposed (bench torus: 23 against 27 ns a
+ * location; Catmull-Clark 33 against 37). */
+static SFB__SIMD_FORCEINLINE void sfb__simd_prep_batch(const sfb__simd_pjob *j, int a, int b, sfb__simd_slot *sl) {
     int q;
-    for (q = first; q < last && q < first + SFB__SIMD_AHEAD; ++q) {
-        if (j->tri) sfb__simd_prep_tri(j, q, &ring[q % SFB__SIMD_AHEAD]);
-        else sfb__simd_prep(j, q, &ring[q % SFB__SIMD_AHEAD]);
-    }
-    for (q = first; q < last; ++q) {
-        const sfb__simd_slot sl = ring[q % SFB__SIMD_AHEAD];
-        float r[6][4];
-        if (q + SFB__SIMD_AHEAD < last) {
-            if (j->tri) sfb__simd_prep_tri(j, q + SFB__SIMD_AHEAD, &ring[q % SFB__SIMD_AHEAD]);
-            else sfb__simd_prep(j, q + SFB__SIMD_AHEAD, &ring[q % SFB__SIMD_AHEAD]);
-        }
-        if (sl.run == SFB__SIMD_RUN_KERNEL || sl.run == SFB__SIMD_RUN_TRI) {
-            if (sl.run == SFB__SIMD_RUN_TRI) j->tri_eval(sl.blk, sl.s, sl.t, j->second, r);
-            else j->bs(sl.blk, sl.cs, sl.s, sl.t, j->second, r);
-            if (!sfb__simd_put_generic(j, q, r, &sl)) sfb__simd_ref_one(j, q);
-        } else if (sl.run == SFB__SIMD_RUN_STAM_FAR) {
-            sfb__simd_stam_far(j, q);
-        } else if (sl.run == SFB__SIMD_RUN_LOOP_FAR) {
-            sfb__simd_loop_far(j, q);
-        } else {
-            sfb__simd_ref_one(j, q);
+    if (j->tri)
+        for (q = a; q < b; ++q) sfb__simd_prep_tri(j, q, &sl[q - a]);
+    else
+        for (q = a; q < b; ++q) sfb__simd_prep(j, q, &sl[q - a]);
+}
+
+static void sfb__simd_prange_generic(const sfb__simd_pjob *j, int first, int last) {
+    sfb__simd_slot batch[2][SFB__SIMD_BATCH];
+    int b, cur = 0;
+    sfb__simd_prep_batch(j, first, last - first > SFB__SIMD_BATCH ? first + SFB__SIMD_BATCH : last, batch[0]);
+    for (b = first; b < last; b += SFB__SIMD_BATCH, cur ^= 1) {
+        const int e = last - b > SFB__SIMD_BATCH ? b + SFB__SIMD_BATCH : last;
+        int q;
+        sfb__simd_prep_batch(j, e, last - e > SFB__SIMD_BATCH ? e + SFB__SIMD_BATCH : last, batch[cur ^ 1]);
+        for (q = b; q < e; ++q) {
+            const sfb__simd_slot *sl = &batch[cur][q - b];
+            float r[6][4];
+            if (sl->run == SFB__SIMD_RUN_KERNEL || sl->run == SFB__SIMD_RUN_TRI) {
+                if (sl->run == SFB__SIMD_RUN_TRI) j->tri_eval(sl->blk, sl->s, sl->t, j->second, r);
+                else j->bs(sl->blk, sl->cs, sl->s, sl->t, j->second, r);
+                if (!sfb__simd_put_generic(j, q, r, sl)) sfb__simd_ref_one(j, q);
+            } else if (sl->run == SFB__SIMD_RUN_STAM_FAR) {
+                sfb__simd_stam_far(j, q);
+            } else if (sl->run == SFB__SIMD_RUN_LOOP_FAR) {
+                sfb__simd_loop_far(j, q);
+            } else {
+                sfb__simd_ref_one(j, q);
+            }
         }
     }
 }
@@ -237,15 +253,18 @@ static inline void sfb__simd_sse2_store3(float *dst, size_t at, __m128 v, int fu
 }
 
 /* Maps the derivatives (rotation, scale), makes the normal and stores location q from a window
- * result; returns 0, having written nothing, where the normal must come from ref. */
-static SFB__SIMD_FORCEINLINE int sfb__simd_sse2_put(const sfb__simd_pjob *j, int q, int full, const __m128 r[6], const sfb__simd_slot *sl) {
+ * result; returns 0, having written nothing, where the normal must come from ref. ef scales the
+ * window's E in the normal's float-trust test (1, or SFB__SIMD_TRI2_EFACTOR for the float pair
+ * kernel's results). */
+static SFB__SIMD_FORCEINLINE int sfb__simd_sse2_put(const sfb__simd_pjob *j, int q, int full, const __m128 r[6], const sfb__simd_slot *sl,
+                                                   float ef) {
     const sfb_eval_output *o = j->out;
     const size_t at = 3 * (size_t)q;
     const __m128 xyz = _mm_castsi128_ps(_mm_set_epi32(0, -1, -1, -1));
     const __m128 Pu = _mm_and_ps(r[1], xyz), Pv = _mm_and_ps(r[2], xyz), vsc = _mm_set1_ps(sl->dsc);
     __m128 du, dv;
     if (o->normal) {
-        const float E = sl->blk[3 * sl->cs + 15];
+        const float E = sl->blk[3 * sl->cs + 15] * ef;
         const __m128 n = SFB__SIMD_YZX(_mm_sub_ps(_mm_mul_ps(Pu, SFB__SIMD_YZX(Pv)), _mm_mul_ps(SFB__SIMD_YZX(Pu), Pv)));
         const __m128 x = _mm_mul_ps(Pu, Pu), y = _mm_mul_ps(Pv, Pv), z = _mm_mul_ps(n, n);
         __m128 ab = _mm_add_ps(_mm_unpacklo_ps(x, y), _mm_unpackhi_ps(x, y)); /* x0+x2 y0+y2 x1+x3 y1+y3 */
@@ -295,44 +314,50 @@ static SFB__SIMD_FORCEINLINE int sfb__simd_sse2_put(const sfb__simd_pjob *j, int
     return 1;
 }
 
-/* The range loop of the 128-bit-finishing kernels. */
-#define SFB__SIMD_PATCH_RANGE(NAME, ATTR, EVAL, TRI)                                                             \
+/* The range loop of the 128-bit-finishing kernels: batches of SFB__SIMD_BATCH locations, each
+ * prepared while the one before is evaluated. With PAIR (avx2, avx512), two triangle locations in
+ * a row without second derivatives go to the float pair kernel TRI2 (patches_tri.h). */
+#define SFB__SIMD_PATCH_RANGE(NAME, ATTR, EVAL, TRI, PAIR, TRI2)                                                 \
     ATTR static void NAME(const sfb__simd_pjob *j, int first, int last) {                                        \
-        sfb__simd_slot ring[SFB__SIMD_AHEAD];                                                                    \
-        int q;                                                                                                   \
-        for (q = first; q < last && q < first + SFB__SIMD_AHEAD; ++q) {                                          \
-            if (j->tri) sfb__simd_prep_tri(j, q, &ring[q % SFB__SIMD_AHEAD]);                                    \
-            else sfb__simd_prep(j, q, &ring[q % SFB__SIMD_AHEAD]);                                               \
-        }                                                                                                        \
-        for (q = first; q < last; ++q) {                                                                         \
-            const sfb__simd_slot sl = ring[q % SFB__SIMD_AHEAD];                                                 \
-            __m128 r[6];                                                                                         \
-            if (q + SFB__SIMD_AHEAD < last) {                                                                    \
-                if (j->tri) sfb__simd_prep_tri(j, q + SFB__SIMD_AHEAD, &ring[q % SFB__SIMD_AHEAD]);              \
-                else sfb__simd_prep(j, q + SFB__SIMD_AHEAD, &ring[q % SFB__SIMD_AHEAD]);                         \
-            }                                                                                                    \
-            if (sl.run == SFB__SIMD_RUN_KERNEL) {                                                                \
-                EVAL(sl.blk, sl.cs, sl.s, sl.t, j->second, r);                                                   \
-                if (!sfb__simd_sse2_put(j, q, q + 1 < last, r, &sl)) sfb__simd_ref_one(j, q);                    \
-            } else if (sl.run == SFB__SIMD_RUN_TRI) {                                                            \
-                TRI(sl.blk, sl.cs, sl.s, sl.t, j->second, r);                                                    \
-                if (!sfb__simd_sse2_put(j, q, q + 1 < last, r, &sl)) sfb__simd_ref_one(j, q);                    \
-            } else if (sl.run == SFB__SIMD_RUN_STAM_FAR) {                                                       \
-                sfb__simd_stam_far(j, q);                                                                        \
-            } else if (sl.run == SFB__SIMD_RUN_LOOP_FAR) {                                                       \
-                sfb__simd_loop_far(j, q);                                                                        \
-            } else {                                                                                             \
-                sfb__simd_ref_one(j, q);                                                                         \
+        sfb__simd_slot batch[2][SFB__SIMD_BATCH];                                                                \
+        int b, cur = 0;                                                                                          \
+        sfb__simd_prep_batch(j, first, last - first > SFB__SIMD_BATCH ? first + SFB__SIMD_BATCH : last, batch[0]); \
+        for (b = first; b < last; b += SFB__SIMD_BATCH, cur ^= 1) {                                              \
+            const int e = last - b > SFB__SIMD_BATCH ? b + SFB__SIMD_BATCH : last;                               \
+            int q;                                                                                               \
+            sfb__simd_prep_batch(j, e, last - e > SFB__SIMD_BATCH ? e + SFB__SIMD_BATCH : last, batch[cur ^ 1]); \
+            for (q = b; q < e; ++q) {                                                                            \
+                const sfb__simd_slot *sl = &batch[cur][q - b];                                                   \
+                __m128 r[6];                                                                                     \
+                if (PAIR && sl->run == SFB__SIMD_RUN_TRI && !j->second && q + 1 < e && sl[1].run == SFB__SIMD_RUN_TRI) { \
+                    __m128 r1[6];                                                                                \
+                    TRI2(sl[0].blk, sl[0].s, sl[0].t, sl[1].blk, sl[1].s, sl[1].t, r, r1);                       \
+                    if (!sfb__simd_sse2_put(j, q, 1, r, sl, SFB__SIMD_TRI2_EFACTOR)) sfb__simd_ref_one(j, q);    \
+                    ++q;                                                                                         \
+                    if (!sfb__simd_sse2_put(j, q, q + 1 < last, r1, sl + 1, SFB__SIMD_TRI2_EFACTOR)) sfb__simd_ref_one(j, q); \
+                } else if (sl->run == SFB__SIMD_RUN_KERNEL) {                                                    \
+                    EVAL(sl->blk, sl->cs, sl->s, sl->t, j->second, r);                                           \
+                    if (!sfb__simd_sse2_put(j, q, q + 1 < last, r, sl, 1.0f)) sfb__simd_ref_one(j, q);           \
+                } else if (sl->run == SFB__SIMD_RUN_TRI) {                                                       \
+                    TRI(sl->blk, sl->cs, sl->s, sl->t, j->second, r);                                            \
+                    if (!sfb__simd_sse2_put(j, q, q + 1 < last, r, sl, 1.0f)) sfb__simd_ref_one(j, q);           \
+                } else if (sl->run == SFB__SIMD_RUN_STAM_FAR) {                                                  \
+                    sfb__simd_stam_far(j, q);                                                                    \
+                } else if (sl->run == SFB__SIMD_RUN_LOOP_FAR) {                                                  \
+                    sfb__simd_loop_far(j, q);                                                                    \
+                } else {                                                                                         \
+                    sfb__simd_ref_one(j, q);                                                                     \
+                }                                                                                                \
             }                                                                                                    \
         }                                                                                                        \
     }
 
-SFB__SIMD_PATCH_RANGE(sfb__simd_prange_sse2, , sfb__simd_sse2_eval, sfb__simd_sse2_tri)
+SFB__SIMD_PATCH_RANGE(sfb__simd_prange_sse2, , sfb__simd_sse2_eval, sfb__simd_sse2_tri, 0, sfb__simd_sse2_tri2_none)
 #endif /* SFB__SIMD_SSE2 */
 
 #ifdef SFB__SIMD_X86_DISPATCH
-SFB__SIMD_PATCH_RANGE(sfb__simd_prange_avx2, SFB__SIMD_TARGET_AVX2, sfb__simd_avx2_eval, sfb__simd_avx2_tri)
-SFB__SIMD_PATCH_RANGE(sfb__simd_prange_avx512, SFB__SIMD_TARGET_AVX512, sfb__simd_avx512_eval, sfb__simd_avx512_tri)
+SFB__SIMD_PATCH_RANGE(sfb__simd_prange_avx2, SFB__SIMD_TARGET_AVX2, sfb__simd_avx2_eval, sfb__simd_avx2_tri, 1, sfb__simd_avx2_tri2)
+SFB__SIMD_PATCH_RANGE(sfb__simd_prange_avx512, SFB__SIMD_TARGET_AVX512, sfb__simd_avx512_eval, sfb__simd_avx512_tri, 1, sfb__simd_avx512_tri2)
 #endif /* SFB__SIMD_X86_DISPATCH */
 
 /* ---- the family ---- */

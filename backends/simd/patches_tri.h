@@ -22,7 +22,9 @@ static void sfb__simd_loop_far(const sfb__simd_pjob *j, int q) {
 /* prep for a Loop table: the triangle descent of sfb__patch_locate, in double with ref's very
  * operations (so the patch, (s, t) and the Stam-Loop level and sub-patch are ref's), without
  * branches on the child (random here): child c's (u, v) is sg (2u - a_u, 2v - a_v) with
- * sg = -1 for the middle child, whose 1 - 2u is -(2u - 1) exactly. */
+ * sg = -1 for the middle child, whose 1 - 2u is -(2u - 1) exactly. sg is 1 - 2 c3 converted,
+ * not `c3 ? -1.0 : 1.0`, which GCC made a branch: mispredicted for a quarter of the locations
+ * at every level, it cost 3.5 ns a location of the 1 M random ones on the bench's torus. */
 static SFB__SIMD_FORCEINLINE void sfb__simd_prep_tri(const sfb__simd_pjob *j, int q, sfb__simd_slot *o) {
     const sfb__simd_patches *h = j->h;
     const sfb_location *l = &j->locs[q];
@@ -30,7 +32,7 @@ static SFB__SIMD_FORCEINLINE void sfb__simd_prep_tri(const sfb__simd_pjob *j, in
     double s = l->u, t = l->v, sc = 1.0;
     while (node >= 0) {
         const int c1 = s >= 0.5, c2 = !c1 & (t >= 0.5), c3 = !c1 & !c2 & !(s + t < 0.5);
-        const double sg = c3 ? -1.0 : 1.0;
+        const double sg = (double)(1 - 2 * c3);
         s = (s + s - (double)(c1 | c3)) * sg;
         t = (t + t - (double)(c2 | c3)) * sg;
         sc = (sc + sc) * sg;
@@ -73,7 +75,7 @@ static SFB__SIMD_FORCEINLINE void sfb__simd_prep_tri(const sfb__simd_pjob *j, in
         c0 = u >= 0.5;
         c1 = !c0 & (v >= 0.5);
         c2 = !c0 & !c1;
-        sg = c2 ? -1.0 : 1.0;
+        sg = (double)(1 - 2 * c2);
         o->s = (float)((u + u - (double)(c0 | c2)) * sg);
         o->t = (float)((v + v - (double)(c1 | c2)) * sg);
         o->blk = h->blk + 4 * (size_t)(code >> 4) + (size_t)(n - 1) * 3 * SFB__SIMD_TRI_FLOATS + (size_t)(c1 + 2 * c2) * SFB__SIMD_TRI_FLOATS;
@@ -167,6 +169,12 @@ static SFB__SIMD_FORCEINLINE void sfb__simd_sse2_tri(const float *blk, int cs, f
 #undef SFB__SIMD_DC_SSE2
 #undef SFB__SIMD_PS2
 }
+
+/* sse2 has no pair kernel (the range loop's PAIR is 0 there, so this is never called). */
+static SFB__SIMD_FORCEINLINE void sfb__simd_sse2_tri2_none(const float *b0, float s0, float t0, const float *b1, float s1, float t1, __m128 r0[6],
+                                                           __m128 r1[6]) {
+    (void)b0; (void)s0; (void)t0; (void)b1; (void)s1; (void)t1; (void)r0; (void)r1;
+}
 #endif /* SFB__SIMD_SSE2 */
 
 #ifdef SFB__SIMD_X86_DISPATCH
@@ -200,6 +208,51 @@ static SFB__SIMD_FORCEINLINE void sfb__simd_sse2_tri(const float *blk, int cs, f
 #define SFB__SIMD_DC_PD(to, from, above) p[to] = _mm256_fmadd_pd(vt, p[above], _mm256_fmadd_pd(vs, p[(from) + 1], _mm256_mul_pd(vw, p[from])));
 SFB__SIMD_TRI_PD(sfb__simd_avx2_tri, SFB__SIMD_TARGET_AVX2)
 SFB__SIMD_TRI_PD(sfb__simd_avx512_tri, SFB__SIMD_TARGET_AVX512)
+
+/* Two locations' quartic triangles at once, position and first derivatives only, in float: the
+ * two points (i, j) as one 256-bit register (xyzw of b0, xyzw of b1), the same de Casteljau steps
+ * as sfb__simd_tri_portable. Half the instructions of two calls of the double kernel: 1 M random
+ * locations (position, du, dv; one thread, avx512 on an AMD EPYC) took 21 instead of 23 ns each
+ * on the bench's torus, and 12.8 instead of 15.5 on tribezier_crease_v5.obj, whose patches stay
+ * in cache (spot.obj, 17 MB of patches, is bound by memory at 37 ns either way).
+ * Its error: the points are float already (2^-24 E each, E as in patches.h), and each of the
+ * three steps down to degree 1 adds up to about one rounding of E, so the tangents
+ * (4 x differences) carry up to ~4 times the double kernel's error: the normal's float-trust
+ * test weighs this kernel's E by SFB__SIMD_TRI2_EFACTOR (16 E in all). Measured against ref on
+ * spot, cow, teapot and the bench's torus (tribezier, 300,000 random locations each): positions
+ * within 5e-8 x diagonal, about one rounding of the coordinates (double kernel 4e-9), du and
+ * dv within 9e-7 of their length (3e-7), normals within 3.1e-6 rad (4.6e-7). Second
+ * derivatives, which would lose too much in float (12 x second differences, times 4^depth),
+ * stay with the double kernel. */
+#define SFB__SIMD_TRI2_PS(NAME, ATTR)                                                                                \
+    ATTR static SFB__SIMD_FORCEINLINE void NAME(const float *b0, float s0, float t0, const float *b1, float s1, float t1, \
+                                               __m128 r0[6], __m128 r1[6]) {                                        \
+        const __m256 vs = _mm256_insertf128_ps(_mm256_set1_ps(s0), _mm_set1_ps(s1), 1);                            \
+        const __m256 vt = _mm256_insertf128_ps(_mm256_set1_ps(t0), _mm_set1_ps(t1), 1);                            \
+        const __m256 vw = _mm256_insertf128_ps(_mm256_set1_ps((float)((1.0 - s0) - t0)), _mm_set1_ps((float)((1.0 - s1) - t1)), 1); \
+        __m256 p[15], x;                                                                                             \
+        int a;                                                                                                       \
+        p[0] = _mm256_setzero_ps();                                                                                  \
+        for (a = 1; a < 15; ++a) p[a] = SFB__SIMD_LD2(b0 + 3 * (a - 1), b1 + 3 * (a - 1));                           \
+        SFB__SIMD_DC4(SFB__SIMD_DC_PS)                                                                               \
+        SFB__SIMD_DC3(SFB__SIMD_DC_PS)                                                                               \
+        SFB__SIMD_DC2(SFB__SIMD_DC_PS)                                                                               \
+        x = _mm256_add_ps(_mm256_fmadd_ps(vt, p[2], _mm256_fmadd_ps(vs, p[1], _mm256_mul_ps(vw, p[0]))),           \
+                          SFB__SIMD_LD2(b0 + SFB__SIMD_TRI_ORIGIN, b1 + SFB__SIMD_TRI_ORIGIN));                     \
+        r0[0] = _mm256_castps256_ps128(x);                                                                           \
+        r1[0] = _mm256_extractf128_ps(x, 1);                                                                         \
+        x = _mm256_mul_ps(_mm256_set1_ps(4.0f), _mm256_sub_ps(p[1], p[0]));                                          \
+        r0[1] = _mm256_castps256_ps128(x);                                                                           \
+        r1[1] = _mm256_extractf128_ps(x, 1);                                                                         \
+        x = _mm256_mul_ps(_mm256_set1_ps(4.0f), _mm256_sub_ps(p[2], p[0]));                                          \
+        r0[2] = _mm256_castps256_ps128(x);                                                                           \
+        r1[2] = _mm256_extractf128_ps(x, 1);                                                                         \
+        r0[3] = r0[4] = r0[5] = r1[3] = r1[4] = r1[5] = _mm_setzero_ps();                                            \
+    }
+#define SFB__SIMD_LD2(a, b) _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(a)), _mm_loadu_ps(b), 1)
+#define SFB__SIMD_DC_PS(to, from, above) p[to] = _mm256_fmadd_ps(vt, p[above], _mm256_fmadd_ps(vs, p[(from) + 1], _mm256_mul_ps(vw, p[from])));
+SFB__SIMD_TRI2_PS(sfb__simd_avx2_tri2, SFB__SIMD_TARGET_AVX2)
+SFB__SIMD_TRI2_PS(sfb__simd_avx512_tri2, SFB__SIMD_TARGET_AVX512)
 #endif /* SFB__SIMD_X86_DISPATCH */
 
 #ifdef SFB__SIMD_NEON
