@@ -203,8 +203,8 @@ static int sfb__simd_put_generic(const sfb__simd_pjob *j, int q, float r[6][4], 
 
 /* Prepares locations [a, b) into sl[0 .. b - a): one tight loop, so that the out-of-order core
  * overlaps the descents of many locations (their dependent quadtree loads), where one prep
- * between two kernels left each descent's latency exposed (bench torus: 23 against 27 ns a
- * location; Catmull-Clark 33 against 37). */
+ * between two kernels left each descent's latency exposed (1 M random locations on the bench's
+ * tori, one thread: Catmull-Clark 33 against 37 ns a location, tribezier 23 against 24). */
 static SFB__SIMD_FORCEINLINE void sfb__simd_prep_batch(const sfb__simd_pjob *j, int a, int b, sfb__simd_slot *sl) {
     int q;
     if (j->tri)
