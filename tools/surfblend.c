@@ -224,7 +224,7 @@ static const opt_spec options[] = {
     { "--orthographic", NULL, K_SET, C_ANALYZE, O_ORTHO, AT(ortho), NULL, NULL, 0, 0, 1, NULL, "orthographic camera (default perspective)" },
     { "--edges", NULL, K_SET, C_RENDER, O_EDGES, AT(edges), NULL, NULL, 0, 0, 1, NULL, "draw the refined mesh's edges" },
     { "--rate", NULL, K_LONG, C_RENDER, O_RATE, AT(rate), "N", NULL, ANY_INT, 0, "a number",
-      "--scheme manifold: segments per parametric-face edge, 1..1024 (default 16)" },
+      "--scheme manifold, tribezier, pn: segments per parametric-face edge, 1..1024 (default 16)" },
     { "--manifold-weights", NULL, K_CHOICE, C_RENDER, O_WEIGHTS, AT(weights), NULL, weight_choices, 0, 0, 0, NULL,
       "--scheme manifold: blend weights Hermite (default) or C-infinity" },
     { "--trim", NULL, K_STRING, C_TESS | C_RENDER, O_TRIM, AT(trim), "MASK.png", NULL, 0, 0, 0, "a PNG file",
@@ -1103,7 +1103,8 @@ static int render_check(cli_opts *o) {
     int manifold = render_tessellates(o);
     if (o->seen[O_MODE] > 1) return usage_error(o->cmd, "render takes one of --highlight, --blend-weights, --normal-colors");
     if (!manifold && (o->seen[O_RATE] || o->trim))
-        return usage_error(o->cmd, "--rate and --trim belong to --scheme manifold (the subdivision schemes render their shaded refinement)");
+        return usage_error(o->cmd, "--rate and --trim belong to the tessellated schemes, manifold, tribezier and pn (the subdivision schemes "
+                                   "render their shaded refinement)");
     if (o->seen[O_TILES] && !o->trim) return usage_error(o->cmd, "--trim-tiles needs --trim MASK.png");
     if (manifold && o->mode == SFB_RENDER_WEIGHTS)
         return usage_error(o->cmd, "--blend-weights pictures belong to subdivision shading (the manifold blend's are --manifold-weights)");
@@ -1478,8 +1479,9 @@ static const cli_command commands[] = {
     { "shade", C_SHADE, "[options] IN.obj -o OUT.obj", "subdivision shading (seed 001): v, blended normals as vn, f v//vn",
       "prints output vertices, split vertices (infinitely sharp creases) and where N_S was computed", 1, "OUT.obj", cmd_shade },
     { "render", C_RENDER, "[options] IN.obj -o OUT.png", "a software picture of the shaded surface (PNG)",
-      "one of --highlight, --blend-weights, --normal-colors (default grey shading); --rate, --manifold-weights\n"
-      "    and --trim belong to --scheme manifold, the shading options and --blend-weights to the other schemes",
+      "one of --highlight, --blend-weights, --normal-colors (default grey shading); --rate and --trim belong to\n"
+      "    the tessellated schemes (manifold, tribezier, pn), --manifold-weights to manifold, the shading options\n"
+      "    and --blend-weights to the subdivision schemes",
       1, "OUT.png", cmd_render },
     { "analyze", C_ANALYZE, "[options] IN.obj -o OUT.png", "surface quality (seed 003) from the exact limit surface per pixel (PNG)",
       "every pixel is projected onto the exact surface along its view ray and shaded from its exact normal\n"
