@@ -26,7 +26,8 @@
  *                            application threads calling eval on one surface at once
  *   simd/threads/patches-S   the simd patch upload over its pool: Catmull-Clark and Loop surfaces of
  *                            a triangulated torus built on 1 and on 4 threads evaluate the same bit
- *                            for bit (position, derivatives, normal)
+ *                            for bit (position, derivatives, normal; and without second derivatives,
+ *                            the simd float pair kernel's case, over an odd count of locations)
  *   BACKEND/eval_gl          sfb_surface_eval_stencils_gl returns SFB_UNSUPPORTED (no host context)
  * and, independent of availability:
  *   env/bogus                SURFBLEND_BACKEND=bogus: the context is still created on the default
@@ -864,7 +865,8 @@ static void *call_thread(void *arg) {
  * patches on): a Catmull-Clark surface of a triangulated torus (every patch a Stam one) and a
  * Loop one (Stam-Loop patches at its valence-4 and -8 vertices), each built on one thread and on
  * four, evaluate (position, first and second derivatives, normal) the same bit for bit at 20000
- * random locations; the table must be large enough for the pool to be used. */
+ * random locations, and (position, du, dv, normal) at 19999 of them; the table must be large
+ * enough for the pool to be used. */
 static void run_patch_threads(void) {
     backend *simd = NULL;
     int b, scheme;
@@ -926,18 +928,27 @@ static void run_patch_threads(void) {
                         loc[i].u = (float)a / 1024.0f;
                         loc[i].v = (float)rng_int(&g, scheme ? 1025 - a : 1025) / 1024.0f;
                     }
-                out[t] = (float *)xmalloc((size_t)NLOC * 21 * sizeof(float));
+                out[t] = (float *)xmalloc((size_t)NLOC * 33 * sizeof(float));
                 o.position = out[t]; o.du = out[t] + 3 * NLOC; o.dv = out[t] + 6 * NLOC; o.normal = out[t] + 9 * NLOC;
                 o.duu = out[t] + 12 * NLOC; o.duv = out[t] + 15 * NLOC; o.dvv = out[t] + 18 * NLOC;
                 if (sfb_surface_eval(s, loc, NLOC, &o) != SFB_SUCCESS) { fail(name, "eval: %s", sfb_last_error(ctx)); ok = 0; }
+                /* without second derivatives (avx2, avx512: triangles two at a time in float),
+                 * NLOC - 1 locations: the pool's chunks then start at odd places */
+                memset(&o, 0, sizeof o);
+                o.position = out[t] + 21 * NLOC; o.du = out[t] + 24 * NLOC; o.dv = out[t] + 27 * NLOC; o.normal = out[t] + 30 * NLOC;
+                memset(out[t] + 21 * NLOC, 0, (size_t)NLOC * 12 * sizeof(float));
+                if (ok && sfb_surface_eval(s, loc, NLOC - 1, &o) != SFB_SUCCESS) { fail(name, "eval: %s", sfb_last_error(ctx)); ok = 0; }
             }
             sfb_surface_destroy(s);
             if (ctx) sfb_context_destroy(ctx);
         }
-        if (ok)
-            check(npatch[0] >= 2048 && npatch[0] == npatch[1] && memcmp(out[0], out[1], (size_t)NLOC * 21 * sizeof(float)) == 0, name,
-                  "%d and %d patches (the pool packs from 2048 on); evaluations %s", npatch[0], npatch[1],
-                  memcmp(out[0], out[1], (size_t)NLOC * 21 * sizeof(float)) == 0 ? "the same" : "DIFFER between 1 and 4 threads");
+        if (ok) {
+            const int same = memcmp(out[0], out[1], (size_t)NLOC * 21 * sizeof(float)) == 0;
+            const int same1 = memcmp(out[0] + 21 * NLOC, out[1] + 21 * NLOC, (size_t)NLOC * 12 * sizeof(float)) == 0;
+            check(npatch[0] >= 2048 && npatch[0] == npatch[1] && same && same1, name,
+                  "%d and %d patches (the pool packs from 2048 on); evaluations %s, without second derivatives %s", npatch[0], npatch[1],
+                  same ? "the same" : "DIFFER between 1 and 4 threads", same1 ? "the same" : "DIFFER between 1 and 4 threads");
+        }
         free(out[0]); free(out[1]); free(loc);
         sfb_mesh_destroy(mesh);
     }

@@ -89,7 +89,6 @@
 #define SFB__SIMD_TRI_EFACTOR 4.0f  /* a triangle's E is scaled by this for the normal test */
 #define SFB__SIMD_TRI_FLOATS 48     /* a packed Bezier triangle (the layout above) */
 #define SFB__SIMD_TRI_ORIGIN 42     /* its o (E follows, at 3 cs + 15 with cs = 10) */
-#define SFB__SIMD_BATCH 64        /* locations prepared in one go, a batch ahead of the kernels */
 #define SFB__SIMD_TRI2_EFACTOR 4.0f /* the float pair kernel's E factor beyond SFB__SIMD_TRI_EFACTOR */
 
 
@@ -316,7 +315,13 @@ static SFB__SIMD_FORCEINLINE int sfb__simd_sse2_put(const sfb__simd_pjob *j, int
 
 /* The range loop of the 128-bit-finishing kernels: batches of SFB__SIMD_BATCH locations, each
  * prepared while the one before is evaluated. With PAIR (avx2, avx512), two triangle locations in
- * a row without second derivatives go to the float pair kernel TRI2 (patches_tri.h). */
+ * a row of a batch without second derivatives go to the float pair kernel TRI2 (patches_tri.h),
+ * a triangle location without such a neighbour to the double kernel: the same call gives the same
+ * bits on any number of threads (eval_patches cuts it in whole batches), but a location may differ
+ * in its last bits between calls where it has a neighbour and where it has none. (Giving a lone
+ * location the pair kernel too, paired with itself, made the loop over a third slower on the bench's torus,
+ * whose locations are all paired: whatever was added there, a branch, a deferred list or a call,
+ * the loop's descent loads stalled longer; not understood, left.) */
 #define SFB__SIMD_PATCH_RANGE(NAME, ATTR, EVAL, TRI, PAIR, TRI2)                                                 \
     ATTR static void NAME(const sfb__simd_pjob *j, int first, int last) {                                        \
         sfb__simd_slot batch[2][SFB__SIMD_BATCH];                                                                \

@@ -609,6 +609,11 @@ static inline float64x2_t sfb__vnd_sel(uint64x2_t m, float64x2_t a, float64x2_t 
  * evaluates the families it holds (sfb__patch_families), and each call to the family's
  * prepare, which picks its kernels for the state's instruction set. */
 #define SFB__SIMD_INLINE_LOCATIONS 4096 /* eval_patches calls with fewer locations stay on the caller's thread */
+/* Locations a patch range loop prepares in one go, a batch ahead of its kernels (patches.h);
+ * eval_patches cuts a call over the pool in whole batches from its first location, so that every
+ * location is in the same place of the same batch whatever the threads (the float pair kernel
+ * pairs neighbours within a batch: the same bits on 1 thread and on 4). */
+#define SFB__SIMD_BATCH 64
 enum { SFB__SIMD_LEAF_BSPLINE = 0, SFB__SIMD_LEAF_STAM = 1, SFB__SIMD_LEAF_REF = 2, SFB__SIMD_LEAF_TRI = 3 };
 
 struct sfb__simd_patch_family;
@@ -641,6 +646,7 @@ typedef struct sfb__simd_pjob {
     sfb__simd_bs_fn bs;
     sfb__simd_tri_fn tri_eval;
     void (*range)(const struct sfb__simd_pjob *j, int first, int last); /* what a pool chunk runs */
+    int first, last;   /* the call's locations (pool chunks: batches first + k SFB__SIMD_BATCH ..) */
 } sfb__simd_pjob;
 
 typedef void (*sfb__simd_prange_fn)(const sfb__simd_pjob *j, int first, int last);

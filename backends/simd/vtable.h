@@ -36,10 +36,12 @@ static sfb_result sfb__simd_upload_patches(void *state, const sfb__patch_table *
 }
 
 #ifdef SFB__SIMD_THREADS
+/* batches [a, b) of the call (SFB__SIMD_BATCH locations each from its first) */
 static void sfb__simd_patch_task(const sfb__simd_state *s, const void *arg, int a, int b) {
     const sfb__simd_pjob *j = (const sfb__simd_pjob *)arg;
+    const long long end = (long long)j->first + (long long)b * SFB__SIMD_BATCH;
     (void)s;
-    j->range(j, a, b);
+    j->range(j, j->first + a * SFB__SIMD_BATCH, end < j->last ? (int)end : j->last);
 }
 #endif
 
@@ -60,9 +62,12 @@ static sfb_result sfb__simd_eval_patches(void *state, const sfb__patch_table *pt
     j.out = out;
     j.second = out->duu || out->duv || out->dvv;
     j.tri = pt->domain == SFB__DOMAIN_TRI;
+    j.first = first;
+    j.last = last;
     h->family->prepare(s, &j);
 #ifdef SFB__SIMD_THREADS
-    if (last - first >= SFB__SIMD_INLINE_LOCATIONS && sfb__simd_pool_run(s, sfb__simd_patch_task, &j, first, last, NULL, 0, 0))
+    if (last - first >= SFB__SIMD_INLINE_LOCATIONS &&
+        sfb__simd_pool_run(s, sfb__simd_patch_task, &j, 0, (last - first - 1) / SFB__SIMD_BATCH + 1, NULL, 0, 0))
         return SFB_SUCCESS;
 #endif
     j.range(&j, first, last);
