@@ -64,14 +64,14 @@
  * quartic's second derivatives (12 x second differences, times 4^depth) lose too much in
  * float at depth 8, and in double they cost AVX2/AVX-512 about as many instructions (one xyzw
  * point per 256-bit register). Without second derivatives, avx2 and avx512 evaluate two
- * triangle locations in a row at once in float (sfb__simd_avx2_tri2: two points per 256-bit
- * register, half the instructions; its error and measurements are beside it). A normal is
- * made from float tangents only when the estimated angle
- * error, ~2e-7 E (|Pu| + |Pv|) / |Pu x Pv|, is below 1e-4 rad (triangles: 4 E, their
- * derivatives weigh the points by up to 8 where a B-spline's weigh them by 1; the float pair
- * kernel's: 16 E); otherwise
- * (collapsed or nearly parallel tangents, overflow, NaN) the location goes to ref, whose
- * double evaluation and degenerate-tangent rule then decide the normal.
+ * triangle locations in a row of a batch at once in float (sfb__simd_avx2_tri2: two points per
+ * 256-bit register, half the instructions; its error and measurements are beside it; a location
+ * without such a neighbour runs the double kernel). A normal is made from float tangents only
+ * when the estimated angle error, ~2e-7 E (|Pu| + |Pv|) / |Pu x Pv|, is below 1e-4 rad
+ * (triangles: 4 E, their derivatives weigh the points by up to 8 where a B-spline's weigh them
+ * by 1; the float pair kernel's: 16 E); otherwise (collapsed or nearly parallel tangents,
+ * overflow, NaN) the location goes to ref, whose double evaluation and degenerate-tangent rule
+ * then decide the normal.
  *
  * Kernels: avx512 (a column of 4 points per register), avx2 (2 points per register), sse2
  * (xyz in 4 lanes per point; no FMA); these finish (scale, rotate, normal, stores) in 128-bit
