@@ -7,7 +7,8 @@
  * (so AddressSanitizer sees any over-read); a junk count is always negative or above
  * SFB_MAX_ELEMENTS and must be refused before its array is read.
  *
- * If sfb_mesh_create accepts the desc: OBJ write/re-read round trip (same counts), then one
+ * If sfb_mesh_create accepts the desc: OBJ write/re-read round trip (same counts),
+ * sfb_mesh_triangulate (k - 2 triangles per face of k corners), then one
  * surface (scheme, level 0..2 and flags from the input), sfb_surface_refine with topology
  * checks, and one sfb_surface_eval_stencils call. Invariant violations abort().
  *
@@ -381,6 +382,25 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         (void)sfb_mesh_valence_histogram(mesh, hist, 16);
 
         round_trip(ctx, mesh);
+
+        /* triangles made of it (raw float bits: NaN, inf, flat polygons): every face of k
+         * corners k - 2 triangles, or an error with a message and no mesh */
+        {
+            sfb_mesh *tri = NULL;
+            int split = -1, want = 0;
+            sfb_result tr = sfb_mesh_triangulate(ctx, mesh, &tri, &split);
+            if (tr == SFB_SUCCESS) {
+                sfb_mesh_info ti;
+                for (int f = 0; f < got.face_count; ++f) want += got.face_sizes[f] - 2;
+                sfb_mesh_get_info(tri, &ti);
+                if (!tri || ti.face_count != want || ti.triangles != want || split != info.quads + info.ngons || ti.vertex_count != info.vertex_count)
+                    fail("sfb_mesh_triangulate's counts");
+            } else {
+                check_error(ctx, tr, "sfb_mesh_triangulate");
+                if (tri) fail("sfb_mesh_triangulate failed with a mesh");
+            }
+            sfb_mesh_destroy(tri);
+        }
 
         sfb_scheme scheme = (sfb_scheme)(u8(r) % 5);
         int level = u8(r) % 3;

@@ -9,7 +9,9 @@
  *     is unit length or zero; when every input position is finite and small (|x| < 1e6), the
  *     positions are finite and every point lies within the bounding box grown by 10 times its
  *     diagonal (the net is an affine combination of the vertices, the G1 solve's change small);
- *   - tessellate at rate 3 and check the triangles' indices.
+ *   - tessellate at rate 3 and check the triangles' indices;
+ *   - a mesh with faces of more than three corners: sfb_mesh_triangulate (pieces, tags, holes
+ *     checked: triangulated()), then all of the above on the result.
  * A violated invariant calls abort().
  *
  * Build (from the repository root):
@@ -107,6 +109,55 @@ static void run(sfb_context *ctx, const sfb_mesh *mesh, size_t size)
     sfb_surface_destroy(s);
 }
 
+/* A mesh with faces of more than three corners: sfb_mesh_triangulate, then the surface of the
+ * result. Invariants: success or a message; on success every face of k corners became k - 2
+ * triangles of its own vertices (in order), the vertices and corners are kept, every crease tag
+ * is one of the mesh's, each hole's pieces are holes. */
+static void triangulated(sfb_context *ctx, const sfb_mesh *mesh, size_t size)
+{
+    sfb_mesh *t = NULL;
+    sfb_mesh_desc d, o;
+    int split = -1, f, k, at = 0, out = 0, nh = 0, h;
+    sfb_result r = sfb_mesh_triangulate(ctx, mesh, &t, &split);
+    if (r != SFB_SUCCESS) {
+        if (!sfb_last_error(ctx)[0]) fail("empty error message after failure of", "sfb_mesh_triangulate");
+        if (t) fail("a mesh returned with an error", NULL);
+        return;
+    }
+    sfb_mesh_get_desc(mesh, &d);
+    sfb_mesh_get_desc(t, &o);
+    /* (two crease tags may become one: a face that repeats a vertex can make two edges of one
+     * vertex pair, which its triangles join) */
+    if (o.vertex_count != d.vertex_count || o.crease_count > d.crease_count || o.corner_count != d.corner_count)
+        fail("triangulate lost vertices or corners, or made creases", NULL);
+    for (k = 0; k < o.crease_count; ++k) {
+        const int a = o.crease_vertices[2 * k], b = o.crease_vertices[2 * k + 1];
+        int j = 0;
+        while (j < d.crease_count && !(((d.crease_vertices[2 * j] == a && d.crease_vertices[2 * j + 1] == b) ||
+                                        (d.crease_vertices[2 * j] == b && d.crease_vertices[2 * j + 1] == a)) &&
+                                       d.crease_sharpness[j] == o.crease_sharpness[k]))
+            ++j;
+        if (j == d.crease_count) fail("a crease tag that was not in the mesh", NULL);
+    }
+    for (f = 0; f < d.face_count; ++f) {
+        const int n = d.face_sizes[f];
+        split -= n > 3;
+        for (k = 0; k < 3 * (n - 2); ++k, ++out) {
+            int j = 0;
+            if (out >= 3 * o.face_count) fail("triangulate made too few faces", NULL);
+            while (j < n && d.face_vertices[at + j] != o.face_vertices[out]) ++j;
+            if (j == n) fail("a triangle's corner is not one of its face's", NULL);
+        }
+        for (h = 0; h < d.hole_count; ++h) nh += d.holes[h] == f ? n - 2 : 0;
+        at += n;
+    }
+    if (out != 3 * o.face_count || split != 0 || nh != o.hole_count) fail("triangulate's counts", NULL);
+    for (f = 0; f < o.face_count; ++f)
+        if (o.face_sizes[f] != 3) fail("triangulate left a face that is not a triangle", NULL);
+    run(ctx, t, size);
+    sfb_mesh_destroy(t);
+}
+
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
     sfb_context_config cc = sfb_context_config_init();
@@ -116,7 +167,10 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     cc.memory_budget = (size_t)256 << 20;
     if (sfb_context_create(&cc, &ctx) != SFB_SUCCESS) return 0;
     if (sfb_mesh_read_obj(ctx, (const char *)data, size, &mesh) == SFB_SUCCESS) {
+        sfb_mesh_info info;
         run(ctx, mesh, size);
+        sfb_mesh_get_info(mesh, &info);
+        if (info.quads + info.ngons > 0) triangulated(ctx, mesh, size);
         sfb_mesh_destroy(mesh);
     }
     sfb_context_destroy(ctx);

@@ -443,6 +443,212 @@ SFB_API sfb_result sfb_mesh_crease_by_angle(sfb_context *ctx, const sfb_mesh *m,
     return r;
 }
 
+/* ---- sfb_mesh_triangulate ---- */
+
+/* The diagonals made so far (vertex pairs, low index first, packed in 64 bits; 0 = empty slot):
+ * open addressing, at most half full. */
+typedef struct sfb__pairs {
+    unsigned long long *slot;
+    size_t mask;
+} sfb__pairs;
+static size_t sfb__pairs_at(const sfb__pairs *P, unsigned long long key) {
+    size_t h = (size_t)((key * 0x9E3779B97F4A7C15ull) >> 17) & P->mask;
+    while (P->slot[h] && P->slot[h] != key) h = (h + 1) & P->mask;
+    return h;
+}
+static unsigned long long sfb__pair_key(int a, int b) {
+    return a < b ? ((unsigned long long)(unsigned)a << 32 | (unsigned)b) + 1 : ((unsigned long long)(unsigned)b << 32 | (unsigned)a) + 1;
+}
+
+/* 1 when the mesh has an edge between vertices a and b, or an earlier split made one. */
+static int sfb__has_edge(const sfb__level *l, const sfb__pairs *P, int a, int b) {
+    int j;
+    for (j = l->ve_off[a]; j < l->ve_off[a + 1]; ++j)
+        if (sfb__other_end(l, l->ve[j], a) == b) return 1;
+    return P->slot[sfb__pairs_at(P, sfb__pair_key(a, b))] != 0;
+}
+
+/* Polygons of more corners than this are fanned from their first corner (ear clipping costs the
+ * square of the corners; a convex cap, the usual big polygon, fans the same) */
+#define SFB__EAR_MAX 256
+
+/* Is corner i (of the remaining polygon nx/pv, 2D points q) an ear: convex, and no other remaining
+ * corner inside or on its triangle? key: its closing diagonal's preference (lower first: a
+ * diagonal that is already an edge of the mesh after every other, then by length). */
+static int sfb__ear(const sfb_mesh *m, const sfb__pairs *P, const int *fv, const double *q, const int *nx, const int *pv, int i, double tol, double *key) {
+    const int p = pv[i], n = nx[i];
+    const double ax = q[2 * p], ay = q[2 * p + 1], bx = q[2 * i], by = q[2 * i + 1], cx = q[2 * n], cy = q[2 * n + 1];
+    const double area = (bx - ax) * (cy - ay) - (by - ay) * (cx - ax);
+    const float *pa = m->positions + 3 * (size_t)fv[p], *pc = m->positions + 3 * (size_t)fv[n];
+    int j;
+    if (!(area > tol)) return 0;
+    for (j = nx[n]; j != p; j = nx[j]) {
+        const double x = q[2 * j], y = q[2 * j + 1];
+        /* inside or on the triangle (a corner at the same place as one of the three counts too:
+         * cutting there would leave a sliver) */
+        if ((bx - ax) * (y - ay) - (by - ay) * (x - ax) >= -tol && (cx - bx) * (y - by) - (cy - by) * (x - bx) >= -tol &&
+            (ax - cx) * (y - cy) - (ay - cy) * (x - cx) >= -tol)
+            return 0;
+    }
+    *key = ((double)pa[0] - pc[0]) * ((double)pa[0] - pc[0]) + ((double)pa[1] - pc[1]) * ((double)pa[1] - pc[1]) +
+           ((double)pa[2] - pc[2]) * ((double)pa[2] - pc[2]);
+    if (sfb__has_edge(&m->base, P, fv[p], fv[n])) *key += 1e300;
+    return 1;
+}
+
+/* Face f (k >= 4 corners) as k - 2 triangles of its local corner indices, into tri. Ear clipping in
+ * the plane of its Newell normal; each step cuts the ear whose closing diagonal is shortest (so a
+ * quad is split along its shorter diagonal where that lies inside it), a diagonal that is already
+ * an edge of the mesh last; where no corner is an ear (a polygon folded over itself, or flat to
+ * rounding) the corner with the largest triangle is cut. Its diagonals join P. Scratch: 3k ints,
+ * 3k doubles. */
+static void sfb__split_face(const sfb_mesh *m, sfb__pairs *P, int f, int *tri, int *iw, double *dw) {
+    const sfb__level *l = &m->base;
+    const int o = l->fv_off[f], k = l->fv_off[f + 1] - o, *fv = l->fv + o;
+    int *nx = iw, *pv = iw + k, *ear = iw + 2 * k, i, left = k, nt = 0;
+    double *q = dw, *key = dw + 2 * k, nrm[3], e1[3], e2[3], len, scale = 0.0, tol;
+    if (k > SFB__EAR_MAX) {
+        for (i = 1; i + 1 < k; ++i) {
+            tri[3 * nt] = 0; tri[3 * nt + 1] = i; tri[3 * nt + 2] = i + 1;
+            ++nt;
+            if (i > 1) {
+                const unsigned long long key2 = sfb__pair_key(fv[0], fv[i]);
+                P->slot[sfb__pairs_at(P, key2)] = key2;
+            }
+        }
+        return;
+    }
+    sfb__face_newell(m, f, nrm);
+    len = sqrt(nrm[0] * nrm[0] + nrm[1] * nrm[1] + nrm[2] * nrm[2]);
+    if (len > 0.0 && isfinite(len)) {
+        /* e1, e2: an orthonormal pair with e1 x e2 along the normal (so the polygon runs
+         * counter-clockwise in (e1, e2)) */
+        const int ax = fabs(nrm[0]) < fabs(nrm[1]) ? (fabs(nrm[0]) < fabs(nrm[2]) ? 0 : 2) : (fabs(nrm[1]) < fabs(nrm[2]) ? 1 : 2);
+        double t[3] = {0.0, 0.0, 0.0}, d;
+        int c;
+        for (c = 0; c < 3; ++c) nrm[c] /= len;
+        t[ax] = 1.0;
+        d = t[0] * nrm[0] + t[1] * nrm[1] + t[2] * nrm[2];
+        for (c = 0; c < 3; ++c) e1[c] = t[c] - d * nrm[c];
+        d = sqrt(e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2]);
+        for (c = 0; c < 3; ++c) e1[c] /= d;
+        e2[0] = nrm[1] * e1[2] - nrm[2] * e1[1];
+        e2[1] = nrm[2] * e1[0] - nrm[0] * e1[2];
+        e2[2] = nrm[0] * e1[1] - nrm[1] * e1[0];
+    } else {
+        e1[0] = 1.0; e1[1] = e1[2] = 0.0;
+        e2[1] = 1.0; e2[0] = e2[2] = 0.0;
+    }
+    for (i = 0; i < k; ++i) {
+        const float *p = m->positions + 3 * (size_t)fv[i];
+        q[2 * i] = p[0] * e1[0] + p[1] * e1[1] + p[2] * e1[2];
+        q[2 * i + 1] = p[0] * e2[0] + p[1] * e2[1] + p[2] * e2[2];
+        nx[i] = (i + 1) % k;
+        pv[i] = (i + k - 1) % k;
+    }
+    for (i = 0; i < k; ++i) {
+        const double dx = q[2 * i] - q[2 * nx[i]], dy = q[2 * i + 1] - q[2 * nx[i] + 1];
+        scale = fmax(scale, dx * dx + dy * dy);
+    }
+    tol = 1e-12 * scale;
+    for (i = 0; i < k; ++i) ear[i] = sfb__ear(m, P, fv, q, nx, pv, i, tol, key + i);
+    for (i = 0; left > 3; --left) {
+        int best = -1, j, c = i;
+        /* the best ear; none: the corner of the largest triangle */
+        for (j = 0; j < left; ++j, c = nx[c])
+            if (ear[c] && (best < 0 || key[c] < key[best])) best = c;
+        if (best < 0) {
+            double amax = -1e300;
+            for (j = 0, c = i; j < left; ++j, c = nx[c]) {
+                const int p = pv[c], n = nx[c];
+                const double a = (q[2 * c] - q[2 * p]) * (q[2 * n + 1] - q[2 * p + 1]) - (q[2 * c + 1] - q[2 * p + 1]) * (q[2 * n] - q[2 * p]);
+                if (best < 0 || a > amax) { best = c; amax = a; }
+            }
+        }
+        tri[3 * nt] = pv[best]; tri[3 * nt + 1] = best; tri[3 * nt + 2] = nx[best];
+        ++nt;
+        {
+            const unsigned long long key2 = sfb__pair_key(fv[pv[best]], fv[nx[best]]);
+            P->slot[sfb__pairs_at(P, key2)] = key2;
+        }
+        nx[pv[best]] = nx[best];
+        pv[nx[best]] = pv[best];
+        i = nx[best];
+        if (left > 4) {
+            ear[pv[best]] = sfb__ear(m, P, fv, q, nx, pv, pv[best], tol, key + pv[best]);
+            ear[nx[best]] = sfb__ear(m, P, fv, q, nx, pv, nx[best], tol, key + nx[best]);
+        }
+    }
+    tri[3 * nt] = pv[i]; tri[3 * nt + 1] = i; tri[3 * nt + 2] = nx[i];
+}
+
+SFB_API sfb_result sfb_mesh_triangulate(sfb_context *ctx, const sfb_mesh *m, sfb_mesh **out, int *split) {
+    const sfb__level *l;
+    sfb_mesh_desc d;
+    int *sizes = NULL, *fvo = NULL, *fuv = NULL, *holes = NULL, *first = NULL, *tri = NULL, *iw = NULL;
+    double *dw = NULL;
+    int f, i, nt = 0, nsplit = 0, kmax = 3, nh = 0;
+    size_t at = 0, ndiag = 0, cap = 16;
+    sfb__pairs P;
+    sfb_result r;
+    if (split) *split = 0;
+    if (!ctx || !m || !out) return SFB_INVALID_ARGS;
+    *out = NULL;
+    l = &m->base;
+    for (f = 0; f < l->nf; ++f) {
+        const int k = l->fv_off[f + 1] - l->fv_off[f];
+        nt += k - 2;
+        nsplit += k > 3;
+        if (k > kmax) kmax = k;
+        ndiag += (size_t)(k - 3);
+    }
+    while (cap < 2 * ndiag + 2) cap *= 2;
+    P.mask = cap - 1;
+    P.slot = (unsigned long long *)sfb__calloc(ctx, cap, sizeof(unsigned long long));
+    sizes = (int *)sfb__alloc(ctx, ((size_t)nt + 1) * sizeof(int));
+    fvo = (int *)sfb__alloc(ctx, ((size_t)nt + 1) * 3 * sizeof(int));
+    fuv = m->face_uvs ? (int *)sfb__alloc(ctx, ((size_t)nt + 1) * 3 * sizeof(int)) : NULL;
+    first = (int *)sfb__alloc(ctx, ((size_t)l->nf + 1) * sizeof(int));
+    tri = (int *)sfb__alloc(ctx, (size_t)kmax * 3 * sizeof(int));
+    iw = (int *)sfb__alloc(ctx, (size_t)kmax * 3 * sizeof(int));
+    dw = (double *)sfb__alloc(ctx, (size_t)kmax * 3 * sizeof(double));
+    holes = (int *)sfb__alloc(ctx, ((size_t)nt + 1) * sizeof(int));
+    if (!sizes || !fvo || (m->face_uvs && !fuv) || !first || !tri || !iw || !dw || !holes || !P.slot) {
+        r = sfb__oom(ctx, "the triangulated faces");
+        goto done;
+    }
+    for (f = 0, nt = 0; f < l->nf; ++f) {
+        const int o = l->fv_off[f], k = l->fv_off[f + 1] - o;
+        first[f] = nt;
+        if (k == 3) { tri[0] = 0; tri[1] = 1; tri[2] = 2; }
+        else sfb__split_face(m, &P, f, tri, iw, dw);
+        for (i = 0; i < 3 * (k - 2); ++i) {
+            fvo[at] = l->fv[o + tri[i]];
+            if (fuv) fuv[at] = m->face_uvs[o + tri[i]];
+            ++at;
+        }
+        for (i = 0; i < k - 2; ++i) sizes[nt++] = 3;
+    }
+    for (i = 0; i < m->hole_count; ++i) {
+        const int h = m->holes[i], k = l->fv_off[h + 1] - l->fv_off[h];
+        int j;
+        for (j = 0; j < k - 2; ++j) holes[nh++] = first[h] + j;
+    }
+    sfb_mesh_get_desc(m, &d);
+    d.face_count = nt;
+    d.face_sizes = sizes;
+    d.face_vertices = fvo;
+    d.face_uvs = fuv;
+    d.hole_count = nh;
+    d.holes = holes;
+    r = sfb_mesh_create(ctx, &d, out);
+    if (r == SFB_SUCCESS && split) *split = nsplit;
+done:
+    sfb__free(ctx, sizes); sfb__free(ctx, fvo); sfb__free(ctx, fuv); sfb__free(ctx, first);
+    sfb__free(ctx, tri); sfb__free(ctx, iw); sfb__free(ctx, dw); sfb__free(ctx, holes); sfb__free(ctx, P.slot);
+    return r;
+}
+
 SFB_API void sfb_mesh_get_info(const sfb_mesh *m, sfb_mesh_info *o) {
     const sfb__level *l;
     sfb__level prep;

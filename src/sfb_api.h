@@ -195,6 +195,18 @@ SFB_API void sfb_mesh_get_desc(const sfb_mesh *mesh, sfb_mesh_desc *out);
  * made sharp. */
 SFB_API sfb_result sfb_mesh_crease_by_angle(sfb_context *ctx, const sfb_mesh *mesh, float degrees, sfb_mesh **out, int *added);
 
+/* A copy of `mesh` with every face of more than three corners split into triangles, what the
+ * loop, tribezier and pn schemes need from a mesh of quads or mixed faces. A quad is split along
+ * its shorter diagonal (the other where the shorter lies outside a non-convex quad); a larger
+ * polygon by ear clipping in the plane of its Newell normal, each step cutting the ear whose
+ * closing diagonal is shortest (polygons of more than 256 corners are fanned from their first
+ * corner). A diagonal that is already an edge of the mesh is taken only where no other will do.
+ * Face f of k corners becomes the k - 2 faces that follow those of the faces before it, in order
+ * (a triangle stays one face), its triangles keep its orientation. Kept: positions, crease tags
+ * (per edge; the new diagonals are smooth), corners, UVs (per corner), the rules; each triangle
+ * of a hole is a hole. *split (may be NULL) gets the number of faces that were split. */
+SFB_API sfb_result sfb_mesh_triangulate(sfb_context *ctx, const sfb_mesh *mesh, sfb_mesh **out, int *split);
+
 typedef int (*sfb_write_fn)(const void *data, size_t size, void *user); /* returns non-zero on failure */
 /* Writes OBJ (v, vt, f, t crease/corner/hole/interpolateboundary/creasemethod/smoothtriangles). */
 SFB_API sfb_result sfb_write_obj(const sfb_mesh_desc *desc, sfb_write_fn write, void *user);

@@ -75,7 +75,8 @@ static sfb_result sfb__surface_check(sfb_context *ctx, const sfb_mesh *mesh, con
     if (si->caps & SFB__SCHEME_TRIANGLES)
         for (f = 0; f < mesh->base.nf; ++f)
             if (mesh->base.fv_off[f + 1] - mesh->base.fv_off[f] != 3)
-                return sfb__error(ctx, SFB_INVALID_TOPOLOGY, SFB_ELEMENT_FACE, f, "%s subdivision needs triangles; this face has %d vertices",
+                return sfb__error(ctx, SFB_INVALID_TOPOLOGY, SFB_ELEMENT_FACE, f, "%s subdivision needs triangles; this face has %d vertices (sfb_mesh_triangulate, "
+                                  "the tools' --triangulate, splits faces into triangles)",
                                   si->title, mesh->base.fv_off[f + 1] - mesh->base.fv_off[f]);
     bytes = sfb__estimate_bytes(mesh, (si->caps & SFB__SCHEME_TRIANGLES) != 0, cfg->refine_level, (cfg->flags & SFB_REFINE_LIMIT) != 0, &faces);
     if (faces > (double)SFB_MAX_ELEMENTS)

@@ -161,7 +161,8 @@ static sfb_result trimesh_of_mesh(sfb_context *ctx, const sfb_mesh *mesh, const 
     l = &mesh->base;
     for (f = 0; f < l->nf; ++f)
         if (l->fv_off[f + 1] - l->fv_off[f] != 3 || l->fv_off[f] != 3 * f)
-            return sfb__error(ctx, SFB_INVALID_TOPOLOGY, SFB_ELEMENT_FACE, f, "%s needs triangles; this face has %d vertices", who,
+            return sfb__error(ctx, SFB_INVALID_TOPOLOGY, SFB_ELEMENT_FACE, f, "%s needs triangles; this face has %d vertices (sfb_mesh_triangulate, the tools' "
+                              "--triangulate, splits faces into triangles)", who,
                               l->fv_off[f + 1] - l->fv_off[f]);
     if (!sfb__mul_size((size_t)l->nv + 1, 3 * sizeof(double), &bytes) || !(*pos = (double *)sfb__alloc(ctx, bytes)))
         return sfb__oom(ctx, who);

@@ -146,6 +146,7 @@ Test(api, result_strings_nonempty_and_distinct)
 
 typedef struct counter {
     long live, total, bad_frees;
+    long fail_after; /* > 0: allocations fail once `total` has reached it */
 } counter;
 
 typedef struct hdr {
@@ -157,6 +158,7 @@ typedef struct hdr {
 static void *c_alloc(size_t n, void *user)
 {
     counter *c = user;
+    if (c->fail_after > 0 && c->total >= c->fail_after) return NULL;
     hdr *h = malloc(sizeof(hdr) + n);
     if (!h) return NULL;
     h->size = n;
@@ -208,7 +210,7 @@ static sfb_context_config counting_config(counter *c)
 
 Test(api, context_custom_allocator_no_leaks)
 {
-    counter c = { 0, 0, 0 };
+    counter c = { 0, 0, 0, 0 };
     sfb_context_config cc = counting_config(&c);
     sfb_context *ctx = NULL;
     cr_assert_eq(sfb_context_create(&cc, &ctx), SFB_SUCCESS);
@@ -320,7 +322,7 @@ static int progress_cb(float done, const char *stage, void *user)
 
 Test(api, progress_cancels_surface_create)
 {
-    counter c = { 0, 0, 0 };
+    counter c = { 0, 0, 0, 0 };
     prog p = { 0, 1 << 30, 0, 0.0f }; /* no cancel while the mesh is built */
     sfb_context_config cc = counting_config(&c);
     cc.progress.func = progress_cb;
@@ -947,6 +949,205 @@ Test(api, crease_by_angle)
     cr_expect_eq(sfb_mesh_crease_by_angle(ctx, NULL, 30.0f, &c, &added), SFB_INVALID_ARGS);
     sfb_mesh_destroy(m);
     sfb_context_destroy(ctx);
+}
+
+/* the edge a-b among a triangle mesh's faces: how many faces have it */
+static int faces_with_edge(const sfb_mesh_desc *d, int a, int b)
+{
+    int n = 0;
+    for (int f = 0; f < d->face_count; ++f)
+        for (int k = 0; k < 3; ++k) {
+            const int p = d->face_vertices[3 * f + k], q = d->face_vertices[3 * f + (k + 1) % 3];
+            n += (p == a && q == b) || (p == b && q == a);
+        }
+    return n;
+}
+
+/* twice the signed area of triangle f's projection on z */
+static double tri_area_z(const sfb_mesh_desc *d, int f)
+{
+    const float *a = d->positions + 3 * d->face_vertices[3 * f], *b = d->positions + 3 * d->face_vertices[3 * f + 1],
+                *c = d->positions + 3 * d->face_vertices[3 * f + 2];
+    return ((double)b[0] - a[0]) * ((double)c[1] - a[1]) - ((double)b[1] - a[1]) * ((double)c[0] - a[0]);
+}
+
+/* sfb_mesh_triangulate: quads along the shorter diagonal that lies inside them, polygons by ear
+ * clipping (no flipped or overlapping triangle: the areas add up), tags, UVs and holes carried,
+ * no diagonal made twice (a valence-2 vertex whose two quads share two edges), the result usable
+ * by the triangle schemes; bad arguments and allocation failures leave nothing behind. */
+Test(api, triangulate)
+{
+    /* face 0: a quad whose diagonal 1-3 (2.2) is shorter than 0-2 (4.1);
+     * face 1: an arrowhead quad (reflex corner 5) whose shorter diagonal 4-6 lies outside;
+     * face 2: a concave L-shaped hexagon of area 3; face 3: a triangle */
+    static const float pos[] = { 0, 0, 0, 3, 0, 0, 4, 1, 0, 1, 1, 0,                   /* 0-3 */
+                                 10, 0, 0, 12, 0.8f, 0, 14, 0, 0, 12, 6, 0,          /* 4-7 */
+                                 20, 0, 0, 22, 0, 0, 22, 1, 0, 21, 1, 0, 21, 2, 0, 20, 2, 0, /* 8-13 */
+                                 30, 0, 0, 31, 0, 0, 30, 1, 0 };                     /* 14-16 */
+    static const int sizes[4] = { 4, 4, 6, 3 };
+    static const int fv[] = { 0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16 };
+    static const float uvs[] = { 0, 0, 1, 0, 1, 1, 0, 1 };
+    static const int fuv[] = { 0, 1, 2, 3, 0, 1, 2, 3, 0, 1, 2, 3, 0, 1, 0, 1, 2 };
+    static const int cv[2] = { 8, 9 };
+    static const float cs[1] = { 2.5f };
+    static const int cornv[1] = { 11 };
+    static const float corns[1] = { 3.0f };
+    static const int holes[1] = { 1 };
+    counter cnt = { 0, 0, 0, 0 };
+    sfb_context_config cc = counting_config(&cnt);
+    sfb_context *ctx = NULL;
+    cr_assert_eq(sfb_context_create(&cc, &ctx), SFB_SUCCESS);
+    sfb_mesh_desc d;
+    memset(&d, 0, sizeof d);
+    d.vertex_count = 17;
+    d.positions = pos;
+    d.face_count = 4;
+    d.face_sizes = sizes;
+    d.face_vertices = fv;
+    d.uv_count = 4;
+    d.uvs = uvs;
+    d.face_uvs = fuv;
+    d.crease_count = 1;
+    d.crease_vertices = cv;
+    d.crease_sharpness = cs;
+    d.corner_count = 1;
+    d.corner_vertices = cornv;
+    d.corner_sharpness = corns;
+    d.hole_count = 1;
+    d.holes = holes;
+    d.boundary = SFB_BOUNDARY_EDGE_AND_CORNER;
+    sfb_mesh *m = NULL, *t = NULL;
+    cr_assert_eq(sfb_mesh_create(ctx, &d, &m), SFB_SUCCESS, "%s", sfb_last_error(ctx));
+    int split = -1;
+    cr_assert_eq(sfb_mesh_triangulate(ctx, m, &t, &split), SFB_SUCCESS, "%s", sfb_last_error(ctx));
+    cr_expect_eq(split, 3);
+    sfb_mesh_desc o;
+    sfb_mesh_get_desc(t, &o);
+    cr_assert_eq(o.face_count, 2 + 2 + 4 + 1);
+    for (int f = 0; f < o.face_count; ++f) cr_expect_eq(o.face_sizes[f], 3, "face %d", f);
+    cr_expect_eq(o.vertex_count, 17);
+    cr_expect_eq(faces_with_edge(&o, 1, 3), 2, "the quad's shorter diagonal");
+    cr_expect_eq(faces_with_edge(&o, 0, 2), 0);
+    cr_expect_eq(faces_with_edge(&o, 5, 7), 2, "the arrowhead's diagonal inside it");
+    cr_expect_eq(faces_with_edge(&o, 4, 6), 0, "not the shorter one outside it");
+    /* every triangle keeps the faces' orientation (+z), and the pieces of each face cover its
+     * area once: 2 x area 3, 2 x 5.2 (the arrowhead: 4 x 6 / 2 - 4 x 0.8 / 2), 2 x 3, 2 x 0.5 */
+    static const double want[4] = { 6.0, 20.8, 6.0, 1.0 };
+    static const int first[5] = { 0, 2, 4, 8, 9 }, fo[4] = { 0, 4, 8, 14 }; /* pieces, corners of each face */
+    for (int f = 0; f < 4; ++f) {
+        double sum = 0.0;
+        for (int k = first[f]; k < first[f + 1]; ++k) {
+            cr_expect_gt(tri_area_z(&o, k), 1e-6, "triangle %d of face %d flipped or flat", k, f);
+            sum += tri_area_z(&o, k);
+        }
+        cr_expect(fabs(sum - want[f]) < 1e-5, "face %d: the pieces' area %g, the polygon's %g", f, sum, want[f]);
+        /* each piece's corners come from its face, with their UVs */
+        for (int k = 3 * first[f]; k < 3 * first[f + 1]; ++k) {
+            int j = 0;
+            while (j < sizes[f] && fv[fo[f] + j] != o.face_vertices[k]) ++j;
+            cr_expect_lt(j, sizes[f], "corner %d of piece of face %d is not one of its vertices", k, f);
+            if (j < sizes[f]) cr_expect_eq(o.face_uvs[k], fuv[fo[f] + j], "corner %d's UV", k);
+        }
+    }
+    /* the tags: the crease, the corner and the rules kept; both pieces of the hole are holes */
+    cr_expect_eq(o.crease_count, 1);
+    cr_expect(o.crease_count == 1 && o.crease_sharpness[0] == 2.5f);
+    cr_expect(o.corner_count == 1 && o.corner_vertices[0] == 11 && o.corner_sharpness[0] == 3.0f);
+    cr_expect_eq(o.boundary, SFB_BOUNDARY_EDGE_AND_CORNER);
+    cr_expect(o.hole_count == 2 && o.holes[0] == 2 && o.holes[1] == 3, "holes %d: %d %d", o.hole_count, o.hole_count > 0 ? o.holes[0] : -1,
+              o.hole_count > 1 ? o.holes[1] : -1);
+    sfb_mesh_destroy(t);
+    t = NULL;
+    sfb_mesh_destroy(m);
+    m = NULL;
+
+    /* a valence-2 vertex v (0) whose two quads (a v b x) and (b v a y) share the edges v-a and
+     * v-b: both quads' shorter diagonal is a-b; made twice it would be an edge of four triangles */
+    static const float pos2[] = { 0, 0, 1, -1, 0, 0, 1, 0, 0, 0, 2, 0, 0, -2, 0 };
+    static const int sizes2[2] = { 4, 4 };
+    static const int fv2[8] = { 1, 0, 2, 3, 2, 0, 1, 4 };
+    memset(&d, 0, sizeof d);
+    d.vertex_count = 5;
+    d.positions = pos2;
+    d.face_count = 2;
+    d.face_sizes = sizes2;
+    d.face_vertices = fv2;
+    cr_assert_eq(sfb_mesh_create(ctx, &d, &m), SFB_SUCCESS, "%s", sfb_last_error(ctx));
+    cr_assert_eq(sfb_mesh_triangulate(ctx, m, &t, NULL), SFB_SUCCESS, "%s", sfb_last_error(ctx));
+    sfb_mesh_info in;
+    sfb_mesh_get_info(t, &in);
+    cr_expect_eq(in.face_count, 4);
+    cr_expect_eq(in.nonmanifold_edges, 0, "a diagonal made twice");
+    sfb_mesh_get_desc(t, &o);
+    cr_expect_eq(faces_with_edge(&o, 1, 2), 2, "the first quad takes a-b");
+    sfb_mesh_destroy(t);
+    t = NULL;
+    sfb_mesh_destroy(m);
+    m = NULL;
+
+    /* a quad grid, triangulated, is what the triangle schemes take; untouched faces are copied */
+    grid g = grid_make(3, 3);
+    d = grid_desc(&g);
+    cr_assert_eq(sfb_mesh_create(ctx, &d, &m), SFB_SUCCESS);
+    sfb_surface *s = NULL;
+    sfb_surface_config sc = sfb_surface_config_init(SFB_SCHEME_TRIBEZIER, 0);
+    sc.flags = SFB_REFINE_PATCHES;
+    cr_expect_eq(sfb_surface_create(ctx, m, &sc, &s), SFB_INVALID_TOPOLOGY, "quads are refused");
+    cr_assert_eq(sfb_mesh_triangulate(ctx, m, &t, &split), SFB_SUCCESS, "%s", sfb_last_error(ctx));
+    cr_expect_eq(split, 9);
+    sfb_mesh_info in2;
+    sfb_mesh_get_info(t, &in2);
+    cr_expect_eq(in2.triangles, 18);
+    cr_expect_eq(in2.nonmanifold_edges, 0);
+    const sfb_scheme schemes[3] = { SFB_SCHEME_TRIBEZIER, SFB_SCHEME_PN, SFB_SCHEME_LOOP };
+    for (int i = 0; i < 3; ++i) {
+        sc = sfb_surface_config_init(schemes[i], schemes[i] == SFB_SCHEME_LOOP ? 1 : 0);
+        if (schemes[i] != SFB_SCHEME_LOOP) sc.flags = SFB_REFINE_PATCHES;
+        cr_expect_eq(sfb_surface_create(ctx, t, &sc, &s), SFB_SUCCESS, "scheme %d: %s", (int)schemes[i], sfb_last_error(ctx));
+        sfb_surface_destroy(s);
+        s = NULL;
+    }
+    sfb_mesh *t2 = NULL;
+    cr_assert_eq(sfb_mesh_triangulate(ctx, t, &t2, &split), SFB_SUCCESS);
+    cr_expect_eq(split, 0, "a triangle mesh has nothing to split");
+    sfb_mesh_get_desc(t, &d);
+    sfb_mesh_get_desc(t2, &o);
+    cr_expect(o.face_count == d.face_count && !memcmp(o.face_vertices, d.face_vertices, sizeof(int) * 3 * (size_t)d.face_count),
+              "a triangle mesh is copied as it is");
+    sfb_mesh_destroy(t2);
+    sfb_mesh_destroy(t);
+    t = NULL;
+
+    /* bad arguments */
+    cr_expect_eq(sfb_mesh_triangulate(NULL, m, &t, &split), SFB_INVALID_ARGS);
+    cr_expect_eq(sfb_mesh_triangulate(ctx, NULL, &t, &split), SFB_INVALID_ARGS);
+    cr_expect_eq(sfb_mesh_triangulate(ctx, m, NULL, &split), SFB_INVALID_ARGS);
+    cr_expect_null(t);
+
+    /* every allocation failing in turn: out of memory, nothing returned, nothing leaked */
+    int fails = 0;
+    for (long k = 0;; ++k) {
+        cnt.fail_after = cnt.total + k;
+        split = -1;
+        sfb_result r = sfb_mesh_triangulate(ctx, m, &t, &split);
+        cnt.fail_after = 0;
+        if (r == SFB_SUCCESS) {
+            cr_expect_eq(split, 9);
+            sfb_mesh_destroy(t);
+            t = NULL;
+            break;
+        }
+        cr_expect_eq(r, SFB_OUT_OF_MEMORY, "allocation %ld failing: %s", k, sfb_result_string(r));
+        cr_expect_null(t);
+        cr_expect_eq(split, 0);
+        ++fails;
+        cr_assert_lt(k, 200, "no success after 200 failing allocations");
+    }
+    cr_expect_gt(fails, 5, "the failures were not reached (%d)", fails);
+    sfb_mesh_destroy(m);
+    grid_free(&g);
+    sfb_context_destroy(ctx);
+    cr_expect_eq(cnt.live, 0, "%ld allocations leaked", cnt.live);
 }
 
 /* the stencil tables and sfb_surface_refine agree, and refine_positions follows new positions */

@@ -1987,7 +1987,8 @@ static sfb_result fil_check(sfb_context *ctx, const sfb_mesh *mesh, const sfb_fi
     if (l->nf == 0) return sfb__error(ctx, SFB_INVALID_TOPOLOGY, SFB_ELEMENT_NONE, -1, "the mesh has no faces");
     for (f = 0; f < l->nf; ++f)
         if (l->fv_off[f + 1] - l->fv_off[f] != 3)
-            return sfb__error(ctx, SFB_INVALID_TOPOLOGY, SFB_ELEMENT_FACE, f, "it has %d vertices: fillets need a triangle mesh",
+            return sfb__error(ctx, SFB_INVALID_TOPOLOGY, SFB_ELEMENT_FACE, f, "it has %d vertices: fillets need a triangle mesh (sfb_mesh_triangulate, "
+                              "the tools' --triangulate, splits faces into triangles)",
                               l->fv_off[f + 1] - l->fv_off[f]);
     for (e = 0; e < l->ne; ++e)
         if (l->ef_off[e + 1] - l->ef_off[e] > 2)
