@@ -75,6 +75,9 @@ check "loop on quads is bad input" 1 "$CLI" refine --scheme loop examples/data/c
 printf 'v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 2 0 0\nf 1 2 3 4\nf 2 5 3\n' > "$TMP/mixed.obj"
 check "info on a mixed mesh succeeds" 0 "$CLI" info "$TMP/mixed.obj"
 contains "info names the faces that are not triangles" "$TMP/out" "mixed face sizes: 1 of 2 faces are not triangles (loop, tribezier and pn"
+contains "info names --triangulate for them" "$TMP/out" "take triangles only: --triangulate"
+check "info --triangulate on a mixed mesh succeeds" 0 "$CLI" info --triangulate "$TMP/mixed.obj"
+contains "info --triangulate: 3 triangles, no problem" "$TMP/out" "problems: *none"
 check "info succeeds" 0 "$CLI" info examples/data/creased_box.obj
 contains "info shows the valence histogram" "$TMP/out" "valence histogram"
 check "refine succeeds" 0 "$CLI" refine --level 2 examples/data/creased_box.obj -o "$TMP/o.obj"
@@ -192,6 +195,23 @@ check "eval --scheme loop with u + v > 1 is bad input" 1 "$CLI" eval --scheme lo
 contains "u + v > 1 is reported with its query" "$TMP/err" "location 1: .* outside the triangle u + v <= 1"
 check "eval --scheme loop on quads is bad input" 1 "$CLI" eval --scheme loop --random 3 "$TMP/cube.obj"
 contains "Loop on quads is reported" "$TMP/err" "Loop subdivision needs triangles"
+# --triangulate (sfb_mesh_triangulate): quads made triangles first, for the triangle schemes
+check "eval --scheme loop --triangulate on quads succeeds" 0 "$CLI" eval --scheme loop --triangulate --random 20 "$TMP/cube.obj"
+if awk 'NF != 9 || $1 < 0 || $1 > 11 { exit 1 } END { exit NR != 20 }' "$TMP/out"; then P=$((P + 1)); echo "ok eval --triangulate samples the cube's 12 triangles"
+else F=$((F + 1)); echo "FAIL eval --triangulate: not 20 samples on faces 0..11"; head -n 3 "$TMP/out"; fi
+for sch in tribezier pn; do
+  check "tess --scheme $sch on quads is bad input" 1 "$CLI" tess --scheme $sch --rate 2 "$TMP/cube.obj" -o "$TMP/tq.obj"
+  contains "tess --scheme $sch on quads names the option" "$TMP/err" "needs triangles.*--triangulate"
+  check "tess --scheme $sch --triangulate on quads succeeds" 0 "$CLI" tess --scheme $sch --rate 2 --triangulate "$TMP/cube.obj" -o "$TMP/tq.obj"
+  st=$(edge_stats "$TMP/tq.obj")
+  if [ "$st" = "0 0 0" ]; then P=$((P + 1)); echo "ok tess $sch --triangulate cube is closed"; else F=$((F + 1)); echo "FAIL tess $sch --triangulate cube is not closed: $st"; fi
+done
+check "info --triangulate succeeds" 0 "$CLI" info --triangulate "$TMP/cube.obj"
+contains "info --triangulate counts 12 triangles" "$TMP/out" "faces: *12 (12 triangles, 0 quads"
+check "info on quads succeeds" 0 "$CLI" info "$TMP/cube.obj"
+check "fillet --triangulate on quads succeeds" 0 "$CLI" fillet --triangulate --angle 60 --radius 0.2 "$TMP/cube.obj" -o "$TMP/cf.obj"
+check "fillet on quads is bad input" 1 "$CLI" fillet --angle 60 --radius 0.2 "$TMP/cube.obj" -o "$TMP/cf2.obj"
+contains "fillet on quads names the option" "$TMP/err" "--triangulate"
 check "eval --scheme bilinear is bad input" 1 "$CLI" eval --scheme bilinear --random 3 "$TMP/cube.obj"
 contains "bilinear limit evaluation is reported unsupported" "$TMP/err" "not supported"
 for r in 1 4; do

@@ -120,6 +120,10 @@ export_ok box_quant.glb "$BOX" --quantize
 export_ok box_quant16.gltf "$BOX" --quantize --position-bits 16 --normal-bits 16 --uv-bits 16
 export_ok torus_quant_tess.glb examples/data/torus.obj --tess 6 --quantize --normal-bits 10
 export_ok box_compress.glb "$BOX" --compress
+# quads made triangles (sfb_mesh_triangulate) for the triangle schemes: the creased box's tags kept
+export_ok box_tribezier_triangulated.glb "$BOX" --scheme tribezier --tess 4 --triangulate
+export_ok box_pn_triangulated.glb "$BOX" --scheme pn --tess 4 --triangulate
+export_ok box_loop_triangulated.glb "$BOX" --scheme loop --level 2 --triangulate
 export_ok box_compress_quant.glb "$BOX" --compress --quantize
 export_ok box_compress_quant.gltf "$BOX" --compress --quantize
 a=$(stat -c %s "$TMP/v/box.glb"); b=$(stat -c %s "$TMP/v/box_compress_quant.glb")

@@ -119,18 +119,30 @@ sfb_mesh *cli_load_obj(sfb_context *ctx, const char *path) {
     return mesh;
 }
 
-sfb_mesh *cli_load_mesh(sfb_context *ctx, const char *path, double crease_angle) {
-    sfb_mesh *mesh = cli_load_obj(ctx, path), *creased = NULL;
+sfb_mesh *cli_load_mesh(sfb_context *ctx, const char *path, double crease_angle, int triangulate) {
+    sfb_mesh *mesh = cli_load_obj(ctx, path), *next = NULL;
     sfb_result r;
-    int added = 0;
-    if (!mesh || crease_angle < 0.0) return mesh;
-    r = sfb_mesh_crease_by_angle(ctx, mesh, (float)crease_angle, &creased, &added);
-    sfb_mesh_destroy(mesh);
-    if (r != SFB_SUCCESS) {
-        cli_error("%s: --crease-angle: %s: %s", path, sfb_result_string(r), sfb_last_error(ctx));
-        return NULL;
+    int added = 0, split = 0;
+    if (mesh && crease_angle >= 0.0) {
+        r = sfb_mesh_crease_by_angle(ctx, mesh, (float)crease_angle, &next, &added);
+        sfb_mesh_destroy(mesh);
+        mesh = next;
+        if (r != SFB_SUCCESS) {
+            cli_error("%s: --crease-angle: %s: %s", path, sfb_result_string(r), sfb_last_error(ctx));
+            return NULL;
+        }
     }
-    return creased;
+    if (mesh && triangulate) {
+        /* after the crease angle: the new diagonals are no features */
+        r = sfb_mesh_triangulate(ctx, mesh, &next, &split);
+        sfb_mesh_destroy(mesh);
+        mesh = next;
+        if (r != SFB_SUCCESS) {
+            cli_error("%s: --triangulate: %s: %s", path, sfb_result_string(r), sfb_last_error(ctx));
+            return NULL;
+        }
+    }
+    return mesh;
 }
 
 int cli_scheme_from_name(const char *s, sfb_scheme *out) { return sfb_scheme_parse(s, out); }

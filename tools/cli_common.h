@@ -51,8 +51,10 @@ int cli_load_rgba(const char *path, unsigned char **texels, int *w, int *h);
 sfb_mesh *cli_load_obj(sfb_context *ctx, const char *path);
 
 /* cli_load_obj, then (crease_angle >= 0, degrees) the edges whose dihedral angle is over it made
- * infinitely sharp creases (sfb_mesh_crease_by_angle): --crease-angle of every tool. */
-sfb_mesh *cli_load_mesh(sfb_context *ctx, const char *path, double crease_angle);
+ * infinitely sharp creases (sfb_mesh_crease_by_angle): --crease-angle of every tool; then
+ * (triangulate) every face of more than three corners split into triangles
+ * (sfb_mesh_triangulate): --triangulate. */
+sfb_mesh *cli_load_mesh(sfb_context *ctx, const char *path, double crease_angle, int triangulate);
 
 /* catmark (or catmull-clark), loop, bilinear, manifold: 1 and *out set; 0 for another name. */
 int cli_scheme_from_name(const char *name, sfb_scheme *out);

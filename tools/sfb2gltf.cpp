@@ -69,6 +69,8 @@ const char *const kUsage =
     "                         limit (exact limit normals; the default with --tess and for manifold) or\n"
     "                         flat (one normal per triangle; the default for bilinear)\n"
     "  --crease-angle DEG     edges whose dihedral angle is over DEG (0..180) become infinitely sharp creases\n"
+    "  --triangulate          split every face of more than three corners into triangles first (quads along\n"
+    "                         the shorter diagonal): what loop, tribezier, pn and --fillet need from quads\n"
     "  --fillet R             round the sharp features (dihedral angle over --crease-angle, which must then be\n"
     "                         in (0, 180); default 30) with a rolling ball of radius R before subdividing (seed\n"
     "                         002: the same triangles, the blend regions' vertices moved onto the ball's sweep;\n"
@@ -113,7 +115,7 @@ struct Options {
     sfb_scheme scheme = SFB_SCHEME_CATMARK;
     int level = 3, rate = 0;
     double tolerance = 0.0, angle = 0.0;
-    bool have_sharpness = false, have_fillet = false;
+    bool have_sharpness = false, have_fillet = false, triangulate = false;
     double fillet = 0.0;    // --fillet R
     double sharpness = 0.0; // --sharpness (tribezier: every tagged crease's and corner's s)
     bool quantize = false, have_bits = false, compress = false;
@@ -206,6 +208,8 @@ int parse_args(int argc, char **argv, Options *o) {
             if (!parse_double(value(a), &o->angle) || o->angle < 0.0 || o->angle > 180.0)
                 return usage_error("--crease-angle needs degrees in 0..180");
             o->have_angle = true;
+        } else if (!strcmp(a, "--triangulate")) {
+            o->triangulate = true;
         } else if (!strcmp(a, "--fillet")) {
             // checked as the float the library takes: 1e-50 would be 0 there, 1e39 infinite
             if (!parse_double(value(a), &o->fillet) || !((float)o->fillet > 0.0f) || !std::isfinite((float)o->fillet))
@@ -1135,7 +1139,7 @@ int read_stage(Run &R) {
     if (is_gltf_name(R.o.in)) return read_gltf(R);
     Part part;
     part.name = R.o.in;
-    part.mesh = cli_load_mesh(R.ctx, R.o.in, R.o.have_angle ? R.o.angle : -1.0);
+    part.mesh = cli_load_mesh(R.ctx, R.o.in, R.o.have_angle ? R.o.angle : -1.0, R.o.triangulate);
     if (!part.mesh) return 1;
     R.parts.push_back(std::move(part));
     // an OBJ: one node and mesh named after the file

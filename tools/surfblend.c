@@ -23,7 +23,7 @@
 enum {
     O_HELP, O_BACKEND, O_OUTPUT, O_SCHEME, O_LEVEL, O_LIMIT, O_WEIGHTS, O_LOCATIONS, O_RANDOM, O_SEED, O_DERIVATIVES,
     O_RATE, O_TOLERANCE, O_SPLIT, O_TRIM, O_TILES, O_VARIANT, O_DARTS, O_NORMALS_LEVEL, O_WEIGHTS_LEVEL, O_P,
-    O_AVERAGING, O_ALL_SUBDIVIDED, O_NORMALS, O_POSITIONS, O_MODE, O_EDGES, O_SIZE, O_VIEW, O_ZOOM, O_STRIPES, O_CREASE_ANGLE, O_SHARPNESS,
+    O_AVERAGING, O_ALL_SUBDIVIDED, O_NORMALS, O_POSITIONS, O_MODE, O_EDGES, O_SIZE, O_VIEW, O_ZOOM, O_STRIPES, O_CREASE_ANGLE, O_TRIANGULATE, O_SHARPNESS,
     O_AMODE, O_LIGHT, O_CURVATURE, O_EYE, O_TARGET, O_UP, O_FOV, O_ORTHO, O_POLYGON, O_BAND,
     O_RADIUS, O_ANGLE, O_PROFILE, O_CURVE, O_SAMPLES, O_ALPHA, O_SKIP_FAILED, O_RELAX,
     O_COUNT_
@@ -49,6 +49,7 @@ typedef struct cli_opts {
     long size[2];
     double view[2], zoom, stripes;
     double crease_angle;                                    /* --crease-angle (seen[O_CREASE_ANGLE]) */
+    int triangulate;                                        /* --triangulate */
     double sharpness;                                       /* --sharpness (seen[O_SHARPNESS]): tribezier */
     int amode, curvature, ortho, polygon;                   /* analyze */
     const char *light;
@@ -237,6 +238,9 @@ static const opt_spec options[] = {
     { "--crease-angle", NULL, K_POSITIVE, C_INFO | C_SURFACE, O_CREASE_ANGLE, AT(crease_angle), "DEG", NULL, 0, 180, 0,
       "degrees in (0, 180]", "edges whose dihedral angle is over DEG become infinitely sharp creases (a faceted\n"
       "mesh with no crease tags; sfb_mesh_crease_by_angle)" },
+    { "--triangulate", NULL, K_SET, C_INFO | C_SURFACE | C_FILLET, O_TRIANGULATE, AT(triangulate), NULL, NULL, 0, 0, 1, NULL,
+      "split every face of more than three corners into triangles first (quads along the shorter\n"
+      "diagonal; sfb_mesh_triangulate): what loop, tribezier, pn and fillet need from quads" },
     { "--radius", NULL, K_POSITIVE, C_FILLET, O_RADIUS, AT(radius), "R", NULL, 0, 1e30, 0, "a number > 0",
       "the rolling ball's radius (required)" },
     { "--angle", NULL, K_POSITIVE, C_FILLET, O_ANGLE, AT(angle), "DEG", NULL, 0, 179.999, 0, "degrees in (0, 180)",
@@ -754,7 +758,7 @@ static int cmd_info(cli_opts *o) {
     int hist[33], over, i, problems = 0;
     ctx = cli_make_context(NULL);
     if (!ctx) return 1;
-    mesh = cli_load_mesh(ctx, o->in, o->seen[O_CREASE_ANGLE] ? o->crease_angle : -1.0);
+    mesh = cli_load_mesh(ctx, o->in, o->seen[O_CREASE_ANGLE] ? o->crease_angle : -1.0, o->triangulate);
     if (!mesh) { sfb_context_destroy(ctx); return 1; }
     sfb_mesh_get_info(mesh, &in);
     printf("file:        %s\n", o->in);
@@ -778,8 +782,8 @@ static int cmd_info(cli_opts *o) {
     if (in.nonmanifold_vertices) { printf(" %d non-manifold vertices (treated as corners);", in.nonmanifold_vertices); problems++; }
     if (in.bare_vertices) { printf(" %d vertices in no face;", in.bare_vertices); problems++; }
     if ((in.triangles > 0 && in.quads + in.ngons > 0) || (in.quads > 0 && in.ngons > 0)) {
-        printf(" mixed face sizes: %d of %d faces are not triangles (loop, tribezier and pn take triangles only);", in.quads + in.ngons,
-               in.triangles + in.quads + in.ngons);
+        printf(" mixed face sizes: %d of %d faces are not triangles (loop, tribezier and pn take triangles only: --triangulate);",
+               in.quads + in.ngons, in.triangles + in.quads + in.ngons);
         problems++;
     }
     if (!problems) printf(" none");
@@ -804,7 +808,7 @@ static int cmd_refine(cli_opts *o) {
     memset(&out, 0, sizeof out);
     ctx = cli_make_context(o->backend);
     if (!ctx) return 1;
-    mesh = cli_load_mesh(ctx, o->in, o->seen[O_CREASE_ANGLE] ? o->crease_angle : -1.0);
+    mesh = cli_load_mesh(ctx, o->in, o->seen[O_CREASE_ANGLE] ? o->crease_angle : -1.0, o->triangulate);
     if (!mesh) goto done;
     cfg = sfb_surface_config_init(scheme, o->level);
     cfg.flags = SFB_REFINE_UVS | (o->limit ? SFB_REFINE_LIMIT : 0u);
@@ -877,7 +881,7 @@ static int cmd_eval(cli_opts *o) {
     if ((o->nrandom >= 0) == (o->locfile != NULL)) return usage_error(o->cmd, "eval needs either --random N or --locations FILE");
     ctx = cli_make_context(o->backend);
     if (!ctx) return 1;
-    mesh = cli_load_mesh(ctx, o->in, o->seen[O_CREASE_ANGLE] ? o->crease_angle : -1.0);
+    mesh = cli_load_mesh(ctx, o->in, o->seen[O_CREASE_ANGLE] ? o->crease_angle : -1.0, o->triangulate);
     if (!mesh) goto done;
     surf = make_patch_surface(ctx, mesh, o->in, scheme, o);
     if (!surf || !eval_locations(ctx, surf, o, &L)) goto done;
@@ -955,7 +959,7 @@ static int cmd_tess(cli_opts *o) {
     if (!load_trim(o, &mask, &texels)) return 1;
     ctx = cli_make_context(o->backend);
     if (!ctx) { free(texels); return 1; }
-    mesh = cli_load_mesh(ctx, o->in, o->seen[O_CREASE_ANGLE] ? o->crease_angle : -1.0);
+    mesh = cli_load_mesh(ctx, o->in, o->seen[O_CREASE_ANGLE] ? o->crease_angle : -1.0, o->triangulate);
     if (!mesh) goto done;
     surf = make_patch_surface(ctx, mesh, o->in, cli_scheme_for(o->in, o->seen[O_SCHEME], (sfb_scheme)o->scheme), o);
     if (!surf) goto done;
@@ -990,7 +994,7 @@ static int shade_mesh(sfb_context *ctx, const cli_opts *o, sfb_mesh **mesh, sfb_
     sfb_surface_config cfg;
     sfb_shade_params sp;
     sfb_result r;
-    *mesh = cli_load_mesh(ctx, o->in, o->seen[O_CREASE_ANGLE] ? o->crease_angle : -1.0);
+    *mesh = cli_load_mesh(ctx, o->in, o->seen[O_CREASE_ANGLE] ? o->crease_angle : -1.0, o->triangulate);
     if (!*mesh) return 0;
     cfg = sfb_surface_config_init(cli_scheme_for(o->in, o->seen[O_SCHEME], (sfb_scheme)o->scheme), o->level);
     cfg.flags = SFB_REFINE_LIMIT | SFB_REFINE_SHADING;
@@ -1118,7 +1122,7 @@ static int render_manifold_mesh(const cli_opts *o, render_state *s) {
     sfb_tess_config tc = sfb_tess_config_init((int)(o->rate > 2147483647L ? 2147483647L : o->rate < -2147483647L ? -2147483647L : o->rate));
     sfb_result r;
     int i;
-    s->mesh = cli_load_mesh(s->ctx, o->in, o->seen[O_CREASE_ANGLE] ? o->crease_angle : -1.0);
+    s->mesh = cli_load_mesh(s->ctx, o->in, o->seen[O_CREASE_ANGLE] ? o->crease_angle : -1.0, o->triangulate);
     if (!s->mesh) return 0;
     s->surf = make_patch_surface(s->ctx, s->mesh, o->in, (sfb_scheme)o->scheme, o);
     if (!s->surf) return 0;
@@ -1283,7 +1287,7 @@ static int cmd_analyze(cli_opts *o) {
     }
     ctx = cli_make_context(o->backend);
     if (!ctx) goto done;
-    mesh = cli_load_mesh(ctx, o->in, o->seen[O_CREASE_ANGLE] ? o->crease_angle : -1.0);
+    mesh = cli_load_mesh(ctx, o->in, o->seen[O_CREASE_ANGLE] ? o->crease_angle : -1.0, o->triangulate);
     if (!mesh) goto done;
     surf = make_patch_surface(ctx, mesh, o->in, scheme, o);
     if (!surf) goto done;
@@ -1423,7 +1427,7 @@ static int cmd_fillet(cli_opts *o) {
     fc.curve_count = ncurves;
     ctx = cli_make_context(NULL);
     if (!ctx) goto done;
-    mesh = cli_load_obj(ctx, o->in);
+    mesh = cli_load_mesh(ctx, o->in, -1.0, o->triangulate);
     if (!mesh) goto done;
     r = sfb_mesh_fillet(ctx, mesh, &fc, &res, &rep);
     if (r != SFB_SUCCESS) {
