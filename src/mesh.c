@@ -629,11 +629,9 @@ SFB_API sfb_result sfb_mesh_triangulate(sfb_context *ctx, const sfb_mesh *m, sfb
         }
         for (i = 0; i < k - 2; ++i) sizes[nt++] = 3;
     }
-    for (i = 0; i < m->hole_count; ++i) {
-        const int h = m->holes[i], k = l->fv_off[h + 1] - l->fv_off[h];
-        int j;
-        for (j = 0; j < k - 2; ++j) holes[nh++] = first[h] + j;
-    }
+    for (f = 0; f < l->nf; ++f)
+        if (l->fhole && l->fhole[f])
+            for (i = 0; i < l->fv_off[f + 1] - l->fv_off[f] - 2; ++i) holes[nh++] = first[f] + i;
     sfb_mesh_get_desc(m, &d);
     d.face_count = nt;
     d.face_sizes = sizes;
