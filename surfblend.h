@@ -7059,7 +7059,9 @@ done:
  *     million unknowns on real meshes (cow.obj: 42,000; 500-680 CGLS iterations each, 0.9-1.2 s
  *     to build); after two, every extraordinary vertex is four edges from the next, its component
  *     is its own and of a shape met hundreds of times (cow: 1,447 components, 11 shapes), so the
- *     templates solve them all (bench: cow 189 -> 42-64 ms per 1,000 triangles).
+ *     templates solve them all (bench: cow 189 -> 42-64 ms per 1,000 triangles). One step too
+ *     where the mesh is too coarse for the construction (TBZ_COVER: the solve may move more than
+ *     half of a net's points, and its waves crossed whole faces).
  *   - characteristic angles phi (the angle each triangle takes at a vertex): 2 pi / n at a
  *     smooth vertex (and at a dart, and at a vertex with only a corner tag); a sector between two
  *     sharp edges with k triangles spans pi at a crease or boundary vertex (its two crease
@@ -9661,11 +9663,20 @@ sfb_result sfb__tribezier_refined_points(sfb_context *ctx, const sfb__level *l, 
 
 /* One patch per triangle where the G1 constraints are solvable on the mesh itself; where they
  * are not (extraordinary vertices of different valences that touch, found up front, or a
- * residual above 1e-10 left), the net is built on the mesh after one Loop step instead (Peters'
+ * residual above 1e-10 left), and where the mesh is too coarse for them (TBZ_COVER below), the
+ * net is built on the mesh after one Loop step instead (Peters'
  * remedy: afterwards every extraordinary vertex is surrounded by ordinary ones), or two where
  * the extraordinary vertices come in large groups (tbz_largest_group), and each triangle gets
  * its four child patches (depth 1 of its parametric triangle) or sixteen grandchildren (depth
- * 2); the refined net is kept if it is closer to G1. */
+ * 2); the refined net is kept if it is closer to G1 (a coarse mesh's: if it is G1). */
+/* The share of a net's points that the G1 solve may move (those within TBZ_REACH net steps of an
+ * irregular vertex) above which the net is built after a Loop step instead, as where the solve
+ * leaves a residual: there the mesh is too coarse for the construction, its irregular vertices'
+ * regions cover most of it, and the correction waved the highlight lines across whole faces (the
+ * creased box triangulated, 26 vertices: 87 % of the sharp net's points, where Loop's lines are
+ * straight); one step halves the regions. A disk of four rings around one extraordinary vertex
+ * (examples/data/tribezier_crease_v5.obj): 38-40 %, kept. */
+#define TBZ_COVER 0.5
 /* Do two interior extraordinary vertices of different valences share an edge? (Then the
  * constraints on the mesh itself have no exact solution: the refined net is built directly.) */
 static int tbz_touching(const sfb__level *l) {
@@ -9745,6 +9756,7 @@ static sfb_result tbz_build(sfb_context *ctx, const sfb__level *l, const float *
     sfb__level rl;
     sfb_result r;
     unsigned two;
+    int cover;
     memset(&st, 0, sizeof st);
     /* progress (stage "tribezier"): the mesh's own net over [0, 0.5], the one after a Loop step
      * over [0.5, 1] (over [0, 1] where it is the only one). One Loop step or two (the top of
@@ -9761,7 +9773,8 @@ static sfb_result tbz_build(sfb_context *ctx, const sfb__level *l, const float *
     }
     r = sfb__tribezier_points(ctx, l, positions, opt, SFB__TBZ_PROGRESS_LOW, &net, &st);
     if (r != SFB_SUCCESS) return r;
-    if (st.residual > 1e-10) {
+    cover = (double)st.unknowns > TBZ_COVER * (double)(st.sharp_only ? 1 : 2) * ((double)l->nv + 3.0 * l->ne + 3.0 * l->nf);
+    if (st.residual > 1e-10 || cover) {
         /* a refused step is this build's own business, not a failure the caller should read
          * after a successful create */
         sfb__error_state kept;
@@ -9775,7 +9788,7 @@ static sfb_result tbz_build(sfb_context *ctx, const sfb__level *l, const float *
             sfb__error_put_back(ctx, &kept);
             st4.residual = HUGE_VAL;
         } else if (r != SFB_SUCCESS) { sfb__free(ctx, net); return r; }
-        if (st4.residual < st.residual) {
+        if (st4.residual < st.residual || (cover && st4.residual <= 1e-10)) {
             sfb__free(ctx, net);
             r = sfb__patch_table_beztri_children(ctx, l, net4, two ? 2 : 1, pt);
             sfb__free(ctx, net4);
