@@ -66,10 +66,12 @@
  * point per 256-bit register). Without second derivatives, avx2 and avx512 evaluate two
  * triangle locations in a row of a batch at once in float (sfb__simd_avx2_tri2: two points per
  * 256-bit register, half the instructions; its error and measurements are beside it; a location
- * without such a neighbour runs the double kernel). A normal is made from float tangents only
- * when the estimated angle error, ~2e-7 E (|Pu| + |Pv|) / |Pu x Pv|, is below 1e-4 rad
+ * without such a neighbour runs the double kernel), and neon on AArch64 every triangle location
+ * in float (sfb__simd_tri_neon: one point per 128-bit register, the same steps and bits as a
+ * lane of the pair kernel; not timed on an ARM core here). A normal is made from float tangents
+ * only when the estimated angle error, ~2e-7 E (|Pu| + |Pv|) / |Pu x Pv|, is below 1e-4 rad
  * (triangles: 4 E, their derivatives weigh the points by up to 8 where a B-spline's weigh them
- * by 1; the float pair kernel's: 16 E); otherwise (collapsed or nearly parallel tangents,
+ * by 1; the float triangle kernels': 16 E); otherwise (collapsed or nearly parallel tangents,
  * overflow, NaN) the location goes to ref, whose double evaluation and degenerate-tangent rule
  * then decide the normal.
  *
@@ -79,7 +81,8 @@
  * (They work on a window's points with shuffles and horizontal sums, which the lane-per-
  * location vector operations of sfb_simd.h do not express: they stay intrinsics.)
  * Triangles: one point per 256-bit register of doubles (avx2, avx512), two 128-bit ones (sse2,
- * neon on AArch64), scalar double (portable, 32-bit neon); the float pair kernel (avx2, avx512).
+ * neon on AArch64 with second derivatives), scalar double (portable, 32-bit neon); in float
+ * without them: the pair kernel (avx2, avx512), one point per register (neon on AArch64).
  * Locations are prepared (located, grids prefetched) in batches of SFB__SIMD_BATCH, a batch
  * ahead of the kernels, so that the loads of many locations are in flight at once and their
  * descents overlap (sfb__simd_prep_batch). Threads: the locations are cut into equal chunks
@@ -89,7 +92,7 @@
 #define SFB__SIMD_TRI_EFACTOR 4.0f  /* a triangle's E is scaled by this for the normal test */
 #define SFB__SIMD_TRI_FLOATS 48     /* a packed Bezier triangle (the layout above) */
 #define SFB__SIMD_TRI_ORIGIN 42     /* its o (E follows, at 3 cs + 15 with cs = 10) */
-#define SFB__SIMD_TRI2_EFACTOR 4.0f /* the float pair kernel's E factor beyond SFB__SIMD_TRI_EFACTOR */
+#define SFB__SIMD_TRI2_EFACTOR 4.0f /* the float triangle kernels' E factor beyond SFB__SIMD_TRI_EFACTOR */
 
 
 /* One location made ready for a kernel: the window, where to evaluate it, and how to map its
@@ -158,12 +161,13 @@ static int sfb__simd_unit_normal(const float *du, const float *dv, float E, doub
 }
 
 /* Finishes a window result r in double (portable, neon); returns 0, having written nothing,
- * where the normal must come from ref. */
-static int sfb__simd_put_generic(const sfb__simd_pjob *j, int q, float r[6][4], const sfb__simd_slot *sl) {
+ * where the normal must come from ref. ef scales the window's E in the normal's float-trust test
+ * (as sfb__simd_sse2_put's). */
+static int sfb__simd_put_generic(const sfb__simd_pjob *j, int q, float r[6][4], const sfb__simd_slot *sl, float ef) {
     double res[6][3], nrm[3] = {0.0, 0.0, 0.0};
     const double d = sl->dsc, d2 = d * d;
     int c;
-    if (j->out->normal && !sfb__simd_unit_normal(r[1], r[2], sl->blk[3 * sl->cs + 15], nrm)) return 0;
+    if (j->out->normal && !sfb__simd_unit_normal(r[1], r[2], sl->blk[3 * sl->cs + 15] * ef, nrm)) return 0;
     for (c = 0; c < 3; ++c) {
         const double Pu = d * r[1][c], Pv = d * r[2][c];
         res[0][c] = r[0][c];
@@ -224,9 +228,10 @@ static void sfb__simd_prange_generic(const sfb__simd_pjob *j, int first, int las
             const sfb__simd_slot *sl = &batch[cur][q - b];
             float r[6][4];
             if (sl->run == SFB__SIMD_RUN_KERNEL || sl->run == SFB__SIMD_RUN_TRI) {
-                if (sl->run == SFB__SIMD_RUN_TRI) j->tri_eval(sl->blk, sl->s, sl->t, j->second, r);
+                float ef = 1.0f;
+                if (sl->run == SFB__SIMD_RUN_TRI) ef = j->tri_eval(sl->blk, sl->s, sl->t, j->second, r);
                 else j->bs(sl->blk, sl->cs, sl->s, sl->t, j->second, r);
-                if (!sfb__simd_put_generic(j, q, r, sl)) sfb__simd_ref_one(j, q);
+                if (!sfb__simd_put_generic(j, q, r, sl, ef)) sfb__simd_ref_one(j, q);
             } else if (sl->run == SFB__SIMD_RUN_STAM_FAR) {
                 sfb__simd_stam_far(j, q);
             } else if (sl->run == SFB__SIMD_RUN_LOOP_FAR) {

@@ -98,7 +98,7 @@ static SFB__SIMD_FORCEINLINE void sfb__simd_prep_tri(const sfb__simd_pjob *j, in
 #define SFB__SIMD_DC4(X) X(0, 0, 5) X(1, 1, 6) X(2, 2, 7) X(3, 3, 8) X(4, 5, 9) X(5, 6, 10) X(6, 7, 11) X(7, 9, 12) X(8, 10, 13) X(9, 12, 14)
 #define SFB__SIMD_DC3(X) X(0, 0, 4) X(1, 1, 5) X(2, 2, 6) X(3, 4, 7) X(4, 5, 8) X(5, 7, 9)
 #define SFB__SIMD_DC2(X) X(0, 0, 3) X(1, 1, 4) X(2, 3, 5)
-static void sfb__simd_tri_portable(const float *blk, float s, float t, int second, float r[6][4]) {
+static float sfb__simd_tri_portable(const float *blk, float s, float t, int second, float r[6][4]) {
     const double w = (1.0 - s) - t;
     double p[15][3];
     int a, c;
@@ -123,6 +123,7 @@ static void sfb__simd_tri_portable(const float *blk, float s, float t, int secon
         r[2][c] = (float)(4.0 * (p[2][c] - p[0][c]));
         r[0][c] = (float)((t * p[2][c] + (s * p[1][c] + w * p[0][c])) + blk[SFB__SIMD_TRI_ORIGIN + c]);
     }
+    return 1.0f;
 }
 
 #ifdef SFB__SIMD_SSE2
@@ -258,13 +259,33 @@ SFB__SIMD_TRI2_PS(sfb__simd_avx512_tri2, SFB__SIMD_TARGET_AVX512)
 #ifdef SFB__SIMD_NEON
 #if defined(__aarch64__)
 #define SFB__SIMD_TRI_NEON 1
-/* The quartic triangle kernel (see sfb__simd_tri_portable) in double, each point as two
- * registers (xy, zw). (32-bit ARM, without double vectors, runs the portable one.) */
-static void sfb__simd_tri_neon(const float *blk, float s, float t, int second, float r[6][4]) {
+/* The quartic triangle kernel (see sfb__simd_tri_portable). Without second derivatives in float,
+ * one point (xyzw) per register: the steps of the x86 float pair kernel (sfb__simd_avx2_tri2,
+ * the same fused operations in the same order, so its lanes' bits), half the instructions of the
+ * double kernel, and its error (the normal's float-trust test weighs E by
+ * SFB__SIMD_TRI2_EFACTOR, returned); with them in double, each point as two registers (xy, zw),
+ * as second derivatives need. (32-bit ARM, without double vectors, runs the portable one.) */
+static float sfb__simd_tri_neon(const float *blk, float s, float t, int second, float r[6][4]) {
     const double sd = s, td = t;
     const float64x2_t vs = vdupq_n_f64(sd), vt = vdupq_n_f64(td), vw = vdupq_n_f64((1.0 - sd) - td);
     float64x2_t pl[15], ph[15];
     int a;
+    if (!second) {
+        const float32x4_t fs = vdupq_n_f32(s), ft = vdupq_n_f32(t), fw = vdupq_n_f32((float)((1.0 - sd) - td));
+        float32x4_t p[15];
+        p[0] = vdupq_n_f32(0.0f);
+        for (a = 1; a < 15; ++a) p[a] = vld1q_f32(blk + 3 * (a - 1));
+#define SFB__SIMD_DC_NEON_F32(to, from, above) p[to] = vfmaq_f32(vfmaq_f32(vmulq_f32(fw, p[from]), fs, p[(from) + 1]), ft, p[above]);
+        SFB__SIMD_DC4(SFB__SIMD_DC_NEON_F32)
+        SFB__SIMD_DC3(SFB__SIMD_DC_NEON_F32)
+        SFB__SIMD_DC2(SFB__SIMD_DC_NEON_F32)
+#undef SFB__SIMD_DC_NEON_F32
+        vst1q_f32(r[0], vaddq_f32(vfmaq_f32(vfmaq_f32(vmulq_f32(fw, p[0]), fs, p[1]), ft, p[2]), vld1q_f32(blk + SFB__SIMD_TRI_ORIGIN)));
+        vst1q_f32(r[1], vmulq_n_f32(vsubq_f32(p[1], p[0]), 4.0f));
+        vst1q_f32(r[2], vmulq_n_f32(vsubq_f32(p[2], p[0]), 4.0f));
+        vst1q_f32(r[3], vdupq_n_f32(0.0f)); vst1q_f32(r[4], vdupq_n_f32(0.0f)); vst1q_f32(r[5], vdupq_n_f32(0.0f));
+        return SFB__SIMD_TRI2_EFACTOR;
+    }
     pl[0] = ph[0] = vdupq_n_f64(0.0);
     for (a = 1; a < 15; ++a) {
         const float32x4_t v = vld1q_f32(blk + 3 * (a - 1));
@@ -296,6 +317,7 @@ static void sfb__simd_tri_neon(const float *blk, float s, float t, int second, f
     }
 #undef SFB__SIMD_DC_NEON
 #undef SFB__SIMD_ST2
+    return 1.0f;
 }
 #endif
 #endif /* SFB__SIMD_NEON */

@@ -632,7 +632,9 @@ typedef struct sfb__simd_patches {
  * neon; patches.h.) */
 typedef void (*sfb__simd_bs_fn)(const float *blk, int cs, float s, float t, int second, float r[6][4]);
 /* The same for a quartic Bezier triangle at blk (15 points, then the origin; patches.h). */
-typedef void (*sfb__simd_tri_fn)(const float *blk, float s, float t, int second, float r[6][4]);
+/* returns the factor on the window's E for the normal's float-trust test (1: a double kernel;
+ * SFB__SIMD_TRI2_EFACTOR: neon's float kernel, patches_tri.h) */
+typedef float (*sfb__simd_tri_fn)(const float *blk, float s, float t, int second, float r[6][4]);
 
 /* One eval_patches call; the family's prepare fills range (and bs, tri_eval where its range
  * loop calls them). */
