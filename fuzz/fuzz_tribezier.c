@@ -110,9 +110,9 @@ static void run(sfb_context *ctx, const sfb_mesh *mesh, size_t size)
 }
 
 /* A mesh with faces of more than three corners: sfb_mesh_triangulate, then the surface of the
- * result. Invariants: success or a message; on success every face of k corners became k - 2
- * triangles of its own vertices (in order), the vertices and corners are kept, every crease tag
- * is one of the mesh's, each hole's pieces are holes. */
+ * result. Invariants: success or a message; on success every face of k corners became the next
+ * k - 2 triangles, of its own vertices; the vertices and corners are kept, every crease tag is
+ * one of the mesh's, each hole's pieces are holes. */
 static void triangulated(sfb_context *ctx, const sfb_mesh *mesh, size_t size)
 {
     sfb_mesh *t = NULL;
