@@ -962,7 +962,7 @@ static void run_patch_threads(void) {
             } else {
                 const float *got = out[0] + 21 * NLOC;
                 double worst_p = 0.0, worst_d = 0.0, worst_n = 0.0;
-                const double diag = 2.0 * (1.35 + 0.35); /* the torus's bounding box, about */
+                const double diag = bbox_diag(ref, NLOC - 1, 3);
                 for (i = 0; i < NLOC - 1; ++i) {
                     double dp = 0.0, du2 = 0.0, dv2 = 0.0, lu = 0.0, lv = 0.0, dot = 0.0, cr[3];
                     int c;

@@ -62,6 +62,24 @@ static void bez_eval(const double *b, double u, double v, double P[3], double Du
         }
 }
 
+/* The second derivatives at (u, v): 12 sum over degree 2 of the second differences. */
+static void bez_eval2(const double *b, double u, double v, double Duu[3], double Duv[3], double Dvv[3]) {
+    const double w = 1.0 - u - v;
+    static const double f[3] = {1, 1, 2};
+    int i, j, c;
+    for (c = 0; c < 3; ++c) Duu[c] = Duv[c] = Dvv[c] = 0.0;
+    for (j = 0; j <= 2; ++j)
+        for (i = 0; i + j <= 2; ++i) {
+            const double B = 2.0 / (f[i] * f[j] * f[2 - i - j]) * pow(w, 2 - i - j) * pow(u, i) * pow(v, j);
+            for (c = 0; c < 3; ++c) {
+                const double b00 = b[3 * qij(i, j) + c];
+                Duu[c] += 12.0 * B * (b[3 * qij(i + 2, j) + c] - 2.0 * b[3 * qij(i + 1, j) + c] + b00);
+                Duv[c] += 12.0 * B * (b[3 * qij(i + 1, j + 1) + c] - b[3 * qij(i + 1, j) + c] - b[3 * qij(i, j + 1) + c] + b00);
+                Dvv[c] += 12.0 * B * (b[3 * qij(i, j + 2) + c] - 2.0 * b[3 * qij(i, j + 1) + c] + b00);
+            }
+        }
+}
+
 static void cross(const double *a, const double *b, double *c) {
     c[0] = a[1] * b[2] - a[2] * b[1]; c[1] = a[2] * b[0] - a[0] * b[2]; c[2] = a[0] * b[1] - a[1] * b[0];
 }
@@ -1194,7 +1212,7 @@ static double net_curvature_energy(const double *net, int nf) {
                                     {0.1012865073, 0.7974269853, 0.1259391805}, {0.1012865073, 0.1012865073, 0.1259391805}};
     const int S = 4;
     double e = 0.0;
-    int f, a, b, up, m, c, i, j;
+    int f, a, b, up, m, c;
     for (f = 0; f < nf; ++f)
         for (a = 0; a < S; ++a)
             for (b = 0; a + b < S; ++b)
@@ -1207,34 +1225,11 @@ static double net_curvature_energy(const double *net, int nf) {
                     for (m = 0; m < 7; ++m) {
                         const double u = (c0[0] + qp[m][0] * (c1[0] - c0[0]) + qp[m][1] * (c2[0] - c0[0])) / S;
                         const double v = (c0[1] + qp[m][0] * (c1[1] - c0[1]) + qp[m][1] * (c2[1] - c0[1])) / S;
-                        /* de Casteljau with (w, u, v) down to degree 2, then the derivatives */
-                        double p[15][3], Pu[3], Pv[3], Puu[3], Puv[3], Pvv[3], n[3], len, E, F, G, L, M, N, H, K, det;
-                        const double w = 1.0 - u - v;
-                        for (i = 0; i < 15; ++i)
-                            for (c = 0; c < 3; ++c) p[i][c] = net[45 * (size_t)f + 3 * i + c];
-                        for (j = 4; j > 2; --j) /* degree j -> j - 1, in place over the index triangle of degree j - 1 */
-                            for (i = 0; i < j; ++i) {
-                                int a2;
-                                for (a2 = 0; a2 + i < j; ++a2) {
-                                    /* point (a2, i) of degree j - 1 from (a2, i), (a2 + 1, i), (a2, i + 1) of degree j;
-                                     * index by qij on a degree-4 layout: rows are reused in place, reading before writing */
-                                    for (c = 0; c < 3; ++c)
-                                        p[qij(a2, i)][c] = w * p[qij(a2, i)][c] + u * p[qij(a2 + 1, i)][c] + v * p[qij(a2, i + 1)][c];
-                                }
-                            }
-                        /* degree 2 points: q00 = p[qij(0,0)], q10 = (1,0), q01 = (0,1), q20, q11, q02 */
-                        for (c = 0; c < 3; ++c) {
-                            const double q00 = p[qij(0, 0)][c], q10 = p[qij(1, 0)][c], q01 = p[qij(0, 1)][c], q20 = p[qij(2, 0)][c],
-                                         q11 = p[qij(1, 1)][c], q02 = p[qij(0, 2)][c];
-                            const double d0 = w * q00 + u * q10 + v * q01, du1 = w * q10 + u * q20 + v * q11, dv1 = w * q01 + u * q11 + v * q02;
-                            Pu[c] = 4.0 * (du1 - d0);
-                            Pv[c] = 4.0 * (dv1 - d0);
-                            Puu[c] = 12.0 * (q20 - 2.0 * q10 + q00);
-                            Puv[c] = 12.0 * (q11 - q10 - q01 + q00);
-                            Pvv[c] = 12.0 * (q02 - 2.0 * q01 + q00);
-                        }
-                        n[0] = Pu[1] * Pv[2] - Pu[2] * Pv[1]; n[1] = Pu[2] * Pv[0] - Pu[0] * Pv[2]; n[2] = Pu[0] * Pv[1] - Pu[1] * Pv[0];
-                        len = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+                        double P[3], Pu[3], Pv[3], Puu[3], Puv[3], Pvv[3], n[3], len, E, F, G, L, M, N, H, K, det;
+                        bez_eval(net + 45 * (size_t)f, u, v, P, Pu, Pv);
+                        bez_eval2(net + 45 * (size_t)f, u, v, Puu, Puv, Pvv);
+                        cross(Pu, Pv, n);
+                        len = norm3(n);
                         if (!(len > 0.0)) continue;
                         for (c = 0; c < 3; ++c) n[c] /= len;
                         E = Pu[0] * Pu[0] + Pu[1] * Pu[1] + Pu[2] * Pu[2];
