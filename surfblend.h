@@ -308,6 +308,8 @@ typedef struct sfb_manifold_options {
 typedef struct sfb_tribezier_options {
     int sharpness_set;  /* nonzero: `sharpness` replaces every tagged crease's and corner's s */
     float sharpness;    /* in [0, 1] */
+    int slider;         /* nonzero: the surface keeps its smooth (s = 0) and sharp (s = 1) nets (about 2.6 times
+                           the patch table's memory), so that sfb_surface_set_sharpness moves s without a rebuild */
 } sfb_tribezier_options;
 
 typedef struct sfb_surface_config {
@@ -332,6 +334,14 @@ typedef struct sfb_surface sfb_surface;
 SFB_API sfb_result sfb_surface_create(sfb_context *ctx, const sfb_mesh *mesh,
                                       const sfb_surface_config *config, sfb_surface **out);
 SFB_API void sfb_surface_destroy(sfb_surface *surface);
+/* The sharpness slider of SFB_SCHEME_TRIBEZIER (seed 004): the surface becomes the one
+ * sfb_surface_create makes with `options` (sharpness_set and sharpness; slider is kept),
+ * bit for bit, in time linear in the patch points: no G1 solve runs again (the surface at s is
+ * (1 - s) x the smooth net + s x the sharp net, point by point). The surface must have been
+ * built with tribezier.slider set. Its patches are uploaded to the backend again; it counts as a
+ * new surface for an sfb_analysis_workspace. Not to be called while another thread uses the
+ * surface. On an error (an s outside [0, 1] or NaN, a surface without the nets) it is unchanged. */
+SFB_API sfb_result sfb_surface_set_sharpness(sfb_surface *surface, const sfb_tribezier_options *options);
 
 /* Which stencil table to apply. */
 typedef enum sfb_table {
@@ -524,7 +534,7 @@ typedef struct sfb_patch_info {
     int bspline, bezier;   /* regular patches: bicubic B-spline (Catmull-Clark), quartic Bezier triangle (Loop) */
     int stam, end_caps, max_depth, points;
     int manifold;          /* MANIFOLD4 blends (one per quad of the manifold mesh) */
-    size_t bytes;  /* memory of the patch table and its points */
+    size_t bytes;  /* memory of the patch table and its points (and the two nets of tribezier.slider) */
     int domain_sides;      /* 4: a parametric face's (u,v) is the unit square; 3: the triangle u + v <= 1 */
 } sfb_patch_info;
 SFB_API sfb_result sfb_surface_patch_info(const sfb_surface *surface, sfb_patch_info *out);
@@ -686,8 +696,8 @@ typedef enum sfb_curvature_kind { SFB_CURVATURE_GAUSSIAN = 0, SFB_CURVATURE_MEAN
  * the simd backend). The buffers grow to the largest analysis run with it and stay (counted
  * against the context's memory budget) until sfb_analysis_workspace_destroy. It also keeps the
  * last surface's proxy and face adjacency (they depend on the surface and the proxy level, not
- * on the view: a surface never changes), so a surface analysed again, from any view, skips
- * their evaluation. A workspace belongs to the context it was made on and, like that context,
+ * on the view; sfb_surface_set_sharpness, the one call that changes a surface, makes it count as
+ * a new one), so a surface analysed again, from any view, skips their evaluation. A workspace belongs to the context it was made on and, like that context,
  * to one thread at a time; results are bit for bit those without it. */
 typedef struct sfb_analysis_workspace sfb_analysis_workspace;
 SFB_API sfb_result sfb_analysis_workspace_create(sfb_context *ctx, sfb_analysis_workspace **out);
@@ -1208,6 +1218,11 @@ typedef struct sfb__patch_table {
     int mf_weights;        /* MANIFOLD4: SFB_MANIFOLD_WEIGHTS_* */
     int npoints;           /* patch points */
     float *point_data;     /* xyz per patch point, for the surface's base positions */
+    /* NULL, or (tribezier with the slider option) per patch SFB__TBZ_BLEND floats: its 15
+     * points in the smooth net (45), in the sharp net (45), and each point's s from the tags
+     * (15; -1: no tagged feature in its part of the mesh); point_data is their blend
+     * (sfb__tribezier_blend). Owned. */
+    float *blend;
     const sfb__eigen_cc *eig[SFB__STAM_MAX_VALENCE + 1]; /* valences used (the context's cache) */
     const sfb__eigen_loop *eigl[SFB__STAM_MAX_VALENCE + 1]; /* Loop: the same */
     /* NULL, or a table of the same parametric faces whose evaluated position, normalised, is
@@ -1412,8 +1427,9 @@ typedef struct sfb__shading {
 /* ---- surfaces ---- */
 struct sfb_surface {
     sfb_context *ctx;
-    unsigned long serial;        /* the context's count of surfaces at its creation (from 1): a surface never changes,
-                                    so data derived from it alone may be kept under it (sfb_analysis_workspace) */
+    unsigned long serial;        /* the context's count of surfaces at its creation (from 1), and again at each
+                                    sfb_surface_set_sharpness, the one call that changes a surface: data derived from
+                                    it alone may be kept under it (sfb_analysis_workspace) */
     sfb_surface_config config;
     int base_vertex_count, base_uv_count, base_face_count;
     float *base_positions, *base_uvs;
@@ -1631,6 +1647,12 @@ SFB__IF sfb_result sfb__tribezier_refined_points(sfb_context *ctx, const sfb__le
  * own G1 constraints have no exact solution. */
 SFB__IF sfb_result sfb__tribezier_build(sfb_context *ctx, const sfb__level *base, const float *positions,
                                         const sfb_tribezier_options *opt, sfb__patch_table *pt);
+/* The slider (sfb_surface_set_sharpness): per patch 45 + 45 + 15 floats in pt->blend, and the
+ * s of a point from its tag s (blend's last 15) for options opt. */
+#define SFB__TBZ_BLEND 105
+SFB__IF double sfb__tribezier_point_s(const sfb_tribezier_options *opt, float tag_s);
+/* The patch points for opt from pt->blend, into point_data (3 floats per patch point). */
+SFB__IF void sfb__tribezier_blend(const sfb__patch_table *pt, const sfb_tribezier_options *opt, float *point_data);
 SFB__IF sfb_result sfb__manifold_build(sfb_context *ctx, const sfb__level *base, int weights, const float *positions, sfb__patch_table *pt);
 SFB__IF void sfb__mf_eval(const float *pts, const int *cv, const unsigned *codes, int kind, double c, double d, double S[3], double Sc[3],
                   double Sd[3]);
@@ -4705,6 +4727,7 @@ void sfb__patch_table_free(sfb_context *ctx, sfb__patch_table *pt) {
     sfb__free(ctx, pt->ptype); sfb__free(ctx, pt->pfirst); sfb__free(ctx, pt->pparam); sfb__free(ctx, pt->pvalence);
     sfb__free(ctx, pt->cv); sfb__free(ctx, pt->ptex_face); sfb__free(ctx, pt->ptex_corner); sfb__free(ctx, pt->face_ptex);
     sfb__free(ctx, pt->ptex_root); sfb__free(ctx, pt->nodes); sfb__free(ctx, pt->point_data); sfb__free(ctx, pt->pcorner);
+    sfb__free(ctx, pt->blend);
     if (pt->normal_field) {
         sfb__patch_table_free(ctx, pt->normal_field);
         sfb__free(ctx, pt->normal_field);
@@ -7025,7 +7048,12 @@ done:
  *     Where creases carry different s, a point takes the s of the nearest feature (graph distance
  *     over mesh edges; at a feature vertex the mean of its features' s, averaged over the point's
  *     home vertices: its corner, its edge's ends, its triangle's corners); for one s everywhere
- *     the blend is exact.
+ *     the blend is exact. The nets depend on which features there are, not on their s (a
+ *     feature at s = 0 is still one: tbz_tag_values), so the slider (tribezier.slider) keeps
+ *     both nets in float and each point's s from the tags, and sfb_surface_set_sharpness blends
+ *     them again for a new s (sfb__tribezier_blend): the build with the slider blends from the
+ *     float nets too (and builds both nets where s = 1 everywhere), so a move is bit for bit a
+ *     fresh build with the slider; without it, within a float rounding of one.
  *   - regular vertices (valence 6, or a crease/boundary vertex with three triangles on each
  *     side) take Sabin's rules (seed eq. 4-7, ALGORITHMS.md 8.1) on the mesh extended across
  *     sharp edges by parallelograms (seed eq. 8 at s = 1: the phantom across wall edge (a, b) is
@@ -9082,7 +9110,8 @@ static int tbz_degenerate(const sfb__tbz *T) {
     return 0;
 }
 
-/* Per vertex the s of the nearest tagged feature (breadth first over mesh edges). */
+/* Per vertex the s of the nearest tagged feature (breadth first over mesh edges), -1 where no
+ * feature can be reached. */
 static sfb_result tbz_vertex_s(sfb__tbz *T, double *vs) {
     const sfb__level *l = T->l;
     int *queue = (int *)sfb__alloc(T->ctx, ((size_t)T->nv + 1) * sizeof(int)), head = 0, tail = 0, v, i;
@@ -9106,21 +9135,48 @@ static sfb_result tbz_vertex_s(sfb__tbz *T, double *vs) {
             if (!seen[w]) { seen[w] = 1; vs[w] = vs[u]; queue[tail++] = w; }
         }
     }
+    /* no tagged feature in the vertex's part of the mesh: -1 (its points take s = 0, whatever
+     * the override: tbz_blend_s) */
+    for (v = 0; v < T->nv; ++v)
+        if (!seen[v]) vs[v] = -1.0;
     sfb__free(T->ctx, queue); sfb__free(T->ctx, seen);
     return SFB_SUCCESS;
+}
+
+/* s per feature: the tag clamped to [0, 1] (infinite: 1), or (override) s; a feature at s = 0
+ * 1e-30, so that it is still one (the nets depend on which features there are, not on their s).
+ * Returns whether there is one. */
+static int tbz_tag_values(sfb__tbz *T, int override, float s) {
+    const sfb__level *l = T->l;
+    int e, v, any = 0;
+    for (e = 0; e < T->ne; ++e)
+        if (l->ef_off[e + 1] - l->ef_off[e] == 2 && l->es[e] > 0.0f) {
+            T->tag_s[e] = override ? s : (l->es[e] < 1.0f ? l->es[e] : 1.0f);
+            if (T->tag_s[e] <= 0.0f) T->tag_s[e] = 1e-30f; /* a feature at s = 0: the smooth net's treatment */
+            any = 1;
+        }
+    for (v = 0; v < T->nv; ++v)
+        if (l->vs[v] > 0.0f && !(tbz_boundary(l, v) && tbz_nf(l, v) == 1)) {
+            T->corner_s[v] = override ? s : (l->vs[v] < 1.0f ? l->vs[v] : 1.0f);
+            if (T->corner_s[v] <= 0.0f) T->corner_s[v] = 1e-30f;
+            any = 1;
+        }
+    return any;
 }
 
 /* fout: NULL, the net into *out (45 doubles per triangle); else the net into fout, 45 floats
  * per triangle that is not a hole, in order (sfb__patch_table_beztri_children's point data),
  * and *out left NULL (the doubles, a net as large again, never made) */
 static sfb_result tbz_points(sfb_context *ctx, const sfb__level *l, const float *positions, const float *sharp_positions,
-                             const sfb_tribezier_options *opt, unsigned flags, double **out, float *fout, sfb__tbz_stats *stats) {
+                             const sfb_tribezier_options *opt, unsigned flags, double **out, float *fout, float **bout,
+                             sfb__tbz_stats *stats) {
     sfb__tbz T;
     tbz_prev prev;
-    double *x0 = NULL, *vs = NULL, *res = NULL;
-    int v, e, f, c, k, any_tag = 0, sharp_only = 0;
+    double *x0 = NULL, *vs = NULL, *vtag = NULL, *res = NULL;
+    int v, e, f, c, k, kb, any_tag = 0, sharp_only = 0;
     sfb_result r = SFB_SUCCESS;
     *out = NULL;
+    if (bout) *bout = NULL;
     /* the nets read rings in fan order: every vertex with triangles a fan, every edge manifold
      * (tbz_check and tbz_split see to it on the mesh; a mesh after Loop steps, tbz_refine,
      * can still fail: two triangles on the same three vertices give four triangles on an edge) */
@@ -9162,19 +9218,7 @@ static sfb_result tbz_points(sfb_context *ctx, const sfb__level *l, const float 
         goto done;
     }
     for (f = 0; f < T.nf; ++f) tbz_patch(&T, f, T.grid + 15 * (size_t)f);
-    /* s per feature: the tag clamped to [0, 1] (infinite: 1), or the override */
-    for (e = 0; e < T.ne; ++e)
-        if (l->ef_off[e + 1] - l->ef_off[e] == 2 && l->es[e] > 0.0f) {
-            T.tag_s[e] = opt && opt->sharpness_set ? opt->sharpness : (l->es[e] < 1.0f ? l->es[e] : 1.0f);
-            if (T.tag_s[e] <= 0.0f) T.tag_s[e] = 1e-30f; /* a feature at s = 0: the smooth net's treatment */
-            any_tag = 1;
-        }
-    for (v = 0; v < T.nv; ++v)
-        if (l->vs[v] > 0.0f && !(tbz_boundary(l, v) && tbz_nf(l, v) == 1)) {
-            T.corner_s[v] = opt && opt->sharpness_set ? opt->sharpness : (l->vs[v] < 1.0f ? l->vs[v] : 1.0f);
-            if (T.corner_s[v] <= 0.0f) T.corner_s[v] = 1e-30f;
-            any_tag = 1;
-        }
+    any_tag = tbz_tag_values(&T, opt && opt->sharpness_set, opt ? opt->sharpness : 0.0f);
     /* s per vertex (tbz_vertex_s) follows from the tags alone. Where it is 1 at every vertex
      * (every tag s = 1: infinitely sharp creases, the corners of split non-manifold vertices --
      * cow.obj and teapot.obj have only those --, an override of 1) every point's blend is the
@@ -9183,9 +9227,24 @@ static sfb_result tbz_points(sfb_context *ctx, const sfb__level *l, const float 
     if (any_tag) {
         vs = (double *)sfb__calloc(ctx, (size_t)T.nv + 1, sizeof(double));
         if (!vs) { r = sfb__oom(ctx, "tribezier"); goto done; }
+        if (bout && opt && opt->sharpness_set) {
+            /* the slider keeps the tags' s too, for an options without the override */
+            vtag = (double *)sfb__calloc(ctx, (size_t)T.nv + 1, sizeof(double));
+            if (!vtag) { r = sfb__oom(ctx, "tribezier"); goto done; }
+            tbz_tag_values(&T, 0, 0.0f);
+            if ((r = tbz_vertex_s(&T, vtag)) != SFB_SUCCESS) goto done;
+            tbz_tag_values(&T, 1, opt->sharpness);
+        }
         if ((r = tbz_vertex_s(&T, vs)) != SFB_SUCCESS) goto done;
-        sharp_only = !(flags & SFB__TBZ_BOTH_NETS);
+        /* the slider needs both nets whatever s is now */
+        sharp_only = !(flags & SFB__TBZ_BOTH_NETS) && !bout;
         for (v = 0; v < T.nv && sharp_only; ++v) sharp_only = vs[v] == 1.0;
+    }
+    if (bout) {
+        int held = 0;
+        for (f = 0; f < T.nf; ++f) held += !l->fhole[f];
+        *bout = (float *)sfb__alloc(ctx, (size_t)SFB__TBZ_BLEND * held * sizeof(float) + 1);
+        if (!*bout) { r = sfb__oom(ctx, "tribezier slider"); goto done; }
     }
     /* progress: this call's window (sfb_internal.h), the smooth net's solve in its first half
      * where a sharp net follows (the seed-plane fallback reports in the same half again, never
@@ -9245,28 +9304,45 @@ static sfb_result tbz_points(sfb_context *ctx, const sfb__level *l, const float 
         if (r != SFB_SUCCESS) goto done;
     }
 blend:
-    for (f = 0, k = 0; f < T.nf; ++f) {
+    for (f = 0, k = 0, kb = 0; f < T.nf; ++f) {
         const int *fv = l->fv + l->fv_off[f];
         const int *g = T.grid + 15 * (size_t)f;
         int i, j, q = 0, kk;
-        float *fo = fout ? fout + 45 * (size_t)k : NULL;
+        float *fo = fout ? fout + 45 * (size_t)k : NULL, *bo = bout && !l->fhole[f] ? *bout + SFB__TBZ_BLEND * (size_t)kb++ : NULL;
         if (fout && l->fhole[f]) continue;
         k += fout != NULL;
         for (j = 0; j <= 4; ++j)
             for (i = 0; i + j <= 4; ++i, ++q) {
-                double s = 0.0, wsum = 0.0;
+                /* the point's home vertices: weights > 0 */
+                const int w[3] = {4 - i - j, i, j};
+                double s = 0.0, st = 0.0, wsum = 0.0;
                 if (any_tag) {
-                    /* the point's home vertices: weights > 0 */
-                    const int w[3] = {4 - i - j, i, j};
                     for (kk = 0; kk < 3; ++kk)
-                        if (w[kk] > 0 && (w[0] == 4 || w[1] == 4 || w[2] == 4 ? w[kk] == 4 : 1)) { s += vs[fv[kk]]; wsum += 1.0; }
+                        if (w[kk] > 0 && (w[0] == 4 || w[1] == 4 || w[2] == 4 ? w[kk] == 4 : 1)) {
+                            s += vs[fv[kk]];
+                            st += vtag ? vtag[fv[kk]] : vs[fv[kk]];
+                            wsum += 1.0;
+                        }
                     s = wsum > 0.0 ? s / wsum : 0.0;
+                    st = wsum > 0.0 ? st / wsum : 0.0;
                     if (s < 1e-20) s = 0.0;
+                } else st = -1.0;
+                if (bo) {
+                    /* the slider: the nets in float, the output their blend as
+                     * sfb_surface_set_sharpness makes it (sfb__tribezier_blend) */
+                    bo[90 + q] = (float)st;
+                    for (c = 0; c < 3; ++c) {
+                        bo[3 * q + c] = (float)(any_tag ? x0 : T.x)[3 * (size_t)g[q] + c];
+                        bo[45 + 3 * q + c] = (float)T.x[3 * (size_t)g[q] + c];
+                    }
+                    s = sfb__tribezier_point_s(opt, bo[90 + q]);
                 }
                 for (c = 0; c < 3; ++c) {
-                    const double sh = T.x[3 * (size_t)g[q] + c], b = any_tag ? (1.0 - s) * x0[3 * (size_t)g[q] + c] + s * sh : sh;
+                    const double sh = T.x[3 * (size_t)g[q] + c];
+                    const double b = bo ? (1.0 - s) * (double)bo[3 * q + c] + s * (double)bo[45 + 3 * q + c]
+                                        : any_tag ? (1.0 - s) * x0[3 * (size_t)g[q] + c] + s * sh : sh;
                     if (fo) fo[3 * q + c] = (float)b;
-                    else res[45 * (size_t)f + 3 * q + c] = b;
+                    else res[45 * (size_t)f + 3 * q + c] = bo ? (double)(float)b : b;
                 }
             }
     }
@@ -9276,9 +9352,27 @@ blend:
 done:
     sfb__free(ctx, T.efeat); sfb__free(ctx, T.vtype); sfb__free(ctx, T.virr); sfb__free(ctx, T.phi);
     sfb__free(ctx, T.x); sfb__free(ctx, T.fixed); sfb__free(ctx, T.dist); sfb__free(ctx, T.grid); sfb__free(ctx, T.tag_s); sfb__free(ctx, T.corner_s);
-    sfb__free(ctx, x0); sfb__free(ctx, vs); sfb__free(ctx, res);
+    sfb__free(ctx, x0); sfb__free(ctx, vs); sfb__free(ctx, vtag); sfb__free(ctx, res);
+    if (r != SFB_SUCCESS && bout) { sfb__free(ctx, *bout); *bout = NULL; }
     tbz_prev_free(ctx, &prev);
     return r;
+}
+
+double sfb__tribezier_point_s(const sfb_tribezier_options *opt, float tag_s) {
+    const double s = opt && opt->sharpness_set ? (tag_s >= 0.0f ? (double)opt->sharpness : 0.0) : (double)tag_s;
+    return s < 1e-20 ? 0.0 : s;
+}
+
+void sfb__tribezier_blend(const sfb__patch_table *pt, const sfb_tribezier_options *opt, float *point_data) {
+    int p, q, c;
+    for (p = 0; p < pt->npatch; ++p) {
+        const float *b = pt->blend + SFB__TBZ_BLEND * (size_t)p;
+        float *o = point_data + 45 * (size_t)p;
+        for (q = 0; q < 15; ++q) {
+            const double s = sfb__tribezier_point_s(opt, b[90 + q]);
+            for (c = 0; c < 3; ++c) o[3 * q + c] = (float)((1.0 - s) * (double)b[3 * q + c] + s * (double)b[45 + 3 * q + c]);
+        }
+    }
 }
 
 /* The refusals of every entry point: an override s outside [0, 1] or NaN, and
@@ -9397,8 +9491,8 @@ sfb_result sfb__tribezier_points(sfb_context *ctx, const sfb__level *l, const fl
     r = tbz_check(ctx, l, positions, opt);
     if (r == SFB_SUCCESS) r = tbz_split(ctx, l, positions, &split, &sl, &spos);
     if (r != SFB_SUCCESS) return r;
-    if (!split) return tbz_points(ctx, l, positions, positions, opt, flags, out, NULL, stats);
-    r = tbz_points(ctx, &sl, spos, spos, opt, flags, out, NULL, stats);
+    if (!split) return tbz_points(ctx, l, positions, positions, opt, flags, out, NULL, NULL, stats);
+    r = tbz_points(ctx, &sl, spos, spos, opt, flags, out, NULL, NULL, stats);
     sfb__level_free(ctx, &sl);
     sfb__free(ctx, spos);
     return r;
@@ -9628,7 +9722,7 @@ done:
 
 /* sfb__tribezier_refined_points, the net into *out or (fout not NULL) into fout (tbz_points) */
 static sfb_result tbz_refined(sfb_context *ctx, const sfb__level *l, const float *positions, const sfb_tribezier_options *opt,
-                              unsigned flags, sfb__level *rl, double **out, float *fout, sfb__tbz_stats *stats) {
+                              unsigned flags, sfb__level *rl, double **out, float *fout, float **bout, sfb__tbz_stats *stats) {
     float *ps = NULL, *pp = NULL, *spos = NULL;
     sfb__level sl;
     int split = 0;
@@ -9647,7 +9741,7 @@ static sfb_result tbz_refined(sfb_context *ctx, const sfb__level *l, const float
         sfb__free(ctx, ps1);
         sfb__free(ctx, pp1);
     }
-    if (r == SFB_SUCCESS) r = tbz_points(ctx, rl, ps, pp, opt, flags, out, fout, stats);
+    if (r == SFB_SUCCESS) r = tbz_points(ctx, rl, ps, pp, opt, flags, out, fout, bout, stats);
     if (r != SFB_SUCCESS) sfb__level_free(ctx, rl);
     if (split) sfb__level_free(ctx, &sl);
     sfb__free(ctx, spos);
@@ -9658,7 +9752,7 @@ static sfb_result tbz_refined(sfb_context *ctx, const sfb__level *l, const float
 
 sfb_result sfb__tribezier_refined_points(sfb_context *ctx, const sfb__level *l, const float *positions, const sfb_tribezier_options *opt,
                                          unsigned flags, sfb__level *rl, double **out, sfb__tbz_stats *stats) {
-    return tbz_refined(ctx, l, positions, opt, flags, rl, out, NULL, stats);
+    return tbz_refined(ctx, l, positions, opt, flags, rl, out, NULL, NULL, stats);
 }
 
 /* One patch per triangle where the G1 constraints are solvable on the mesh itself; where they
@@ -9752,6 +9846,7 @@ sfb_result sfb__tribezier_build(sfb_context *ctx, const sfb__level *l, const flo
 static sfb_result tbz_build(sfb_context *ctx, const sfb__level *l, const float *positions, const sfb_tribezier_options *opt,
                             sfb__patch_table *pt) {
     double *net = NULL, *net4 = NULL;
+    float *blend = NULL, *blend4 = NULL, **want = opt && opt->slider ? &blend : NULL, **want4 = opt && opt->slider ? &blend4 : NULL;
     sfb__tbz_stats st, st4;
     sfb__level rl;
     sfb_result r;
@@ -9766,12 +9861,14 @@ static sfb_result tbz_build(sfb_context *ctx, const sfb__level *l, const float *
         two = tbz_largest_group(ctx, l) > TBZ_ONE_STEP_GROUP ? SFB__TBZ_TWO_STEPS : 0;
         /* the table first, the net written into its point data (tbz_points) */
         if ((r = sfb__patch_table_beztri_children(ctx, l, NULL, two ? 2 : 1, pt)) != SFB_SUCCESS) return r;
-        r = tbz_refined(ctx, l, positions, opt, two, &rl, &net4, pt->point_data, NULL);
+        r = tbz_refined(ctx, l, positions, opt, two, &rl, &net4, pt->point_data, want4, NULL);
         if (r != SFB_SUCCESS) { sfb__patch_table_free(ctx, pt); return r; }
+        pt->blend = blend4;
         sfb__level_free(ctx, &rl);
         return r;
     }
-    r = sfb__tribezier_points(ctx, l, positions, opt, SFB__TBZ_PROGRESS_LOW, &net, &st);
+    /* l is checked and split (sfb__tribezier_build): the points directly */
+    r = tbz_points(ctx, l, positions, positions, opt, SFB__TBZ_PROGRESS_LOW, &net, NULL, want, &st);
     if (r != SFB_SUCCESS) return r;
     cover = (double)st.unknowns > TBZ_COVER * (double)(st.sharp_only ? 1 : 2) * ((double)l->nv + 3.0 * l->ne + 3.0 * l->nf);
     if (st.residual > 1e-10 || cover) {
@@ -9781,25 +9878,31 @@ static sfb_result tbz_build(sfb_context *ctx, const sfb__level *l, const float *
         two = tbz_largest_group(ctx, l) > TBZ_ONE_STEP_GROUP ? SFB__TBZ_TWO_STEPS : 0;
         sfb__error_keep(ctx, &kept);
         memset(&st4, 0, sizeof st4);
-        r = sfb__tribezier_refined_points(ctx, l, positions, opt, SFB__TBZ_PROGRESS_HIGH | two, &rl, &net4, &st4);
+        r = tbz_refined(ctx, l, positions, opt, SFB__TBZ_PROGRESS_HIGH | two, &rl, &net4, NULL, want4, &st4);
         if (r == SFB_INVALID_TOPOLOGY) { /* not built after the steps: the mesh's own net */
             sfb__log(ctx, SFB_LOG_INFO, "tribezier: the net after Loop steps is refused (%s); the mesh's own net is kept (G1 residual %.3g)",
                      ctx->error, st.residual);
             sfb__error_put_back(ctx, &kept);
             st4.residual = HUGE_VAL;
-        } else if (r != SFB_SUCCESS) { sfb__free(ctx, net); return r; }
+        } else if (r != SFB_SUCCESS) { sfb__free(ctx, net); sfb__free(ctx, blend); return r; }
         if (st4.residual < st.residual || (cover && st4.residual <= 1e-10)) {
             sfb__free(ctx, net);
+            sfb__free(ctx, blend);
             r = sfb__patch_table_beztri_children(ctx, l, net4, two ? 2 : 1, pt);
             sfb__free(ctx, net4);
             sfb__level_free(ctx, &rl);
+            if (r == SFB_SUCCESS) pt->blend = blend4;
+            else sfb__free(ctx, blend4);
             return r;
         }
         sfb__free(ctx, net4);
+        sfb__free(ctx, blend4);
         sfb__level_free(ctx, &rl);
     }
     r = sfb__patch_table_beztri_own(ctx, l, net, pt);
     sfb__free(ctx, net);
+    if (r == SFB_SUCCESS) pt->blend = blend;
+    else sfb__free(ctx, blend);
     return r;
 }
 #line 1 "src/tess.c"
@@ -12799,6 +12902,7 @@ sfb_result sfb__surface_uv_patches(const sfb_surface *s, sfb__patch_table *upt) 
         P[3 * i + 2] = 0.0f;
     }
     ucfg = s->config;
+    ucfg.tribezier.slider = 0; /* the layout's own surface is built for this s only */
     for (i = 0; i < s->uv_base.nv; ++i)
         if (s->uv_base.vtag[i] & SFB__TAG_NONMANIFOLD) break;
     if (i < s->uv_base.nv) {
@@ -12887,6 +12991,49 @@ fail:
     return oom ? sfb__oom(ctx, "surface") : r;
 }
 
+/* The slider: the nets kept at create (patch/tribezier.c, pt->blend) blended for the new s into
+ * a new point array; the backend gets a new upload of it before the old one is released, so an
+ * error anywhere leaves the surface as it was. */
+SFB_API sfb_result sfb_surface_set_sharpness(sfb_surface *s, const sfb_tribezier_options *options) {
+    sfb_context *ctx;
+    sfb__patch_table *pt;
+    float *old, *fresh;
+    void *handle = NULL;
+    sfb_tribezier_options o;
+    if (!s) return SFB_INVALID_ARGS;
+    ctx = s->ctx;
+    if (!options) return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "sfb_surface_set_sharpness: options is NULL");
+    pt = &s->patches;
+    if (s->config.scheme != SFB_SCHEME_TRIBEZIER || !s->has_patches || !pt->blend)
+        return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1,
+                          "sfb_surface_set_sharpness: the surface %s", s->config.scheme != SFB_SCHEME_TRIBEZIER ? "is not SFB_SCHEME_TRIBEZIER"
+                          : "was built without tribezier.slider (its smooth and sharp nets were not kept)");
+    if (options->sharpness_set && !(options->sharpness >= 0.0f && options->sharpness <= 1.0f))
+        return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "sfb_surface_set_sharpness: sharpness %g is not in [0, 1]",
+                          (double)options->sharpness);
+    o = *options;
+    o.slider = 1;
+    fresh = (float *)sfb__alloc(ctx, 3 * (size_t)pt->npoints * sizeof(float) + 1);
+    if (!fresh) return sfb__oom(ctx, "sfb_surface_set_sharpness");
+    sfb__tribezier_blend(pt, &o, fresh);
+    old = pt->point_data;
+    pt->point_data = fresh;
+    if (s->backend_patches && s->uploaded_by && s->uploaded_by->upload_patches) {
+        const sfb_result r = s->uploaded_by->upload_patches(ctx->backend_state, pt, &handle);
+        if (r != SFB_SUCCESS) {
+            pt->point_data = old;
+            sfb__free(ctx, fresh);
+            return r;
+        }
+        if (s->uploaded_by->release_patches) s->uploaded_by->release_patches(ctx->backend_state, s->backend_patches);
+        s->backend_patches = handle;
+    }
+    sfb__free(ctx, old);
+    s->config.tribezier = o;
+    s->serial = ++ctx->surfaces_made;
+    return SFB_SUCCESS;
+}
+
 SFB_API int sfb_surface_param_face_count(const sfb_surface *s) { return s && s->has_patches ? s->patches.nptex : 0; }
 
 SFB_API sfb_result sfb_surface_param_faces(const sfb_surface *s, int base_face, int *first, int *count) {
@@ -12913,7 +13060,8 @@ SFB_API sfb_result sfb_surface_param_face_base(const sfb_surface *s, int pf, int
 static size_t sfb__patch_table_bytes(const sfb__patch_table *pt) {
     return (size_t)pt->npatch * (4 * sizeof(int)) + (size_t)pt->ncv * sizeof(int) + (size_t)pt->nptex * 3 * sizeof(int) +
            (size_t)pt->nnodes * 4 * sizeof(int) + (size_t)pt->npoints * 3 * sizeof(float) +
-           (pt->pcorner ? (size_t)pt->npatch * 4 * sizeof(unsigned) : 0) + (pt->normal_field ? sfb__patch_table_bytes(pt->normal_field) : 0);
+           (pt->pcorner ? (size_t)pt->npatch * 4 * sizeof(unsigned) : 0) + (pt->normal_field ? sfb__patch_table_bytes(pt->normal_field) : 0) +
+           (pt->blend ? (size_t)pt->npatch * SFB__TBZ_BLEND * sizeof(float) : 0);
 }
 
 SFB_API sfb_result sfb_surface_patch_info(const sfb_surface *s, sfb_patch_info *o) {

@@ -295,6 +295,8 @@ typedef struct sfb_manifold_options {
 typedef struct sfb_tribezier_options {
     int sharpness_set;  /* nonzero: `sharpness` replaces every tagged crease's and corner's s */
     float sharpness;    /* in [0, 1] */
+    int slider;         /* nonzero: the surface keeps its smooth (s = 0) and sharp (s = 1) nets (about 2.6 times
+                           the patch table's memory), so that sfb_surface_set_sharpness moves s without a rebuild */
 } sfb_tribezier_options;
 
 typedef struct sfb_surface_config {
@@ -319,6 +321,14 @@ typedef struct sfb_surface sfb_surface;
 SFB_API sfb_result sfb_surface_create(sfb_context *ctx, const sfb_mesh *mesh,
                                       const sfb_surface_config *config, sfb_surface **out);
 SFB_API void sfb_surface_destroy(sfb_surface *surface);
+/* The sharpness slider of SFB_SCHEME_TRIBEZIER (seed 004): the surface becomes the one
+ * sfb_surface_create makes with `options` (sharpness_set and sharpness; slider is kept),
+ * bit for bit, in time linear in the patch points: no G1 solve runs again (the surface at s is
+ * (1 - s) x the smooth net + s x the sharp net, point by point). The surface must have been
+ * built with tribezier.slider set. Its patches are uploaded to the backend again; it counts as a
+ * new surface for an sfb_analysis_workspace. Not to be called while another thread uses the
+ * surface. On an error (an s outside [0, 1] or NaN, a surface without the nets) it is unchanged. */
+SFB_API sfb_result sfb_surface_set_sharpness(sfb_surface *surface, const sfb_tribezier_options *options);
 
 /* Which stencil table to apply. */
 typedef enum sfb_table {
@@ -511,7 +521,7 @@ typedef struct sfb_patch_info {
     int bspline, bezier;   /* regular patches: bicubic B-spline (Catmull-Clark), quartic Bezier triangle (Loop) */
     int stam, end_caps, max_depth, points;
     int manifold;          /* MANIFOLD4 blends (one per quad of the manifold mesh) */
-    size_t bytes;  /* memory of the patch table and its points */
+    size_t bytes;  /* memory of the patch table and its points (and the two nets of tribezier.slider) */
     int domain_sides;      /* 4: a parametric face's (u,v) is the unit square; 3: the triangle u + v <= 1 */
 } sfb_patch_info;
 SFB_API sfb_result sfb_surface_patch_info(const sfb_surface *surface, sfb_patch_info *out);
@@ -673,8 +683,8 @@ typedef enum sfb_curvature_kind { SFB_CURVATURE_GAUSSIAN = 0, SFB_CURVATURE_MEAN
  * the simd backend). The buffers grow to the largest analysis run with it and stay (counted
  * against the context's memory budget) until sfb_analysis_workspace_destroy. It also keeps the
  * last surface's proxy and face adjacency (they depend on the surface and the proxy level, not
- * on the view: a surface never changes), so a surface analysed again, from any view, skips
- * their evaluation. A workspace belongs to the context it was made on and, like that context,
+ * on the view; sfb_surface_set_sharpness, the one call that changes a surface, makes it count as
+ * a new one), so a surface analysed again, from any view, skips their evaluation. A workspace belongs to the context it was made on and, like that context,
  * to one thread at a time; results are bit for bit those without it. */
 typedef struct sfb_analysis_workspace sfb_analysis_workspace;
 SFB_API sfb_result sfb_analysis_workspace_create(sfb_context *ctx, sfb_analysis_workspace **out);

@@ -322,6 +322,11 @@ typedef struct sfb__patch_table {
     int mf_weights;        /* MANIFOLD4: SFB_MANIFOLD_WEIGHTS_* */
     int npoints;           /* patch points */
     float *point_data;     /* xyz per patch point, for the surface's base positions */
+    /* NULL, or (tribezier with the slider option) per patch SFB__TBZ_BLEND floats: its 15
+     * points in the smooth net (45), in the sharp net (45), and each point's s from the tags
+     * (15; -1: no tagged feature in its part of the mesh); point_data is their blend
+     * (sfb__tribezier_blend). Owned. */
+    float *blend;
     const sfb__eigen_cc *eig[SFB__STAM_MAX_VALENCE + 1]; /* valences used (the context's cache) */
     const sfb__eigen_loop *eigl[SFB__STAM_MAX_VALENCE + 1]; /* Loop: the same */
     /* NULL, or a table of the same parametric faces whose evaluated position, normalised, is
@@ -526,8 +531,9 @@ typedef struct sfb__shading {
 /* ---- surfaces ---- */
 struct sfb_surface {
     sfb_context *ctx;
-    unsigned long serial;        /* the context's count of surfaces at its creation (from 1): a surface never changes,
-                                    so data derived from it alone may be kept under it (sfb_analysis_workspace) */
+    unsigned long serial;        /* the context's count of surfaces at its creation (from 1), and again at each
+                                    sfb_surface_set_sharpness, the one call that changes a surface: data derived from
+                                    it alone may be kept under it (sfb_analysis_workspace) */
     sfb_surface_config config;
     int base_vertex_count, base_uv_count, base_face_count;
     float *base_positions, *base_uvs;
@@ -745,6 +751,12 @@ SFB__IF sfb_result sfb__tribezier_refined_points(sfb_context *ctx, const sfb__le
  * own G1 constraints have no exact solution. */
 SFB__IF sfb_result sfb__tribezier_build(sfb_context *ctx, const sfb__level *base, const float *positions,
                                         const sfb_tribezier_options *opt, sfb__patch_table *pt);
+/* The slider (sfb_surface_set_sharpness): per patch 45 + 45 + 15 floats in pt->blend, and the
+ * s of a point from its tag s (blend's last 15) for options opt. */
+#define SFB__TBZ_BLEND 105
+SFB__IF double sfb__tribezier_point_s(const sfb_tribezier_options *opt, float tag_s);
+/* The patch points for opt from pt->blend, into point_data (3 floats per patch point). */
+SFB__IF void sfb__tribezier_blend(const sfb__patch_table *pt, const sfb_tribezier_options *opt, float *point_data);
 SFB__IF sfb_result sfb__manifold_build(sfb_context *ctx, const sfb__level *base, int weights, const float *positions, sfb__patch_table *pt);
 SFB__IF void sfb__mf_eval(const float *pts, const int *cv, const unsigned *codes, int kind, double c, double d, double S[3], double Sc[3],
                   double Sd[3]);

@@ -209,6 +209,7 @@ sfb_result sfb__surface_uv_patches(const sfb_surface *s, sfb__patch_table *upt) 
         P[3 * i + 2] = 0.0f;
     }
     ucfg = s->config;
+    ucfg.tribezier.slider = 0; /* the layout's own surface is built for this s only */
     for (i = 0; i < s->uv_base.nv; ++i)
         if (s->uv_base.vtag[i] & SFB__TAG_NONMANIFOLD) break;
     if (i < s->uv_base.nv) {
@@ -297,6 +298,49 @@ fail:
     return oom ? sfb__oom(ctx, "surface") : r;
 }
 
+/* The slider: the nets kept at create (patch/tribezier.c, pt->blend) blended for the new s into
+ * a new point array; the backend gets a new upload of it before the old one is released, so an
+ * error anywhere leaves the surface as it was. */
+SFB_API sfb_result sfb_surface_set_sharpness(sfb_surface *s, const sfb_tribezier_options *options) {
+    sfb_context *ctx;
+    sfb__patch_table *pt;
+    float *old, *fresh;
+    void *handle = NULL;
+    sfb_tribezier_options o;
+    if (!s) return SFB_INVALID_ARGS;
+    ctx = s->ctx;
+    if (!options) return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "sfb_surface_set_sharpness: options is NULL");
+    pt = &s->patches;
+    if (s->config.scheme != SFB_SCHEME_TRIBEZIER || !s->has_patches || !pt->blend)
+        return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1,
+                          "sfb_surface_set_sharpness: the surface %s", s->config.scheme != SFB_SCHEME_TRIBEZIER ? "is not SFB_SCHEME_TRIBEZIER"
+                          : "was built without tribezier.slider (its smooth and sharp nets were not kept)");
+    if (options->sharpness_set && !(options->sharpness >= 0.0f && options->sharpness <= 1.0f))
+        return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "sfb_surface_set_sharpness: sharpness %g is not in [0, 1]",
+                          (double)options->sharpness);
+    o = *options;
+    o.slider = 1;
+    fresh = (float *)sfb__alloc(ctx, 3 * (size_t)pt->npoints * sizeof(float) + 1);
+    if (!fresh) return sfb__oom(ctx, "sfb_surface_set_sharpness");
+    sfb__tribezier_blend(pt, &o, fresh);
+    old = pt->point_data;
+    pt->point_data = fresh;
+    if (s->backend_patches && s->uploaded_by && s->uploaded_by->upload_patches) {
+        const sfb_result r = s->uploaded_by->upload_patches(ctx->backend_state, pt, &handle);
+        if (r != SFB_SUCCESS) {
+            pt->point_data = old;
+            sfb__free(ctx, fresh);
+            return r;
+        }
+        if (s->uploaded_by->release_patches) s->uploaded_by->release_patches(ctx->backend_state, s->backend_patches);
+        s->backend_patches = handle;
+    }
+    sfb__free(ctx, old);
+    s->config.tribezier = o;
+    s->serial = ++ctx->surfaces_made;
+    return SFB_SUCCESS;
+}
+
 SFB_API int sfb_surface_param_face_count(const sfb_surface *s) { return s && s->has_patches ? s->patches.nptex : 0; }
 
 SFB_API sfb_result sfb_surface_param_faces(const sfb_surface *s, int base_face, int *first, int *count) {
@@ -323,7 +367,8 @@ SFB_API sfb_result sfb_surface_param_face_base(const sfb_surface *s, int pf, int
 static size_t sfb__patch_table_bytes(const sfb__patch_table *pt) {
     return (size_t)pt->npatch * (4 * sizeof(int)) + (size_t)pt->ncv * sizeof(int) + (size_t)pt->nptex * 3 * sizeof(int) +
            (size_t)pt->nnodes * 4 * sizeof(int) + (size_t)pt->npoints * 3 * sizeof(float) +
-           (pt->pcorner ? (size_t)pt->npatch * 4 * sizeof(unsigned) : 0) + (pt->normal_field ? sfb__patch_table_bytes(pt->normal_field) : 0);
+           (pt->pcorner ? (size_t)pt->npatch * 4 * sizeof(unsigned) : 0) + (pt->normal_field ? sfb__patch_table_bytes(pt->normal_field) : 0) +
+           (pt->blend ? (size_t)pt->npatch * SFB__TBZ_BLEND * sizeof(float) : 0);
 }
 
 SFB_API sfb_result sfb_surface_patch_info(const sfb_surface *s, sfb_patch_info *o) {

@@ -1509,7 +1509,15 @@ static void test_backends_refined(const char *dir) {
 
 /* Bad input: clear errors, nothing left allocated (the counting allocator). */
 static long g_live;
-static void *cnt_alloc(size_t n, void *u) { void *p = malloc(n); (void)u; if (p) g_live++; return p; }
+static int g_fail_next; /* the next allocation fails */
+static void *cnt_alloc(size_t n, void *u) {
+    void *p;
+    (void)u;
+    if (g_fail_next) { g_fail_next = 0; return NULL; }
+    p = malloc(n);
+    if (p) g_live++;
+    return p;
+}
 static void *cnt_realloc(void *p, size_t n, void *u) { (void)u; if (!p) return cnt_alloc(n, u); return realloc(p, n); }
 static void cnt_free(void *p, void *u) { (void)u; if (p) { g_live--; free(p); } }
 
@@ -1594,6 +1602,236 @@ static void test_backends(void) {
         sfb__free(ctx, net);
         tmesh_free(ctx, &t);
     }
+    free(obj);
+}
+
+/* The slider (sfb_surface_set_sharpness) on every backend: a surface built once with
+ * tribezier.slider at s = 1 and moved to s = 0, 0.3, its tags' s and 1 evaluates (positions and
+ * first derivatives, 300 locations) bit for bit as one built afresh with those options and the
+ * slider, and within float rounding (2e-7 x diagonal) as one built without it; s = 0 and s = 1
+ * differ. Meshes: a creased disk with semi-sharp tags and a hole, joined to an untagged disk (the
+ * mesh's own net); the triangulated cube with two tagged edges (extraordinary vertices touching:
+ * the net after a Loop step, written straight into the table); a coarse creased disk (the net
+ * after a Loop step for coverage). */
+static int slider_eval(sfb_surface *sf, int nf, float *P, float *D) {
+    /* slider_mesh(0)'s hole: its next face instead */
+    const int hole = nf == 180 + 54 ? 40 : -1;
+    sfb_location L[300];
+    sfb_eval_output eo;
+    unsigned seed = 7u;
+    int q;
+    for (q = 0; q < 300; ++q) {
+        float u = (float)tbm_unit(&seed), v = (float)tbm_unit(&seed);
+        if (u + v > 1.0f) { u = 1.0f - u; v = 1.0f - v; }
+        L[q].face = (int)(tbm_rand(&seed) % (unsigned)nf);
+        if (L[q].face == hole) L[q].face++;
+        L[q].u = u; L[q].v = v;
+    }
+    memset(&eo, 0, sizeof eo);
+    eo.position = P; eo.du = D; eo.dv = D + 900;
+    memset(P, 0, 900 * sizeof(float));
+    memset(D, 0, 1800 * sizeof(float));
+    return sfb_surface_eval(sf, L, 300, &eo) == SFB_SUCCESS;
+}
+
+static char *slider_mesh(int which) {
+    tbm_opts o;
+    memset(&o, 0, sizeof o);
+    if (which == 0) {
+        char *a, *b, *j, *obj = NULL;
+        o.n = 5; o.R = 6; o.crease_k = 2; o.sharp = 0.5; o.ridge = 0.4; o.bump = 1.0; o.jitter = 0.2; o.seed = 9u;
+        a = tbm_obj(&o);
+        memset(&o, 0, sizeof o);
+        o.n = 6; o.R = 3; o.bump = 1.0; o.jitter = 0.15; o.seed = 12u;
+        b = tbm_obj(&o);
+        j = a && b ? obj_join(a, b) : NULL;
+        if (j) {
+            obj = (char *)malloc(strlen(j) + 64);
+            if (obj) sprintf(obj, "%st hole 1/0/0 40\n", j);
+        }
+        free(a); free(b); free(j);
+        return obj;
+    }
+    if (which == 1) {
+        char *obj = (char *)malloc(strlen(tri_cube) + 64);
+        if (obj) sprintf(obj, "%st crease 2/1/0 0 1 0.3\nt crease 2/1/0 1 2 1\n", tri_cube);
+        return obj;
+    }
+    o.n = 5; o.R = 2; o.crease_k = 2; o.sharp = 0.6; o.ridge = 0.5; o.bump = 1.0;
+    return tbm_obj(&o);
+}
+
+static void test_slider(void) {
+    static const char *names[3] = {"creased_disk_hole_and_untagged_disk", "cube_touching_evs", "coarse_creased_disk"};
+    static const float svals[4] = {0.0f, 0.3f, -1.0f, 1.0f}; /* -1: the tags' s (the surface is built with s = 1) */
+    int b, w, i;
+    for (w = 0; w < 3; ++w) {
+        char *obj = slider_mesh(w);
+        for (b = 0; b < g_nbe; ++b) {
+            char nm[200];
+            sfb_context *ctx = g_be[b].ctx;
+            sfb_mesh *m = NULL;
+            sfb_surface *sl = NULL;
+            sfb_surface_config sc = sfb_surface_config_init(SFB_SCHEME_TRIBEZIER, 0);
+            float *buf = (float *)malloc(6 * 2700 * sizeof(float));
+            float *P0 = buf, *D0 = buf + 900, *P1 = buf + 2700, *D1 = buf + 3600, *P2 = buf + 5400, *D2 = buf + 6300;
+            double diag = 0.0, far01 = 0.0;
+            int nf = 0, bits_ok = 1, near_ok = 1, evals = 1;
+            double worst = 0.0;
+            snprintf(nm, sizeof nm, "%s/slider/%s", g_be[b].name, names[w]);
+            if (!g_be[b].available) { backend_missing(&g_be[b], nm); free(buf); continue; }
+            if (!obj || !buf || sfb_mesh_read_obj(ctx, obj, strlen(obj), &m) != SFB_SUCCESS) { fail(nm, "load: %s", sfb_last_error(ctx)); free(buf); continue; }
+            {
+                sfb_mesh_desc d;
+                sfb_mesh_get_desc(m, &d);
+                nf = d.face_count;
+                diag = diag_of(d.positions, d.vertex_count);
+            }
+            sc.flags = SFB_REFINE_PATCHES;
+            sc.tribezier.slider = 1;
+            sc.tribezier.sharpness_set = 1;
+            sc.tribezier.sharpness = 1.0f;
+            if (sfb_surface_create(ctx, m, &sc, &sl) != SFB_SUCCESS) { fail(nm, "create: %s", sfb_last_error(ctx)); sfb_mesh_destroy(m); free(buf); continue; }
+            for (i = 0; i < 4; ++i) {
+                sfb_tribezier_options to;
+                sfb_surface *fresh = NULL, *plain = NULL;
+                size_t q;
+                memset(&to, 0, sizeof to);
+                to.sharpness_set = svals[i] >= 0.0f;
+                to.sharpness = svals[i] >= 0.0f ? svals[i] : 0.0f;
+                sc.tribezier = to;
+                sc.tribezier.slider = 1;
+                if (sfb_surface_set_sharpness(sl, &to) != SFB_SUCCESS || sfb_surface_create(ctx, m, &sc, &fresh) != SFB_SUCCESS) {
+                    fail(nm, "s %g: %s", (double)svals[i], sfb_last_error(ctx));
+                    evals = 0;
+                    break;
+                }
+                sc.tribezier.slider = 0;
+                if (sfb_surface_create(ctx, m, &sc, &plain) != SFB_SUCCESS) { fail(nm, "plain: %s", sfb_last_error(ctx)); evals = 0; sfb_surface_destroy(fresh); break; }
+                evals = evals && slider_eval(sl, nf, P0, D0) && slider_eval(fresh, nf, P1, D1) && slider_eval(plain, nf, P2, D2);
+                bits_ok = bits_ok && memcmp(P0, P1, 900 * sizeof(float)) == 0 && memcmp(D0, D1, 1800 * sizeof(float)) == 0;
+                for (q = 0; q < 900; ++q) worst = fmax(worst, fabs((double)P0[q] - P2[q]));
+                if (i == 0) memcpy(buf + 8100, P0, 900 * sizeof(float)); /* s = 0 kept (after the six arrays) */
+                if (i == 3)
+                    for (q = 0; q < 900; ++q) far01 = fmax(far01, fabs((double)P0[q] - buf[8100 + q]));
+                sfb_surface_destroy(fresh);
+                sfb_surface_destroy(plain);
+            }
+            near_ok = worst <= 2e-7 * diag;
+            {
+                /* the build's path: the mesh's own net (depth 0), the net after a Loop step (1) */
+                static const int depth[3] = {0, 1, 1};
+                sfb_patch_info pi;
+                memset(&pi, 0, sizeof pi);
+                sfb_surface_patch_info(sl, &pi);
+                check(evals && bits_ok && near_ok && far01 > 1e-3 * diag && pi.max_depth == depth[w], nm,
+                      "evaluated %d, bit for bit as built afresh %d, off the build without the slider by %.3g (diag %.3g), s = 0 to 1 moves %.3g, "
+                      "patch depth %d",
+                      evals, bits_ok, worst, diag, far01, pi.max_depth);
+                printf("  %s: off the build without the slider by %.3g diagonals, s = 0 to 1 moves %.3g diagonals, patch depth %d\n", nm,
+                       worst / diag, far01 / diag, pi.max_depth);
+            }
+            sfb_surface_destroy(sl);
+            sfb_mesh_destroy(m);
+            free(buf);
+        }
+        free(obj);
+    }
+}
+
+/* sfb_surface_set_sharpness's refusals leave the surface as it was (evaluated bit for bit the
+ * same) and allocate nothing: a surface built without the slider, a Loop surface, an s outside
+ * [0, 1] or NaN, NULL options, an allocation that fails; and the slider's repeated moves leave
+ * nothing behind. An analysis workspace that saw the surface before a move gives the picture a
+ * fresh analysis gives after it. */
+static void test_slider_refusals(void) {
+    sfb_context_config cc = sfb_context_config_init();
+    sfb_context *ctx = NULL;
+    sfb_mesh *m = NULL;
+    sfb_surface *sl = NULL, *plain = NULL, *loop = NULL;
+    sfb_surface_config sc = sfb_surface_config_init(SFB_SCHEME_TRIBEZIER, 0), lc = sfb_surface_config_init(SFB_SCHEME_LOOP, 0);
+    char *obj = slider_mesh(0);
+    static float P0[900], D0[1800], P1[900], D1[1800];
+    sfb_mesh_desc d;
+    long before;
+    int k;
+    cc.ignore_environment = 1;
+    cc.allocator.alloc = cnt_alloc; cc.allocator.realloc = cnt_realloc; cc.allocator.free = cnt_free;
+    if (!obj || sfb_context_create(&cc, &ctx) != SFB_SUCCESS) { fail("slider/refusals", "context"); free(obj); return; }
+    if (sfb_mesh_read_obj(ctx, obj, strlen(obj), &m) != SFB_SUCCESS) { fail("slider/refusals", "load"); sfb_context_destroy(ctx); free(obj); return; }
+    sfb_mesh_get_desc(m, &d);
+    sc.flags = lc.flags = SFB_REFINE_PATCHES;
+    if (sfb_surface_create(ctx, m, &sc, &plain) != SFB_SUCCESS || sfb_surface_create(ctx, m, &lc, &loop) != SFB_SUCCESS)
+        fail("slider/refusals", "create: %s", sfb_last_error(ctx));
+    before = g_live; /* after the context's caches (Loop's eigen structures) are made */
+    sc.tribezier.slider = 1;
+    if (sfb_surface_create(ctx, m, &sc, &sl) != SFB_SUCCESS) fail("slider/refusals", "create: %s", sfb_last_error(ctx));
+    if (sl && plain && loop && slider_eval(sl, d.face_count, P0, D0)) {
+        static const char *cases[7] = {"not_built_with_the_slider", "loop_surface", "sharpness_above_1", "sharpness_nan", "sharpness_negative",
+                                       "null_options", "allocation_fails"};
+        static const char *says[7] = {"slider", "not SFB_SCHEME_TRIBEZIER", "not in [0, 1]", "not in [0, 1]", "not in [0, 1]", "NULL", "memory"};
+        static const sfb_result want[7] = {SFB_INVALID_ARGS, SFB_INVALID_ARGS, SFB_INVALID_ARGS, SFB_INVALID_ARGS, SFB_INVALID_ARGS, SFB_INVALID_ARGS,
+                                           SFB_OUT_OF_MEMORY};
+        for (k = 0; k < 7; ++k) {
+            sfb_tribezier_options to;
+            char nm[120];
+            long live;
+            sfb_result r;
+            memset(&to, 0, sizeof to);
+            to.sharpness_set = 1;
+            to.sharpness = k == 2 ? 1.5f : k == 3 ? (float)NAN : k == 4 ? -0.25f : 0.5f;
+            snprintf(nm, sizeof nm, "slider/refused/%s", cases[k]);
+            live = g_live;
+            g_fail_next = k == 6;
+            r = sfb_surface_set_sharpness(k == 0 ? plain : k == 1 ? loop : sl, k == 5 ? NULL : &to);
+            g_fail_next = 0;
+            check(r == want[k] && strstr(sfb_last_error(ctx), says[k]) && g_live == live && slider_eval(sl, d.face_count, P1, D1) &&
+                      memcmp(P0, P1, sizeof P0) == 0 && memcmp(D0, D1, sizeof D0) == 0,
+                  nm, "result %d (want %d), '%s', %ld blocks left", (int)r, (int)want[k], sfb_last_error(ctx), g_live - live);
+        }
+    } else fail("slider/refusals", "surfaces: %s", sfb_last_error(ctx));
+    {
+        /* the workspace: an analysis at s = 0.3 with it, the surface moved to s = 1, analysed
+         * again with it and without one */
+        sfb_analysis_workspace *ws = NULL;
+        sfb_analysis a0, a1, a2;
+        sfb_analyze_config ac = sfb_analyze_config_init(SFB_ANALYZE_REFLECTION);
+        sfb_tribezier_options to;
+        int ok;
+        memset(&a0, 0, sizeof a0); memset(&a1, 0, sizeof a1); memset(&a2, 0, sizeof a2);
+        memset(&to, 0, sizeof to);
+        ac.width = 96; ac.height = 72;
+        to.sharpness_set = 1; to.sharpness = 0.3f;
+        ok = sl && sfb_analysis_workspace_create(ctx, &ws) == SFB_SUCCESS && sfb_surface_set_sharpness(sl, &to) == SFB_SUCCESS;
+        ac.workspace = ws;
+        ok = ok && sfb_surface_analyze(sl, &ac, &a0) == SFB_SUCCESS;
+        to.sharpness = 1.0f;
+        ok = ok && sfb_surface_set_sharpness(sl, &to) == SFB_SUCCESS && sfb_surface_analyze(sl, &ac, &a1) == SFB_SUCCESS;
+        ac.workspace = NULL;
+        ok = ok && sfb_surface_analyze(sl, &ac, &a2) == SFB_SUCCESS;
+        check(ok && memcmp(a1.rgba, a2.rgba, 96 * 72 * 4) == 0 && memcmp(a0.rgba, a1.rgba, 96 * 72 * 4) != 0, "slider/analysis_workspace_sees_the_move",
+              "analysed %d, with the workspace as without %d, the move changed the picture %d", ok, ok && !memcmp(a1.rgba, a2.rgba, 96 * 72 * 4),
+              ok && memcmp(a0.rgba, a1.rgba, 96 * 72 * 4) != 0);
+        sfb_analysis_free(&a0); sfb_analysis_free(&a1); sfb_analysis_free(&a2);
+        sfb_analysis_workspace_destroy(ws);
+    }
+    {
+        /* twenty moves leave nothing behind */
+        long live = g_live;
+        sfb_tribezier_options to;
+        memset(&to, 0, sizeof to);
+        for (k = 0; k < 20 && sl; ++k) {
+            to.sharpness_set = k % 5 != 4;
+            to.sharpness = (float)(k % 5) * 0.25f;
+            if (sfb_surface_set_sharpness(sl, &to) != SFB_SUCCESS) break;
+        }
+        check(k == 20 && g_live == live, "slider/moves_leak_nothing", "%d moves, %ld blocks left", k, g_live - live);
+    }
+    sfb_surface_destroy(sl);
+    check(g_live == before, "slider/destroyed_leaves_nothing", "%ld blocks left", g_live - before);
+    sfb_surface_destroy(plain); sfb_surface_destroy(loop);
+    sfb_mesh_destroy(m);
+    sfb_context_destroy(ctx);
     free(obj);
 }
 
@@ -1802,5 +2040,7 @@ int main(int argc, char **argv) {
     if (!probe_backends()) return 1;
     test_backends();
     test_backends_refined(argc > 1 ? argv[1] : "../shared/peers/real-meshes");
+    test_slider();
+    test_slider_refusals();
     return close_tests();
 }
