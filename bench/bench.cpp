@@ -1945,6 +1945,82 @@ static int tribezier_meshes_section() {
     return status;
 }
 
+/* The slider (sfb_surface_set_sharpness) against a rebuild for each new s, on the real models
+ * with their edges over 40 degrees made creases (sfb_mesh_crease_by_angle) and on the seed-style
+ * crease disk of examples/data: the build with the slider (both nets kept), the build without it
+ * at one s (what a rebuild per slider move costs), one move (median of 9, s from 0.1 to 0.9), all
+ * on the simd backend with its threads; the patch memory with and without the slider. */
+static int tribezier_slider_section() {
+    struct Case { const char *label, *path; float angle; };
+    const Case cases[] = {{"cow (40 deg creases)", "../shared/peers/real-meshes/cow.obj", 40.0f},
+                          {"spot (40 deg creases)", "../shared/peers/real-meshes/spot.obj", 40.0f},
+                          {"teapot (40 deg creases)", "../shared/peers/real-meshes/teapot.obj", 40.0f},
+                          {"crease disk, valence 5", "examples/data/tribezier_crease_v5.obj", 0.0f}};
+    std::string why;
+    sfb_context *ctx = eval_context(SFB_BACKEND_SIMD, 0, 0, &why);
+    int status = 0;
+    printf("\ntribezier sharpness slider: sfb_surface_set_sharpness against a rebuild per move (ms, simd, all threads;\n"
+           "'x' = rebuild / move; memory: the patch table without and with the slider's two nets):\n");
+    printf("%-24s %7s %7s | %10s %10s %10s %8s | %9s %9s\n", "mesh", "tris", "creases", "build+nets", "rebuild", "move", "x", "MB", "MB slider");
+    if (!ctx) { printf("skipped: no simd context: %s\n", why.c_str()); return 0; }
+    for (const Case &c : cases) {
+        std::string text;
+        if (!read_text(c.path, &text)) { printf("%-24s skipped: %s not found\n", c.label, c.path); continue; }
+        sfb_mesh *m0 = NULL, *m = NULL;
+        int added = 0;
+        if (sfb_mesh_read_obj(ctx, text.data(), text.size(), &m0) != SFB_SUCCESS ||
+            (c.angle > 0.0f ? sfb_mesh_crease_by_angle(ctx, m0, c.angle, &m, &added) : SFB_SUCCESS) != SFB_SUCCESS) {
+            printf("%-24s failed: %s\n", c.label, sfb_last_error(ctx));
+            sfb_mesh_destroy(m0);
+            status = 1;
+            continue;
+        }
+        if (!m) { m = m0; m0 = NULL; }
+        sfb_mesh_info mi;
+        sfb_mesh_get_info(m, &mi);
+        sfb_surface_config cfg = sfb_surface_config_init(SFB_SCHEME_TRIBEZIER, 0);
+        cfg.flags = SFB_REFINE_PATCHES;
+        cfg.tribezier.sharpness_set = 1;
+        cfg.tribezier.sharpness = 0.5f;
+        sfb_surface *plain = NULL, *sl = NULL;
+        Clock::time_point t0 = Clock::now();
+        sfb_result r = sfb_surface_create(ctx, m, &cfg, &plain);
+        const double rebuild = ms_since(t0);
+        cfg.tribezier.slider = 1;
+        t0 = Clock::now();
+        if (r == SFB_SUCCESS) r = sfb_surface_create(ctx, m, &cfg, &sl);
+        const double build = ms_since(t0);
+        std::vector<double> moves;
+        for (int i = 1; i <= 9 && r == SFB_SUCCESS; ++i) {
+            sfb_tribezier_options to;
+            memset(&to, 0, sizeof to);
+            to.sharpness_set = 1;
+            to.sharpness = 0.1f * (float)i;
+            t0 = Clock::now();
+            r = sfb_surface_set_sharpness(sl, &to);
+            moves.push_back(ms_since(t0));
+        }
+        if (r != SFB_SUCCESS) {
+            printf("%-24s failed: %s\n", c.label, sfb_last_error(ctx));
+            status = 1;
+        } else {
+            sfb_patch_info p0, p1;
+            sfb_surface_patch_info(plain, &p0);
+            sfb_surface_patch_info(sl, &p1);
+            const double mv = median(moves);
+            printf("%-24s %7d %7d | %10.1f %10.1f %10.3f %8.0f | %9.1f %9.1f\n", c.label, mi.triangles, mi.sharp_edges, build, rebuild, mv,
+                   mv > 0 ? rebuild / mv : 0.0, p0.bytes / 1048576.0, p1.bytes / 1048576.0);
+        }
+        fflush(stdout);
+        sfb_surface_destroy(plain);
+        sfb_surface_destroy(sl);
+        sfb_mesh_destroy(m);
+        sfb_mesh_destroy(m0);
+    }
+    sfb_context_destroy(ctx);
+    return status;
+}
+
 int main(int argc, char **argv) {
     int max_level = 4;
     bool limit_only = false;
@@ -1962,17 +2038,19 @@ int main(int argc, char **argv) {
     if (argc > 1 && strcmp(argv[1], "--analyze") == 0) return analyze_section();
     if (argc > 1 && strcmp(argv[1], "--fillet") == 0) return fillet_section();
     if (argc > 1 && strcmp(argv[1], "--tribezier-meshes") == 0) return tribezier_meshes_section();
+    if (argc > 1 && strcmp(argv[1], "--tribezier-slider") == 0) return tribezier_slider_section();
     if (argc > 1 && strcmp(argv[1], "--tribezier") == 0) {
         TorusMesh t(100, 60);
         int st = limit_section(bbox_diagonal(t), LIMIT_TRIBEZIER);
         if (tribezier_meshes_section() != 0) st = 1;
+        if (tribezier_slider_section() != 0) st = 1;
         return st;
     }
     if (argc > 1) {
         limit_only = strcmp(argv[1], "--limit") == 0;
         max_level = limit_only ? 0 : atoi(argv[1]);
         if (argc > 2 || (!limit_only && (max_level < 1 || max_level > 6))) {
-            fprintf(stderr, "usage: bench [MAX_LEVEL 1..6, default 4 | --limit (the limit evaluation section alone) | --shade (the shading section alone) | --manifold (the manifold blending section alone) | --tribezier (the tribezier section alone) | --tribezier-meshes (its real and remeshed meshes alone) | --analyze (the analysis section alone) | --fillet (the fillet section alone)]\n");
+            fprintf(stderr, "usage: bench [MAX_LEVEL 1..6, default 4 | --limit (the limit evaluation section alone) | --shade (the shading section alone) | --manifold (the manifold blending section alone) | --tribezier (the tribezier section alone) | --tribezier-meshes (its real and remeshed meshes alone) | --tribezier-slider (its slider rows alone) | --analyze (the analysis section alone) | --fillet (the fillet section alone)]\n");
             return 2;
         }
     }
@@ -2142,6 +2220,7 @@ int main(int argc, char **argv) {
     if (limit_section(diag, LIMIT_LOOP) != 0) status = 1;
     if (limit_section(diag, LIMIT_TRIBEZIER) != 0) status = 1;
     if (tribezier_meshes_section() != 0) status = 1;
+    if (tribezier_slider_section() != 0) status = 1;
     if (shade_section() != 0) status = 1;
     if (manifold_section() != 0) status = 1;
     if (analyze_section() != 0) status = 1;
