@@ -4,7 +4,8 @@
  * extraordinary vertex of valence 4, 5 and 7 with a straight crease through it, and a disk around
  * a vertex of valence 3 with three crease edges meeting at a corner. Each is made a
  * SFB_SCHEME_TRIBEZIER surface with the crease's sharpness s = 0 (the smooth G1 spline surface),
- * 0.5 and 1 (the crease; the corner interpolated), and drawn with highlight lines from the exact
+ * then moved to 0.5 and 1 with the slider (sfb_surface_set_sharpness: built once, tribezier.slider)
+ * (the crease; the corner interpolated), and drawn with highlight lines from the exact
  * limit normals: rows are the meshes, columns the three values of s (the seed's Figs. 8-11 as one
  * picture).
  *
@@ -129,7 +130,8 @@ static void free_mesh(panel_mesh *m) {
     free(m->positions); free(m->faces); free(m->sizes); free(m->creases); free(m->sharpness);
 }
 
-/* The surface of `m` at sharpness s, or NULL with the reason printed. */
+/* The surface of `m` at sharpness s, or NULL with the reason printed; built with the slider, so
+ * that the other columns' s are set on it (sfb_surface_set_sharpness) rather than built again. */
 static sfb_surface *make_surface(sfb_context *ctx, const panel_mesh *m, float s, sfb_mesh **mesh_out) {
     static const int corner_vertex[1] = {0};
     static const float corner_sharpness[1] = {1.0f};
@@ -144,6 +146,7 @@ static sfb_surface *make_surface(sfb_context *ctx, const panel_mesh *m, float s,
     cfg.flags = SFB_REFINE_PATCHES;
     cfg.tribezier.sharpness_set = 1;
     cfg.tribezier.sharpness = s;
+    cfg.tribezier.slider = 1;
     if (sfb_mesh_create(ctx, &desc, mesh_out) != SFB_SUCCESS || sfb_surface_create(ctx, *mesh_out, &cfg, &surface) != SFB_SUCCESS) {
         fprintf(stderr, "04_tribezier_panel: %s\n", sfb_last_error(ctx));
         return NULL;
@@ -268,6 +271,8 @@ int main(int argc, char **argv) {
     unsigned char *panel = NULL;
     sfb_context *ctx = NULL;
     int row, col, status = 0;
+    sfb_mesh *mesh;
+    sfb_surface *surface;
     if (argc == 2 && (!strcmp(argv[1], "--help") || !strcmp(argv[1], "-h"))) { usage(stdout); return 0; }
     if (argc > 2 || (argc == 2 && argv[1][0] == '-')) { usage(stderr); return 2; }
     if (argc == 2) outp = argv[1];
@@ -281,11 +286,24 @@ int main(int argc, char **argv) {
         char name[32];
         if (!build_mesh(&m, valence[row], row == 3)) { fprintf(stderr, "04_tribezier_panel: out of memory\n"); status = 1; free_mesh(&m); break; }
         snprintf(name, sizeof name, "n=%d %s", valence[row], row == 3 ? "corner" : "crease");
+        mesh = NULL;
+        surface = make_surface(ctx, &m, svals[0], &mesh);
         for (col = 0; col < 3; ++col) {
-            sfb_mesh *mesh = NULL;
-            sfb_surface *surface = make_surface(ctx, &m, svals[col], &mesh);
             sfb_image img;
             memset(&img, 0, sizeof img);
+            if (col > 0 && surface) {
+                /* the slider: the same surface at the next s, its nets blended again (no G1 solve) */
+                sfb_tribezier_options to;
+                memset(&to, 0, sizeof to);
+                to.sharpness_set = 1;
+                to.sharpness = svals[col];
+                to.slider = 1;
+                if (sfb_surface_set_sharpness(surface, &to) != SFB_SUCCESS) {
+                    fprintf(stderr, "04_tribezier_panel: %s\n", sfb_last_error(ctx));
+                    sfb_surface_destroy(surface);
+                    surface = NULL;
+                }
+            }
             jump[col] = surface ? crease_normal_jump(surface, &m) : -1.0;
             if (surface && panel && render_tile(ctx, surface, &m, &img)) {
                 int y;
@@ -297,9 +315,9 @@ int main(int argc, char **argv) {
                 panel_draw_text(panel, W, H, col * TILE_W + 8, row * TILE_H + 8, label);
             } else if (panel) status = 1;
             sfb_image_free(&img);
-            sfb_surface_destroy(surface);
-            sfb_mesh_destroy(mesh);
         }
+        sfb_surface_destroy(surface);
+        sfb_mesh_destroy(mesh);
         printf("  %-16s %10.3g %10.3g %10.3g\n", name, jump[0] * 180.0 / PANEL_PI, jump[1] * 180.0 / PANEL_PI, jump[2] * 180.0 / PANEL_PI);
         /* s = 0 is G1 (the patch points are floats: 1e-3 degrees is far above their rounding); the
          * crease appears and sharpens as s grows */
