@@ -9,6 +9,9 @@
  *     is unit length or zero; when every input position is finite and small (|x| < 1e6), the
  *     positions are finite and every point lies within the bounding box grown by 10 times its
  *     diagonal (the net is an affine combination of the vertices, the G1 solve's change small);
+ *   - inputs whose length is a multiple of 5 are built with the slider (tribezier.slider): moved to
+ *     s = (length mod 7) / 6 and back to the options they were built with, the positions must be
+ *     bit for bit the first ones (sfb_surface_set_sharpness);
  *   - tessellate at rate 3 and check the triangles' indices;
  *   - a mesh with faces of more than three corners: sfb_mesh_triangulate (pieces, tags, holes
  *     checked: triangulated()), then all of the above on the result.
@@ -46,6 +49,7 @@ static void run(sfb_context *ctx, const sfb_mesh *mesh, size_t size)
         cfg.tribezier.sharpness_set = 1;
         cfg.tribezier.sharpness = (float)(size % 11) / 10.0f;
     }
+    cfg.tribezier.slider = size % 5 == 0;
     r = sfb_surface_create(ctx, mesh, &cfg, &s);
     if (r != SFB_SUCCESS) {
         const char *m = sfb_last_error(ctx);
@@ -91,6 +95,26 @@ static void run(sfb_context *ctx, const sfb_mesh *mesh, size_t size)
                 if (!isfinite(p[c])) fail("non-finite position from finite input", NULL);
                 if (p[c] < info.bbox_min[c] - 10 * diag - 1e-3 || p[c] > info.bbox_max[c] + 10 * diag + 1e-3) fail("point far outside", NULL);
             }
+        }
+        if (cfg.tribezier.slider) {
+            /* the slider moved and back: the same surface, bit for bit (evaluated for the same
+             * outputs: the simd backend's float kernel hands a location whose normal it cannot
+             * trust to its double kernel, position included, so a position may differ by a
+             * rounding with and without normals asked) */
+            float *P2 = (float *)malloc(sizeof(float) * 6 * (size_t)(n + 1));
+            sfb_tribezier_options to = cfg.tribezier;
+            if (!P2) fail("test allocation", NULL);
+            to.sharpness_set = 1;
+            to.sharpness = (float)(size % 7) / 6.0f;
+            if (sfb_surface_set_sharpness(s, &to) != SFB_SUCCESS || sfb_surface_set_sharpness(s, &cfg.tribezier) != SFB_SUCCESS)
+                fail("sfb_surface_set_sharpness on a slider surface", sfb_last_error(ctx));
+            memset(&o, 0, sizeof o);
+            o.position = P2;
+            o.normal = P2 + 3 * (size_t)(n + 1);
+            if (sfb_surface_eval(s, L, n, &o) != SFB_SUCCESS) fail("sfb_surface_eval after the slider", sfb_last_error(ctx));
+            if (memcmp(P, P2, sizeof(float) * 3 * (size_t)n) != 0 || memcmp(N, o.normal, sizeof(float) * 3 * (size_t)n) != 0)
+                fail("the slider moved and back changed the surface", NULL);
+            free(P2);
         }
         free(L);
         free(P);
