@@ -18,7 +18,13 @@
 //  - EXT_meshopt_compression files are decoded first (meshoptimizer's decoders) into a plain
 //    glTF in memory, which tinygltf then reads;
 //  - --quantize (with sfb2gltf's --position-bits, --normal-bits, --uv-bits): the data is read
-//    dequantised and through the node transforms, and must agree within half a grid step.
+//    dequantised and through the node transforms, and must agree within half a grid step;
+//  - --sharpness S: the library's tribezier surface at s = S;
+//  - --morph W (a file of --sharpness-morph): one morph target named "sharpness", the mesh's
+//    default weight S (--sharpness, else 1); the mesh at weight W (POSITION + W x target, NORMAL +
+//    W x target normalised, as a viewer shows it) against the library at s = W: positions as
+//    above, and normals within --morph-degrees D (default 5) of the library's, the largest angle
+//    printed (a blend of the two ends' normals, not the normal at W).
 #include <tiny_gltf.h>
 #include <meshoptimizer.h>
 #include <nlohmann/json.hpp>
@@ -102,7 +108,7 @@ struct Reference {
     bool uvs = false;
 };
 
-bool reference(const char *in, sfb_scheme scheme, int level, const std::string &normals, double angle, int rate, Reference *R) {
+bool reference(const char *in, sfb_scheme scheme, int level, const std::string &normals, double angle, int rate, double sharpness, Reference *R) {
     sfb_context *ctx = nullptr;
     sfb_context_config cc = sfb_context_config_init();
     static const sfb_backend_kind ref[1] = {SFB_BACKEND_REF};
@@ -130,6 +136,10 @@ bool reference(const char *in, sfb_scheme scheme, int level, const std::string &
         sfb_surface_config cfg = sfb_surface_config_init(scheme, rate > 0 ? 0 : level);
         cfg.flags = rate > 0 ? (unsigned)SFB_REFINE_PATCHES | (md.uv_count > 0 ? (unsigned)SFB_REFINE_UVS : 0u)
                              : ((normals == "flat" ? 0u : (unsigned)SFB_REFINE_SHADING) | (md.uv_count > 0 ? (unsigned)SFB_REFINE_UVS : 0u));
+        if (sharpness >= 0.0) {
+            cfg.tribezier.sharpness_set = 1;
+            cfg.tribezier.sharpness = (float)sharpness;
+        }
         ok = sfb_surface_create(ctx, mesh, &cfg, &surf) == SFB_SUCCESS;
     }
     if (ok && rate > 0) {
@@ -292,7 +302,7 @@ int main(int argc, char **argv) {
     sfb_scheme scheme = SFB_SCHEME_CATMARK;
     bool have_scheme = false;
     int level = 3, rate = 0, min_splits = -1;
-    double angle = -1.0;
+    double angle = -1.0, sharpness = -1.0, morph = -1.0, morph_degrees = 5.0;
     std::string normals, uvs_want;
     bool quantized = false;
     int position_bits = 14, normal_bits = 8, uv_bits = 12;
@@ -304,6 +314,7 @@ int main(int argc, char **argv) {
         if (a == "--no-optimize" || a == "--gltf" || a == "-q" || a == "--quiet") continue;
         if (a == "--quantize") { quantized = true; continue; }
         if (a == "--compress") continue; // decoded whenever the file uses it
+        if (a == "--sharpness-morph") continue; // --morph W says what to check
         if (a == "--scheme") have_scheme = sfb_scheme_parse(v, &scheme);
         else if (a == "--level") level = atoi(v);
         else if (a == "--normals") normals = v;
@@ -311,6 +322,9 @@ int main(int argc, char **argv) {
         else if (a == "--tess") rate = atoi(v);
         else if (a == "--min-splits") min_splits = atoi(v);
         else if (a == "--uvs") uvs_want = v;
+        else if (a == "--sharpness") sharpness = atof(v);
+        else if (a == "--morph") morph = atof(v);
+        else if (a == "--morph-degrees") morph_degrees = atof(v);
         else if (a == "--backend") {}
         else if (a == "--position-bits") position_bits = atoi(v);
         else if (a == "--normal-bits") normal_bits = atoi(v);
@@ -374,6 +388,27 @@ int main(int argc, char **argv) {
         }
         check(ok, (name + ": POSITION min/max are the data's").c_str(), "they differ");
     }
+    if (morph >= 0.0) {
+        // the mesh at weight `morph`, as a viewer blends it (after the base's min/max check)
+        const tinygltf::Mesh &mesh = model.meshes[0];
+        std::vector<float> dP, dN;
+        const bool one = prim.targets.size() == 1 && prim.targets[0].count("POSITION") && prim.targets[0].count("NORMAL") &&
+                         read_floats(model, prim.targets[0].at("POSITION"), 3, &dP) && read_floats(model, prim.targets[0].at("NORMAL"), 3, &dN) &&
+                         dP.size() == P.size() && dN.size() == N.size();
+        const tinygltf::Value &names = mesh.extras.Get("targetNames");
+        const bool named = names.IsArray() && names.ArrayLen() == 1 && names.Get(0).IsString() && names.Get(0).Get<std::string>() == "sharpness";
+        const double want_w = sharpness >= 0.0 ? sharpness : 1.0;
+        check(one && named && mesh.weights.size() == 1 && std::fabs(mesh.weights[0] - want_w) < 1e-12,
+              (name + ": one morph target \"sharpness\", default weight --sharpness").c_str(), "targets %zu, named %d, weights %zu (%g, want %g)",
+              prim.targets.size(), named, mesh.weights.size(), mesh.weights.empty() ? -1.0 : mesh.weights[0], want_w);
+        if (!one) return close_tests();
+        for (size_t i = 0; i < P.size(); ++i) {
+            P[i] = (float)((double)P[i] + morph * dP[i]);
+            N[i] = (float)((double)N[i] + morph * dN[i]);
+        }
+        for (size_t v = 0; v < P.size() / 3; ++v) unit(&N[3 * v]);
+        sharpness = morph; // the library's surface at s = W
+    }
     // positions into the scene: the transforms of the nodes down to the (first) node of mesh 0
     // (translation and uniform-or-not scale; --quantize's dequantisation is such a node)
     {
@@ -411,7 +446,7 @@ int main(int argc, char **argv) {
     check(worst_len < 2.0 * ntol, (name + ": normals are unit").c_str(), "| |n| - 1 | up to %g", worst_len);
 
     Reference R;
-    if (!reference(in, scheme, level, normals, angle, rate, &R)) {
+    if (!reference(in, scheme, level, normals, angle, rate, sharpness, &R)) {
         fail((name + ": the library's reference").c_str(), "could not be computed");
         return close_tests();
     }
@@ -435,7 +470,7 @@ int main(int argc, char **argv) {
         // a zero library normal (the shading's at non-manifold vertices, where no limit normal
         // exists) becomes a face normal in sfb2gltf: any unit normal matches it
         const bool zero = a.n[0] == 0.0f && a.n[1] == 0.0f && a.n[2] == 0.0f;
-        if (!flat && !zero)
+        if (!flat && !zero && morph < 0.0)
             for (int c = 0; c < 3; ++c)
                 if (std::fabs(a.n[c] - n[c]) > ntol) return false;
         if (t && R.uvs)
@@ -444,6 +479,7 @@ int main(int argc, char **argv) {
         return true;
     };
     size_t unmatched = 0, first_bad = 0;
+    double morph_worst = 0.0; // --morph: per vertex the smallest angle to a library normal at its position, the largest of those
     for (size_t v = 0; v < nv; ++v) {
         const float *p = &P[3 * v], *n = &N[3 * v], *t = has_uv ? &T[2 * v] : nullptr;
         const Key k = key_of(p, cell);
@@ -454,9 +490,32 @@ int main(int argc, char **argv) {
                     auto it = grid.find(Key{k[0] + dx, k[1] + dy, k[2] + dz});
                     if (it == grid.end()) continue;
                     for (size_t r : it->second)
-                        if (same(R.verts[r], p, n, t)) { found = true; break; }
+                        if (same(R.verts[r], p, n, t)) {
+                            found = true;
+                            if (morph < 0.0) break;
+                        }
                 }
         if (!found && unmatched++ == 0) first_bad = v;
+        if (found && morph >= 0.0) {
+            double best = M_PI;
+            for (size_t r = 0; r < R.verts.size(); ++r)
+                if (same(R.verts[r], p, n, t)) {
+                    // atan2 of |m x n| and m . n: acos of a dot product of float unit vectors
+                    // reads 3.5e-4 rad for equal ones
+                    const float *m = R.verts[r].n;
+                    const double d = (double)m[0] * n[0] + (double)m[1] * n[1] + (double)m[2] * n[2];
+                    const double cx = (double)m[1] * n[2] - (double)m[2] * n[1], cy = (double)m[2] * n[0] - (double)m[0] * n[2],
+                                 cz = (double)m[0] * n[1] - (double)m[1] * n[0];
+                    best = std::min(best, std::atan2(std::sqrt(cx * cx + cy * cy + cz * cz), d));
+                }
+            morph_worst = std::max(morph_worst, best);
+        }
+    }
+    if (morph >= 0.0) {
+        printf("  %s: at weight %g the blended normals are within %.3g degrees of the library's at s = %g\n", name.c_str(), morph,
+               morph_worst * 180.0 / M_PI, morph);
+        check(morph_worst * 180.0 / M_PI <= morph_degrees, (name + ": morph normals near the library's").c_str(), "%.3g degrees, bound %g",
+              morph_worst * 180.0 / M_PI, morph_degrees);
     }
     check(unmatched == 0, (name + ": every vertex is the library's (position, normal, uv)").c_str(),
           "%zu of %zu are not; the first, %zu: (%g %g %g) n (%g %g %g)", unmatched, nv, first_bad, P[3 * first_bad], P[3 * first_bad + 1],

@@ -122,6 +122,17 @@ export_ok torus_quant_tess.glb examples/data/torus.obj --tess 6 --quantize --nor
 export_ok box_compress.glb "$BOX" --compress
 # quads made triangles (sfb_mesh_triangulate) for the triangle schemes: the creased box's tags kept
 export_ok box_tribezier_triangulated.glb "$BOX" --scheme tribezier --tess 4 --triangulate
+# the sharpness slider as a glTF morph target (--sharpness-morph): the base at s = 0, one target
+# to s = 1, default weight 0.5; read back at weights 0 and 1 (the library's surface there, normals
+# included) and 0.5 (positions exact, the blended normals within 5 degrees: printed)
+TBZ=examples/data/tribezier_crease_v5.obj
+check "tribezier --sharpness-morph is exported" 0 "$TOOL" -q --scheme tribezier --tess 8 --sharpness-morph --sharpness 0.5 "$TBZ" -o "$TMP/v/tbz_morph.glb"
+for w in 0 1; do count_check "$TMP/v/tbz_morph.glb" "$TBZ" --scheme tribezier --tess 8 --sharpness 0.5 --morph $w --morph-degrees 0.001; done
+count_check "$TMP/v/tbz_morph.glb" "$TBZ" --scheme tribezier --tess 8 --sharpness 0.5 --morph 0.5 --morph-degrees 5
+"$CHECK" "$TMP/v/tbz_morph.glb" "$TBZ" --scheme tribezier --tess 8 --sharpness 0.5 --morph 0.5 | grep "blended normals"
+check "--sharpness-morph on another scheme is a usage error (exit 2)" 2 "$TOOL" --scheme loop --sharpness-morph "$TBZ" -o "$TMP/x.glb"
+check "--sharpness-morph with --quantize is a usage error (exit 2)" 2 "$TOOL" --scheme tribezier --tess 8 --sharpness-morph --quantize "$TBZ" -o "$TMP/x.glb"
+check "--sharpness-morph with --tolerance is a usage error (exit 2)" 2 "$TOOL" --scheme tribezier --tess 8 --tolerance 0.01 --sharpness-morph "$TBZ" -o "$TMP/x.glb"
 export_ok box_pn_triangulated.glb "$BOX" --scheme pn --tess 4 --triangulate
 export_ok box_loop_triangulated.glb "$BOX" --scheme loop --level 2 --triangulate
 export_ok box_compress_quant.glb "$BOX" --compress --quantize

@@ -77,6 +77,10 @@ const char *const kUsage =
     "                         manifold triangle meshes only; curves the radius cannot fillet stay sharp, said)\n"
     "  --sharpness S          --scheme tribezier: s in [0, 1] for every tagged crease and corner (0: the smooth\n"
     "                         G1 surface, 1: the crease; default: each tag's value clamped to [0, 1])\n"
+    "  --sharpness-morph      --scheme tribezier: the seed's sharpness slider as a glTF morph target:\n"
+    "                         the base mesh at s = 0, one target (named \"sharpness\") to s = 1, the mesh's\n"
+    "                         default weight --sharpness S (1 without it); a viewer's weight w then shows s = w,\n"
+    "                         positions exactly (the surface is linear in s), normals blended (not exact)\n"
     "  --trim MASK.png        with --tess: trim the surface by a mask over each parametric face (seed 000)\n"
     "  --backend NAME         ref, simd, gl or osmesa (default: the library's order)\n"
     "  --quantize             KHR_mesh_quantization: positions as unsigned 16-bit integers on a grid of\n"
@@ -115,7 +119,7 @@ struct Options {
     sfb_scheme scheme = SFB_SCHEME_CATMARK;
     int level = 3, rate = 0;
     double tolerance = 0.0, angle = 0.0;
-    bool have_sharpness = false, have_fillet = false, triangulate = false;
+    bool have_sharpness = false, have_fillet = false, triangulate = false, morph = false;
     double fillet = 0.0;    // --fillet R
     double sharpness = 0.0; // --sharpness (tribezier: every tagged crease's and corner's s)
     bool quantize = false, have_bits = false, compress = false;
@@ -219,6 +223,8 @@ int parse_args(int argc, char **argv, Options *o) {
             if (!parse_double(value(a), &o->sharpness) || !(o->sharpness >= 0.0 && o->sharpness <= 1.0))
                 return usage_error("--sharpness needs a number in [0, 1]");
             o->have_sharpness = true;
+        } else if (!strcmp(a, "--sharpness-morph")) {
+            o->morph = true;
         } else if (!strcmp(a, "--trim")) {
             if (!(o->trim = value(a))) return usage_error("--trim needs a PNG file");
         } else if (!strcmp(a, "--backend")) {
@@ -283,6 +289,14 @@ int parse_args(int argc, char **argv, Options *o) {
         return usage_error("--tess needs a scheme with a limit surface (%s has none)", sfb_scheme_name(o->scheme));
     if (o->have_tolerance && !o->have_tess) return usage_error("--tolerance belongs to --tess");
     if (o->have_sharpness && o->scheme != SFB_SCHEME_TRIBEZIER) return usage_error("--sharpness belongs to --scheme tribezier");
+    if (o->morph) {
+        // the target is the tessellation at s = 1 minus the one at s = 0, vertex for vertex: the
+        // same vertices at both (one rate, no adaptive choice), in float (no grid, no codec)
+        if (o->scheme != SFB_SCHEME_TRIBEZIER) return usage_error("--sharpness-morph belongs to --scheme tribezier");
+        if (o->have_tolerance || !o->lods.empty() || o->quantize || o->compress || o->normals == NORMALS_FLAT)
+            return usage_error("--sharpness-morph takes one fixed rate, float data and limit normals: not with --tolerance, --lods, --quantize, "
+                               "--compress or --normals flat");
+    }
     // --fillet's features are the edges over --crease-angle: 0 (the library's "default 30") and
     // 180 (no feature; the library refuses it) would silently fillet at 30 degrees instead
     if (o->have_fillet && o->have_angle && !((float)o->angle > 0.0f && (float)o->angle < 180.0f))
@@ -352,6 +366,8 @@ struct OutMesh {
     // per vertex: the exact limit surface's point and unit normal there (--report measures the
     // written data against them)
     std::vector<float> exact_p, exact_n;
+    // --sharpness-morph: per vertex the change of position and normal from s = 0 to s = 1
+    std::vector<float> morph_p, morph_n;
 };
 
 void normalize3(float *n, const float *fallback) {
@@ -493,6 +509,8 @@ template <class F> void each_stream(OutMesh *m, F f) {
     f(m->uvs, 2);
     f(m->exact_p, 3);
     f(m->exact_n, 3);
+    f(m->morph_p, 3);
+    f(m->morph_n, 3);
 }
 
 // Drops triangles with a repeated index (meshoptimizer and the validator dislike them; a
@@ -734,6 +752,21 @@ tinygltf::Primitive add_primitive(tinygltf::Model *model, const OutMesh &m, int 
     if (!m.uvs.empty()) {
         view = add_view(*model, m.uvs.data(), m.uvs.size() * sizeof(float), TINYGLTF_TARGET_ARRAY_BUFFER, 8);
         prim.attributes["TEXCOORD_0"] = add_accessor(*model, view, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC2, nv);
+    }
+    if (!m.morph_p.empty()) {
+        // --sharpness-morph: one target (POSITION needs its min/max there too)
+        std::map<std::string, int> target;
+        for (size_t v = 0; v < nv; ++v)
+            for (int c = 0; c < 3; ++c) {
+                const double x = m.morph_p[3 * v + (size_t)c];
+                if (v == 0 || x < mn[(size_t)c]) mn[(size_t)c] = x;
+                if (v == 0 || x > mx[(size_t)c]) mx[(size_t)c] = x;
+            }
+        view = add_view(*model, m.morph_p.data(), m.morph_p.size() * sizeof(float), TINYGLTF_TARGET_ARRAY_BUFFER, 12);
+        target["POSITION"] = add_accessor(*model, view, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, nv, mn, mx);
+        view = add_view(*model, m.morph_n.data(), m.morph_n.size() * sizeof(float), TINYGLTF_TARGET_ARRAY_BUFFER, 12);
+        target["NORMAL"] = add_accessor(*model, view, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, nv);
+        prim.targets.push_back(target);
     }
     prim.material = material;
     return prim;
@@ -1190,6 +1223,41 @@ int fillet_stage(Run &R) {
     return 0;
 }
 
+// --sharpness-morph: the slider moved to s = 1 (sfb_surface_set_sharpness, no rebuild), the
+// tessellation again, and its change from t (s = 0) per vertex into part.out's morph streams.
+int morph_target(Run &R, Part &part, sfb_surface *surf, const sfb_tess_config &tc, const sfb_tess_data &t) {
+    sfb_tribezier_options to;
+    memset(&to, 0, sizeof to);
+    to.sharpness_set = 1;
+    to.sharpness = 1.0f;
+    to.slider = 1;
+    sfb_result r = sfb_surface_set_sharpness(surf, &to);
+    if (r != SFB_SUCCESS) return R.fail_lib(part.name, "moving the sharpness slider to 1", r);
+    sfb_tess_data t1;
+    memset(&t1, 0, sizeof t1);
+    r = sfb_surface_tessellate(surf, &tc, &t1);
+    if (r != SFB_SUCCESS) return R.fail_lib(part.name, "tessellating at s = 1", r);
+    int rc = 0;
+    if (t1.vertex_count != t.vertex_count || t1.triangle_count != t.triangle_count ||
+        memcmp(t1.triangles, t.triangles, 3 * sizeof(int) * (size_t)t.triangle_count) != 0) {
+        cli_error("%s: the tessellations at s = 0 and s = 1 do not have the same vertices (%d and %d): no morph target", part.name.c_str(),
+                  t.vertex_count, t1.vertex_count);
+        rc = 1;
+    } else {
+        OutMesh one;
+        mesh_from_tess(t1, false, false, &one);
+        OutMesh &m = part.out;
+        m.morph_p.resize(m.positions.size());
+        m.morph_n.resize(m.normals.size());
+        for (size_t i = 0; i < m.positions.size(); ++i) {
+            m.morph_p[i] = one.positions[i] - m.positions[i];
+            m.morph_n[i] = one.normals[i] - m.normals[i];
+        }
+    }
+    sfb_tess_data_free(&t1);
+    return rc;
+}
+
 // Builds and evaluates each part into its OutMesh (the surface and its data freed as it goes).
 int evaluate_part(Run &R, Part &part) {
     sfb_mesh_desc d;
@@ -1198,6 +1266,12 @@ int evaluate_part(Run &R, Part &part) {
     if (R.o.have_sharpness) {
         cfg.tribezier.sharpness_set = 1;
         cfg.tribezier.sharpness = (float)R.o.sharpness;
+    }
+    if (R.o.morph) {
+        // built once with both nets: s = 0 for the base, s = 1 for the target
+        cfg.tribezier.sharpness_set = 1;
+        cfg.tribezier.sharpness = 0.0f;
+        cfg.tribezier.slider = 1;
     }
     if (R.o.have_tess) cfg.flags = SFB_REFINE_PATCHES | (d.uv_count > 0 ? (unsigned)SFB_REFINE_UVS : 0u);
     else cfg.flags = (R.o.normals == NORMALS_FLAT ? (R.o.report ? (unsigned)SFB_REFINE_LIMIT : 0u) : (unsigned)SFB_REFINE_SHADING) |
@@ -1231,6 +1305,7 @@ int evaluate_part(Run &R, Part &part) {
         r = sfb_surface_tessellate(surf, &tc, &t);
         if (r == SFB_SUCCESS) mesh_from_tess(t, R.o.normals == NORMALS_FLAT, R.o.report != nullptr, &part.out);
         else rc = R.fail_lib(part.name, "tessellating", r);
+        if (rc == 0 && R.o.morph) rc = morph_target(R, part, surf, tc, t);
         sfb_tess_data_free(&t);
         free(texels);
     } else {
@@ -1327,6 +1402,16 @@ void assemble(Run &R, tinygltf::Model *model) {
         model->meshes[(size_t)p.gltf_mesh].primitives.push_back(R.o.quantize ? add_primitive_quantized(model, p.out, mat, quant[(size_t)p.gltf_mesh], R.o, &R.filtered)
                                                                               : add_primitive(model, p.out, mat));
     }
+    if (R.o.morph)
+        for (tinygltf::Mesh &mesh : model->meshes) {
+            if (mesh.primitives.empty()) continue;
+            // the default weight (the s shown), and the target's name (three.js reads
+            // extras.targetNames into morphTargetDictionary)
+            mesh.weights = {R.o.have_sharpness ? R.o.sharpness : 1.0};
+            tinygltf::Value::Object ex;
+            ex["targetNames"] = tinygltf::Value(tinygltf::Value::Array{tinygltf::Value(std::string("sharpness"))});
+            mesh.extras = tinygltf::Value(ex);
+        }
     // a mesh left without primitives (all its parts empty) cannot be written: its nodes lose it
     std::vector<int> remap(model->meshes.size(), -1);
     std::vector<tinygltf::Mesh> kept;
