@@ -7,7 +7,8 @@
 # the counts three.js reports must be the OBJ's, the glTF files must validate, and a
 # deliberately different view must fall well below (< BAD_IOU), so that the check can fail.
 # sfb2gltf's own exports (plain, quantized, compressed, and --lods with MSFT_lod, of which the
-# page must draw the most detailed LOD alone) are drawn and counted the same way.
+# page must draw the most detailed LOD alone) are drawn and counted the same way, and its
+# --sharpness-morph files (seed 004's slider as a morph target) at their default weights.
 # Closes with "N passed, N failed, N skipped". Without node, the npm packages, Chromium or
 # WebGL: skipped with the reason (failed instead when SFB_REQUIRE_WEB is set, as on CI).
 set -u
@@ -126,6 +127,26 @@ if [ -d "$SHAPES" ]; then
   prepare loop_toroidal_tet "$SHAPES/loop_toroidal_tet.obj" 3 15 40 1 300x300
 else
   skip "catmark_car, loop_toroidal_tet: peer shapes not found at $SHAPES"
+fi
+
+# seed 004's sharpness slider as a glTF morph target (sfb2gltf --sharpness-morph: the base at s = 0,
+# one target to s = 1, the mesh's default weight --sharpness S): three.js applies that weight, so
+# the file written with S = 0 must draw as the library's surface at s = 0 and the one with S = 1
+# as at s = 1 (the creased box cut into triangles: rounded at 0, boxy at 1); and the S = 1 file
+# drawn against the s = 0 picture must fall below BAD_IOU, so the weight is seen to matter
+if [ -x "$BUILD/sfb2gltf" ]; then
+  for s in 0 1; do
+    "$SFB" render --scheme tribezier --triangulate --sharpness $s --rate 8 --view 30,25 --size 320x240 examples/data/creased_box.obj \
+      -o "$W/tbzmorph$s.sfb.png" 2> "$W/tbzmorph$s.render.log" || { fail "tbzmorph$s: surfblend render"; cat "$W/tbzmorph$s.render.log"; continue; }
+    if "$BUILD/sfb2gltf" --scheme tribezier --triangulate --tess 8 --sharpness-morph --sharpness $s examples/data/creased_box.obj \
+      -o "$W/tbzmorph$s.glb" 2> "$W/tbzmorph$s.sfb2gltf.log"; then
+      read -r gv gt <<< "$(sed -nE 's/.* ([0-9]+) vertices, ([0-9]+) triangles.*/\1 \2/p' "$W/tbzmorph$s.sfb2gltf.log")"
+      job "tbzmorph$s.morph" "$W/tbzmorph$s.glb" 30 25 1 320x240; CHECKS+=("iou tbzmorph$s morph $gv $gt")
+    else
+      fail "tbzmorph$s: sfb2gltf --sharpness-morph"; cat "$W/tbzmorph$s.sfb2gltf.log"
+    fi
+  done
+  [ -f "$W/tbzmorph1.glb" ] && { job "tbzmorph0.weight1" "$W/tbzmorph1.glb" 30 25 1 320x240; CHECKS+=("wrong tbzmorph0 weight1 0 0"); }
 fi
 
 t0=$(date +%s.%N)
