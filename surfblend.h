@@ -308,8 +308,9 @@ typedef struct sfb_manifold_options {
 typedef struct sfb_tribezier_options {
     int sharpness_set;  /* nonzero: `sharpness` replaces every tagged crease's and corner's s */
     float sharpness;    /* in [0, 1] */
-    int slider;         /* nonzero: the surface keeps its smooth (s = 0) and sharp (s = 1) nets (about 2.6 times
-                           the patch table's memory), so that sfb_surface_set_sharpness moves s without a rebuild */
+    int slider;         /* nonzero: the surface keeps its smooth (s = 0) and sharp (s = 1) nets (about 2.5 times
+                           the patch table's memory), so that sfb_surface_set_sharpness and
+                           sfb_surface_set_feature_sharpness move s without a rebuild */
 } sfb_tribezier_options;
 
 typedef struct sfb_surface_config {
@@ -342,6 +343,19 @@ SFB_API void sfb_surface_destroy(sfb_surface *surface);
  * new surface for an sfb_analysis_workspace. Not to be called while another thread uses the
  * surface. On an error (an s outside [0, 1] or NaN, a surface without the nets) it is unchanged. */
 SFB_API sfb_result sfb_surface_set_sharpness(sfb_surface *surface, const sfb_tribezier_options *options);
+/* The slider per feature: the s of some of the mesh's tagged creases (crease_count pairs of
+ * vertex indices, each an edge tagged when the surface was built; on a boundary, which is sharp
+ * anyway, it changes nothing) and corners (tagged vertices), as tag values (>= 0; clamped to
+ * [0, 1] as at create; a crease at 0 is still a feature -- the smooth surface there, its tangent
+ * plane through the crease --, which an untagged edge is not). The surface becomes the one sfb_surface_create makes from the mesh with
+ * those tags changed (the others as they are now) and tribezier.sharpness_set 0, bit for bit, as
+ * sfb_surface_set_sharpness does (built with tribezier.slider; no G1 solve; uploaded again). A
+ * feature that was not tagged at create cannot be added here: the nets depend on which features
+ * there are (SFB_INVALID_VALUE, the surface unchanged, as for a negative or NaN value). A later
+ * sfb_surface_set_sharpness without the override shows these values. */
+SFB_API sfb_result sfb_surface_set_feature_sharpness(sfb_surface *surface, int crease_count, const int *crease_vertices,
+                                                     const float *crease_sharpness, int corner_count, const int *corner_vertices,
+                                                     const float *corner_sharpness);
 
 /* Which stencil table to apply. */
 typedef enum sfb_table {
@@ -696,9 +710,10 @@ typedef enum sfb_curvature_kind { SFB_CURVATURE_GAUSSIAN = 0, SFB_CURVATURE_MEAN
  * the simd backend). The buffers grow to the largest analysis run with it and stay (counted
  * against the context's memory budget) until sfb_analysis_workspace_destroy. It also keeps the
  * last surface's proxy and face adjacency (they depend on the surface and the proxy level, not
- * on the view; sfb_surface_set_sharpness, the one call that changes a surface, makes it count as
- * a new one), so a surface analysed again, from any view, skips their evaluation. A workspace belongs to the context it was made on and, like that context,
- * to one thread at a time; results are bit for bit those without it. */
+ * on the view; sfb_surface_set_sharpness and sfb_surface_set_feature_sharpness, the calls that
+ * change a surface, make it count as a new one), so a surface analysed again, from any view,
+ * skips their evaluation. A workspace belongs to the context it was made on and, like that
+ * context, to one thread at a time; results are bit for bit those without it. */
 typedef struct sfb_analysis_workspace sfb_analysis_workspace;
 SFB_API sfb_result sfb_analysis_workspace_create(sfb_context *ctx, sfb_analysis_workspace **out);
 SFB_API void sfb_analysis_workspace_destroy(sfb_analysis_workspace *workspace); /* NULL: nothing */
@@ -1219,10 +1234,10 @@ typedef struct sfb__patch_table {
     int npoints;           /* patch points */
     float *point_data;     /* xyz per patch point, for the surface's base positions */
     /* NULL, or (tribezier with the slider option) per patch SFB__TBZ_BLEND floats: its 15
-     * points in the smooth net (45), in the sharp net (45), and each point's s from the tags
-     * (15; -1: no tagged feature in its part of the mesh); point_data is their blend
-     * (sfb__tribezier_blend). Owned. */
+     * points in the smooth net (45) and in the sharp net (45); point_data is their blend
+     * (sfb__tribezier_blend), each point's s from `features`. Owned, both. */
     float *blend;
+    struct sfb__tbz_features *features;
     const sfb__eigen_cc *eig[SFB__STAM_MAX_VALENCE + 1]; /* valences used (the context's cache) */
     const sfb__eigen_loop *eigl[SFB__STAM_MAX_VALENCE + 1]; /* Loop: the same */
     /* NULL, or a table of the same parametric faces whose evaluated position, normalised, is
@@ -1428,8 +1443,8 @@ typedef struct sfb__shading {
 struct sfb_surface {
     sfb_context *ctx;
     unsigned long serial;        /* the context's count of surfaces at its creation (from 1), and again at each
-                                    sfb_surface_set_sharpness, the one call that changes a surface: data derived from
-                                    it alone may be kept under it (sfb_analysis_workspace) */
+                                    sfb_surface_set_sharpness or _set_feature_sharpness, the calls that change a
+                                    surface: data derived from it alone may be kept under it (sfb_analysis_workspace) */
     sfb_surface_config config;
     int base_vertex_count, base_uv_count, base_face_count;
     float *base_positions, *base_uvs;
@@ -1523,6 +1538,10 @@ SFB__IF void sfb__limit_masks(const sfb__level *l, int v, sfb_scheme scheme, sfb
 /* Copy of the base level with OpenSubdiv's boundary/non-manifold sharpening and holes applied. */
 SFB__IF sfb_result sfb__level_prepare(sfb_context *ctx, const sfb__level *src, int sharpen_corners, int make_boundary_holes,
                               sfb__level *dst);
+/* Does sfb__level_prepare make vertex v of a prepared level infinitely sharp whatever its tag (a
+ * boundary vertex of one face with sharpen_corners; a non-manifold vertex, unless it joins two
+ * sheets along two non-manifold edges)? */
+SFB__IF int sfb__level_forced_sharp(const sfb__level *d, int v, int sharpen_corners);
 
 /* Rows [0, rows) of table t on the context's backend (handle: its upload of t), or on ref when
  * the backend lacks eval_stencils (surface.c). */
@@ -1647,12 +1666,24 @@ SFB__IF sfb_result sfb__tribezier_refined_points(sfb_context *ctx, const sfb__le
  * own G1 constraints have no exact solution. */
 SFB__IF sfb_result sfb__tribezier_build(sfb_context *ctx, const sfb__level *base, const float *positions,
                                         const sfb_tribezier_options *opt, sfb__patch_table *pt);
-/* The slider (sfb_surface_set_sharpness): per patch 45 + 45 + 15 floats in pt->blend, and the
- * s of a point from its tag s (blend's last 15) for options opt. */
-#define SFB__TBZ_BLEND 105
-SFB__IF double sfb__tribezier_point_s(const sfb_tribezier_options *opt, float tag_s);
-/* The patch points for opt from pt->blend, into point_data (3 floats per patch point). */
-SFB__IF void sfb__tribezier_blend(const sfb__patch_table *pt, const sfb_tribezier_options *opt, float *point_data);
+/* The slider (tribezier.slider; sfb_surface_set_sharpness, sfb_surface_set_feature_sharpness):
+ * per patch 45 + 45 floats in pt->blend, and how each patch point's s follows from the s of the
+ * base mesh's tagged creases and corners. L is the level the nets were built on: the base mesh,
+ * its non-manifold vertices split, or after one or two Loop steps. */
+#define SFB__TBZ_BLEND 90
+typedef struct sfb__tbz_features {
+    int nv;              /* L's vertices */
+    int *src;            /* per L vertex: the L vertex whose features give its s (the nearest, breadth first), -1: none */
+    int *eoff, *eid;     /* per L vertex: its tagged interior edges in ring order, as base edges */
+    int *corner;         /* per L vertex: the base vertex whose corner tag counts there, -1: none */
+    int *pv;             /* per patch: its triangle's three L vertices, in order */
+    int nbe, nbv;        /* the base mesh's edges and vertices */
+    float *es, *cs;      /* per base edge / vertex: the crease's / corner's tag now, clamped to [0, 1] (0: none) */
+} sfb__tbz_features;
+SFB__IF void sfb__tbz_features_free(sfb_context *ctx, sfb__tbz_features *F);
+/* The patch points for opt (its override s, or the features' s) into point_data (3 floats per
+ * patch point). Returns 0 when out of memory. */
+SFB__IF int sfb__tribezier_blend(sfb_context *ctx, const sfb__patch_table *pt, const sfb_tribezier_options *opt, float *point_data);
 SFB__IF sfb_result sfb__manifold_build(sfb_context *ctx, const sfb__level *base, int weights, const float *positions, sfb__patch_table *pt);
 SFB__IF void sfb__mf_eval(const float *pts, const int *cv, const unsigned *codes, int kind, double c, double d, double S[3], double Sc[3],
                   double Sd[3]);
@@ -3075,21 +3106,22 @@ sfb_result sfb__level_prepare(sfb_context *ctx, const sfb__level *s, int sharpen
         if (d->es[e] > SFB_SHARPNESS_INFINITE) d->es[e] = SFB_SHARPNESS_INFINITE;
     }
     for (v = 0; v < d->nv; ++v) {
-        int k = d->vf_off[v + 1] - d->vf_off[v], m = d->ve_off[v + 1] - d->ve_off[v];
-        int nm_edges = 0, bnd_edges = 0;
-        for (i = d->ve_off[v]; i < d->ve_off[v + 1]; ++i) {
-            nm_edges += (d->etag[d->ve[i]] & SFB__TAG_NONMANIFOLD) != 0;
-            bnd_edges += (d->etag[d->ve[i]] & SFB__TAG_BOUNDARY) != 0;
-        }
-        if (k == 1 && m == 2 && sharpen_corners) {
-            d->vs[v] = SFB_SHARPNESS_INFINITE;
-        } else if (d->vtag[v] & SFB__TAG_NONMANIFOLD) {
-            if (!(nm_edges == 2 && bnd_edges == 0 && k > m)) d->vs[v] = SFB_SHARPNESS_INFINITE;
-        }
+        if (sfb__level_forced_sharp(d, v, sharpen_corners)) d->vs[v] = SFB_SHARPNESS_INFINITE;
         if (d->vs[v] > SFB_SHARPNESS_INFINITE) d->vs[v] = SFB_SHARPNESS_INFINITE;
     }
     sfb__level_compute_rules(d);
     return SFB_SUCCESS;
+}
+
+int sfb__level_forced_sharp(const sfb__level *d, int v, int sharpen_corners) {
+    const int k = d->vf_off[v + 1] - d->vf_off[v], m = d->ve_off[v + 1] - d->ve_off[v];
+    int nm_edges = 0, bnd_edges = 0, i;
+    for (i = d->ve_off[v]; i < d->ve_off[v + 1]; ++i) {
+        nm_edges += (d->etag[d->ve[i]] & SFB__TAG_NONMANIFOLD) != 0;
+        bnd_edges += (d->etag[d->ve[i]] & SFB__TAG_BOUNDARY) != 0;
+    }
+    if (k == 1 && m == 2) return sharpen_corners;
+    return (d->vtag[v] & SFB__TAG_NONMANIFOLD) && !(nm_edges == 2 && bnd_edges == 0 && k > m);
 }
 
 /* The end of edge e that is not v. */
@@ -4728,6 +4760,7 @@ void sfb__patch_table_free(sfb_context *ctx, sfb__patch_table *pt) {
     sfb__free(ctx, pt->cv); sfb__free(ctx, pt->ptex_face); sfb__free(ctx, pt->ptex_corner); sfb__free(ctx, pt->face_ptex);
     sfb__free(ctx, pt->ptex_root); sfb__free(ctx, pt->nodes); sfb__free(ctx, pt->point_data); sfb__free(ctx, pt->pcorner);
     sfb__free(ctx, pt->blend);
+    sfb__tbz_features_free(ctx, pt->features);
     if (pt->normal_field) {
         sfb__patch_table_free(ctx, pt->normal_field);
         sfb__free(ctx, pt->normal_field);
@@ -7050,10 +7083,13 @@ done:
  *     home vertices: its corner, its edge's ends, its triangle's corners); for one s everywhere
  *     the blend is exact. The nets depend on which features there are, not on their s (a
  *     feature at s = 0 is still one: tbz_tag_values), so the slider (tribezier.slider) keeps
- *     both nets in float and each point's s from the tags, and sfb_surface_set_sharpness blends
- *     them again for a new s (sfb__tribezier_blend): the build with the slider blends from the
- *     float nets too (and builds both nets where s = 1 everywhere), so a move is bit for bit a
- *     fresh build with the slider; without it, within a float rounding of one.
+ *     both nets in float and how each point's s follows from the base mesh's tags
+ *     (sfb__tbz_features: the edges and corners each vertex's s is taken from, mapped back
+ *     through the split and the Loop steps), and sfb_surface_set_sharpness and
+ *     sfb_surface_set_feature_sharpness blend them again (sfb__tribezier_blend): the build with
+ *     the slider takes its points' s the same way and blends from the float nets too (and
+ *     builds both nets where s = 1 everywhere), so a move is bit for bit a fresh build with the
+ *     slider; without it, within a float rounding of one.
  *   - regular vertices (valence 6, or a crease/boundary vertex with three triangles on each
  *     side) take Sabin's rules (seed eq. 4-7, ALGORITHMS.md 8.1) on the mesh extended across
  *     sharp edges by parallelograms (seed eq. 8 at s = 1: the phantom across wall edge (a, b) is
@@ -9136,7 +9172,7 @@ static sfb_result tbz_vertex_s(sfb__tbz *T, double *vs) {
         }
     }
     /* no tagged feature in the vertex's part of the mesh: -1 (its points take s = 0, whatever
-     * the override: tbz_blend_s) */
+     * the override: tbz_slider_s) */
     for (v = 0; v < T->nv; ++v)
         if (!seen[v]) vs[v] = -1.0;
     sfb__free(T->ctx, queue); sfb__free(T->ctx, seen);
@@ -9164,19 +9200,163 @@ static int tbz_tag_values(sfb__tbz *T, int override, float s) {
     return any;
 }
 
+/* The slider (tribezier.slider): where the level the nets are built on (L) came from -- per L
+ * edge and vertex the base mesh's (NULL: the same ids), and the base mesh's counts and tags --,
+ * and what the build leaves for sfb_surface_set_sharpness: both nets per patch in float
+ * (SFB__TBZ_BLEND floats) and how each point's s follows from the features (sfb__tbz_features). */
+typedef struct tbz_origin {
+    const int *e, *v;
+    int nbe, nbv;
+    const float *bes, *bvs;
+} tbz_origin;
+typedef struct tbz_slider {
+    tbz_origin org;
+    float *blend;
+    sfb__tbz_features *F;
+} tbz_slider;
+
+static void tbz_slider_free(sfb_context *ctx, tbz_slider *sv) {
+    sfb__free(ctx, sv->blend);
+    sfb__tbz_features_free(ctx, sv->F);
+    sv->blend = NULL;
+    sv->F = NULL;
+}
+
+void sfb__tbz_features_free(sfb_context *ctx, sfb__tbz_features *F) {
+    if (!F) return;
+    sfb__free(ctx, F->src); sfb__free(ctx, F->eoff); sfb__free(ctx, F->eid); sfb__free(ctx, F->corner); sfb__free(ctx, F->pv);
+    sfb__free(ctx, F->es); sfb__free(ctx, F->cs);
+    sfb__free(ctx, F);
+}
+
+/* The features of L for the slider (T classified, its tag_s and corner_s set: which edges and
+ * vertices are features does not depend on their s): the edges tbz_vertex_s sums, as base edges,
+ * the corners it takes, its breadth-first sources, each patch's triangle; and the base mesh's
+ * tags, clamped. */
+static sfb_result tbz_features_make(sfb__tbz *T, const tbz_origin *org, sfb__tbz_features **out) {
+    const sfb__level *l = T->l;
+    sfb__tbz_features *F = (sfb__tbz_features *)sfb__calloc(T->ctx, 1, sizeof *F);
+    int v, i, f, n = 0, head = 0, tail = 0, held = 0;
+    int *queue = NULL;
+    *out = NULL;
+    if (!F) return sfb__oom(T->ctx, "tribezier slider");
+    for (f = 0; f < l->nf; ++f) held += !l->fhole[f];
+    F->nv = l->nv; F->nbe = org->nbe; F->nbv = org->nbv;
+    F->src = (int *)sfb__alloc(T->ctx, ((size_t)l->nv + 1) * sizeof(int));
+    F->eoff = (int *)sfb__alloc(T->ctx, ((size_t)l->nv + 1) * sizeof(int));
+    F->eid = (int *)sfb__alloc(T->ctx, ((size_t)l->ve_off[l->nv] + 1) * sizeof(int));
+    F->corner = (int *)sfb__alloc(T->ctx, ((size_t)l->nv + 1) * sizeof(int));
+    F->pv = (int *)sfb__alloc(T->ctx, 3 * (size_t)held * sizeof(int) + 1);
+    F->es = (float *)sfb__calloc(T->ctx, (size_t)org->nbe + 1, sizeof(float));
+    F->cs = (float *)sfb__calloc(T->ctx, (size_t)org->nbv + 1, sizeof(float));
+    queue = (int *)sfb__alloc(T->ctx, ((size_t)l->nv + 1) * sizeof(int));
+    if (!F->src || !F->eoff || !F->eid || !F->corner || !F->pv || !F->es || !F->cs || !queue) {
+        sfb__tbz_features_free(T->ctx, F);
+        sfb__free(T->ctx, queue);
+        return sfb__oom(T->ctx, "tribezier slider");
+    }
+    for (i = 0; i < org->nbe; ++i) F->es[i] = org->bes[i] > 0.0f ? (org->bes[i] < 1.0f ? org->bes[i] : 1.0f) : 0.0f;
+    for (i = 0; i < org->nbv; ++i) F->cs[i] = org->bvs[i] > 0.0f ? (org->bvs[i] < 1.0f ? org->bvs[i] : 1.0f) : 0.0f;
+    for (v = 0; v < l->nv; ++v) {
+        F->eoff[v] = n;
+        for (i = l->ve_off[v]; i < l->ve_off[v + 1]; ++i)
+            if (T->tag_s[l->ve[i]] > 0.0f && l->ef_off[l->ve[i] + 1] - l->ef_off[l->ve[i]] == 2)
+                F->eid[n++] = org->e ? org->e[l->ve[i]] : l->ve[i];
+        F->corner[v] = T->corner_s[v] > 0.0f ? (org->v ? org->v[v] : v) : -1;
+        F->src[v] = -1;
+        if (n > F->eoff[v] || F->corner[v] >= 0) { F->src[v] = v; queue[tail++] = v; }
+    }
+    F->eoff[l->nv] = n;
+    /* tbz_vertex_s's breadth-first order */
+    while (head < tail) {
+        const int u = queue[head++];
+        for (i = l->ve_off[u]; i < l->ve_off[u + 1]; ++i) {
+            const int w = sfb__other_end(l, l->ve[i], u);
+            if (F->src[w] < 0) { F->src[w] = F->src[u]; queue[tail++] = w; }
+        }
+    }
+    sfb__free(T->ctx, queue);
+    for (f = 0, n = 0; f < l->nf; ++f)
+        if (!l->fhole[f])
+            for (i = 0; i < 3; ++i) F->pv[n++] = l->fv[l->fv_off[f] + i];
+    *out = F;
+    return SFB_SUCCESS;
+}
+
+/* Per L vertex its s from the features' tags now, as tbz_vertex_s gives it (-1: none reached). */
+static void tbz_features_vs(const sfb__tbz_features *F, double *vs) {
+    int v, i;
+    for (v = 0; v < F->nv; ++v) vs[v] = -1.0;
+    for (v = 0; v < F->nv; ++v) {
+        double sum = 0.0;
+        int cnt = 0;
+        if (F->src[v] != v) continue;
+        for (i = F->eoff[v]; i < F->eoff[v + 1]; ++i) {
+            const float t = F->es[F->eid[i]] > 0.0f ? F->es[F->eid[i]] : 1e-30f; /* tbz_tag_values */
+            sum += t;
+            cnt++;
+        }
+        vs[v] = cnt ? sum / cnt : 0.0;
+        if (F->corner[v] >= 0) {
+            const float c = F->cs[F->corner[v]] > 0.0f ? F->cs[F->corner[v]] : 1e-30f;
+            vs[v] = cnt ? fmax(vs[v], c) : c;
+        }
+    }
+    for (v = 0; v < F->nv; ++v)
+        if (F->src[v] >= 0 && F->src[v] != v) vs[v] = vs[F->src[v]];
+}
+
+/* The mean s of point (i, j) of a triangle over its home vertices fv (weights > 0; at a corner
+ * the corner alone). */
+static double tbz_home_s(const double *vs, const int *fv, int i, int j) {
+    const int w[3] = {4 - i - j, i, j};
+    double s = 0.0, wsum = 0.0;
+    int kk;
+    for (kk = 0; kk < 3; ++kk)
+        if (w[kk] > 0 && (w[0] == 4 || w[1] == 4 || w[2] == 4 ? w[kk] == 4 : 1)) { s += vs[fv[kk]]; wsum += 1.0; }
+    return wsum > 0.0 ? s / wsum : 0.0;
+}
+
+/* A point's s for options opt: the override where the point has a feature in its part of the
+ * mesh (home mean >= 0), else the features' s; below 1e-20 none. In float first, as the
+ * slider's build and sfb__tribezier_blend both take it. */
+static double tbz_slider_s(const sfb_tribezier_options *opt, float home) {
+    const double s = opt && opt->sharpness_set ? (home >= 0.0f ? (double)opt->sharpness : 0.0) : (double)home;
+    return s < 1e-20 ? 0.0 : s;
+}
+
+int sfb__tribezier_blend(sfb_context *ctx, const sfb__patch_table *pt, const sfb_tribezier_options *opt, float *point_data) {
+    const sfb__tbz_features *F = pt->features;
+    double *vs = (double *)sfb__alloc(ctx, ((size_t)F->nv + 1) * sizeof(double));
+    int p, q, c, i, j;
+    if (!vs) return 0;
+    tbz_features_vs(F, vs);
+    for (p = 0; p < pt->npatch; ++p) {
+        const float *b = pt->blend + SFB__TBZ_BLEND * (size_t)p;
+        float *o = point_data + 45 * (size_t)p;
+        for (j = 0, q = 0; j <= 4; ++j)
+            for (i = 0; i + j <= 4; ++i, ++q) {
+                const double s = tbz_slider_s(opt, (float)tbz_home_s(vs, F->pv + 3 * (size_t)p, i, j));
+                for (c = 0; c < 3; ++c) o[3 * q + c] = (float)((1.0 - s) * (double)b[3 * q + c] + s * (double)b[45 + 3 * q + c]);
+            }
+    }
+    sfb__free(ctx, vs);
+    return 1;
+}
+
 /* fout: NULL, the net into *out (45 doubles per triangle); else the net into fout, 45 floats
  * per triangle that is not a hole, in order (sfb__patch_table_beztri_children's point data),
  * and *out left NULL (the doubles, a net as large again, never made) */
 static sfb_result tbz_points(sfb_context *ctx, const sfb__level *l, const float *positions, const float *sharp_positions,
-                             const sfb_tribezier_options *opt, unsigned flags, double **out, float *fout, float **bout,
+                             const sfb_tribezier_options *opt, unsigned flags, double **out, float *fout, tbz_slider *sv,
                              sfb__tbz_stats *stats) {
     sfb__tbz T;
     tbz_prev prev;
-    double *x0 = NULL, *vs = NULL, *vtag = NULL, *res = NULL;
+    double *x0 = NULL, *vs = NULL, *vsf = NULL, *res = NULL;
     int v, e, f, c, k, kb, any_tag = 0, sharp_only = 0;
     sfb_result r = SFB_SUCCESS;
     *out = NULL;
-    if (bout) *bout = NULL;
+    if (sv) { sv->blend = NULL; sv->F = NULL; }
     /* the nets read rings in fan order: every vertex with triangles a fan, every edge manifold
      * (tbz_check and tbz_split see to it on the mesh; a mesh after Loop steps, tbz_refine,
      * can still fail: two triangles on the same three vertices give four triangles on an edge) */
@@ -9227,24 +9407,21 @@ static sfb_result tbz_points(sfb_context *ctx, const sfb__level *l, const float 
     if (any_tag) {
         vs = (double *)sfb__calloc(ctx, (size_t)T.nv + 1, sizeof(double));
         if (!vs) { r = sfb__oom(ctx, "tribezier"); goto done; }
-        if (bout && opt && opt->sharpness_set) {
-            /* the slider keeps the tags' s too, for an options without the override */
-            vtag = (double *)sfb__calloc(ctx, (size_t)T.nv + 1, sizeof(double));
-            if (!vtag) { r = sfb__oom(ctx, "tribezier"); goto done; }
-            tbz_tag_values(&T, 0, 0.0f);
-            if ((r = tbz_vertex_s(&T, vtag)) != SFB_SUCCESS) goto done;
-            tbz_tag_values(&T, 1, opt->sharpness);
-        }
         if ((r = tbz_vertex_s(&T, vs)) != SFB_SUCCESS) goto done;
         /* the slider needs both nets whatever s is now */
-        sharp_only = !(flags & SFB__TBZ_BOTH_NETS) && !bout;
+        sharp_only = !(flags & SFB__TBZ_BOTH_NETS) && !sv;
         for (v = 0; v < T.nv && sharp_only; ++v) sharp_only = vs[v] == 1.0;
     }
-    if (bout) {
+    if (sv) {
+        /* the slider: the features, each vertex's s from their tags (tbz_features_vs, as
+         * sfb__tribezier_blend takes it), the two nets' room */
         int held = 0;
         for (f = 0; f < T.nf; ++f) held += !l->fhole[f];
-        *bout = (float *)sfb__alloc(ctx, (size_t)SFB__TBZ_BLEND * held * sizeof(float) + 1);
-        if (!*bout) { r = sfb__oom(ctx, "tribezier slider"); goto done; }
+        if ((r = tbz_features_make(&T, &sv->org, &sv->F)) != SFB_SUCCESS) goto done;
+        vsf = (double *)sfb__alloc(ctx, ((size_t)T.nv + 1) * sizeof(double));
+        sv->blend = (float *)sfb__alloc(ctx, (size_t)SFB__TBZ_BLEND * held * sizeof(float) + 1);
+        if (!vsf || !sv->blend) { r = sfb__oom(ctx, "tribezier slider"); goto done; }
+        tbz_features_vs(sv->F, vsf);
     }
     /* progress: this call's window (sfb_internal.h), the smooth net's solve in its first half
      * where a sharp net follows (the seed-plane fallback reports in the same half again, never
@@ -9307,35 +9484,25 @@ blend:
     for (f = 0, k = 0, kb = 0; f < T.nf; ++f) {
         const int *fv = l->fv + l->fv_off[f];
         const int *g = T.grid + 15 * (size_t)f;
-        int i, j, q = 0, kk;
-        float *fo = fout ? fout + 45 * (size_t)k : NULL, *bo = bout && !l->fhole[f] ? *bout + SFB__TBZ_BLEND * (size_t)kb++ : NULL;
+        int i, j, q = 0;
+        float *fo = fout ? fout + 45 * (size_t)k : NULL, *bo = sv && !l->fhole[f] ? sv->blend + SFB__TBZ_BLEND * (size_t)kb++ : NULL;
         if (fout && l->fhole[f]) continue;
         k += fout != NULL;
         for (j = 0; j <= 4; ++j)
             for (i = 0; i + j <= 4; ++i, ++q) {
-                /* the point's home vertices: weights > 0 */
-                const int w[3] = {4 - i - j, i, j};
-                double s = 0.0, st = 0.0, wsum = 0.0;
+                double s = 0.0;
                 if (any_tag) {
-                    for (kk = 0; kk < 3; ++kk)
-                        if (w[kk] > 0 && (w[0] == 4 || w[1] == 4 || w[2] == 4 ? w[kk] == 4 : 1)) {
-                            s += vs[fv[kk]];
-                            st += vtag ? vtag[fv[kk]] : vs[fv[kk]];
-                            wsum += 1.0;
-                        }
-                    s = wsum > 0.0 ? s / wsum : 0.0;
-                    st = wsum > 0.0 ? st / wsum : 0.0;
+                    s = tbz_home_s(vs, fv, i, j);
                     if (s < 1e-20) s = 0.0;
-                } else st = -1.0;
+                }
                 if (bo) {
                     /* the slider: the nets in float, the output their blend as
-                     * sfb_surface_set_sharpness makes it (sfb__tribezier_blend) */
-                    bo[90 + q] = (float)st;
+                     * sfb__tribezier_blend makes it */
                     for (c = 0; c < 3; ++c) {
                         bo[3 * q + c] = (float)(any_tag ? x0 : T.x)[3 * (size_t)g[q] + c];
                         bo[45 + 3 * q + c] = (float)T.x[3 * (size_t)g[q] + c];
                     }
-                    s = sfb__tribezier_point_s(opt, bo[90 + q]);
+                    s = tbz_slider_s(opt, (float)tbz_home_s(vsf, fv, i, j));
                 }
                 for (c = 0; c < 3; ++c) {
                     const double sh = T.x[3 * (size_t)g[q] + c];
@@ -9352,27 +9519,15 @@ blend:
 done:
     sfb__free(ctx, T.efeat); sfb__free(ctx, T.vtype); sfb__free(ctx, T.virr); sfb__free(ctx, T.phi);
     sfb__free(ctx, T.x); sfb__free(ctx, T.fixed); sfb__free(ctx, T.dist); sfb__free(ctx, T.grid); sfb__free(ctx, T.tag_s); sfb__free(ctx, T.corner_s);
-    sfb__free(ctx, x0); sfb__free(ctx, vs); sfb__free(ctx, vtag); sfb__free(ctx, res);
-    if (r != SFB_SUCCESS && bout) { sfb__free(ctx, *bout); *bout = NULL; }
+    sfb__free(ctx, x0); sfb__free(ctx, vs); sfb__free(ctx, vsf); sfb__free(ctx, res);
+    if (r != SFB_SUCCESS && sv) {
+        sfb__free(ctx, sv->blend);
+        sfb__tbz_features_free(ctx, sv->F);
+        sv->blend = NULL;
+        sv->F = NULL;
+    }
     tbz_prev_free(ctx, &prev);
     return r;
-}
-
-double sfb__tribezier_point_s(const sfb_tribezier_options *opt, float tag_s) {
-    const double s = opt && opt->sharpness_set ? (tag_s >= 0.0f ? (double)opt->sharpness : 0.0) : (double)tag_s;
-    return s < 1e-20 ? 0.0 : s;
-}
-
-void sfb__tribezier_blend(const sfb__patch_table *pt, const sfb_tribezier_options *opt, float *point_data) {
-    int p, q, c;
-    for (p = 0; p < pt->npatch; ++p) {
-        const float *b = pt->blend + SFB__TBZ_BLEND * (size_t)p;
-        float *o = point_data + 45 * (size_t)p;
-        for (q = 0; q < 15; ++q) {
-            const double s = sfb__tribezier_point_s(opt, b[90 + q]);
-            for (c = 0; c < 3; ++c) o[3 * q + c] = (float)((1.0 - s) * (double)b[3 * q + c] + s * (double)b[45 + 3 * q + c]);
-        }
-    }
 }
 
 /* The refusals of every entry point: an override s outside [0, 1] or NaN, and
@@ -9720,30 +9875,60 @@ done:
     return r;
 }
 
-/* sfb__tribezier_refined_points, the net into *out or (fout not NULL) into fout (tbz_points) */
+/* The slider's origin maps one Loop step down (tbz_refine's numbering: the half of parent edge
+ * e at either end is child edge 2e or 2e + 1, the inner edges come after; the parent's vertices
+ * keep their ids): into *e and *v (freed by the caller). */
+static int tbz_origin_step(sfb_context *ctx, const tbz_origin *in, int pnv, int pne, const sfb__level *child, int **e, int **v) {
+    int i;
+    *e = (int *)sfb__alloc(ctx, ((size_t)child->ne + 1) * sizeof(int));
+    *v = (int *)sfb__alloc(ctx, ((size_t)child->nv + 1) * sizeof(int));
+    if (!*e || !*v) return 0;
+    for (i = 0; i < child->ne; ++i) (*e)[i] = i < 2 * pne ? (in->e ? in->e[i / 2] : i / 2) : -1;
+    for (i = 0; i < child->nv; ++i) (*v)[i] = i < pnv ? (in->v ? in->v[i] : i) : -1;
+    return 1;
+}
+
+/* sfb__tribezier_refined_points, the net into *out or (fout not NULL) into fout (tbz_points);
+ * sv: the slider's (l as sfb__tribezier_build hands it to tbz_build, its vertices split) */
 static sfb_result tbz_refined(sfb_context *ctx, const sfb__level *l, const float *positions, const sfb_tribezier_options *opt,
-                              unsigned flags, sfb__level *rl, double **out, float *fout, float **bout, sfb__tbz_stats *stats) {
+                              unsigned flags, sfb__level *rl, double **out, float *fout, tbz_slider *sv, sfb__tbz_stats *stats) {
     float *ps = NULL, *pp = NULL, *spos = NULL;
     sfb__level sl;
-    int split = 0;
+    int split = 0, *oe = NULL, *ov = NULL;
+    tbz_slider sv2;
     sfb_result r;
     *out = NULL;
     memset(rl, 0, sizeof *rl);
+    if (sv) sv2 = *sv;
     r = tbz_check(ctx, l, positions, opt);
     if (r == SFB_SUCCESS) r = tbz_split(ctx, l, positions, &split, &sl, &spos);
     if (r == SFB_SUCCESS) r = tbz_refine(ctx, split ? &sl : l, split ? spos : positions, split ? spos : positions, rl, &ps, &pp);
+    if (r == SFB_SUCCESS && sv && (split || !tbz_origin_step(ctx, &sv->org, l->nv, l->ne, rl, &oe, &ov)))
+        r = split ? sfb__error(ctx, SFB_INVALID_TOPOLOGY, SFB_ELEMENT_NONE, -1, "tribezier slider: a non-manifold vertex left") : sfb__oom(ctx, "tribezier slider");
     if (r == SFB_SUCCESS && (flags & SFB__TBZ_TWO_STEPS)) {
         /* the second step: each net's positions by its own rules again */
         sfb__level r1 = *rl;
         float *ps1 = ps, *pp1 = pp;
         r = tbz_refine(ctx, &r1, ps1, pp1, rl, &ps, &pp);
+        if (r == SFB_SUCCESS && sv) {
+            tbz_origin o1 = sv->org;
+            int *e1 = oe, *v1 = ov;
+            o1.e = e1; o1.v = v1;
+            if (!tbz_origin_step(ctx, &o1, r1.nv, r1.ne, rl, &oe, &ov)) r = sfb__oom(ctx, "tribezier slider");
+            sfb__free(ctx, e1);
+            sfb__free(ctx, v1);
+        }
         sfb__level_free(ctx, &r1);
         sfb__free(ctx, ps1);
         sfb__free(ctx, pp1);
     }
-    if (r == SFB_SUCCESS) r = tbz_points(ctx, rl, ps, pp, opt, flags, out, fout, bout, stats);
+    if (sv) { sv2.org.e = oe; sv2.org.v = ov; }
+    if (r == SFB_SUCCESS) r = tbz_points(ctx, rl, ps, pp, opt, flags, out, fout, sv ? &sv2 : NULL, stats);
+    if (sv) { sv->blend = r == SFB_SUCCESS ? sv2.blend : NULL; sv->F = r == SFB_SUCCESS ? sv2.F : NULL; }
     if (r != SFB_SUCCESS) sfb__level_free(ctx, rl);
     if (split) sfb__level_free(ctx, &sl);
+    sfb__free(ctx, oe);
+    sfb__free(ctx, ov);
     sfb__free(ctx, spos);
     sfb__free(ctx, ps);
     sfb__free(ctx, pp);
@@ -9784,7 +9969,7 @@ static int tbz_touching(const sfb__level *l) {
 }
 
 static sfb_result tbz_build(sfb_context *ctx, const sfb__level *l, const float *positions, const sfb_tribezier_options *opt,
-                            sfb__patch_table *pt);
+                            const tbz_origin *org, sfb__patch_table *pt);
 
 /* The most interior extraordinary vertices in one group of them joined by edges (union-find;
  * out of memory: all of them, taken as large). After one Loop step each group's regions of
@@ -9826,13 +10011,28 @@ sfb_result sfb__tribezier_build(sfb_context *ctx, const sfb__level *l, const flo
      * mesh's */
     sfb__level sl;
     float *spos = NULL;
-    int split;
+    int split, *oe = NULL, *ov = NULL, k;
+    tbz_origin org;
     sfb_result r;
     memset(pt, 0, sizeof *pt);
     r = tbz_check(ctx, l, positions, opt);
     if (r == SFB_SUCCESS) r = tbz_split(ctx, l, positions, &split, &sl, &spos);
     if (r != SFB_SUCCESS) return r;
-    r = split ? tbz_build(ctx, &sl, spos, opt, pt) : tbz_build(ctx, l, positions, opt, pt);
+    /* the slider's features are the base mesh's: the split level's edges and vertices mapped
+     * back through the same face slots */
+    memset(&org, 0, sizeof org);
+    org.nbe = l->ne; org.nbv = l->nv; org.bes = l->es; org.bvs = l->vs;
+    if (split && opt && opt->slider) {
+        oe = (int *)sfb__alloc(ctx, ((size_t)sl.ne + 1) * sizeof(int));
+        ov = (int *)sfb__alloc(ctx, ((size_t)sl.nv + 1) * sizeof(int));
+        if (!oe || !ov) r = sfb__oom(ctx, "tribezier slider");
+        else
+            for (k = 0; k < l->nfv; ++k) { oe[sl.fe[k]] = l->fe[k]; ov[sl.fv[k]] = l->fv[k]; }
+        org.e = oe; org.v = ov;
+    }
+    if (r == SFB_SUCCESS) r = split ? tbz_build(ctx, &sl, spos, opt, &org, pt) : tbz_build(ctx, l, positions, opt, &org, pt);
+    sfb__free(ctx, oe);
+    sfb__free(ctx, ov);
     if (split) {
         sfb__level_free(ctx, &sl);
         sfb__free(ctx, spos);
@@ -9842,17 +10042,25 @@ sfb_result sfb__tribezier_build(sfb_context *ctx, const sfb__level *l, const flo
     return r;
 }
 
-/* sfb__tribezier_build on a mesh of manifold vertices (checked). */
+/* sfb__tribezier_build on a mesh of manifold vertices (checked); org: where its edges and
+ * vertices came from (the slider's). */
 static sfb_result tbz_build(sfb_context *ctx, const sfb__level *l, const float *positions, const sfb_tribezier_options *opt,
-                            sfb__patch_table *pt) {
+                            const tbz_origin *org, sfb__patch_table *pt) {
     double *net = NULL, *net4 = NULL;
-    float *blend = NULL, *blend4 = NULL, **want = opt && opt->slider ? &blend : NULL, **want4 = opt && opt->slider ? &blend4 : NULL;
+    tbz_slider sv, sv4, *want = NULL, *want4 = NULL;
     sfb__tbz_stats st, st4;
     sfb__level rl;
     sfb_result r;
     unsigned two;
     int cover;
     memset(&st, 0, sizeof st);
+    memset(&sv, 0, sizeof sv);
+    memset(&sv4, 0, sizeof sv4);
+    if (opt && opt->slider) {
+        sv.org = sv4.org = *org;
+        want = &sv;
+        want4 = &sv4;
+    }
     /* progress (stage "tribezier"): the mesh's own net over [0, 0.5], the one after a Loop step
      * over [0.5, 1] (over [0, 1] where it is the only one). One Loop step or two (the top of
      * this file): two where a group of more than TBZ_ONE_STEP_GROUP extraordinary vertices would
@@ -9863,7 +10071,8 @@ static sfb_result tbz_build(sfb_context *ctx, const sfb__level *l, const float *
         if ((r = sfb__patch_table_beztri_children(ctx, l, NULL, two ? 2 : 1, pt)) != SFB_SUCCESS) return r;
         r = tbz_refined(ctx, l, positions, opt, two, &rl, &net4, pt->point_data, want4, NULL);
         if (r != SFB_SUCCESS) { sfb__patch_table_free(ctx, pt); return r; }
-        pt->blend = blend4;
+        pt->blend = sv4.blend;
+        pt->features = sv4.F;
         sfb__level_free(ctx, &rl);
         return r;
     }
@@ -9884,25 +10093,25 @@ static sfb_result tbz_build(sfb_context *ctx, const sfb__level *l, const float *
                      ctx->error, st.residual);
             sfb__error_put_back(ctx, &kept);
             st4.residual = HUGE_VAL;
-        } else if (r != SFB_SUCCESS) { sfb__free(ctx, net); sfb__free(ctx, blend); return r; }
+        } else if (r != SFB_SUCCESS) { sfb__free(ctx, net); tbz_slider_free(ctx, &sv); return r; }
         if (st4.residual < st.residual || (cover && st4.residual <= 1e-10)) {
             sfb__free(ctx, net);
-            sfb__free(ctx, blend);
+            tbz_slider_free(ctx, &sv);
             r = sfb__patch_table_beztri_children(ctx, l, net4, two ? 2 : 1, pt);
             sfb__free(ctx, net4);
             sfb__level_free(ctx, &rl);
-            if (r == SFB_SUCCESS) pt->blend = blend4;
-            else sfb__free(ctx, blend4);
+            if (r == SFB_SUCCESS) { pt->blend = sv4.blend; pt->features = sv4.F; }
+            else tbz_slider_free(ctx, &sv4);
             return r;
         }
         sfb__free(ctx, net4);
-        sfb__free(ctx, blend4);
+        tbz_slider_free(ctx, &sv4);
         sfb__level_free(ctx, &rl);
     }
     r = sfb__patch_table_beztri_own(ctx, l, net, pt);
     sfb__free(ctx, net);
-    if (r == SFB_SUCCESS) pt->blend = blend;
-    else sfb__free(ctx, blend);
+    if (r == SFB_SUCCESS) { pt->blend = sv.blend; pt->features = sv.F; }
+    else tbz_slider_free(ctx, &sv);
     return r;
 }
 #line 1 "src/tess.c"
@@ -12991,31 +13200,18 @@ fail:
     return oom ? sfb__oom(ctx, "surface") : r;
 }
 
-/* The slider: the nets kept at create (patch/tribezier.c, pt->blend) blended for the new s into
- * a new point array; the backend gets a new upload of it before the old one is released, so an
- * error anywhere leaves the surface as it was. */
-SFB_API sfb_result sfb_surface_set_sharpness(sfb_surface *s, const sfb_tribezier_options *options) {
-    sfb_context *ctx;
-    sfb__patch_table *pt;
-    float *old, *fresh;
+/* The slider: the nets kept at create (patch/tribezier.c, pt->blend) blended for `o` into a new
+ * point array; the backend gets a new upload of it before the old one is released, so an error
+ * anywhere leaves the points as they were (0 and the error then). */
+static sfb_result sfb__surface_reblend(sfb_surface *s, const sfb_tribezier_options *o) {
+    sfb_context *ctx = s->ctx;
+    sfb__patch_table *pt = &s->patches;
+    float *old, *fresh = (float *)sfb__alloc(ctx, 3 * (size_t)pt->npoints * sizeof(float) + 1);
     void *handle = NULL;
-    sfb_tribezier_options o;
-    if (!s) return SFB_INVALID_ARGS;
-    ctx = s->ctx;
-    if (!options) return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "sfb_surface_set_sharpness: options is NULL");
-    pt = &s->patches;
-    if (s->config.scheme != SFB_SCHEME_TRIBEZIER || !s->has_patches || !pt->blend)
-        return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1,
-                          "sfb_surface_set_sharpness: the surface %s", s->config.scheme != SFB_SCHEME_TRIBEZIER ? "is not SFB_SCHEME_TRIBEZIER"
-                          : "was built without tribezier.slider (its smooth and sharp nets were not kept)");
-    if (options->sharpness_set && !(options->sharpness >= 0.0f && options->sharpness <= 1.0f))
-        return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "sfb_surface_set_sharpness: sharpness %g is not in [0, 1]",
-                          (double)options->sharpness);
-    o = *options;
-    o.slider = 1;
-    fresh = (float *)sfb__alloc(ctx, 3 * (size_t)pt->npoints * sizeof(float) + 1);
-    if (!fresh) return sfb__oom(ctx, "sfb_surface_set_sharpness");
-    sfb__tribezier_blend(pt, &o, fresh);
+    if (!fresh || !sfb__tribezier_blend(ctx, pt, o, fresh)) {
+        sfb__free(ctx, fresh);
+        return sfb__oom(ctx, "the sharpness slider");
+    }
     old = pt->point_data;
     pt->point_data = fresh;
     if (s->backend_patches && s->uploaded_by && s->uploaded_by->upload_patches) {
@@ -13029,9 +13225,108 @@ SFB_API sfb_result sfb_surface_set_sharpness(sfb_surface *s, const sfb_tribezier
         s->backend_patches = handle;
     }
     sfb__free(ctx, old);
-    s->config.tribezier = o;
     s->serial = ++ctx->surfaces_made;
     return SFB_SUCCESS;
+}
+
+/* A slider surface, or the error why not (who: the caller's name). */
+static sfb_result sfb__surface_slider(sfb_surface *s, const char *who) {
+    if (s->config.scheme != SFB_SCHEME_TRIBEZIER || !s->has_patches || !s->patches.blend || !s->patches.features)
+        return sfb__error(s->ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "%s: the surface %s", who,
+                          s->config.scheme != SFB_SCHEME_TRIBEZIER ? "is not SFB_SCHEME_TRIBEZIER"
+                                                                    : "was built without tribezier.slider (its smooth and sharp nets were not kept)");
+    return SFB_SUCCESS;
+}
+
+SFB_API sfb_result sfb_surface_set_sharpness(sfb_surface *s, const sfb_tribezier_options *options) {
+    sfb_tribezier_options o;
+    sfb_result r;
+    if (!s) return SFB_INVALID_ARGS;
+    if (!options) return sfb__error(s->ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "sfb_surface_set_sharpness: options is NULL");
+    if ((r = sfb__surface_slider(s, "sfb_surface_set_sharpness")) != SFB_SUCCESS) return r;
+    if (options->sharpness_set && !(options->sharpness >= 0.0f && options->sharpness <= 1.0f))
+        return sfb__error(s->ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "sfb_surface_set_sharpness: sharpness %g is not in [0, 1]",
+                          (double)options->sharpness);
+    o = *options;
+    o.slider = 1;
+    if ((r = sfb__surface_reblend(s, &o)) == SFB_SUCCESS) s->config.tribezier = o;
+    return r;
+}
+
+/* The base edge from a to b (the surface's prepared base level), or -1. */
+static int sfb__surface_edge(const sfb_surface *s, int a, int b) {
+    const sfb__level *l = &s->pbase;
+    int i;
+    if (a < 0 || b < 0 || a >= l->nv || b >= l->nv) return -1;
+    for (i = l->ve_off[a]; i < l->ve_off[a + 1]; ++i)
+        if (sfb__other_end(l, l->ve[i], a) == b) return l->ve[i];
+    return -1;
+}
+
+SFB_API sfb_result sfb_surface_set_feature_sharpness(sfb_surface *s, int crease_count, const int *crease_vertices,
+                                                     const float *crease_sharpness, int corner_count, const int *corner_vertices,
+                                                     const float *corner_sharpness) {
+    static const char *who = "sfb_surface_set_feature_sharpness";
+    sfb_context *ctx;
+    sfb__tbz_features *F;
+    float *es = NULL, *cs = NULL;
+    sfb_tribezier_options o;
+    sfb_result r;
+    int i;
+    if (!s) return SFB_INVALID_ARGS;
+    ctx = s->ctx;
+    if ((r = sfb__surface_slider(s, who)) != SFB_SUCCESS) return r;
+    if (crease_count < 0 || corner_count < 0 || (crease_count && (!crease_vertices || !crease_sharpness)) ||
+        (corner_count && (!corner_vertices || !corner_sharpness)))
+        return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "%s: a negative count, or a NULL array with a count", who);
+    F = s->patches.features;
+    /* checked whole first: nothing changes on an error */
+    for (i = 0; i < crease_count; ++i) {
+        const int a = crease_vertices[2 * i], b = crease_vertices[2 * i + 1], e = sfb__surface_edge(s, a, b);
+        if (!(crease_sharpness[i] >= 0.0f))
+            return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_EDGE, e, "%s: crease %d (%d, %d): sharpness %g is not >= 0", who, i, a, b,
+                              (double)crease_sharpness[i]);
+        if (e < 0 || e >= F->nbe || !(s->pbase.es[e] > 0.0f))
+            return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_EDGE, e,
+                              "%s: crease %d (%d, %d) is not a tagged edge of the surface's mesh (the nets depend on which edges are "
+                              "creases: build the surface again to add one)", who, i, a, b);
+    }
+    for (i = 0; i < corner_count; ++i) {
+        const int v = corner_vertices[i];
+        if (!(corner_sharpness[i] >= 0.0f))
+            return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_VERTEX, v, "%s: corner %d (vertex %d): sharpness %g is not >= 0", who, i, v,
+                              (double)corner_sharpness[i]);
+        if (v < 0 || v >= F->nbv || !(s->pbase.vs[v] > 0.0f))
+            return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_VERTEX, v,
+                              "%s: corner %d (vertex %d) is not a tagged corner of the surface's mesh (build the surface again to add one)", who,
+                              i, v);
+    }
+    es = (float *)sfb__alloc(ctx, ((size_t)F->nbe + 1) * sizeof(float));
+    cs = (float *)sfb__alloc(ctx, ((size_t)F->nbv + 1) * sizeof(float));
+    if (!es || !cs) {
+        sfb__free(ctx, es);
+        sfb__free(ctx, cs);
+        return sfb__oom(ctx, who);
+    }
+    memcpy(es, F->es, (size_t)F->nbe * sizeof(float));
+    memcpy(cs, F->cs, (size_t)F->nbv * sizeof(float));
+    /* as the build takes a tag: clamped to [0, 1] (a crease at 0 stays one: the smooth net's) */
+    for (i = 0; i < crease_count; ++i) F->es[sfb__surface_edge(s, crease_vertices[2 * i], crease_vertices[2 * i + 1])] = crease_sharpness[i] < 1.0f ? crease_sharpness[i] : 1.0f;
+    /* a vertex the preparation made sharp whatever its tag (non-manifold) stays so, as at create */
+    for (i = 0; i < corner_count; ++i)
+        if (!sfb__level_forced_sharp(&s->pbase, corner_vertices[i], s->boundary == SFB_BOUNDARY_EDGE_AND_CORNER))
+            F->cs[corner_vertices[i]] = corner_sharpness[i] < 1.0f ? corner_sharpness[i] : 1.0f;
+    o = s->config.tribezier;
+    o.sharpness_set = 0;
+    o.slider = 1;
+    if ((r = sfb__surface_reblend(s, &o)) == SFB_SUCCESS) s->config.tribezier = o;
+    else {
+        memcpy(F->es, es, (size_t)F->nbe * sizeof(float));
+        memcpy(F->cs, cs, (size_t)F->nbv * sizeof(float));
+    }
+    sfb__free(ctx, es);
+    sfb__free(ctx, cs);
+    return r;
 }
 
 SFB_API int sfb_surface_param_face_count(const sfb_surface *s) { return s && s->has_patches ? s->patches.nptex : 0; }
@@ -13061,7 +13356,10 @@ static size_t sfb__patch_table_bytes(const sfb__patch_table *pt) {
     return (size_t)pt->npatch * (4 * sizeof(int)) + (size_t)pt->ncv * sizeof(int) + (size_t)pt->nptex * 3 * sizeof(int) +
            (size_t)pt->nnodes * 4 * sizeof(int) + (size_t)pt->npoints * 3 * sizeof(float) +
            (pt->pcorner ? (size_t)pt->npatch * 4 * sizeof(unsigned) : 0) + (pt->normal_field ? sfb__patch_table_bytes(pt->normal_field) : 0) +
-           (pt->blend ? (size_t)pt->npatch * SFB__TBZ_BLEND * sizeof(float) : 0);
+           (pt->blend ? (size_t)pt->npatch * SFB__TBZ_BLEND * sizeof(float) : 0) +
+           (pt->features ? ((size_t)pt->features->nv * 4 + (size_t)pt->features->eoff[pt->features->nv] + 3 * (size_t)pt->npatch) * sizeof(int) +
+                               ((size_t)pt->features->nbe + pt->features->nbv) * sizeof(float)
+                         : 0);
 }
 
 SFB_API sfb_result sfb_surface_patch_info(const sfb_surface *s, sfb_patch_info *o) {

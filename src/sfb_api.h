@@ -295,8 +295,9 @@ typedef struct sfb_manifold_options {
 typedef struct sfb_tribezier_options {
     int sharpness_set;  /* nonzero: `sharpness` replaces every tagged crease's and corner's s */
     float sharpness;    /* in [0, 1] */
-    int slider;         /* nonzero: the surface keeps its smooth (s = 0) and sharp (s = 1) nets (about 2.6 times
-                           the patch table's memory), so that sfb_surface_set_sharpness moves s without a rebuild */
+    int slider;         /* nonzero: the surface keeps its smooth (s = 0) and sharp (s = 1) nets (about 2.5 times
+                           the patch table's memory), so that sfb_surface_set_sharpness and
+                           sfb_surface_set_feature_sharpness move s without a rebuild */
 } sfb_tribezier_options;
 
 typedef struct sfb_surface_config {
@@ -329,6 +330,19 @@ SFB_API void sfb_surface_destroy(sfb_surface *surface);
  * new surface for an sfb_analysis_workspace. Not to be called while another thread uses the
  * surface. On an error (an s outside [0, 1] or NaN, a surface without the nets) it is unchanged. */
 SFB_API sfb_result sfb_surface_set_sharpness(sfb_surface *surface, const sfb_tribezier_options *options);
+/* The slider per feature: the s of some of the mesh's tagged creases (crease_count pairs of
+ * vertex indices, each an edge tagged when the surface was built; on a boundary, which is sharp
+ * anyway, it changes nothing) and corners (tagged vertices), as tag values (>= 0; clamped to
+ * [0, 1] as at create; a crease at 0 is still a feature -- the smooth surface there, its tangent
+ * plane through the crease --, which an untagged edge is not). The surface becomes the one sfb_surface_create makes from the mesh with
+ * those tags changed (the others as they are now) and tribezier.sharpness_set 0, bit for bit, as
+ * sfb_surface_set_sharpness does (built with tribezier.slider; no G1 solve; uploaded again). A
+ * feature that was not tagged at create cannot be added here: the nets depend on which features
+ * there are (SFB_INVALID_VALUE, the surface unchanged, as for a negative or NaN value). A later
+ * sfb_surface_set_sharpness without the override shows these values. */
+SFB_API sfb_result sfb_surface_set_feature_sharpness(sfb_surface *surface, int crease_count, const int *crease_vertices,
+                                                     const float *crease_sharpness, int corner_count, const int *corner_vertices,
+                                                     const float *corner_sharpness);
 
 /* Which stencil table to apply. */
 typedef enum sfb_table {
@@ -683,9 +697,10 @@ typedef enum sfb_curvature_kind { SFB_CURVATURE_GAUSSIAN = 0, SFB_CURVATURE_MEAN
  * the simd backend). The buffers grow to the largest analysis run with it and stay (counted
  * against the context's memory budget) until sfb_analysis_workspace_destroy. It also keeps the
  * last surface's proxy and face adjacency (they depend on the surface and the proxy level, not
- * on the view; sfb_surface_set_sharpness, the one call that changes a surface, makes it count as
- * a new one), so a surface analysed again, from any view, skips their evaluation. A workspace belongs to the context it was made on and, like that context,
- * to one thread at a time; results are bit for bit those without it. */
+ * on the view; sfb_surface_set_sharpness and sfb_surface_set_feature_sharpness, the calls that
+ * change a surface, make it count as a new one), so a surface analysed again, from any view,
+ * skips their evaluation. A workspace belongs to the context it was made on and, like that
+ * context, to one thread at a time; results are bit for bit those without it. */
 typedef struct sfb_analysis_workspace sfb_analysis_workspace;
 SFB_API sfb_result sfb_analysis_workspace_create(sfb_context *ctx, sfb_analysis_workspace **out);
 SFB_API void sfb_analysis_workspace_destroy(sfb_analysis_workspace *workspace); /* NULL: nothing */

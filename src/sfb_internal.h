@@ -323,10 +323,10 @@ typedef struct sfb__patch_table {
     int npoints;           /* patch points */
     float *point_data;     /* xyz per patch point, for the surface's base positions */
     /* NULL, or (tribezier with the slider option) per patch SFB__TBZ_BLEND floats: its 15
-     * points in the smooth net (45), in the sharp net (45), and each point's s from the tags
-     * (15; -1: no tagged feature in its part of the mesh); point_data is their blend
-     * (sfb__tribezier_blend). Owned. */
+     * points in the smooth net (45) and in the sharp net (45); point_data is their blend
+     * (sfb__tribezier_blend), each point's s from `features`. Owned, both. */
     float *blend;
+    struct sfb__tbz_features *features;
     const sfb__eigen_cc *eig[SFB__STAM_MAX_VALENCE + 1]; /* valences used (the context's cache) */
     const sfb__eigen_loop *eigl[SFB__STAM_MAX_VALENCE + 1]; /* Loop: the same */
     /* NULL, or a table of the same parametric faces whose evaluated position, normalised, is
@@ -532,8 +532,8 @@ typedef struct sfb__shading {
 struct sfb_surface {
     sfb_context *ctx;
     unsigned long serial;        /* the context's count of surfaces at its creation (from 1), and again at each
-                                    sfb_surface_set_sharpness, the one call that changes a surface: data derived from
-                                    it alone may be kept under it (sfb_analysis_workspace) */
+                                    sfb_surface_set_sharpness or _set_feature_sharpness, the calls that change a
+                                    surface: data derived from it alone may be kept under it (sfb_analysis_workspace) */
     sfb_surface_config config;
     int base_vertex_count, base_uv_count, base_face_count;
     float *base_positions, *base_uvs;
@@ -627,6 +627,10 @@ SFB__IF void sfb__limit_masks(const sfb__level *l, int v, sfb_scheme scheme, sfb
 /* Copy of the base level with OpenSubdiv's boundary/non-manifold sharpening and holes applied. */
 SFB__IF sfb_result sfb__level_prepare(sfb_context *ctx, const sfb__level *src, int sharpen_corners, int make_boundary_holes,
                               sfb__level *dst);
+/* Does sfb__level_prepare make vertex v of a prepared level infinitely sharp whatever its tag (a
+ * boundary vertex of one face with sharpen_corners; a non-manifold vertex, unless it joins two
+ * sheets along two non-manifold edges)? */
+SFB__IF int sfb__level_forced_sharp(const sfb__level *d, int v, int sharpen_corners);
 
 /* Rows [0, rows) of table t on the context's backend (handle: its upload of t), or on ref when
  * the backend lacks eval_stencils (surface.c). */
@@ -751,12 +755,24 @@ SFB__IF sfb_result sfb__tribezier_refined_points(sfb_context *ctx, const sfb__le
  * own G1 constraints have no exact solution. */
 SFB__IF sfb_result sfb__tribezier_build(sfb_context *ctx, const sfb__level *base, const float *positions,
                                         const sfb_tribezier_options *opt, sfb__patch_table *pt);
-/* The slider (sfb_surface_set_sharpness): per patch 45 + 45 + 15 floats in pt->blend, and the
- * s of a point from its tag s (blend's last 15) for options opt. */
-#define SFB__TBZ_BLEND 105
-SFB__IF double sfb__tribezier_point_s(const sfb_tribezier_options *opt, float tag_s);
-/* The patch points for opt from pt->blend, into point_data (3 floats per patch point). */
-SFB__IF void sfb__tribezier_blend(const sfb__patch_table *pt, const sfb_tribezier_options *opt, float *point_data);
+/* The slider (tribezier.slider; sfb_surface_set_sharpness, sfb_surface_set_feature_sharpness):
+ * per patch 45 + 45 floats in pt->blend, and how each patch point's s follows from the s of the
+ * base mesh's tagged creases and corners. L is the level the nets were built on: the base mesh,
+ * its non-manifold vertices split, or after one or two Loop steps. */
+#define SFB__TBZ_BLEND 90
+typedef struct sfb__tbz_features {
+    int nv;              /* L's vertices */
+    int *src;            /* per L vertex: the L vertex whose features give its s (the nearest, breadth first), -1: none */
+    int *eoff, *eid;     /* per L vertex: its tagged interior edges in ring order, as base edges */
+    int *corner;         /* per L vertex: the base vertex whose corner tag counts there, -1: none */
+    int *pv;             /* per patch: its triangle's three L vertices, in order */
+    int nbe, nbv;        /* the base mesh's edges and vertices */
+    float *es, *cs;      /* per base edge / vertex: the crease's / corner's tag now, clamped to [0, 1] (0: none) */
+} sfb__tbz_features;
+SFB__IF void sfb__tbz_features_free(sfb_context *ctx, sfb__tbz_features *F);
+/* The patch points for opt (its override s, or the features' s) into point_data (3 floats per
+ * patch point). Returns 0 when out of memory. */
+SFB__IF int sfb__tribezier_blend(sfb_context *ctx, const sfb__patch_table *pt, const sfb_tribezier_options *opt, float *point_data);
 SFB__IF sfb_result sfb__manifold_build(sfb_context *ctx, const sfb__level *base, int weights, const float *positions, sfb__patch_table *pt);
 SFB__IF void sfb__mf_eval(const float *pts, const int *cv, const unsigned *codes, int kind, double c, double d, double S[3], double Sc[3],
                   double Sd[3]);

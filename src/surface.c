@@ -298,31 +298,18 @@ fail:
     return oom ? sfb__oom(ctx, "surface") : r;
 }
 
-/* The slider: the nets kept at create (patch/tribezier.c, pt->blend) blended for the new s into
- * a new point array; the backend gets a new upload of it before the old one is released, so an
- * error anywhere leaves the surface as it was. */
-SFB_API sfb_result sfb_surface_set_sharpness(sfb_surface *s, const sfb_tribezier_options *options) {
-    sfb_context *ctx;
-    sfb__patch_table *pt;
-    float *old, *fresh;
+/* The slider: the nets kept at create (patch/tribezier.c, pt->blend) blended for `o` into a new
+ * point array; the backend gets a new upload of it before the old one is released, so an error
+ * anywhere leaves the points as they were (0 and the error then). */
+static sfb_result sfb__surface_reblend(sfb_surface *s, const sfb_tribezier_options *o) {
+    sfb_context *ctx = s->ctx;
+    sfb__patch_table *pt = &s->patches;
+    float *old, *fresh = (float *)sfb__alloc(ctx, 3 * (size_t)pt->npoints * sizeof(float) + 1);
     void *handle = NULL;
-    sfb_tribezier_options o;
-    if (!s) return SFB_INVALID_ARGS;
-    ctx = s->ctx;
-    if (!options) return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "sfb_surface_set_sharpness: options is NULL");
-    pt = &s->patches;
-    if (s->config.scheme != SFB_SCHEME_TRIBEZIER || !s->has_patches || !pt->blend)
-        return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1,
-                          "sfb_surface_set_sharpness: the surface %s", s->config.scheme != SFB_SCHEME_TRIBEZIER ? "is not SFB_SCHEME_TRIBEZIER"
-                          : "was built without tribezier.slider (its smooth and sharp nets were not kept)");
-    if (options->sharpness_set && !(options->sharpness >= 0.0f && options->sharpness <= 1.0f))
-        return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "sfb_surface_set_sharpness: sharpness %g is not in [0, 1]",
-                          (double)options->sharpness);
-    o = *options;
-    o.slider = 1;
-    fresh = (float *)sfb__alloc(ctx, 3 * (size_t)pt->npoints * sizeof(float) + 1);
-    if (!fresh) return sfb__oom(ctx, "sfb_surface_set_sharpness");
-    sfb__tribezier_blend(pt, &o, fresh);
+    if (!fresh || !sfb__tribezier_blend(ctx, pt, o, fresh)) {
+        sfb__free(ctx, fresh);
+        return sfb__oom(ctx, "the sharpness slider");
+    }
     old = pt->point_data;
     pt->point_data = fresh;
     if (s->backend_patches && s->uploaded_by && s->uploaded_by->upload_patches) {
@@ -336,9 +323,108 @@ SFB_API sfb_result sfb_surface_set_sharpness(sfb_surface *s, const sfb_tribezier
         s->backend_patches = handle;
     }
     sfb__free(ctx, old);
-    s->config.tribezier = o;
     s->serial = ++ctx->surfaces_made;
     return SFB_SUCCESS;
+}
+
+/* A slider surface, or the error why not (who: the caller's name). */
+static sfb_result sfb__surface_slider(sfb_surface *s, const char *who) {
+    if (s->config.scheme != SFB_SCHEME_TRIBEZIER || !s->has_patches || !s->patches.blend || !s->patches.features)
+        return sfb__error(s->ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "%s: the surface %s", who,
+                          s->config.scheme != SFB_SCHEME_TRIBEZIER ? "is not SFB_SCHEME_TRIBEZIER"
+                                                                    : "was built without tribezier.slider (its smooth and sharp nets were not kept)");
+    return SFB_SUCCESS;
+}
+
+SFB_API sfb_result sfb_surface_set_sharpness(sfb_surface *s, const sfb_tribezier_options *options) {
+    sfb_tribezier_options o;
+    sfb_result r;
+    if (!s) return SFB_INVALID_ARGS;
+    if (!options) return sfb__error(s->ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "sfb_surface_set_sharpness: options is NULL");
+    if ((r = sfb__surface_slider(s, "sfb_surface_set_sharpness")) != SFB_SUCCESS) return r;
+    if (options->sharpness_set && !(options->sharpness >= 0.0f && options->sharpness <= 1.0f))
+        return sfb__error(s->ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "sfb_surface_set_sharpness: sharpness %g is not in [0, 1]",
+                          (double)options->sharpness);
+    o = *options;
+    o.slider = 1;
+    if ((r = sfb__surface_reblend(s, &o)) == SFB_SUCCESS) s->config.tribezier = o;
+    return r;
+}
+
+/* The base edge from a to b (the surface's prepared base level), or -1. */
+static int sfb__surface_edge(const sfb_surface *s, int a, int b) {
+    const sfb__level *l = &s->pbase;
+    int i;
+    if (a < 0 || b < 0 || a >= l->nv || b >= l->nv) return -1;
+    for (i = l->ve_off[a]; i < l->ve_off[a + 1]; ++i)
+        if (sfb__other_end(l, l->ve[i], a) == b) return l->ve[i];
+    return -1;
+}
+
+SFB_API sfb_result sfb_surface_set_feature_sharpness(sfb_surface *s, int crease_count, const int *crease_vertices,
+                                                     const float *crease_sharpness, int corner_count, const int *corner_vertices,
+                                                     const float *corner_sharpness) {
+    static const char *who = "sfb_surface_set_feature_sharpness";
+    sfb_context *ctx;
+    sfb__tbz_features *F;
+    float *es = NULL, *cs = NULL;
+    sfb_tribezier_options o;
+    sfb_result r;
+    int i;
+    if (!s) return SFB_INVALID_ARGS;
+    ctx = s->ctx;
+    if ((r = sfb__surface_slider(s, who)) != SFB_SUCCESS) return r;
+    if (crease_count < 0 || corner_count < 0 || (crease_count && (!crease_vertices || !crease_sharpness)) ||
+        (corner_count && (!corner_vertices || !corner_sharpness)))
+        return sfb__error(ctx, SFB_INVALID_ARGS, SFB_ELEMENT_NONE, -1, "%s: a negative count, or a NULL array with a count", who);
+    F = s->patches.features;
+    /* checked whole first: nothing changes on an error */
+    for (i = 0; i < crease_count; ++i) {
+        const int a = crease_vertices[2 * i], b = crease_vertices[2 * i + 1], e = sfb__surface_edge(s, a, b);
+        if (!(crease_sharpness[i] >= 0.0f))
+            return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_EDGE, e, "%s: crease %d (%d, %d): sharpness %g is not >= 0", who, i, a, b,
+                              (double)crease_sharpness[i]);
+        if (e < 0 || e >= F->nbe || !(s->pbase.es[e] > 0.0f))
+            return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_EDGE, e,
+                              "%s: crease %d (%d, %d) is not a tagged edge of the surface's mesh (the nets depend on which edges are "
+                              "creases: build the surface again to add one)", who, i, a, b);
+    }
+    for (i = 0; i < corner_count; ++i) {
+        const int v = corner_vertices[i];
+        if (!(corner_sharpness[i] >= 0.0f))
+            return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_VERTEX, v, "%s: corner %d (vertex %d): sharpness %g is not >= 0", who, i, v,
+                              (double)corner_sharpness[i]);
+        if (v < 0 || v >= F->nbv || !(s->pbase.vs[v] > 0.0f))
+            return sfb__error(ctx, SFB_INVALID_VALUE, SFB_ELEMENT_VERTEX, v,
+                              "%s: corner %d (vertex %d) is not a tagged corner of the surface's mesh (build the surface again to add one)", who,
+                              i, v);
+    }
+    es = (float *)sfb__alloc(ctx, ((size_t)F->nbe + 1) * sizeof(float));
+    cs = (float *)sfb__alloc(ctx, ((size_t)F->nbv + 1) * sizeof(float));
+    if (!es || !cs) {
+        sfb__free(ctx, es);
+        sfb__free(ctx, cs);
+        return sfb__oom(ctx, who);
+    }
+    memcpy(es, F->es, (size_t)F->nbe * sizeof(float));
+    memcpy(cs, F->cs, (size_t)F->nbv * sizeof(float));
+    /* as the build takes a tag: clamped to [0, 1] (a crease at 0 stays one: the smooth net's) */
+    for (i = 0; i < crease_count; ++i) F->es[sfb__surface_edge(s, crease_vertices[2 * i], crease_vertices[2 * i + 1])] = crease_sharpness[i] < 1.0f ? crease_sharpness[i] : 1.0f;
+    /* a vertex the preparation made sharp whatever its tag (non-manifold) stays so, as at create */
+    for (i = 0; i < corner_count; ++i)
+        if (!sfb__level_forced_sharp(&s->pbase, corner_vertices[i], s->boundary == SFB_BOUNDARY_EDGE_AND_CORNER))
+            F->cs[corner_vertices[i]] = corner_sharpness[i] < 1.0f ? corner_sharpness[i] : 1.0f;
+    o = s->config.tribezier;
+    o.sharpness_set = 0;
+    o.slider = 1;
+    if ((r = sfb__surface_reblend(s, &o)) == SFB_SUCCESS) s->config.tribezier = o;
+    else {
+        memcpy(F->es, es, (size_t)F->nbe * sizeof(float));
+        memcpy(F->cs, cs, (size_t)F->nbv * sizeof(float));
+    }
+    sfb__free(ctx, es);
+    sfb__free(ctx, cs);
+    return r;
 }
 
 SFB_API int sfb_surface_param_face_count(const sfb_surface *s) { return s && s->has_patches ? s->patches.nptex : 0; }
@@ -368,7 +454,10 @@ static size_t sfb__patch_table_bytes(const sfb__patch_table *pt) {
     return (size_t)pt->npatch * (4 * sizeof(int)) + (size_t)pt->ncv * sizeof(int) + (size_t)pt->nptex * 3 * sizeof(int) +
            (size_t)pt->nnodes * 4 * sizeof(int) + (size_t)pt->npoints * 3 * sizeof(float) +
            (pt->pcorner ? (size_t)pt->npatch * 4 * sizeof(unsigned) : 0) + (pt->normal_field ? sfb__patch_table_bytes(pt->normal_field) : 0) +
-           (pt->blend ? (size_t)pt->npatch * SFB__TBZ_BLEND * sizeof(float) : 0);
+           (pt->blend ? (size_t)pt->npatch * SFB__TBZ_BLEND * sizeof(float) : 0) +
+           (pt->features ? ((size_t)pt->features->nv * 4 + (size_t)pt->features->eoff[pt->features->nv] + 3 * (size_t)pt->npatch) * sizeof(int) +
+                               ((size_t)pt->features->nbe + pt->features->nbv) * sizeof(float)
+                         : 0);
 }
 
 SFB_API sfb_result sfb_surface_patch_info(const sfb_surface *s, sfb_patch_info *o) {

@@ -228,21 +228,22 @@ sfb_result sfb__level_prepare(sfb_context *ctx, const sfb__level *s, int sharpen
         if (d->es[e] > SFB_SHARPNESS_INFINITE) d->es[e] = SFB_SHARPNESS_INFINITE;
     }
     for (v = 0; v < d->nv; ++v) {
-        int k = d->vf_off[v + 1] - d->vf_off[v], m = d->ve_off[v + 1] - d->ve_off[v];
-        int nm_edges = 0, bnd_edges = 0;
-        for (i = d->ve_off[v]; i < d->ve_off[v + 1]; ++i) {
-            nm_edges += (d->etag[d->ve[i]] & SFB__TAG_NONMANIFOLD) != 0;
-            bnd_edges += (d->etag[d->ve[i]] & SFB__TAG_BOUNDARY) != 0;
-        }
-        if (k == 1 && m == 2 && sharpen_corners) {
-            d->vs[v] = SFB_SHARPNESS_INFINITE;
-        } else if (d->vtag[v] & SFB__TAG_NONMANIFOLD) {
-            if (!(nm_edges == 2 && bnd_edges == 0 && k > m)) d->vs[v] = SFB_SHARPNESS_INFINITE;
-        }
+        if (sfb__level_forced_sharp(d, v, sharpen_corners)) d->vs[v] = SFB_SHARPNESS_INFINITE;
         if (d->vs[v] > SFB_SHARPNESS_INFINITE) d->vs[v] = SFB_SHARPNESS_INFINITE;
     }
     sfb__level_compute_rules(d);
     return SFB_SUCCESS;
+}
+
+int sfb__level_forced_sharp(const sfb__level *d, int v, int sharpen_corners) {
+    const int k = d->vf_off[v + 1] - d->vf_off[v], m = d->ve_off[v + 1] - d->ve_off[v];
+    int nm_edges = 0, bnd_edges = 0, i;
+    for (i = d->ve_off[v]; i < d->ve_off[v + 1]; ++i) {
+        nm_edges += (d->etag[d->ve[i]] & SFB__TAG_NONMANIFOLD) != 0;
+        bnd_edges += (d->etag[d->ve[i]] & SFB__TAG_BOUNDARY) != 0;
+    }
+    if (k == 1 && m == 2) return sharpen_corners;
+    return (d->vtag[v] & SFB__TAG_NONMANIFOLD) && !(nm_edges == 2 && bnd_edges == 0 && k > m);
 }
 
 /* The end of edge e that is not v. */

@@ -1173,12 +1173,16 @@ static void sharp_only_one(sfb_context *ctx, const char *name, const char *obj, 
 
 /* Two OBJ texts in the forms tbm_obj writes (v, f, t crease, t corner) as one mesh: b's
  * vertex indices moved past a's vertices (malloc'd). */
-static char *obj_join(const char *a, const char *b) {
+static char *obj_join_ex(const char *a, const char *b, int share);
+static char *obj_join(const char *a, const char *b) { return obj_join_ex(a, b, 0); }
+/* share: b's centre (its first vertex) is a's, b's other vertices follow a's, lifted by 2 in z
+ * (two disks through one non-manifold vertex) */
+static char *obj_join_ex(const char *a, const char *b, int share) {
     const size_t la = strlen(a), lb = strlen(b), cap = la + 2 * lb + 64;
     char *s = (char *)malloc(cap), line[512];
     const char *p;
     size_t len;
-    int nva = 0;
+    int nva = 0, seen_v = 0;
     if (!s) return NULL;
     memcpy(s, a, la);
     len = la;
@@ -1188,15 +1192,21 @@ static char *obj_join(const char *a, const char *b) {
         const char *e = strchr(p, '\n');
         size_t n = e ? (size_t)(e - p) : strlen(p);
         int i, j, k;
-        double x;
+        double x, y, z;
+#define OBJ_MAP(q) (share ? ((q) == 1 ? 1 : (q) + nva - 1) : (q) + nva)
         if (n >= sizeof line) n = sizeof line - 1;
         memcpy(line, p, n);
         line[n] = 0;
-        if (sscanf(line, "f %d %d %d", &i, &j, &k) == 3) len += (size_t)snprintf(s + len, cap - len, "f %d %d %d\n", i + nva, j + nva, k + nva);
-        else if (sscanf(line, "t crease 2/1/0 %d %d %lf", &i, &j, &x) == 3)
-            len += (size_t)snprintf(s + len, cap - len, "t crease 2/1/0 %d %d %.17g\n", i + nva, j + nva, x);
-        else if (sscanf(line, "t corner 1/1/0 %d %lf", &i, &x) == 2) len += (size_t)snprintf(s + len, cap - len, "t corner 1/1/0 %d %.17g\n", i + nva, x);
+        if (share && sscanf(line, "v %lf %lf %lf", &x, &y, &z) == 3) {
+            if (seen_v++) len += (size_t)snprintf(s + len, cap - len, "v %.17g %.17g %.17g\n", x, y, z + 2.0);
+        } else if (sscanf(line, "f %d %d %d", &i, &j, &k) == 3)
+            len += (size_t)snprintf(s + len, cap - len, "f %d %d %d\n", OBJ_MAP(i), OBJ_MAP(j), OBJ_MAP(k));
+        else if (sscanf(line, "t crease 2/1/0 %d %d %lf", &i, &j, &x) == 3) /* 0-based */
+            len += (size_t)snprintf(s + len, cap - len, "t crease 2/1/0 %d %d %.17g\n", OBJ_MAP(i + 1) - 1, OBJ_MAP(j + 1) - 1, x);
+        else if (sscanf(line, "t corner 1/1/0 %d %lf", &i, &x) == 2)
+            len += (size_t)snprintf(s + len, cap - len, "t corner 1/1/0 %d %.17g\n", OBJ_MAP(i + 1) - 1, x);
         else len += (size_t)snprintf(s + len, cap - len, "%s\n", line);
+#undef OBJ_MAP
         p += e ? (size_t)(e - p) + 1 : n;
     }
     return s;
@@ -1835,6 +1845,208 @@ static void test_slider_refusals(void) {
     free(obj);
 }
 
+/* The slider per feature (sfb_surface_set_feature_sharpness): on every backend, a surface built
+ * with the slider has every other tagged crease (and its corner) given a new value (0.05, 0.35,
+ * 0.8, 2.5: clamped to 1; corners 0.9); it must evaluate bit for bit as a surface built afresh
+ * from the mesh with those tags (and within 2e-7 diagonals of one built so without the slider,
+ * whose points take their s another way), and so again after an override and back
+ * (sfb_surface_set_sharpness without it shows the features' values). Meshes: slider_mesh 0 (own
+ * net) with a corner tag at its extraordinary vertex, 1 (after a Loop step, touching), two disks
+ * through one vertex with a corner there (split in two: its copy's corner mapped back); on ref
+ * also teapot.obj with its edges over 40 degrees creased (38 non-manifold vertices split). Then the refusals: an untagged edge, an untagged corner, a negative or NaN value, a
+ * vertex out of range, NULL arrays with a count, a surface without the slider: an error, the
+ * surface unchanged. */
+static int feature_mesh(sfb_context *ctx, int which, const char *dir, sfb_mesh **out) {
+    char *obj = NULL;
+    size_t n = 0;
+    sfb_result r;
+    *out = NULL;
+    if (which == 2) {
+        /* a creased disk and a smooth one through the same centre, a corner there */
+        tbm_opts o;
+        char *a, *b, *j;
+        memset(&o, 0, sizeof o);
+        o.n = 5; o.R = 3; o.crease_k = 2; o.sharp = 0.4; o.ridge = 0.4; o.bump = 1.0; o.jitter = 0.1; o.seed = 5u;
+        a = tbm_obj(&o);
+        memset(&o, 0, sizeof o);
+        o.n = 6; o.R = 3; o.bump = 1.0; o.jitter = 0.1; o.seed = 6u;
+        b = tbm_obj(&o);
+        j = a && b ? obj_join_ex(a, b, 1) : NULL;
+        obj = j ? (char *)malloc(strlen(j) + 64) : NULL;
+        if (obj) sprintf(obj, "%st corner 1/1/0 0 0.2\n", j);
+        free(a); free(b); free(j);
+        r = obj ? sfb_mesh_read_obj(ctx, obj, strlen(obj), out) : SFB_OUT_OF_MEMORY;
+        free(obj);
+        return r == SFB_SUCCESS;
+    }
+    if (which == 3) {
+        char path[1024];
+        sfb_mesh *m0 = NULL;
+        snprintf(path, sizeof path, "%s/teapot.obj", dir);
+        if (!(obj = slurp(path, &n))) return -1;
+        r = sfb_mesh_read_obj(ctx, obj, n, &m0);
+        if (r == SFB_SUCCESS) r = sfb_mesh_crease_by_angle(ctx, m0, 40.0f, out, NULL);
+        sfb_mesh_destroy(m0);
+        free(obj);
+        return r == SFB_SUCCESS;
+    }
+    obj = slider_mesh(which);
+    if (obj && which == 0) {
+        char *c = (char *)malloc(strlen(obj) + 64);
+        if (c) sprintf(c, "%st corner 1/1/0 0 0.6\n", obj);
+        free(obj);
+        obj = c;
+    }
+    r = obj ? sfb_mesh_read_obj(ctx, obj, strlen(obj), out) : SFB_OUT_OF_MEMORY;
+    free(obj);
+    return r == SFB_SUCCESS;
+}
+
+static void test_feature_slider(const char *dir) {
+    static const char *names[4] = {"creased_disk_corner", "cube_touching_evs", "bowtie_split_corner", "teapot_creased_40_degrees"};
+    static const float vals[4] = {0.05f, 0.35f, 0.8f, 2.5f};
+    int w, b;
+    for (w = 0; w < 4; ++w)
+        for (b = 0; b < g_nbe; ++b) {
+            char nm[200];
+            sfb_context *ctx = g_be[b].ctx;
+            sfb_mesh *m = NULL, *m2 = NULL;
+            sfb_surface *sl = NULL, *fresh = NULL, *plain = NULL;
+            sfb_surface_config sc = sfb_surface_config_init(SFB_SCHEME_TRIBEZIER, 0);
+            sfb_mesh_desc d, d2;
+            int *cv = NULL, nc = 0, i, got, ok = 1, same = 0, same2 = 0;
+            double worst = 0.0, diag = 0.0;
+            static float P2[900], D2[1800];
+            float *csh = NULL, *nsh = NULL, *ksh = NULL;
+            static float P0[900], D0[1800], P1[900], D1[1800];
+            snprintf(nm, sizeof nm, "%s/feature_slider/%s", g_be[b].name, names[w]);
+            if (!g_be[b].available) { backend_missing(&g_be[b], nm); continue; }
+            if (w == 3 && g_be[b].kind != SFB_BACKEND_REF) continue; /* the real mesh on ref alone */
+            got = feature_mesh(ctx, w, dir, &m);
+            if (got < 0) { skip(nm, "teapot.obj not found (pass the real-meshes folder)"); continue; }
+            if (!got) { fail(nm, "load: %s", sfb_last_error(ctx)); continue; }
+            sfb_mesh_get_desc(m, &d);
+            /* every other crease and every corner a new value */
+            cv = (int *)malloc(sizeof(int) * 2 * (size_t)(d.crease_count + 1));
+            csh = (float *)malloc(sizeof(float) * (size_t)(d.crease_count + 1));
+            nsh = (float *)malloc(sizeof(float) * (size_t)(d.crease_count + 1));
+            ksh = (float *)malloc(sizeof(float) * (size_t)(d.corner_count + 1));
+            if (!cv || !csh || !nsh || !ksh) { fail(nm, "test memory"); ok = 0; }
+            for (i = 0; ok && i < d.crease_count; ++i) {
+                nsh[i] = d.crease_sharpness[i];
+                if (i % 2 == 0) {
+                    cv[2 * nc] = d.crease_vertices[2 * i];
+                    cv[2 * nc + 1] = d.crease_vertices[2 * i + 1];
+                    csh[nc] = vals[(i / 2) % 4];
+                    nsh[i] = csh[nc];
+                    nc++;
+                }
+            }
+            for (i = 0; ok && i < d.corner_count; ++i) ksh[i] = 0.9f; /* above its creases' mean: the corner's max counts */
+            d2 = d;
+            d2.crease_sharpness = nsh;
+            d2.corner_sharpness = ksh;
+            sc.flags = SFB_REFINE_PATCHES;
+            sc.tribezier.slider = 1;
+            ok = ok && nc > 0 && sfb_surface_create(ctx, m, &sc, &sl) == SFB_SUCCESS && sfb_mesh_create(ctx, &d2, &m2) == SFB_SUCCESS &&
+                 sfb_surface_create(ctx, m2, &sc, &fresh) == SFB_SUCCESS;
+            /* and the build without the slider, whose s per point comes another way
+             * (tbz_vertex_s on the level itself, not the features mapped to the base mesh) */
+            sc.tribezier.slider = 0;
+            ok = ok && sfb_surface_create(ctx, m2, &sc, &plain) == SFB_SUCCESS;
+            diag = diag_of(d.positions, d.vertex_count);
+            if (!ok) { fail(nm, "build: %s", sfb_last_error(ctx)); }
+            else if (sfb_surface_set_feature_sharpness(sl, nc, cv, csh, d.corner_count, d.corner_vertices, ksh) != SFB_SUCCESS) {
+                fail(nm, "set: %s", sfb_last_error(ctx));
+            } else {
+                sfb_tribezier_options to;
+                int moved = 0;
+                ok = slider_eval(sl, d.face_count, P0, D0) && slider_eval(fresh, d.face_count, P1, D1) && slider_eval(plain, d.face_count, P2, D2);
+                same = ok && !memcmp(P0, P1, sizeof P0) && !memcmp(D0, D1, sizeof D0);
+                for (i = 0; i < 900; ++i) worst = fmax(worst, fabs((double)P0[i] - P2[i]));
+                memset(&to, 0, sizeof to);
+                to.sharpness_set = 1;
+                to.sharpness = 0.5f;
+                ok = ok && sfb_surface_set_sharpness(sl, &to) == SFB_SUCCESS && slider_eval(sl, d.face_count, P0, D0);
+                moved = ok && memcmp(P0, P1, sizeof P0) != 0;
+                to.sharpness_set = 0;
+                ok = ok && sfb_surface_set_sharpness(sl, &to) == SFB_SUCCESS && slider_eval(sl, d.face_count, P0, D0);
+                same2 = ok && !memcmp(P0, P1, sizeof P0) && !memcmp(D0, D1, sizeof D0);
+                check(ok && same && moved && same2 && worst <= 2e-7 * diag, nm,
+                      "%d creases and %d corners set; bit for bit as built with those tags %d, the override moved it %d, and back %d; "
+                      "off the build without the slider by %.3g (diag %.3g)", nc, d.corner_count, same, moved, same2, worst, diag);
+                printf("  %s: %d of %d creases and %d corners set\n", nm, nc, d.crease_count, d.corner_count);
+            }
+            sfb_surface_destroy(sl);
+            sfb_surface_destroy(fresh);
+            sfb_surface_destroy(plain);
+            sfb_mesh_destroy(m);
+            sfb_mesh_destroy(m2);
+            free(cv); free(csh); free(nsh); free(ksh);
+        }
+}
+
+static void test_feature_slider_refusals(void) {
+    sfb_context_config cc = sfb_context_config_init();
+    sfb_context *ctx = NULL;
+    sfb_mesh *m = NULL;
+    sfb_surface *sl = NULL, *plain = NULL;
+    sfb_surface_config sc = sfb_surface_config_init(SFB_SCHEME_TRIBEZIER, 0);
+    static float P0[900], D0[1800], P1[900], D1[1800];
+    sfb_mesh_desc d;
+    int k;
+    cc.ignore_environment = 1;
+    if (sfb_context_create(&cc, &ctx) != SFB_SUCCESS || feature_mesh(ctx, 0, NULL, &m) != 1) { fail("feature_slider/refusals", "setup"); sfb_context_destroy(ctx); return; }
+    sfb_mesh_get_desc(m, &d);
+    sc.flags = SFB_REFINE_PATCHES;
+    sc.tribezier.slider = 1;
+    if (sfb_surface_create(ctx, m, &sc, &sl) != SFB_SUCCESS) fail("feature_slider/refusals", "create: %s", sfb_last_error(ctx));
+    sc.tribezier.slider = 0;
+    if (sfb_surface_create(ctx, m, &sc, &plain) != SFB_SUCCESS) fail("feature_slider/refusals", "create: %s", sfb_last_error(ctx));
+    if (sl && plain && slider_eval(sl, d.face_count, P0, D0)) {
+        /* an untagged edge: the first ring's edge from ray 1 (vertices 0 and 2; rays 0 and 2 are the crease) */
+        static const int untagged[2] = {0, 2}, tagged[2] = {0, 1}, corner0[1] = {0}, corner_untagged[1] = {5}, far[1] = {100000};
+        static const char *cases[8] = {"untagged_edge", "untagged_corner", "negative", "nan", "vertex_out_of_range", "null_array",
+                                       "not_built_with_the_slider", "negative_count"};
+        static const char *says[8] = {"not a tagged edge", "not a tagged corner", "not >= 0", "not >= 0", "not a tagged edge", "NULL",
+                                      "slider", "negative"};
+        static const sfb_result want[8] = {SFB_INVALID_VALUE, SFB_INVALID_VALUE, SFB_INVALID_VALUE, SFB_INVALID_VALUE, SFB_INVALID_VALUE,
+                                           SFB_INVALID_ARGS, SFB_INVALID_ARGS, SFB_INVALID_ARGS};
+        const float half[1] = {0.5f}, neg[1] = {-0.5f}, nan1[1] = {(float)NAN};
+        const int oob[2] = {0, 100000};
+        (void)far;
+        for (k = 0; k < 8; ++k) {
+            char nm[120];
+            sfb_result r;
+            snprintf(nm, sizeof nm, "feature_slider/refused/%s", cases[k]);
+            switch (k) {
+            case 0: r = sfb_surface_set_feature_sharpness(sl, 1, untagged, half, 0, NULL, NULL); break;
+            case 1: r = sfb_surface_set_feature_sharpness(sl, 1, tagged, half, 1, corner_untagged, half); break;
+            case 2: r = sfb_surface_set_feature_sharpness(sl, 1, tagged, neg, 0, NULL, NULL); break;
+            case 3: r = sfb_surface_set_feature_sharpness(sl, 0, NULL, NULL, 1, corner0, nan1); break;
+            case 4: r = sfb_surface_set_feature_sharpness(sl, 1, oob, half, 0, NULL, NULL); break;
+            case 5: r = sfb_surface_set_feature_sharpness(sl, 1, NULL, half, 0, NULL, NULL); break;
+            case 6: r = sfb_surface_set_feature_sharpness(plain, 1, tagged, half, 0, NULL, NULL); break;
+            default: r = sfb_surface_set_feature_sharpness(sl, -1, tagged, half, 0, NULL, NULL); break;
+            }
+            check(r == want[k] && strstr(sfb_last_error(ctx), says[k]) && slider_eval(sl, d.face_count, P1, D1) && !memcmp(P0, P1, sizeof P0) &&
+                      !memcmp(D0, D1, sizeof D0),
+                  nm, "result %d (want %d), '%s'", (int)r, (int)want[k], sfb_last_error(ctx));
+        }
+        {
+            /* a crease at 0 is still a feature: accepted, and the surface moves */
+            const float zero[1] = {0.0f};
+            check(sfb_surface_set_feature_sharpness(sl, 1, tagged, zero, 0, NULL, NULL) == SFB_SUCCESS && slider_eval(sl, d.face_count, P1, D1) &&
+                      memcmp(P0, P1, sizeof P0) != 0,
+                  "feature_slider/a_crease_at_0_is_accepted", "%s", sfb_last_error(ctx));
+        }
+    } else fail("feature_slider/refusals", "surfaces: %s", sfb_last_error(ctx));
+    sfb_surface_destroy(sl);
+    sfb_surface_destroy(plain);
+    sfb_mesh_destroy(m);
+    sfb_context_destroy(ctx);
+}
+
 /* The constraint regions are solved in blocks on the backend's threads (tbz_solve_todo), and a
  * large region with each iteration's loops on them: the nets must be bit for bit those of a
  * context that lends no threads (ref, one thread), the smooth and the sharp (crease tags on every
@@ -2042,5 +2254,7 @@ int main(int argc, char **argv) {
     test_backends_refined(argc > 1 ? argv[1] : "../shared/peers/real-meshes");
     test_slider();
     test_slider_refusals();
+    test_feature_slider(argc > 1 ? argv[1] : "../shared/peers/real-meshes");
+    test_feature_slider_refusals();
     return close_tests();
 }

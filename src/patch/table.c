@@ -9,6 +9,7 @@ void sfb__patch_table_free(sfb_context *ctx, sfb__patch_table *pt) {
     sfb__free(ctx, pt->cv); sfb__free(ctx, pt->ptex_face); sfb__free(ctx, pt->ptex_corner); sfb__free(ctx, pt->face_ptex);
     sfb__free(ctx, pt->ptex_root); sfb__free(ctx, pt->nodes); sfb__free(ctx, pt->point_data); sfb__free(ctx, pt->pcorner);
     sfb__free(ctx, pt->blend);
+    sfb__tbz_features_free(ctx, pt->features);
     if (pt->normal_field) {
         sfb__patch_table_free(ctx, pt->normal_field);
         sfb__free(ctx, pt->normal_field);

@@ -15,10 +15,13 @@
  *     home vertices: its corner, its edge's ends, its triangle's corners); for one s everywhere
  *     the blend is exact. The nets depend on which features there are, not on their s (a
  *     feature at s = 0 is still one: tbz_tag_values), so the slider (tribezier.slider) keeps
- *     both nets in float and each point's s from the tags, and sfb_surface_set_sharpness blends
- *     them again for a new s (sfb__tribezier_blend): the build with the slider blends from the
- *     float nets too (and builds both nets where s = 1 everywhere), so a move is bit for bit a
- *     fresh build with the slider; without it, within a float rounding of one.
+ *     both nets in float and how each point's s follows from the base mesh's tags
+ *     (sfb__tbz_features: the edges and corners each vertex's s is taken from, mapped back
+ *     through the split and the Loop steps), and sfb_surface_set_sharpness and
+ *     sfb_surface_set_feature_sharpness blend them again (sfb__tribezier_blend): the build with
+ *     the slider takes its points' s the same way and blends from the float nets too (and
+ *     builds both nets where s = 1 everywhere), so a move is bit for bit a fresh build with the
+ *     slider; without it, within a float rounding of one.
  *   - regular vertices (valence 6, or a crease/boundary vertex with three triangles on each
  *     side) take Sabin's rules (seed eq. 4-7, ALGORITHMS.md 8.1) on the mesh extended across
  *     sharp edges by parallelograms (seed eq. 8 at s = 1: the phantom across wall edge (a, b) is
@@ -2101,7 +2104,7 @@ static sfb_result tbz_vertex_s(sfb__tbz *T, double *vs) {
         }
     }
     /* no tagged feature in the vertex's part of the mesh: -1 (its points take s = 0, whatever
-     * the override: tbz_blend_s) */
+     * the override: tbz_slider_s) */
     for (v = 0; v < T->nv; ++v)
         if (!seen[v]) vs[v] = -1.0;
     sfb__free(T->ctx, queue); sfb__free(T->ctx, seen);
@@ -2129,19 +2132,163 @@ static int tbz_tag_values(sfb__tbz *T, int override, float s) {
     return any;
 }
 
+/* The slider (tribezier.slider): where the level the nets are built on (L) came from -- per L
+ * edge and vertex the base mesh's (NULL: the same ids), and the base mesh's counts and tags --,
+ * and what the build leaves for sfb_surface_set_sharpness: both nets per patch in float
+ * (SFB__TBZ_BLEND floats) and how each point's s follows from the features (sfb__tbz_features). */
+typedef struct tbz_origin {
+    const int *e, *v;
+    int nbe, nbv;
+    const float *bes, *bvs;
+} tbz_origin;
+typedef struct tbz_slider {
+    tbz_origin org;
+    float *blend;
+    sfb__tbz_features *F;
+} tbz_slider;
+
+static void tbz_slider_free(sfb_context *ctx, tbz_slider *sv) {
+    sfb__free(ctx, sv->blend);
+    sfb__tbz_features_free(ctx, sv->F);
+    sv->blend = NULL;
+    sv->F = NULL;
+}
+
+void sfb__tbz_features_free(sfb_context *ctx, sfb__tbz_features *F) {
+    if (!F) return;
+    sfb__free(ctx, F->src); sfb__free(ctx, F->eoff); sfb__free(ctx, F->eid); sfb__free(ctx, F->corner); sfb__free(ctx, F->pv);
+    sfb__free(ctx, F->es); sfb__free(ctx, F->cs);
+    sfb__free(ctx, F);
+}
+
+/* The features of L for the slider (T classified, its tag_s and corner_s set: which edges and
+ * vertices are features does not depend on their s): the edges tbz_vertex_s sums, as base edges,
+ * the corners it takes, its breadth-first sources, each patch's triangle; and the base mesh's
+ * tags, clamped. */
+static sfb_result tbz_features_make(sfb__tbz *T, const tbz_origin *org, sfb__tbz_features **out) {
+    const sfb__level *l = T->l;
+    sfb__tbz_features *F = (sfb__tbz_features *)sfb__calloc(T->ctx, 1, sizeof *F);
+    int v, i, f, n = 0, head = 0, tail = 0, held = 0;
+    int *queue = NULL;
+    *out = NULL;
+    if (!F) return sfb__oom(T->ctx, "tribezier slider");
+    for (f = 0; f < l->nf; ++f) held += !l->fhole[f];
+    F->nv = l->nv; F->nbe = org->nbe; F->nbv = org->nbv;
+    F->src = (int *)sfb__alloc(T->ctx, ((size_t)l->nv + 1) * sizeof(int));
+    F->eoff = (int *)sfb__alloc(T->ctx, ((size_t)l->nv + 1) * sizeof(int));
+    F->eid = (int *)sfb__alloc(T->ctx, ((size_t)l->ve_off[l->nv] + 1) * sizeof(int));
+    F->corner = (int *)sfb__alloc(T->ctx, ((size_t)l->nv + 1) * sizeof(int));
+    F->pv = (int *)sfb__alloc(T->ctx, 3 * (size_t)held * sizeof(int) + 1);
+    F->es = (float *)sfb__calloc(T->ctx, (size_t)org->nbe + 1, sizeof(float));
+    F->cs = (float *)sfb__calloc(T->ctx, (size_t)org->nbv + 1, sizeof(float));
+    queue = (int *)sfb__alloc(T->ctx, ((size_t)l->nv + 1) * sizeof(int));
+    if (!F->src || !F->eoff || !F->eid || !F->corner || !F->pv || !F->es || !F->cs || !queue) {
+        sfb__tbz_features_free(T->ctx, F);
+        sfb__free(T->ctx, queue);
+        return sfb__oom(T->ctx, "tribezier slider");
+    }
+    for (i = 0; i < org->nbe; ++i) F->es[i] = org->bes[i] > 0.0f ? (org->bes[i] < 1.0f ? org->bes[i] : 1.0f) : 0.0f;
+    for (i = 0; i < org->nbv; ++i) F->cs[i] = org->bvs[i] > 0.0f ? (org->bvs[i] < 1.0f ? org->bvs[i] : 1.0f) : 0.0f;
+    for (v = 0; v < l->nv; ++v) {
+        F->eoff[v] = n;
+        for (i = l->ve_off[v]; i < l->ve_off[v + 1]; ++i)
+            if (T->tag_s[l->ve[i]] > 0.0f && l->ef_off[l->ve[i] + 1] - l->ef_off[l->ve[i]] == 2)
+                F->eid[n++] = org->e ? org->e[l->ve[i]] : l->ve[i];
+        F->corner[v] = T->corner_s[v] > 0.0f ? (org->v ? org->v[v] : v) : -1;
+        F->src[v] = -1;
+        if (n > F->eoff[v] || F->corner[v] >= 0) { F->src[v] = v; queue[tail++] = v; }
+    }
+    F->eoff[l->nv] = n;
+    /* tbz_vertex_s's breadth-first order */
+    while (head < tail) {
+        const int u = queue[head++];
+        for (i = l->ve_off[u]; i < l->ve_off[u + 1]; ++i) {
+            const int w = sfb__other_end(l, l->ve[i], u);
+            if (F->src[w] < 0) { F->src[w] = F->src[u]; queue[tail++] = w; }
+        }
+    }
+    sfb__free(T->ctx, queue);
+    for (f = 0, n = 0; f < l->nf; ++f)
+        if (!l->fhole[f])
+            for (i = 0; i < 3; ++i) F->pv[n++] = l->fv[l->fv_off[f] + i];
+    *out = F;
+    return SFB_SUCCESS;
+}
+
+/* Per L vertex its s from the features' tags now, as tbz_vertex_s gives it (-1: none reached). */
+static void tbz_features_vs(const sfb__tbz_features *F, double *vs) {
+    int v, i;
+    for (v = 0; v < F->nv; ++v) vs[v] = -1.0;
+    for (v = 0; v < F->nv; ++v) {
+        double sum = 0.0;
+        int cnt = 0;
+        if (F->src[v] != v) continue;
+        for (i = F->eoff[v]; i < F->eoff[v + 1]; ++i) {
+            const float t = F->es[F->eid[i]] > 0.0f ? F->es[F->eid[i]] : 1e-30f; /* tbz_tag_values */
+            sum += t;
+            cnt++;
+        }
+        vs[v] = cnt ? sum / cnt : 0.0;
+        if (F->corner[v] >= 0) {
+            const float c = F->cs[F->corner[v]] > 0.0f ? F->cs[F->corner[v]] : 1e-30f;
+            vs[v] = cnt ? fmax(vs[v], c) : c;
+        }
+    }
+    for (v = 0; v < F->nv; ++v)
+        if (F->src[v] >= 0 && F->src[v] != v) vs[v] = vs[F->src[v]];
+}
+
+/* The mean s of point (i, j) of a triangle over its home vertices fv (weights > 0; at a corner
+ * the corner alone). */
+static double tbz_home_s(const double *vs, const int *fv, int i, int j) {
+    const int w[3] = {4 - i - j, i, j};
+    double s = 0.0, wsum = 0.0;
+    int kk;
+    for (kk = 0; kk < 3; ++kk)
+        if (w[kk] > 0 && (w[0] == 4 || w[1] == 4 || w[2] == 4 ? w[kk] == 4 : 1)) { s += vs[fv[kk]]; wsum += 1.0; }
+    return wsum > 0.0 ? s / wsum : 0.0;
+}
+
+/* A point's s for options opt: the override where the point has a feature in its part of the
+ * mesh (home mean >= 0), else the features' s; below 1e-20 none. In float first, as the
+ * slider's build and sfb__tribezier_blend both take it. */
+static double tbz_slider_s(const sfb_tribezier_options *opt, float home) {
+    const double s = opt && opt->sharpness_set ? (home >= 0.0f ? (double)opt->sharpness : 0.0) : (double)home;
+    return s < 1e-20 ? 0.0 : s;
+}
+
+int sfb__tribezier_blend(sfb_context *ctx, const sfb__patch_table *pt, const sfb_tribezier_options *opt, float *point_data) {
+    const sfb__tbz_features *F = pt->features;
+    double *vs = (double *)sfb__alloc(ctx, ((size_t)F->nv + 1) * sizeof(double));
+    int p, q, c, i, j;
+    if (!vs) return 0;
+    tbz_features_vs(F, vs);
+    for (p = 0; p < pt->npatch; ++p) {
+        const float *b = pt->blend + SFB__TBZ_BLEND * (size_t)p;
+        float *o = point_data + 45 * (size_t)p;
+        for (j = 0, q = 0; j <= 4; ++j)
+            for (i = 0; i + j <= 4; ++i, ++q) {
+                const double s = tbz_slider_s(opt, (float)tbz_home_s(vs, F->pv + 3 * (size_t)p, i, j));
+                for (c = 0; c < 3; ++c) o[3 * q + c] = (float)((1.0 - s) * (double)b[3 * q + c] + s * (double)b[45 + 3 * q + c]);
+            }
+    }
+    sfb__free(ctx, vs);
+    return 1;
+}
+
 /* fout: NULL, the net into *out (45 doubles per triangle); else the net into fout, 45 floats
  * per triangle that is not a hole, in order (sfb__patch_table_beztri_children's point data),
  * and *out left NULL (the doubles, a net as large again, never made) */
 static sfb_result tbz_points(sfb_context *ctx, const sfb__level *l, const float *positions, const float *sharp_positions,
-                             const sfb_tribezier_options *opt, unsigned flags, double **out, float *fout, float **bout,
+                             const sfb_tribezier_options *opt, unsigned flags, double **out, float *fout, tbz_slider *sv,
                              sfb__tbz_stats *stats) {
     sfb__tbz T;
     tbz_prev prev;
-    double *x0 = NULL, *vs = NULL, *vtag = NULL, *res = NULL;
+    double *x0 = NULL, *vs = NULL, *vsf = NULL, *res = NULL;
     int v, e, f, c, k, kb, any_tag = 0, sharp_only = 0;
     sfb_result r = SFB_SUCCESS;
     *out = NULL;
-    if (bout) *bout = NULL;
+    if (sv) { sv->blend = NULL; sv->F = NULL; }
     /* the nets read rings in fan order: every vertex with triangles a fan, every edge manifold
      * (tbz_check and tbz_split see to it on the mesh; a mesh after Loop steps, tbz_refine,
      * can still fail: two triangles on the same three vertices give four triangles on an edge) */
@@ -2192,24 +2339,21 @@ static sfb_result tbz_points(sfb_context *ctx, const sfb__level *l, const float 
     if (any_tag) {
         vs = (double *)sfb__calloc(ctx, (size_t)T.nv + 1, sizeof(double));
         if (!vs) { r = sfb__oom(ctx, "tribezier"); goto done; }
-        if (bout && opt && opt->sharpness_set) {
-            /* the slider keeps the tags' s too, for an options without the override */
-            vtag = (double *)sfb__calloc(ctx, (size_t)T.nv + 1, sizeof(double));
-            if (!vtag) { r = sfb__oom(ctx, "tribezier"); goto done; }
-            tbz_tag_values(&T, 0, 0.0f);
-            if ((r = tbz_vertex_s(&T, vtag)) != SFB_SUCCESS) goto done;
-            tbz_tag_values(&T, 1, opt->sharpness);
-        }
         if ((r = tbz_vertex_s(&T, vs)) != SFB_SUCCESS) goto done;
         /* the slider needs both nets whatever s is now */
-        sharp_only = !(flags & SFB__TBZ_BOTH_NETS) && !bout;
+        sharp_only = !(flags & SFB__TBZ_BOTH_NETS) && !sv;
         for (v = 0; v < T.nv && sharp_only; ++v) sharp_only = vs[v] == 1.0;
     }
-    if (bout) {
+    if (sv) {
+        /* the slider: the features, each vertex's s from their tags (tbz_features_vs, as
+         * sfb__tribezier_blend takes it), the two nets' room */
         int held = 0;
         for (f = 0; f < T.nf; ++f) held += !l->fhole[f];
-        *bout = (float *)sfb__alloc(ctx, (size_t)SFB__TBZ_BLEND * held * sizeof(float) + 1);
-        if (!*bout) { r = sfb__oom(ctx, "tribezier slider"); goto done; }
+        if ((r = tbz_features_make(&T, &sv->org, &sv->F)) != SFB_SUCCESS) goto done;
+        vsf = (double *)sfb__alloc(ctx, ((size_t)T.nv + 1) * sizeof(double));
+        sv->blend = (float *)sfb__alloc(ctx, (size_t)SFB__TBZ_BLEND * held * sizeof(float) + 1);
+        if (!vsf || !sv->blend) { r = sfb__oom(ctx, "tribezier slider"); goto done; }
+        tbz_features_vs(sv->F, vsf);
     }
     /* progress: this call's window (sfb_internal.h), the smooth net's solve in its first half
      * where a sharp net follows (the seed-plane fallback reports in the same half again, never
@@ -2272,35 +2416,25 @@ blend:
     for (f = 0, k = 0, kb = 0; f < T.nf; ++f) {
         const int *fv = l->fv + l->fv_off[f];
         const int *g = T.grid + 15 * (size_t)f;
-        int i, j, q = 0, kk;
-        float *fo = fout ? fout + 45 * (size_t)k : NULL, *bo = bout && !l->fhole[f] ? *bout + SFB__TBZ_BLEND * (size_t)kb++ : NULL;
+        int i, j, q = 0;
+        float *fo = fout ? fout + 45 * (size_t)k : NULL, *bo = sv && !l->fhole[f] ? sv->blend + SFB__TBZ_BLEND * (size_t)kb++ : NULL;
         if (fout && l->fhole[f]) continue;
         k += fout != NULL;
         for (j = 0; j <= 4; ++j)
             for (i = 0; i + j <= 4; ++i, ++q) {
-                /* the point's home vertices: weights > 0 */
-                const int w[3] = {4 - i - j, i, j};
-                double s = 0.0, st = 0.0, wsum = 0.0;
+                double s = 0.0;
                 if (any_tag) {
-                    for (kk = 0; kk < 3; ++kk)
-                        if (w[kk] > 0 && (w[0] == 4 || w[1] == 4 || w[2] == 4 ? w[kk] == 4 : 1)) {
-                            s += vs[fv[kk]];
-                            st += vtag ? vtag[fv[kk]] : vs[fv[kk]];
-                            wsum += 1.0;
-                        }
-                    s = wsum > 0.0 ? s / wsum : 0.0;
-                    st = wsum > 0.0 ? st / wsum : 0.0;
+                    s = tbz_home_s(vs, fv, i, j);
                     if (s < 1e-20) s = 0.0;
-                } else st = -1.0;
+                }
                 if (bo) {
                     /* the slider: the nets in float, the output their blend as
-                     * sfb_surface_set_sharpness makes it (sfb__tribezier_blend) */
-                    bo[90 + q] = (float)st;
+                     * sfb__tribezier_blend makes it */
                     for (c = 0; c < 3; ++c) {
                         bo[3 * q + c] = (float)(any_tag ? x0 : T.x)[3 * (size_t)g[q] + c];
                         bo[45 + 3 * q + c] = (float)T.x[3 * (size_t)g[q] + c];
                     }
-                    s = sfb__tribezier_point_s(opt, bo[90 + q]);
+                    s = tbz_slider_s(opt, (float)tbz_home_s(vsf, fv, i, j));
                 }
                 for (c = 0; c < 3; ++c) {
                     const double sh = T.x[3 * (size_t)g[q] + c];
@@ -2317,27 +2451,15 @@ blend:
 done:
     sfb__free(ctx, T.efeat); sfb__free(ctx, T.vtype); sfb__free(ctx, T.virr); sfb__free(ctx, T.phi);
     sfb__free(ctx, T.x); sfb__free(ctx, T.fixed); sfb__free(ctx, T.dist); sfb__free(ctx, T.grid); sfb__free(ctx, T.tag_s); sfb__free(ctx, T.corner_s);
-    sfb__free(ctx, x0); sfb__free(ctx, vs); sfb__free(ctx, vtag); sfb__free(ctx, res);
-    if (r != SFB_SUCCESS && bout) { sfb__free(ctx, *bout); *bout = NULL; }
+    sfb__free(ctx, x0); sfb__free(ctx, vs); sfb__free(ctx, vsf); sfb__free(ctx, res);
+    if (r != SFB_SUCCESS && sv) {
+        sfb__free(ctx, sv->blend);
+        sfb__tbz_features_free(ctx, sv->F);
+        sv->blend = NULL;
+        sv->F = NULL;
+    }
     tbz_prev_free(ctx, &prev);
     return r;
-}
-
-double sfb__tribezier_point_s(const sfb_tribezier_options *opt, float tag_s) {
-    const double s = opt && opt->sharpness_set ? (tag_s >= 0.0f ? (double)opt->sharpness : 0.0) : (double)tag_s;
-    return s < 1e-20 ? 0.0 : s;
-}
-
-void sfb__tribezier_blend(const sfb__patch_table *pt, const sfb_tribezier_options *opt, float *point_data) {
-    int p, q, c;
-    for (p = 0; p < pt->npatch; ++p) {
-        const float *b = pt->blend + SFB__TBZ_BLEND * (size_t)p;
-        float *o = point_data + 45 * (size_t)p;
-        for (q = 0; q < 15; ++q) {
-            const double s = sfb__tribezier_point_s(opt, b[90 + q]);
-            for (c = 0; c < 3; ++c) o[3 * q + c] = (float)((1.0 - s) * (double)b[3 * q + c] + s * (double)b[45 + 3 * q + c]);
-        }
-    }
 }
 
 /* The refusals of every entry point: an override s outside [0, 1] or NaN, and
@@ -2685,30 +2807,60 @@ done:
     return r;
 }
 
-/* sfb__tribezier_refined_points, the net into *out or (fout not NULL) into fout (tbz_points) */
+/* The slider's origin maps one Loop step down (tbz_refine's numbering: the half of parent edge
+ * e at either end is child edge 2e or 2e + 1, the inner edges come after; the parent's vertices
+ * keep their ids): into *e and *v (freed by the caller). */
+static int tbz_origin_step(sfb_context *ctx, const tbz_origin *in, int pnv, int pne, const sfb__level *child, int **e, int **v) {
+    int i;
+    *e = (int *)sfb__alloc(ctx, ((size_t)child->ne + 1) * sizeof(int));
+    *v = (int *)sfb__alloc(ctx, ((size_t)child->nv + 1) * sizeof(int));
+    if (!*e || !*v) return 0;
+    for (i = 0; i < child->ne; ++i) (*e)[i] = i < 2 * pne ? (in->e ? in->e[i / 2] : i / 2) : -1;
+    for (i = 0; i < child->nv; ++i) (*v)[i] = i < pnv ? (in->v ? in->v[i] : i) : -1;
+    return 1;
+}
+
+/* sfb__tribezier_refined_points, the net into *out or (fout not NULL) into fout (tbz_points);
+ * sv: the slider's (l as sfb__tribezier_build hands it to tbz_build, its vertices split) */
 static sfb_result tbz_refined(sfb_context *ctx, const sfb__level *l, const float *positions, const sfb_tribezier_options *opt,
-                              unsigned flags, sfb__level *rl, double **out, float *fout, float **bout, sfb__tbz_stats *stats) {
+                              unsigned flags, sfb__level *rl, double **out, float *fout, tbz_slider *sv, sfb__tbz_stats *stats) {
     float *ps = NULL, *pp = NULL, *spos = NULL;
     sfb__level sl;
-    int split = 0;
+    int split = 0, *oe = NULL, *ov = NULL;
+    tbz_slider sv2;
     sfb_result r;
     *out = NULL;
     memset(rl, 0, sizeof *rl);
+    if (sv) sv2 = *sv;
     r = tbz_check(ctx, l, positions, opt);
     if (r == SFB_SUCCESS) r = tbz_split(ctx, l, positions, &split, &sl, &spos);
     if (r == SFB_SUCCESS) r = tbz_refine(ctx, split ? &sl : l, split ? spos : positions, split ? spos : positions, rl, &ps, &pp);
+    if (r == SFB_SUCCESS && sv && (split || !tbz_origin_step(ctx, &sv->org, l->nv, l->ne, rl, &oe, &ov)))
+        r = split ? sfb__error(ctx, SFB_INVALID_TOPOLOGY, SFB_ELEMENT_NONE, -1, "tribezier slider: a non-manifold vertex left") : sfb__oom(ctx, "tribezier slider");
     if (r == SFB_SUCCESS && (flags & SFB__TBZ_TWO_STEPS)) {
         /* the second step: each net's positions by its own rules again */
         sfb__level r1 = *rl;
         float *ps1 = ps, *pp1 = pp;
         r = tbz_refine(ctx, &r1, ps1, pp1, rl, &ps, &pp);
+        if (r == SFB_SUCCESS && sv) {
+            tbz_origin o1 = sv->org;
+            int *e1 = oe, *v1 = ov;
+            o1.e = e1; o1.v = v1;
+            if (!tbz_origin_step(ctx, &o1, r1.nv, r1.ne, rl, &oe, &ov)) r = sfb__oom(ctx, "tribezier slider");
+            sfb__free(ctx, e1);
+            sfb__free(ctx, v1);
+        }
         sfb__level_free(ctx, &r1);
         sfb__free(ctx, ps1);
         sfb__free(ctx, pp1);
     }
-    if (r == SFB_SUCCESS) r = tbz_points(ctx, rl, ps, pp, opt, flags, out, fout, bout, stats);
+    if (sv) { sv2.org.e = oe; sv2.org.v = ov; }
+    if (r == SFB_SUCCESS) r = tbz_points(ctx, rl, ps, pp, opt, flags, out, fout, sv ? &sv2 : NULL, stats);
+    if (sv) { sv->blend = r == SFB_SUCCESS ? sv2.blend : NULL; sv->F = r == SFB_SUCCESS ? sv2.F : NULL; }
     if (r != SFB_SUCCESS) sfb__level_free(ctx, rl);
     if (split) sfb__level_free(ctx, &sl);
+    sfb__free(ctx, oe);
+    sfb__free(ctx, ov);
     sfb__free(ctx, spos);
     sfb__free(ctx, ps);
     sfb__free(ctx, pp);
@@ -2749,7 +2901,7 @@ static int tbz_touching(const sfb__level *l) {
 }
 
 static sfb_result tbz_build(sfb_context *ctx, const sfb__level *l, const float *positions, const sfb_tribezier_options *opt,
-                            sfb__patch_table *pt);
+                            const tbz_origin *org, sfb__patch_table *pt);
 
 /* The most interior extraordinary vertices in one group of them joined by edges (union-find;
  * out of memory: all of them, taken as large). After one Loop step each group's regions of
@@ -2791,13 +2943,28 @@ sfb_result sfb__tribezier_build(sfb_context *ctx, const sfb__level *l, const flo
      * mesh's */
     sfb__level sl;
     float *spos = NULL;
-    int split;
+    int split, *oe = NULL, *ov = NULL, k;
+    tbz_origin org;
     sfb_result r;
     memset(pt, 0, sizeof *pt);
     r = tbz_check(ctx, l, positions, opt);
     if (r == SFB_SUCCESS) r = tbz_split(ctx, l, positions, &split, &sl, &spos);
     if (r != SFB_SUCCESS) return r;
-    r = split ? tbz_build(ctx, &sl, spos, opt, pt) : tbz_build(ctx, l, positions, opt, pt);
+    /* the slider's features are the base mesh's: the split level's edges and vertices mapped
+     * back through the same face slots */
+    memset(&org, 0, sizeof org);
+    org.nbe = l->ne; org.nbv = l->nv; org.bes = l->es; org.bvs = l->vs;
+    if (split && opt && opt->slider) {
+        oe = (int *)sfb__alloc(ctx, ((size_t)sl.ne + 1) * sizeof(int));
+        ov = (int *)sfb__alloc(ctx, ((size_t)sl.nv + 1) * sizeof(int));
+        if (!oe || !ov) r = sfb__oom(ctx, "tribezier slider");
+        else
+            for (k = 0; k < l->nfv; ++k) { oe[sl.fe[k]] = l->fe[k]; ov[sl.fv[k]] = l->fv[k]; }
+        org.e = oe; org.v = ov;
+    }
+    if (r == SFB_SUCCESS) r = split ? tbz_build(ctx, &sl, spos, opt, &org, pt) : tbz_build(ctx, l, positions, opt, &org, pt);
+    sfb__free(ctx, oe);
+    sfb__free(ctx, ov);
     if (split) {
         sfb__level_free(ctx, &sl);
         sfb__free(ctx, spos);
@@ -2807,17 +2974,25 @@ sfb_result sfb__tribezier_build(sfb_context *ctx, const sfb__level *l, const flo
     return r;
 }
 
-/* sfb__tribezier_build on a mesh of manifold vertices (checked). */
+/* sfb__tribezier_build on a mesh of manifold vertices (checked); org: where its edges and
+ * vertices came from (the slider's). */
 static sfb_result tbz_build(sfb_context *ctx, const sfb__level *l, const float *positions, const sfb_tribezier_options *opt,
-                            sfb__patch_table *pt) {
+                            const tbz_origin *org, sfb__patch_table *pt) {
     double *net = NULL, *net4 = NULL;
-    float *blend = NULL, *blend4 = NULL, **want = opt && opt->slider ? &blend : NULL, **want4 = opt && opt->slider ? &blend4 : NULL;
+    tbz_slider sv, sv4, *want = NULL, *want4 = NULL;
     sfb__tbz_stats st, st4;
     sfb__level rl;
     sfb_result r;
     unsigned two;
     int cover;
     memset(&st, 0, sizeof st);
+    memset(&sv, 0, sizeof sv);
+    memset(&sv4, 0, sizeof sv4);
+    if (opt && opt->slider) {
+        sv.org = sv4.org = *org;
+        want = &sv;
+        want4 = &sv4;
+    }
     /* progress (stage "tribezier"): the mesh's own net over [0, 0.5], the one after a Loop step
      * over [0.5, 1] (over [0, 1] where it is the only one). One Loop step or two (the top of
      * this file): two where a group of more than TBZ_ONE_STEP_GROUP extraordinary vertices would
@@ -2828,7 +3003,8 @@ static sfb_result tbz_build(sfb_context *ctx, const sfb__level *l, const float *
         if ((r = sfb__patch_table_beztri_children(ctx, l, NULL, two ? 2 : 1, pt)) != SFB_SUCCESS) return r;
         r = tbz_refined(ctx, l, positions, opt, two, &rl, &net4, pt->point_data, want4, NULL);
         if (r != SFB_SUCCESS) { sfb__patch_table_free(ctx, pt); return r; }
-        pt->blend = blend4;
+        pt->blend = sv4.blend;
+        pt->features = sv4.F;
         sfb__level_free(ctx, &rl);
         return r;
     }
@@ -2849,24 +3025,24 @@ static sfb_result tbz_build(sfb_context *ctx, const sfb__level *l, const float *
                      ctx->error, st.residual);
             sfb__error_put_back(ctx, &kept);
             st4.residual = HUGE_VAL;
-        } else if (r != SFB_SUCCESS) { sfb__free(ctx, net); sfb__free(ctx, blend); return r; }
+        } else if (r != SFB_SUCCESS) { sfb__free(ctx, net); tbz_slider_free(ctx, &sv); return r; }
         if (st4.residual < st.residual || (cover && st4.residual <= 1e-10)) {
             sfb__free(ctx, net);
-            sfb__free(ctx, blend);
+            tbz_slider_free(ctx, &sv);
             r = sfb__patch_table_beztri_children(ctx, l, net4, two ? 2 : 1, pt);
             sfb__free(ctx, net4);
             sfb__level_free(ctx, &rl);
-            if (r == SFB_SUCCESS) pt->blend = blend4;
-            else sfb__free(ctx, blend4);
+            if (r == SFB_SUCCESS) { pt->blend = sv4.blend; pt->features = sv4.F; }
+            else tbz_slider_free(ctx, &sv4);
             return r;
         }
         sfb__free(ctx, net4);
-        sfb__free(ctx, blend4);
+        tbz_slider_free(ctx, &sv4);
         sfb__level_free(ctx, &rl);
     }
     r = sfb__patch_table_beztri_own(ctx, l, net, pt);
     sfb__free(ctx, net);
-    if (r == SFB_SUCCESS) pt->blend = blend;
-    else sfb__free(ctx, blend);
+    if (r == SFB_SUCCESS) { pt->blend = sv.blend; pt->features = sv.F; }
+    else tbz_slider_free(ctx, &sv);
     return r;
 }
