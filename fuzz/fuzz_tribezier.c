@@ -11,7 +11,8 @@
  *     diagonal (the net is an affine combination of the vertices, the G1 solve's change small);
  *   - inputs whose length is a multiple of 5 are built with the slider (tribezier.slider): moved to
  *     s = (length mod 7) / 6 and back to the options they were built with, the positions must be
- *     bit for bit the first ones (sfb_surface_set_sharpness);
+ *     bit for bit the first ones (sfb_surface_set_sharpness); without the override, the first
+ *     tagged crease moved to 0.5 and back to its tag (sfb_surface_set_feature_sharpness) too;
  *   - tessellate at rate 3 and check the triangles' indices;
  *   - a mesh with faces of more than three corners: sfb_mesh_triangulate (pieces, tags, holes
  *     checked: triangulated()), then all of the above on the result.
@@ -108,6 +109,17 @@ static void run(sfb_context *ctx, const sfb_mesh *mesh, size_t size)
             to.sharpness = (float)(size % 7) / 6.0f;
             if (sfb_surface_set_sharpness(s, &to) != SFB_SUCCESS || sfb_surface_set_sharpness(s, &cfg.tribezier) != SFB_SUCCESS)
                 fail("sfb_surface_set_sharpness on a slider surface", sfb_last_error(ctx));
+            int once = d.crease_count > 0, k;
+            for (k = 1; k < d.crease_count && once; ++k) /* tagged once: its tag is the mesh's */
+                once = !((d.crease_vertices[2 * k] == d.crease_vertices[0] && d.crease_vertices[2 * k + 1] == d.crease_vertices[1]) ||
+                         (d.crease_vertices[2 * k] == d.crease_vertices[1] && d.crease_vertices[2 * k + 1] == d.crease_vertices[0]));
+            if (!cfg.tribezier.sharpness_set && once && d.crease_sharpness[0] > 0.0f) {
+                /* a tagged crease: moved and back (its tag as the mesh has it) */
+                const float half = 0.5f;
+                r = sfb_surface_set_feature_sharpness(s, 1, d.crease_vertices, &half, 0, NULL, NULL);
+                if (r == SFB_SUCCESS) r = sfb_surface_set_feature_sharpness(s, 1, d.crease_vertices, d.crease_sharpness, 0, NULL, NULL);
+                if (r != SFB_SUCCESS) fail("sfb_surface_set_feature_sharpness on a tagged crease", sfb_last_error(ctx));
+            }
             memset(&o, 0, sizeof o);
             o.position = P2;
             o.normal = P2 + 3 * (size_t)(n + 1);
