@@ -1948,8 +1948,9 @@ static int tribezier_meshes_section() {
 /* The slider (sfb_surface_set_sharpness) against a rebuild for each new s, on the real models
  * with their edges over 40 degrees made creases (sfb_mesh_crease_by_angle) and on the seed-style
  * crease disk of examples/data: the build with the slider (both nets kept), the build without it
- * at one s (what a rebuild per slider move costs), one move (median of 9, s from 0.1 to 0.9), all
- * on the simd backend with its threads; the patch memory with and without the slider. */
+ * at one s (what a rebuild per slider move costs), one move (median of 9, s from 0.1 to 0.9), one
+ * crease moved (sfb_surface_set_feature_sharpness, the same), all on the simd backend with its
+ * threads; the patch memory with and without the slider. */
 static int tribezier_slider_section() {
     struct Case { const char *label, *path; float angle; };
     const Case cases[] = {{"cow (40 deg creases)", "../shared/peers/real-meshes/cow.obj", 40.0f},
@@ -1961,7 +1962,8 @@ static int tribezier_slider_section() {
     int status = 0;
     printf("\ntribezier sharpness slider: sfb_surface_set_sharpness against a rebuild per move (ms, simd, all threads;\n"
            "'x' = rebuild / move; memory: the patch table without and with the slider's two nets):\n");
-    printf("%-24s %7s %7s | %10s %10s %10s %8s | %9s %9s\n", "mesh", "tris", "creases", "build+nets", "rebuild", "move", "x", "MB", "MB slider");
+    printf("%-24s %7s %7s | %10s %10s %10s %8s %10s | %9s %9s\n", "mesh", "tris", "creases", "build+nets", "rebuild", "move", "x", "one crease",
+           "MB", "MB slider");
     if (!ctx) { printf("skipped: no simd context: %s\n", why.c_str()); return 0; }
     for (const Case &c : cases) {
         std::string text;
@@ -2000,6 +2002,16 @@ static int tribezier_slider_section() {
             r = sfb_surface_set_sharpness(sl, &to);
             moves.push_back(ms_since(t0));
         }
+        // one crease moved (sfb_surface_set_feature_sharpness), median of 9
+        std::vector<double> ones;
+        sfb_mesh_desc md;
+        sfb_mesh_get_desc(m, &md);
+        for (int i = 1; i <= 9 && r == SFB_SUCCESS && md.crease_count > 0; ++i) {
+            const float v = 0.1f * (float)i;
+            t0 = Clock::now();
+            r = sfb_surface_set_feature_sharpness(sl, 1, md.crease_vertices, &v, 0, NULL, NULL);
+            ones.push_back(ms_since(t0));
+        }
         if (r != SFB_SUCCESS) {
             printf("%-24s failed: %s\n", c.label, sfb_last_error(ctx));
             status = 1;
@@ -2008,8 +2020,8 @@ static int tribezier_slider_section() {
             sfb_surface_patch_info(plain, &p0);
             sfb_surface_patch_info(sl, &p1);
             const double mv = median(moves);
-            printf("%-24s %7d %7d | %10.1f %10.1f %10.3f %8.0f | %9.1f %9.1f\n", c.label, mi.triangles, mi.sharp_edges, build, rebuild, mv,
-                   mv > 0 ? rebuild / mv : 0.0, p0.bytes / 1048576.0, p1.bytes / 1048576.0);
+            printf("%-24s %7d %7d | %10.1f %10.1f %10.3f %8.0f %10.3f | %9.1f %9.1f\n", c.label, mi.triangles, mi.sharp_edges, build, rebuild, mv,
+                   mv > 0 ? rebuild / mv : 0.0, ones.empty() ? 0.0 : median(ones), p0.bytes / 1048576.0, p1.bytes / 1048576.0);
         }
         fflush(stdout);
         sfb_surface_destroy(plain);
