@@ -409,7 +409,8 @@ SFB_API sfb_result sfb_surface_set_feature_sharpness(sfb_surface *s, int crease_
     memcpy(es, F->es, (size_t)F->nbe * sizeof(float));
     memcpy(cs, F->cs, (size_t)F->nbv * sizeof(float));
     /* as the build takes a tag: clamped to [0, 1] (a crease at 0 stays one: the smooth net's) */
-    for (i = 0; i < crease_count; ++i) F->es[sfb__surface_edge(s, crease_vertices[2 * i], crease_vertices[2 * i + 1])] = crease_sharpness[i] < 1.0f ? crease_sharpness[i] : 1.0f;
+    for (i = 0; i < crease_count; ++i)
+        F->es[sfb__surface_edge(s, crease_vertices[2 * i], crease_vertices[2 * i + 1])] = crease_sharpness[i] < 1.0f ? crease_sharpness[i] : 1.0f;
     /* a vertex the preparation made sharp whatever its tag (non-manifold) stays so, as at create */
     for (i = 0; i < corner_count; ++i)
         if (!sfb__level_forced_sharp(&s->pbase, corner_vertices[i], s->boundary == SFB_BOUNDARY_EDGE_AND_CORNER))

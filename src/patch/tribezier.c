@@ -2820,6 +2820,9 @@ static int tbz_origin_step(sfb_context *ctx, const tbz_origin *in, int pnv, int 
     return 1;
 }
 
+/* tbz_refined's flag: l is checked and its non-manifold vertices split already (tbz_build's) */
+#define TBZ_CHECKED (1u << 24)
+
 /* sfb__tribezier_refined_points, the net into *out or (fout not NULL) into fout (tbz_points);
  * sv: the slider's (l as sfb__tribezier_build hands it to tbz_build, its vertices split) */
 static sfb_result tbz_refined(sfb_context *ctx, const sfb__level *l, const float *positions, const sfb_tribezier_options *opt,
@@ -2832,8 +2835,8 @@ static sfb_result tbz_refined(sfb_context *ctx, const sfb__level *l, const float
     *out = NULL;
     memset(rl, 0, sizeof *rl);
     if (sv) sv2 = *sv;
-    r = tbz_check(ctx, l, positions, opt);
-    if (r == SFB_SUCCESS) r = tbz_split(ctx, l, positions, &split, &sl, &spos);
+    r = flags & TBZ_CHECKED ? SFB_SUCCESS : tbz_check(ctx, l, positions, opt);
+    if (r == SFB_SUCCESS && !(flags & TBZ_CHECKED)) r = tbz_split(ctx, l, positions, &split, &sl, &spos);
     if (r == SFB_SUCCESS) r = tbz_refine(ctx, split ? &sl : l, split ? spos : positions, split ? spos : positions, rl, &ps, &pp);
     if (r == SFB_SUCCESS && sv && (split || !tbz_origin_step(ctx, &sv->org, l->nv, l->ne, rl, &oe, &ov)))
         r = split ? sfb__error(ctx, SFB_INVALID_TOPOLOGY, SFB_ELEMENT_NONE, -1, "tribezier slider: a non-manifold vertex left") : sfb__oom(ctx, "tribezier slider");
@@ -3001,7 +3004,7 @@ static sfb_result tbz_build(sfb_context *ctx, const sfb__level *l, const float *
         two = tbz_largest_group(ctx, l) > TBZ_ONE_STEP_GROUP ? SFB__TBZ_TWO_STEPS : 0;
         /* the table first, the net written into its point data (tbz_points) */
         if ((r = sfb__patch_table_beztri_children(ctx, l, NULL, two ? 2 : 1, pt)) != SFB_SUCCESS) return r;
-        r = tbz_refined(ctx, l, positions, opt, two, &rl, &net4, pt->point_data, want4, NULL);
+        r = tbz_refined(ctx, l, positions, opt, two | TBZ_CHECKED, &rl, &net4, pt->point_data, want4, NULL);
         if (r != SFB_SUCCESS) { sfb__patch_table_free(ctx, pt); return r; }
         pt->blend = sv4.blend;
         pt->features = sv4.F;
@@ -3019,7 +3022,7 @@ static sfb_result tbz_build(sfb_context *ctx, const sfb__level *l, const float *
         two = tbz_largest_group(ctx, l) > TBZ_ONE_STEP_GROUP ? SFB__TBZ_TWO_STEPS : 0;
         sfb__error_keep(ctx, &kept);
         memset(&st4, 0, sizeof st4);
-        r = tbz_refined(ctx, l, positions, opt, SFB__TBZ_PROGRESS_HIGH | two, &rl, &net4, NULL, want4, &st4);
+        r = tbz_refined(ctx, l, positions, opt, SFB__TBZ_PROGRESS_HIGH | two | TBZ_CHECKED, &rl, &net4, NULL, want4, &st4);
         if (r == SFB_INVALID_TOPOLOGY) { /* not built after the steps: the mesh's own net */
             sfb__log(ctx, SFB_LOG_INFO, "tribezier: the net after Loop steps is refused (%s); the mesh's own net is kept (G1 residual %.3g)",
                      ctx->error, st.residual);
