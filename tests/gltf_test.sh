@@ -131,7 +131,12 @@ for w in 0 1; do count_check "$TMP/v/tbz_morph.glb" "$TBZ" --scheme tribezier --
 count_check "$TMP/v/tbz_morph.glb" "$TBZ" --scheme tribezier --tess 8 --sharpness 0.5 --morph 0.5 --morph-degrees 5
 "$CHECK" "$TMP/v/tbz_morph.glb" "$TBZ" --scheme tribezier --tess 8 --sharpness 0.5 --morph 0.5 | grep "blended normals"
 check "--sharpness-morph on another scheme is a usage error (exit 2)" 2 "$TOOL" --scheme loop --sharpness-morph "$TBZ" -o "$TMP/x.glb"
-check "--sharpness-morph with --quantize is a usage error (exit 2)" 2 "$TOOL" --scheme tribezier --tess 8 --sharpness-morph --quantize "$TBZ" -o "$TMP/x.glb"
+# quantized (KHR_mesh_quantization: the target in grid steps): within half a step at every weight,
+# the 8-bit normals within 1 degree at the ends
+check "tribezier --sharpness-morph --quantize is exported" 0 "$TOOL" -q --scheme tribezier --tess 8 --sharpness-morph --quantize "$TBZ" -o "$TMP/v/tbz_morph_q.glb"
+for w in 0 1; do count_check "$TMP/v/tbz_morph_q.glb" "$TBZ" --scheme tribezier --tess 8 --quantize --morph $w --morph-degrees 1; done
+count_check "$TMP/v/tbz_morph_q.glb" "$TBZ" --scheme tribezier --tess 8 --quantize --morph 0.5 --morph-degrees 5
+check "--sharpness-morph with --compress is a usage error (exit 2)" 2 "$TOOL" --scheme tribezier --tess 8 --sharpness-morph --quantize --compress "$TBZ" -o "$TMP/x.glb"
 check "--sharpness-morph with --tolerance is a usage error (exit 2)" 2 "$TOOL" --scheme tribezier --tess 8 --tolerance 0.01 --sharpness-morph "$TBZ" -o "$TMP/x.glb"
 export_ok box_pn_triangulated.glb "$BOX" --scheme pn --tess 4 --triangulate
 export_ok box_loop_triangulated.glb "$BOX" --scheme loop --level 2 --triangulate

@@ -80,7 +80,8 @@ const char *const kUsage =
     "  --sharpness-morph      --scheme tribezier: the seed's sharpness slider as a glTF morph target:\n"
     "                         the base mesh at s = 0, one target (named \"sharpness\") to s = 1, the mesh's\n"
     "                         default weight --sharpness S (1 without it); a viewer's weight w then shows s = w,\n"
-    "                         positions exactly (the surface is linear in s), normals blended (not exact)\n"
+    "                         positions exactly (the surface is linear in s), normals blended (not exact);\n"
+    "                         with --quantize the target is in the grid's steps (float)\n"
     "  --trim MASK.png        with --tess: trim the surface by a mask over each parametric face (seed 000)\n"
     "  --backend NAME         ref, simd, gl or osmesa (default: the library's order)\n"
     "  --quantize             KHR_mesh_quantization: positions as unsigned 16-bit integers on a grid of\n"
@@ -293,9 +294,9 @@ int parse_args(int argc, char **argv, Options *o) {
         // the target is the tessellation at s = 1 minus the one at s = 0, vertex for vertex: the
         // same vertices at both (one rate, no adaptive choice), in float (no grid, no codec)
         if (o->scheme != SFB_SCHEME_TRIBEZIER) return usage_error("--sharpness-morph belongs to --scheme tribezier");
-        if (o->have_tolerance || !o->lods.empty() || o->quantize || o->compress || o->normals == NORMALS_FLAT)
-            return usage_error("--sharpness-morph takes one fixed rate, float data and limit normals: not with --tolerance, --lods, --quantize, "
-                               "--compress or --normals flat");
+        if (o->have_tolerance || !o->lods.empty() || o->compress || o->normals == NORMALS_FLAT)
+            return usage_error("--sharpness-morph takes one fixed rate and limit normals: not with --tolerance, --lods, --compress or "
+                               "--normals flat");
     }
     // --fillet's features are the edges over --crease-angle: 0 (the library's "default 30") and
     // 180 (no feature; the library refuses it) would silently fillet at 30 degrees instead
@@ -729,6 +730,32 @@ tinygltf::Primitive add_primitive_quantized(tinygltf::Model *model, const OutMes
             view = add_view(*model, m.uvs.data(), m.uvs.size() * sizeof(float), TINYGLTF_TARGET_ARRAY_BUFFER, 8);
             prim.attributes["TEXCOORD_0"] = add_accessor(*model, view, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC2, nv);
         }
+    }
+    if (!m.morph_p.empty()) {
+        // --sharpness-morph: the target in the base's units -- positions in grid steps (the s = 1
+        // point's own grid value minus the base's: both ends land on the grid, within half a
+        // step of the surface, and the surface between them is linear), normals as the
+        // difference of the two ends' stored (rounded) normals -- as floats, which
+        // KHR_mesh_quantization allows for targets (a step count can exceed a short's range)
+        const long full = o.normal_bits <= 8 ? 127 : 32767;
+        std::vector<float> dP(nv * 3), dN(nv * 3);
+        std::map<std::string, int> target;
+        for (size_t v = 0; v < nv; ++v)
+            for (int c = 0; c < 3; ++c) {
+                const size_t i = 3 * v + (size_t)c;
+                const double p1 = (double)m.positions[i] + (double)m.morph_p[i];
+                dP[i] = (float)(std::lround((p1 - q.t[c]) / q.s) - (long)P[4 * v + (size_t)c]);
+                const double n1 = (double)m.normals[i] + (double)m.morph_n[i];
+                dN[i] = (float)((double)snap(n1, o.normal_bits, full, true) / (double)full -
+                                (double)snap(m.normals[i], o.normal_bits, full, true) / (double)full);
+                if (v == 0 || dP[i] < mn[(size_t)c]) mn[(size_t)c] = dP[i];
+                if (v == 0 || dP[i] > mx[(size_t)c]) mx[(size_t)c] = dP[i];
+            }
+        view = add_view(*model, dP.data(), dP.size() * sizeof(float), TINYGLTF_TARGET_ARRAY_BUFFER, 12);
+        target["POSITION"] = add_accessor(*model, view, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, nv, mn, mx);
+        view = add_view(*model, dN.data(), dN.size() * sizeof(float), TINYGLTF_TARGET_ARRAY_BUFFER, 12);
+        target["NORMAL"] = add_accessor(*model, view, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, nv);
+        prim.targets.push_back(target);
     }
     prim.material = material;
     return prim;

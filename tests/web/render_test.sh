@@ -147,6 +147,14 @@ if [ -x "$BUILD/sfb2gltf" ]; then
     fi
   done
   [ -f "$W/tbzmorph1.glb" ] && { job "tbzmorph0.weight1" "$W/tbzmorph1.glb" 30 25 1 320x240; CHECKS+=("wrong tbzmorph0 weight1 0 0"); }
+  # quantized (KHR_mesh_quantization, the target in grid steps under the dequantising node)
+  if "$BUILD/sfb2gltf" --scheme tribezier --triangulate --tess 8 --sharpness-morph --sharpness 1 --quantize examples/data/creased_box.obj \
+    -o "$W/tbzmorph1q.glb" 2> "$W/tbzmorph1q.sfb2gltf.log"; then
+    read -r gv gt <<< "$(sed -nE 's/.* ([0-9]+) vertices, ([0-9]+) triangles.*/\1 \2/p' "$W/tbzmorph1q.sfb2gltf.log")"
+    job "tbzmorph1.morphq" "$W/tbzmorph1q.glb" 30 25 1 320x240; CHECKS+=("iou tbzmorph1 morphq $gv $gt")
+  else
+    fail "tbzmorph1q: sfb2gltf --sharpness-morph --quantize"; cat "$W/tbzmorph1q.sfb2gltf.log"
+  fi
 fi
 
 t0=$(date +%s.%N)
