@@ -1172,11 +1172,9 @@ static void sharp_only_one(sfb_context *ctx, const char *name, const char *obj, 
 }
 
 /* Two OBJ texts in the forms tbm_obj writes (v, f, t crease, t corner) as one mesh: b's
- * vertex indices moved past a's vertices (malloc'd). */
-static char *obj_join_ex(const char *a, const char *b, int share);
-static char *obj_join(const char *a, const char *b) { return obj_join_ex(a, b, 0); }
-/* share: b's centre (its first vertex) is a's, b's other vertices follow a's, lifted by 2 in z
- * (two disks through one non-manifold vertex) */
+ * vertex indices moved past a's vertices (malloc'd); with share, b's centre (its first vertex)
+ * is a's, b's other vertices follow a's, lifted by 2 in z (two disks through one non-manifold
+ * vertex). */
 static char *obj_join_ex(const char *a, const char *b, int share) {
     const size_t la = strlen(a), lb = strlen(b), cap = la + 2 * lb + 64;
     char *s = (char *)malloc(cap), line[512];
@@ -1210,6 +1208,25 @@ static char *obj_join_ex(const char *a, const char *b, int share) {
         p += e ? (size_t)(e - p) + 1 : n;
     }
     return s;
+}
+
+/* Two test disks in one OBJ (obj_join_ex; with share through one vertex): a, of valence an and
+ * aR rings, a straight crease tagged asharp through its centre on a ridge, b untagged; both
+ * bumpy and jittered (malloc'd). */
+static char *two_disks(int an, int aR, double asharp, double aridge, double ajit, unsigned aseed, int bn, int bR, double bjit, unsigned bseed,
+                       int share) {
+    tbm_opts o;
+    char *a, *b, *j;
+    memset(&o, 0, sizeof o);
+    o.n = an; o.R = aR; o.crease_k = an / 2; o.sharp = asharp; o.ridge = aridge; o.bump = 1.0; o.jitter = ajit; o.seed = aseed;
+    a = tbm_obj(&o);
+    memset(&o, 0, sizeof o);
+    o.n = bn; o.R = bR; o.bump = 1.0; o.jitter = bjit; o.seed = bseed;
+    b = tbm_obj(&o);
+    j = a && b ? obj_join_ex(a, b, share) : NULL;
+    free(a);
+    free(b);
+    return j;
 }
 
 /* The surface's curvature energy, integral of k1^2 + k2^2 dA (geometric: the same whatever the
@@ -1354,19 +1371,12 @@ static void test_coarse(sfb_context *ctx) {
  * between the nets and must be solved) and an untagged valence-7 vertex (the same system in both:
  * reused). */
 static void test_reuse_disks(sfb_context *ctx) {
-    tbm_opts o;
     tmesh t;
-    char *a, *b, *obj;
+    char *obj;
     double *x = NULL, *y = NULL;
     sfb__tbz_stats sa, sb;
     const char *nm = "sharp_net_reuse_is_exact/crease_disk_and_smooth_disk";
-    memset(&o, 0, sizeof o);
-    o.n = 5; o.R = 5; o.crease_k = 2; o.sharp = 1.0; o.ridge = 0.5; o.bump = 1.0; o.jitter = 0.15; o.seed = 11u;
-    a = tbm_obj(&o);
-    memset(&o, 0, sizeof o);
-    o.n = 7; o.R = 5; o.bump = 1.0; o.jitter = 0.15; o.seed = 12u;
-    b = tbm_obj(&o);
-    obj = a && b ? obj_join(a, b) : NULL;
+    obj = two_disks(5, 5, 1.0, 0.5, 0.15, 11u, 7, 5, 0.15, 12u, 0);
     memset(&sa, 0, sizeof sa); memset(&sb, 0, sizeof sb);
     if (!obj || !tmesh_load(ctx, obj, &t)) {
         fail(nm, "load");
@@ -1383,7 +1393,7 @@ static void test_reuse_disks(sfb_context *ctx) {
         tmesh_free(ctx, &t);
     }
     sfb__free(ctx, x); sfb__free(ctx, y);
-    free(a); free(b); free(obj);
+    free(obj);
 }
 
 static void test_refined(sfb_context *ctx, const char *dir) {
@@ -1648,18 +1658,12 @@ static char *slider_mesh(int which) {
     tbm_opts o;
     memset(&o, 0, sizeof o);
     if (which == 0) {
-        char *a, *b, *j, *obj = NULL;
-        o.n = 5; o.R = 6; o.crease_k = 2; o.sharp = 0.5; o.ridge = 0.4; o.bump = 1.0; o.jitter = 0.2; o.seed = 9u;
-        a = tbm_obj(&o);
-        memset(&o, 0, sizeof o);
-        o.n = 6; o.R = 3; o.bump = 1.0; o.jitter = 0.15; o.seed = 12u;
-        b = tbm_obj(&o);
-        j = a && b ? obj_join(a, b) : NULL;
+        char *j = two_disks(5, 6, 0.5, 0.4, 0.2, 9u, 6, 3, 0.15, 12u, 0), *obj = NULL;
         if (j) {
             obj = (char *)malloc(strlen(j) + 64);
             if (obj) sprintf(obj, "%st hole 1/0/0 40\n", j);
         }
-        free(a); free(b); free(j);
+        free(j);
         return obj;
     }
     if (which == 1) {
@@ -1863,18 +1867,10 @@ static int feature_mesh(sfb_context *ctx, int which, const char *dir, sfb_mesh *
     *out = NULL;
     if (which == 2) {
         /* a creased disk and a smooth one through the same centre, a corner there */
-        tbm_opts o;
-        char *a, *b, *j;
-        memset(&o, 0, sizeof o);
-        o.n = 5; o.R = 3; o.crease_k = 2; o.sharp = 0.4; o.ridge = 0.4; o.bump = 1.0; o.jitter = 0.1; o.seed = 5u;
-        a = tbm_obj(&o);
-        memset(&o, 0, sizeof o);
-        o.n = 6; o.R = 3; o.bump = 1.0; o.jitter = 0.1; o.seed = 6u;
-        b = tbm_obj(&o);
-        j = a && b ? obj_join_ex(a, b, 1) : NULL;
+        char *j = two_disks(5, 3, 0.4, 0.4, 0.1, 5u, 6, 3, 0.1, 6u, 1);
         obj = j ? (char *)malloc(strlen(j) + 64) : NULL;
         if (obj) sprintf(obj, "%st corner 1/1/0 0 0.2\n", j);
-        free(a); free(b); free(j);
+        free(j);
         r = obj ? sfb_mesh_read_obj(ctx, obj, strlen(obj), out) : SFB_OUT_OF_MEMORY;
         free(obj);
         return r == SFB_SUCCESS;
