@@ -292,7 +292,8 @@ int parse_args(int argc, char **argv, Options *o) {
     if (o->have_sharpness && o->scheme != SFB_SCHEME_TRIBEZIER) return usage_error("--sharpness belongs to --scheme tribezier");
     if (o->morph) {
         // the target is the tessellation at s = 1 minus the one at s = 0, vertex for vertex: the
-        // same vertices at both (one rate, no adaptive choice), in float (no grid, no codec)
+        // same vertices at both (one rate, no adaptive choice, one mesh per node), no codec (the
+        // octahedral normals would need the target decoded the same way)
         if (o->scheme != SFB_SCHEME_TRIBEZIER) return usage_error("--sharpness-morph belongs to --scheme tribezier");
         if (o->have_tolerance || !o->lods.empty() || o->compress || o->normals == NORMALS_FLAT)
             return usage_error("--sharpness-morph takes one fixed rate and limit normals: not with --tolerance, --lods, --compress or "
