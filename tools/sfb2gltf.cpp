@@ -639,6 +639,25 @@ tinygltf::Primitive add_triangles(tinygltf::Model *model, const OutMesh &m) {
     return prim;
 }
 
+// --sharpness-morph: one morph target of float position (with its min/max, as glTF asks of
+// POSITION) and normal changes per vertex, appended to prim.
+void add_morph_target(tinygltf::Model *model, const std::vector<float> &dP, const std::vector<float> &dN, tinygltf::Primitive *prim) {
+    const size_t nv = dP.size() / 3;
+    std::vector<double> mn(3, 0.0), mx(3, 0.0);
+    std::map<std::string, int> target;
+    for (size_t v = 0; v < nv; ++v)
+        for (int c = 0; c < 3; ++c) {
+            const double x = dP[3 * v + (size_t)c];
+            if (v == 0 || x < mn[(size_t)c]) mn[(size_t)c] = x;
+            if (v == 0 || x > mx[(size_t)c]) mx[(size_t)c] = x;
+        }
+    int view = add_view(*model, dP.data(), dP.size() * sizeof(float), TINYGLTF_TARGET_ARRAY_BUFFER, 12);
+    target["POSITION"] = add_accessor(*model, view, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, nv, mn, mx);
+    view = add_view(*model, dN.data(), dN.size() * sizeof(float), TINYGLTF_TARGET_ARRAY_BUFFER, 12);
+    target["NORMAL"] = add_accessor(*model, view, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, nv);
+    prim->targets.push_back(target);
+}
+
 // The quantization of one output mesh (all its primitives): positions p = t + s q with q the
 // stored integers, 0 <= q <= 2^bits - 1 (a uniform scale, so that normals need nothing).
 struct Quant {
@@ -740,7 +759,6 @@ tinygltf::Primitive add_primitive_quantized(tinygltf::Model *model, const OutMes
         // KHR_mesh_quantization allows for targets (a step count can exceed a short's range)
         const long full = o.normal_bits <= 8 ? 127 : 32767;
         std::vector<float> dP(nv * 3), dN(nv * 3);
-        std::map<std::string, int> target;
         for (size_t v = 0; v < nv; ++v)
             for (int c = 0; c < 3; ++c) {
                 const size_t i = 3 * v + (size_t)c;
@@ -749,14 +767,8 @@ tinygltf::Primitive add_primitive_quantized(tinygltf::Model *model, const OutMes
                 const double n1 = (double)m.normals[i] + (double)m.morph_n[i];
                 dN[i] = (float)((double)snap(n1, o.normal_bits, full, true) / (double)full -
                                 (double)snap(m.normals[i], o.normal_bits, full, true) / (double)full);
-                if (v == 0 || dP[i] < mn[(size_t)c]) mn[(size_t)c] = dP[i];
-                if (v == 0 || dP[i] > mx[(size_t)c]) mx[(size_t)c] = dP[i];
             }
-        view = add_view(*model, dP.data(), dP.size() * sizeof(float), TINYGLTF_TARGET_ARRAY_BUFFER, 12);
-        target["POSITION"] = add_accessor(*model, view, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, nv, mn, mx);
-        view = add_view(*model, dN.data(), dN.size() * sizeof(float), TINYGLTF_TARGET_ARRAY_BUFFER, 12);
-        target["NORMAL"] = add_accessor(*model, view, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, nv);
-        prim.targets.push_back(target);
+        add_morph_target(model, dP, dN, &prim);
     }
     prim.material = material;
     return prim;
@@ -781,21 +793,7 @@ tinygltf::Primitive add_primitive(tinygltf::Model *model, const OutMesh &m, int 
         view = add_view(*model, m.uvs.data(), m.uvs.size() * sizeof(float), TINYGLTF_TARGET_ARRAY_BUFFER, 8);
         prim.attributes["TEXCOORD_0"] = add_accessor(*model, view, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC2, nv);
     }
-    if (!m.morph_p.empty()) {
-        // --sharpness-morph: one target (POSITION needs its min/max there too)
-        std::map<std::string, int> target;
-        for (size_t v = 0; v < nv; ++v)
-            for (int c = 0; c < 3; ++c) {
-                const double x = m.morph_p[3 * v + (size_t)c];
-                if (v == 0 || x < mn[(size_t)c]) mn[(size_t)c] = x;
-                if (v == 0 || x > mx[(size_t)c]) mx[(size_t)c] = x;
-            }
-        view = add_view(*model, m.morph_p.data(), m.morph_p.size() * sizeof(float), TINYGLTF_TARGET_ARRAY_BUFFER, 12);
-        target["POSITION"] = add_accessor(*model, view, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, nv, mn, mx);
-        view = add_view(*model, m.morph_n.data(), m.morph_n.size() * sizeof(float), TINYGLTF_TARGET_ARRAY_BUFFER, 12);
-        target["NORMAL"] = add_accessor(*model, view, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, nv);
-        prim.targets.push_back(target);
-    }
+    if (!m.morph_p.empty()) add_morph_target(model, m.morph_p, m.morph_n, &prim);
     prim.material = material;
     return prim;
 }

@@ -2078,39 +2078,6 @@ static int tbz_degenerate(const sfb__tbz *T) {
     return 0;
 }
 
-/* Per vertex the s of the nearest tagged feature (breadth first over mesh edges), -1 where no
- * feature can be reached. */
-static sfb_result tbz_vertex_s(sfb__tbz *T, double *vs) {
-    const sfb__level *l = T->l;
-    int *queue = (int *)sfb__alloc(T->ctx, ((size_t)T->nv + 1) * sizeof(int)), head = 0, tail = 0, v, i;
-    unsigned char *seen;
-    if (!queue) return sfb__oom(T->ctx, "tribezier");
-    seen = (unsigned char *)sfb__calloc(T->ctx, (size_t)T->nv + 1, 1);
-    if (!seen) { sfb__free(T->ctx, queue); return sfb__oom(T->ctx, "tribezier"); }
-    for (v = 0; v < T->nv; ++v) {
-        double sum = 0.0;
-        int cnt = 0;
-        for (i = l->ve_off[v]; i < l->ve_off[v + 1]; ++i)
-            if (T->tag_s[l->ve[i]] > 0.0f && l->ef_off[l->ve[i] + 1] - l->ef_off[l->ve[i]] == 2) { sum += T->tag_s[l->ve[i]]; cnt++; }
-        vs[v] = cnt ? sum / cnt : 0.0;
-        if (T->corner_s[v] > 0.0f) { vs[v] = cnt ? fmax(vs[v], T->corner_s[v]) : T->corner_s[v]; cnt = 1; }
-        if (cnt) { seen[v] = 1; queue[tail++] = v; }
-    }
-    while (head < tail) {
-        const int u = queue[head++];
-        for (i = l->ve_off[u]; i < l->ve_off[u + 1]; ++i) {
-            const int w = sfb__other_end(l, l->ve[i], u);
-            if (!seen[w]) { seen[w] = 1; vs[w] = vs[u]; queue[tail++] = w; }
-        }
-    }
-    /* no tagged feature in the vertex's part of the mesh: -1 (its points take s = 0, whatever
-     * the override: tbz_slider_s) */
-    for (v = 0; v < T->nv; ++v)
-        if (!seen[v]) vs[v] = -1.0;
-    sfb__free(T->ctx, queue); sfb__free(T->ctx, seen);
-    return SFB_SUCCESS;
-}
-
 /* s per feature: the tag clamped to [0, 1] (infinite: 1), or (override) s; a feature at s = 0
  * 1e-30, so that it is still one (the nets depend on which features there are, not on their s).
  * Returns whether there is one. */
@@ -2236,6 +2203,22 @@ static void tbz_features_vs(const sfb__tbz_features *F, double *vs) {
     }
     for (v = 0; v < F->nv; ++v)
         if (F->src[v] >= 0 && F->src[v] != v) vs[v] = vs[F->src[v]];
+}
+
+/* Per vertex the s of the nearest tagged feature (breadth first over mesh edges; -1 where none
+ * can be reached), for T's tag values: the slider's features on T's own level
+ * (tbz_features_make, tbz_features_vs), so that the slider and the plain build take the same
+ * arithmetic. */
+static sfb_result tbz_vertex_s(sfb__tbz *T, double *vs) {
+    tbz_origin own;
+    sfb__tbz_features *F = NULL;
+    sfb_result r;
+    memset(&own, 0, sizeof own);
+    own.nbe = T->ne; own.nbv = T->nv; own.bes = T->tag_s; own.bvs = T->corner_s;
+    if ((r = tbz_features_make(T, &own, &F)) != SFB_SUCCESS) return r;
+    tbz_features_vs(F, vs);
+    sfb__tbz_features_free(T->ctx, F);
+    return SFB_SUCCESS;
 }
 
 /* The mean s of point (i, j) of a triangle over its home vertices fv (weights > 0; at a corner
