@@ -720,12 +720,15 @@ SFB__IF sfb_result sfb__pn_build(sfb_context *ctx, const sfb__level *base, const
  * templates give the same net), SFB__TBZ_TWO_STEPS makes sfb__tribezier_refined_points take two
  * Loop steps, SFB__TBZ_BOTH_NETS builds the smooth net even where s = 1 at every vertex (for the
  * test that skipping it gives the same net), SFB__TBZ_REJECT_TEMPLATES fails every template's
- * check (for the test that what fails goes to CGLS from the net as it was). Progress (stage
+ * check (for the test that what fails goes to CGLS from the net as it was), SFB__TBZ_NO_STRAIGHT
+ * solves the smooth net with its crease curves' points weighed as any other (tbz_crease_points;
+ * for the undulation measurement). Progress (stage
  * "tribezier") runs over [0, 1], or [0, 0.5] with SFB__TBZ_PROGRESS_LOW and [0.5, 1] with
  * SFB__TBZ_PROGRESS_HIGH (sfb__tribezier_build: the mesh's own net, then the one after a Loop
  * step); a cancel returns SFB_CANCELLED. */
 enum { SFB__TBZ_SEED_PLANE = 1, SFB__TBZ_NO_REUSE = 2, SFB__TBZ_PAR_SMALL = 4, SFB__TBZ_PROGRESS_LOW = 8, SFB__TBZ_PROGRESS_HIGH = 16,
-       SFB__TBZ_NO_TEMPLATES = 32, SFB__TBZ_TWO_STEPS = 64, SFB__TBZ_BOTH_NETS = 128, SFB__TBZ_REJECT_TEMPLATES = 256 };
+       SFB__TBZ_NO_TEMPLATES = 32, SFB__TBZ_TWO_STEPS = 64, SFB__TBZ_BOTH_NETS = 128, SFB__TBZ_REJECT_TEMPLATES = 256,
+       SFB__TBZ_NO_STRAIGHT = 512 };
 typedef struct sfb__tbz_stats {
     long iterations;   /* CGLS iterations, all coordinates and nets */
     long unknowns;     /* points moved by the G1 solve, per coordinate and net */
@@ -733,7 +736,14 @@ typedef struct sfb__tbz_stats {
     double residual;   /* largest G1 row left, relative to the net's largest coordinate */
     double ours_residual; /* the same within the constraint components around extraordinary crease vertices with
                              our tangent plane */
-    int fallbacks;     /* smooth nets rebuilt with the seed's tangent plane (ours unsolvable) */
+    int fallbacks;     /* smooth nets rebuilt with the seed's tangent plane at some vertices (ours unsolvable there;
+                          1: at those, 2: then at every vertex) */
+    int seed_vertices; /* extraordinary crease vertices given the seed's plane in the smooth net (fallbacks) */
+    long crease_weighted; /* unknowns on the smooth net's crease curves, whose moves the solve weighs (tbz_crease_points;
+                             SFB__TBZ_NO_STRAIGHT: none) */
+    int straight;      /* smooth nets solved again with the crease weighted (SFB__TBZ_NO_STRAIGHT: none) */
+    int straight_kept_first; /* of those, the second solve left a row unmet: the first net kept */
+    int straight_skipped; /* components around our vertices too large for the second pass's dense solve: the first pass's */
     int reused;        /* sharp-net constraint components that were the same system as a smooth-net one and took its
                           solution (SFB__TBZ_NO_REUSE: none) */
     int templates;     /* templates made (tbz_templates: one dense solve per shape of neighbourhood met twice or more) */

@@ -629,6 +629,8 @@ static void test_corner_only(sfb_context *ctx) {
     }
 }
 
+static double net_curvature_energy(const double *net, int nf);
+
 /* The subdivision reading of the slider, for comparison with ours: (1 - s) x Loop's limit of the
  * untagged mesh + s x Loop's limit with the crease infinitely sharp, point by point along the
  * same crease edges (rays 0 and k, rings 0..2, 200 samples per edge, the extraordinary vertex
@@ -712,13 +714,16 @@ static int loop_blend_profile(sfb_context *ctx, const tbm_opts *o, double s, dou
 /* The seed's open problem: the crease curve near an extraordinary crease vertex at s = 0.25,
  * 0.5, 0.75: (a) its largest distance from the vertical plane through the (straight) crease
  * line y = 0, (b) the curvature sign changes of its projection into that plane (x, z) within two
- * edges of the vertex, ours against the seed's tangent plane. */
+ * edges of the vertex; ours (mode 0) against the seed's tangent plane (1) and against ours with
+ * the smooth net solved once (2: SFB__TBZ_NO_STRAIGHT, its crease curve bent by the solve), whose
+ * surface ours must be as fair as (curvature energy at s = 0). */
 static void test_undulation(sfb_context *ctx) {
     static const int vals[3] = {4, 5, 7};
-    double ours_dev[4] = {0, 0, 0, 0}, ours_range[4] = {0, 0, 0, 0};
+    static const char *mode_name[3] = {"ours", "ours_no_worse_than_the_seed_plane", "ours_against_one_pass"};
+    double ours_dev[4] = {0, 0, 0, 0}, ours_range[4] = {0, 0, 0, 0}, ours_energy = 0.0;
     int vi, mode, si, ours_changes[4] = {0, 0, 0, 0};
     for (vi = 0; vi < 3; ++vi)
-        for (mode = 0; mode < 2; ++mode) {
+        for (mode = 0; mode < 3; ++mode) {
             tbm_opts o;
             tmesh t;
             char *obj;
@@ -763,9 +768,34 @@ static void test_undulation(sfb_context *ctx) {
                 free(lobj);
             }
             to.sharpness_set = 1; to.sharpness = 0.0f;
-            n0 = net_of(ctx, &t, &to, mode ? SFB__TBZ_SEED_PLANE : 0, NULL);
-            to.sharpness = 1.0f;
-            n1 = net_of(ctx, &t, &to, mode ? SFB__TBZ_SEED_PLANE : 0, NULL);
+            {
+                const unsigned fl = mode == 1 ? SFB__TBZ_SEED_PLANE : mode == 2 ? SFB__TBZ_NO_STRAIGHT : 0;
+                sfb__tbz_stats st;
+                n0 = net_of(ctx, &t, &to, fl, &st);
+                to.sharpness = 1.0f;
+                n1 = net_of(ctx, &t, &to, fl, NULL);
+                if (n0 && mode != 1) {
+                    /* the surface beside the crease: the s = 0 net's curvature energy */
+                    const double en = net_curvature_energy(n0, t.prep.nf);
+                    char nb[160];
+                    if (mode == 0) {
+                        ours_energy = en;
+                        snprintf(nb, sizeof nb, "undulation/valence_%d/second_pass_taken", o.n);
+                        check(st.straight == 1 && st.straight_kept_first == 0 && st.crease_weighted > 0, nb,
+                              "second passes %d, first nets kept %d, crease unknowns weighted %ld", st.straight, st.straight_kept_first,
+                              st.crease_weighted);
+                    } else {
+                        /* asserted: holding the crease costs the surface beside it at most 3 % of
+                         * its curvature energy (measured -0.2 to +1.4 %; held in every direction
+                         * as well, tbz_mix's M = I, +4.4 % at valence 5; coarse_one asserts the
+                         * same on bumped disks) */
+                        snprintf(nb, sizeof nb, "undulation/valence_%d/as_fair_as_one_pass", o.n);
+                        check(ours_energy <= 1.03 * en && st.straight == 0, nb, "curvature energy at s = 0: ours %.4g, one pass %.4g", ours_energy,
+                              en);
+                        printf("  %s: curvature energy at s = 0: ours %.4g, one pass %.4g\n", nb, ours_energy, en);
+                    }
+                }
+            }
             for (si = 1; n0 && n1 && si <= 3; ++si) {
                 const double s = 0.25 * si;
                 double dev = 0.0, prev_k = 0.0, zlo = 1e300, zhi = -1e300;
@@ -818,7 +848,7 @@ static void test_undulation(sfb_context *ctx) {
                         }
                     }
                 }
-                snprintf(nm, sizeof nm, "undulation/valence_%d/s_%.2f/%s", o.n, s, mode ? "ours_no_worse_than_the_seed_plane" : "ours");
+                snprintf(nm, sizeof nm, "undulation/valence_%d/s_%.2f/%s", o.n, s, mode_name[mode]);
                 /* (a) the deviation from the vertical plane; (b) the curvature sign changes of the
                  * projection into it; and the undulation within the plane, the height range of
                  * the projection (the crease line is straight and level: 0 at s = 1) */
@@ -844,14 +874,22 @@ static void test_undulation(sfb_context *ctx) {
                     /* asserted: ours is within 10% of the deviation Loop's limit forces */
                     snprintf(nb, sizeof nb, "%s_near_the_loop_bound", nm);
                     check(dev <= 1.1 * (1.0 - s) * loop_off + 1e-12 * mean_edge, nb, "deviation %.3g, Loop's bound %.3g", dev, (1.0 - s) * loop_off);
-                } else {
+                    /* asserted: the check (b), no curvature sign change within two edges */
+                    snprintf(nb, sizeof nb, "%s_no_curvature_sign_change", nm);
+                    check(changes == 0, nb, "%d curvature sign changes, height range %.3g mean edges", changes, (zhi - zlo) / mean_edge);
+                } else if (mode == 1) {
                     /* asserted: ours deviates from the crease plane, and undulates within it, no
                      * more than the seed's kind; printed, not met: the issue's bound of 1e-3 mean
-                     * edges at valence 5 and 7 (below Loop's own offset) and no curvature sign change */
+                     * edges at valence 5 and 7 (below Loop's own offset) */
                     check(ours_dev[si] <= dev + 1e-12 && ours_range[si] <= zhi - zlo + 1e-12, nm,
                           "ours %.3g against the seed's %.3g, height range %.3g against %.3g (sign changes %d against %d)", ours_dev[si], dev,
                           ours_range[si] / mean_edge, (zhi - zlo) / mean_edge, ours_changes[si], changes);
                     printf("  %s: ours within 1e-3 mean edges: %s\n", nm, ours_dev[si] <= 1e-3 * mean_edge ? "yes" : "no");
+                } else {
+                    /* asserted: the one-pass net bends the crease (what the second pass removes:
+                     * were it straight already, the check above would not tell the two apart) */
+                    check(changes > 0 && ours_range[si] * 100.0 < zhi - zlo, nm, "one pass: %d sign changes, height range %.3g mean edges (ours %.3g)",
+                          changes, (zhi - zlo) / mean_edge, ours_range[si] / mean_edge);
                 }
             }
             sfb__free(ctx, n0); sfb__free(ctx, n1);
@@ -1302,6 +1340,17 @@ static void coarse_one(sfb_context *ctx, const char *nm, tmesh *t, const sfb_tri
         snprintf(nb, sizeof nb, "%s_%s", nm, refined ? "built_after_a_loop_step" : "built_on_the_mesh");
         check(refined ? pt.npatch == 4 * t->prep.nf && cover > 0.5 : pt.npatch == t->prep.nf && cover < 0.5, nb,
               "%d patches for %d triangles, %.0f %% of the points moved", pt.npatch, t->prep.nf, 100.0 * cover);
+        if (!refined && !st.sharp_only) {
+            /* asserted: the second pass, which holds the crease near the extraordinary vertex
+             * (tbz_mix), leaves the surface about as fair as the one-pass net (measured +0 to +5 %;
+             * with the crease held in every direction +19 to +25 %) */
+            double *one = net_of(ctx, t, to, SFB__TBZ_NO_STRAIGHT, NULL);
+            const double e2 = one ? net_curvature_energy(one, t->prep.nf) : 0.0;
+            snprintf(nb, sizeof nb, "%s_as_fair_as_one_pass", nm);
+            check(one && st.straight == 1 && e0 <= 1.1 * e2, nb, "curvature energy %.4g, one pass %.4g (second passes %d)", e0, e2, st.straight);
+            printf("  %s: curvature energy %.4g, one pass %.4g\n", nb, e0, e2);
+            sfb__free(ctx, one);
+        }
     }
     sfb__patch_table_free(ctx, &pt);
     sfb__free(ctx, net);
@@ -1394,6 +1443,54 @@ static void test_reuse_disks(sfb_context *ctx) {
     }
     sfb__free(ctx, x); sfb__free(ctx, y);
     free(obj);
+}
+
+/* The seed-plane fallback is per vertex: one mesh of two creased disks, a crease turning by 60
+ * degrees at a regular-lattice vertex of valence 6 (one triangle on one side: our plane makes
+ * that triangle's corner degenerate, its two crease tangents opposite) and a straight one through
+ * a valence-5 vertex; only the first gets the seed's plane, the second keeps ours and its second
+ * pass, and the smooth net is G1 everywhere. */
+static void test_partial_fallback(sfb_context *ctx) {
+    const char *nm = "partial_fallback/two_creased_disks";
+    tbm_opts o;
+    char *a, *b, *j = NULL, *a2 = NULL;
+    tmesh t;
+    int r;
+    memset(&o, 0, sizeof o);
+    o.n = 6; o.R = 5; o.bump = 2.0; o.seed = 9u;
+    a = tbm_obj(&o);
+    if (a && (a2 = (char *)malloc(strlen(a) + 64 * (size_t)o.R + 1)) != NULL) {
+        size_t len = strlen(a);
+        memcpy(a2, a, len + 1);
+        for (r = 0; r < o.R; ++r)
+            len += (size_t)sprintf(a2 + len, "t crease 2/1/0 %d %d 0.5\nt crease 2/1/0 %d %d 0.5\n", tbm_index(&o, 0, r, 0),
+                                   tbm_index(&o, 0, r + 1, 0), tbm_index(&o, 1, r, 0), tbm_index(&o, 1, r + 1, 0));
+    }
+    memset(&o, 0, sizeof o);
+    o.n = 5; o.R = 5; o.crease_k = 2; o.sharp = 0.5; o.ridge = 0.4; o.bump = 2.0; o.seed = 10u;
+    b = tbm_obj(&o);
+    if (a2 && b) j = obj_join_ex(a2, b, 0);
+    if (!j || !tmesh_load(ctx, j, &t)) {
+        fail(nm, "load");
+    } else {
+        sfb_tribezier_options to;
+        sfb__tbz_stats st;
+        double *net;
+        memset(&to, 0, sizeof to);
+        to.sharpness_set = 1; to.sharpness = 0.0f;
+        net = net_of(ctx, &t, &to, 0, &st);
+        if (!net) fail(nm, "not built");
+        else {
+            const g1_result g = g1_measure(&t.prep, net, 0);
+            check(st.fallbacks == 1 && st.seed_vertices == 1 && st.straight == 1 && st.straight_kept_first == 0 && g.jump <= 1e-9 &&
+                      g.gap <= 1e-7 * t.diag,
+                  nm, "fallbacks %d, vertices with the seed's plane %d, second passes %d (first kept %d), normal jump %.3g rad, gap %.3g",
+                  st.fallbacks, st.seed_vertices, st.straight, st.straight_kept_first, g.jump, g.gap);
+        }
+        sfb__free(ctx, net);
+        tmesh_free(ctx, &t);
+    }
+    free(a); free(a2); free(b); free(j);
 }
 
 static void test_refined(sfb_context *ctx, const char *dir) {
@@ -2226,6 +2323,7 @@ int main(int argc, char **argv) {
     test_undulation(ctx);
     test_coarse(ctx);
     test_reuse_disks(ctx);
+    test_partial_fallback(ctx);
     test_bad_input();
     {
         /* a real mesh whose extraordinary vertices of different valences touch: there the
