@@ -781,9 +781,9 @@ static void test_undulation(sfb_context *ctx) {
                     if (mode == 0) {
                         ours_energy = en;
                         snprintf(nb, sizeof nb, "undulation/valence_%d/second_pass_taken", o.n);
-                        check(st.straight == 1 && st.straight_kept_first == 0 && st.crease_weighted > 0, nb,
-                              "second passes %d, first nets kept %d, crease unknowns weighted %ld", st.straight, st.straight_kept_first,
-                              st.crease_weighted);
+                        check(st.straight == 1 && st.straight_kept_first == 0 && st.straight_unfair == 0 && st.crease_weighted > 0, nb,
+                              "second passes %d, first nets kept %d, components given back as less fair %d, crease unknowns weighted %ld",
+                              st.straight, st.straight_kept_first, st.straight_unfair, st.crease_weighted);
                     } else {
                         /* asserted: holding the crease costs the surface beside it at most 3 % of
                          * its curvature energy (measured -0.2 to +1.4 %; held in every direction
@@ -888,7 +888,7 @@ static void test_undulation(sfb_context *ctx) {
                 } else {
                     /* asserted: the one-pass net bends the crease (what the second pass removes:
                      * were it straight already, the check above would not tell the two apart) */
-                    check(changes > 0 && ours_range[si] * 100.0 < zhi - zlo, nm, "one pass: %d sign changes, height range %.3g mean edges (ours %.3g)",
+                    check(changes > 0 && ours_range[si] * 10.0 < zhi - zlo, nm, "one pass: %d sign changes, height range %.3g mean edges (ours %.3g)",
                           changes, (zhi - zlo) / mean_edge, ours_range[si] / mean_edge);
                 }
             }
@@ -1342,12 +1342,13 @@ static void coarse_one(sfb_context *ctx, const char *nm, tmesh *t, const sfb_tri
               "%d patches for %d triangles, %.0f %% of the points moved", pt.npatch, t->prep.nf, 100.0 * cover);
         if (!refined && !st.sharp_only) {
             /* asserted: the second pass, which holds the crease near the extraordinary vertex
-             * (tbz_mix), leaves the surface about as fair as the one-pass net (measured +0 to +5 %;
-             * with the crease held in every direction +19 to +25 %) */
+             * (tbz_mix), leaves the surface about as fair as the one-pass net (measured -0.2 to
+             * +0.9 %; at valence 5 tbz_keep_fair gives it back, which kept gives +8 %; with the
+             * crease held in every direction +19 to +25 %) */
             double *one = net_of(ctx, t, to, SFB__TBZ_NO_STRAIGHT, NULL);
             const double e2 = one ? net_curvature_energy(one, t->prep.nf) : 0.0;
             snprintf(nb, sizeof nb, "%s_as_fair_as_one_pass", nm);
-            check(one && st.straight == 1 && e0 <= 1.1 * e2, nb, "curvature energy %.4g, one pass %.4g (second passes %d)", e0, e2, st.straight);
+            check(one && st.straight == 1 && e0 <= 1.03 * e2, nb, "curvature energy %.4g, one pass %.4g (second passes %d)", e0, e2, st.straight);
             printf("  %s: curvature energy %.4g, one pass %.4g\n", nb, e0, e2);
             sfb__free(ctx, one);
         }
