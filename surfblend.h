@@ -1632,8 +1632,8 @@ SFB__IF sfb_result sfb__pn_build(sfb_context *ctx, const sfb__level *base, const
  * Loop steps, SFB__TBZ_BOTH_NETS builds the smooth net even where s = 1 at every vertex (for the
  * test that skipping it gives the same net), SFB__TBZ_REJECT_TEMPLATES fails every template's
  * check (for the test that what fails goes to CGLS from the net as it was), SFB__TBZ_NO_STRAIGHT
- * solves the smooth net with its crease curves' points weighed as any other (tbz_crease_points;
- * for the undulation measurement). Progress (stage
+ * solves the smooth net in one pass, its crease curves bent as the least-norm solve leaves them
+ * (no second pass: tbz_crease_points; for the undulation measurement). Progress (stage
  * "tribezier") runs over [0, 1], or [0, 0.5] with SFB__TBZ_PROGRESS_LOW and [0.5, 1] with
  * SFB__TBZ_PROGRESS_HIGH (sfb__tribezier_build: the mesh's own net, then the one after a Loop
  * step); a cancel returns SFB_CANCELLED. */
@@ -8977,10 +8977,6 @@ out:
     return res;
 }
 
-/* Applies the smallest change of the unknowns that satisfies the constraints: the minimum-norm
- * least-squares solution, per connected component of the constraint graph (the solution of a
- * block-diagonal system is the blocks' solutions; each block converges at its own pace, so a
- * slow block near touching extraordinary vertices does not hold the others up). */
 /* The frame of our extraordinary crease vertex v: d along the crease (its two crease
  * neighbours' difference), n the crease's own normal: the bisector of the mean unit normals of
  * the mesh triangles on its two sides (the vertical of the test's valley, whatever the
@@ -9208,6 +9204,10 @@ static int tbz_crease_points(const sfb__tbz *T, const int *ucol, unsigned char *
     return n;
 }
 
+/* Applies the smallest change of the unknowns that satisfies the constraints: the minimum-norm
+ * least-squares solution, per connected component of the constraint graph (the solution of a
+ * block-diagonal system is the blocks' solutions; each block converges at its own pace, so a
+ * slow block near touching extraordinary vertices does not hold the others up). */
 static sfb_result tbz_solve(sfb__tbz *T) {
     const sfb__level *l = T->l;
     tbz_sys S;

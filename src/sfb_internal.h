@@ -721,8 +721,8 @@ SFB__IF sfb_result sfb__pn_build(sfb_context *ctx, const sfb__level *base, const
  * Loop steps, SFB__TBZ_BOTH_NETS builds the smooth net even where s = 1 at every vertex (for the
  * test that skipping it gives the same net), SFB__TBZ_REJECT_TEMPLATES fails every template's
  * check (for the test that what fails goes to CGLS from the net as it was), SFB__TBZ_NO_STRAIGHT
- * solves the smooth net with its crease curves' points weighed as any other (tbz_crease_points;
- * for the undulation measurement). Progress (stage
+ * solves the smooth net in one pass, its crease curves bent as the least-norm solve leaves them
+ * (no second pass: tbz_crease_points; for the undulation measurement). Progress (stage
  * "tribezier") runs over [0, 1], or [0, 0.5] with SFB__TBZ_PROGRESS_LOW and [0.5, 1] with
  * SFB__TBZ_PROGRESS_HIGH (sfb__tribezier_build: the mesh's own net, then the one after a Loop
  * step); a cancel returns SFB_CANCELLED. */

@@ -1898,10 +1898,6 @@ out:
     return res;
 }
 
-/* Applies the smallest change of the unknowns that satisfies the constraints: the minimum-norm
- * least-squares solution, per connected component of the constraint graph (the solution of a
- * block-diagonal system is the blocks' solutions; each block converges at its own pace, so a
- * slow block near touching extraordinary vertices does not hold the others up). */
 /* The frame of our extraordinary crease vertex v: d along the crease (its two crease
  * neighbours' difference), n the crease's own normal: the bisector of the mean unit normals of
  * the mesh triangles on its two sides (the vertical of the test's valley, whatever the
@@ -2129,6 +2125,10 @@ static int tbz_crease_points(const sfb__tbz *T, const int *ucol, unsigned char *
     return n;
 }
 
+/* Applies the smallest change of the unknowns that satisfies the constraints: the minimum-norm
+ * least-squares solution, per connected component of the constraint graph (the solution of a
+ * block-diagonal system is the blocks' solutions; each block converges at its own pace, so a
+ * slow block near touching extraordinary vertices does not hold the others up). */
 static sfb_result tbz_solve(sfb__tbz *T) {
     const sfb__level *l = T->l;
     tbz_sys S;
