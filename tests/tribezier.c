@@ -11,8 +11,10 @@
  *   - 0 < s < 1: positions are (1 - s) P(0) + s P(1) within 1e-9 x diagonal, the normal jump
  *     across the crease grows with s, and is continuous in s;
  *   - the undulation of the crease curve at s = 0.25, 0.5, 0.75 near extraordinary crease
- *     vertices of valence 4, 5, 7 (ours against the seed's tangent plane and against Loop's
- *     smooth and sharp limits blended, printed; ours flatter than both);
+ *     vertices of valence 4, 5, 7 (ours against the seed's tangent plane, against ours in one
+ *     pass and against Loop's smooth and sharp limits blended, printed; ours with no curvature
+ *     sign change within two edges, flatter than all three and as fair as one pass);
+ *   - the seed-plane fallback per vertex (two creased disks in one mesh);
  *   - the solves' shortcuts give the nets of the plain ones: templates and per-region factors
  *     against CGLS alone, the sharp net alone (s = 1 at every vertex) against both nets built,
  *     the smooth net's regions reused in the sharp net against solving them again;
