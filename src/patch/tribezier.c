@@ -204,6 +204,8 @@ static int tbz_rot_q(int r, int q) {
 static int tbz_ring(const sfb__level *l, int v, int j) { return sfb__other_end(l, l->ve[l->ve_off[v] + j], v); }
 static int tbz_nf(const sfb__level *l, int v) { return l->vf_off[v + 1] - l->vf_off[v]; }
 static int tbz_boundary(const sfb__level *l, int v) { return l->ve_off[v + 1] - l->ve_off[v] > tbz_nf(l, v); }
+/* Is v an extraordinary crease vertex with our plane in the current (smooth) net? */
+static int tbz_ours(const sfb__tbz *T, int v) { return T->vtype[v] == (TBZ_CREASE | 16) && T->virr[v]; }
 
 static void tbz_get(const sfb__tbz *T, int v, double out[3]) {
     out[0] = T->pos[3 * (size_t)v]; out[1] = T->pos[3 * (size_t)v + 1]; out[2] = T->pos[3 * (size_t)v + 2];
@@ -758,7 +760,7 @@ static sfb_result tbz_distances(sfb__tbz *T) {
     /* from every irregular vertex; in the smooth net's second pass from those with our plane
      * alone (tbz_state) */
     for (i = 0; i < T->nv; ++i)
-        if (T->virr[i] && (!T->straight_x || T->vtype[i] == (TBZ_CREASE | 16))) { T->dist[tbz_vp(T, i)] = 0; queue[tail++] = tbz_vp(T, i); }
+        if (T->virr[i] && (!T->straight_x || tbz_ours(T, i))) { T->dist[tbz_vp(T, i)] = 0; queue[tail++] = tbz_vp(T, i); }
     while (head < tail) {
         const int p = queue[head++], d = T->dist[p];
         int f0, f1, fi;
@@ -1963,7 +1965,7 @@ static void tbz_crease_fit(sfb__tbz *T) {
         double d[3], n[3];
         const double *P = T->x + 3 * (size_t)v;
         int rays[2], nr = 0;
-        if (T->vtype[v] != (TBZ_CREASE | 16) || !T->virr[v] || !tbz_crease_frame(T, v, d, n)) continue;
+        if (!tbz_ours(T, v) || !tbz_crease_frame(T, v, d, n)) continue;
         for (j = l->ve_off[v]; j < l->ve_off[v + 1]; ++j)
             if (T->tag_s[l->ve[j]] > 0.0f && nr < 2) rays[nr++] = l->ve[j];
         for (k = 0; k < nr; ++k) {
@@ -2017,7 +2019,7 @@ static void tbz_mix(sfb__tbz *T, const tbz_sys *S, const int *rows, int nr, cons
     for (r = 0; r < nr && v < 0; ++r) {
         const int e = S->edge[rows[r]];
         for (j = 0; j < 2 && v < 0; ++j)
-            if (T->vtype[l->ev[2 * e + j]] == (TBZ_CREASE | 16) && T->virr[l->ev[2 * e + j]]) v = l->ev[2 * e + j];
+            if (tbz_ours(T, l->ev[2 * e + j])) v = l->ev[2 * e + j];
     }
     if (v < 0 || !tbz_crease_frame(T, v, dir, nrm)) {
         /* M = 0 */
@@ -2300,8 +2302,8 @@ static sfb_result tbz_solve(sfb__tbz *T) {
             if (ours[i] && T->bad_v && ci > TBZ_OURS_RESIDUAL)
                 for (r = rstart[i]; r < rstart[i + 1]; ++r) {
                     const int e2 = S.edge[rows[r]], a = l->ev[2 * e2], b = l->ev[2 * e2 + 1];
-                    if (T->vtype[a] == (TBZ_CREASE | 16) && T->virr[a]) T->bad_v[a] = 1;
-                    if (T->vtype[b] == (TBZ_CREASE | 16) && T->virr[b]) T->bad_v[b] = 1;
+                    if (tbz_ours(T, a)) T->bad_v[a] = 1;
+                    if (tbz_ours(T, b)) T->bad_v[b] = 1;
                 }
         }
     }
@@ -2369,7 +2371,7 @@ static int tbz_ours_bad(const sfb__tbz *T, unsigned char *bad) {
     for (f = 0; f < T->nf; ++f) {
         const int *fv = l->fv + l->fv_off[f];
         int ours = 0, degen = 0;
-        for (k = 0; k < 3; ++k) ours |= T->vtype[fv[k]] == (TBZ_CREASE | 16) && T->virr[fv[k]];
+        for (k = 0; k < 3; ++k) ours |= tbz_ours(T, fv[k]);
         if (!ours) continue;
         for (k = 0; k < 3 && !degen; ++k) {
             int w[3], p0, p1, p2;
@@ -2391,7 +2393,7 @@ static int tbz_ours_bad(const sfb__tbz *T, unsigned char *bad) {
         if (!degen) continue;
         if (!bad) { ++n; continue; }
         for (k = 0; k < 3; ++k)
-            if (T->vtype[fv[k]] == (TBZ_CREASE | 16) && T->virr[fv[k]]) bad[fv[k]] = 1;
+            if (tbz_ours(T, fv[k])) bad[fv[k]] = 1;
     }
     if (bad)
         for (v = 0; v < T->nv; ++v) n += bad[v] != 0;
@@ -2579,6 +2581,26 @@ int sfb__tribezier_blend(sfb_context *ctx, const sfb__patch_table *pt, const sfb
     return 1;
 }
 
+/* The smooth net built again (the seed-plane fallback, the second pass) from the current one,
+ * first: the constraint components away from our vertices of first are the same systems,
+ * copied rather than solved again (reuse_x, reuse_ours); rec: record it for the sharp net. */
+static sfb_result tbz_state_again(sfb__tbz *T, const double *first, tbz_prev *rec) {
+    unsigned char *was = (unsigned char *)sfb__calloc(T->ctx, (size_t)T->nv + 1, 1);
+    sfb_result r;
+    int v;
+    if (!was) return sfb__oom(T->ctx, "tribezier");
+    for (v = 0; v < T->nv; ++v) was[v] = (unsigned char)tbz_ours(T, v);
+    T->reuse_x = first;
+    T->reuse_ours = was;
+    T->rec = rec;
+    r = tbz_state(T, 0);
+    T->rec = NULL;
+    T->reuse_x = NULL;
+    T->reuse_ours = NULL;
+    sfb__free(T->ctx, was);
+    return r;
+}
+
 /* fout: NULL, the net into *out (45 doubles per triangle); else the net into fout, 45 floats
  * per triangle that is not a hole, in order (sfb__patch_table_beztri_children's point data),
  * and *out left NULL (the doubles, a net as large again, never made) */
@@ -2694,29 +2716,17 @@ static sfb_result tbz_points(sfb_context *ctx, const sfb__level *l, const float 
          * vertices are no reason to. (The fallback was the whole net's at once, and on those real
          * meshes the seed's plane was all there was.) */
         double *first = T.x;
-        unsigned char *was;
-        const int nbad = tbz_ours_bad(&T, T.bad_v);
-        if (!nbad) break;
-        was = (unsigned char *)sfb__calloc(ctx, (size_t)T.nv + 1, 1);
+        if (!tbz_ours_bad(&T, T.bad_v)) break;
         T.x = (double *)sfb__calloc(ctx, 3 * (size_t)T.np + 1, sizeof(double));
-        if (!T.x || !was) { sfb__free(ctx, first); sfb__free(ctx, was); r = sfb__oom(ctx, "tribezier"); goto done; }
+        if (!T.x) { T.x = first; r = sfb__oom(ctx, "tribezier"); goto done; }
         tbz_prev_free(ctx, &prev); /* the record is of the net now replaced */
-        for (v = 0; v < T.nv; ++v) {
-            was[v] = (unsigned char)((T.vtype[v] & 16) && T.virr[v]);
+        for (v = 0; v < T.nv; ++v)
             if (T.bad_v[v]) T.seed_v[v] = 1;
-        }
         memset(T.bad_v, 0, (size_t)T.nv);
         memset(&T.st, 0, sizeof T.st);
         if (round == 1) T.seed_plane = 1;
-        T.reuse_x = first;
-        T.reuse_ours = was;
-        T.rec = !(flags & SFB__TBZ_NO_REUSE) ? &prev : NULL; /* the copied components: the same systems, solved */
-        r = tbz_state(&T, 0);
-        T.rec = NULL;
-        T.reuse_x = NULL;
-        T.reuse_ours = NULL;
+        r = tbz_state_again(&T, first, !(flags & SFB__TBZ_NO_REUSE) ? &prev : NULL);
         sfb__free(ctx, first);
-        sfb__free(ctx, was);
         T.st.fallbacks = round + 1;
     }
     for (v = 0; T.seed_v && v < T.nv; ++v) T.st.seed_vertices += T.seed_v[v];
@@ -2727,26 +2737,19 @@ static sfb_result tbz_points(sfb_context *ctx, const sfb__level *l, const float 
          * the first (the same systems); the first net kept where the second leaves a row around
          * one unmet or a patch corner degenerate (not seen on the tests' meshes) */
         int any = 0;
-        for (v = 0; v < T.nv && !any; ++v) any = T.vtype[v] == (TBZ_CREASE | 16) && T.virr[v];
+        for (v = 0; v < T.nv && !any; ++v) any = tbz_ours(&T, v);
         if (any) {
             double *first = T.x;
-            unsigned char *was = (unsigned char *)sfb__calloc(ctx, (size_t)T.nv + 1, 1);
             const sfb__tbz_stats st1 = T.st;
             T.x = (double *)sfb__alloc(ctx, (3 * (size_t)T.np + 1) * sizeof(double));
-            if (!T.x || !was) { sfb__free(ctx, T.x); T.x = first; sfb__free(ctx, was); r = sfb__oom(ctx, "tribezier"); goto done; }
-            for (v = 0; v < T.nv; ++v) was[v] = (unsigned char)(T.vtype[v] == (TBZ_CREASE | 16) && T.virr[v]);
+            if (!T.x) { T.x = first; r = sfb__oom(ctx, "tribezier"); goto done; }
             /* the record for the sharp net stays the first pass's: the second solves the
              * components around our vertices alone, which the sharp net does not share (its
              * crease edges have no rows) */
             memset(&T.st, 0, sizeof T.st);
             T.straight_x = first;
-            T.reuse_x = first;
-            T.reuse_ours = was;
-            r = tbz_state(&T, 0);
+            r = tbz_state_again(&T, first, NULL);
             T.straight_x = NULL;
-            T.reuse_x = NULL;
-            T.reuse_ours = NULL;
-            sfb__free(ctx, was);
             if (r == SFB_SUCCESS && (T.st.ours_residual > TBZ_OURS_RESIDUAL || tbz_ours_bad(&T, NULL))) {
                 sfb__free(ctx, T.x);
                 T.x = first;
