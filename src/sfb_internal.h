@@ -743,7 +743,8 @@ typedef struct sfb__tbz_stats {
                              SFB__TBZ_NO_STRAIGHT: none) */
     int straight;      /* smooth nets solved again with the crease weighted (SFB__TBZ_NO_STRAIGHT: none) */
     int straight_kept_first; /* of those, the second solve left a row unmet: the first net kept */
-    int straight_unfair;  /* components where the second pass bent the net more than the first (tbz_keep_fair): the first's */
+    int straight_across;  /* components where it holds the crease's place across it too (tbz_take_second) */
+    int straight_unfair;  /* components where the second pass bent the net more than the first (tbz_take_second): the first's */
     int straight_skipped; /* components around our vertices too large for the second pass's dense solve: the first pass's */
     int reused;        /* sharp-net constraint components that were the same system as a smooth-net one and took its
                           solution (SFB__TBZ_NO_REUSE: none) */

@@ -13,7 +13,9 @@
  *   - the undulation of the crease curve at s = 0.25, 0.5, 0.75 near extraordinary crease
  *     vertices of valence 4, 5, 7 (ours against the seed's tangent plane, against ours in one
  *     pass and against Loop's smooth and sharp limits blended, printed; ours with no curvature
- *     sign change within two edges, flatter than all three and as fair as one pass);
+ *     sign change within two edges, flatter than all three and as fair as one pass; within
+ *     1e-3 mean edges of the crease's vertical plane where the mesh's rows are level, within
+ *     10 % of Loop's own offset from it where they are not);
  *   - the seed-plane fallback per vertex (two creased disks in one mesh);
  *   - the solves' shortcuts give the nets of the plain ones: templates and per-region factors
  *     against CGLS alone, the sharp net alone (s = 1 at every vertex) against both nets built,
@@ -718,14 +720,25 @@ static int loop_blend_profile(sfb_context *ctx, const tbm_opts *o, double s, dou
  * line y = 0, (b) the curvature sign changes of its projection into that plane (x, z) within two
  * edges of the vertex; ours (mode 0) against the seed's tangent plane (1) and against ours with
  * the smooth net solved once (2: SFB__TBZ_NO_STRAIGHT, its crease curve bent by the solve), whose
- * surface ours must be as fair as (curvature energy at s = 0). */
+ * surface ours must be as fair as (curvature energy at s = 0).
+ * Two layouts of each disk (tbm_opts.level). Level rows ("undulation_level/..."): the lattice
+ * rows on both sides of the crease at the same heights, so that Loop's limit surface, which
+ * ours equals where the mesh is regular, lies in the crease's vertical plane along the crease
+ * by symmetry; there (a) measures the construction at the vertex alone, and the issue's bound
+ * of 1e-3 mean edges is asserted. Fanned rays ("undulation/..."): the rays spread evenly over
+ * each side's pi, the rows of a side with two or four wedges at other heights than the other
+ * side's; Loop's own limit lies 0.015-0.02 mean edges off the plane at valence 5 and 7 there,
+ * a bound no construction that keeps Loop's surface can beat, and ours is asserted within 10 %
+ * of it. */
 static void test_undulation(sfb_context *ctx) {
     static const int vals[3] = {4, 5, 7};
     static const char *mode_name[3] = {"ours", "ours_no_worse_than_the_seed_plane", "ours_against_one_pass"};
     double ours_dev[4] = {0, 0, 0, 0}, ours_range[4] = {0, 0, 0, 0}, ours_energy = 0.0;
-    int vi, mode, si, ours_changes[4] = {0, 0, 0, 0};
+    int vi, mode, si, ours_changes[4] = {0, 0, 0, 0}, level;
+    for (level = 0; level < 2; ++level)
     for (vi = 0; vi < 3; ++vi)
         for (mode = 0; mode < 3; ++mode) {
+            const char *un = level ? "undulation_level" : "undulation";
             tbm_opts o;
             tmesh t;
             char *obj;
@@ -733,9 +746,9 @@ static void test_undulation(sfb_context *ctx) {
             sfb_tribezier_options to;
             int e;
             memset(&o, 0, sizeof o);
-            o.n = vals[vi]; o.R = 5; o.crease_k = vals[vi] / 2; o.sharp = 1.0; o.ridge = 0.5; o.bump = 0.0;
+            o.n = vals[vi]; o.R = 5; o.crease_k = vals[vi] / 2; o.sharp = 1.0; o.ridge = 0.5; o.bump = 0.0; o.level = level;
             obj = tbm_obj(&o);
-            if (!tmesh_load(ctx, obj, &t)) { fail("undulation/load", "load"); free(obj); continue; }
+            if (!tmesh_load(ctx, obj, &t)) { fail(un, "load"); free(obj); continue; }
             for (e = 0; e < t.prep.ne; ++e) {
                 const float *a = t.m->positions + 3 * t.prep.ev[2 * e], *b = t.m->positions + 3 * t.prep.ev[2 * e + 1];
                 mean_edge += sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2])) / t.prep.ne;
@@ -763,7 +776,7 @@ static void test_undulation(sfb_context *ctx) {
                     for (sd = 0; sd < 2; ++sd)
                         for (r2 = 1; r2 <= 2; ++r2)
                             loop_off = fmax(loop_off, fabs(ld.limit_positions[3 * tbm_index(&o, sd ? o.crease_k : 0, r2, 0) + 1]));
-                } else fail("undulation/loop", "Loop limit: %s", sfb_last_error(ctx));
+                } else fail(un, "Loop limit: %s", sfb_last_error(ctx));
                 sfb_mesh_data_free(&ld);
                 sfb_surface_destroy(ls);
                 sfb_mesh_destroy(lm);
@@ -782,16 +795,19 @@ static void test_undulation(sfb_context *ctx) {
                     char nb[160];
                     if (mode == 0) {
                         ours_energy = en;
-                        snprintf(nb, sizeof nb, "undulation/valence_%d/second_pass_taken", o.n);
-                        check(st.straight == 1 && st.straight_kept_first == 0 && st.straight_unfair == 0 && st.crease_weighted > 0, nb,
-                              "second passes %d, first nets kept %d, components given back as less fair %d, crease unknowns weighted %ld",
-                              st.straight, st.straight_kept_first, st.straight_unfair, st.crease_weighted);
+                        /* on the level disks the crease is held across too (tbz_take_second) */
+                        snprintf(nb, sizeof nb, "%s/valence_%d/second_pass_taken", un, o.n);
+                        check(st.straight == 1 && st.straight_kept_first == 0 && st.straight_unfair == 0 && st.crease_weighted > 0 &&
+                                  (!level || st.straight_across == 1),
+                              nb, "second passes %d, first nets kept %d, components given back as less fair %d, held across too %d, crease "
+                              "unknowns weighted %ld", st.straight, st.straight_kept_first, st.straight_unfair, st.straight_across, st.crease_weighted);
                     } else {
                         /* asserted: holding the crease costs the surface beside it at most 3 % of
-                         * its curvature energy (measured -0.2 to +1.4 %; held in every direction
-                         * as well, tbz_mix's M = I, +4.4 % at valence 5; coarse_one asserts the
-                         * same on bumped disks) */
-                        snprintf(nb, sizeof nb, "undulation/valence_%d/as_fair_as_one_pass", o.n);
+                         * its curvature energy (measured -0.2 to +1.4 %, +2.0 % on the level disk
+                         * of valence 5, held across too; held in every direction as well, M = I
+                         * in tbz_mix, +4.4 % at valence 5; coarse_one asserts the same on bumped
+                         * disks) */
+                        snprintf(nb, sizeof nb, "%s/valence_%d/as_fair_as_one_pass", un, o.n);
                         check(ours_energy <= 1.03 * en && st.straight == 0, nb, "curvature energy at s = 0: ours %.4g, one pass %.4g", ours_energy,
                               en);
                         printf("  %s: curvature energy at s = 0: ours %.4g, one pass %.4g\n", nb, ours_energy, en);
@@ -850,7 +866,7 @@ static void test_undulation(sfb_context *ctx) {
                         }
                     }
                 }
-                snprintf(nm, sizeof nm, "undulation/valence_%d/s_%.2f/%s", o.n, s, mode_name[mode]);
+                snprintf(nm, sizeof nm, "%s/valence_%d/s_%.2f/%s", un, o.n, s, mode_name[mode]);
                 /* (a) the deviation from the vertical plane; (b) the curvature sign changes of the
                  * projection into it; and the undulation within the plane, the height range of
                  * the projection (the crease line is straight and level: 0 at s = 1) */
@@ -873,16 +889,25 @@ static void test_undulation(sfb_context *ctx) {
                         check(zhi - zlo < lrange, nb, "height range %.3g against the Loop blend's %.3g mean edges", (zhi - zlo) / mean_edge,
                               lrange / mean_edge);
                     }
-                    /* asserted: ours is within 10% of the deviation Loop's limit forces */
-                    snprintf(nb, sizeof nb, "%s_near_the_loop_bound", nm);
-                    check(dev <= 1.1 * (1.0 - s) * loop_off + 1e-12 * mean_edge, nb, "deviation %.3g, Loop's bound %.3g", dev, (1.0 - s) * loop_off);
+                    if (level) {
+                        /* asserted: the check (a), within 1e-3 mean edges of the plane */
+                        snprintf(nb, sizeof nb, "%s_in_the_crease_plane", nm);
+                        check(dev <= 1e-3 * mean_edge && loop_off <= 1e-6 * mean_edge, nb, "deviation %.3g mean edges (Loop's limit %.3g)",
+                              dev / mean_edge, loop_off / mean_edge);
+                    } else {
+                        /* asserted: ours is within 10% of the deviation Loop's limit forces */
+                        snprintf(nb, sizeof nb, "%s_near_the_loop_bound", nm);
+                        check(dev <= 1.1 * (1.0 - s) * loop_off + 1e-12 * mean_edge, nb, "deviation %.3g, Loop's bound %.3g", dev,
+                              (1.0 - s) * loop_off);
+                    }
                     /* asserted: the check (b), no curvature sign change within two edges */
                     snprintf(nb, sizeof nb, "%s_no_curvature_sign_change", nm);
                     check(changes == 0, nb, "%d curvature sign changes, height range %.3g mean edges", changes, (zhi - zlo) / mean_edge);
                 } else if (mode == 1) {
                     /* asserted: ours deviates from the crease plane, and undulates within it, no
-                     * more than the seed's kind; printed, not met: the issue's bound of 1e-3 mean
-                     * edges at valence 5 and 7 (below Loop's own offset) */
+                     * more than the seed's kind; printed: ours within the issue's bound of 1e-3
+                     * mean edges (on the fanned disks not at valence 5 and 7: Loop's own offset
+                     * is larger) */
                     check(ours_dev[si] <= dev + 1e-12 && ours_range[si] <= zhi - zlo + 1e-12, nm,
                           "ours %.3g against the seed's %.3g, height range %.3g against %.3g (sign changes %d against %d)", ours_dev[si], dev,
                           ours_range[si] / mean_edge, (zhi - zlo) / mean_edge, ours_changes[si], changes);
@@ -1344,9 +1369,9 @@ static void coarse_one(sfb_context *ctx, const char *nm, tmesh *t, const sfb_tri
               "%d patches for %d triangles, %.0f %% of the points moved", pt.npatch, t->prep.nf, 100.0 * cover);
         if (!refined && !st.sharp_only) {
             /* asserted: the second pass, which holds the crease near the extraordinary vertex
-             * (tbz_mix), leaves the surface about as fair as the one-pass net (measured -0.2 to
-             * +0.9 %; at valence 5 tbz_keep_fair gives it back, which kept gives +8 %; with the
-             * crease held in every direction +19 to +25 %) */
+             * (tbz_mix), leaves the surface about as fair as the one-pass net (measured -0.3 to
+             * +0.9 %; at valence 5 tbz_take_second gives it back, which kept gives +8 %; with
+             * the crease held in every direction +19 to +25 %) */
             double *one = net_of(ctx, t, to, SFB__TBZ_NO_STRAIGHT, NULL);
             const double e2 = one ? net_curvature_energy(one, t->prep.nf) : 0.0;
             snprintf(nb, sizeof nb, "%s_as_fair_as_one_pass", nm);

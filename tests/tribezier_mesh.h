@@ -19,6 +19,7 @@ typedef struct tbm_opts {
     double sharp;        /* the crease tag (0: untagged) */
     double ridge, bump;  /* z = ridge |y| + bump (x^2 - 0.5 y^2) / R^2 */
     double jitter;       /* random displacement of every vertex, in edge lengths */
+    int level;           /* with crease_k: level rows (below) */
     unsigned seed;
 } tbm_opts;
 
@@ -39,13 +40,25 @@ static char *tbm_obj(const tbm_opts *o) {
     char *s = (char *)malloc(cap);
     unsigned seed = o->seed ? o->seed : 1u;
     int r, w, b, a;
-    double *ang = (double *)malloc(sizeof(double) * (size_t)(n + 1));
-    /* ray angles */
+    double *ex = (double *)malloc(sizeof(double) * 2 * (size_t)(n + 1)), *ey = ex + n + 1;
+    /* ray steps: unit vectors at angles spread evenly (over pi per side of a crease) */
     for (w = 0; w <= n; ++w) {
+        double ang = 2.0 * TBM_PI * w / n;
         if (o->crease_k > 0 && !o->corner3)
-            ang[w] = w <= o->crease_k ? TBM_PI * w / o->crease_k : TBM_PI + TBM_PI * (w - o->crease_k) / (n - o->crease_k);
-        else
-            ang[w] = 2.0 * TBM_PI * w / n;
+            ang = w <= o->crease_k ? TBM_PI * w / o->crease_k : TBM_PI + TBM_PI * (w - o->crease_k) / (n - o->crease_k);
+        ex[w] = cos(ang); ey[w] = sin(ang);
+        if (o->level && o->crease_k > 0 && !o->corner3) {
+            /* level rows: every ray step off the crease rises sqrt(3)/2 from it, so the lattice
+             * rows of both sides lie at y = +-(sqrt(3)/2) x row, as in the regular lattice
+             * (where a side has three wedges it is the regular lattice); Loop's limit surface
+             * along the regular crease edges then lies in the vertical plane through the
+             * crease by symmetry */
+            const int side = w > o->crease_k, k = side ? n - o->crease_k : o->crease_k, i = side ? w - o->crease_k : w;
+            const double sg = side ? -1.0 : 1.0;
+            if (i == 0) { ex[w] = sg; ey[w] = 0.0; }
+            else if (i == k) { ex[w] = -sg; ey[w] = 0.0; }
+            else { ex[w] = sg * (k > 2 ? (k - 2.0 * i) / (2.0 * (k - 2)) : 0.0); ey[w] = sg * sqrt(0.75); }
+        }
     }
     len += (size_t)snprintf(s + len, cap - len, "v 0 0 %.17g\n", 0.0);
     for (r = 1; r <= R; ++r)
@@ -54,7 +67,7 @@ static char *tbm_obj(const tbm_opts *o) {
                 /* point b of ring r in wedge w: between ray w and ray w+1 */
                 const double t = (double)b / r;
                 /* straight lattice rows: interpolate the two ray points linearly */
-                const double x0 = r * cos(ang[w]), y0 = r * sin(ang[w]), x1 = r * cos(ang[w + 1]), y1 = r * sin(ang[w + 1]);
+                const double x0 = r * ex[w], y0 = r * ey[w], x1 = r * ex[w + 1], y1 = r * ey[w + 1];
                 double x = x0 + t * (x1 - x0), y = y0 + t * (y1 - y0), z;
                 if (o->jitter > 0) { x += o->jitter * (tbm_unit(&seed) - 0.5); y += o->jitter * (tbm_unit(&seed) - 0.5); }
                 z = o->ridge * fabs(y) + o->bump * (x * x - 0.5 * y * y) / (R * R);
@@ -81,7 +94,7 @@ static char *tbm_obj(const tbm_opts *o) {
                                         tbm_index(o, rays[k], r + 1, 0), o->sharp);
         if (o->corner3) len += (size_t)snprintf(s + len, cap - len, "t corner 1/1/0 0 %.17g\n", o->sharp);
     }
-    free(ang);
+    free(ex);
     return s;
 }
 #endif
