@@ -2,8 +2,9 @@
  * rings around one vertex of valence n, made of n wedges of the regular triangle lattice (every
  * other vertex inside has valence 6), as OBJ text. Optionally a straight crease through the
  * centre (the wedges 0..k-1 span pi, the others pi, so the crease vertices lie on the x axis and
- * the surface is a height field: a ridge z = ridge |y| plus a smooth bump), a corner (three
- * crease rays), and a jitter of every position. */
+ * the surface is a height field: a ridge z = ridge |y| plus a smooth bump; the rays fanned
+ * evenly over each side, or with level rows), a corner (three crease rays), and a jitter of
+ * every position. */
 #ifndef SFB_TRIBEZIER_MESH_H
 #define SFB_TRIBEZIER_MESH_H
 #include <math.h>
@@ -14,7 +15,7 @@
 
 typedef struct tbm_opts {
     int n, R;
-    int crease_k;        /* > 0: crease rays 0 and k (a straight crease when angles_pi) */
+    int crease_k;        /* > 0: crease rays 0 and k, a straight crease (without corner3) */
     int corner3;         /* crease rays 0, n/3, 2n/3, the centre tagged as a corner */
     double sharp;        /* the crease tag (0: untagged) */
     double ridge, bump;  /* z = ridge |y| + bump (x^2 - 0.5 y^2) / R^2 */

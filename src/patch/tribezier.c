@@ -2081,10 +2081,9 @@ static double tbz_face_bend(const sfb__tbz *T, const double *x, int f) {
  * basis and its first and second derivatives at those places, with their weights, made once
  * per net (tbz_energy_rule: TBZ_QN x 6 x 15 + TBZ_QN doubles). The rule on each quarter of the
  * triangle (28 places) moved the ratios the choice rests on by 0.001 at most and made cow.obj's
- * build after two Loop steps about 30 % slower. A geometric
- * measure: the net's bending (tbz_face_bend) also counts how its points spread along the
- * surface, and rose 19 % for that hold on the level undulation disk of valence 5
- * (tests/tribezier.c) where this rose 0.7 %. */
+ * build after two Loop steps about 30 % slower. A geometric measure: the net's bending
+ * (tbz_face_bend) also counts how its points spread along the surface, and rose 19 % for that
+ * hold on the level undulation disk of valence 5 (tests/tribezier.c) where this rose 0.7 %. */
 #define TBZ_QN 7
 static void tbz_energy_rule(double *B, double *wq) {
     static const double qp[TBZ_QN][3] = {{1.0 / 3, 1.0 / 3, 0.225},
@@ -2144,11 +2143,12 @@ static double tbz_face_energy(const sfb__tbz *T, const double *B, const double *
  *   - then the crease's place across it too (M = I - d d^T: the second pass's change in every
  *     direction but along the crease), where the surface's curvature energy over those
  *     triangles (tbz_face_energy) is within TBZ_FAIR_ACROSS of the profile's alone. Measured:
- *     -0.2 to +0.3 % on the crease disks of valence 4 and 7 to 12, +0.7 % on the level
- *     undulation disk of valence 5 (kept: its crease 8e-5 mean edges off the plane instead of
- *     0.0017), +1.2 % on the fanned one (given back: Loop's own limit lies 0.015 off the plane
- *     there). Judged by the net's bending it would have cost +19 % at valence 5: the hold moves
- *     the points along the surface more than it bends it. */
+ *     -0.2 to +0.3 % on the crease disks of valence 4 and 9 to 12 and on the undulation disks
+ *     of valence 4 and 7 (kept), +0.7 % on the level undulation disk of valence 5 (kept: its
+ *     crease 8e-5 mean edges off the plane instead of 0.0017), +1.3 % on the fanned one (given
+ *     back: Loop's own limit lies 0.015 off the plane there). Judged by the net's bending it
+ *     would have cost +19 % at valence 5: the hold moves the points along the surface more
+ *     than it bends it. */
 #define TBZ_FAIR 0.03
 #define TBZ_FAIR_ACROSS 0.01
 static sfb_result tbz_take_second(sfb__tbz *T, const tbz_sys *S, int nc, const int *rstart, const int *rows, const int *ustart, const int *unk,
