@@ -7461,12 +7461,12 @@ static void tbz_ours_offset(sfb__tbz *T) {
     for (v = 0; v < T->nv; ++v) {
         double off[3] = {0.0, 0.0, 0.0};
         int m = l->ve_off[v + 1] - l->ve_off[v], cnt = 0;
-        if (T->vtype[v] != (TBZ_CREASE | 16) || !T->virr[v]) continue;
+        if (!tbz_ours(T, v)) continue;
         for (j = 0; j < m; ++j) {
             const int w = tbz_ring(l, v, j);
             int nb[2], nn = 0, i2, m2 = l->ve_off[w + 1] - l->ve_off[w];
             double W[3], A[3], B[3];
-            if (!(T->tag_s[l->ve[l->ve_off[v] + j]] > 0.0f) || (T->vtype[w] == (TBZ_CREASE | 16) && T->virr[w])) continue;
+            if (!(T->tag_s[l->ve[l->ve_off[v] + j]] > 0.0f) || tbz_ours(T, w)) continue;
             for (i2 = 0; i2 < m2; ++i2)
                 if (T->tag_s[l->ve[l->ve_off[w] + i2]] > 0.0f) { if (nn < 2) nb[nn] = tbz_ring(l, w, i2); ++nn; }
             if (nn != 2 || tbz_boundary(l, w) || T->corner_s[w] > 0.0f) continue;
@@ -7613,7 +7613,7 @@ static void tbz_initial(sfb__tbz *T) {
         /* the smooth net at our crease vertex: the crease tangent is the B-spline's */
         for (k = 0; k < 2; ++k) {
             const int v = k ? b : a, w = k ? a : b;
-            if ((T->vtype[v] & 16) && T->virr[v] && T->tag_s[e] > 0.0f) {
+            if (tbz_ours(T, v) && T->tag_s[e] > 0.0f) {
                 double V[3], W[3], *E = T->x + 3 * (size_t)tbz_ep(T, e, k ? 2 : 0);
                 const double *P = T->x + 3 * (size_t)v;
                 tbz_get(T, v, V); tbz_get(T, w, W);
@@ -7642,7 +7642,7 @@ static void tbz_initial(sfb__tbz *T) {
      * crease tangents lie in the plane), b = 2/(3n) sum sin(theta_j) (r_j - V); fixed, so the
      * t = 0 relations hold and no tangent can collapse */
     for (v = 0; v < T->nv; ++v)
-        if (T->vtype[v] == (TBZ_CREASE | 16) && T->virr[v]) {
+        if (tbz_ours(T, v)) {
             const int n = tbz_nf(l, v);
             const double *P = T->x + 3 * (size_t)v, *phi = T->phi + l->vf_off[v];
             double th[64], a[3], bv[3] = {0, 0, 0}, V[3], R[3], A[3], B[3];
@@ -9060,10 +9060,10 @@ static void tbz_crease_fit(sfb__tbz *T) {
         sfb__cross3(n, d, lat);
         for (k = 0; k < nr; ++k) {
             int pts[6], np = 0, e = rays[k], w = sfb__other_end(l, e, v), e2 = -1;
-            double suz = 0.0, suy = 0.0, su4 = 0.0, cf, cl;
+            double suz = 0.0, suy = 0.0, su4 = 0.0, cf, cl, u[6], z[6], y[6];
             pts[np++] = tbz_ep(T, e, 1);
             pts[np++] = tbz_ep(T, e, l->ev[2 * e] == w ? 0 : 2);
-            if (!((T->vtype[w] & 16) && T->virr[w]) && !tbz_boundary(l, w) && !(T->corner_s[w] > 0.0f)) {
+            if (!tbz_ours(T, w) && !tbz_boundary(l, w) && !(T->corner_s[w] > 0.0f)) {
                 int nt = 0;
                 for (j = l->ve_off[w]; j < l->ve_off[w + 1]; ++j)
                     if (T->tag_s[l->ve[j]] > 0.0f) { ++nt; if (l->ve[j] != e) e2 = l->ve[j]; }
@@ -9075,22 +9075,22 @@ static void tbz_crease_fit(sfb__tbz *T) {
                 pts[np++] = tbz_ep(T, e2, 1);
                 pts[np++] = tbz_ep(T, e2, l->ev[2 * e2] == w ? 2 : 0);
             }
+            /* each point's place from v's corner: along d, n and l */
             for (i = 0; i < np; ++i) {
-                double u = 0.0, z = 0.0, y = 0.0;
+                u[i] = z[i] = y[i] = 0.0;
                 for (c = 0; c < 3; ++c) {
                     const double q = X1[3 * (size_t)pts[i] + c] - P[c];
-                    u += q * d[c]; z += q * n[c]; y += q * lat[c];
+                    u[i] += q * d[c]; z[i] += q * n[c]; y[i] += q * lat[c];
                 }
-                suz += u * u * z; suy += u * u * y; su4 += u * u * u * u;
+                suz += u[i] * u[i] * z[i]; suy += u[i] * u[i] * y[i]; su4 += u[i] * u[i] * u[i] * u[i];
             }
             if (!(su4 > 0.0)) continue;
             cf = suz / su4; cl = suy / su4;
             for (i = 0; i < np; ++i) {
-                double u = 0.0, z = 0.0, y = 0.0, *x = T->x + 3 * (size_t)pts[i];
+                double *x = T->x + 3 * (size_t)pts[i];
                 const double *x1 = X1 + 3 * (size_t)pts[i];
                 if (T->fixed[pts[i]] || T->dist[pts[i]] > TBZ_REACH) continue; /* not an unknown: the first pass's */
-                for (c = 0; c < 3; ++c) { u += (x1[c] - P[c]) * d[c]; z += (x1[c] - P[c]) * n[c]; y += (x1[c] - P[c]) * lat[c]; }
-                for (c = 0; c < 3; ++c) x[c] = x1[c] + (cf * u * u - z) * n[c] + (cl * u * u - y) * lat[c];
+                for (c = 0; c < 3; ++c) x[c] = x1[c] + (cf * u[i] * u[i] - z[i]) * n[c] + (cl * u[i] * u[i] - y[i]) * lat[c];
             }
         }
     }
@@ -9133,8 +9133,9 @@ static void tbz_mix(sfb__tbz *T, const int *unk, int nu, const double *x2, const
  * the Bezier points along the three lattice directions of each triangle, summed over the
  * triangles with a point in it (a fairness measure of the control net; both nets compared share
  * the lattice). */
-static double tbz_face_bend(const sfb__tbz *T, const double *x, int f) {
+static double tbz_face_bend(const sfb__tbz *T, int f) {
     static const int dir[3][3] = {{1, -1, 0}, {0, 1, -1}, {-1, 0, 1}};
+    const double *x = T->x;
     double e = 0.0;
     int a, b, k, c;
     for (k = 0; k < 3; ++k)
@@ -9236,14 +9237,15 @@ static sfb_result tbz_take_second(sfb__tbz *T, const tbz_sys *S, int nc, const i
     const double *X1 = T->straight_x;
     int *comp = (int *)sfb__alloc(T->ctx, ((size_t)T->np + 1) * sizeof(int));
     int *fstart = (int *)sfb__calloc(T->ctx, (size_t)nc + 2, sizeof(int)), *flist = NULL;
-    double *B = (double *)sfb__alloc(T->ctx, (TBZ_QN * 90 + TBZ_QN) * sizeof(double)), *x2 = NULL;
+    double *B = (double *)sfb__alloc(T->ctx, (TBZ_QN * 90 + TBZ_QN) * sizeof(double)), *wq, *x2 = NULL;
     int i, j, f, q, mu = 0;
     sfb_result res = SFB_SUCCESS;
     for (i = 0; i < nc; ++i) mu = TBZ_MAX(mu, ustart[i + 1] - ustart[i]);
     x2 = (double *)sfb__alloc(T->ctx, 3 * (size_t)mu * sizeof(double) + 1);
     flist = (int *)sfb__alloc(T->ctx, (size_t)T->nf * sizeof(int) + 1);
     if (!comp || !fstart || !B || !x2 || !flist) { res = sfb__oom(T->ctx, "tribezier"); goto out; }
-    tbz_energy_rule(B, B + TBZ_QN * 90);
+    wq = B + TBZ_QN * 90;
+    tbz_energy_rule(B, wq);
     for (i = 0; i < T->np; ++i) comp[i] = -1;
     for (i = 0; i < nc; ++i)
         if (ours[i] == 1)
@@ -9268,15 +9270,15 @@ static sfb_result tbz_take_second(sfb__tbz *T, const tbz_sys *S, int nc, const i
         for (j = 0; j < nu; ++j) memcpy(x2 + 3 * (size_t)j, T->x + 3 * (size_t)uk[j], 3 * sizeof(double));
         for (j = 0; j < nu; ++j) memcpy(T->x + 3 * (size_t)uk[j], X1 + 3 * (size_t)uk[j], 3 * sizeof(double));
         if (!tbz_mix_frame(T, S, rows + rstart[i], rstart[i + 1] - rstart[i], d, n)) continue; /* M = 0 */
-        for (f = 0; f < nfc; ++f) b1 += tbz_face_bend(T, T->x, fl[f]);
+        for (f = 0; f < nfc; ++f) b1 += tbz_face_bend(T, fl[f]);
         tbz_mix(T, uk, nu, x2, d, n, 0);
-        for (f = 0; f < nfc; ++f) bn += tbz_face_bend(T, T->x, fl[f]);
+        for (f = 0; f < nfc; ++f) bn += tbz_face_bend(T, fl[f]);
         if (bn <= (1.0 + TBZ_FAIR) * b1) {
             double en = 0.0, ea = 0.0;
             kept = 1;
-            for (f = 0; f < nfc; ++f) en += tbz_face_energy(T, B, B + TBZ_QN * 90, fl[f]);
+            for (f = 0; f < nfc; ++f) en += tbz_face_energy(T, B, wq, fl[f]);
             tbz_mix(T, uk, nu, x2, d, n, 1);
-            for (f = 0; f < nfc; ++f) ea += tbz_face_energy(T, B, B + TBZ_QN * 90, fl[f]);
+            for (f = 0; f < nfc; ++f) ea += tbz_face_energy(T, B, wq, fl[f]);
             if (ea <= (1.0 + TBZ_FAIR_ACROSS) * en) T->st.straight_across++;
             else tbz_mix(T, uk, nu, x2, d, n, 0);
         }
@@ -9428,11 +9430,11 @@ static sfb_result tbz_solve(sfb__tbz *T) {
     ours = (unsigned char *)sfb__calloc(T->ctx, (size_t)nc + 1, 1);
     if (!ours) { res = sfb__oom(T->ctx, "tribezier constraints"); goto done; }
     any16 = T->reuse_ours != NULL; /* none: no row to look at */
-    for (i = 0; i < T->nv && !any16; ++i) any16 = (T->vtype[i] & 16) && T->virr[i];
+    for (i = 0; i < T->nv && !any16; ++i) any16 = tbz_ours(T, i);
     for (i = 0; i < nc && any16; ++i)
         for (r = rstart[i]; r < rstart[i + 1] && !ours[i]; ++r) {
             const int e2 = S.edge[rows[r]], a = l->ev[2 * e2], b = l->ev[2 * e2 + 1];
-            ours[i] = (unsigned char)(((T->vtype[a] & 16) && T->virr[a]) || ((T->vtype[b] & 16) && T->virr[b]) ||
+            ours[i] = (unsigned char)(tbz_ours(T, a) || tbz_ours(T, b) ||
                                       (T->reuse_ours && (T->reuse_ours[a] || T->reuse_ours[b])));
         }
     for (i = 0; i < nc; ++i) {
